@@ -1,0 +1,14 @@
+# Warnings for firmware code: every integer conversion must be deliberate.
+set(SERVO_FIRMWARE_WARNINGS
+    -Wall -Wextra -Werror -Wpedantic
+    -Wconversion -Wsign-conversion -Wshadow -Wcast-qual -Wcast-align
+    -Wstrict-prototypes -Wmissing-prototypes -Wundef -Wdouble-promotion
+    -Wfloat-equal -Wformat=2 -Wswitch-default -Wvla -Wnull-dereference
+    -Wredundant-decls -Wwrite-strings)
+
+# Tests and tools: strict, but cmocka's macros convert freely.
+set(SERVO_TEST_WARNINGS -Wall -Wextra -Werror -Wshadow -Wno-unused-parameter)
+
+function(servo_firmware_target target)
+  target_compile_options(${target} PRIVATE ${SERVO_FIRMWARE_WARNINGS})
+endfunction()

@@ -1,0 +1,128 @@
+#include "servo.h"
+
+#include <string.h>
+
+#include "identity.h"
+#include "protocol/data_table.h"
+
+static void apply_link_settings(struct servo *s)
+{
+    s->active_id = s->regs.user.servo_id;
+    if (s->active_baud_index != s->regs.user.baud_index) {
+        s->active_baud_index = s->regs.user.baud_index;
+        uint32_t baud = baud_rate_of_index(s->active_baud_index);
+        s->hal->uart_set_baud(s->hal->ctx, baud);
+        frame_rx_set_idle_timeout(&s->rx, frame_rx_idle_us(baud));
+    }
+}
+
+void servo_init(struct servo *s, const struct hal_port *hal)
+{
+    *s = (struct servo){.hal = hal};
+    config_store_load(&s->store, hal->flash, &s->regs.user);
+    s->regs.status.model = SERVO_MODEL;
+    s->regs.status.firmware_version = FIRMWARE_VERSION;
+    s->regs.status.serial_number = hal->serial_number;
+    motion_init(&s->motion, &s->regs.user);
+    frame_rx_init(&s->rx, &s->active_id, frame_rx_idle_us(0));
+    dispatcher_init(&s->dispatcher, &s->regs, &s->motion, &s->active_id);
+    s->active_baud_index = 0; /* forces the first apply to set the UART */
+    apply_link_settings(s);
+}
+
+static void start_send(struct servo *s)
+{
+    s->tx.waiting = 0;
+    s->tx.sending = 1;
+    s->hal->uart_send(s->hal->ctx, s->tx.frame, s->tx.size);
+}
+
+/* Sync Monitor: each listed servo answers after the ones listed before it.
+ * A turn passes when their response has gone by, or when the line has been
+ * silent for SYNC_SLOT_SILENCE_US (that servo is absent). */
+static void wait_for_turn(struct servo *s)
+{
+    uint32_t seen = s->rx.stats.responses_skipped - s->tx.responses_base;
+    uint32_t now = s->hal->now_us(s->hal->ctx);
+    uint32_t last_byte = s->rx.last_byte_us;
+    if (now - last_byte < now - s->tx.silence_from_us) {
+        s->tx.silence_from_us = last_byte; /* the line was busy since */
+    }
+    if (seen >= s->tx.turns_left) {
+        start_send(s);
+    } else if (now - s->tx.silence_from_us >= SYNC_SLOT_SILENCE_US) {
+        s->tx.turns_left--;
+        s->tx.silence_from_us = now;
+    }
+}
+
+static void queue_response(struct servo *s, const struct response *r, uint8_t wait,
+                           uint32_t responses_base)
+{
+    s->tx.size = frame_tx_encode(r, s->tx.frame);
+    s->tx.turns_left = wait;
+    s->tx.responses_base = responses_base;
+    s->tx.silence_from_us = s->hal->now_us(s->hal->ctx);
+    if (wait == 0u) {
+        start_send(s);
+    } else {
+        s->tx.waiting = 1;
+    }
+}
+
+static void answer_finished_move(struct servo *s)
+{
+    uint8_t packet = motion_take_finished(&s->motion);
+    if (packet == 0u) {
+        return;
+    }
+    struct response r = {.code = packet, .length = 2, .content = {s->active_id, 1}};
+    queue_response(s, &r, 0, 0);
+}
+
+static void handle_next_frame(struct servo *s)
+{
+    const struct rx_frame *frame = frame_rx_peek(&s->rx);
+    if (frame == NULL) {
+        return;
+    }
+    struct response r;
+    struct dispatch_result result;
+    dispatch(&s->dispatcher, frame, &r, &result);
+    uint32_t responses_base = frame->responses_seen;
+    frame_rx_release(&s->rx);
+    s->config_dirty |= result.config_changed;
+    if (result.answer) {
+        queue_response(s, &r, result.wait_responses, responses_base);
+    }
+}
+
+void servo_poll(struct servo *s)
+{
+    if (s->tx.sending) {
+        if (!s->hal->uart_tx_done(s->hal->ctx)) {
+            return; /* half duplex: nothing else goes out meanwhile */
+        }
+        s->tx.sending = 0;
+    }
+    if (s->tx.waiting) {
+        wait_for_turn(s);
+        return;
+    }
+    /* A new ID or baud rate takes effect once the response has left. */
+    if (s->active_id != s->regs.user.servo_id ||
+        s->active_baud_index != s->regs.user.baud_index) {
+        apply_link_settings(s);
+    }
+    if (s->config_dirty) {
+        s->config_dirty = 0;
+        config_store_save(&s->store, &s->regs.user);
+    }
+    uint8_t status = (uint8_t)(s->regs.status.status & ~STATUS_EXECUTING);
+    s->regs.status.status =
+        motion_is_executing(&s->motion) ? (uint8_t)(status | STATUS_EXECUTING) : status;
+    answer_finished_move(s);
+    if (!s->tx.sending) {
+        handle_next_frame(s);
+    }
+}

@@ -1,0 +1,47 @@
+/* Reset handler and vector table for the STM32F103 (Cortex-M3). */
+#include <stdint.h>
+
+extern uint32_t _sidata, _sdata, _edata, _sbss, _ebss, _estack;
+int main(void);
+void Reset_Handler(void);
+void Default_Handler(void);
+void SysTick_Handler(void) __attribute__((weak, alias("Default_Handler")));
+void USART1_IRQHandler(void) __attribute__((weak, alias("Default_Handler")));
+
+void Reset_Handler(void)
+{
+    uint32_t *src = &_sidata;
+    for (uint32_t *dst = &_sdata; dst < &_edata;) {
+        *dst++ = *src++;
+    }
+    for (uint32_t *dst = &_sbss; dst < &_ebss;) {
+        *dst++ = 0;
+    }
+    (void)main();
+    for (;;) {
+    }
+}
+
+void Default_Handler(void)
+{
+    for (;;) {
+    }
+}
+
+enum { CORE_VECTORS = 16, USART1_IRQ = 37 };
+
+/* Core exceptions, then device interrupts up to USART1. */
+__attribute__((section(".isr_vector"), used))
+static void (*const vector_table[CORE_VECTORS + USART1_IRQ + 1])(void) = {
+    [0] = (void (*)(void))(uintptr_t)&_estack,
+    [1] = Reset_Handler,
+    [2] = Default_Handler,  /* NMI */
+    [3] = Default_Handler,  /* HardFault */
+    [4] = Default_Handler,  /* MemManage */
+    [5] = Default_Handler,  /* BusFault */
+    [6] = Default_Handler,  /* UsageFault */
+    [11] = Default_Handler, /* SVCall */
+    [14] = Default_Handler, /* PendSV */
+    [15] = SysTick_Handler,
+    [CORE_VECTORS + USART1_IRQ] = USART1_IRQHandler,
+};

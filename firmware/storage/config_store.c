@@ -1,0 +1,156 @@
+#include "config_store.h"
+
+#include <string.h>
+
+#include "crc32.h"
+#include "protocol/data_table.h"
+#include "protocol/wire.h"
+
+/* Record layout, little-endian. */
+enum {
+    REC_MAGIC = 0,      /* u16 */
+    REC_FORMAT = 2,     /* u8 */
+    REC_LENGTH = 3,     /* u8: payload bytes */
+    REC_SEQUENCE = 4,   /* u32 */
+    REC_PAYLOAD = 8,    /* USER_AREA_SIZE bytes */
+    REC_CRC = REC_PAYLOAD + USER_AREA_SIZE, /* u32 over bytes 0..REC_CRC-1 */
+    RECORD_MAGIC = 0xC0F1,
+    RECORD_FORMAT = 1,
+};
+
+_Static_assert(REC_CRC + 4 == CONFIG_RECORD_SIZE, "record layout");
+_Static_assert(CONFIG_RECORD_SIZE % 2 == 0, "records are programmed in half-words");
+
+uint16_t config_store_slots_per_page(const struct config_store *s)
+{
+    return (uint16_t)(s->flash->page_size / CONFIG_RECORD_SIZE);
+}
+
+static uint32_t slot_addr(const struct config_store *s, uint8_t page, uint16_t slot)
+{
+    return s->flash->page_addr[page] + (uint32_t)slot * CONFIG_RECORD_SIZE;
+}
+
+static void read_slot(const struct config_store *s, uint8_t page, uint16_t slot,
+                      uint8_t rec[CONFIG_RECORD_SIZE])
+{
+    s->flash->read(s->flash->ctx, slot_addr(s, page, slot), rec, CONFIG_RECORD_SIZE);
+}
+
+/* A record whose every field checks out, including the item ranges: a
+ * record from a firmware with other ranges is not loaded half-valid. */
+static bool record_valid(const uint8_t rec[CONFIG_RECORD_SIZE], struct user_config *out)
+{
+    if (wire_get_u16(&rec[REC_MAGIC]) != RECORD_MAGIC || rec[REC_FORMAT] != RECORD_FORMAT ||
+        rec[REC_LENGTH] != USER_AREA_SIZE || wire_get_u32(&rec[REC_SEQUENCE]) == 0u ||
+        wire_get_u32(&rec[REC_CRC]) != crc32(rec, REC_CRC)) {
+        return false;
+    }
+    return user_config_decode(out, &rec[REC_PAYLOAD]);
+}
+
+static bool slot_erased(const struct config_store *s, uint8_t page, uint16_t slot)
+{
+    uint8_t rec[CONFIG_RECORD_SIZE];
+    read_slot(s, page, slot, rec);
+    for (uint32_t i = 0; i < CONFIG_RECORD_SIZE; i++) {
+        if (rec[i] != 0xFFu) {
+            return false;
+        }
+    }
+    return true;
+}
+
+bool config_store_load(struct config_store *s, const struct hal_flash *flash,
+                       struct user_config *cfg)
+{
+    *s = (struct config_store){.flash = flash};
+    struct user_config newest;
+    user_config_factory(&newest);
+    const uint16_t slots = config_store_slots_per_page(s);
+    for (uint8_t page = 0; page < 2u; page++) {
+        for (uint16_t slot = 0; slot < slots; slot++) {
+            uint8_t rec[CONFIG_RECORD_SIZE];
+            struct user_config candidate;
+            read_slot(s, page, slot, rec);
+            uint32_t seq = wire_get_u32(&rec[REC_SEQUENCE]);
+            if (seq > s->sequence && record_valid(rec, &candidate)) {
+                s->sequence = seq;
+                s->page = page;
+                s->slot = slot;
+                newest = candidate;
+            }
+        }
+    }
+    *cfg = newest;
+    user_config_encode(&newest, s->saved);
+    return s->sequence != 0u;
+}
+
+/* Where the next record goes: the first erased slot after the newest in its
+ * page, else slot 0 of the other page (which must be erased first). */
+static bool next_slot(const struct config_store *s, uint8_t *page, uint16_t *slot)
+{
+    const uint16_t slots = config_store_slots_per_page(s);
+    if (s->sequence != 0u) {
+        for (uint16_t i = (uint16_t)(s->slot + 1u); i < slots; i++) {
+            if (slot_erased(s, s->page, i)) {
+                *page = s->page;
+                *slot = i;
+                return true;
+            }
+        }
+        *page = (uint8_t)(s->page ^ 1u);
+    } else {
+        *page = 0;
+    }
+    *slot = 0;
+    return false;
+}
+
+static bool program_record(const struct config_store *s, uint8_t page, uint16_t slot,
+                           const uint8_t rec[CONFIG_RECORD_SIZE])
+{
+    uint32_t base = slot_addr(s, page, slot);
+    for (uint32_t i = 0; i < CONFIG_RECORD_SIZE; i += 2u) {
+        if (!s->flash->program_u16(s->flash->ctx, base + i, wire_get_u16(&rec[i]))) {
+            return false;
+        }
+    }
+    return true;
+}
+
+enum config_save_result config_store_save(struct config_store *s, const struct user_config *cfg)
+{
+    uint8_t rec[CONFIG_RECORD_SIZE];
+    user_config_encode(cfg, &rec[REC_PAYLOAD]);
+    if (memcmp(&rec[REC_PAYLOAD], s->saved, USER_AREA_SIZE) == 0) {
+        return CONFIG_UNCHANGED;
+    }
+    uint32_t seq = s->sequence + 1u;
+    wire_put_u16(&rec[REC_MAGIC], RECORD_MAGIC);
+    rec[REC_FORMAT] = RECORD_FORMAT;
+    rec[REC_LENGTH] = USER_AREA_SIZE;
+    wire_put_u32(&rec[REC_SEQUENCE], seq);
+    wire_put_u32(&rec[REC_CRC], crc32(rec, REC_CRC));
+
+    uint8_t page;
+    uint16_t slot;
+    if (!next_slot(s, &page, &slot) &&
+        !s->flash->erase_page(s->flash->ctx, s->flash->page_addr[page])) {
+        s->write_failures++;
+        return CONFIG_WRITE_FAILED;
+    }
+    if (!program_record(s, page, slot, rec)) {
+        /* The sequence number is spent: should the record have landed after
+         * all, no later record may share its number. */
+        s->sequence = seq;
+        s->write_failures++;
+        return CONFIG_WRITE_FAILED;
+    }
+    s->sequence = seq;
+    s->page = page;
+    s->slot = slot;
+    memcpy(s->saved, &rec[REC_PAYLOAD], USER_AREA_SIZE);
+    return CONFIG_SAVED;
+}

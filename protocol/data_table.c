@@ -1,0 +1,231 @@
+#include "protocol/data_table.h"
+
+#include <stddef.h>
+#include <string.h>
+
+#define RO_STATUS(id_, field_, size_)                                              \
+    {(id_), (size_), DATA_READ, (uint8_t)offsetof(struct status_area, field_), 0, 0, 0}
+#define USER(id_, field_, size_, access_, min_, max_, factory_)                    \
+    {(id_), (size_), (uint8_t)((access_) | DATA_USER),                             \
+     (uint8_t)offsetof(struct user_config, field_), (min_), (max_), (factory_)}
+#define RW (DATA_READ | DATA_WRITE)
+#define RW_SIGNED (DATA_READ | DATA_WRITE | DATA_SIGNED)
+#define RESERVED 0u /* kept in the batch block, hidden from ReadData/WriteData */
+
+/* Rows in ID order; status area first, then the user area in wire order. */
+static const struct data_item items[] = {
+    RO_STATUS(1, voltage_mv, 2),
+    RO_STATUS(2, current_ma, 2),
+    RO_STATUS(3, power_mw, 2),
+    RO_STATUS(4, temperature_adc, 2),
+    RO_STATUS(5, status, 1),
+    RO_STATUS(6, model, 2),
+    RO_STATUS(7, firmware_version, 2),
+    RO_STATUS(8, serial_number, 4),
+    USER(32, check_flag, 1, RW, 1, 1, 1),
+    USER(33, control_response, 1, RW, 0, 1, 0),
+    USER(34, servo_id, 1, RW, 0, 254, 0),
+    USER(35, reserved_35, 1, RESERVED, 0, 255, 0),
+    USER(36, baud_index, 1, RW, 1, 8, 5),
+    USER(37, stall_release, 1, RW, 0, 1, 0),
+    USER(38, stall_power_mw, 2, RW, 0, 65535, 10000),
+    USER(39, low_voltage_mv, 2, RW, 0, 65535, 4000),
+    USER(40, high_voltage_mv, 2, RW, 0, 65535, 8400),
+    USER(41, temperature_limit_adc, 2, RW, 0, 65535, 651),
+    USER(42, power_limit_mw, 2, RW, 0, 65535, 10000),
+    USER(43, current_limit_ma, 2, RW, 0, 65535, 4000),
+    USER(44, start_force, 1, RW, 0, 255, 0),
+    USER(45, reserved_45, 1, RESERVED, 0, 255, 0),
+    USER(46, power_on_lock, 1, RW, 0, 1, 0),
+    USER(47, wheel_brake, 1, RW, 0, 1, 0),
+    USER(48, angle_limit_on, 1, RW, 0, 1, 1),
+    USER(49, soft_start_on, 1, RW, 0, 1, 1),
+    USER(50, soft_start_ms, 2, RW, 0, 65535, 3000),
+    USER(51, angle_max_decideg, 2, RW_SIGNED, -1800, 1800, 1350),
+    USER(52, angle_min_decideg, 2, RW_SIGNED, -1800, 1800, -1350),
+    USER(53, center_offset_decideg, 2, RW_SIGNED, -1800, 1800, 0),
+};
+
+enum {
+    ITEM_COUNT = sizeof items / sizeof items[0],
+    STATUS_FIRST = 1,
+    STATUS_LAST = 8,
+    USER_FIRST = 32,
+    USER_LAST = 53,
+    USER_ROW = STATUS_LAST - STATUS_FIRST + 1,
+};
+
+_Static_assert(ITEM_COUNT == USER_ROW + (USER_LAST - USER_FIRST + 1), "table rows");
+
+const struct data_item *data_table_find(uint8_t id)
+{
+    if (id >= STATUS_FIRST && id <= STATUS_LAST) {
+        return &items[id - STATUS_FIRST];
+    }
+    if (id >= USER_FIRST && id <= USER_LAST) {
+        return &items[USER_ROW + (id - USER_FIRST)];
+    }
+    return NULL;
+}
+
+static const uint8_t *field_of(const struct registers *regs, const struct data_item *it)
+{
+    const uint8_t *base = (it->access & DATA_USER) ? (const uint8_t *)&regs->user
+                                                   : (const uint8_t *)&regs->status;
+    return base + it->offset;
+}
+
+/* The value of a field as a signed 32-bit number (u32 items are never
+ * range-checked, so their reinterpretation is harmless). */
+static int32_t field_get(const uint8_t *field, const struct data_item *it)
+{
+    switch (it->size) {
+    case 1: {
+        uint8_t v;
+        memcpy(&v, field, 1);
+        return v;
+    }
+    case 2:
+        if (it->access & DATA_SIGNED) {
+            int16_t v;
+            memcpy(&v, field, 2);
+            return v;
+        } else {
+            uint16_t v;
+            memcpy(&v, field, 2);
+            return v;
+        }
+    default: {
+        uint32_t v;
+        memcpy(&v, field, 4);
+        return (int32_t)v;
+    }
+    }
+}
+
+/* Only user-area items are ever written. */
+static void field_set(struct user_config *cfg, const struct data_item *it, int32_t value)
+{
+    uint8_t *field = (uint8_t *)cfg + it->offset;
+    if (it->size == 1) {
+        uint8_t v = (uint8_t)value;
+        memcpy(field, &v, 1);
+    } else if (it->size == 2) {
+        uint16_t v = (uint16_t)value;
+        memcpy(field, &v, 2);
+    }
+}
+
+/* Little-endian wire bytes of an item, sign-extended for signed items. */
+static int32_t wire_value(const uint8_t *data, const struct data_item *it)
+{
+    if (it->size == 1) {
+        return data[0];
+    }
+    uint16_t raw = (uint16_t)(data[0] | (uint16_t)(data[1] << 8));
+    return (it->access & DATA_SIGNED) ? (int32_t)(int16_t)raw : (int32_t)raw;
+}
+
+static void put_wire(uint8_t *out, const struct data_item *it, int32_t value)
+{
+    uint32_t v = (uint32_t)value;
+    for (uint8_t i = 0; i < it->size; i++) {
+        out[i] = (uint8_t)(v >> (8u * i));
+    }
+}
+
+uint8_t data_table_read(const struct registers *regs, uint8_t id, uint8_t *out)
+{
+    const struct data_item *it = data_table_find(id);
+    if (it == NULL || !(it->access & DATA_READ)) {
+        return 0;
+    }
+    put_wire(out, it, field_get(field_of(regs, it), it));
+    return it->size;
+}
+
+bool user_config_valid(const struct user_config *cfg)
+{
+    struct registers view = {.user = *cfg};
+    for (uint8_t id = USER_FIRST; id <= USER_LAST; id++) {
+        const struct data_item *it = data_table_find(id);
+        int32_t v = field_get(field_of(&view, it), it);
+        if (v < it->min || v > it->max) {
+            return false;
+        }
+    }
+    return cfg->low_voltage_mv < cfg->high_voltage_mv &&
+           cfg->angle_max_decideg > cfg->angle_min_decideg;
+}
+
+bool data_table_write(struct registers *regs, uint8_t id, const uint8_t *data, uint8_t len)
+{
+    const struct data_item *it = data_table_find(id);
+    if (it == NULL || !(it->access & DATA_WRITE) || !(it->access & DATA_USER) ||
+        len != it->size) {
+        return false;
+    }
+    struct user_config candidate = regs->user;
+    field_set(&candidate, it, wire_value(data, it));
+    if (!user_config_valid(&candidate)) {
+        return false;
+    }
+    regs->user = candidate;
+    return true;
+}
+
+void user_config_factory(struct user_config *cfg)
+{
+    struct user_config factory = {0};
+    for (uint8_t id = USER_FIRST; id <= USER_LAST; id++) {
+        const struct data_item *it = data_table_find(id);
+        field_set(&factory, it, it->factory);
+    }
+    *cfg = factory;
+}
+
+void user_config_reset(struct user_config *cfg)
+{
+    uint8_t servo_id = cfg->servo_id;
+    uint8_t baud_index = cfg->baud_index;
+    user_config_factory(cfg);
+    cfg->servo_id = servo_id;
+    cfg->baud_index = baud_index;
+}
+
+void user_config_encode(const struct user_config *cfg, uint8_t out[USER_AREA_SIZE])
+{
+    struct registers view = {.user = *cfg};
+    uint8_t pos = 0;
+    for (uint8_t id = USER_FIRST; id <= USER_LAST; id++) {
+        const struct data_item *it = data_table_find(id);
+        put_wire(&out[pos], it, field_get(field_of(&view, it), it));
+        pos = (uint8_t)(pos + it->size);
+    }
+}
+
+bool user_config_decode(struct user_config *cfg, const uint8_t in[USER_AREA_SIZE])
+{
+    struct user_config decoded = {0};
+    uint8_t pos = 0;
+    for (uint8_t id = USER_FIRST; id <= USER_LAST; id++) {
+        const struct data_item *it = data_table_find(id);
+        field_set(&decoded, it, wire_value(&in[pos], it));
+        pos = (uint8_t)(pos + it->size);
+    }
+    if (!user_config_valid(&decoded)) {
+        return false;
+    }
+    *cfg = decoded;
+    return true;
+}
+
+uint32_t baud_rate_of_index(uint8_t index)
+{
+    static const uint32_t rates[] = {9600u,   19200u,  38400u,  57600u,
+                                     115200u, 250000u, 500000u, 1000000u};
+    if (index < 1u || index > sizeof rates / sizeof rates[0]) {
+        return 0;
+    }
+    return rates[index - 1u];
+}

@@ -1,0 +1,136 @@
+#include "protocol/dispatcher.h"
+
+#include <stddef.h>
+
+#include "protocol/packet_codes.h"
+#include "protocol/packet_table.h"
+#include "protocol/wire.h"
+
+void dispatcher_init(struct dispatcher *d, struct registers *regs, struct motion *motion,
+                     const volatile uint8_t *own_id)
+{
+    d->regs = regs;
+    d->motion = motion;
+    d->own_id = own_id;
+}
+
+static void set_command_error(struct dispatcher *d, bool on)
+{
+    uint8_t s = d->regs->status.status;
+    d->regs->status.status =
+        on ? (uint8_t)(s | STATUS_COMMAND_ERROR) : (uint8_t)(s & ~STATUS_COMMAND_ERROR);
+}
+
+static bool answers(const struct dispatcher *d, uint8_t flags)
+{
+    return (flags & PF_ANSWERS) ||
+           ((flags & PF_ANSWERS_IF_CONTROL_RESPONSE) && d->regs->user.control_response);
+}
+
+void dispatch_packet(struct dispatcher *d, const struct packet_desc *desc,
+                     const uint8_t *content, uint16_t length, struct packet_origin origin,
+                     struct response *response, struct dispatch_result *result)
+{
+    /* Answering packets would make every servo talk at once. */
+    if (origin.broadcast && !(desc->flags & PF_BROADCAST)) {
+        return;
+    }
+    bool alone = !origin.broadcast && !origin.from_sync;
+    const struct packet_call call = {
+        .d = d,
+        .content = content,
+        .length = length,
+        .code = desc->code,
+        .answer_when_done = alone && d->regs->user.control_response,
+        .sync_index = origin.sync_index,
+        .result = result,
+    };
+    response->code = desc->code;
+    response->length = 0;
+
+    enum packet_outcome outcome = desc->handler(&call, response);
+    switch (outcome) {
+    case OUTCOME_NONE:
+        return;
+    case OUTCOME_FAILED:
+    case OUTCOME_ERROR:
+        set_command_error(d, true);
+        break;
+    default:
+        if (!(desc->flags & PF_QUERY)) {
+            set_command_error(d, false);
+        }
+        break;
+    }
+    /* Sync records answer only where the packet always answers (Monitor). */
+    bool may_answer = alone || (origin.from_sync && (desc->flags & PF_ANSWERS));
+    result->answer = may_answer && answers(d, desc->flags) &&
+                     (outcome == OUTCOME_OK || outcome == OUTCOME_FAILED);
+    if (origin.from_sync) {
+        result->wait_responses = origin.sync_index;
+    }
+}
+
+static bool length_ok(const struct packet_desc *desc, const struct rx_frame *frame)
+{
+    return frame->length >= desc->min_length && frame->length <= desc->max_length &&
+           !(frame->flags & (FRAME_TRUNCATED | FRAME_BAD_SYNC));
+}
+
+void dispatch(struct dispatcher *d, const struct rx_frame *frame, struct response *response,
+              struct dispatch_result *result)
+{
+    *result = (struct dispatch_result){0};
+    const struct packet_desc *desc = packet_find(frame->code);
+    struct packet_origin origin = {.sync_index = frame->sync_index};
+
+    /* Unknown packets are judged by the ID position every addressed packet
+     * uses, so a packet meant for another servo flags nothing here. */
+    if (desc == NULL || (desc->flags & PF_ADDRESSED)) {
+        if (frame->stored == 0u) {
+            if (desc != NULL) {
+                set_command_error(d, true); /* addressed packet with no ID */
+            }
+            return;
+        }
+        uint8_t id = frame->content[0];
+        if (id != *d->own_id && id != WIRE_BROADCAST_ID) {
+            return;
+        }
+        origin.broadcast = id == WIRE_BROADCAST_ID;
+    }
+    if (desc == NULL || !length_ok(desc, frame)) {
+        set_command_error(d, true);
+        return;
+    }
+    dispatch_packet(d, desc, frame->content, frame->length, origin, response, result);
+}
+
+enum packet_outcome answer_result(const struct packet_call *c, struct response *r, bool ok)
+{
+    r->content[0] = c->content[0];
+    r->content[1] = ok ? 1u : 0u;
+    r->length = 2;
+    return ok ? OUTCOME_OK : OUTCOME_FAILED;
+}
+
+enum packet_outcome handle_ignored(const struct packet_call *c, struct response *r)
+{
+    (void)c;
+    (void)r;
+    return OUTCOME_NONE;
+}
+
+enum packet_outcome handle_sync(const struct packet_call *c, struct response *r)
+{
+    if (c->sync_index == FRAME_SYNC_NO_RECORD) {
+        return OUTCOME_NONE; /* no record for this servo */
+    }
+    const struct packet_desc *inner = packet_find(c->content[0]);
+    if (inner == NULL || !(inner->flags & PF_SYNCABLE) || c->content[1] != inner->min_length) {
+        return OUTCOME_ERROR;
+    }
+    struct packet_origin origin = {.from_sync = true, .sync_index = c->sync_index};
+    dispatch_packet(c->d, inner, &c->content[3], c->content[1], origin, r, c->result);
+    return OUTCOME_NONE;
+}

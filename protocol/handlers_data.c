@@ -1,0 +1,74 @@
+/* Packets that read or write the register file: 1-6 and Monitor (22). */
+#include <string.h>
+
+#include "protocol/data_table.h"
+#include "protocol/packet_table.h"
+#include "protocol/wire.h"
+
+enum packet_outcome handle_ping(const struct packet_call *c, struct response *r)
+{
+    r->content[0] = c->content[0];
+    r->length = 1;
+    return OUTCOME_OK;
+}
+
+enum packet_outcome handle_reset_user_data(const struct packet_call *c, struct response *r)
+{
+    user_config_reset(&c->d->regs->user);
+    c->result->config_changed = true;
+    return answer_result(c, r, true);
+}
+
+enum packet_outcome handle_read_data(const struct packet_call *c, struct response *r)
+{
+    r->content[0] = c->content[0];
+    r->content[1] = c->content[1];
+    uint8_t size = data_table_read(c->d->regs, c->content[1], &r->content[2]);
+    r->length = (uint8_t)(2u + size);
+    return OUTCOME_OK;
+}
+
+enum packet_outcome handle_write_data(const struct packet_call *c, struct response *r)
+{
+    uint8_t data_length = (uint8_t)(c->length - 2u);
+    bool ok = data_table_write(c->d->regs, c->content[1], &c->content[2], data_length);
+    c->result->config_changed = ok;
+    r->content[0] = c->content[0];
+    r->content[1] = c->content[1];
+    r->content[2] = ok ? 1u : 0u;
+    r->length = 3;
+    return ok ? OUTCOME_OK : OUTCOME_FAILED;
+}
+
+enum packet_outcome handle_read_batch(const struct packet_call *c, struct response *r)
+{
+    r->content[0] = c->content[0];
+    user_config_encode(&c->d->regs->user, &r->content[1]);
+    r->length = 1u + USER_AREA_SIZE;
+    return OUTCOME_OK;
+}
+
+enum packet_outcome handle_write_batch(const struct packet_call *c, struct response *r)
+{
+    bool ok = user_config_decode(&c->d->regs->user, &c->content[1]);
+    c->result->config_changed = ok;
+    return answer_result(c, r, ok);
+}
+
+enum packet_outcome handle_monitor(const struct packet_call *c, struct response *r)
+{
+    const struct status_area *s = &c->d->regs->status;
+    struct motion_angle angle;
+    motion_read_angle(c->d->motion, &angle);
+    uint8_t *p = r->content;
+    p[0] = c->content[0];
+    wire_put_u16(&p[1], s->voltage_mv);
+    wire_put_u16(&p[3], s->current_ma);
+    wire_put_u16(&p[5], s->power_mw);
+    wire_put_u16(&p[7], s->temperature_adc);
+    p[9] = s->status;
+    wire_put_u32(&p[10], (uint32_t)angle.multi_turn_decideg);
+    wire_put_u16(&p[14], (uint16_t)angle.turns);
+    r->length = 16;
+    return OUTCOME_OK;
+}

@@ -1,0 +1,180 @@
+/* Packets that command or read the motion layer: 7-19, 23, 24. They decode
+ * the request into a struct motion_command and leave clamping, limits and
+ * timing to the motion layer. */
+#include <stddef.h>
+
+#include "protocol/packet_codes.h"
+#include "protocol/packet_table.h"
+#include "protocol/wire.h"
+
+/* Ramps of the packets that carry none (8, 13): behaviour.md, "Motion". */
+enum { DEFAULT_RAMP_MS = 20 };
+
+enum time_field { TIME_INTERVAL_U16, TIME_INTERVAL_U32, TIME_VELOCITY };
+
+/* Field layout of the angle packets after the ID:
+ * angle (2 or 4), interval or velocity, [acc, dec], power. */
+struct angle_layout {
+    uint8_t code;
+    uint8_t angle_size;
+    uint8_t time_field;   /* enum time_field */
+    uint8_t has_ramps;
+};
+
+static const struct angle_layout angle_layouts[] = {
+    {PKT_MOVE_ANGLE, 2, TIME_INTERVAL_U16, 0},
+    {PKT_MOVE_ANGLE_BY_INTERVAL, 2, TIME_INTERVAL_U16, 1},
+    {PKT_MOVE_ANGLE_BY_VELOCITY, 2, TIME_VELOCITY, 1},
+    {PKT_MOVE_MULTI_TURN, 4, TIME_INTERVAL_U32, 0},
+    {PKT_MOVE_MULTI_TURN_BY_INTERVAL, 4, TIME_INTERVAL_U32, 1},
+    {PKT_MOVE_MULTI_TURN_BY_VELOCITY, 4, TIME_VELOCITY, 1},
+};
+
+static const struct angle_layout *angle_layout_of(uint8_t code)
+{
+    for (size_t i = 0; i < sizeof angle_layouts / sizeof angle_layouts[0]; i++) {
+        if (angle_layouts[i].code == code) {
+            return &angle_layouts[i];
+        }
+    }
+    return NULL;
+}
+
+static struct motion_command command_for(const struct packet_call *c, uint8_t kind)
+{
+    return (struct motion_command){
+        .packet = c->code,
+        .kind = kind,
+        .answer_when_done = c->answer_when_done,
+    };
+}
+
+static enum packet_outcome submit(const struct packet_call *c, const struct motion_command *cmd)
+{
+    /* A full queue drops the command: no answer, command error. */
+    return motion_submit(c->d->motion, cmd) == MOTION_ACCEPTED ? OUTCOME_DEFERRED
+                                                              : OUTCOME_ERROR;
+}
+
+enum packet_outcome handle_move_angle(const struct packet_call *c, struct response *r)
+{
+    (void)r;
+    const struct angle_layout *layout = angle_layout_of(c->code);
+    if (layout == NULL) {
+        return OUTCOME_ERROR;
+    }
+    const uint8_t *p = &c->content[1];
+    struct motion_command cmd = command_for(c, MOTION_ANGLE);
+    cmd.multi_turn = layout->angle_size == 4u;
+    cmd.angle_decideg = cmd.multi_turn ? wire_get_i32(p) : wire_get_i16(p);
+    p += layout->angle_size;
+    switch (layout->time_field) {
+    case TIME_INTERVAL_U16:
+        cmd.interval_ms = wire_get_u16(p);
+        p += 2;
+        break;
+    case TIME_INTERVAL_U32:
+        cmd.interval_ms = wire_get_u32(p);
+        p += 4;
+        break;
+    default:
+        cmd.profile = PROFILE_VELOCITY;
+        cmd.velocity_decideg_s = wire_get_u16(p);
+        p += 2;
+        break;
+    }
+    cmd.acc_ms = DEFAULT_RAMP_MS;
+    cmd.dec_ms = DEFAULT_RAMP_MS;
+    if (layout->has_ramps) {
+        cmd.acc_ms = wire_get_u16(p);
+        cmd.dec_ms = wire_get_u16(p + 2);
+        p += 4;
+    }
+    cmd.power_mw = wire_get_u16(p);
+    return submit(c, &cmd);
+}
+
+enum packet_outcome handle_move_wheel(const struct packet_call *c, struct response *r)
+{
+    (void)r;
+    struct motion_command cmd = command_for(c, MOTION_WHEEL);
+    cmd.method = c->content[1];
+    cmd.wheel_speed_deg_s = wire_get_u16(&c->content[2]);
+    cmd.wheel_value = wire_get_u16(&c->content[4]);
+    return submit(c, &cmd);
+}
+
+enum packet_outcome handle_move_damping(const struct packet_call *c, struct response *r)
+{
+    struct motion_command cmd = command_for(c, MOTION_DAMPING);
+    cmd.power_mw = wire_get_u16(&c->content[1]);
+    cmd.answer_when_done = 0; /* nothing to finish: answered at once */
+    if (motion_submit(c->d->motion, &cmd) != MOTION_ACCEPTED) {
+        return OUTCOME_ERROR;
+    }
+    return answer_result(c, r, true);
+}
+
+enum packet_outcome handle_stop(const struct packet_call *c, struct response *r)
+{
+    (void)r;
+    enum { STOP_RELEASE = 0x10, STOP_DAMPING = 0x12 };
+    struct motion_command cmd = command_for(c, MOTION_STOP);
+    cmd.method = c->content[1];
+    cmd.power_mw = wire_get_u16(&c->content[2]);
+    cmd.answer_when_done = 0;
+    if (cmd.method < STOP_RELEASE || cmd.method > STOP_DAMPING) {
+        return OUTCOME_ERROR;
+    }
+    return motion_submit(c->d->motion, &cmd) == MOTION_ACCEPTED ? OUTCOME_OK : OUTCOME_ERROR;
+}
+
+enum packet_outcome handle_read_angle(const struct packet_call *c, struct response *r)
+{
+    struct motion_angle angle;
+    motion_read_angle(c->d->motion, &angle);
+    r->content[0] = c->content[0];
+    wire_put_u16(&r->content[1], (uint16_t)angle.single_turn_decideg);
+    r->length = 3;
+    return OUTCOME_OK;
+}
+
+enum packet_outcome handle_read_multi_turn(const struct packet_call *c, struct response *r)
+{
+    struct motion_angle angle;
+    motion_read_angle(c->d->motion, &angle);
+    r->content[0] = c->content[0];
+    wire_put_u32(&r->content[1], (uint32_t)angle.multi_turn_decideg);
+    wire_put_u16(&r->content[5], (uint16_t)angle.turns);
+    r->length = 7;
+    return OUTCOME_OK;
+}
+
+enum packet_outcome handle_reset_multi_turn(const struct packet_call *c, struct response *r)
+{
+    return answer_result(c, r, motion_reset_multi_turn(c->d->motion));
+}
+
+enum packet_outcome handle_set_origin(const struct packet_call *c, struct response *r)
+{
+    (void)r;
+    return motion_set_origin(c->d->motion) ? OUTCOME_OK : OUTCOME_FAILED;
+}
+
+enum packet_outcome handle_begin_async(const struct packet_call *c, struct response *r)
+{
+    (void)r;
+    motion_begin_async(c->d->motion);
+    return OUTCOME_OK;
+}
+
+enum packet_outcome handle_end_async(const struct packet_call *c, struct response *r)
+{
+    (void)r;
+    uint8_t cancel = c->content[0];
+    if (cancel > 1u) {
+        return OUTCOME_ERROR;
+    }
+    motion_end_async(c->d->motion, cancel == 1u);
+    return OUTCOME_OK;
+}

@@ -1,0 +1,54 @@
+/* The data table: one row per data item (ID, size, signedness, access,
+ * range, factory value, storage), and the operations packets 3-6 and 2 need.
+ * The code reads the table; no item has code of its own except the two
+ * cross-item rules (39 < 40, 51 > 52). */
+#ifndef PROTOCOL_DATA_TABLE_H
+#define PROTOCOL_DATA_TABLE_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "protocol/registers.h"
+
+enum data_access {
+    DATA_READ = 1u << 0,   /* ReadData answers the value */
+    DATA_WRITE = 1u << 1,  /* WriteData may change it */
+    DATA_SIGNED = 1u << 2,
+    DATA_USER = 1u << 3,   /* lives in struct user_config, else status_area */
+};
+
+struct data_item {
+    uint8_t id;
+    uint8_t size;     /* bytes on the wire: 1, 2 or 4 */
+    uint8_t access;   /* enum data_access */
+    uint8_t offset;   /* offsetof() in its area's struct */
+    int32_t min;      /* accepted range for writes, inclusive */
+    int32_t max;
+    int32_t factory;  /* user area: factory value (extensions.md) */
+};
+
+/* Largest item: the serial number, 4 bytes. */
+#define DATA_ITEM_MAX_SIZE 4u
+
+const struct data_item *data_table_find(uint8_t id);
+
+/* ReadData: the item's bytes into out (DATA_ITEM_MAX_SIZE); 0 when the ID is
+ * unknown or not public. */
+uint8_t data_table_read(const struct registers *regs, uint8_t id, uint8_t *out);
+
+/* WriteData: applies the value only if the item is writable, len matches its
+ * size and the resulting configuration is valid. */
+bool data_table_write(struct registers *regs, uint8_t id, const uint8_t *data, uint8_t len);
+
+void user_config_factory(struct user_config *cfg);
+/* ResetUserData: factory values except the servo ID and the baud rate. */
+void user_config_reset(struct user_config *cfg);
+bool user_config_valid(const struct user_config *cfg);
+void user_config_encode(const struct user_config *cfg, uint8_t out[USER_AREA_SIZE]);
+/* Decodes and validates; cfg is changed only when the block is valid. */
+bool user_config_decode(struct user_config *cfg, const uint8_t in[USER_AREA_SIZE]);
+
+/* Baud rate for data ID 36's index (1-8); 0 for an invalid index. */
+uint32_t baud_rate_of_index(uint8_t index);
+
+#endif

@@ -1,0 +1,34 @@
+/* Command dispatcher: checks a received request against the packet table
+ * (addressing, length, broadcast rules), runs its handler and says what to
+ * send back. Owns status bit 1 (command error). */
+#ifndef PROTOCOL_DISPATCHER_H
+#define PROTOCOL_DISPATCHER_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "motion/motion.h"
+#include "protocol/frame_rx.h"
+#include "protocol/frame_tx.h"
+#include "protocol/registers.h"
+
+struct dispatcher {
+    struct registers *regs;
+    struct motion *motion;
+    const volatile uint8_t *own_id; /* the ID the servo answers to right now */
+};
+
+struct dispatch_result {
+    bool answer;            /* response holds a frame to send */
+    bool config_changed;    /* the user area may have changed: save it */
+    /* Sync Monitor: let this many other servos' responses pass first. */
+    uint8_t wait_responses;
+};
+
+void dispatcher_init(struct dispatcher *d, struct registers *regs, struct motion *motion,
+                     const volatile uint8_t *own_id);
+
+void dispatch(struct dispatcher *d, const struct rx_frame *frame, struct response *response,
+              struct dispatch_result *result);
+
+#endif

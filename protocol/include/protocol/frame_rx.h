@@ -1,0 +1,93 @@
+/* Request framer: fed one received byte at a time from the UART receive
+ * interrupt, hands complete, checksum-verified request frames to the main
+ * loop through a small single-producer/single-consumer queue.
+ *
+ * Work per byte is constant and nothing blocks. Other servos' response
+ * frames are skipped whole by their length. SyncCommand (25) frames of any
+ * length are never buffered: only this servo's record is kept. */
+#ifndef PROTOCOL_FRAME_RX_H
+#define PROTOCOL_FRAME_RX_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+/* Largest request content kept: WriteBatchData is 1 + 32 bytes. A longer
+ * request is consumed by its length and delivered with FRAME_TRUNCATED so the
+ * dispatcher can reject it as a length error. */
+#define FRAME_CONTENT_MAX 34u
+/* Largest SyncCommand record kept (packet 14: 15 bytes). */
+#define FRAME_SYNC_RECORD_MAX 15u
+/* Slots in the frame queue; one is always the framer's work slot. */
+#define FRAME_QUEUE_SLOTS 4u
+#define FRAME_SYNC_NO_RECORD 0xFFu
+
+enum frame_flags {
+    FRAME_TRUNCATED = 1u << 0,  /* content longer than FRAME_CONTENT_MAX */
+    FRAME_BAD_SYNC = 1u << 1,   /* sync header inconsistent with length */
+};
+
+/* A received request. For SyncCommand, content holds cmd, record_len, count
+ * and then this servo's record (if sync_index != FRAME_SYNC_NO_RECORD). */
+struct rx_frame {
+    uint32_t responses_seen; /* stats.responses_skipped when it completed */
+    uint16_t length;      /* content length as announced on the wire */
+    uint8_t code;         /* packet number */
+    uint8_t flags;        /* enum frame_flags */
+    uint8_t stored;       /* bytes of content[] that are valid */
+    uint8_t sync_index;   /* position of this servo's record in a sync frame */
+    uint8_t content[FRAME_CONTENT_MAX];
+};
+
+struct frame_rx_stats {
+    uint32_t frames;            /* requests delivered */
+    uint32_t checksum_errors;   /* requests dropped for a bad checksum */
+    uint32_t responses_skipped; /* other servos' response frames passed over */
+    uint32_t idle_timeouts;     /* partial frames dropped after an idle gap */
+    uint32_t queue_overflows;   /* requests dropped because the queue was full */
+    uint32_t garbage_bytes;     /* bytes outside any frame */
+};
+
+struct frame_rx {
+    /* Written only by the interrupt side. */
+    struct rx_frame slots[FRAME_QUEUE_SLOTS];
+    volatile uint8_t head;      /* next slot the framer fills */
+    volatile uint8_t tail;      /* next slot the main loop reads */
+    uint8_t state;
+    uint8_t is_request;
+    uint8_t checksum;
+    uint8_t discard;            /* queue was full when this frame began */
+    uint16_t remaining;         /* content bytes still to come */
+    uint16_t position;          /* content bytes received so far */
+    uint8_t sync_record_len;
+    uint8_t sync_record_pos;    /* byte position within the current record */
+    uint8_t sync_record_index;  /* index of the current record */
+    uint8_t sync_capturing;
+    uint32_t last_byte_us;
+    uint32_t idle_timeout_us;
+    const volatile uint8_t *own_id; /* the servo's active ID, for sync records */
+    struct frame_rx_stats stats;
+};
+
+/* own_id must stay valid for the framer's lifetime; the framer reads it when
+ * a sync record starts. */
+void frame_rx_init(struct frame_rx *rx, const volatile uint8_t *own_id,
+                   uint32_t idle_timeout_us);
+
+/* Idle time after which a partial frame is dropped (see frame_rx_idle_us). */
+void frame_rx_set_idle_timeout(struct frame_rx *rx, uint32_t idle_timeout_us);
+
+/* Interrupt side: one received byte and the microsecond clock at its arrival
+ * (a free-running counter; wrap-around is handled). */
+void frame_rx_feed(struct frame_rx *rx, uint8_t byte, uint32_t now_us);
+
+/* Main-loop side: the oldest complete frame, or NULL. The frame stays valid
+ * until frame_rx_release(). */
+const struct rx_frame *frame_rx_peek(struct frame_rx *rx);
+void frame_rx_release(struct frame_rx *rx);
+
+/* The documented idle timeout for a baud rate: ten byte times (10 bits each),
+ * but never below 1 ms so that gaps inside one write by a USB serial adapter
+ * do not cut a frame. */
+uint32_t frame_rx_idle_us(uint32_t baud);
+
+#endif

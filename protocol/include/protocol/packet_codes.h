@@ -1,0 +1,33 @@
+/* Packet numbers of servo-protocol.md (1-17) and extensions.md (18-25). */
+#ifndef PROTOCOL_PACKET_CODES_H
+#define PROTOCOL_PACKET_CODES_H
+
+enum packet_code {
+    PKT_PING = 1,
+    PKT_RESET_USER_DATA = 2,
+    PKT_READ_DATA = 3,
+    PKT_WRITE_DATA = 4,
+    PKT_READ_BATCH_DATA = 5,
+    PKT_WRITE_BATCH_DATA = 6,
+    PKT_MOVE_WHEEL = 7,
+    PKT_MOVE_ANGLE = 8,
+    PKT_MOVE_DAMPING = 9,
+    PKT_READ_ANGLE = 10,
+    PKT_MOVE_ANGLE_BY_INTERVAL = 11,
+    PKT_MOVE_ANGLE_BY_VELOCITY = 12,
+    PKT_MOVE_MULTI_TURN = 13,
+    PKT_MOVE_MULTI_TURN_BY_INTERVAL = 14,
+    PKT_MOVE_MULTI_TURN_BY_VELOCITY = 15,
+    PKT_READ_MULTI_TURN_ANGLE = 16,
+    PKT_RESET_MULTI_TURN_ANGLE = 17,
+    PKT_BEGIN_ASYNC = 18,
+    PKT_END_ASYNC = 19,
+    PKT_START_MONITOR = 20, /* no published format: ignored */
+    PKT_STOP_MONITOR = 21,  /* no published format: ignored */
+    PKT_MONITOR = 22,
+    PKT_SET_ORIGIN_POINT = 23,
+    PKT_STOP_ON_CONTROL_MODE = 24,
+    PKT_SYNC_COMMAND = 25,
+};
+
+#endif

@@ -1,0 +1,89 @@
+/* One row per packet: request size rule, handler and answering rules.
+ * Internal to the protocol stack. */
+#ifndef PROTOCOL_PACKET_TABLE_H
+#define PROTOCOL_PACKET_TABLE_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "protocol/dispatcher.h"
+
+enum packet_flags {
+    PF_ADDRESSED = 1u << 0,   /* content starts with the servo ID */
+    PF_ANSWERS = 1u << 1,     /* always answers (so never on broadcast) */
+    PF_ANSWERS_IF_CONTROL_RESPONSE = 1u << 2, /* answers only with 33 on */
+    PF_BROADCAST = 1u << 3,   /* runs on every servo when sent to 0xFF */
+    PF_QUERY = 1u << 4,       /* reads only: leaves the command-error bit */
+    PF_SYNCABLE = 1u << 5,    /* may be a SyncCommand record */
+};
+
+enum packet_outcome {
+    OUTCOME_OK,       /* done; answer now if the flags say so */
+    OUTCOME_FAILED,   /* refused (result 0); answer now if due */
+    OUTCOME_DEFERRED, /* accepted; any answer comes when the move finishes */
+    OUTCOME_ERROR,    /* malformed or dropped: no answer, command error */
+    OUTCOME_NONE,     /* not for this servo, or already handled: nothing */
+};
+
+/* What a handler sees of the request it runs. */
+struct packet_call {
+    struct dispatcher *d;
+    const uint8_t *content;
+    uint16_t length;
+    uint8_t code;
+    bool answer_when_done; /* control response on and addressed to us alone */
+    uint8_t sync_index;    /* SyncCommand: position of this servo's record */
+    struct dispatch_result *result;
+};
+
+typedef enum packet_outcome (*packet_handler)(const struct packet_call *call,
+                                              struct response *response);
+
+struct packet_desc {
+    uint8_t code;
+    uint8_t flags;       /* enum packet_flags */
+    uint16_t min_length; /* content length rule, inclusive */
+    uint16_t max_length;
+    packet_handler handler;
+};
+
+const struct packet_desc *packet_find(uint8_t code);
+
+/* Handlers, grouped by what they touch. */
+enum packet_outcome handle_ping(const struct packet_call *c, struct response *r);
+enum packet_outcome handle_reset_user_data(const struct packet_call *c, struct response *r);
+enum packet_outcome handle_read_data(const struct packet_call *c, struct response *r);
+enum packet_outcome handle_write_data(const struct packet_call *c, struct response *r);
+enum packet_outcome handle_read_batch(const struct packet_call *c, struct response *r);
+enum packet_outcome handle_write_batch(const struct packet_call *c, struct response *r);
+enum packet_outcome handle_monitor(const struct packet_call *c, struct response *r);
+
+enum packet_outcome handle_move_wheel(const struct packet_call *c, struct response *r);
+enum packet_outcome handle_move_angle(const struct packet_call *c, struct response *r);
+enum packet_outcome handle_move_damping(const struct packet_call *c, struct response *r);
+enum packet_outcome handle_read_angle(const struct packet_call *c, struct response *r);
+enum packet_outcome handle_read_multi_turn(const struct packet_call *c, struct response *r);
+enum packet_outcome handle_reset_multi_turn(const struct packet_call *c, struct response *r);
+enum packet_outcome handle_begin_async(const struct packet_call *c, struct response *r);
+enum packet_outcome handle_end_async(const struct packet_call *c, struct response *r);
+enum packet_outcome handle_set_origin(const struct packet_call *c, struct response *r);
+enum packet_outcome handle_stop(const struct packet_call *c, struct response *r);
+
+enum packet_outcome handle_sync(const struct packet_call *c, struct response *r);
+enum packet_outcome handle_ignored(const struct packet_call *c, struct response *r);
+
+/* Runs one packet for this servo, as dispatch() does for a whole frame;
+ * SyncCommand runs its record through it. */
+struct packet_origin {
+    bool broadcast;      /* sent to 0xFF */
+    bool from_sync;      /* a SyncCommand record */
+    uint8_t sync_index;
+};
+void dispatch_packet(struct dispatcher *d, const struct packet_desc *desc,
+                     const uint8_t *content, uint16_t length, struct packet_origin origin,
+                     struct response *response, struct dispatch_result *result);
+
+/* The "id, result" answer most packets give. */
+enum packet_outcome answer_result(const struct packet_call *c, struct response *r, bool ok);
+
+#endif

@@ -1,0 +1,54 @@
+#include "protocol/packet_table.h"
+
+#include <stddef.h>
+
+#include "protocol/packet_codes.h"
+
+#define ADDR PF_ADDRESSED
+#define QUERY (PF_ADDRESSED | PF_ANSWERS | PF_QUERY)
+#define SETTING (PF_ADDRESSED | PF_ANSWERS)
+#define MOVE (PF_ADDRESSED | PF_ANSWERS_IF_CONTROL_RESPONSE | PF_BROADCAST)
+#define LEN(n) (n), (n)
+#define ANY_LENGTH 0, 0xFFFFu
+
+/* Request content lengths are those of servo-protocol.md section 3 and
+ * extensions.md. WriteData carries 1 to 4 data bytes: a mismatch with the
+ * item's size is answered with result 0, not treated as malformed. */
+static const struct packet_desc packets[] = {
+    {PKT_PING, QUERY, LEN(1), handle_ping},
+    {PKT_RESET_USER_DATA, SETTING, LEN(1), handle_reset_user_data},
+    {PKT_READ_DATA, QUERY, LEN(2), handle_read_data},
+    {PKT_WRITE_DATA, SETTING, 3, 6, handle_write_data},
+    {PKT_READ_BATCH_DATA, QUERY, LEN(1), handle_read_batch},
+    {PKT_WRITE_BATCH_DATA, SETTING, LEN(33), handle_write_batch},
+    {PKT_MOVE_WHEEL, MOVE, LEN(6), handle_move_wheel},
+    {PKT_MOVE_ANGLE, MOVE | PF_SYNCABLE, LEN(7), handle_move_angle},
+    {PKT_MOVE_DAMPING, MOVE, LEN(3), handle_move_damping},
+    {PKT_READ_ANGLE, QUERY, LEN(1), handle_read_angle},
+    {PKT_MOVE_ANGLE_BY_INTERVAL, MOVE | PF_SYNCABLE, LEN(11), handle_move_angle},
+    {PKT_MOVE_ANGLE_BY_VELOCITY, MOVE | PF_SYNCABLE, LEN(11), handle_move_angle},
+    {PKT_MOVE_MULTI_TURN, MOVE | PF_SYNCABLE, LEN(11), handle_move_angle},
+    {PKT_MOVE_MULTI_TURN_BY_INTERVAL, MOVE | PF_SYNCABLE, LEN(15), handle_move_angle},
+    {PKT_MOVE_MULTI_TURN_BY_VELOCITY, MOVE | PF_SYNCABLE, LEN(13), handle_move_angle},
+    {PKT_READ_MULTI_TURN_ANGLE, QUERY, LEN(1), handle_read_multi_turn},
+    {PKT_RESET_MULTI_TURN_ANGLE, MOVE, LEN(1), handle_reset_multi_turn},
+    {PKT_BEGIN_ASYNC, 0, LEN(0), handle_begin_async},
+    {PKT_END_ASYNC, 0, LEN(1), handle_end_async},
+    {PKT_START_MONITOR, PF_QUERY, ANY_LENGTH, handle_ignored},
+    {PKT_STOP_MONITOR, PF_QUERY, ANY_LENGTH, handle_ignored},
+    {PKT_MONITOR, QUERY | PF_SYNCABLE, LEN(1), handle_monitor},
+    {PKT_SET_ORIGIN_POINT, ADDR | PF_BROADCAST, LEN(2), handle_set_origin},
+    {PKT_STOP_ON_CONTROL_MODE, ADDR | PF_BROADCAST, LEN(4), handle_stop},
+    {PKT_SYNC_COMMAND, 0, 3, 0xFFFFu, handle_sync},
+};
+
+_Static_assert(sizeof packets / sizeof packets[0] == PKT_SYNC_COMMAND,
+               "one row per packet number, in order");
+
+const struct packet_desc *packet_find(uint8_t code)
+{
+    if (code < PKT_PING || code > PKT_SYNC_COMMAND) {
+        return NULL;
+    }
+    return &packets[code - PKT_PING];
+}
