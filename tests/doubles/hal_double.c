@@ -1,0 +1,50 @@
+#include "hal_double.h"
+
+#include <string.h>
+
+static uint32_t now_us(void *ctx)
+{
+    return ((struct hal_double *)ctx)->now_us;
+}
+
+static void uart_send(void *ctx, const uint8_t *data, uint16_t len)
+{
+    struct hal_double *h = ctx;
+    for (uint16_t i = 0; i < len && h->sent_length < HAL_DOUBLE_SENT_MAX; i++) {
+        h->sent[h->sent_length++] = data[i];
+    }
+    h->sends++;
+}
+
+static bool uart_tx_done(void *ctx)
+{
+    return !((struct hal_double *)ctx)->tx_busy;
+}
+
+static void uart_set_baud(void *ctx, uint32_t baud)
+{
+    struct hal_double *h = ctx;
+    h->baud = baud;
+    h->baud_changes++;
+}
+
+void hal_double_init(struct hal_double *h)
+{
+    memset(h, 0, sizeof *h);
+    flash_double_init(&h->flash, 1024);
+    h->port = (struct hal_port){
+        .ctx = h,
+        .now_us = now_us,
+        .uart_send = uart_send,
+        .uart_tx_done = uart_tx_done,
+        .uart_set_baud = uart_set_baud,
+        .flash = &h->flash.hal,
+        .serial_number = 0x12345678u,
+    };
+}
+
+void hal_double_clear_sent(struct hal_double *h)
+{
+    h->sent_length = 0;
+    h->sends = 0;
+}

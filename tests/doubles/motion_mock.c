@@ -1,0 +1,50 @@
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+
+#include "motion_mock.h"
+
+struct motion_command motion_mock_last;
+
+enum motion_submit_result motion_submit(struct motion *m, const struct motion_command *cmd)
+{
+    (void)m;
+    function_called();
+    motion_mock_last = *cmd;
+    return (enum motion_submit_result)mock();
+}
+
+void motion_read_angle(const struct motion *m, struct motion_angle *out)
+{
+    (void)m;
+    *out = *mock_ptr_type(const struct motion_angle *);
+}
+
+bool motion_reset_multi_turn(struct motion *m)
+{
+    (void)m;
+    function_called();
+    return (bool)mock();
+}
+
+bool motion_set_origin(struct motion *m)
+{
+    (void)m;
+    function_called();
+    return (bool)mock();
+}
+
+void motion_begin_async(struct motion *m)
+{
+    (void)m;
+    function_called();
+}
+
+void motion_end_async(struct motion *m, bool cancel)
+{
+    (void)m;
+    check_expected(cancel);
+}

@@ -1,0 +1,10 @@
+/* cmocka mock of motion/motion.h for dispatcher tests. motion_submit keeps
+ * the last command it was given in motion_mock_last. */
+#ifndef TEST_MOTION_MOCK_H
+#define TEST_MOTION_MOCK_H
+
+#include "motion/motion.h"
+
+extern struct motion_command motion_mock_last;
+
+#endif

@@ -1,0 +1,255 @@
+/* The data table against servo-protocol.md 4.2, extensions.md (factory
+ * values) and behaviour.md, "The data table": every item. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "protocol/data_table.h"
+
+static struct registers regs;
+
+static int setup(void **state)
+{
+    (void)state;
+    memset(&regs, 0, sizeof regs);
+    user_config_factory(&regs.user);
+    return 0;
+}
+
+/* Factory values as extensions.md lists them, on the wire (ReadBatchData). */
+static const uint8_t factory_block[USER_AREA_SIZE] = {
+    1,    /* 32 check flag */
+    0,    /* 33 control response */
+    0,    /* 34 servo ID */
+    0,    /* 35 reserved */
+    5,    /* 36 baud 115200 */
+    0,    /* 37 stall protection */
+    0x10, 0x27, /* 38 10000 mW */
+    0xA0, 0x0F, /* 39 4000 mV */
+    0xD0, 0x20, /* 40 8400 mV */
+    0x8B, 0x02, /* 41 651 */
+    0x10, 0x27, /* 42 10000 mW */
+    0xA0, 0x0F, /* 43 4000 mA */
+    0,    /* 44 */
+    0,    /* 45 */
+    0,    /* 46 */
+    0,    /* 47 */
+    1,    /* 48 */
+    1,    /* 49 */
+    0xB8, 0x0B, /* 50 3000 ms */
+    0x46, 0x05, /* 51 1350 */
+    0xBA, 0xFA, /* 52 -1350 */
+    0x00, 0x00, /* 53 */
+};
+
+static void test_factory_block_is_the_documented_one(void **state)
+{
+    (void)state;
+    uint8_t block[USER_AREA_SIZE];
+    user_config_encode(&regs.user, block);
+    assert_memory_equal(block, factory_block, USER_AREA_SIZE);
+}
+
+static void test_every_user_item_reads_its_factory_bytes(void **state)
+{
+    (void)state;
+    unsigned pos = 0;
+    for (uint8_t id = 32; id <= 53; id++) {
+        const struct data_item *it = data_table_find(id);
+        assert_non_null(it);
+        uint8_t out[DATA_ITEM_MAX_SIZE];
+        uint8_t n = data_table_read(&regs, id, out);
+        if (id == 35 || id == 45) {
+            assert_int_equal(n, 0); /* reserved: not public */
+        } else {
+            assert_int_equal(n, it->size);
+            assert_memory_equal(out, &factory_block[pos], n);
+        }
+        pos += it->size;
+    }
+    assert_int_equal(pos, USER_AREA_SIZE);
+}
+
+static void test_status_items_read_live_values(void **state)
+{
+    (void)state;
+    regs.status = (struct status_area){
+        .voltage_mv = 7400,
+        .current_ma = 350,
+        .power_mw = 2590,
+        .temperature_adc = 2048,
+        .status = 0x41,
+        .model = 0x0F00,
+        .firmware_version = 0x0010,
+        .serial_number = 0xA1B2C3D4,
+    };
+    const struct {
+        uint8_t id;
+        uint8_t size;
+        uint8_t bytes[4];
+    } expect[] = {
+        {1, 2, {0xE8, 0x1C}}, {2, 2, {0x5E, 0x01}}, {3, 2, {0x1E, 0x0A}},
+        {4, 2, {0x00, 0x08}}, {5, 1, {0x41}},       {6, 2, {0x00, 0x0F}},
+        {7, 2, {0x10, 0x00}}, {8, 4, {0xD4, 0xC3, 0xB2, 0xA1}},
+    };
+    for (size_t i = 0; i < sizeof expect / sizeof expect[0]; i++) {
+        uint8_t out[DATA_ITEM_MAX_SIZE];
+        assert_int_equal(data_table_read(&regs, expect[i].id, out), expect[i].size);
+        assert_memory_equal(out, expect[i].bytes, expect[i].size);
+    }
+}
+
+static void test_unknown_ids_read_nothing(void **state)
+{
+    (void)state;
+    const uint8_t unknown[] = {0, 9, 20, 31, 54, 100, 255};
+    for (size_t i = 0; i < sizeof unknown; i++) {
+        uint8_t out[DATA_ITEM_MAX_SIZE];
+        assert_null(data_table_find(unknown[i]));
+        assert_int_equal(data_table_read(&regs, unknown[i], out), 0);
+    }
+}
+
+static void test_status_and_reserved_items_refuse_writes(void **state)
+{
+    (void)state;
+    const uint8_t four[4] = {1, 2, 3, 4};
+    for (uint8_t id = 1; id <= 8; id++) {
+        const struct data_item *it = data_table_find(id);
+        assert_false(data_table_write(&regs, id, four, it->size));
+    }
+    assert_false(data_table_write(&regs, 35, four, 1));
+    assert_false(data_table_write(&regs, 45, four, 1));
+    assert_false(data_table_write(&regs, 54, four, 1));
+    test_factory_block_is_the_documented_one(state);
+}
+
+/* Range of every writable item: its limits accepted, one past refused. */
+static void test_every_item_range(void **state)
+{
+    (void)state;
+    const struct {
+        uint8_t id;
+        int32_t min, max;
+    } ranges[] = {
+        {32, 1, 1},         {33, 0, 1},         {34, 0, 254},       {36, 1, 8},
+        {37, 0, 1},         {38, 0, 65535},     {39, 0, 8399},      {40, 4001, 65535},
+        {41, 0, 65535},     {42, 0, 65535},     {43, 0, 65535},     {44, 0, 255},
+        {46, 0, 1},         {47, 0, 1},         {48, 0, 1},         {49, 0, 1},
+        {50, 0, 65535},     {51, -1349, 1800},  {52, -1800, 1349},  {53, -1800, 1800},
+    };
+    for (size_t i = 0; i < sizeof ranges / sizeof ranges[0]; i++) {
+        const struct data_item *it = data_table_find(ranges[i].id);
+        assert_non_null(it);
+        int32_t probes[] = {ranges[i].min - 1, ranges[i].min, ranges[i].max, ranges[i].max + 1};
+        for (size_t p = 0; p < 4; p++) {
+            int32_t v = probes[p];
+            bool representable = it->size == 1 ? (v >= 0 && v <= 255)
+                                 : (it->access & DATA_SIGNED) ? (v >= -32768 && v <= 32767)
+                                                              : (v >= 0 && v <= 65535);
+            if (!representable) {
+                continue;
+            }
+            setup(NULL);
+            uint8_t bytes[2] = {(uint8_t)((uint32_t)v & 0xFF), (uint8_t)(((uint32_t)v >> 8) & 0xFF)};
+            bool ok = data_table_write(&regs, ranges[i].id, bytes, it->size);
+            bool in_range = v >= ranges[i].min && v <= ranges[i].max;
+            assert_int_equal(ok, in_range);
+            uint8_t out[DATA_ITEM_MAX_SIZE];
+            assert_int_equal(data_table_read(&regs, ranges[i].id, out), it->size);
+            if (ok) {
+                assert_memory_equal(out, bytes, it->size);
+            }
+        }
+    }
+}
+
+static void test_wrong_data_length_is_refused(void **state)
+{
+    (void)state;
+    const uint8_t bytes[4] = {1, 0, 0, 0};
+    assert_false(data_table_write(&regs, 33, bytes, 2)); /* 1-byte item */
+    assert_false(data_table_write(&regs, 38, bytes, 1)); /* 2-byte item */
+    assert_false(data_table_write(&regs, 38, bytes, 3));
+    assert_true(data_table_write(&regs, 33, bytes, 1));
+}
+
+static void test_cross_item_rules(void **state)
+{
+    (void)state;
+    /* 39 < 40: raising the low limit to the high one is refused. */
+    const uint8_t v8400[] = {0xD0, 0x20};
+    assert_false(data_table_write(&regs, 39, v8400, 2));
+    const uint8_t v8399[] = {0xCF, 0x20};
+    assert_true(data_table_write(&regs, 39, v8399, 2));
+    /* 51 > 52 */
+    const uint8_t minus1350[] = {0xBA, 0xFA};
+    assert_false(data_table_write(&regs, 51, minus1350, 2));
+    const uint8_t v1350[] = {0x46, 0x05};
+    assert_false(data_table_write(&regs, 52, v1350, 2));
+}
+
+static void test_batch_decode_is_all_or_nothing(void **state)
+{
+    (void)state;
+    uint8_t block[USER_AREA_SIZE];
+    memcpy(block, factory_block, sizeof block);
+    block[1] = 1;      /* control response on: valid */
+    block[4] = 9;      /* baud index 9: invalid */
+    assert_false(user_config_decode(&regs.user, block));
+    assert_int_equal(regs.user.control_response, 0); /* nothing applied */
+    block[4] = 8;
+    block[3] = 0x77;   /* reserved bytes are stored as given */
+    block[19] = 0x99; /* 45 */
+    assert_true(user_config_decode(&regs.user, block));
+    uint8_t back[USER_AREA_SIZE];
+    user_config_encode(&regs.user, back);
+    assert_memory_equal(back, block, USER_AREA_SIZE);
+}
+
+static void test_reset_keeps_id_and_baud(void **state)
+{
+    (void)state;
+    regs.user.servo_id = 7;
+    regs.user.baud_index = 8;
+    regs.user.control_response = 1;
+    regs.user.angle_max_decideg = 900;
+    regs.user.reserved_45 = 3;
+    user_config_reset(&regs.user);
+    assert_int_equal(regs.user.servo_id, 7);
+    assert_int_equal(regs.user.baud_index, 8);
+    assert_int_equal(regs.user.control_response, 0);
+    assert_int_equal(regs.user.angle_max_decideg, 1350);
+    assert_int_equal(regs.user.reserved_45, 0);
+}
+
+static void test_baud_rates(void **state)
+{
+    (void)state;
+    const uint32_t rates[] = {0, 9600, 19200, 38400, 57600, 115200, 250000, 500000, 1000000, 0};
+    for (uint8_t i = 0; i < 10; i++) {
+        assert_int_equal(baud_rate_of_index(i), rates[i]);
+    }
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test_setup(test_factory_block_is_the_documented_one, setup),
+        cmocka_unit_test_setup(test_every_user_item_reads_its_factory_bytes, setup),
+        cmocka_unit_test_setup(test_status_items_read_live_values, setup),
+        cmocka_unit_test_setup(test_unknown_ids_read_nothing, setup),
+        cmocka_unit_test_setup(test_status_and_reserved_items_refuse_writes, setup),
+        cmocka_unit_test_setup(test_every_item_range, setup),
+        cmocka_unit_test_setup(test_wrong_data_length_is_refused, setup),
+        cmocka_unit_test_setup(test_cross_item_rules, setup),
+        cmocka_unit_test_setup(test_batch_decode_is_all_or_nothing, setup),
+        cmocka_unit_test_setup(test_reset_keeps_id_and_baud, setup),
+        cmocka_unit_test_setup(test_baud_rates, setup),
+    };
+    return cmocka_run_group_tests_name("data_table", tests, NULL, NULL);
+}
