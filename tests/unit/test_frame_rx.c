@@ -284,7 +284,7 @@ static void test_sync_keeps_only_own_record(void **state)
     for (unsigned k = 0; k < 254; k++) {
         ids[k] = (uint8_t)(k + 10); /* IDs 10..263 wrap; 3 is at k = 249 */
     }
-    static uint8_t wire[3 + 6 + 254 * 15];
+    static uint8_t wire[7 + 3 + 254 * 15]; /* header, ext. length, checksum */
     size_t n = make_sync(wire, 14, 15, 254, ids);
     assert_true(n > 3000);
     feed(f, wire, n);
