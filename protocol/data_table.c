@@ -158,20 +158,28 @@ bool user_config_valid(const struct user_config *cfg)
            cfg->angle_max_decideg > cfg->angle_min_decideg;
 }
 
-bool data_table_write(struct registers *regs, uint8_t id, const uint8_t *data, uint8_t len)
+enum data_write_result data_table_write(struct registers *regs, uint8_t id, const uint8_t *data,
+                                        uint8_t len)
 {
     const struct data_item *it = data_table_find(id);
     if (it == NULL || !(it->access & DATA_WRITE) || !(it->access & DATA_USER) ||
         len != it->size) {
-        return false;
+        return DATA_WRITE_REFUSED;
+    }
+    int32_t value = wire_value(data, it);
+    if (value < it->min || value > it->max) {
+        return DATA_WRITE_REFUSED;
+    }
+    if (value == field_get(field_of(regs, it), it)) {
+        return DATA_WRITE_SAME;
     }
     struct user_config candidate = regs->user;
-    field_set(&candidate, it, wire_value(data, it));
+    field_set(&candidate, it, value);
     if (!user_config_valid(&candidate)) {
-        return false;
+        return DATA_WRITE_REFUSED;
     }
     regs->user = candidate;
-    return true;
+    return DATA_WRITE_CHANGED;
 }
 
 void user_config_factory(struct user_config *cfg)

@@ -31,8 +31,10 @@ enum packet_outcome handle_read_data(const struct packet_call *c, struct respons
 enum packet_outcome handle_write_data(const struct packet_call *c, struct response *r)
 {
     uint8_t data_length = (uint8_t)(c->length - 2u);
-    bool ok = data_table_write(c->d->regs, c->content[1], &c->content[2], data_length);
-    c->result->config_changed = ok;
+    enum data_write_result w =
+        data_table_write(c->d->regs, c->content[1], &c->content[2], data_length);
+    bool ok = w != DATA_WRITE_REFUSED;
+    c->result->config_changed = w == DATA_WRITE_CHANGED;
     r->content[0] = c->content[0];
     r->content[1] = c->content[1];
     r->content[2] = ok ? 1u : 0u;

@@ -120,11 +120,11 @@ static void test_status_and_reserved_items_refuse_writes(void **state)
     const uint8_t four[4] = {1, 2, 3, 4};
     for (uint8_t id = 1; id <= 8; id++) {
         const struct data_item *it = data_table_find(id);
-        assert_false(data_table_write(&regs, id, four, it->size));
+        assert_int_equal(data_table_write(&regs, id, four, it->size), DATA_WRITE_REFUSED);
     }
-    assert_false(data_table_write(&regs, 35, four, 1));
-    assert_false(data_table_write(&regs, 45, four, 1));
-    assert_false(data_table_write(&regs, 54, four, 1));
+    assert_int_equal(data_table_write(&regs, 35, four, 1), DATA_WRITE_REFUSED);
+    assert_int_equal(data_table_write(&regs, 45, four, 1), DATA_WRITE_REFUSED);
+    assert_int_equal(data_table_write(&regs, 54, four, 1), DATA_WRITE_REFUSED);
     test_factory_block_is_the_documented_one(state);
 }
 
@@ -156,7 +156,7 @@ static void test_every_item_range(void **state)
             }
             setup(NULL);
             uint8_t bytes[2] = {(uint8_t)((uint32_t)v & 0xFF), (uint8_t)(((uint32_t)v >> 8) & 0xFF)};
-            bool ok = data_table_write(&regs, ranges[i].id, bytes, it->size);
+            bool ok = data_table_write(&regs, ranges[i].id, bytes, it->size) != DATA_WRITE_REFUSED;
             bool in_range = v >= ranges[i].min && v <= ranges[i].max;
             assert_int_equal(ok, in_range);
             uint8_t out[DATA_ITEM_MAX_SIZE];
@@ -172,10 +172,22 @@ static void test_wrong_data_length_is_refused(void **state)
 {
     (void)state;
     const uint8_t bytes[4] = {1, 0, 0, 0};
-    assert_false(data_table_write(&regs, 33, bytes, 2)); /* 1-byte item */
-    assert_false(data_table_write(&regs, 38, bytes, 1)); /* 2-byte item */
-    assert_false(data_table_write(&regs, 38, bytes, 3));
-    assert_true(data_table_write(&regs, 33, bytes, 1));
+    assert_int_equal(data_table_write(&regs, 33, bytes, 2), DATA_WRITE_REFUSED); /* 1-byte item */
+    assert_int_equal(data_table_write(&regs, 38, bytes, 1), DATA_WRITE_REFUSED); /* 2-byte item */
+    assert_int_equal(data_table_write(&regs, 38, bytes, 3), DATA_WRITE_REFUSED);
+    assert_int_equal(data_table_write(&regs, 33, bytes, 1), DATA_WRITE_CHANGED);
+}
+
+static void test_unchanged_value_is_reported_as_same(void **state)
+{
+    (void)state;
+    const uint8_t v3000[] = {0xB8, 0x0B};
+    assert_int_equal(data_table_write(&regs, 50, v3000, 2), DATA_WRITE_SAME);
+    const uint8_t one[] = {1};
+    assert_int_equal(data_table_write(&regs, 32, one, 1), DATA_WRITE_SAME);
+    const uint8_t v3001[] = {0xB9, 0x0B};
+    assert_int_equal(data_table_write(&regs, 50, v3001, 2), DATA_WRITE_CHANGED);
+    assert_int_equal(regs.user.soft_start_ms, 3001);
 }
 
 static void test_cross_item_rules(void **state)
@@ -183,14 +195,14 @@ static void test_cross_item_rules(void **state)
     (void)state;
     /* 39 < 40: raising the low limit to the high one is refused. */
     const uint8_t v8400[] = {0xD0, 0x20};
-    assert_false(data_table_write(&regs, 39, v8400, 2));
+    assert_int_equal(data_table_write(&regs, 39, v8400, 2), DATA_WRITE_REFUSED);
     const uint8_t v8399[] = {0xCF, 0x20};
-    assert_true(data_table_write(&regs, 39, v8399, 2));
+    assert_int_equal(data_table_write(&regs, 39, v8399, 2), DATA_WRITE_CHANGED);
     /* 51 > 52 */
     const uint8_t minus1350[] = {0xBA, 0xFA};
-    assert_false(data_table_write(&regs, 51, minus1350, 2));
+    assert_int_equal(data_table_write(&regs, 51, minus1350, 2), DATA_WRITE_REFUSED);
     const uint8_t v1350[] = {0x46, 0x05};
-    assert_false(data_table_write(&regs, 52, v1350, 2));
+    assert_int_equal(data_table_write(&regs, 52, v1350, 2), DATA_WRITE_REFUSED);
 }
 
 static void test_batch_decode_is_all_or_nothing(void **state)
@@ -246,6 +258,7 @@ int main(void)
         cmocka_unit_test_setup(test_status_and_reserved_items_refuse_writes, setup),
         cmocka_unit_test_setup(test_every_item_range, setup),
         cmocka_unit_test_setup(test_wrong_data_length_is_refused, setup),
+        cmocka_unit_test_setup(test_unchanged_value_is_reported_as_same, setup),
         cmocka_unit_test_setup(test_cross_item_rules, setup),
         cmocka_unit_test_setup(test_batch_decode_is_all_or_nothing, setup),
         cmocka_unit_test_setup(test_reset_keeps_id_and_baud, setup),

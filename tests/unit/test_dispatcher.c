@@ -187,6 +187,9 @@ static void test_write_data_result_and_config_flag(void **state)
     RUN(4, OWN_ID, 33, 1);
     ASSERT_ANSWER(4, OWN_ID, 33, 1);
     assert_true(result.config_changed);
+    RUN(4, OWN_ID, 33, 1); /* the same value again: nothing to save */
+    ASSERT_ANSWER(4, OWN_ID, 33, 1);
+    assert_false(result.config_changed);
     RUN(4, OWN_ID, 33, 2); /* out of range */
     ASSERT_ANSWER(4, OWN_ID, 33, 0);
     assert_false(result.config_changed);

@@ -36,9 +36,16 @@ const struct data_item *data_table_find(uint8_t id);
  * unknown or not public. */
 uint8_t data_table_read(const struct registers *regs, uint8_t id, uint8_t *out);
 
+enum data_write_result {
+    DATA_WRITE_REFUSED,   /* not writable, wrong size or invalid: unchanged */
+    DATA_WRITE_SAME,      /* accepted; the item already held that value */
+    DATA_WRITE_CHANGED,   /* accepted and changed: the store must save it */
+};
+
 /* WriteData: applies the value only if the item is writable, len matches its
  * size and the resulting configuration is valid. */
-bool data_table_write(struct registers *regs, uint8_t id, const uint8_t *data, uint8_t len);
+enum data_write_result data_table_write(struct registers *regs, uint8_t id, const uint8_t *data,
+                                        uint8_t len);
 
 void user_config_factory(struct user_config *cfg);
 /* ResetUserData: factory values except the servo ID and the baud rate. */
