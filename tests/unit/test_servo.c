@@ -315,6 +315,16 @@ static void test_async_moves_start_together(void **state)
     EXPECT_RESPONSE(10, 0, 0x84, 0x03);
 }
 
+/* Servo `id` sends its Monitor response on the shared wire. */
+static void other_servo_answers(uint8_t id)
+{
+    uint8_t frame[32];
+    uint8_t content[16] = {id};
+    size_t n = make_response(frame, 22, content, sizeof content);
+    feed(frame, n);
+    poll_n(3);
+}
+
 /* Sync Monitor: servo 0 is third in the list, so it lets two responses go
  * by first. */
 static void test_sync_monitor_waits_its_turn(void **state)
@@ -323,16 +333,9 @@ static void test_sync_monitor_waits_its_turn(void **state)
     const uint8_t sync[] = {22, 1, 4, 5, 6, 0, 9};
     request(25, sync, sizeof sync);
     expect_silence();
-    uint8_t other[32];
-    uint8_t content[16] = {5};
-    size_t n = make_response(other, 22, content, 16);
-    feed(other, n);
-    poll_n(3);
+    other_servo_answers(5);
     expect_silence();
-    content[0] = 6;
-    n = make_response(other, 22, content, 16);
-    feed(other, n);
-    poll_n(3);
+    other_servo_answers(6);
     assert_int_equal(hal.sent_length, 21);
     assert_int_equal(hal.sent[2], 22);
     assert_int_equal(hal.sent[4], 0);
@@ -343,11 +346,7 @@ static void test_sync_monitor_passes_a_silent_servo(void **state)
     (void)state;
     const uint8_t sync[] = {22, 1, 3, 5, 6, 0};
     request(25, sync, sizeof sync);
-    uint8_t other[32];
-    uint8_t content[16] = {5};
-    size_t n = make_response(other, 22, content, 16);
-    feed(other, n);
-    poll_n(3);
+    other_servo_answers(5);
     expect_silence();
     /* Servo 6 never answers: after the documented silence, servo 0 goes. */
     hal.now_us += SYNC_SLOT_SILENCE_US - 1;

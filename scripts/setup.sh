@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# Installs what building and testing need, only what is missing: Debian
+# packages (as root, or through sudo) and the project's Python virtual
+# environment in .venv. Safe to run again.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+PACKAGES=(cmake ninja-build gcc pkg-config libcmocka-dev clang libclang-rt-14-dev
+          gcc-arm-none-eabi libnewlib-arm-none-eabi valgrind python3-venv)
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "setup: installing ${missing[*]}"
+  if [ "$(id -u)" -eq 0 ]; then SUDO=(); elif command -v sudo >/dev/null; then SUDO=(sudo); else
+    echo "setup: missing packages ${missing[*]} and no root or sudo to install them" >&2
+    exit 1
+  fi
+  "${SUDO[@]}" apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive "${SUDO[@]}" apt-get install -y -qq "${missing[@]}" >/dev/null
+fi
+
+if [ ! -x .venv/bin/python ]; then
+  echo "setup: creating .venv"
+  python3 -m venv .venv
+fi
+if ! .venv/bin/python -m pip install -q --disable-pip-version-check -r tools/requirements.txt; then
+  echo "setup: pip could not install tools/requirements.txt" >&2
+  exit 1
+fi
+echo "setup: ready"

@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# Runs every test: unit tests under ASan + UBSan, a bounded fuzz run, and the
+# ARM image build with its flash/RAM budget and soft-float checks.
+# FUZZ_SECONDS sets the fuzz run's length (default 60).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/setup.sh
+
+step() { printf '\n== %s\n' "$*"; }
+
+step "unit tests (host, AddressSanitizer + UndefinedBehaviorSanitizer)"
+cmake --preset host >/dev/null
+cmake --build --preset host
+ctest --preset host | tee build/host/ctest.log
+unit=$(sed -nE 's/.*tests passed, 0 tests failed out of ([0-9]+).*/\1/p' build/host/ctest.log)
+
+step "fuzzing the servo core for ${FUZZ_SECONDS:-60} s (libFuzzer, ASan + UBSan)"
+cmake --preset fuzz >/dev/null
+cmake --build --preset fuzz --target fuzz_servo
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+# New inputs go to the scratch folder; the committed seeds stay as they are.
+./build/fuzz/tests/fuzz/fuzz_servo -max_total_time="${FUZZ_SECONDS:-60}" -seed=1 \
+  -print_final_stats=1 "$work" tests/fuzz/corpus 2>"$work/log" || {
+  tail -n 60 "$work/log" >&2
+  echo "fuzzing found a failure (crash input saved in the working directory)" >&2
+  exit 1
+}
+grep -E '^(#[0-9]+\s+DONE|stat::number_of_executed_units)' "$work/log"
+
+step "ARM image (STM32F103): budget and soft-float checks"
+cmake --preset arm >/dev/null
+cmake --build --preset arm
+
+echo
+# CTest programs, the fuzz run and the ARM image check.
+echo "summary: $((unit + 2)) passed, 0 failed"

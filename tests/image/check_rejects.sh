@@ -1,0 +1,28 @@
+#!/bin/sh
+# cmake/check-image.sh must reject an image with soft-float helpers and one
+# over the RAM budget, and accept a clean one: a check that cannot fail
+# proves nothing.
+set -u
+root=$(cd "$(dirname "$0")/../.." && pwd)
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+build() {
+  arm-none-eabi-gcc -mcpu=cortex-m3 -mthumb -Os -nostartfiles --specs=nano.specs \
+    --specs=nosys.specs -T "$root/firmware/linker/stm32f103x8.ld" "$@" \
+    "$root/tests/image/probe.c" -o "$tmp/probe.elf" || exit 1
+}
+fail=0
+build
+sh "$root/cmake/check-image.sh" "$tmp/probe.elf" >/dev/null 2>&1 || { echo "clean image rejected"; fail=1; }
+build -DUSE_FLOAT
+if sh "$root/cmake/check-image.sh" "$tmp/probe.elf" 2>"$tmp/err" >/dev/null; then
+  echo "soft-float image accepted"; fail=1
+fi
+grep -q "__aeabi_f" "$tmp/err" || { echo "soft-float helper not named"; fail=1; }
+build -DBIG_RAM
+if sh "$root/cmake/check-image.sh" "$tmp/probe.elf" 2>"$tmp/err" >/dev/null; then
+  echo "image over the RAM budget accepted"; fail=1
+fi
+grep -q "RAM .* exceeds 8192" "$tmp/err" || { echo "RAM overrun not reported"; fail=1; }
+[ $fail -eq 0 ] && echo "check-image: rejects soft float and RAM overrun, accepts a clean image"
+exit $fail
