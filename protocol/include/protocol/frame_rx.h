@@ -41,7 +41,8 @@ struct rx_frame {
 struct frame_rx_stats {
     uint32_t frames;            /* requests delivered */
     uint32_t checksum_errors;   /* requests dropped for a bad checksum */
-    uint32_t responses_skipped; /* other servos' response frames passed over */
+    /* Other servos' response frames passed over; the main loop reads it. */
+    volatile uint32_t responses_skipped;
     uint32_t idle_timeouts;     /* partial frames dropped after an idle gap */
     uint32_t queue_overflows;   /* requests dropped because the queue was full */
     uint32_t garbage_bytes;     /* bytes outside any frame */
@@ -62,7 +63,7 @@ struct frame_rx {
     uint8_t sync_record_pos;    /* byte position within the current record */
     uint8_t sync_record_index;  /* index of the current record */
     uint8_t sync_capturing;
-    uint32_t last_byte_us;
+    volatile uint32_t last_byte_us; /* the main loop reads it */
     uint32_t idle_timeout_us;
     const volatile uint8_t *own_id; /* the servo's active ID, for sync records */
     struct frame_rx_stats stats;
