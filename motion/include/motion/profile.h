@@ -1,0 +1,78 @@
+/* Trapezoidal motion profile in fixed point.
+ *
+ * Units: time in control ticks (MOTION_TICK_HZ); positions in Q32
+ * decidegrees (int64, 1 decideg = 2^32); velocities in Q32 decidegrees per
+ * tick; the two ramp coefficients in Q40 decidegrees per tick squared.
+ *
+ * A profile has three phases of whole ticks: acceleration (N1 ticks, from the
+ * start velocity v0 to the cruise velocity V), cruise (Nc) and deceleration
+ * (N3, from V to rest at the target). V follows from the phase lengths so the
+ * move covers exactly target - start:
+ *     V = (2 D - v0 N1) / (N1 + 2 Nc + N3)
+ * Planning uses 64-bit division; evaluating a tick uses two multiplies and
+ * shifts, no division. The last tick's setpoint is the target exactly. */
+#ifndef MOTION_PROFILE_H
+#define MOTION_PROFILE_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#define MOTION_TICK_HZ 1000u
+/* 1 decidegree in the Q32 position format. */
+#define DECIDEG_Q32 ((int64_t)1 << 32)
+/* Fastest setpoint the planner makes, 16384 decideg per tick (1 638 400
+ * deg/s, far beyond any servo): a move that would need more takes longer. It
+ * keeps every product of planning and evaluation within int64. */
+#define PROFILE_MAX_VELOCITY ((int64_t)16384 << 32)
+/* Longest cruise, in ticks (24.8 days). */
+#define PROFILE_MAX_CRUISE 0x7FFFFFFFu
+/* Longest ramp, in ticks (the protocol's u16 ms). */
+#define PROFILE_MAX_RAMP 65535u
+
+struct profile {
+    int64_t start;        /* position at tick 0 */
+    int64_t target;       /* position from total_ticks on */
+    int64_t v0;           /* velocity at tick 0 */
+    int64_t cruise;       /* V */
+    int64_t cruise_start; /* position at tick accel_ticks */
+    int64_t accel_k;      /* (V - v0) / (2 N1), Q40 */
+    int64_t decel_k;      /* V / (2 N3), Q40 */
+    uint32_t accel_ticks; /* N1 */
+    uint32_t cruise_end;  /* N1 + Nc */
+    uint32_t total_ticks; /* N1 + Nc + N3; UINT32_MAX cruises for ever */
+};
+
+/* Phase lengths in ticks. */
+struct profile_timing {
+    uint32_t accel;
+    uint32_t cruise;
+    uint32_t decel;
+};
+
+/* A move from start (moving at v0) to target with the given phase lengths.
+ * accel and decel must not exceed PROFILE_MAX_RAMP. If the cruise velocity
+ * would exceed PROFILE_MAX_VELOCITY, the cruise is lengthened. */
+void profile_plan(struct profile *p, int64_t start, int64_t v0, int64_t target,
+                  struct profile_timing timing);
+
+/* Accelerate from v0 to velocity over accel ticks, then cruise for ever
+ * (wheel mode). */
+void profile_plan_endless(struct profile *p, int64_t start, int64_t v0, int64_t velocity,
+                          uint32_t accel);
+
+/* Phase lengths of a velocity-based move (packets 12, 15): peak |velocity|
+ * vmax, ramps of accel and decel ticks. The cruise time is rounded to whole
+ * ticks; a stroke too short for a cruise shrinks both ramps in their ratio
+ * (each rounded down) and keeps the total within a tick of the exact one. distance and v0 in Q32, vmax in Q32 per tick (> 0). */
+struct profile_timing profile_velocity_timing(int64_t distance, int64_t v0, int64_t vmax,
+                                              uint32_t accel, uint32_t decel);
+
+int64_t profile_position(const struct profile *p, uint32_t tick);
+int64_t profile_velocity(const struct profile *p, uint32_t tick);
+
+static inline bool profile_done(const struct profile *p, uint32_t tick)
+{
+    return tick >= p->total_ticks;
+}
+
+#endif

@@ -1,0 +1,136 @@
+#include "motion/profile.h"
+
+/* Right shifts of negative values are arithmetic with gcc and clang, the
+ * only compilers this code is built with (implementation-defined in C11). */
+
+static int64_t div_round(int64_t num, int64_t den)
+{
+    /* den > 0 */
+    return num >= 0 ? (num + den / 2) / den : -((-num + den / 2) / den);
+}
+
+static int64_t abs64(int64_t v)
+{
+    return v < 0 ? -v : v;
+}
+
+/* k t^2 with k in Q40 and t <= PROFILE_MAX_RAMP: the result in Q32.
+ * With |V|, |v0| <= PROFILE_MAX_VELOCITY (2^46), |k t| <= 2^54 for t within
+ * the ramp, so |(k t) >> 8| t <= 2^62. */
+static int64_t quadratic(int64_t k, uint32_t t)
+{
+    return ((k * (int64_t)t) >> 8) * (int64_t)t;
+}
+
+void profile_plan(struct profile *p, int64_t start, int64_t v0, int64_t target,
+                  struct profile_timing timing)
+{
+    int64_t n1 = timing.accel;
+    int64_t n3 = timing.decel;
+    int64_t nc = timing.cruise;
+    if (v0 > PROFILE_MAX_VELOCITY) {
+        v0 = PROFILE_MAX_VELOCITY;
+    } else if (v0 < -PROFILE_MAX_VELOCITY) {
+        v0 = -PROFILE_MAX_VELOCITY;
+    }
+    int64_t num = 2 * (target - start) - v0 * n1;
+    int64_t den = n1 + 2 * nc + n3;
+    if (den == 0) {
+        den = 2; /* nothing to time: arrive on the next tick */
+        nc = 1;
+    }
+    /* Stretch the cruise so V stays within the planner's limit. */
+    int64_t needed = (abs64(num) + PROFILE_MAX_VELOCITY - 1) / PROFILE_MAX_VELOCITY;
+    if (needed > den) {
+        nc += (needed - den + 1) / 2;
+        den = n1 + 2 * nc + n3;
+    }
+    int64_t v = div_round(num, den);
+
+    p->start = start;
+    p->target = target;
+    p->v0 = v0;
+    p->cruise = v;
+    p->accel_k = n1 ? div_round((v - v0) * 256, 2 * n1) : 0;
+    p->decel_k = n3 ? div_round(v * 256, 2 * n3) : 0;
+    p->accel_ticks = (uint32_t)n1;
+    p->cruise_end = (uint32_t)(n1 + nc);
+    p->total_ticks = (uint32_t)(n1 + nc + n3);
+    p->cruise_start = start + v0 * n1 + quadratic(p->accel_k, (uint32_t)n1);
+}
+
+void profile_plan_endless(struct profile *p, int64_t start, int64_t v0, int64_t velocity,
+                          uint32_t accel)
+{
+    p->start = start;
+    p->target = start;
+    p->v0 = v0;
+    p->cruise = velocity;
+    p->accel_k = accel ? div_round((velocity - v0) * 256, 2 * (int64_t)accel) : 0;
+    p->decel_k = 0;
+    p->accel_ticks = accel;
+    p->cruise_end = UINT32_MAX;
+    p->total_ticks = UINT32_MAX;
+    p->cruise_start = start + v0 * (int64_t)accel + quadratic(p->accel_k, accel);
+}
+
+struct profile_timing profile_velocity_timing(int64_t distance, int64_t v0, int64_t vmax,
+                                              uint32_t accel, uint32_t decel)
+{
+    struct profile_timing t = {.accel = accel, .cruise = 0, .decel = decel};
+    int64_t v = distance >= 0 ? vmax : -vmax;
+    /* Distance the two ramps cover at full velocity, and what is left. */
+    int64_t ramps = ((v0 + v) * (int64_t)accel + v * (int64_t)decel) / 2;
+    int64_t rest = distance - ramps;
+    if (rest == 0 || (rest > 0) == (v > 0)) {
+        int64_t cruise = div_round(abs64(rest), vmax);
+        t.cruise = cruise < PROFILE_MAX_CRUISE ? (uint32_t)cruise : PROFILE_MAX_CRUISE;
+        return t;
+    }
+    if (distance == 0 || (ramps > 0) != (distance > 0)) {
+        return t; /* no stroke to fit: the ramps as commanded, no cruise */
+    }
+    /* Too short: shrink both ramps by distance / ramps, in Q16 so the
+     * products stay within int64. */
+    int64_t d16 = abs64(distance) >> 16;
+    int64_t r16 = abs64(ramps) >> 16;
+    if (r16 == 0) {
+        t.accel = 0; /* a stroke of under 2^-16 decideg */
+        t.decel = 0;
+        return t;
+    }
+    t.accel = (uint32_t)((int64_t)accel * d16 / r16);
+    t.decel = (uint32_t)((int64_t)decel * d16 / r16);
+    int64_t total = div_round((int64_t)(accel + decel) * d16, r16);
+    int64_t cruise = total - (int64_t)t.accel - (int64_t)t.decel;
+    t.cruise = (uint32_t)(cruise > 0 ? cruise : 0);
+    return t;
+}
+
+int64_t profile_position(const struct profile *p, uint32_t tick)
+{
+    if (tick < p->accel_ticks) {
+        return p->start + p->v0 * (int64_t)tick + quadratic(p->accel_k, tick);
+    }
+    if (tick < p->cruise_end) {
+        return p->cruise_start + p->cruise * (int64_t)(tick - p->accel_ticks);
+    }
+    if (tick >= p->total_ticks) {
+        return p->target;
+    }
+    return p->target - quadratic(p->decel_k, p->total_ticks - tick);
+}
+
+int64_t profile_velocity(const struct profile *p, uint32_t tick)
+{
+    if (tick < p->accel_ticks) {
+        return p->v0 + ((2 * p->accel_k * (int64_t)tick) >> 8);
+    }
+    if (tick < p->cruise_end) {
+        return p->cruise;
+    }
+    if (tick >= p->total_ticks) {
+        return 0;
+    }
+    return (2 * p->decel_k * (int64_t)(p->total_ticks - tick)) >> 8;
+}
