@@ -118,7 +118,6 @@ enum packet_outcome handle_move_damping(const struct packet_call *c, struct resp
 enum packet_outcome handle_stop(const struct packet_call *c, struct response *r)
 {
     (void)r;
-    enum { STOP_RELEASE = 0x10, STOP_DAMPING = 0x12 };
     struct motion_command cmd = command_for(c, MOTION_STOP);
     cmd.method = c->content[1];
     cmd.power_mw = wire_get_u16(&c->content[2]);

@@ -23,7 +23,8 @@ void servo_init(struct servo *s, const struct hal_port *hal)
     s->regs.status.model = SERVO_MODEL;
     s->regs.status.firmware_version = FIRMWARE_VERSION;
     s->regs.status.serial_number = hal->serial_number;
-    motion_init(&s->motion, &s->regs.user);
+    motion_init(&s->motion, &s->regs, hal);
+    s->next_tick_us = hal->now_us(hal->ctx) + CONTROL_TICK_US;
     frame_rx_init(&s->rx, &s->active_id, frame_rx_idle_us(0));
     dispatcher_init(&s->dispatcher, &s->regs, &s->motion, &s->active_id);
     s->active_baud_index = 0; /* forces the first apply to set the UART */
@@ -97,8 +98,26 @@ static void handle_next_frame(struct servo *s)
     }
 }
 
+/* The control loop runs from the main loop, so commands and ticks never
+ * interleave. One tick per pass; a main loop more than a few ticks late
+ * (flash erase) drops the missed ticks rather than racing to catch up. */
+static void run_control_tick(struct servo *s)
+{
+    uint32_t now = s->hal->now_us(s->hal->ctx);
+    int32_t late = (int32_t)(now - s->next_tick_us);
+    if (late < 0) {
+        return;
+    }
+    motion_tick(&s->motion);
+    s->next_tick_us += CONTROL_TICK_US;
+    if (late > (int32_t)(4u * CONTROL_TICK_US)) {
+        s->next_tick_us = now + CONTROL_TICK_US;
+    }
+}
+
 void servo_poll(struct servo *s)
 {
+    run_control_tick(s);
     if (s->tx.sending) {
         if (!s->hal->uart_tx_done(s->hal->ctx)) {
             return; /* half duplex: nothing else goes out meanwhile */

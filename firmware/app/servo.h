@@ -18,6 +18,8 @@
 /* Silence after which a SyncCommand Monitor turn-taker stops waiting for a
  * servo listed before it that does not answer. */
 #define SYNC_SLOT_SILENCE_US 3000u
+/* Control tick period. */
+#define CONTROL_TICK_US (1000000u / MOTION_TICK_HZ)
 
 struct servo_tx {
     uint8_t frame[RESPONSE_FRAME_MAX];
@@ -37,6 +39,7 @@ struct servo {
     struct dispatcher dispatcher;
     struct config_store store;
     struct servo_tx tx;
+    uint32_t next_tick_us;       /* when the next control tick is due */
     volatile uint8_t active_id;  /* the ID answered to now */
     uint8_t active_baud_index;
     uint8_t config_dirty;

@@ -28,6 +28,30 @@ static void uart_set_baud(void *ctx, uint32_t baud)
     h->baud_changes++;
 }
 
+static void motor_drive(void *ctx, int16_t duty)
+{
+    struct hal_double *h = ctx;
+    h->duty = duty;
+    h->coasting = false;
+    int16_t a = duty < 0 ? (int16_t)-duty : duty;
+    if (a > h->max_abs_duty) {
+        h->max_abs_duty = a;
+    }
+}
+
+static void motor_coast(void *ctx)
+{
+    struct hal_double *h = ctx;
+    h->duty = 0;
+    h->coasting = true;
+}
+
+static uint16_t encoder_read(void *ctx)
+{
+    struct hal_double *h = ctx;
+    return h->encoder_model ? h->encoder_model(h->model) : h->encoder_raw;
+}
+
 void hal_double_init(struct hal_double *h)
 {
     memset(h, 0, sizeof *h);
@@ -38,6 +62,9 @@ void hal_double_init(struct hal_double *h)
         .uart_send = uart_send,
         .uart_tx_done = uart_tx_done,
         .uart_set_baud = uart_set_baud,
+        .motor_drive = motor_drive,
+        .motor_coast = motor_coast,
+        .encoder_read = encoder_read,
         .flash = &h->flash.hal,
         .serial_number = 0x12345678u,
     };

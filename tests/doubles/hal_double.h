@@ -22,6 +22,13 @@ struct hal_double {
     bool tx_busy;         /* uart_tx_done answers !tx_busy */
     uint32_t baud;        /* last uart_set_baud */
     unsigned baud_changes;
+    int16_t duty;         /* last motor_drive */
+    int16_t max_abs_duty; /* largest |duty| since the test last cleared it */
+    bool coasting;        /* motor_coast since the last motor_drive */
+    uint16_t encoder_raw; /* what encoder_read answers without a model */
+    /* If set, encoder_read answers this (a plant, an ideal tracker). */
+    uint16_t (*encoder_model)(void *model);
+    void *model;
 };
 
 void hal_double_init(struct hal_double *h);

@@ -20,6 +20,14 @@ struct hal_port {
     /* True once the last stop bit of the last send has left the wire. */
     bool (*uart_tx_done)(void *ctx);
     void (*uart_set_baud)(void *ctx, uint32_t baud);
+    /* H-bridge: signed duty, Q15 (32767 = full supply; positive turns the
+     * output towards increasing angle, counter-clockwise seen from the horn). */
+    void (*motor_drive)(void *ctx, int16_t duty_q15);
+    /* Both bridge halves off: the output turns freely (release). */
+    void (*motor_coast)(void *ctx);
+    /* Output-shaft angle from the 12-bit absolute magnetic encoder, 0..4095,
+     * increasing counter-clockwise. */
+    uint16_t (*encoder_read)(void *ctx);
     const struct hal_flash *flash;
     /* Data ID 8: derived by the port from the MCU's unique ID. */
     uint32_t serial_number;

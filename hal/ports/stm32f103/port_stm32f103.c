@@ -1,6 +1,7 @@
 /* STM32F103 port, board-stub stage: the clock, the receive interrupt and
- * the unique ID are real; UART transmit and flash writes are stubs until the
- * MCU port lands (issue 6), so the image links and sizes the whole core. */
+ * the unique ID are real; UART transmit, PWM, encoder and flash writes are
+ * stubs until the MCU port lands (issue 6), so the image links and sizes the
+ * whole core. */
 #include <stdint.h>
 
 #include "port_stm32f103.h"
@@ -66,6 +67,23 @@ static void uart_set_baud(void *ctx, uint32_t baud)
     (void)baud; /* stub */
 }
 
+static void motor_drive(void *ctx, int16_t duty)
+{
+    (void)ctx;
+    (void)duty; /* stub: PWM lands with the MCU port */
+}
+
+static void motor_coast(void *ctx)
+{
+    (void)ctx; /* stub */
+}
+
+static uint16_t encoder_read(void *ctx)
+{
+    (void)ctx;
+    return 0; /* stub: ADC lands with the MCU port */
+}
+
 static bool flash_erase(void *ctx, uint32_t addr)
 {
     (void)ctx;
@@ -111,6 +129,9 @@ void port_init(struct hal_port *port, struct servo *servo)
         .uart_send = uart_send,
         .uart_tx_done = uart_tx_done,
         .uart_set_baud = uart_set_baud,
+        .motor_drive = motor_drive,
+        .motor_coast = motor_coast,
+        .encoder_read = encoder_read,
         .flash = &flash,
         .serial_number = serial_from_uid(),
     };

@@ -1,11 +1,17 @@
-/* The motion layer as the dispatcher sees it: decoded motion commands in,
- * position and state out. Units are the protocol's (0.1 degree, ms, mW). */
+/* The motion layer: turns decoded motion commands into profiles, runs the
+ * control loop every tick and answers for position and state. Units at this
+ * interface are the protocol's (0.1 degree, ms, mW); behaviour.md, "Motion",
+ * says what each command does. */
 #ifndef MOTION_MOTION_H
 #define MOTION_MOTION_H
 
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "hal/hal_port.h"
+#include "motion/controller.h"
+#include "motion/encoder.h"
+#include "motion/profile.h"
 #include "protocol/registers.h"
 
 enum motion_kind {
@@ -20,6 +26,22 @@ enum motion_profile {
     PROFILE_VELOCITY, /* cruise time derived from velocity_decideg_s */
 };
 
+/* Packet 7 method: direction | action. */
+enum wheel_method {
+    WHEEL_CLOCKWISE = 0x80, /* else counter-clockwise: increasing angle */
+    WHEEL_STOP = 0x00,
+    WHEEL_RUN = 0x01,
+    WHEEL_TURNS = 0x02,
+    WHEEL_TIME = 0x03,
+};
+
+/* Packet 24 method. */
+enum stop_method {
+    STOP_RELEASE = 0x10,
+    STOP_HOLD = 0x11,
+    STOP_DAMPING = 0x12,
+};
+
 /* One motion request as it arrived, fields not yet clamped. */
 struct motion_command {
     uint8_t packet;           /* request packet number, for the finish answer */
@@ -27,7 +49,7 @@ struct motion_command {
     uint8_t profile;          /* enum motion_profile */
     uint8_t multi_turn;       /* packets 13-15 */
     uint8_t answer_when_done; /* control response on, sent to this servo alone */
-    uint8_t method;           /* wheel: direction | action; stop: 0x10-0x12 */
+    uint8_t method;           /* enum wheel_method or enum stop_method */
     int32_t angle_decideg;
     uint32_t interval_ms;
     uint16_t acc_ms;
@@ -40,18 +62,74 @@ struct motion_command {
 
 enum motion_submit_result {
     MOTION_ACCEPTED,
-    MOTION_QUEUE_FULL, /* control response on and the queue is full */
+    MOTION_QUEUE_FULL, /* the queue (control response on) or async buffer is full */
 };
 
 struct motion_angle {
     int32_t multi_turn_decideg;  /* ReadMultiTurnAngle / Monitor angle */
     int16_t turns;               /* whole turns in multi_turn_decideg */
-    int16_t single_turn_decideg; /* ReadAngle: within -1800..1800 */
+    int16_t single_turn_decideg; /* ReadAngle: -1800..1799 */
 };
 
-#include "motion/motion_state.h"
+/* Motion commands waiting with control response on, run one after another. */
+#define MOTION_QUEUE_DEPTH 8u
+/* Commands buffered between BeginAsync and EndAsync. */
+#define MOTION_ASYNC_DEPTH 8u
+/* Finish answers not yet sent. */
+#define MOTION_ANSWERS_DEPTH 4u
 
-void motion_init(struct motion *m, const struct user_config *cfg);
+enum motion_mode {
+    MODE_RELEASED, /* output off, turns freely */
+    MODE_POSITION, /* following a profile, then holding its end */
+    MODE_DAMPING,  /* braking in proportion to speed */
+};
+
+/* What the servo does once a profile has run out. */
+enum motion_end {
+    END_HOLD,
+    END_RELEASE,
+};
+
+struct motion_queue {
+    struct motion_command slots[MOTION_QUEUE_DEPTH];
+    uint8_t head;
+    uint8_t count;
+};
+
+struct motion {
+    const struct registers *regs;
+    const struct hal_port *hal;
+    struct encoder_track encoder;
+    int32_t origin_counts;     /* encoder counts of angle 0 (before offset 53) */
+    int64_t measured;          /* Q32 decideg, relative to the origin */
+    int32_t measured_velocity_q8;
+    struct profile profile;
+    uint32_t tick;             /* ticks since the profile started */
+    int64_t setpoint;          /* Q32 decideg */
+    int64_t last_setpoint;
+    struct controller controller;
+    int16_t duty_limit;        /* Q15, from the running command's power */
+    uint16_t power_mw;
+    uint16_t supply_mv_used;   /* supply the duty limit was worked out for */
+    uint8_t mode;              /* enum motion_mode */
+    uint8_t end;               /* enum motion_end */
+    uint8_t running;           /* a command runs: status bit 0 */
+    uint8_t endless;           /* wheel run: finished once at speed */
+    uint8_t answer_packet;     /* owed when the running command finishes */
+    uint8_t soft_start_pending;
+    uint8_t async_open;
+    struct motion_queue queue;
+    struct motion_queue async;
+    uint8_t answers[MOTION_ANSWERS_DEPTH];
+    uint8_t answers_count;
+};
+
+/* Reads the encoder and takes the power-on state (46). regs and hal must
+ * outlive m; the user area in regs is read live (limits, offset, ...). */
+void motion_init(struct motion *m, const struct registers *regs, const struct hal_port *hal);
+/* One control tick (1/MOTION_TICK_HZ s): encoder, profile, controller, motor. */
+void motion_tick(struct motion *m);
+
 enum motion_submit_result motion_submit(struct motion *m, const struct motion_command *cmd);
 bool motion_is_released(const struct motion *m);
 void motion_read_angle(const struct motion *m, struct motion_angle *out);

@@ -1,0 +1,83 @@
+#include "servo_harness.h"
+
+#include <setjmp.h>
+#include <stdarg.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+struct hal_double hal;
+struct servo servo;
+
+static uint16_t held_raw;
+
+void harness_init(void)
+{
+    hal_double_init(&hal);
+    hal.now_us = 5000;
+    servo_init(&servo, &hal.port);
+}
+
+void harness_restart(void)
+{
+    flash_double_power_on(&hal.flash);
+    servo_init(&servo, &hal.port);
+}
+
+void harness_poll(unsigned n)
+{
+    for (unsigned i = 0; i < n; i++) {
+        servo_poll(&servo);
+    }
+}
+
+void harness_feed(const uint8_t *bytes, size_t n)
+{
+    for (size_t i = 0; i < n; i++) {
+        hal.now_us += HARNESS_BYTE_US;
+        servo_on_rx_byte(&servo, bytes[i], hal.now_us);
+    }
+}
+
+void harness_request(uint8_t code, const uint8_t *content, size_t length)
+{
+    static uint8_t wire[4096];
+    size_t n = make_request(wire, code, content, length);
+    hal_double_clear_sent(&hal);
+    harness_feed(wire, n);
+    harness_poll(4);
+}
+
+void harness_run_ms(uint32_t ms)
+{
+    for (uint32_t i = 0; i < 4u * ms; i++) {
+        hal.now_us += 250u;
+        servo_poll(&servo);
+    }
+}
+
+static uint16_t ideal_encoder(void *model)
+{
+    (void)model;
+    const struct motion *m = &servo.motion;
+    if (m->mode == MODE_POSITION) {
+        /* Nearest count to the setpoint: decideg Q32 / (225 << 24). */
+        int64_t per_count = (int64_t)DECIDEG_Q8_PER_COUNT << 24;
+        int64_t sp = m->setpoint;
+        int64_t counts = (sp >= 0 ? sp + per_count / 2 : sp - per_count / 2) / per_count;
+        held_raw = (uint16_t)((counts + m->origin_counts) & (ENCODER_COUNTS - 1));
+    }
+    return held_raw;
+}
+
+void harness_ideal_tracking(void)
+{
+    held_raw = (uint16_t)(servo.motion.encoder.counts & (ENCODER_COUNTS - 1));
+    hal.encoder_model = ideal_encoder;
+}
+
+void harness_assert_sent(const uint8_t *frame, size_t n)
+{
+    assert_int_equal(hal.sent_length, n);
+    assert_memory_equal(hal.sent, frame, n);
+}

@@ -1,0 +1,449 @@
+/* Every motion packet and every rule of behaviour.md, "Motion": request
+ * bytes in, response bytes and behaviour out, on an ideal servo (the encoder
+ * follows the setpoint while under control). */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdlib.h>
+
+#include <cmocka.h>
+
+#include "motion/controller.h"
+#include "servo_harness.h"
+
+static int setup(void **state)
+{
+    (void)state;
+    harness_init();
+    harness_ideal_tracking();
+    REQUEST(4, 0, 49, 0); /* soft start off, except where a test turns it on */
+    return 0;
+}
+
+static int setup_soft_start(void **state)
+{
+    (void)state;
+    harness_init();
+    harness_ideal_tracking();
+    return 0;
+}
+
+static bool executing(void)
+{
+    return servo.regs.status.status & STATUS_EXECUTING;
+}
+
+static int32_t angle_now(void)
+{
+    struct motion_angle a;
+    motion_read_angle(&servo.motion, &a);
+    return a.multi_turn_decideg;
+}
+
+/* Runs until the executing bit falls and returns the milliseconds that
+ * took; then lets 5 ms pass, as the encoder reads a tick behind. */
+static uint32_t run_until_done(uint32_t limit_ms)
+{
+    uint32_t ms = 0;
+    while (executing() && ms < limit_ms) {
+        harness_run_ms(1);
+        ms++;
+    }
+    assert_false(executing());
+    harness_run_ms(5);
+    return ms;
+}
+
+static void test_angle_move_reaches_target(void **state)
+{
+    (void)state;
+    REQUEST(8, 0, 0x84, 0x03, 0xF4, 0x01, 0x00, 0x00); /* 90.0 deg in 500 ms */
+    EXPECT_SILENCE();
+    REQUEST(3, 0, 5);
+    EXPECT_RESPONSE(3, 0, 5, STATUS_EXECUTING);
+    assert_in_range(run_until_done(1000), 495, 505);
+    REQUEST(3, 0, 5);
+    EXPECT_RESPONSE(3, 0, 5, 0x00);
+    REQUEST(10, 0);
+    EXPECT_RESPONSE(10, 0, 0x84, 0x03);
+    REQUEST(16, 0);
+    EXPECT_RESPONSE(16, 0, 0x84, 0x03, 0x00, 0x00, 0x00, 0x00);
+    /* Then it holds there, under control. */
+    assert_false(motion_is_released(&servo.motion));
+    assert_false(hal.coasting);
+}
+
+static void test_soft_start_times_the_first_move(void **state)
+{
+    (void)state;
+    REQUEST(8, 0, 0x84, 0x03, 0xF4, 0x01, 0x00, 0x00);
+    assert_in_range(run_until_done(5000), 2995, 3005); /* 3000 ms (data 50) */
+    REQUEST(8, 0, 0x00, 0x00, 0xF4, 0x01, 0x00, 0x00);
+    assert_in_range(run_until_done(5000), 495, 505); /* only the first */
+    REQUEST(10, 0);
+    EXPECT_RESPONSE(10, 0, 0x00, 0x00);
+}
+
+static void test_single_turn_targets_are_clamped_to_the_limits(void **state)
+{
+    (void)state;
+    REQUEST(8, 0, 0xDC, 0x05, 0xC8, 0x00, 0x00, 0x00); /* 150.0 > 135.0 limit */
+    run_until_done(1000);
+    REQUEST(10, 0);
+    EXPECT_RESPONSE(10, 0, 0x46, 0x05); /* 1350 */
+    REQUEST(8, 0, 0x24, 0xFA, 0xC8, 0x00, 0x00, 0x00); /* -150.0 */
+    run_until_done(1000);
+    REQUEST(10, 0);
+    EXPECT_RESPONSE(10, 0, 0xBA, 0xFA); /* -1350 */
+    REQUEST(4, 0, 51, 0x84, 0x03);                      /* upper limit 90.0 */
+    REQUEST(8, 0, 0xE8, 0x03, 0xC8, 0x00, 0x00, 0x00); /* 100.0 */
+    run_until_done(1000);
+    REQUEST(10, 0);
+    EXPECT_RESPONSE(10, 0, 0x84, 0x03);
+    REQUEST(4, 0, 48, 0);                               /* limits off */
+    REQUEST(8, 0, 0xA4, 0x06, 0xC8, 0x00, 0x00, 0x00); /* 170.0 */
+    run_until_done(1000);
+    REQUEST(10, 0);
+    EXPECT_RESPONSE(10, 0, 0xA4, 0x06);
+    REQUEST(8, 0, 0x10, 0x27, 0xC8, 0x00, 0x00, 0x00); /* 1000.0: clamped to 180.0 */
+    run_until_done(1000);
+    assert_int_equal(angle_now(), 1800);
+}
+
+static void test_single_turn_angle_is_within_the_current_turn(void **state)
+{
+    (void)state;
+    REQUEST(13, 0, 0x10, 0x0E, 0, 0, 0xB8, 0x0B, 0, 0, 0, 0); /* 360.0 deg, 3 s */
+    run_until_done(4000);
+    REQUEST(8, 0, 0x84, 0x03, 0xF4, 0x01, 0x00, 0x00); /* 90.0 */
+    run_until_done(1000);
+    REQUEST(16, 0);
+    EXPECT_RESPONSE(16, 0, 0x94, 0x11, 0x00, 0x00, 0x01, 0x00); /* 450.0, 1 turn */
+    REQUEST(10, 0);
+    EXPECT_RESPONSE(10, 0, 0x84, 0x03);
+}
+
+static void test_multi_turn_target_is_clamped(void **state)
+{
+    (void)state;
+    /* 400 000.0 deg asked, 368 640.0 deg (1024 turns) allowed; 10 s. */
+    REQUEST(13, 0, 0x00, 0x09, 0x3D, 0x00, 0x10, 0x27, 0x00, 0x00, 0x00, 0x00);
+    run_until_done(11000);
+    REQUEST(16, 0);
+    EXPECT_RESPONSE(16, 0, 0x00, 0x40, 0x38, 0x00, 0x00, 0x04);
+}
+
+static void test_interval_shorter_than_ramps_is_clamped(void **state)
+{
+    (void)state;
+    /* 11: 90.0 deg, interval 100 ms, ramps 100 + 200 ms: runs 300 ms. */
+    REQUEST(11, 0, 0x84, 0x03, 0x64, 0x00, 0x64, 0x00, 0xC8, 0x00, 0x00, 0x00);
+    assert_in_range(run_until_done(1000), 297, 303);
+    /* 14: ramps below 20 ms count as 20; 1 ms interval becomes 40 ms. */
+    REQUEST(14, 0, 0x00, 0x00, 0x00, 0x00, 0x01, 0x00, 0x00, 0x00, 0x05, 0x00, 0x05, 0x00,
+            0x00, 0x00);
+    assert_in_range(run_until_done(1000), 37, 43);
+    REQUEST(16, 0);
+    EXPECT_RESPONSE(16, 0, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00);
+}
+
+static void test_velocity_is_clamped(void **state)
+{
+    (void)state;
+    /* 90.0 deg at 900 deg/s asked, 750 deg/s allowed, 20/20 ms: 140 ms. */
+    REQUEST(12, 0, 0x84, 0x03, 0x28, 0x23, 0x14, 0x00, 0x14, 0x00, 0x00, 0x00);
+    assert_in_range(run_until_done(1000), 137, 143);
+    /* 1.0 deg at 0.5 deg/s asked, 1 deg/s the least: 1020 ms. */
+    REQUEST(12, 0, 0x8E, 0x03, 0x05, 0x00, 0x14, 0x00, 0x14, 0x00, 0x00, 0x00);
+    assert_in_range(run_until_done(3000), 1017, 1023);
+}
+
+static void test_velocity_profile_worked_examples(void **state)
+{
+    (void)state;
+    /* 100 deg at 300 deg/s, ramps 100/200 ms: 483 ms. */
+    REQUEST(12, 0, 0xE8, 0x03, 0xB8, 0x0B, 0x64, 0x00, 0xC8, 0x00, 0x00, 0x00);
+    assert_in_range(run_until_done(1000), 481, 485);
+    /* 20 deg more at 300 deg/s: ramps shrink to 44/88 ms, 133 ms in all. */
+    REQUEST(12, 0, 0xB0, 0x04, 0xB8, 0x0B, 0x64, 0x00, 0xC8, 0x00, 0x00, 0x00);
+    assert_int_equal(servo.motion.profile.accel_ticks, 44);
+    assert_int_equal(servo.motion.profile.total_ticks - servo.motion.profile.cruise_end, 88);
+    assert_in_range(run_until_done(1000), 131, 135);
+    REQUEST(10, 0);
+    EXPECT_RESPONSE(10, 0, 0xB0, 0x04); /* 120.0 */
+}
+
+static void test_center_offset_shifts_the_zero(void **state)
+{
+    (void)state;
+    REQUEST(4, 0, 53, 0x64, 0x00); /* +10.0 deg */
+    REQUEST(10, 0);
+    EXPECT_RESPONSE(10, 0, 0x9C, 0xFF); /* the servo at raw 0 reads -10.0 */
+    REQUEST(8, 0, 0x00, 0x00, 0xC8, 0x00, 0x00, 0x00);
+    run_until_done(1000);
+    REQUEST(10, 0);
+    EXPECT_RESPONSE(10, 0, 0x00, 0x00);
+    /* Raw: 10.0 deg = 113.8 counts. */
+    assert_int_equal(servo.motion.encoder.counts, 114);
+}
+
+static void test_power_bounds_the_output(void **state)
+{
+    (void)state;
+    assert_int_equal(duty_limit_for_power(500, 7400), 4428);
+    assert_int_equal(duty_limit_for_power(10000, 7400), 19802);
+    /* A fast move at 500 mW: the output saturates at that power's duty. */
+    REQUEST(12, 0, 0x84, 0x03, 0x4C, 0x1D, 0x14, 0x00, 0x14, 0x00, 0xF4, 0x01);
+    run_until_done(1000);
+    assert_int_equal(hal.max_abs_duty, 4428);
+    /* 0 and anything above the power protection (42) mean 42. */
+    hal.max_abs_duty = 0;
+    REQUEST(12, 0, 0x00, 0x00, 0x4C, 0x1D, 0x14, 0x00, 0x14, 0x00, 0x00, 0x00);
+    run_until_done(1000);
+    assert_int_equal(hal.max_abs_duty, 19802);
+    hal.max_abs_duty = 0;
+    REQUEST(12, 0, 0x84, 0x03, 0x4C, 0x1D, 0x14, 0x00, 0x14, 0x00, 0x60, 0xEA);
+    run_until_done(1000);
+    assert_int_equal(hal.max_abs_duty, 19802);
+}
+
+static void test_control_response_queues_and_answers_each(void **state)
+{
+    (void)state;
+    REQUEST(4, 0, 33, 1);
+    REQUEST(8, 0, 0x64, 0x00, 0x64, 0x00, 0x00, 0x00); /* 10.0, 100 ms */
+    REQUEST(8, 0, 0xC8, 0x00, 0x64, 0x00, 0x00, 0x00); /* 20.0 */
+    REQUEST(8, 0, 0x2C, 0x01, 0x64, 0x00, 0x00, 0x00); /* 30.0 */
+    EXPECT_SILENCE();
+    for (int i = 1; i <= 3; i++) {
+        hal_double_clear_sent(&hal);
+        uint32_t waited = 0;
+        while (hal.sent_length == 0 && waited < 200) {
+            harness_run_ms(1);
+            waited++;
+        }
+        EXPECT_RESPONSE(8, 0, 1);
+        assert_int_equal(angle_now(), 100 * i);
+    }
+    assert_false(executing());
+    /* One running and MOTION_QUEUE_DEPTH waiting; the next is dropped. */
+    for (unsigned i = 0; i < 1 + MOTION_QUEUE_DEPTH; i++) {
+        REQUEST(8, 0, 0x00, 0x00, 0xE8, 0x03, 0x00, 0x00);
+    }
+    REQUEST(3, 0, 5);
+    EXPECT_RESPONSE(3, 0, 5, STATUS_EXECUTING);
+    REQUEST(8, 0, 0x00, 0x00, 0xE8, 0x03, 0x00, 0x00);
+    REQUEST(3, 0, 5);
+    EXPECT_RESPONSE(3, 0, 5, STATUS_EXECUTING | STATUS_COMMAND_ERROR);
+    assert_int_equal(servo.motion.queue.count, MOTION_QUEUE_DEPTH);
+}
+
+static void test_new_move_replaces_the_running_one_smoothly(void **state)
+{
+    (void)state;
+    /* 10 turns in 10 s with 1 s ramps; 0.5 s in, mid-ramp, turn back. */
+    REQUEST(14, 0, 0xA0, 0x8C, 0x00, 0x00, 0x10, 0x27, 0x00, 0x00, 0xE8, 0x03, 0xE8, 0x03,
+            0x00, 0x00);
+    harness_run_ms(500);
+    int64_t before = servo.motion.setpoint - servo.motion.last_setpoint;
+    assert_true(before > 0);
+    REQUEST(14, 0, 0x00, 0x00, 0x00, 0x00, 0x88, 0x13, 0x00, 0x00, 0xE8, 0x03, 0xE8, 0x03,
+            0x00, 0x00);
+    harness_run_ms(1);
+    int64_t after = servo.motion.setpoint - servo.motion.last_setpoint;
+    /* The velocity carries over: no jerk to a stop (the change within two
+     * ticks is a few thousandths of a degree per tick). */
+    assert_true(llabs(after - before) < DECIDEG_Q32 / 20);
+    assert_in_range(run_until_done(6000), 4990, 5010);
+    assert_int_equal(angle_now(), 0);
+}
+
+static void test_reset_turns_and_origin_only_when_released(void **state)
+{
+    (void)state;
+    REQUEST(4, 0, 33, 1);
+    REQUEST(13, 0, 0x10, 0x1F, 0, 0, 0xB8, 0x0B, 0, 0, 0, 0); /* 795.2 deg */
+    run_until_done(4000);
+    REQUEST(17, 0);
+    EXPECT_RESPONSE(17, 0, 0); /* under angle control */
+    REQUEST(23, 0, 0);
+    EXPECT_SILENCE();
+    REQUEST(16, 0);
+    EXPECT_RESPONSE(16, 0, 0x10, 0x1F, 0, 0, 0x02, 0x00);
+    REQUEST(24, 0, 0x10, 0, 0); /* stop and release */
+    EXPECT_SILENCE();
+    assert_true(hal.coasting);
+    REQUEST(17, 0);
+    EXPECT_RESPONSE(17, 0, 1);
+    REQUEST(16, 0);
+    EXPECT_RESPONSE(16, 0, 0xF0, 0x02, 0, 0, 0, 0); /* 75.2 deg, 0 turns */
+    REQUEST(23, 0, 0);
+    REQUEST(10, 0);
+    EXPECT_RESPONSE(10, 0, 0, 0);
+}
+
+static void test_wheel_run_and_stop(void **state)
+{
+    (void)state;
+    REQUEST(4, 0, 33, 1);
+    REQUEST(7, 0, 0x01, 0x5A, 0x00, 0x00, 0x00); /* counter-clockwise, 90 deg/s */
+    EXPECT_SILENCE();
+    harness_run_ms(25);
+    EXPECT_RESPONSE(7, 0, 1); /* answered once at speed */
+    int32_t a0 = angle_now();
+    harness_run_ms(1000);
+    assert_in_range(angle_now() - a0, 898, 902); /* 90.0 deg in a second */
+    REQUEST(7, 0, 0x00, 0x00, 0x00, 0x00, 0x00);  /* stop */
+    harness_run_ms(25);
+    EXPECT_RESPONSE(7, 0, 1);
+    assert_true(hal.coasting); /* 47 = 0: released when stopped */
+    assert_true(motion_is_released(&servo.motion));
+    REQUEST(4, 0, 47, 1);
+    REQUEST(7, 0, 0x81, 0x5A, 0x00, 0x00, 0x00); /* clockwise */
+    harness_run_ms(500);
+    assert_true(angle_now() < a0 + 900 - 400);
+    REQUEST(7, 0, 0x80, 0x00, 0x00, 0x00, 0x00);
+    harness_run_ms(25);
+    assert_false(hal.coasting); /* 47 = 1: holds when stopped */
+    assert_false(motion_is_released(&servo.motion));
+}
+
+static void test_wheel_turns_and_time(void **state)
+{
+    (void)state;
+    int32_t a0 = angle_now();
+    REQUEST(7, 0, 0x82, 0xB4, 0x00, 0x02, 0x00); /* clockwise, 180 deg/s, 2 turns */
+    uint32_t ms = run_until_done(6000);
+    assert_in_range(ms, 4015, 4025); /* 4 s at speed plus half of each ramp */
+    assert_int_equal(angle_now(), a0 - 7200);
+    assert_true(hal.coasting);
+    REQUEST(7, 0, 0x03, 0x5A, 0x00, 0xF4, 0x01); /* ccw, 90 deg/s, 500 ms */
+    assert_in_range(run_until_done(1000), 497, 503);
+    assert_int_equal(angle_now(), a0 - 7200 + 432); /* 0.9 x (500 - 20) */
+}
+
+static void test_damping_brakes_in_proportion_to_speed(void **state)
+{
+    (void)state;
+    REQUEST(9, 0, 0x10, 0x27); /* 10 000 mW */
+    EXPECT_SILENCE();
+    hal.encoder_model = NULL; /* an outside hand turns the horn */
+    for (int i = 0; i < 10; i++) {
+        hal.encoder_raw = (uint16_t)(hal.encoder_raw + 1);
+        harness_run_ms(1);
+    }
+    assert_true(hal.duty < 0);
+    int16_t slow = hal.duty;
+    for (int i = 0; i < 10; i++) {
+        hal.encoder_raw = (uint16_t)(hal.encoder_raw + 2);
+        harness_run_ms(1);
+    }
+    assert_true(hal.duty < slow); /* twice the speed, more braking */
+    for (int i = 0; i < 10; i++) {
+        hal.encoder_raw = (uint16_t)(hal.encoder_raw - 200);
+        harness_run_ms(1);
+    }
+    assert_int_equal(hal.duty, duty_limit_for_power(10000, 7400)); /* bounded */
+    assert_true(motion_is_released(&servo.motion)); /* not angle control */
+}
+
+static void test_stop_on_control_mode(void **state)
+{
+    (void)state;
+    REQUEST(8, 0, 0x84, 0x03, 0xE8, 0x03, 0x00, 0x00);
+    harness_run_ms(500);
+    int32_t mid = angle_now();
+    REQUEST(24, 0, 0x11, 0x00, 0x00); /* stop and hold */
+    EXPECT_SILENCE();
+    harness_run_ms(200);
+    assert_false(executing());
+    assert_false(hal.coasting);
+    assert_in_range(angle_now(), mid - 10, mid + 10);
+    REQUEST(24, 0, 0x12, 0xE8, 0x03); /* stop into damping */
+    assert_int_equal(servo.motion.mode, MODE_DAMPING);
+    REQUEST(24, 0, 0x10, 0x00, 0x00); /* stop and release */
+    assert_true(hal.coasting);
+    assert_int_equal(servo.motion.mode, MODE_RELEASED);
+}
+
+static void test_async_moves_start_together(void **state)
+{
+    (void)state;
+    harness_request(18, NULL, 0);
+    REQUEST(8, 0, 0x84, 0x03, 0xC8, 0x00, 0x00, 0x00);
+    harness_run_ms(300);
+    assert_int_equal(angle_now(), 0); /* buffered, not started */
+    REQUEST(19, 0);
+    run_until_done(1000);
+    assert_int_equal(angle_now(), 900);
+    harness_request(18, NULL, 0);
+    REQUEST(8, 0, 0x10, 0x00, 0xC8, 0x00, 0x00, 0x00);
+    REQUEST(19, 1); /* discarded */
+    harness_run_ms(300);
+    assert_int_equal(angle_now(), 900);
+}
+
+static void test_sync_and_broadcast_moves(void **state)
+{
+    (void)state;
+    REQUEST(4, 0, 33, 1); /* even with control response on: no answers */
+    const uint8_t sync[] = {8, 7, 2, 4, 0x10, 0, 0, 0, 0, 0, 0, 0x84, 0x03, 0xC8, 0x00, 0, 0};
+    harness_request(25, sync, sizeof sync);
+    run_until_done(1000);
+    EXPECT_SILENCE();
+    assert_int_equal(angle_now(), 900);
+    REQUEST(8, 0xFF, 0x00, 0x00, 0xC8, 0x00, 0x00, 0x00);
+    run_until_done(1000);
+    EXPECT_SILENCE();
+    assert_int_equal(angle_now(), 0);
+}
+
+static void test_power_on_lock(void **state)
+{
+    (void)state;
+    assert_true(hal.coasting); /* 46 = 0: released at power-up */
+    REQUEST(4, 0, 46, 1);
+    harness_restart();
+    harness_run_ms(5);
+    assert_false(hal.coasting); /* 46 = 1: holds at power-up */
+    assert_false(motion_is_released(&servo.motion));
+}
+
+static void test_monitor_after_move(void **state)
+{
+    (void)state;
+    servo.regs.status.voltage_mv = 7400;
+    REQUEST(12, 0, 0x2C, 0x01, 0xB8, 0x0B, 0x64, 0x00, 0xC8, 0x00, 0x00, 0x00); /* 30.0 */
+    run_until_done(1000);
+    REQUEST(22, 0);
+    EXPECT_RESPONSE(22, 0, 0xE8, 0x1C, 0, 0, 0, 0, 0, 0, 0x00, 0x2C, 0x01, 0, 0, 0, 0);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test_setup(test_angle_move_reaches_target, setup),
+        cmocka_unit_test_setup(test_soft_start_times_the_first_move, setup_soft_start),
+        cmocka_unit_test_setup(test_single_turn_targets_are_clamped_to_the_limits, setup),
+        cmocka_unit_test_setup(test_single_turn_angle_is_within_the_current_turn, setup),
+        cmocka_unit_test_setup(test_multi_turn_target_is_clamped, setup),
+        cmocka_unit_test_setup(test_interval_shorter_than_ramps_is_clamped, setup),
+        cmocka_unit_test_setup(test_velocity_is_clamped, setup),
+        cmocka_unit_test_setup(test_velocity_profile_worked_examples, setup),
+        cmocka_unit_test_setup(test_center_offset_shifts_the_zero, setup),
+        cmocka_unit_test_setup(test_power_bounds_the_output, setup),
+        cmocka_unit_test_setup(test_control_response_queues_and_answers_each, setup),
+        cmocka_unit_test_setup(test_new_move_replaces_the_running_one_smoothly, setup),
+        cmocka_unit_test_setup(test_reset_turns_and_origin_only_when_released, setup),
+        cmocka_unit_test_setup(test_wheel_run_and_stop, setup),
+        cmocka_unit_test_setup(test_wheel_turns_and_time, setup),
+        cmocka_unit_test_setup(test_damping_brakes_in_proportion_to_speed, setup),
+        cmocka_unit_test_setup(test_stop_on_control_mode, setup),
+        cmocka_unit_test_setup(test_async_moves_start_together, setup),
+        cmocka_unit_test_setup(test_sync_and_broadcast_moves, setup),
+        cmocka_unit_test_setup(test_power_on_lock, setup),
+        cmocka_unit_test_setup(test_monitor_after_move, setup),
+    };
+    return cmocka_run_group_tests_name("motion_packets", tests, NULL, NULL);
+}
