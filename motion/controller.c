@@ -1,5 +1,7 @@
 #include "motion/controller.h"
 
+#include <stdbool.h>
+
 #include "motion/gains.h"
 
 static int32_t clamp32(int64_t v, int32_t limit)
@@ -12,34 +14,40 @@ void controller_reset(struct controller *c)
     c->integral_q15 = 0;
 }
 
+int16_t controller_limit(int32_t duty, int32_t measured_velocity_q8, int16_t duty_limit)
+{
+    int32_t emf = clamp32(((int64_t)measured_velocity_q8 * GAIN_KV) >> 8, 32767);
+    int32_t lo = emf - duty_limit;
+    int32_t hi = emf + duty_limit;
+    int32_t d = duty < lo ? lo : duty > hi ? hi : duty;
+    return (int16_t)clamp32(d, 32767);
+}
+
 int16_t controller_position(struct controller *c, const struct controller_input *in)
 {
     /* Beyond 2^22 (16 384 decideg) the output is saturated anyway. */
     int32_t e = clamp32(in->error_q8, 1 << 22);
     int64_t p = ((int64_t)e * GAIN_KP) >> 8;
-    c->integral_q15 = clamp32(c->integral_q15 + (((int64_t)e * GAIN_KI) >> 8), INTEGRAL_LIMIT_Q15);
-    int64_t ff = ((int64_t)in->velocity_q8 * GAIN_KV) >> 8;
-    int64_t d = ((int64_t)in->measured_velocity_q8 * GAIN_KD) >> 8;
-    return (int16_t)clamp32(p + c->integral_q15 + ff - d, in->duty_limit);
+    int32_t integral =
+        clamp32(c->integral_q15 + (((int64_t)e * GAIN_KI) >> 8), INTEGRAL_LIMIT_Q15);
+    int64_t ff = (((int64_t)in->velocity_q8 * GAIN_KV) >> 8) +
+                 (((int64_t)in->acceleration_q16 * GAIN_KA) >> 16);
+    int64_t d = ((int64_t)(in->velocity_q8 - in->measured_velocity_q8) * GAIN_KD) >> 8;
+    int32_t out = clamp32(p + integral + ff + d, 1 << 20);
+    int16_t limited = controller_limit(out, in->measured_velocity_q8, in->duty_limit);
+    /* Anti-windup: no integrating while the limit holds the output back in
+     * the direction the error asks for. */
+    bool pushing = (out > limited && e > 0) || (out < limited && e < 0);
+    if (!pushing) {
+        c->integral_q15 = integral;
+    }
+    return limited;
 }
 
 int16_t controller_damping(int32_t measured_velocity_q8, int16_t duty_limit)
 {
-    return (int16_t)clamp32(-(((int64_t)measured_velocity_q8 * GAIN_DAMPING) >> 8), duty_limit);
-}
-
-static uint32_t isqrt32(uint32_t x)
-{
-    uint32_t root = 0;
-    for (uint32_t bit = 1u << 30; bit != 0; bit >>= 2) {
-        if (x >= root + bit) {
-            x -= root + bit;
-            root = (root >> 1) + bit;
-        } else {
-            root >>= 1;
-        }
-    }
-    return root;
+    int32_t brake = clamp32(-(((int64_t)measured_velocity_q8 * GAIN_DAMPING) >> 8), 1 << 20);
+    return controller_limit(brake, measured_velocity_q8, duty_limit);
 }
 
 int16_t duty_limit_for_power(uint16_t power_mw, uint16_t supply_mv)
@@ -47,7 +55,7 @@ int16_t duty_limit_for_power(uint16_t power_mw, uint16_t supply_mv)
     if (supply_mv == 0u) {
         supply_mv = NOMINAL_SUPPLY_MV;
     }
-    uint32_t root = isqrt32((uint32_t)power_mw * MOTOR_RESISTANCE_MOHM);
-    uint32_t duty = (root << 15) / supply_mv;
+    uint64_t num = (uint64_t)power_mw * MOTOR_RESISTANCE_MOHM << 15;
+    uint64_t duty = num / ((uint64_t)supply_mv * supply_mv);
     return (int16_t)(duty > 32767u ? 32767u : duty);
 }

@@ -429,12 +429,19 @@ static void rebase_endless(struct motion *m)
     }
 }
 
+/* One encoder count per tick is 88 deg/s, so the per-tick difference is
+ * low-passed (time constant 2^VELOCITY_FILTER_SHIFT ticks; state in Q12 so
+ * it decays to zero) before the controller and the current limit use it. */
+enum { VELOCITY_FILTER_SHIFT = 3 };
+
 static void measure(struct motion *m)
 {
     int64_t before = m->measured;
     encoder_update(&m->encoder, m->hal->encoder_read(m->hal->ctx));
     m->measured = counts_to_q32(m->encoder.counts - m->origin_counts);
-    m->measured_velocity_q8 = (int32_t)((m->measured - before) >> 24);
+    int32_t raw_q12 = (int32_t)((m->measured - before) >> 20);
+    m->velocity_filter_q12 += (raw_q12 - m->velocity_filter_q12) >> VELOCITY_FILTER_SHIFT;
+    m->measured_velocity_q8 = (m->velocity_filter_q12 + 8) >> 4; /* nearest */
 }
 
 void motion_tick(struct motion *m)
@@ -460,11 +467,14 @@ void motion_tick(struct motion *m)
     if (m->tick < UINT32_MAX) {
         m->tick++;
     }
+    int64_t last_step = m->setpoint - m->last_setpoint;
     m->last_setpoint = m->setpoint;
     m->setpoint = profile_position(&m->profile, m->tick);
+    int64_t step = m->setpoint - m->last_setpoint;
     const struct controller_input in = {
         .error_q8 = (int32_t)((m->setpoint - m->measured) >> 24),
-        .velocity_q8 = (int32_t)((m->setpoint - m->last_setpoint) >> 24),
+        .velocity_q8 = (int32_t)(step >> 24),
+        .acceleration_q16 = (int32_t)((step - last_step) >> 16),
         .measured_velocity_q8 = m->measured_velocity_q8,
         .duty_limit = m->duty_limit,
     };

@@ -10,6 +10,7 @@
 #include <cmocka.h>
 
 #include "motion/controller.h"
+#include "motion/gains.h"
 #include "servo_harness.h"
 
 static int setup(void **state)
@@ -191,21 +192,28 @@ static void test_center_offset_shifts_the_zero(void **state)
 static void test_power_bounds_the_output(void **state)
 {
     (void)state;
-    assert_int_equal(duty_limit_for_power(500, 7400), 4428);
-    assert_int_equal(duty_limit_for_power(10000, 7400), 19802);
-    /* A fast move at 500 mW: the output saturates at that power's duty. */
-    REQUEST(12, 0, 0x84, 0x03, 0x4C, 0x1D, 0x14, 0x00, 0x14, 0x00, 0xF4, 0x01);
-    run_until_done(1000);
-    assert_int_equal(hal.max_abs_duty, 4428);
-    /* 0 and anything above the power protection (42) mean 42. */
-    hal.max_abs_duty = 0;
-    REQUEST(12, 0, 0x00, 0x00, 0x4C, 0x1D, 0x14, 0x00, 0x14, 0x00, 0x00, 0x00);
-    run_until_done(1000);
-    assert_int_equal(hal.max_abs_duty, 19802);
-    hal.max_abs_duty = 0;
-    REQUEST(12, 0, 0x84, 0x03, 0x4C, 0x1D, 0x14, 0x00, 0x14, 0x00, 0x60, 0xEA);
-    run_until_done(1000);
-    assert_int_equal(hal.max_abs_duty, 19802);
+    /* P R / V^2 in Q15 with R = 2 ohm, V = 7.4 V. */
+    assert_int_equal(duty_limit_for_power(500, 7400), 598);
+    assert_int_equal(duty_limit_for_power(10000, 7400), 11967);
+    /* Hold at 0 with 500 mW while a hand holds the horn 20 degrees away: the
+     * output stands at 500 mW's duty. */
+    REQUEST(8, 0, 0x00, 0x00, 0x14, 0x00, 0xF4, 0x01);
+    run_until_done(100);
+    hal.encoder_model = NULL;
+    hal.encoder_raw = 228; /* 20.04 degrees */
+    harness_run_ms(200);   /* the jump's filtered velocity dies away */
+    assert_int_equal(hal.duty, -598);
+    /* 0, and anything above the power protection (42), mean 42. */
+    REQUEST(8, 0, 0x00, 0x00, 0x14, 0x00, 0x00, 0x00);
+    harness_run_ms(50);
+    assert_int_equal(hal.duty, -11967);
+    REQUEST(8, 0, 0x00, 0x00, 0x14, 0x00, 0x60, 0xEA);
+    harness_run_ms(50);
+    assert_int_equal(hal.duty, -11967);
+    REQUEST(4, 0, 42, 0xE8, 0x03); /* power protection 1000 mW */
+    REQUEST(8, 0, 0x00, 0x00, 0x14, 0x00, 0x00, 0x00);
+    harness_run_ms(50);
+    assert_int_equal(hal.duty, -duty_limit_for_power(1000, 7400));
 }
 
 static void test_control_response_queues_and_answers_each(void **state)
@@ -323,28 +331,37 @@ static void test_wheel_turns_and_time(void **state)
     assert_int_equal(angle_now(), a0 - 7200 + 432); /* 0.9 x (500 - 20) */
 }
 
+/* Braking effort: how far the output stands below the back-EMF duty of the
+ * present speed (the winding current, in duty terms). */
+static int32_t braking_effort(void)
+{
+    int64_t emf = ((int64_t)servo.motion.measured_velocity_q8 * GAIN_KV) >> 8;
+    return (int32_t)(emf > 32767 ? 32767 : emf) - hal.duty;
+}
+
 static void test_damping_brakes_in_proportion_to_speed(void **state)
 {
     (void)state;
     REQUEST(9, 0, 0x10, 0x27); /* 10 000 mW */
     EXPECT_SILENCE();
     hal.encoder_model = NULL; /* an outside hand turns the horn */
-    for (int i = 0; i < 10; i++) {
-        hal.encoder_raw = (uint16_t)(hal.encoder_raw + 1);
+    for (int i = 0; i < 40; i++) {
+        hal.encoder_raw = (uint16_t)(hal.encoder_raw + (i % 4 == 0)); /* 22 deg/s */
         harness_run_ms(1);
     }
-    assert_true(hal.duty < 0);
-    int16_t slow = hal.duty;
-    for (int i = 0; i < 10; i++) {
-        hal.encoder_raw = (uint16_t)(hal.encoder_raw + 2);
+    int32_t slow = braking_effort();
+    assert_true(slow > 0);
+    for (int i = 0; i < 40; i++) {
+        hal.encoder_raw = (uint16_t)(hal.encoder_raw + (i % 2 == 0)); /* 44 deg/s */
         harness_run_ms(1);
     }
-    assert_true(hal.duty < slow); /* twice the speed, more braking */
-    for (int i = 0; i < 10; i++) {
-        hal.encoder_raw = (uint16_t)(hal.encoder_raw - 200);
+    assert_true(braking_effort() > slow); /* twice the speed, more braking */
+    for (int i = 0; i < 40; i++) {
+        hal.encoder_raw = (uint16_t)(hal.encoder_raw + 40);
         harness_run_ms(1);
     }
-    assert_int_equal(hal.duty, duty_limit_for_power(10000, 7400)); /* bounded */
+    /* Bounded by the power: the braking current is at most P / V. */
+    assert_int_equal(braking_effort(), duty_limit_for_power(10000, 7400));
     assert_true(motion_is_released(&servo.motion)); /* not angle control */
 }
 

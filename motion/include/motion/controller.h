@@ -1,6 +1,11 @@
-/* Position/velocity controller: PI on position error, feed-forward of the
- * planned velocity, damping on the measured one; output a Q15 duty bounded
- * by the running command's power. Gains: motion/gains.h. */
+/* Position/velocity controller: PI on position error, D on velocity error,
+ * feed-forward of the planned velocity and acceleration;
+ * output a Q15 duty kept within the running command's power. Gains:
+ * motion/gains.h.
+ *
+ * The power limit is a current limit, |I| <= P / V: the winding current is
+ * (V d - back-EMF) / R, so the duty may stray from the back-EMF duty of the
+ * present speed by at most P R / V^2 either way. */
 #ifndef MOTION_CONTROLLER_H
 #define MOTION_CONTROLLER_H
 
@@ -13,16 +18,19 @@ struct controller {
 struct controller_input {
     int32_t error_q8;             /* setpoint - measured, decideg Q8 */
     int32_t velocity_q8;          /* planned velocity, decideg per tick Q8 */
+    int32_t acceleration_q16;     /* planned, decideg per tick^2 Q16 */
     int32_t measured_velocity_q8; /* decideg per tick Q8 */
-    int16_t duty_limit;           /* Q15, 0..32767 */
+    int16_t duty_limit;           /* Q15 duty of the current limit, 0..32767 */
 };
 
 void controller_reset(struct controller *c);
 int16_t controller_position(struct controller *c, const struct controller_input *in);
 /* Damping mode: a braking duty proportional to the measured velocity. */
 int16_t controller_damping(int32_t measured_velocity_q8, int16_t duty_limit);
-/* The duty at which the winding dissipates power_mw from supply_mv at
- * stall: d = sqrt(P R) / V, Q15. */
+/* Keeps duty within duty_limit of the back-EMF duty at this speed. */
+int16_t controller_limit(int32_t duty, int32_t measured_velocity_q8, int16_t duty_limit);
+/* The duty that drives the current limit P / V through the winding at
+ * standstill: P R / V^2, Q15. Planning-time: it divides. */
 int16_t duty_limit_for_power(uint16_t power_mw, uint16_t supply_mv);
 
 #endif

@@ -102,7 +102,8 @@ struct motion {
     struct encoder_track encoder;
     int32_t origin_counts;     /* encoder counts of angle 0 (before offset 53) */
     int64_t measured;          /* Q32 decideg, relative to the origin */
-    int32_t measured_velocity_q8;
+    int32_t measured_velocity_q8; /* filtered, decideg per tick */
+    int32_t velocity_filter_q12;
     struct profile profile;
     uint32_t tick;             /* ticks since the profile started */
     int64_t setpoint;          /* Q32 decideg */

@@ -1,0 +1,154 @@
+/* The controller closing the loop around the physical plant model
+ * (hal/ports/host/plant.c): moves track their profile and settle on target,
+ * a load is held, damping brakes. Requests go in as bytes, as in the field. */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#include <cmocka.h>
+
+#include "plant.h"
+#include "servo_harness.h"
+
+static struct plant plant;
+static uint32_t plant_time_us;
+
+/* Called once per control tick: the plant runs with the last output until
+ * now, then the encoder is read. */
+static uint16_t plant_encoder_model(void *model)
+{
+    (void)model;
+    if (hal.coasting) {
+        plant_coast(&plant);
+    } else {
+        plant_drive(&plant, hal.duty);
+    }
+    plant_step(&plant, (hal.now_us - plant_time_us) * 1e-6);
+    plant_time_us = hal.now_us;
+    return plant_encoder(&plant);
+}
+
+static int setup(void **state)
+{
+    (void)state;
+    plant_init(&plant);
+    harness_init();
+    plant_time_us = hal.now_us;
+    hal.encoder_model = plant_encoder_model;
+    REQUEST(4, 0, 49, 0); /* no soft start */
+    return 0;
+}
+
+static double setpoint_deg(void)
+{
+    return (double)servo.motion.setpoint / 4294967296.0 / 10.0;
+}
+
+/* Runs ms milliseconds; the largest |setpoint - plant| seen, in degrees. */
+static double run_tracking(uint32_t ms)
+{
+    double worst = 0;
+    for (uint32_t i = 0; i < ms; i++) {
+        harness_run_ms(1);
+        double err = fabs(setpoint_deg() - plant_angle_deg(&plant));
+        worst = err > worst ? err : worst;
+    }
+    return worst;
+}
+
+static void test_interval_move_tracks_and_settles(void **state)
+{
+    (void)state;
+    REQUEST(11, 0, 0x84, 0x03, 0xF4, 0x01, 0x64, 0x00, 0x64, 0x00, 0x00, 0x00); /* 90 deg, 500 ms */
+    double tracking = run_tracking(500);
+    double peak = 0;
+    for (int i = 0; i < 300; i++) {
+        harness_run_ms(1);
+        peak = plant_angle_deg(&plant) > peak ? plant_angle_deg(&plant) : peak;
+    }
+    double final_error = fabs(plant_angle_deg(&plant) - 90.0);
+    printf("# 90 deg in 500 ms: tracking error %.2f deg, overshoot %.2f deg, final error %.3f deg\n",
+           tracking, peak - 90.0, final_error);
+    assert_true(tracking < 0.5);
+    assert_true(peak - 90.0 < 0.2);
+    assert_true(final_error < 0.1);
+    REQUEST(10, 0);
+    EXPECT_RESPONSE(10, 0, 0x84, 0x03);
+}
+
+static void test_velocity_move_and_return(void **state)
+{
+    (void)state;
+    /* 180 deg at 300 deg/s, ramps 100/100 ms; then back to 0. */
+    REQUEST(12, 0, 0x08, 0x07, 0xB8, 0x0B, 0x64, 0x00, 0x64, 0x00, 0x00, 0x00);
+    double out = run_tracking(800);
+    REQUEST(12, 0, 0x00, 0x00, 0xB8, 0x0B, 0x64, 0x00, 0x64, 0x00, 0x00, 0x00);
+    double back = run_tracking(800);
+    printf("# 180 deg at 300 deg/s: tracking error %.2f / %.2f deg, final %.3f deg\n", out, back,
+           plant_angle_deg(&plant));
+    assert_true(out < 0.5 && back < 0.5);
+    assert_true(fabs(plant_angle_deg(&plant)) < 0.1);
+}
+
+static void test_load_is_held(void **state)
+{
+    (void)state;
+    REQUEST(8, 0, 0x00, 0x00, 0xC8, 0x00, 0x00, 0x00); /* hold at 0 */
+    plant.load_torque = 1.0;                           /* N m, a quarter of stall */
+    harness_run_ms(1000);
+    printf("# 1 N m load: held at %.3f deg\n", plant_angle_deg(&plant));
+    assert_true(fabs(plant_angle_deg(&plant)) < 0.15);
+}
+
+/* The move's power is a bound on the current drawn: |I| <= P / V. */
+static void test_power_bounds_the_current(void **state)
+{
+    (void)state;
+    /* 90 deg at 750 deg/s with 20 ms ramps at 2000 mW: far more than that
+     * power can do, so the current limit governs the whole move. */
+    REQUEST(12, 0, 0x84, 0x03, 0x4C, 0x1D, 0x14, 0x00, 0x14, 0x00, 0xD0, 0x07);
+    double peak = 0;
+    double furthest = 0;
+    for (int i = 0; i < 3000; i++) {
+        harness_run_ms(1);
+        peak = fabs(plant.current) > peak ? fabs(plant.current) : peak;
+        furthest = plant_angle_deg(&plant) > furthest ? plant_angle_deg(&plant) : furthest;
+    }
+    double limit = 2.0 / 7.4;
+    printf("# 2000 mW: peak current %.3f A, limit %.3f A; overshoot %.2f deg, at 3 s %.2f deg\n",
+           peak, limit, furthest - 90.0, plant_angle_deg(&plant));
+    /* The limit follows the filtered measured speed: a little slack. The
+     * overshoot is the known limit of a profile faster than its power allows
+     * (the planner does not yet stretch ramps to the power): it is reported,
+     * and the servo still settles on target. */
+    assert_true(peak < limit * 1.15);
+    assert_true(fabs(plant_angle_deg(&plant) - 90.0) < 0.2);
+}
+
+static void test_damping_brakes_a_spinning_horn(void **state)
+{
+    (void)state;
+    plant.velocity = 3.0; /* rad/s, about 170 deg/s, then let go */
+    harness_run_ms(100);
+    double coasting = plant.velocity;
+    plant.velocity = 3.0;
+    REQUEST(9, 0, 0x10, 0x27);
+    harness_run_ms(100);
+    printf("# after 100 ms: coasting %.2f rad/s, damped %.2f rad/s\n", coasting, plant.velocity);
+    assert_true(plant.velocity < coasting / 2.0);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test_setup(test_interval_move_tracks_and_settles, setup),
+        cmocka_unit_test_setup(test_velocity_move_and_return, setup),
+        cmocka_unit_test_setup(test_load_is_held, setup),
+        cmocka_unit_test_setup(test_power_bounds_the_current, setup),
+        cmocka_unit_test_setup(test_damping_brakes_a_spinning_horn, setup),
+    };
+    return cmocka_run_group_tests_name("control_loop", tests, NULL, NULL);
+}
