@@ -4,7 +4,7 @@
 
 #include "motion/gains.h"
 
-static int32_t clamp32(int64_t v, int32_t limit)
+static inline int32_t clamp32(int64_t v, int32_t limit)
 {
     return v > limit ? limit : v < -limit ? -limit : (int32_t)v;
 }
@@ -14,13 +14,18 @@ void controller_reset(struct controller *c)
     c->integral_q15 = 0;
 }
 
-int16_t controller_limit(int32_t duty, int32_t measured_velocity_q8, int16_t duty_limit)
+static inline int16_t limit(int32_t duty, int32_t measured_velocity_q8, int16_t duty_limit)
 {
     int32_t emf = clamp32(((int64_t)measured_velocity_q8 * GAIN_KV) >> 8, 32767);
     int32_t lo = emf - duty_limit;
     int32_t hi = emf + duty_limit;
     int32_t d = duty < lo ? lo : duty > hi ? hi : duty;
     return (int16_t)clamp32(d, 32767);
+}
+
+int16_t controller_limit(int32_t duty, int32_t measured_velocity_q8, int16_t duty_limit)
+{
+    return limit(duty, measured_velocity_q8, duty_limit);
 }
 
 int16_t controller_position(struct controller *c, const struct controller_input *in)
@@ -34,7 +39,7 @@ int16_t controller_position(struct controller *c, const struct controller_input 
                  (((int64_t)in->acceleration_q16 * GAIN_KA) >> 16);
     int64_t d = ((int64_t)(in->velocity_q8 - in->measured_velocity_q8) * GAIN_KD) >> 8;
     int32_t out = clamp32(p + integral + ff + d, 1 << 20);
-    int16_t limited = controller_limit(out, in->measured_velocity_q8, in->duty_limit);
+    int16_t limited = limit(out, in->measured_velocity_q8, in->duty_limit);
     /* Anti-windup: no integrating while the limit holds the output back in
      * the direction the error asks for. */
     bool pushing = (out > limited && e > 0) || (out < limited && e < 0);
@@ -47,7 +52,7 @@ int16_t controller_position(struct controller *c, const struct controller_input 
 int16_t controller_damping(int32_t measured_velocity_q8, int16_t duty_limit)
 {
     int32_t brake = clamp32(-(((int64_t)measured_velocity_q8 * GAIN_DAMPING) >> 8), 1 << 20);
-    return controller_limit(brake, measured_velocity_q8, duty_limit);
+    return limit(brake, measured_velocity_q8, duty_limit);
 }
 
 int16_t duty_limit_for_power(uint16_t power_mw, uint16_t supply_mv)

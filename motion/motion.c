@@ -444,13 +444,25 @@ static void measure(struct motion *m)
     m->measured_velocity_q8 = (m->velocity_filter_q12 + 8) >> 4; /* nearest */
 }
 
-void motion_tick(struct motion *m)
+/* The supply moves slowly: the duty margin for the power follows it every
+ * SUPPLY_CHECK_TICKS ticks, when it has moved more than the hysteresis. */
+enum { SUPPLY_CHECK_TICKS = 32 };
+
+static void follow_supply(struct motion *m)
 {
-    measure(m);
     uint16_t v = supply_mv(m);
     if (v > m->supply_mv_used + SUPPLY_HYSTERESIS_MV || v + SUPPLY_HYSTERESIS_MV < m->supply_mv_used) {
         m->supply_mv_used = v;
         m->duty_limit = duty_limit_for_power(m->power_mw, v);
+    }
+}
+
+void motion_tick(struct motion *m)
+{
+    measure(m);
+    if (++m->supply_check == SUPPLY_CHECK_TICKS) {
+        m->supply_check = 0;
+        follow_supply(m);
     }
     switch (m->mode) {
     case MODE_DAMPING:

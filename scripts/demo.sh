@@ -19,4 +19,4 @@ ctest --preset host | tail -n 3
 echo; echo "== protocol benchmark (callgrind)"
 cmake --preset bench >/dev/null
 cmake --build --preset bench >/dev/null
-.venv/bin/python tests/bench/run_bench.py build/bench/tests/bench/bench_protocol
+.venv/bin/python tests/bench/run_bench.py build/bench/tests/bench

@@ -112,6 +112,7 @@ struct motion {
     int16_t duty_limit;        /* Q15, from the running command's power */
     uint16_t power_mw;
     uint16_t supply_mv_used;   /* supply the duty limit was worked out for */
+    uint8_t supply_check;      /* ticks since the supply was last looked at */
     uint8_t mode;              /* enum motion_mode */
     uint8_t end;               /* enum motion_end */
     uint8_t running;           /* a command runs: status bit 0 */
