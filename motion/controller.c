@@ -12,6 +12,7 @@ static inline int32_t clamp32(int64_t v, int32_t limit)
 void controller_reset(struct controller *c)
 {
     c->integral_q15 = 0;
+    c->at_limit = 0;
 }
 
 static inline int16_t limit(int32_t duty, int32_t measured_velocity_q8, int16_t duty_limit)
@@ -46,6 +47,7 @@ int16_t controller_position(struct controller *c, const struct controller_input 
     if (!pushing) {
         c->integral_q15 = integral;
     }
+    c->at_limit = out != limited;
     return limited;
 }
 
@@ -62,5 +64,15 @@ int16_t duty_limit_for_power(uint16_t power_mw, uint16_t supply_mv)
     }
     uint64_t num = (uint64_t)power_mw * MOTOR_RESISTANCE_MOHM << 15;
     uint64_t duty = num / ((uint64_t)supply_mv * supply_mv);
+    return (int16_t)(duty > 32767u ? 32767u : duty);
+}
+
+int16_t duty_limit_for_current(uint16_t current_ma, uint16_t supply_mv)
+{
+    if (supply_mv == 0u) {
+        supply_mv = NOMINAL_SUPPLY_MV;
+    }
+    uint64_t num = ((uint64_t)current_ma * MOTOR_RESISTANCE_MOHM << 15) / 1000u;
+    uint64_t duty = num / supply_mv;
     return (int16_t)(duty > 32767u ? 32767u : duty);
 }

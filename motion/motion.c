@@ -74,18 +74,37 @@ static uint16_t supply_mv(const struct motion *m)
     return v ? v : NOMINAL_SUPPLY_MV;
 }
 
+/* The current the output may draw: the move's power (0 or above 42 means
+ * 42), capped by a stall, within the current protection (43), halved while
+ * over-current or over-power lasts. Divides: on changes only. */
+static void update_duty_limit(struct motion *m)
+{
+    const struct user_config *cfg = &m->regs->user;
+    uint16_t power = m->power_mw;
+    if (power == 0u || power > cfg->power_limit_mw) {
+        power = cfg->power_limit_mw;
+    }
+    if (m->power_cap_mw != 0u && power > m->power_cap_mw) {
+        power = m->power_cap_mw;
+    }
+    m->supply_mv_used = supply_mv(m);
+    int16_t by_power = duty_limit_for_power(power, m->supply_mv_used);
+    int16_t by_current = duty_limit_for_current(cfg->current_limit_ma, m->supply_mv_used);
+    int16_t limit = (int16_t)(by_power < by_current ? by_power : by_current);
+    m->duty_limit = (int16_t)(m->derate ? limit / 2 : limit);
+}
+
 static void set_power(struct motion *m, uint16_t power_mw)
 {
-    uint16_t limit = m->regs->user.power_limit_mw;
-    m->power_mw = (power_mw == 0u || power_mw > limit) ? limit : power_mw;
-    m->supply_mv_used = supply_mv(m);
-    m->duty_limit = duty_limit_for_power(m->power_mw, m->supply_mv_used);
+    m->power_mw = power_mw;
+    update_duty_limit(m);
 }
 
 static void release(struct motion *m)
 {
     m->mode = MODE_RELEASED;
     m->running = 0;
+    m->controller.at_limit = 0;
     m->hal->motor_coast(m->hal->ctx);
 }
 
@@ -295,6 +314,10 @@ static enum motion_submit_result dispatch_command(struct motion *m, const struct
 
 enum motion_submit_result motion_submit(struct motion *m, const struct motion_command *cmd)
 {
+    m->commands++;
+    if (m->inhibit) {
+        return MOTION_REFUSED;
+    }
     if (m->async_open) {
         return queue_push(&m->async, cmd) ? MOTION_ACCEPTED : MOTION_QUEUE_FULL;
     }
@@ -452,9 +475,35 @@ static void follow_supply(struct motion *m)
 {
     uint16_t v = supply_mv(m);
     if (v > m->supply_mv_used + SUPPLY_HYSTERESIS_MV || v + SUPPLY_HYSTERESIS_MV < m->supply_mv_used) {
-        m->supply_mv_used = v;
-        m->duty_limit = duty_limit_for_power(m->power_mw, v);
+        update_duty_limit(m);
     }
+}
+
+void motion_guard(struct motion *m, bool inhibit, bool derate, uint16_t power_cap_mw)
+{
+    if (inhibit && !m->inhibit) {
+        m->queue.count = 0;
+        m->answer_packet = 0;
+        release(m);
+    }
+    m->inhibit = inhibit;
+    if (derate != m->derate || power_cap_mw != m->power_cap_mw) {
+        m->derate = derate;
+        m->power_cap_mw = power_cap_mw;
+        update_duty_limit(m);
+    }
+}
+
+void motion_release(struct motion *m)
+{
+    m->queue.count = 0;
+    m->answer_packet = 0;
+    release(m);
+}
+
+bool motion_output_at_limit(const struct motion *m)
+{
+    return m->mode == MODE_POSITION && m->controller.at_limit;
 }
 
 void motion_tick(struct motion *m)

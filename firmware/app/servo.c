@@ -23,6 +23,7 @@ void servo_init(struct servo *s, const struct hal_port *hal)
     s->regs.status.model = SERVO_MODEL;
     s->regs.status.firmware_version = FIRMWARE_VERSION;
     s->regs.status.serial_number = hal->serial_number;
+    protection_init(&s->protection);
     motion_init(&s->motion, &s->regs, hal);
     s->next_tick_us = hal->now_us(hal->ctx) + CONTROL_TICK_US;
     frame_rx_init(&s->rx, &s->active_id, frame_rx_idle_us(0));
@@ -98,6 +99,37 @@ static void handle_next_frame(struct servo *s)
     }
 }
 
+/* Sensors to the status area (IDs 1-4), monitors to status bits 2-7 and
+ * to what the output may do. */
+static void sense_and_protect(struct servo *s)
+{
+    struct sensor_raw raw;
+    struct sensor_readings now;
+    struct sensor_readings filtered;
+    s->hal->sensors_read(s->hal->ctx, &raw);
+    sensors_scale(s->hal->calibration, &raw, &now);
+    sensors_filter(&s->sensors, &now, &filtered);
+    struct status_area *st = &s->regs.status;
+    st->voltage_mv = filtered.voltage_mv;
+    st->current_ma = filtered.current_ma;
+    st->power_mw = filtered.power_mw;
+    st->temperature_adc = filtered.temperature_adc;
+
+    const struct protection_input in = {
+        .readings = filtered,
+        .output_at_limit = motion_output_at_limit(&s->motion),
+        .speed_q8 = s->motion.measured_velocity_q8,
+        .motion_commands = s->motion.commands,
+    };
+    struct protection_action act;
+    uint8_t bits = protection_update(&s->protection, &s->regs.user, &in, &act);
+    st->status = (uint8_t)((st->status & (STATUS_EXECUTING | STATUS_COMMAND_ERROR)) | bits);
+    if (act.release_now) {
+        motion_release(&s->motion);
+    }
+    motion_guard(&s->motion, act.inhibit, act.derate, act.power_cap_mw);
+}
+
 /* The control loop runs from the main loop, so commands and ticks never
  * interleave. One tick per pass; a main loop more than a few ticks late
  * (flash erase) drops the missed ticks rather than racing to catch up. */
@@ -108,6 +140,7 @@ static void run_control_tick(struct servo *s)
     if (late < 0) {
         return;
     }
+    sense_and_protect(s);
     motion_tick(&s->motion);
     s->next_tick_us += CONTROL_TICK_US;
     if (late > (int32_t)(4u * CONTROL_TICK_US)) {

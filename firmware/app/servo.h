@@ -9,6 +9,8 @@
 
 #include "config_store.h"
 #include "hal/hal_port.h"
+#include "protection.h"
+#include "scaling.h"
 #include "motion/motion.h"
 #include "protocol/dispatcher.h"
 #include "protocol/frame_rx.h"
@@ -39,6 +41,8 @@ struct servo {
     struct dispatcher dispatcher;
     struct config_store store;
     struct servo_tx tx;
+    struct sensor_filter sensors;
+    struct protection protection;
     uint32_t next_tick_us;       /* when the next control tick is due */
     volatile uint8_t active_id;  /* the ID answered to now */
     uint8_t active_baud_index;

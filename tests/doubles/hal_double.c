@@ -52,10 +52,18 @@ static uint16_t encoder_read(void *ctx)
     return h->encoder_model ? h->encoder_model(h->model) : h->encoder_raw;
 }
 
+static void sensors_read(void *ctx, struct sensor_raw *out)
+{
+    *out = ((struct hal_double *)ctx)->sensors;
+}
+
 void hal_double_init(struct hal_double *h)
 {
     memset(h, 0, sizeof *h);
     flash_double_init(&h->flash, 1024);
+    h->sensors = (struct sensor_raw){.supply = 7400, .current = 0, .ntc = 2048};
+    h->calibration = (struct sensor_calibration){.supply_uv_per_count = 1000,
+                                                 .current_ua_per_count = 1000};
     h->port = (struct hal_port){
         .ctx = h,
         .now_us = now_us,
@@ -65,6 +73,8 @@ void hal_double_init(struct hal_double *h)
         .motor_drive = motor_drive,
         .motor_coast = motor_coast,
         .encoder_read = encoder_read,
+        .sensors_read = sensors_read,
+        .calibration = &h->calibration,
         .flash = &h->flash.hal,
         .serial_number = 0x12345678u,
     };

@@ -29,6 +29,11 @@ struct hal_double {
     /* If set, encoder_read answers this (a plant, an ideal tracker). */
     uint16_t (*encoder_model)(void *model);
     void *model;
+    /* What sensors_read answers; with the double's calibration, supply in
+     * mV, current in mA, NTC as the protocol's ADC value. Healthy at init:
+     * 7400 mV, 0 mA, 2048 (25 degC). */
+    struct sensor_raw sensors;
+    struct sensor_calibration calibration;
 };
 
 void hal_double_init(struct hal_double *h);

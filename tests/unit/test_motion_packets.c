@@ -430,11 +430,11 @@ static void test_power_on_lock(void **state)
 static void test_monitor_after_move(void **state)
 {
     (void)state;
-    servo.regs.status.voltage_mv = 7400;
     REQUEST(12, 0, 0x2C, 0x01, 0xB8, 0x0B, 0x64, 0x00, 0xC8, 0x00, 0x00, 0x00); /* 30.0 */
     run_until_done(1000);
     REQUEST(22, 0);
-    EXPECT_RESPONSE(22, 0, 0xE8, 0x1C, 0, 0, 0, 0, 0, 0, 0x00, 0x2C, 0x01, 0, 0, 0, 0);
+    /* Live readings from the double's sensors: 7400 mV, 0 mA, 0 mW, NTC 2048. */
+    EXPECT_RESPONSE(22, 0, 0xE8, 0x1C, 0, 0, 0, 0, 0x00, 0x08, 0x00, 0x2C, 0x01, 0, 0, 0, 0);
 }
 
 int main(void)

@@ -9,6 +9,7 @@
 #include <stdint.h>
 
 #include "hal/hal_flash.h"
+#include "hal/hal_sensors.h"
 
 struct hal_port {
     void *ctx;
@@ -28,6 +29,9 @@ struct hal_port {
     /* Output-shaft angle from the 12-bit absolute magnetic encoder, 0..4095,
      * increasing counter-clockwise. */
     uint16_t (*encoder_read)(void *ctx);
+    /* Samples the analogue sensors (called once per control tick). */
+    void (*sensors_read)(void *ctx, struct sensor_raw *out);
+    const struct sensor_calibration *calibration;
     const struct hal_flash *flash;
     /* Data ID 8: derived by the port from the MCU's unique ID. */
     uint32_t serial_number;

@@ -84,6 +84,20 @@ static uint16_t encoder_read(void *ctx)
     return 0; /* stub: ADC lands with the MCU port */
 }
 
+static void sensors_read(void *ctx, struct sensor_raw *out)
+{
+    (void)ctx;
+    *out = (struct sensor_raw){0}; /* stub: ADC lands with the MCU port */
+}
+
+/* Reference board front end: 3.3 V reference; supply through 100k/10k
+ * (11:1); 25 mOhm shunt into a gain-of-20 amplifier (0.5 V/A). */
+static const struct sensor_calibration calibration = {
+    .supply_uv_per_count = 8862,  /* 3.3 V x 11 / 4096 */
+    .current_ua_per_count = 1611, /* 3.3 V / 0.5 V/A / 4096 */
+    .current_zero_counts = 0,
+};
+
 static bool flash_erase(void *ctx, uint32_t addr)
 {
     (void)ctx;
@@ -132,6 +146,8 @@ void port_init(struct hal_port *port, struct servo *servo)
         .motor_drive = motor_drive,
         .motor_coast = motor_coast,
         .encoder_read = encoder_read,
+        .sensors_read = sensors_read,
+        .calibration = &calibration,
         .flash = &flash,
         .serial_number = serial_from_uid(),
     };

@@ -13,6 +13,7 @@
 
 struct controller {
     int32_t integral_q15;
+    uint8_t at_limit; /* the last output was held back by the limit */
 };
 
 struct controller_input {
@@ -32,5 +33,8 @@ int16_t controller_limit(int32_t duty, int32_t measured_velocity_q8, int16_t dut
 /* The duty that drives the current limit P / V through the winding at
  * standstill: P R / V^2, Q15. Planning-time: it divides. */
 int16_t duty_limit_for_power(uint16_t power_mw, uint16_t supply_mv);
+/* The duty that drives current_ma through the winding at standstill:
+ * I R / V, Q15. Planning-time: it divides. */
+int16_t duty_limit_for_current(uint16_t current_ma, uint16_t supply_mv);
 
 #endif

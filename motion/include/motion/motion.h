@@ -63,6 +63,7 @@ struct motion_command {
 enum motion_submit_result {
     MOTION_ACCEPTED,
     MOTION_QUEUE_FULL, /* the queue (control response on) or async buffer is full */
+    MOTION_REFUSED,    /* a protection inhibits motion (voltage, temperature) */
 };
 
 struct motion_angle {
@@ -109,8 +110,8 @@ struct motion {
     int64_t setpoint;          /* Q32 decideg */
     int64_t last_setpoint;
     struct controller controller;
-    int16_t duty_limit;        /* Q15, from the running command's power */
-    uint16_t power_mw;
+    int16_t duty_limit;        /* Q15 current margin: power, 43, protection */
+    uint16_t power_mw;         /* the running command's power, 0 = 42's value */
     uint16_t supply_mv_used;   /* supply the duty limit was worked out for */
     uint8_t supply_check;      /* ticks since the supply was last looked at */
     uint8_t mode;              /* enum motion_mode */
@@ -124,6 +125,11 @@ struct motion {
     struct motion_queue async;
     uint8_t answers[MOTION_ANSWERS_DEPTH];
     uint8_t answers_count;
+    /* Set by the protection monitors (motion_guard). */
+    uint8_t inhibit;
+    uint8_t derate;
+    uint16_t power_cap_mw;
+    uint32_t commands;         /* motion commands received */
 };
 
 /* Reads the encoder and takes the power-on state (46). regs and hal must
@@ -144,5 +150,14 @@ void motion_end_async(struct motion *m, bool cancel);
 uint8_t motion_take_finished(struct motion *m);
 /* True while a motion command runs (status bit 0). */
 bool motion_is_executing(const struct motion *m);
+
+/* What the protection monitors require of the output: inhibit releases it
+ * and refuses motion until lifted; derate halves the current it may draw;
+ * power_cap_mw (0 = none) bounds every move's power. */
+void motion_guard(struct motion *m, bool inhibit, bool derate, uint16_t power_cap_mw);
+/* Releases the output now (a stall in release mode). */
+void motion_release(struct motion *m);
+/* The controller's output was held back by its limit on the last tick. */
+bool motion_output_at_limit(const struct motion *m);
 
 #endif

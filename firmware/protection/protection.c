@@ -1,0 +1,126 @@
+#include "protection.h"
+
+#include "ntc.h"
+
+void protection_init(struct protection *p)
+{
+    *p = (struct protection){0};
+}
+
+/* One row per threshold monitor: which reading, which limit, which way it
+ * trips, and the level it must come back to. */
+struct threshold {
+    uint8_t bit;
+    uint8_t trips_above;   /* else below */
+    uint8_t inclusive;     /* the limit itself trips */
+    uint16_t (*clear_level)(uint16_t limit);
+};
+
+static uint16_t up_voltage(uint16_t limit)
+{
+    return (uint16_t)(limit + VOLTAGE_HYSTERESIS_MV);
+}
+
+static uint16_t down_voltage(uint16_t limit)
+{
+    return limit > VOLTAGE_HYSTERESIS_MV ? (uint16_t)(limit - VOLTAGE_HYSTERESIS_MV) : 0u;
+}
+
+static uint16_t down_current(uint16_t limit)
+{
+    return limit > CURRENT_HYSTERESIS_MA ? (uint16_t)(limit - CURRENT_HYSTERESIS_MA) : 0u;
+}
+
+static uint16_t down_power(uint16_t limit)
+{
+    return limit > POWER_HYSTERESIS_MW ? (uint16_t)(limit - POWER_HYSTERESIS_MW) : 0u;
+}
+
+/* The temperature limit is an ADC value that falls as it heats: the clear
+ * level is the ADC value 5 degC cooler. */
+static uint16_t cooler_temperature(uint16_t limit)
+{
+    return ntc_adc((int16_t)(ntc_decicelsius(limit) - TEMPERATURE_HYSTERESIS_DECIC));
+}
+
+static const struct threshold thresholds[] = {
+    [MON_LOW_VOLTAGE] = {STATUS_LOW_VOLTAGE, 0, 0, up_voltage},
+    [MON_HIGH_VOLTAGE] = {STATUS_HIGH_VOLTAGE, 1, 0, down_voltage},
+    [MON_CURRENT] = {STATUS_OVER_CURRENT, 1, 0, down_current},
+    [MON_POWER] = {STATUS_OVER_POWER, 1, 0, down_power},
+    [MON_TEMPERATURE] = {STATUS_OVER_TEMPERATURE, 0, 1, cooler_temperature},
+};
+
+static bool beyond(const struct threshold *t, uint16_t value, uint16_t limit)
+{
+    if (t->trips_above) {
+        return t->inclusive ? value >= limit : value > limit;
+    }
+    return t->inclusive ? value <= limit : value < limit;
+}
+
+static bool back_inside(const struct threshold *t, uint16_t value, uint16_t limit)
+{
+    uint16_t level = t->clear_level(limit);
+    return t->trips_above ? value <= level : value >= level;
+}
+
+/* Debounce: trip after PROTECT_TRIP_TICKS (or trip_ticks) samples beyond,
+ * clear after PROTECT_CLEAR_TICKS samples back inside. */
+static void step(struct monitor *m, bool out, bool in, uint16_t trip_ticks)
+{
+    bool towards = m->active ? in : out;
+    m->count = towards ? (uint16_t)(m->count + 1u) : 0u;
+    if (m->count >= (m->active ? PROTECT_CLEAR_TICKS : trip_ticks)) {
+        m->active = (uint8_t)!m->active;
+        m->count = 0;
+    }
+}
+
+uint8_t protection_update(struct protection *p, const struct user_config *cfg,
+                          const struct protection_input *in, struct protection_action *act)
+{
+    const struct sensor_readings *r = &in->readings;
+    const uint16_t values[] = {r->voltage_mv, r->voltage_mv, r->current_ma, r->power_mw,
+                               r->temperature_adc};
+    const uint16_t limits[] = {cfg->low_voltage_mv, cfg->high_voltage_mv, cfg->current_limit_ma,
+                               cfg->power_limit_mw, cfg->temperature_limit_adc};
+    uint8_t bits = 0;
+    for (int i = 0; i < MON_STALL; i++) {
+        const struct threshold *t = &thresholds[i];
+        step(&p->mon[i], beyond(t, values[i], limits[i]), back_inside(t, values[i], limits[i]),
+             PROTECT_TRIP_TICKS);
+        bits = (uint8_t)(bits | (p->mon[i].active ? t->bit : 0u));
+    }
+
+    int32_t speed = in->speed_q8 < 0 ? -in->speed_q8 : in->speed_q8;
+    bool stalled = in->output_at_limit && speed < STALL_SPEED_Q8;
+    bool was_stalled = p->mon[MON_STALL].active;
+    step(&p->mon[MON_STALL], stalled, !stalled, STALL_TICKS);
+    bool tripped = p->mon[MON_STALL].active && !was_stalled;
+    *act = (struct protection_action){0};
+    if (cfg->stall_release) {
+        /* Released, nothing pushes and the stall cannot be seen to end: the
+         * bit holds until the next motion command. */
+        if (tripped) {
+            p->stall_latched = 1;
+            p->commands_at_stall = in->motion_commands;
+            act->release_now = true;
+        }
+        if (p->stall_latched && in->motion_commands != p->commands_at_stall) {
+            p->stall_latched = 0;
+            p->mon[MON_STALL] = (struct monitor){0};
+        }
+        bits = (uint8_t)(bits | (p->stall_latched ? STATUS_STALL : 0u));
+    } else {
+        p->stall_latched = 0;
+        if (p->mon[MON_STALL].active) {
+            bits |= STATUS_STALL;
+            act->power_cap_mw = cfg->stall_power_mw;
+        }
+    }
+
+    act->inhibit = (bits & (STATUS_LOW_VOLTAGE | STATUS_HIGH_VOLTAGE | STATUS_OVER_TEMPERATURE)) != 0;
+    act->derate = (bits & (STATUS_OVER_CURRENT | STATUS_OVER_POWER)) != 0;
+    return bits;
+}
