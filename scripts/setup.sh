@@ -26,8 +26,9 @@ if [ ! -x .venv/bin/python ]; then
   echo "setup: creating .venv"
   python3 -m venv .venv
 fi
-if ! .venv/bin/python -m pip install -q --disable-pip-version-check -r tools/requirements.txt; then
-  echo "setup: pip could not install tools/requirements.txt" >&2
+if ! .venv/bin/python -m pip install -q --disable-pip-version-check -r tools/requirements.txt \
+     || ! .venv/bin/python -m pip install -q --disable-pip-version-check -e tools; then
+  echo "setup: pip could not install tools/requirements.txt or the servoctl package" >&2
   exit 1
 fi
 echo "setup: ready"

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Runs every test: unit tests under ASan + UBSan, a bounded fuzz run, and the
-# ARM image build with its flash/RAM budget and soft-float checks.
+# Runs every test: unit tests under ASan + UBSan, the PC tool's pytest tests,
+# a bounded fuzz run, and the ARM image build with its flash/RAM budget and
+# soft-float checks.
 # FUZZ_SECONDS sets the fuzz run's length (default 60).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -13,6 +14,10 @@ cmake --preset host >/dev/null
 cmake --build --preset host
 ctest --preset host | tee build/host/ctest.log
 unit=$(sed -nE 's/.*tests passed, 0 tests failed out of ([0-9]+).*/\1/p' build/host/ctest.log)
+
+step "PC tool tests (pytest)"
+(cd tools && ../.venv/bin/python -m pytest -q) | tee build/host/pytest.log
+tools_passed=$(sed -nE 's/^([0-9]+) passed.*/\1/p' build/host/pytest.log)
 
 step "fuzzing the servo core for ${FUZZ_SECONDS:-60} s (libFuzzer, ASan + UBSan)"
 cmake --preset fuzz >/dev/null
@@ -33,5 +38,5 @@ cmake --preset arm >/dev/null
 cmake --build --preset arm
 
 echo
-# CTest programs, the fuzz run and the ARM image check.
-echo "summary: $((unit + 2)) passed, 0 failed"
+# CTest programs, pytest tests, the fuzz run and the ARM image check.
+echo "summary: $((unit + tools_passed + 2)) passed, 0 failed"

@@ -130,6 +130,12 @@ static void sense_and_protect(struct servo *s)
     motion_guard(&s->motion, act.inhibit, act.derate, act.power_cap_mw);
 }
 
+void servo_control_tick(struct servo *s)
+{
+    sense_and_protect(s);
+    motion_tick(&s->motion);
+}
+
 /* The control loop runs from the main loop, so commands and ticks never
  * interleave. One tick per pass; a main loop more than a few ticks late
  * (flash erase) drops the missed ticks rather than racing to catch up. */
@@ -140,8 +146,7 @@ static void run_control_tick(struct servo *s)
     if (late < 0) {
         return;
     }
-    sense_and_protect(s);
-    motion_tick(&s->motion);
+    servo_control_tick(s);
     s->next_tick_us += CONTROL_TICK_US;
     if (late > (int32_t)(4u * CONTROL_TICK_US)) {
         s->next_tick_us = now + CONTROL_TICK_US;

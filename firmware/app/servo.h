@@ -57,7 +57,12 @@ static inline void servo_on_rx_byte(struct servo *s, uint8_t byte, uint32_t now_
     frame_rx_feed(&s->rx, byte, now_us);
 }
 
-/* Main loop: one pass over every pending job. Never blocks. */
+/* Main loop: one pass over every pending job, the control tick when it is
+ * due among them. Never blocks. */
 void servo_poll(struct servo *s);
+
+/* One control tick: sensors, protection, motion. servo_poll runs it every
+ * CONTROL_TICK_US. */
+void servo_control_tick(struct servo *s);
 
 #endif

@@ -50,13 +50,15 @@ def inclusive(path, functions):
 def protocol(binary, tmp):
     facts, totals, files = callgrind(binary, tmp)
     stream_bytes = int(facts["stream_bytes"])
-    # The main loop also runs control ticks: they are the motion layer's cost.
-    inc = inclusive(files["stream"], {"frame_rx_feed", "servo_poll", "motion_tick"})
+    # The main loop also runs control ticks (sensors, protection, motion):
+    # they are not the protocol's cost.
+    tick = "servo_control_tick"
+    inc = inclusive(files["stream"], {"frame_rx_feed", "servo_poll", tick})
     framer = inc["frame_rx_feed"]
-    main_loop = inc["servo_poll"] - inc.get("motion_tick", 0)
+    main_loop = inc["servo_poll"] - inc.get(tick, 0)
     for name, path in files.items():
         if name == "idle_poll" or name.startswith("latency_"):
-            totals[name] -= inclusive(path, {"motion_tick"}).get("motion_tick", 0)
+            totals[name] -= inclusive(path, {tick}).get(tick, 0)
     print(f"protocol: mixed stream of {stream_bytes} bytes, {facts['stream_messages']} messages, "
           f"{facts['frames_for_all']} requests delivered, "
           f"{facts['responses_skipped']} responses skipped")

@@ -141,6 +141,59 @@ static void test_damping_brakes_a_spinning_horn(void **state)
     assert_true(plant.velocity < coasting / 2.0);
 }
 
+/* A hard stop at 45 degrees and a move to 90: the output pushes at its limit
+ * without moving, so after the stall time bit 2 sets and 37 decides. */
+static void stall_against_a_stop(void)
+{
+    plant.has_stop = true;
+    plant.stop_angle = 45.0 * 3.14159265358979 / 180.0;
+    REQUEST(8, 0, 0x84, 0x03, 0xF4, 0x01, 0x00, 0x00);
+    /* The horn meets the stop half-way through the 500 ms move: the stall
+     * time (1 s) runs from about 0.26 s. */
+    harness_run_ms(1100);
+    assert_int_equal(servo.regs.status.status & STATUS_STALL, 0);
+    harness_run_ms(300);
+}
+
+static void test_stall_limits_to_the_stall_power(void **state)
+{
+    (void)state;
+    REQUEST(4, 0, 38, 0xD0, 0x07); /* stall power limit 2000 mW */
+    stall_against_a_stop();
+    REQUEST(3, 0, 5);
+    EXPECT_RESPONSE(3, 0, 5, STATUS_STALL);
+    harness_run_ms(100);
+    double limit = 2.0 / 7.4;
+    printf("# stalled at %.1f deg: current %.3f A, stall-power limit %.3f A\n",
+           plant_angle_deg(&plant), fabs(plant.current), limit);
+    assert_true(fabs(plant.current) < limit * 1.05);
+    assert_false(hal.coasting);
+    /* The stop goes away: it moves on to 90 and the bit clears. */
+    plant.has_stop = false;
+    harness_run_ms(2000);
+    REQUEST(3, 0, 5);
+    EXPECT_RESPONSE(3, 0, 5, 0x00);
+    assert_true(fabs(plant_angle_deg(&plant) - 90.0) < 0.3);
+}
+
+static void test_stall_releases_when_37_says_so(void **state)
+{
+    (void)state;
+    REQUEST(4, 0, 37, 1);
+    stall_against_a_stop();
+    REQUEST(3, 0, 5);
+    EXPECT_RESPONSE(3, 0, 5, STATUS_STALL);
+    assert_true(hal.coasting);
+    harness_run_ms(1000);
+    REQUEST(3, 0, 5);
+    EXPECT_RESPONSE(3, 0, 5, STATUS_STALL); /* until the next command */
+    plant.has_stop = false;
+    REQUEST(8, 0, 0x00, 0x00, 0xF4, 0x01, 0x00, 0x00);
+    harness_run_ms(700);
+    REQUEST(3, 0, 5);
+    EXPECT_RESPONSE(3, 0, 5, 0x00);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -149,6 +202,8 @@ int main(void)
         cmocka_unit_test_setup(test_load_is_held, setup),
         cmocka_unit_test_setup(test_power_bounds_the_current, setup),
         cmocka_unit_test_setup(test_damping_brakes_a_spinning_horn, setup),
+        cmocka_unit_test_setup(test_stall_limits_to_the_stall_power, setup),
+        cmocka_unit_test_setup(test_stall_releases_when_37_says_so, setup),
     };
     return cmocka_run_group_tests_name("control_loop", tests, NULL, NULL);
 }

@@ -1,0 +1,222 @@
+/* The protection monitors driven with sequences of readings: every threshold
+ * at, just below and just above its limit, debouncing, hysteresis, recovery,
+ * both stall modes, several faults at once; the exact status bits (2-7) and
+ * action after each step. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+
+#include "ntc.h"
+#include "protection.h"
+#include "protocol/data_table.h"
+
+static struct protection prot;
+static struct user_config cfg;
+static struct protection_input in;
+static struct protection_action act;
+
+static int setup(void **state)
+{
+    (void)state;
+    protection_init(&prot);
+    user_config_factory(&cfg);
+    /* Healthy: 7.4 V, 0.5 A, 3.7 W, 25 degC, moving freely. */
+    in = (struct protection_input){
+        .readings = {.voltage_mv = 7400, .current_ma = 500, .power_mw = 3700, .temperature_adc = 2048},
+    };
+    return 0;
+}
+
+/* n samples of the current input; the status bits after the last. */
+static uint8_t run(unsigned n)
+{
+    uint8_t bits = 0;
+    for (unsigned i = 0; i < n; i++) {
+        bits = protection_update(&prot, &cfg, &in, &act);
+    }
+    return bits;
+}
+
+/* A threshold monitor, generically: value pointer, limit, the first value
+ * that trips, a value inside the hysteresis band (does not clear), the first
+ * value that clears, and the expected bit. */
+static void check_threshold(uint16_t *value, uint16_t healthy, uint16_t at_limit_ok,
+                            uint16_t trips, uint16_t in_band, uint16_t clears, uint8_t bit)
+{
+    *value = at_limit_ok;
+    assert_int_equal(run(1000), 0); /* at (or just inside) the limit: fine */
+    *value = trips;
+    assert_int_equal(run(PROTECT_TRIP_TICKS - 1), 0); /* not yet */
+    assert_int_equal(run(1), bit);                    /* tripped */
+    *value = in_band;
+    assert_int_equal(run(1000), bit); /* inside the band: still set */
+    *value = clears;
+    assert_int_equal(run(PROTECT_CLEAR_TICKS - 1), bit);
+    assert_int_equal(run(1), 0); /* cleared */
+    *value = healthy;
+    assert_int_equal(run(10), 0);
+}
+
+static void test_low_voltage(void **state)
+{
+    (void)state;
+    uint16_t *v = &in.readings.voltage_mv;
+    check_threshold(v, 7400, 4000, 3999, 4199, 4200, STATUS_LOW_VOLTAGE);
+    *v = 3999;
+    run(PROTECT_TRIP_TICKS);
+    assert_true(act.inhibit);
+    assert_false(act.derate);
+}
+
+static void test_high_voltage(void **state)
+{
+    (void)state;
+    check_threshold(&in.readings.voltage_mv, 7400, 8400, 8401, 8201, 8200, STATUS_HIGH_VOLTAGE);
+    in.readings.voltage_mv = 8401;
+    run(PROTECT_TRIP_TICKS);
+    assert_true(act.inhibit);
+}
+
+static void test_over_current(void **state)
+{
+    (void)state;
+    check_threshold(&in.readings.current_ma, 500, 4000, 4001, 3901, 3900, STATUS_OVER_CURRENT);
+    in.readings.current_ma = 4001;
+    run(PROTECT_TRIP_TICKS);
+    assert_true(act.derate);
+    assert_false(act.inhibit);
+}
+
+static void test_over_power(void **state)
+{
+    (void)state;
+    check_threshold(&in.readings.power_mw, 3700, 10000, 10001, 9501, 9500, STATUS_OVER_POWER);
+    in.readings.power_mw = 10001;
+    run(PROTECT_TRIP_TICKS);
+    assert_true(act.derate);
+}
+
+static void test_over_temperature_trips_at_or_below(void **state)
+{
+    (void)state;
+    /* 41 = 651 (about 75.6 degC); the ADC falls as it heats, 651 itself
+     * trips; clearing needs 5 degC cooler. */
+    uint16_t cool = ntc_adc((int16_t)(ntc_decicelsius(651) - 50));
+    assert_true(cool > 700 && cool < 800);
+    check_threshold(&in.readings.temperature_adc, 2048, 652, 651, (uint16_t)(cool - 1), cool,
+                    STATUS_OVER_TEMPERATURE);
+    in.readings.temperature_adc = 600;
+    run(PROTECT_TRIP_TICKS);
+    assert_true(act.inhibit);
+}
+
+static void test_one_noisy_sample_neither_trips_nor_clears(void **state)
+{
+    (void)state;
+    for (int i = 0; i < 50; i++) {
+        in.readings.voltage_mv = (i % 5 == 0) ? 2000 : 7400; /* spikes, never 10 in a row */
+        assert_int_equal(run(1), 0);
+    }
+    in.readings.voltage_mv = 2000;
+    assert_int_equal(run(PROTECT_TRIP_TICKS), STATUS_LOW_VOLTAGE);
+    for (int i = 0; i < 500; i++) {
+        in.readings.voltage_mv = (i % 50 == 0) ? 7400 : 2000;
+        assert_int_equal(run(1), STATUS_LOW_VOLTAGE);
+    }
+}
+
+static void test_several_faults_at_once(void **state)
+{
+    (void)state;
+    in.readings.voltage_mv = 3000;
+    in.readings.current_ma = 5000;
+    in.readings.temperature_adc = 500;
+    assert_int_equal(run(PROTECT_TRIP_TICKS),
+                     STATUS_LOW_VOLTAGE | STATUS_OVER_CURRENT | STATUS_OVER_TEMPERATURE);
+    assert_int_equal(STATUS_LOW_VOLTAGE | STATUS_OVER_CURRENT | STATUS_OVER_TEMPERATURE, 0xB0);
+    assert_true(act.inhibit && act.derate);
+    in.readings.voltage_mv = 7400; /* one clears, the others stay */
+    assert_int_equal(run(PROTECT_CLEAR_TICKS), STATUS_OVER_CURRENT | STATUS_OVER_TEMPERATURE);
+    assert_true(act.inhibit); /* still hot */
+    in.readings.temperature_adc = 2048;
+    in.readings.current_ma = 100;
+    assert_int_equal(run(PROTECT_CLEAR_TICKS), 0);
+    assert_false(act.inhibit || act.derate);
+}
+
+static void test_limits_follow_the_user_area(void **state)
+{
+    (void)state;
+    cfg.low_voltage_mv = 6000;
+    in.readings.voltage_mv = 5999;
+    assert_int_equal(run(PROTECT_TRIP_TICKS), STATUS_LOW_VOLTAGE);
+}
+
+static void test_stall_limits_power_in_mode_0(void **state)
+{
+    (void)state;
+    cfg.stall_release = 0;
+    cfg.stall_power_mw = 2500;
+    in.output_at_limit = true;
+    in.speed_q8 = STALL_SPEED_Q8 - 1; /* just below 5 deg/s */
+    assert_int_equal(run(STALL_TICKS - 1), 0);
+    assert_int_equal(act.power_cap_mw, 0);
+    assert_int_equal(run(1), STATUS_STALL);
+    assert_int_equal(act.power_cap_mw, 2500);
+    assert_false(act.release_now);
+    /* Still pushing at the (now lower) limit: stays. */
+    assert_int_equal(run(1000), STATUS_STALL);
+    /* It moves again: clears after the clear time. */
+    in.speed_q8 = -STALL_SPEED_Q8; /* at the speed limit, either way */
+    assert_int_equal(run(PROTECT_CLEAR_TICKS - 1), STATUS_STALL);
+    assert_int_equal(run(1), 0);
+    assert_int_equal(act.power_cap_mw, 0);
+}
+
+static void test_no_stall_while_moving_or_not_pushing(void **state)
+{
+    (void)state;
+    in.output_at_limit = true;
+    in.speed_q8 = STALL_SPEED_Q8; /* 5 deg/s: moving */
+    assert_int_equal(run(3 * STALL_TICKS), 0);
+    in.output_at_limit = false;
+    in.speed_q8 = 0; /* still, but not pushing hard */
+    assert_int_equal(run(3 * STALL_TICKS), 0);
+}
+
+static void test_stall_releases_in_mode_1(void **state)
+{
+    (void)state;
+    cfg.stall_release = 1;
+    in.output_at_limit = true;
+    in.motion_commands = 7;
+    assert_int_equal(run(STALL_TICKS), STATUS_STALL);
+    assert_true(act.release_now); /* once */
+    in.output_at_limit = false;    /* released: nothing pushes */
+    assert_int_equal(run(1), STATUS_STALL);
+    assert_false(act.release_now);
+    assert_int_equal(run(5000), STATUS_STALL); /* held until a new command */
+    in.motion_commands = 8;
+    assert_int_equal(run(1), 0);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test_setup(test_low_voltage, setup),
+        cmocka_unit_test_setup(test_high_voltage, setup),
+        cmocka_unit_test_setup(test_over_current, setup),
+        cmocka_unit_test_setup(test_over_power, setup),
+        cmocka_unit_test_setup(test_over_temperature_trips_at_or_below, setup),
+        cmocka_unit_test_setup(test_one_noisy_sample_neither_trips_nor_clears, setup),
+        cmocka_unit_test_setup(test_several_faults_at_once, setup),
+        cmocka_unit_test_setup(test_limits_follow_the_user_area, setup),
+        cmocka_unit_test_setup(test_stall_limits_power_in_mode_0, setup),
+        cmocka_unit_test_setup(test_no_stall_while_moving_or_not_pushing, setup),
+        cmocka_unit_test_setup(test_stall_releases_in_mode_1, setup),
+    };
+    return cmocka_run_group_tests_name("protection", tests, NULL, NULL);
+}

@@ -1,0 +1,111 @@
+/* Sensor scaling and the generated NTC table, against appendix 5.1's exact
+ * formula (floating point only here, in the test). */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#include <cmocka.h>
+
+#include "ntc.h"
+#include "scaling.h"
+
+static double exact_adc(double celsius)
+{
+    double rt = 10000.0 * exp(3435.0 * (1.0 / (273.15 + celsius) - 1.0 / (273.15 + 25.0)));
+    return rt * 4096.0 / (rt + 10000.0);
+}
+
+static double exact_celsius(double adc)
+{
+    double rt = 10000.0 * adc / (4096.0 - adc);
+    return 1.0 / (log(rt / 10000.0) / 3435.0 + 1.0 / (273.15 + 25.0)) - 273.15;
+}
+
+static void test_table_falls_and_matches_the_formula(void **state)
+{
+    (void)state;
+    for (int i = 1; i < NTC_TABLE_SIZE; i++) {
+        assert_true(ntc_adc_at[i] < ntc_adc_at[i - 1]);
+    }
+    double worst_c = 0, worst_adc = 0;
+    for (int t10 = -200; t10 <= 1200; t10++) {
+        double c = t10 / 10.0;
+        double adc = exact_adc(c);
+        double back = ntc_decicelsius((uint16_t)lround(adc)) / 10.0;
+        double err_c = fabs(back - exact_celsius(lround(adc)));
+        /* degC to ADC, judged in degC: the curve is steep near 25 degC. */
+        double err_adc = fabs(exact_celsius(ntc_adc((int16_t)t10)) - c);
+        worst_c = err_c > worst_c ? err_c : worst_c;
+        worst_adc = err_adc > worst_adc ? err_adc : worst_adc;
+    }
+    printf("# -20..120 degC: worst %.3f degC ADC to degC, %.3f degC degC to ADC\n", worst_c,
+           worst_adc);
+    assert_true(worst_c <= 0.2);
+    assert_true(worst_adc <= 0.2);
+}
+
+static void test_protocol_reference_points(void **state)
+{
+    (void)state;
+    assert_int_equal(ntc_adc(250), 2048);           /* 25 degC: R_t = R_1 */
+    /* extensions.md: 651 is "about 75 degC". */
+    assert_true(fabs(ntc_decicelsius(651) / 10.0 - exact_celsius(651)) <= 0.2);
+    assert_in_range(ntc_decicelsius(2048), 249, 251);
+    /* Beyond the table's ends: clamped. */
+    assert_int_equal(ntc_decicelsius(4095), -400);
+    assert_int_equal(ntc_decicelsius(0), 1500);
+    assert_int_equal(ntc_adc(-1000), ntc_adc_at[0]);
+    assert_int_equal(ntc_adc(3000), ntc_adc_at[NTC_TABLE_SIZE - 1]);
+}
+
+/* The reference board: 3.3 V, 11:1 supply divider, 0.5 V/A current sense. */
+static const struct sensor_calibration board = {
+    .supply_uv_per_count = 8862, .current_ua_per_count = 1611, .current_zero_counts = 12};
+
+static void test_scaling_to_units(void **state)
+{
+    (void)state;
+    struct sensor_readings r;
+    sensors_scale(&board, &(struct sensor_raw){.supply = 835, .current = 632, .ntc = 1500}, &r);
+    assert_int_equal(r.voltage_mv, 7399);  /* 835 x 8.862 mV */
+    assert_int_equal(r.current_ma, 998);   /* (632 - 12) x 1.611 mA */
+    assert_int_equal(r.power_mw, 7384);    /* 7399 mV x 998 mA */
+    assert_int_equal(r.temperature_adc, 1500);
+    /* Below the amplifier's zero: no current, not a wrap-around. */
+    sensors_scale(&board, &(struct sensor_raw){.supply = 4095, .current = 3, .ntc = 0}, &r);
+    assert_int_equal(r.current_ma, 0);
+    assert_int_equal(r.voltage_mv, 36289);
+}
+
+static void test_filter_tames_one_sample(void **state)
+{
+    (void)state;
+    struct sensor_filter f = {0};
+    struct sensor_readings in = {.voltage_mv = 7400, .current_ma = 800, .temperature_adc = 2000};
+    struct sensor_readings out;
+    sensors_filter(&f, &in, &out); /* primes */
+    assert_int_equal(out.voltage_mv, 7400);
+    assert_int_equal(out.power_mw, 5920);
+    in.voltage_mv = 3400; /* one sample 4 V low */
+    sensors_filter(&f, &in, &out);
+    assert_int_equal(out.voltage_mv, 6900); /* an eighth of the jump */
+    in.voltage_mv = 7400;
+    for (int i = 0; i < 100; i++) {
+        sensors_filter(&f, &in, &out);
+    }
+    assert_int_equal(out.voltage_mv, 7400); /* settles exactly */
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_table_falls_and_matches_the_formula),
+        cmocka_unit_test(test_protocol_reference_points),
+        cmocka_unit_test(test_scaling_to_units),
+        cmocka_unit_test(test_filter_tames_one_sample),
+    };
+    return cmocka_run_group_tests_name("sensors", tests, NULL, NULL);
+}

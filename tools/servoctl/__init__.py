@@ -1,0 +1,1 @@
+"""servoctl: the PC side of the open servo firmware."""
