@@ -4,6 +4,7 @@
  * whole core. */
 #include <stdint.h>
 
+#include "calibration.h"
 #include "port_stm32f103.h"
 
 #define REG32(addr) (*(volatile uint32_t *)(addr))
@@ -90,12 +91,10 @@ static void sensors_read(void *ctx, struct sensor_raw *out)
     *out = (struct sensor_raw){0}; /* stub: ADC lands with the MCU port */
 }
 
-/* Reference board front end: 3.3 V reference; supply through 100k/10k
- * (11:1); 25 mOhm shunt into a gain-of-20 amplifier (0.5 V/A). */
 static const struct sensor_calibration calibration = {
-    .supply_uv_per_count = 8862,  /* 3.3 V x 11 / 4096 */
-    .current_ua_per_count = 1611, /* 3.3 V / 0.5 V/A / 4096 */
-    .current_zero_counts = 0,
+    .supply_uv_per_count = BOARD_SUPPLY_UV_PER_COUNT,
+    .current_ua_per_count = BOARD_CURRENT_UA_PER_COUNT,
+    .current_zero_counts = BOARD_CURRENT_ZERO_COUNTS,
 };
 
 static bool flash_erase(void *ctx, uint32_t addr)

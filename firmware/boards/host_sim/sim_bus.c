@@ -1,0 +1,93 @@
+#include "sim_bus.h"
+
+#include <errno.h>
+#include <stdio.h>
+#include <unistd.h>
+
+#include "sim_servo.h"
+
+void sim_bus_init(struct sim_bus *b)
+{
+    *b = (struct sim_bus){.host_fd = -1, .last_sender = -1};
+}
+
+uint64_t sim_bus_send(struct sim_bus *b, unsigned sender, const uint8_t *data, unsigned len,
+                      uint32_t baud, uint64_t now_us)
+{
+    if (now_us < b->busy_until_us && b->last_sender != (int)sender) {
+        b->collisions++;
+        fprintf(stderr, "servo_sim: collision: servo %u started while servo %d was sending\n",
+                b->servos[sender]->cmdline_id, b->servos[b->last_sender]->cmdline_id);
+    }
+    uint64_t byte_us = baud ? (10000000u + baud - 1u) / baud : 87u;
+    uint64_t t = now_us > b->busy_until_us ? now_us : b->busy_until_us;
+    for (unsigned i = 0; i < len; i++) {
+        t += byte_us;
+        if (b->count == SIM_BUS_QUEUE) {
+            b->dropped++;
+            continue;
+        }
+        b->queue[(b->head + b->count) % SIM_BUS_QUEUE] =
+            (struct sim_bus_byte){.at_us = t, .byte = data[i], .sender = (uint8_t)sender};
+        b->count++;
+    }
+    b->busy_until_us = t;
+    b->last_sender = (int)sender;
+    return t;
+}
+
+static void write_host(struct sim_bus *b, const uint8_t *data, unsigned len)
+{
+    while (b->host_fd >= 0 && len > 0) {
+        ssize_t n = write(b->host_fd, data, len);
+        if (n < 0 && errno == EINTR) {
+            continue;
+        }
+        if (n <= 0) {
+            return; /* host gone or not reading: the wire does not wait */
+        }
+        data += n;
+        len -= (unsigned)n;
+    }
+}
+
+void sim_bus_deliver(struct sim_bus *b, uint64_t now_us)
+{
+    uint8_t out[256];
+    unsigned n = 0;
+    while (b->count > 0 && b->queue[b->head].at_us <= now_us) {
+        const struct sim_bus_byte *e = &b->queue[b->head];
+        for (unsigned s = 0; s < b->servo_count; s++) {
+            if (s != e->sender) {
+                /* Delivery time, not wire time: timestamps never run backwards. */
+                servo_on_rx_byte(&b->servos[s]->core, e->byte, (uint32_t)now_us);
+            }
+        }
+        out[n++] = e->byte;
+        if (n == sizeof out) {
+            write_host(b, out, n);
+            n = 0;
+        }
+        b->head = (b->head + 1u) % SIM_BUS_QUEUE;
+        b->count--;
+    }
+    write_host(b, out, n);
+}
+
+void sim_bus_from_host(struct sim_bus *b, const uint8_t *data, unsigned len, uint64_t now_us)
+{
+    for (unsigned i = 0; i < len; i++) {
+        for (unsigned s = 0; s < b->servo_count; s++) {
+            servo_on_rx_byte(&b->servos[s]->core, data[i], (uint32_t)now_us);
+        }
+    }
+}
+
+int64_t sim_bus_next_due(const struct sim_bus *b, uint64_t now_us)
+{
+    if (b->count == 0) {
+        return -1;
+    }
+    uint64_t at = b->queue[b->head].at_us;
+    return at > now_us ? (int64_t)(at - now_us) : 0;
+}

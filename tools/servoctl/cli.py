@@ -1,0 +1,409 @@
+"""servoctl: talk to a UART bus servo on a serial port or the simulator.
+
+Angles are given in degrees and speeds in degrees per second; the tool turns
+them into the protocol's 0.1 degree units and checks every value before
+anything is sent."""
+import argparse
+import csv
+import json
+import os
+import sys
+import time
+
+from . import ntc, registers
+from .profile import positions, velocity_timing
+from .protocol import Bus, NoReply, ServoError, ValueOutOfRange
+from .servo import Servo
+
+
+def decideg(degrees: float) -> int:
+    return int(round(degrees * 10))
+
+
+def fmt_status(status: int) -> str:
+    names = registers.status_names(status)
+    return ", ".join(names) if names else "ok"
+
+
+def describe_temperature(adc: int) -> str:
+    try:
+        return f"{ntc.adc_to_celsius(adc):.1f} degC (ADC {adc})"
+    except ValueError:
+        return f"ADC {adc} (no sensor?)"
+
+
+# ---- commands --------------------------------------------------------------
+
+def cmd_scan(bus, args):
+    found = []
+    for servo_id in range(args.first, args.last + 1):
+        if Servo(bus, servo_id).ping():
+            found.append(servo_id)
+            print(f"servo {servo_id}")
+        if sys.stderr.isatty():
+            print(f"\rscanning {servo_id}/{args.last}", end="", file=sys.stderr)
+    if sys.stderr.isatty():
+        print(file=sys.stderr)
+    print(f"{len(found)} servo(s) found" if found else "no servo answered")
+    return 0 if found else 1
+
+
+def cmd_ping(bus, args):
+    if Servo(bus, args.id).ping():
+        print(f"servo {args.id}: answered")
+        return 0
+    print(f"servo {args.id}: no reply")
+    return 1
+
+
+def cmd_info(bus, args):
+    s = Servo(bus, args.id)
+    m = s.monitor()
+    print(f"servo {args.id}")
+    print(f"  voltage      {m.voltage_mv / 1000:.2f} V")
+    print(f"  current      {m.current_ma / 1000:.3f} A")
+    print(f"  power        {m.power_mw / 1000:.2f} W")
+    print(f"  temperature  {describe_temperature(m.temperature_adc)}")
+    print(f"  status       0x{m.status:02x}: {fmt_status(m.status)}")
+    print(f"  angle        {m.angle_decideg / 10:.1f} deg ({m.turns} turns)")
+    print(f"  model        0x{s.read('model'):04x}")
+    print(f"  firmware     0x{s.read('firmware'):04x}")
+    print(f"  serial       0x{s.read('serial'):08x}")
+    return 0
+
+
+def _print_config(values: dict):
+    for item in registers.USER:
+        value = values[item.name]
+        unit = f" {item.unit}" if item.unit else ""
+        print(f"  {item.id:2d} {item.name:<18} {value}{unit}")
+
+
+def cmd_config(bus, args):
+    s = Servo(bus, args.id)
+    if args.action == "get":
+        item = registers.find(args.name)
+        value = s.read(item.id)
+        print(f"{item.name} = {value}{' ' + item.unit if item.unit else ''}")
+    elif args.action == "set":
+        item = registers.find(args.name)
+        s.write(item.id, int(args.value, 0))
+        print(f"{item.name} = {int(args.value, 0)}")
+    elif args.action == "dump":
+        _print_config(s.read_all())
+    elif args.action == "save":
+        values = s.read_all()
+        with open(args.file, "w") as f:
+            json.dump(values, f, indent=2)
+        print(f"saved the user area of servo {args.id} to {args.file}")
+    elif args.action == "load":
+        with open(args.file) as f:
+            values = json.load(f)
+        missing = [i.name for i in registers.USER if i.name not in values]
+        if missing:
+            raise ValueOutOfRange(f"{args.file} lacks {', '.join(missing)}")
+        s.write_all(values)  # validated before sending
+        print(f"loaded {args.file} into servo {args.id}")
+    elif args.action == "reset":
+        s.reset_user_data()
+        print(f"servo {args.id}: user area reset (ID and baud rate kept)")
+    return 0
+
+
+def _move_args(args):
+    kw = dict(acc_ms=args.acc, dec_ms=args.dec, power_mw=args.power, multi_turn=args.multi_turn)
+    if args.velocity is not None:
+        kw["velocity"] = decideg(args.velocity)
+    else:
+        kw["interval_ms"] = args.interval if args.interval is not None else 1000
+    return kw
+
+
+def _wait_done(s: Servo, timeout: float):
+    """Waits for status bit 0 to fall; returns the seconds it took."""
+    start = time.monotonic()
+    time.sleep(0.01)
+    while time.monotonic() - start < timeout:
+        if not s.status() & 1:
+            return time.monotonic() - start
+        time.sleep(0.005)
+    raise ServoError(f"servo {s.id} still moving after {timeout:.1f} s")
+
+
+def cmd_move(bus, args):
+    s = Servo(bus, args.id)
+    s.move(decideg(args.angle), **_move_args(args))
+    if args.wait:
+        took = _wait_done(s, args.timeout_s)
+        angle, turns = s.multi_turn_angle()
+        print(f"servo {args.id}: at {angle / 10:.1f} deg after {took * 1000:.0f} ms")
+    return 0
+
+
+def cmd_wheel(bus, args):
+    Servo(bus, args.id).wheel(args.action, args.speed, args.value, args.cw)
+    return 0
+
+
+def cmd_damping(bus, args):
+    Servo(bus, args.id).damping(args.power)
+    return 0
+
+
+def cmd_stop(bus, args):
+    Servo(bus, args.id).stop(args.mode, args.power)
+    return 0
+
+
+def cmd_origin(bus, args):
+    s = Servo(bus, args.id)
+    if args.reset_turns:
+        s.reset_multi_turn()
+    else:
+        s.set_origin()
+    time.sleep(0.01)
+    angle, turns = s.multi_turn_angle()
+    print(f"servo {args.id}: now {angle / 10:.1f} deg, {turns} turns"
+          + ("" if s.status() & 2 == 0 else " (refused: release it first with 'stop')"))
+    return 0
+
+
+def cmd_monitor(bus, args):
+    servos = [Servo(bus, i) for i in args.ids]
+    print(f"{'id':>3} {'angle deg':>10} {'V':>6} {'A':>6} {'W':>6} {'degC':>6}  status")
+    n = 0
+    try:
+        while args.count == 0 or n < args.count:
+            for s in servos:
+                try:
+                    m = s.monitor()
+                    try:
+                        c = f"{ntc.adc_to_celsius(m.temperature_adc):6.1f}"
+                    except ValueError:
+                        c = "   n/a"
+                    print(f"{m.id:>3} {m.angle_decideg / 10:>10.1f} {m.voltage_mv / 1000:>6.2f} "
+                          f"{m.current_ma / 1000:>6.3f} {m.power_mw / 1000:>6.2f} {c}  {fmt_status(m.status)}")
+                except NoReply as e:
+                    print(f"{s.id:>3} {e}")
+            n += 1
+            time.sleep(args.every)
+    except KeyboardInterrupt:
+        pass
+    return 0
+
+
+def cmd_record(bus, args):
+    """Samples angle, velocity and current during a move; CSV and PNG."""
+    s = Servo(bus, args.id)
+    start = s.monitor().angle_decideg
+    target = decideg(args.angle)
+    kw = _move_args(args)
+    acc = max(args.acc, 20)
+    dec = max(args.dec, 20)
+    if "velocity" in kw:
+        n1, nc, n3 = velocity_timing(target - start, 0.0, kw["velocity"] / 1000.0, acc, dec)
+    else:
+        interval = max(kw["interval_ms"], acc + dec)
+        n1, nc, n3 = acc, interval - acc - dec, dec
+    plan = positions(start, target, n1, nc, n3)
+    t0 = time.monotonic()
+    s.move(target, **kw)
+    samples = []
+    done_at = None
+    limit = len(plan) / 1000.0 + 10.0  # soft start (49/50) can stretch the first move
+    while time.monotonic() - t0 < limit:
+        m = s.monitor()
+        now = time.monotonic() - t0
+        samples.append((now, m.angle_decideg / 10.0, m.current_ma / 1000.0))
+        if done_at is None and now > 0.02 and not m.status & 1:
+            done_at = now
+        if done_at is not None and now > done_at + args.settle / 1000.0:
+            break
+    if done_at is None:
+        raise ServoError(f"servo {args.id} still moving after {limit:.1f} s")
+    rows = []
+    for k, (t, angle, amps) in enumerate(samples):
+        if 0 < k < len(samples) - 1:
+            v = (samples[k + 1][1] - samples[k - 1][1]) / (samples[k + 1][0] - samples[k - 1][0])
+        else:
+            v = 0.0
+        ms = int(t * 1000)
+        planned = plan[min(ms, len(plan) - 1)] / 10.0
+        rows.append((round(t * 1000, 1), angle, round(v, 2), amps, round(planned, 2)))
+    csv_path = args.out + ".csv"
+    with open(csv_path, "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["time_ms", "angle_deg", "velocity_dps", "current_a", "planned_deg"])
+        w.writerows(rows)
+    png_path = args.out + ".png"
+    _plot(rows, plan, png_path, f"servo {args.id}: {start / 10:.1f} -> {target / 10:.1f} deg")
+    worst = max(abs(r[1] - r[4]) for r in rows)
+    print(f"{len(rows)} samples over {rows[-1][0]:.0f} ms; finished after {done_at * 1000:.0f} ms "
+          f"(planned {len(plan) - 1} ms); worst gap to the plan {worst:.2f} deg; "
+          f"final {rows[-1][1]:.1f} deg")
+    print(f"csv  {os.path.abspath(csv_path)}")
+    print(f"plot {os.path.abspath(png_path)}")
+    return 0
+
+
+def _plot(rows, plan, path, title):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    t = [r[0] for r in rows]
+    fig, (ax1, ax2) = plt.subplots(2, 1, sharex=True, figsize=(8, 6))
+    ax1.plot(range(len(plan)), [p / 10.0 for p in plan], label="planned", color="0.6", lw=3)
+    ax1.plot(t, [r[1] for r in rows], ".-", label="measured", ms=3)
+    ax1.set_ylabel("angle (deg)")
+    ax1.legend()
+    ax1.set_title(title)
+    ax2.plot(t, [r[2] for r in rows], label="velocity (deg/s)")
+    ax2.set_ylabel("velocity (deg/s)")
+    ax3 = ax2.twinx()
+    ax3.plot(t, [r[3] for r in rows], color="tab:red", label="current (A)")
+    ax3.set_ylabel("current (A)", color="tab:red")
+    ax2.set_xlabel("time (ms)")
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+
+
+def cmd_sim(args):
+    from .sim import Simulator
+
+    sim = Simulator(ids=args.ids or [1], tcp=args.tcp, link=args.link, state_dir=args.state)
+    sim.start()
+    print(f"simulator running: bus {sim.url}, control 127.0.0.1:{sim.control_port}")
+    print(f"  e.g. servoctl --port {sim.url} scan --last 10     (Ctrl-C stops it)")
+    try:
+        sim.process.wait()
+    except KeyboardInterrupt:
+        pass
+    finally:
+        sim.stop()
+    return 0
+
+
+# ---- argument parsing -------------------------------------------------------
+
+def build_parser():
+    ap = argparse.ArgumentParser(prog="servoctl", description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--port", default=os.environ.get("SERVOCTL_PORT"),
+                    help="serial port or pyserial URL (socket://HOST:PORT); env SERVOCTL_PORT")
+    ap.add_argument("--baud", type=int, default=115200)
+    ap.add_argument("--timeout", type=float, default=0.1, help="reply timeout, seconds")
+    sub = ap.add_subparsers(dest="command", required=True)
+
+    c = sub.add_parser("scan", help="find servos by pinging IDs")
+    c.add_argument("--first", type=int, default=0)
+    c.add_argument("--last", type=int, default=253)
+    c.set_defaults(run=cmd_scan)
+
+    c = sub.add_parser("ping", help="is this servo there")
+    c.add_argument("id", type=int)
+    c.set_defaults(run=cmd_ping)
+
+    c = sub.add_parser("info", help="status area decoded: V, A, W, degC, status bits")
+    c.add_argument("id", type=int)
+    c.set_defaults(run=cmd_info)
+
+    c = sub.add_parser("config", help="the user area by name: get, set, dump, save, load, reset")
+    c.add_argument("action", choices=["get", "set", "dump", "save", "load", "reset"])
+    c.add_argument("id", type=int)
+    c.add_argument("rest", nargs="*", help="get NAME | set NAME VALUE | save FILE | load FILE")
+    c.set_defaults(run=cmd_config)
+
+    def motion_options(c):
+        c.add_argument("id", type=int)
+        c.add_argument("angle", type=float, help="degrees")
+        g = c.add_mutually_exclusive_group()
+        g.add_argument("--interval", type=int, help="ms to get there (default 1000)")
+        g.add_argument("--velocity", type=float, help="peak speed, deg/s")
+        c.add_argument("--acc", type=int, default=20, help="acceleration ramp, ms (>= 20)")
+        c.add_argument("--dec", type=int, default=20, help="deceleration ramp, ms (>= 20)")
+        c.add_argument("--power", type=int, default=0, help="mW; 0 = the power limit (42)")
+        c.add_argument("--multi-turn", action="store_true")
+
+    c = sub.add_parser("move", help="an angle move (every angle mode)")
+    motion_options(c)
+    c.add_argument("--wait", action="store_true", help="wait until it has finished")
+    c.add_argument("--timeout-s", type=float, default=30.0)
+    c.set_defaults(run=cmd_move)
+
+    c = sub.add_parser("wheel", help="wheel mode: stop, run, turns, time")
+    c.add_argument("id", type=int)
+    c.add_argument("action", choices=["stop", "run", "turns", "time"])
+    c.add_argument("--speed", type=int, default=90, help="deg/s")
+    c.add_argument("--value", type=int, default=0, help="turns or ms")
+    c.add_argument("--cw", action="store_true", help="clockwise (default counter-clockwise)")
+    c.set_defaults(run=cmd_wheel)
+
+    c = sub.add_parser("damping", help="damping mode")
+    c.add_argument("id", type=int)
+    c.add_argument("--power", type=int, default=0, help="mW")
+    c.set_defaults(run=cmd_damping)
+
+    c = sub.add_parser("stop", help="stop: release, hold or damping")
+    c.add_argument("id", type=int)
+    c.add_argument("--mode", choices=["release", "hold", "damping"], default="release")
+    c.add_argument("--power", type=int, default=0, help="mW, for damping")
+    c.set_defaults(run=cmd_stop)
+
+    c = sub.add_parser("origin", help="make here angle 0 (only while released)")
+    c.add_argument("id", type=int)
+    c.add_argument("--reset-turns", action="store_true", help="only drop the whole turns")
+    c.set_defaults(run=cmd_origin)
+
+    c = sub.add_parser("monitor", help="live table of angle, V, A, W, degC, status")
+    c.add_argument("ids", type=int, nargs="+")
+    c.add_argument("--every", type=float, default=0.2, help="seconds between rows")
+    c.add_argument("--count", type=int, default=0, help="rows to print (0: until Ctrl-C)")
+    c.set_defaults(run=cmd_monitor)
+
+    c = sub.add_parser("record", help="record a move: CSV and PNG against the plan")
+    motion_options(c)
+    c.add_argument("--out", default="record", help="file name prefix (default: record)")
+    c.add_argument("--settle", type=int, default=300, help="ms to keep sampling after the plan")
+    c.set_defaults(run=cmd_record)
+
+    c = sub.add_parser("sim", help="run the simulator")
+    c.add_argument("--id", dest="ids", type=int, action="append")
+    c.add_argument("--tcp", action="store_true", help="a TCP port instead of a pty")
+    c.add_argument("--link", help="symlink to the pty")
+    c.add_argument("--state", help="folder for the flash files")
+    c.set_defaults(run=None)
+    return ap
+
+
+def main(argv=None) -> int:
+    args = build_parser().parse_args(argv)
+    if args.command == "sim":
+        try:
+            return cmd_sim(args)
+        except ServoError as e:
+            print(f"servoctl: error: {e}", file=sys.stderr)
+            return 1
+    if args.command == "config":
+        need = {"get": 1, "set": 2, "dump": 0, "save": 1, "load": 1, "reset": 0}[args.action]
+        if len(args.rest) != need:
+            print(f"servoctl: error: config {args.action} takes {need} argument(s)", file=sys.stderr)
+            return 2
+        args.name = args.rest[0] if args.action in ("get", "set") else None
+        args.value = args.rest[1] if args.action == "set" else None
+        args.file = args.rest[0] if args.action in ("save", "load") else None
+    if not args.port:
+        print("servoctl: error: no port: give --port or set SERVOCTL_PORT", file=sys.stderr)
+        return 2
+    try:
+        with Bus(args.port, args.baud, args.timeout) as bus:
+            return args.run(bus, args)
+    except ServoError as e:
+        print(f"servoctl: error: {e}", file=sys.stderr)
+        return 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

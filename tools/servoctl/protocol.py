@@ -1,0 +1,153 @@
+"""Frames of the servo protocol (servo-protocol.md, extensions.md) and a bus
+that sends requests and waits for the matching response."""
+import struct
+import time
+
+REQUEST_HEADER = b"\x12\x4c"
+RESPONSE_HEADER = b"\x05\x1c"
+BROADCAST = 0xFF
+
+PING = 1
+RESET_USER_DATA = 2
+READ_DATA = 3
+WRITE_DATA = 4
+READ_BATCH = 5
+WRITE_BATCH = 6
+WHEEL = 7
+ANGLE = 8
+DAMPING = 9
+READ_ANGLE = 10
+ANGLE_BY_INTERVAL = 11
+ANGLE_BY_VELOCITY = 12
+MULTI_TURN = 13
+MULTI_TURN_BY_INTERVAL = 14
+MULTI_TURN_BY_VELOCITY = 15
+READ_MULTI_TURN = 16
+RESET_MULTI_TURN = 17
+BEGIN_ASYNC = 18
+END_ASYNC = 19
+MONITOR = 22
+SET_ORIGIN = 23
+STOP_ON_CONTROL = 24
+SYNC = 25
+
+
+class ServoError(Exception):
+    """Base of every error servoctl reports."""
+
+
+class NoReply(ServoError):
+    pass
+
+
+class BadChecksum(ServoError):
+    pass
+
+
+class ValueOutOfRange(ServoError):
+    pass
+
+
+def checksum(data: bytes) -> int:
+    return sum(data) % 256
+
+
+def request_frame(code: int, content: bytes) -> bytes:
+    """A request frame; content of 255 bytes or more uses the extended length."""
+    if len(content) >= 255:
+        head = REQUEST_HEADER + bytes([code, 0xFF]) + struct.pack("<H", len(content))
+    else:
+        head = REQUEST_HEADER + bytes([code, len(content)])
+    body = head + content
+    return body + bytes([checksum(body)])
+
+
+def response_frame(code: int, content: bytes) -> bytes:
+    body = RESPONSE_HEADER + bytes([code, len(content)]) + content
+    return body + bytes([checksum(body)])
+
+
+class Bus:
+    """A serial port (or pyserial URL such as socket://127.0.0.1:5000) with
+    the request/response discipline of the protocol."""
+
+    def __init__(self, port: str, baud: int = 115200, timeout: float = 0.1):
+        import serial  # pyserial
+
+        self.timeout = timeout
+        try:
+            self.serial = serial.serial_for_url(port, baudrate=baud, timeout=0.005)
+        except (serial.SerialException, ValueError) as e:
+            raise ServoError(f"cannot open {port}: {e}") from None
+        sock = getattr(self.serial, "_socket", None)
+        if sock is not None:  # socket://: no Nagle delay on small frames
+            import socket
+
+            sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        self._buffer = b""
+
+    def close(self):
+        self.serial.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def send(self, code: int, content: bytes) -> None:
+        self.serial.reset_input_buffer()
+        self._buffer = b""
+        self.serial.write(request_frame(code, content))
+
+    def _fill(self) -> None:
+        data = self.serial.read(256)
+        if data:
+            self._buffer += data
+
+    def read_response(self, code: int, servo_id: int, timeout=None):
+        """Content of the next response with this packet number from this
+        servo; other frames on the wire are skipped."""
+        deadline = time.monotonic() + (self.timeout if timeout is None else timeout)
+        bad = None
+        while True:
+            frame = self._take_frame()
+            if frame is not None:
+                fcode, content, ok = frame
+                if not ok:
+                    bad = fcode
+                elif fcode == code and content[:1] == bytes([servo_id]):
+                    return content
+                continue
+            if time.monotonic() > deadline:
+                if bad is not None:
+                    raise BadChecksum(f"servo {servo_id}: response to packet {code} had a bad checksum")
+                raise NoReply(f"servo {servo_id}: no reply to packet {code} within "
+                              f"{(self.timeout if timeout is None else timeout) * 1000:.0f} ms")
+            self._fill()
+
+    def _take_frame(self):
+        """(code, content, checksum_ok) of a complete response frame at the
+        head of the buffer, or None; garbage before a header is dropped."""
+        buf = self._buffer
+        start = buf.find(RESPONSE_HEADER)
+        if start < 0:
+            self._buffer = buf[-1:] if buf[-1:] == RESPONSE_HEADER[:1] else b""
+            return None
+        buf = buf[start:]
+        self._buffer = buf
+        if len(buf) < 5:
+            return None
+        length = buf[3]
+        end = 4 + length + 1
+        if len(buf) < end:
+            return None
+        self._buffer = buf[end:]
+        frame = buf[:end]
+        return frame[2], frame[4:-1], checksum(frame[:-1]) == frame[-1]
+
+    def request(self, code: int, content: bytes, timeout=None) -> bytes:
+        """Sends a request for the servo named by content[0] and returns its
+        answer's content."""
+        self.send(code, content)
+        return self.read_response(code, content[0], timeout)

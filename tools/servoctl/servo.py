@@ -1,0 +1,145 @@
+"""One servo on a bus: every packet of the protocol as a method, values in
+protocol units (0.1 degree, ms, mW) unless the name says otherwise."""
+from dataclasses import dataclass
+import struct
+
+from . import protocol as p
+from . import registers
+from .protocol import ServoError, ValueOutOfRange
+
+
+@dataclass
+class Monitor:
+    id: int
+    voltage_mv: int
+    current_ma: int
+    power_mw: int
+    temperature_adc: int
+    status: int
+    angle_decideg: int
+    turns: int
+
+    @classmethod
+    def decode(cls, content: bytes) -> "Monitor":
+        return cls(*struct.unpack("<BHHHHBih", content))
+
+
+def _check(name: str, value: int, low: int, high: int, unit: str = "") -> int:
+    if not low <= value <= high:
+        raise ValueOutOfRange(f"{name} must be {low}..{high}{' ' + unit if unit else ''}, not {value}")
+    return value
+
+
+class Servo:
+    def __init__(self, bus: p.Bus, servo_id: int):
+        self.bus = bus
+        self.id = _check("servo ID", servo_id, 0, 254)
+
+    # ---- queries -------------------------------------------------------
+    def ping(self) -> bool:
+        try:
+            self.bus.request(p.PING, bytes([self.id]), timeout=0.05)
+            return True
+        except p.NoReply:
+            return False
+
+    def read(self, key) -> int:
+        item = registers.find(key)
+        content = self.bus.request(p.READ_DATA, bytes([self.id, item.id]))
+        data = content[2:]
+        if len(data) != item.size:
+            raise ServoError(f"servo {self.id} has no readable {item.name} ({item.id})")
+        return item.unpack(data)
+
+    def write(self, key, value: int) -> None:
+        item = registers.find(key)
+        item.check(value)
+        content = self.bus.request(p.WRITE_DATA, bytes([self.id, item.id]) + item.pack(value))
+        if content[2] != 1:
+            raise ServoError(f"servo {self.id} refused {item.name} = {value}")
+
+    def read_all(self) -> dict:
+        content = self.bus.request(p.READ_BATCH, bytes([self.id]))
+        return registers.decode_user_area(content[1:])
+
+    def write_all(self, values: dict) -> None:
+        block = registers.encode_user_area(values)
+        content = self.bus.request(p.WRITE_BATCH, bytes([self.id]) + block)
+        if content[1] != 1:
+            raise ServoError(f"servo {self.id} refused the user area block")
+
+    def reset_user_data(self) -> None:
+        if self.bus.request(p.RESET_USER_DATA, bytes([self.id]))[1] != 1:
+            raise ServoError(f"servo {self.id} refused the reset")
+
+    def angle(self) -> int:
+        return struct.unpack("<h", self.bus.request(p.READ_ANGLE, bytes([self.id]))[1:3])[0]
+
+    def multi_turn_angle(self):
+        """(angle in 0.1 degree, turns)."""
+        return struct.unpack("<ih", self.bus.request(p.READ_MULTI_TURN, bytes([self.id]))[1:7])
+
+    def monitor(self) -> Monitor:
+        return Monitor.decode(self.bus.request(p.MONITOR, bytes([self.id])))
+
+    def status(self) -> int:
+        return self.read("status")
+
+    # ---- motion ----------------------------------------------------------
+    def _move(self, code: int, content: bytes, wait: bool):
+        """Sends a motion command; with control response on and wait, waits
+        for its answer (sent when the move has finished)."""
+        self.bus.send(code, content)
+        if wait:
+            return self.bus.read_response(code, self.id, timeout=wait)
+        return None
+
+    def move(self, angle_decideg: int, interval_ms: int = None, velocity: int = None,
+             acc_ms: int = 20, dec_ms: int = 20, power_mw: int = 0, multi_turn: bool = False,
+             wait=False):
+        """An angle move: by interval (packets 8/11, 13/14) or by velocity in
+        0.1 deg/s (12, 15)."""
+        _check("power", power_mw, 0, 65535, "mW")
+        _check("acceleration time", acc_ms, 0, 65535, "ms")
+        _check("deceleration time", dec_ms, 0, 65535, "ms")
+        if multi_turn:
+            _check("angle", angle_decideg, -3686400, 3686400, "x0.1 deg")
+        else:
+            _check("angle", angle_decideg, -1800, 1800, "x0.1 deg")
+        if (interval_ms is None) == (velocity is None):
+            raise ValueOutOfRange("give either an interval or a velocity")
+        if velocity is not None:
+            _check("velocity", velocity, 10, 7500, "x0.1 deg/s")
+            fmt, code = ("<BiHHHH", p.MULTI_TURN_BY_VELOCITY) if multi_turn else ("<BhHHHH", p.ANGLE_BY_VELOCITY)
+            content = struct.pack(fmt, self.id, angle_decideg, velocity, acc_ms, dec_ms, power_mw)
+        else:
+            _check("interval", interval_ms, 0, 4096000 if multi_turn else 65535, "ms")
+            fmt, code = ("<BiIHHH", p.MULTI_TURN_BY_INTERVAL) if multi_turn else ("<BhHHHH", p.ANGLE_BY_INTERVAL)
+            content = struct.pack(fmt, self.id, angle_decideg, interval_ms, acc_ms, dec_ms, power_mw)
+        return self._move(code, content, wait)
+
+    def wheel(self, action: str, speed_dps: int = 0, value: int = 0, clockwise: bool = False, wait=False):
+        """Wheel mode: action stop, run, turns (value turns) or time (value ms)."""
+        actions = {"stop": 0, "run": 1, "turns": 2, "time": 3}
+        if action not in actions:
+            raise ValueOutOfRange(f"wheel action must be one of {', '.join(actions)}, not {action!r}")
+        _check("wheel speed", speed_dps, 0, 65535, "deg/s")
+        _check("wheel value", value, 0, 65535)
+        method = actions[action] | (0x80 if clockwise else 0)
+        return self._move(p.WHEEL, struct.pack("<BBHH", self.id, method, speed_dps, value), wait)
+
+    def damping(self, power_mw: int = 0) -> None:
+        _check("power", power_mw, 0, 65535, "mW")
+        self.bus.send(p.DAMPING, struct.pack("<BH", self.id, power_mw))
+
+    def stop(self, mode: str = "release", power_mw: int = 0) -> None:
+        modes = {"release": 0x10, "hold": 0x11, "damping": 0x12}
+        if mode not in modes:
+            raise ValueOutOfRange(f"stop mode must be one of {', '.join(modes)}, not {mode!r}")
+        self.bus.send(p.STOP_ON_CONTROL, struct.pack("<BBH", self.id, modes[mode], power_mw))
+
+    def set_origin(self) -> None:
+        self.bus.send(p.SET_ORIGIN, bytes([self.id, 0]))
+
+    def reset_multi_turn(self) -> None:
+        self.bus.send(p.RESET_MULTI_TURN, bytes([self.id]))

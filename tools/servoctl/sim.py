@@ -1,0 +1,121 @@
+"""Starts servo_sim (the firmware on simulated servos) and talks to its
+fault-injection channel."""
+import os
+from pathlib import Path
+import socket
+import subprocess
+import tempfile
+import time
+
+from .protocol import ServoError
+
+REPO = Path(__file__).resolve().parents[2]
+DEFAULT_BINARY = REPO / "build" / "host" / "firmware" / "boards" / "host_sim" / "servo_sim"
+
+
+def find_binary() -> Path:
+    path = Path(os.environ.get("SERVO_SIM", DEFAULT_BINARY))
+    if not path.exists():
+        raise ServoError(f"no simulator at {path}: build it with "
+                         f"'cmake --preset host && cmake --build --preset host' "
+                         f"or point SERVO_SIM at it")
+    return path
+
+
+class Simulator:
+    """servo_sim as a context manager. The bus is a TCP port (pyserial
+    socket://) unless tcp=False, then a pseudo-terminal (optionally linked)."""
+
+    def __init__(self, ids=(1,), tcp=True, link=None, state_dir=None, supply_mv=None,
+                 ambient_c=None):
+        self.ids = list(ids)
+        self.tcp = tcp
+        self.link = link
+        self._own_state = state_dir is None
+        self.state_dir = state_dir or tempfile.mkdtemp(prefix="servo-sim-")
+        self.supply_mv = supply_mv
+        self.ambient_c = ambient_c
+        self.process = None
+        self.url = None
+        self.control_port = None
+
+    def start(self) -> "Simulator":
+        cmd = [str(find_binary()), "--state", self.state_dir]
+        for i in self.ids:
+            cmd += ["--id", str(i)]
+        if self.tcp:
+            cmd += ["--tcp", str(_free_port())]
+        if self.link:
+            cmd += ["--link", str(self.link)]
+        if self.supply_mv is not None:
+            cmd += ["--supply", str(self.supply_mv)]
+        if self.ambient_c is not None:
+            cmd += ["--ambient", str(self.ambient_c)]
+        self.process = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                        text=True)
+        deadline = time.monotonic() + 20
+        while time.monotonic() < deadline:
+            line = self.process.stdout.readline()
+            if not line:
+                err = self.process.stderr.read()
+                raise ServoError(f"servo_sim exited: {err.strip()}")
+            words = line.split()
+            if words[1:2] == ["bus"]:
+                self.url = words[2]
+            elif words[1:2] == ["control"]:
+                self.control_port = int(words[2].rsplit(":", 1)[1])
+            elif words[1:2] == ["ready"]:
+                return self
+        self.stop()
+        raise ServoError("servo_sim did not become ready within 20 s")
+
+    def control(self, line: str) -> str:
+        """Sends one control command; returns the reply."""
+        with socket.create_connection(("127.0.0.1", self.control_port), timeout=2) as s:
+            s.sendall(line.encode() + b"\n")
+            s.shutdown(socket.SHUT_WR)
+            reply = b""
+            while chunk := s.recv(4096):
+                reply += chunk
+        text = reply.decode()
+        if text.startswith("error"):
+            raise ServoError(f"servo_sim: {text.strip()}")
+        return text
+
+    def state(self, servo_id: int) -> dict:
+        """The models' state of one servo: angle (deg), velocity, current,
+        winding temperature, supply, status, collisions, ..."""
+        line = self.control(f"state {servo_id}").strip()
+        out = {}
+        for pair in line.split():
+            key, value = pair.split("=", 1)
+            try:
+                out[key] = float(value) if "." in value else int(value, 0)
+            except ValueError:
+                out[key] = value
+        return out
+
+    def stop(self) -> str:
+        """Stops the simulator; returns what it wrote to stderr."""
+        if self.process is None:
+            return ""
+        self.process.terminate()
+        try:
+            _, err = self.process.communicate(timeout=10)
+        except subprocess.TimeoutExpired:
+            self.process.kill()
+            _, err = self.process.communicate()
+        self.process = None
+        return err
+
+    def __enter__(self):
+        return self.start()
+
+    def __exit__(self, *exc):
+        self.stop()
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
