@@ -28,6 +28,7 @@ void servo_init(struct servo *s, const struct hal_port *hal)
     s->next_tick_us = hal->now_us(hal->ctx) + CONTROL_TICK_US;
     frame_rx_init(&s->rx, &s->active_id, frame_rx_idle_us(0));
     dispatcher_init(&s->dispatcher, &s->regs, &s->motion, &s->active_id);
+    s->max_catch_up = SERVO_MAX_CATCH_UP;
     s->active_baud_index = 0; /* forces the first apply to set the UART */
     apply_link_settings(s);
 }
@@ -137,18 +138,23 @@ void servo_control_tick(struct servo *s)
 }
 
 /* The control loop runs from the main loop, so commands and ticks never
- * interleave. One tick per pass; a main loop more than a few ticks late
- * (flash erase) drops the missed ticks rather than racing to catch up. */
+ * interleave. A pass runs every tick that is due, up to max_catch_up; a
+ * main loop later than that (a flash erase) drops the rest rather than
+ * racing through them. */
 static void run_control_tick(struct servo *s)
 {
+    for (unsigned n = 0; n < s->max_catch_up; n++) {
+        uint32_t now = s->hal->now_us(s->hal->ctx);
+        if ((int32_t)(now - s->next_tick_us) < 0) {
+            return;
+        }
+        servo_control_tick(s);
+        s->next_tick_us += CONTROL_TICK_US;
+    }
     uint32_t now = s->hal->now_us(s->hal->ctx);
     int32_t late = (int32_t)(now - s->next_tick_us);
-    if (late < 0) {
-        return;
-    }
-    servo_control_tick(s);
-    s->next_tick_us += CONTROL_TICK_US;
-    if (late > (int32_t)(4u * CONTROL_TICK_US)) {
+    if (late >= 0) {
+        s->ticks_dropped += (uint32_t)late / CONTROL_TICK_US + 1u;
         s->next_tick_us = now + CONTROL_TICK_US;
     }
 }

@@ -20,6 +20,8 @@
 /* Silence after which a SyncCommand Monitor turn-taker stops waiting for a
  * servo listed before it that does not answer. */
 #define SYNC_SLOT_SILENCE_US 3000u
+/* Ticks a late main loop catches up before it drops the rest. */
+#define SERVO_MAX_CATCH_UP 4u
 /* Control tick period. */
 #define CONTROL_TICK_US (1000000u / MOTION_TICK_HZ)
 
@@ -44,6 +46,10 @@ struct servo {
     struct sensor_filter sensors;
     struct protection protection;
     uint32_t next_tick_us;       /* when the next control tick is due */
+    uint32_t ticks_dropped;      /* control ticks skipped by a late main loop */
+    /* Most ticks one pass catches up (SERVO_MAX_CATCH_UP unless a port says
+     * otherwise: the simulator, scheduled by a PC, allows more). */
+    uint8_t max_catch_up;
     volatile uint8_t active_id;  /* the ID answered to now */
     uint8_t active_baud_index;
     uint8_t config_dirty;

@@ -1,7 +1,6 @@
 /* servo_sim: the servo firmware on simulated servos, on a pseudo-terminal
  * or a TCP port, in real time. See `servo_sim --help` and README.md. */
-#define _XOPEN_SOURCE 700
-#define _DEFAULT_SOURCE
+#define _GNU_SOURCE
 
 #include <arpa/inet.h>
 #include <errno.h>
@@ -17,6 +16,7 @@
 #include <sys/socket.h>
 #include <sys/stat.h>
 #include <termios.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "sim_bus.h"
@@ -203,11 +203,11 @@ static void state_of(const struct sim_servo *s, char *out, size_t size)
     motion_read_angle(&s->core.motion, &a);
     snprintf(out, size,
              "id=%u angle=%.3f velocity=%.2f current=%.3f winding=%.2f ambient=%.1f supply=%.3f "
-             "load=%.3f stop=%s status=0x%02x reported=%d collisions=%lu\n",
+             "load=%.3f stop=%s status=0x%02x reported=%d collisions=%lu dropped_ticks=%u\n",
              s->cmdline_id, plant_angle_deg(&s->plant), s->plant.velocity * 180.0 / M_PI,
              s->plant.current, s->thermal.winding_c, s->thermal.ambient_c, s->plant.p.supply_v,
              s->plant.load_torque, s->plant.has_stop ? "on" : "off", s->core.regs.status.status,
-             a.multi_turn_decideg, bus.collisions);
+             a.multi_turn_decideg, bus.collisions, s->core.ticks_dropped);
 }
 
 /* One control line: "command [value] [servo id]". */
@@ -358,10 +358,11 @@ int main(int argc, char **argv)
         for (int i = 0; i < MAX_CONTROL_CLIENTS; i++) {
             fds[nfds++] = (struct pollfd){.fd = clients[i].fd, .events = POLLIN};
         }
-        /* Wake for the next control tick or bus byte, whichever is first. */
+        /* Wake often enough for every control tick and bus byte. */
         int64_t due = sim_bus_next_due(&bus, sim_now_us());
-        int timeout_ms = (due >= 0 && due < 1000) ? 0 : 1;
-        if (poll(fds, (nfds_t)nfds, timeout_ms) < 0 && errno != EINTR) {
+        long wait_us = (due >= 0 && due < 250) ? due : 250;
+        struct timespec timeout = {.tv_sec = 0, .tv_nsec = wait_us * 1000};
+        if (ppoll(fds, (nfds_t)nfds, &timeout, NULL) < 0 && errno != EINTR) {
             perror("servo_sim: poll");
             break;
         }

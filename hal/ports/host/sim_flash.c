@@ -1,21 +1,16 @@
+#define _POSIX_C_SOURCE 200809L
 #include "sim_flash.h"
 
-#include <stdio.h>
+#include <fcntl.h>
 #include <string.h>
+#include <unistd.h>
 
 #define BASE 0x0800F800u
 
-static bool save(const struct sim_flash *f)
+/* Writes len bytes of the chip at offset through to the file. */
+static bool save(const struct sim_flash *f, uint32_t offset, uint32_t len)
 {
-    char tmp[300];
-    snprintf(tmp, sizeof tmp, "%s.tmp", f->path);
-    FILE *out = fopen(tmp, "wb");
-    if (out == NULL) {
-        return false;
-    }
-    bool ok = fwrite(f->mem, 1, sizeof f->mem, out) == sizeof f->mem;
-    ok = (fclose(out) == 0) && ok;
-    return ok && rename(tmp, f->path) == 0;
+    return pwrite(f->fd, &f->mem[offset], len, (off_t)offset) == (ssize_t)len;
 }
 
 static bool erase_page(void *ctx, uint32_t addr)
@@ -25,7 +20,7 @@ static bool erase_page(void *ctx, uint32_t addr)
         return false;
     }
     memset(&f->mem[addr - BASE], 0xFF, SIM_FLASH_PAGE);
-    return save(f);
+    return save(f, addr - BASE, SIM_FLASH_PAGE);
 }
 
 static bool program_u16(void *ctx, uint32_t addr, uint16_t value)
@@ -40,10 +35,10 @@ static bool program_u16(void *ctx, uint32_t addr, uint16_t value)
     }
     cell[0] = (uint8_t)(value & 0xFFu);
     cell[1] = (uint8_t)(value >> 8);
-    return save(f);
+    return save(f, addr - BASE, 2);
 }
 
-static void read(void *ctx, uint32_t addr, uint8_t *dst, uint32_t len)
+static void flash_read(void *ctx, uint32_t addr, uint8_t *dst, uint32_t len)
 {
     struct sim_flash *f = ctx;
     for (uint32_t i = 0; i < len; i++) {
@@ -55,17 +50,16 @@ static void read(void *ctx, uint32_t addr, uint8_t *dst, uint32_t len)
 bool sim_flash_open(struct sim_flash *f, const char *path)
 {
     memset(f, 0, sizeof *f);
-    snprintf(f->path, sizeof f->path, "%s", path);
     memset(f->mem, 0xFF, sizeof f->mem);
-    FILE *in = fopen(path, "rb");
-    if (in != NULL) {
-        size_t n = fread(f->mem, 1, sizeof f->mem, in);
-        fclose(in);
-        if (n != sizeof f->mem) {
-            memset(f->mem, 0xFF, sizeof f->mem); /* truncated: a blank chip */
-        }
-    } else if (!save(f)) {
+    f->fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (f->fd < 0) {
         return false;
+    }
+    if (pread(f->fd, f->mem, sizeof f->mem, 0) != (ssize_t)sizeof f->mem) {
+        memset(f->mem, 0xFF, sizeof f->mem); /* new or truncated: a blank chip */
+        if (!save(f, 0, sizeof f->mem)) {
+            return false;
+        }
     }
     f->hal = (struct hal_flash){
         .ctx = f,
@@ -73,7 +67,7 @@ bool sim_flash_open(struct sim_flash *f, const char *path)
         .page_addr = {BASE, BASE + SIM_FLASH_PAGE},
         .erase_page = erase_page,
         .program_u16 = program_u16,
-        .read = read,
+        .read = flash_read,
     };
     return true;
 }

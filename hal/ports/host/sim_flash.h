@@ -13,7 +13,7 @@
 struct sim_flash {
     struct hal_flash hal;
     uint8_t mem[2 * SIM_FLASH_PAGE];
-    char path[256];
+    int fd; /* the file, kept open; each erase or program writes through */
 };
 
 /* Opens (or creates, erased) the file; false with errno on failure. */

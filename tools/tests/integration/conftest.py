@@ -1,0 +1,62 @@
+"""Fixtures: the firmware on simulated servos (servo_sim from the host
+build) and servoctl's bus to it. Every test checks at the end that no two
+servos ever talked over each other."""
+import time
+
+import pytest
+
+from servoctl.protocol import Bus
+from servoctl.servo import Servo
+from servoctl.sim import Simulator
+
+
+def _start(tmp_path, ids, tcp=True):
+    sim = Simulator(ids=ids, tcp=tcp, state_dir=str(tmp_path / "state"))
+    sim.start()
+    return sim
+
+
+def _finish(sim, ids):
+    state = sim.state(ids[0])
+    err = sim.stop()
+    assert state["collisions"] == 0, f"responses collided on the bus: {err}"
+    # A real-time simulator that fell far behind would stretch every move.
+    assert state["dropped_ticks"] == 0, f"the simulator dropped {state['dropped_ticks']} ticks"
+    assert "runtime error" not in err and "AddressSanitizer" not in err, err
+
+
+@pytest.fixture
+def sim(tmp_path):
+    s = _start(tmp_path, [1])
+    yield s
+    _finish(s, [1])
+
+
+@pytest.fixture
+def sim3(tmp_path):
+    s = _start(tmp_path, [1, 2, 3])
+    yield s
+    _finish(s, [1, 2, 3])
+
+
+@pytest.fixture
+def bus(sim):
+    with Bus(sim.url, timeout=0.2) as b:
+        yield b
+
+
+@pytest.fixture
+def servo(bus):
+    s = Servo(bus, 1)
+    s.write("soft_start_on", 0)
+    return s
+
+
+def wait_until(predicate, timeout, step=0.005):
+    """Polls predicate until true; returns seconds waited or fails."""
+    start = time.monotonic()
+    while time.monotonic() - start < timeout:
+        if predicate():
+            return time.monotonic() - start
+        time.sleep(step)
+    raise AssertionError(f"not within {timeout} s")
