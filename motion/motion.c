@@ -425,6 +425,22 @@ void motion_init(struct motion *m, const struct registers *regs, const struct ha
 
 /* ---- the control tick --------------------------------------------------- */
 
+/* A move that ends released (wheel mode with 47 = 0) first holds its end
+ * until the horn is there and nearly still, at most SETTLE_MAX_TICKS. */
+enum {
+    SETTLE_MAX_TICKS = 200,
+    SETTLE_DECIDEG = 10,   /* 1 degree */
+    SETTLE_SPEED_Q8 = 64,  /* 0.25 decideg per tick, 25 deg/s */
+};
+
+static bool settled(const struct motion *m)
+{
+    int64_t gap = m->setpoint - m->measured;
+    int32_t speed = m->measured_velocity_q8;
+    return gap < SETTLE_DECIDEG * DECIDEG_Q32 && gap > -SETTLE_DECIDEG * DECIDEG_Q32 &&
+           speed < SETTLE_SPEED_Q8 && speed > -SETTLE_SPEED_Q8;
+}
+
 /* Turning without end (wheel run) must not outgrow the number formats: past
  * the protocol's multi-turn range the frame moves back by whole turns, and
  * the profile restarts its clock before the tick count gets large. */
@@ -541,6 +557,10 @@ void motion_tick(struct motion *m)
     };
     m->hal->motor_drive(m->hal->ctx, controller_position(&m->controller, &in));
     bool done = m->endless ? m->tick >= m->profile.accel_ticks : profile_done(&m->profile, m->tick);
+    if (done && m->end == END_RELEASE && !settled(m) &&
+        m->tick - m->profile.total_ticks < SETTLE_MAX_TICKS) {
+        done = false; /* released now, the horn would coast on past the end */
+    }
     if (m->running && done) {
         finish(m);
     }

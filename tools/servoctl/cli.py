@@ -130,13 +130,26 @@ def _wait_done(s: Servo, timeout: float):
     raise ServoError(f"servo {s.id} still moving after {timeout:.1f} s")
 
 
+def _settled_angle(s: Servo, timeout: float = 0.5) -> int:
+    """The multi-turn angle once two readings 20 ms apart agree to 0.1 deg."""
+    start = time.monotonic()
+    last = s.multi_turn_angle()[0]
+    while time.monotonic() - start < timeout:
+        time.sleep(0.02)
+        now = s.multi_turn_angle()[0]
+        if abs(now - last) <= 1:
+            return now
+        last = now
+    return last
+
+
 def cmd_move(bus, args):
     s = Servo(bus, args.id)
     s.move(decideg(args.angle), **_move_args(args))
     if args.wait:
         took = _wait_done(s, args.timeout_s)
-        angle, turns = s.multi_turn_angle()
-        print(f"servo {args.id}: at {angle / 10:.1f} deg after {took * 1000:.0f} ms")
+        angle = _settled_angle(s)
+        print(f"servo {args.id}: at {angle / 10:.1f} deg, move finished after {took * 1000:.0f} ms")
     return 0
 
 

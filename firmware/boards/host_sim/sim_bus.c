@@ -11,16 +11,13 @@ void sim_bus_init(struct sim_bus *b)
     *b = (struct sim_bus){.host_fd = -1, .last_sender = -1};
 }
 
-uint64_t sim_bus_send(struct sim_bus *b, unsigned sender, const uint8_t *data, unsigned len,
-                      uint32_t baud, uint64_t now_us)
+/* Bytes go on the one wire one byte time apart, after whatever is on it,
+ * so the queue's times never run backwards. */
+static uint64_t enqueue(struct sim_bus *b, uint8_t sender, const uint8_t *data, unsigned len,
+                        uint32_t baud, uint64_t now_us)
 {
-    if (now_us < b->busy_until_us && b->last_sender != (int)sender) {
-        b->collisions++;
-        fprintf(stderr, "servo_sim: collision: servo %u started while servo %d was sending\n",
-                b->servos[sender]->cmdline_id, b->servos[b->last_sender]->cmdline_id);
-    }
     uint64_t byte_us = baud ? (10000000u + baud - 1u) / baud : 87u;
-    uint64_t t = now_us > b->busy_until_us ? now_us : b->busy_until_us;
+    uint64_t t = now_us > b->wire_until_us ? now_us : b->wire_until_us;
     for (unsigned i = 0; i < len; i++) {
         t += byte_us;
         if (b->count == SIM_BUS_QUEUE) {
@@ -28,10 +25,23 @@ uint64_t sim_bus_send(struct sim_bus *b, unsigned sender, const uint8_t *data, u
             continue;
         }
         b->queue[(b->head + b->count) % SIM_BUS_QUEUE] =
-            (struct sim_bus_byte){.at_us = t, .byte = data[i], .sender = (uint8_t)sender};
+            (struct sim_bus_byte){.at_us = t, .byte = data[i], .sender = sender};
         b->count++;
     }
-    b->busy_until_us = t;
+    b->wire_until_us = t;
+    return t;
+}
+
+uint64_t sim_bus_send(struct sim_bus *b, unsigned sender, const uint8_t *data, unsigned len,
+                      uint32_t baud, uint64_t now_us)
+{
+    if (now_us < b->servo_until_us && b->last_sender != (int)sender) {
+        b->collisions++;
+        fprintf(stderr, "servo_sim: collision: servo %u started while servo %d was sending\n",
+                b->servos[sender]->cmdline_id, b->servos[b->last_sender]->cmdline_id);
+    }
+    uint64_t t = enqueue(b, (uint8_t)sender, data, len, baud, now_us);
+    b->servo_until_us = t;
     b->last_sender = (int)sender;
     return t;
 }
@@ -57,10 +67,20 @@ void sim_bus_deliver(struct sim_bus *b, uint64_t now_us)
     unsigned n = 0;
     while (b->count > 0 && b->queue[b->head].at_us <= now_us) {
         const struct sim_bus_byte *e = &b->queue[b->head];
+        /* Each byte carries the time it ended on the wire, as a receive
+         * interrupt would stamp it: a stalled simulator loop does not look
+         * like an idle line. The queue's times never run backwards. */
+        if (e->sender == SIM_HOST) {
+            for (unsigned s = 0; s < b->servo_count; s++) {
+                servo_on_rx_byte(&b->servos[s]->core, e->byte, (uint32_t)e->at_us);
+            }
+            b->head = (b->head + 1u) % SIM_BUS_QUEUE;
+            b->count--;
+            continue;
+        }
         for (unsigned s = 0; s < b->servo_count; s++) {
             if (s != e->sender) {
-                /* Delivery time, not wire time: timestamps never run backwards. */
-                servo_on_rx_byte(&b->servos[s]->core, e->byte, (uint32_t)now_us);
+                servo_on_rx_byte(&b->servos[s]->core, e->byte, (uint32_t)e->at_us);
             }
         }
         out[n++] = e->byte;
@@ -76,11 +96,8 @@ void sim_bus_deliver(struct sim_bus *b, uint64_t now_us)
 
 void sim_bus_from_host(struct sim_bus *b, const uint8_t *data, unsigned len, uint64_t now_us)
 {
-    for (unsigned i = 0; i < len; i++) {
-        for (unsigned s = 0; s < b->servo_count; s++) {
-            servo_on_rx_byte(&b->servos[s]->core, data[i], (uint32_t)now_us);
-        }
-    }
+    uint32_t baud = b->servo_count ? b->servos[0]->baud : 115200u;
+    (void)enqueue(b, SIM_HOST, data, len, baud, now_us);
 }
 
 int64_t sim_bus_next_due(const struct sim_bus *b, uint64_t now_us)

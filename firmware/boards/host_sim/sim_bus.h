@@ -1,6 +1,7 @@
 /* The shared half-duplex wire of the simulator: what one servo sends reaches
  * the host and every other servo one byte time after another, after whatever
- * is already on the wire; the host's bytes reach every servo at once. A
+ * is already on the wire; the host's bytes reach every servo paced the same
+ * way (a pty or socket delivers them in bursts a UART never would). A
  * servo that starts sending while another's bytes are on the wire is a
  * collision, counted and logged: on a real bus it would garble both. */
 #ifndef SIM_BUS_H
@@ -10,6 +11,7 @@
 
 #define SIM_BUS_QUEUE 8192u
 #define SIM_MAX_SERVOS 16u
+#define SIM_HOST 0xFFu /* sender of the host's bytes */
 
 struct sim_servo;
 
@@ -23,8 +25,9 @@ struct sim_bus {
     struct sim_bus_byte queue[SIM_BUS_QUEUE];
     unsigned head;
     unsigned count;
-    uint64_t busy_until_us;   /* end of the last byte queued */
-    int last_sender;
+    uint64_t wire_until_us;   /* end of the last byte queued, host's or servo's */
+    uint64_t servo_until_us;  /* end of the last servo byte queued */
+    int last_sender;          /* servo that queued it */
     int host_fd;              /* -1: no host connected */
     struct sim_servo *servos[SIM_MAX_SERVOS];
     unsigned servo_count;

@@ -1,0 +1,51 @@
+"""servoctl's framing, error reporting and data table, without a servo."""
+import pytest
+
+from servoctl import protocol as p
+from servoctl import registers
+from servoctl.protocol import Bus, BadChecksum, NoReply, ValueOutOfRange
+
+
+def test_frames():
+    assert p.request_frame(1, bytes([1])) == bytes.fromhex("124c01010161")
+    assert p.response_frame(1, bytes([0])) == bytes.fromhex("051c01010023")
+    long = p.request_frame(25, bytes(300))
+    assert long[3] == 0xFF and long[4:6] == (300).to_bytes(2, "little")
+    assert sum(long[:-1]) % 256 == long[-1]
+
+
+def test_no_reply_says_who_and_what():
+    with Bus("loop://", timeout=0.05) as bus:
+        with pytest.raises(NoReply, match="servo 3: no reply to packet 1 within 50 ms"):
+            bus.request(p.PING, bytes([3]))  # loop:// echoes the request: not a response
+
+
+def test_bad_checksum_is_reported():
+    with Bus("loop://", timeout=0.05) as bus:
+        frame = bytearray(p.response_frame(p.PING, bytes([3])))
+        frame[-1] ^= 0x55
+        bus.serial.write(bytes(frame))
+        with pytest.raises(BadChecksum, match="servo 3: response to packet 1 had a bad checksum"):
+            bus.read_response(p.PING, 3)
+
+
+def test_other_frames_are_skipped():
+    with Bus("loop://", timeout=0.05) as bus:
+        bus.serial.write(b"\x00\x12" + p.response_frame(p.PING, bytes([4])) +
+                         p.response_frame(p.READ_ANGLE, bytes([3, 1, 2])))
+        assert bus.read_response(p.READ_ANGLE, 3) == bytes([3, 1, 2])
+
+
+def test_values_are_checked_before_sending():
+    with pytest.raises(ValueOutOfRange, match=r"angle_max \(51\) must be -1800..1800"):
+        registers.find("angle_max").check(2000)
+    with pytest.raises(ValueOutOfRange, match="read-only"):
+        registers.find(1).check(5)
+    with pytest.raises(ValueOutOfRange, match="no data item"):
+        registers.find("colour")
+    values = {i.name: i.default for i in registers.USER}
+    block = registers.encode_user_area(values)
+    assert len(block) == 32 and registers.decode_user_area(block) == values
+    values["low_voltage"] = 9000
+    with pytest.raises(ValueOutOfRange, match="below high_voltage"):
+        registers.encode_user_area(values)
