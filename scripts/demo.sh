@@ -1,22 +1,35 @@
 #!/usr/bin/env bash
-# The demo, for now: builds the STM32F103 image and shows its footprint, runs
-# the unit tests, and prints the protocol benchmark. (A simulated servo driven
-# by the PC tool joins it with the simulator.)
+# The demo: builds everything, starts a simulated servo running the firmware,
+# and drives it with servoctl: scan, info, a velocity-profile move, and a
+# recorded move plotted against its plan (the PNG's path is printed).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
 
-echo; echo "== firmware image for the STM32F103"
-cmake --preset arm >/dev/null
-cmake --build --preset arm | grep -E '^image:' || true
-ls -l build/arm/firmware/boards/stm32f103/servo_stm32f103.bin
-
-echo; echo "== unit tests"
+echo; echo "== building: host (simulator, tests) and the STM32F103 image"
 cmake --preset host >/dev/null
 cmake --build --preset host >/dev/null
-ctest --preset host | tail -n 3
+cmake --preset arm >/dev/null
+cmake --build --preset arm | grep -E '^image:' || true
 
-echo; echo "== protocol benchmark (callgrind)"
-cmake --preset bench >/dev/null
-cmake --build --preset bench >/dev/null
-.venv/bin/python tests/bench/run_bench.py build/bench/tests/bench
+out=demo-output
+mkdir -p "$out"
+state=$(mktemp -d)
+port=$(.venv/bin/python -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
+./build/host/firmware/boards/host_sim/servo_sim --id 1 --tcp "$port" --state "$state" >"$out/sim.log" 2>&1 &
+sim=$!
+trap 'kill $sim 2>/dev/null || true; rm -rf "$state"' EXIT
+for _ in $(seq 100); do grep -q ready "$out/sim.log" 2>/dev/null && break; sleep 0.05; done
+grep -q ready "$out/sim.log" || { cat "$out/sim.log" >&2; echo "demo: the simulator did not start" >&2; exit 1; }
+export SERVOCTL_PORT="socket://127.0.0.1:$port"
+servoctl=.venv/bin/servoctl
+echo; echo "== a simulated servo on $SERVOCTL_PORT"
+
+step() { echo; echo "\$ servoctl $*"; "$servoctl" "$@"; }
+step scan --last 10
+step info 1
+step config set 1 soft_start_on 0
+step move 1 100 --velocity 300 --acc 100 --dec 200 --wait
+step record 1 -45 --velocity 200 --acc 100 --dec 100 --out "$out/record"
+echo
+echo "demo: done; the recorded move is plotted in $(pwd)/$out/record.png"

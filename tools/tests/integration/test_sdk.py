@@ -8,10 +8,11 @@ import time
 import pytest
 import serial
 
-fashionstar = pytest.importorskip("fashionstar_uart_sdk")
-from fashionstar_uart_sdk import PortHandler, SyncPositionControlOptions, UartServoManager  # noqa: E402
+# Installed by scripts/setup.sh (tools/requirements.txt): a missing SDK fails
+# here rather than skipping quietly.
+from fashionstar_uart_sdk import PortHandler, SyncPositionControlOptions, UartServoManager
 
-from servoctl.sim import Simulator  # noqa: E402
+from servoctl.sim import Simulator
 
 IDS = (0, 1, 2)
 
