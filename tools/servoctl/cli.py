@@ -111,11 +111,16 @@ def cmd_config(bus, args):
 
 
 def _move_args(args):
-    kw = dict(acc_ms=args.acc, dec_ms=args.dec, power_mw=args.power, multi_turn=args.multi_turn)
+    """Packet choice: --velocity: 12/15; --interval with --acc or --dec:
+    11/14; --interval alone: the plain angle modes 8/13."""
+    acc = 20 if args.acc is None else args.acc
+    dec = 20 if args.dec is None else args.dec
+    kw = dict(acc_ms=acc, dec_ms=dec, power_mw=args.power, multi_turn=args.multi_turn)
     if args.velocity is not None:
         kw["velocity"] = decideg(args.velocity)
     else:
         kw["interval_ms"] = args.interval if args.interval is not None else 1000
+        kw["ramps"] = args.acc is not None or args.dec is not None
     return kw
 
 
@@ -211,8 +216,8 @@ def cmd_record(bus, args):
     start = s.monitor().angle_decideg
     target = decideg(args.angle)
     kw = _move_args(args)
-    acc = max(args.acc, 20)
-    dec = max(args.dec, 20)
+    acc = max(kw["acc_ms"], 20)
+    dec = max(kw["dec_ms"], 20)
     if "velocity" in kw:
         n1, nc, n3 = velocity_timing(target - start, 0.0, kw["velocity"] / 1000.0, acc, dec)
     else:
@@ -335,8 +340,8 @@ def build_parser():
         g = c.add_mutually_exclusive_group()
         g.add_argument("--interval", type=int, help="ms to get there (default 1000)")
         g.add_argument("--velocity", type=float, help="peak speed, deg/s")
-        c.add_argument("--acc", type=int, default=20, help="acceleration ramp, ms (>= 20)")
-        c.add_argument("--dec", type=int, default=20, help="deceleration ramp, ms (>= 20)")
+        c.add_argument("--acc", type=int, help="acceleration ramp, ms (>= 20; default 20)")
+        c.add_argument("--dec", type=int, help="deceleration ramp, ms (>= 20; default 20)")
         c.add_argument("--power", type=int, default=0, help="mW; 0 = the power limit (42)")
         c.add_argument("--multi-turn", action="store_true")
 

@@ -96,9 +96,10 @@ class Servo:
 
     def move(self, angle_decideg: int, interval_ms: int = None, velocity: int = None,
              acc_ms: int = 20, dec_ms: int = 20, power_mw: int = 0, multi_turn: bool = False,
-             wait=False):
-        """An angle move: by interval (packets 8/11, 13/14) or by velocity in
-        0.1 deg/s (12, 15)."""
+             wait=False, ramps: bool = True):
+        """An angle move: by interval with ramps (packets 11, 14) or without
+        (ramps=False: 8, 13, which ramp 20 ms), or by velocity in 0.1 deg/s
+        (12, 15)."""
         _check("power", power_mw, 0, 65535, "mW")
         _check("acceleration time", acc_ms, 0, 65535, "ms")
         _check("deceleration time", dec_ms, 0, 65535, "ms")
@@ -112,6 +113,10 @@ class Servo:
             _check("velocity", velocity, 10, 7500, "x0.1 deg/s")
             fmt, code = ("<BiHHHH", p.MULTI_TURN_BY_VELOCITY) if multi_turn else ("<BhHHHH", p.ANGLE_BY_VELOCITY)
             content = struct.pack(fmt, self.id, angle_decideg, velocity, acc_ms, dec_ms, power_mw)
+        elif not ramps:
+            _check("interval", interval_ms, 0, 4096000 if multi_turn else 65535, "ms")
+            fmt, code = ("<BiIH", p.MULTI_TURN) if multi_turn else ("<BhHH", p.ANGLE)
+            content = struct.pack(fmt, self.id, angle_decideg, interval_ms, power_mw)
         else:
             _check("interval", interval_ms, 0, 4096000 if multi_turn else 65535, "ms")
             fmt, code = ("<BiIHHH", p.MULTI_TURN_BY_INTERVAL) if multi_turn else ("<BhHHHH", p.ANGLE_BY_INTERVAL)

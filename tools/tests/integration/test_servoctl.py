@@ -65,7 +65,16 @@ def test_motion_commands(sim, capsys):
     assert sim.state(1)["velocity"] > 80
     run(sim, capsys, "wheel", "1", "stop")
     run(sim, capsys, "damping", "1", "--power", "500")
-    run(sim, capsys, "move", "1", "720", "--multi-turn", "--interval", "2000", "--wait")
+    # Every angle mode: plain 8 and 13 (interval alone), 11 and 14 (with
+    # ramps), 12 and 15 (velocity).
+    for argv, target in [(["30", "--interval", "300"], 30.0),
+                         (["-30", "--interval", "400", "--acc", "100"], -30.0),
+                         (["20", "--velocity", "200"], 20.0),
+                         (["400", "--multi-turn", "--interval", "1500"], 400.0),
+                         (["-400", "--multi-turn", "--interval", "3000", "--dec", "200"], -400.0),
+                         (["720", "--multi-turn", "--velocity", "300"], 720.0)]:
+        rc, out, _ = run(sim, capsys, "move", "1", *argv, "--wait")
+        assert rc == 0 and abs(float(out.split(" at ")[1].split(" deg")[0]) - target) <= 0.5, out
     rc, out, _ = run(sim, capsys, "monitor", "1", "--count", "2", "--every", "0.01")
     rows = [line for line in out.splitlines() if line.strip().startswith("1 ")]
     assert len(rows) == 2
