@@ -167,7 +167,10 @@ static bool header_start(struct frame_rx *rx, uint8_t byte)
 
 void frame_rx_feed(struct frame_rx *rx, uint8_t byte, uint32_t now_us)
 {
-    if (rx->state != RX_HDR0 && now_us - rx->last_byte_us > rx->idle_timeout_us) {
+    /* Signed: a clock that stepped back a little (an emulated SysTick can)
+     * is no idle line. */
+    int32_t gap = (int32_t)(now_us - rx->last_byte_us);
+    if (rx->state != RX_HDR0 && gap > (int32_t)rx->idle_timeout_us) {
         rx->stats.idle_timeouts++;
         rx->state = RX_HDR0;
     }

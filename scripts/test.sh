@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# Runs every test: unit tests under ASan + UBSan, the PC tool's pytest tests,
-# a bounded fuzz run, and the ARM image build with its flash/RAM budget and
-# soft-float checks.
+# Runs every test: unit tests under ASan + UBSan; the ARM images with their
+# flash/RAM budget and soft-float checks; pytest: the PC tool, the firmware on
+# simulated servos (servoctl and the maker's SDK), the real ARM image under
+# QEMU; a bounded fuzz run.
 # FUZZ_SECONDS sets the fuzz run's length (default 60).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -15,7 +16,11 @@ cmake --build --preset host
 ctest --preset host | tee build/host/ctest.log
 unit=$(sed -nE 's/.*tests passed, 0 tests failed out of ([0-9]+).*/\1/p' build/host/ctest.log)
 
-step "PC tool tests (pytest)"
+step "ARM images (STM32F103, and the QEMU board): budget and soft-float checks"
+cmake --preset arm >/dev/null
+cmake --build --preset arm
+
+step "PC tool, simulator, maker's SDK and QEMU board tests (pytest)"
 (cd tools && ../.venv/bin/python -m pytest -q) | tee build/host/pytest.log
 tools_passed=$(sed -nE 's/^([0-9]+) passed.*/\1/p' build/host/pytest.log)
 
@@ -33,9 +38,6 @@ trap 'rm -rf "$work"' EXIT
 }
 grep -E '^(#[0-9]+\s+DONE|stat::number_of_executed_units)' "$work/log"
 
-step "ARM image (STM32F103): budget and soft-float checks"
-cmake --preset arm >/dev/null
-cmake --build --preset arm
 
 echo
 # CTest programs, pytest tests, the fuzz run and the ARM image check.

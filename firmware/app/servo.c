@@ -5,6 +5,12 @@
 #include "identity.h"
 #include "protocol/data_table.h"
 
+static uint32_t idle_timeout_us(const struct servo *s, uint32_t baud)
+{
+    uint32_t us = frame_rx_idle_us(baud);
+    return us > s->hal->rx_gap_tolerance_us ? us : s->hal->rx_gap_tolerance_us;
+}
+
 static void apply_link_settings(struct servo *s)
 {
     s->active_id = s->regs.user.servo_id;
@@ -12,7 +18,7 @@ static void apply_link_settings(struct servo *s)
         s->active_baud_index = s->regs.user.baud_index;
         uint32_t baud = baud_rate_of_index(s->active_baud_index);
         s->hal->uart_set_baud(s->hal->ctx, baud);
-        frame_rx_set_idle_timeout(&s->rx, frame_rx_idle_us(baud));
+        frame_rx_set_idle_timeout(&s->rx, idle_timeout_us(s, baud));
     }
 }
 
@@ -26,7 +32,7 @@ void servo_init(struct servo *s, const struct hal_port *hal)
     protection_init(&s->protection);
     motion_init(&s->motion, &s->regs, hal);
     s->next_tick_us = hal->now_us(hal->ctx) + CONTROL_TICK_US;
-    frame_rx_init(&s->rx, &s->active_id, frame_rx_idle_us(0));
+    frame_rx_init(&s->rx, &s->active_id, idle_timeout_us(s, 0));
     dispatcher_init(&s->dispatcher, &s->regs, &s->motion, &s->active_id);
     s->max_catch_up = SERVO_MAX_CATCH_UP;
     s->active_baud_index = 0; /* forces the first apply to set the UART */

@@ -191,6 +191,19 @@ static void test_idle_timeout_survives_clock_wrap(void **state)
     assert_int_equal(f->rx.stats.idle_timeouts, 0);
 }
 
+static void test_clock_stepping_back_is_not_an_idle_gap(void **state)
+{
+    struct fixture *f = *state;
+    uint8_t wire[16];
+    const uint8_t ping[] = {3};
+    size_t n = make_request(wire, 1, ping, 1);
+    feed(f, wire, 3);
+    f->now -= 1000; /* the clock reads 1 ms earlier than the last byte */
+    feed(f, wire + 3, n - 3);
+    assert_non_null(take(f));
+    assert_int_equal(f->rx.stats.idle_timeouts, 0);
+}
+
 static void test_without_idle_gap_truncated_frame_swallows_next(void **state)
 {
     /* Documents why the idle timeout exists: with no gap, a truncated frame
@@ -376,6 +389,7 @@ int main(void)
         cmocka_unit_test_setup(test_partial_frame_dropped_after_idle, setup),
         cmocka_unit_test_setup(test_gap_at_the_idle_limit_keeps_the_frame, setup),
         cmocka_unit_test_setup(test_idle_timeout_survives_clock_wrap, setup),
+        cmocka_unit_test_setup(test_clock_stepping_back_is_not_an_idle_gap, setup),
         cmocka_unit_test_setup(test_without_idle_gap_truncated_frame_swallows_next, setup),
         cmocka_unit_test_setup(test_extended_length, setup),
         cmocka_unit_test_setup(test_extended_length_short_frame, setup),

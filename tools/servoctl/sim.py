@@ -119,3 +119,57 @@ def _free_port() -> int:
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
         return s.getsockname()[1]
+
+
+QEMU_IMAGE = REPO / "build" / "arm" / "firmware" / "boards" / "qemu_stm32vl" / "servo_qemu_stm32vl.elf"
+
+
+class QemuBoard:
+    """The real ARM image on QEMU's stm32vldiscovery, its USART1 on a TCP
+    port (pyserial socket://)."""
+
+    def __init__(self, image=None):
+        self.image = Path(image or os.environ.get("SERVO_QEMU_IMAGE", QEMU_IMAGE))
+        self.process = None
+        self.url = None
+
+    def start(self) -> "QemuBoard":
+        if not self.image.exists():
+            raise ServoError(f"no image at {self.image}: build it with "
+                             f"'cmake --preset arm && cmake --build --preset arm'")
+        port = _free_port()
+        self.process = subprocess.Popen(
+            ["qemu-system-arm", "-M", "stm32vldiscovery", "-kernel", str(self.image),
+             "-nographic", "-monitor", "none",
+             "-serial", f"tcp:127.0.0.1:{port},server=on,wait=off,nodelay=on"],
+            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        self.url = f"socket://127.0.0.1:{port}"
+        deadline = time.monotonic() + 10
+        while time.monotonic() < deadline:
+            if self.process.poll() is not None:
+                raise ServoError(f"qemu exited: {self.process.stderr.read().strip()}")
+            try:
+                socket.create_connection(("127.0.0.1", port), timeout=0.2).close()
+                return self
+            except OSError:
+                time.sleep(0.05)
+        self.stop()
+        raise ServoError("qemu did not open its serial port within 10 s")
+
+    def stop(self) -> str:
+        if self.process is None:
+            return ""
+        self.process.terminate()
+        try:
+            _, err = self.process.communicate(timeout=10)
+        except subprocess.TimeoutExpired:
+            self.process.kill()
+            _, err = self.process.communicate()
+        self.process = None
+        return err
+
+    def __enter__(self):
+        return self.start()
+
+    def __exit__(self, *exc):
+        self.stop()

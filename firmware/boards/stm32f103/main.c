@@ -1,15 +1,125 @@
-/* Reference board: STM32F103 servo controller. */
-#include "port_stm32f103.h"
+/* The reference board: STM32F103 servo controller (pin map: README.md). */
+#include "board_f103.h"
+#include "calibration.h"
+#include "flash_f1.h"
 #include "servo.h"
+#include "stm32f1_regs.h"
+#include "systick_clock.h"
+#include "usart_hd.h"
+
+/* The last two 1 KB pages of the 64 KB part hold the config store (kept out
+ * of the image by the linker script). */
+#define CONFIG_PAGE0 0x0800F800u
+#define CONFIG_PAGE1 0x0800FC00u
 
 static struct servo servo;
 static struct hal_port port;
+static struct usart_hd usart;
+static struct hal_flash flash;
+
+static void on_byte(void *ctx, uint8_t byte)
+{
+    servo_on_rx_byte(ctx, byte, systick_now_us());
+}
+
+void USART1_IRQHandler(void);
+void USART1_IRQHandler(void)
+{
+    usart_hd_irq(&usart);
+}
+
+static uint32_t now_us(void *ctx)
+{
+    (void)ctx;
+    return systick_now_us();
+}
+
+static void uart_send(void *ctx, const uint8_t *data, uint16_t len)
+{
+    usart_hd_send(ctx, data, len);
+}
+
+static bool uart_tx_done(void *ctx)
+{
+    return usart_hd_tx_done(ctx);
+}
+
+static void uart_set_baud(void *ctx, uint32_t baud)
+{
+    usart_hd_set_baud(ctx, baud);
+}
+
+static void motor_drive(void *ctx, int16_t duty)
+{
+    (void)ctx;
+    pwm_bridge_drive(duty);
+}
+
+static void motor_coast(void *ctx)
+{
+    (void)ctx;
+    pwm_bridge_coast();
+}
+
+static uint16_t encoder_read(void *ctx)
+{
+    (void)ctx;
+    return adc_scan_values[ADC_POSITION];
+}
+
+static void sensors_read(void *ctx, struct sensor_raw *out)
+{
+    (void)ctx;
+    out->supply = adc_scan_values[ADC_SUPPLY];
+    out->current = adc_scan_values[ADC_CURRENT];
+    out->ntc = adc_scan_values[ADC_NTC];
+}
+
+static const struct sensor_calibration calibration = {
+    .supply_uv_per_count = BOARD_SUPPLY_UV_PER_COUNT,
+    .current_ua_per_count = BOARD_CURRENT_UA_PER_COUNT,
+    .current_zero_counts = BOARD_CURRENT_ZERO_COUNTS,
+};
+
+static void gpio_init(void)
+{
+    RCC_APB2ENR |= RCC_APB2ENR_GPIOA | RCC_APB2ENR_AFIO | RCC_APB2ENR_USART1;
+    /* PA0-PA3 analogue; PA6, PA7 TIM3 CH1/CH2 push-pull. */
+    GPIOA_CRL = (GPIO_ANALOG << 0) | (GPIO_ANALOG << 4) | (GPIO_ANALOG << 8) |
+                (GPIO_ANALOG << 12) | (GPIO_AF_PUSH_PULL_50MHZ << 24) |
+                (GPIO_AF_PUSH_PULL_50MHZ << 28) | (0x4u << 16) | (0x4u << 20);
+    /* PA9 USART1 TX, open drain: the single bus wire (external pull-up). */
+    GPIOA_CRH = (GPIOA_CRH & ~(0xFu << 4)) | (GPIO_AF_OPEN_DRAIN_50MHZ << 4);
+}
 
 int main(void)
 {
-    port_init(&port, &servo);
+    clock_f103_init();
+    gpio_init();
+    systick_clock_init(F103_CORE_HZ);
+    adc_scan_init();
+    pwm_bridge_init();
+    flash_f1_init(&flash, 1024u, CONFIG_PAGE0, CONFIG_PAGE1);
+    usart_hd_init(&usart, USART1_BASE, F103_PCLK2_HZ, 115200u, true, on_byte, &servo);
+    port = (struct hal_port){
+        .ctx = &usart,
+        .now_us = now_us,
+        .uart_send = uart_send,
+        .uart_tx_done = uart_tx_done,
+        .uart_set_baud = uart_set_baud,
+        .motor_drive = motor_drive,
+        .motor_coast = motor_coast,
+        .encoder_read = encoder_read,
+        .sensors_read = sensors_read,
+        .calibration = &calibration,
+        .flash = &flash,
+        .serial_number = unique_id_serial(),
+    };
     servo_init(&servo, &port);
+    NVIC_ISER(USART1_IRQ / 32u) = 1u << (USART1_IRQ % 32u);
+    iwdg_start();
     for (;;) {
         servo_poll(&servo);
+        iwdg_kick();
     }
 }

@@ -35,6 +35,10 @@ struct hal_port {
     const struct hal_flash *flash;
     /* Data ID 8: derived by the port from the MCU's unique ID. */
     uint32_t serial_number;
+    /* Longest gap between the bytes of one frame the link can produce, in
+     * us; 0 for a real UART (the framer's own rule, frame_rx_idle_us). An
+     * emulated UART delivers bytes with the host's scheduling jitter. */
+    uint32_t rx_gap_tolerance_us;
 };
 
 #endif

@@ -1,0 +1,153 @@
+/* The servo on QEMU's stm32vldiscovery (STM32F100): the real USART driver
+ * and the real core; motor, sensors and flash come from models compiled into
+ * the image, since QEMU has no ADC, timers or flash controller for it. */
+#include "calibration.h"
+#include "plant_fixed.h"
+#include "servo.h"
+#include "stm32f1_regs.h"
+#include "systick_clock.h"
+#include "usart_hd.h"
+
+#define QEMU_CORE_HZ 24000000u /* QEMU's fixed sysclk for this board */
+#define FLASH_PAGE 1024u
+#define RAM_FLASH_BASE 0x0801F800u /* where the pages would be; kept in RAM */
+
+static struct servo servo;
+static struct hal_port port;
+static struct usart_hd usart;
+static struct plant_fixed plant;
+static uint8_t flash_mem[2 * FLASH_PAGE];
+static struct hal_flash flash;
+
+static void on_byte(void *ctx, uint8_t byte)
+{
+    servo_on_rx_byte(ctx, byte, systick_now_us());
+}
+
+void USART1_IRQHandler(void);
+void USART1_IRQHandler(void)
+{
+    usart_hd_irq(&usart);
+}
+
+static uint32_t now_us(void *ctx)
+{
+    (void)ctx;
+    return systick_now_us();
+}
+
+static void uart_send(void *ctx, const uint8_t *data, uint16_t len)
+{
+    usart_hd_send(ctx, data, len);
+}
+
+static bool uart_tx_done(void *ctx)
+{
+    return usart_hd_tx_done(ctx);
+}
+
+static void uart_set_baud(void *ctx, uint32_t baud)
+{
+    usart_hd_set_baud(ctx, baud);
+}
+
+static void motor_drive(void *ctx, int16_t duty)
+{
+    (void)ctx;
+    plant.duty = duty;
+    plant.coast = false;
+}
+
+static void motor_coast(void *ctx)
+{
+    (void)ctx;
+    plant.coast = true;
+}
+
+/* Read once per control tick: the model advances one tick. */
+static uint16_t encoder_read(void *ctx)
+{
+    (void)ctx;
+    plant_fixed_step(&plant);
+    return plant_fixed_encoder(&plant);
+}
+
+static void sensors_read(void *ctx, struct sensor_raw *out)
+{
+    (void)ctx;
+    out->supply = (uint16_t)(7400u * 1000u / BOARD_SUPPLY_UV_PER_COUNT);
+    out->current = (uint16_t)(plant_fixed_current_ma(&plant) * 1000u / BOARD_CURRENT_UA_PER_COUNT);
+    out->ntc = 2048; /* 25 degC */
+}
+
+static const struct sensor_calibration calibration = {
+    .supply_uv_per_count = BOARD_SUPPLY_UV_PER_COUNT,
+    .current_ua_per_count = BOARD_CURRENT_UA_PER_COUNT,
+    .current_zero_counts = BOARD_CURRENT_ZERO_COUNTS,
+};
+
+static bool ram_erase(void *ctx, uint32_t addr)
+{
+    (void)ctx;
+    uint32_t offset = addr - RAM_FLASH_BASE;
+    for (uint32_t i = 0; i < FLASH_PAGE; i++) {
+        flash_mem[offset + i] = 0xFF;
+    }
+    return true;
+}
+
+static bool ram_program(void *ctx, uint32_t addr, uint16_t value)
+{
+    (void)ctx;
+    uint32_t offset = addr - RAM_FLASH_BASE;
+    flash_mem[offset] &= (uint8_t)(value & 0xFFu);
+    flash_mem[offset + 1u] &= (uint8_t)(value >> 8);
+    return true;
+}
+
+static void ram_read(void *ctx, uint32_t addr, uint8_t *dst, uint32_t len)
+{
+    (void)ctx;
+    for (uint32_t i = 0; i < len; i++) {
+        dst[i] = flash_mem[addr - RAM_FLASH_BASE + i];
+    }
+}
+
+int main(void)
+{
+    for (uint32_t i = 0; i < sizeof flash_mem; i++) {
+        flash_mem[i] = 0xFF;
+    }
+    flash = (struct hal_flash){
+        .page_size = FLASH_PAGE,
+        .page_addr = {RAM_FLASH_BASE, RAM_FLASH_BASE + FLASH_PAGE},
+        .erase_page = ram_erase,
+        .program_u16 = ram_program,
+        .read = ram_read,
+    };
+    systick_clock_init(QEMU_CORE_HZ);
+    usart_hd_init(&usart, USART1_BASE, QEMU_CORE_HZ, 115200u, true, on_byte, &servo);
+    usart_hd_tx_polled(&usart); /* QEMU 7.2's USART raises no transmit interrupts */
+    usart_hd_no_echo(&usart);   /* and its socket does not echo our bytes */
+    port = (struct hal_port){
+        .ctx = &usart,
+        .now_us = now_us,
+        .uart_send = uart_send,
+        .uart_tx_done = uart_tx_done,
+        .uart_set_baud = uart_set_baud,
+        .motor_drive = motor_drive,
+        .motor_coast = motor_coast,
+        .encoder_read = encoder_read,
+        .sensors_read = sensors_read,
+        .calibration = &calibration,
+        .flash = &flash,
+        .serial_number = 0x0E3A0001u,
+        .rx_gap_tolerance_us = 50000u, /* QEMU delivers a frame's bytes with jitter */
+    };
+    servo_init(&servo, &port);
+    NVIC_ISER(USART1_IRQ / 32u) = 1u << (USART1_IRQ % 32u);
+    for (;;) {
+        usart_hd_service(&usart);
+        servo_poll(&servo);
+    }
+}

@@ -1,0 +1,97 @@
+#include "board_f103.h"
+
+#include "stm32f1_regs.h"
+
+enum { HSE_STARTUP_TRIES = 100000, PWM_HZ = 20000 };
+
+void clock_f103_init(void)
+{
+    RCC_CR |= RCC_CR_HSEON;
+    for (int i = 0; !(RCC_CR & RCC_CR_HSERDY); i++) {
+        if (i == HSE_STARTUP_TRIES) {
+            return; /* no crystal: run on HSI; the UART timing will be off */
+        }
+    }
+    FLASH_ACR = FLASH_ACR_PRFTBE | FLASH_ACR_LATENCY_2; /* 72 MHz needs 2 wait states */
+    RCC_CFGR = RCC_CFGR_PLLSRC_HSE | RCC_CFGR_PLLMUL9 | RCC_CFGR_PPRE1_DIV2 | RCC_CFGR_ADCPRE_DIV6;
+    RCC_CR |= RCC_CR_PLLON;
+    while (!(RCC_CR & RCC_CR_PLLRDY)) {
+    }
+    RCC_CFGR |= RCC_CFGR_SW_PLL;
+    while ((RCC_CFGR & RCC_CFGR_SWS_MASK) != RCC_CFGR_SWS_PLL) {
+    }
+}
+
+static uint32_t pwm_top;
+
+void pwm_bridge_init(void)
+{
+    RCC_APB1ENR |= RCC_APB1ENR_TIM3;
+    /* Timer clock is 2 x PCLK1 = 72 MHz. */
+    pwm_top = 2u * F103_PCLK1_HZ / PWM_HZ;
+    TIM_PSC(TIM3_BASE) = 0;
+    TIM_ARR(TIM3_BASE) = pwm_top - 1u;
+    TIM_CCMR1(TIM3_BASE) = TIM_CCMR1_PWM1_BOTH;
+    TIM_CCR1(TIM3_BASE) = 0;
+    TIM_CCR2(TIM3_BASE) = 0;
+    TIM_CCER(TIM3_BASE) = TIM_CCER_CC1E_CC2E;
+    TIM_EGR(TIM3_BASE) = 1u; /* load the preloaded values */
+    TIM_CR1(TIM3_BASE) = 1u | (1u << 7); /* CEN, ARPE */
+}
+
+void pwm_bridge_drive(int16_t duty_q15)
+{
+    uint32_t magnitude = (uint32_t)(duty_q15 < 0 ? -(int32_t)duty_q15 : duty_q15);
+    uint32_t compare = magnitude * pwm_top >> 15;
+    TIM_CCR1(TIM3_BASE) = duty_q15 > 0 ? compare : 0u;
+    TIM_CCR2(TIM3_BASE) = duty_q15 < 0 ? compare : 0u;
+}
+
+void pwm_bridge_coast(void)
+{
+    TIM_CCR1(TIM3_BASE) = 0;
+    TIM_CCR2(TIM3_BASE) = 0;
+}
+
+volatile uint16_t adc_scan_values[ADC_CHANNELS];
+
+void adc_scan_init(void)
+{
+    RCC_AHBENR |= RCC_AHBENR_DMA1;
+    RCC_APB2ENR |= RCC_APB2ENR_ADC1;
+    DMA1_CPAR1 = ADC_DR_ADDR;
+    DMA1_CMAR1 = (uint32_t)(uintptr_t)adc_scan_values;
+    DMA1_CNDTR1 = ADC_CHANNELS;
+    DMA1_CCR1 = DMA_CCR_ADC_CIRCULAR;
+    /* Channels 0-3 (PA0-PA3), 55.5 cycles each: 4 x 5.8 us at 12 MHz. */
+    ADC_SMPR2 = 5u | (5u << 3) | (5u << 6) | (5u << 9);
+    ADC_SQR1 = (uint32_t)(ADC_CHANNELS - 1) << 20;
+    ADC_SQR3 = 0u | (1u << 5) | (2u << 10) | (3u << 15);
+    ADC_CR1 = ADC_CR1_SCAN;
+    ADC_CR2 = ADC_CR2_ADON;
+    ADC_CR2 = ADC_CR2_ADON | ADC_CR2_CAL;
+    while (ADC_CR2 & ADC_CR2_CAL) {
+    }
+    ADC_CR2 = ADC_CR2_ADON | ADC_CR2_CONT | ADC_CR2_DMA | ADC_CR2_EXTSEL_SWSTART |
+              ADC_CR2_EXTTRIG;
+    ADC_CR2 |= ADC_CR2_SWSTART;
+}
+
+void iwdg_start(void)
+{
+    IWDG_KR = IWDG_KEY_START;
+    IWDG_KR = IWDG_KEY_ACCESS;
+    IWDG_PR = 0; /* 40 kHz / 4 */
+    IWDG_RLR = 1250u; /* 125 ms */
+    IWDG_KR = IWDG_KEY_RELOAD;
+}
+
+void iwdg_kick(void)
+{
+    IWDG_KR = IWDG_KEY_RELOAD;
+}
+
+uint32_t unique_id_serial(void)
+{
+    return REG32(UID_ADDR) ^ REG32(UID_ADDR + 4u) ^ REG32(UID_ADDR + 8u);
+}

@@ -1,0 +1,68 @@
+#include "flash_f1.h"
+
+#include "stm32f1_regs.h"
+
+static void unlock(void)
+{
+    if (FLASH_CR & FLASH_CR_LOCK) {
+        FLASH_KEYR = FLASH_KEY1;
+        FLASH_KEYR = FLASH_KEY2;
+    }
+}
+
+/* Waits for the operation, clears its flags, says whether it succeeded. */
+static bool finish(void)
+{
+    while (FLASH_SR & FLASH_SR_BSY) {
+    }
+    uint32_t sr = FLASH_SR;
+    FLASH_SR = FLASH_SR_EOP | FLASH_SR_PGERR | FLASH_SR_WRPRTERR;
+    FLASH_CR = FLASH_CR_LOCK;
+    return (sr & (FLASH_SR_PGERR | FLASH_SR_WRPRTERR)) == 0u;
+}
+
+static bool erase_page(void *ctx, uint32_t addr)
+{
+    const struct hal_flash *f = ctx;
+    unlock();
+    FLASH_CR = FLASH_CR_PER;
+    FLASH_AR = addr;
+    FLASH_CR = FLASH_CR_PER | FLASH_CR_STRT;
+    bool ok = finish();
+    for (uint32_t i = 0; ok && i < f->page_size; i += 4u) {
+        ok = REG32(addr + i) == 0xFFFFFFFFu;
+    }
+    return ok;
+}
+
+static bool program_u16(void *ctx, uint32_t addr, uint16_t value)
+{
+    (void)ctx;
+    volatile uint16_t *cell = (volatile uint16_t *)(uintptr_t)addr;
+    unlock();
+    FLASH_CR = FLASH_CR_PG;
+    *cell = value;
+    bool ok = finish();
+    return ok && *cell == value;
+}
+
+static void flash_read(void *ctx, uint32_t addr, uint8_t *dst, uint32_t len)
+{
+    (void)ctx;
+    const volatile uint8_t *src = (const volatile uint8_t *)(uintptr_t)addr;
+    for (uint32_t i = 0; i < len; i++) {
+        dst[i] = src[i];
+    }
+}
+
+void flash_f1_init(struct hal_flash *f, uint32_t page_size, uint32_t page0, uint32_t page1)
+{
+    *f = (struct hal_flash){
+        .ctx = f,
+        .page_size = page_size,
+        .page_addr = {page0, page1},
+        .erase_page = erase_page,
+        .program_u16 = program_u16,
+        .read = flash_read,
+    };
+}

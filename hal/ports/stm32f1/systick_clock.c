@@ -1,0 +1,45 @@
+#include "systick_clock.h"
+
+#include "stm32f1_regs.h"
+
+#define SCB_ICSR REG32(0xE000ED04u)
+#define ICSR_PENDSTSET (1u << 26)
+
+static volatile uint32_t uptime_ms;
+static uint32_t reload;
+static uint32_t ticks_per_us;
+
+void SysTick_Handler(void);
+
+void SysTick_Handler(void)
+{
+    uptime_ms++;
+}
+
+void systick_clock_init(uint32_t core_hz)
+{
+    reload = core_hz / 1000u - 1u;
+    ticks_per_us = core_hz / 1000000u;
+    SYSTICK_LOAD = reload;
+    SYSTICK_VAL = 0;
+    SYSTICK_CTRL = SYSTICK_ENABLE_CORE_CLOCK_IRQ;
+}
+
+uint32_t systick_now_us(void)
+{
+    uint32_t ms;
+    uint32_t val;
+    uint32_t pending;
+    do {
+        ms = uptime_ms;
+        val = SYSTICK_VAL;
+        pending = SCB_ICSR & ICSR_PENDSTSET;
+    } while (ms != uptime_ms);
+    /* Called from an interrupt that holds off SysTick: the counter may have
+     * wrapped with the millisecond not yet counted. A value read near the
+     * top of the count was read after that wrap. */
+    if (pending && val > reload / 2u) {
+        ms++;
+    }
+    return ms * 1000u + (reload - val) / ticks_per_us;
+}

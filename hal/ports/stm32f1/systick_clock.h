@@ -1,0 +1,12 @@
+/* A free-running microsecond clock from SysTick (1 ms interrupt plus the
+ * counter in between); wraps at 2^32 us like hal_port.now_us wants. */
+#ifndef STM32F1_SYSTICK_CLOCK_H
+#define STM32F1_SYSTICK_CLOCK_H
+
+#include <stdint.h>
+
+void systick_clock_init(uint32_t core_hz);
+/* Safe from any interrupt priority. */
+uint32_t systick_now_us(void);
+
+#endif

@@ -1,0 +1,120 @@
+#include "usart_hd.h"
+
+#include "stm32f1_regs.h"
+
+void usart_hd_set_baud(struct usart_hd *u, uint32_t baud)
+{
+    /* 16x oversampling: BRR is the divider in 1/16ths, i.e. pclk / baud. */
+    USART_BRR(u->base) = (u->pclk_hz + baud / 2u) / baud;
+}
+
+void usart_hd_init(struct usart_hd *u, uint32_t base, uint32_t pclk_hz, uint32_t baud,
+                   bool single_wire, void (*on_byte)(void *ctx, uint8_t byte), void *ctx)
+{
+    u->base = base;
+    u->tx_irq = true;
+    u->hears_own_bytes = single_wire;
+    u->pclk_hz = pclk_hz;
+    u->tx = 0;
+    u->tx_left = 0;
+    u->tx_busy = 0;
+    u->on_byte = on_byte;
+    u->ctx = ctx;
+    USART_CR1(base) = 0;
+    usart_hd_set_baud(u, baud);
+    USART_CR3(base) = single_wire ? USART_CR3_HDSEL : 0u;
+    /* Clear the status flags. On silicon this only clears stale flags; QEMU
+     * (7.2) misplaces TXE in its reset value and reports it only once SR has
+     * been written. */
+    USART_SR(base) = 0;
+    USART_CR1(base) = USART_CR1_UE | USART_CR1_TE | USART_CR1_RE | USART_CR1_RXNEIE;
+}
+
+void usart_hd_tx_polled(struct usart_hd *u)
+{
+    u->tx_irq = false;
+}
+
+void usart_hd_no_echo(struct usart_hd *u)
+{
+    u->hears_own_bytes = false;
+}
+
+void usart_hd_send(struct usart_hd *u, const uint8_t *data, uint16_t len)
+{
+    if (len == 0u) {
+        return;
+    }
+    u->tx = data;
+    u->tx_left = len;
+    u->tx_busy = 1;
+    /* Turn the line around: stop listening, start talking. TXEIE and TCIE
+     * also mark the transmit phase when the main loop does the work. */
+    uint32_t cr1 = USART_CR1(u->base);
+    if (u->hears_own_bytes) {
+        cr1 &= ~USART_CR1_RE;
+    }
+    USART_CR1(u->base) = u->tx_irq ? (cr1 | USART_CR1_TXEIE) : cr1;
+}
+
+/* One step of a transmission: the next byte while the data register is
+ * empty, then the stop bit of the last one, then the line turned around. */
+static void transmit_step(struct usart_hd *u, uint32_t sr)
+{
+    uint32_t cr1 = USART_CR1(u->base);
+    if (u->tx_left > 0u) {
+        if (sr & USART_SR_TXE) {
+            USART_DR(u->base) = *u->tx;
+            u->tx++;
+            u->tx_left--;
+            if (u->tx_left == 0u && u->tx_irq) {
+                /* Last byte in the shifter: wait for its stop bit. */
+                USART_CR1(u->base) = (cr1 & ~USART_CR1_TXEIE) | USART_CR1_TCIE;
+            }
+        }
+    } else if (sr & USART_SR_TC) {
+        USART_CR1(u->base) = (cr1 & ~(USART_CR1_TCIE | USART_CR1_TXEIE)) | USART_CR1_RE;
+        u->tx_busy = 0;
+    }
+}
+
+void usart_hd_service(struct usart_hd *u)
+{
+    if (u->tx_irq) {
+        return;
+    }
+    /* As far as the flags allow now: a model that completes each byte at
+     * once gets the whole frame and the line turned around in one call, so
+     * no reply of the host's finds the receiver still off. */
+    while (u->tx_busy) {
+        uint32_t sr = USART_SR(u->base);
+        if (!(sr & (u->tx_left > 0u ? USART_SR_TXE : USART_SR_TC))) {
+            return;
+        }
+        transmit_step(u, sr);
+    }
+}
+
+bool usart_hd_tx_done(const struct usart_hd *u)
+{
+    return !u->tx_busy;
+}
+
+void usart_hd_irq(struct usart_hd *u)
+{
+    uint32_t sr = USART_SR(u->base);
+    uint32_t cr1 = USART_CR1(u->base);
+    /* Drain: on silicon this sees one byte (two at most, bytes are 87 us
+     * apart at 115200). QEMU 7.2 can hand over the next byte while DR is
+     * read and lower the interrupt after it, so a byte would wait unseen. */
+    while (sr & (USART_SR_RXNE | USART_SR_ORE)) {
+        uint8_t byte = (uint8_t)USART_DR(u->base); /* also clears an overrun */
+        if ((sr & USART_SR_RXNE) && (cr1 & USART_CR1_RE)) {
+            u->on_byte(u->ctx, byte);
+        }
+        sr = USART_SR(u->base);
+    }
+    if (u->tx_irq && (cr1 & (USART_CR1_TXEIE | USART_CR1_TCIE))) {
+        transmit_step(u, sr);
+    }
+}

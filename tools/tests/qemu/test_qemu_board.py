@@ -1,0 +1,82 @@
+"""The real ARM image (real USART driver, real core; plant model compiled
+in) on QEMU's stm32vldiscovery, driven by servoctl over socket://."""
+import struct
+import time
+
+import pytest
+
+from servoctl import protocol as p
+from servoctl.protocol import Bus
+from servoctl.servo import Servo
+from servoctl.sim import QemuBoard
+
+
+@pytest.fixture(scope="module")
+def board():
+    with QemuBoard() as b:
+        yield b
+
+
+@pytest.fixture
+def servo(board):
+    with Bus(board.url, timeout=0.3) as bus:
+        yield Servo(bus, 0)
+
+
+def test_ping(servo):
+    assert servo.ping()
+    assert servo.read("serial") == 0x0E3A0001  # the emulated board's
+    assert servo.read("model") == 0x0F00
+
+
+def test_read_and_write_data(servo):
+    assert servo.read("voltage") == pytest.approx(7400, abs=10)
+    assert servo.read("temperature") == 2048
+    servo.write("stall_power", 4321)
+    assert servo.read("stall_power") == 4321
+    servo.bus.send(p.WRITE_DATA, bytes([0, 53]) + struct.pack("<h", 1801))  # out of range
+    assert servo.bus.read_response(p.WRITE_DATA, 0)[2] == 0
+
+
+def test_batch_read_and_write(servo):
+    values = servo.read_all()
+    assert values["check_flag"] == 1 and values["baud"] == 5
+    values["current_limit"] = 3000
+    values["angle_max"] = 900
+    servo.write_all(values)
+    assert servo.read_all() == values
+    servo.reset_user_data()
+    assert servo.read("current_limit") == 4000
+
+
+def test_move_and_read_back(servo):
+    servo.write("soft_start_on", 0)
+    servo.move(angle_decideg=900, interval_ms=500)
+    t0 = time.monotonic()
+    time.sleep(0.05)
+    while servo.status() & 1:
+        assert time.monotonic() - t0 < 3, "the move did not finish"
+        time.sleep(0.01)
+    time.sleep(0.3)
+    assert abs(servo.angle() - 900) <= 5
+    assert abs(servo.multi_turn_angle()[0] - 900) <= 5
+    servo.move(angle_decideg=-450, velocity=3000, acc_ms=100, dec_ms=100)
+    time.sleep(0.8)
+    assert abs(servo.monitor().angle_decideg + 450) <= 5
+
+
+def test_bad_checksum_then_good_frame(servo):
+    frame = bytearray(p.request_frame(p.PING, bytes([0])))
+    frame[-1] ^= 0xFF
+    servo.bus.serial.write(bytes(frame))
+    time.sleep(0.05)
+    assert servo.bus.serial.read(100) == b""  # no answer to it
+    assert servo.ping()                      # the next good one is answered
+
+
+def test_request_for_another_id_is_ignored(servo):
+    servo.bus.serial.write(p.request_frame(p.PING, bytes([7])))
+    servo.bus.serial.write(p.request_frame(p.READ_DATA, bytes([9, 1])))
+    time.sleep(0.1)
+    assert servo.bus.serial.read(100) == b""
+    assert servo.ping()
