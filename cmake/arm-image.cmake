@@ -14,5 +14,7 @@ function(servo_arm_image name)
   add_custom_command(TARGET ${name}.elf POST_BUILD
     COMMAND ${CMAKE_OBJCOPY} -O binary $<TARGET_FILE:${name}.elf> ${CMAKE_CURRENT_BINARY_DIR}/${name}.bin
     COMMAND sh ${PROJECT_SOURCE_DIR}/cmake/check-image.sh $<TARGET_FILE:${name}.elf>
+    COMMAND Python3::Interpreter ${PROJECT_SOURCE_DIR}/cmake/stack-report.py
+            $<TARGET_FILE:${name}.elf> ${CMAKE_BINARY_DIR}
     VERBATIM)
 endfunction()

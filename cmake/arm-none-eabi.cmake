@@ -9,7 +9,7 @@ set(CMAKE_NM arm-none-eabi-nm CACHE FILEPATH "")
 set(CMAKE_TRY_COMPILE_TARGET_TYPE STATIC_LIBRARY)
 
 set(SERVO_CPU_FLAGS "-mcpu=cortex-m3 -mthumb -mfloat-abi=soft")
-set(CMAKE_C_FLAGS_INIT "${SERVO_CPU_FLAGS} -ffunction-sections -fdata-sections -fno-common -fstack-usage")
+set(CMAKE_C_FLAGS_INIT "${SERVO_CPU_FLAGS} -ffunction-sections -fdata-sections -fno-common -fstack-usage -fcallgraph-info=su")
 set(CMAKE_EXE_LINKER_FLAGS_INIT
     "${SERVO_CPU_FLAGS} -nostartfiles --specs=nano.specs --specs=nosys.specs -Wl,--gc-sections")
 

@@ -1,0 +1,159 @@
+#!/usr/bin/env python3
+"""Worst-case stack use of an image, from GCC's call graphs
+(-fcallgraph-info=su, one .ci file per object) and the linked symbols.
+
+Roots: main and every interrupt handler defined in the image. Functions
+nothing calls directly are what a function only reached through a pointer
+looks like; the firmware has three kinds of function pointer, and an
+indirect call is bounded by the worst target of its kind:
+  in dispatch_packet   the packet handlers (handle_*)
+  in usart_hd_irq      the receive callback (on_byte)
+  anywhere else        the port's HAL operations (everything else)
+Recursion is an error, but for one bounded case: handle_sync runs its
+record through dispatch_packet, and a record is never itself a sync
+(PF_SYNCABLE), so dispatch_packet may appear twice on a path. A
+library function without a call graph (memcpy, libgcc) is charged
+LIBRARY_BYTES. All interrupts share one priority, so they do not nest: the
+worst case is main's deepest path plus the deepest handler plus the
+Cortex-M3's 32-byte exception frame. Fails when that exceeds the stack the
+linker script reserves, less a margin."""
+import argparse
+import pathlib
+import re
+import subprocess
+import sys
+
+LIBRARY_BYTES = 64
+EXCEPTION_FRAME = 32
+MARGIN = 0.25
+
+node_re = re.compile(r'node: \{ title: "([^"]+)" label: "([^"]*)"')
+edge_re = re.compile(r'edge: \{ sourcename: "([^"]+)" targetname: "([^"]+)"')
+
+
+def load(ci_files, linked):
+    stack, calls, qualifier = {}, {}, {}
+    for path in ci_files:
+        for line in path.read_text().splitlines():
+            m = node_re.search(line)
+            if m:
+                title, label = m.groups()
+                b = re.search(r"\\n(\d+) bytes \((\w+)\)", label)
+                if b:
+                    stack[title] = int(b.group(1))
+                    qualifier[title] = b.group(2)
+                continue
+            m = edge_re.search(line)
+            if m:
+                calls.setdefault(m.group(1), set()).add(m.group(2))
+    # Keep only what the image links (static functions are "file:name").
+    keep = {t for t in stack if t.split(":")[-1] in linked}
+    return ({t: stack[t] for t in keep}, {t: calls.get(t, set()) for t in keep},
+            {t: qualifier[t] for t in keep})
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("elf")
+    ap.add_argument("build_dir")
+    ap.add_argument("--nm", default="arm-none-eabi-nm")
+    ap.add_argument("--size", default="arm-none-eabi-size")
+    args = ap.parse_args()
+    # The stack the linker script reserves: the .stack section.
+    sections = subprocess.run([args.size, "-A", args.elf], capture_output=True, text=True,
+                              check=True).stdout
+    stack_line = [l.split() for l in sections.splitlines() if l.startswith(".stack ")]
+    if not stack_line:
+        print("error: the image has no .stack section", file=sys.stderr)
+        return 1
+    args.stack_size = int(stack_line[0][1])
+    nm = subprocess.run([args.nm, args.elf], capture_output=True, text=True, check=True).stdout
+    linked = {line.split()[-1] for line in nm.splitlines() if re.match(r"\S+ [tT] ", line)}
+    ci_files = list(pathlib.Path(args.build_dir).rglob("*.ci"))
+    stack, calls, qualifier = load(ci_files, linked)
+    dynamic = [t for t, q in qualifier.items() if q != "static"]
+    roots = [t for t in stack if t.split(":")[-1] == "main" or (
+        t.split(":")[-1].endswith("Handler") and t.split(":")[-1] != "Reset_Handler")]
+    called = {c for cs in calls.values() for c in cs}
+    # Vector-table entries are reached by the hardware, not our pointers.
+    pointer_targets = [t for t in stack if t not in called and t not in roots
+                       and not t.split(":")[-1].endswith("Handler")]
+
+    def short(t):
+        return t.split(":")[-1]
+
+    kinds = {
+        "dispatch_packet": [t for t in pointer_targets if short(t).startswith("handle_")],
+        "usart_hd_irq": [t for t in pointer_targets if short(t) == "on_byte"],
+    }
+    hal_ops = [t for t in pointer_targets
+               if not short(t).startswith("handle_") and short(t) != "on_byte"]
+    memo = {}
+    indirect_below = {}
+
+    class Recursion(Exception):
+        pass
+
+    def has_indirect(title, seen=frozenset()):
+        if title not in stack or title in seen:
+            return False
+        if title not in indirect_below:
+            cs = calls[title]
+            indirect_below[title] = "__indirect_call" in cs or any(
+                has_indirect(c, seen | {title}) for c in cs)
+        return indirect_below[title]
+
+    reentry = {"dispatch_packet": 2}  # times it may stand on one path
+
+    def worst(title, path):
+        if path.count(title) >= reentry.get(title.split(":")[-1], 1):
+            raise Recursion(title)
+        if title not in stack:
+            return LIBRARY_BYTES, [title.split(":")[-1] + " (library)"]
+        if title in memo and title not in path:
+            return memo[title]
+        best, chain = 0, []
+        for callee in calls[title]:
+            if callee == "__indirect_call":
+                targets = kinds.get(short(title), hal_ops)
+                if short(title) == "dispatch_packet" and title in path:
+                    targets = [t for t in targets if short(t) != "handle_sync"]  # a record is no sync
+                for c in targets:
+                    d, ch = worst(c, path + (title,))
+                    if d > best:
+                        best, chain = d, ["(indirect) " + ch[0]] + ch[1:]
+            else:
+                d, ch = worst(callee, path + (title,))
+                if d > best:
+                    best, chain = d, ch
+        result = (stack[title] + best, [title.split(":")[-1]] + chain)
+        if not has_indirect(title) and title not in path:
+            memo[title] = result  # path-independent
+        return result
+
+    try:
+        results = {r.split(":")[-1]: worst(r, ()) for r in roots}
+    except Recursion as e:
+        print(f"error: recursion through {e}: no static stack bound", file=sys.stderr)
+        return 1
+    main_depth = results.get("main", (0, []))[0]
+    handlers = {k: v for k, v in results.items() if k != "main"}
+    worst_handler = max(handlers.items(), key=lambda kv: kv[1][0]) if handlers else ("none", (0, []))
+    total = main_depth + EXCEPTION_FRAME + worst_handler[1][0]
+    limit = int(args.stack_size * (1 - MARGIN))
+    print(f"stack: {pathlib.Path(args.elf).name}: worst case {total} B of {args.stack_size} B reserved "
+          f"(main {main_depth} + exception frame {EXCEPTION_FRAME} + {worst_handler[0]} "
+          f"{worst_handler[1][0]}); limit with {int(MARGIN * 100)}% margin {limit} B")
+    for name, (depth, chain) in sorted(results.items()):
+        print(f"  {name:<20} {depth:5d} B  {' > '.join(chain[:9])}{' > ...' if len(chain) > 9 else ''}")
+    if dynamic:
+        print(f"error: functions with dynamic stack use: {', '.join(dynamic)}", file=sys.stderr)
+        return 1
+    if total > limit:
+        print(f"error: worst-case stack {total} B exceeds {limit} B", file=sys.stderr)
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
