@@ -1,0 +1,57 @@
+#!/usr/bin/env python3
+"""Per-module flash and RAM of an image, from the linker map: only what was
+linked (after --gc-sections), grouped by the project folder each object
+comes from; libc and libgcc as one row."""
+import re
+import sys
+from collections import defaultdict
+
+MODULES = [  # (part of the object's path in the map, name)
+    ("libservo_protocol.a", "protocol: framer, dispatcher, handlers, data table"),
+    ("libservo_motion.a", "motion: profile, controller, commands"),
+    ("libservo_storage.a", "config store and CRC"),
+    ("libservo_sensors.a", "sensors: scaling, NTC table"),
+    ("libservo_protection.a", "protection monitors"),
+    ("libservo_app.a", "servo core (servo.c)"),
+    ("libservo_stm32f1.a", "STM32F1 port (USART, SysTick, flash, clock, PWM, ADC, IWDG)"),
+    ("startup_stm32f103", "startup, vector table"),
+    ("boards/", "board (main, HAL ops, static servo state)"),
+]
+
+
+def module_of(obj):
+    for prefix, name in MODULES:
+        if prefix in obj:
+            return name
+    return "libc, libgcc"
+
+
+def main() -> int:
+    text = open(sys.argv[1]).read()
+    body = text[text.index("Linker script and memory map"):]
+    flash, ram = defaultdict(int), defaultdict(int)
+    section = None
+    # Input sections: " .text.name  0xADDR  0xSIZE object" (one or two lines)
+    for m in re.finditer(r"^ (\.[\w.]+)(?:\s*\n)?\s+0x([0-9a-f]+)\s+0x([0-9a-f]+)\s+(\S+)$",
+                         body, re.M):
+        section, addr, size, obj = m.group(1), int(m.group(2), 16), int(m.group(3), 16), m.group(4)
+        if size == 0 or addr == 0:
+            continue
+        mod = module_of(obj)
+        if section.startswith((".text", ".rodata", ".isr_vector", ".ARM.exidx")):
+            flash[mod] += size
+        elif section.startswith(".data"):
+            flash[mod] += size
+            ram[mod] += size
+        elif section.startswith((".bss", "COMMON")):
+            ram[mod] += size
+    rows = sorted(set(flash) | set(ram), key=lambda k: -flash[k])
+    print(f"| module | flash (B) | RAM (B) |\n|---|---:|---:|")
+    for r in rows:
+        print(f"| {r} | {flash[r]} | {ram[r]} |")
+    print(f"| **total (without the {1536} B stack)** | **{sum(flash.values())}** | **{sum(ram.values())}** |")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
