@@ -97,14 +97,7 @@ class Simulator:
 
     def stop(self) -> str:
         """Stops the simulator; returns what it wrote to stderr."""
-        if self.process is None:
-            return ""
-        self.process.terminate()
-        try:
-            _, err = self.process.communicate(timeout=10)
-        except subprocess.TimeoutExpired:
-            self.process.kill()
-            _, err = self.process.communicate()
+        err = _stop(self.process)
         self.process = None
         return err
 
@@ -113,6 +106,19 @@ class Simulator:
 
     def __exit__(self, *exc):
         self.stop()
+
+
+def _stop(process) -> str:
+    """Stops a child process; returns what it wrote to stderr."""
+    if process is None:
+        return ""
+    process.terminate()
+    try:
+        _, err = process.communicate(timeout=10)
+    except subprocess.TimeoutExpired:
+        process.kill()
+        _, err = process.communicate()
+    return err
 
 
 def _free_port() -> int:
@@ -157,14 +163,7 @@ class QemuBoard:
         raise ServoError("qemu did not open its serial port within 10 s")
 
     def stop(self) -> str:
-        if self.process is None:
-            return ""
-        self.process.terminate()
-        try:
-            _, err = self.process.communicate(timeout=10)
-        except subprocess.TimeoutExpired:
-            self.process.kill()
-            _, err = self.process.communicate()
+        err = _stop(self.process)
         self.process = None
         return err
 

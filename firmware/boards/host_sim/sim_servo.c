@@ -100,11 +100,7 @@ static void sensors_read(void *ctx, struct sensor_raw *out)
     out->ntc = (uint16_t)thermal_ntc_adc(&s->thermal);
 }
 
-static const struct sensor_calibration calibration = {
-    .supply_uv_per_count = BOARD_SUPPLY_UV_PER_COUNT,
-    .current_ua_per_count = BOARD_CURRENT_UA_PER_COUNT,
-    .current_zero_counts = BOARD_CURRENT_ZERO_COUNTS,
-};
+static const struct sensor_calibration calibration = BOARD_SENSOR_CALIBRATION;
 
 /* A blank chip gets the ID it was started with, as at the factory. */
 static bool program_id(struct sim_flash *flash, uint8_t id)

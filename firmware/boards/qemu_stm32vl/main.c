@@ -6,6 +6,7 @@
 #include "servo.h"
 #include "stm32f1_regs.h"
 #include "systick_clock.h"
+#include "port_uart.h"
 #include "usart_hd.h"
 
 #define QEMU_CORE_HZ 24000000u /* QEMU's fixed sysclk for this board */
@@ -18,38 +19,6 @@ static struct usart_hd usart;
 static struct plant_fixed plant;
 static uint8_t flash_mem[2 * FLASH_PAGE];
 static struct hal_flash flash;
-
-static void on_byte(void *ctx, uint8_t byte)
-{
-    servo_on_rx_byte(ctx, byte, systick_now_us());
-}
-
-void USART1_IRQHandler(void);
-void USART1_IRQHandler(void)
-{
-    usart_hd_irq(&usart);
-}
-
-static uint32_t now_us(void *ctx)
-{
-    (void)ctx;
-    return systick_now_us();
-}
-
-static void uart_send(void *ctx, const uint8_t *data, uint16_t len)
-{
-    usart_hd_send(ctx, data, len);
-}
-
-static bool uart_tx_done(void *ctx)
-{
-    return usart_hd_tx_done(ctx);
-}
-
-static void uart_set_baud(void *ctx, uint32_t baud)
-{
-    usart_hd_set_baud(ctx, baud);
-}
 
 static void motor_drive(void *ctx, int16_t duty)
 {
@@ -80,11 +49,7 @@ static void sensors_read(void *ctx, struct sensor_raw *out)
     out->ntc = 2048; /* 25 degC */
 }
 
-static const struct sensor_calibration calibration = {
-    .supply_uv_per_count = BOARD_SUPPLY_UV_PER_COUNT,
-    .current_ua_per_count = BOARD_CURRENT_UA_PER_COUNT,
-    .current_zero_counts = BOARD_CURRENT_ZERO_COUNTS,
-};
+static const struct sensor_calibration calibration = BOARD_SENSOR_CALIBRATION;
 
 static bool ram_erase(void *ctx, uint32_t addr)
 {
@@ -126,15 +91,7 @@ int main(void)
         .read = ram_read,
     };
     systick_clock_init(QEMU_CORE_HZ);
-    usart_hd_init(&usart, USART1_BASE, QEMU_CORE_HZ, 115200u, true, on_byte, &servo);
-    usart_hd_tx_polled(&usart); /* QEMU 7.2's USART raises no transmit interrupts */
-    usart_hd_no_echo(&usart);   /* and its socket does not echo our bytes */
     port = (struct hal_port){
-        .ctx = &usart,
-        .now_us = now_us,
-        .uart_send = uart_send,
-        .uart_tx_done = uart_tx_done,
-        .uart_set_baud = uart_set_baud,
         .motor_drive = motor_drive,
         .motor_coast = motor_coast,
         .encoder_read = encoder_read,
@@ -144,6 +101,9 @@ int main(void)
         .serial_number = 0x0E3A0001u,
         .rx_gap_tolerance_us = 50000u, /* QEMU delivers a frame's bytes with jitter */
     };
+    port_uart_init(&port, &usart, &servo, QEMU_CORE_HZ);
+    usart_hd_tx_polled(&usart); /* QEMU 7.2's USART raises no transmit interrupts */
+    usart_hd_no_echo(&usart);   /* and its socket does not echo our bytes */
     servo_init(&servo, &port);
     NVIC_ISER(USART1_IRQ / 32u) = 1u << (USART1_IRQ % 32u);
     for (;;) {

@@ -9,4 +9,12 @@
 #define BOARD_CURRENT_UA_PER_COUNT 1611u /* 3.3 V / 0.5 V/A / 4096 */
 #define BOARD_CURRENT_ZERO_COUNTS 0u
 
+/* Initialiser of a struct sensor_calibration for this front end. */
+#define BOARD_SENSOR_CALIBRATION                           \
+    {                                                      \
+        .supply_uv_per_count = BOARD_SUPPLY_UV_PER_COUNT,  \
+        .current_ua_per_count = BOARD_CURRENT_UA_PER_COUNT, \
+        .current_zero_counts = BOARD_CURRENT_ZERO_COUNTS,  \
+    }
+
 #endif

@@ -5,6 +5,7 @@
 #include "servo.h"
 #include "stm32f1_regs.h"
 #include "systick_clock.h"
+#include "port_uart.h"
 #include "usart_hd.h"
 
 /* The last two 1 KB pages of the 64 KB part hold the config store (kept out
@@ -16,38 +17,6 @@ static struct servo servo;
 static struct hal_port port;
 static struct usart_hd usart;
 static struct hal_flash flash;
-
-static void on_byte(void *ctx, uint8_t byte)
-{
-    servo_on_rx_byte(ctx, byte, systick_now_us());
-}
-
-void USART1_IRQHandler(void);
-void USART1_IRQHandler(void)
-{
-    usart_hd_irq(&usart);
-}
-
-static uint32_t now_us(void *ctx)
-{
-    (void)ctx;
-    return systick_now_us();
-}
-
-static void uart_send(void *ctx, const uint8_t *data, uint16_t len)
-{
-    usart_hd_send(ctx, data, len);
-}
-
-static bool uart_tx_done(void *ctx)
-{
-    return usart_hd_tx_done(ctx);
-}
-
-static void uart_set_baud(void *ctx, uint32_t baud)
-{
-    usart_hd_set_baud(ctx, baud);
-}
 
 static void motor_drive(void *ctx, int16_t duty)
 {
@@ -75,11 +44,7 @@ static void sensors_read(void *ctx, struct sensor_raw *out)
     out->ntc = adc_scan_values[ADC_NTC];
 }
 
-static const struct sensor_calibration calibration = {
-    .supply_uv_per_count = BOARD_SUPPLY_UV_PER_COUNT,
-    .current_ua_per_count = BOARD_CURRENT_UA_PER_COUNT,
-    .current_zero_counts = BOARD_CURRENT_ZERO_COUNTS,
-};
+static const struct sensor_calibration calibration = BOARD_SENSOR_CALIBRATION;
 
 static void gpio_init(void)
 {
@@ -100,13 +65,7 @@ int main(void)
     adc_scan_init();
     pwm_bridge_init();
     flash_f1_init(&flash, 1024u, CONFIG_PAGE0, CONFIG_PAGE1);
-    usart_hd_init(&usart, USART1_BASE, F103_PCLK2_HZ, 115200u, true, on_byte, &servo);
     port = (struct hal_port){
-        .ctx = &usart,
-        .now_us = now_us,
-        .uart_send = uart_send,
-        .uart_tx_done = uart_tx_done,
-        .uart_set_baud = uart_set_baud,
         .motor_drive = motor_drive,
         .motor_coast = motor_coast,
         .encoder_read = encoder_read,
@@ -115,6 +74,7 @@ int main(void)
         .flash = &flash,
         .serial_number = unique_id_serial(),
     };
+    port_uart_init(&port, &usart, &servo, F103_PCLK2_HZ);
     servo_init(&servo, &port);
     NVIC_ISER(USART1_IRQ / 32u) = 1u << (USART1_IRQ % 32u);
     iwdg_start();
