@@ -149,19 +149,16 @@ void servo_control_tick(struct servo *s)
  * racing through them. */
 static void run_control_tick(struct servo *s)
 {
-    for (unsigned n = 0; n < s->max_catch_up; n++) {
-        uint32_t now = s->hal->now_us(s->hal->ctx);
-        if ((int32_t)(now - s->next_tick_us) < 0) {
+    /* One reading of the clock per pass: the ticks due by then run now. */
+    uint32_t now = s->hal->now_us(s->hal->ctx);
+    for (unsigned n = 0; (int32_t)(now - s->next_tick_us) >= 0; n++) {
+        if (n == s->max_catch_up) {
+            s->ticks_dropped += (uint32_t)(now - s->next_tick_us) / CONTROL_TICK_US + 1u;
+            s->next_tick_us = now + CONTROL_TICK_US;
             return;
         }
         servo_control_tick(s);
         s->next_tick_us += CONTROL_TICK_US;
-    }
-    uint32_t now = s->hal->now_us(s->hal->ctx);
-    int32_t late = (int32_t)(now - s->next_tick_us);
-    if (late >= 0) {
-        s->ticks_dropped += (uint32_t)late / CONTROL_TICK_US + 1u;
-        s->next_tick_us = now + CONTROL_TICK_US;
     }
 }
 
