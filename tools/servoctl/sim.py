@@ -22,7 +22,28 @@ def find_binary() -> Path:
     return path
 
 
-class Simulator:
+class _Child:
+    """A child process started by start(), stopped on leaving a with-block."""
+
+    process = None
+
+    def start(self):
+        raise NotImplementedError
+
+    def stop(self) -> str:
+        """Stops it; returns what it wrote to stderr."""
+        err = _stop(self.process)
+        self.process = None
+        return err
+
+    def __enter__(self):
+        return self.start()
+
+    def __exit__(self, *exc):
+        self.stop()
+
+
+class Simulator(_Child):
     """servo_sim as a context manager. The bus is a TCP port (pyserial
     socket://) unless tcp=False, then a pseudo-terminal (optionally linked)."""
 
@@ -95,17 +116,6 @@ class Simulator:
                 out[key] = value
         return out
 
-    def stop(self) -> str:
-        """Stops the simulator; returns what it wrote to stderr."""
-        err = _stop(self.process)
-        self.process = None
-        return err
-
-    def __enter__(self):
-        return self.start()
-
-    def __exit__(self, *exc):
-        self.stop()
 
 
 def _stop(process) -> str:
@@ -130,7 +140,7 @@ def _free_port() -> int:
 QEMU_IMAGE = REPO / "build" / "arm" / "firmware" / "boards" / "qemu_stm32vl" / "servo_qemu_stm32vl.elf"
 
 
-class QemuBoard:
+class QemuBoard(_Child):
     """The real ARM image on QEMU's stm32vldiscovery, its USART1 on a TCP
     port (pyserial socket://)."""
 
@@ -162,13 +172,3 @@ class QemuBoard:
         self.stop()
         raise ServoError("qemu did not open its serial port within 10 s")
 
-    def stop(self) -> str:
-        err = _stop(self.process)
-        self.process = None
-        return err
-
-    def __enter__(self):
-        return self.start()
-
-    def __exit__(self, *exc):
-        self.stop()
