@@ -34,7 +34,6 @@ void servo_init(struct servo *s, const struct hal_port *hal)
     s->next_tick_us = hal->now_us(hal->ctx) + CONTROL_TICK_US;
     frame_rx_init(&s->rx, &s->active_id, idle_timeout_us(s, 0));
     dispatcher_init(&s->dispatcher, &s->regs, &s->motion, &s->active_id);
-    s->max_catch_up = SERVO_MAX_CATCH_UP;
     s->active_baud_index = 0; /* forces the first apply to set the UART */
     apply_link_settings(s);
 }
@@ -144,7 +143,7 @@ void servo_control_tick(struct servo *s)
 }
 
 /* The control loop runs from the main loop, so commands and ticks never
- * interleave. A pass runs every tick that is due, up to max_catch_up; a
+ * interleave. A pass runs every tick that is due, up to SERVO_MAX_CATCH_UP; a
  * main loop later than that (a flash erase) drops the rest rather than
  * racing through them. */
 static void run_control_tick(struct servo *s)
@@ -152,7 +151,7 @@ static void run_control_tick(struct servo *s)
     /* One reading of the clock per pass: the ticks due by then run now. */
     uint32_t now = s->hal->now_us(s->hal->ctx);
     for (unsigned n = 0; (int32_t)(now - s->next_tick_us) >= 0; n++) {
-        if (n == s->max_catch_up) {
+        if (n == SERVO_MAX_CATCH_UP) {
             s->ticks_dropped += (uint32_t)(now - s->next_tick_us) / CONTROL_TICK_US + 1u;
             s->next_tick_us = now + CONTROL_TICK_US;
             return;

@@ -47,9 +47,6 @@ struct servo {
     struct protection protection;
     uint32_t next_tick_us;       /* when the next control tick is due */
     uint32_t ticks_dropped;      /* control ticks skipped by a late main loop */
-    /* Most ticks one pass catches up (SERVO_MAX_CATCH_UP unless a port says
-     * otherwise: the simulator, scheduled by a PC, allows more). */
-    uint8_t max_catch_up;
     volatile uint8_t active_id;  /* the ID answered to now */
     uint8_t active_baud_index;
     uint8_t config_dirty;

@@ -34,10 +34,15 @@ def describe_temperature(adc: int) -> str:
 
 # ---- commands --------------------------------------------------------------
 
+# A servo answers a ping within about a millisecond; a short wait keeps a
+# full scan of 254 IDs near 13 s.
+SCAN_REPLY_S = 0.05
+
+
 def cmd_scan(bus, args):
     found = []
     for servo_id in range(args.first, args.last + 1):
-        if Servo(bus, servo_id).ping():
+        if Servo(bus, servo_id).ping(timeout=SCAN_REPLY_S):
             found.append(servo_id)
             print(f"servo {servo_id}")
         if sys.stderr.isatty():

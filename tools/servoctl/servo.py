@@ -36,9 +36,10 @@ class Servo:
         self.id = _check("servo ID", servo_id, 0, 254)
 
     # ---- queries -------------------------------------------------------
-    def ping(self) -> bool:
+    def ping(self, timeout=None) -> bool:
+        """True if the servo answers within timeout (the bus's if None)."""
         try:
-            self.bus.request(p.PING, bytes([self.id]), timeout=0.05)
+            self.bus.request(p.PING, bytes([self.id]), timeout=timeout)
             return True
         except p.NoReply:
             return False

@@ -7,9 +7,11 @@ import subprocess
 import tempfile
 import time
 
-from .protocol import ServoError
+from .protocol import Bus, ServoError
+from .servo import Servo
 
 REPO = Path(__file__).resolve().parents[2]
+BOOT_TIMEOUT_S = 10
 DEFAULT_BINARY = REPO / "build" / "host" / "firmware" / "boards" / "host_sim" / "servo_sim"
 
 
@@ -160,15 +162,19 @@ class QemuBoard(_Child):
              "-serial", f"tcp:127.0.0.1:{port},server=on,wait=off,nodelay=on"],
             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         self.url = f"socket://127.0.0.1:{port}"
-        deadline = time.monotonic() + 10
+        # QEMU opens the port before the guest has booted, so the board is
+        # ready only once the firmware answers (slow on a loaded machine).
+        deadline = time.monotonic() + BOOT_TIMEOUT_S
         while time.monotonic() < deadline:
             if self.process.poll() is not None:
                 raise ServoError(f"qemu exited: {self.process.stderr.read().strip()}")
             try:
-                socket.create_connection(("127.0.0.1", port), timeout=0.2).close()
-                return self
-            except OSError:
+                with Bus(self.url, timeout=0.2) as bus:
+                    while time.monotonic() < deadline:
+                        if Servo(bus, 0).ping():
+                            return self
+            except ServoError:  # the port is not open yet
                 time.sleep(0.05)
         self.stop()
-        raise ServoError("qemu did not open its serial port within 10 s")
+        raise ServoError(f"the firmware on qemu did not answer a ping within {BOOT_TIMEOUT_S} s")
 

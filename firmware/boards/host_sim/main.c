@@ -303,7 +303,7 @@ int main(int argc, char **argv)
     signal(SIGPIPE, SIG_IGN);
     mkdir(o.state_dir, 0755);
 
-    sim_bus_init(&bus);
+    sim_bus_init(&bus, sim_now_us());
     for (unsigned i = 0; i < o.id_count; i++) {
         if (!sim_servo_start(&servos[i], &bus, i, o.ids[i], o.state_dir, o.supply_v, o.ambient_c)) {
             return 1;
@@ -358,20 +358,24 @@ int main(int argc, char **argv)
         for (int i = 0; i < MAX_CONTROL_CLIENTS; i++) {
             fds[nfds++] = (struct pollfd){.fd = clients[i].fd, .events = POLLIN};
         }
-        /* Wake often enough for every control tick and bus byte. */
-        int64_t due = sim_bus_next_due(&bus, sim_now_us());
-        long wait_us = (due >= 0 && due < 250) ? due : 250;
+        /* Wake often enough for every control tick and bus byte; not at all
+         * while the bus clock is behind the wall clock. */
+        uint64_t wall = sim_now_us();
+        int64_t due = sim_bus_next_due(&bus, wall);
+        long wait_us = (due >= 0 && due < SIM_BUS_STEP_US) ? (long)due : SIM_BUS_STEP_US;
+        if (wall > bus.now_us + SIM_BUS_STEP_US) {
+            wait_us = 0;
+        }
         struct timespec timeout = {.tv_sec = 0, .tv_nsec = wait_us * 1000};
         if (ppoll(fds, (nfds_t)nfds, &timeout, NULL) < 0 && errno != EINTR) {
             perror("servo_sim: poll");
             break;
         }
-        uint64_t now = sim_now_us();
         if (host_slot >= 0 && (fds[host_slot].revents & (POLLIN | POLLHUP | POLLERR))) {
             uint8_t buf[512];
             ssize_t n = read(bus.host_fd, buf, sizeof buf);
             if (n > 0) {
-                sim_bus_from_host(&bus, buf, (unsigned)n, now);
+                sim_bus_from_host(&bus, buf, (unsigned)n, bus.now_us);
             } else if (listen_fd >= 0 && (n == 0 || errno != EAGAIN)) {
                 close(bus.host_fd); /* the TCP client left: wait for the next */
                 bus.host_fd = -1;
@@ -404,7 +408,7 @@ int main(int argc, char **argv)
                 control_read(&clients[i]);
             }
         }
-        sim_bus_deliver(&bus, sim_now_us());
+        sim_bus_deliver(&bus, sim_bus_step_to(&bus, sim_now_us()));
         for (unsigned i = 0; i < bus.servo_count; i++) {
             servo_poll(&servos[i].core);
         }

@@ -6,9 +6,15 @@
 
 #include "sim_servo.h"
 
-void sim_bus_init(struct sim_bus *b)
+void sim_bus_init(struct sim_bus *b, uint64_t now_us)
 {
-    *b = (struct sim_bus){.host_fd = -1, .last_sender = -1};
+    *b = (struct sim_bus){.host_fd = -1, .last_sender = -1, .now_us = now_us};
+}
+
+uint64_t sim_bus_step_to(const struct sim_bus *b, uint64_t wall_us)
+{
+    uint64_t limit = b->now_us + SIM_BUS_STEP_US;
+    return wall_us < limit ? wall_us : limit;
 }
 
 /* Bytes go on the one wire one byte time apart, after whatever is on it,
@@ -92,6 +98,9 @@ void sim_bus_deliver(struct sim_bus *b, uint64_t now_us)
         b->count--;
     }
     write_host(b, out, n);
+    if (now_us > b->now_us) {
+        b->now_us = now_us;
+    }
 }
 
 void sim_bus_from_host(struct sim_bus *b, const uint8_t *data, unsigned len, uint64_t now_us)

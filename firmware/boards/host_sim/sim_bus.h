@@ -3,7 +3,16 @@
  * is already on the wire; the host's bytes reach every servo paced the same
  * way (a pty or socket delivers them in bursts a UART never would). A
  * servo that starts sending while another's bytes are on the wire is a
- * collision, counted and logged: on a real bus it would garble both. */
+ * collision, counted and logged: on a real bus it would garble both.
+ *
+ * The servos and their models run on the bus's clock, `now_us`. It follows
+ * the wall clock, but a pass of the simulator's loop moves it by at most
+ * SIM_BUS_STEP_US, and it stands still while the servos run. On silicon a
+ * byte's interrupt runs as it arrives and the main loop answers within
+ * microseconds; a PC that preempts the simulator for milliseconds must not
+ * let a servo see time it has not reacted in (it would take the line for
+ * silent and talk over a Sync Monitor answer). A preempted simulator falls
+ * behind the wall clock instead, and catches up at full speed. */
 #ifndef SIM_BUS_H
 #define SIM_BUS_H
 
@@ -11,6 +20,7 @@
 
 #define SIM_BUS_QUEUE 8192u
 #define SIM_MAX_SERVOS 16u
+#define SIM_BUS_STEP_US 250u /* most the bus clock moves in one pass */
 #define SIM_HOST 0xFFu /* sender of the host's bytes */
 
 struct sim_servo;
@@ -27,6 +37,7 @@ struct sim_bus {
     unsigned count;
     uint64_t wire_until_us;   /* end of the last byte queued, host's or servo's */
     uint64_t servo_until_us;  /* end of the last servo byte queued */
+    uint64_t now_us;          /* every byte due by then has been delivered */
     int last_sender;          /* servo that queued it */
     int host_fd;              /* -1: no host connected */
     struct sim_servo *servos[SIM_MAX_SERVOS];
@@ -35,11 +46,13 @@ struct sim_bus {
     unsigned long dropped;    /* queue overflow */
 };
 
-void sim_bus_init(struct sim_bus *b);
+void sim_bus_init(struct sim_bus *b, uint64_t now_us);
 /* Queues len bytes from servo `sender`; returns when the last stop bit ends. */
 uint64_t sim_bus_send(struct sim_bus *b, unsigned sender, const uint8_t *data, unsigned len,
                       uint32_t baud, uint64_t now_us);
-/* Delivers every byte whose time has come. */
+/* Where the next pass may move the bus clock: the wall clock, or one step. */
+uint64_t sim_bus_step_to(const struct sim_bus *b, uint64_t wall_us);
+/* Delivers every byte due by now_us and moves the bus clock there. */
 void sim_bus_deliver(struct sim_bus *b, uint64_t now_us);
 void sim_bus_from_host(struct sim_bus *b, const uint8_t *data, unsigned len, uint64_t now_us);
 /* Microseconds until the next queued byte is due; -1 if none. */

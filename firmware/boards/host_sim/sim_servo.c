@@ -22,39 +22,38 @@ uint64_t sim_now_us(void)
     return us - start;
 }
 
-/* Runs motor and winding up to now with the drive last set. */
+/* Runs motor and winding up to now with the drive last set; the bus clock
+ * moves in small steps, so dt stays near one control tick. */
 static void run_models(struct sim_servo *s)
 {
-    uint64_t now = sim_now_us();
+    uint64_t now = s->bus->now_us;
     double dt = (double)(now - s->stepped_us) * 1e-6;
     s->stepped_us = now;
     if (dt <= 0) {
         return;
-    }
-    if (dt > 0.05) {
-        dt = 0.05; /* the simulator stalled (debugger, load): do not explode */
     }
     plant_step(&s->plant, dt);
     double i = s->plant.current;
     thermal_step(&s->thermal, i * i * s->plant.p.resistance_ohm, dt);
 }
 
+/* The firmware's clock is the bus's (see sim_bus.h). */
 static uint32_t now_us(void *ctx)
 {
-    (void)ctx;
-    return (uint32_t)sim_now_us();
+    const struct sim_servo *s = ctx;
+    return (uint32_t)s->bus->now_us;
 }
 
 static void uart_send(void *ctx, const uint8_t *data, uint16_t len)
 {
     struct sim_servo *s = ctx;
-    s->tx_done_us = sim_bus_send(s->bus, s->index, data, len, s->baud, sim_now_us());
+    s->tx_done_us = sim_bus_send(s->bus, s->index, data, len, s->baud, s->bus->now_us);
 }
 
 static bool uart_tx_done(void *ctx)
 {
-    struct sim_servo *s = ctx;
-    return sim_now_us() >= s->tx_done_us;
+    const struct sim_servo *s = ctx;
+    return s->bus->now_us >= s->tx_done_us;
 }
 
 static void uart_set_baud(void *ctx, uint32_t baud)
@@ -134,7 +133,7 @@ bool sim_servo_start(struct sim_servo *s, struct sim_bus *bus, unsigned index, u
     plant_init(&s->plant);
     s->plant.p.supply_v = supply_v;
     thermal_init(&s->thermal, ambient_c);
-    s->stepped_us = sim_now_us();
+    s->stepped_us = bus->now_us;
     s->port = (struct hal_port){
         .ctx = s,
         .now_us = now_us,
@@ -150,6 +149,5 @@ bool sim_servo_start(struct sim_servo *s, struct sim_bus *bus, unsigned index, u
         .serial_number = 0x51A00000u | id,
     };
     servo_init(&s->core, &s->port);
-    s->core.max_catch_up = 50; /* a PC may not run the loop for tens of ms */
     return true;
 }

@@ -16,7 +16,7 @@ def _start(tmp_path, ids, tcp=True):
     return sim
 
 
-def _finish(sim, ids):
+def finish(sim, ids):
     state = sim.state(ids[0])
     err = sim.stop()
     assert state["collisions"] == 0, f"responses collided on the bus: {err}"
@@ -29,14 +29,14 @@ def _finish(sim, ids):
 def sim(tmp_path):
     s = _start(tmp_path, [1])
     yield s
-    _finish(s, [1])
+    finish(s, [1])
 
 
 @pytest.fixture
 def sim3(tmp_path):
     s = _start(tmp_path, [1, 2, 3])
     yield s
-    _finish(s, [1, 2, 3])
+    finish(s, [1, 2, 3])
 
 
 @pytest.fixture

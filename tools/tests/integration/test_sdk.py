@@ -14,6 +14,8 @@ from fashionstar_uart_sdk import PortHandler, SyncPositionControlOptions, UartSe
 
 from servoctl.sim import Simulator
 
+from .conftest import finish
+
 IDS = (0, 1, 2)
 
 
@@ -26,9 +28,7 @@ def rig(tmp_path):
         assert manager.write_data(i, 49, b"\x00")  # soft start off
     yield sim, manager
     uart.close()
-    state = sim.state(IDS[0])
-    sim.stop()
-    assert state["collisions"] == 0
+    finish(sim, IDS)
 
 
 def angle_of(sim, servo_id):
