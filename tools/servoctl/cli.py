@@ -140,17 +140,19 @@ def _wait_done(s: Servo, timeout: float):
     raise ServoError(f"servo {s.id} still moving after {timeout:.1f} s")
 
 
-def _settled_angle(s: Servo, timeout: float = 0.5) -> int:
-    """The multi-turn angle once two readings 20 ms apart agree to 0.1 deg."""
+def _settled_angle(s: Servo, timeout: float = 1.0):
+    """(multi-turn angle, settled): settled once four readings 20 ms apart
+    agree to 0.1 deg. Status bit 0 falls when the profile ends, while the
+    horn may still be swinging in; a longer window also rides out a
+    simulator that the PC did not schedule for a while."""
     start = time.monotonic()
-    last = s.multi_turn_angle()[0]
+    readings = [s.multi_turn_angle()[0]]
     while time.monotonic() - start < timeout:
         time.sleep(0.02)
-        now = s.multi_turn_angle()[0]
-        if abs(now - last) <= 1:
-            return now
-        last = now
-    return last
+        readings = readings[-3:] + [s.multi_turn_angle()[0]]
+        if len(readings) == 4 and max(readings) - min(readings) <= 1:
+            return readings[-1], True
+    return readings[-1], False
 
 
 def cmd_move(bus, args):
@@ -158,8 +160,9 @@ def cmd_move(bus, args):
     s.move(decideg(args.angle), **_move_args(args))
     if args.wait:
         took = _wait_done(s, args.timeout_s)
-        angle = _settled_angle(s)
-        print(f"servo {args.id}: at {angle / 10:.1f} deg, move finished after {took * 1000:.0f} ms")
+        angle, settled = _settled_angle(s)
+        print(f"servo {args.id}: at {angle / 10:.1f} deg{'' if settled else ' (still settling)'}, "
+              f"move finished after {took * 1000:.0f} ms")
     return 0
 
 

@@ -51,7 +51,7 @@ def test_config(sim, capsys, tmp_path):
 def test_motion_commands(sim, capsys):
     run(sim, capsys, "config", "set", "1", "soft_start_on", "0")
     rc, out, _ = run(sim, capsys, "move", "1", "90", "--velocity", "300", "--acc", "100", "--wait")
-    assert rc == 0
+    assert rc == 0 and "still settling" not in out
     at = float(out.split(" at ")[1].split(" deg")[0])
     assert abs(at - 90.0) <= 0.5, out
     rc, out, _ = run(sim, capsys, "origin", "1")
@@ -74,7 +74,8 @@ def test_motion_commands(sim, capsys):
                          (["-400", "--multi-turn", "--interval", "3000", "--dec", "200"], -400.0),
                          (["720", "--multi-turn", "--velocity", "300"], 720.0)]:
         rc, out, _ = run(sim, capsys, "move", "1", *argv, "--wait")
-        assert rc == 0 and abs(float(out.split(" at ")[1].split(" deg")[0]) - target) <= 0.5, out
+        assert rc == 0 and "still settling" not in out, out
+        assert abs(float(out.split(" at ")[1].split(" deg")[0]) - target) <= 0.5, out
     rc, out, _ = run(sim, capsys, "monitor", "1", "--count", "2", "--every", "0.01")
     rows = [line for line in out.splitlines() if line.strip().startswith("1 ")]
     assert len(rows) == 2
