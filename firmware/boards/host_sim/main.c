@@ -197,17 +197,22 @@ static void reply(int fd, const char *text)
     }
 }
 
+/* Furthest the bus clock has fallen behind the wall clock (a busy PC). */
+static uint64_t most_behind_us;
+
 static void state_of(const struct sim_servo *s, char *out, size_t size)
 {
     struct motion_angle a;
     motion_read_angle(&s->core.motion, &a);
     snprintf(out, size,
              "id=%u angle=%.3f velocity=%.2f current=%.3f winding=%.2f ambient=%.1f supply=%.3f "
-             "load=%.3f stop=%s status=0x%02x reported=%d collisions=%lu dropped_ticks=%u\n",
+             "load=%.3f stop=%s status=0x%02x reported=%d collisions=%lu dropped_ticks=%u "
+             "most_behind_ms=%.1f\n",
              s->cmdline_id, plant_angle_deg(&s->plant), s->plant.velocity * 180.0 / M_PI,
              s->plant.current, s->thermal.winding_c, s->thermal.ambient_c, s->plant.p.supply_v,
              s->plant.load_torque, s->plant.has_stop ? "on" : "off", s->core.regs.status.status,
-             a.multi_turn_decideg, bus.collisions, s->core.ticks_dropped);
+             a.multi_turn_decideg, bus.collisions, s->core.ticks_dropped,
+             (double)most_behind_us / 1000.0);
 }
 
 /* One control line: "command [value] [servo id]". */
@@ -408,7 +413,11 @@ int main(int argc, char **argv)
                 control_read(&clients[i]);
             }
         }
-        sim_bus_deliver(&bus, sim_bus_step_to(&bus, sim_now_us()));
+        uint64_t wall_now = sim_now_us();
+        sim_bus_deliver(&bus, sim_bus_step_to(&bus, wall_now));
+        if (wall_now - bus.now_us > most_behind_us) {
+            most_behind_us = wall_now - bus.now_us;
+        }
         for (unsigned i = 0; i < bus.servo_count; i++) {
             servo_poll(&servos[i].core);
         }
