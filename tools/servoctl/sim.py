@@ -165,16 +165,21 @@ class QemuBoard(_Child):
         # QEMU opens the port before the guest has booted, so the board is
         # ready only once the firmware answers (slow on a loaded machine).
         deadline = time.monotonic() + BOOT_TIMEOUT_S
-        while time.monotonic() < deadline:
-            if self.process.poll() is not None:
-                raise ServoError(f"qemu exited: {self.process.stderr.read().strip()}")
-            try:
-                with Bus(self.url, timeout=0.2) as bus:
-                    while time.monotonic() < deadline:
-                        if Servo(bus, 0).ping():
-                            return self
-            except ServoError:  # the port is not open yet
-                time.sleep(0.05)
+        bus = None
+        try:
+            while time.monotonic() < deadline:
+                if self.process.poll() is not None:
+                    raise ServoError(f"qemu exited: {self.process.stderr.read().strip()}")
+                try:
+                    bus = bus or Bus(self.url, timeout=0.2)
+                except ServoError:  # the port is not open yet
+                    time.sleep(0.05)
+                    continue
+                if Servo(bus, 0).ping():
+                    return self
+        finally:
+            if bus is not None:
+                bus.close()
         self.stop()
         raise ServoError(f"the firmware on qemu did not answer a ping within {BOOT_TIMEOUT_S} s")
 

@@ -368,7 +368,7 @@ int main(int argc, char **argv)
         uint64_t wall = sim_now_us();
         int64_t due = sim_bus_next_due(&bus, wall);
         long wait_us = (due >= 0 && due < SIM_BUS_STEP_US) ? (long)due : SIM_BUS_STEP_US;
-        if (wall > bus.now_us + SIM_BUS_STEP_US) {
+        if (sim_bus_step_to(&bus, wall) < wall) {
             wait_us = 0;
         }
         struct timespec timeout = {.tv_sec = 0, .tv_nsec = wait_us * 1000};
