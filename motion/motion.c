@@ -16,6 +16,7 @@ enum {
     DECIDEG_PER_TURN = 3600,
     WHEEL_RAMP_MS = 20,
     SUPPLY_HYSTERESIS_MV = 128,
+    CLOCK_REAL_TIME = 256, /* clock_rate, Q8 */
 };
 
 static int32_t clamp_i32(int32_t v, int32_t lo, int32_t hi)
@@ -91,7 +92,8 @@ static void update_duty_limit(struct motion *m)
     int16_t by_power = duty_limit_for_power(power, m->supply_mv_used);
     int16_t by_current = duty_limit_for_current(cfg->current_limit_ma, m->supply_mv_used);
     int16_t limit = (int16_t)(by_power < by_current ? by_power : by_current);
-    m->duty_limit = (int16_t)(m->derate ? limit / 2 : limit);
+    m->drive.duty_limit = (int16_t)(m->derate ? limit / 2 : limit);
+    drive_limits_for_supply(&m->drive, m->supply_mv_used);
 }
 
 static void set_power(struct motion *m, uint16_t power_mw)
@@ -108,6 +110,16 @@ static void release(struct motion *m)
     m->hal->motor_coast(m->hal->ctx);
 }
 
+/* Starts the profile's clock at its tick 0. */
+static void clock_restart(struct motion *m)
+{
+    m->tick = 0;
+    m->tick_frac = 0;
+    m->clock_rate = CLOCK_REAL_TIME;
+    m->at_tick = profile_position(&m->profile, 0);
+    m->at_next = profile_position(&m->profile, 1);
+}
+
 /* Hold still where the setpoint is now (or where the servo is, if it was
  * released): a zero-length profile. */
 static void hold_here(struct motion *m)
@@ -115,7 +127,7 @@ static void hold_here(struct motion *m)
     int64_t here = m->mode == MODE_POSITION ? m->setpoint : m->measured;
     profile_plan(&m->profile, here, 0, here, (struct profile_timing){0, 0, 0});
     m->profile.total_ticks = 0;
-    m->tick = 0;
+    clock_restart(m);
     m->setpoint = here;
     m->last_setpoint = here;
     if (m->mode != MODE_POSITION) {
@@ -126,12 +138,13 @@ static void hold_here(struct motion *m)
 }
 
 /* Where a new profile starts: the current setpoint and its velocity when
- * following one (no jerk to a stop), else the measured position at rest. */
+ * following one (no jerk to a stop; the velocity the slowed clock gives
+ * it), else the measured position at rest. */
 static void start_state(const struct motion *m, int64_t *start, int64_t *v0)
 {
     if (m->mode == MODE_POSITION) {
         *start = m->setpoint;
-        *v0 = profile_velocity(&m->profile, m->tick);
+        *v0 = m->setpoint - m->last_setpoint;
     } else {
         *start = m->measured;
         *v0 = 0;
@@ -144,9 +157,9 @@ static void begin_profile(struct motion *m, uint8_t end)
         controller_reset(&m->controller);
     }
     m->setpoint = m->profile.start;
-    m->last_setpoint = m->profile.start;
+    m->last_setpoint = m->profile.start - m->profile.v0; /* moving at v0 */
     m->mode = MODE_POSITION;
-    m->tick = 0;
+    clock_restart(m);
     m->end = end;
     m->running = 1;
 }
@@ -155,6 +168,41 @@ static void begin_profile(struct motion *m, uint8_t end)
 static int64_t velocity_q32(uint32_t decideg_per_s)
 {
     return (int64_t)(((uint64_t)decideg_per_s << 32) / MOTION_TICK_HZ);
+}
+
+/* ---- braking within what the motor can do --------------------------------
+ * The deceleration the output can count on moving in direction dir: the
+ * duty margin of the current limit, less what holding the load takes (the
+ * integral term carries it; only a load pushing the way the horn turns
+ * counts against braking), and a quarter of that kept for the controller
+ * to correct errors with. As a duty; duty / ka is decideg per tick^2. */
+static int32_t brake_duty(const struct motion *m, int32_t dir)
+{
+    int32_t assisting = dir > 0 ? -m->controller.integral_q15 : m->controller.integral_q15;
+    int32_t duty = m->drive.duty_limit - (assisting > 0 ? assisting : 0);
+    duty -= duty >> 2;
+    return duty > 1 ? duty : 1;
+}
+
+/* v in Q8 decideg per tick, saturated to int32. */
+static int32_t q32_to_q8_sat(int64_t v)
+{
+    int64_t q8 = v >> 24;
+    return q8 > INT32_MAX ? INT32_MAX : q8 < -INT32_MAX ? -INT32_MAX : (int32_t)q8;
+}
+
+/* From start moving at v0, come to rest at the output's braking (in at
+ * least min_ticks): the target is where that ends. Plans: it divides. */
+static void plan_stop(struct motion *m, int64_t start, int64_t v0, uint32_t min_ticks)
+{
+    int32_t v = q32_to_q8_sat(v0);
+    uint64_t speed = (uint64_t)(v < 0 ? -(int64_t)v : v);
+    uint64_t per_tick = (uint64_t)brake_duty(m, v) << 8; /* x ka: decideg Q8 per tick^2 */
+    uint64_t n = (speed * (uint64_t)m->drive.ka + per_tick - 1u) / per_tick;
+    n = n > min_ticks ? n : min_ticks;
+    n = n < PROFILE_MAX_RAMP ? n : PROFILE_MAX_RAMP;
+    int64_t target = start + v0 * (int64_t)n / 2;
+    profile_plan(&m->profile, start, v0, target, (struct profile_timing){0, 0, (uint32_t)n});
 }
 
 /* ---- commands ----------------------------------------------------------- */
@@ -230,9 +278,10 @@ static void run_wheel(struct motion *m, const struct motion_command *cmd)
         timing.cruise = t - 2u * WHEEL_RAMP_MS;
         target = start + v * (int64_t)(t - WHEEL_RAMP_MS);
     } else {
-        /* Stop: come to rest within one ramp, from the present speed. */
-        timing = (struct profile_timing){0, 0, WHEEL_RAMP_MS};
-        target = start + v0 * (WHEEL_RAMP_MS / 2);
+        /* Stop: come to rest within one ramp, or as fast as the motor can. */
+        plan_stop(m, start, v0, WHEEL_RAMP_MS);
+        begin_profile(m, end);
+        return;
     }
     profile_plan(&m->profile, start, v0, target, timing);
     begin_profile(m, end);
@@ -242,8 +291,15 @@ static void run_stop(struct motion *m, const struct motion_command *cmd)
 {
     switch (cmd->method) {
     case STOP_HOLD:
-        m->mode = MODE_RELEASED; /* hold where the servo is, not where it aimed */
-        hold_here(m);
+        /* Hold where the servo comes to rest, braking as hard as the motor
+         * can from where it is, not where it aimed. */
+        if (m->mode == MODE_POSITION) {
+            plan_stop(m, m->setpoint, m->setpoint - m->last_setpoint, 0);
+        } else {
+            int64_t v = (int64_t)m->measured_velocity_q8 << 24;
+            plan_stop(m, m->measured, v, 0);
+        }
+        begin_profile(m, END_HOLD);
         break;
     case STOP_DAMPING:
         m->mode = MODE_DAMPING;
@@ -425,20 +481,14 @@ void motion_init(struct motion *m, const struct registers *regs, const struct ha
 
 /* ---- the control tick --------------------------------------------------- */
 
-/* A move that ends released (wheel mode with 47 = 0) first holds its end
- * until the horn is there and nearly still, at most SETTLE_MAX_TICKS. */
-enum {
-    SETTLE_MAX_TICKS = 200,
-    SETTLE_DECIDEG = 10,   /* 1 degree */
-    SETTLE_SPEED_Q8 = 64,  /* 0.25 decideg per tick, 25 deg/s */
-};
+/* A move has finished when its setpoint has reached the target and the
+ * horn has arrived there, within ARRIVE_DECIDEG. */
+enum { ARRIVE_DECIDEG = 3 }; /* 0.3 degree */
 
-static bool settled(const struct motion *m)
+static bool arrived(const struct motion *m)
 {
-    int64_t gap = m->setpoint - m->measured;
-    int32_t speed = m->measured_velocity_q8;
-    return gap < SETTLE_DECIDEG * DECIDEG_Q32 && gap > -SETTLE_DECIDEG * DECIDEG_Q32 &&
-           speed < SETTLE_SPEED_Q8 && speed > -SETTLE_SPEED_Q8;
+    int64_t gap = m->profile.target - m->measured;
+    return gap <= ARRIVE_DECIDEG * DECIDEG_Q32 && gap >= -ARRIVE_DECIDEG * DECIDEG_Q32;
 }
 
 /* Turning without end (wheel run) must not outgrow the number formats: past
@@ -452,7 +502,7 @@ static void rebase_endless(struct motion *m)
     if (m->tick >= REBASE_TICKS) {
         int64_t v = m->profile.cruise;
         profile_plan_endless(&m->profile, m->setpoint, v, v, 0);
-        m->tick = 0;
+        clock_restart(m);
     }
     int32_t rel = m->encoder.counts - m->origin_counts;
     if (rel > REBASE_COUNTS || rel < -REBASE_COUNTS) {
@@ -465,6 +515,8 @@ static void rebase_endless(struct motion *m)
         m->profile.start -= shift_q32;
         m->profile.target -= shift_q32;
         m->profile.cruise_start -= shift_q32;
+        m->at_tick -= shift_q32;
+        m->at_next -= shift_q32;
     }
 }
 
@@ -522,6 +574,78 @@ bool motion_output_at_limit(const struct motion *m)
     return m->mode == MODE_POSITION && m->controller.at_limit;
 }
 
+/* ---- the profile's clock -------------------------------------------------
+ * The setpoint runs along the profile at clock_rate: in real time while the
+ * horn follows, slower while the output is at its limit and the setpoint
+ * leads the horn by more than LEAD_FREE (it stops at LEAD_FREE + 8 decideg),
+ * so a move faster than the motor arrives late instead of running away
+ * from the horn. The rate recovers by CLOCK_RECOVER per tick. */
+enum {
+    LEAD_FREE_Q8 = 5 << 8, /* 0.5 degree */
+    LEAD_SPAN_SHIFT = 3,   /* (lead - free) >> 3: 256 at 8 decideg */
+    CLOCK_RECOVER = 8,     /* a stopped clock is back to real time in 32 ticks */
+};
+
+static void govern_clock(struct motion *m, int32_t error_q8)
+{
+    int64_t step = m->at_next - m->at_tick;
+    int32_t lead = step > 0 ? error_q8 : step < 0 ? -error_q8 : 0;
+    uint32_t target = CLOCK_REAL_TIME;
+    if (m->controller.at_limit && lead > LEAD_FREE_Q8) {
+        uint32_t slow = (uint32_t)(lead - LEAD_FREE_Q8) >> LEAD_SPAN_SHIFT;
+        target = slow >= CLOCK_REAL_TIME ? 0u : CLOCK_REAL_TIME - slow;
+    }
+    uint32_t rate = m->clock_rate;
+    rate = target < rate ? target : rate + CLOCK_RECOVER < target ? rate + CLOCK_RECOVER : target;
+    m->clock_rate = (uint16_t)rate;
+}
+
+/* Moves the setpoint on by clock_rate: between the profile's positions at
+ * two whole ticks, linearly (the profile bends by far less than an encoder
+ * count within one tick). */
+static void advance_clock(struct motion *m)
+{
+    uint32_t frac = (uint32_t)m->tick_frac + m->clock_rate;
+    if (frac >= CLOCK_REAL_TIME && m->tick < UINT32_MAX) {
+        frac -= CLOCK_REAL_TIME;
+        m->tick++;
+        m->at_tick = m->at_next;
+        m->at_next = profile_position(&m->profile, m->tick + 1u);
+    }
+    m->tick_frac = (uint16_t)frac;
+    m->setpoint = m->at_tick + (((m->at_next - m->at_tick) * (int64_t)frac) >> 8);
+}
+
+/* Before its deceleration, a profile whose setpoint could no longer stop on
+ * the target at the output's braking (v^2 > 2 a r, a = brake_duty / ka)
+ * decelerates from here and now, at v^2 / 2r. This catches plans whose
+ * ramps are steeper than the motor, and setpoints the slowed clock has left
+ * moving at another speed. Speeds beyond 2^16 (256 decideg per tick) count
+ * as 2^16: far beyond any servo, and the products stay within int64. */
+static void guard_braking(struct motion *m)
+{
+    if (m->endless || m->tick >= m->profile.cruise_end) {
+        return;
+    }
+    int64_t v_q32 = m->setpoint - m->last_setpoint;
+    int32_t v = q32_to_q8_sat(v_q32);
+    int32_t r = q32_to_q8_sat(m->profile.target - m->setpoint);
+    if (v == 0 || r == 0 || (v > 0) != (r > 0)) {
+        return;
+    }
+    int64_t speed = v < 0 ? -(int64_t)v : v;
+    int64_t room = r < 0 ? -(int64_t)r : r;
+    int64_t capped = speed < (1 << 16) ? speed : (1 << 16);
+    if (capped * capped * m->drive.ka <= ((int64_t)brake_duty(m, v) * room) << 9) {
+        return;
+    }
+    uint32_t n = (uint32_t)((2 * room + speed - 1) / speed);
+    n = n < PROFILE_MAX_RAMP ? n : PROFILE_MAX_RAMP;
+    profile_plan(&m->profile, m->setpoint, v_q32, m->profile.target,
+                 (struct profile_timing){0, 0, n});
+    clock_restart(m);
+}
+
 void motion_tick(struct motion *m)
 {
     measure(m);
@@ -531,7 +655,7 @@ void motion_tick(struct motion *m)
     }
     switch (m->mode) {
     case MODE_DAMPING:
-        m->hal->motor_drive(m->hal->ctx, controller_damping(m->measured_velocity_q8, m->duty_limit));
+        m->hal->motor_drive(m->hal->ctx, controller_damping(m->measured_velocity_q8, &m->drive));
         return;
     case MODE_POSITION:
         break;
@@ -541,26 +665,26 @@ void motion_tick(struct motion *m)
     if (m->endless) {
         rebase_endless(m);
     }
-    if (m->tick < UINT32_MAX) {
-        m->tick++;
-    }
+    govern_clock(m, q32_to_q8_sat(m->setpoint - m->measured));
     int64_t last_step = m->setpoint - m->last_setpoint;
+    bool real_time = m->clock_rate == CLOCK_REAL_TIME;
     m->last_setpoint = m->setpoint;
-    m->setpoint = profile_position(&m->profile, m->tick);
+    advance_clock(m);
+    guard_braking(m);
     int64_t step = m->setpoint - m->last_setpoint;
+    /* The acceleration feed-forward only while the clock keeps real time:
+     * a rate change is no acceleration the horn should be given (the
+     * output is at its limit then anyway). */
+    real_time = real_time && m->clock_rate == CLOCK_REAL_TIME;
     const struct controller_input in = {
-        .error_q8 = (int32_t)((m->setpoint - m->measured) >> 24),
-        .velocity_q8 = (int32_t)(step >> 24),
-        .acceleration_q16 = (int32_t)((step - last_step) >> 16),
+        .error_q8 = q32_to_q8_sat(m->setpoint - m->measured),
+        .velocity_q8 = q32_to_q8_sat(step),
+        .acceleration_q16 = real_time ? (int32_t)((step - last_step) >> 16) : 0,
         .measured_velocity_q8 = m->measured_velocity_q8,
-        .duty_limit = m->duty_limit,
     };
-    m->hal->motor_drive(m->hal->ctx, controller_position(&m->controller, &in));
-    bool done = m->endless ? m->tick >= m->profile.accel_ticks : profile_done(&m->profile, m->tick);
-    if (done && m->end == END_RELEASE && !settled(m) &&
-        m->tick - m->profile.total_ticks < SETTLE_MAX_TICKS) {
-        done = false; /* released now, the horn would coast on past the end */
-    }
+    m->hal->motor_drive(m->hal->ctx, controller_position(&m->controller, &in, &m->drive));
+    bool done = m->endless ? m->tick >= m->profile.accel_ticks
+                           : profile_done(&m->profile, m->tick) && arrived(m);
     if (m->running && done) {
         finish(m);
     }

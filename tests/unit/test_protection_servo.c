@@ -94,21 +94,21 @@ static void test_over_current_halves_the_output_while_moving(void **state)
     REQUEST(8, 0, 0x10, 0x27, 0xE8, 0x03, 0x00, 0x00); /* a long move */
     harness_run_ms(50);
     /* Factory: 42's 10 W binds before 43's 4 A (4 A x 2 ohm > the supply). */
-    assert_int_equal(servo.motion.duty_limit, duty_limit_for_power(10000, 7400));
+    assert_int_equal(servo.motion.drive.duty_limit, duty_limit_for_power(10000, 7400));
     REQUEST(4, 0, 43, 0xE8, 0x03); /* 43 = 1000 mA: now it binds */
     REQUEST(8, 0, 0x10, 0x27, 0xE8, 0x03, 0x00, 0x00);
-    int16_t normal = servo.motion.duty_limit;
+    int16_t normal = servo.motion.drive.duty_limit;
     assert_int_equal(normal, duty_limit_for_current(1000, 7400));
     assert_true(normal < duty_limit_for_power(10000, 7400));
     hal.sensors.current = 1200;
     harness_run_ms(60);
     REQUEST(3, 0, 5);
     EXPECT_RESPONSE(3, 0, 5, STATUS_EXECUTING | STATUS_OVER_CURRENT);
-    assert_int_equal(servo.motion.duty_limit, normal / 2);
+    assert_int_equal(servo.motion.drive.duty_limit, normal / 2);
     assert_false(hal.coasting); /* limited, not released */
     hal.sensors.current = 300;
     harness_run_ms(200);
-    assert_int_equal(servo.motion.duty_limit, normal);
+    assert_int_equal(servo.motion.drive.duty_limit, normal);
 }
 
 int main(void)

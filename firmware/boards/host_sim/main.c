@@ -205,11 +205,13 @@ static void state_of(const struct sim_servo *s, char *out, size_t size)
     struct motion_angle a;
     motion_read_angle(&s->core.motion, &a);
     snprintf(out, size,
-             "id=%u angle=%.3f velocity=%.2f current=%.3f winding=%.2f ambient=%.1f supply=%.3f "
+             "id=%u angle=%.3f velocity=%.2f current=%.3f winding=%.2f case=%.2f ambient=%.1f "
+             "supply=%.3f "
              "load=%.3f stop=%s status=0x%02x reported=%d collisions=%lu dropped_ticks=%u "
              "most_behind_ms=%.1f\n",
              s->cmdline_id, plant_angle_deg(&s->plant), s->plant.velocity * 180.0 / M_PI,
-             s->plant.current, s->thermal.winding_c, s->thermal.ambient_c, s->plant.p.supply_v,
+             s->plant.current, s->thermal.winding_c, s->thermal.case_c, s->thermal.ambient_c,
+             s->plant.p.supply_v,
              s->plant.load_torque, s->plant.has_stop ? "on" : "off", s->core.regs.status.status,
              a.multi_turn_decideg, bus.collisions, s->core.ticks_dropped,
              (double)most_behind_us / 1000.0);
@@ -238,7 +240,7 @@ static void control_command(int fd, char *line)
         }
     }
     if (strcmp(cmd, "help") == 0) {
-        reply(fd, "ok supply MV | load NM | stop DEG | stop off | ambient DEGC | state [ID]\n");
+        reply(fd, "ok supply MV | load NM | stop DEG | stop off | ambient DEGC | soak DEGC | state [ID]\n");
         return;
     }
     if (takes_value && n < 2) {
@@ -264,6 +266,8 @@ static void control_command(int fd, char *line)
             s->plant.load_torque = value;
         } else if (strcmp(cmd, "ambient") == 0) {
             s->thermal.ambient_c = value;
+        } else if (strcmp(cmd, "soak") == 0) {
+            thermal_soak(&s->thermal, value);
         } else if (strcmp(cmd, "stop") == 0) {
             s->plant.has_stop = !off;
             s->plant.stop_angle = value * M_PI / 180.0;

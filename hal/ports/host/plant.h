@@ -1,8 +1,19 @@
 /* Physical model of the servo's drive train for the host port and tests:
- * a DC motor behind a gearbox, driven by a PWM duty, with viscous and
- * Coulomb friction, back-EMF, an external load and an optional hard stop,
- * read through a 12-bit absolute encoder on the output. Host code: double
- * precision is fine here; none of this runs on the MCU. */
+ * a brushed DC motor behind a spur gearbox, driven by a PWM H-bridge, read
+ * through a 12-bit absolute encoder on the output. Host code: double
+ * precision is fine here; none of this runs on the MCU.
+ *
+ * What it models, because a real servo fails that way:
+ * - the winding current (V d - back-EMF) / R, so speed and torque both
+ *   saturate at the supply;
+ * - gear losses that grow with the transmitted torque (efficiency), so a
+ *   load back-drives the output only through the gearbox's losses;
+ * - the bridge's body diodes: released, the motor turns into a generator
+ *   once its back-EMF exceeds the supply plus two diode drops, which brakes
+ *   a back-driven output hard;
+ * - motor drag (the no-load current), Coulomb and viscous;
+ * - a hard stop, and an external load torque.
+ * The parameters and where each number comes from: plant.c. */
 #ifndef HOST_PLANT_H
 #define HOST_PLANT_H
 
@@ -11,29 +22,29 @@
 
 struct plant_params {
     double supply_v;        /* bridge supply */
-    double resistance_ohm;  /* winding */
-    double kt;              /* torque constant = back-EMF constant, motor side, N m/A */
+    double resistance_ohm;  /* winding plus bridge */
+    double kt;              /* torque constant = back-EMF constant, motor side, N m/A, V s/rad */
     double gear_ratio;      /* motor turns per output turn */
-    double inertia;         /* at the output, kg m^2 (rotor reflected + horn) */
-    double viscous;         /* at the output, N m s/rad */
-    double coulomb;         /* at the output, N m */
+    double efficiency;      /* gearbox, each way */
+    double rotor_inertia;   /* motor side, kg m^2 (the horn's is negligible beside it x ratio^2) */
+    double drag_coulomb;    /* motor side, N m */
+    double drag_viscous;    /* motor side, N m s/rad */
+    double diode_v;         /* one body diode's forward drop */
 };
 
 struct plant {
     struct plant_params p;
     double angle;        /* output, rad, multi-turn, counter-clockwise positive */
     double velocity;     /* output, rad/s */
-    double current;      /* winding, A */
+    double current;      /* winding, A (negative: braking, or regenerating released) */
     double duty;         /* -1..1 */
     bool coast;          /* bridge off */
-    double load_torque;  /* external, N m, opposing positive motion if positive */
+    double load_torque;  /* external, at the output, N m, opposing positive motion if positive */
     bool has_stop;       /* a hard stop at stop_angle, from below */
     double stop_angle;
 };
 
-/* The reference servo the gains were tuned on: 7.4 V, 2 ohm, 200:1,
- * 0.005 kg m^2 at the output, about 420 deg/s unloaded at full duty,
- * 3.7 N m stall. */
+/* The reference servo: a 20 kg cm class bus servo at 7.4 V. */
 void plant_init(struct plant *pl);
 void plant_drive(struct plant *pl, int16_t duty_q15);
 void plant_coast(struct plant *pl);
@@ -41,5 +52,11 @@ void plant_coast(struct plant *pl);
 void plant_step(struct plant *pl, double dt);
 uint16_t plant_encoder(const struct plant *pl);
 double plant_angle_deg(const struct plant *pl);
+
+/* Figures of the parameters, at the output: stall torque (N m) at duty 1
+ * and the present supply; no-load speed (rad/s); inertia (kg m^2). */
+double plant_stall_torque(const struct plant *pl);
+double plant_no_load_speed(const struct plant *pl);
+double plant_output_inertia(const struct plant *pl);
 
 #endif

@@ -16,20 +16,30 @@ struct controller {
     uint8_t at_limit; /* the last output was held back by the limit */
 };
 
+/* What the drive can do at the present supply, worked out when the supply
+ * or the limit changes (it divides), used every tick. */
+struct drive_limits {
+    int32_t kv;         /* back-EMF duty per decideg per tick, Q8 input */
+    int32_t ka;         /* duty per decideg per tick^2, Q16 input */
+    int16_t duty_limit; /* Q15 duty of the current limit, 0..32767 */
+};
+
 struct controller_input {
     int32_t error_q8;             /* setpoint - measured, decideg Q8 */
     int32_t velocity_q8;          /* planned velocity, decideg per tick Q8 */
     int32_t acceleration_q16;     /* planned, decideg per tick^2 Q16 */
     int32_t measured_velocity_q8; /* decideg per tick Q8 */
-    int16_t duty_limit;           /* Q15 duty of the current limit, 0..32767 */
 };
 
 void controller_reset(struct controller *c);
-int16_t controller_position(struct controller *c, const struct controller_input *in);
+int16_t controller_position(struct controller *c, const struct controller_input *in,
+                            const struct drive_limits *lim);
 /* Damping mode: a braking duty proportional to the measured velocity. */
-int16_t controller_damping(int32_t measured_velocity_q8, int16_t duty_limit);
-/* Keeps duty within duty_limit of the back-EMF duty at this speed. */
-int16_t controller_limit(int32_t duty, int32_t measured_velocity_q8, int16_t duty_limit);
+int16_t controller_damping(int32_t measured_velocity_q8, const struct drive_limits *lim);
+/* Keeps duty within the duty limit of the back-EMF duty at this speed. */
+int16_t controller_limit(int32_t duty, int32_t measured_velocity_q8, const struct drive_limits *lim);
+/* kv and ka at supply_mv (0: the nominal supply). Planning-time: it divides. */
+void drive_limits_for_supply(struct drive_limits *lim, uint16_t supply_mv);
 /* The duty that drives the current limit P / V through the winding at
  * standstill: P R / V^2, Q15. Planning-time: it divides. */
 int16_t duty_limit_for_power(uint16_t power_mw, uint16_t supply_mv);

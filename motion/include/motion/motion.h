@@ -106,11 +106,18 @@ struct motion {
     int32_t measured_velocity_q8; /* filtered, decideg per tick */
     int32_t velocity_filter_q12;
     struct profile profile;
-    uint32_t tick;             /* ticks since the profile started */
+    /* The profile's own clock: whole ticks and a Q8 fraction. It runs at
+     * clock_rate (Q8, 256 = real time) and slows while the horn cannot
+     * follow, so the setpoint never runs away from the horn. */
+    uint32_t tick;
+    uint16_t tick_frac;
+    uint16_t clock_rate;
+    int64_t at_tick;           /* profile position at tick, Q32 decideg */
+    int64_t at_next;           /* and at tick + 1 */
     int64_t setpoint;          /* Q32 decideg */
     int64_t last_setpoint;
     struct controller controller;
-    int16_t duty_limit;        /* Q15 current margin: power, 43, protection */
+    struct drive_limits drive; /* current margin (power, 43, protection), kv, ka */
     uint16_t power_mw;         /* the running command's power, 0 = 42's value */
     uint16_t supply_mv_used;   /* supply the duty limit was worked out for */
     uint8_t supply_check;      /* ticks since the supply was last looked at */
