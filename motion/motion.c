@@ -116,6 +116,8 @@ static void clock_restart(struct motion *m)
     m->tick = 0;
     m->tick_frac = 0;
     m->clock_rate = CLOCK_REAL_TIME;
+    m->lead_q8 = 0;
+    m->braking = 0;
     m->at_tick = profile_position(&m->profile, 0);
     m->at_next = profile_position(&m->profile, 1);
 }
@@ -172,14 +174,18 @@ static int64_t velocity_q32(uint32_t decideg_per_s)
 
 /* ---- braking within what the motor can do --------------------------------
  * The deceleration the output can count on moving in direction dir: the
- * duty margin of the current limit, less what holding the load takes (the
- * integral term carries it; only a load pushing the way the horn turns
- * counts against braking), and a quarter of that kept for the controller
- * to correct errors with. As a duty; duty / ka is decideg per tick^2. */
+ * duty margin of the current limit, less what holding a load that pushes
+ * the way the horn turns takes (the integral term carries it; counted up
+ * to half the margin, since in motion it also holds transient errors: a
+ * load of 0.8 of the stall torque at this power takes 0.8 x efficiency^2 =
+ * 0.26, plant.c), and a quarter of that kept for the controller to correct
+ * errors with. As a duty; duty / ka is decideg per tick^2. */
 static int32_t brake_duty(const struct motion *m, int32_t dir)
 {
+    int32_t limit = m->drive.duty_limit;
     int32_t assisting = dir > 0 ? -m->controller.integral_q15 : m->controller.integral_q15;
-    int32_t duty = m->drive.duty_limit - (assisting > 0 ? assisting : 0);
+    assisting = assisting < 0 ? 0 : assisting > limit / 2 ? limit / 2 : assisting;
+    int32_t duty = limit - assisting;
     duty -= duty >> 2;
     return duty > 1 ? duty : 1;
 }
@@ -296,7 +302,7 @@ static void run_stop(struct motion *m, const struct motion_command *cmd)
         if (m->mode == MODE_POSITION) {
             plan_stop(m, m->setpoint, m->setpoint - m->last_setpoint, 0);
         } else {
-            int64_t v = (int64_t)m->measured_velocity_q8 << 24;
+            int64_t v = (int64_t)m->measured_velocity_q8 * ((int64_t)1 << 24);
             plan_stop(m, m->measured, v, 0);
         }
         begin_profile(m, END_HOLD);
@@ -579,24 +585,34 @@ bool motion_output_at_limit(const struct motion *m)
  * horn follows, slower while the output is at its limit and the setpoint
  * leads the horn by more than LEAD_FREE (it stops at LEAD_FREE + 8 decideg),
  * so a move faster than the motor arrives late instead of running away
- * from the horn. The rate recovers by CLOCK_RECOVER per tick. */
+ * from the horn. The lead is low-passed (the encoder's counts are coarse
+ * beside one tick's motion) and the rate moves by at most CLOCK_SLEW per
+ * tick, so the setpoint's speed changes smoothly. */
 enum {
     LEAD_FREE_Q8 = 5 << 8, /* 0.5 degree */
     LEAD_SPAN_SHIFT = 3,   /* (lead - free) >> 3: 256 at 8 decideg */
-    CLOCK_RECOVER = 8,     /* a stopped clock is back to real time in 32 ticks */
+    LEAD_FILTER_SHIFT = 2, /* time constant 4 ticks */
+    CLOCK_SLEW = 8,        /* a stopped clock is back to real time in 32 ticks */
 };
 
 static void govern_clock(struct motion *m, int32_t error_q8)
 {
     int64_t step = m->at_next - m->at_tick;
     int32_t lead = step > 0 ? error_q8 : step < 0 ? -error_q8 : 0;
+    m->lead_q8 += (lead - m->lead_q8) >> LEAD_FILTER_SHIFT;
     uint32_t target = CLOCK_REAL_TIME;
-    if (m->controller.at_limit && lead > LEAD_FREE_Q8) {
-        uint32_t slow = (uint32_t)(lead - LEAD_FREE_Q8) >> LEAD_SPAN_SHIFT;
+    if (m->controller.at_limit && m->lead_q8 > LEAD_FREE_Q8) {
+        uint32_t slow = (uint32_t)(m->lead_q8 - LEAD_FREE_Q8) >> LEAD_SPAN_SHIFT;
         target = slow >= CLOCK_REAL_TIME ? 0u : CLOCK_REAL_TIME - slow;
     }
     uint32_t rate = m->clock_rate;
-    rate = target < rate ? target : rate + CLOCK_RECOVER < target ? rate + CLOCK_RECOVER : target;
+    if (target + CLOCK_SLEW < rate) {
+        rate -= CLOCK_SLEW;
+    } else if (target > rate + CLOCK_SLEW) {
+        rate += CLOCK_SLEW;
+    } else {
+        rate = target;
+    }
     m->clock_rate = (uint16_t)rate;
 }
 
@@ -616,20 +632,31 @@ static void advance_clock(struct motion *m)
     m->setpoint = m->at_tick + (((m->at_next - m->at_tick) * (int64_t)frac) >> 8);
 }
 
-/* Before its deceleration, a profile whose setpoint could no longer stop on
- * the target at the output's braking (v^2 > 2 a r, a = brake_duty / ka)
- * decelerates from here and now, at v^2 / 2r. This catches plans whose
- * ramps are steeper than the motor, and setpoints the slowed clock has left
- * moving at another speed. Speeds beyond 2^16 (256 decideg per tick) count
- * as 2^16: far beyond any servo, and the products stay within int64. */
+/* A profile whose horn could no longer stop on the target at the output's
+ * braking (v^2 > 2 a r, a = brake_duty / ka, v the setpoint's or the horn's
+ * speed, r what is left from the horn) decelerates from where the horn is, at v^2 / 2r,
+ * and is left alone after that (braking). Starting from the horn rather
+ * than the setpoint drops the lead the slowed clock kept, which would
+ * otherwise push on against the braking. This catches plans whose ramps
+ * are steeper than the motor, and setpoints the slowed clock has left
+ * moving at another speed, in any phase. Speeds beyond 2^16 (256 decideg
+ * per tick) count as 2^16: far beyond any servo, and the products stay
+ * within int64. */
 static void guard_braking(struct motion *m)
 {
-    if (m->endless || m->tick >= m->profile.cruise_end) {
+    if (m->endless || m->braking) {
         return;
     }
+    /* The faster of setpoint and horn must stop: in a slowed deceleration
+     * the setpoint moves slower than the horn still does. */
     int64_t v_q32 = m->setpoint - m->last_setpoint;
     int32_t v = q32_to_q8_sat(v_q32);
-    int32_t r = q32_to_q8_sat(m->profile.target - m->setpoint);
+    int32_t w = m->measured_velocity_q8;
+    if ((w > 0) == (v > 0) && (w > v) == (v > 0) && w != v) {
+        v = w;
+        v_q32 = (int64_t)w * ((int64_t)1 << 24);
+    }
+    int32_t r = q32_to_q8_sat(m->profile.target - m->measured);
     if (v == 0 || r == 0 || (v > 0) != (r > 0)) {
         return;
     }
@@ -641,9 +668,12 @@ static void guard_braking(struct motion *m)
     }
     uint32_t n = (uint32_t)((2 * room + speed - 1) / speed);
     n = n < PROFILE_MAX_RAMP ? n : PROFILE_MAX_RAMP;
-    profile_plan(&m->profile, m->setpoint, v_q32, m->profile.target,
+    profile_plan(&m->profile, m->measured, v_q32, m->profile.target,
                  (struct profile_timing){0, 0, n});
     clock_restart(m);
+    m->setpoint = m->profile.start;
+    m->last_setpoint = m->profile.start - v_q32;
+    m->braking = 1;
 }
 
 void motion_tick(struct motion *m)

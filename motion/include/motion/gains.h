@@ -15,11 +15,12 @@
 /* Proportional: full duty at 6.0 degrees of error. */
 #define GAIN_KP 546
 /* Integral, per tick: removes the steady error a load leaves. */
-#define GAIN_KI 4
+#define GAIN_KI 8
 /* No integrating within one encoder count (3600 / 4096 decideg, Q8). */
 #define INTEGRAL_DEADBAND_Q8 225
-/* Integral term bound, Q15 duty: half of full. */
-#define INTEGRAL_LIMIT_Q15 16384
+/* Integral term bound, Q15 duty: full, so a load near the stall torque at
+ * the lowest supply can be held (anti-windup keeps it from running away). */
+#define INTEGRAL_LIMIT_Q15 32767
 /* Velocity feed-forward at the nominal supply: the back-EMF duty of a speed,
  * kt x 345 x (100 deg/s in rad/s) / 7.4 V = 0.3022 -> 9902 per decideg per
  * tick. The current limit works around the same duty. Scaled by

@@ -112,6 +112,8 @@ struct motion {
     uint32_t tick;
     uint16_t tick_frac;
     uint16_t clock_rate;
+    int32_t lead_q8;           /* setpoint ahead of the horn, low-passed, decideg Q8 */
+    uint8_t braking;           /* the profile is the braking guard's: left alone */
     int64_t at_tick;           /* profile position at tick, Q32 decideg */
     int64_t at_next;           /* and at tick + 1 */
     int64_t setpoint;          /* Q32 decideg */
