@@ -648,11 +648,14 @@ static void guard_braking(struct motion *m)
         return;
     }
     /* The faster of setpoint and horn must stop: in a slowed deceleration
-     * the setpoint moves slower than the horn still does. */
+     * the setpoint moves slower than the horn still does. In real time the
+     * horn follows the setpoint, whose speed is exact (the measured one
+     * lags by the filter). */
     int64_t v_q32 = m->setpoint - m->last_setpoint;
     int32_t v = q32_to_q8_sat(v_q32);
     int32_t w = m->measured_velocity_q8;
-    if ((w > 0) == (v > 0) && (w > v) == (v > 0) && w != v) {
+    bool slowed = m->clock_rate != CLOCK_REAL_TIME;
+    if (slowed && (w > 0) == (v > 0) && (w > v) == (v > 0) && w != v) {
         v = w;
         v_q32 = (int64_t)w * ((int64_t)1 << 24);
     }
