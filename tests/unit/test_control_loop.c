@@ -10,6 +10,10 @@
 
 #include <cmocka.h>
 
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
 #include "plant.h"
 #include "servo_harness.h"
 
@@ -132,6 +136,31 @@ static void test_power_bounds_the_current(void **state)
     assert_true(fabs(plant_angle_deg(&plant) - 90.0) < 0.14);
 }
 
+/* Released under a load beyond the stall torque, the output is back-driven
+ * through the gears' losses, and the motor, turned into a generator, brakes
+ * through the bridge's body diodes: the speed stays bounded, and once the
+ * load is gone friction stops the horn. */
+static void test_back_driving_is_bounded(void **state)
+{
+    (void)state;
+    REQUEST(24, 0, 0x10, 0x00, 0x00); /* stop and release */
+    plant.load_torque = 3.0;          /* N m, 1.6 x the stall torque */
+    double fastest = 0;
+    for (int i = 0; i < 2000; i++) {
+        harness_run_ms(1);
+        double speed = fabs(plant.velocity) * 180.0 / M_PI;
+        fastest = speed > fastest ? speed : fastest;
+    }
+    plant.load_torque = 0.0;
+    harness_run_ms(1500); /* the rotor's inertia coasts down against friction */
+    double after = fabs(plant.velocity) * 180.0 / M_PI;
+    printf("# released under 3 N m: at most %.0f deg/s; 1.5 s after the load is gone %.1f deg/s\n",
+           fastest, after);
+    assert_true(hal.coasting);
+    assert_true(fastest > 100.0 && fastest < 2000.0);
+    assert_true(after < 1.0);
+}
+
 static void test_damping_brakes_a_spinning_horn(void **state)
 {
     (void)state;
@@ -205,6 +234,7 @@ int main(void)
         cmocka_unit_test_setup(test_velocity_move_and_return, setup),
         cmocka_unit_test_setup(test_load_is_held, setup),
         cmocka_unit_test_setup(test_power_bounds_the_current, setup),
+        cmocka_unit_test_setup(test_back_driving_is_bounded, setup),
         cmocka_unit_test_setup(test_damping_brakes_a_spinning_horn, setup),
         cmocka_unit_test_setup(test_stall_limits_to_the_stall_power, setup),
         cmocka_unit_test_setup(test_stall_releases_when_37_says_so, setup),

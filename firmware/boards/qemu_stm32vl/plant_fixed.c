@@ -1,11 +1,14 @@
 #include "plant_fixed.h"
 
+/* The reference servo of hal/ports/host/plant.c, where each number comes
+ * from: 312.5 deg/s unloaded at 7.4 V, mechanical time constant
+ * J R / (kt N)^2 = 0.0119 x 2.741 / (3.714e-3 x 345)^2 = 20 ms. */
 enum {
-    NO_LOAD_Q8 = 1224,    /* 4.78 counts per ms = 420 deg/s, Q8 */
-    DRIVE_TAU_TICKS = 10, /* mechanical time constant while driven */
+    NO_LOAD_Q8 = 910,     /* 3.556 counts per ms = 312.5 deg/s, Q8 */
+    DRIVE_TAU_TICKS = 20, /* mechanical time constant while driven */
     COAST_TAU_TICKS = 200,/* friction alone */
     SUPPLY_MV = 7400,
-    RESISTANCE_OHM = 2,
+    RESISTANCE_MOHM = 2741,
 };
 
 void plant_fixed_step(struct plant_fixed *p)
@@ -28,6 +31,6 @@ uint16_t plant_fixed_current_ma(const struct plant_fixed *p)
     }
     int32_t drive_mv = (int32_t)p->duty * SUPPLY_MV / 32767;
     int32_t emf_mv = p->velocity_q8 * SUPPLY_MV / NO_LOAD_Q8;
-    int32_t ma = (drive_mv - emf_mv) / RESISTANCE_OHM;
+    int32_t ma = (drive_mv - emf_mv) * 1000 / RESISTANCE_MOHM;
     return (uint16_t)(ma < 0 ? -ma : ma);
 }

@@ -1,7 +1,7 @@
 /* The drive train in integers, for the emulated board (no FPU, no soft
  * float in any image): the output's speed follows the duty with the
- * reference plant's 10 ms mechanical time constant, up to its no-load speed
- * (about 420 deg/s at full duty); read through a 12-bit encoder. One step per
+ * reference plant's 20 ms mechanical time constant, up to its no-load speed
+ * (312.5 deg/s at full duty); read through a 12-bit encoder. One step per
  * control tick. */
 #ifndef QEMU_PLANT_FIXED_H
 #define QEMU_PLANT_FIXED_H

@@ -31,10 +31,10 @@ def timed_move(servo, sim, **move):
 @pytest.mark.parametrize("move, expected_ms", [
     (dict(angle_decideg=900, interval_ms=500), 500),
     (dict(angle_decideg=-450, interval_ms=800, acc_ms=100, dec_ms=200), 800),
-    (dict(angle_decideg=7200, interval_ms=2000, acc_ms=300, dec_ms=300, multi_turn=True), 2000),
+    (dict(angle_decideg=7200, interval_ms=3000, acc_ms=300, dec_ms=300, multi_turn=True), 3000),
     (dict(angle_decideg=1000, velocity=3000, acc_ms=100, dec_ms=200), None),
     (dict(angle_decideg=200, velocity=3000, acc_ms=100, dec_ms=200), None),
-    (dict(angle_decideg=-4000, velocity=4000, acc_ms=50, dec_ms=50, multi_turn=True), None),
+    (dict(angle_decideg=-4000, velocity=2800, acc_ms=50, dec_ms=50, multi_turn=True), None),
 ])
 def test_moves_end_on_target_and_on_time(servo, sim, move, expected_ms):
     start = servo.multi_turn_angle()[0]
@@ -46,6 +46,26 @@ def test_moves_end_on_target_and_on_time(servo, sim, move, expected_ms):
     assert abs(angle - move["angle_decideg"] / 10.0) <= 0.5
     assert abs(took * 1000 - expected_ms) <= 20, f"took {took * 1000:.0f} ms, planned {expected_ms}"
     assert abs(servo.multi_turn_angle()[0] - move["angle_decideg"]) <= 5
+
+
+@pytest.mark.xfail(strict=True, reason="issue 9, open: braking from the top speed (312 deg/s) "
+                   "overshoots by 4.2 deg on the simulator; the goal is 1 deg")
+def test_a_move_faster_than_the_motor_arrives_late_without_overshoot(servo, sim):
+    """720 deg in 1 s asks 800 deg/s of a servo that makes 312: it takes longer,
+    status bit 0 stays set until the horn is there, and it does not overshoot."""
+    servo.move(angle_decideg=7200, interval_ms=1000, multi_turn=True)
+    t0 = time.monotonic()
+    furthest = 0.0
+    while servo.status() & EXECUTING and time.monotonic() - t0 < 10:
+        furthest = max(furthest, sim.state(1)["angle"])
+    took = time.monotonic() - t0
+    angle = sim.state(1)["angle"]
+    for _ in range(20):
+        furthest = max(furthest, sim.state(1)["angle"])
+        time.sleep(0.01)
+    assert took > 2.0, f"finished after {took:.2f} s: 720 deg at 312 deg/s take at least 2.3 s"
+    assert abs(angle - 720.0) <= 0.5
+    assert furthest - 720.0 <= 1.0
 
 
 def test_protocol_worked_example_timing(servo, sim):
