@@ -14,34 +14,14 @@
 #define M_PI 3.14159265358979323846
 #endif
 
-#include "plant.h"
-#include "servo_harness.h"
-
-static struct plant plant;
-static uint32_t plant_time_us;
-
-/* Called once per control tick: the plant runs with the last output until
- * now, then the encoder is read. */
-static uint16_t plant_encoder_model(void *model)
-{
-    (void)model;
-    if (hal.coasting) {
-        plant_coast(&plant);
-    } else {
-        plant_drive(&plant, hal.duty);
-    }
-    plant_step(&plant, (hal.now_us - plant_time_us) * 1e-6);
-    plant_time_us = hal.now_us;
-    return plant_encoder(&plant);
-}
+#include "plant_harness.h"
 
 static int setup(void **state)
 {
     (void)state;
     plant_init(&plant);
     harness_init();
-    plant_time_us = hal.now_us;
-    hal.encoder_model = plant_encoder_model;
+    plant_harness_attach();
     REQUEST(4, 0, 49, 0); /* no soft start */
     return 0;
 }

@@ -20,27 +20,7 @@
 
 #include <cmocka.h>
 
-#include "plant.h"
-#include "servo_harness.h"
-
-static struct plant plant;
-static uint32_t plant_time_us;
-
-/* Once per control tick: the plant runs until now with the last output;
- * the sensors read what it draws. */
-static uint16_t plant_encoder_model(void *model)
-{
-    (void)model;
-    if (hal.coasting) {
-        plant_coast(&plant);
-    } else {
-        plant_drive(&plant, hal.duty);
-    }
-    plant_step(&plant, (hal.now_us - plant_time_us) * 1e-6);
-    plant_time_us = hal.now_us;
-    hal.sensors.current = (uint16_t)lround(fabs(plant.current) * 1000.0);
-    return plant_encoder(&plant);
-}
+#include "plant_harness.h"
 
 static uint64_t rng_state;
 static int trace_trial = -1; /* MOTION_TRACE: print one trial's move */
@@ -187,8 +167,7 @@ static void run_trial(unsigned trial, double inertia_scale)
     plant.angle = (rng_unit() - 0.5) * 2.0; /* within a turn, released */
     harness_init();
     hal.sensors.supply = (uint16_t)lround(plant.p.supply_v * 1000.0);
-    plant_time_us = hal.now_us;
-    hal.encoder_model = plant_encoder_model;
+    plant_harness_attach();
     REQUEST(4, 0, 49, 0);        /* no soft start */
     REQUEST(4, 0, 40, 0x28, 0x23); /* high-voltage protection 9000 mV */
     bool queued = rng() % 4u == 0u;

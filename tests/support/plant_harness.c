@@ -1,0 +1,26 @@
+#include "plant_harness.h"
+
+#include <math.h>
+
+struct plant plant;
+static uint32_t plant_time_us;
+
+static uint16_t plant_encoder_model(void *model)
+{
+    (void)model;
+    if (hal.coasting) {
+        plant_coast(&plant);
+    } else {
+        plant_drive(&plant, hal.duty);
+    }
+    plant_step(&plant, (hal.now_us - plant_time_us) * 1e-6);
+    plant_time_us = hal.now_us;
+    hal.sensors.current = (uint16_t)lround(fabs(plant.current) * 1000.0);
+    return plant_encoder(&plant);
+}
+
+void plant_harness_attach(void)
+{
+    plant_time_us = hal.now_us;
+    hal.encoder_model = plant_encoder_model;
+}

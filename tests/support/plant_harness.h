@@ -1,0 +1,15 @@
+/* The servo harness closed around the physical plant (hal/ports/host/
+ * plant.c): once per control tick the plant runs with the last output until
+ * now, the encoder reads its angle and the current sensor its current. */
+#ifndef TEST_PLANT_HARNESS_H
+#define TEST_PLANT_HARNESS_H
+
+#include "plant.h"
+#include "servo_harness.h"
+
+extern struct plant plant;
+
+/* After plant_init and harness_init: the plant drives the encoder from now. */
+void plant_harness_attach(void);
+
+#endif
