@@ -32,6 +32,12 @@ int16_t controller_limit(int32_t duty, int32_t measured_velocity_q8, const struc
 int16_t controller_position(struct controller *c, const struct controller_input *in,
                             const struct drive_limits *lim)
 {
+    if (in->push != 0) {
+        /* The setpoint waits for the horn: all the current the limit allows,
+         * nothing integrated (the error is the motor's, no load's). */
+        c->at_limit = 1;
+        return limit(in->push > 0 ? 1 << 20 : -(1 << 20), in->measured_velocity_q8, lim);
+    }
     /* Beyond 2^22 (16 384 decideg) the output is saturated anyway. */
     int32_t e = clamp32(in->error_q8, 1 << 22);
     int64_t p = ((int64_t)e * GAIN_KP) >> 8;
@@ -42,8 +48,9 @@ int16_t controller_position(struct controller *c, const struct controller_input 
     int32_t integral = in_count ? c->integral_q15
                                 : clamp32(c->integral_q15 + (((int64_t)e * GAIN_KI) >> 8),
                                           INTEGRAL_LIMIT_Q15);
-    int64_t ff = (((int64_t)in->velocity_q8 * lim->kv) >> 8) +
-                 (((int64_t)in->acceleration_q16 * lim->ka) >> 16);
+    int32_t drag = in->velocity_q8 > 0 ? lim->friction : in->velocity_q8 < 0 ? -lim->friction : 0;
+    int64_t ff = (((int64_t)in->velocity_q8 * (lim->kv + lim->viscous)) >> 8) +
+                 (((int64_t)in->acceleration_q16 * lim->ka) >> 16) + drag;
     int64_t d = ((int64_t)(in->velocity_q8 - in->measured_velocity_q8) * GAIN_KD) >> 8;
     int32_t out = clamp32(p + integral + ff + d, 1 << 20);
     int16_t limited = limit(out, in->measured_velocity_q8, lim);
@@ -70,6 +77,8 @@ void drive_limits_for_supply(struct drive_limits *lim, uint16_t supply_mv)
     }
     lim->kv = (int32_t)(((uint32_t)GAIN_KV * NOMINAL_SUPPLY_MV) / supply_mv);
     lim->ka = (int32_t)(((uint64_t)GAIN_KA * NOMINAL_SUPPLY_MV) / supply_mv);
+    lim->friction = (int32_t)(((uint32_t)GAIN_FRICTION * NOMINAL_SUPPLY_MV) / supply_mv);
+    lim->viscous = (int32_t)(((uint32_t)GAIN_VISCOUS * NOMINAL_SUPPLY_MV) / supply_mv);
 }
 
 int16_t duty_limit_for_power(uint16_t power_mw, uint16_t supply_mv)

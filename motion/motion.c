@@ -19,6 +19,19 @@ enum {
     CLOCK_REAL_TIME = 256, /* clock_rate, Q8 */
 };
 
+/* Setpoint and horn agree within these: 0.5 degree, 25 deg/s. */
+#define FOLLOW_GAP_Q32 (5 * DECIDEG_Q32)
+enum { FOLLOW_SPEED_Q8 = 64 };
+
+/* The profile's clock (see "the profile's clock" below). */
+enum {
+    LEAD_FREE_Q8 = 5 << 8, /* 0.5 degree */
+    LEAD_SPAN_SHIFT = 3,   /* (lead - free) >> 3: 256 at 8 decideg */
+    LEAD_FILTER_SHIFT = 2, /* time constant 4 ticks */
+    CLOCK_SLOWING = 64,    /* the clock stops within 4 ticks */
+    CLOCK_RECOVERY = 8,    /* a stopped clock is back to real time in 32 ticks */
+};
+
 static int32_t clamp_i32(int32_t v, int32_t lo, int32_t hi)
 {
     return v < lo ? lo : v > hi ? hi : v;
@@ -139,12 +152,27 @@ static void hold_here(struct motion *m)
     m->end = END_HOLD;
 }
 
+/* The horn is within FOLLOW_GAP of the setpoint and within FOLLOW_SPEED
+ * of its speed. */
+static bool horn_follows(const struct motion *m)
+{
+    int64_t gap = m->setpoint - m->measured;
+    int64_t speed = ((m->setpoint - m->last_setpoint) >> 24) - m->measured_velocity_q8;
+    return gap < FOLLOW_GAP_Q32 && gap > -FOLLOW_GAP_Q32 && speed < FOLLOW_SPEED_Q8 &&
+           speed > -FOLLOW_SPEED_Q8;
+}
+
 /* Where a new profile starts: the current setpoint and its velocity when
  * following one (no jerk to a stop; the velocity the slowed clock gives
  * it), else the measured position at rest. */
 static void start_state(const struct motion *m, int64_t *start, int64_t *v0)
 {
-    if (m->mode == MODE_POSITION) {
+    if (m->mode == MODE_POSITION && !horn_follows(m)) {
+        /* The horn is elsewhere or moves otherwise than the setpoint (a
+         * slowed clock, a load): take over from where it really is. */
+        *start = m->measured;
+        *v0 = (int64_t)m->measured_velocity_q8 * ((int64_t)1 << 24);
+    } else if (m->mode == MODE_POSITION) {
         *start = m->setpoint;
         *v0 = m->setpoint - m->last_setpoint;
     } else {
@@ -477,6 +505,7 @@ void motion_init(struct motion *m, const struct registers *regs, const struct ha
     encoder_start(&m->encoder, hal->encoder_read(hal->ctx));
     m->origin_counts = 0;
     m->measured = counts_to_q32(m->encoder.counts);
+    m->track_q32 = m->measured;
     set_power(m, 0);
     if (regs->user.power_on_lock) {
         hold_here(m);
@@ -488,13 +517,16 @@ void motion_init(struct motion *m, const struct registers *regs, const struct ha
 /* ---- the control tick --------------------------------------------------- */
 
 /* A move has finished when its setpoint has reached the target and the
- * horn has arrived there, within ARRIVE_DECIDEG. */
+ * horn has arrived there, within ARRIVE_DECIDEG, and nearly stopped (not
+ * just passing through). */
 enum { ARRIVE_DECIDEG = 3 }; /* 0.3 degree */
 
 static bool arrived(const struct motion *m)
 {
     int64_t gap = m->profile.target - m->measured;
-    return gap <= ARRIVE_DECIDEG * DECIDEG_Q32 && gap >= -ARRIVE_DECIDEG * DECIDEG_Q32;
+    int32_t speed = m->measured_velocity_q8;
+    return gap <= ARRIVE_DECIDEG * DECIDEG_Q32 && gap >= -ARRIVE_DECIDEG * DECIDEG_Q32 &&
+           speed < FOLLOW_SPEED_Q8 && speed > -FOLLOW_SPEED_Q8;
 }
 
 /* Turning without end (wheel run) must not outgrow the number formats: past
@@ -526,19 +558,28 @@ static void rebase_endless(struct motion *m)
     }
 }
 
-/* One encoder count per tick is 88 deg/s, so the per-tick difference is
- * low-passed (time constant 2^VELOCITY_FILTER_SHIFT ticks; state in Q12 so
- * it decays to zero) before the controller and the current limit use it. */
-enum { VELOCITY_FILTER_SHIFT = 3 };
+/* The horn's speed from a 12-bit encoder: one count per tick is 88 deg/s, so
+ * a plain difference is mostly rounding. An alpha-beta tracker predicts
+ * where the horn should be and corrects position and speed by part of the
+ * miss (1/2 and 1/8): it follows a steady speed without lag, where a
+ * low-pass lags by its time constant, which left the current limit working
+ * around a stale back-EMF after a preemption. It runs on the encoder's own
+ * counts, which no change of origin moves. */
+enum { TRACK_POSITION_SHIFT = 1, TRACK_VELOCITY_SHIFT = 3 };
 
 static void measure(struct motion *m)
 {
-    int64_t before = m->measured;
     encoder_update(&m->encoder, m->hal->encoder_read(m->hal->ctx));
     m->measured = counts_to_q32(m->encoder.counts - m->origin_counts);
-    int32_t raw_q12 = (int32_t)((m->measured - before) >> 20);
-    m->velocity_filter_q12 += (raw_q12 - m->velocity_filter_q12) >> VELOCITY_FILTER_SHIFT;
-    m->measured_velocity_q8 = (m->velocity_filter_q12 + 8) >> 4; /* nearest */
+    int64_t at = counts_to_q32(m->encoder.counts);
+    int64_t predicted = m->track_q32 + (int64_t)m->track_velocity_q12 * ((int64_t)1 << 20);
+    int64_t miss = (at - predicted) >> 20; /* Q12 */
+    miss = miss > INT32_MAX / 2 ? INT32_MAX / 2 : miss < -INT32_MAX / 2 ? -INT32_MAX / 2 : miss;
+    m->track_q32 = predicted + (miss >> TRACK_POSITION_SHIFT) * ((int64_t)1 << 20);
+    int64_t v = m->track_velocity_q12 + (miss >> TRACK_VELOCITY_SHIFT);
+    m->track_velocity_q12 = (int32_t)(v > INT32_MAX / 2 ? INT32_MAX / 2 : v < -INT32_MAX / 2 ? -INT32_MAX / 2 : v);
+    /* Q12 inside, so the rounding left over is far below one Q8 step. */
+    m->measured_velocity_q8 = (m->track_velocity_q12 + 8) >> 4;
 }
 
 /* The supply moves slowly: the duty margin for the power follows it every
@@ -586,14 +627,10 @@ bool motion_output_at_limit(const struct motion *m)
  * leads the horn by more than LEAD_FREE (it stops at LEAD_FREE + 8 decideg),
  * so a move faster than the motor arrives late instead of running away
  * from the horn. The lead is low-passed (the encoder's counts are coarse
- * beside one tick's motion) and the rate moves by at most CLOCK_SLEW per
- * tick, so the setpoint's speed changes smoothly. */
-enum {
-    LEAD_FREE_Q8 = 5 << 8, /* 0.5 degree */
-    LEAD_SPAN_SHIFT = 3,   /* (lead - free) >> 3: 256 at 8 decideg */
-    LEAD_FILTER_SHIFT = 2, /* time constant 4 ticks */
-    CLOCK_SLEW = 8,        /* a stopped clock is back to real time in 32 ticks */
-};
+ * beside one tick's motion); the rate falls by at most CLOCK_SLOWING and
+ * rises by at most CLOCK_RECOVERY per tick, so the setpoint's speed changes
+ * smoothly, and a clock that must stop (a reversal the motor cannot make
+ * as fast as planned) stops before the profile has run out. */
 
 static void govern_clock(struct motion *m, int32_t error_q8)
 {
@@ -606,10 +643,10 @@ static void govern_clock(struct motion *m, int32_t error_q8)
         target = slow >= CLOCK_REAL_TIME ? 0u : CLOCK_REAL_TIME - slow;
     }
     uint32_t rate = m->clock_rate;
-    if (target + CLOCK_SLEW < rate) {
-        rate -= CLOCK_SLEW;
-    } else if (target > rate + CLOCK_SLEW) {
-        rate += CLOCK_SLEW;
+    if (target + CLOCK_SLOWING < rate) {
+        rate -= CLOCK_SLOWING;
+    } else if (target > rate + CLOCK_RECOVERY) {
+        rate += CLOCK_RECOVERY;
     } else {
         rate = target;
     }
@@ -648,14 +685,11 @@ static void guard_braking(struct motion *m)
         return;
     }
     /* The faster of setpoint and horn must stop: in a slowed deceleration
-     * the setpoint moves slower than the horn still does. In real time the
-     * horn follows the setpoint, whose speed is exact (the measured one
-     * lags by the filter). */
+     * the setpoint moves slower than the horn still does. */
     int64_t v_q32 = m->setpoint - m->last_setpoint;
     int32_t v = q32_to_q8_sat(v_q32);
     int32_t w = m->measured_velocity_q8;
-    bool slowed = m->clock_rate != CLOCK_REAL_TIME;
-    if (slowed && (w > 0) == (v > 0) && (w > v) == (v > 0) && w != v) {
+    if ((w > 0) == (v > 0) && (w > v) == (v > 0) && w != v) {
         v = w;
         v_q32 = (int64_t)w * ((int64_t)1 << 24);
     }
@@ -714,6 +748,13 @@ void motion_tick(struct motion *m)
         .velocity_q8 = q32_to_q8_sat(step),
         .acceleration_q16 = real_time ? (int32_t)((step - last_step) >> 16) : 0,
         .measured_velocity_q8 = m->measured_velocity_q8,
+        /* While the clock is slowed and the horn lags, the motor is the
+         * bottleneck: drive at the limit the way the profile goes (not
+         * while braking, nor once the horn has caught up). */
+        .push = real_time || m->braking || m->lead_q8 <= LEAD_FREE_Q8 ? 0
+                : m->at_next > m->at_tick                             ? 1
+                : m->at_next < m->at_tick                             ? -1
+                                                                      : 0,
     };
     m->hal->motor_drive(m->hal->ctx, controller_position(&m->controller, &in, &m->drive));
     bool done = m->endless ? m->tick >= m->profile.accel_ticks

@@ -21,6 +21,8 @@ struct controller {
 struct drive_limits {
     int32_t kv;         /* back-EMF duty per decideg per tick, Q8 input */
     int32_t ka;         /* duty per decideg per tick^2, Q16 input */
+    int32_t friction;   /* duty that carries the Coulomb drag */
+    int32_t viscous;    /* and the viscous drag, per decideg per tick (Q8 input) */
     int16_t duty_limit; /* Q15 duty of the current limit, 0..32767 */
 };
 
@@ -29,6 +31,8 @@ struct controller_input {
     int32_t velocity_q8;          /* planned velocity, decideg per tick Q8 */
     int32_t acceleration_q16;     /* planned, decideg per tick^2 Q16 */
     int32_t measured_velocity_q8; /* decideg per tick Q8 */
+    int8_t push;                  /* +1/-1: drive at the limit that way (the
+                                   * motor is the bottleneck); 0: control */
 };
 
 void controller_reset(struct controller *c);
@@ -38,7 +42,8 @@ int16_t controller_position(struct controller *c, const struct controller_input 
 int16_t controller_damping(int32_t measured_velocity_q8, const struct drive_limits *lim);
 /* Keeps duty within the duty limit of the back-EMF duty at this speed. */
 int16_t controller_limit(int32_t duty, int32_t measured_velocity_q8, const struct drive_limits *lim);
-/* kv and ka at supply_mv (0: the nominal supply). Planning-time: it divides. */
+/* kv, ka and the drag at supply_mv (0: the nominal supply). Planning-time:
+ * it divides. */
 void drive_limits_for_supply(struct drive_limits *lim, uint16_t supply_mv);
 /* The duty that drives the current limit P / V through the winding at
  * standstill: P R / V^2, Q15. Planning-time: it divides. */

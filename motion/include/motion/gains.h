@@ -30,6 +30,14 @@
  * (Q16 input): the duty whose current accelerates the rotor, 1 g cm^2 x
  * 345 x 1745 rad/s^2 / kt x R / 7.4 V = 6.005 -> 196770. */
 #define GAIN_KA 196770
+/* Friction feed-forward at the nominal supply, in the planned direction:
+ * the duty whose current carries the motor's Coulomb drag, 0.279 mN m / kt
+ * x R / 7.4 V = 0.0278 -> 911. */
+#define GAIN_FRICTION 911
+/* Viscous drag feed-forward at the nominal supply, per decideg per tick:
+ * 0.148 uN m s/rad x 345 x 1.745 rad/s / kt x R / 7.4 V = 0.0089 -> 291.
+ * Apart from GAIN_KV, which is the back-EMF alone (the current limit). */
+#define GAIN_VISCOUS 291
 /* Derivative, on velocity error (planned - measured): damps without
  * braking against the feed-forward. */
 #define GAIN_KD 3000

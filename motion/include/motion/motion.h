@@ -103,8 +103,9 @@ struct motion {
     struct encoder_track encoder;
     int32_t origin_counts;     /* encoder counts of angle 0 (before offset 53) */
     int64_t measured;          /* Q32 decideg, relative to the origin */
-    int32_t measured_velocity_q8; /* filtered, decideg per tick */
-    int32_t velocity_filter_q12;
+    int32_t measured_velocity_q8; /* tracked, decideg per tick */
+    int64_t track_q32;         /* tracked encoder position, Q32 decideg, no origin */
+    int32_t track_velocity_q12;
     struct profile profile;
     /* The profile's own clock: whole ticks and a Q8 fraction. It runs at
      * clock_rate (Q8, 256 = real time) and slows while the horn cannot
