@@ -56,6 +56,13 @@ static int32_t q32_to_decideg(int64_t q32)
     return (int32_t)((q32 + (DECIDEG_Q32 / 2)) >> 32); /* nearest */
 }
 
+/* Q32 to Q8 (decideg, or decideg per tick), saturated to int32. */
+static int32_t q32_to_q8_sat(int64_t v)
+{
+    int64_t q8 = v >> 24;
+    return q8 > INT32_MAX ? INT32_MAX : q8 < -INT32_MAX ? -INT32_MAX : (int32_t)q8;
+}
+
 static int64_t center_offset_q32(const struct motion *m)
 {
     return (int64_t)m->regs->user.center_offset_decideg * DECIDEG_Q32;
@@ -78,6 +85,32 @@ void motion_read_angle(const struct motion *m, struct motion_angle *out)
     out->multi_turn_decideg = angle;
     out->turns = (int16_t)(angle / DECIDEG_PER_TURN);
     out->single_turn_decideg = (int16_t)wrap_single_turn(angle);
+}
+
+static int16_t saturate_i16(int32_t v)
+{
+    return (int16_t)(v > INT16_MAX ? INT16_MAX : v < -INT16_MAX ? -INT16_MAX : v);
+}
+
+void motion_read_diagnostics(const struct motion *m, struct motion_diagnostics *out)
+{
+    bool controlled = m->mode == MODE_POSITION;
+    int64_t offset = center_offset_q32(m);
+    int64_t setpoint = controlled ? m->setpoint : m->measured;
+    /* decideg per tick Q8 to decideg per s: x 1000 / 256 = x 125 / 32. */
+    int32_t error_q8 = q32_to_q8_sat(setpoint - m->measured);
+    *out = (struct motion_diagnostics){
+        .angle_decideg = q32_to_decideg(m->measured - offset),
+        .setpoint_decideg = q32_to_decideg(setpoint - offset),
+        .target_decideg = q32_to_decideg((controlled ? m->profile.target : m->measured) - offset),
+        .velocity_decideg_s = saturate_i16(m->measured_velocity_q8 * 125 / 32),
+        .tracking_error_centideg = saturate_i16((int32_t)(((int64_t)error_q8 * 10) / 256)),
+        .flags = (uint8_t)((controlled && m->tick >= m->profile.total_ticks ? DIAG_PROFILE_ENDED : 0u) |
+                           (controlled && m->clock_rate != CLOCK_REAL_TIME ? DIAG_CLOCK_SLOWED : 0u) |
+                           (controlled && m->braking ? DIAG_BRAKING : 0u) |
+                           (motion_output_at_limit(m) ? DIAG_AT_LIMIT : 0u) |
+                           (controlled ? 0u : DIAG_RELEASED)),
+    };
 }
 
 /* ---- the output --------------------------------------------------------- */
@@ -218,12 +251,6 @@ static int32_t brake_duty(const struct motion *m, int32_t dir)
     return duty > 1 ? duty : 1;
 }
 
-/* v in Q8 decideg per tick, saturated to int32. */
-static int32_t q32_to_q8_sat(int64_t v)
-{
-    int64_t q8 = v >> 24;
-    return q8 > INT32_MAX ? INT32_MAX : q8 < -INT32_MAX ? -INT32_MAX : (int32_t)q8;
-}
 
 /* From start moving at v0, come to rest at the output's braking (in at
  * least min_ticks): the target is where that ends. Plans: it divides. */

@@ -138,6 +138,27 @@ enum packet_outcome handle_read_angle(const struct packet_call *c, struct respon
     return OUTCOME_OK;
 }
 
+/* ReadMotion (0x40): one instant of the motion state, docs/packets.md. */
+enum { READ_MOTION_ANSWER_LENGTH = 21 };
+
+enum packet_outcome handle_read_motion(const struct packet_call *c, struct response *r)
+{
+    struct motion_diagnostics d;
+    motion_read_diagnostics(c->d->motion, &d);
+    uint8_t *p = r->content;
+    p[0] = c->content[0];
+    wire_put_u32(&p[1], (uint32_t)d.angle_decideg);
+    wire_put_u32(&p[5], (uint32_t)d.setpoint_decideg);
+    wire_put_u32(&p[9], (uint32_t)d.target_decideg);
+    wire_put_u16(&p[13], (uint16_t)d.velocity_decideg_s);
+    wire_put_u16(&p[15], (uint16_t)d.tracking_error_centideg);
+    wire_put_u16(&p[17], c->d->regs->status.current_ma);
+    p[19] = c->d->regs->status.status;
+    p[20] = d.flags;
+    r->length = READ_MOTION_ANSWER_LENGTH;
+    return OUTCOME_OK;
+}
+
 enum packet_outcome handle_read_multi_turn(const struct packet_call *c, struct response *r)
 {
     struct motion_angle angle;

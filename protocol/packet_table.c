@@ -45,10 +45,20 @@ static const struct packet_desc packets[] = {
 _Static_assert(sizeof packets / sizeof packets[0] == PKT_SYNC_COMMAND,
                "one row per packet number, in order");
 
+/* This firmware's own packets, from PKT_READ_MOTION on (docs/packets.md). */
+static const struct packet_desc firmware_packets[] = {
+    {PKT_READ_MOTION, QUERY, LEN(1), handle_read_motion},
+};
+
+enum { FIRMWARE_PACKETS = sizeof firmware_packets / sizeof firmware_packets[0] };
+
 const struct packet_desc *packet_find(uint8_t code)
 {
-    if (code < PKT_PING || code > PKT_SYNC_COMMAND) {
-        return NULL;
+    if (code >= PKT_PING && code <= PKT_SYNC_COMMAND) {
+        return &packets[code - PKT_PING];
     }
-    return &packets[code - PKT_PING];
+    if (code >= PKT_READ_MOTION && code < PKT_READ_MOTION + FIRMWARE_PACKETS) {
+        return &firmware_packets[code - PKT_READ_MOTION];
+    }
+    return NULL;
 }

@@ -23,6 +23,12 @@ void motion_read_angle(const struct motion *m, struct motion_angle *out)
     *out = *mock_ptr_type(const struct motion_angle *);
 }
 
+void motion_read_diagnostics(const struct motion *m, struct motion_diagnostics *out)
+{
+    (void)m;
+    *out = *mock_ptr_type(const struct motion_diagnostics *);
+}
+
 bool motion_reset_multi_turn(struct motion *m)
 {
     (void)m;

@@ -116,6 +116,80 @@ static void test_power_bounds_the_current(void **state)
     assert_true(fabs(plant_angle_deg(&plant) - 90.0) < 0.14);
 }
 
+/* Holding still shows no limit cycle: after a move has settled, the horn
+ * stays within one encoder count and the current does not creep, with and
+ * without a load. */
+static void hold_and_watch(double load, const char *what)
+{
+    plant.load_torque = load;
+    REQUEST(11, 0, 0x84, 0x03, 0xF4, 0x01, 0x64, 0x00, 0x64, 0x00, 0x00, 0x00); /* 90 deg */
+    harness_run_ms(1500); /* the move, then settling */
+    uint16_t lo = 4096, hi = 0;
+    double i_lo = 1e9, i_hi = -1e9;
+    for (int i = 0; i < 5000; i++) {
+        harness_run_ms(1);
+        uint16_t count = plant_encoder(&plant);
+        lo = count < lo ? count : lo;
+        hi = count > hi ? count : hi;
+        i_lo = plant.current < i_lo ? plant.current : i_lo;
+        i_hi = plant.current > i_hi ? plant.current : i_hi;
+    }
+    printf("# holding 5 s %s: encoder %u..%u, current %.4f..%.4f A\n", what, lo, hi, i_lo, i_hi);
+    assert_true(hi - lo <= 1);
+    assert_true(i_hi - i_lo < 0.005);
+}
+
+static void test_holding_has_no_limit_cycle(void **state)
+{
+    (void)state;
+    hold_and_watch(0.0, "unloaded");
+    hold_and_watch(0.4, "under 0.4 N m");
+}
+
+/* Stopping within what the motor can do: from a wheel run the motor cannot
+ * reach (750 deg/s asked at 2 W), wheel stop and StopOnControlMode hold
+ * brake at the output's limit. The horn comes to rest where it stops and
+ * does not swing back to a point it had already passed. */
+static void stop_from_wheel_run(uint8_t packet)
+{
+    REQUEST(7, 0, 0x01, 0xEE, 0x02, 0x00, 0x00); /* run counter-clockwise at 750 deg/s */
+    harness_run_ms(1500);
+    double speed = plant.velocity * 180.0 / M_PI;
+    if (packet == 7) {
+        REQUEST(4, 0, 47, 1); /* wheel brake: hold where it stops */
+        REQUEST(7, 0, 0x00, 0x00, 0x00, 0x00, 0x00);
+    } else {
+        REQUEST(24, 0, 0x11, 0x00, 0x00);
+    }
+    double furthest = plant_angle_deg(&plant);
+    for (int i = 0; i < 1000; i++) {
+        harness_run_ms(1);
+        double a = plant_angle_deg(&plant);
+        furthest = a > furthest ? a : furthest;
+    }
+    double rest = plant_angle_deg(&plant);
+    printf("# stop (%u) from %.0f deg/s: swings back %.2f deg, at rest %.2f deg/s\n", packet,
+           speed, furthest - rest, plant.velocity * 180.0 / M_PI);
+    assert_true(speed > 250.0);             /* it ran at the motor's top speed */
+    assert_true(furthest - rest < 0.3);     /* no swing back */
+    assert_true(fabs(plant.velocity) < 1e-3);
+    assert_false(hal.coasting);
+}
+
+static void test_wheel_stop_brakes_within_the_motor(void **state)
+{
+    (void)state;
+    REQUEST(4, 0, 42, 0xD0, 0x07); /* power protection 2000 mW */
+    stop_from_wheel_run(7);
+}
+
+static void test_stop_and_hold_brakes_within_the_motor(void **state)
+{
+    (void)state;
+    REQUEST(4, 0, 42, 0xD0, 0x07);
+    stop_from_wheel_run(24);
+}
+
 /* Released under a load beyond the stall torque, the output is back-driven
  * through the gears' losses, and the motor, turned into a generator, brakes
  * through the bridge's body diodes: the speed stays bounded, and once the
@@ -216,6 +290,9 @@ int main(void)
         cmocka_unit_test_setup(test_velocity_move_and_return, setup),
         cmocka_unit_test_setup(test_load_is_held, setup),
         cmocka_unit_test_setup(test_power_bounds_the_current, setup),
+        cmocka_unit_test_setup(test_holding_has_no_limit_cycle, setup),
+        cmocka_unit_test_setup(test_wheel_stop_brakes_within_the_motor, setup),
+        cmocka_unit_test_setup(test_stop_and_hold_brakes_within_the_motor, setup),
         cmocka_unit_test_setup(test_back_driving_is_bounded, setup),
         cmocka_unit_test_setup(test_damping_brakes_a_spinning_horn, setup),
         cmocka_unit_test_setup(test_stall_limits_to_the_stall_power, setup),

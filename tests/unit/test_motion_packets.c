@@ -188,6 +188,63 @@ static void test_velocity_profile_worked_examples(void **state)
     EXPECT_RESPONSE(10, 0, 0xB0, 0x04); /* 120.0 */
 }
 
+/* ReadMotion (0x40) as decoded from its answer. */
+struct motion_snapshot {
+    int32_t angle, setpoint, target;
+    int16_t speed, tracking_error;
+    uint8_t status, flags;
+};
+
+static int32_t le(const uint8_t *p, unsigned size)
+{
+    uint32_t v = 0;
+    for (unsigned i = 0; i < size; i++) {
+        v |= (uint32_t)p[i] << (8u * i);
+    }
+    return size == 2 ? (int16_t)v : (int32_t)v;
+}
+
+static struct motion_snapshot read_motion(void)
+{
+    REQUEST(0x40, 0);
+    assert_int_equal(hal.sent_length, 4u + 21u + 1u);
+    assert_int_equal(hal.sent[2], 0x40);
+    const uint8_t *c = &hal.sent[4];
+    return (struct motion_snapshot){le(&c[1], 4), le(&c[5], 4), le(&c[9], 4),
+                                    (int16_t)le(&c[13], 2), (int16_t)le(&c[15], 2), c[19],
+                                    c[20]};
+}
+
+/* ReadMotion: angle, setpoint, target, the servo's own speed and tracking
+ * error, all of one instant; flags for where the profile is. */
+static void test_read_motion_snapshot(void **state)
+{
+    (void)state;
+    struct motion_snapshot at_rest = read_motion();
+    assert_true(at_rest.flags & DIAG_RELEASED);
+    REQUEST(12, 0, 0x84, 0x03, 0xE8, 0x03, 0x14, 0x00, 0x14, 0x00, 0x00, 0x00); /* 100 deg/s */
+    harness_run_ms(400);
+    struct motion_snapshot moving = read_motion();
+    /* 0.1 deg/s. The encoder counts 1.14 per tick here; the tracker's
+     * share of a half-count miss leaves about +-55 of noise. */
+    assert_in_range(moving.speed, 940, 1060);
+    assert_in_range(moving.angle, angle_now() - 1, angle_now() + 1);
+    assert_true(abs(moving.setpoint - moving.angle) <= 1); /* the ideal servo follows */
+    assert_true(abs(moving.tracking_error) <= 9);         /* within a count, 0.01 deg */
+    assert_int_equal(moving.target, 900);
+    assert_int_equal(moving.status & STATUS_EXECUTING, STATUS_EXECUTING);
+    assert_int_equal(moving.flags & (DIAG_PROFILE_ENDED | DIAG_RELEASED), 0);
+    run_until_done(1000);
+    struct motion_snapshot done = read_motion();
+    assert_int_equal(done.setpoint, 900);
+    assert_true(done.flags & DIAG_PROFILE_ENDED);
+    assert_true(abs(done.speed) <= 10); /* settling: under 1 deg/s */
+    /* A wrong length is a command error, as for the maker's packets. */
+    REQUEST(0x40, 0, 0);
+    EXPECT_SILENCE();
+    assert_true(servo.regs.status.status & STATUS_COMMAND_ERROR);
+}
+
 static void test_center_offset_shifts_the_zero(void **state)
 {
     (void)state;
@@ -464,6 +521,7 @@ int main(void)
         cmocka_unit_test_setup(test_interval_shorter_than_ramps_is_clamped, setup),
         cmocka_unit_test_setup(test_velocity_is_clamped, setup),
         cmocka_unit_test_setup(test_velocity_profile_worked_examples, setup),
+        cmocka_unit_test_setup(test_read_motion_snapshot, setup),
         cmocka_unit_test_setup(test_center_offset_shifts_the_zero, setup),
         cmocka_unit_test_setup(test_power_bounds_the_output, setup),
         cmocka_unit_test_setup(test_control_response_queues_and_answers_each, setup),

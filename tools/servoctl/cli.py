@@ -219,7 +219,9 @@ def cmd_monitor(bus, args):
 
 
 def cmd_record(bus, args):
-    """Samples angle, velocity and current during a move; CSV and PNG."""
+    """Samples a move as the servo sees it (ReadMotion, 0x40: angle, setpoint,
+    its own measured speed and tracking error, current and status, all of one
+    instant); CSV and a PNG with the plan, the tracking error and the speeds."""
     s = Servo(bus, args.id)
     start = s.monitor().angle_decideg
     target = decideg(args.angle)
@@ -236,11 +238,13 @@ def cmd_record(bus, args):
     s.move(target, **kw)
     samples = []
     done_at = None
-    limit = len(plan) / 1000.0 + 10.0  # soft start (49/50) can stretch the first move
+    # A move the motor cannot follow arrives late; soft start (49/50) can
+    # stretch the first one too.
+    limit = 2.0 * len(plan) / 1000.0 + 10.0
     while time.monotonic() - t0 < limit:
-        m = s.monitor()
+        m = s.read_motion()  # one instant: angle, setpoint, speed, error, current, status
         now = time.monotonic() - t0
-        samples.append((now, m.angle_decideg / 10.0, m.current_ma / 1000.0))
+        samples.append((now, m))
         if done_at is None and now > 0.02 and not m.status & 1:
             done_at = now
         if done_at is not None and now > done_at + args.settle / 1000.0:
@@ -248,49 +252,71 @@ def cmd_record(bus, args):
     if done_at is None:
         raise ServoError(f"servo {args.id} still moving after {limit:.1f} s")
     rows = []
-    for k, (t, angle, amps) in enumerate(samples):
-        if 0 < k < len(samples) - 1:
-            v = (samples[k + 1][1] - samples[k - 1][1]) / (samples[k + 1][0] - samples[k - 1][0])
-        else:
-            v = 0.0
+    profile_end = None
+    for t, m in samples:
         ms = int(t * 1000)
+        k = min(ms, len(plan) - 2)
         planned = plan[min(ms, len(plan) - 1)] / 10.0
-        rows.append((round(t * 1000, 1), angle, round(v, 2), amps, round(planned, 2)))
+        planned_speed = (plan[k + 1] - plan[k]) * 100.0 if ms < len(plan) - 1 else 0.0
+        if profile_end is None and m.flags & m.PROFILE_ENDED:
+            profile_end = round(t * 1000, 1)
+        rows.append((round(t * 1000, 1), m.angle_decideg / 10.0, m.velocity_decideg_s / 10.0,
+                     m.current_ma / 1000.0, round(planned, 2), m.setpoint_decideg / 10.0,
+                     m.tracking_error_centideg / 100.0, round(planned_speed, 1), m.status,
+                     m.flags))
     csv_path = args.out + ".csv"
     with open(csv_path, "w", newline="") as f:
         w = csv.writer(f)
-        w.writerow(["time_ms", "angle_deg", "velocity_dps", "current_a", "planned_deg"])
+        w.writerow(["time_ms", "angle_deg", "velocity_dps", "current_a", "planned_deg",
+                    "setpoint_deg", "tracking_error_deg", "planned_velocity_dps", "status",
+                    "motion_flags"])
         w.writerows(rows)
     png_path = args.out + ".png"
-    _plot(rows, plan, png_path, f"servo {args.id}: {start / 10:.1f} -> {target / 10:.1f} deg")
-    worst = max(abs(r[1] - r[4]) for r in rows)
-    print(f"{len(rows)} samples over {rows[-1][0]:.0f} ms; finished after {done_at * 1000:.0f} ms "
-          f"(planned {len(plan) - 1} ms); worst gap to the plan {worst:.2f} deg; "
-          f"final {rows[-1][1]:.1f} deg")
+    _plot(rows, plan, png_path, f"servo {args.id}: {start / 10:.1f} -> {target / 10:.1f} deg",
+          profile_end, done_at * 1000)
+    worst = max(abs(r[6]) for r in rows)
+    ends = f"profile ended after {profile_end:.0f} ms, " if profile_end is not None else ""
+    print(f"{len(rows)} samples over {rows[-1][0]:.0f} ms; {ends}finished after "
+          f"{done_at * 1000:.0f} ms (planned {len(plan) - 1} ms); worst tracking error "
+          f"{worst:.2f} deg; final {rows[-1][1]:.1f} deg")
     print(f"csv  {os.path.abspath(csv_path)}")
     print(f"plot {os.path.abspath(png_path)}")
     return 0
 
 
-def _plot(rows, plan, path, title):
+def _plot(rows, plan, path, title, profile_end, finished):
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     t = [r[0] for r in rows]
-    fig, (ax1, ax2) = plt.subplots(2, 1, sharex=True, figsize=(8, 6))
-    ax1.plot(range(len(plan)), [p / 10.0 for p in plan], label="planned", color="0.6", lw=3)
+    fig, (ax1, ax2, ax3) = plt.subplots(3, 1, sharex=True, figsize=(8, 8),
+                                        gridspec_kw={"height_ratios": [3, 2, 2]})
+    ax1.plot(range(len(plan)), [p / 10.0 for p in plan], label="planned", color="0.7", lw=3)
+    ax1.plot(t, [r[5] for r in rows], label="setpoint (servo)", color="tab:green", lw=1)
     ax1.plot(t, [r[1] for r in rows], ".-", label="measured", ms=3)
     ax1.set_ylabel("angle (deg)")
-    ax1.legend()
     ax1.set_title(title)
-    ax2.plot(t, [r[2] for r in rows], label="velocity (deg/s)")
-    ax2.set_ylabel("velocity (deg/s)")
-    ax3 = ax2.twinx()
-    ax3.plot(t, [r[3] for r in rows], color="tab:red", label="current (A)")
-    ax3.set_ylabel("current (A)", color="tab:red")
-    ax2.set_xlabel("time (ms)")
+    ax2.plot(t, [r[6] for r in rows], color="tab:purple")
+    ax2.axhline(0, color="0.8", lw=0.8)
+    ax2.set_ylabel("tracking error\nsetpoint - measured (deg)")
+    ax3.plot(range(len(plan) - 1), [(plan[k + 1] - plan[k]) * 100.0 for k in range(len(plan) - 1)],
+             label="planned", color="0.7", lw=3)
+    ax3.plot(t, [r[2] for r in rows], label="measured by the servo")
+    ax3.set_ylabel("speed (deg/s)")
+    ax3.set_xlabel("time (ms)")
+    amps = ax3.twinx()
+    amps.plot(t, [r[3] for r in rows], color="tab:red", lw=0.8)
+    amps.set_ylabel("current (A)", color="tab:red")
+    for ax in (ax1, ax2, ax3):
+        if profile_end is not None:
+            ax.axvline(profile_end, color="tab:green", ls="--", lw=0.8)
+        ax.axvline(finished, color="tab:orange", ls=":", lw=1)
+    ax1.plot([], [], color="tab:green", ls="--", lw=0.8, label="profile ends")
+    ax1.plot([], [], color="tab:orange", ls=":", lw=1, label="finished (status bit 0)")
+    ax1.legend(fontsize=8)
+    ax3.legend(fontsize=8, loc="upper right")
     fig.tight_layout()
     fig.savefig(path, dpi=100)
     plt.close(fig)

@@ -30,6 +30,7 @@ MONITOR = 22
 SET_ORIGIN = 23
 STOP_ON_CONTROL = 24
 SYNC = 25
+READ_MOTION = 0x40  # this firmware's own (docs/packets.md)
 
 
 class ServoError(Exception):

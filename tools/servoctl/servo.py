@@ -24,6 +24,26 @@ class Monitor:
         return cls(*struct.unpack("<BHHHHBih", content))
 
 
+@dataclass
+class MotionSnapshot:
+    """ReadMotion (0x40): one instant of the motion state, docs/packets.md."""
+    id: int
+    angle_decideg: int
+    setpoint_decideg: int
+    target_decideg: int
+    velocity_decideg_s: int
+    tracking_error_centideg: int
+    current_ma: int
+    status: int
+    flags: int
+
+    PROFILE_ENDED, CLOCK_SLOWED, BRAKING, AT_LIMIT, RELEASED = 1, 2, 4, 8, 16
+
+    @classmethod
+    def decode(cls, content: bytes) -> "MotionSnapshot":
+        return cls(*struct.unpack("<BiiihhHBB", content))
+
+
 def _check(name: str, value: int, low: int, high: int, unit: str = "") -> int:
     if not low <= value <= high:
         raise ValueOutOfRange(f"{name} must be {low}..{high}{' ' + unit if unit else ''}, not {value}")
@@ -82,6 +102,10 @@ class Servo:
 
     def monitor(self) -> Monitor:
         return Monitor.decode(self.bus.request(p.MONITOR, bytes([self.id])))
+
+    def read_motion(self) -> MotionSnapshot:
+        """Needs this firmware: the maker's servos do not know packet 0x40."""
+        return MotionSnapshot.decode(self.bus.request(p.READ_MOTION, bytes([self.id])))
 
     def status(self) -> int:
         return self.read("status")

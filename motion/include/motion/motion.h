@@ -153,6 +153,27 @@ bool motion_is_released(const struct motion *m);
 void motion_read_angle(const struct motion *m, struct motion_angle *out);
 /* ResetMultiTurnAngle (17), SetOriginPoint (23): false unless released. */
 bool motion_reset_multi_turn(struct motion *m);
+
+/* One instant of the motion state, for tuning (ReadMotion, 0x40). Angles in
+ * 0.1 deg in the frame of ReadMultiTurnAngle. */
+struct motion_diagnostics {
+    int32_t angle_decideg;           /* the horn */
+    int32_t setpoint_decideg;        /* where the profile puts it now */
+    int32_t target_decideg;          /* where the profile ends */
+    int16_t velocity_decideg_s;      /* the horn's speed, measured */
+    int16_t tracking_error_centideg; /* setpoint - horn, 0.01 deg, saturated */
+    uint8_t flags;                   /* enum motion_diagnostic_flag */
+};
+
+enum motion_diagnostic_flag {
+    DIAG_PROFILE_ENDED = 1u << 0, /* the setpoint is at the target */
+    DIAG_CLOCK_SLOWED = 1u << 1,  /* the horn cannot follow: the move runs late */
+    DIAG_BRAKING = 1u << 2,       /* braking within the output's limit */
+    DIAG_AT_LIMIT = 1u << 3,      /* the output is at its current or supply limit */
+    DIAG_RELEASED = 1u << 4,      /* not under position control */
+};
+
+void motion_read_diagnostics(const struct motion *m, struct motion_diagnostics *out);
 bool motion_set_origin(struct motion *m);
 void motion_begin_async(struct motion *m);
 void motion_end_async(struct motion *m, bool cancel);

@@ -1,4 +1,6 @@
-/* Packet numbers of servo-protocol.md (1-17) and extensions.md (18-25). */
+/* Packet numbers of servo-protocol.md (1-17) and extensions.md (18-25), and
+ * this firmware's own from 0x40 (docs/packets.md), a range the maker's
+ * protocol does not use. */
 #ifndef PROTOCOL_PACKET_CODES_H
 #define PROTOCOL_PACKET_CODES_H
 
@@ -28,6 +30,10 @@ enum packet_code {
     PKT_SET_ORIGIN_POINT = 23,
     PKT_STOP_ON_CONTROL_MODE = 24,
     PKT_SYNC_COMMAND = 25,
+};
+
+enum firmware_packet_code {
+    PKT_READ_MOTION = 0x40, /* a snapshot of the motion state, for tuning */
 };
 
 #endif

@@ -94,6 +94,11 @@ def test_record_writes_csv_and_plot(sim, capsys, tmp_path):
     assert len(rows) > 50
     assert abs(float(rows[-1]["angle_deg"]) - 60.0) <= 0.5
     assert max(abs(float(r["angle_deg"]) - float(r["planned_deg"])) for r in rows) < 5.0
+    # What the servo itself reports: its setpoint and speed follow the plan.
+    assert max(abs(float(r["tracking_error_deg"])) for r in rows) < 1.0
+    cruise = [r for r in rows if float(r["planned_velocity_dps"]) > 199.0]
+    assert cruise and all(abs(float(r["velocity_dps"]) - 200.0) < 25.0 for r in cruise[2:-2])
+    assert "profile ended after" in out
     png = open(prefix + ".png", "rb").read()
     assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 10000
     assert f"plot {prefix}.png" in out
