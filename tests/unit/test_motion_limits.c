@@ -202,11 +202,12 @@ static void run_trial(unsigned trial, double inertia_scale)
         if (trace_trial == (int)trial && elapsed % 5u == 0u) {
             const struct motion *m = &servo.motion;
             printf("# %5u ms: horn %8.2f deg %7.1f deg/s, setpoint %8.2f, target %8.2f, "
-                   "tick %u/%u (cruise to %u), rate %u, duty %6d, limit %d, I %.2f A, w %d int %d\n",
+                   "tick %u/%u (cruise to %u), rate %u, braking %u, duty %6d, limit %d, I %.2f A, "
+                   "w %d int %d\n",
                    elapsed, plant_angle_deg(&plant), plant.velocity * 57.29578,
                    (double)m->setpoint / 42949672960.0,
                    (double)m->profile.target / 42949672960.0, m->tick, m->profile.total_ticks,
-                   m->profile.cruise_end, m->clock_rate + 1000u * m->braking, hal.duty, m->drive.duty_limit,
+                   m->profile.cruise_end, m->clock_rate, m->braking, hal.duty, m->drive.duty_limit,
                    plant.current, m->measured_velocity_q8, m->controller.integral_q15);
         }
         if (queued && planned_ms == 0 && servo.motion.queue.count == 0u) {
