@@ -1,0 +1,229 @@
+/* The control tick: the horn's position and speed from the encoder, the
+ * profile's clock (slowed while the horn cannot follow), the braking check,
+ * the controller, and when a move has finished. Once per 1/MOTION_TICK_HZ s,
+ * from the main loop; no division except when a deceleration is replanned. */
+#include "motion/motion.h"
+
+#include "motion/gains.h"
+#include "motion_internal.h"
+
+/* A move has finished when its setpoint has reached the target and the
+ * horn has arrived there, within ARRIVE_DECIDEG, and nearly stopped (not
+ * just passing through). */
+enum { ARRIVE_DECIDEG = 3 }; /* 0.3 degree */
+
+static bool arrived(const struct motion *m)
+{
+    int64_t gap = m->profile.target - m->measured;
+    int32_t speed = m->measured_velocity_q8;
+    return gap <= ARRIVE_DECIDEG * DECIDEG_Q32 && gap >= -ARRIVE_DECIDEG * DECIDEG_Q32 &&
+           speed < FOLLOW_SPEED_Q8 && speed > -FOLLOW_SPEED_Q8;
+}
+
+/* Turning without end (wheel run) must not outgrow the number formats: past
+ * the protocol's multi-turn range the frame moves back by whole turns, and
+ * the profile restarts its clock before the tick count gets large. */
+enum { REBASE_TICKS = 1u << 24 };
+#define REBASE_COUNTS ((int32_t)(MULTI_TURN_LIMIT / DECIDEG_PER_TURN) * ENCODER_COUNTS)
+
+static void rebase_endless(struct motion *m)
+{
+    if (m->tick >= REBASE_TICKS) {
+        int64_t v = m->profile.cruise;
+        profile_plan_endless(&m->profile, m->setpoint, v, v, 0);
+        motion_clock_restart(m);
+    }
+    int32_t rel = m->encoder.counts - m->origin_counts;
+    if (rel > REBASE_COUNTS || rel < -REBASE_COUNTS) {
+        int32_t shift = rel > 0 ? REBASE_COUNTS : -REBASE_COUNTS;
+        int64_t shift_q32 = counts_to_q32(shift);
+        m->origin_counts += shift;
+        m->measured -= shift_q32;
+        m->setpoint -= shift_q32;
+        m->last_setpoint -= shift_q32;
+        m->profile.start -= shift_q32;
+        m->profile.target -= shift_q32;
+        m->profile.cruise_start -= shift_q32;
+        m->at_tick -= shift_q32;
+        m->at_next -= shift_q32;
+    }
+}
+
+/* The horn's speed from a 12-bit encoder: one count per tick is 88 deg/s, so
+ * a plain difference is mostly rounding. An alpha-beta tracker predicts
+ * where the horn should be and corrects position and speed by part of the
+ * miss (1/2 and 1/8): it follows a steady speed without lag, where a
+ * low-pass lags by its time constant, which left the current limit working
+ * around a stale back-EMF after a preemption. It runs on the encoder's own
+ * counts, which no change of origin moves. */
+enum { TRACK_POSITION_SHIFT = 1, TRACK_VELOCITY_SHIFT = 3 };
+
+static void measure(struct motion *m)
+{
+    encoder_update(&m->encoder, m->hal->encoder_read(m->hal->ctx));
+    m->measured = counts_to_q32(m->encoder.counts - m->origin_counts);
+    int64_t at = counts_to_q32(m->encoder.counts);
+    int64_t predicted = m->track_q32 + (int64_t)m->track_velocity_q12 * ((int64_t)1 << 20);
+    int64_t miss = (at - predicted) >> 20; /* Q12 */
+    miss = miss > INT32_MAX / 2 ? INT32_MAX / 2 : miss < -INT32_MAX / 2 ? -INT32_MAX / 2 : miss;
+    m->track_q32 = predicted + (miss >> TRACK_POSITION_SHIFT) * ((int64_t)1 << 20);
+    int64_t v = m->track_velocity_q12 + (miss >> TRACK_VELOCITY_SHIFT);
+    m->track_velocity_q12 = (int32_t)(v > INT32_MAX / 2 ? INT32_MAX / 2 : v < -INT32_MAX / 2 ? -INT32_MAX / 2 : v);
+    /* Q12 inside, so the rounding left over is far below one Q8 step. */
+    m->measured_velocity_q8 = (m->track_velocity_q12 + 8) >> 4;
+}
+
+/* The supply moves slowly: the duty margin for the power follows it every
+ * SUPPLY_CHECK_TICKS ticks, when it has moved more than the hysteresis. */
+enum { SUPPLY_CHECK_TICKS = 32 };
+
+static void follow_supply(struct motion *m)
+{
+    uint16_t v = motion_supply_mv(m);
+    if (v > m->supply_mv_used + SUPPLY_HYSTERESIS_MV || v + SUPPLY_HYSTERESIS_MV < m->supply_mv_used) {
+        motion_update_limits(m);
+    }
+}
+
+/* ---- the profile's clock -------------------------------------------------
+ * The setpoint runs along the profile at clock_rate: in real time while the
+ * horn follows, slower while the output is at its limit and the setpoint
+ * leads the horn by more than LEAD_FREE (it stops at LEAD_FREE + 8 decideg),
+ * so a move faster than the motor arrives late instead of running away
+ * from the horn. The lead is low-passed (the encoder's counts are coarse
+ * beside one tick's motion); the rate falls by at most CLOCK_SLOWING and
+ * rises by at most CLOCK_RECOVERY per tick, so the setpoint's speed changes
+ * smoothly, and a clock that must stop (a reversal the motor cannot make
+ * as fast as planned) stops before the profile has run out. */
+
+static void govern_clock(struct motion *m, int32_t error_q8)
+{
+    int64_t step = m->at_next - m->at_tick;
+    int32_t lead = step > 0 ? error_q8 : step < 0 ? -error_q8 : 0;
+    m->lead_q8 += (lead - m->lead_q8) >> LEAD_FILTER_SHIFT;
+    uint32_t target = CLOCK_REAL_TIME;
+    if (m->controller.at_limit && m->lead_q8 > LEAD_FREE_Q8) {
+        uint32_t slow = (uint32_t)(m->lead_q8 - LEAD_FREE_Q8) >> LEAD_SPAN_SHIFT;
+        target = slow >= CLOCK_REAL_TIME ? 0u : CLOCK_REAL_TIME - slow;
+    }
+    uint32_t rate = m->clock_rate;
+    if (target + CLOCK_SLOWING < rate) {
+        rate -= CLOCK_SLOWING;
+    } else if (target > rate + CLOCK_RECOVERY) {
+        rate += CLOCK_RECOVERY;
+    } else {
+        rate = target;
+    }
+    m->clock_rate = (uint16_t)rate;
+}
+
+/* Moves the setpoint on by clock_rate: between the profile's positions at
+ * two whole ticks, linearly (the profile bends by far less than an encoder
+ * count within one tick). */
+static void advance_clock(struct motion *m)
+{
+    uint32_t frac = (uint32_t)m->tick_frac + m->clock_rate;
+    if (frac >= CLOCK_REAL_TIME && m->tick < UINT32_MAX) {
+        frac -= CLOCK_REAL_TIME;
+        m->tick++;
+        m->at_tick = m->at_next;
+        m->at_next = profile_position(&m->profile, m->tick + 1u);
+    }
+    m->tick_frac = (uint16_t)frac;
+    m->setpoint = m->at_tick + (((m->at_next - m->at_tick) * (int64_t)frac) >> 8);
+}
+
+/* A profile whose horn could no longer stop on the target at the output's
+ * braking (v^2 > 2 a r, a = brake_duty / ka, v the setpoint's or the horn's
+ * speed, r what is left from the horn) decelerates from where the horn is, at v^2 / 2r,
+ * and is left alone after that (braking). Starting from the horn rather
+ * than the setpoint drops the lead the slowed clock kept, which would
+ * otherwise push on against the braking. This catches plans whose ramps
+ * are steeper than the motor, and setpoints the slowed clock has left
+ * moving at another speed, in any phase. Speeds beyond 2^16 (256 decideg
+ * per tick) count as 2^16: far beyond any servo, and the products stay
+ * within int64. */
+static void guard_braking(struct motion *m)
+{
+    if (m->endless || m->braking) {
+        return;
+    }
+    /* The faster of setpoint and horn must stop: in a slowed deceleration
+     * the setpoint moves slower than the horn still does. */
+    int64_t v_q32 = m->setpoint - m->last_setpoint;
+    int32_t v = q32_to_q8_sat(v_q32);
+    int32_t w = m->measured_velocity_q8;
+    if ((w > 0) == (v > 0) && (w > v) == (v > 0) && w != v) {
+        v = w;
+        v_q32 = (int64_t)w * ((int64_t)1 << 24);
+    }
+    int32_t r = q32_to_q8_sat(m->profile.target - m->measured);
+    if (v == 0 || r == 0 || (v > 0) != (r > 0)) {
+        return;
+    }
+    int64_t speed = v < 0 ? -(int64_t)v : v;
+    int64_t room = r < 0 ? -(int64_t)r : r;
+    int64_t capped = speed < (1 << 16) ? speed : (1 << 16);
+    if (capped * capped * m->drive.ka <= ((int64_t)motion_brake_duty(m, v) * room) << 9) {
+        return;
+    }
+    uint32_t n = (uint32_t)((2 * room + speed - 1) / speed);
+    n = n < PROFILE_MAX_RAMP ? n : PROFILE_MAX_RAMP;
+    profile_plan(&m->profile, m->measured, v_q32, m->profile.target,
+                 (struct profile_timing){0, 0, n});
+    motion_clock_restart(m);
+    m->setpoint = m->profile.start;
+    m->last_setpoint = m->profile.start - v_q32;
+    m->braking = 1;
+}
+
+void motion_tick(struct motion *m)
+{
+    measure(m);
+    if (++m->supply_check == SUPPLY_CHECK_TICKS) {
+        m->supply_check = 0;
+        follow_supply(m);
+    }
+    switch (m->mode) {
+    case MODE_DAMPING:
+        m->hal->motor_drive(m->hal->ctx, controller_damping(m->measured_velocity_q8, &m->drive));
+        return;
+    case MODE_POSITION:
+        break;
+    default:
+        return; /* released: the output stays off */
+    }
+    if (m->endless) {
+        rebase_endless(m);
+    }
+    govern_clock(m, q32_to_q8_sat(m->setpoint - m->measured));
+    int64_t last_step = m->setpoint - m->last_setpoint;
+    bool real_time = m->clock_rate == CLOCK_REAL_TIME;
+    m->last_setpoint = m->setpoint;
+    advance_clock(m);
+    guard_braking(m);
+    int64_t step = m->setpoint - m->last_setpoint;
+    /* The acceleration feed-forward only while the clock keeps real time:
+     * a rate change is no acceleration the horn should be given (the
+     * output is at its limit then anyway). */
+    real_time = real_time && m->clock_rate == CLOCK_REAL_TIME;
+    const struct controller_input in = {
+        .error_q8 = q32_to_q8_sat(m->setpoint - m->measured),
+        .velocity_q8 = q32_to_q8_sat(step),
+        .acceleration_q16 = real_time ? (int32_t)((step - last_step) >> 16) : 0,
+        .measured_velocity_q8 = m->measured_velocity_q8,
+        /* While the clock is slowed and the horn lags, the motor is the
+         * bottleneck: drive at the limit the way the profile goes (not
+         * while braking, nor once the horn has caught up). */
+        .push = real_time || m->braking || m->lead_q8 <= LEAD_FREE_Q8 ? 0
+                : m->at_next > m->at_tick                             ? 1
+                : m->at_next < m->at_tick                             ? -1
+                                                                      : 0,
+    };
+    m->hal->motor_drive(m->hal->ctx, controller_position(&m->controller, &in, &m->drive));
+    bool done = m->endless ? m->tick >= m->profile.accel_ticks
+                           : profile_done(&m->profile, m->tick) && arrived(m);
+    if (m->running && done) {
+        motion_finish(m);
+    }
+}
