@@ -48,6 +48,7 @@ SEEDS = {
     "reset_turns_origin": req(24, b"\x00\x10\x00\x00") + req(17, b"\x00") + req(23, b"\x00\x00"),
     "async": req(18, b"") + req(8, struct.pack("<BhHH", 0, 900, 500, 0)) + req(19, b"\x00"),
     "monitor": req(22, b"\x00"),
+    "read_motion": req(11, struct.pack("<BhHHHH", 0, 900, 300, 100, 100, 0)) + req(0x40, b"\x00"),
     "control_response": req(4, b"\x00\x21\x01") + req(11, struct.pack("<BhHHHH", 0, 1000, 1000, 100, 200, 0)),
     "sync_monitor": req(25, bytes([22, 1, 4, 5, 6, 0, 9])) + resp(22, bytes(16)) + resp(22, bytes(16)),
     "sync_move": req(25, bytes([8, 7, 2]) + struct.pack("<BhHH", 4, 0, 0, 0) + struct.pack("<BhHH", 0, 900, 500, 0)),
