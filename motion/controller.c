@@ -35,7 +35,7 @@ int16_t controller_position(struct controller *c, const struct controller_input 
     if (in->push != 0) {
         /* The setpoint waits for the horn: all the current the limit allows,
          * nothing integrated (the error is the motor's, no load's). */
-        c->at_limit = 1;
+        c->at_limit = in->push;
         return limit(in->push > 0 ? 1 << 20 : -(1 << 20), in->measured_velocity_q8, lim);
     }
     /* Beyond 2^22 (16 384 decideg) the output is saturated anyway. */
@@ -60,7 +60,7 @@ int16_t controller_position(struct controller *c, const struct controller_input 
     if (!pushing) {
         c->integral_q15 = integral;
     }
-    c->at_limit = out != limited;
+    c->at_limit = (int8_t)(out > limited ? 1 : out < limited ? -1 : 0);
     return limited;
 }
 

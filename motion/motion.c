@@ -83,7 +83,7 @@ void motion_read_diagnostics(const struct motion *m, struct motion_diagnostics *
         .flags = (uint8_t)((controlled && m->tick >= m->profile.total_ticks ? DIAG_PROFILE_ENDED : 0u) |
                            (controlled && m->clock_rate != CLOCK_REAL_TIME ? DIAG_CLOCK_SLOWED : 0u) |
                            (controlled && m->braking ? DIAG_BRAKING : 0u) |
-                           (motion_output_at_limit(m) ? DIAG_AT_LIMIT : 0u) |
+                           (motion_output_at_limit(m) != 0 ? DIAG_AT_LIMIT : 0u) |
                            (controlled ? 0u : DIAG_RELEASED)),
     };
 }
@@ -540,7 +540,7 @@ void motion_release(struct motion *m)
     release(m);
 }
 
-bool motion_output_at_limit(const struct motion *m)
+int8_t motion_output_at_limit(const struct motion *m)
 {
-    return m->mode == MODE_POSITION && m->controller.at_limit;
+    return m->mode == MODE_POSITION ? m->controller.at_limit : 0;
 }

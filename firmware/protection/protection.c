@@ -16,9 +16,11 @@ struct threshold {
     uint16_t (*clear_level)(uint16_t limit);
 };
 
+/* Saturates: a limit near 65535 must not wrap its clear level to near 0. */
 static uint16_t up_voltage(uint16_t limit)
 {
-    return (uint16_t)(limit + VOLTAGE_HYSTERESIS_MV);
+    uint32_t level = (uint32_t)limit + VOLTAGE_HYSTERESIS_MV;
+    return level > UINT16_MAX ? UINT16_MAX : (uint16_t)level;
 }
 
 static uint16_t down_voltage(uint16_t limit)
@@ -59,10 +61,14 @@ static bool beyond(const struct threshold *t, uint16_t value, uint16_t limit)
     return t->inclusive ? value <= limit : value < limit;
 }
 
+/* Never true while the value is still beyond the limit: at the ends of the
+ * range (or through the NTC table's clamping) the clear level can land on the
+ * wrong side of the limit, and the bit would then flap every 100 ms. */
 static bool back_inside(const struct threshold *t, uint16_t value, uint16_t limit)
 {
     uint16_t level = t->clear_level(limit);
-    return t->trips_above ? value <= level : value >= level;
+    bool inside = t->trips_above ? value <= level : value >= level;
+    return inside && !beyond(t, value, limit);
 }
 
 /* Debounce: trip after PROTECT_TRIP_TICKS (or trip_ticks) samples beyond,
@@ -94,7 +100,9 @@ uint8_t protection_update(struct protection *p, const struct user_config *cfg,
     }
 
     int32_t speed = in->speed_q8 < 0 ? -in->speed_q8 : in->speed_q8;
-    bool stalled = in->output_at_limit && speed < STALL_SPEED_Q8;
+    bool overpowered = (in->output_at_limit > 0 && in->speed_q8 <= -STALL_SPEED_Q8) ||
+                       (in->output_at_limit < 0 && in->speed_q8 >= STALL_SPEED_Q8);
+    bool stalled = in->output_at_limit != 0 && (speed < STALL_SPEED_Q8 || overpowered);
     bool was_stalled = p->mon[MON_STALL].active;
     step(&p->mon[MON_STALL], stalled, !stalled, STALL_TICKS);
     bool tripped = p->mon[MON_STALL].active && !was_stalled;

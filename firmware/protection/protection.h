@@ -25,14 +25,16 @@
 #define CURRENT_HYSTERESIS_MA 100u
 #define POWER_HYSTERESIS_MW 500u
 #define TEMPERATURE_HYSTERESIS_DECIC 50 /* 5.0 degC, through the NTC table */
-/* Stall: the output held at its limit while the horn turns slower than
- * STALL_SPEED_Q8 (decideg per tick, Q8: 13 = 5 deg/s) for STALL_TICKS. */
+/* Stall: the output held at its limit for STALL_TICKS while the horn turns
+ * slower than STALL_SPEED_Q8 (decideg per tick, Q8: 13 = 5 deg/s) or is
+ * pushed the other way by a load stronger than the motor. */
 #define STALL_SPEED_Q8 13
 #define STALL_TICKS 1000u         /* 1 s */
 
 struct protection_input {
     struct sensor_readings readings;  /* filtered */
-    bool output_at_limit;             /* the controller is saturated */
+    int8_t output_at_limit;           /* the controller is saturated, driving
+                                       * this way (+1/-1); 0: it is not */
     int32_t speed_q8;                 /* measured, decideg per tick Q8 */
     uint32_t motion_commands;         /* count of motion commands so far */
 };

@@ -215,6 +215,27 @@ static void test_back_driving_is_bounded(void **state)
     assert_true(after < 1.0);
 }
 
+/* Holding at 30 deg when a load 2.6 x the stall torque arrives: the output
+ * pushes at its limit while the horn is turned backwards. After the stall
+ * time bit 2 sets, as against a hard stop. */
+static void test_pushed_backwards_is_a_stall(void **state)
+{
+    (void)state;
+    REQUEST(8, 0, 0x2C, 0x01, 0x2C, 0x01, 0x00, 0x00); /* 30.0 deg in 300 ms */
+    harness_run_ms(600);
+    REQUEST(3, 0, 5);
+    EXPECT_RESPONSE(3, 0, 5, 0x00);
+    plant.load_torque = 5.0; /* through the gears' losses: 1.5 x stall at the motor */
+    harness_run_ms(300);
+    double speed = plant.velocity * 180.0 / M_PI;
+    assert_true(fabs(speed) > 20.0); /* turned backwards, well beyond 5 deg/s */
+    assert_int_equal(servo.regs.status.status & STATUS_STALL, 0);
+    harness_run_ms(1000);
+    printf("# held at 30 deg under 5 N m: turned at %.0f deg/s, now at %.1f deg\n", speed,
+           plant_angle_deg(&plant));
+    assert_int_equal(servo.regs.status.status & STATUS_STALL, STATUS_STALL);
+}
+
 static void test_damping_brakes_a_spinning_horn(void **state)
 {
     (void)state;
@@ -294,6 +315,7 @@ int main(void)
         cmocka_unit_test_setup(test_wheel_stop_brakes_within_the_motor, setup),
         cmocka_unit_test_setup(test_stop_and_hold_brakes_within_the_motor, setup),
         cmocka_unit_test_setup(test_back_driving_is_bounded, setup),
+        cmocka_unit_test_setup(test_pushed_backwards_is_a_stall, setup),
         cmocka_unit_test_setup(test_damping_brakes_a_spinning_horn, setup),
         cmocka_unit_test_setup(test_stall_limits_to_the_stall_power, setup),
         cmocka_unit_test_setup(test_stall_releases_when_37_says_so, setup),

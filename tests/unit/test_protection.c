@@ -155,12 +155,63 @@ static void test_limits_follow_the_user_area(void **state)
     assert_int_equal(run(PROTECT_TRIP_TICKS), STATUS_LOW_VOLTAGE);
 }
 
+/* Every monitor at both ends of its range: whatever the limit and the
+ * (constant) reading, the bit changes at most once, and it is set exactly
+ * when the reading is beyond the limit. A limit of 65535 used to wrap the
+ * low-voltage clear level to 199 mV, and the bit flipped every 110 ms. */
+static void test_no_monitor_flaps_at_the_ends_of_its_range(void **state)
+{
+    (void)state;
+    struct {
+        uint16_t *limit;
+        uint16_t *value;
+        uint8_t bit;
+        int trips_above;
+        int inclusive;
+    } const rows[] = {
+        {&cfg.low_voltage_mv, &in.readings.voltage_mv, STATUS_LOW_VOLTAGE, 0, 0},
+        {&cfg.high_voltage_mv, &in.readings.voltage_mv, STATUS_HIGH_VOLTAGE, 1, 0},
+        {&cfg.current_limit_ma, &in.readings.current_ma, STATUS_OVER_CURRENT, 1, 0},
+        {&cfg.power_limit_mw, &in.readings.power_mw, STATUS_OVER_POWER, 1, 0},
+        {&cfg.temperature_limit_adc, &in.readings.temperature_adc, STATUS_OVER_TEMPERATURE, 0, 1},
+    };
+    const uint16_t ends[] = {0, 1, 99, 100, 199, 200, 201, 4095, 65334, 65335, 65336, 65400, 65534, 65535};
+    for (size_t r = 0; r < sizeof rows / sizeof rows[0]; r++) {
+        for (size_t l = 0; l < sizeof ends / sizeof ends[0]; l++) {
+            for (size_t v = 0; v < sizeof ends / sizeof ends[0]; v++) {
+                setup(NULL);
+                cfg.low_voltage_mv = 0; /* only the monitor under test can trip */
+                cfg.high_voltage_mv = UINT16_MAX;
+                cfg.current_limit_ma = UINT16_MAX;
+                cfg.power_limit_mw = UINT16_MAX;
+                cfg.temperature_limit_adc = 0;
+                in.readings.temperature_adc = 4095;
+                *rows[r].limit = ends[l];
+                *rows[r].value = ends[v];
+                uint16_t value = ends[v];
+                uint16_t limit = ends[l];
+                int beyond = rows[r].trips_above ? (rows[r].inclusive ? value >= limit : value > limit)
+                                                 : (rows[r].inclusive ? value <= limit : value < limit);
+                unsigned changes = 0;
+                uint8_t last = 0;
+                for (int i = 0; i < 1000; i++) {
+                    uint8_t bits = run(1);
+                    changes += (bits != last);
+                    last = bits;
+                }
+                assert_true(changes <= 1);
+                assert_int_equal(last, beyond ? rows[r].bit : 0);
+            }
+        }
+    }
+}
+
 static void test_stall_limits_power_in_mode_0(void **state)
 {
     (void)state;
     cfg.stall_release = 0;
     cfg.stall_power_mw = 2500;
-    in.output_at_limit = true;
+    in.output_at_limit = 1;
     in.speed_q8 = STALL_SPEED_Q8 - 1; /* just below 5 deg/s */
     assert_int_equal(run(STALL_TICKS - 1), 0);
     assert_int_equal(act.power_cap_mw, 0);
@@ -170,7 +221,7 @@ static void test_stall_limits_power_in_mode_0(void **state)
     /* Still pushing at the (now lower) limit: stays. */
     assert_int_equal(run(1000), STATUS_STALL);
     /* It moves again: clears after the clear time. */
-    in.speed_q8 = -STALL_SPEED_Q8; /* at the speed limit, either way */
+    in.speed_q8 = STALL_SPEED_Q8; /* at the speed limit, the way it pushes */
     assert_int_equal(run(PROTECT_CLEAR_TICKS - 1), STATUS_STALL);
     assert_int_equal(run(1), 0);
     assert_int_equal(act.power_cap_mw, 0);
@@ -179,11 +230,31 @@ static void test_stall_limits_power_in_mode_0(void **state)
 static void test_no_stall_while_moving_or_not_pushing(void **state)
 {
     (void)state;
-    in.output_at_limit = true;
+    in.output_at_limit = 1;
     in.speed_q8 = STALL_SPEED_Q8; /* 5 deg/s: moving */
     assert_int_equal(run(3 * STALL_TICKS), 0);
-    in.output_at_limit = false;
+    in.output_at_limit = 0;
     in.speed_q8 = 0; /* still, but not pushing hard */
+    assert_int_equal(run(3 * STALL_TICKS), 0);
+}
+
+/* A load stronger than the motor turns the horn backwards while the output
+ * pushes forwards at its limit: that is a stall too, either way round. */
+static void test_pushed_backwards_at_the_limit_is_a_stall(void **state)
+{
+    (void)state;
+    cfg.stall_release = 0;
+    in.output_at_limit = 1;
+    in.speed_q8 = -40 * STALL_SPEED_Q8; /* 200 deg/s the wrong way */
+    assert_int_equal(run(STALL_TICKS - 1), 0);
+    assert_int_equal(run(1), STATUS_STALL);
+    setup(NULL);
+    in.output_at_limit = -1;
+    in.speed_q8 = STALL_SPEED_Q8;
+    assert_int_equal(run(STALL_TICKS), STATUS_STALL);
+    setup(NULL);
+    in.output_at_limit = -1; /* at the limit, moving the way it pushes */
+    in.speed_q8 = -STALL_SPEED_Q8;
     assert_int_equal(run(3 * STALL_TICKS), 0);
 }
 
@@ -191,11 +262,11 @@ static void test_stall_releases_in_mode_1(void **state)
 {
     (void)state;
     cfg.stall_release = 1;
-    in.output_at_limit = true;
+    in.output_at_limit = 1;
     in.motion_commands = 7;
     assert_int_equal(run(STALL_TICKS), STATUS_STALL);
     assert_true(act.release_now); /* once */
-    in.output_at_limit = false;    /* released: nothing pushes */
+    in.output_at_limit = 0;    /* released: nothing pushes */
     assert_int_equal(run(1), STATUS_STALL);
     assert_false(act.release_now);
     assert_int_equal(run(5000), STATUS_STALL); /* held until a new command */
@@ -214,8 +285,10 @@ int main(void)
         cmocka_unit_test_setup(test_one_noisy_sample_neither_trips_nor_clears, setup),
         cmocka_unit_test_setup(test_several_faults_at_once, setup),
         cmocka_unit_test_setup(test_limits_follow_the_user_area, setup),
+        cmocka_unit_test_setup(test_no_monitor_flaps_at_the_ends_of_its_range, setup),
         cmocka_unit_test_setup(test_stall_limits_power_in_mode_0, setup),
         cmocka_unit_test_setup(test_no_stall_while_moving_or_not_pushing, setup),
+        cmocka_unit_test_setup(test_pushed_backwards_at_the_limit_is_a_stall, setup),
         cmocka_unit_test_setup(test_stall_releases_in_mode_1, setup),
     };
     return cmocka_run_group_tests_name("protection", tests, NULL, NULL);

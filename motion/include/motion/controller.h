@@ -13,7 +13,8 @@
 
 struct controller {
     int32_t integral_q15;
-    uint8_t at_limit; /* the last output was held back by the limit */
+    int8_t at_limit; /* the last output was held back by the limit: the way
+                      * it wanted to go (+1/-1), else 0 */
 };
 
 /* What the drive can do at the present supply, worked out when the supply

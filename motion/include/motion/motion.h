@@ -188,7 +188,8 @@ bool motion_is_executing(const struct motion *m);
 void motion_guard(struct motion *m, bool inhibit, bool derate, uint16_t power_cap_mw);
 /* Releases the output now (a stall in release mode). */
 void motion_release(struct motion *m);
-/* The controller's output was held back by its limit on the last tick. */
-bool motion_output_at_limit(const struct motion *m);
+/* The controller's output was held back by its limit on the last tick:
+ * the way it wanted to drive (+1/-1), else 0. */
+int8_t motion_output_at_limit(const struct motion *m);
 
 #endif
