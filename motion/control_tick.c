@@ -20,11 +20,9 @@ static bool arrived(const struct motion *m)
            speed < FOLLOW_SPEED_Q8 && speed > -FOLLOW_SPEED_Q8;
 }
 
-/* Turning without end (wheel run) must not outgrow the number formats: past
- * the protocol's multi-turn range the frame moves back by whole turns, and
- * the profile restarts its clock before the tick count gets large. */
+/* Turning without end (wheel run) must not outgrow the tick count: the
+ * profile restarts its clock before it gets large. */
 enum { REBASE_TICKS = 1u << 24 };
-#define REBASE_COUNTS ((int32_t)(MULTI_TURN_LIMIT / DECIDEG_PER_TURN) * ENCODER_COUNTS)
 
 static void rebase_endless(struct motion *m)
 {
@@ -33,19 +31,24 @@ static void rebase_endless(struct motion *m)
         profile_plan_endless(&m->profile, m->setpoint, v, v, 0);
         motion_clock_restart(m);
     }
-    int32_t rel = m->encoder.counts - m->origin_counts;
-    if (rel > REBASE_COUNTS || rel < -REBASE_COUNTS) {
-        int32_t shift = rel > 0 ? REBASE_COUNTS : -REBASE_COUNTS;
-        int64_t shift_q32 = counts_to_q32(shift);
-        m->origin_counts += shift;
-        m->measured -= shift_q32;
-        m->setpoint -= shift_q32;
-        m->last_setpoint -= shift_q32;
-        m->profile.start -= shift_q32;
-        m->profile.target -= shift_q32;
-        m->profile.cruise_start -= shift_q32;
-        m->at_tick -= shift_q32;
-        m->at_next -= shift_q32;
+}
+
+/* The multi-turn reading stays within +-MULTI_TURN_LIMIT whatever turns the
+ * horn (wheel mode, many turns, a load back-driving it): past either end
+ * the origin moves FRAME_SHIFT (1024 turns) the same way and the reading
+ * goes on from about 0 (docs/decisions.md, "The ends of every range"). A
+ * whole range lies between two shifts, so a horn held at an end does not
+ * shift back and forth. */
+#define FRAME_SHIFT_COUNTS ((int32_t)(MULTI_TURN_LIMIT / DECIDEG_PER_TURN) * ENCODER_COUNTS)
+#define READING_LIMIT_Q32 ((int64_t)MULTI_TURN_LIMIT * DECIDEG_Q32)
+
+static void keep_in_range(struct motion *m)
+{
+    int64_t reading = m->measured - motion_center_offset_q32(m);
+    if (reading > READING_LIMIT_Q32) {
+        motion_move_origin(m, FRAME_SHIFT_COUNTS);
+    } else if (reading < -READING_LIMIT_Q32) {
+        motion_move_origin(m, -FRAME_SHIFT_COUNTS);
     }
 }
 
@@ -71,6 +74,7 @@ static void measure(struct motion *m)
     m->track_velocity_q12 = (int32_t)(v > INT32_MAX / 2 ? INT32_MAX / 2 : v < -INT32_MAX / 2 ? -INT32_MAX / 2 : v);
     /* Q12 inside, so the rounding left over is far below one Q8 step. */
     m->measured_velocity_q8 = (m->track_velocity_q12 + 8) >> 4;
+    keep_in_range(m);
 }
 
 /* The supply moves slowly: the duty margin for the power follows it every

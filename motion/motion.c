@@ -38,9 +38,26 @@ static int32_t q32_to_decideg(int64_t q32)
     return (int32_t)((q32 + (DECIDEG_Q32 / 2)) >> 32); /* nearest */
 }
 
-static int64_t center_offset_q32(const struct motion *m)
+void motion_move_origin(struct motion *m, int32_t counts)
 {
-    return (int64_t)m->regs->user.center_offset_decideg * DECIDEG_Q32;
+    int64_t shift = counts_to_q32(counts);
+    m->origin_counts += counts;
+    m->measured -= shift;
+    m->setpoint -= shift;
+    m->last_setpoint -= shift;
+    m->profile.start -= shift;
+    m->profile.target -= shift;
+    m->profile.cruise_start -= shift;
+    m->at_tick -= shift;
+    m->at_next -= shift;
+    /* Whole turns of the origin come off the encoder's count too: the raw
+     * reading's place in the turn, and the difference, stay as they were. */
+    int32_t within = m->origin_counts % ENCODER_COUNTS;
+    within = within < 0 ? within + ENCODER_COUNTS : within;
+    int32_t whole = m->origin_counts - within;
+    m->origin_counts = within;
+    m->encoder.counts -= whole;
+    m->track_q32 -= counts_to_q32(whole);
 }
 
 static int32_t wrap_single_turn(int32_t decideg)
@@ -56,7 +73,7 @@ static int32_t wrap_single_turn(int32_t decideg)
 
 void motion_read_angle(const struct motion *m, struct motion_angle *out)
 {
-    int32_t angle = q32_to_decideg(m->measured - center_offset_q32(m));
+    int32_t angle = q32_to_decideg(m->measured - motion_center_offset_q32(m));
     out->multi_turn_decideg = angle;
     out->turns = (int16_t)(angle / DECIDEG_PER_TURN);
     out->single_turn_decideg = (int16_t)wrap_single_turn(angle);
@@ -70,7 +87,7 @@ static int16_t saturate_i16(int32_t v)
 void motion_read_diagnostics(const struct motion *m, struct motion_diagnostics *out)
 {
     bool controlled = m->mode == MODE_POSITION;
-    int64_t offset = center_offset_q32(m);
+    int64_t offset = motion_center_offset_q32(m);
     int64_t setpoint = controlled ? m->setpoint : m->measured;
     /* decideg per tick Q8 to decideg per s: x 1000 / 256 = x 125 / 32. */
     int32_t error_q8 = q32_to_q8_sat(setpoint - m->measured);
@@ -248,7 +265,7 @@ static int64_t angle_target(const struct motion *m, const struct motion_command 
     const struct user_config *cfg = &m->regs->user;
     if (cmd->multi_turn) {
         int32_t angle = clamp_i32(cmd->angle_decideg, -MULTI_TURN_LIMIT, MULTI_TURN_LIMIT);
-        return (int64_t)angle * DECIDEG_Q32 + center_offset_q32(m);
+        return (int64_t)angle * DECIDEG_Q32 + motion_center_offset_q32(m);
     }
     int32_t angle = clamp_i32(cmd->angle_decideg, -SINGLE_TURN_LIMIT, SINGLE_TURN_LIMIT);
     if (cfg->angle_limit_on) {
@@ -258,7 +275,7 @@ static int64_t angle_target(const struct motion *m, const struct motion_command 
     struct motion_angle now;
     motion_read_angle(m, &now);
     int32_t turn_base = now.multi_turn_decideg - now.single_turn_decideg;
-    return ((int64_t)turn_base + angle) * DECIDEG_Q32 + center_offset_q32(m);
+    return ((int64_t)turn_base + angle) * DECIDEG_Q32 + motion_center_offset_q32(m);
 }
 
 static void run_angle(struct motion *m, const struct motion_command *cmd)
@@ -457,8 +474,7 @@ bool motion_reset_multi_turn(struct motion *m)
     } else if (within < -ENCODER_COUNTS / 2) {
         within += ENCODER_COUNTS;
     }
-    m->origin_counts += rel - within;
-    m->measured = counts_to_q32(m->encoder.counts - m->origin_counts);
+    motion_move_origin(m, rel - within);
     return true;
 }
 
@@ -467,8 +483,7 @@ bool motion_set_origin(struct motion *m)
     if (!motion_is_released(m)) {
         return false;
     }
-    m->origin_counts = m->encoder.counts;
-    m->measured = 0;
+    motion_move_origin(m, m->encoder.counts - m->origin_counts);
     return true;
 }
 

@@ -42,6 +42,17 @@ static inline int32_t q32_to_q8_sat(int64_t v)
     return q8 > INT32_MAX ? INT32_MAX : q8 < -INT32_MAX ? -INT32_MAX : (int32_t)q8;
 }
 
+/* The center offset (53): protocol angles are measured minus this. */
+static inline int64_t motion_center_offset_q32(const struct motion *m)
+{
+    return (int64_t)m->regs->user.center_offset_decideg * DECIDEG_Q32;
+}
+
+/* Moves the origin by counts the way the angle grows: every position the
+ * motion layer holds (horn, setpoint, profile) moves with it, so a move in
+ * flight goes on unchanged. The encoder's count and the origin are kept
+ * within a turn of each other's whole turns, so neither outgrows int32. */
+void motion_move_origin(struct motion *m, int32_t counts);
 /* The supply the limits are worked out for: the measured one, 7.4 V until
  * there is one. */
 uint16_t motion_supply_mv(const struct motion *m);
