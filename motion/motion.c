@@ -487,6 +487,11 @@ bool motion_set_origin(struct motion *m)
     return true;
 }
 
+bool motion_has_finished(const struct motion *m)
+{
+    return m->answers_count != 0u;
+}
+
 uint8_t motion_take_finished(struct motion *m)
 {
     if (m->answers_count == 0u) {

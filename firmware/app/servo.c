@@ -20,6 +20,11 @@ static void apply_link_settings(struct servo *s)
         s->hal->uart_set_baud(s->hal->ctx, baud);
         frame_rx_set_idle_timeout(&s->rx, idle_timeout_us(s, baud));
     }
+    /* Divides: on a change of link settings only. */
+    uint32_t baud = baud_rate_of_index(s->active_baud_index);
+    uint32_t byte_us = baud != 0u ? (10000000u + baud - 1u) / baud : 0u;
+    s->unsolicited_slot_us = UNSOLICITED_WINDOW_US + 2u * byte_us + UNSOLICITED_DRIFT_GUARD_US;
+    s->unsolicited_first_us = UNSOLICITED_QUIET_US + (uint32_t)s->active_id * s->unsolicited_slot_us;
 }
 
 void servo_init(struct servo *s, const struct hal_port *hal)
@@ -78,8 +83,27 @@ static void queue_response(struct servo *s, const struct response *r, uint8_t wa
     }
 }
 
+/* Nobody asked for a "move finished" answer just now, so nobody has left
+ * the line free for it: it goes out in this ID's slot (servo.h). Divides
+ * while an answer waits, once a pass. */
+static bool in_unsolicited_slot(const struct servo *s)
+{
+    uint32_t now = s->hal->now_us(s->hal->ctx);
+    uint32_t heard = now - s->rx.last_byte_us;
+    uint32_t said = now - s->tx.ended_us;
+    uint32_t quiet = heard < said ? heard : said;
+    if (quiet < s->unsolicited_first_us) {
+        return false;
+    }
+    uint32_t cycle = UNSOLICITED_SLOTS * s->unsolicited_slot_us;
+    return (quiet - s->unsolicited_first_us) % cycle < UNSOLICITED_WINDOW_US;
+}
+
 static void answer_finished_move(struct servo *s)
 {
+    if (!motion_has_finished(&s->motion) || !in_unsolicited_slot(s)) {
+        return;
+    }
     uint8_t packet = motion_take_finished(&s->motion);
     if (packet == 0u) {
         return;
@@ -169,6 +193,7 @@ void servo_poll(struct servo *s)
             return; /* half duplex: nothing else goes out meanwhile */
         }
         s->tx.sending = 0;
+        s->tx.ended_us = s->hal->now_us(s->hal->ctx);
     }
     if (s->tx.waiting) {
         wait_for_turn(s);
@@ -186,8 +211,10 @@ void servo_poll(struct servo *s)
     uint8_t status = (uint8_t)(s->regs.status.status & ~STATUS_EXECUTING);
     s->regs.status.status =
         motion_is_executing(&s->motion) ? (uint8_t)(status | STATUS_EXECUTING) : status;
-    answer_finished_move(s);
-    if (!s->tx.sending) {
-        handle_next_frame(s);
+    /* Requests first: the host waits for their answers, while a finished
+     * move's answer waits for a quiet line anyway. */
+    handle_next_frame(s);
+    if (!s->tx.sending && !s->tx.waiting) {
+        answer_finished_move(s);
     }
 }

@@ -20,6 +20,19 @@
 /* Silence after which a SyncCommand Monitor turn-taker stops waiting for a
  * servo listed before it that does not answer. */
 #define SYNC_SLOT_SILENCE_US 3000u
+/* Unsolicited answers (a finished move, 33 = 1) go out in time slots, one
+ * per ID, counted from the end of the last activity on the line, so two
+ * servos never start together (docs/decisions.md, "Sharing the bus"):
+ *   slot of ID i, cycle k:  last activity + QUIET + (k x 254 + i) x SLOT
+ * QUIET is longer than a Sync Monitor slot, so a round in progress is never
+ * cut into. A servo starts only within the first UNSOLICITED_WINDOW_US of
+ * its slot (the main loop's longest pass, the simulator's 250 us step
+ * included); SLOT adds two byte times, by which the next ID has heard the
+ * first byte, and a guard for the drift of two crystals. */
+#define UNSOLICITED_QUIET_US (SYNC_SLOT_SILENCE_US + 1000u)
+#define UNSOLICITED_WINDOW_US 300u
+#define UNSOLICITED_DRIFT_GUARD_US 50u
+#define UNSOLICITED_SLOTS 254u
 /* Ticks a late main loop catches up before it drops the rest. */
 #define SERVO_MAX_CATCH_UP 4u
 /* Control tick period. */
@@ -33,6 +46,7 @@ struct servo_tx {
     uint8_t turns_left;        /* other responses still to let pass */
     uint32_t responses_base;   /* framer's response count at the request */
     uint32_t silence_from_us;  /* start of the current wait for a turn */
+    uint32_t ended_us;         /* when the last response left the wire */
 };
 
 struct servo {
@@ -49,6 +63,8 @@ struct servo {
     uint32_t ticks_dropped;      /* control ticks skipped by a late main loop */
     volatile uint8_t active_id;  /* the ID answered to now */
     uint8_t active_baud_index;
+    uint32_t unsolicited_slot_us;  /* slot length at this baud */
+    uint32_t unsolicited_first_us; /* quiet before this ID's first slot */
     uint8_t config_dirty;
 };
 

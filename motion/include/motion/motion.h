@@ -177,6 +177,8 @@ void motion_read_diagnostics(const struct motion *m, struct motion_diagnostics *
 bool motion_set_origin(struct motion *m);
 void motion_begin_async(struct motion *m);
 void motion_end_async(struct motion *m, bool cancel);
+/* A finished move is owed an answer. */
+bool motion_has_finished(const struct motion *m);
 /* Packet number of a finished move that must be answered, 0 if none. */
 uint8_t motion_take_finished(struct motion *m);
 /* True while a motion command runs (status bit 0). */
