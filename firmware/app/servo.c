@@ -196,8 +196,15 @@ void servo_poll(struct servo *s)
         s->tx.ended_us = s->hal->now_us(s->hal->ctx);
     }
     if (s->tx.waiting) {
-        wait_for_turn(s);
-        return;
+        if (frame_rx_peek(&s->rx) == NULL) {
+            wait_for_turn(s);
+            return;
+        }
+        /* A new request (to anyone) while this servo waits for its Sync
+         * Monitor turn: the host has given up on that round, and is owed
+         * this answer instead. */
+        s->tx.waiting = 0;
+        s->sync_turns_abandoned++;
     }
     /* A new ID or baud rate takes effect once the response has left. */
     if (s->active_id != s->regs.user.servo_id ||

@@ -61,6 +61,7 @@ struct servo {
     struct protection protection;
     uint32_t next_tick_us;       /* when the next control tick is due */
     uint32_t ticks_dropped;      /* control ticks skipped by a late main loop */
+    uint32_t sync_turns_abandoned; /* Sync Monitor answers dropped for a new request */
     volatile uint8_t active_id;  /* the ID answered to now */
     uint8_t active_baud_index;
     uint32_t unsolicited_slot_us;  /* slot length at this baud */

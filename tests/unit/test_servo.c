@@ -235,6 +235,47 @@ static void test_sync_monitor_passes_a_silent_servo(void **state)
     assert_int_equal(hal.sent_length, 21);
 }
 
+/* Listed after 251 absent servos, this one would wait 251 x 3 ms for its
+ * turn. A request meanwhile (to it or to anyone) means the host has given
+ * up on the round: the servo drops its Sync Monitor answer and serves the
+ * requests at once, none of them lost. */
+static void test_a_new_request_ends_the_wait_for_a_sync_turn(void **state)
+{
+    (void)state;
+    uint8_t sync[3 + 252] = {22, 1, 252};
+    for (int i = 0; i < 251; i++) {
+        sync[3 + i] = (uint8_t)(1 + i);
+    }
+    sync[3 + 251] = 0;
+    harness_request(25, sync, sizeof sync);
+    hal.now_us += 10000;
+    harness_poll(3);
+    EXPECT_SILENCE(); /* still waiting: 3 of 251 turns gone */
+    static const uint8_t six[][1] = {{7}, {0}, {0}, {9}, {0}, {0}};
+    uint8_t wire[64 * 6];
+    size_t n = 0;
+    for (int i = 0; i < 6; i++) {
+        n += make_request(&wire[n], 1, six[i], 1); /* pings, two to others */
+    }
+    hal_double_clear_sent(&hal);
+    uint32_t sent_at = hal.now_us;
+    for (size_t i = 0; i < n; i++) {
+        harness_feed(&wire[i], 1);
+        harness_poll(1);
+    }
+    harness_poll(3);
+    uint8_t pong[16];
+    size_t one = make_response(pong, 1, (const uint8_t[]){0}, 1);
+    assert_int_equal(hal.sent_length, 4 * one); /* the four pings to servo 0 */
+    for (int i = 0; i < 4; i++) {
+        assert_memory_equal(&hal.sent[i * one], pong, one);
+    }
+    assert_true(hal.now_us - sent_at < 10000); /* not 750 ms later */
+    assert_int_equal(servo.sync_turns_abandoned, 1);
+    hal.now_us += 1000000; /* and the dropped answer never comes */
+    harness_poll(3);
+    assert_int_equal(hal.sent_length, 4 * one);
+}
 
 static void test_garbage_between_frames_and_responses_of_others(void **state)
 {
@@ -268,6 +309,7 @@ int main(void)
         cmocka_unit_test_setup(test_reset_keeps_link, setup),
         cmocka_unit_test_setup(test_sync_monitor_waits_its_turn, setup),
         cmocka_unit_test_setup(test_sync_monitor_passes_a_silent_servo, setup),
+        cmocka_unit_test_setup(test_a_new_request_ends_the_wait_for_a_sync_turn, setup),
         cmocka_unit_test_setup(test_garbage_between_frames_and_responses_of_others, setup),
     };
     return cmocka_run_group_tests_name("servo", tests, NULL, NULL);
