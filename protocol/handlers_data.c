@@ -14,6 +14,9 @@ enum packet_outcome handle_ping(const struct packet_call *c, struct response *r)
 
 enum packet_outcome handle_reset_user_data(const struct packet_call *c, struct response *r)
 {
+    if (c->d->store_failed) {
+        return answer_result(c, r, false);
+    }
     user_config_reset(&c->d->regs->user);
     c->result->config_changed = true;
     return answer_result(c, r, true);
@@ -32,7 +35,8 @@ enum packet_outcome handle_write_data(const struct packet_call *c, struct respon
 {
     uint8_t data_length = (uint8_t)(c->length - 2u);
     enum data_write_result w =
-        data_table_write(c->d->regs, c->content[1], &c->content[2], data_length);
+        c->d->store_failed ? DATA_WRITE_REFUSED
+                           : data_table_write(c->d->regs, c->content[1], &c->content[2], data_length);
     bool ok = w != DATA_WRITE_REFUSED;
     c->result->config_changed = w == DATA_WRITE_CHANGED;
     r->content[0] = c->content[0];
@@ -52,9 +56,27 @@ enum packet_outcome handle_read_batch(const struct packet_call *c, struct respon
 
 enum packet_outcome handle_write_batch(const struct packet_call *c, struct response *r)
 {
-    bool ok = user_config_decode(&c->d->regs->user, &c->content[1]);
+    bool ok = !c->d->store_failed && user_config_decode(&c->d->regs->user, &c->content[1]);
     c->result->config_changed = ok;
     return answer_result(c, r, ok);
+}
+
+enum { READ_STORE_ANSWER_LENGTH = 26 };
+
+enum packet_outcome handle_read_store(const struct packet_call *c, struct response *r)
+{
+    const struct store_health *h = &c->d->regs->store;
+    uint8_t *p = r->content;
+    p[0] = c->content[0];
+    p[1] = h->flags;
+    wire_put_u32(&p[2], h->records);
+    wire_put_u32(&p[6], h->page_erases);
+    wire_put_u32(&p[10], h->rated_cycles);
+    wire_put_u32(&p[14], h->budget);
+    wire_put_u32(&p[18], h->op_seconds);
+    wire_put_u32(&p[22], h->failures);
+    r->length = READ_STORE_ANSWER_LENGTH;
+    return OUTCOME_OK;
 }
 
 enum packet_outcome handle_monitor(const struct packet_call *c, struct response *r)

@@ -48,6 +48,7 @@ _Static_assert(sizeof packets / sizeof packets[0] == PKT_SYNC_COMMAND,
 /* This firmware's own packets, from PKT_READ_MOTION on (docs/packets.md). */
 static const struct packet_desc firmware_packets[] = {
     {PKT_READ_MOTION, QUERY, LEN(1), handle_read_motion},
+    {PKT_READ_STORE, QUERY, LEN(1), handle_read_store},
 };
 
 enum { FIRMWARE_PACKETS = sizeof firmware_packets / sizeof firmware_packets[0] };

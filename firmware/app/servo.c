@@ -31,6 +31,7 @@ void servo_init(struct servo *s, const struct hal_port *hal)
 {
     *s = (struct servo){.hal = hal};
     config_store_load(&s->store, hal->flash, &s->regs.user);
+    save_policy_init(&s->saver, &s->store, hal->now_us(hal->ctx));
     s->regs.status.model = SERVO_MODEL;
     s->regs.status.firmware_version = FIRMWARE_VERSION;
     s->regs.status.serial_number = hal->serial_number;
@@ -123,10 +124,51 @@ static void handle_next_frame(struct servo *s)
     dispatch(&s->dispatcher, frame, &r, &result);
     uint32_t responses_base = frame->responses_seen;
     frame_rx_release(&s->rx);
-    s->config_dirty |= result.config_changed;
+    if (result.config_changed) {
+        save_policy_changed(&s->saver, s->hal->now_us(s->hal->ctx));
+    }
     if (result.answer) {
         queue_response(s, &r, result.wait_responses, responses_base);
     }
+}
+
+/* The user area to flash when the save policy says so. A failed save sets
+ * status bit 1 and refuses further writes until a retry succeeds. */
+/* ReadStore's register group, on a change or a new second only: it
+ * divides. */
+static void report_store(struct servo *s)
+{
+    struct store_health *h = &s->regs.store;
+    uint8_t flags = (uint8_t)((s->store.failed ? STORE_FAILED : 0u) |
+                              (s->saver.deferred ? STORE_DEFERRED : 0u) |
+                              (s->saver.pending ? STORE_PENDING : 0u));
+    uint32_t op_seconds = save_policy_op_seconds(&s->saver);
+    if (flags == h->flags && op_seconds == h->op_seconds && h->rated_cycles != 0u &&
+        s->store.sequence == h->records && s->store.write_failures == h->failures) {
+        return;
+    }
+    h->flags = flags;
+    h->records = s->store.sequence;
+    h->page_erases = config_store_page_erases(&s->store);
+    h->rated_cycles = FLASH_RATED_CYCLES;
+    h->budget = save_policy_budget(&s->saver);
+    h->op_seconds = save_policy_op_seconds(&s->saver);
+    h->failures = s->store.write_failures;
+}
+
+static void save_config(struct servo *s)
+{
+    uint32_t now = s->hal->now_us(s->hal->ctx);
+    if (save_policy_due(&s->saver, &s->store, now)) {
+        enum config_save_result r =
+            config_store_save(&s->store, &s->regs.user, save_policy_op_seconds(&s->saver));
+        save_policy_saved(&s->saver, r, now);
+        if (r == CONFIG_WRITE_FAILED) {
+            s->regs.status.status |= STATUS_COMMAND_ERROR;
+        }
+        s->dispatcher.store_failed = s->store.failed;
+    }
+    report_store(s);
 }
 
 /* Sensors to the status area (IDs 1-4), monitors to status bits 2-7 and
@@ -211,10 +253,7 @@ void servo_poll(struct servo *s)
         s->active_baud_index != s->regs.user.baud_index) {
         apply_link_settings(s);
     }
-    if (s->config_dirty) {
-        s->config_dirty = 0;
-        config_store_save(&s->store, &s->regs.user);
-    }
+    save_config(s);
     uint8_t status = (uint8_t)(s->regs.status.status & ~STATUS_EXECUTING);
     s->regs.status.status =
         motion_is_executing(&s->motion) ? (uint8_t)(status | STATUS_EXECUTING) : status;

@@ -8,6 +8,7 @@
 #include <stdint.h>
 
 #include "config_store.h"
+#include "save_policy.h"
 #include "hal/hal_port.h"
 #include "protection.h"
 #include "scaling.h"
@@ -66,7 +67,7 @@ struct servo {
     uint8_t active_baud_index;
     uint32_t unsolicited_slot_us;  /* slot length at this baud */
     uint32_t unsolicited_first_us; /* quiet before this ID's first slot */
-    uint8_t config_dirty;
+    struct save_policy saver;
 };
 
 void servo_init(struct servo *s, const struct hal_port *hal);

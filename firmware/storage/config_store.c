@@ -6,16 +6,22 @@
 #include "protocol/data_table.h"
 #include "protocol/wire.h"
 
-/* Record layout, little-endian. */
+/* Record layout, little-endian. Format 2 adds the operating time; format 1
+ * records (44 bytes, no operating time) from older firmware still load. */
 enum {
     REC_MAGIC = 0,      /* u16 */
     REC_FORMAT = 2,     /* u8 */
     REC_LENGTH = 3,     /* u8: payload bytes */
     REC_SEQUENCE = 4,   /* u32 */
-    REC_PAYLOAD = 8,    /* USER_AREA_SIZE bytes */
+    REC_OP_SECONDS = 8, /* u32, format 2 */
+    REC_PAYLOAD = 12,   /* USER_AREA_SIZE bytes */
     REC_CRC = REC_PAYLOAD + USER_AREA_SIZE, /* u32 over bytes 0..REC_CRC-1 */
     RECORD_MAGIC = 0xC0F1,
-    RECORD_FORMAT = 1,
+    RECORD_FORMAT = 2,
+    V1_PAYLOAD = 8,
+    V1_CRC = V1_PAYLOAD + USER_AREA_SIZE,
+    V1_RECORD_SIZE = V1_CRC + 4,
+    V1_FORMAT = 1,
 };
 
 _Static_assert(REC_CRC + 4 == CONFIG_RECORD_SIZE, "record layout");
@@ -26,19 +32,15 @@ uint16_t config_store_slots_per_page(const struct config_store *s)
     return (uint16_t)(s->flash->page_size / CONFIG_RECORD_SIZE);
 }
 
-static uint32_t slot_addr(const struct config_store *s, uint8_t page, uint16_t slot)
+static uint32_t slot_addr(const struct config_store *s, uint8_t page, uint16_t slot,
+                          uint32_t size)
 {
-    return s->flash->page_addr[page] + (uint32_t)slot * CONFIG_RECORD_SIZE;
+    return s->flash->page_addr[page] + (uint32_t)slot * size;
 }
 
-static void read_slot(const struct config_store *s, uint8_t page, uint16_t slot,
-                      uint8_t rec[CONFIG_RECORD_SIZE])
-{
-    s->flash->read(s->flash->ctx, slot_addr(s, page, slot), rec, CONFIG_RECORD_SIZE);
-}
-
-/* A record whose every field checks out, including the item ranges: a
- * record from a firmware with other ranges is not loaded half-valid. */
+/* A format-2 record whose every field checks out, including the item
+ * ranges: a record from a firmware with other ranges is not loaded
+ * half-valid. */
 static bool record_valid(const uint8_t rec[CONFIG_RECORD_SIZE], struct user_config *out)
 {
     if (wire_get_u16(&rec[REC_MAGIC]) != RECORD_MAGIC || rec[REC_FORMAT] != RECORD_FORMAT ||
@@ -49,16 +51,49 @@ static bool record_valid(const uint8_t rec[CONFIG_RECORD_SIZE], struct user_conf
     return user_config_decode(out, &rec[REC_PAYLOAD]);
 }
 
+static bool v1_record_valid(const uint8_t rec[V1_RECORD_SIZE], struct user_config *out)
+{
+    if (wire_get_u16(&rec[REC_MAGIC]) != RECORD_MAGIC || rec[REC_FORMAT] != V1_FORMAT ||
+        rec[REC_LENGTH] != USER_AREA_SIZE || wire_get_u32(&rec[REC_SEQUENCE]) == 0u ||
+        wire_get_u32(&rec[V1_CRC]) != crc32(rec, V1_CRC)) {
+        return false;
+    }
+    return user_config_decode(out, &rec[V1_PAYLOAD]);
+}
+
 static bool slot_erased(const struct config_store *s, uint8_t page, uint16_t slot)
 {
     uint8_t rec[CONFIG_RECORD_SIZE];
-    read_slot(s, page, slot, rec);
+    s->flash->read(s->flash->ctx, slot_addr(s, page, slot, CONFIG_RECORD_SIZE), rec,
+                   CONFIG_RECORD_SIZE);
     for (uint32_t i = 0; i < CONFIG_RECORD_SIZE; i++) {
         if (rec[i] != 0xFFu) {
             return false;
         }
     }
     return true;
+}
+
+/* The newest valid format-1 record, for a store written by older firmware. */
+static bool load_v1(struct config_store *s, struct user_config *newest)
+{
+    const uint16_t slots = (uint16_t)(s->flash->page_size / V1_RECORD_SIZE);
+    for (uint8_t page = 0; page < 2u; page++) {
+        for (uint16_t slot = 0; slot < slots; slot++) {
+            uint8_t rec[V1_RECORD_SIZE];
+            struct user_config candidate;
+            s->flash->read(s->flash->ctx, slot_addr(s, page, slot, V1_RECORD_SIZE), rec,
+                           V1_RECORD_SIZE);
+            uint32_t seq = wire_get_u32(&rec[REC_SEQUENCE]);
+            if (seq > s->sequence && v1_record_valid(rec, &candidate)) {
+                s->sequence = seq;
+                s->page = page;
+                *newest = candidate;
+            }
+        }
+    }
+    s->legacy = s->sequence != 0u;
+    return s->legacy;
 }
 
 bool config_store_load(struct config_store *s, const struct hal_flash *flash,
@@ -72,19 +107,33 @@ bool config_store_load(struct config_store *s, const struct hal_flash *flash,
         for (uint16_t slot = 0; slot < slots; slot++) {
             uint8_t rec[CONFIG_RECORD_SIZE];
             struct user_config candidate;
-            read_slot(s, page, slot, rec);
+            flash->read(flash->ctx, slot_addr(s, page, slot, CONFIG_RECORD_SIZE), rec,
+                        CONFIG_RECORD_SIZE);
             uint32_t seq = wire_get_u32(&rec[REC_SEQUENCE]);
             if (seq > s->sequence && record_valid(rec, &candidate)) {
                 s->sequence = seq;
                 s->page = page;
                 s->slot = slot;
+                s->op_seconds = wire_get_u32(&rec[REC_OP_SECONDS]);
                 newest = candidate;
             }
         }
     }
+    if (s->sequence == 0u) {
+        load_v1(s, &newest);
+    }
     *cfg = newest;
     user_config_encode(&newest, s->saved);
     return s->sequence != 0u;
+}
+
+uint32_t config_store_page_erases(const struct config_store *s)
+{
+    /* A page is erased each time records start on it: every slots-per-page
+     * records, the two pages in turn. */
+    uint32_t pages_started = (s->sequence + config_store_slots_per_page(s) - 1u) /
+                             config_store_slots_per_page(s);
+    return (pages_started + 1u) / 2u;
 }
 
 /* Where the next record goes: the first erased slot after the newest in its
@@ -92,7 +141,9 @@ bool config_store_load(struct config_store *s, const struct hal_flash *flash,
 static bool next_slot(const struct config_store *s, uint8_t *page, uint16_t *slot)
 {
     const uint16_t slots = config_store_slots_per_page(s);
-    if (s->sequence != 0u) {
+    if (s->legacy) {
+        *page = (uint8_t)(s->page ^ 1u); /* a format-1 page takes no format-2 slots */
+    } else if (s->sequence != 0u) {
         for (uint16_t i = (uint16_t)(s->slot + 1u); i < slots; i++) {
             if (slot_erased(s, s->page, i)) {
                 *page = s->page;
@@ -111,7 +162,7 @@ static bool next_slot(const struct config_store *s, uint8_t *page, uint16_t *slo
 static bool program_record(const struct config_store *s, uint8_t page, uint16_t slot,
                            const uint8_t rec[CONFIG_RECORD_SIZE])
 {
-    uint32_t base = slot_addr(s, page, slot);
+    uint32_t base = slot_addr(s, page, slot, CONFIG_RECORD_SIZE);
     for (uint32_t i = 0; i < CONFIG_RECORD_SIZE; i += 2u) {
         if (!s->flash->program_u16(s->flash->ctx, base + i, wire_get_u16(&rec[i]))) {
             return false;
@@ -120,7 +171,8 @@ static bool program_record(const struct config_store *s, uint8_t page, uint16_t 
     return true;
 }
 
-enum config_save_result config_store_save(struct config_store *s, const struct user_config *cfg)
+enum config_save_result config_store_save(struct config_store *s, const struct user_config *cfg,
+                                          uint32_t op_seconds)
 {
     uint8_t rec[CONFIG_RECORD_SIZE];
     user_config_encode(cfg, &rec[REC_PAYLOAD]);
@@ -132,6 +184,7 @@ enum config_save_result config_store_save(struct config_store *s, const struct u
     rec[REC_FORMAT] = RECORD_FORMAT;
     rec[REC_LENGTH] = USER_AREA_SIZE;
     wire_put_u32(&rec[REC_SEQUENCE], seq);
+    wire_put_u32(&rec[REC_OP_SECONDS], op_seconds);
     wire_put_u32(&rec[REC_CRC], crc32(rec, REC_CRC));
 
     uint8_t page;
@@ -139,6 +192,7 @@ enum config_save_result config_store_save(struct config_store *s, const struct u
     if (!next_slot(s, &page, &slot) &&
         !s->flash->erase_page(s->flash->ctx, s->flash->page_addr[page])) {
         s->write_failures++;
+        s->failed = 1;
         return CONFIG_WRITE_FAILED;
     }
     if (!program_record(s, page, slot, rec)) {
@@ -146,11 +200,15 @@ enum config_save_result config_store_save(struct config_store *s, const struct u
          * all, no later record may share its number. */
         s->sequence = seq;
         s->write_failures++;
+        s->failed = 1;
         return CONFIG_WRITE_FAILED;
     }
     s->sequence = seq;
     s->page = page;
     s->slot = slot;
+    s->legacy = 0;
+    s->failed = 0;
+    s->op_seconds = op_seconds;
     memcpy(s->saved, &rec[REC_PAYLOAD], USER_AREA_SIZE);
     return CONFIG_SAVED;
 }

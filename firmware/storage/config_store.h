@@ -1,7 +1,8 @@
 /* Power-safe store of the user area in two flash pages.
  *
  * Each page is a log of fixed-size records: magic, format, length, sequence
- * number, the 32-byte user area and a CRC-32 over all of it. A save appends
+ * number, the operating time so far, the 32-byte user area and a CRC-32
+ * over all of it. A save appends
  * a record with the next sequence number to the first erased slot after the
  * newest record; when that page is full it erases the other page and starts
  * there. The page holding the newest record is never erased, and a record
@@ -16,7 +17,7 @@
 #include "hal/hal_flash.h"
 #include "protocol/registers.h"
 
-#define CONFIG_RECORD_SIZE 44u
+#define CONFIG_RECORD_SIZE 48u
 
 enum config_save_result {
     CONFIG_UNCHANGED,    /* identical to the stored record: nothing written */
@@ -30,7 +31,10 @@ struct config_store {
     uint8_t page;        /* where the newest record is */
     uint16_t slot;
     uint8_t saved[USER_AREA_SIZE]; /* what a boot would load now */
+    uint32_t op_seconds; /* operating time recorded with the newest record */
     uint32_t write_failures;
+    uint8_t failed;      /* the last save failed (and nothing saved since) */
+    uint8_t legacy;      /* the newest record is format 1: the next starts a page */
 };
 
 /* Loads the newest valid record into cfg; factory values when the store is
@@ -38,8 +42,14 @@ struct config_store {
 bool config_store_load(struct config_store *s, const struct hal_flash *flash,
                        struct user_config *cfg);
 
-/* Appends cfg unless it equals what is stored. Call from the main loop. */
-enum config_save_result config_store_save(struct config_store *s, const struct user_config *cfg);
+/* Appends cfg, with the operating time so far, unless cfg equals what is
+ * stored. Call from the main loop. */
+enum config_save_result config_store_save(struct config_store *s, const struct user_config *cfg,
+                                          uint32_t op_seconds);
+
+/* Erases of the more worn page so far, from the records written (every
+ * record counts, failed ones too: each spends a slot). */
+uint32_t config_store_page_erases(const struct config_store *s);
 
 /* Records that fit in one page. */
 uint16_t config_store_slots_per_page(const struct config_store *s);

@@ -10,6 +10,7 @@
 #include <cmocka.h>
 
 #include "config_store.h"
+#include "crc32.h"
 #include "flash_double.h"
 #include "protocol/data_table.h"
 
@@ -73,7 +74,7 @@ static void test_garbage_store_boots_factory(void **state)
     assert_config_equal(&c, &factory);
     /* And it can still save: the garbage page gets erased first. */
     struct user_config n = config_n(1);
-    assert_int_equal(config_store_save(&s, &n), CONFIG_SAVED);
+    assert_int_equal(config_store_save(&s, &n, 0), CONFIG_SAVED);
     struct user_config back = boot(&s);
     assert_config_equal(&back, &n);
     assert_false(flash.misuse);
@@ -85,12 +86,12 @@ static void test_save_round_trip_and_only_on_change(void **state)
     struct config_store s;
     struct user_config c = boot(&s);
     /* Factory values are what a blank store boots with: nothing to write. */
-    assert_int_equal(config_store_save(&s, &c), CONFIG_UNCHANGED);
+    assert_int_equal(config_store_save(&s, &c, 0), CONFIG_UNCHANGED);
     assert_int_equal(flash.steps, 0);
     struct user_config n = config_n(5);
-    assert_int_equal(config_store_save(&s, &n), CONFIG_SAVED);
+    assert_int_equal(config_store_save(&s, &n, 0), CONFIG_SAVED);
     long steps = flash.steps;
-    assert_int_equal(config_store_save(&s, &n), CONFIG_UNCHANGED);
+    assert_int_equal(config_store_save(&s, &n, 0), CONFIG_UNCHANGED);
     assert_int_equal(flash.steps, steps);
     struct user_config back = boot(&s);
     assert_config_equal(&back, &n);
@@ -102,14 +103,14 @@ static void test_record_with_invalid_values_is_ignored(void **state)
     struct config_store s;
     boot(&s);
     struct user_config good = config_n(1);
-    assert_int_equal(config_store_save(&s, &good), CONFIG_SAVED);
+    assert_int_equal(config_store_save(&s, &good, 0), CONFIG_SAVED);
     /* A newer record, correctly framed and CRC'd, but with 39 >= 40: it is
      * written through the store with validation bypassed by the test. */
     struct user_config bad = config_n(2);
     bad.low_voltage_mv = 9000;
     bad.high_voltage_mv = 8000;
     assert_false(user_config_valid(&bad));
-    assert_int_equal(config_store_save(&s, &bad), CONFIG_SAVED);
+    assert_int_equal(config_store_save(&s, &bad, 0), CONFIG_SAVED);
     struct user_config back = boot(&s);
     assert_config_equal(&back, &good);
 }
@@ -124,7 +125,7 @@ static void test_pages_alternate_and_wear_evenly(void **state)
     unsigned saves = 10u * 2u * slots;
     for (unsigned i = 1; i <= saves; i++) {
         struct user_config n = config_n(i);
-        assert_int_equal(config_store_save(&s, &n), CONFIG_SAVED);
+        assert_int_equal(config_store_save(&s, &n, 0), CONFIG_SAVED);
     }
     struct user_config back = boot(&s);
     struct user_config last = config_n(saves);
@@ -142,7 +143,7 @@ static void prepare(struct config_store *s, unsigned saved)
     boot(s);
     for (unsigned i = 1; i <= saved; i++) {
         struct user_config n = config_n(i);
-        assert_int_equal(config_store_save(s, &n), CONFIG_SAVED);
+        assert_int_equal(config_store_save(s, &n, 0), CONFIG_SAVED);
     }
     boot(s);
 }
@@ -172,7 +173,7 @@ static void test_power_cut_at_every_step(void **state)
 
         /* How many steps a clean save takes from this history. */
         prepare(&s, saved);
-        assert_int_equal(config_store_save(&s, &new_cfg), CONFIG_SAVED);
+        assert_int_equal(config_store_save(&s, &new_cfg, 0), CONFIG_SAVED);
         long total = flash.steps;
         assert_true(total >= CONFIG_RECORD_SIZE / 2);
 
@@ -181,13 +182,13 @@ static void test_power_cut_at_every_step(void **state)
                 prepare(&s, saved);
                 flash.cut_at = cut;
                 flash.cut_mode = (enum cut_mode)mode;
-                config_store_save(&s, &new_cfg);
+                config_store_save(&s, &new_cfg, 0);
                 struct user_config after = boot(&s);
                 bool last_step_done = cut == total - 1 && mode == CUT_AFTER;
                 assert_config_equal(&after, last_step_done ? &new_cfg : &old_cfg);
                 /* The store recovers: the next save lands and boots. */
                 struct user_config next = config_n(saved + 2000u);
-                assert_int_equal(config_store_save(&s, &next), CONFIG_SAVED);
+                assert_int_equal(config_store_save(&s, &next, 0), CONFIG_SAVED);
                 struct user_config again = boot(&s);
                 assert_config_equal(&again, &next);
                 assert_false(flash.misuse);
@@ -213,7 +214,7 @@ static void test_random_cuts_over_many_saves(void **state)
         bool cut = rand() % 3 == 0;
         flash.cut_at = cut ? rand() % 30 : -1;
         flash.cut_mode = (enum cut_mode)(rand() % CUT_MODES);
-        enum config_save_result r = config_store_save(&s, &next);
+        enum config_save_result r = config_store_save(&s, &next, 0);
         struct user_config after = boot(&s);
         if (!cut) {
             assert_int_equal(r, CONFIG_SAVED);
@@ -231,6 +232,43 @@ static void test_random_cuts_over_many_saves(void **state)
     assert_false(flash.misuse);
 }
 
+/* A store written by the firmware before format 2 (44-byte records, no
+ * operating time) still loads; the first save starts a fresh page in
+ * format 2 and the old page is left alone until its turn to be erased. */
+static void test_a_format_1_store_still_loads(void **state)
+{
+    (void)state;
+    struct user_config old = config_n(3);
+    for (uint32_t seq = 1; seq <= 5; seq++) {
+        uint8_t *rec = &flash.mem[1][(seq - 1u) * 44u];
+        struct user_config c = seq == 5 ? old : config_n(seq + 40u);
+        rec[0] = 0xF1; /* magic 0xC0F1 */
+        rec[1] = 0xC0;
+        rec[2] = 1;    /* format 1 */
+        rec[3] = USER_AREA_SIZE;
+        rec[4] = (uint8_t)seq;
+        rec[5] = rec[6] = rec[7] = 0;
+        user_config_encode(&c, &rec[8]);
+        uint32_t crc = crc32(rec, 40);
+        for (int i = 0; i < 4; i++) {
+            rec[40 + i] = (uint8_t)(crc >> (8 * i));
+        }
+    }
+    struct config_store s;
+    struct user_config back = boot(&s);
+    assert_config_equal(&back, &old);
+    assert_int_equal(s.sequence, 5);
+    struct user_config n = config_n(4);
+    assert_int_equal(config_store_save(&s, &n, 77), CONFIG_SAVED);
+    assert_int_equal(flash.erases[0], 1);
+    assert_int_equal(flash.erases[1], 0);
+    back = boot(&s);
+    assert_config_equal(&back, &n);
+    assert_int_equal(s.sequence, 6);
+    assert_int_equal(s.op_seconds, 77);
+    assert_false(flash.misuse);
+}
+
 static void test_failed_flash_write_is_reported(void **state)
 {
     (void)state;
@@ -238,8 +276,9 @@ static void test_failed_flash_write_is_reported(void **state)
     boot(&s);
     flash.cut_at = 3; /* the flash stops answering mid-record */
     struct user_config n = config_n(1);
-    assert_int_equal(config_store_save(&s, &n), CONFIG_WRITE_FAILED);
+    assert_int_equal(config_store_save(&s, &n, 0), CONFIG_WRITE_FAILED);
     assert_int_equal(s.write_failures, 1);
+    assert_true(s.failed);
 }
 
 int main(void)
@@ -252,6 +291,7 @@ int main(void)
         cmocka_unit_test_setup(test_pages_alternate_and_wear_evenly, setup),
         cmocka_unit_test_setup(test_power_cut_at_every_step, setup),
         cmocka_unit_test_setup(test_random_cuts_over_many_saves, setup),
+        cmocka_unit_test_setup(test_a_format_1_store_still_loads, setup),
         cmocka_unit_test_setup(test_failed_flash_write_is_reported, setup),
     };
     return cmocka_run_group_tests_name("config_store", tests, NULL, NULL);

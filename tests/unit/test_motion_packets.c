@@ -507,6 +507,7 @@ static void test_power_on_lock(void **state)
     (void)state;
     assert_true(hal.coasting); /* 46 = 0: released at power-up */
     REQUEST(4, 0, 46, 1);
+    harness_run_ms(60); /* saved */
     harness_restart();
     harness_run_ms(5);
     assert_false(hal.coasting); /* 46 = 1: holds at power-up */

@@ -6,6 +6,7 @@
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <string.h>
 
 #include <cmocka.h>
@@ -166,7 +167,7 @@ static void test_config_survives_restart(void **state)
     REQUEST(4, 0, 34, 9);
     REQUEST(4, 9, 43, 0xD0, 0x07);
     EXPECT_RESPONSE(4, 9, 43, 1);
-    harness_poll(2);
+    harness_run_ms(SAVE_SETTLE_US / 1000u + 1u); /* saved once nothing changes for 50 ms */
     harness_restart();
     REQUEST(3, 9, 43);
     EXPECT_RESPONSE(3, 9, 43, 0xD0, 0x07);
@@ -174,8 +175,115 @@ static void test_config_survives_restart(void **state)
     long steps = hal.flash.steps;
     REQUEST(4, 9, 43, 0xD0, 0x07);
     EXPECT_RESPONSE(4, 9, 43, 1);
-    harness_poll(2);
+    harness_run_ms(100);
     assert_int_equal(hal.flash.steps, steps);
+}
+
+/* ReadStore (0x41): field at offset `at` of the answer's content. */
+static uint32_t store_field(size_t at)
+{
+    REQUEST(0x41, 0);
+    assert_int_equal(hal.sent_length, 4 + 26 + 1);
+    const uint8_t *c = &hal.sent[4];
+    if (at == 1) {
+        return c[1];
+    }
+    return (uint32_t)c[at] | (uint32_t)c[at + 1] << 8 | (uint32_t)c[at + 2] << 16 |
+           (uint32_t)c[at + 3] << 24;
+}
+
+/* Every flash write fails (a dead or worn page). The first write is
+ * answered before its save runs, so it says 1; the failed save then sets
+ * bit 1, and every later write is refused with 0 and changes nothing, so
+ * what the host reads is never more than the servo keeps. Once the flash
+ * works again, the retry saves and writes are taken again. */
+static void test_a_failed_save_is_reported_and_refuses_writes(void **state)
+{
+    (void)state;
+    hal.flash.dead = true;
+    REQUEST(4, 0, 43, 0xD0, 0x07);
+    EXPECT_RESPONSE(4, 0, 43, 1);
+    harness_run_ms(60);
+    assert_int_equal(servo.store.write_failures, 1);
+    REQUEST(3, 0, 5);
+    EXPECT_RESPONSE(3, 0, 5, STATUS_COMMAND_ERROR);
+    assert_int_equal(store_field(1), STORE_FAILED | STORE_PENDING);
+    assert_int_equal(store_field(22), 1); /* failures */
+    REQUEST(4, 0, 43, 0xB8, 0x0B);
+    EXPECT_RESPONSE(4, 0, 43, 0);
+    REQUEST(3, 0, 43);
+    EXPECT_RESPONSE(3, 0, 43, 0xD0, 0x07);
+    uint8_t batch[1 + USER_AREA_SIZE] = {0};
+    user_config_encode(&servo.regs.user, &batch[1]);
+    harness_request(6, batch, sizeof batch);
+    EXPECT_RESPONSE(6, 0, 0);
+    REQUEST(2, 0);
+    EXPECT_RESPONSE(2, 0, 0);
+    harness_run_ms(2000); /* retries once a second, all failing */
+    assert_true(servo.store.write_failures >= 2);
+    hal.flash.dead = false;
+    harness_run_ms(1100);
+    REQUEST(4, 0, 43, 0xB8, 0x0B);
+    EXPECT_RESPONSE(4, 0, 43, 1);
+    harness_run_ms(60);
+    assert_int_equal(store_field(1), 0);
+    harness_restart();
+    REQUEST(3, 0, 43);
+    EXPECT_RESPONSE(3, 0, 43, 0xB8, 0x0B);
+}
+
+/* A burst of writes at line rate is one save. */
+static void test_a_burst_of_writes_is_one_save(void **state)
+{
+    (void)state;
+    for (int i = 0; i < 200; i++) {
+        REQUEST(4, 0, 44, (uint8_t)(i & 1)); /* 44 toggled, a write each ms */
+    }
+    harness_run_ms(60);
+    assert_int_equal(servo.store.sequence, 1);
+}
+
+/* A host toggling item 44 as fast as saves settle, for 2 hours of
+ * operation with a power cycle every 20 minutes: after the allowance the
+ * servo saves once per seconds_per_save of operating time, the budget that
+ * keeps 10 years of this within the pages' rated cycles, and the operating
+ * time recorded with each save keeps power cycles from refilling it (time
+ * since the last save is lost at each cut, so it only under-counts). */
+static void test_writes_in_a_loop_stay_within_the_wear_budget(void **state)
+{
+    (void)state;
+    uint32_t per_save = servo.saver.seconds_per_save;
+    uint32_t records = 2u * FLASH_RATED_CYCLES * config_store_slots_per_page(&servo.store);
+    /* 10 years at this rate, and the allowance, within 90 % of the rating */
+    assert_true(SAVE_ALLOWANCE + SAVE_LIFE_SECONDS / per_save <= records / 10u * 9u);
+    uint32_t ms = 0;
+    for (uint32_t i = 0; ms < 2u * 3600u * 1000u; i++) {
+        REQUEST(4, 0, 44, (uint8_t)(i & 1));
+        hal.now_us += 60000u; /* no motion: ticks beyond the catch-up drop */
+        harness_poll(2);
+        ms += 61;
+        if (i % 20000u == 19999u) {
+            harness_restart();
+        }
+        assert_true(servo.store.sequence <= save_policy_budget(&servo.saver));
+    }
+    uint32_t op = save_policy_op_seconds(&servo.saver);
+    printf("# 2 h of writes every 61 ms: %u saves, %u page erases; budget %u (1 per %u s)\n",
+           (unsigned)servo.store.sequence, (unsigned)config_store_page_erases(&servo.store),
+           (unsigned)save_policy_budget(&servo.saver), (unsigned)per_save);
+    assert_true(op > 3600u && op <= 7200u);
+    REQUEST(4, 0, 44, 1);
+    REQUEST(4, 0, 44, 0);
+    harness_run_ms(60);
+    assert_int_equal(store_field(1), STORE_DEFERRED | STORE_PENDING);
+    assert_int_equal(store_field(2), servo.store.sequence);
+    uint32_t pages_started = (servo.store.sequence + 20u) / 21u; /* 21 records a page */
+    assert_int_equal(store_field(6), (pages_started + 1u) / 2u);
+    assert_int_equal(store_field(10), FLASH_RATED_CYCLES);
+    assert_int_equal(store_field(14), save_policy_budget(&servo.saver));
+    assert_int_equal(store_field(18), op);
+    assert_true(servo.store.sequence > SAVE_ALLOWANCE);
+    assert_true(servo.store.sequence >= SAVE_ALLOWANCE + op / per_save - 1u);
 }
 
 static void test_reset_keeps_link(void **state)
@@ -310,6 +418,9 @@ int main(void)
         cmocka_unit_test_setup(test_sync_monitor_waits_its_turn, setup),
         cmocka_unit_test_setup(test_sync_monitor_passes_a_silent_servo, setup),
         cmocka_unit_test_setup(test_a_new_request_ends_the_wait_for_a_sync_turn, setup),
+        cmocka_unit_test_setup(test_a_failed_save_is_reported_and_refuses_writes, setup),
+        cmocka_unit_test_setup(test_a_burst_of_writes_is_one_save, setup),
+        cmocka_unit_test_setup(test_writes_in_a_loop_stay_within_the_wear_budget, setup),
         cmocka_unit_test_setup(test_garbage_between_frames_and_responses_of_others, setup),
     };
     return cmocka_run_group_tests_name("servo", tests, NULL, NULL);

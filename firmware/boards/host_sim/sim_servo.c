@@ -110,7 +110,7 @@ static bool program_id(struct sim_flash *flash, uint8_t id)
         return true;
     }
     cfg.servo_id = id;
-    return config_store_save(&store, &cfg) != CONFIG_WRITE_FAILED;
+    return config_store_save(&store, &cfg, 0) != CONFIG_WRITE_FAILED;
 }
 
 bool sim_servo_start(struct sim_servo *s, struct sim_bus *bus, unsigned index, uint8_t id,

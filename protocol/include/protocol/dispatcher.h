@@ -16,6 +16,9 @@ struct dispatcher {
     struct registers *regs;
     struct motion *motion;
     const volatile uint8_t *own_id; /* the ID the servo answers to right now */
+    /* The config store failed its last save: writes to the user area are
+     * refused (result 0), so what the host reads is what a boot loads. */
+    uint8_t store_failed;
 };
 
 struct dispatch_result {

@@ -34,6 +34,7 @@ enum packet_code {
 
 enum firmware_packet_code {
     PKT_READ_MOTION = 0x40, /* a snapshot of the motion state, for tuning */
+    PKT_READ_STORE = 0x41,  /* the config store's health and wear */
 };
 
 #endif

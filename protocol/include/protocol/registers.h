@@ -56,9 +56,28 @@ struct user_config {
     int16_t center_offset_decideg;   /* 53 */
 };
 
+/* How the config store is doing (ReadStore, 0x41, docs/packets.md): kept
+ * up to date by the application, read by the dispatcher. */
+enum store_flag {
+    STORE_FAILED = 1u << 0,   /* the last save failed; writes are refused */
+    STORE_DEFERRED = 1u << 1, /* a change waits for the wear budget */
+    STORE_PENDING = 1u << 2,  /* a change is not saved yet */
+};
+
+struct store_health {
+    uint8_t flags;          /* enum store_flag */
+    uint32_t records;       /* records written since the store was blank */
+    uint32_t page_erases;   /* erases of the more worn page */
+    uint32_t rated_cycles;  /* erases a page is rated for */
+    uint32_t budget;        /* records the wear budget allows by now */
+    uint32_t op_seconds;    /* operating time, as recorded with the saves */
+    uint32_t failures;      /* failed saves since power-up */
+};
+
 struct registers {
     struct status_area status;
     struct user_config user;
+    struct store_health store;
 };
 
 /* Size of the user area on the wire (ReadBatchData/WriteBatchData) and in

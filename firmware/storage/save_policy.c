@@ -1,0 +1,62 @@
+#include "save_policy.h"
+
+void save_policy_init(struct save_policy *p, const struct config_store *store, uint32_t now_us)
+{
+    uint64_t lifetime = 2ull * FLASH_RATED_CYCLES * config_store_slots_per_page(store);
+    uint64_t budget = lifetime * SAVE_BUDGET_PERCENT / 100u - SAVE_ALLOWANCE;
+    uint64_t per_save = (SAVE_LIFE_SECONDS + budget - 1u) / budget;
+    *p = (struct save_policy){
+        .seconds_per_save = (uint32_t)per_save,
+        .op_seconds_at_boot = store->op_seconds,
+        .second_mark_us = now_us,
+    };
+}
+
+void save_policy_changed(struct save_policy *p, uint32_t now_us)
+{
+    if (!p->pending) {
+        p->pending = 1;
+        p->first_change_us = now_us;
+    }
+    p->last_change_us = now_us;
+}
+
+uint32_t save_policy_op_seconds(const struct save_policy *p)
+{
+    return p->op_seconds_at_boot + p->uptime_s;
+}
+
+uint32_t save_policy_budget(const struct save_policy *p)
+{
+    return SAVE_ALLOWANCE + save_policy_op_seconds(p) / p->seconds_per_save;
+}
+
+bool save_policy_due(struct save_policy *p, const struct config_store *store, uint32_t now_us)
+{
+    while (now_us - p->second_mark_us >= 1000000u) {
+        p->second_mark_us += 1000000u;
+        p->uptime_s++;
+    }
+    if (!p->pending) {
+        return false;
+    }
+    if (store->failed && now_us - p->failed_at_us < SAVE_RETRY_US) {
+        return false;
+    }
+    bool settled = now_us - p->last_change_us >= SAVE_SETTLE_US ||
+                   now_us - p->first_change_us >= SAVE_LATEST_US;
+    if (!settled) {
+        return false;
+    }
+    p->deferred = store->sequence >= save_policy_budget(p);
+    return !p->deferred;
+}
+
+void save_policy_saved(struct save_policy *p, enum config_save_result result, uint32_t now_us)
+{
+    if (result == CONFIG_WRITE_FAILED) {
+        p->failed_at_us = now_us; /* still pending: tried again later */
+        return;
+    }
+    p->pending = 0;
+}
