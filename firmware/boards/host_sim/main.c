@@ -19,6 +19,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "host_baud.h"
 #include "sim_bus.h"
 #include "sim_servo.h"
 
@@ -64,7 +65,8 @@ static void usage(FILE *out)
           "  --supply MV    supply voltage (default 7400)\n"
           "  --ambient DEGC ambient temperature (default 25)\n"
           "Control commands, one per line, optional servo ID last:\n"
-          "  supply MV | load NM | stop DEG | stop off | ambient DEGC | state | help\n",
+          "  supply MV | load NM | stop DEG | stop off | ambient DEGC | soak DEGC |\n"
+          "  hostbaud BAUD (a TCP host's rate; a pty's is what the host set) | state | help\n",
           out);
 }
 
@@ -208,13 +210,14 @@ static void state_of(const struct sim_servo *s, char *out, size_t size)
              "id=%u angle=%.3f velocity=%.2f current=%.3f winding=%.2f case=%.2f ambient=%.1f "
              "supply=%.3f "
              "load=%.3f stop=%s status=0x%02x reported=%d collisions=%lu dropped_ticks=%u "
-             "most_behind_ms=%.1f\n",
+             "most_behind_ms=%.1f baud=%u host_baud=%u baud_mismatches=%lu\n",
              s->cmdline_id, plant_angle_deg(&s->plant), s->plant.velocity * 180.0 / M_PI,
              s->plant.current, s->thermal.winding_c, s->thermal.case_c, s->thermal.ambient_c,
              s->plant.p.supply_v,
              s->plant.load_torque, s->plant.has_stop ? "on" : "off", s->core.regs.status.status,
              a.multi_turn_decideg, bus.collisions, s->core.ticks_dropped,
-             (double)most_behind_us / 1000.0);
+             (double)most_behind_us / 1000.0, (unsigned)s->baud, (unsigned)bus.host_baud,
+             bus.baud_mismatches);
 }
 
 /* One control line: "command [value] [servo id]". */
@@ -240,7 +243,8 @@ static void control_command(int fd, char *line)
         }
     }
     if (strcmp(cmd, "help") == 0) {
-        reply(fd, "ok supply MV | load NM | stop DEG | stop off | ambient DEGC | soak DEGC | state [ID]\n");
+        reply(fd, "ok supply MV | load NM | stop DEG | stop off | ambient DEGC | soak DEGC | "
+                  "hostbaud BAUD | state [ID]\n");
         return;
     }
     if (takes_value && n < 2) {
@@ -252,6 +256,35 @@ static void control_command(int fd, char *line)
     bool off = takes_value && strcmp(words[1], "off") == 0;
     if (takes_value && !off && (end == words[1] || *end != '\0')) {
         reply(fd, "error: the value must be a number\n");
+        return;
+    }
+    /* What each model can take: a NaN or an infinity would stay in the
+     * plant for good. */
+    static const struct {
+        const char *cmd;
+        double lo, hi;
+        const char *unit;
+    } ranges[] = {
+        {"supply", 0, 30000, "mV"},   {"load", -50, 50, "N m"},
+        {"ambient", -40, 150, "degC"}, {"soak", -40, 150, "degC"},
+        {"stop", -1e6, 1e6, "deg"},    {"hostbaud", 1200, 4000000, "baud"},
+    };
+    for (size_t r = 0; takes_value && !off && r < sizeof ranges / sizeof ranges[0]; r++) {
+        if (strcmp(cmd, ranges[r].cmd) == 0 && !(value >= ranges[r].lo && value <= ranges[r].hi)) {
+            char msg[128];
+            snprintf(msg, sizeof msg, "error: %s takes %g to %g %s, not %s\n", cmd, ranges[r].lo,
+                     ranges[r].hi, ranges[r].unit, words[1]);
+            reply(fd, msg);
+            return;
+        }
+    }
+    if (off && strcmp(cmd, "stop") != 0) {
+        reply(fd, "error: only stop takes off\n");
+        return;
+    }
+    if (strcmp(cmd, "hostbaud") == 0) {
+        bus.host_baud = (uint32_t)value;
+        reply(fd, "ok\n");
         return;
     }
     char out[4096] = "";
@@ -354,9 +387,12 @@ int main(int argc, char **argv)
         struct pollfd fds[3 + MAX_CONTROL_CLIENTS];
         int nfds = 0;
         int host_slot = -1, listen_slot = -1, control_slot;
+        /* A host that writes faster than the line waits (it is not read),
+         * as behind its own UART. */
         if (bus.host_fd >= 0) {
             host_slot = nfds;
-            fds[nfds++] = (struct pollfd){.fd = bus.host_fd, .events = POLLIN};
+            short events = sim_bus_room(&bus) >= 512u ? POLLIN : 0;
+            fds[nfds++] = (struct pollfd){.fd = bus.host_fd, .events = events};
         } else if (listen_fd >= 0) {
             listen_slot = nfds;
             fds[nfds++] = (struct pollfd){.fd = listen_fd, .events = POLLIN};
@@ -380,7 +416,12 @@ int main(int argc, char **argv)
             perror("servo_sim: poll");
             break;
         }
-        if (host_slot >= 0 && (fds[host_slot].revents & (POLLIN | POLLHUP | POLLERR))) {
+        if (slave_fd >= 0) {
+            uint32_t baud = host_baud_of(slave_fd);
+            bus.host_baud = baud != 0u ? baud : bus.host_baud;
+        }
+        if (host_slot >= 0 && (fds[host_slot].revents & (POLLIN | POLLHUP | POLLERR)) &&
+            sim_bus_room(&bus) >= 512u) {
             uint8_t buf[512];
             ssize_t n = read(bus.host_fd, buf, sizeof buf);
             if (n > 0) {

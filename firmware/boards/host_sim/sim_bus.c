@@ -8,7 +8,7 @@
 
 void sim_bus_init(struct sim_bus *b, uint64_t now_us)
 {
-    *b = (struct sim_bus){.host_fd = -1, .last_sender = -1, .now_us = now_us};
+    *b = (struct sim_bus){.host_fd = -1, .last_sender = -1, .now_us = now_us, .host_baud = 115200u};
 }
 
 uint64_t sim_bus_step_to(const struct sim_bus *b, uint64_t wall_us)
@@ -25,13 +25,13 @@ static uint64_t enqueue(struct sim_bus *b, uint8_t sender, const uint8_t *data, 
     uint64_t byte_us = baud ? (10000000u + baud - 1u) / baud : 87u;
     uint64_t t = now_us > b->wire_until_us ? now_us : b->wire_until_us;
     for (unsigned i = 0; i < len; i++) {
-        t += byte_us;
         if (b->count == SIM_BUS_QUEUE) {
-            b->dropped++;
+            b->dropped++; /* never on the wire: it takes no wire time */
             continue;
         }
+        t += byte_us;
         b->queue[(b->head + b->count) % SIM_BUS_QUEUE] =
-            (struct sim_bus_byte){.at_us = t, .byte = data[i], .sender = sender};
+            (struct sim_bus_byte){.at_us = t, .baud = baud, .byte = data[i], .sender = sender};
         b->count++;
     }
     b->wire_until_us = t;
@@ -76,24 +76,22 @@ void sim_bus_deliver(struct sim_bus *b, uint64_t now_us)
         /* Each byte carries the time it ended on the wire, as a receive
          * interrupt would stamp it: a stalled simulator loop does not look
          * like an idle line. The queue's times never run backwards. */
-        if (e->sender == SIM_HOST) {
-            for (unsigned s = 0; s < b->servo_count; s++) {
-                servo_on_rx_byte(&b->servos[s]->core, e->byte, (uint32_t)e->at_us);
-            }
-            b->head = (b->head + 1u) % SIM_BUS_QUEUE;
-            b->count--;
-            continue;
-        }
+        bool received = false;
         for (unsigned s = 0; s < b->servo_count; s++) {
-            if (s != e->sender) {
+            if (s != e->sender && b->servos[s]->baud == e->baud) {
                 servo_on_rx_byte(&b->servos[s]->core, e->byte, (uint32_t)e->at_us);
+                received = true;
             }
         }
-        out[n++] = e->byte;
-        if (n == sizeof out) {
-            write_host(b, out, n);
-            n = 0;
+        if (e->sender != SIM_HOST && b->host_baud == e->baud) {
+            received = true;
+            out[n++] = e->byte;
+            if (n == sizeof out) {
+                write_host(b, out, n);
+                n = 0;
+            }
         }
+        b->baud_mismatches += !received;
         b->head = (b->head + 1u) % SIM_BUS_QUEUE;
         b->count--;
     }
@@ -105,8 +103,12 @@ void sim_bus_deliver(struct sim_bus *b, uint64_t now_us)
 
 void sim_bus_from_host(struct sim_bus *b, const uint8_t *data, unsigned len, uint64_t now_us)
 {
-    uint32_t baud = b->servo_count ? b->servos[0]->baud : 115200u;
-    (void)enqueue(b, SIM_HOST, data, len, baud, now_us);
+    (void)enqueue(b, SIM_HOST, data, len, b->host_baud, now_us);
+}
+
+unsigned sim_bus_room(const struct sim_bus *b)
+{
+    return SIM_BUS_QUEUE - b->count;
 }
 
 int64_t sim_bus_next_due(const struct sim_bus *b, uint64_t now_us)

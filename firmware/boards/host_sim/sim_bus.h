@@ -5,6 +5,13 @@
  * servo that starts sending while another's bytes are on the wire is a
  * collision, counted and logged: on a real bus it would garble both.
  *
+ * Each byte goes at its sender's baud rate and only a receiver at the same
+ * rate gets it (at another rate a UART sees framing errors, dropped here).
+ * The host's rate is what it set on the pty, or `hostbaud` on the control
+ * port for a TCP host (115200 until then). A host that writes faster than
+ * the line is held back (the simulator stops reading it), as its own UART
+ * would be, so no byte is dropped and no backlog of wire time builds up.
+ *
  * The servos and their models run on the bus's clock, `now_us`. It follows
  * the wall clock, but a pass of the simulator's loop moves it by at most
  * SIM_BUS_STEP_US, and it stands still while the servos run. On silicon a
@@ -27,6 +34,7 @@ struct sim_servo;
 
 struct sim_bus_byte {
     uint64_t at_us;
+    uint32_t baud;
     uint8_t byte;
     uint8_t sender;
 };
@@ -40,11 +48,16 @@ struct sim_bus {
     uint64_t now_us;          /* every byte due by then has been delivered */
     int last_sender;          /* servo that queued it */
     int host_fd;              /* -1: no host connected */
+    uint32_t host_baud;       /* the host's UART rate */
     struct sim_servo *servos[SIM_MAX_SERVOS];
     unsigned servo_count;
     unsigned long collisions;
-    unsigned long dropped;    /* queue overflow */
+    unsigned long dropped;    /* queue overflow (servo bytes; the host is held back) */
+    unsigned long baud_mismatches; /* bytes no station at that rate received */
 };
+
+/* Room for this many more bytes: the host is read no faster. */
+unsigned sim_bus_room(const struct sim_bus *b);
 
 void sim_bus_init(struct sim_bus *b, uint64_t now_us);
 /* Queues len bytes from servo `sender`; returns when the last stop bit ends. */

@@ -1,0 +1,78 @@
+"""The simulator fails the way a real bus fails: a servo at another baud
+rate than the host hears nothing, a host that floods the line is held back
+by it rather than leaving hours of backlog, and the fault channel refuses
+values no model can take."""
+import math
+import struct
+import threading
+import time
+
+import pytest
+import serial
+
+from servoctl import protocol as p
+from servoctl.protocol import Bus, NoReply, ServoError
+from servoctl.servo import Servo
+from servoctl.sim import Simulator
+
+
+@pytest.fixture
+def pty_sim(tmp_path):
+    with Simulator(ids=[1, 2], tcp=False, state_dir=str(tmp_path / "state")) as sim:
+        yield sim
+
+
+def test_a_servo_at_another_baud_rate_is_not_heard(pty_sim):
+    with Bus(pty_sim.url, baud=115200) as bus:
+        assert Servo(bus, 1).ping() and Servo(bus, 2).ping()
+        Servo(bus, 2).write("baud", 7)  # 500000: answered at 115200, then it switches
+        time.sleep(0.05)
+        assert Servo(bus, 1).ping()
+        with pytest.raises(NoReply):
+            bus.request(p.PING, bytes([2]))
+    assert pty_sim.state(2)["baud"] == 500000
+    with Bus(pty_sim.url, baud=500000) as bus:
+        assert Servo(bus, 2).ping()
+        with pytest.raises(NoReply):
+            bus.request(p.PING, bytes([1]))
+
+
+def test_a_flood_is_held_back_not_queued_for_hours(pty_sim):
+    """Two seconds of garbage written as fast as the pty takes it: at
+    115200 baud the line carries about 23 kB of it; the rest waits in the
+    writer. Once the writer stops, the bus is usable within a second or two
+    (it used to owe the wire time of every byte it had dropped)."""
+    port = serial.Serial(pty_sim.url, 115200, write_timeout=0.05)
+    sent = 0
+    deadline = time.monotonic() + 2.0
+    junk = bytes(range(256)) * 16
+    while time.monotonic() < deadline:
+        try:
+            sent += port.write(junk)
+        except serial.SerialTimeoutException:
+            pass
+    port.reset_output_buffer()
+    port.close()
+    with Bus(pty_sim.url, baud=115200, timeout=0.2) as bus:
+        start = time.monotonic()
+        while True:
+            try:
+                bus.request(p.PING, bytes([1]))
+                break
+            except ServoError:
+                assert time.monotonic() - start < 5.0, "the bus stayed dead after the flood"
+        waited = time.monotonic() - start
+    print(f"flood: {sent} bytes accepted in 2 s; bus answering {waited:.2f} s after")
+    assert pty_sim.state(1)["collisions"] == 0
+
+
+@pytest.mark.parametrize("value", ["nan", "inf", "-inf", "1e300", "-1e300"])
+def test_the_fault_channel_refuses_what_no_model_can_take(sim, value):
+    for command in ("supply", "load", "ambient", "soak", "stop"):
+        with pytest.raises(ServoError, match=f"{command} takes"):
+            sim.control(f"{command} {value}")
+    state = sim.state(1)
+    for key in ("angle", "velocity", "current", "winding", "case", "supply"):
+        assert math.isfinite(state[key]), key
+    with Bus(sim.url) as bus:
+        assert Servo(bus, 1).ping()
