@@ -120,17 +120,3 @@ int64_t profile_position(const struct profile *p, uint32_t tick)
     }
     return p->target - quadratic(p->decel_k, p->total_ticks - tick);
 }
-
-int64_t profile_velocity(const struct profile *p, uint32_t tick)
-{
-    if (tick < p->accel_ticks) {
-        return p->v0 + ((2 * p->accel_k * (int64_t)tick) >> 8);
-    }
-    if (tick < p->cruise_end) {
-        return p->cruise;
-    }
-    if (tick >= p->total_ticks) {
-        return 0;
-    }
-    return (2 * p->decel_k * (int64_t)(p->total_ticks - tick)) >> 8;
-}

@@ -1,5 +1,8 @@
 #include "protection.h"
 
+#include <stddef.h>
+#include <string.h>
+
 #include "ntc.h"
 
 void protection_init(struct protection *p)
@@ -10,6 +13,8 @@ void protection_init(struct protection *p)
 /* One row per threshold monitor: which reading, which limit, which way it
  * trips, and the level it must come back to. */
 struct threshold {
+    uint8_t reading; /* offset in struct sensor_readings */
+    uint8_t limit;   /* offset in struct user_config */
     uint8_t bit;
     uint8_t trips_above;   /* else below */
     uint8_t inclusive;     /* the limit itself trips */
@@ -45,13 +50,27 @@ static uint16_t cooler_temperature(uint16_t limit)
     return ntc_adc((int16_t)(ntc_decicelsius(limit) - TEMPERATURE_HYSTERESIS_DECIC));
 }
 
+#define READING(field) (uint8_t) offsetof(struct sensor_readings, field)
+#define LIMIT(field) (uint8_t) offsetof(struct user_config, field)
+
 static const struct threshold thresholds[] = {
-    [MON_LOW_VOLTAGE] = {STATUS_LOW_VOLTAGE, 0, 0, up_voltage},
-    [MON_HIGH_VOLTAGE] = {STATUS_HIGH_VOLTAGE, 1, 0, down_voltage},
-    [MON_CURRENT] = {STATUS_OVER_CURRENT, 1, 0, down_current},
-    [MON_POWER] = {STATUS_OVER_POWER, 1, 0, down_power},
-    [MON_TEMPERATURE] = {STATUS_OVER_TEMPERATURE, 0, 1, cooler_temperature},
+    [MON_LOW_VOLTAGE] = {READING(voltage_mv), LIMIT(low_voltage_mv), STATUS_LOW_VOLTAGE, 0, 0,
+                         up_voltage},
+    [MON_HIGH_VOLTAGE] = {READING(voltage_mv), LIMIT(high_voltage_mv), STATUS_HIGH_VOLTAGE, 1, 0,
+                          down_voltage},
+    [MON_CURRENT] = {READING(current_ma), LIMIT(current_limit_ma), STATUS_OVER_CURRENT, 1, 0,
+                     down_current},
+    [MON_POWER] = {READING(power_mw), LIMIT(power_limit_mw), STATUS_OVER_POWER, 1, 0, down_power},
+    [MON_TEMPERATURE] = {READING(temperature_adc), LIMIT(temperature_limit_adc),
+                         STATUS_OVER_TEMPERATURE, 0, 1, cooler_temperature},
 };
+
+static uint16_t field_u16(const void *base, uint8_t offset)
+{
+    uint16_t v;
+    memcpy(&v, (const uint8_t *)base + offset, sizeof v);
+    return v;
+}
 
 static bool beyond(const struct threshold *t, uint16_t value, uint16_t limit)
 {
@@ -64,9 +83,15 @@ static bool beyond(const struct threshold *t, uint16_t value, uint16_t limit)
 /* Never true while the value is still beyond the limit: at the ends of the
  * range (or through the NTC table's clamping) the clear level can land on the
  * wrong side of the limit, and the bit would then flap every 100 ms. */
-static bool back_inside(const struct threshold *t, uint16_t value, uint16_t limit)
+static bool back_inside(const struct threshold *t, struct monitor *m, uint16_t value,
+                        uint16_t limit)
 {
-    uint16_t level = t->clear_level(limit);
+    if (!m->level_known || m->limit != limit) {
+        m->limit = limit;
+        m->clear_level = t->clear_level(limit);
+        m->level_known = 1;
+    }
+    uint16_t level = m->clear_level;
     bool inside = t->trips_above ? value <= level : value >= level;
     return inside && !beyond(t, value, limit);
 }
@@ -86,15 +111,12 @@ static void step(struct monitor *m, bool out, bool in, uint16_t trip_ticks)
 uint8_t protection_update(struct protection *p, const struct user_config *cfg,
                           const struct protection_input *in, struct protection_action *act)
 {
-    const struct sensor_readings *r = &in->readings;
-    const uint16_t values[] = {r->voltage_mv, r->voltage_mv, r->current_ma, r->power_mw,
-                               r->temperature_adc};
-    const uint16_t limits[] = {cfg->low_voltage_mv, cfg->high_voltage_mv, cfg->current_limit_ma,
-                               cfg->power_limit_mw, cfg->temperature_limit_adc};
     uint8_t bits = 0;
     for (int i = 0; i < MON_STALL; i++) {
         const struct threshold *t = &thresholds[i];
-        step(&p->mon[i], beyond(t, values[i], limits[i]), back_inside(t, values[i], limits[i]),
+        uint16_t value = field_u16(&in->readings, t->reading);
+        uint16_t limit = field_u16(cfg, t->limit);
+        step(&p->mon[i], beyond(t, value, limit), back_inside(t, &p->mon[i], value, limit),
              PROTECT_TRIP_TICKS);
         bits = (uint8_t)(bits | (p->mon[i].active ? t->bit : 0u));
     }

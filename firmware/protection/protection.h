@@ -60,6 +60,10 @@ enum monitor_id {
 struct monitor {
     uint16_t count;  /* samples in a row towards the other state */
     uint8_t active;
+    uint8_t level_known;  /* clear_level is worked out for limit */
+    uint16_t limit;
+    uint16_t clear_level; /* worked out when the limit changes (the NTC
+                           * conversion searches a table) */
 };
 
 struct protection {

@@ -90,9 +90,14 @@ static bool program_u16(void *ctx, uint32_t addr, uint16_t value)
 static void read(void *ctx, uint32_t addr, uint8_t *dst, uint32_t len)
 {
     struct flash_double *f = ctx;
+    uint32_t offset;
+    int p = page_of(f, addr, &offset);
+    if (p >= 0 && len <= f->hal.page_size - offset) {
+        memcpy(dst, &f->mem[p][offset], len); /* the usual case, at one go */
+        return;
+    }
     for (uint32_t i = 0; i < len; i++) {
-        uint32_t offset;
-        int p = page_of(f, addr + i, &offset);
+        p = page_of(f, addr + i, &offset);
         dst[i] = p < 0 ? 0xFF : f->mem[p][offset];
         f->misuse |= p < 0;
     }

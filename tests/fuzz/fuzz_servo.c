@@ -1,12 +1,28 @@
-/* libFuzzer harness: arbitrary byte streams through the receive path,
- * framer, dispatcher, register file and config store of one servo.
+/* libFuzzer harness over the whole servo: receive path, framer,
+ * dispatcher, register file, motion, protection and config store, with the
+ * input driving the wire, the clock, the horn, the sensors, the flash and
+ * the power.
  *
- * Input: one control byte, then the bytes "on the wire". The control byte
- * picks how often the main loop runs, whether the UART is slow to finish
- * and where idle gaps fall, so timeouts and queueing are reached too.
- * Beyond the sanitizers, after every main-loop pass it checks that the
- * register file holds only valid values and that everything sent is a
- * well-formed response frame. */
+ * Input: a setup byte, then operations (docs in make_corpus.py, which
+ * writes the seeds):
+ *   setup  bits 0-1 flash image (blank; used; used, its page one record from
+ *          full; used, answering moves), bits 2-3 bytes between main-loop
+ *          passes (1, 2, 4, 8), bit 4 a UART slow to finish
+ *   op     low 3 bits what, high 5 bits n:
+ *          0, 7  n+1 bytes on the wire follow
+ *          1     n+1 ms pass, a main-loop pass (and tick) each
+ *          2     the horn: next byte, as int8 counts per tick; n bit 0: the
+ *                encoder follows the setpoint instead; n bit 1: it is held
+ *          3     sensors: next 3 bytes are supply (x 40 mV), current
+ *                (x 20 mA) and NTC (x 16 counts)
+ *          4     flash: n bit 0 every write fails; n bit 1 the power is cut
+ *                at the write step the next byte names
+ *          5     power cycle: the servo boots again from its flash (3 at most)
+ *          6     (n+1) x 50 ms pass at once (the main loop was stalled)
+ * Every servo starts from a snapshot taken once per flash image, so an
+ * input costs no init. After each main-loop pass: everything sent is a
+ * well-formed response frame, a changed user area is valid, the multi-turn
+ * reading is in range and its turn count agrees. */
 #include <stddef.h>
 #include <stdint.h>
 #include <string.h>
@@ -17,8 +33,19 @@
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
-static struct hal_double hal;
-static struct servo servo;
+enum { IMAGES = 4, BYTE_US = 87, MAX_SIM_MS = 1200, MAX_BOOTS = 3 };
+
+struct world {
+    struct hal_double hal;
+    struct servo servo;
+};
+
+static struct world live;
+static struct world snapshots[IMAGES];
+static struct user_config last_valid;
+static int32_t spin_per_tick;
+static int encoder_mode; /* 0 spin, 1 follow the setpoint, 2 held */
+static int32_t encoder_counts;
 
 #define CHECK(cond)              \
     do {                         \
@@ -27,64 +54,222 @@ static struct servo servo;
         }                        \
     } while (0)
 
+static uint16_t encoder_model(void *model)
+{
+    (void)model;
+    const struct motion *m = &live.servo.motion;
+    if (encoder_mode == 1 && m->mode == MODE_POSITION) {
+        int64_t per_count = (int64_t)DECIDEG_Q8_PER_COUNT << 24;
+        int64_t sp = m->setpoint;
+        encoder_counts = (int32_t)((sp >= 0 ? sp + per_count / 2 : sp - per_count / 2) / per_count) +
+                         m->origin_counts;
+    } else if (encoder_mode == 0) {
+        encoder_counts += spin_per_tick;
+    }
+    return (uint16_t)(encoder_counts & (ENCODER_COUNTS - 1));
+}
+
 /* Every byte sent must belong to a complete, correct response frame. */
 static void check_sent(void)
 {
+    const struct hal_double *h = &live.hal;
     size_t i = 0;
-    while (i < hal.sent_length) {
-        CHECK(hal.sent_length - i >= 5);
-        CHECK(hal.sent[i] == 0x05 && hal.sent[i + 1] == 0x1C);
-        size_t n = 4u + hal.sent[i + 3] + 1u;
-        CHECK(hal.sent_length - i >= n);
+    while (i < h->sent_length) {
+        CHECK(h->sent_length - i >= 5);
+        CHECK(h->sent[i] == 0x05 && h->sent[i + 1] == 0x1C);
+        size_t n = 4u + h->sent[i + 3] + 1u;
+        CHECK(h->sent_length - i >= n);
         uint8_t sum = 0;
         for (size_t k = 0; k + 1 < n; k++) {
-            sum = (uint8_t)(sum + hal.sent[i + k]);
+            sum = (uint8_t)(sum + h->sent[i + k]);
         }
-        CHECK(sum == hal.sent[i + n - 1]);
+        CHECK(sum == h->sent[i + n - 1]);
         i += n;
     }
-    hal_double_clear_sent(&hal);
+    hal_double_clear_sent(&live.hal);
 }
 
+/* Only what can have changed: the user area is revalidated when it did;
+ * the angle only moves with ticks (checked after time passes). */
 static void check_invariants(void)
 {
-    CHECK(user_config_valid(&servo.regs.user));
-    CHECK(servo.active_id != 0xFF);
-    CHECK(servo.regs.status.serial_number == hal.port.serial_number);
-    CHECK(!hal.flash.misuse);
-    CHECK(servo.rx.head < FRAME_QUEUE_SLOTS && servo.rx.tail < FRAME_QUEUE_SLOTS);
-    check_sent();
+    const struct servo *s = &live.servo;
+    if (memcmp(&s->regs.user, &last_valid, sizeof last_valid) != 0) {
+        CHECK(user_config_valid(&s->regs.user));
+        last_valid = s->regs.user;
+    }
+    CHECK(s->active_id != 0xFF);
+    CHECK(!live.hal.flash.misuse);
+    CHECK(s->rx.head < FRAME_QUEUE_SLOTS && s->rx.tail < FRAME_QUEUE_SLOTS);
+    if (live.hal.sent_length != 0u) {
+        check_sent();
+    }
+}
+
+static void check_angle(void)
+{
+    struct motion_angle a;
+    motion_read_angle(&live.servo.motion, &a);
+    CHECK(a.multi_turn_decideg >= -3686400 && a.multi_turn_decideg <= 3686400);
+    CHECK(a.turns == a.multi_turn_decideg / 3600);
+}
+
+static void poll(void)
+{
+    servo_poll(&live.servo);
+    check_invariants();
+}
+
+static void boot(void)
+{
+    flash_double_power_on(&live.hal.flash);
+    servo_init(&live.servo, &live.hal.port);
+    last_valid = live.servo.regs.user;
+}
+
+static void write_item(uint8_t item, uint16_t value, uint8_t size)
+{
+    uint8_t content[4] = {live.servo.active_id, item, (uint8_t)value, (uint8_t)(value >> 8)};
+    struct rx_frame f = {.code = 4, .length = (uint16_t)(2u + size), .stored = (uint8_t)(2u + size)};
+    memcpy(f.content, content, sizeof content);
+    struct response r;
+    struct dispatch_result res;
+    dispatch(&live.servo.dispatcher, &f, &r, &res);
+    save_policy_changed(&live.servo.saver, live.hal.now_us);
+}
+
+static void run_ms(uint32_t ms)
+{
+    for (uint32_t i = 0; i < 4u * ms; i++) {
+        live.hal.now_us += 250u;
+        poll();
+    }
+}
+
+/* The flash images: a store that has been used, and one whose page is a
+ * record from full, so the next save erases the other page. */
+static void make_snapshot(int image)
+{
+    memset(&live, 0, sizeof live);
+    hal_double_init(&live.hal);
+    live.hal.now_us = 5000;
+    live.hal.encoder_model = encoder_model;
+    boot();
+    if (image != 0) {
+        unsigned records = image == 2 ? 20u : 5u;
+        for (unsigned k = 0; k < records; k++) {
+            write_item(49, (k & 1u) ? 0u : 1u, 1); /* soft start toggled, ends off */
+            if (k + 1u == records) {
+                write_item(49, 0, 1);
+            }
+            run_ms(60);
+        }
+        if (image == 3) {
+            write_item(33, 1, 1);   /* control response on */
+            write_item(42, 0xFFFF, 2);
+            run_ms(60);
+        }
+        boot();
+    }
+    hal_double_clear_sent(&live.hal);
+    snapshots[image] = live;
+}
+
+static void feed(uint8_t byte, unsigned *fed, unsigned poll_every)
+{
+    live.hal.now_us += BYTE_US;
+    servo_on_rx_byte(&live.servo, byte, live.hal.now_us);
+    if (++*fed % poll_every == 0u) {
+        poll();
+    }
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
+    static bool ready;
+    if (!ready) {
+        for (int i = 0; i < IMAGES; i++) {
+            make_snapshot(i);
+        }
+        ready = true;
+    }
     if (size == 0) {
         return 0;
     }
-    hal_double_init(&hal);
-    servo_init(&servo, &hal.port);
-    uint8_t control = data[0];
-    unsigned poll_every = 1u + (control & 0x0Fu);   /* bytes between passes */
-    bool slow_uart = control & 0x10u;
-    unsigned gap_every = (control >> 5) ? 7u * (control >> 5) : 0u;
+    uint8_t setup = data[0];
+    live = snapshots[setup & 3u];
+    last_valid = live.servo.regs.user;
+    spin_per_tick = 0;
+    encoder_mode = 1;
+    encoder_counts = live.servo.motion.encoder.counts + live.servo.motion.origin_counts;
+    unsigned poll_every = 1u << ((setup >> 2) & 3u);
+    bool slow_uart = setup & 0x10u;
+    unsigned fed = 0;
+    unsigned boots = 0;
+    uint32_t sim_ms = 0;
 
-    for (size_t i = 1; i < size; i++) {
-        hal.now_us += 87u;
-        if (gap_every && i % gap_every == 0) {
-            hal.now_us += 20000u; /* longer than any idle timeout */
-        }
-        servo_on_rx_byte(&servo, data[i], hal.now_us);
-        if (i % poll_every == 0) {
-            hal.tx_busy = slow_uart && (i & 1u);
-            servo_poll(&servo);
-            check_invariants();
+    size_t i = 1;
+    while (i < size) {
+        uint8_t op = data[i++];
+        unsigned n = op >> 3;
+        switch (op & 7u) {
+        case 1:
+            /* A pass per tick: the main loop's other jobs are reached by
+             * the wire bytes' passes. */
+            if (sim_ms + n + 1u <= MAX_SIM_MS) {
+                sim_ms += n + 1u;
+                for (unsigned k = 0; k < n + 1u; k++) {
+                    live.hal.now_us += 1000u;
+                    live.hal.tx_busy = slow_uart && (k & 1u);
+                    servo_poll(&live.servo);
+                    if (live.hal.sent_length != 0u) {
+                        check_sent();
+                    }
+                }
+                live.hal.tx_busy = false;
+                check_invariants();
+                check_angle();
+            }
+            break;
+        case 2:
+            encoder_mode = (n & 1u) ? 1 : (n & 2u) ? 2 : 0;
+            spin_per_tick = i < size ? (int8_t)data[i++] : 0;
+            break;
+        case 3:
+            if (size - i >= 3) {
+                live.hal.sensors.supply = (uint16_t)(data[i] * 40u);
+                live.hal.sensors.current = (uint16_t)(data[i + 1] * 20u);
+                live.hal.sensors.ntc = (uint16_t)(data[i + 2] * 16u);
+                i += 3;
+            }
+            break;
+        case 4:
+            live.hal.flash.dead = n & 1u;
+            if ((n & 2u) && i < size) {
+                live.hal.flash.cut_at = live.hal.flash.steps + data[i++];
+                live.hal.flash.cut_mode = (enum cut_mode)(n >> 2 & 3u);
+            }
+            break;
+        case 5:
+            if (boots++ < MAX_BOOTS) {
+                boot();
+            }
+            break;
+        case 6:
+            live.hal.now_us += (n + 1u) * 50000u;
+            poll();
+            break;
+        default:
+            for (unsigned k = 0; k <= n && i < size; k++) {
+                feed(data[i++], &fed, poll_every);
+            }
+            break;
         }
     }
-    hal.tx_busy = false;
-    for (int k = 0; k < 8; k++) {
-        hal.now_us += 5000u; /* lets sync turn-taking time out */
-        servo_poll(&servo);
-        check_invariants();
+    for (int k = 0; k < 3; k++) {
+        live.hal.now_us += 5000u; /* lets sync turn-taking time out */
+        poll();
     }
+    check_angle();
     return 0;
 }

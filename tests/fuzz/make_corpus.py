@@ -1,7 +1,13 @@
 #!/usr/bin/env python3
-"""Writes the fuzz seed corpus: one file per seed, a control byte followed by
-valid request frames (every packet), other servos' responses and sync frames.
-Run it after changing the protocol; the output is committed."""
+"""Writes the fuzz seed corpus for fuzz_servo.c: a setup byte, then
+operations (the format is fuzz_servo.c's header comment). The protocol seeds
+put every packet on the wire; the servo seeds also move the clock, the horn,
+the sensors, the flash and the power, so that motion, protection and the
+config store are reached: moves to completion and their answers, wheel
+modes, hold and damping, stall (a held horn, a horn pushed back), every
+monitor tripping and clearing, a move refused under a fault, encoder wrap,
+page rotation, failed and cut saves, reloads. Run it after changing the
+protocol or the harness; the output is committed."""
 import pathlib
 import struct
 
@@ -59,14 +65,132 @@ SEEDS = {
 }
 
 
+# Setup byte: flash image (0 blank, 1 used with soft start off, 2 used with
+# its page one record from full, 3 used and answering moves), bytes between
+# main-loop passes, slow UART.
+BLANK, USED, PAGE_FULL, ANSWERING = 0, 1, 2, 3
+SLOW_UART = 0x10
+
+
+def wire(stream: bytes) -> bytes:
+    out = b""
+    for k in range(0, len(stream), 32):
+        chunk = stream[k:k + 32]
+        out += bytes([(len(chunk) - 1) << 3 | 0]) + chunk
+    return out
+
+
+def ms(t: int) -> bytes:
+    out = b""
+    while t > 0:
+        step = min(t, 32)
+        out += bytes([(step - 1) << 3 | 1])
+        t -= step
+    return out
+
+
+FOLLOW, SPIN, HELD = 1, 0, 2
+
+
+def horn(mode: int, counts_per_tick: int = 0) -> bytes:
+    return bytes([mode << 3 | 2, counts_per_tick & 0xFF])
+
+
+def sensors(supply_mv: int, current_ma: int, ntc: int) -> bytes:
+    return bytes([3, supply_mv // 40, current_ma // 20, ntc // 16])
+
+
+HEALTHY = sensors(7400, 200, 2048)
+
+
+def flash(dead: bool = False, cut_at: int = None, mode: int = 0) -> bytes:
+    n = (1 if dead else 0) | (2 if cut_at is not None else 0) | mode << 2
+    return bytes([n << 3 | 4]) + (bytes([cut_at]) if cut_at is not None else b"")
+
+
+POWER_CYCLE = bytes([5])
+
+
+def stall_main_loop(t_ms: int) -> bytes:
+    return bytes([(t_ms // 50 - 1) << 3 | 6])
+
+
+def move(angle: int, interval: int, power: int = 0) -> bytes:
+    return req(8, struct.pack("<BhHH", 0, angle, interval, power))
+
+
+def write(item: int, value: int, size: int = 1) -> bytes:
+    return req(4, bytes([0, item]) + value.to_bytes(size, "little", signed=value < 0))
+
+
+SERVO_SEEDS = {
+    "move_to_completion": (USED, wire(move(900, 200)) + ms(400) + wire(req(0x40, b"\x00"))),
+    "move_answered": (ANSWERING, wire(move(-450, 100)) + ms(300) + wire(req(3, b"\x00\x05"))),
+    "queued_moves_answered": (ANSWERING, wire(move(300, 60) + move(0, 60) + move(600, 60)) + ms(400)),
+    "velocity_moves": (USED, wire(req(12, struct.pack("<BhHHHH", 0, 200, 3000, 100, 200, 0))) + ms(200)
+                       + wire(req(15, struct.pack("<BiHHHH", 0, -7200, 7500, 50, 60, 0))) + ms(600)),
+    "interval_moves": (USED, wire(req(11, struct.pack("<BhHHHH", 0, 1000, 300, 100, 100, 0))) + ms(150)
+                       + wire(req(14, struct.pack("<BiIHHH", 0, 3600, 200, 20, 30, 0))) + ms(400)),
+    "preempted": (USED, wire(move(1800, 500)) + ms(100) + wire(move(-1800, 300)) + ms(100)
+                  + wire(req(13, struct.pack("<BiIH", 0, 36000, 400, 0))) + ms(500)),
+    "wheel_run_stop": (USED, wire(req(7, struct.pack("<BBHH", 0, 0x01, 300, 0))) + ms(100)
+                       + wire(req(7, struct.pack("<BBHH", 0, 0x00, 0, 0))) + ms(60)
+                       + wire(write(47, 1) + req(7, struct.pack("<BBHH", 0, 0x81, 90, 0))) + ms(60)
+                       + wire(req(7, struct.pack("<BBHH", 0, 0x80, 0, 0))) + ms(60)),
+    "wheel_time_turns": (USED, wire(req(7, struct.pack("<BBHH", 0, 0x03, 200, 150))) + ms(250)
+                         + wire(req(7, struct.pack("<BBHH", 0, 0x82, 750, 1))) + ms(700)),
+    "hold_and_damping": (USED, wire(move(900, 300)) + ms(100) + wire(req(24, b"\x00\x11\x00\x00"))
+                         + ms(50) + wire(req(9, struct.pack("<BH", 0, 800))) + horn(SPIN, 20) + ms(60)
+                         + wire(req(24, b"\x00\x12\x00\x00")) + ms(30) + wire(req(24, b"\x00\x10\x00\x00"))
+                         + ms(10) + wire(req(17, b"\x00") + req(23, b"\x00\x00")) + horn(FOLLOW)),
+    "stall_held_horn": (USED, horn(HELD) + wire(move(900, 200, 3000)) + ms(1080)
+                        + wire(req(3, b"\x00\x05")) + horn(FOLLOW) + ms(100)),
+    "stall_releases": (USED, wire(write(37, 1)) + horn(HELD) + wire(move(-900, 200)) + ms(1080)
+                       + wire(move(0, 100)) + horn(FOLLOW) + ms(100)),
+    "pushed_backwards": (USED, wire(move(300, 100)) + ms(120) + horn(SPIN, -30) + ms(1070)),
+    "encoder_wrap": (USED, horn(SPIN, 100) + ms(300) + horn(SPIN, -120) + ms(300)
+                     + wire(req(16, b"\x00"))),
+    "low_voltage_refuses": (USED, sensors(3000, 100, 2048) + ms(30) + wire(move(900, 200)) + ms(30)
+                            + HEALTHY + ms(200) + wire(move(900, 100)) + ms(200)),
+    "high_voltage": (USED, wire(move(900, 400)) + ms(50) + sensors(9600, 100, 2048) + ms(50)
+                     + HEALTHY + ms(200)),
+    "over_current_power": (USED, wire(move(900, 400)) + ms(50) + sensors(7400, 5000, 2048) + ms(50)
+                           + HEALTHY + ms(200)),
+    "over_temperature": (USED, wire(move(900, 400)) + ms(50) + sensors(7400, 200, 500) + ms(50)
+                         + HEALTHY + ms(150) + sensors(7400, 200, 800) + ms(150)),
+    "supply_sag_during_move": (USED, wire(move(1800, 600)) + ms(100) + sensors(5000, 300, 2048)
+                               + ms(100) + sensors(8200, 300, 2048) + ms(300)),
+    "page_rotation_and_reload": (PAGE_FULL, wire(write(38, 1234, 2)) + ms(60) + wire(write(44, 1))
+                                 + ms(60) + POWER_CYCLE + wire(req(3, b"\x00\x26")) + ms(5)),
+    "failed_save_refuses": (USED, flash(dead=True) + wire(write(43, 2000, 2)) + ms(60)
+                            + wire(write(43, 3000, 2) + req(2, b"\x00") + req(0x41, b"\x00"))
+                            + flash(dead=False) + ms(1100) + wire(write(43, 3000, 2)) + ms(60)),
+    "cut_mid_save": (PAGE_FULL, flash(cut_at=3, mode=2) + wire(write(50, 500, 2)) + ms(60) + POWER_CYCLE
+                     + wire(write(50, 600, 2)) + ms(60) + POWER_CYCLE + wire(req(3, b"\x00\x32"))),
+    "power_on_lock": (USED, wire(write(46, 1)) + ms(60) + POWER_CYCLE + ms(20)),
+    "main_loop_stalled": (USED, wire(move(900, 300)) + ms(50) + stall_main_loop(200) + ms(50)),
+    "async_then_go": (USED, wire(req(18, b"") + move(900, 100) + req(19, b"\x00")) + ms(200)
+                      + wire(req(18, b"") + move(0, 100) + req(19, b"\x01")) + ms(20)),
+    "soft_start": (BLANK, wire(move(900, 100)) + ms(300)),
+    "faster_than_the_planner": (USED, wire(req(13, struct.pack("<BiIH", 0, 3686400, 40, 0))) + ms(50)
+                                + wire(req(24, b"\x00\x11\x00\x00")) + ms(20)),
+    "velocity_move_to_here": (USED, wire(req(12, struct.pack("<BhHHHH", 0, 0, 3000, 100, 200, 0)))
+                              + ms(50)),
+    "slow_uart_sync": (USED | SLOW_UART | 1 << 2, wire(req(25, bytes([22, 1, 3, 5, 0, 9]))) + ms(10)
+                       + wire(resp(22, bytes(16))) + ms(10)),
+}
+
+
 def main() -> None:
     OUT.mkdir(exist_ok=True)
     for old in OUT.glob("*.bin"):
         old.unlink()
     for name, stream in SEEDS.items():
-        # Control byte 0x00: poll after every byte, fast UART, no gaps.
-        (OUT / f"{name}.bin").write_bytes(b"\x00" + stream)
-    print(f"wrote {len(SEEDS)} seeds to {OUT}")
+        # Blank flash, a pass after every byte, fast UART.
+        (OUT / f"{name}.bin").write_bytes(bytes([BLANK]) + wire(stream))
+    for name, (setup, ops) in SERVO_SEEDS.items():
+        (OUT / f"{name}.bin").write_bytes(bytes([setup]) + ops)
+    print(f"wrote {len(SEEDS) + len(SERVO_SEEDS)} seeds to {OUT}")
 
 
 if __name__ == "__main__":

@@ -68,7 +68,6 @@ struct profile_timing profile_velocity_timing(int64_t distance, int64_t v0, int6
                                               uint32_t accel, uint32_t decel);
 
 int64_t profile_position(const struct profile *p, uint32_t tick);
-int64_t profile_velocity(const struct profile *p, uint32_t tick);
 
 static inline bool profile_done(const struct profile *p, uint32_t tick)
 {
