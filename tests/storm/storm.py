@@ -1,0 +1,401 @@
+"""A long mixed storm against the simulator (three servos on one bus, the
+ASan + UBSan build of servo_sim), with a summary at the end.
+
+One host, as on a real bus, mixes without pause:
+  - requests that must be answered (ping, ReadData, ReadMotion, Monitor);
+  - moves that preempt each other (servo 3, control response off);
+  - moves answered when finished (servos 1 and 2, control response on);
+  - Sync Monitor rounds, some listing an absent servo;
+  - config writes (stall power 38, soft-start time 50), each remembered;
+  - garbage at line rate, bytes that hold no frame header (0x12, 0x05);
+  - faults through the control port: supply sags and surges, loads beyond
+    the stall torque, hard stops, heat;
+  - power cuts: servo_sim killed with SIGKILL at random, restarted on the
+    same flash files, every servo's config read back and checked.
+
+Summary: frames lost (an answer due and not received, or received garbled),
+collisions, control ticks dropped, configs corrupted (a value after a cut
+that was never acknowledged), changes lost (acknowledged more than the
+documented 1 s before a cut and gone), sanitizer findings. All must be 0.
+
+    python tests/storm/storm.py --minutes 30 --out build/storm
+"""
+import argparse
+import json
+import os
+import random
+import re
+import shutil
+import signal
+import socket
+import struct
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT / "tools"))
+
+from servoctl import protocol as p  # noqa: E402
+from servoctl.protocol import checksum, request_frame  # noqa: E402
+
+try:
+    from rich.console import Console
+    from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+except ImportError:  # the storm runs without rich, only less pretty
+    Progress = None
+
+SIM = ROOT / "build/host/firmware/boards/host_sim/servo_sim"
+IDS = (1, 2, 3)
+ANSWERING = (1, 2)  # control response on
+BYTE_S = 10 / 115200
+CONFIG_ITEMS = (38, 50)
+SAVE_LATEST_S = 1.0  # save_policy.h: a change is saved within this
+NO_HEADER = bytes(b for b in range(256) if b not in (0x12, 0x05))
+
+
+class Sim:
+    """servo_sim on a TCP port, its stderr in a log file."""
+
+    def __init__(self, binary: Path, state: Path, log: Path):
+        self.binary, self.state, self.log = binary, state, log
+        self.process = None
+
+    def start(self):
+        self.errors = open(self.log, "a")
+        with socket.socket() as probe:
+            probe.bind(("127.0.0.1", 0))
+            port = probe.getsockname()[1]
+        self.process = subprocess.Popen(
+            [str(self.binary), "--state", str(self.state), "--tcp", str(port),
+             *sum((["--id", str(i)] for i in IDS), [])],
+            stdout=subprocess.PIPE, stderr=self.errors, text=True)
+        self.url = self.control = None
+        for line in self.process.stdout:
+            words = line.split()
+            if words[1:2] == ["bus"]:
+                self.url = words[2]
+            elif words[1:2] == ["control"]:
+                self.control = int(words[2].rsplit(":", 1)[1])
+            elif words[1:2] == ["ready"]:
+                break
+        host, port = self.url.replace("socket://", "").split(":")
+        self.sock = socket.create_connection((host, int(port)))
+        self.sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        self.sock.settimeout(0.005)
+
+    def command(self, line: str) -> str:
+        with socket.create_connection(("127.0.0.1", self.control), timeout=5) as s:
+            s.sendall(line.encode() + b"\n")
+            s.shutdown(socket.SHUT_WR)
+            out = b""
+            while chunk := s.recv(4096):
+                out += chunk
+        return out.decode()
+
+    def state_of(self, servo_id: int) -> dict:
+        out = {}
+        for pair in self.command(f"state {servo_id}").split():
+            key, _, value = pair.partition("=")
+            out[key] = value
+        return out
+
+    def kill(self):
+        self.sock.close()
+        self.process.send_signal(signal.SIGKILL)
+        self.process.wait()
+        self.errors.close()
+
+    def stop(self):
+        self.sock.close()
+        self.process.send_signal(signal.SIGTERM)
+        self.process.wait(timeout=10)
+        self.errors.close()
+
+
+class Host:
+    """The one master on the bus: every frame that comes back is parsed; a
+    finished move's answer may come at any time."""
+
+    def __init__(self, sim: Sim, stats: dict):
+        self.sim, self.stats = sim, stats
+        self.buffer = b""
+        self.finished = {i: 0 for i in ANSWERING}
+
+    def send(self, data: bytes):
+        self.sim.sock.sendall(data)
+
+    def _frames(self):
+        while True:
+            start = self.buffer.find(p.RESPONSE_HEADER)
+            if start < 0:
+                keep = 1 if self.buffer.endswith(p.RESPONSE_HEADER[:1]) else 0
+                self.stats["stray_bytes"] += len(self.buffer) - keep
+                self.buffer = self.buffer[len(self.buffer) - keep:]
+                return
+            self.stats["stray_bytes"] += start
+            self.buffer = self.buffer[start:]
+            if len(self.buffer) < 5 or len(self.buffer) < 4 + self.buffer[3] + 1:
+                return
+            end = 4 + self.buffer[3] + 1
+            frame, self.buffer = self.buffer[:end], self.buffer[end:]
+            if checksum(frame[:-1]) != frame[-1]:
+                self.stats["garbled"] += 1
+                continue
+            yield frame[2], frame[4:-1]
+
+    def listen(self, seconds: float, want=None):
+        """Reads for up to `seconds`; returns the first frame `want` accepts,
+        counting finished-move answers on the way."""
+        deadline = time.monotonic() + seconds
+        while True:
+            for code, content in self._frames():
+                if code in (p.ANGLE, p.MULTI_TURN_BY_INTERVAL) and content[:1] and content[0] in ANSWERING \
+                        and len(content) == 2:
+                    self.finished[content[0]] += 1
+                    continue
+                if want is not None and want(code, content):
+                    return code, content
+            if time.monotonic() > deadline:
+                return None
+            try:
+                data = self.sim.sock.recv(4096)
+                if not data:
+                    raise ConnectionError("servo_sim closed the bus")
+                self.buffer += data
+            except socket.timeout:
+                pass
+
+    def request(self, code: int, content: bytes, answers: bool = True, timeout: float = 0.25):
+        self.send(request_frame(code, content))
+        self.stats["requests"] += 1
+        if not answers:
+            return None
+        got = self.listen(timeout, lambda c, body: c == code and body[:1] == content[:1])
+        if got is None:
+            self.stats["frames_lost"] += 1
+            self.stats["lost_examples"].append(f"packet {code} to {content[0]}")
+        return got
+
+
+def fault(sim: Sim, rng: random.Random, stats: dict):
+    """Something physical happens to servo 3 (its own moves are not
+    answered, so a refused move loses nothing)."""
+    kind = rng.choice(["sag", "surge", "load", "stop", "heat", "clear"])
+    cmd = {
+        "sag": f"supply {rng.choice([3000, 4200, 5500])} 3",
+        "surge": f"supply {rng.choice([8600, 9500])} 3",
+        "load": f"load {rng.choice([-5.0, -2.0, 1.0, 4.0])} 3",
+        "stop": f"stop {rng.uniform(-60, 60):.1f} 3",
+        "heat": f"soak {rng.choice([60, 90, 110])} 3",
+    }.get(kind)
+    if kind == "clear":
+        for line in ("supply 7400 3", "load 0 3", "stop off 3", "soak 25 3"):
+            sim.command(line)
+    else:
+        sim.command(cmd)
+    stats["faults"] += 1
+
+
+def read_item(host: Host, servo_id: int, item: int):
+    got = host.request(p.READ_DATA, bytes([servo_id, item]))
+    if got is None or len(got[1]) != 4:
+        return None
+    return struct.unpack("<H", got[1][2:4])[0]
+
+
+def check_configs(host: Host, history: dict, cut_at: float, stats: dict, log):
+    for (servo_id, item), writes in history.items():
+        value = read_item(host, servo_id, item)
+        if value is None:
+            continue  # counted as a lost frame
+        acked = [v for v, _ in writes]
+        if value not in acked:
+            stats["configs_corrupted"] += 1
+            log(f"servo {servo_id} item {item}: {value} after the cut, never written")
+            continue
+        last, at = writes[-1]
+        if value != last and cut_at - at > SAVE_LATEST_S:
+            stats["changes_lost"] += 1
+            log(f"servo {servo_id} item {item}: {value} after the cut, {last} was acked "
+                f"{cut_at - at:.1f} s before it")
+        # What survived is the history from here on.
+        history[(servo_id, item)] = [(value, 0.0)]
+
+
+def run(minutes: float, out: Path, seed: int):
+    out.mkdir(parents=True, exist_ok=True)
+    state = out / "state"
+    shutil.rmtree(state, ignore_errors=True)
+    # Its own copy: a rebuild during the storm must not change the servos.
+    sim_binary = out / "servo_sim"
+    shutil.copy2(SIM, sim_binary)
+    sanitizer_log = out / "servo_sim.stderr"
+    sanitizer_log.write_text("")
+    rng = random.Random(seed)
+    stats = {k: 0 for k in ("requests", "frames_lost", "garbled", "stray_bytes", "collisions",
+                            "ticks_dropped", "configs_corrupted", "changes_lost", "power_cuts",
+                            "moves", "answered_moves", "finished_answers", "finished_lost",
+                            "sync_rounds", "config_writes", "garbage_bytes", "faults",
+                            "configs_checked")}
+    stats["lost_examples"] = []
+    events = open(out / "events.log", "w")
+
+    def log(text):
+        events.write(f"{time.strftime('%H:%M:%S')} {text}\n")
+        events.flush()
+
+    sim = Sim(sim_binary, state, sanitizer_log)
+    sim.start()
+    host = Host(sim, stats)
+    history = {}
+    for i in IDS:
+        host.request(p.WRITE_DATA, bytes([i, 49, 0]))  # soft start off
+        host.request(p.WRITE_DATA, bytes([i, 33, 1 if i in ANSWERING else 0]))
+        for item in CONFIG_ITEMS:
+            history[(i, item)] = [(read_item(host, i, item), 0.0)]
+    expected = {i: 0 for i in ANSWERING}
+    seen_base = dict(host.finished)
+    end = time.monotonic() + minutes * 60
+    next_cut = time.monotonic() + rng.uniform(20, 120)
+    next_config = 0.0
+
+    progress = None
+    if Progress is not None:
+        progress = Progress(TextColumn("storm"), BarColumn(), TextColumn("{task.fields[line]}"),
+                            TimeRemainingColumn(), console=Console(stderr=True))
+        progress.start()
+        task = progress.add_task("storm", total=minutes * 60, line="")
+    start = time.monotonic()
+
+    def settle_answers():
+        """Leave the line quiet until every finished move has answered
+        (each goes out in its slot once the host pauses)."""
+        deadline = time.monotonic() + 3.0
+        while time.monotonic() < deadline:
+            if all(host.finished[i] - seen_base[i] >= expected[i] for i in ANSWERING):
+                return
+            host.listen(0.05)
+
+    while time.monotonic() < end:
+        now = time.monotonic()
+        if now >= next_cut:
+            settle_answers()
+            for i in ANSWERING:
+                stats["finished_lost"] += max(0, expected[i] - (host.finished[i] - seen_base[i]))
+            st = sim.state_of(1)
+            stats["collisions"] += int(st["collisions"])
+            stats["ticks_dropped"] += sum(int(sim.state_of(i)["dropped_ticks"]) for i in IDS)
+            cut_at = time.monotonic()
+            sim.kill()
+            stats["power_cuts"] += 1
+            log(f"power cut {stats['power_cuts']}")
+            sim.start()
+            host = Host(sim, stats)
+            seen_base = dict(host.finished)
+            expected = {i: 0 for i in ANSWERING}
+            check_configs(host, history, cut_at, stats, log)
+            stats["configs_checked"] += len(history)
+            next_cut = time.monotonic() + rng.uniform(20, 120)
+            continue
+        action = rng.choices(
+            ["query", "preempt", "answered_move", "sync", "config", "garbage", "fault", "listen"],
+            weights=[30, 20, 8, 8, 5, 6, 3, 6])[0]
+        if action == "query":
+            i = rng.choice(IDS)
+            kind = rng.choice([(p.PING, bytes([i])), (p.READ_DATA, bytes([i, rng.choice([1, 5, 33, 50])])),
+                               (p.READ_MOTION, bytes([i])), (p.MONITOR, bytes([i])),
+                               (p.READ_MULTI_TURN, bytes([i]))])
+            host.request(*kind)
+        elif action == "preempt":
+            host.request(p.ANGLE_BY_INTERVAL, struct.pack("<BhHHHH", 3, rng.randint(-1800, 1800),
+                                                          rng.randint(40, 600), 20, 20, 0), answers=False)
+            stats["moves"] += 1
+        elif action == "answered_move":
+            i = rng.choice(ANSWERING)
+            if expected[i] - (host.finished[i] - seen_base[i]) < 3:
+                host.request(p.ANGLE, struct.pack("<BhHH", i, rng.randint(-900, 900), rng.randint(50, 300), 0),
+                             answers=False)
+                expected[i] += 1
+                stats["answered_moves"] += 1
+        elif action == "sync":
+            order = rng.sample(IDS, 3) + ([9] if rng.random() < 0.3 else [])
+            rng.shuffle(order)
+            host.send(request_frame(p.SYNC, bytes([p.MONITOR, 1, len(order)] + order)))
+            stats["sync_rounds"] += 1
+            for sid in [s for s in order if s in IDS]:
+                stats["requests"] += 1
+                got = host.listen(0.3 + 0.004 * len(order), lambda c, body, sid=sid: c == p.MONITOR and body[:1] == bytes([sid]))
+                if got is None:
+                    stats["frames_lost"] += 1
+                    stats["lost_examples"].append(f"sync monitor answer of {sid} in {order}")
+        elif action == "config" and time.monotonic() >= next_config:
+            # One write every 2 s or so keeps each servo within its save
+            # allowance (save_policy.h), so every change must survive a cut.
+            next_config = time.monotonic() + rng.uniform(1.0, 3.0)
+            i = rng.choice(IDS)
+            item = rng.choice(CONFIG_ITEMS)
+            value = rng.randint(100, 60000)
+            got = host.request(p.WRITE_DATA, bytes([i, item]) + struct.pack("<H", value))
+            if got is not None and got[1][2:3] == b"\x01":
+                history[(i, item)].append((value, time.monotonic()))
+                stats["config_writes"] += 1
+        elif action == "garbage":
+            burst = bytes(rng.choice(NO_HEADER) for _ in range(rng.randint(16, 2048)))
+            host.send(burst)
+            stats["garbage_bytes"] += len(burst)
+            host.listen(len(burst) * BYTE_S + 0.01)  # the line is busy meanwhile
+        elif action == "fault":
+            fault(sim, rng, stats)
+        else:
+            host.listen(rng.uniform(0.01, 0.2))
+        if sum(expected[i] - (host.finished[i] - seen_base[i]) for i in ANSWERING) > 0 and rng.random() < 0.1:
+            host.listen(0.2)  # a pause, as a host waiting for answers makes
+        if progress is not None:
+            progress.update(task, completed=time.monotonic() - start,
+                            line=f"requests {stats['requests']} lost {stats['frames_lost']} "
+                                 f"cuts {stats['power_cuts']}")
+    settle_answers()
+    for i in ANSWERING:
+        stats["finished_lost"] += max(0, expected[i] - (host.finished[i] - seen_base[i]))
+    stats["collisions"] += int(sim.state_of(1)["collisions"])
+    stats["ticks_dropped"] += sum(int(sim.state_of(i)["dropped_ticks"]) for i in IDS)
+    sim.stop()
+    if progress is not None:
+        progress.stop()
+    text = sanitizer_log.read_text()
+    stats["sanitizer_findings"] = len(re.findall(r"runtime error|AddressSanitizer|LeakSanitizer", text))
+    stats["finished_answers"] = stats["answered_moves"] - stats["finished_lost"]
+    stats["minutes"] = minutes
+    stats["seed"] = seed
+    stats["lost_examples"] = stats["lost_examples"][:20]
+    (out / "summary.json").write_text(json.dumps(stats, indent=2))
+    must_be_zero = ("frames_lost", "garbled", "finished_lost", "collisions", "ticks_dropped",
+                    "configs_corrupted", "changes_lost", "sanitizer_findings")
+    lines = [f"storm: {minutes:g} min, seed {seed}, 3 servos at 115200 baud",
+             f"  requests {stats['requests']}, sync rounds {stats['sync_rounds']}, moves {stats['moves']}"
+             f" preempting, {stats['answered_moves']} answered moves, {stats['config_writes']} config writes,"
+             f" {stats['garbage_bytes']} garbage bytes, {stats['faults']} faults, {stats['power_cuts']} power cuts"
+             f" ({stats['configs_checked']} configs checked)"]
+    lines += [f"  {key.replace('_', ' ')}: {stats[key]}" for key in must_be_zero]
+    summary = "\n".join(lines)
+    (out / "summary.txt").write_text(summary + "\n")
+    print(summary)
+    return all(stats[k] == 0 for k in must_be_zero)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--minutes", type=float, default=30.0)
+    ap.add_argument("--out", type=Path, default=ROOT / "build/storm")
+    ap.add_argument("--seed", type=int, default=1)
+    args = ap.parse_args()
+    if not SIM.exists():
+        sys.exit(f"storm: {SIM} is missing; build it with: cmake --preset host && cmake --build --preset host")
+    ok = run(args.minutes, args.out, args.seed)
+    sys.exit(0 if ok else 1)
+
+
+if __name__ == "__main__":
+    main()
