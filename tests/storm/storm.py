@@ -39,6 +39,7 @@ sys.path.insert(0, str(ROOT / "tools"))
 
 from servoctl import protocol as p  # noqa: E402
 from servoctl.protocol import checksum, request_frame  # noqa: E402
+from servoctl.sim import control_command  # noqa: E402
 
 try:
     from rich.console import Console
@@ -86,13 +87,7 @@ class Sim:
         self.sock.settimeout(0.005)
 
     def command(self, line: str) -> str:
-        with socket.create_connection(("127.0.0.1", self.control), timeout=5) as s:
-            s.sendall(line.encode() + b"\n")
-            s.shutdown(socket.SHUT_WR)
-            out = b""
-            while chunk := s.recv(4096):
-                out += chunk
-        return out.decode()
+        return control_command(self.control, line, timeout=5)
 
     def state_of(self, servo_id: int) -> dict:
         out = {}

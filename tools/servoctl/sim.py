@@ -94,16 +94,7 @@ class Simulator(_Child):
 
     def control(self, line: str) -> str:
         """Sends one control command; returns the reply."""
-        with socket.create_connection(("127.0.0.1", self.control_port), timeout=2) as s:
-            s.sendall(line.encode() + b"\n")
-            s.shutdown(socket.SHUT_WR)
-            reply = b""
-            while chunk := s.recv(4096):
-                reply += chunk
-        text = reply.decode()
-        if text.startswith("error"):
-            raise ServoError(f"servo_sim: {text.strip()}")
-        return text
+        return control_command(self.control_port, line)
 
     def state(self, servo_id: int) -> dict:
         """The models' state of one servo: angle (deg), velocity, current,
@@ -118,6 +109,21 @@ class Simulator(_Child):
                 out[key] = value
         return out
 
+
+
+def control_command(port: int, line: str, timeout: float = 2.0) -> str:
+    """One line to servo_sim's control port on 127.0.0.1:port; its reply.
+    An "error: ..." reply raises ServoError."""
+    with socket.create_connection(("127.0.0.1", port), timeout=timeout) as s:
+        s.sendall(line.encode() + b"\n")
+        s.shutdown(socket.SHUT_WR)
+        reply = b""
+        while chunk := s.recv(4096):
+            reply += chunk
+    text = reply.decode()
+    if text.startswith("error"):
+        raise ServoError(f"servo_sim: {text.strip()}")
+    return text
 
 
 def _stop(process) -> str:
