@@ -2,22 +2,40 @@
 
 Angles are given in degrees and speeds in degrees per second; the tool turns
 them into the protocol's 0.1 degree units and checks every value before
-anything is sent."""
+anything is sent.
+
+Exit codes: 0 done; 1 the servo refused, or a move did not arrive (the
+message says why); 2 a usage error (nothing was sent); 3 no reply; 4 the
+serial link failed; 130 interrupted (Ctrl-C)."""
 import argparse
 import csv
 import json
+import math
 import os
 import sys
 import time
 
-from . import ntc, registers
+from . import __version__, ntc, outcome, registers
 from .profile import positions, velocity_timing
-from .protocol import Bus, NoReply, ServoError, ValueOutOfRange
+from .protocol import Bus, NoReply, Refused, ServoError, UsageError, ValueOutOfRange
 from .servo import Servo
+
+EXIT_INTERRUPTED = 130
 
 
 def decideg(degrees: float) -> int:
     return int(round(degrees * 10))
+
+
+def finite(text: str) -> float:
+    """argparse type: a real number of degrees (no nan, no inf)."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"not a finite number: {text!r}")
+    return value
 
 
 def fmt_status(status: int) -> str:
@@ -92,27 +110,57 @@ def cmd_config(bus, args):
         print(f"{item.name} = {value}{' ' + item.unit if item.unit else ''}")
     elif args.action == "set":
         item = registers.find(args.name)
-        s.write(item.id, int(args.value, 0))
-        print(f"{item.name} = {int(args.value, 0)}")
+        try:
+            value = int(args.value, 0)
+        except ValueError:
+            raise UsageError(f"{item.name} takes a whole number"
+                             f"{' of ' + item.unit if item.unit else ''}, not {args.value!r}") from None
+        s.write(item.id, value)
+        print(f"{item.name} = {value}")
     elif args.action == "dump":
         _print_config(s.read_all())
     elif args.action == "save":
         values = s.read_all()
-        with open(args.file, "w") as f:
-            json.dump(values, f, indent=2)
+        try:
+            with open(args.file, "w") as f:
+                json.dump(values, f, indent=2)
+        except OSError as e:
+            raise UsageError(f"cannot write {args.file}: {e.strerror}") from None
         print(f"saved the user area of servo {args.id} to {args.file}")
     elif args.action == "load":
-        with open(args.file) as f:
-            values = json.load(f)
-        missing = [i.name for i in registers.USER if i.name not in values]
-        if missing:
-            raise ValueOutOfRange(f"{args.file} lacks {', '.join(missing)}")
-        s.write_all(values)  # validated before sending
-        print(f"loaded {args.file} into servo {args.id}")
+        values = _read_config_file(args.file)
+        current = s.read_all()
+        # The ID and baud rate stay unless asked: another servo's file must
+        # not make two servos with one ID.
+        keep = [] if args.with_link else ["servo_id", "baud"]
+        merged = dict(current, **{k: v for k, v in values.items() if k not in keep})
+        s.write_all(merged)  # validated before sending
+        kept = [k for k in keep if k in values and values[k] != current[k]]
+        note = f" (kept {', '.join(f'{k} {current[k]}' for k in kept)}; --with-link to change)" if kept else ""
+        print(f"loaded {len(values)} item(s) from {args.file} into servo {args.id}{note}")
     elif args.action == "reset":
         s.reset_user_data()
         print(f"servo {args.id}: user area reset (ID and baud rate kept)")
     return 0
+
+
+def _read_config_file(path: str) -> dict:
+    try:
+        with open(path) as f:
+            values = json.load(f)
+    except OSError as e:
+        raise UsageError(f"cannot read {path}: {e.strerror}") from None
+    except json.JSONDecodeError as e:
+        raise UsageError(f"{path} is not a config file (JSON): {e}") from None
+    if not isinstance(values, dict):
+        raise UsageError(f"{path} is not a config file: expected {{name: value}}")
+    unknown = [k for k in values if k not in {i.name for i in registers.USER}]
+    if unknown:
+        raise UsageError(f"{path}: unknown item(s) {', '.join(unknown)}")
+    bad = [k for k, v in values.items() if not isinstance(v, int) or isinstance(v, bool)]
+    if bad:
+        raise UsageError(f"{path}: {', '.join(bad)} must be whole numbers")
+    return values
 
 
 def _move_args(args):
@@ -129,55 +177,41 @@ def _move_args(args):
     return kw
 
 
-def _wait_done(s: Servo, timeout: float):
-    """Waits for status bit 0 to fall; returns the seconds it took."""
-    start = time.monotonic()
-    time.sleep(0.01)
-    while time.monotonic() - start < timeout:
-        if not s.status() & 1:
-            return time.monotonic() - start
-        time.sleep(0.005)
-    raise ServoError(f"servo {s.id} still moving after {timeout:.1f} s")
-
-
-def _settled_angle(s: Servo, timeout: float = 1.0):
-    """(multi-turn angle, settled): settled once four readings 20 ms apart
-    agree to 0.1 deg. Status bit 0 falls when the profile ends, while the
-    horn may still be swinging in; a longer window also rides out a
-    simulator that the PC did not schedule for a while."""
-    start = time.monotonic()
-    readings = [s.multi_turn_angle()[0]]
-    while time.monotonic() - start < timeout:
-        time.sleep(0.02)
-        readings = readings[-3:] + [s.multi_turn_angle()[0]]
-        if len(readings) == 4 and max(readings) - min(readings) <= 1:
-            return readings[-1], True
-    return readings[-1], False
-
-
 def cmd_move(bus, args):
     s = Servo(bus, args.id)
-    s.move(decideg(args.angle), **_move_args(args))
-    if args.wait:
-        took = _wait_done(s, args.timeout_s)
-        angle, settled = _settled_angle(s)
-        print(f"servo {args.id}: at {angle / 10:.1f} deg{'' if settled else ' (still settling)'}, "
-              f"move finished after {took * 1000:.0f} ms")
+    kw = _move_args(args)
+    asked = decideg(args.angle)
+    plan = outcome.plan_move(s, asked, kw) if args.wait else None
+    s.move(asked, **kw)
+    outcome.taken(s, "the move")
+    if not args.wait:
+        return 0
+    result = outcome.wait_for_arrival(s, plan, args.tolerance, args.timeout_s)
+    if not result.arrived:
+        raise Refused(f"servo {args.id}: {result.reason}")
+    print(f"servo {args.id}: at {result.angle / 10:.1f} deg after {result.took_s * 1000:.0f} ms "
+          f"(planned {plan.planned_s * 1000:.0f} ms)")
     return 0
 
 
 def cmd_wheel(bus, args):
-    Servo(bus, args.id).wheel(args.action, args.speed, args.value, args.cw)
+    s = Servo(bus, args.id)
+    s.wheel(args.action, args.speed, args.value, args.cw)
+    outcome.taken(s, f"wheel {args.action}")
     return 0
 
 
 def cmd_damping(bus, args):
-    Servo(bus, args.id).damping(args.power)
+    s = Servo(bus, args.id)
+    s.damping(args.power)
+    outcome.taken(s, "damping")
     return 0
 
 
 def cmd_stop(bus, args):
-    Servo(bus, args.id).stop(args.mode, args.power)
+    s = Servo(bus, args.id)
+    s.stop(args.mode, args.power)
+    outcome.taken(s, f"stop ({args.mode})")
     return 0
 
 
@@ -188,9 +222,13 @@ def cmd_origin(bus, args):
     else:
         s.set_origin()
     time.sleep(0.01)
+    try:
+        outcome.taken(s, "a new origin")
+    except Refused:
+        raise Refused(f"servo {args.id} refused a new origin: release it first with "
+                      f"'servoctl stop {args.id}'") from None
     angle, turns = s.multi_turn_angle()
-    print(f"servo {args.id}: now {angle / 10:.1f} deg, {turns} turns"
-          + ("" if s.status() & 2 == 0 else " (refused: release it first with 'stop')"))
+    print(f"servo {args.id}: now {angle / 10:.1f} deg, {turns} turns")
     return 0
 
 
@@ -222,6 +260,9 @@ def cmd_record(bus, args):
     """Samples a move as the servo sees it (ReadMotion, 0x40: angle, setpoint,
     its own measured speed and tracking error, current and status, all of one
     instant); CSV and a PNG with the plan, the tracking error and the speeds."""
+    folder = os.path.dirname(os.path.abspath(args.out))
+    if not os.path.isdir(folder) or not os.access(folder, os.W_OK):
+        raise UsageError(f"cannot write {args.out}.csv: {folder} is not a writable folder")
     s = Servo(bus, args.id)
     start = s.monitor().angle_decideg
     target = decideg(args.angle)
@@ -250,7 +291,7 @@ def cmd_record(bus, args):
         if done_at is not None and now > done_at + args.settle / 1000.0:
             break
     if done_at is None:
-        raise ServoError(f"servo {args.id} still moving after {limit:.1f} s")
+        raise Refused(f"servo {args.id} still moving after {limit:.1f} s (the samples are not written)")
     rows = []
     profile_end = None
     for t, m in samples:
@@ -347,6 +388,7 @@ def build_parser():
                     help="serial port or pyserial URL (socket://HOST:PORT); env SERVOCTL_PORT")
     ap.add_argument("--baud", type=int, default=115200)
     ap.add_argument("--timeout", type=float, default=0.1, help="reply timeout, seconds")
+    ap.add_argument("--version", action="version", version=f"servoctl {__version__}")
     sub = ap.add_subparsers(dest="command", required=True)
 
     c = sub.add_parser("scan", help="find servos by pinging IDs")
@@ -366,14 +408,16 @@ def build_parser():
     c.add_argument("action", choices=["get", "set", "dump", "save", "load", "reset"])
     c.add_argument("id", type=int)
     c.add_argument("rest", nargs="*", help="get NAME | set NAME VALUE | save FILE | load FILE")
+    c.add_argument("--with-link", action="store_true",
+                   help="config load: also set the ID and baud rate from the file")
     c.set_defaults(run=cmd_config)
 
     def motion_options(c):
         c.add_argument("id", type=int)
-        c.add_argument("angle", type=float, help="degrees")
+        c.add_argument("angle", type=finite, help="degrees")
         g = c.add_mutually_exclusive_group()
         g.add_argument("--interval", type=int, help="ms to get there (default 1000)")
-        g.add_argument("--velocity", type=float, help="peak speed, deg/s")
+        g.add_argument("--velocity", type=finite, help="peak speed, deg/s")
         c.add_argument("--acc", type=int, help="acceleration ramp, ms (>= 20; default 20)")
         c.add_argument("--dec", type=int, help="deceleration ramp, ms (>= 20; default 20)")
         c.add_argument("--power", type=int, default=0, help="mW; 0 = the power limit (42)")
@@ -381,8 +425,12 @@ def build_parser():
 
     c = sub.add_parser("move", help="an angle move (every angle mode)")
     motion_options(c)
-    c.add_argument("--wait", action="store_true", help="wait until it has finished")
-    c.add_argument("--timeout-s", type=float, default=30.0)
+    c.add_argument("--wait", action="store_true",
+                   help="wait until the horn has arrived; exit 1 and say why if it does not")
+    c.add_argument("--tolerance", type=finite, default=outcome.TOLERANCE_DEG,
+                   help=f"degrees the horn may be off (default {outcome.TOLERANCE_DEG})")
+    c.add_argument("--timeout-s", type=finite, default=None,
+                   help="give up after this (default: twice the plan, soft start, 2 s)")
     c.set_defaults(run=cmd_move)
 
     c = sub.add_parser("wheel", help="wheel mode: stop, run, turns, time")
@@ -431,30 +479,32 @@ def build_parser():
 
 
 def main(argv=None) -> int:
+    """The one boundary where every error becomes a line and an exit code."""
     args = build_parser().parse_args(argv)
+    try:
+        return _run(args)
+    except ServoError as e:
+        print(f"servoctl: error: {e}", file=sys.stderr)
+        return e.exit_code
+    except KeyboardInterrupt:
+        print("servoctl: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+
+
+def _run(args) -> int:
     if args.command == "sim":
-        try:
-            return cmd_sim(args)
-        except ServoError as e:
-            print(f"servoctl: error: {e}", file=sys.stderr)
-            return 1
+        return cmd_sim(args)
     if args.command == "config":
         need = {"get": 1, "set": 2, "dump": 0, "save": 1, "load": 1, "reset": 0}[args.action]
         if len(args.rest) != need:
-            print(f"servoctl: error: config {args.action} takes {need} argument(s)", file=sys.stderr)
-            return 2
+            raise UsageError(f"config {args.action} takes {need} argument(s)")
         args.name = args.rest[0] if args.action in ("get", "set") else None
         args.value = args.rest[1] if args.action == "set" else None
         args.file = args.rest[0] if args.action in ("save", "load") else None
     if not args.port:
-        print("servoctl: error: no port: give --port or set SERVOCTL_PORT", file=sys.stderr)
-        return 2
-    try:
-        with Bus(args.port, args.baud, args.timeout) as bus:
-            return args.run(bus, args)
-    except ServoError as e:
-        print(f"servoctl: error: {e}", file=sys.stderr)
-        return 1
+        raise UsageError("no port: give --port or set SERVOCTL_PORT")
+    with Bus(args.port, args.baud, args.timeout) as bus:
+        return args.run(bus, args)
 
 
 if __name__ == "__main__":

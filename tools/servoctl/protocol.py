@@ -34,19 +34,38 @@ READ_MOTION = 0x40  # this firmware's own (docs/packets.md)
 
 
 class ServoError(Exception):
-    """Base of every error servoctl reports."""
+    """Base of every error servoctl reports. exit_code is the command
+    line's (README, "Exit codes")."""
+    exit_code = 1
+
+
+class Refused(ServoError):
+    """The servo answered but did not do it (result 0, status bit 1, a
+    protection), or a move did not arrive."""
+    exit_code = 1
+
+
+class UsageError(ServoError):
+    """A value, name, file or option the tool cannot use: nothing was sent."""
+    exit_code = 2
+
+
+class ValueOutOfRange(UsageError):
+    pass
 
 
 class NoReply(ServoError):
+    """No servo answered (absent, another ID, another baud rate)."""
+    exit_code = 3
+
+
+class BadChecksum(NoReply):
     pass
 
 
-class BadChecksum(ServoError):
-    pass
-
-
-class ValueOutOfRange(ServoError):
-    pass
+class LinkError(ServoError):
+    """The serial port or socket failed: cannot open, gone, write error."""
+    exit_code = 4
 
 
 def checksum(data: bytes) -> int:
@@ -76,10 +95,11 @@ class Bus:
         import serial  # pyserial
 
         self.timeout = timeout
+        self.port = port
         try:
             self.serial = serial.serial_for_url(port, baudrate=baud, timeout=0.005)
-        except (serial.SerialException, ValueError) as e:
-            raise ServoError(f"cannot open {port}: {e}") from None
+        except (serial.SerialException, ValueError, OSError) as e:
+            raise LinkError(f"cannot open {port}: {e}") from None
         sock = getattr(self.serial, "_socket", None)
         if sock is not None:  # socket://: no Nagle delay on small frames
             import socket
@@ -96,13 +116,23 @@ class Bus:
     def __exit__(self, *exc):
         self.close()
 
+    def _link(self, what, *args):
+        """pyserial's own exceptions stay inside: a dropped link is a
+        LinkError with the port's name."""
+        import serial
+
+        try:
+            return what(*args)
+        except (serial.SerialException, OSError) as e:
+            raise LinkError(f"{self.port}: {e}") from None
+
     def send(self, code: int, content: bytes) -> None:
-        self.serial.reset_input_buffer()
+        self._link(self.serial.reset_input_buffer)
         self._buffer = b""
-        self.serial.write(request_frame(code, content))
+        self._link(self.serial.write, request_frame(code, content))
 
     def _fill(self) -> None:
-        data = self.serial.read(256)
+        data = self._link(self.serial.read, 256)
         if data:
             self._buffer += data
 

@@ -5,7 +5,7 @@ import struct
 
 from . import protocol as p
 from . import registers
-from .protocol import ServoError, ValueOutOfRange
+from .protocol import Refused, ServoError, ValueOutOfRange
 
 
 @dataclass
@@ -77,7 +77,7 @@ class Servo:
         item.check(value)
         content = self.bus.request(p.WRITE_DATA, bytes([self.id, item.id]) + item.pack(value))
         if content[2] != 1:
-            raise ServoError(f"servo {self.id} refused {item.name} = {value}")
+            raise Refused(f"servo {self.id} refused {item.name} = {value}")
 
     def read_all(self) -> dict:
         content = self.bus.request(p.READ_BATCH, bytes([self.id]))
@@ -87,11 +87,11 @@ class Servo:
         block = registers.encode_user_area(values)
         content = self.bus.request(p.WRITE_BATCH, bytes([self.id]) + block)
         if content[1] != 1:
-            raise ServoError(f"servo {self.id} refused the user area block")
+            raise Refused(f"servo {self.id} refused the user area block")
 
     def reset_user_data(self) -> None:
         if self.bus.request(p.RESET_USER_DATA, bytes([self.id]))[1] != 1:
-            raise ServoError(f"servo {self.id} refused the reset")
+            raise Refused(f"servo {self.id} refused the reset")
 
     def angle(self) -> int:
         return struct.unpack("<h", self.bus.request(p.READ_ANGLE, bytes([self.id]))[1:3])[0]

@@ -30,7 +30,7 @@ def test_config(sim, capsys, tmp_path):
     assert run(sim, capsys, "config", "set", "1", "stall_power", "2500")[1] == "stall_power = 2500\n"
     assert run(sim, capsys, "config", "get", "1", "38")[1] == "stall_power = 2500 mW\n"
     rc, _, err = run(sim, capsys, "config", "set", "1", "angle_max", "2000")
-    assert rc == 1 and "angle_max (51) must be -1800..1800" in err
+    assert rc == 2 and "angle_max (51) must be -1800..1800" in err
     assert run(sim, capsys, "config", "get", "1", "angle_max")[1] == "angle_max = 1350 0.1deg\n"
     rc, out, _ = run(sim, capsys, "config", "dump", "1")
     assert "38 stall_power        2500 mW" in out
@@ -45,7 +45,7 @@ def test_config(sim, capsys, tmp_path):
     values["high_voltage"] = 100  # below low_voltage: refused before sending
     saved.write_text(json.dumps(values))
     rc, _, err = run(sim, capsys, "config", "load", "1", str(saved))
-    assert rc == 1 and "must be below high_voltage" in err
+    assert rc == 2 and "must be below high_voltage" in err
 
 
 def test_motion_commands(sim, capsys):
@@ -54,8 +54,8 @@ def test_motion_commands(sim, capsys):
     assert rc == 0 and "still settling" not in out
     at = float(out.split(" at ")[1].split(" deg")[0])
     assert abs(at - 90.0) <= 0.5, out
-    rc, out, _ = run(sim, capsys, "origin", "1")
-    assert "refused" in out  # under angle control
+    rc, _, err = run(sim, capsys, "origin", "1")
+    assert rc == 1 and "refused" in err  # under angle control
     run(sim, capsys, "stop", "1", "--mode", "release")
     rc, out, _ = run(sim, capsys, "origin", "1")
     assert "now 0.0 deg" in out and "refused" not in out
@@ -108,4 +108,4 @@ def test_errors_say_what_happened(capsys):
     assert main(["scan"]) == 2 if not __import__("os").environ.get("SERVOCTL_PORT") else True
     rc = main(["--port", "/dev/nonexistent-servo", "ping", "1"])
     err = capsys.readouterr().err
-    assert rc == 1 and "cannot open /dev/nonexistent-servo" in err
+    assert rc == 4 and "cannot open /dev/nonexistent-servo" in err

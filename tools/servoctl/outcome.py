@@ -1,0 +1,121 @@
+"""What became of a motion command: did the servo take it, and did the horn
+arrive where it was asked to go, or why not."""
+from dataclasses import dataclass
+import time
+
+from . import registers
+from .profile import velocity_timing
+from .protocol import NoReply, Refused
+from .servo import Servo
+
+TOLERANCE_DEG = 0.5
+# Status bits under which the servo refuses motion (behaviour.md,
+# "Protection"): high and low voltage, over-temperature.
+INHIBITING = (1 << 3) | (1 << 4) | (1 << 7)
+STALL = 1 << 2
+COMMAND_ERROR = 1 << 1
+EXECUTING = 1 << 0
+
+
+def taken(s: Servo, what: str) -> int:
+    """After a command that has no answer of its own: the servo is there
+    and did not refuse it. Returns the status byte."""
+    try:
+        status = s.status()
+    except NoReply:
+        raise NoReply(f"servo {s.id} did not answer: is it on the bus, at this baud rate?") from None
+    if status & INHIBITING:
+        raise Refused(f"servo {s.id} refused {what}: a protection holds it "
+                      f"({', '.join(registers.status_names(status & INHIBITING))})")
+    if status & COMMAND_ERROR:
+        raise Refused(f"servo {s.id} refused {what} (status: {', '.join(registers.status_names(status))})")
+    return status
+
+
+@dataclass
+class Plan:
+    start: int        # 0.1 deg, multi-turn
+    asked: int        # 0.1 deg, as the user asked
+    target: int       # 0.1 deg, after the angle limits
+    target_abs: int   # 0.1 deg, multi-turn: where the horn should end
+    clamped: bool
+    planned_s: float  # the profile's length
+    soft_start_s: float
+
+
+def _turn_base(multi_turn: int) -> int:
+    """The whole turns of a multi-turn angle, as the firmware counts them
+    for a single-turn target (ReadAngle wraps into -180.0 .. 179.9)."""
+    within = multi_turn % 3600
+    if within >= 1800:
+        within -= 3600
+    return multi_turn - within
+
+
+def plan_move(s: Servo, asked: int, kw: dict) -> Plan:
+    """Where the move will end and how long it is planned to take, from the
+    servo's own settings: angle limits (48, 51, 52) clamp a single-turn
+    target; soft start (49, 50) may stretch it."""
+    cfg = s.read_all()
+    start, _ = s.multi_turn_angle()
+    target = asked
+    if not kw.get("multi_turn") and cfg["angle_limit_on"]:
+        target = min(max(asked, cfg["angle_min"]), cfg["angle_max"])
+    # A single-turn target is taken within the turn the servo is in.
+    target_abs = target if kw.get("multi_turn") else _turn_base(start) + target
+    acc, dec = max(kw["acc_ms"], 20), max(kw["dec_ms"], 20)
+    if "velocity" in kw:
+        n1, nc, n3 = velocity_timing(target_abs - start, 0.0, kw["velocity"] / 1000.0, acc, dec)
+        planned = (n1 + nc + n3) / 1000.0
+    else:
+        planned = max(kw["interval_ms"], acc + dec if kw.get("ramps", True) else 40) / 1000.0
+    soft = cfg["soft_start_time"] / 1000.0 if cfg["soft_start_on"] else 0.0
+    return Plan(start, asked, target, target_abs, target != asked, planned, soft)
+
+
+@dataclass
+class Outcome:
+    arrived: bool
+    angle: int        # 0.1 deg, where the horn settled
+    took_s: float
+    reason: str
+
+
+def wait_for_arrival(s: Servo, plan: Plan, tolerance_deg: float = TOLERANCE_DEG,
+                     timeout_s: float = None) -> Outcome:
+    """Waits for status bit 0 to fall (the firmware clears it once the horn
+    has arrived, nearly still) within a timeout that follows the plan, and
+    judges the result against the asked angle."""
+    limit = timeout_s if timeout_s is not None else 2.0 * plan.planned_s + plan.soft_start_s + 2.0
+    start = time.monotonic()
+    seen = 0
+    status = EXECUTING
+    time.sleep(0.01)
+    while time.monotonic() - start < limit:
+        status = s.status()
+        seen |= status
+        if not status & EXECUTING:
+            break
+        time.sleep(0.01)
+    took = time.monotonic() - start
+    angle, _ = s.multi_turn_angle()
+    off = abs(angle - plan.target_abs) / 10.0
+    if status & EXECUTING:
+        why = f"did not arrive within {limit:.1f} s (planned {plan.planned_s:.2f} s)"
+        if seen & STALL:
+            why = f"blocked: it stalled (status bit 2) and {why}"
+        return Outcome(False, angle, took, f"{why}; at {angle / 10:.1f} deg")
+    if off > tolerance_deg:
+        if seen & INHIBITING:
+            why = f"stopped by a protection ({', '.join(registers.status_names(seen & INHIBITING))})"
+        elif seen & STALL:
+            why = "blocked: it stalled (status bit 2)"
+        else:
+            why = "stopped short"
+        return Outcome(False, angle, took,
+                       f"{why} at {angle / 10:.1f} deg, {off:.1f} deg from {plan.target_abs / 10:.1f} deg")
+    if plan.clamped:
+        return Outcome(False, angle, took,
+                       f"at {angle / 10:.1f} deg, not {plan.asked / 10:.1f} deg: clamped by the angle "
+                       f"limits (51/52, switch 48)")
+    return Outcome(True, angle, took, "")

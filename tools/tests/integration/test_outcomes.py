@@ -1,0 +1,141 @@
+"""servoctl says what really happened, in one line, with an exit code
+(0 done, 1 refused or not arrived, 2 usage, 3 no reply, 4 link, 130
+interrupted): every case a new user met (issue 11, "Why")."""
+import json
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+
+import pytest
+
+from servoctl import __version__
+from servoctl.cli import main
+
+TOOLS = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+
+def run(sim, capsys, *args):
+    rc = main(["--port", sim.url, *args])
+    out = capsys.readouterr()
+    assert "Traceback" not in out.err
+    assert len(out.err.strip().splitlines()) <= 1, out.err
+    return rc, out.out, out.err
+
+
+@pytest.fixture
+def ready(sim, capsys):
+    assert run(sim, capsys, "config", "set", "1", "soft_start_on", "0")[0] == 0
+    return sim
+
+
+def test_a_blocked_move_fails_and_says_so(ready, capsys):
+    ready.control("stop 20")
+    rc, out, err = run(ready, capsys, "move", "1", "60", "--interval", "500", "--wait")
+    assert rc == 1 and "blocked" in err and "stalled" in err, err
+    ready.control("stop off")
+
+
+def test_a_move_without_power_fails(ready, capsys):
+    rc, _, err = run(ready, capsys, "move", "1", "90", "--power", "1", "--wait")
+    assert rc == 1 and "servo 1:" in err and ("stalled" in err or "did not arrive" in err), err
+
+
+def test_a_move_refused_by_a_protection_fails(ready, capsys):
+    ready.control("soak 100")
+    time.sleep(0.3)
+    rc, _, err = run(ready, capsys, "move", "1", "0", "--wait")
+    assert rc == 1 and "refused" in err and "over_temperature" in err, err
+    ready.control("soak 25")
+
+
+def test_a_clamped_move_says_so(ready, capsys):
+    rc, _, err = run(ready, capsys, "move", "1", "170", "--interval", "300", "--wait")
+    assert rc == 1 and "clamped by the angle limits" in err and "not 170.0 deg" in err, err
+    assert abs(float(err.split(" at ")[1].split(" deg")[0]) - 135.0) <= 0.5, err
+
+
+def test_the_wait_follows_the_plan(ready, capsys):
+    rc, out, _ = run(ready, capsys, "move", "1", "30", "--interval", "2500", "--wait")
+    assert rc == 0 and "planned 2500 ms" in out, out
+    took = float(out.split(" after ")[1].split(" ms")[0])
+    assert 2400 < took < 3500, out
+    rc, _, err = run(ready, capsys, "move", "1", "-30", "--interval", "3000", "--wait", "--timeout-s", "0.5")
+    assert rc == 1 and "did not arrive within 0.5 s" in err, err
+
+
+@pytest.mark.parametrize("argv", [["move", "7", "30"], ["stop", "9"], ["damping", "9"],
+                                  ["wheel", "9", "run"], ["origin", "9"]])
+def test_a_command_to_an_absent_servo_fails(sim, capsys, argv):
+    rc, _, err = run(sim, capsys, *argv)
+    assert rc == 3 and "did not answer" in err, err
+
+
+def test_origin_refused_while_holding_fails(ready, capsys):
+    assert run(ready, capsys, "move", "1", "10", "--interval", "100", "--wait")[0] == 0
+    rc, _, err = run(ready, capsys, "origin", "1")
+    assert rc == 1 and "release it first" in err, err
+
+
+@pytest.mark.parametrize("value", ["abc", "2.5W", "true"])
+def test_a_bad_config_value_is_one_line(sim, capsys, value):
+    rc, _, err = run(sim, capsys, "config", "set", "1", "stall_power", value)
+    assert rc == 2 and f"not {value!r}" in err, err
+
+
+def test_a_bad_angle_is_one_line(sim, capsys):
+    with pytest.raises(SystemExit) as e:
+        main(["--port", sim.url, "move", "1", "nan"])
+    assert e.value.code == 2
+    assert "not a finite number" in capsys.readouterr().err
+
+
+def test_config_files_that_cannot_be_loaded(sim, capsys, tmp_path):
+    rc, _, err = run(sim, capsys, "config", "load", "1", str(tmp_path / "missing.json"))
+    assert rc == 2 and "cannot read" in err
+    bad = tmp_path / "bad.json"
+    bad.write_text("{stall_power: 1")
+    rc, _, err = run(sim, capsys, "config", "load", "1", str(bad))
+    assert rc == 2 and "is not a config file" in err
+
+
+def test_config_load_keeps_the_link_and_takes_part_of_a_file(sim, capsys, tmp_path):
+    other = tmp_path / "other.json"
+    other.write_text(json.dumps({"servo_id": 5, "baud": 8, "stall_power": 1234}))
+    rc, out, _ = run(sim, capsys, "config", "load", "1", str(other))
+    assert rc == 0 and "kept servo_id 1" in out, out
+    assert run(sim, capsys, "config", "get", "1", "stall_power")[1] == "stall_power = 1234 mW\n"
+    assert run(sim, capsys, "ping", "1")[0] == 0
+
+
+def test_record_checks_where_it_writes_before_moving(ready, capsys):
+    before = ready.state(1)["angle"]
+    rc, _, err = run(ready, capsys, "record", "1", "60", "--out", "/nonexistent/x")
+    assert rc == 2 and "not a writable folder" in err
+    time.sleep(0.2)
+    assert abs(ready.state(1)["angle"] - before) < 0.5  # it did not move
+
+
+def test_a_dropped_link_is_one_line(sim, capsys):
+    threading.Timer(0.5, lambda: sim.process.kill()).start()
+    rc, _, err = run(sim, capsys, "monitor", "1", "--every", "0.05", "--count", "100")
+    assert rc == 4, err
+    sim.start()  # for the fixture's final check
+
+
+def test_version(capsys):
+    with pytest.raises(SystemExit) as e:
+        main(["--version"])
+    assert e.value.code == 0 and capsys.readouterr().out.strip() == f"servoctl {__version__}"
+
+
+def test_ctrl_c_stops_cleanly(sim):
+    proc = subprocess.Popen([sys.executable, "-m", "servoctl.cli", "--port", sim.url, "scan"],
+                            cwd=TOOLS, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(1.5)
+    proc.send_signal(signal.SIGINT)
+    out, err = proc.communicate(timeout=10)
+    assert proc.returncode == 130, err
+    assert "Traceback" not in err and "interrupted" in err
