@@ -15,7 +15,7 @@ import os
 import sys
 import time
 
-from . import __version__, ntc, outcome, registers
+from . import __version__, ntc, outcome, registers, units
 from .profile import positions, velocity_timing
 from .protocol import Bus, NoReply, Refused, ServoError, UsageError, ValueOutOfRange
 from .servo import Servo
@@ -95,30 +95,36 @@ def cmd_info(bus, args):
     return 0
 
 
-def _print_config(values: dict):
+def _shown(item, raw: int, as_raw: bool) -> str:
+    if as_raw:
+        return f"{raw}{' ' + item.unit if item.unit else ''}"
+    return units.show(item, raw)
+
+
+def _print_config(values: dict, as_raw: bool):
     for item in registers.USER:
-        value = values[item.name]
-        unit = f" {item.unit}" if item.unit else ""
-        print(f"  {item.id:2d} {item.name:<18} {value}{unit}")
+        print(f"  {item.id:2d} {item.name:<18} {_shown(item, values[item.name], as_raw)}")
 
 
 def cmd_config(bus, args):
     s = Servo(bus, args.id)
     if args.action == "get":
         item = registers.find(args.name)
-        value = s.read(item.id)
-        print(f"{item.name} = {value}{' ' + item.unit if item.unit else ''}")
+        print(f"{item.name} = {_shown(item, s.read(item.id), args.raw)}")
     elif args.action == "set":
         item = registers.find(args.name)
-        try:
-            value = int(args.value, 0)
-        except ValueError:
-            raise UsageError(f"{item.name} takes a whole number"
-                             f"{' of ' + item.unit if item.unit else ''}, not {args.value!r}") from None
+        if args.raw:
+            try:
+                value = int(args.value, 0)
+            except ValueError:
+                raise UsageError(f"{item.name} takes a whole number in protocol units, "
+                                 f"not {args.value!r}") from None
+        else:
+            value = units.to_raw(item, args.value)
         s.write(item.id, value)
-        print(f"{item.name} = {value}")
+        print(f"{item.name} = {_shown(item, value, args.raw)}")
     elif args.action == "dump":
-        _print_config(s.read_all())
+        _print_config(s.read_all(), args.raw)
     elif args.action == "save":
         values = s.read_all()
         try:
@@ -410,6 +416,8 @@ def build_parser():
     c.add_argument("rest", nargs="*", help="get NAME | set NAME VALUE | save FILE | load FILE")
     c.add_argument("--with-link", action="store_true",
                    help="config load: also set the ID and baud rate from the file")
+    c.add_argument("--raw", action="store_true",
+                   help="get/set/dump in protocol units (0.1 deg, NTC ADC, baud code)")
     c.set_defaults(run=cmd_config)
 
     def motion_options(c):

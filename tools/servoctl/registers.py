@@ -19,6 +19,7 @@ class Item:
     high: int = 0
     default: int = 0
     help: str = ""
+    quantity: str = ""    # what units.py shows it in: angle, temperature, baud, ...
 
     def pack(self, value: int) -> bytes:
         fmt = {1: "b", 2: "h", 4: "i"}[self.size]
@@ -53,24 +54,24 @@ USER = [
     Item(33, "control_response", 1, low=0, high=1, default=0, help="answer motion when finished"),
     Item(34, "servo_id", 1, low=0, high=254, default=0),
     Item(35, "reserved_35", 1, writable=False, public=False, high=255),
-    Item(36, "baud", 1, low=1, high=8, default=5, help="1=9600 ... 5=115200 ... 8=1000000"),
+    Item(36, "baud", 1, low=1, high=8, default=5, help="1=9600 ... 5=115200 ... 8=1000000", quantity="baud"),
     Item(37, "stall_release", 1, low=0, high=1, default=0, help="0 limit to stall power, 1 release"),
-    Item(38, "stall_power", 2, unit="mW", high=U16, default=10000),
-    Item(39, "low_voltage", 2, unit="mV", high=U16, default=4000),
-    Item(40, "high_voltage", 2, unit="mV", high=U16, default=8400),
-    Item(41, "temperature_limit", 2, unit="ADC", high=U16, default=651, help="trips at or below"),
-    Item(42, "power_limit", 2, unit="mW", high=U16, default=10000),
-    Item(43, "current_limit", 2, unit="mA", high=U16, default=4000),
+    Item(38, "stall_power", 2, unit="mW", high=U16, default=10000, quantity="power"),
+    Item(39, "low_voltage", 2, unit="mV", high=U16, default=4000, quantity="voltage"),
+    Item(40, "high_voltage", 2, unit="mV", high=U16, default=8400, quantity="voltage"),
+    Item(41, "temperature_limit", 2, unit="ADC", high=U16, default=651, help="trips at or below", quantity="temperature"),
+    Item(42, "power_limit", 2, unit="mW", high=U16, default=10000, quantity="power"),
+    Item(43, "current_limit", 2, unit="mA", high=U16, default=4000, quantity="current"),
     Item(44, "start_force", 1, high=255, default=0),
     Item(45, "reserved_45", 1, writable=False, public=False, high=255),
     Item(46, "power_on_lock", 1, low=0, high=1, default=0),
     Item(47, "wheel_brake", 1, low=0, high=1, default=0),
     Item(48, "angle_limit_on", 1, low=0, high=1, default=1),
     Item(49, "soft_start_on", 1, low=0, high=1, default=1),
-    Item(50, "soft_start_time", 2, unit="ms", high=U16, default=3000),
-    Item(51, "angle_max", 2, signed=True, unit="0.1deg", low=-1800, high=1800, default=1350),
-    Item(52, "angle_min", 2, signed=True, unit="0.1deg", low=-1800, high=1800, default=-1350),
-    Item(53, "center_offset", 2, signed=True, unit="0.1deg", low=-1800, high=1800, default=0),
+    Item(50, "soft_start_time", 2, unit="ms", high=U16, default=3000, quantity="time"),
+    Item(51, "angle_max", 2, signed=True, unit="0.1deg", low=-1800, high=1800, default=1350, quantity="angle"),
+    Item(52, "angle_min", 2, signed=True, unit="0.1deg", low=-1800, high=1800, default=-1350, quantity="angle"),
+    Item(53, "center_offset", 2, signed=True, unit="0.1deg", low=-1800, high=1800, default=0, quantity="angle"),
 ]
 ITEMS = STATUS + USER
 BY_ID = {i.id: i for i in ITEMS}

@@ -27,11 +27,11 @@ def test_scan_ping_info(sim, capsys):
 
 
 def test_config(sim, capsys, tmp_path):
-    assert run(sim, capsys, "config", "set", "1", "stall_power", "2500")[1] == "stall_power = 2500\n"
+    assert run(sim, capsys, "config", "set", "1", "stall_power", "2500")[1] == "stall_power = 2500 mW\n"
     assert run(sim, capsys, "config", "get", "1", "38")[1] == "stall_power = 2500 mW\n"
-    rc, _, err = run(sim, capsys, "config", "set", "1", "angle_max", "2000")
-    assert rc == 2 and "angle_max (51) must be -1800..1800" in err
-    assert run(sim, capsys, "config", "get", "1", "angle_max")[1] == "angle_max = 1350 0.1deg\n"
+    rc, _, err = run(sim, capsys, "config", "set", "1", "angle_max", "200")
+    assert rc == 2 and "angle_max (51) must be -180.0 deg..180.0 deg" in err
+    assert run(sim, capsys, "config", "get", "1", "angle_max")[1] == "angle_max = 135.0 deg\n"
     rc, out, _ = run(sim, capsys, "config", "dump", "1")
     assert "38 stall_power        2500 mW" in out
     saved = tmp_path / "cfg.json"

@@ -1,0 +1,92 @@
+"""Data items in engineering units: what the user types and reads. Each
+item's quantity (registers.py) says how its raw protocol value is shown and
+which units it takes; a plain number is in the unit it is shown in.
+
+    angle        0.1 deg on the wire; deg ("90", "90deg", "-45.5°")
+    temperature  NTC ADC on the wire; degC ("75", "75C", "75degC")
+    voltage      mV ("7400", "7400mV", "7.4V")
+    current      mA ("4000", "4000mA", "4A")
+    power        mW ("2500", "2500mW", "2.5W")
+    time         ms ("3000", "3000ms", "3s")
+    baud         the index 1..8 on the wire; the rate ("115200", "1000000baud")
+"""
+import math
+import re
+
+from . import ntc, registers
+from .protocol import UsageError, ValueOutOfRange
+
+# quantity: (unit shown, {suffix: factor to the raw unit})
+SCALES = {
+    "voltage": ("mV", {"": 1, "mv": 1, "v": 1000}),
+    "current": ("mA", {"": 1, "ma": 1, "a": 1000}),
+    "power": ("mW", {"": 1, "mw": 1, "w": 1000}),
+    "time": ("ms", {"": 1, "ms": 1, "s": 1000}),
+    "angle": ("deg", {"": 10, "deg": 10, "°": 10}),
+}
+_NUMBER = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*([A-Za-z°]*)\s*$")
+
+
+def _split(item, text: str):
+    m = _NUMBER.match(str(text))
+    if not m:
+        raise UsageError(f"{item.name} takes a number{_units_hint(item)}, not {text!r}")
+    value = float(m.group(1))
+    if not math.isfinite(value):
+        raise UsageError(f"{item.name} takes a finite number, not {text!r}")
+    return value, m.group(2).lower()
+
+
+def _units_hint(item) -> str:
+    if item.quantity in SCALES:
+        return " in " + " or ".join(s for s in SCALES[item.quantity][1] if s)
+    return {"temperature": " in degC", "baud": " (a baud rate)"}.get(item.quantity, "")
+
+
+def to_raw(item, text) -> int:
+    """The protocol value for what the user typed; range-checked, with the
+    range said in the same units."""
+    value, suffix = _split(item, text)
+    q = item.quantity
+    if q in SCALES:
+        shown, factors = SCALES[q]
+        if suffix not in factors:
+            raise UsageError(f"{item.name} takes{_units_hint(item)}, not {text!r}")
+        raw = round(value * factors[suffix])
+    elif q == "temperature":
+        if suffix not in ("", "c", "degc", "°c"):
+            raise UsageError(f"{item.name} takes degC, not {text!r}")
+        if not -40 <= value <= 150:
+            raise ValueOutOfRange(f"{item.name} ({item.id}) must be -40..150 degC, not {value:g}")
+        raw = ntc.celsius_to_adc(value)
+    elif q == "baud":
+        rates = {rate: code for code, rate in registers.BAUD_RATES.items()}
+        if suffix not in ("", "baud") or value not in rates:
+            raise ValueOutOfRange(f"{item.name} ({item.id}) must be one of "
+                                  f"{', '.join(str(r) for r in rates)}, not {text!r}")
+        raw = rates[value]
+    else:
+        if suffix or value != int(value):
+            raise UsageError(f"{item.name} takes a whole number, not {text!r}")
+        raw = int(value)
+    if not item.low <= raw <= item.high:
+        raise ValueOutOfRange(f"{item.name} ({item.id}) must be {show(item, item.low)}.."
+                              f"{show(item, item.high)}, not {text}")
+    return raw
+
+
+def show(item, raw: int) -> str:
+    """A raw protocol value in the item's engineering unit."""
+    q = item.quantity
+    if q == "angle":
+        return f"{raw / 10:.1f} deg"
+    if q in SCALES:
+        return f"{raw} {SCALES[q][0]}"
+    if q == "temperature":
+        try:
+            return f"{ntc.adc_to_celsius(raw):.1f} degC (ADC {raw})"
+        except ValueError:
+            return f"ADC {raw}"
+    if q == "baud":
+        return f"{registers.BAUD_RATES.get(raw, '?')} baud (code {raw})"
+    return f"{raw}{' ' + item.unit if item.unit else ''}"

@@ -1,0 +1,73 @@
+"""Config items in engineering units (degrees, degC, V/mV, A/mA, W/mW,
+s/ms, real baud rates), the raw value still reachable with --raw; and the
+tool's data table checked against the firmware's own, so they cannot
+drift."""
+import re
+from pathlib import Path
+
+import pytest
+
+from servoctl import ntc, registers, units
+from servoctl.cli import main
+from servoctl.protocol import UsageError, ValueOutOfRange
+
+ROOT = Path(__file__).resolve().parents[3]
+
+
+def run(sim, capsys, *args):
+    rc = main(["--port", sim.url, *args])
+    out = capsys.readouterr()
+    return rc, out.out, out.err
+
+
+def test_config_takes_and_shows_engineering_units(sim, capsys):
+    assert run(sim, capsys, "config", "set", "1", "angle_max", "90")[1] == "angle_max = 90.0 deg\n"
+    assert run(sim, capsys, "config", "get", "1", "angle_max", "--raw")[1] == "angle_max = 900 0.1deg\n"
+    rc, out, _ = run(sim, capsys, "config", "set", "1", "temperature_limit", "75C")
+    assert rc == 0 and out.startswith("temperature_limit = 75.0 degC (ADC ")
+    assert run(sim, capsys, "config", "get", "1", "41", "--raw")[1] == \
+        f"temperature_limit = {ntc.celsius_to_adc(75)} ADC\n"
+    assert run(sim, capsys, "config", "set", "1", "low_voltage", "4.5V")[1] == "low_voltage = 4500 mV\n"
+    assert run(sim, capsys, "config", "set", "1", "power_limit", "2.5W")[1] == "power_limit = 2500 mW\n"
+    assert run(sim, capsys, "config", "set", "1", "soft_start_time", "1.5s")[1] == "soft_start_time = 1500 ms\n"
+    rc, out, _ = run(sim, capsys, "config", "dump", "1")
+    assert "51 angle_max          90.0 deg" in out and "115200 baud (code 5)" in out
+    rc, _, err = run(sim, capsys, "config", "set", "1", "baud", "123456")
+    assert rc == 2 and "9600, 19200" in err
+    rc, _, err = run(sim, capsys, "config", "set", "1", "angle_max", "90V")
+    assert rc == 2 and "takes in deg" in err
+
+
+@pytest.mark.parametrize("name,text,raw", [
+    ("angle_min", "-45.5", -455), ("angle_min", "-45.5deg", -455), ("center_offset", "10°", 100),
+    ("current_limit", "1.2A", 1200), ("current_limit", "800mA", 800), ("baud", "1000000", 8),
+    ("baud", "9600baud", 1), ("stall_power", "0.5W", 500), ("servo_id", "12", 12),
+])
+def test_to_raw(name, text, raw):
+    assert units.to_raw(registers.find(name), text) == raw
+
+
+@pytest.mark.parametrize("name,text,error", [
+    ("servo_id", "1.5", UsageError), ("servo_id", "255", ValueOutOfRange),
+    ("temperature_limit", "200C", ValueOutOfRange), ("stall_power", "70W", ValueOutOfRange),
+    ("angle_max", "nan", UsageError), ("low_voltage", "true", UsageError),
+])
+def test_to_raw_refuses(name, text, error):
+    with pytest.raises(error):
+        units.to_raw(registers.find(name), text)
+
+
+def test_the_tool_table_matches_the_firmware_table():
+    """protocol/data_table.c's USER(...) rows: ID, size, signedness, range
+    and factory value of every user item, item for item."""
+    source = (ROOT / "protocol/data_table.c").read_text()
+    rows = re.findall(r"USER\((\d+), (\w+), (\d), (\w+), (-?\d+), (-?\d+), (-?\d+)\)", source)
+    assert len(rows) == len(registers.USER) == 22
+    for (ident, field, size, access, low, high, factory), item in zip(rows, registers.USER):
+        assert int(ident) == item.id, field
+        assert int(size) == item.size, field
+        assert (access == "RW_SIGNED") == item.signed, field
+        assert (access != "RESERVED") == item.writable, field
+        assert int(factory) == item.default, field
+        if item.writable:
+            assert (int(low), int(high)) == (item.low, item.high), field
