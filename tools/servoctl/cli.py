@@ -27,6 +27,17 @@ def decideg(degrees: float) -> int:
     return int(round(degrees * 10))
 
 
+def id_number(text: str) -> int:
+    """argparse type: a servo ID, 0..254."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a servo ID: {text!r}") from None
+    if not 0 <= value <= 254:
+        raise argparse.ArgumentTypeError(f"servo IDs are 0..254, not {value}")
+    return value
+
+
 def finite(text: str) -> float:
     """argparse type: a real number of degrees (no nan, no inf)."""
     try:
@@ -52,23 +63,49 @@ def describe_temperature(adc: int) -> str:
 
 # ---- commands --------------------------------------------------------------
 
-# A servo answers a ping within about a millisecond; a short wait keeps a
-# full scan of 254 IDs near 13 s.
-SCAN_REPLY_S = 0.05
+def scan_timeout_s(baud: int) -> float:
+    """How long to wait for one ID's ping answer: the request and the answer
+    (6 bytes each, 10 bits a byte) at this baud rate, and 3 ms for the servo
+    and the link to turn around. 0-253 take about a second at 115200."""
+    return 12 * 10 / baud + 0.003
+
+
+def _scan_one_rate(bus, first: int, last: int, timeout: float, found: list, progress, task,
+                   quiet: bool):
+    for servo_id in range(first, last + 1):
+        if Servo(bus, servo_id).ping(timeout=timeout):
+            found.append((servo_id, bus.serial.baudrate))
+            if not quiet:
+                progress.console.print(f"servo {servo_id} at {bus.serial.baudrate} baud")
+        progress.advance(task)
 
 
 def cmd_scan(bus, args):
+    from rich.progress import Progress
+
+    rates = [bus.serial.baudrate]  # the one asked for first
+    if args.all_bauds:
+        rates += [r for r in sorted(registers.BAUD_RATES.values()) if r != rates[0]]
     found = []
-    for servo_id in range(args.first, args.last + 1):
-        if Servo(bus, servo_id).ping(timeout=SCAN_REPLY_S):
-            found.append(servo_id)
-            print(f"servo {servo_id}")
-        if sys.stderr.isatty():
-            print(f"\rscanning {servo_id}/{args.last}", end="", file=sys.stderr)
-    if sys.stderr.isatty():
-        print(file=sys.stderr)
-    print(f"{len(found)} servo(s) found" if found else "no servo answered")
-    return 0 if found else 1
+    interrupted = False
+    with Progress(transient=True, disable=not sys.stderr.isatty()) as progress:
+        task = progress.add_task("scanning", total=len(rates) * (args.last - args.first + 1))
+        try:
+            for rate in rates:
+                bus.serial.baudrate = rate
+                timeout = args.reply_timeout or scan_timeout_s(rate)
+                _scan_one_rate(bus, args.first, args.last, timeout, found, progress, task, args.json)
+        except KeyboardInterrupt:
+            interrupted = True
+    if args.json:
+        print(json.dumps([{"id": i, "baud": b} for i, b in found]))
+    else:
+        print(f"{len(found)} servo(s) found" if found else "no servo answered",
+              "(interrupted)" if interrupted else "")
+    if interrupted:
+        print("servoctl: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    return 0 if found else 3
 
 
 def cmd_ping(bus, args):
@@ -398,8 +435,12 @@ def build_parser():
     sub = ap.add_subparsers(dest="command", required=True)
 
     c = sub.add_parser("scan", help="find servos by pinging IDs")
-    c.add_argument("--first", type=int, default=0)
-    c.add_argument("--last", type=int, default=253)
+    c.add_argument("--first", type=id_number, default=0)
+    c.add_argument("--last", type=id_number, default=253)
+    c.add_argument("--all-bauds", action="store_true", help="every baud rate of item 36 in turn")
+    c.add_argument("--reply-timeout", type=finite, default=None,
+                   help="seconds per ID (default: from the baud rate, about 4 ms at 115200)")
+    c.add_argument("--json", action="store_true", help="the servos found, as JSON")
     c.set_defaults(run=cmd_scan)
 
     c = sub.add_parser("ping", help="is this servo there")

@@ -132,10 +132,25 @@ def test_version(capsys):
 
 
 def test_ctrl_c_stops_cleanly(sim):
-    proc = subprocess.Popen([sys.executable, "-m", "servoctl.cli", "--port", sim.url, "scan"],
+    proc = subprocess.Popen([sys.executable, "-m", "servoctl.cli", "--port", sim.url, "scan", "--all-bauds"],
                             cwd=TOOLS, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     time.sleep(1.5)
     proc.send_signal(signal.SIGINT)
     out, err = proc.communicate(timeout=10)
     assert proc.returncode == 130, err
     assert "Traceback" not in err and "interrupted" in err
+    assert "servo 1 at 115200 baud" in out and "1 servo(s) found (interrupted)" in out
+
+
+def test_a_full_scan_takes_about_a_second(sim, capsys):
+    start = time.monotonic()
+    rc, out, _ = run(sim, capsys, "scan", "--json")
+    took = time.monotonic() - start
+    assert rc == 0 and json.loads(out) == [{"id": 1, "baud": 115200}]
+    assert took < 2.0, f"0-253 took {took:.1f} s"
+
+
+def test_scan_refuses_ids_beyond_254(sim, capsys):
+    with pytest.raises(SystemExit) as e:
+        main(["--port", sim.url, "scan", "--last", "300"])
+    assert e.value.code == 2 and "servo IDs are 0..254" in capsys.readouterr().err
