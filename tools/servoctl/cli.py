@@ -406,19 +406,32 @@ def _plot(rows, plan, path, title, profile_end, finished):
     plt.close(fig)
 
 
+def _interrupt(signum, frame):
+    raise KeyboardInterrupt
+
+
 def cmd_sim(args):
+    """Runs servo_sim until Ctrl-C or SIGTERM; either stops it cleanly and
+    removes a state folder it made."""
+    import signal
+
     from .sim import Simulator
 
-    sim = Simulator(ids=args.ids or [1], tcp=args.tcp, link=args.link, state_dir=args.state)
-    sim.start()
-    print(f"simulator running: bus {sim.url}, control 127.0.0.1:{sim.control_port}")
-    print(f"  e.g. servoctl --port {sim.url} scan --last 10     (Ctrl-C stops it)")
+    tcp_port = args.tcp if args.tcp else None
+    sim = Simulator(ids=args.ids or [1], tcp=args.tcp is not None, link=args.link,
+                    state_dir=args.state, tcp_port=tcp_port)
+    previous = signal.signal(signal.SIGTERM, _interrupt)
     try:
+        sim.start()
+        print(f"simulator running: bus {sim.url}, control 127.0.0.1:{sim.control_port}", flush=True)
+        print(f"  e.g. servoctl --port {sim.url} scan --last 10     (Ctrl-C stops it)", flush=True)
         sim.process.wait()
     except KeyboardInterrupt:
         pass
     finally:
         sim.stop()
+        signal.signal(signal.SIGTERM, previous)
+    print("simulator stopped")
     return 0
 
 
@@ -520,7 +533,8 @@ def build_parser():
 
     c = sub.add_parser("sim", help="run the simulator")
     c.add_argument("--id", dest="ids", type=int, action="append")
-    c.add_argument("--tcp", action="store_true", help="a TCP port instead of a pty")
+    c.add_argument("--tcp", type=int, nargs="?", const=0, default=None, metavar="PORT",
+                   help="a TCP port instead of a pty (any free port if none given)")
     c.add_argument("--link", help="symlink to the pty")
     c.add_argument("--state", help="folder for the flash files")
     c.set_defaults(run=None)

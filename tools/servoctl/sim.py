@@ -2,6 +2,7 @@
 fault-injection channel."""
 import os
 from pathlib import Path
+import shutil
 import socket
 import subprocess
 import tempfile
@@ -16,12 +17,19 @@ DEFAULT_BINARY = REPO / "build" / "host" / "firmware" / "boards" / "host_sim" / 
 
 
 def find_binary() -> Path:
-    path = Path(os.environ.get("SERVO_SIM", DEFAULT_BINARY))
-    if not path.exists():
-        raise ServoError(f"no simulator at {path}: build it with "
-                         f"'cmake --preset host && cmake --build --preset host' "
-                         f"or point SERVO_SIM at it")
-    return path
+    """servo_sim: $SERVO_SIM, else the repository's host build, else the
+    PATH (an installed servoctl has no repository around it)."""
+    if "SERVO_SIM" in os.environ:
+        candidates = [Path(os.environ["SERVO_SIM"])]
+    else:
+        on_path = shutil.which("servo_sim")
+        candidates = [DEFAULT_BINARY] + ([Path(on_path)] if on_path else [])
+    for path in candidates:
+        if path.exists():
+            return path
+    raise ServoError(f"no simulator at {candidates[0]}: build it with "
+                     f"'cmake --preset host && cmake --build --preset host', "
+                     f"put servo_sim on the PATH, or point SERVO_SIM at it")
 
 
 class _Child:
@@ -50,9 +58,10 @@ class Simulator(_Child):
     socket://) unless tcp=False, then a pseudo-terminal (optionally linked)."""
 
     def __init__(self, ids=(1,), tcp=True, link=None, state_dir=None, supply_mv=None,
-                 ambient_c=None):
+                 ambient_c=None, tcp_port=None):
         self.ids = list(ids)
-        self.tcp = tcp
+        self.tcp = tcp or tcp_port is not None
+        self.tcp_port = tcp_port
         self.link = link
         self._own_state = state_dir is None
         self.state_dir = state_dir or tempfile.mkdtemp(prefix="servo-sim-")
@@ -67,7 +76,7 @@ class Simulator(_Child):
         for i in self.ids:
             cmd += ["--id", str(i)]
         if self.tcp:
-            cmd += ["--tcp", str(_free_port())]
+            cmd += ["--tcp", str(self.tcp_port or _free_port())]
         if self.link:
             cmd += ["--link", str(self.link)]
         if self.supply_mv is not None:
@@ -91,6 +100,13 @@ class Simulator(_Child):
                 return self
         self.stop()
         raise ServoError("servo_sim did not become ready within 20 s")
+
+    def stop(self) -> str:
+        """Stops servo_sim; a state folder it made itself goes with it."""
+        err = super().stop()
+        if self._own_state:
+            shutil.rmtree(self.state_dir, ignore_errors=True)
+        return err
 
     def control(self, line: str) -> str:
         """Sends one control command; returns the reply."""

@@ -154,3 +154,40 @@ def test_scan_refuses_ids_beyond_254(sim, capsys):
     with pytest.raises(SystemExit) as e:
         main(["--port", sim.url, "scan", "--last", "300"])
     assert e.value.code == 2 and "servo IDs are 0..254" in capsys.readouterr().err
+
+
+def test_sim_stops_cleanly_on_sigterm_and_leaves_nothing(tmp_path):
+    import glob
+    import socket
+    import tempfile
+
+    before = set(glob.glob(os.path.join(tempfile.gettempdir(), "servo-sim-*")))
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    proc = subprocess.Popen([sys.executable, "-m", "servoctl.cli", "sim", "--tcp", str(port)],
+                            cwd=TOOLS, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    line = proc.stdout.readline()
+    assert f"socket://127.0.0.1:{port}" in line, line
+    assert main(["--port", f"socket://127.0.0.1:{port}", "ping", "1"]) == 0
+    proc.send_signal(signal.SIGTERM)
+    out, err = proc.communicate(timeout=15)
+    assert proc.returncode == 0 and "simulator stopped" in out, err
+    assert "Traceback" not in err
+    assert subprocess.run(["pgrep", "-f", f"servo_sim.*--tcp {port}"], capture_output=True).returncode == 1
+    after = set(glob.glob(os.path.join(tempfile.gettempdir(), "servo-sim-*")))
+    assert after <= before, f"left behind: {after - before}"
+
+
+def test_servo_sim_is_found_on_the_path_outside_the_repository(tmp_path, monkeypatch):
+    from servoctl import sim as simmod
+
+    real = simmod.find_binary()
+    (tmp_path / "servo_sim").symlink_to(real)
+    monkeypatch.delenv("SERVO_SIM", raising=False)
+    monkeypatch.setattr(simmod, "DEFAULT_BINARY", tmp_path / "no-repository" / "servo_sim")
+    monkeypatch.setenv("PATH", f"{tmp_path}{os.pathsep}{os.environ['PATH']}")
+    assert simmod.find_binary() == tmp_path / "servo_sim"
+    monkeypatch.setenv("PATH", "/nonexistent")
+    with pytest.raises(simmod.ServoError, match="put servo_sim on the PATH"):
+        simmod.find_binary()
