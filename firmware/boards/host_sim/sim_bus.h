@@ -26,7 +26,7 @@
 #include <stdint.h>
 
 #define SIM_BUS_QUEUE 8192u
-#define SIM_MAX_SERVOS 16u
+#define SIM_MAX_SERVOS 254u /* IDs 0..253, and 254 */
 #define SIM_BUS_STEP_US 250u /* most the bus clock moves in one pass */
 #define SIM_HOST 0xFFu /* sender of the host's bytes */
 
