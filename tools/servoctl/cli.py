@@ -15,7 +15,7 @@ import os
 import sys
 import time
 
-from . import __version__, ntc, outcome, registers, units
+from . import __version__, group, ntc, outcome, registers, units
 from .profile import positions, velocity_timing
 from .protocol import Bus, NoReply, Refused, ServoError, UsageError, ValueOutOfRange
 from .servo import Servo
@@ -275,6 +275,61 @@ def cmd_origin(bus, args):
     return 0
 
 
+def _target(text: str):
+    """ID:DEGREES, for sync-move."""
+    servo_id, sep, degrees = text.partition(":")
+    try:
+        if not sep:
+            raise ValueError
+        return int(servo_id), finite(degrees)
+    except (ValueError, argparse.ArgumentTypeError):
+        raise argparse.ArgumentTypeError(f"not ID:DEGREES: {text!r}") from None
+
+
+def cmd_sync_move(bus, args):
+    targets = dict(args.targets)
+    group.sync_move(bus, targets, args.interval / 1000.0, args.power / 1000.0)
+    for servo_id in targets:
+        outcome.taken(Servo(bus, servo_id), "the sync move")
+    print(f"{len(targets)} servo(s) moving together")
+    return 0
+
+
+def cmd_broadcast_move(bus, args):
+    group.broadcast_move(bus, args.angle, args.interval / 1000.0, args.power / 1000.0)
+    return 0
+
+
+def cmd_async(bus, args):
+    if args.action == "begin":
+        group.begin_async(bus)
+    else:
+        group.end_async(bus, cancel=args.action == "cancel")
+    return 0
+
+
+def _ids_on_bus(bus, ids):
+    if ids:
+        return ids
+    timeout = scan_timeout_s(bus.serial.baudrate)
+    return [i for i in range(254) if Servo(bus, i).ping(timeout=timeout)]
+
+
+def cmd_backup(bus, args):
+    ids = _ids_on_bus(bus, args.ids)
+    if not ids:
+        raise NoReply("no servo answered: nothing to back up")
+    group.backup(bus, ids, args.file)
+    print(f"saved {len(ids)} servo(s) ({', '.join(map(str, ids))}) to {args.file}")
+    return 0
+
+
+def cmd_restore(bus, args):
+    done = group.restore(bus, args.file, args.with_link)
+    print(f"restored {len(done)} servo(s) ({', '.join(map(str, done))}) from {args.file}")
+    return 0
+
+
 def cmd_monitor(bus, args):
     servos = [Servo(bus, i) for i in args.ids]
     print(f"{'id':>3} {'angle deg':>10} {'V':>6} {'A':>6} {'W':>6} {'degC':>6}  status")
@@ -530,6 +585,32 @@ def build_parser():
     c.add_argument("--out", default="record", help="file name prefix (default: record)")
     c.add_argument("--settle", type=int, default=300, help="ms to keep sampling after the plan")
     c.set_defaults(run=cmd_record)
+
+    c = sub.add_parser("sync-move", help="several servos start their moves in one frame")
+    c.add_argument("targets", type=_target, nargs="+", metavar="ID:DEGREES")
+    c.add_argument("--interval", type=int, default=1000, help="ms to get there (default 1000)")
+    c.add_argument("--power", type=int, default=0, help="mW; 0 = each servo's power limit")
+    c.set_defaults(run=cmd_sync_move)
+
+    c = sub.add_parser("broadcast-move", help="every servo on the bus to one angle")
+    c.add_argument("angle", type=finite, help="degrees, -180..180")
+    c.add_argument("--interval", type=int, default=1000, help="ms to get there (default 1000)")
+    c.add_argument("--power", type=int, default=0, help="mW; 0 = each servo's power limit")
+    c.set_defaults(run=cmd_broadcast_move)
+
+    c = sub.add_parser("async", help="begin: servos buffer moves; end: all start; cancel: drop")
+    c.add_argument("action", choices=["begin", "end", "cancel"])
+    c.set_defaults(run=cmd_async)
+
+    c = sub.add_parser("backup", help="every servo's user area to one file")
+    c.add_argument("file")
+    c.add_argument("--ids", type=id_number, nargs="+", help="these servos (default: scan)")
+    c.set_defaults(run=cmd_backup)
+
+    c = sub.add_parser("restore", help="write a backup back, each servo by its ID")
+    c.add_argument("file")
+    c.add_argument("--with-link", action="store_true", help="also set IDs and baud rates")
+    c.set_defaults(run=cmd_restore)
 
     c = sub.add_parser("sim", help="run the simulator")
     c.add_argument("--id", dest="ids", type=int, action="append")

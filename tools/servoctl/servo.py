@@ -45,6 +45,9 @@ class MotionSnapshot:
 
 
 def _check(name: str, value: int, low: int, high: int, unit: str = "") -> int:
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise ValueOutOfRange(f"{name} takes a whole number{' of ' + unit if unit else ''}, not {value!r}"
+                              f"{' (move_to() takes degrees)' if name == 'angle' else ''}")
     if not low <= value <= high:
         raise ValueOutOfRange(f"{name} must be {low}..{high}{' ' + unit if unit else ''}, not {value}")
     return value
@@ -173,3 +176,79 @@ class Servo:
 
     def reset_multi_turn(self) -> None:
         self.bus.send(p.RESET_MULTI_TURN, bytes([self.id]))
+
+    # ---- engineering units: the documented Python API (README) -------------
+    def move_to(self, degrees: float, duration_s: float = None, speed_dps: float = None,
+                accel_s: float = 0.02, decel_s: float = 0.02, power_w: float = 0.0,
+                multi_turn: bool = None, wait: bool = False, tolerance_deg: float = 0.5):
+        """Moves to an angle in degrees, in duration_s seconds or at
+        speed_dps degrees per second (one of them; default 1 s). Beyond
+        +-180 degrees it is a multi-turn move. With wait, returns when the
+        horn has arrived within tolerance_deg, and raises Refused saying
+        why when it does not (stalled, a protection, clamped, timed out)."""
+        from . import outcome
+
+        if multi_turn is None:
+            multi_turn = abs(degrees) > 180.0
+        if duration_s is not None and speed_dps is not None:
+            raise ValueOutOfRange("give a duration or a speed, not both")
+        kw = dict(acc_ms=_ms(accel_s, "accel_s"), dec_ms=_ms(decel_s, "decel_s"),
+                  power_mw=_scaled(power_w, 1000, "power_w"), multi_turn=multi_turn)
+        if speed_dps is not None:
+            kw["velocity"] = _scaled(speed_dps, 10, "speed_dps")
+        else:
+            kw["interval_ms"] = _ms(1.0 if duration_s is None else duration_s, "duration_s")
+        asked = _scaled(degrees, 10, "degrees")
+        plan = outcome.plan_move(self, asked, kw) if wait else None
+        self.move(asked, **kw)
+        outcome.taken(self, "the move")
+        if not wait:
+            return None
+        result = outcome.wait_for_arrival(self, plan, tolerance_deg)
+        if not result.arrived:
+            raise Refused(f"servo {self.id}: {result.reason}")
+        return result
+
+    def position_deg(self) -> float:
+        """The multi-turn angle, degrees."""
+        return self.multi_turn_angle()[0] / 10.0
+
+    def velocity_dps(self) -> float:
+        """The horn's speed as the servo measures it, degrees per second."""
+        return self.read_motion().velocity_decideg_s / 10.0
+
+    def supply_v(self) -> float:
+        return self.read("voltage") / 1000.0
+
+    def current_a(self) -> float:
+        return self.read("current") / 1000.0
+
+    def power_w(self) -> float:
+        return self.read("power") / 1000.0
+
+    def temperature_c(self) -> float:
+        from . import ntc
+
+        return ntc.adc_to_celsius(self.read("temperature"))
+
+    def status_names(self) -> list:
+        """The status bits that are set, by name (registers.STATUS_BITS)."""
+        return registers.status_names(self.status())
+
+    def release(self) -> None:
+        self.stop("release")
+
+    def hold(self) -> None:
+        self.stop("hold")
+
+
+def _scaled(value: float, factor: int, name: str) -> int:
+    import math
+
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise ValueOutOfRange(f"{name} takes a finite number, not {value!r}")
+    return int(round(value * factor))
+
+
+def _ms(seconds: float, name: str) -> int:
+    return _scaled(seconds, 1000, name)

@@ -191,3 +191,57 @@ def test_servo_sim_is_found_on_the_path_outside_the_repository(tmp_path, monkeyp
     monkeypatch.setenv("PATH", "/nonexistent")
     with pytest.raises(simmod.ServoError, match="put servo_sim on the PATH"):
         simmod.find_binary()
+
+
+def test_sync_broadcast_and_async_moves(sim3, capsys):
+    for i in (1, 2, 3):
+        assert run(sim3, capsys, "config", "set", str(i), "soft_start_on", "0")[0] == 0
+    rc, out, _ = run(sim3, capsys, "sync-move", "1:30", "2:-20", "3:400", "--interval", "1500")
+    assert rc == 0 and "3 servo(s) moving together" in out
+    time.sleep(2.0)
+    assert [round(sim3.state(i)["angle"]) for i in (1, 2, 3)] == [30, -20, 400]
+    assert run(sim3, capsys, "broadcast-move", "10", "--interval", "300")[0] == 0
+    time.sleep(0.6)
+    assert [round(sim3.state(i)["angle"]) for i in (1, 2)] == [10, 10]
+    assert run(sim3, capsys, "async", "begin")[0] == 0
+    assert run(sim3, capsys, "move", "1", "-45", "--interval", "200")[0] == 0
+    time.sleep(0.3)
+    assert round(sim3.state(1)["angle"]) == 10  # buffered
+    assert run(sim3, capsys, "async", "end")[0] == 0
+    time.sleep(0.5)
+    assert round(sim3.state(1)["angle"]) == -45
+
+
+def test_backup_and_restore_a_whole_bus(sim3, capsys, tmp_path):
+    for i in (1, 2, 3):
+        run(sim3, capsys, "config", "set", str(i), "stall_power", str(1000 * i))
+    backup = tmp_path / "bus.json"
+    rc, out, _ = run(sim3, capsys, "backup", str(backup))
+    assert rc == 0 and "saved 3 servo(s) (1, 2, 3)" in out
+    for i in (1, 2, 3):
+        run(sim3, capsys, "config", "reset", str(i))
+    rc, out, _ = run(sim3, capsys, "restore", str(backup))
+    assert rc == 0 and "restored 3 servo(s)" in out
+    for i in (1, 2, 3):
+        assert run(sim3, capsys, "config", "get", str(i), "stall_power")[1] == f"stall_power = {1000 * i} mW\n"
+    rc, _, err = run(sim3, capsys, "restore", str(tmp_path / "nothing.json"))
+    assert rc == 2 and "cannot read" in err
+
+
+def test_the_python_api_speaks_degrees_and_seconds(sim):
+    from servoctl.protocol import Bus, ValueOutOfRange
+    from servoctl.servo import Servo
+    from servoctl import group
+
+    with Bus(sim.url) as bus:
+        s = Servo(bus, 1)
+        s.write("soft_start_on", 0)
+        result = s.move_to(90.0, duration_s=0.4, wait=True)
+        assert abs(result.angle / 10 - 90.0) <= 0.5 and abs(s.position_deg() - 90.0) <= 0.5
+        s.move_to(-30.5, speed_dps=200, wait=True)
+        assert abs(s.position_deg() + 30.5) <= 0.5
+        assert 7.0 < s.supply_v() < 7.8 and 20 < s.temperature_c() < 30
+        assert s.status_names() == []
+        with pytest.raises(ValueOutOfRange, match="move_to"):
+            s.move(90.0, interval_ms=500)  # protocol units take whole numbers
+        assert set(group.sync_monitor(bus, [1, 9])) == {1}

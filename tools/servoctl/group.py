@@ -1,0 +1,115 @@
+"""Several servos at once: a sync move (SyncCommand, one frame for every
+listed servo), a broadcast move, async begin and end, Sync Monitor, and the
+backup and restore of a whole bus. Angles in degrees, times in seconds."""
+import json
+import struct
+
+from . import protocol as p
+from . import registers
+from .protocol import NoReply, UsageError, ValueOutOfRange
+from .servo import Monitor, Servo, _check, _ms, _scaled
+
+# SyncCommand records (servo-protocol.md 3.25): the packet's own content.
+_ANGLE_RECORD = "<BhHH"       # packet 8: id, angle, interval, power
+_MULTI_TURN_RECORD = "<BiIH"  # packet 13
+MAX_SYNC_RECORDS = 255
+
+
+def sync_move(bus: p.Bus, targets: dict, duration_s: float, power_w: float = 0.0) -> None:
+    """Every servo in targets ({id: degrees}) starts its move in the same
+    frame. Multi-turn records when any target is beyond +-180 degrees. No
+    servo answers a sync move (behaviour.md)."""
+    if not targets or len(targets) > MAX_SYNC_RECORDS:
+        raise UsageError(f"a sync move takes 1..{MAX_SYNC_RECORDS} servos, not {len(targets)}")
+    multi = any(abs(deg) > 180.0 for deg in targets.values())
+    interval = _ms(duration_s, "duration_s")
+    power = _check("power", _scaled(power_w, 1000, "power_w"), 0, 65535, "mW")
+    if multi:
+        fmt, code = _MULTI_TURN_RECORD, p.MULTI_TURN
+        _check("interval", interval, 0, 4096000, "ms")
+    else:
+        fmt, code = _ANGLE_RECORD, p.ANGLE
+        _check("interval", interval, 0, 65535, "ms")
+    records = b""
+    for servo_id, degrees in targets.items():
+        _check("servo ID", servo_id, 0, 253)
+        angle = _scaled(degrees, 10, "degrees")
+        _check("angle", angle, -3686400, 3686400) if multi else _check("angle", angle, -1800, 1800)
+        records += struct.pack(fmt, servo_id, angle, interval, power)
+    bus.send(p.SYNC, bytes([code, struct.calcsize(fmt), len(targets)]) + records)
+
+
+def broadcast_move(bus: p.Bus, degrees: float, duration_s: float, power_w: float = 0.0) -> None:
+    """Every servo on the bus moves to one single-turn angle; none answers."""
+    angle = _check("angle", _scaled(degrees, 10, "degrees"), -1800, 1800, "x0.1 deg")
+    interval = _check("interval", _ms(duration_s, "duration_s"), 0, 65535, "ms")
+    power = _check("power", _scaled(power_w, 1000, "power_w"), 0, 65535, "mW")
+    bus.send(p.ANGLE, struct.pack(_ANGLE_RECORD, p.BROADCAST, angle, interval, power))
+
+
+def begin_async(bus: p.Bus) -> None:
+    """From now on every servo buffers its motion commands (up to 8)."""
+    bus.send(p.BEGIN_ASYNC, b"")
+
+
+def end_async(bus: p.Bus, cancel: bool = False) -> None:
+    """Every servo starts its buffered commands at once, or drops them."""
+    bus.send(p.END_ASYNC, bytes([1 if cancel else 0]))
+
+
+def sync_monitor(bus: p.Bus, ids: list, timeout_s: float = None) -> dict:
+    """One SyncCommand Monitor: each listed servo answers in list order.
+    {id: Monitor} of those that answered."""
+    for servo_id in ids:
+        _check("servo ID", servo_id, 0, 253)
+    if not ids or len(ids) > MAX_SYNC_RECORDS:
+        raise UsageError(f"a sync monitor takes 1..{MAX_SYNC_RECORDS} servos")
+    bus.send(p.SYNC, bytes([p.MONITOR, 1, len(ids)] + list(ids)))
+    # Each answer is 21 bytes; an absent servo costs 3 ms of silence.
+    wait = timeout_s if timeout_s is not None else 0.05 + len(ids) * (0.004 + 210 / bus.serial.baudrate)
+    out = {}
+    for servo_id in ids:
+        try:
+            out[servo_id] = Monitor.decode(bus.read_response(p.MONITOR, servo_id, timeout=wait))
+        except NoReply:
+            continue
+    return out
+
+
+def backup(bus: p.Bus, ids: list, path: str) -> dict:
+    """Every listed servo's user area, by ID, to one JSON file (protocol
+    units, as `config save` writes)."""
+    data = {str(servo_id): Servo(bus, servo_id).read_all() for servo_id in ids}
+    try:
+        with open(path, "w") as f:
+            json.dump({"servoctl_backup": 1, "servos": data}, f, indent=2)
+    except OSError as e:
+        raise UsageError(f"cannot write {path}: {e.strerror}") from None
+    return data
+
+
+def restore(bus: p.Bus, path: str, with_link: bool = False) -> list:
+    """Writes each servo's saved user area back to the servo with that ID.
+    IDs and baud rates stay as they are unless with_link. Returns the IDs."""
+    try:
+        with open(path) as f:
+            data = json.load(f)
+    except OSError as e:
+        raise UsageError(f"cannot read {path}: {e.strerror}") from None
+    except json.JSONDecodeError as e:
+        raise UsageError(f"{path} is not a backup (JSON): {e}") from None
+    if not isinstance(data, dict) or data.get("servoctl_backup") != 1:
+        raise UsageError(f"{path} is not a servoctl backup")
+    servos = data.get("servos", {})
+    names = {i.name for i in registers.USER}
+    for key, values in servos.items():
+        if not key.isdigit() or not isinstance(values, dict) or set(values) - names:
+            raise ValueOutOfRange(f"{path}: servo {key!r} has no valid user area")
+    done = []
+    for key, values in servos.items():
+        s = Servo(bus, int(key))
+        current = s.read_all()
+        keep = [] if with_link else ["servo_id", "baud"]
+        s.write_all(dict(current, **{k: v for k, v in values.items() if k not in keep}))
+        done.append(int(key))
+    return done
