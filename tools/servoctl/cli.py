@@ -54,6 +54,13 @@ def fmt_status(status: int) -> str:
     return ", ".join(names) if names else "ok"
 
 
+def live_celsius(adc: int):
+    try:
+        return round(ntc.adc_to_celsius(adc), 2)
+    except ValueError:
+        return None
+
+
 def describe_temperature(adc: int) -> str:
     try:
         return f"{ntc.adc_to_celsius(adc):.1f} degC (ADC {adc})"
@@ -119,6 +126,14 @@ def cmd_ping(bus, args):
 def cmd_info(bus, args):
     s = Servo(bus, args.id)
     m = s.monitor()
+    if args.json:
+        print(json.dumps({
+            "id": args.id, "voltage_v": m.voltage_mv / 1000, "current_a": m.current_ma / 1000,
+            "power_w": m.power_mw / 1000, "temperature_adc": m.temperature_adc,
+            "temperature_c": live_celsius(m.temperature_adc), "status": registers.status_names(m.status),
+            "angle_deg": m.angle_decideg / 10, "turns": m.turns, "model": s.read("model"),
+            "firmware": s.read("firmware"), "serial": s.read("serial")}))
+        return 0
     print(f"servo {args.id}")
     print(f"  voltage      {m.voltage_mv / 1000:.2f} V")
     print(f"  current      {m.current_ma / 1000:.3f} A")
@@ -147,7 +162,11 @@ def cmd_config(bus, args):
     s = Servo(bus, args.id)
     if args.action == "get":
         item = registers.find(args.name)
-        print(f"{item.name} = {_shown(item, s.read(item.id), args.raw)}")
+        raw = s.read(item.id)
+        if args.json:
+            print(json.dumps({"id": item.id, "name": item.name, "raw": raw, "value": units.show(item, raw)}))
+        else:
+            print(f"{item.name} = {_shown(item, raw, args.raw)}")
     elif args.action == "set":
         item = registers.find(args.name)
         if args.raw:
@@ -161,7 +180,11 @@ def cmd_config(bus, args):
         s.write(item.id, value)
         print(f"{item.name} = {_shown(item, value, args.raw)}")
     elif args.action == "dump":
-        _print_config(s.read_all(), args.raw)
+        values = s.read_all()
+        if args.json:
+            print(json.dumps(values))
+        else:
+            _print_config(values, args.raw)
     elif args.action == "save":
         values = s.read_all()
         try:
@@ -331,36 +354,30 @@ def cmd_restore(bus, args):
 
 
 def cmd_monitor(bus, args):
-    servos = [Servo(bus, i) for i in args.ids]
-    print(f"{'id':>3} {'angle deg':>10} {'V':>6} {'A':>6} {'W':>6} {'degC':>6}  status")
-    n = 0
+    from .live import monitor
+
+    if args.plot_file:
+        _writable(args.plot_file)
     try:
-        while args.count == 0 or n < args.count:
-            for s in servos:
-                try:
-                    m = s.monitor()
-                    try:
-                        c = f"{ntc.adc_to_celsius(m.temperature_adc):6.1f}"
-                    except ValueError:
-                        c = "   n/a"
-                    print(f"{m.id:>3} {m.angle_decideg / 10:>10.1f} {m.voltage_mv / 1000:>6.2f} "
-                          f"{m.current_ma / 1000:>6.3f} {m.power_mw / 1000:>6.2f} {c}  {fmt_status(m.status)}")
-                except NoReply as e:
-                    print(f"{s.id:>3} {e}")
-            n += 1
-            time.sleep(args.every)
+        monitor(bus, args.ids, args.every, args.count, args.sync, args.json, args.plot, args.plot_file)
     except KeyboardInterrupt:
-        pass
+        pass  # the way to stop a monitor
+    if args.plot_file:
+        print(f"plot {os.path.abspath(args.plot_file)}", file=sys.stderr if args.json else sys.stdout)
     return 0
+
+
+def _writable(path: str):
+    folder = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(folder) or not os.access(folder, os.W_OK):
+        raise UsageError(f"cannot write {path}: {folder} is not a writable folder")
 
 
 def cmd_record(bus, args):
     """Samples a move as the servo sees it (ReadMotion, 0x40: angle, setpoint,
     its own measured speed and tracking error, current and status, all of one
     instant); CSV and a PNG with the plan, the tracking error and the speeds."""
-    folder = os.path.dirname(os.path.abspath(args.out))
-    if not os.path.isdir(folder) or not os.access(folder, os.W_OK):
-        raise UsageError(f"cannot write {args.out}.csv: {folder} is not a writable folder")
+    _writable(args.out + ".csv")
     s = Servo(bus, args.id)
     start = s.monitor().angle_decideg
     target = decideg(args.angle)
@@ -517,6 +534,7 @@ def build_parser():
 
     c = sub.add_parser("info", help="status area decoded: V, A, W, degC, status bits")
     c.add_argument("id", type=int)
+    c.add_argument("--json", action="store_true", help="as one JSON object, SI units")
     c.set_defaults(run=cmd_info)
 
     c = sub.add_parser("config", help="the user area by name: get, set, dump, save, load, reset")
@@ -527,6 +545,7 @@ def build_parser():
                    help="config load: also set the ID and baud rate from the file")
     c.add_argument("--raw", action="store_true",
                    help="get/set/dump in protocol units (0.1 deg, NTC ADC, baud code)")
+    c.add_argument("--json", action="store_true", help="get/dump as JSON (raw values)")
     c.set_defaults(run=cmd_config)
 
     def motion_options(c):
@@ -574,10 +593,14 @@ def build_parser():
     c.add_argument("--reset-turns", action="store_true", help="only drop the whole turns")
     c.set_defaults(run=cmd_origin)
 
-    c = sub.add_parser("monitor", help="live table of angle, V, A, W, degC, status")
-    c.add_argument("ids", type=int, nargs="+")
-    c.add_argument("--every", type=float, default=0.2, help="seconds between rows")
-    c.add_argument("--count", type=int, default=0, help="rows to print (0: until Ctrl-C)")
+    c = sub.add_parser("monitor", help="live table (and plot) of angle, speed, V, A, W, degC, status")
+    c.add_argument("ids", type=id_number, nargs="+")
+    c.add_argument("--every", type=finite, default=0.2, help="seconds between samples")
+    c.add_argument("--count", type=int, default=0, help="samples to take (0: until Ctrl-C)")
+    c.add_argument("--sync", action="store_true", help="one Sync Monitor frame for all the servos")
+    c.add_argument("--json", action="store_true", help="one JSON object per servo and sample")
+    c.add_argument("--plot", action="store_true", help="a live plot window")
+    c.add_argument("--plot-file", help="save the plot of the whole run here at the end (PNG)")
     c.set_defaults(run=cmd_monitor)
 
     c = sub.add_parser("record", help="record a move: CSV and PNG against the plan")

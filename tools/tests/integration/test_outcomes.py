@@ -245,3 +245,30 @@ def test_the_python_api_speaks_degrees_and_seconds(sim):
         with pytest.raises(ValueOutOfRange, match="move_to"):
             s.move(90.0, interval_ms=500)  # protocol units take whole numbers
         assert set(group.sync_monitor(bus, [1, 9])) == {1}
+
+
+def test_monitor_live_views(sim3, capsys, tmp_path):
+    for i in (1, 2):
+        assert run(sim3, capsys, "config", "set", str(i), "soft_start_on", "0")[0] == 0
+    assert run(sim3, capsys, "sync-move", "1:90", "2:-90", "--interval", "1500")[0] == 0
+    png = tmp_path / "monitor.png"
+    rc, out, _ = run(sim3, capsys, "monitor", "1", "2", "9", "--sync", "--json", "--every", "0.05",
+                     "--count", "20", "--plot-file", str(png))
+    assert rc == 0
+    rows = [json.loads(line) for line in out.splitlines()]
+    assert {r["id"] for r in rows} == {1, 2} and len(rows) == 40
+    assert max(r["velocity_dps"] for r in rows if r["id"] == 1) > 50
+    assert min(r["velocity_dps"] for r in rows if r["id"] == 2) < -50
+    assert all(20 < r["temperature_c"] < 30 and 7.0 < r["voltage_v"] < 7.8 for r in rows)
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    rc, out, _ = run(sim3, capsys, "monitor", "1", "9", "--count", "1")
+    assert "no reply from 9" in out
+
+
+def test_read_commands_speak_json(sim, capsys):
+    info = json.loads(run(sim, capsys, "info", "1", "--json")[1])
+    assert info["id"] == 1 and info["status"] == [] and 7.0 < info["voltage_v"] < 7.8
+    item = json.loads(run(sim, capsys, "config", "get", "1", "angle_max", "--json")[1])
+    assert item == {"id": 51, "name": "angle_max", "raw": 1350, "value": "135.0 deg"}
+    dump = json.loads(run(sim, capsys, "config", "dump", "1", "--json")[1])
+    assert dump["servo_id"] == 1 and len(dump) == 22

@@ -1,0 +1,174 @@
+"""servoctl monitor: samples several servos (one Monitor each, or one Sync
+Monitor for all) and shows them as a live table (rich) on a terminal, plain
+rows or JSON lines otherwise, and as a live plot of angle, speed, current
+and temperature against time (matplotlib), or a plot file at the end."""
+from dataclasses import dataclass, asdict
+import json
+import sys
+import time
+
+from . import group, ntc, registers
+from .protocol import NoReply
+from .servo import Servo
+
+
+@dataclass
+class Sample:
+    t_s: float
+    id: int
+    angle_deg: float
+    velocity_dps: float  # from two successive angles
+    voltage_v: float
+    current_a: float
+    power_w: float
+    temperature_c: float  # NaN without a sensor reading
+    status: list
+
+
+def _celsius(adc: int) -> float:
+    try:
+        return round(ntc.adc_to_celsius(adc), 1)
+    except ValueError:
+        return float("nan")
+
+
+class Sampler:
+    def __init__(self, bus, ids, sync: bool):
+        self.bus, self.ids, self.sync = bus, list(ids), sync
+        self.last = {}
+        self.t0 = time.monotonic()
+
+    def take(self) -> list:
+        """One sample of every servo that answered; absent ones are left out."""
+        if self.sync:
+            monitors = group.sync_monitor(self.bus, self.ids)
+        else:
+            monitors = {}
+            for servo_id in self.ids:
+                try:
+                    monitors[servo_id] = Servo(self.bus, servo_id).monitor()
+                except NoReply:
+                    continue
+        now = time.monotonic() - self.t0
+        out = []
+        for servo_id, m in monitors.items():
+            angle = m.angle_decideg / 10.0
+            before = self.last.get(servo_id)
+            speed = (angle - before[1]) / (now - before[0]) if before and now > before[0] else 0.0
+            self.last[servo_id] = (now, angle)
+            out.append(Sample(round(now, 3), servo_id, angle, round(speed, 1), m.voltage_mv / 1000.0,
+                              m.current_ma / 1000.0, m.power_mw / 1000.0, _celsius(m.temperature_adc),
+                              registers.status_names(m.status)))
+        return out
+
+
+def _table(samples: dict):
+    from rich.table import Table
+
+    t = Table(title="servoctl monitor (Ctrl-C stops)")
+    for name in ("id", "angle deg", "deg/s", "V", "A", "W", "degC", "status"):
+        t.add_column(name, justify="right" if name != "status" else "left")
+    for servo_id in sorted(samples):
+        s = samples[servo_id]
+        t.add_row(str(s.id), f"{s.angle_deg:.1f}", f"{s.velocity_dps:.0f}", f"{s.voltage_v:.2f}",
+                  f"{s.current_a:.3f}", f"{s.power_w:.2f}", f"{s.temperature_c:.1f}",
+                  ", ".join(s.status) or "ok")
+    return t
+
+
+def _row(s: Sample) -> str:
+    return (f"{s.id:>3} {s.angle_deg:>10.1f} {s.velocity_dps:>7.0f} {s.voltage_v:>6.2f} "
+            f"{s.current_a:>6.3f} {s.power_w:>6.2f} {s.temperature_c:>6.1f}  "
+            f"{', '.join(s.status) or 'ok'}")
+
+
+class Plot:
+    """Angle, speed, current and temperature against time, one line per
+    servo; shown live, or saved at the end (headless)."""
+
+    PANELS = (("angle_deg", "angle, deg"), ("velocity_dps", "speed, deg/s"),
+              ("current_a", "current, A"), ("temperature_c", "temperature, degC"))
+
+    def __init__(self, live: bool):
+        import matplotlib
+
+        if not live:
+            matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        self.plt = plt
+        self.live = live
+        self.fig, self.axes = plt.subplots(len(self.PANELS), 1, sharex=True, figsize=(9, 9))
+        for ax, (_, label) in zip(self.axes, self.PANELS):
+            ax.set_ylabel(label)
+            ax.grid(True, alpha=0.3)
+        self.axes[-1].set_xlabel("time, s")
+        self.lines = {}
+        self.data = {}
+        if live:
+            plt.ion()
+            plt.show(block=False)
+
+    def add(self, samples: list):
+        for s in samples:
+            series = self.data.setdefault(s.id, {key: [] for key, _ in self.PANELS} | {"t": []})
+            series["t"].append(s.t_s)
+            for key, _ in self.PANELS:
+                series[key].append(getattr(s, key))
+            if s.id not in self.lines:
+                self.lines[s.id] = [ax.plot([], [], label=f"servo {s.id}")[0] for ax in self.axes]
+                self.axes[0].legend(loc="upper left")
+            for line, (key, _) in zip(self.lines[s.id], self.PANELS):
+                line.set_data(series["t"], series[key])
+        if self.live:
+            for ax in self.axes:
+                ax.relim()
+                ax.autoscale_view()
+            self.plt.pause(0.001)
+
+    def save(self, path: str):
+        for ax in self.axes:
+            ax.relim()
+            ax.autoscale_view()
+        self.fig.tight_layout()
+        self.fig.savefig(path, dpi=100)
+
+
+def monitor(bus, ids, every_s: float, count: int, sync: bool, as_json: bool,
+            plot: bool, plot_file: str):
+    sampler = Sampler(bus, ids, sync)
+    figure = Plot(live=plot) if plot or plot_file else None
+    tty = sys.stdout.isatty() and not as_json
+    latest = {}
+    n = 0
+    live = None
+    if tty:
+        from rich.live import Live
+
+        live = Live(_table(latest), refresh_per_second=10)
+        live.start()
+    elif not as_json:
+        print(f"{'id':>3} {'angle deg':>10} {'deg/s':>7} {'V':>6} {'A':>6} {'W':>6} {'degC':>6}  status")
+    try:
+        while count == 0 or n < count:
+            samples = sampler.take()
+            for s in samples:
+                latest[s.id] = s
+                if as_json:
+                    print(json.dumps(asdict(s)), flush=True)
+                elif not tty:
+                    print(_row(s), flush=True)
+            missing = set(ids) - {s.id for s in samples}
+            if missing and not as_json and not tty:
+                print(f"    no reply from {', '.join(map(str, sorted(missing)))}", flush=True)
+            if live is not None:
+                live.update(_table(latest))
+            if figure is not None:
+                figure.add(samples)
+            n += 1
+            time.sleep(every_s)
+    finally:
+        if live is not None:
+            live.stop()
+        if figure is not None and plot_file:
+            figure.save(plot_file)
