@@ -116,11 +116,15 @@ def cmd_scan(bus, args):
 
 
 def cmd_ping(bus, args):
+    if args.json:
+        answered = Servo(bus, args.id).ping()
+        print(json.dumps({"id": args.id, "answered": answered}))
+        return 0 if answered else 3
     if Servo(bus, args.id).ping():
         print(f"servo {args.id}: answered")
         return 0
     print(f"servo {args.id}: no reply")
-    return 1
+    return NoReply.exit_code
 
 
 def cmd_info(bus, args):
@@ -530,6 +534,7 @@ def build_parser():
 
     c = sub.add_parser("ping", help="is this servo there")
     c.add_argument("id", type=int)
+    c.add_argument("--json", action="store_true")
     c.set_defaults(run=cmd_ping)
 
     c = sub.add_parser("info", help="status area decoded: V, A, W, degC, status bits")

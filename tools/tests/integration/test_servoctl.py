@@ -18,7 +18,8 @@ def test_scan_ping_info(sim, capsys):
     assert rc == 0 and "servo 1 at 115200 baud\n" in out and "1 servo(s) found" in out
     assert run(sim, capsys, "ping", "1")[0] == 0
     rc, out, _ = run(sim, capsys, "ping", "9")
-    assert rc == 1 and "no reply" in out
+    assert rc == 3 and "no reply" in out
+    assert json.loads(run(sim, capsys, "ping", "1", "--json")[1]) == {"id": 1, "answered": True}
     rc, out, _ = run(sim, capsys, "info", "1")
     assert "voltage      7.40 V" in out
     assert "temperature  25.0 degC (ADC 2048)" in out
