@@ -199,14 +199,8 @@ def cmd_config(bus, args):
         print(f"saved the user area of servo {args.id} to {args.file}")
     elif args.action == "load":
         values = _read_config_file(args.file)
-        current = s.read_all()
-        # The ID and baud rate stay unless asked: another servo's file must
-        # not make two servos with one ID.
-        keep = [] if args.with_link else ["servo_id", "baud"]
-        merged = dict(current, **{k: v for k, v in values.items() if k not in keep})
-        s.write_all(merged)  # validated before sending
-        kept = [k for k in keep if k in values and values[k] != current[k]]
-        note = f" (kept {', '.join(f'{k} {current[k]}' for k in kept)}; --with-link to change)" if kept else ""
+        kept = group.write_user_area(s, values, args.with_link)  # validated before sending
+        note = f" (kept {', '.join(f'{k} {s.read(k)}' for k in kept)}; --with-link to change)" if kept else ""
         print(f"loaded {len(values)} item(s) from {args.file} into servo {args.id}{note}")
     elif args.action == "reset":
         s.reset_user_data()
@@ -215,13 +209,7 @@ def cmd_config(bus, args):
 
 
 def _read_config_file(path: str) -> dict:
-    try:
-        with open(path) as f:
-            values = json.load(f)
-    except OSError as e:
-        raise UsageError(f"cannot read {path}: {e.strerror}") from None
-    except json.JSONDecodeError as e:
-        raise UsageError(f"{path} is not a config file (JSON): {e}") from None
+    values = group.read_json_file(path, "a config file")
     if not isinstance(values, dict):
         raise UsageError(f"{path} is not a config file: expected {{name: value}}")
     unknown = [k for k in values if k not in {i.name for i in registers.USER}]

@@ -88,16 +88,31 @@ def backup(bus: p.Bus, ids: list, path: str) -> dict:
     return data
 
 
-def restore(bus: p.Bus, path: str, with_link: bool = False) -> list:
-    """Writes each servo's saved user area back to the servo with that ID.
-    IDs and baud rates stay as they are unless with_link. Returns the IDs."""
+def read_json_file(path: str, what: str):
+    """A JSON file's contents; a UsageError naming the file otherwise."""
     try:
         with open(path) as f:
-            data = json.load(f)
+            return json.load(f)
     except OSError as e:
         raise UsageError(f"cannot read {path}: {e.strerror}") from None
     except json.JSONDecodeError as e:
-        raise UsageError(f"{path} is not a backup (JSON): {e}") from None
+        raise UsageError(f"{path} is not {what} (JSON): {e}") from None
+
+
+def write_user_area(s: Servo, values: dict, with_link: bool = False) -> list:
+    """Writes values (all or some items, by name) over the servo's own.
+    The ID and baud rate stay unless with_link: another servo's file must
+    not put two servos on one ID. Returns the items kept that differed."""
+    current = s.read_all()
+    keep = [] if with_link else ["servo_id", "baud"]
+    s.write_all(dict(current, **{k: v for k, v in values.items() if k not in keep}))
+    return [k for k in keep if k in values and values[k] != current[k]]
+
+
+def restore(bus: p.Bus, path: str, with_link: bool = False) -> list:
+    """Writes each servo's saved user area back to the servo with that ID.
+    IDs and baud rates stay as they are unless with_link. Returns the IDs."""
+    data = read_json_file(path, "a backup")
     if not isinstance(data, dict) or data.get("servoctl_backup") != 1:
         raise UsageError(f"{path} is not a servoctl backup")
     servos = data.get("servos", {})
@@ -107,9 +122,6 @@ def restore(bus: p.Bus, path: str, with_link: bool = False) -> list:
             raise ValueOutOfRange(f"{path}: servo {key!r} has no valid user area")
     done = []
     for key, values in servos.items():
-        s = Servo(bus, int(key))
-        current = s.read_all()
-        keep = [] if with_link else ["servo_id", "baud"]
-        s.write_all(dict(current, **{k: v for k, v in values.items() if k not in keep}))
+        write_user_area(Servo(bus, int(key)), values, with_link)
         done.append(int(key))
     return done
