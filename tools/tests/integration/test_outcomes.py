@@ -272,3 +272,15 @@ def test_read_commands_speak_json(sim, capsys):
     assert item == {"id": 51, "name": "angle_max", "raw": 1350, "value": "135.0 deg"}
     dump = json.loads(run(sim, capsys, "config", "dump", "1", "--json")[1])
     assert dump["servo_id"] == 1 and len(dump) == 22
+
+
+def test_ctrl_c_during_a_wait_releases_nothing(ready):
+    proc = subprocess.Popen([sys.executable, "-m", "servoctl.cli", "--port", ready.url, "move", "1", "90",
+                             "--interval", "3000", "--wait"],
+                            cwd=TOOLS, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(1.5)
+    proc.send_signal(signal.SIGINT)
+    out, err = proc.communicate(timeout=10)
+    assert proc.returncode == 130 and "Traceback" not in err and "interrupted" in err, err
+    time.sleep(2.0)
+    assert abs(ready.state(1)["angle"] - 90.0) <= 0.5  # the move went on to its end
