@@ -8,7 +8,12 @@ set(CMAKE_SIZE arm-none-eabi-size CACHE FILEPATH "")
 set(CMAKE_NM arm-none-eabi-nm CACHE FILEPATH "")
 set(CMAKE_TRY_COMPILE_TARGET_TYPE STATIC_LIBRARY)
 
-set(SERVO_CPU_FLAGS "-mcpu=cortex-m3 -mthumb -mfloat-abi=soft")
+# SERVO_CPU: cortex-m3 (the reference MCU) or cortex-m0 (the target
+# benchmark's second build, tests/bench/target).
+if(NOT DEFINED SERVO_CPU)
+  set(SERVO_CPU cortex-m3)
+endif()
+set(SERVO_CPU_FLAGS "-mcpu=${SERVO_CPU} -mthumb -mfloat-abi=soft")
 set(CMAKE_C_FLAGS_INIT "${SERVO_CPU_FLAGS} -ffunction-sections -fdata-sections -fno-common -fstack-usage -fcallgraph-info=su")
 set(CMAKE_EXE_LINKER_FLAGS_INIT
     "${SERVO_CPU_FLAGS} -nostartfiles --specs=nano.specs --specs=nosys.specs -Wl,--gc-sections")

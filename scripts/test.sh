@@ -21,6 +21,13 @@ step "ARM images (STM32F103, and the QEMU board): budget and soft-float checks"
 cmake --preset arm >/dev/null
 cmake --build --preset arm
 
+step "target benchmark: Thumb instructions on the Cortex-M3 and M0 under QEMU (report; budgets: issue 10)"
+for cpu in m3 m0; do
+  cmake --preset "target-bench-$cpu" >/dev/null
+  cmake --build --preset "target-bench-$cpu" >/dev/null
+done
+python3 tests/bench/target/run_target_bench.py --json build/target-bench.json
+
 step "PC tool, simulator, maker's SDK and QEMU board tests (pytest)"
 (cd tools && ../.venv/bin/python -m pytest -q) | tee build/host/pytest.log
 tools_passed=$(sed -nE 's/^([0-9]+) passed.*/\1/p' build/host/pytest.log)
@@ -50,5 +57,6 @@ step "line coverage of motion, protection and the config store by the fuzz corpu
 bash scripts/fuzz_coverage.sh
 
 echo
-# CTest programs, pytest tests, the fuzz run, its coverage and the ARM image check.
-echo "summary: $((unit + tools_passed + 3)) passed, 0 failed"
+# CTest programs, pytest tests, the fuzz run, its coverage, the ARM image check
+# and the target benchmark (its calibration).
+echo "summary: $((unit + tools_passed + 4)) passed, 0 failed"

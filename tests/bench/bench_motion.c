@@ -1,15 +1,16 @@
 /* Benchmark (not a test): instructions to plan a move and to run a control
  * tick, counted by callgrind. Run it through run_bench.py.
  *
- * Regions, each dumped as its own callgrind profile:
+ * Regions (bench_region.h: callgrind on the host, the QEMU plugin on the
+ * target):
  *   plan_interval, plan_velocity, plan_short_stroke, plan_preempt
  *       motion_submit() of one move: clamping, timing, profile planning
  *   ticks  MOTION_BENCH_TICKS control ticks of a move (encoder read,
  *          profile evaluation, controller, motor output) */
 #include <stdio.h>
 #include <string.h>
-#include <valgrind/callgrind.h>
 
+#include "bench_region.h"
 #include "hal_double.h"
 #include "motion/motion.h"
 
@@ -33,29 +34,27 @@ static void fresh(void)
 
 static void plan(const char *name, const struct motion_command *cmd)
 {
-    CALLGRIND_TOGGLE_COLLECT;
+    bench_begin();
     motion_submit(&motion, cmd);
-    CALLGRIND_TOGGLE_COLLECT;
-    CALLGRIND_DUMP_STATS_AT(name);
+    bench_end(name);
 }
 
 int main(void)
 {
     fresh();
-    CALLGRIND_ZERO_STATS;
+    bench_setup();
     const struct motion_command interval = {.packet = 14, .kind = MOTION_ANGLE, .multi_turn = 1,
                                             .angle_decideg = 36000, .interval_ms = 3000,
                                             .acc_ms = 300, .dec_ms = 300};
     plan("plan_interval", &interval);
 
     /* Ticks of that move: ramp and cruise, the encoder following. */
-    CALLGRIND_TOGGLE_COLLECT;
+    bench_begin();
     for (unsigned i = 0; i < MOTION_BENCH_TICKS; i++) {
         hal.encoder_raw = (uint16_t)(hal.encoder_raw + 5u);
         motion_tick(&motion);
     }
-    CALLGRIND_TOGGLE_COLLECT;
-    CALLGRIND_DUMP_STATS_AT("ticks");
+    bench_end("ticks");
 
     const struct motion_command preempt = {.packet = 12, .kind = MOTION_ANGLE,
                                            .profile = PROFILE_VELOCITY, .angle_decideg = -900,
