@@ -1,36 +1,59 @@
 /* QEMU TCG plugin: counts the guest instructions executed between two
- * marker addresses, region after region.
+ * marker addresses, region after region, and models their cycles.
  *
- *   -plugin libqemu_insn_count.so,begin=0xADDR,end=0xADDR,out=FILE
+ *   -plugin libqemu_insn_count.so,begin=0xADDR,end=0xADDR,out=FILE[,core=m3|m0][,ws=N]
  *
- * Every instruction adds one to a counter (an inline op, no call); the
- * first instruction of each marker function takes a snapshot. At exit the
- * counts of the regions, in order, go to FILE, one per line. A guest that
- * exits through semihosting ends the process without QEMU's own plugin
- * exit hooks, so the file is written from the C library's atexit. */
+ * Instructions: every instruction adds one to a counter (an inline op, no
+ * call); the first instruction of each marker function takes a snapshot.
+ *
+ * Cycles (a model, thumb_cycles.h for the instruction costs): each
+ * translation block adds its instructions' own costs when it runs, and a
+ * block that does not start where the last one ended follows a taken
+ * branch: + 2 for the pipeline refill (M3 TRM 18.2: "P", 1-3; M0: a taken
+ * branch is 3 cycles) + the flash's wait states (ws; STM32F1 at 72 MHz: 2,
+ * RM0008 3.3.3), which the prefetch buffer cannot hide after a jump. A
+ * literal load from flash pays the wait states too, and straight-line code
+ * runs no faster than the prefetch buffer fills: 8 bytes per 1 + ws cycles.
+ *
+ * At exit, "total I C" and then "I C" per region go to FILE. A guest that
+ * exits through semihosting ends the process without QEMU's plugin exit
+ * hooks, so the file is written from the C library's atexit. */
 #include <inttypes.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "qemu_plugin_api.h"
+#include "thumb_cycles.h"
 
 PLUGIN_EXPORT int qemu_plugin_version = 1;
 
-enum { MAX_REGIONS = 256 };
+enum { MAX_REGIONS = 256, MAX_BLOCKS = 65536 };
 
-static uint64_t executed;
-static uint64_t begun_at;
-static uint64_t regions[MAX_REGIONS];
+static uint64_t executed, cycles;
+static uint64_t begun_at, begun_cycles;
+static uint64_t regions[MAX_REGIONS][2];
 static unsigned region_count;
 static uint64_t begin_addr, end_addr;
 static char out_path[512];
+static enum core core = CORE_M3;
+static unsigned wait_states = 2;
+
+/* What a translated block costs when it runs; blocks are never freed. */
+struct block {
+    uint64_t start, end;
+    uint32_t cycles;
+};
+static struct block blocks[MAX_BLOCKS];
+static unsigned block_count;
+static uint64_t last_end;
 
 static void on_begin(unsigned int vcpu, void *userdata)
 {
     (void)vcpu;
     (void)userdata;
     begun_at = executed;
+    begun_cycles = cycles;
 }
 
 static void on_end(unsigned int vcpu, void *userdata)
@@ -38,23 +61,55 @@ static void on_end(unsigned int vcpu, void *userdata)
     (void)vcpu;
     (void)userdata;
     if (region_count < MAX_REGIONS) {
-        regions[region_count++] = executed - begun_at;
+        regions[region_count][0] = executed - begun_at;
+        regions[region_count][1] = cycles - begun_cycles;
+        region_count++;
     }
+}
+
+static void on_block(unsigned int vcpu, void *userdata)
+{
+    (void)vcpu;
+    const struct block *b = userdata;
+    if (b->start != last_end) {
+        cycles += 2u + wait_states; /* after a taken branch */
+    }
+    cycles += b->cycles;
+    last_end = b->end;
 }
 
 static void on_translate(qemu_plugin_id_t id, struct qemu_plugin_tb *tb)
 {
     (void)id;
     size_t n = qemu_plugin_tb_n_insns(tb);
+    uint32_t own = 0;
+    uint32_t bytes = 0;
+    uint64_t end = qemu_plugin_tb_vaddr(tb);
     for (size_t i = 0; i < n; i++) {
         struct qemu_plugin_insn *insn = qemu_plugin_tb_get_insn(tb, i);
         uint64_t at = qemu_plugin_insn_vaddr(insn);
+        size_t size = qemu_plugin_insn_size(insn);
+        const uint8_t *code = qemu_plugin_insn_data(insn);
+        uint16_t hw = (uint16_t)(code[0] | code[1] << 8);
+        uint16_t hw2 = size == 4u ? (uint16_t)(code[2] | code[3] << 8) : 0u;
+        struct insn_cost c = thumb_cost(core, hw, hw2, (unsigned)size);
+        own += c.cycles + (c.literal_load ? wait_states : 0u);
+        bytes += (uint32_t)size;
+        end = at + size;
         if (at == begin_addr) {
             qemu_plugin_register_vcpu_insn_exec_cb(insn, on_begin, QEMU_PLUGIN_CB_NO_REGS, NULL);
         } else if (at == end_addr) {
             qemu_plugin_register_vcpu_insn_exec_cb(insn, on_end, QEMU_PLUGIN_CB_NO_REGS, NULL);
         }
         qemu_plugin_register_vcpu_insn_exec_inline(insn, QEMU_PLUGIN_INLINE_ADD_U64, &executed, 1);
+    }
+    /* Straight-line code runs no faster than the flash fills the prefetch
+     * buffer: 8 bytes per 1 + ws cycles. */
+    uint32_t fetch = (bytes + 7u) / 8u * (1u + wait_states);
+    if (block_count < MAX_BLOCKS) {
+        struct block *b = &blocks[block_count++];
+        *b = (struct block){qemu_plugin_tb_vaddr(tb), end, own > fetch ? own : fetch};
+        qemu_plugin_register_vcpu_tb_exec_cb(tb, on_block, QEMU_PLUGIN_CB_NO_REGS, b);
     }
 }
 
@@ -65,9 +120,9 @@ static void write_counts(void)
         perror(out_path);
         return;
     }
-    fprintf(f, "total %" PRIu64 "\n", executed);
+    fprintf(f, "total %" PRIu64 " %" PRIu64 "\n", executed, cycles);
     for (unsigned i = 0; i < region_count; i++) {
-        fprintf(f, "%" PRIu64 "\n", regions[i]);
+        fprintf(f, "%" PRIu64 " %" PRIu64 "\n", regions[i][0], regions[i][1]);
     }
     fclose(f);
 }
@@ -86,6 +141,10 @@ PLUGIN_EXPORT int qemu_plugin_install(qemu_plugin_id_t id, const qemu_info_t *in
             end_addr = strtoull(argv[i] + 4, NULL, 0) & ~1ull;
         } else if (strncmp(argv[i], "out=", 4) == 0) {
             snprintf(out_path, sizeof out_path, "%s", argv[i] + 4);
+        } else if (strcmp(argv[i], "core=m0") == 0) {
+            core = CORE_M0;
+        } else if (strncmp(argv[i], "ws=", 3) == 0) {
+            wait_states = (unsigned)strtoul(argv[i] + 3, NULL, 0);
         }
     }
     if (begin_addr == 0 || end_addr == 0 || out_path[0] == '\0') {

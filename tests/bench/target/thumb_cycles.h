@@ -1,0 +1,29 @@
+/* Cycle costs of Thumb instructions, by class, from ARM's timing tables,
+ * for the instruction-counting plugin's cycle model:
+ *   Cortex-M3: Cortex-M3 Technical Reference Manual r2p0, table 18-1
+ *     ("Cortex-M3 instruction timings");
+ *   Cortex-M0: Cortex-M0 Technical Reference Manual r0p0, table 3-1
+ *     ("Cortex-M0 instruction summary"), with the single-cycle multiplier.
+ * The cost here is the instruction's own, a branch's as not taken; a taken
+ * branch's pipeline refill and the flash's wait states are added by the
+ * plugin where they happen (thumb_cycles.c). Where a table gives a range
+ * the middle is used (a multiply-long 3-5: 4; a divide 2-12: 7), and an
+ * IT instruction, which the M3 folds into its neighbour (0-1), counts 1. */
+#ifndef THUMB_CYCLES_H
+#define THUMB_CYCLES_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+enum core { CORE_M3, CORE_M0 };
+
+struct insn_cost {
+    uint8_t cycles;        /* the instruction's own, not taken */
+    bool literal_load;     /* LDR from a PC-relative literal: a flash read */
+    bool writes_pc;        /* a branch, or a POP / LDM / LDR of the PC */
+};
+
+/* hw: the instruction's first half-word; hw2 its second (32-bit ones). */
+struct insn_cost thumb_cost(enum core core, uint16_t hw, uint16_t hw2, unsigned size);
+
+#endif
