@@ -14,8 +14,8 @@ IDS = list(range(254))
 def test_a_full_bus_scans_and_sync_monitors_without_collisions(tmp_path, capsys):
     with Simulator(ids=IDS, state_dir=str(tmp_path / "state")) as sim:
         # The ASan build runs 254 servos at about real time; a scan allows
-        # 10 ms an ID.
-        rc = main(["--port", sim.url, "scan", "--reply-timeout", "0.01", "--json"])
+        # 20 ms an ID.
+        rc = main(["--port", sim.url, "scan", "--reply-timeout", "0.02", "--json"])
         out = capsys.readouterr().out
         assert rc == 0
         found = [entry["id"] for entry in __import__("json").loads(out)]
