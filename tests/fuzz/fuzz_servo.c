@@ -10,7 +10,7 @@
  *          passes (1, 2, 4, 8), bit 4 a UART slow to finish
  *   op     low 3 bits what, high 5 bits n:
  *          0, 7  n+1 bytes on the wire follow
- *          1     n+1 ms pass, a main-loop pass (and tick) each
+ *          1     (n & 15) + 1 ms pass, a main-loop pass (and tick) each
  *          2     the horn: next byte, as int8 counts per tick; n bit 0: the
  *                encoder follows the setpoint instead; n bit 1: it is held
  *          3     sensors: next 3 bytes are supply (x 40 mV), current
@@ -33,7 +33,7 @@
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
-enum { IMAGES = 4, BYTE_US = 87, MAX_SIM_MS = 1200, MAX_BOOTS = 3 };
+enum { IMAGES = 4, BYTE_US = 87, MAX_SIM_MS = 1150, MAX_BOOTS = 3 };
 
 struct world {
     struct hal_double hal;
@@ -216,9 +216,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         case 1:
             /* A pass per tick: the main loop's other jobs are reached by
              * the wire bytes' passes. */
-            if (sim_ms + n + 1u <= MAX_SIM_MS) {
-                sim_ms += n + 1u;
-                for (unsigned k = 0; k < n + 1u; k++) {
+            if (sim_ms + (n & 15u) + 1u <= MAX_SIM_MS) {
+                sim_ms += (n & 15u) + 1u;
+                for (unsigned k = 0; k < (n & 15u) + 1u; k++) {
                     live.hal.now_us += 1000u;
                     live.hal.tx_busy = slow_uart && (k & 1u);
                     servo_poll(&live.servo);

@@ -83,7 +83,7 @@ def wire(stream: bytes) -> bytes:
 def ms(t: int) -> bytes:
     out = b""
     while t > 0:
-        step = min(t, 32)
+        step = min(t, 16)
         out += bytes([(step - 1) << 3 | 1])
         t -= step
     return out
@@ -143,11 +143,11 @@ SERVO_SEEDS = {
                          + ms(50) + wire(req(9, struct.pack("<BH", 0, 800))) + horn(SPIN, 20) + ms(60)
                          + wire(req(24, b"\x00\x12\x00\x00")) + ms(30) + wire(req(24, b"\x00\x10\x00\x00"))
                          + ms(10) + wire(req(17, b"\x00") + req(23, b"\x00\x00")) + horn(FOLLOW)),
-    "stall_held_horn": (USED, horn(HELD) + wire(move(900, 200, 3000)) + ms(1080)
-                        + wire(req(3, b"\x00\x05")) + horn(FOLLOW) + ms(100)),
-    "stall_releases": (USED, wire(write(37, 1)) + horn(HELD) + wire(move(-900, 200)) + ms(1080)
-                       + wire(move(0, 100)) + horn(FOLLOW) + ms(100)),
-    "pushed_backwards": (USED, wire(move(300, 100)) + ms(120) + horn(SPIN, -30) + ms(1070)),
+    "stall_held_horn": (USED, horn(HELD) + wire(move(900, 200, 3000)) + ms(1040)
+                        + wire(req(3, b"\x00\x05")) + horn(FOLLOW) + ms(60)),
+    "stall_releases": (USED, wire(write(37, 1)) + horn(HELD) + wire(move(-900, 200)) + ms(1040)
+                       + wire(move(0, 100)) + horn(FOLLOW) + ms(60)),
+    "pushed_backwards": (USED, wire(move(300, 100)) + ms(100) + horn(SPIN, -30) + ms(1040)),
     "encoder_wrap": (USED, horn(SPIN, 100) + ms(300) + horn(SPIN, -120) + ms(300)
                      + wire(req(16, b"\x00"))),
     "low_voltage_refuses": (USED, sensors(3000, 100, 2048) + ms(30) + wire(move(900, 200)) + ms(30)
@@ -162,9 +162,9 @@ SERVO_SEEDS = {
                                + ms(100) + sensors(8200, 300, 2048) + ms(300)),
     "page_rotation_and_reload": (PAGE_FULL, wire(write(38, 1234, 2)) + ms(60) + wire(write(44, 1))
                                  + ms(60) + POWER_CYCLE + wire(req(3, b"\x00\x26")) + ms(5)),
-    "failed_save_refuses": (USED, flash(dead=True) + wire(write(43, 2000, 2)) + ms(60)
+    "failed_save_refuses": (USED, flash(dead=True) + wire(write(43, 2000, 2)) + ms(55)
                             + wire(write(43, 3000, 2) + req(2, b"\x00") + req(0x41, b"\x00"))
-                            + flash(dead=False) + ms(1100) + wire(write(43, 3000, 2)) + ms(60)),
+                            + flash(dead=False) + ms(1001) + wire(write(43, 3000, 2)) + ms(60)),
     "cut_mid_save": (PAGE_FULL, flash(cut_at=3, mode=2) + wire(write(50, 500, 2)) + ms(60) + POWER_CYCLE
                      + wire(write(50, 600, 2)) + ms(60) + POWER_CYCLE + wire(req(3, b"\x00\x32"))),
     "power_on_lock": (USED, wire(write(46, 1)) + ms(60) + POWER_CYCLE + ms(20)),
