@@ -27,6 +27,11 @@ static void apply_link_settings(struct servo *s)
     s->unsolicited_first_us = UNSOLICITED_QUIET_US + (uint32_t)s->active_id * s->unsolicited_slot_us;
 }
 
+void servo_rx_byte(void *servo, uint8_t byte, uint32_t now_us)
+{
+    servo_on_rx_byte(servo, byte, now_us);
+}
+
 void servo_init(struct servo *s, const struct hal_port *hal)
 {
     *s = (struct servo){.hal = hal};

@@ -16,7 +16,7 @@
 #include "protocol/dispatcher.h"
 #include "protocol/frame_rx.h"
 #include "protocol/frame_tx.h"
-#include "protocol/registers.h"
+#include "registers/registers.h"
 
 /* Silence after which a SyncCommand Monitor turn-taker stops waiting for a
  * servo listed before it that does not answer. */
@@ -77,6 +77,10 @@ static inline void servo_on_rx_byte(struct servo *s, uint8_t byte, uint32_t now_
 {
     frame_rx_feed(&s->rx, byte, now_us);
 }
+
+/* The same, shaped as the HAL's hal_rx_byte_fn (ctx: the servo), for a
+ * port's receive interrupt. */
+void servo_rx_byte(void *servo, uint8_t byte, uint32_t now_us);
 
 /* Main loop: one pass over every pending job, the control tick when it is
  * due among them. Never blocks. */

@@ -15,7 +15,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
-#include "protocol/registers.h"
+#include "registers/registers.h"
 #include "scaling.h"
 
 #define PROTECT_TRIP_TICKS 10u    /* 10 ms */

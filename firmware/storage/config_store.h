@@ -15,7 +15,7 @@
 #include <stdint.h>
 
 #include "hal/hal_flash.h"
-#include "protocol/registers.h"
+#include "registers/registers.h"
 
 #define CONFIG_RECORD_SIZE 48u
 

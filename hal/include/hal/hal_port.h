@@ -11,6 +11,12 @@
 #include "hal/hal_flash.h"
 #include "hal/hal_sensors.h"
 
+/* Where a port's receive interrupt hands each byte off the wire, with the
+ * microsecond clock at its arrival. The application gives one to the port
+ * when it starts it; the port knows nothing above the HAL. Called in
+ * interrupt context: it must not block. */
+typedef void (*hal_rx_byte_fn)(void *ctx, uint8_t byte, uint32_t now_us);
+
 struct hal_port {
     void *ctx;
     /* Free-running microsecond clock; wraps at 2^32. */

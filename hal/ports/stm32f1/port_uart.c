@@ -1,10 +1,10 @@
 #include "port_uart.h"
 
-#include "servo.h"
 #include "stm32f1_regs.h"
 #include "systick_clock.h"
 
 static struct usart_hd *bus_usart;
+static hal_rx_byte_fn rx_to;
 
 void USART1_IRQHandler(void);
 void USART1_IRQHandler(void)
@@ -14,7 +14,7 @@ void USART1_IRQHandler(void)
 
 static void on_byte(void *ctx, uint8_t byte)
 {
-    servo_on_rx_byte(ctx, byte, systick_now_us());
+    rx_to(ctx, byte, systick_now_us());
 }
 
 static uint32_t now_us(void *ctx)
@@ -38,11 +38,12 @@ static void uart_set_baud(void *ctx, uint32_t baud)
     usart_hd_set_baud(ctx, baud);
 }
 
-void port_uart_init(struct hal_port *port, struct usart_hd *usart, struct servo *servo,
-                    uint32_t pclk_hz)
+void port_uart_init(struct hal_port *port, struct usart_hd *usart, hal_rx_byte_fn on_rx,
+                    void *rx_ctx, uint32_t pclk_hz)
 {
     bus_usart = usart;
-    usart_hd_init(usart, USART1_BASE, pclk_hz, 115200u, true, on_byte, servo);
+    rx_to = on_rx;
+    usart_hd_init(usart, USART1_BASE, pclk_hz, 115200u, true, on_byte, rx_ctx);
     port->ctx = usart;
     port->now_us = now_us;
     port->uart_send = uart_send;

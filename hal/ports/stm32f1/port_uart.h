@@ -6,12 +6,10 @@
 #include "hal/hal_port.h"
 #include "usart_hd.h"
 
-struct servo;
-
-/* Starts USART1 for the servo (single wire, 115200 until data ID 36 says
- * otherwise), routes its receive interrupt to the servo, and fills the
- * port's now_us and uart_* operations (ctx: the usart). */
-void port_uart_init(struct hal_port *port, struct usart_hd *usart, struct servo *servo,
-                    uint32_t pclk_hz);
+/* Starts USART1 for the bus (single wire, 115200 until data ID 36 says
+ * otherwise), hands every received byte to on_rx(rx_ctx, ...), and fills
+ * the port's now_us and uart_* operations (ctx: the usart). */
+void port_uart_init(struct hal_port *port, struct usart_hd *usart, hal_rx_byte_fn on_rx,
+                    void *rx_ctx, uint32_t pclk_hz);
 
 #endif

@@ -12,7 +12,7 @@
 #include "motion/controller.h"
 #include "motion/encoder.h"
 #include "motion/profile.h"
-#include "protocol/registers.h"
+#include "registers/registers.h"
 
 enum motion_kind {
     MOTION_ANGLE,    /* packets 8, 11-15 */

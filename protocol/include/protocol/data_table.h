@@ -8,7 +8,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
-#include "protocol/registers.h"
+#include "registers/registers.h"
 
 enum data_access {
     DATA_READ = 1u << 0,   /* ReadData answers the value */

@@ -10,7 +10,7 @@
 #include "motion/motion.h"
 #include "protocol/frame_rx.h"
 #include "protocol/frame_tx.h"
-#include "protocol/registers.h"
+#include "registers/registers.h"
 
 struct dispatcher {
     struct registers *regs;

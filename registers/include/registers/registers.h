@@ -1,7 +1,7 @@
 /* The register file: one struct per area of the data table
  * (servo-protocol.md 4.2), in protocol units. */
-#ifndef PROTOCOL_REGISTERS_H
-#define PROTOCOL_REGISTERS_H
+#ifndef REGISTERS_REGISTERS_H
+#define REGISTERS_REGISTERS_H
 
 #include <stdint.h>
 
