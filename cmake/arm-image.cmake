@@ -1,10 +1,15 @@
-# servo_arm_image(NAME LINKER script SOURCES src...): an STM32F1 image with
-# the startup code, a .bin beside it, a map, and the budget / soft-float
-# check after every link.
+# servo_arm_image(NAME SOURCES src... [LIBS lib...]): the image of the board
+# whose board.cmake was included last (its startup code, port library and
+# linker script), a .bin beside it, a map, and the budget / soft-float and
+# stack checks after every link.
 function(servo_arm_image name)
-  cmake_parse_arguments(I "" "LINKER" "SOURCES;LIBS" ${ARGN})
-  add_executable(${name}.elf ${I_SOURCES} ${PROJECT_SOURCE_DIR}/firmware/startup/startup_stm32f103.c)
-  target_link_libraries(${name}.elf PRIVATE ${I_LIBS} servo_stm32f1 servo_app)
+  cmake_parse_arguments(I "" "" "SOURCES;LIBS" ${ARGN})
+  if(NOT SERVO_BOARD_CPU STREQUAL SERVO_CPU)
+    message(FATAL_ERROR "${name}: the board is a ${SERVO_BOARD_CPU}; this build is for ${SERVO_CPU}")
+  endif()
+  set(I_LINKER ${SERVO_BOARD_LINKER})
+  add_executable(${name}.elf ${I_SOURCES} ${SERVO_BOARD_STARTUP})
+  target_link_libraries(${name}.elf PRIVATE ${I_LIBS} ${SERVO_BOARD_PORT} servo_app)
   target_include_directories(${name}.elf PRIVATE ${PROJECT_SOURCE_DIR}/firmware/boards/stm32f103)
   servo_firmware_target(${name}.elf)
   target_link_options(${name}.elf PRIVATE -L${PROJECT_SOURCE_DIR}/firmware/linker -T${I_LINKER}

@@ -8,7 +8,7 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 build() {
   arm-none-eabi-gcc -mcpu=cortex-m3 -mthumb -Os -nostartfiles --specs=nano.specs \
-    --specs=nosys.specs -L "$root/firmware/linker" -T "$root/firmware/linker/stm32f103x8.ld" "$@" \
+    --specs=nosys.specs -L "$root/firmware/linker" -T "$root/firmware/boards/stm32f103/stm32f103x8.ld" "$@" \
     "$root/tests/image/probe.c" -o "$tmp/probe.elf" || exit 1
 }
 fail=0
