@@ -25,7 +25,7 @@ enum {
 };
 
 _Static_assert(REC_CRC + 4 == CONFIG_RECORD_SIZE, "record layout");
-_Static_assert(CONFIG_RECORD_SIZE % 2 == 0, "records are programmed in half-words");
+_Static_assert(CONFIG_RECORD_SIZE % 8 == 0, "a record is whole write blocks of 2, 4 or 8 bytes");
 
 uint16_t config_store_slots_per_page(const struct config_store *s)
 {
@@ -162,9 +162,14 @@ static bool next_slot(const struct config_store *s, uint8_t *page, uint16_t *slo
 static bool program_record(const struct config_store *s, uint8_t page, uint16_t slot,
                            const uint8_t rec[CONFIG_RECORD_SIZE])
 {
+    /* Block by block in order: the CRC, in the last block, lands last. */
     uint32_t base = slot_addr(s, page, slot, CONFIG_RECORD_SIZE);
-    for (uint32_t i = 0; i < CONFIG_RECORD_SIZE; i += 2u) {
-        if (!s->flash->program_u16(s->flash->ctx, base + i, wire_get_u16(&rec[i]))) {
+    uint32_t block = s->flash->write_block;
+    if (block == 0u || CONFIG_RECORD_SIZE % block != 0u) {
+        return false;
+    }
+    for (uint32_t i = 0; i < CONFIG_RECORD_SIZE; i += block) {
+        if (!s->flash->program(s->flash->ctx, base + i, &rec[i])) {
             return false;
         }
     }

@@ -60,30 +60,36 @@ static bool erase_page(void *ctx, uint32_t addr)
     return false;
 }
 
-static bool program_u16(void *ctx, uint32_t addr, uint16_t value)
+/* One program step of write_block bytes; a cut leaves some of its bits. */
+static bool program(void *ctx, uint32_t addr, const uint8_t *data)
 {
     struct flash_double *f = ctx;
+    uint32_t block = f->hal.write_block;
     uint32_t offset;
     int p = page_of(f, addr, &offset);
-    if (f->dead || p < 0 || (offset & 1u)) {
-        f->misuse |= p < 0 || (offset & 1u);
+    if (f->dead || p < 0 || offset % block != 0u || offset + block > f->hal.page_size) {
+        f->misuse |= p < 0 || offset % block != 0u;
         return false;
     }
     uint8_t *cell = &f->mem[p][offset];
-    if (cell[0] != 0xFF || cell[1] != 0xFF) {
-        f->misuse = true; /* the STM32F1 refuses to program a non-erased half-word */
-        return false;
+    for (uint32_t i = 0; i < block; i++) {
+        if (cell[i] != 0xFF) {
+            f->misuse = true; /* flash refuses to program a non-erased block */
+            return false;
+        }
     }
-    uint16_t mask = 0xFFFF; /* bits that really get cleared */
+    uint8_t mask = 0xFF; /* bits that really get cleared */
     if (cut_now(f)) {
         f->dead = true;
-        static const uint16_t partial[CUT_MODES] = {0x0000, 0xFFFF, 0x00FF, 0xAAAA};
+        static const uint8_t partial[CUT_MODES] = {0x00, 0xFF, 0xFF, 0xAA};
         mask = partial[f->cut_mode];
     }
-    uint16_t now = (uint16_t)(cell[0] | (cell[1] << 8));
-    now = (uint16_t)(now & (value | (uint16_t)~mask));
-    cell[0] = (uint8_t)(now & 0xFF);
-    cell[1] = (uint8_t)(now >> 8);
+    for (uint32_t i = 0; i < block; i++) {
+        /* A partial cut lands the block's first half; a scattered one every
+         * other bit. */
+        uint8_t m = (f->dead && f->cut_mode == CUT_PARTIAL && i >= block / 2u) ? 0x00 : mask;
+        cell[i] = (uint8_t)(cell[i] & (data[i] | (uint8_t)~m));
+    }
     return !f->dead;
 }
 
@@ -112,7 +118,8 @@ void flash_double_init(struct flash_double *f, uint32_t page_size)
         .page_size = page_size,
         .page_addr = {FLASH_DOUBLE_BASE, FLASH_DOUBLE_BASE + page_size},
         .erase_page = erase_page,
-        .program_u16 = program_u16,
+        .write_block = 2,
+        .program = program,
         .read = read,
     };
     f->cut_at = -1;

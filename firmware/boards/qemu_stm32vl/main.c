@@ -61,12 +61,12 @@ static bool ram_erase(void *ctx, uint32_t addr)
     return true;
 }
 
-static bool ram_program(void *ctx, uint32_t addr, uint16_t value)
+static bool ram_program(void *ctx, uint32_t addr, const uint8_t *data)
 {
     (void)ctx;
     uint32_t offset = addr - RAM_FLASH_BASE;
-    flash_mem[offset] &= (uint8_t)(value & 0xFFu);
-    flash_mem[offset + 1u] &= (uint8_t)(value >> 8);
+    flash_mem[offset] &= data[0];
+    flash_mem[offset + 1u] &= data[1];
     return true;
 }
 
@@ -87,7 +87,8 @@ int main(void)
         .page_size = FLASH_PAGE,
         .page_addr = {RAM_FLASH_BASE, RAM_FLASH_BASE + FLASH_PAGE},
         .erase_page = ram_erase,
-        .program_u16 = ram_program,
+        .write_block = 2,
+        .program = ram_program,
         .read = ram_read,
     };
     systick_clock_init(QEMU_CORE_HZ);

@@ -23,7 +23,8 @@ static bool erase_page(void *ctx, uint32_t addr)
     return save(f, addr - BASE, SIM_FLASH_PAGE);
 }
 
-static bool program_u16(void *ctx, uint32_t addr, uint16_t value)
+/* Half-words, as the reference board's STM32F1. */
+static bool program(void *ctx, uint32_t addr, const uint8_t *data)
 {
     struct sim_flash *f = ctx;
     if (addr < BASE || addr + 2u > BASE + sizeof f->mem || (addr & 1u)) {
@@ -33,8 +34,8 @@ static bool program_u16(void *ctx, uint32_t addr, uint16_t value)
     if (cell[0] != 0xFF || cell[1] != 0xFF) {
         return false;
     }
-    cell[0] = (uint8_t)(value & 0xFFu);
-    cell[1] = (uint8_t)(value >> 8);
+    cell[0] = data[0];
+    cell[1] = data[1];
     return save(f, addr - BASE, 2);
 }
 
@@ -66,7 +67,8 @@ bool sim_flash_open(struct sim_flash *f, const char *path)
         .page_size = SIM_FLASH_PAGE,
         .page_addr = {BASE, BASE + SIM_FLASH_PAGE},
         .erase_page = erase_page,
-        .program_u16 = program_u16,
+        .write_block = 2,
+        .program = program,
         .read = flash_read,
     };
     return true;

@@ -35,9 +35,11 @@ static bool erase_page(void *ctx, uint32_t addr)
     return ok;
 }
 
-static bool program_u16(void *ctx, uint32_t addr, uint16_t value)
+/* The F1 programs a half-word at a time (RM0008 3.3.3): the write block. */
+static bool program(void *ctx, uint32_t addr, const uint8_t *data)
 {
     (void)ctx;
+    uint16_t value = (uint16_t)(data[0] | (uint16_t)(data[1] << 8));
     volatile uint16_t *cell = (volatile uint16_t *)(uintptr_t)addr;
     unlock();
     FLASH_CR = FLASH_CR_PG;
@@ -62,7 +64,8 @@ void flash_f1_init(struct hal_flash *f, uint32_t page_size, uint32_t page0, uint
         .page_size = page_size,
         .page_addr = {page0, page1},
         .erase_page = erase_page,
-        .program_u16 = program_u16,
+        .write_block = 2,
+        .program = program,
         .read = flash_read,
     };
 }
