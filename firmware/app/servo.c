@@ -14,14 +14,13 @@ static uint32_t idle_timeout_us(const struct servo *s, uint32_t baud)
 static void apply_link_settings(struct servo *s)
 {
     s->active_id = s->regs.user.servo_id;
+    uint32_t baud = baud_rate_of_index(s->regs.user.baud_index);
     if (s->active_baud_index != s->regs.user.baud_index) {
         s->active_baud_index = s->regs.user.baud_index;
-        uint32_t baud = baud_rate_of_index(s->active_baud_index);
         s->hal->uart_set_baud(s->hal->ctx, baud);
         frame_rx_set_idle_timeout(&s->rx, idle_timeout_us(s, baud));
     }
     /* Divides: on a change of link settings only. */
-    uint32_t baud = baud_rate_of_index(s->active_baud_index);
     uint32_t byte_us = baud != 0u ? (10000000u + baud - 1u) / baud : 0u;
     s->unsolicited_slot_us = UNSOLICITED_WINDOW_US + 2u * byte_us + UNSOLICITED_DRIFT_GUARD_US;
     s->unsolicited_first_us = UNSOLICITED_QUIET_US + (uint32_t)s->active_id * s->unsolicited_slot_us;
@@ -137,8 +136,6 @@ static void handle_next_frame(struct servo *s)
     }
 }
 
-/* The user area to flash when the save policy says so. A failed save sets
- * status bit 1 and refuses further writes until a retry succeeds. */
 /* ReadStore's register group, on a change or a new second only: it
  * divides. */
 static void report_store(struct servo *s)
@@ -157,10 +154,12 @@ static void report_store(struct servo *s)
     h->page_erases = config_store_page_erases(&s->store);
     h->rated_cycles = FLASH_RATED_CYCLES;
     h->budget = save_policy_budget(&s->saver);
-    h->op_seconds = save_policy_op_seconds(&s->saver);
+    h->op_seconds = op_seconds;
     h->failures = s->store.write_failures;
 }
 
+/* The user area to flash when the save policy says so. A failed save sets
+ * status bit 1 and refuses further writes until a retry succeeds. */
 static void save_config(struct servo *s)
 {
     uint32_t now = s->hal->now_us(s->hal->ctx);

@@ -38,27 +38,26 @@ static uint32_t slot_addr(const struct config_store *s, uint8_t page, uint16_t s
     return s->flash->page_addr[page] + (uint32_t)slot * size;
 }
 
-/* A format-2 record whose every field checks out, including the item
- * ranges: a record from a firmware with other ranges is not loaded
- * half-valid. */
-static bool record_valid(const uint8_t rec[CONFIG_RECORD_SIZE], struct user_config *out)
-{
-    if (wire_get_u16(&rec[REC_MAGIC]) != RECORD_MAGIC || rec[REC_FORMAT] != RECORD_FORMAT ||
-        rec[REC_LENGTH] != USER_AREA_SIZE || wire_get_u32(&rec[REC_SEQUENCE]) == 0u ||
-        wire_get_u32(&rec[REC_CRC]) != crc32(rec, REC_CRC)) {
-        return false;
-    }
-    return user_config_decode(out, &rec[REC_PAYLOAD]);
-}
+/* Where the fields of each record format are. */
+struct record_layout {
+    uint8_t format;
+    uint8_t size;
+    uint8_t payload;
+    uint8_t crc;
+};
+static const struct record_layout FORMAT_2 = {RECORD_FORMAT, CONFIG_RECORD_SIZE, REC_PAYLOAD, REC_CRC};
+static const struct record_layout FORMAT_1 = {V1_FORMAT, V1_RECORD_SIZE, V1_PAYLOAD, V1_CRC};
 
-static bool v1_record_valid(const uint8_t rec[V1_RECORD_SIZE], struct user_config *out)
+/* A record whose every field checks out, including the item ranges: a
+ * record from a firmware with other ranges is not loaded half-valid. */
+static bool record_valid(const uint8_t *rec, const struct record_layout *l, struct user_config *out)
 {
-    if (wire_get_u16(&rec[REC_MAGIC]) != RECORD_MAGIC || rec[REC_FORMAT] != V1_FORMAT ||
+    if (wire_get_u16(&rec[REC_MAGIC]) != RECORD_MAGIC || rec[REC_FORMAT] != l->format ||
         rec[REC_LENGTH] != USER_AREA_SIZE || wire_get_u32(&rec[REC_SEQUENCE]) == 0u ||
-        wire_get_u32(&rec[V1_CRC]) != crc32(rec, V1_CRC)) {
+        wire_get_u32(&rec[l->crc]) != crc32(rec, l->crc)) {
         return false;
     }
-    return user_config_decode(out, &rec[V1_PAYLOAD]);
+    return user_config_decode(out, &rec[l->payload]);
 }
 
 static bool slot_erased(const struct config_store *s, uint8_t page, uint16_t slot)
@@ -74,26 +73,29 @@ static bool slot_erased(const struct config_store *s, uint8_t page, uint16_t slo
     return true;
 }
 
-/* The newest valid format-1 record, for a store written by older firmware. */
-static bool load_v1(struct config_store *s, struct user_config *newest)
+/* The newest valid record of one format in both pages, if newer than what
+ * the store holds: it becomes the store's newest. */
+static bool scan(struct config_store *s, const struct record_layout *l, struct user_config *newest)
 {
-    const uint16_t slots = (uint16_t)(s->flash->page_size / V1_RECORD_SIZE);
+    bool found = false;
+    const uint16_t slots = (uint16_t)(s->flash->page_size / l->size);
     for (uint8_t page = 0; page < 2u; page++) {
         for (uint16_t slot = 0; slot < slots; slot++) {
-            uint8_t rec[V1_RECORD_SIZE];
+            uint8_t rec[CONFIG_RECORD_SIZE];
             struct user_config candidate;
-            s->flash->read(s->flash->ctx, slot_addr(s, page, slot, V1_RECORD_SIZE), rec,
-                           V1_RECORD_SIZE);
+            s->flash->read(s->flash->ctx, slot_addr(s, page, slot, l->size), rec, l->size);
             uint32_t seq = wire_get_u32(&rec[REC_SEQUENCE]);
-            if (seq > s->sequence && v1_record_valid(rec, &candidate)) {
+            if (seq > s->sequence && record_valid(rec, l, &candidate)) {
                 s->sequence = seq;
                 s->page = page;
+                s->slot = slot;
+                s->op_seconds = l == &FORMAT_2 ? wire_get_u32(&rec[REC_OP_SECONDS]) : 0u;
                 *newest = candidate;
+                found = true;
             }
         }
     }
-    s->legacy = s->sequence != 0u;
-    return s->legacy;
+    return found;
 }
 
 bool config_store_load(struct config_store *s, const struct hal_flash *flash,
@@ -102,25 +104,10 @@ bool config_store_load(struct config_store *s, const struct hal_flash *flash,
     *s = (struct config_store){.flash = flash};
     struct user_config newest;
     user_config_factory(&newest);
-    const uint16_t slots = config_store_slots_per_page(s);
-    for (uint8_t page = 0; page < 2u; page++) {
-        for (uint16_t slot = 0; slot < slots; slot++) {
-            uint8_t rec[CONFIG_RECORD_SIZE];
-            struct user_config candidate;
-            flash->read(flash->ctx, slot_addr(s, page, slot, CONFIG_RECORD_SIZE), rec,
-                        CONFIG_RECORD_SIZE);
-            uint32_t seq = wire_get_u32(&rec[REC_SEQUENCE]);
-            if (seq > s->sequence && record_valid(rec, &candidate)) {
-                s->sequence = seq;
-                s->page = page;
-                s->slot = slot;
-                s->op_seconds = wire_get_u32(&rec[REC_OP_SECONDS]);
-                newest = candidate;
-            }
-        }
-    }
-    if (s->sequence == 0u) {
-        load_v1(s, &newest);
+    /* A store written by older firmware holds format 1 only; the next save
+     * starts a page in format 2. */
+    if (!scan(s, &FORMAT_2, &newest)) {
+        s->legacy = scan(s, &FORMAT_1, &newest);
     }
     *cfg = newest;
     user_config_encode(&newest, s->saved);

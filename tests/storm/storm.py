@@ -22,7 +22,6 @@ documented 1 s before a cut and gone), sanitizer findings. All must be 0.
 """
 import argparse
 import json
-import os
 import random
 import re
 import shutil

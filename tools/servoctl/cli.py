@@ -17,7 +17,7 @@ import time
 
 from . import __version__, group, ntc, outcome, registers, units
 from .profile import positions, velocity_timing
-from .protocol import Bus, NoReply, Refused, ServoError, UsageError, ValueOutOfRange
+from .protocol import Bus, NoReply, Refused, ServoError, UsageError
 from .servo import Servo
 
 EXIT_INTERRUPTED = 130

@@ -3,8 +3,6 @@ rate than the host hears nothing, a host that floods the line is held back
 by it rather than leaving hours of backlog, and the fault channel refuses
 values no model can take."""
 import math
-import struct
-import threading
 import time
 
 import pytest
