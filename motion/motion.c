@@ -456,11 +456,6 @@ bool motion_is_released(const struct motion *m)
     return m->mode != MODE_POSITION;
 }
 
-bool motion_is_executing(const struct motion *m)
-{
-    return m->running != 0u;
-}
-
 bool motion_reset_multi_turn(struct motion *m)
 {
     if (!motion_is_released(m)) {
@@ -485,11 +480,6 @@ bool motion_set_origin(struct motion *m)
     }
     motion_move_origin(m, m->encoder.counts - m->origin_counts);
     return true;
-}
-
-bool motion_has_finished(const struct motion *m)
-{
-    return m->answers_count != 0u;
 }
 
 uint8_t motion_take_finished(struct motion *m)

@@ -56,6 +56,12 @@ enum {
 };
 
 _Static_assert(ITEM_COUNT == USER_ROW + (USER_LAST - USER_FIRST + 1), "table rows");
+/* struct user_config is laid out as its wire image: every item at its own
+ * size, in ID order, no padding (test_data_table checks each row's offset
+ * against its wire position). On a little-endian CPU the wire bytes are
+ * then a copy of the struct, and ReadBatchData answers at memcpy speed. */
+_Static_assert(sizeof(struct user_config) == USER_AREA_SIZE, "user area is its wire image");
+_Static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "the wire and the CPU are little-endian");
 
 const struct data_item *data_table_find(uint8_t id)
 {
@@ -144,6 +150,12 @@ uint8_t data_table_read(const struct registers *regs, uint8_t id, uint8_t *out)
     return it->size;
 }
 
+static bool cross_item_rules_hold(const struct user_config *cfg)
+{
+    return cfg->low_voltage_mv < cfg->high_voltage_mv &&
+           cfg->angle_max_decideg > cfg->angle_min_decideg;
+}
+
 bool user_config_valid(const struct user_config *cfg)
 {
     struct registers view = {.user = *cfg};
@@ -154,8 +166,7 @@ bool user_config_valid(const struct user_config *cfg)
             return false;
         }
     }
-    return cfg->low_voltage_mv < cfg->high_voltage_mv &&
-           cfg->angle_max_decideg > cfg->angle_min_decideg;
+    return cross_item_rules_hold(cfg);
 }
 
 enum data_write_result data_table_write(struct registers *regs, uint8_t id, const uint8_t *data,
@@ -173,9 +184,12 @@ enum data_write_result data_table_write(struct registers *regs, uint8_t id, cons
     if (value == field_get(field_of(regs, it), it)) {
         return DATA_WRITE_SAME;
     }
+    /* The user area is valid before (every write comes through here or
+     * user_config_decode), so only this item and the rules across items
+     * need checking. */
     struct user_config candidate = regs->user;
     field_set(&candidate, it, value);
-    if (!user_config_valid(&candidate)) {
+    if (!cross_item_rules_hold(&candidate)) {
         return DATA_WRITE_REFUSED;
     }
     regs->user = candidate;
@@ -203,24 +217,13 @@ void user_config_reset(struct user_config *cfg)
 
 void user_config_encode(const struct user_config *cfg, uint8_t out[USER_AREA_SIZE])
 {
-    struct registers view = {.user = *cfg};
-    uint8_t pos = 0;
-    for (uint8_t id = USER_FIRST; id <= USER_LAST; id++) {
-        const struct data_item *it = data_table_find(id);
-        put_wire(&out[pos], it, field_get(field_of(&view, it), it));
-        pos = (uint8_t)(pos + it->size);
-    }
+    memcpy(out, cfg, USER_AREA_SIZE);
 }
 
 bool user_config_decode(struct user_config *cfg, const uint8_t in[USER_AREA_SIZE])
 {
-    struct user_config decoded = {0};
-    uint8_t pos = 0;
-    for (uint8_t id = USER_FIRST; id <= USER_LAST; id++) {
-        const struct data_item *it = data_table_find(id);
-        field_set(&decoded, it, wire_value(&in[pos], it));
-        pos = (uint8_t)(pos + it->size);
-    }
+    struct user_config decoded;
+    memcpy(&decoded, in, USER_AREA_SIZE);
     if (!user_config_valid(&decoded)) {
         return false;
     }

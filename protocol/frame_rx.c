@@ -1,9 +1,9 @@
 #include "protocol/frame_rx.h"
 
-#include <stdatomic.h>
 #include <stddef.h>
 
 #include "protocol/packet_codes.h"
+#include "protocol/packet_table.h"
 #include "protocol/wire.h"
 
 enum rx_state {
@@ -13,8 +13,9 @@ enum rx_state {
     RX_LENGTH,
     RX_LENGTH_LO, /* extended length, low byte */
     RX_LENGTH_HI,
-    RX_CONTENT,
+    RX_CONTENT,   /* a request this servo keeps */
     RX_CHECKSUM,
+    RX_SKIP,      /* a frame not kept: remaining counts its checksum too */
 };
 
 /* SyncCommand content: cmd, record_len, count, then the records. */
@@ -25,18 +26,11 @@ static uint8_t next_slot(uint8_t i)
     return (uint8_t)((i + 1u) % FRAME_QUEUE_SLOTS);
 }
 
-void frame_rx_init(struct frame_rx *rx, const volatile uint8_t *own_id,
-                   uint32_t idle_timeout_us)
+void frame_rx_init(struct frame_rx *rx, const volatile uint8_t *own_id)
 {
     *rx = (struct frame_rx){0};
     rx->own_id = own_id;
-    rx->idle_timeout_us = idle_timeout_us;
     rx->state = RX_HDR0;
-}
-
-void frame_rx_set_idle_timeout(struct frame_rx *rx, uint32_t idle_timeout_us)
-{
-    rx->idle_timeout_us = idle_timeout_us;
 }
 
 uint32_t frame_rx_idle_us(uint32_t baud)
@@ -55,12 +49,19 @@ static struct rx_frame *work_slot(struct frame_rx *rx)
     return &rx->slots[rx->head];
 }
 
+/* The rest of a frame not kept, its checksum included, goes by its length. */
+static void skip(struct frame_rx *rx, uint32_t bytes)
+{
+    rx->skip_left = bytes;
+    rx->state = RX_SKIP;
+}
+
 static void start_content(struct frame_rx *rx, uint16_t length)
 {
     rx->remaining = length;
     rx->position = 0;
-    if (!rx->is_request) {
-        rx->state = length ? RX_CONTENT : RX_CHECKSUM;
+    if (!rx->is_request || rx->discard) {
+        skip(rx, (uint32_t)length + 1u);
         return;
     }
     struct rx_frame *f = work_slot(rx);
@@ -111,18 +112,30 @@ static void sync_content_byte(struct frame_rx *rx, struct rx_frame *f, uint8_t b
     }
 }
 
+/* A request addressed to another servo (unknown packets count as
+ * addressed, as in the dispatcher): nothing of it is kept. */
+static bool for_another_servo(const struct frame_rx *rx, uint8_t code, uint8_t id)
+{
+    if (id == *rx->own_id || id == WIRE_BROADCAST_ID) {
+        return false;
+    }
+    const struct packet_desc *desc = packet_find(code);
+    return desc == NULL || (desc->flags & PF_ADDRESSED);
+}
+
 static void content_byte(struct frame_rx *rx, uint8_t byte)
 {
-    if (rx->is_request && !rx->discard) {
-        struct rx_frame *f = work_slot(rx);
-        if (f->code == PKT_SYNC_COMMAND) {
-            sync_content_byte(rx, f, byte);
-        } else if (rx->position < FRAME_CONTENT_MAX) {
-            f->content[rx->position] = byte;
-            f->stored = (uint8_t)(rx->position + 1u);
-        } else {
-            f->flags |= FRAME_TRUNCATED;
-        }
+    struct rx_frame *f = work_slot(rx);
+    if (f->code == PKT_SYNC_COMMAND) {
+        sync_content_byte(rx, f, byte);
+    } else if (rx->position == 0u && for_another_servo(rx, f->code, byte)) {
+        skip(rx, rx->remaining); /* the rest and the checksum */
+        return;
+    } else if (rx->position < FRAME_CONTENT_MAX) {
+        f->content[rx->position] = byte;
+        f->stored = (uint8_t)(rx->position + 1u);
+    } else {
+        f->flags |= FRAME_TRUNCATED;
     }
     rx->position++;
     rx->remaining--;
@@ -131,24 +144,28 @@ static void content_byte(struct frame_rx *rx, uint8_t byte)
     }
 }
 
-static void finish_frame(struct frame_rx *rx, uint8_t checksum)
+static void finish_skipped(struct frame_rx *rx)
 {
     rx->state = RX_HDR0;
     if (!rx->is_request) {
         rx->stats.responses_skipped++;
         return;
     }
+    rx->stats.requests_seen++;
+    if (rx->discard) {
+        rx->stats.queue_overflows++;
+    }
+}
+
+static void finish_frame(struct frame_rx *rx, uint8_t checksum)
+{
+    rx->state = RX_HDR0;
+    rx->stats.requests_seen++;
     if (checksum != rx->checksum) {
         rx->stats.checksum_errors++;
         return;
     }
-    if (rx->discard) {
-        rx->stats.queue_overflows++;
-        return;
-    }
     work_slot(rx)->responses_seen = rx->stats.responses_skipped;
-    /* Publish the slot only after its contents are written. */
-    atomic_signal_fence(memory_order_release);
     rx->head = next_slot(rx->head);
     rx->stats.frames++;
 }
@@ -165,17 +182,9 @@ static bool header_start(struct frame_rx *rx, uint8_t byte)
     return false;
 }
 
-void frame_rx_feed(struct frame_rx *rx, uint8_t byte, uint32_t now_us)
+/* One byte through the state machine. */
+static void step(struct frame_rx *rx, uint8_t byte)
 {
-    /* Signed: a clock that stepped back a little (an emulated SysTick can)
-     * is no idle line. */
-    int32_t gap = (int32_t)(now_us - rx->last_byte_us);
-    if (rx->state != RX_HDR0 && gap > (int32_t)rx->idle_timeout_us) {
-        rx->stats.idle_timeouts++;
-        rx->state = RX_HDR0;
-    }
-    rx->last_byte_us = now_us;
-
     switch (rx->state) {
     case RX_HDR0:
         if (!header_start(rx, byte)) {
@@ -230,25 +239,131 @@ void frame_rx_feed(struct frame_rx *rx, uint8_t byte, uint32_t now_us)
     case RX_CHECKSUM:
         finish_frame(rx, byte);
         return;
+    case RX_SKIP:
+        if (--rx->skip_left == 0u) {
+            finish_skipped(rx);
+        }
+        return;
     default:
         rx->state = RX_HDR0;
         return;
     }
 }
 
-const struct rx_frame *frame_rx_peek(struct frame_rx *rx)
+/* A kept request's plain content (not SyncCommand, past the ID, within
+ * FRAME_CONTENT_MAX) in one run: copy and sum. Returns the bytes taken. */
+static uint32_t content_run(struct frame_rx *rx, const uint8_t *data, uint32_t n)
 {
-    if (rx->tail == rx->head) {
-        return NULL;
+    struct rx_frame *f = work_slot(rx);
+    if (f->code == PKT_SYNC_COMMAND || rx->position == 0u || rx->position >= FRAME_CONTENT_MAX) {
+        return 0;
     }
-    atomic_signal_fence(memory_order_acquire);
-    return &rx->slots[rx->tail];
+    uint32_t take = FRAME_CONTENT_MAX - rx->position;
+    take = take < n ? take : n;
+    take = take < rx->remaining ? take : rx->remaining;
+    uint8_t sum = rx->checksum;
+    uint8_t *to = &f->content[rx->position];
+    for (uint32_t i = 0; i < take; i++) {
+        to[i] = data[i];
+        sum = (uint8_t)(sum + data[i]);
+    }
+    rx->checksum = sum;
+    rx->position = (uint16_t)(rx->position + take);
+    rx->remaining = (uint16_t)(rx->remaining - take);
+    f->stored = (uint8_t)rx->position;
+    if (rx->remaining == 0u) {
+        rx->state = RX_CHECKSUM;
+    }
+    return take;
+}
+
+/* Bytes outside any frame up to the next that may start a header. */
+static uint32_t garbage_run(struct frame_rx *rx, const uint8_t *data, uint32_t n)
+{
+    uint32_t i = 0;
+    while (i < n && data[i] != WIRE_REQUEST_HDR0 && data[i] != WIRE_RESPONSE_HDR0) {
+        i++;
+    }
+    rx->stats.garbage_bytes += i;
+    return i;
+}
+
+/* A whole plain header (both header bytes, code, a one-byte length) when
+ * all four have arrived: what step() would do in four calls. */
+static uint32_t header_run(struct frame_rx *rx, const uint8_t *data, uint32_t n)
+{
+    if (n < WIRE_HEADER_SIZE) {
+        return 0;
+    }
+    bool request = data[0] == WIRE_REQUEST_HDR0;
+    if (data[1] != (request ? WIRE_REQUEST_HDR1 : WIRE_RESPONSE_HDR1) ||
+        (request && data[3] == WIRE_EXTENDED_LENGTH)) {
+        return 0;
+    }
+    rx->is_request = request;
+    rx->checksum = (uint8_t)(data[0] + data[1] + data[2] + data[3]);
+    if (request) {
+        rx->discard = next_slot(rx->head) == rx->tail;
+        work_slot(rx)->code = data[2];
+    }
+    start_content(rx, data[3]);
+    return WIRE_HEADER_SIZE;
+}
+
+void frame_rx_feed_bytes(struct frame_rx *rx, const uint8_t *data, uint32_t n)
+{
+    while (n > 0u) {
+        uint32_t took = 0;
+        switch (rx->state) {
+        case RX_SKIP:
+            took = rx->skip_left < n ? rx->skip_left : n;
+            rx->skip_left -= took;
+            if (rx->skip_left == 0u) {
+                finish_skipped(rx);
+            }
+            break;
+        case RX_CONTENT:
+            took = content_run(rx, data, n);
+            break;
+        case RX_HDR0:
+            took = garbage_run(rx, data, n);
+            if (took == 0u) {
+                took = header_run(rx, data, n);
+            }
+            break;
+        default:
+            break;
+        }
+        if (took == 0u) {
+            step(rx, *data);
+            took = 1;
+        }
+        data += took;
+        n -= took;
+    }
+}
+
+void frame_rx_feed(struct frame_rx *rx, uint8_t byte)
+{
+    frame_rx_feed_bytes(rx, &byte, 1);
+}
+
+void frame_rx_line_idle(struct frame_rx *rx)
+{
+    if (rx->state != RX_HDR0) {
+        rx->stats.idle_timeouts++;
+        rx->state = RX_HDR0;
+    }
+}
+
+bool frame_rx_in_frame(const struct frame_rx *rx)
+{
+    return rx->state != RX_HDR0;
 }
 
 void frame_rx_release(struct frame_rx *rx)
 {
     if (rx->tail != rx->head) {
-        atomic_signal_fence(memory_order_release);
         rx->tail = next_slot(rx->tail);
     }
 }

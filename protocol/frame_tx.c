@@ -1,6 +1,23 @@
 #include "protocol/frame_tx.h"
 
+#include <string.h>
+
 #include "protocol/wire.h"
+
+/* The byte sum, four bytes a pass: a response is up to 40 bytes, and its
+ * encoding is on the path from request to answer. */
+static uint8_t byte_sum(const uint8_t *p, uint32_t n)
+{
+    uint32_t sum = 0;
+    uint32_t i = 0;
+    for (; i + 4u <= n; i += 4u) {
+        sum += (uint32_t)p[i] + p[i + 1u] + p[i + 2u] + p[i + 3u];
+    }
+    for (; i < n; i++) {
+        sum += p[i];
+    }
+    return (uint8_t)sum;
+}
 
 uint8_t frame_tx_encode(const struct response *r, uint8_t out[RESPONSE_FRAME_MAX])
 {
@@ -9,11 +26,7 @@ uint8_t frame_tx_encode(const struct response *r, uint8_t out[RESPONSE_FRAME_MAX
     out[1] = WIRE_RESPONSE_HDR1;
     out[2] = r->code;
     out[3] = length;
-    uint8_t sum = (uint8_t)(out[0] + out[1] + out[2] + out[3]);
-    for (uint8_t i = 0; i < length; i++) {
-        out[WIRE_HEADER_SIZE + i] = r->content[i];
-        sum = (uint8_t)(sum + r->content[i]);
-    }
-    out[WIRE_HEADER_SIZE + length] = sum;
+    memcpy(&out[WIRE_HEADER_SIZE], r->content, length);
+    out[WIRE_HEADER_SIZE + length] = byte_sum(out, WIRE_HEADER_SIZE + (uint32_t)length);
     return (uint8_t)(WIRE_HEADER_SIZE + length + 1u);
 }

@@ -18,17 +18,12 @@ static void apply_link_settings(struct servo *s)
     if (s->active_baud_index != s->regs.user.baud_index) {
         s->active_baud_index = s->regs.user.baud_index;
         s->hal->uart_set_baud(s->hal->ctx, baud);
-        frame_rx_set_idle_timeout(&s->rx, idle_timeout_us(s, baud));
+        s->rx_idle_us = idle_timeout_us(s, baud);
     }
     /* Divides: on a change of link settings only. */
     uint32_t byte_us = baud != 0u ? (10000000u + baud - 1u) / baud : 0u;
     s->unsolicited_slot_us = UNSOLICITED_WINDOW_US + 2u * byte_us + UNSOLICITED_DRIFT_GUARD_US;
     s->unsolicited_first_us = UNSOLICITED_QUIET_US + (uint32_t)s->active_id * s->unsolicited_slot_us;
-}
-
-void servo_rx_byte(void *servo, uint8_t byte, uint32_t now_us)
-{
-    servo_on_rx_byte(servo, byte, now_us);
 }
 
 void servo_init(struct servo *s, const struct hal_port *hal)
@@ -42,7 +37,8 @@ void servo_init(struct servo *s, const struct hal_port *hal)
     protection_init(&s->protection);
     motion_init(&s->motion, &s->regs, hal);
     s->next_tick_us = hal->now_us(hal->ctx) + CONTROL_TICK_US;
-    frame_rx_init(&s->rx, &s->active_id, idle_timeout_us(s, 0));
+    frame_rx_init(&s->rx, &s->active_id);
+    s->rx_idle_us = idle_timeout_us(s, 0);
     dispatcher_init(&s->dispatcher, &s->regs, &s->motion, &s->active_id);
     s->active_baud_index = 0; /* forces the first apply to set the UART */
     apply_link_settings(s);
@@ -62,7 +58,7 @@ static void wait_for_turn(struct servo *s)
 {
     uint32_t seen = s->rx.stats.responses_skipped - s->tx.responses_base;
     uint32_t now = s->hal->now_us(s->hal->ctx);
-    uint32_t last_byte = s->rx.last_byte_us;
+    uint32_t last_byte = s->hal->rx->heard_us;
     if (now - last_byte < now - s->tx.silence_from_us) {
         s->tx.silence_from_us = last_byte; /* the line was busy since */
     }
@@ -80,6 +76,7 @@ static void queue_response(struct servo *s, const struct response *r, uint8_t wa
     s->tx.size = frame_tx_encode(r, s->tx.frame);
     s->tx.turns_left = wait;
     s->tx.responses_base = responses_base;
+    s->tx.requests_base = s->rx.stats.requests_seen;
     s->tx.silence_from_us = s->hal->now_us(s->hal->ctx);
     if (wait == 0u) {
         start_send(s);
@@ -94,7 +91,7 @@ static void queue_response(struct servo *s, const struct response *r, uint8_t wa
 static bool in_unsolicited_slot(const struct servo *s)
 {
     uint32_t now = s->hal->now_us(s->hal->ctx);
-    uint32_t heard = now - s->rx.last_byte_us;
+    uint32_t heard = now - s->hal->rx->heard_us;
     uint32_t said = now - s->tx.ended_us;
     uint32_t quiet = heard < said ? heard : said;
     if (quiet < s->unsolicited_first_us) {
@@ -158,8 +155,9 @@ static void report_store(struct servo *s)
     h->failures = s->store.write_failures;
 }
 
-/* The user area to flash when the save policy says so. A failed save sets
- * status bit 1 and refuses further writes until a retry succeeds. */
+/* The user area to flash when the save policy says so, checked once a
+ * control tick. A failed save sets status bit 1 and refuses further writes
+ * until a retry succeeds. */
 static void save_config(struct servo *s)
 {
     uint32_t now = s->hal->now_us(s->hal->ctx);
@@ -216,33 +214,75 @@ void servo_control_tick(struct servo *s)
  * interleave. A pass runs every tick that is due, up to SERVO_MAX_CATCH_UP; a
  * main loop later than that (a flash erase) drops the rest rather than
  * racing through them. */
-static void run_control_tick(struct servo *s)
+static bool run_control_tick(struct servo *s, uint32_t now)
 {
-    /* One reading of the clock per pass: the ticks due by then run now. */
-    uint32_t now = s->hal->now_us(s->hal->ctx);
-    for (unsigned n = 0; (int32_t)(now - s->next_tick_us) >= 0; n++) {
+    unsigned n = 0;
+    for (; (int32_t)(now - s->next_tick_us) >= 0; n++) {
         if (n == SERVO_MAX_CATCH_UP) {
             s->ticks_dropped += (uint32_t)(now - s->next_tick_us) / CONTROL_TICK_US + 1u;
             s->next_tick_us = now + CONTROL_TICK_US;
-            return;
+            return true;
         }
         servo_control_tick(s);
         s->next_tick_us += CONTROL_TICK_US;
     }
+    return n != 0u;
+}
+
+/* What the port has received since the last pass, to the framer; a line
+ * silent for the idle timeout drops a partial frame. */
+static void receive(struct servo *s, uint32_t now)
+{
+    struct hal_rx_ring *ring = s->hal->rx;
+    if (s->hal->rx_sync != NULL) {
+        s->hal->rx_sync(s->hal->ctx, now);
+    }
+    uint32_t written = ring->written;
+    uint32_t read = ring->read;
+    uint32_t waiting = written - read;
+    if (waiting == 0u) {
+        if (frame_rx_in_frame(&s->rx) && (int32_t)(now - ring->heard_us) >= (int32_t)s->rx_idle_us) {
+            frame_rx_line_idle(&s->rx);
+        }
+        return;
+    }
+    if (waiting > HAL_RX_RING_SIZE) { /* the DMA went round past us */
+        s->rx_lost += waiting - HAL_RX_RING_SIZE;
+        read = written - HAL_RX_RING_SIZE;
+        waiting = HAL_RX_RING_SIZE;
+    }
+    uint32_t at = read & (HAL_RX_RING_SIZE - 1u);
+    uint32_t first = HAL_RX_RING_SIZE - at < waiting ? HAL_RX_RING_SIZE - at : waiting;
+    frame_rx_feed_bytes(&s->rx, &ring->data[at], first);
+    frame_rx_feed_bytes(&s->rx, ring->data, waiting - first);
+    ring->read = written;
 }
 
 void servo_poll(struct servo *s)
 {
-    run_control_tick(s);
-    if (s->tx.sending) {
-        if (!s->hal->uart_tx_done(s->hal->ctx)) {
-            return; /* half duplex: nothing else goes out meanwhile */
-        }
+    /* One reading of the clock per pass: the ticks due by then run now. */
+    uint32_t now = s->hal->now_us(s->hal->ctx);
+    bool ticked = run_control_tick(s, now);
+    if (s->tx.sending && s->hal->uart_tx_done(s->hal->ctx)) {
         s->tx.sending = 0;
-        s->tx.ended_us = s->hal->now_us(s->hal->ctx);
+        s->tx.ended_us = now;
+    }
+    /* A new ID or baud rate takes effect once the response has left, and
+     * before the next request is read. */
+    if (!s->tx.sending && !s->tx.waiting &&
+        (s->active_id != s->regs.user.servo_id ||
+         s->active_baud_index != s->regs.user.baud_index)) {
+        apply_link_settings(s);
+    }
+    receive(s, now);
+    if (ticked) {
+        save_config(s);
+    }
+    if (s->tx.sending) {
+        return; /* half duplex: nothing else goes out meanwhile */
     }
     if (s->tx.waiting) {
-        if (frame_rx_peek(&s->rx) == NULL) {
+        if (s->rx.stats.requests_seen == s->tx.requests_base) {
             wait_for_turn(s);
             return;
         }
@@ -252,12 +292,6 @@ void servo_poll(struct servo *s)
         s->tx.waiting = 0;
         s->sync_turns_abandoned++;
     }
-    /* A new ID or baud rate takes effect once the response has left. */
-    if (s->active_id != s->regs.user.servo_id ||
-        s->active_baud_index != s->regs.user.baud_index) {
-        apply_link_settings(s);
-    }
-    save_config(s);
     uint8_t status = (uint8_t)(s->regs.status.status & ~STATUS_EXECUTING);
     s->regs.status.status =
         motion_is_executing(&s->motion) ? (uint8_t)(status | STATUS_EXECUTING) : status;

@@ -46,6 +46,7 @@ struct servo_tx {
     uint8_t waiting;           /* ready, waiting for its turn (sync Monitor) */
     uint8_t turns_left;        /* other responses still to let pass */
     uint32_t responses_base;   /* framer's response count at the request */
+    uint32_t requests_base;    /* framer's request count when it began to wait */
     uint32_t silence_from_us;  /* start of the current wait for a turn */
     uint32_t ended_us;         /* when the last response left the wire */
 };
@@ -63,6 +64,8 @@ struct servo {
     uint32_t next_tick_us;       /* when the next control tick is due */
     uint32_t ticks_dropped;      /* control ticks skipped by a late main loop */
     uint32_t sync_turns_abandoned; /* Sync Monitor answers dropped for a new request */
+    uint32_t rx_lost;            /* bytes the DMA wrote over before the main loop took them */
+    uint32_t rx_idle_us;         /* line idle this long drops a partial frame */
     volatile uint8_t active_id;  /* the ID answered to now */
     uint8_t active_baud_index;
     uint32_t unsolicited_slot_us;  /* slot length at this baud */
@@ -72,15 +75,12 @@ struct servo {
 
 void servo_init(struct servo *s, const struct hal_port *hal);
 
-/* Receive interrupt: one byte off the wire. */
+/* A byte off the wire into the port's receive ring, as a receive
+ * interrupt would put it (simulator, tests). */
 static inline void servo_on_rx_byte(struct servo *s, uint8_t byte, uint32_t now_us)
 {
-    frame_rx_feed(&s->rx, byte, now_us);
+    hal_rx_ring_put(s->hal->rx, byte, now_us);
 }
-
-/* The same, shaped as the HAL's hal_rx_byte_fn (ctx: the servo), for a
- * port's receive interrupt. */
-void servo_rx_byte(void *servo, uint8_t byte, uint32_t now_us);
 
 /* Main loop: one pass over every pending job, the control tick when it is
  * due among them. Never blocks. */

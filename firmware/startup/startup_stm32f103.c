@@ -7,6 +7,7 @@ void Reset_Handler(void);
 void Default_Handler(void);
 void SysTick_Handler(void) __attribute__((weak, alias("Default_Handler")));
 void USART1_IRQHandler(void) __attribute__((weak, alias("Default_Handler")));
+void DMA1_Channel5_IRQHandler(void) __attribute__((weak, alias("Default_Handler")));
 
 void Reset_Handler(void)
 {
@@ -28,7 +29,7 @@ void Default_Handler(void)
     }
 }
 
-enum { CORE_VECTORS = 16, USART1_IRQ = 37 };
+enum { CORE_VECTORS = 16, DMA1_CHANNEL5_IRQ = 15, USART1_IRQ = 37 };
 
 /* Core exceptions, then device interrupts up to USART1. */
 __attribute__((section(".isr_vector"), used))
@@ -43,5 +44,6 @@ static void (*const vector_table[CORE_VECTORS + USART1_IRQ + 1])(void) = {
     [11] = Default_Handler, /* SVCall */
     [14] = Default_Handler, /* PendSV */
     [15] = SysTick_Handler,
+    [CORE_VECTORS + DMA1_CHANNEL5_IRQ] = DMA1_Channel5_IRQHandler,
     [CORE_VECTORS + USART1_IRQ] = USART1_IRQHandler,
 };

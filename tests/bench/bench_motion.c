@@ -1,8 +1,7 @@
 /* Benchmark (not a test): instructions to plan a move and to run a control
- * tick, counted by callgrind. Run it through run_bench.py.
+ * tick. Run it through tests/bench/target/run_target_bench.py.
  *
- * Regions (bench_region.h: callgrind on the host, the QEMU plugin on the
- * target):
+ * Regions (bench_region.h):
  *   plan_interval, plan_velocity, plan_short_stroke, plan_preempt
  *       motion_submit() of one move: clamping, timing, profile planning
  *   ticks  MOTION_BENCH_TICKS control ticks of a move (encoder read,

@@ -1,8 +1,7 @@
-/* A measured region of a benchmark. On the host, callgrind counts x86
- * instructions (bench_region_callgrind.c); on the target, the ARM build runs
- * under QEMU and an instruction-counting TCG plugin counts the Thumb-2
- * instructions executed between bench_begin() and bench_end()
- * (bench_region_target.c, tests/bench/target/). */
+/* A measured region of a benchmark: the ARM build runs under QEMU and an
+ * instruction-counting TCG plugin counts the Thumb-2 instructions executed
+ * between bench_begin() and bench_end() (bench_region_target.c,
+ * tests/bench/target/). A name measured more than once is summed. */
 #ifndef BENCH_REGION_H
 #define BENCH_REGION_H
 

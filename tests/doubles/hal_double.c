@@ -70,6 +70,7 @@ void hal_double_init(struct hal_double *h)
         .uart_send = uart_send,
         .uart_tx_done = uart_tx_done,
         .uart_set_baud = uart_set_baud,
+        .rx = &h->rx,
         .motor_drive = motor_drive,
         .motor_coast = motor_coast,
         .encoder_read = encoder_read,

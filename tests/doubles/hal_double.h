@@ -15,6 +15,7 @@
 struct hal_double {
     struct hal_port port;
     struct flash_double flash;
+    struct hal_rx_ring rx; /* servo_on_rx_byte puts received bytes here */
     uint32_t now_us;
     uint8_t sent[HAL_DOUBLE_SENT_MAX];
     size_t sent_length;

@@ -223,6 +223,38 @@ static void test_batch_decode_is_all_or_nothing(void **state)
     assert_memory_equal(back, block, USER_AREA_SIZE);
 }
 
+/* The firmware copies struct user_config as the wire's user area: each
+ * item's field must sit at its wire position (sizes in ID order), and a
+ * batch read must give what ReadData gives item by item. */
+static void test_the_user_area_is_its_wire_image(void **state)
+{
+    (void)state;
+    unsigned pos = 0;
+    for (uint8_t id = 32; id <= 53; id++) {
+        const struct data_item *it = data_table_find(id);
+        assert_non_null(it);
+        assert_int_equal(it->offset, pos);
+        pos += it->size;
+    }
+    assert_int_equal(pos, USER_AREA_SIZE);
+    for (unsigned seed = 0; seed < 64; seed++) {
+        for (unsigned i = 0; i < sizeof regs.user; i++) {
+            ((uint8_t *)&regs.user)[i] = (uint8_t)(seed * 37u + i * 11u);
+        }
+        uint8_t block[USER_AREA_SIZE];
+        user_config_encode(&regs.user, block);
+        pos = 0;
+        for (uint8_t id = 32; id <= 53; id++) {
+            uint8_t one[4];
+            uint8_t n = data_table_read(&regs, id, one);
+            if (n != 0u) {
+                assert_memory_equal(one, &block[pos], n);
+            }
+            pos += data_table_find(id)->size;
+        }
+    }
+}
+
 static void test_reset_keeps_id_and_baud(void **state)
 {
     (void)state;
@@ -261,6 +293,7 @@ int main(void)
         cmocka_unit_test_setup(test_unchanged_value_is_reported_as_same, setup),
         cmocka_unit_test_setup(test_cross_item_rules, setup),
         cmocka_unit_test_setup(test_batch_decode_is_all_or_nothing, setup),
+        cmocka_unit_test_setup(test_the_user_area_is_its_wire_image, setup),
         cmocka_unit_test_setup(test_reset_keeps_id_and_baud, setup),
         cmocka_unit_test_setup(test_baud_rates, setup),
     };

@@ -134,13 +134,19 @@ static void test_new_id_takes_effect_after_the_response(void **state)
     hal.tx_busy = true; /* the response is still on the wire */
     REQUEST(4, 0, 34, 7);
     EXPECT_RESPONSE(4, 0, 34, 1); /* answered with the old ID */
-    REQUEST(1, 7); /* waits in the queue while the response is on the wire */
-    assert_int_equal(servo.active_id, 0);
-    hal_double_clear_sent(&hal);
+    harness_poll(2);
+    assert_int_equal(servo.active_id, 0); /* not while the response is on the wire */
+    /* The host's next request, to the new ID, follows the last stop bit at
+     * once: the pass that finds the line free takes the new ID before it
+     * reads the request. */
     hal.tx_busy = false;
+    uint8_t wire[8];
+    size_t n = make_request(wire, 1, (const uint8_t[]){7}, 1);
+    hal_double_clear_sent(&hal);
+    harness_feed(wire, n);
     harness_poll(2);
     assert_int_equal(servo.active_id, 7);
-    EXPECT_RESPONSE(1, 7); /* dispatched after the change took effect */
+    EXPECT_RESPONSE(1, 7);
     REQUEST(1, 7);
     EXPECT_RESPONSE(1, 7);
     REQUEST(1, 0);
@@ -158,7 +164,66 @@ static void test_new_baud_takes_effect_after_the_response(void **state)
     hal.tx_busy = false;
     harness_poll(2);
     assert_int_equal(hal.baud, 1000000);
-    assert_int_equal(servo.rx.idle_timeout_us, 1000);
+    assert_int_equal(servo.rx_idle_us, 1000);
+}
+
+/* The line idle for the idle time (1 ms at 115200) between two passes of
+ * the main loop drops a partial frame; a shorter pause does not. */
+static void feed_ping_in_two(uint32_t pause_us)
+{
+    uint8_t wire[8];
+    size_t n = make_request(wire, 1, (const uint8_t[]){0}, 1);
+    hal_double_clear_sent(&hal);
+    harness_feed(wire, 3);
+    harness_poll(1);
+    hal.now_us += pause_us;
+    harness_poll(1);
+    harness_feed(wire + 3, n - 3);
+    harness_poll(2);
+}
+
+static void test_an_idle_line_drops_a_partial_frame(void **state)
+{
+    (void)state;
+    feed_ping_in_two(servo.rx_idle_us);
+    EXPECT_SILENCE();
+    assert_int_equal(servo.rx.stats.idle_timeouts, 1);
+    REQUEST(1, 0); /* the next frame is whole */
+    EXPECT_RESPONSE(1, 0);
+}
+
+static void test_a_pause_within_the_idle_time_keeps_the_frame(void **state)
+{
+    (void)state;
+    feed_ping_in_two(servo.rx_idle_us - 1u - HARNESS_BYTE_US);
+    EXPECT_RESPONSE(1, 0);
+    assert_int_equal(servo.rx.stats.idle_timeouts, 0);
+}
+
+static void test_the_idle_time_survives_the_clock_wrap(void **state)
+{
+    (void)state;
+    hal.now_us = 0xFFFFFFFFu - 3u * HARNESS_BYTE_US;
+    servo.next_tick_us = hal.now_us;
+    feed_ping_in_two(100);
+    EXPECT_RESPONSE(1, 0);
+    assert_int_equal(servo.rx.stats.idle_timeouts, 0);
+}
+
+static void test_a_clock_stepping_back_is_no_idle_line(void **state)
+{
+    (void)state;
+    /* An emulated SysTick can read a little earlier than the byte's stamp. */
+    uint8_t wire[8];
+    size_t n = make_request(wire, 1, (const uint8_t[]){0}, 1);
+    hal_double_clear_sent(&hal);
+    harness_feed(wire, 3);
+    hal.now_us -= 1000u;
+    harness_poll(1);
+    harness_feed(wire + 3, n - 3);
+    harness_poll(2);
+    EXPECT_RESPONSE(1, 0);
+    assert_int_equal(servo.rx.stats.idle_timeouts, 0);
 }
 
 static void test_config_survives_restart(void **state)
@@ -413,6 +478,10 @@ int main(void)
         cmocka_unit_test_setup(test_batch_read_write_and_reset, setup),
         cmocka_unit_test_setup(test_new_id_takes_effect_after_the_response, setup),
         cmocka_unit_test_setup(test_new_baud_takes_effect_after_the_response, setup),
+        cmocka_unit_test_setup(test_an_idle_line_drops_a_partial_frame, setup),
+        cmocka_unit_test_setup(test_a_pause_within_the_idle_time_keeps_the_frame, setup),
+        cmocka_unit_test_setup(test_the_idle_time_survives_the_clock_wrap, setup),
+        cmocka_unit_test_setup(test_a_clock_stepping_back_is_no_idle_line, setup),
         cmocka_unit_test_setup(test_config_survives_restart, setup),
         cmocka_unit_test_setup(test_reset_keeps_link, setup),
         cmocka_unit_test_setup(test_sync_monitor_waits_its_turn, setup),

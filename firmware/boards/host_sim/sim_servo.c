@@ -140,6 +140,7 @@ bool sim_servo_start(struct sim_servo *s, struct sim_bus *bus, unsigned index, u
         .uart_send = uart_send,
         .uart_tx_done = uart_tx_done,
         .uart_set_baud = uart_set_baud,
+        .rx = &s->rx,
         .motor_drive = motor_drive,
         .motor_coast = motor_coast,
         .encoder_read = encoder_read,

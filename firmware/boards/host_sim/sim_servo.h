@@ -18,6 +18,7 @@ struct sim_servo {
     struct plant plant;
     struct thermal thermal;
     struct sim_flash flash;
+    struct hal_rx_ring rx;
     struct sim_bus *bus;
     unsigned index;       /* on the bus */
     uint8_t cmdline_id;   /* the ID it was started with (names its flash file) */

@@ -102,7 +102,7 @@ int main(void)
         .serial_number = 0x0E3A0001u,
         .rx_gap_tolerance_us = 50000u, /* QEMU delivers a frame's bytes with jitter */
     };
-    port_uart_init(&port, &usart, servo_rx_byte, &servo, QEMU_CORE_HZ);
+    port_uart_init(&port, &usart, PORT_UART_RX_INTERRUPT, QEMU_CORE_HZ);
     usart_hd_tx_polled(&usart); /* QEMU 7.2's USART raises no transmit interrupts */
     usart_hd_no_echo(&usart);   /* and its socket does not echo our bytes */
     servo_init(&servo, &port);

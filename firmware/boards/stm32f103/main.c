@@ -74,7 +74,7 @@ int main(void)
         .flash = &flash,
         .serial_number = unique_id_serial(),
     };
-    port_uart_init(&port, &usart, servo_rx_byte, &servo, F103_PCLK2_HZ);
+    port_uart_init(&port, &usart, PORT_UART_RX_DMA, F103_PCLK2_HZ);
     servo_init(&servo, &port);
     NVIC_ISER(USART1_IRQ / 32u) = 1u << (USART1_IRQ % 32u);
     iwdg_start();

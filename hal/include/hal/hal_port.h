@@ -1,7 +1,6 @@
 /* What the servo core needs of its hardware. Each port (MCU, host
  * simulator, test double) fills one; the core never touches hardware
- * otherwise. Functions are called from the main loop only, except now_us,
- * which the receive interrupt also uses. */
+ * otherwise. Functions are called from the main loop only. */
 #ifndef HAL_HAL_PORT_H
 #define HAL_HAL_PORT_H
 
@@ -9,13 +8,8 @@
 #include <stdint.h>
 
 #include "hal/hal_flash.h"
+#include "hal/hal_rx_ring.h"
 #include "hal/hal_sensors.h"
-
-/* Where a port's receive interrupt hands each byte off the wire, with the
- * microsecond clock at its arrival. The application gives one to the port
- * when it starts it; the port knows nothing above the HAL. Called in
- * interrupt context: it must not block. */
-typedef void (*hal_rx_byte_fn)(void *ctx, uint8_t byte, uint32_t now_us);
 
 struct hal_port {
     void *ctx;
@@ -27,6 +21,11 @@ struct hal_port {
     /* True once the last stop bit of the last send has left the wire. */
     bool (*uart_tx_done)(void *ctx);
     void (*uart_set_baud)(void *ctx, uint32_t baud);
+    /* Received bytes, in the ring the port owns and fills. */
+    struct hal_rx_ring *rx;
+    /* Brings rx->written and rx->heard_us up to date, for a port whose DMA
+     * fills the ring; NULL when its receive interrupt does. */
+    void (*rx_sync)(void *ctx, uint32_t now_us);
     /* H-bridge: signed duty, Q15 (32767 = full supply; positive turns the
      * output towards increasing angle, counter-clockwise seen from the horn). */
     void (*motor_drive)(void *ctx, int16_t duty_q15);

@@ -1,10 +1,14 @@
 #include "port_uart.h"
 
+#include <stddef.h>
+
+#include "dma_rx.h"
 #include "stm32f1_regs.h"
 #include "systick_clock.h"
 
 static struct usart_hd *bus_usart;
-static hal_rx_byte_fn rx_to;
+static struct hal_rx_ring ring;
+static struct dma_rx dma;
 
 void USART1_IRQHandler(void);
 void USART1_IRQHandler(void)
@@ -12,9 +16,11 @@ void USART1_IRQHandler(void)
     usart_hd_irq(bus_usart);
 }
 
-static void on_byte(void *ctx, uint8_t byte)
+void DMA1_Channel5_IRQHandler(void);
+void DMA1_Channel5_IRQHandler(void)
 {
-    rx_to(ctx, byte, systick_now_us());
+    DMA1_IFCR = DMA1_CH5_FLAGS;
+    dma_rx_lap(&dma);
 }
 
 static uint32_t now_us(void *ctx)
@@ -38,15 +44,29 @@ static void uart_set_baud(void *ctx, uint32_t baud)
     usart_hd_set_baud(ctx, baud);
 }
 
-void port_uart_init(struct hal_port *port, struct usart_hd *usart, hal_rx_byte_fn on_rx,
-                    void *rx_ctx, uint32_t pclk_hz)
+static void rx_sync(void *ctx, uint32_t now)
+{
+    (void)ctx;
+    dma_rx_sync(&dma, now);
+}
+
+void port_uart_init(struct hal_port *port, struct usart_hd *usart, enum port_uart_rx rx,
+                    uint32_t pclk_hz)
 {
     bus_usart = usart;
-    rx_to = on_rx;
-    usart_hd_init(usart, USART1_BASE, pclk_hz, 115200u, true, on_byte, rx_ctx);
+    usart_hd_init(usart, USART1_BASE, pclk_hz, 115200u, true, &ring, systick_now_us);
     port->ctx = usart;
     port->now_us = now_us;
     port->uart_send = uart_send;
     port->uart_tx_done = uart_tx_done;
     port->uart_set_baud = uart_set_baud;
+    port->rx = &ring;
+    port->rx_sync = NULL;
+    if (rx == PORT_UART_RX_DMA) {
+        RCC_AHBENR |= RCC_AHBENR_DMA1;
+        dma_rx_start(&dma, DMA1_CCR5_ADDR, USART1_BASE + 0x04u, &ring);
+        usart_hd_rx_dma(usart);
+        port->rx_sync = rx_sync;
+        NVIC_ISER(DMA1_CH5_IRQ / 32u) = 1u << (DMA1_CH5_IRQ % 32u);
+    }
 }

@@ -79,6 +79,9 @@
 #define USART_SR_TC (1u << 6)
 #define USART_SR_TXE (1u << 7)
 #define USART_SR_ORE (1u << 3)
+#define USART_SR_IDLE (1u << 4)
+#define USART_CR1_IDLEIE (1u << 4)
+#define USART_CR3_DMAR (1u << 6)
 #define USART_CR1_RE (1u << 2)
 #define USART_CR1_TE (1u << 3)
 #define USART_CR1_RXNEIE (1u << 5)
@@ -122,6 +125,13 @@
 #define DMA1_CNDTR1 REG32(0x4002000Cu)
 #define DMA1_CPAR1 REG32(0x40020010u)
 #define DMA1_CMAR1 REG32(0x40020014u)
+/* DMA1 channel 5 serves USART1_RX (RM0008 table 78); its CCR, and its
+ * flags in DMA1_ISR / DMA1_IFCR (bits 16-19: GIF, TCIF, HTIF, TEIF). */
+#define DMA1_ISR REG32(0x40020000u)
+#define DMA1_IFCR REG32(0x40020004u)
+#define DMA1_CCR5_ADDR 0x40020058u
+#define DMA1_CH5_FLAGS (0xFu << 16)
+#define DMA1_CH5_IRQ 15u
 /* MINC | CIRC | PSIZE 16 | MSIZE 16 | EN */
 #define DMA_CCR_ADC_CIRCULAR ((1u << 7) | (1u << 5) | (1u << 8) | (1u << 10) | (1u << 0))
 

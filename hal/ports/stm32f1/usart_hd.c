@@ -8,8 +8,8 @@ void usart_hd_set_baud(struct usart_hd *u, uint32_t baud)
     USART_BRR(u->base) = (u->pclk_hz + baud / 2u) / baud;
 }
 
-void usart_hd_init(struct usart_hd *u, uint32_t base, uint32_t pclk_hz, uint32_t baud,
-                   bool single_wire, void (*on_byte)(void *ctx, uint8_t byte), void *ctx)
+void usart_hd_init(struct usart_hd *u, uintptr_t base, uint32_t pclk_hz, uint32_t baud,
+                   bool single_wire, struct hal_rx_ring *rx, uint32_t (*clock_us)(void))
 {
     u->base = base;
     u->tx_irq = true;
@@ -18,8 +18,9 @@ void usart_hd_init(struct usart_hd *u, uint32_t base, uint32_t pclk_hz, uint32_t
     u->tx = 0;
     u->tx_left = 0;
     u->tx_busy = 0;
-    u->on_byte = on_byte;
-    u->ctx = ctx;
+    u->rx_dma = false;
+    u->rx = rx;
+    u->clock_us = clock_us;
     USART_CR1(base) = 0;
     usart_hd_set_baud(u, baud);
     USART_CR3(base) = single_wire ? USART_CR3_HDSEL : 0u;
@@ -28,6 +29,13 @@ void usart_hd_init(struct usart_hd *u, uint32_t base, uint32_t pclk_hz, uint32_t
      * been written. */
     USART_SR(base) = 0;
     USART_CR1(base) = USART_CR1_UE | USART_CR1_TE | USART_CR1_RE | USART_CR1_RXNEIE;
+}
+
+void usart_hd_rx_dma(struct usart_hd *u)
+{
+    u->rx_dma = true;
+    USART_CR3(u->base) |= USART_CR3_DMAR;
+    USART_CR1(u->base) = (USART_CR1(u->base) & ~USART_CR1_RXNEIE) | USART_CR1_IDLEIE;
 }
 
 void usart_hd_tx_polled(struct usart_hd *u)
@@ -100,19 +108,34 @@ bool usart_hd_tx_done(const struct usart_hd *u)
     return !u->tx_busy;
 }
 
+/* Receive interrupt, without DMA. Drain: on silicon this sees one byte
+ * (two at most, bytes are 87 us apart at 115200). QEMU 7.2 can hand over
+ * the next byte while DR is read and lower the interrupt after it, so a
+ * byte would wait unseen. */
+static uint32_t receive_bytes(struct usart_hd *u, uint32_t sr, uint32_t cr1)
+{
+    while (sr & (USART_SR_RXNE | USART_SR_ORE)) {
+        uint8_t byte = (uint8_t)USART_DR(u->base); /* also clears an overrun */
+        if (sr & USART_SR_ORE) {
+            u->rx->overruns++; /* a byte came before the last was read */
+        }
+        if ((sr & USART_SR_RXNE) && (cr1 & USART_CR1_RE)) {
+            hal_rx_ring_put(u->rx, byte, u->clock_us());
+        }
+        sr = USART_SR(u->base);
+    }
+    return sr;
+}
+
 void usart_hd_irq(struct usart_hd *u)
 {
     uint32_t sr = USART_SR(u->base);
     uint32_t cr1 = USART_CR1(u->base);
-    /* Drain: on silicon this sees one byte (two at most, bytes are 87 us
-     * apart at 115200). QEMU 7.2 can hand over the next byte while DR is
-     * read and lower the interrupt after it, so a byte would wait unseen. */
-    while (sr & (USART_SR_RXNE | USART_SR_ORE)) {
-        uint8_t byte = (uint8_t)USART_DR(u->base); /* also clears an overrun */
-        if ((sr & USART_SR_RXNE) && (cr1 & USART_CR1_RE)) {
-            u->on_byte(u->ctx, byte);
-        }
-        sr = USART_SR(u->base);
+    if (!u->rx_dma) {
+        sr = receive_bytes(u, sr, cr1);
+    } else if (sr & USART_SR_IDLE) {
+        (void)USART_DR(u->base); /* SR then DR clears IDLE (RM0008 27.6.1) */
+        u->rx->heard_us = u->clock_us();
     }
     if (u->tx_irq && (cr1 & (USART_CR1_TXEIE | USART_CR1_TCIE))) {
         transmit_step(u, sr);

@@ -1,27 +1,36 @@
-/* USART in single-wire half-duplex mode, interrupt-driven both ways: every
- * received byte goes to on_byte from the interrupt; a send runs from the
- * interrupt too and turns the line around (receiver off while sending, back
- * on after the last stop bit), so the servo never hears its own echo. */
+/* USART in single-wire half-duplex mode. Received bytes go into the HAL's
+ * ring: by DMA (dma_rx.h), the interrupt only marking when the line goes
+ * idle, or by the receive interrupt a byte at a time where there is no DMA
+ * (QEMU's USART). A send runs from the interrupt and turns the line around
+ * (receiver off while sending, back on after the last stop bit), so the
+ * servo never hears its own echo. */
 #ifndef STM32F1_USART_HD_H
 #define STM32F1_USART_HD_H
 
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "hal/hal_rx_ring.h"
+
 struct usart_hd {
-    uint32_t base;
+    uintptr_t base;
     bool tx_irq;                 /* transmit from the interrupt (else usart_hd_service) */
     bool hears_own_bytes;        /* single wire: receiver off while sending */
     uint32_t pclk_hz;
     const uint8_t *volatile tx;
     volatile uint16_t tx_left;
     volatile uint8_t tx_busy;
-    void (*on_byte)(void *ctx, uint8_t byte);
-    void *ctx;
+    bool rx_dma;                 /* a DMA channel receives: the interrupt marks idle lines */
+    struct hal_rx_ring *rx;
+    uint32_t (*clock_us)(void);  /* stamps received bytes and idle lines */
 };
 
-void usart_hd_init(struct usart_hd *u, uint32_t base, uint32_t pclk_hz, uint32_t baud,
-                   bool single_wire, void (*on_byte)(void *ctx, uint8_t byte), void *ctx);
+void usart_hd_init(struct usart_hd *u, uintptr_t base, uint32_t pclk_hz, uint32_t baud,
+                   bool single_wire, struct hal_rx_ring *rx, uint32_t (*clock_us)(void));
+/* Receive by DMA from now on (the caller starts the channel, dma_rx.h):
+ * the USART requests DMA and interrupts on an idle line instead of on
+ * every byte. */
+void usart_hd_rx_dma(struct usart_hd *u);
 /* Transmit from the main loop instead (usart_hd_service), for USART models
  * that raise no transmit interrupts (QEMU 7.2). Receive stays on the
  * interrupt. */

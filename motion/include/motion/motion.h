@@ -178,11 +178,17 @@ bool motion_set_origin(struct motion *m);
 void motion_begin_async(struct motion *m);
 void motion_end_async(struct motion *m, bool cancel);
 /* A finished move is owed an answer. */
-bool motion_has_finished(const struct motion *m);
+static inline bool motion_has_finished(const struct motion *m)
+{
+    return m->answers_count != 0u;
+}
 /* Packet number of a finished move that must be answered, 0 if none. */
 uint8_t motion_take_finished(struct motion *m);
 /* True while a motion command runs (status bit 0). */
-bool motion_is_executing(const struct motion *m);
+static inline bool motion_is_executing(const struct motion *m)
+{
+    return m->running != 0u;
+}
 
 /* What the protection monitors require of the output: inhibit releases it
  * and refuses motion until lifted; derate halves the current it may draw;

@@ -1,10 +1,11 @@
-/* Request framer: fed one received byte at a time from the UART receive
- * interrupt, hands complete, checksum-verified request frames to the main
- * loop through a small single-producer/single-consumer queue.
+/* Request framer: fed the received bytes in bursts by the main loop (from
+ * the port's receive ring), it queues complete, checksum-verified requests
+ * for this servo.
  *
- * Work per byte is constant and nothing blocks. Other servos' response
- * frames are skipped whole by their length. SyncCommand (25) frames of any
- * length are never buffered: only this servo's record is kept. */
+ * What is not kept costs nothing per byte: other servos' responses, and
+ * requests addressed to another ID (from their ID byte on), are passed over
+ * by their length in one step. SyncCommand (25) frames of any length are
+ * never buffered: only this servo's record is kept. */
 #ifndef PROTOCOL_FRAME_RX_H
 #define PROTOCOL_FRAME_RX_H
 
@@ -40,19 +41,18 @@ struct rx_frame {
 
 struct frame_rx_stats {
     uint32_t frames;            /* requests delivered */
+    uint32_t requests_seen;     /* requests on the wire, to any ID, whole or not */
     uint32_t checksum_errors;   /* requests dropped for a bad checksum */
-    /* Other servos' response frames passed over; the main loop reads it. */
-    volatile uint32_t responses_skipped;
+    uint32_t responses_skipped; /* other servos' response frames passed over */
     uint32_t idle_timeouts;     /* partial frames dropped after an idle gap */
     uint32_t queue_overflows;   /* requests dropped because the queue was full */
     uint32_t garbage_bytes;     /* bytes outside any frame */
 };
 
 struct frame_rx {
-    /* Written only by the interrupt side. */
     struct rx_frame slots[FRAME_QUEUE_SLOTS];
-    volatile uint8_t head;      /* next slot the framer fills */
-    volatile uint8_t tail;      /* next slot the main loop reads */
+    uint8_t head;               /* next slot the framer fills */
+    uint8_t tail;               /* next slot the dispatcher reads */
     uint8_t state;
     uint8_t is_request;
     uint8_t checksum;
@@ -63,27 +63,32 @@ struct frame_rx {
     uint8_t sync_record_pos;    /* byte position within the current record */
     uint8_t sync_record_index;  /* index of the current record */
     uint8_t sync_capturing;
-    volatile uint32_t last_byte_us; /* the main loop reads it */
-    uint32_t idle_timeout_us;
+    uint32_t skip_left;         /* RX_SKIP: bytes to pass over, checksum included */
     const volatile uint8_t *own_id; /* the servo's active ID, for sync records */
     struct frame_rx_stats stats;
 };
 
 /* own_id must stay valid for the framer's lifetime; the framer reads it when
  * a sync record starts. */
-void frame_rx_init(struct frame_rx *rx, const volatile uint8_t *own_id,
-                   uint32_t idle_timeout_us);
+void frame_rx_init(struct frame_rx *rx, const volatile uint8_t *own_id);
 
-/* Idle time after which a partial frame is dropped (see frame_rx_idle_us). */
-void frame_rx_set_idle_timeout(struct frame_rx *rx, uint32_t idle_timeout_us);
+/* Received bytes, in order. */
+void frame_rx_feed_bytes(struct frame_rx *rx, const uint8_t *data, uint32_t n);
+/* One received byte. */
+void frame_rx_feed(struct frame_rx *rx, uint8_t byte);
 
-/* Interrupt side: one received byte and the microsecond clock at its arrival
- * (a free-running counter; wrap-around is handled). */
-void frame_rx_feed(struct frame_rx *rx, uint8_t byte, uint32_t now_us);
+/* The line has been idle for the idle timeout (frame_rx_idle_us): a partial
+ * frame is dropped. */
+void frame_rx_line_idle(struct frame_rx *rx);
+/* A frame has begun and not ended. */
+bool frame_rx_in_frame(const struct frame_rx *rx);
 
-/* Main-loop side: the oldest complete frame, or NULL. The frame stays valid
- * until frame_rx_release(). */
-const struct rx_frame *frame_rx_peek(struct frame_rx *rx);
+/* The oldest complete frame, or NULL. The frame stays valid until
+ * frame_rx_release(). */
+static inline const struct rx_frame *frame_rx_peek(const struct frame_rx *rx)
+{
+    return rx->tail == rx->head ? (const struct rx_frame *)0 : &rx->slots[rx->tail];
+}
 void frame_rx_release(struct frame_rx *rx);
 
 /* The documented idle timeout for a baud rate: ten byte times (10 bits each),

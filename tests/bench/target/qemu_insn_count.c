@@ -2,6 +2,7 @@
  * marker addresses, region after region, and models their cycles.
  *
  *   -plugin libqemu_insn_count.so,begin=0xADDR,end=0xADDR,out=FILE[,core=m3|m0][,ws=N]
+ *           [,profile=PFILE]
  *
  * Instructions: every instruction adds one to a counter (an inline op, no
  * call); the first instruction of each marker function takes a snapshot.
@@ -14,6 +15,9 @@
  * RM0008 3.3.3), which the prefetch buffer cannot hide after a jump. A
  * literal load from flash pays the wait states too, and straight-line code
  * runs no faster than the prefetch buffer fills: 8 bytes per 1 + ws cycles.
+ *
+ * With profile=PFILE, each region's blocks go to PFILE as they end:
+ * "region start_address instructions" lines, for a per-function breakdown.
  *
  * At exit, "total I C" and then "I C" per region go to FILE. A guest that
  * exits through semihosting ends the process without QEMU's plugin exit
@@ -28,7 +32,7 @@
 
 PLUGIN_EXPORT int qemu_plugin_version = 1;
 
-enum { MAX_REGIONS = 256, MAX_BLOCKS = 65536 };
+enum { MAX_REGIONS = 4096, MAX_BLOCKS = 65536 };
 
 static uint64_t executed, cycles;
 static uint64_t begun_at, begun_cycles;
@@ -38,11 +42,15 @@ static uint64_t begin_addr, end_addr;
 static char out_path[512];
 static enum core core = CORE_M3;
 static unsigned wait_states = 2;
+static FILE *profile;
+static int in_region;
 
 /* What a translated block costs when it runs; blocks are never freed. */
 struct block {
     uint64_t start, end;
     uint32_t cycles;
+    uint32_t insns;
+    uint64_t hits; /* runs inside the current region, for the profile */
 };
 static struct block blocks[MAX_BLOCKS];
 static unsigned block_count;
@@ -54,6 +62,7 @@ static void on_begin(unsigned int vcpu, void *userdata)
     (void)userdata;
     begun_at = executed;
     begun_cycles = cycles;
+    in_region = 1;
 }
 
 static void on_end(unsigned int vcpu, void *userdata)
@@ -65,12 +74,23 @@ static void on_end(unsigned int vcpu, void *userdata)
         regions[region_count][1] = cycles - begun_cycles;
         region_count++;
     }
+    in_region = 0;
+    if (profile != NULL) {
+        for (unsigned i = 0; i < block_count; i++) {
+            if (blocks[i].hits != 0u) {
+                fprintf(profile, "%u %#" PRIx64 " %" PRIu64 "\n", region_count - 1u, blocks[i].start,
+                        blocks[i].hits * blocks[i].insns);
+                blocks[i].hits = 0;
+            }
+        }
+    }
 }
 
 static void on_block(unsigned int vcpu, void *userdata)
 {
     (void)vcpu;
-    const struct block *b = userdata;
+    struct block *b = userdata;
+    b->hits += (uint64_t)in_region;
     if (b->start != last_end) {
         cycles += 2u + wait_states; /* after a taken branch */
     }
@@ -108,13 +128,16 @@ static void on_translate(qemu_plugin_id_t id, struct qemu_plugin_tb *tb)
     uint32_t fetch = (bytes + 7u) / 8u * (1u + wait_states);
     if (block_count < MAX_BLOCKS) {
         struct block *b = &blocks[block_count++];
-        *b = (struct block){qemu_plugin_tb_vaddr(tb), end, own > fetch ? own : fetch};
+        *b = (struct block){qemu_plugin_tb_vaddr(tb), end, own > fetch ? own : fetch, (uint32_t)n, 0};
         qemu_plugin_register_vcpu_tb_exec_cb(tb, on_block, QEMU_PLUGIN_CB_NO_REGS, b);
     }
 }
 
 static void write_counts(void)
 {
+    if (profile != NULL) {
+        fclose(profile);
+    }
     FILE *f = fopen(out_path, "w");
     if (f == NULL) {
         perror(out_path);
@@ -143,6 +166,12 @@ PLUGIN_EXPORT int qemu_plugin_install(qemu_plugin_id_t id, const qemu_info_t *in
             snprintf(out_path, sizeof out_path, "%s", argv[i] + 4);
         } else if (strcmp(argv[i], "core=m0") == 0) {
             core = CORE_M0;
+        } else if (strncmp(argv[i], "profile=", 8) == 0) {
+            profile = fopen(argv[i] + 8, "w");
+            if (profile == NULL) {
+                perror(argv[i] + 8);
+                return 1;
+            }
         } else if (strncmp(argv[i], "ws=", 3) == 0) {
             wait_states = (unsigned)strtoul(argv[i] + 3, NULL, 0);
         }

@@ -3,7 +3,7 @@
 instruction-counting plugin and prints Thumb-2 instruction counts per region
 for the Cortex-M3 and the Cortex-M0, beside issue 10's budgets.
 
-    python3 tests/bench/target/run_target_bench.py [--json FILE]
+    python3 tests/bench/target/run_target_bench.py [--json FILE] [--profile REGION]
 
 Needs: cmake --build --preset target-bench-m3, --preset target-bench-m0, and
 the host preset's build/host/tests/libqemu_insn_count.so.
@@ -43,12 +43,48 @@ def symbol(elf: Path, name: str) -> int:
     raise SystemExit(f"run_target_bench: {elf} has no {name}")
 
 
-def run(elf: Path, cpu: str) -> tuple:
+def functions(elf: Path) -> list:
+    """[(start, end, name)] of the image's functions, by address."""
+    out = subprocess.run(["arm-none-eabi-nm", "-S", "--defined-only", str(elf)],
+                         capture_output=True, text=True, check=True).stdout
+    funcs = []
+    for line in out.splitlines():
+        parts = line.split()
+        if len(parts) == 4 and parts[2] in "tTwW":
+            start = int(parts[0], 16) & ~1
+            funcs.append((start, start + int(parts[1], 16), parts[3]))
+    return sorted(funcs)
+
+
+def print_profile(elf: Path, names: list, profile_file: Path, region: str) -> None:
+    """Instructions of one region per function, self only (not callees)."""
+    if region not in names:
+        return
+    indices = {i for i, name in enumerate(names) if name == region}
+    funcs = functions(elf)
+    per_function = {}
+    for line in profile_file.read_text().splitlines():
+        r, start, count = line.split()
+        if int(r) not in indices:
+            continue
+        addr = int(start, 16)
+        name = next((n for s, e, n in funcs if s <= addr < e), f"{addr:#x}")
+        per_function[name] = per_function.get(name, 0) + int(count)
+    total = sum(per_function.values())
+    print(f"profile of {region} in {elf.name}: {total} instructions, self, by function")
+    for name, count in sorted(per_function.items(), key=lambda kv: -kv[1]):
+        print(f"  {count:>10} {100 * count / total:5.1f} %  {name}")
+
+
+def run(elf: Path, cpu: str, profile_region: str = "") -> tuple:
     """{region: instructions less the markers' cost}, and the stats lines."""
     with tempfile.TemporaryDirectory() as tmp:
         counts_file = Path(tmp) / "counts.txt"
+        profile_file = Path(tmp) / "profile.txt"
         plugin = (f"{PLUGIN},begin={symbol(elf, 'bench_marker_begin'):#x},"
                   f"end={symbol(elf, 'bench_marker_end'):#x},out={counts_file},{MODEL[cpu]}")
+        if profile_region:
+            plugin += f",profile={profile_file}"
         proc = subprocess.run(
             ["qemu-system-arm", "-M", "lm3s6965evb", "-cpu", cpu, "-nographic",
              "-semihosting-config", "enable=on,target=native", "-kernel", str(elf), "-plugin", plugin],
@@ -56,15 +92,20 @@ def run(elf: Path, cpu: str) -> tuple:
         if proc.returncode != 0:
             raise SystemExit(f"run_target_bench: {elf.name} on {cpu} failed: {proc.stderr.strip()}")
         lines = counts_file.read_text().splitlines()
+        names = [line.split()[1] for line in proc.stdout.splitlines() if line.startswith("region ")]
+        if profile_region:
+            print_profile(elf, names, profile_file, profile_region)
     counts = [tuple(int(x) for x in line.split()) for line in lines[1:]]  # after "total I C"
-    names = [line.split()[1] for line in proc.stdout.splitlines() if line.startswith("region ")]
     stats = dict(line.split() for line in proc.stdout.splitlines()
                  if len(line.split()) == 2 and not line.startswith("region "))
     if len(names) != len(counts):
         raise SystemExit(f"run_target_bench: {len(names)} regions named, {len(counts)} counted")
-    raw = dict(zip(names, counts))
-    overhead = raw.pop("overhead")
-    regions = {name: (i - overhead[0], c - overhead[1]) for name, (i, c) in raw.items()}
+    overhead = counts[names.index("overhead")]
+    regions = {}
+    for name, (i, c) in zip(names, counts):
+        if name != "overhead":  # a name measured many times is summed
+            total = regions.get(name, (0, 0))
+            regions[name] = (total[0] + i - overhead[0], total[1] + c - overhead[1])
     extra = regions.pop("calibration_200")[0] - regions.pop("calibration_100")[0]
     if extra != KNOWN_LOOP:
         raise SystemExit(f"run_target_bench: 100 more iterations of a 2-instruction loop counted {extra} "
@@ -72,10 +113,10 @@ def run(elf: Path, cpu: str) -> tuple:
     return regions, stats
 
 
-def figures(cpu: str) -> dict:
+def figures(cpu: str, profile_region: str = "") -> dict:
     """{figure: (instructions, cycles)}."""
-    proto, pstats = run(CPUS[cpu] / "bench_protocol.elf", cpu)
-    motion, mstats = run(CPUS[cpu] / "bench_motion.elf", cpu)
+    proto, pstats = run(CPUS[cpu] / "bench_protocol.elf", cpu, profile_region)
+    motion, mstats = run(CPUS[cpu] / "bench_motion.elf", cpu, profile_region)
     nbytes, nticks = int(pstats["stream_bytes"]), int(mstats["ticks"])
     plans = {k: v for k, v in motion.items() if k.startswith("plan_")}
     out = {
@@ -92,10 +133,12 @@ def figures(cpu: str) -> dict:
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--json", type=Path, help="also write the figures here")
+    ap.add_argument("--profile", metavar="REGION", default="",
+                    help="print REGION's instructions by function (Cortex-M3)")
     args = ap.parse_args()
     if not PLUGIN.exists():
         sys.exit(f"run_target_bench: {PLUGIN} is missing: cmake --build --preset host")
-    results = {cpu: figures(cpu) for cpu in CPUS}
+    results = {cpu: figures(cpu, args.profile if cpu == "cortex-m3" else "") for cpu in CPUS}
     m3, m0 = results["cortex-m3"], results["cortex-m0"]
     print(f"target benchmark: Thumb instructions executed, exact (QEMU 7.2 + plugin; the "
           f"calibration loop's {KNOWN_LOOP} counted exactly on both), and modelled cycles")

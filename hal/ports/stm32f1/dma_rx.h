@@ -1,0 +1,34 @@
+/* USART receive by DMA into the HAL's ring (RM0008 13, "DMA controller"):
+ * one channel in circular mode writes every received byte into
+ * hal_rx_ring.data, with no code per byte; its counter (CNDTR, counting
+ * down from the ring's size) is the write position, and a transfer-complete
+ * interrupt, once a lap of the ring, counts laps. So `written` runs free
+ * like a receive interrupt's would, and a main loop lapped by the DMA (held
+ * up longer than a ring's time) sees how much it lost.
+ *
+ * The channel's registers are found from `channel` (the address of its
+ * CCR), so the benchmark can run this on registers in RAM. */
+#ifndef STM32F1_DMA_RX_H
+#define STM32F1_DMA_RX_H
+
+#include <stdint.h>
+
+#include "hal/hal_rx_ring.h"
+
+struct dma_rx {
+    uintptr_t channel;       /* address of the channel's CCR */
+    struct hal_rx_ring *ring;
+    volatile uint32_t laps;  /* transfer-complete interrupts */
+    uint32_t written;        /* bytes written as last seen */
+};
+
+/* Starts the channel on the peripheral's data register. */
+void dma_rx_start(struct dma_rx *d, uintptr_t channel, uintptr_t data_register,
+                  struct hal_rx_ring *ring);
+/* From the channel's interrupt, after its transfer-complete flag is clear. */
+void dma_rx_lap(struct dma_rx *d);
+/* Brings ring->written up to date; bytes new since the last call mark the
+ * line busy at now_us. Main loop. */
+void dma_rx_sync(struct dma_rx *d, uint32_t now_us);
+
+#endif
