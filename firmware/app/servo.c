@@ -30,6 +30,11 @@ void servo_init(struct servo *s, const struct hal_port *hal)
 {
     *s = (struct servo){.hal = hal};
     config_store_load(&s->store, hal->flash, &s->regs.user);
+    /* Erase ahead at power-up, before the control loop runs: saves need
+     * no erase until the page in use is full. */
+    if (config_store_spare_dirty(&s->store)) {
+        (void)config_store_erase_spare(&s->store); /* a failure shows at the next save */
+    }
     save_policy_init(&s->saver, &s->store, hal->now_us(hal->ctx));
     s->regs.status.model = SERVO_MODEL;
     s->regs.status.firmware_version = FIRMWARE_VERSION;
@@ -140,7 +145,8 @@ static void report_store(struct servo *s)
     struct store_health *h = &s->regs.store;
     uint8_t flags = (uint8_t)((s->store.failed ? STORE_FAILED : 0u) |
                               (s->saver.deferred ? STORE_DEFERRED : 0u) |
-                              (s->saver.pending ? STORE_PENDING : 0u));
+                              (s->saver.pending || s->store.job_active ? STORE_PENDING : 0u) |
+                              (s->saver.awaits_erase ? STORE_AWAITS_ERASE : 0u));
     uint32_t op_seconds = save_policy_op_seconds(&s->saver);
     if (flags == h->flags && op_seconds == h->op_seconds && h->rated_cycles != 0u &&
         s->store.sequence == h->records && s->store.write_failures == h->failures) {
@@ -155,20 +161,64 @@ static void report_store(struct servo *s)
     h->failures = s->store.write_failures;
 }
 
-/* The user area to flash when the save policy says so, checked once a
- * control tick. A failed save sets status bit 1 and refuses further writes
- * until a retry succeeds. */
-static void save_config(struct servo *s)
+static void save_finished(struct servo *s, enum config_save_result r, uint32_t now)
 {
-    uint32_t now = s->hal->now_us(s->hal->ctx);
-    if (save_policy_due(&s->saver, &s->store, now)) {
-        enum config_save_result r =
-            config_store_save(&s->store, &s->regs.user, save_policy_op_seconds(&s->saver));
-        save_policy_saved(&s->saver, r, now);
-        if (r == CONFIG_WRITE_FAILED) {
-            s->regs.status.status |= STATUS_COMMAND_ERROR;
+    save_policy_saved(&s->saver, r, now);
+    if (r == CONFIG_WRITE_FAILED) {
+        s->regs.status.status |= STATUS_COMMAND_ERROR;
+    }
+    s->dispatcher.store_failed = s->store.failed;
+}
+
+/* A page erase stalls the CPU for 20-40 ms: bytes wait in the DMA ring,
+ * ticks do not run. Only while no move runs and the line is quiet (servo.h,
+ * STORE_ERASE_*). */
+static bool erase_may_stall(const struct servo *s, uint32_t now)
+{
+    const struct hal_rx_ring *ring = s->hal->rx;
+    bool overdue = s->saver.awaits_erase &&
+                   now - s->saver.awaits_erase_since_us >= STORE_ERASE_OVERDUE_US;
+    uint32_t quiet = overdue ? STORE_ERASE_SHORT_QUIET_US : STORE_ERASE_QUIET_US;
+    return !motion_is_executing(&s->motion) && !s->tx.sending && !s->tx.waiting &&
+           ring->written == ring->read && now - ring->heard_us >= quiet &&
+           now - s->tx.ended_us >= quiet &&
+           (!s->store.failed || now - s->saver.failed_at_us >= SAVE_RETRY_US);
+}
+
+/* The user area to flash when the save policy says so (checked once a
+ * control tick), one write block a main-loop pass, so no stall is longer
+ * than one block's programming (52.5 us on the STM32F1). A failed save
+ * sets status bit 1 and refuses further writes until a retry succeeds. */
+static void save_config(struct servo *s, uint32_t now, bool ticked)
+{
+    if (s->store.job_active) {
+        enum config_save_result r = config_store_step(&s->store);
+        if (r != CONFIG_BUSY) {
+            save_finished(s, r, now);
         }
-        s->dispatcher.store_failed = s->store.failed;
+        return;
+    }
+    if (!ticked) {
+        return;
+    }
+    /* The policy counts operating time, so it is asked every tick; a save
+     * that needs the erase is not tried again before that is done. */
+    bool due = save_policy_due(&s->saver, &s->store, now);
+    if (due && !(s->saver.awaits_erase && config_store_spare_dirty(&s->store))) {
+        enum config_save_result r =
+            config_store_begin(&s->store, &s->regs.user, save_policy_op_seconds(&s->saver));
+        if (r == CONFIG_STARTED) {
+            save_policy_started(&s->saver);
+        } else if (r == CONFIG_NEEDS_ERASE) {
+            s->saver.awaits_erase = 1;
+            s->saver.awaits_erase_since_us = now;
+        } else {
+            save_finished(s, r, now);
+        }
+    }
+    if (config_store_spare_dirty(&s->store) && erase_may_stall(s, now) &&
+        !config_store_erase_spare(&s->store)) {
+        save_finished(s, CONFIG_WRITE_FAILED, now);
     }
     report_store(s);
 }
@@ -275,9 +325,7 @@ void servo_poll(struct servo *s)
         apply_link_settings(s);
     }
     receive(s, now);
-    if (ticked) {
-        save_config(s);
-    }
+    save_config(s, now, ticked);
     if (s->tx.sending) {
         return; /* half duplex: nothing else goes out meanwhile */
     }

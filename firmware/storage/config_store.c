@@ -98,6 +98,24 @@ static bool scan(struct config_store *s, const struct record_layout *l, struct u
     return found;
 }
 
+/* The page without the newest record; for a blank store page 0, where the
+ * first record goes. */
+static uint8_t spare_page(const struct config_store *s)
+{
+    return (uint8_t)(s->sequence != 0u ? s->page ^ 1u : 0u);
+}
+
+static bool page_erased(const struct config_store *s, uint8_t page)
+{
+    const uint16_t slots = config_store_slots_per_page(s);
+    for (uint16_t slot = 0; slot < slots; slot++) {
+        if (!slot_erased(s, page, slot)) {
+            return false;
+        }
+    }
+    return true;
+}
+
 bool config_store_load(struct config_store *s, const struct hal_flash *flash,
                        struct user_config *cfg)
 {
@@ -111,6 +129,7 @@ bool config_store_load(struct config_store *s, const struct hal_flash *flash,
     }
     *cfg = newest;
     user_config_encode(&newest, s->saved);
+    s->spare_erased = page_erased(s, spare_page(s));
     return s->sequence != 0u;
 }
 
@@ -146,61 +165,109 @@ static bool next_slot(const struct config_store *s, uint8_t *page, uint16_t *slo
     return false;
 }
 
-static bool program_record(const struct config_store *s, uint8_t page, uint16_t slot,
-                           const uint8_t rec[CONFIG_RECORD_SIZE])
+enum config_save_result config_store_begin(struct config_store *s, const struct user_config *cfg,
+                                           uint32_t op_seconds)
 {
+    uint8_t *rec = s->job;
+    user_config_encode(cfg, &rec[REC_PAYLOAD]);
+    if (memcmp(&rec[REC_PAYLOAD], s->saved, USER_AREA_SIZE) == 0) {
+        return CONFIG_UNCHANGED;
+    }
+    uint8_t page;
+    uint16_t slot;
+    if (!next_slot(s, &page, &slot) && page == spare_page(s) && !s->spare_erased) {
+        return CONFIG_NEEDS_ERASE;
+    }
+    wire_put_u16(&rec[REC_MAGIC], RECORD_MAGIC);
+    rec[REC_FORMAT] = RECORD_FORMAT;
+    rec[REC_LENGTH] = USER_AREA_SIZE;
+    wire_put_u32(&rec[REC_SEQUENCE], s->sequence + 1u);
+    wire_put_u32(&rec[REC_OP_SECONDS], op_seconds);
+    wire_put_u32(&rec[REC_CRC], crc32(rec, REC_CRC));
+    s->job_active = 1;
+    s->job_page = page;
+    s->job_slot = slot;
+    s->job_next = 0;
+    s->job_op_seconds = op_seconds;
+    return CONFIG_STARTED;
+}
+
+static enum config_save_result save_failed(struct config_store *s)
+{
+    s->write_failures++;
+    s->failed = 1;
+    return CONFIG_WRITE_FAILED;
+}
+
+enum config_save_result config_store_step(struct config_store *s)
+{
+    if (!s->job_active) {
+        return CONFIG_UNCHANGED;
+    }
     /* Block by block in order: the CRC, in the last block, lands last. */
-    uint32_t base = slot_addr(s, page, slot, CONFIG_RECORD_SIZE);
     uint32_t block = s->flash->write_block;
-    if (block == 0u || CONFIG_RECORD_SIZE % block != 0u) {
+    uint32_t addr = slot_addr(s, s->job_page, s->job_slot, CONFIG_RECORD_SIZE) + s->job_next;
+    if (block == 0u || CONFIG_RECORD_SIZE % block != 0u ||
+        !s->flash->program(s->flash->ctx, addr, &s->job[s->job_next])) {
+        /* The sequence number is spent: should the record have landed after
+         * all, no later record may share its number. */
+        s->job_active = 0;
+        if (s->job_page == spare_page(s)) {
+            s->spare_erased = 0;
+        }
+        s->sequence++;
+        return save_failed(s);
+    }
+    s->job_next = (uint16_t)(s->job_next + block);
+    if (s->job_next < CONFIG_RECORD_SIZE) {
+        return CONFIG_BUSY;
+    }
+    s->job_active = 0;
+    bool was_blank = s->sequence == 0u;
+    bool new_page = s->job_page == spare_page(s);
+    s->sequence++;
+    s->page = s->job_page;
+    s->slot = s->job_slot;
+    if (new_page) {
+        /* The old page is the spare now: it holds records, unless this was
+         * the first record of a blank store (then look). */
+        s->spare_erased = was_blank && page_erased(s, spare_page(s));
+    }
+    s->legacy = 0;
+    s->failed = 0;
+    s->op_seconds = s->job_op_seconds;
+    memcpy(s->saved, &s->job[REC_PAYLOAD], USER_AREA_SIZE);
+    return CONFIG_SAVED;
+}
+
+bool config_store_spare_dirty(const struct config_store *s)
+{
+    return !s->spare_erased && !s->job_active;
+}
+
+bool config_store_erase_spare(struct config_store *s)
+{
+    uint8_t page = spare_page(s);
+    if (!s->flash->erase_page(s->flash->ctx, s->flash->page_addr[page])) {
+        save_failed(s);
         return false;
     }
-    for (uint32_t i = 0; i < CONFIG_RECORD_SIZE; i += block) {
-        if (!s->flash->program(s->flash->ctx, base + i, &rec[i])) {
-            return false;
-        }
-    }
+    s->spare_erased = 1;
     return true;
 }
 
 enum config_save_result config_store_save(struct config_store *s, const struct user_config *cfg,
                                           uint32_t op_seconds)
 {
-    uint8_t rec[CONFIG_RECORD_SIZE];
-    user_config_encode(cfg, &rec[REC_PAYLOAD]);
-    if (memcmp(&rec[REC_PAYLOAD], s->saved, USER_AREA_SIZE) == 0) {
-        return CONFIG_UNCHANGED;
+    enum config_save_result r = config_store_begin(s, cfg, op_seconds);
+    if (r == CONFIG_NEEDS_ERASE) {
+        if (!config_store_erase_spare(s)) {
+            return CONFIG_WRITE_FAILED;
+        }
+        r = config_store_begin(s, cfg, op_seconds);
     }
-    uint32_t seq = s->sequence + 1u;
-    wire_put_u16(&rec[REC_MAGIC], RECORD_MAGIC);
-    rec[REC_FORMAT] = RECORD_FORMAT;
-    rec[REC_LENGTH] = USER_AREA_SIZE;
-    wire_put_u32(&rec[REC_SEQUENCE], seq);
-    wire_put_u32(&rec[REC_OP_SECONDS], op_seconds);
-    wire_put_u32(&rec[REC_CRC], crc32(rec, REC_CRC));
-
-    uint8_t page;
-    uint16_t slot;
-    if (!next_slot(s, &page, &slot) &&
-        !s->flash->erase_page(s->flash->ctx, s->flash->page_addr[page])) {
-        s->write_failures++;
-        s->failed = 1;
-        return CONFIG_WRITE_FAILED;
+    while (r == CONFIG_STARTED || r == CONFIG_BUSY) {
+        r = config_store_step(s);
     }
-    if (!program_record(s, page, slot, rec)) {
-        /* The sequence number is spent: should the record have landed after
-         * all, no later record may share its number. */
-        s->sequence = seq;
-        s->write_failures++;
-        s->failed = 1;
-        return CONFIG_WRITE_FAILED;
-    }
-    s->sequence = seq;
-    s->page = page;
-    s->slot = slot;
-    s->legacy = 0;
-    s->failed = 0;
-    s->op_seconds = op_seconds;
-    memcpy(s->saved, &rec[REC_PAYLOAD], USER_AREA_SIZE);
-    return CONFIG_SAVED;
+    return r;
 }

@@ -2,12 +2,19 @@
  *
  * Each page is a log of fixed-size records: magic, format, length, sequence
  * number, the operating time so far, the 32-byte user area and a CRC-32
- * over all of it. A save appends
- * a record with the next sequence number to the first erased slot after the
- * newest record; when that page is full it erases the other page and starts
- * there. The page holding the newest record is never erased, and a record
- * is only valid once its CRC (programmed last) matches, so a power cut at
- * any instant leaves the old or the new record as the newest valid one. */
+ * over all of it. A save appends a record with the next sequence number to
+ * the first erased slot after the newest record; when that page is full it
+ * starts on the other page. The page holding the newest record is never
+ * erased, and a record is only valid once its CRC (programmed last)
+ * matches, so a power cut at any instant leaves the old or the new record
+ * as the newest valid one.
+ *
+ * The CPU stalls while the flash works (it fetches from it), so the
+ * application saves in steps: config_store_begin() takes the record,
+ * config_store_step() programs one write block a call (52.5 us on the
+ * STM32F1), and the other page is erased ahead of time, when a stall of
+ * 20-40 ms costs nothing (config_store_erase_spare()). config_store_save()
+ * does it all at once, for tools and tests. */
 #ifndef STORAGE_CONFIG_STORE_H
 #define STORAGE_CONFIG_STORE_H
 
@@ -23,6 +30,9 @@ enum config_save_result {
     CONFIG_UNCHANGED,    /* identical to the stored record: nothing written */
     CONFIG_SAVED,
     CONFIG_WRITE_FAILED, /* flash refused an erase or program step */
+    CONFIG_STARTED,      /* config_store_begin: call config_store_step */
+    CONFIG_BUSY,         /* config_store_step: more blocks to go */
+    CONFIG_NEEDS_ERASE,  /* config_store_begin: the other page is not erased yet */
 };
 
 struct config_store {
@@ -35,6 +45,14 @@ struct config_store {
     uint32_t write_failures;
     uint8_t failed;      /* the last save failed (and nothing saved since) */
     uint8_t legacy;      /* the newest record is format 1: the next starts a page */
+    uint8_t spare_erased; /* the page without the newest record is all 0xFF */
+    /* The save in progress: its record, where it goes, the next block. */
+    uint8_t job[CONFIG_RECORD_SIZE];
+    uint8_t job_active;
+    uint8_t job_page;
+    uint16_t job_slot;
+    uint16_t job_next;
+    uint32_t job_op_seconds;
 };
 
 /* Loads the newest valid record into cfg; factory values when the store is
@@ -42,8 +60,20 @@ struct config_store {
 bool config_store_load(struct config_store *s, const struct hal_flash *flash,
                        struct user_config *cfg);
 
-/* Appends cfg, with the operating time so far, unless cfg equals what is
- * stored. Call from the main loop. */
+/* Starts appending cfg, with the operating time so far: CONFIG_STARTED,
+ * CONFIG_UNCHANGED when cfg equals what is stored, CONFIG_NEEDS_ERASE when
+ * the record must start the other page and that is not erased yet. */
+enum config_save_result config_store_begin(struct config_store *s, const struct user_config *cfg,
+                                           uint32_t op_seconds);
+/* Programs the next write block of the save begun: CONFIG_BUSY, then
+ * CONFIG_SAVED or CONFIG_WRITE_FAILED. */
+enum config_save_result config_store_step(struct config_store *s);
+/* The page without the newest record holds something: erase it ahead. */
+bool config_store_spare_dirty(const struct config_store *s);
+/* Erases that page (a 20-40 ms stall on the STM32F1). False on failure. */
+bool config_store_erase_spare(struct config_store *s);
+
+/* All of a save at once: begin, erase if needed, every step. */
 enum config_save_result config_store_save(struct config_store *s, const struct user_config *cfg,
                                           uint32_t op_seconds);
 

@@ -52,10 +52,21 @@ bool save_policy_due(struct save_policy *p, const struct config_store *store, ui
     return !p->deferred;
 }
 
+void save_policy_started(struct save_policy *p)
+{
+    p->pending = 0;
+    p->awaits_erase = 0;
+}
+
 void save_policy_saved(struct save_policy *p, enum config_save_result result, uint32_t now_us)
 {
     if (result == CONFIG_WRITE_FAILED) {
-        p->failed_at_us = now_us; /* still pending: tried again later */
+        p->failed_at_us = now_us; /* pending again: tried after SAVE_RETRY_US */
+        if (!p->pending) {
+            p->pending = 1;
+            p->first_change_us = now_us;
+            p->last_change_us = now_us;
+        }
         return;
     }
     p->pending = 0;

@@ -42,6 +42,8 @@ struct save_policy {
     uint32_t failed_at_us;
     uint8_t pending;   /* a change not yet saved */
     uint8_t deferred;  /* the wear budget holds the pending change back */
+    uint8_t awaits_erase; /* the pending change needs the other page erased */
+    uint32_t awaits_erase_since_us;
 };
 
 /* After config_store_load. Divides (once). */
@@ -50,7 +52,11 @@ void save_policy_init(struct save_policy *p, const struct config_store *store, u
 void save_policy_changed(struct save_policy *p, uint32_t now_us);
 /* Counts operating time; true when the pending change should be saved now. */
 bool save_policy_due(struct save_policy *p, const struct config_store *store, uint32_t now_us);
-/* The outcome of the save save_policy_due asked for. */
+/* The save save_policy_due asked for has taken the user area as it is now:
+ * a change from here on is pending again. */
+void save_policy_started(struct save_policy *p);
+/* The outcome of that save. A failed one is pending again, retried after
+ * SAVE_RETRY_US. */
 void save_policy_saved(struct save_policy *p, enum config_save_result result, uint32_t now_us);
 /* Operating seconds so far, across power cycles (as recorded). */
 uint32_t save_policy_op_seconds(const struct save_policy *p);

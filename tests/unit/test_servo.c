@@ -232,7 +232,9 @@ static void test_config_survives_restart(void **state)
     REQUEST(4, 0, 34, 9);
     REQUEST(4, 9, 43, 0xD0, 0x07);
     EXPECT_RESPONSE(4, 9, 43, 1);
-    harness_run_ms(SAVE_SETTLE_US / 1000u + 1u); /* saved once nothing changes for 50 ms */
+    /* Saved once nothing changes for 50 ms, a write block a main-loop pass
+     * (the harness makes 4 passes a millisecond, silicon hundreds). */
+    harness_run_ms(SAVE_SETTLE_US / 1000u + 8u);
     harness_restart();
     REQUEST(3, 9, 43);
     EXPECT_RESPONSE(3, 9, 43, 0xD0, 0x07);
@@ -450,6 +452,40 @@ static void test_a_new_request_ends_the_wait_for_a_sync_turn(void **state)
     assert_int_equal(hal.sent_length, 4 * one);
 }
 
+/* A page erase stalls the CPU for 20-40 ms, so the other page is erased
+ * only while no move runs and the line is quiet. With both pages full,
+ * a change made during a move waits (ReadStore flags bit 3) until the
+ * move has ended; then the erase runs and the save lands. */
+static void test_the_flash_is_erased_only_while_no_move_runs(void **state)
+{
+    (void)state;
+    harness_ideal_tracking();
+    const unsigned slots = config_store_slots_per_page(&servo.store);
+    for (unsigned i = 0; i < 2u * slots; i++) {
+        REQUEST(4, 0, 43, (uint8_t)(100u + i), 0x07); /* a new value each time */
+        harness_run_ms(70); /* saved; too short a pause for an erase */
+    }
+    assert_int_equal(servo.store.sequence, 2u * slots);
+    uint32_t erases = hal.flash.erases[0] + hal.flash.erases[1];
+    /* A 3 s move to 100 degrees, and a change during it. */
+    REQUEST(11, 0, 0xE8, 0x03, 0xB8, 0x0B, 0x64, 0, 0xC8, 0, 0, 0);
+    REQUEST(4, 0, 43, 0x55, 0x06);
+    harness_run_ms(2000);
+    assert_true(motion_is_executing(&servo.motion));
+    assert_int_equal(hal.flash.erases[0] + hal.flash.erases[1], erases);
+    assert_int_equal(store_field(1), STORE_PENDING | STORE_AWAITS_ERASE);
+    harness_run_ms(1200); /* the move ends, then the line is quiet for 100 ms */
+    assert_false(motion_is_executing(&servo.motion));
+    /* The page the save needed, then, ahead, the one it left. */
+    assert_int_equal(hal.flash.erases[0] + hal.flash.erases[1], erases + 2u);
+    assert_false(config_store_spare_dirty(&servo.store));
+    assert_int_equal(servo.store.sequence, 2u * slots + 1u);
+    assert_int_equal(store_field(1), 0);
+    harness_restart();
+    REQUEST(3, 0, 43);
+    EXPECT_RESPONSE(3, 0, 43, 0x55, 0x06);
+}
+
 static void test_garbage_between_frames_and_responses_of_others(void **state)
 {
     (void)state;
@@ -490,6 +526,7 @@ int main(void)
         cmocka_unit_test_setup(test_a_failed_save_is_reported_and_refuses_writes, setup),
         cmocka_unit_test_setup(test_a_burst_of_writes_is_one_save, setup),
         cmocka_unit_test_setup(test_writes_in_a_loop_stay_within_the_wear_budget, setup),
+        cmocka_unit_test_setup(test_the_flash_is_erased_only_while_no_move_runs, setup),
         cmocka_unit_test_setup(test_garbage_between_frames_and_responses_of_others, setup),
     };
     return cmocka_run_group_tests_name("servo", tests, NULL, NULL);

@@ -62,6 +62,7 @@ enum store_flag {
     STORE_FAILED = 1u << 0,   /* the last save failed; writes are refused */
     STORE_DEFERRED = 1u << 1, /* a change waits for the wear budget */
     STORE_PENDING = 1u << 2,  /* a change is not saved yet */
+    STORE_AWAITS_ERASE = 1u << 3, /* it waits for the other page to be erased */
 };
 
 struct store_health {
