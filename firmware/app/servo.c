@@ -179,7 +179,7 @@ static bool erase_may_stall(const struct servo *s, uint32_t now)
     bool overdue = s->saver.awaits_erase &&
                    now - s->saver.awaits_erase_since_us >= STORE_ERASE_OVERDUE_US;
     uint32_t quiet = overdue ? STORE_ERASE_SHORT_QUIET_US : STORE_ERASE_QUIET_US;
-    return !motion_is_executing(&s->motion) && !s->tx.sending && !s->tx.waiting &&
+    return !motion_is_moving(&s->motion) && !s->tx.sending && !s->tx.waiting &&
            ring->written == ring->read && now - ring->heard_us >= quiet &&
            now - s->tx.ended_us >= quiet &&
            (!s->store.failed || now - s->saver.failed_at_us >= SAVE_RETRY_US);

@@ -58,7 +58,7 @@ class Simulator(_Child):
     socket://) unless tcp=False, then a pseudo-terminal (optionally linked)."""
 
     def __init__(self, ids=(1,), tcp=True, link=None, state_dir=None, supply_mv=None,
-                 ambient_c=None, tcp_port=None):
+                 ambient_c=None, tcp_port=None, rx=None):
         self.ids = list(ids)
         self.tcp = tcp or tcp_port is not None
         self.tcp_port = tcp_port
@@ -67,6 +67,7 @@ class Simulator(_Child):
         self.state_dir = state_dir or tempfile.mkdtemp(prefix="servo-sim-")
         self.supply_mv = supply_mv
         self.ambient_c = ambient_c
+        self.rx = rx  # "dma" (default) or "interrupt": how the servos' port receives
         self.process = None
         self.url = None
         self.control_port = None
@@ -83,6 +84,8 @@ class Simulator(_Child):
             cmd += ["--supply", str(self.supply_mv)]
         if self.ambient_c is not None:
             cmd += ["--ambient", str(self.ambient_c)]
+        if self.rx is not None:
+            cmd += ["--rx", self.rx]
         self.process = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                                         text=True)
         deadline = time.monotonic() + 20

@@ -34,6 +34,7 @@ struct options {
     const char *state_dir;
     double supply_v;
     double ambient_c;
+    bool rx_interrupt;
 };
 
 struct control_client {
@@ -64,6 +65,9 @@ static void usage(FILE *out)
           "  --state DIR    where each servo's flash file lives (default ./sim-state)\n"
           "  --supply MV    supply voltage (default 7400)\n"
           "  --ambient DEGC ambient temperature (default 25)\n"
+          "  --rx dma|interrupt  how the port receives: DMA into a ring (the reference\n"
+          "                 board, default) or a byte per interrupt, which overruns\n"
+          "                 while the flash stalls the CPU\n"
           "Control commands, one per line, optional servo ID last:\n"
           "  supply MV | load NM | stop DEG | stop off | ambient DEGC | soak DEGC |\n"
           "  hostbaud BAUD (a TCP host's rate; a pty's is what the host set) | state | help\n",
@@ -122,6 +126,12 @@ static void parse(int argc, char **argv, struct options *o)
             o->supply_v = parse_int(v, "--supply", 0, 30000) / 1000.0;
         } else if (strcmp(a, "--ambient") == 0) {
             o->ambient_c = parse_int(v, "--ambient", -40, 150);
+        } else if (strcmp(a, "--rx") == 0) {
+            if (strcmp(v, "dma") != 0 && strcmp(v, "interrupt") != 0) {
+                fprintf(stderr, "servo_sim: --rx is dma or interrupt, not '%s'\n", v);
+                exit(2);
+            }
+            o->rx_interrupt = strcmp(v, "interrupt") == 0;
         } else {
             fprintf(stderr, "servo_sim: unknown option %s\n", a);
             usage(stderr);
@@ -210,14 +220,16 @@ static void state_of(const struct sim_servo *s, char *out, size_t size)
              "id=%u angle=%.3f velocity=%.2f current=%.3f winding=%.2f case=%.2f ambient=%.1f "
              "supply=%.3f "
              "load=%.3f stop=%s status=0x%02x reported=%d collisions=%lu dropped_ticks=%u "
-             "most_behind_ms=%.1f baud=%u host_baud=%u baud_mismatches=%lu\n",
+             "most_behind_ms=%.1f baud=%u host_baud=%u baud_mismatches=%lu rx_overruns=%u "
+             "rx_lost=%u flash_stall_ms=%.2f saves=%u\n",
              s->cmdline_id, plant_angle_deg(&s->plant), s->plant.velocity * 180.0 / M_PI,
              s->plant.current, s->thermal.winding_c, s->thermal.case_c, s->thermal.ambient_c,
              s->plant.p.supply_v,
              s->plant.load_torque, s->plant.has_stop ? "on" : "off", s->core.regs.status.status,
              a.multi_turn_decideg, bus.collisions, s->core.ticks_dropped,
              (double)most_behind_us / 1000.0, (unsigned)s->baud, (unsigned)bus.host_baud,
-             bus.baud_mismatches);
+             bus.baud_mismatches, (unsigned)s->rx.overruns, (unsigned)s->core.rx_lost,
+             (double)s->flash_stall_us / 1000.0, (unsigned)s->core.store.sequence);
 }
 
 /* One control line: "command [value] [servo id]". */
@@ -350,6 +362,7 @@ int main(int argc, char **argv)
         if (!sim_servo_start(&servos[i], &bus, i, o.ids[i], o.state_dir, o.supply_v, o.ambient_c)) {
             return 1;
         }
+        servos[i].rx_interrupt = o.rx_interrupt;
         bus.servos[i] = &servos[i];
         bus.servo_count++;
     }
@@ -464,7 +477,7 @@ int main(int argc, char **argv)
             most_behind_us = wall_now - bus.now_us;
         }
         for (unsigned i = 0; i < bus.servo_count; i++) {
-            servo_poll(&servos[i].core);
+            sim_servo_poll(&servos[i], bus.now_us);
         }
     }
     if (o.link) {

@@ -79,7 +79,7 @@ void sim_bus_deliver(struct sim_bus *b, uint64_t now_us)
         bool received = false;
         for (unsigned s = 0; s < b->servo_count; s++) {
             if (s != e->sender && b->servos[s]->baud == e->baud) {
-                servo_on_rx_byte(&b->servos[s]->core, e->byte, (uint32_t)e->at_us);
+                sim_servo_receive(b->servos[s], e->byte, e->at_us);
                 received = true;
             }
         }

@@ -150,5 +150,44 @@ bool sim_servo_start(struct sim_servo *s, struct sim_bus *bus, unsigned index, u
         .serial_number = 0x51A00000u | id,
     };
     servo_init(&s->core, &s->port);
+    s->flash.stall_us = 0; /* power-up, before the servo joins the bus */
     return true;
+}
+
+void sim_servo_receive(struct sim_servo *s, uint8_t byte, uint64_t at_us)
+{
+    if (s->rx_interrupt) {
+        if (at_us < s->cpu_free_us) {
+            if (s->uart_full) {
+                s->rx.overruns++; /* the receive interrupt could not run */
+            } else {
+                s->uart_full = true;
+                s->uart_held = byte;
+                s->uart_held_at_us = (uint32_t)at_us;
+            }
+            return;
+        }
+        if (s->uart_full) {
+            s->uart_full = false;
+            hal_rx_ring_put(&s->rx, s->uart_held, s->uart_held_at_us);
+        }
+    }
+    servo_on_rx_byte(&s->core, byte, (uint32_t)at_us);
+}
+
+void sim_servo_poll(struct sim_servo *s, uint64_t now_us)
+{
+    if (now_us < s->cpu_free_us) {
+        return;
+    }
+    if (s->uart_full) { /* the interrupt runs as soon as the CPU does */
+        s->uart_full = false;
+        hal_rx_ring_put(&s->rx, s->uart_held, s->uart_held_at_us);
+    }
+    servo_poll(&s->core);
+    if (s->flash.stall_us != 0u) {
+        s->cpu_free_us = now_us + s->flash.stall_us;
+        s->flash_stall_us += s->flash.stall_us;
+        s->flash.stall_us = 0;
+    }
 }

@@ -20,6 +20,7 @@ static bool erase_page(void *ctx, uint32_t addr)
         return false;
     }
     memset(&f->mem[addr - BASE], 0xFF, SIM_FLASH_PAGE);
+    f->stall_us += SIM_FLASH_ERASE_US;
     return save(f, addr - BASE, SIM_FLASH_PAGE);
 }
 
@@ -36,6 +37,7 @@ static bool program(void *ctx, uint32_t addr, const uint8_t *data)
     }
     cell[0] = data[0];
     cell[1] = data[1];
+    f->stall_us += SIM_FLASH_PROGRAM_US;
     return save(f, addr - BASE, 2);
 }
 

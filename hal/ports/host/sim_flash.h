@@ -1,5 +1,11 @@
 /* Flash kept in a file, with the STM32F1's rules (erase to 0xFF, program
- * half-words that are erased), so the configuration survives a restart. */
+ * half-words that are erased), so the configuration survives a restart.
+ *
+ * It also keeps the time the CPU would have stalled: the F1 fetches code
+ * from the flash it is writing, so nothing runs, the main loop and the
+ * interrupts alike, while a page erases or a half-word programs. The
+ * datasheet's longest times are used (DS5319, "Flash memory
+ * characteristics": tERASE 20-40 ms, tPROG 40-70 us, 52.5 us typical). */
 #ifndef HOST_SIM_FLASH_H
 #define HOST_SIM_FLASH_H
 
@@ -9,11 +15,14 @@
 #include "hal/hal_flash.h"
 
 #define SIM_FLASH_PAGE 1024u
+#define SIM_FLASH_ERASE_US 40000u
+#define SIM_FLASH_PROGRAM_US 70u
 
 struct sim_flash {
     struct hal_flash hal;
     uint8_t mem[2 * SIM_FLASH_PAGE];
     int fd; /* the file, kept open; each erase or program writes through */
+    uint32_t stall_us; /* CPU stall owed by erases and programs since last taken */
 };
 
 /* Opens (or creates, erased) the file; false with errno on failure. */

@@ -190,6 +190,12 @@ static inline bool motion_is_executing(const struct motion *m)
     return m->running != 0u;
 }
 
+/* A move runs, or the wheel turns on (its command finished at speed). */
+static inline bool motion_is_moving(const struct motion *m)
+{
+    return m->running != 0u || m->endless != 0u;
+}
+
 /* What the protection monitors require of the output: inhibit releases it
  * and refuses motion until lifted; derate halves the current it may draw;
  * power_cap_mw (0 = none) bounds every move's power. */
