@@ -2,6 +2,7 @@
 
 #include <stdbool.h>
 
+#include "motion/div64.h"
 #include "motion/gains.h"
 
 static inline int32_t clamp32(int64_t v, int32_t limit)
@@ -76,7 +77,7 @@ void drive_limits_for_supply(struct drive_limits *lim, uint16_t supply_mv)
         supply_mv = NOMINAL_SUPPLY_MV;
     }
     lim->kv = (int32_t)(((uint32_t)GAIN_KV * NOMINAL_SUPPLY_MV) / supply_mv);
-    lim->ka = (int32_t)(((uint64_t)GAIN_KA * NOMINAL_SUPPLY_MV) / supply_mv);
+    lim->ka = (int32_t)div64_u((uint64_t)GAIN_KA * NOMINAL_SUPPLY_MV, supply_mv);
     lim->friction = (int32_t)(((uint32_t)GAIN_FRICTION * NOMINAL_SUPPLY_MV) / supply_mv);
     lim->viscous = (int32_t)(((uint32_t)GAIN_VISCOUS * NOMINAL_SUPPLY_MV) / supply_mv);
 }
@@ -87,7 +88,7 @@ int16_t duty_limit_for_power(uint16_t power_mw, uint16_t supply_mv)
         supply_mv = NOMINAL_SUPPLY_MV;
     }
     uint64_t num = (uint64_t)power_mw * MOTOR_RESISTANCE_MOHM << 15;
-    uint64_t duty = num / ((uint64_t)supply_mv * supply_mv);
+    uint64_t duty = div64_u(num, (uint32_t)supply_mv * supply_mv);
     return (int16_t)(duty > 32767u ? 32767u : duty);
 }
 
@@ -96,7 +97,7 @@ int16_t duty_limit_for_current(uint16_t current_ma, uint16_t supply_mv)
     if (supply_mv == 0u) {
         supply_mv = NOMINAL_SUPPLY_MV;
     }
-    uint64_t num = ((uint64_t)current_ma * MOTOR_RESISTANCE_MOHM << 15) / 1000u;
-    uint64_t duty = num / supply_mv;
+    uint64_t num = div64_u((uint64_t)current_ma * MOTOR_RESISTANCE_MOHM << 15, 1000u);
+    uint64_t duty = div64_u(num, supply_mv);
     return (int16_t)(duty > 32767u ? 32767u : duty);
 }

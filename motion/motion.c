@@ -5,6 +5,7 @@
 
 #include <stddef.h>
 
+#include "motion/div64.h"
 #include "motion/gains.h"
 #include "motion_internal.h"
 
@@ -222,7 +223,7 @@ static void begin_profile(struct motion *m, uint8_t end)
 /* Q32 decideg per tick for a velocity in 0.1 deg/s. */
 static int64_t velocity_q32(uint32_t decideg_per_s)
 {
-    return (int64_t)(((uint64_t)decideg_per_s << 32) / MOTION_TICK_HZ);
+    return (int64_t)div64_u((uint64_t)decideg_per_s << 32, MOTION_TICK_HZ);
 }
 
 /* ---- braking within what the motor can do --------------------------------
@@ -251,7 +252,7 @@ static void plan_stop(struct motion *m, int64_t start, int64_t v0, uint32_t min_
     int32_t v = q32_to_q8_sat(v0);
     uint64_t speed = (uint64_t)(v < 0 ? -(int64_t)v : v);
     uint64_t per_tick = (uint64_t)motion_brake_duty(m, v) << 8; /* x ka: decideg Q8 per tick^2 */
-    uint64_t n = (speed * (uint64_t)m->drive.ka + per_tick - 1u) / per_tick;
+    uint64_t n = div64_u(speed * (uint64_t)m->drive.ka + per_tick - 1u, per_tick);
     n = n > min_ticks ? n : min_ticks;
     n = n < PROFILE_MAX_RAMP ? n : PROFILE_MAX_RAMP;
     int64_t target = start + v0 * (int64_t)n / 2;

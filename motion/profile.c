@@ -1,12 +1,13 @@
 #include "motion/profile.h"
 
+#include "motion/div64.h"
+
 /* Right shifts of negative values are arithmetic with gcc and clang, the
  * only compilers this code is built with (implementation-defined in C11). */
 
 static int64_t div_round(int64_t num, int64_t den)
 {
-    /* den > 0 */
-    return num >= 0 ? (num + den / 2) / den : -((-num + den / 2) / den);
+    return div64_round(num, den);
 }
 
 static int64_t abs64(int64_t v)
@@ -83,7 +84,10 @@ struct profile_timing profile_velocity_timing(int64_t distance, int64_t v0, int6
     int64_t ramps = ((v0 + v) * (int64_t)accel + v * (int64_t)decel) / 2;
     int64_t rest = distance - ramps;
     if (rest == 0 || (rest > 0) == (v > 0)) {
-        int64_t cruise = div_round(abs64(rest), vmax);
+        /* Ticks at vmax: both scaled until vmax fits 32 bits (fast
+         * division), which changes the count by far less than a tick. */
+        unsigned shift = vmax >> 32 != 0 ? 32u - (unsigned)__builtin_clz((uint32_t)(vmax >> 32)) : 0u;
+        int64_t cruise = div_round(abs64(rest) >> shift, vmax >> shift);
         t.cruise = cruise < PROFILE_MAX_CRUISE ? (uint32_t)cruise : PROFILE_MAX_CRUISE;
         return t;
     }
@@ -99,8 +103,8 @@ struct profile_timing profile_velocity_timing(int64_t distance, int64_t v0, int6
         t.decel = 0;
         return t;
     }
-    t.accel = (uint32_t)((int64_t)accel * d16 / r16);
-    t.decel = (uint32_t)((int64_t)decel * d16 / r16);
+    t.accel = (uint32_t)div64_u((uint64_t)accel * (uint64_t)d16, (uint64_t)r16);
+    t.decel = (uint32_t)div64_u((uint64_t)decel * (uint64_t)d16, (uint64_t)r16);
     int64_t total = div_round((int64_t)(accel + decel) * d16, r16);
     int64_t cruise = total - (int64_t)t.accel - (int64_t)t.decel;
     t.cruise = (uint32_t)(cruise > 0 ? cruise : 0);
