@@ -7,7 +7,7 @@
 #include "protocol/wire.h"
 
 enum rx_state {
-    RX_HDR0,
+    RX_HDR0,      /* 0: frame_rx_in_frame() knows it */
     RX_HDR1,
     RX_CODE,
     RX_LENGTH,
@@ -56,7 +56,8 @@ static void skip(struct frame_rx *rx, uint32_t bytes)
     rx->state = RX_SKIP;
 }
 
-static void start_content(struct frame_rx *rx, uint16_t length)
+static inline __attribute__((always_inline)) void start_content(struct frame_rx *rx,
+                                                                uint16_t length)
 {
     rx->remaining = length;
     rx->position = 0;
@@ -116,11 +117,7 @@ static void sync_content_byte(struct frame_rx *rx, struct rx_frame *f, uint8_t b
  * addressed, as in the dispatcher): nothing of it is kept. */
 static bool for_another_servo(const struct frame_rx *rx, uint8_t code, uint8_t id)
 {
-    if (id == *rx->own_id || id == WIRE_BROADCAST_ID) {
-        return false;
-    }
-    const struct packet_desc *desc = packet_find(code);
-    return desc == NULL || (desc->flags & PF_ADDRESSED);
+    return id != *rx->own_id && id != WIRE_BROADCAST_ID && packet_is_addressed(code);
 }
 
 static void content_byte(struct frame_rx *rx, uint8_t byte)
@@ -144,7 +141,7 @@ static void content_byte(struct frame_rx *rx, uint8_t byte)
     }
 }
 
-static void finish_skipped(struct frame_rx *rx)
+static inline __attribute__((always_inline)) void finish_skipped(struct frame_rx *rx)
 {
     rx->state = RX_HDR0;
     if (!rx->is_request) {
@@ -303,6 +300,14 @@ static uint32_t header_run(struct frame_rx *rx, const uint8_t *data, uint32_t n)
     rx->is_request = request;
     rx->checksum = (uint8_t)(data[0] + data[1] + data[2] + data[3]);
     if (request) {
+        /* The ID has arrived too: a request for another servo goes by
+         * its length from here. */
+        if (n > WIRE_HEADER_SIZE && data[3] != 0u && data[2] != PKT_SYNC_COMMAND &&
+            for_another_servo(rx, data[2], data[WIRE_HEADER_SIZE])) {
+            rx->discard = 0;
+            skip(rx, (uint32_t)data[3] + 1u);
+            return WIRE_HEADER_SIZE;
+        }
         rx->discard = next_slot(rx->head) == rx->tail;
         work_slot(rx)->code = data[2];
     }
@@ -356,10 +361,6 @@ void frame_rx_line_idle(struct frame_rx *rx)
     }
 }
 
-bool frame_rx_in_frame(const struct frame_rx *rx)
-{
-    return rx->state != RX_HDR0;
-}
 
 void frame_rx_release(struct frame_rx *rx)
 {

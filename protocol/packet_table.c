@@ -63,3 +63,4 @@ const struct packet_desc *packet_find(uint8_t code)
     }
     return NULL;
 }
+

@@ -59,10 +59,9 @@ static void start_send(struct servo *s)
 /* Sync Monitor: each listed servo answers after the ones listed before it.
  * A turn passes when their response has gone by, or when the line has been
  * silent for SYNC_SLOT_SILENCE_US (that servo is absent). */
-static void wait_for_turn(struct servo *s)
+static void wait_for_turn(struct servo *s, uint32_t now)
 {
     uint32_t seen = s->rx.stats.responses_skipped - s->tx.responses_base;
-    uint32_t now = s->hal->now_us(s->hal->ctx);
     uint32_t last_byte = s->hal->rx->heard_us;
     if (now - last_byte < now - s->tx.silence_from_us) {
         s->tx.silence_from_us = last_byte; /* the line was busy since */
@@ -76,13 +75,13 @@ static void wait_for_turn(struct servo *s)
 }
 
 static void queue_response(struct servo *s, const struct response *r, uint8_t wait,
-                           uint32_t responses_base)
+                           uint32_t responses_base, uint32_t now)
 {
     s->tx.size = frame_tx_encode(r, s->tx.frame);
     s->tx.turns_left = wait;
     s->tx.responses_base = responses_base;
     s->tx.requests_base = s->rx.stats.requests_seen;
-    s->tx.silence_from_us = s->hal->now_us(s->hal->ctx);
+    s->tx.silence_from_us = now;
     if (wait == 0u) {
         start_send(s);
     } else {
@@ -93,9 +92,8 @@ static void queue_response(struct servo *s, const struct response *r, uint8_t wa
 /* Nobody asked for a "move finished" answer just now, so nobody has left
  * the line free for it: it goes out in this ID's slot (servo.h). Divides
  * while an answer waits, once a pass. */
-static bool in_unsolicited_slot(const struct servo *s)
+static bool in_unsolicited_slot(const struct servo *s, uint32_t now)
 {
-    uint32_t now = s->hal->now_us(s->hal->ctx);
     uint32_t heard = now - s->hal->rx->heard_us;
     uint32_t said = now - s->tx.ended_us;
     uint32_t quiet = heard < said ? heard : said;
@@ -106,9 +104,9 @@ static bool in_unsolicited_slot(const struct servo *s)
     return (quiet - s->unsolicited_first_us) % cycle < UNSOLICITED_WINDOW_US;
 }
 
-static void answer_finished_move(struct servo *s)
+static void answer_finished_move(struct servo *s, uint32_t now)
 {
-    if (!motion_has_finished(&s->motion) || !in_unsolicited_slot(s)) {
+    if (!motion_has_finished(&s->motion) || !in_unsolicited_slot(s, now)) {
         return;
     }
     uint8_t packet = motion_take_finished(&s->motion);
@@ -116,10 +114,18 @@ static void answer_finished_move(struct servo *s)
         return;
     }
     struct response r = {.code = packet, .length = 2, .content = {s->active_id, 1}};
-    queue_response(s, &r, 0, 0);
+    queue_response(s, &r, 0, 0, now);
 }
 
-static void handle_next_frame(struct servo *s)
+/* Status bit 0 follows the motion: after each tick and each command. */
+static void show_executing(struct servo *s)
+{
+    uint8_t status = (uint8_t)(s->regs.status.status & ~STATUS_EXECUTING);
+    s->regs.status.status =
+        motion_is_executing(&s->motion) ? (uint8_t)(status | STATUS_EXECUTING) : status;
+}
+
+static void handle_next_frame(struct servo *s, uint32_t now)
 {
     const struct rx_frame *frame = frame_rx_peek(&s->rx);
     if (frame == NULL) {
@@ -130,11 +136,13 @@ static void handle_next_frame(struct servo *s)
     dispatch(&s->dispatcher, frame, &r, &result);
     uint32_t responses_base = frame->responses_seen;
     frame_rx_release(&s->rx);
+    show_executing(s);
     if (result.config_changed) {
-        save_policy_changed(&s->saver, s->hal->now_us(s->hal->ctx));
+        save_policy_changed(&s->saver, now);
+        s->link_check = 1;
     }
     if (result.answer) {
-        queue_response(s, &r, result.wait_responses, responses_base);
+        queue_response(s, &r, result.wait_responses, responses_base, now);
     }
 }
 
@@ -258,6 +266,7 @@ void servo_control_tick(struct servo *s)
 {
     sense_and_protect(s);
     motion_tick(&s->motion);
+    show_executing(s);
 }
 
 /* The control loop runs from the main loop, so commands and ticks never
@@ -266,6 +275,9 @@ void servo_control_tick(struct servo *s)
  * racing through them. */
 static bool run_control_tick(struct servo *s, uint32_t now)
 {
+    if ((int32_t)(now - s->next_tick_us) < 0) {
+        return false; /* most passes */
+    }
     unsigned n = 0;
     for (; (int32_t)(now - s->next_tick_us) >= 0; n++) {
         if (n == SERVO_MAX_CATCH_UP) {
@@ -304,7 +316,9 @@ static void receive(struct servo *s, uint32_t now)
     uint32_t at = read & (HAL_RX_RING_SIZE - 1u);
     uint32_t first = HAL_RX_RING_SIZE - at < waiting ? HAL_RX_RING_SIZE - at : waiting;
     frame_rx_feed_bytes(&s->rx, &ring->data[at], first);
-    frame_rx_feed_bytes(&s->rx, ring->data, waiting - first);
+    if (waiting > first) { /* the rest, from the ring's start */
+        frame_rx_feed_bytes(&s->rx, ring->data, waiting - first);
+    }
     ring->read = written;
 }
 
@@ -319,10 +333,12 @@ void servo_poll(struct servo *s)
     }
     /* A new ID or baud rate takes effect once the response has left, and
      * before the next request is read. */
-    if (!s->tx.sending && !s->tx.waiting &&
-        (s->active_id != s->regs.user.servo_id ||
-         s->active_baud_index != s->regs.user.baud_index)) {
-        apply_link_settings(s);
+    if (s->link_check && !s->tx.sending && !s->tx.waiting) {
+        s->link_check = 0;
+        if (s->active_id != s->regs.user.servo_id ||
+            s->active_baud_index != s->regs.user.baud_index) {
+            apply_link_settings(s);
+        }
     }
     receive(s, now);
     save_config(s, now, ticked);
@@ -331,7 +347,7 @@ void servo_poll(struct servo *s)
     }
     if (s->tx.waiting) {
         if (s->rx.stats.requests_seen == s->tx.requests_base) {
-            wait_for_turn(s);
+            wait_for_turn(s, now);
             return;
         }
         /* A new request (to anyone) while this servo waits for its Sync
@@ -340,13 +356,10 @@ void servo_poll(struct servo *s)
         s->tx.waiting = 0;
         s->sync_turns_abandoned++;
     }
-    uint8_t status = (uint8_t)(s->regs.status.status & ~STATUS_EXECUTING);
-    s->regs.status.status =
-        motion_is_executing(&s->motion) ? (uint8_t)(status | STATUS_EXECUTING) : status;
     /* Requests first: the host waits for their answers, while a finished
      * move's answer waits for a quiet line anyway. */
-    handle_next_frame(s);
+    handle_next_frame(s, now);
     if (!s->tx.sending && !s->tx.waiting) {
-        answer_finished_move(s);
+        answer_finished_move(s, now);
     }
 }

@@ -28,16 +28,15 @@ void dma_rx_lap(struct dma_rx *d)
 
 void dma_rx_sync(struct dma_rx *d, uint32_t now_us)
 {
-    /* Laps, counter, laps: a lap that ends in between shows as a change. */
-    uint32_t laps;
-    uint32_t left;
-    do {
-        laps = d->laps;
-        left = DMA_CNDTR(d->channel);
-    } while (laps != d->laps);
-    /* The counter reloads at the end of a lap a moment before the
-     * interrupt counts it: a position behind the last one seen waits for
-     * the next call. */
+    /* Laps, counter, laps: a lap that ended in between waits for the next
+     * call, as does a counter that has reloaded at the end of a lap a
+     * moment before the interrupt counts it (a position behind the last
+     * one seen). */
+    uint32_t laps = d->laps;
+    uint32_t left = DMA_CNDTR(d->channel);
+    if (laps != d->laps) {
+        return;
+    }
     uint32_t written = laps * HAL_RX_RING_SIZE + (HAL_RX_RING_SIZE - left);
     if ((int32_t)(written - d->written) > 0) {
         d->written = written;

@@ -4,7 +4,10 @@
  * down from the ring's size) is the write position, and a transfer-complete
  * interrupt, once a lap of the ring, counts laps. So `written` runs free
  * like a receive interrupt's would, and a main loop lapped by the DMA (held
- * up longer than a ring's time) sees how much it lost.
+ * up longer than a ring's time) sees how much it lost. No code runs per
+ * byte or per frame: the line counts as heard when the main loop finds new
+ * bytes, at most one pass late, which only makes the servo wait longer
+ * for a quiet line.
  *
  * The channel's registers are found from `channel` (the address of its
  * CCR), so the benchmark can run this on registers in RAM. */

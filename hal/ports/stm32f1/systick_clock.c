@@ -7,7 +7,7 @@
 
 static volatile uint32_t uptime_ms;
 static uint32_t reload;
-static uint32_t ticks_per_us;
+static uint32_t us_per_tick_q16; /* 2^16 / ticks per us: a multiply, not a division */
 
 void SysTick_Handler(void);
 
@@ -19,7 +19,8 @@ void SysTick_Handler(void)
 void systick_clock_init(uint32_t core_hz)
 {
     reload = core_hz / 1000u - 1u;
-    ticks_per_us = core_hz / 1000000u;
+    /* Rounded down, so (reload * us_per_tick_q16) >> 16 stays below 1000. */
+    us_per_tick_q16 = 65536u / (core_hz / 1000000u);
     SYSTICK_LOAD = reload;
     SYSTICK_VAL = 0;
     SYSTICK_CTRL = SYSTICK_ENABLE_CORE_CLOCK_IRQ;
@@ -41,5 +42,5 @@ uint32_t systick_now_us(void)
     if (pending && val > reload / 2u) {
         ms++;
     }
-    return ms * 1000u + (reload - val) / ticks_per_us;
+    return ms * 1000u + (((reload - val) * us_per_tick_q16) >> 16);
 }

@@ -35,7 +35,7 @@ void usart_hd_rx_dma(struct usart_hd *u)
 {
     u->rx_dma = true;
     USART_CR3(u->base) |= USART_CR3_DMAR;
-    USART_CR1(u->base) = (USART_CR1(u->base) & ~USART_CR1_RXNEIE) | USART_CR1_IDLEIE;
+    USART_CR1(u->base) &= ~USART_CR1_RXNEIE;
 }
 
 void usart_hd_tx_polled(struct usart_hd *u)
@@ -133,9 +133,6 @@ void usart_hd_irq(struct usart_hd *u)
     uint32_t cr1 = USART_CR1(u->base);
     if (!u->rx_dma) {
         sr = receive_bytes(u, sr, cr1);
-    } else if (sr & USART_SR_IDLE) {
-        (void)USART_DR(u->base); /* SR then DR clears IDLE (RM0008 27.6.1) */
-        u->rx->heard_us = u->clock_us();
     }
     if (u->tx_irq && (cr1 & (USART_CR1_TXEIE | USART_CR1_TCIE))) {
         transmit_step(u, sr);

@@ -1,7 +1,7 @@
 /* USART in single-wire half-duplex mode. Received bytes go into the HAL's
- * ring: by DMA (dma_rx.h), the interrupt only marking when the line goes
- * idle, or by the receive interrupt a byte at a time where there is no DMA
- * (QEMU's USART). A send runs from the interrupt and turns the line around
+ * ring: by DMA (dma_rx.h), with no receive interrupt at all (the main loop
+ * reads the DMA's counter and notes when bytes came), or by the receive
+ * interrupt a byte at a time where there is no DMA (QEMU's USART). A send runs from the interrupt and turns the line around
  * (receiver off while sending, back on after the last stop bit), so the
  * servo never hears its own echo. */
 #ifndef STM32F1_USART_HD_H
@@ -22,14 +22,13 @@ struct usart_hd {
     volatile uint8_t tx_busy;
     bool rx_dma;                 /* a DMA channel receives: the interrupt marks idle lines */
     struct hal_rx_ring *rx;
-    uint32_t (*clock_us)(void);  /* stamps received bytes and idle lines */
+    uint32_t (*clock_us)(void);  /* stamps bytes the receive interrupt takes */
 };
 
 void usart_hd_init(struct usart_hd *u, uintptr_t base, uint32_t pclk_hz, uint32_t baud,
                    bool single_wire, struct hal_rx_ring *rx, uint32_t (*clock_us)(void));
 /* Receive by DMA from now on (the caller starts the channel, dma_rx.h):
- * the USART requests DMA and interrupts on an idle line instead of on
- * every byte. */
+ * the USART requests DMA and raises no receive interrupt. */
 void usart_hd_rx_dma(struct usart_hd *u);
 /* Transmit from the main loop instead (usart_hd_service), for USART models
  * that raise no transmit interrupts (QEMU 7.2). Receive stays on the

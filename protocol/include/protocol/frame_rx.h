@@ -81,7 +81,10 @@ void frame_rx_feed(struct frame_rx *rx, uint8_t byte);
  * frame is dropped. */
 void frame_rx_line_idle(struct frame_rx *rx);
 /* A frame has begun and not ended. */
-bool frame_rx_in_frame(const struct frame_rx *rx);
+static inline bool frame_rx_in_frame(const struct frame_rx *rx)
+{
+    return rx->state != 0u; /* RX_HDR0 */
+}
 
 /* The oldest complete frame, or NULL. The frame stays valid until
  * frame_rx_release(). */

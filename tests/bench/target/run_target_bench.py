@@ -154,7 +154,7 @@ def main():
             mark = f"{RESPONSE_BUDGET_US} us{' (over)' if us > RESPONSE_BUDGET_US else ''}"
         else:
             mark = ""
-        print(f"{key:<22} {i3:>9.1f} {c3:>10.1f} {c3 / CLOCK_MHZ['cortex-m3']:>7.1f} {i0:>9.1f} "
+        print(f"{key:<22} {i3:>9.2f} {c3:>10.1f} {c3 / CLOCK_MHZ['cortex-m3']:>7.1f} {i0:>9.1f} "
               f"{c0:>10.1f} {c0 / CLOCK_MHZ['cortex-m0']:>7.1f}  {mark}")
     if args.json:
         args.json.write_text(json.dumps(results, indent=2))
