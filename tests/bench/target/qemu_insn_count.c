@@ -17,7 +17,8 @@
  * runs no faster than the prefetch buffer fills: 8 bytes per 1 + ws cycles.
  *
  * With profile=PFILE, each region's blocks go to PFILE as they end:
- * "region start_address instructions" lines, for a per-function breakdown.
+ * "region start_address instructions block_length" lines, for a breakdown
+ * by function or by source line.
  *
  * At exit, "total I C" and then "I C" per region go to FILE. A guest that
  * exits through semihosting ends the process without QEMU's plugin exit
@@ -78,8 +79,8 @@ static void on_end(unsigned int vcpu, void *userdata)
     if (profile != NULL) {
         for (unsigned i = 0; i < block_count; i++) {
             if (blocks[i].hits != 0u) {
-                fprintf(profile, "%u %#" PRIx64 " %" PRIu64 "\n", region_count - 1u, blocks[i].start,
-                        blocks[i].hits * blocks[i].insns);
+                fprintf(profile, "%u %#" PRIx64 " %" PRIu64 " %" PRIu32 "\n", region_count - 1u,
+                        blocks[i].start, blocks[i].hits * blocks[i].insns, blocks[i].insns);
                 blocks[i].hits = 0;
             }
         }

@@ -3,7 +3,7 @@
 instruction-counting plugin and prints Thumb-2 instruction counts per region
 for the Cortex-M3 and the Cortex-M0, beside issue 10's budgets.
 
-    python3 tests/bench/target/run_target_bench.py [--json FILE] [--profile REGION]
+    python3 tests/bench/target/run_target_bench.py [--check] [--json FILE] [--profile REGION]
 
 Needs: cmake --build --preset target-bench-m3, --preset target-bench-m0, and
 the host preset's build/host/tests/libqemu_insn_count.so.
@@ -29,8 +29,11 @@ CPUS = {"cortex-m3": ROOT / "build/target-bench-m3/bench", "cortex-m0": ROOT / "
 MODEL = {"cortex-m3": "core=m3,ws=2", "cortex-m0": "core=m0,ws=0"}
 CLOCK_MHZ = {"cortex-m3": 72, "cortex-m0": 48}
 KNOWN_LOOP = 200  # 100 more iterations of a 2-instruction loop
-# Issue 10's budgets (Cortex-M3), for comparison; not yet met, not yet enforced.
+# Issue 10's budgets (Cortex-M3 instructions; responses in modelled us at
+# 72 MHz). Those met fail the run when exceeded; the tick's is not met yet
+# (README, "Performance") and is reported only.
 BUDGETS = {"rx_per_byte": 40, "tick": 150, "plan": 1000}
+NOT_YET_MET = {"tick"}
 RESPONSE_BUDGET_US = 20
 
 
@@ -64,7 +67,7 @@ def print_profile(elf: Path, names: list, profile_file: Path, region: str) -> No
     funcs = functions(elf)
     per_function = {}
     for line in profile_file.read_text().splitlines():
-        r, start, count = line.split()
+        r, start, count = line.split()[:3]
         if int(r) not in indices:
             continue
         addr = int(start, 16)
@@ -133,6 +136,8 @@ def figures(cpu: str, profile_region: str = "") -> dict:
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--json", type=Path, help="also write the figures here")
+    ap.add_argument("--check", action="store_true",
+                    help="fail when a figure is over its budget (those met so far)")
     ap.add_argument("--profile", metavar="REGION", default="",
                     help="print REGION's instructions by function (Cortex-M3)")
     args = ap.parse_args()
@@ -144,20 +149,29 @@ def main():
           f"calibration loop's {KNOWN_LOOP} counted exactly on both), and modelled cycles")
     print(f"{'figure':<22} {'M3 instr':>9} {'M3 cycles':>10} {'M3 us':>7} {'M0 instr':>9} "
           f"{'M0 cycles':>10} {'M0 us':>7}  budget (M3)")
+    over = []
     for key in m3:
         budget = BUDGETS.get(key)
         (i3, c3), (i0, c0) = m3[key], m0[key]
+        exceeded = False
         if budget is not None:
-            mark = f"{budget} instr{' (over)' if i3 > budget else ''}"
+            exceeded = i3 > budget
+            mark = f"{budget} instr"
         elif key.startswith("latency_"):
-            us = c3 / CLOCK_MHZ["cortex-m3"]
-            mark = f"{RESPONSE_BUDGET_US} us{' (over)' if us > RESPONSE_BUDGET_US else ''}"
+            exceeded = c3 / CLOCK_MHZ["cortex-m3"] > RESPONSE_BUDGET_US
+            mark = f"{RESPONSE_BUDGET_US} us"
         else:
             mark = ""
+        if exceeded:
+            mark += " (over, not yet met: reported only)" if key in NOT_YET_MET else " (OVER)"
+            if key not in NOT_YET_MET:
+                over.append(key)
         print(f"{key:<22} {i3:>9.2f} {c3:>10.1f} {c3 / CLOCK_MHZ['cortex-m3']:>7.1f} {i0:>9.1f} "
               f"{c0:>10.1f} {c0 / CLOCK_MHZ['cortex-m0']:>7.1f}  {mark}")
     if args.json:
         args.json.write_text(json.dumps(results, indent=2))
+    if over and args.check:
+        sys.exit(f"run_target_bench: over budget on the Cortex-M3: {', '.join(over)}")
 
 
 if __name__ == "__main__":
