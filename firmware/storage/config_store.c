@@ -201,9 +201,6 @@ static enum config_save_result save_failed(struct config_store *s)
 
 enum config_save_result config_store_step(struct config_store *s)
 {
-    if (!s->job_active) {
-        return CONFIG_UNCHANGED;
-    }
     /* Block by block in order: the CRC, in the last block, lands last. */
     uint32_t block = s->flash->write_block;
     uint32_t addr = slot_addr(s, s->job_page, s->job_slot, CONFIG_RECORD_SIZE) + s->job_next;
@@ -254,20 +251,4 @@ bool config_store_erase_spare(struct config_store *s)
     }
     s->spare_erased = 1;
     return true;
-}
-
-enum config_save_result config_store_save(struct config_store *s, const struct user_config *cfg,
-                                          uint32_t op_seconds)
-{
-    enum config_save_result r = config_store_begin(s, cfg, op_seconds);
-    if (r == CONFIG_NEEDS_ERASE) {
-        if (!config_store_erase_spare(s)) {
-            return CONFIG_WRITE_FAILED;
-        }
-        r = config_store_begin(s, cfg, op_seconds);
-    }
-    while (r == CONFIG_STARTED || r == CONFIG_BUSY) {
-        r = config_store_step(s);
-    }
-    return r;
 }

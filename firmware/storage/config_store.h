@@ -65,15 +65,17 @@ bool config_store_load(struct config_store *s, const struct hal_flash *flash,
  * the record must start the other page and that is not erased yet. */
 enum config_save_result config_store_begin(struct config_store *s, const struct user_config *cfg,
                                            uint32_t op_seconds);
-/* Programs the next write block of the save begun: CONFIG_BUSY, then
- * CONFIG_SAVED or CONFIG_WRITE_FAILED. */
+/* Programs the next write block of the save begun (only after
+ * CONFIG_STARTED or CONFIG_BUSY): CONFIG_BUSY, then CONFIG_SAVED or
+ * CONFIG_WRITE_FAILED. */
 enum config_save_result config_store_step(struct config_store *s);
 /* The page without the newest record holds something: erase it ahead. */
 bool config_store_spare_dirty(const struct config_store *s);
 /* Erases that page (a 20-40 ms stall on the STM32F1). False on failure. */
 bool config_store_erase_spare(struct config_store *s);
 
-/* All of a save at once: begin, erase if needed, every step. */
+/* All of a save at once: begin, erase if needed, every step
+ * (config_store_save.c). */
 enum config_save_result config_store_save(struct config_store *s, const struct user_config *cfg,
                                           uint32_t op_seconds);
 

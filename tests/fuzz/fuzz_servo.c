@@ -156,14 +156,14 @@ static void make_snapshot(int image)
     live.hal.encoder_model = encoder_model;
     boot();
     if (image != 0) {
+        /* Every record a change: soft start times, then soft start off. */
         unsigned records = image == 2 ? 20u : 5u;
-        for (unsigned k = 0; k < records; k++) {
-            write_item(49, (k & 1u) ? 0u : 1u, 1); /* soft start toggled, ends off */
-            if (k + 1u == records) {
-                write_item(49, 0, 1);
-            }
+        for (unsigned k = 0; k + 1u < records; k++) {
+            write_item(50, (uint16_t)(1000u + k), 2);
             run_ms(60);
         }
+        write_item(49, 0, 1);
+        run_ms(60);
         if (image == 3) {
             write_item(33, 1, 1);   /* control response on */
             write_item(42, 0xFFFF, 2);

@@ -160,14 +160,20 @@ SERVO_SEEDS = {
                          + HEALTHY + ms(150) + sensors(7400, 200, 800) + ms(150)),
     "supply_sag_during_move": (USED, wire(move(1800, 600)) + ms(100) + sensors(5000, 300, 2048)
                                + ms(100) + sensors(8200, 300, 2048) + ms(300)),
-    "page_rotation_and_reload": (PAGE_FULL, wire(write(38, 1234, 2)) + ms(60) + wire(write(44, 1))
-                                 + ms(60) + POWER_CYCLE + wire(req(3, b"\x00\x26")) + ms(5)),
+    # A save settles 50 ms, then programs a write block a pass (24 here,
+    # a pass per ms): 80 ms after a write it has landed.
+    "page_rotation_and_reload": (PAGE_FULL, wire(write(38, 1234, 2)) + ms(80) + wire(write(44, 1))
+                                 + ms(80) + POWER_CYCLE + wire(req(3, b"\x00\x26")) + ms(5)),
+    "erase_ahead_when_quiet": (PAGE_FULL, wire(write(38, 1234, 2)) + ms(80) + wire(move(900, 150))
+                               + wire(write(44, 1)) + ms(200) + wire(req(0x41, b"\x00")) + ms(120)),
+    "cut_save_on_the_new_page": (PAGE_FULL, wire(write(38, 1234, 2)) + ms(80) + flash(cut_at=5, mode=1)
+                                 + wire(write(44, 1)) + ms(80) + POWER_CYCLE + ms(5)),
     "failed_save_refuses": (USED, flash(dead=True) + wire(write(43, 2000, 2)) + ms(55)
                             + wire(write(43, 3000, 2) + req(2, b"\x00") + req(0x41, b"\x00"))
-                            + flash(dead=False) + ms(1001) + wire(write(43, 3000, 2)) + ms(60)),
-    "cut_mid_save": (PAGE_FULL, flash(cut_at=3, mode=2) + wire(write(50, 500, 2)) + ms(60) + POWER_CYCLE
-                     + wire(write(50, 600, 2)) + ms(60) + POWER_CYCLE + wire(req(3, b"\x00\x32"))),
-    "power_on_lock": (USED, wire(write(46, 1)) + ms(60) + POWER_CYCLE + ms(20)),
+                            + flash(dead=False) + ms(1001) + wire(write(43, 3000, 2)) + ms(80)),
+    "cut_mid_save": (PAGE_FULL, flash(cut_at=3, mode=2) + wire(write(50, 500, 2)) + ms(80) + POWER_CYCLE
+                     + wire(write(50, 600, 2)) + ms(80) + POWER_CYCLE + wire(req(3, b"\x00\x32"))),
+    "power_on_lock": (USED, wire(write(46, 1)) + ms(80) + POWER_CYCLE + ms(20)),
     "main_loop_stalled": (USED, wire(move(900, 300)) + ms(50) + stall_main_loop(200) + ms(50)),
     "async_then_go": (USED, wire(req(18, b"") + move(900, 100) + req(19, b"\x00")) + ms(200)
                       + wire(req(18, b"") + move(0, 100) + req(19, b"\x01")) + ms(20)),

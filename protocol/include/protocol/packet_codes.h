@@ -35,6 +35,13 @@ enum packet_code {
 enum firmware_packet_code {
     PKT_READ_MOTION = 0x40, /* a snapshot of the motion state, for tuning */
     PKT_READ_STORE = 0x41,  /* the config store's health and wear */
+    /* Firmware update over the bus (docs/packets.md, firmware/bootloader/). */
+    PKT_UPDATE_ENTER = 0x50,  /* the application restarts into the bootloader */
+    PKT_UPDATE_ERASE = 0x51,  /* erase one page of the application slot */
+    PKT_UPDATE_WRITE = 0x52,  /* program bytes at an offset, with their CRC */
+    PKT_UPDATE_VERIFY = 0x53, /* check the image in the slot */
+    PKT_UPDATE_BOOT = 0x54,   /* start the image, if it checks */
+    PKT_UPDATE_STATUS = 0x55, /* who answers: application or bootloader, versions */
 };
 
 #endif

@@ -1,0 +1,60 @@
+/* The application image in its flash slot: a 256-byte header, then the
+ * application's vector table and code. The bootloader starts an image only
+ * when the header and the CRC over the whole image check, so a slot half
+ * erased or half written (a power cut during an update) is never started.
+ *
+ *   offset  size  field
+ *   0       4     magic "SVAP" (0x50415653, little-endian)
+ *   4       2     format (1)
+ *   6       2     board (an image for another board is refused)
+ *   8       4     image size: bytes from offset 256 on
+ *   12      4     CRC-32 of those bytes
+ *   16      2     firmware version (data item 7)
+ *   18      6     reserved, 0
+ *   24      4     CRC-32 of bytes 0-23
+ *   28      228   0xFF (the vector table must sit 256-byte aligned)
+ *
+ * tools/servoctl/image.py writes the same layout. */
+#ifndef BOOTLOADER_APP_IMAGE_H
+#define BOOTLOADER_APP_IMAGE_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "hal/hal_flash.h"
+
+#define APP_IMAGE_MAGIC 0x50415653u
+#define APP_IMAGE_FORMAT 1u
+#define APP_HEADER_SIZE 256u  /* the vector table follows */
+#define APP_HEADER_CHECKED 24u /* bytes the header's own CRC covers */
+
+/* The flash the application lives in: whole pages of `flash` from base. */
+struct app_slot {
+    const struct hal_flash *flash; /* page_size, write_block, erase, program, read */
+    uint32_t base;
+    uint32_t pages;
+};
+
+struct app_image_info {
+    uint32_t size;    /* after the header */
+    uint32_t crc;
+    uint16_t version;
+    uint16_t board;
+};
+
+enum app_image_verdict {
+    APP_IMAGE_VALID,
+    APP_IMAGE_NO_HEADER,   /* erased, or not an image */
+    APP_IMAGE_BAD_HEADER,  /* header CRC, format or size wrong */
+    APP_IMAGE_WRONG_BOARD,
+    APP_IMAGE_BAD_CRC,     /* the image itself does not match its CRC */
+};
+
+uint32_t app_slot_size(const struct app_slot *slot);
+
+/* Reads and checks the image in the slot; info is filled from the header
+ * whenever it checks (also when the image's CRC does not). */
+enum app_image_verdict app_image_check(const struct app_slot *slot, uint16_t board,
+                                       struct app_image_info *info);
+
+#endif

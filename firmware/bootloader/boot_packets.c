@@ -1,0 +1,122 @@
+#include "boot_packets.h"
+
+#include <stddef.h>
+
+#include "protocol/packet_codes.h"
+#include "protocol/wire.h"
+#include "slot_write.h"
+
+/* Mode in UpdateStatus: who answers. */
+enum { MODE_BOOTLOADER = 1 };
+
+struct call {
+    struct bootloader *b;
+    const uint8_t *content;
+    uint16_t length;
+};
+
+static uint8_t answer(struct response *r, const struct call *c, uint8_t length)
+{
+    r->content[0] = c->content[0];
+    return length;
+}
+
+static uint8_t on_ping(const struct call *c, struct response *r)
+{
+    return answer(r, c, 1);
+}
+
+static uint8_t on_enter(const struct call *c, struct response *r)
+{
+    r->content[1] = 1; /* here already */
+    return answer(r, c, 2);
+}
+
+static uint8_t on_erase(const struct call *c, struct response *r)
+{
+    enum slot_write_result w = slot_erase_page(c->b->slot, wire_get_u16(&c->content[1]));
+    r->content[1] = w == SLOT_WRITE_OK;
+    r->content[2] = (uint8_t)w;
+    return answer(r, c, 3);
+}
+
+static uint8_t on_write(const struct call *c, struct response *r)
+{
+    uint16_t n = (uint16_t)(c->length - 9u);
+    enum slot_write_result w = slot_write(c->b->slot, wire_get_u32(&c->content[1]), &c->content[5],
+                                          n, wire_get_u32(&c->content[5u + n]));
+    r->content[1] = w == SLOT_WRITE_OK;
+    r->content[2] = (uint8_t)w;
+    return answer(r, c, 3);
+}
+
+static uint8_t on_verify(const struct call *c, struct response *r)
+{
+    struct app_image_info info = {0};
+    r->content[1] = (uint8_t)app_image_check(c->b->slot, c->b->board, &info);
+    wire_put_u32(&r->content[2], info.size);
+    wire_put_u32(&r->content[6], info.crc);
+    wire_put_u16(&r->content[10], info.version);
+    wire_put_u16(&r->content[12], info.board);
+    return answer(r, c, 14);
+}
+
+static uint8_t on_boot(const struct call *c, struct response *r)
+{
+    struct app_image_info info;
+    bool valid = app_image_check(c->b->slot, c->b->board, &info) == APP_IMAGE_VALID;
+    c->b->boot_now = valid;
+    r->content[1] = valid;
+    return answer(r, c, 2);
+}
+
+static uint8_t on_status(const struct call *c, struct response *r)
+{
+    const struct app_slot *slot = c->b->slot;
+    struct app_image_info info = {0};
+    r->content[1] = MODE_BOOTLOADER;
+    wire_put_u16(&r->content[2], BOOTLOADER_VERSION);
+    r->content[4] = (uint8_t)app_image_check(slot, c->b->board, &info);
+    wire_put_u16(&r->content[5], info.version);
+    wire_put_u16(&r->content[7], c->b->board);
+    wire_put_u16(&r->content[9], (uint16_t)slot->flash->page_size);
+    wire_put_u16(&r->content[11], (uint16_t)slot->pages);
+    r->content[13] = (uint8_t)slot->flash->write_block;
+    wire_put_u16(&r->content[14], UPDATE_WRITE_MAX);
+    return answer(r, c, 16);
+}
+
+struct boot_packet_desc {
+    uint8_t code;
+    uint16_t min_length;
+    uint16_t max_length;
+    uint8_t (*handle)(const struct call *c, struct response *r); /* answer length */
+};
+
+static const struct boot_packet_desc packets[] = {
+    {PKT_PING, 1, 1, on_ping},
+    {PKT_UPDATE_ENTER, 1, 1, on_enter},
+    {PKT_UPDATE_ERASE, 3, 3, on_erase},
+    {PKT_UPDATE_WRITE, 9u + 1u, 9u + UPDATE_WRITE_MAX, on_write},
+    {PKT_UPDATE_VERIFY, 1, 1, on_verify},
+    {PKT_UPDATE_BOOT, 1, 1, on_boot},
+    {PKT_UPDATE_STATUS, 1, 1, on_status},
+};
+
+bool boot_packet(struct bootloader *b, uint8_t code, const uint8_t *content, uint16_t length,
+                 struct response *r)
+{
+    if (length == 0u || content[0] != b->id) {
+        return false; /* another servo's, or broadcast */
+    }
+    for (size_t i = 0; i < sizeof packets / sizeof packets[0]; i++) {
+        const struct boot_packet_desc *d = &packets[i];
+        if (d->code == code && length >= d->min_length && length <= d->max_length) {
+            const struct call c = {.b = b, .content = content, .length = length};
+            r->code = code;
+            r->length = d->handle(&c, r);
+            return true;
+        }
+    }
+    return false;
+}

@@ -1,0 +1,32 @@
+/* What the bootloader answers on the bus, at the servo's stored ID and
+ * baud rate: the maker's Ping, so tools find a servo waiting for an image,
+ * and the update packets (docs/packets.md, 0x50-0x55). One table row per
+ * packet: code, content length, handler. Broadcast is never taken: an
+ * update is for one servo on a shared bus. */
+#ifndef BOOTLOADER_BOOT_PACKETS_H
+#define BOOTLOADER_BOOT_PACKETS_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "app_image.h"
+#include "protocol/frame_tx.h"
+
+#define BOOTLOADER_VERSION 1u
+/* Largest data in one UpdateWrite: the bootloader's framer keeps requests
+ * of 9 + this many content bytes. */
+#define UPDATE_WRITE_MAX 128u
+
+struct bootloader {
+    const struct app_slot *slot;
+    uint16_t board;        /* images for another board are refused */
+    uint8_t id;            /* the servo's stored ID */
+    uint8_t boot_now;      /* UpdateBoot taken: start the image once the answer is out */
+};
+
+/* A request's packet code and content; true with r filled when it is
+ * answered. */
+bool boot_packet(struct bootloader *b, uint8_t code, const uint8_t *content, uint16_t length,
+                 struct response *r);
+
+#endif

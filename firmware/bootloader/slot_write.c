@@ -1,0 +1,42 @@
+#include "slot_write.h"
+
+#include <string.h>
+
+#include "crc32.h"
+
+enum slot_write_result slot_erase_page(const struct app_slot *slot, uint32_t page)
+{
+    const struct hal_flash *f = slot->flash;
+    if (page >= slot->pages) {
+        return SLOT_WRITE_OUT_OF_SLOT;
+    }
+    return f->erase_page(f->ctx, slot->base + page * f->page_size) ? SLOT_WRITE_OK
+                                                                    : SLOT_WRITE_FLASH_FAILED;
+}
+
+enum slot_write_result slot_write(const struct app_slot *slot, uint32_t offset,
+                                  const uint8_t *data, uint32_t len, uint32_t crc)
+{
+    const struct hal_flash *f = slot->flash;
+    uint32_t block = f->write_block;
+    if (crc32(data, len) != crc) {
+        return SLOT_WRITE_BAD_CRC;
+    }
+    if (len == 0u || block == 0u || block > 8u || offset % block != 0u || len % block != 0u ||
+        offset > app_slot_size(slot) || len > app_slot_size(slot) - offset) {
+        return SLOT_WRITE_OUT_OF_SLOT;
+    }
+    for (uint32_t i = 0; i < len; i += block) {
+        if (!f->program(f->ctx, slot->base + offset + i, &data[i])) {
+            return SLOT_WRITE_FLASH_FAILED;
+        }
+    }
+    uint8_t back[8];
+    for (uint32_t i = 0; i < len; i += block) {
+        f->read(f->ctx, slot->base + offset + i, back, block);
+        if (memcmp(back, &data[i], block) != 0) {
+            return SLOT_WRITE_READ_BACK;
+        }
+    }
+    return SLOT_WRITE_OK;
+}

@@ -1,0 +1,19 @@
+/* All of a save at once, for tools and tests (the simulator programs a
+ * blank chip's ID with it); the firmware saves in steps (servo.c). */
+#include "config_store.h"
+
+enum config_save_result config_store_save(struct config_store *s, const struct user_config *cfg,
+                                          uint32_t op_seconds)
+{
+    enum config_save_result r = config_store_begin(s, cfg, op_seconds);
+    if (r == CONFIG_NEEDS_ERASE) {
+        if (!config_store_erase_spare(s)) {
+            return CONFIG_WRITE_FAILED;
+        }
+        r = config_store_begin(s, cfg, op_seconds);
+    }
+    while (r == CONFIG_STARTED || r == CONFIG_BUSY) {
+        r = config_store_step(s);
+    }
+    return r;
+}
