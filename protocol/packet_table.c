@@ -53,6 +53,20 @@ static const struct packet_desc firmware_packets[] = {
 
 enum { FIRMWARE_PACKETS = sizeof firmware_packets / sizeof firmware_packets[0] };
 
+/* The update packets (docs/packets.md). The application takes UpdateEnter
+ * and UpdateStatus; the rest are the bootloader's, and an application
+ * leaves them unanswered (a tool then knows to send UpdateEnter). */
+static const struct packet_desc update_packets[] = {
+    {PKT_UPDATE_ENTER, SETTING, LEN(1), handle_update_enter},
+    {PKT_UPDATE_ERASE, ADDR, 0, 0xFFFFu, handle_ignored},
+    {PKT_UPDATE_WRITE, ADDR, 0, 0xFFFFu, handle_ignored},
+    {PKT_UPDATE_VERIFY, ADDR, 0, 0xFFFFu, handle_ignored},
+    {PKT_UPDATE_BOOT, ADDR, 0, 0xFFFFu, handle_ignored},
+    {PKT_UPDATE_STATUS, QUERY, LEN(1), handle_update_status},
+};
+
+enum { UPDATE_PACKETS = sizeof update_packets / sizeof update_packets[0] };
+
 const struct packet_desc *packet_find(uint8_t code)
 {
     if (code >= PKT_PING && code <= PKT_SYNC_COMMAND) {
@@ -60,6 +74,9 @@ const struct packet_desc *packet_find(uint8_t code)
     }
     if (code >= PKT_READ_MOTION && code < PKT_READ_MOTION + FIRMWARE_PACKETS) {
         return &firmware_packets[code - PKT_READ_MOTION];
+    }
+    if (code >= PKT_UPDATE_ENTER && code < PKT_UPDATE_ENTER + UPDATE_PACKETS) {
+        return &update_packets[code - PKT_UPDATE_ENTER];
     }
     return NULL;
 }

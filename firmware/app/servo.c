@@ -45,6 +45,8 @@ void servo_init(struct servo *s, const struct hal_port *hal)
     frame_rx_init(&s->rx, &s->active_id);
     s->rx_idle_us = idle_timeout_us(s, 0);
     dispatcher_init(&s->dispatcher, &s->regs, &s->motion, &s->active_id);
+    s->dispatcher.bootloader_present = hal->enter_bootloader != NULL;
+    s->dispatcher.board = hal->board;
     s->active_baud_index = 0; /* forces the first apply to set the UART */
     apply_link_settings(s);
 }
@@ -141,6 +143,7 @@ static void handle_next_frame(struct servo *s, uint32_t now)
         save_policy_changed(&s->saver, now);
         s->link_check = 1;
     }
+    s->enter_bootloader |= result.enter_bootloader;
     if (result.answer) {
         queue_response(s, &r, result.wait_responses, responses_base, now);
     }
@@ -322,6 +325,20 @@ static void receive(struct servo *s, uint32_t now)
     ring->read = written;
 }
 
+/* UpdateEnter, its answer gone: the user area to flash first, whatever the
+ * stall (the servo restarts anyway), so no change is lost. */
+static void restart_into_bootloader(struct servo *s)
+{
+    s->enter_bootloader = 0;
+    while (s->store.job_active) {
+        (void)config_store_step(&s->store);
+    }
+    if (s->saver.pending) {
+        (void)config_store_save(&s->store, &s->regs.user, save_policy_op_seconds(&s->saver));
+    }
+    s->hal->enter_bootloader(s->hal->ctx);
+}
+
 void servo_poll(struct servo *s)
 {
     /* One reading of the clock per pass: the ticks due by then run now. */
@@ -344,6 +361,10 @@ void servo_poll(struct servo *s)
     save_config(s, now, ticked);
     if (s->tx.sending) {
         return; /* half duplex: nothing else goes out meanwhile */
+    }
+    if (s->enter_bootloader) {
+        restart_into_bootloader(s);
+        return;
     }
     if (s->tx.waiting) {
         if (s->rx.stats.requests_seen == s->tx.requests_base) {

@@ -79,6 +79,7 @@ struct servo {
     volatile uint8_t active_id;  /* the ID answered to now */
     uint8_t active_baud_index;
     uint8_t link_check;          /* the user area changed: ID or baud may have */
+    uint8_t enter_bootloader;    /* UpdateEnter taken: restart once the answer is out */
     uint32_t unsolicited_slot_us;  /* slot length at this baud */
     uint32_t unsolicited_first_us; /* quiet before this ID's first slot */
     struct save_policy saver;

@@ -57,6 +57,11 @@ static void sensors_read(void *ctx, struct sensor_raw *out)
     *out = ((struct hal_double *)ctx)->sensors;
 }
 
+void hal_double_enter_bootloader(void *ctx)
+{
+    ((struct hal_double *)ctx)->bootloader_entries++;
+}
+
 void hal_double_init(struct hal_double *h)
 {
     memset(h, 0, sizeof *h);

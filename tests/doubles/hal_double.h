@@ -35,10 +35,14 @@ struct hal_double {
      * 7400 mV, 0 mA, 2048 (25 degC). */
     struct sensor_raw sensors;
     struct sensor_calibration calibration;
+    unsigned bootloader_entries; /* hal_double_enter_bootloader calls */
 };
 
 void hal_double_init(struct hal_double *h);
 /* Forgets what was sent so far. */
 void hal_double_clear_sent(struct hal_double *h);
+/* An enter_bootloader op that counts its calls (port.enter_bootloader is
+ * NULL until a test sets it to this). */
+void hal_double_enter_bootloader(void *ctx);
 
 #endif

@@ -486,6 +486,42 @@ static void test_the_flash_is_erased_only_while_no_move_runs(void **state)
     EXPECT_RESPONSE(3, 0, 43, 0x55, 0x06);
 }
 
+/* UpdateEnter (0x50): refused without a bootloader or while a move runs;
+ * otherwise answered, and the restart waits for the answer to leave and
+ * for the user area to be in flash. UpdateStatus says the application
+ * answers, with its version. */
+static void test_update_enter_restarts_into_the_bootloader(void **state)
+{
+    (void)state;
+    REQUEST(0x50, 0);
+    EXPECT_RESPONSE(0x50, 0, 0); /* no bootloader on this port */
+    hal.port.enter_bootloader = hal_double_enter_bootloader;
+    hal.port.board = 0x0103;
+    servo_init(&servo, &hal.port);
+    harness_ideal_tracking();
+    REQUEST(0x55, 0);
+    uint16_t version = servo.regs.status.firmware_version;
+    EXPECT_RESPONSE(0x55, 0, 0, 0, 0, 0, (uint8_t)version, (uint8_t)(version >> 8), 0x03, 0x01,
+                    0, 0, 0, 0, 0, 0, 0);
+    REQUEST(4, 0, 49, 0); /* soft start off: the move starts at once */
+    REQUEST(11, 0, 0xE8, 0x03, 0xE8, 0x03, 0x64, 0, 0xC8, 0, 0, 0);
+    REQUEST(0x50, 0);
+    EXPECT_RESPONSE(0x50, 0, 0); /* a move runs */
+    harness_run_ms(1200);
+    REQUEST(4, 0, 43, 0x55, 0x06); /* a change not yet saved */
+    hal.tx_busy = true;
+    REQUEST(0x50, 0);
+    EXPECT_RESPONSE(0x50, 0, 1);
+    harness_poll(4);
+    assert_int_equal(hal.bootloader_entries, 0); /* the answer is still on the wire */
+    hal.tx_busy = false;
+    harness_poll(2);
+    assert_int_equal(hal.bootloader_entries, 1);
+    harness_restart();
+    REQUEST(3, 0, 43);
+    EXPECT_RESPONSE(3, 0, 43, 0x55, 0x06);
+}
+
 static void test_garbage_between_frames_and_responses_of_others(void **state)
 {
     (void)state;
@@ -527,6 +563,7 @@ int main(void)
         cmocka_unit_test_setup(test_a_burst_of_writes_is_one_save, setup),
         cmocka_unit_test_setup(test_writes_in_a_loop_stay_within_the_wear_budget, setup),
         cmocka_unit_test_setup(test_the_flash_is_erased_only_while_no_move_runs, setup),
+        cmocka_unit_test_setup(test_update_enter_restarts_into_the_bootloader, setup),
         cmocka_unit_test_setup(test_garbage_between_frames_and_responses_of_others, setup),
     };
     return cmocka_run_group_tests_name("servo", tests, NULL, NULL);

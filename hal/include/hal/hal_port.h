@@ -40,6 +40,11 @@ struct hal_port {
     const struct hal_flash *flash;
     /* Data ID 8: derived by the port from the MCU's unique ID. */
     uint32_t serial_number;
+    /* Restarts into the bootloader, which then stays (UpdateEnter); NULL
+     * where there is none. Does not return on silicon. */
+    void (*enter_bootloader)(void *ctx);
+    /* The board images are built for (the update image header's board). */
+    uint16_t board;
     /* Longest gap between the bytes of one frame the link can produce, in
      * us; 0 for a real UART (the framer's own rule, frame_rx_idle_us). An
      * emulated UART delivers bytes with the host's scheduling jitter. */

@@ -19,6 +19,10 @@ struct dispatcher {
     /* The config store failed its last save: writes to the user area are
      * refused (result 0), so what the host reads is what a boot loads. */
     uint8_t store_failed;
+    /* A bootloader is there to restart into (UpdateEnter), and the board
+     * images are built for (UpdateStatus). */
+    uint8_t bootloader_present;
+    uint16_t board;
 };
 
 struct dispatch_result {
@@ -26,6 +30,8 @@ struct dispatch_result {
     bool config_changed;    /* the user area may have changed: save it */
     /* Sync Monitor: let this many other servos' responses pass first. */
     uint8_t wait_responses;
+    /* UpdateEnter: restart into the bootloader once the answer has left. */
+    bool enter_bootloader;
 };
 
 void dispatcher_init(struct dispatcher *d, struct registers *regs, struct motion *motion,

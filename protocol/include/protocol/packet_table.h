@@ -74,6 +74,8 @@ enum packet_outcome handle_write_batch(const struct packet_call *c, struct respo
 enum packet_outcome handle_monitor(const struct packet_call *c, struct response *r);
 enum packet_outcome handle_read_motion(const struct packet_call *c, struct response *r);
 enum packet_outcome handle_read_store(const struct packet_call *c, struct response *r);
+enum packet_outcome handle_update_enter(const struct packet_call *c, struct response *r);
+enum packet_outcome handle_update_status(const struct packet_call *c, struct response *r);
 
 enum packet_outcome handle_move_wheel(const struct packet_call *c, struct response *r);
 enum packet_outcome handle_move_angle(const struct packet_call *c, struct response *r);
