@@ -300,29 +300,12 @@ static void receive(struct servo *s, uint32_t now)
 {
     struct hal_rx_ring *ring = s->hal->rx;
     if (s->hal->rx_sync != NULL) {
-        s->hal->rx_sync(s->hal->ctx, now);
+        s->hal->rx_sync(s->hal->rx_ctx, now);
     }
-    uint32_t written = ring->written;
-    uint32_t read = ring->read;
-    uint32_t waiting = written - read;
-    if (waiting == 0u) {
-        if (frame_rx_in_frame(&s->rx) && (int32_t)(now - ring->heard_us) >= (int32_t)s->rx_idle_us) {
-            frame_rx_line_idle(&s->rx);
-        }
-        return;
+    if (!frame_rx_take_ring(&s->rx, ring, &s->rx_lost) && frame_rx_in_frame(&s->rx) &&
+        (int32_t)(now - ring->heard_us) >= (int32_t)s->rx_idle_us) {
+        frame_rx_line_idle(&s->rx);
     }
-    if (waiting > HAL_RX_RING_SIZE) { /* the DMA went round past us */
-        s->rx_lost += waiting - HAL_RX_RING_SIZE;
-        read = written - HAL_RX_RING_SIZE;
-        waiting = HAL_RX_RING_SIZE;
-    }
-    uint32_t at = read & (HAL_RX_RING_SIZE - 1u);
-    uint32_t first = HAL_RX_RING_SIZE - at < waiting ? HAL_RX_RING_SIZE - at : waiting;
-    frame_rx_feed_bytes(&s->rx, &ring->data[at], first);
-    if (waiting > first) { /* the rest, from the ring's start */
-        frame_rx_feed_bytes(&s->rx, ring->data, waiting - first);
-    }
-    ring->read = written;
 }
 
 /* UpdateEnter, its answer gone: the user area to flash first, whatever the
@@ -347,6 +330,10 @@ void servo_poll(struct servo *s)
     if (s->tx.sending && s->hal->uart_tx_done(s->hal->ctx)) {
         s->tx.sending = 0;
         s->tx.ended_us = now;
+        if (s->enter_bootloader) { /* UpdateEnter's answer has left */
+            restart_into_bootloader(s);
+            return;
+        }
     }
     /* A new ID or baud rate takes effect once the response has left, and
      * before the next request is read. */
@@ -361,10 +348,6 @@ void servo_poll(struct servo *s)
     save_config(s, now, ticked);
     if (s->tx.sending) {
         return; /* half duplex: nothing else goes out meanwhile */
-    }
-    if (s->enter_bootloader) {
-        restart_into_bootloader(s);
-        return;
     }
     if (s->tx.waiting) {
         if (s->rx.stats.requests_seen == s->tx.requests_base) {

@@ -3,11 +3,11 @@
  *
  * It stays when the application asked for it (UpdateEnter leaves a word in
  * RAM that survives the reset), when the slot holds no valid image (an
- * update cut short, a blank part), and when a request for this servo
- * arrives in the first BOOT_LISTEN_MS after reset (so a servo whose
+ * update cut short, a blank part), and when an update packet for this
+ * servo arrives in the first BOOT_LISTEN_MS after reset (so a servo whose
  * application hangs the bus can still be reached: power it up and send
- * UpdateStatus at once). Otherwise it starts the application once that
- * window has passed. */
+ * UpdateStatus at once; a Ping does not keep it). Otherwise it starts the
+ * application once that window has passed. */
 #ifndef BOOTLOADER_BOOT_FLOW_H
 #define BOOTLOADER_BOOT_FLOW_H
 
@@ -31,7 +31,7 @@ struct boot_flow {
 };
 
 void boot_flow_start(struct boot_flow *f, bool app_valid, uint32_t stay_word);
-/* A request for this servo was answered. */
+/* An update packet for this servo was answered. */
 void boot_flow_heard(struct boot_flow *f);
 enum boot_choice boot_flow_step(struct boot_flow *f, uint32_t elapsed_ms);
 

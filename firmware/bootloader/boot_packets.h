@@ -13,9 +13,10 @@
 #include "protocol/frame_tx.h"
 
 #define BOOTLOADER_VERSION 1u
-/* Largest data in one UpdateWrite: the bootloader's framer keeps requests
- * of 9 + this many content bytes. */
-#define UPDATE_WRITE_MAX 128u
+/* Largest data in one UpdateWrite: the request (9 + 24 bytes) fits the
+ * framer every build shares (FRAME_CONTENT_MAX, 34), so the bootloader
+ * needs no framer of its own. */
+#define UPDATE_WRITE_MAX 24u
 
 struct bootloader {
     const struct app_slot *slot;
@@ -25,7 +26,8 @@ struct bootloader {
 };
 
 /* A request's packet code and content; true with r filled when it is
- * answered. */
+ * answered. An answered update packet (not a Ping) keeps the bootloader
+ * from starting the application (boot_flow_heard). */
 bool boot_packet(struct bootloader *b, uint8_t code, const uint8_t *content, uint16_t length,
                  struct response *r);
 

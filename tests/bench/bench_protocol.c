@@ -121,12 +121,6 @@ static uint32_t port_now_us(void *ctx)
     return hal.now_us;
 }
 
-static void port_rx_sync(void *ctx, uint32_t now_us)
-{
-    (void)ctx;
-    dma_rx_sync(&dma, now_us);
-}
-
 static void port_uart_send(void *ctx, const uint8_t *data, uint16_t len)
 {
     (void)ctx;
@@ -193,7 +187,8 @@ static void fresh_servo(void)
     usart_hd_rx_dma(&usart);
     laps_due = 0;
     hal.port.now_us = port_now_us;
-    hal.port.rx_sync = port_rx_sync;
+    hal.port.rx_sync = dma_rx_sync;
+    hal.port.rx_ctx = &dma;
     hal.port.uart_send = port_uart_send;
     hal.port.uart_tx_done = port_uart_tx_done;
     servo_init(&servo, &hal.port);

@@ -24,8 +24,10 @@ struct hal_port {
     /* Received bytes, in the ring the port owns and fills. */
     struct hal_rx_ring *rx;
     /* Brings rx->written and rx->heard_us up to date, for a port whose DMA
-     * fills the ring; NULL when its receive interrupt does. */
-    void (*rx_sync)(void *ctx, uint32_t now_us);
+     * fills the ring (called with rx_ctx); NULL when its receive interrupt
+     * does. */
+    void (*rx_sync)(void *rx_ctx, uint32_t now_us);
+    void *rx_ctx;
     /* H-bridge: signed duty, Q15 (32767 = full supply; positive turns the
      * output towards increasing angle, counter-clockwise seen from the horn). */
     void (*motor_drive)(void *ctx, int16_t duty_q15);

@@ -26,8 +26,9 @@ void dma_rx_lap(struct dma_rx *d)
     d->laps++;
 }
 
-void dma_rx_sync(struct dma_rx *d, uint32_t now_us)
+void dma_rx_sync(void *dma, uint32_t now_us)
 {
+    struct dma_rx *d = dma;
     /* Laps, counter, laps: a lap that ended in between waits for the next
      * call, as does a counter that has reloaded at the end of a lap a
      * moment before the interrupt counts it (a position behind the last

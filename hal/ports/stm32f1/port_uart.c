@@ -44,12 +44,6 @@ static void uart_set_baud(void *ctx, uint32_t baud)
     usart_hd_set_baud(ctx, baud);
 }
 
-static void rx_sync(void *ctx, uint32_t now)
-{
-    (void)ctx;
-    dma_rx_sync(&dma, now);
-}
-
 void port_uart_init(struct hal_port *port, struct usart_hd *usart, enum port_uart_rx rx,
                     uint32_t pclk_hz)
 {
@@ -66,7 +60,8 @@ void port_uart_init(struct hal_port *port, struct usart_hd *usart, enum port_uar
         RCC_AHBENR |= RCC_AHBENR_DMA1;
         dma_rx_start(&dma, DMA1_CCR5_ADDR, USART1_BASE + 0x04u, &ring);
         usart_hd_rx_dma(usart);
-        port->rx_sync = rx_sync;
+        port->rx_sync = dma_rx_sync;
+        port->rx_ctx = &dma;
         NVIC_ISER(DMA1_CH5_IRQ / 32u) = 1u << (DMA1_CH5_IRQ % 32u);
     }
 }

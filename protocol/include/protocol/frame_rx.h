@@ -12,6 +12,8 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "hal/hal_rx_ring.h"
+
 /* Largest request content kept: WriteBatchData is 1 + 32 bytes. A longer
  * request is consumed by its length and delivered with FRAME_TRUNCATED so the
  * dispatcher can reject it as a length error. */
@@ -77,6 +79,7 @@ void frame_rx_feed_bytes(struct frame_rx *rx, const uint8_t *data, uint32_t n);
 /* One received byte. */
 void frame_rx_feed(struct frame_rx *rx, uint8_t byte);
 
+
 /* The line has been idle for the idle timeout (frame_rx_idle_us): a partial
  * frame is dropped. */
 void frame_rx_line_idle(struct frame_rx *rx);
@@ -93,6 +96,33 @@ static inline const struct rx_frame *frame_rx_peek(const struct frame_rx *rx)
     return rx->tail == rx->head ? (const struct rx_frame *)0 : &rx->slots[rx->tail];
 }
 void frame_rx_release(struct frame_rx *rx);
+
+/* Everything waiting in the port's ring, framed: false when nothing was.
+ * Bytes the port wrote over before they were taken (its DMA lapped the
+ * reader) are added to *lost. Inline: it runs every main-loop pass. */
+static inline bool frame_rx_take_ring(struct frame_rx *rx, struct hal_rx_ring *ring,
+                                      uint32_t *lost)
+{
+    uint32_t written = ring->written;
+    uint32_t read = ring->read;
+    uint32_t waiting = written - read;
+    if (waiting == 0u) {
+        return false;
+    }
+    if (waiting > HAL_RX_RING_SIZE) {
+        *lost += waiting - HAL_RX_RING_SIZE;
+        read = written - HAL_RX_RING_SIZE;
+        waiting = HAL_RX_RING_SIZE;
+    }
+    uint32_t at = read & (HAL_RX_RING_SIZE - 1u);
+    uint32_t first = HAL_RX_RING_SIZE - at < waiting ? HAL_RX_RING_SIZE - at : waiting;
+    frame_rx_feed_bytes(rx, &ring->data[at], first);
+    if (waiting > first) { /* the rest, from the ring's start */
+        frame_rx_feed_bytes(rx, ring->data, waiting - first);
+    }
+    ring->read = written;
+    return true;
+}
 
 /* The documented idle timeout for a baud rate: ten byte times (10 bits each),
  * but never below 1 ms so that gaps inside one write by a USB serial adapter
