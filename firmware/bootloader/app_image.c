@@ -1,7 +1,23 @@
 #include "app_image.h"
 
+#include <string.h>
+
 #include "crc32.h"
 #include "protocol/wire.h"
+
+void app_image_make_header(uint8_t header[APP_HEADER_SIZE], const uint8_t *code, uint32_t size,
+                           uint16_t version, uint16_t board)
+{
+    memset(header, 0xFF, APP_HEADER_SIZE);
+    wire_put_u32(&header[0], APP_IMAGE_MAGIC);
+    wire_put_u16(&header[4], APP_IMAGE_FORMAT);
+    wire_put_u16(&header[6], board);
+    wire_put_u32(&header[8], size);
+    wire_put_u32(&header[12], crc32(code, size));
+    wire_put_u16(&header[16], version);
+    memset(&header[18], 0, 6);
+    wire_put_u32(&header[APP_HEADER_CHECKED], crc32(header, APP_HEADER_CHECKED));
+}
 
 uint32_t app_slot_size(const struct app_slot *slot)
 {

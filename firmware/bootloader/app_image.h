@@ -52,6 +52,11 @@ enum app_image_verdict {
 
 uint32_t app_slot_size(const struct app_slot *slot);
 
+/* The header for `size` bytes of code (size even), as tools/servoctl/image.py
+ * writes it; for the simulator's factory image and the tests. */
+void app_image_make_header(uint8_t header[APP_HEADER_SIZE], const uint8_t *code, uint32_t size,
+                           uint16_t version, uint16_t board);
+
 /* Reads and checks the image in the slot; info is filled from the header
  * whenever it checks (also when the image's CRC does not). */
 enum app_image_verdict app_image_check(const struct app_slot *slot, uint16_t board,

@@ -103,23 +103,14 @@ static int setup(void **state)
     return 0;
 }
 
-/* An image of `size` code bytes (seeded), version, for board, as
- * tools/servoctl/image.py builds it. */
+/* An image of `size` code bytes (seeded), version, for board. */
 static size_t make_image(uint8_t *out, uint32_t size, uint16_t version, uint16_t board,
                          unsigned seed)
 {
-    memset(out, 0xFF, APP_HEADER_SIZE);
     for (uint32_t i = 0; i < size; i++) {
         out[APP_HEADER_SIZE + i] = (uint8_t)(seed * 31u + i * 7u + (i >> 8));
     }
-    wire_put_u32(&out[0], APP_IMAGE_MAGIC);
-    wire_put_u16(&out[4], APP_IMAGE_FORMAT);
-    wire_put_u16(&out[6], board);
-    wire_put_u32(&out[8], size);
-    wire_put_u32(&out[12], crc32(&out[APP_HEADER_SIZE], size));
-    wire_put_u16(&out[16], version);
-    memset(&out[18], 0, 6);
-    wire_put_u32(&out[24], crc32(out, APP_HEADER_CHECKED));
+    app_image_make_header(out, &out[APP_HEADER_SIZE], size, version, board);
     return APP_HEADER_SIZE + size;
 }
 
@@ -216,6 +207,18 @@ static void test_an_update_by_packets(void **state)
     assert_int_equal(last.content[1], 1);
     assert_true(boot.boot_now);
     assert_memory_equal(chip.mem, image, n);
+}
+
+/* The header matches what tools/servoctl/image.py builds: the same bytes
+ * for the same code (tools/tests/test_image.py holds the same vector). */
+static void test_the_header_matches_the_tool(void **state)
+{
+    (void)state;
+    uint8_t code[8] = {1, 2, 3, 4, 5, 6, 7, 8};
+    uint8_t header[APP_HEADER_SIZE];
+    app_image_make_header(header, code, sizeof code, 0x0011, 0x0103);
+    assert_int_equal(wire_get_u32(&header[12]), 0x3FCA88C5u); /* zlib.crc32(bytes(1..8)) */
+    assert_int_equal(wire_get_u32(&header[24]), 0x790C7AB0u);
 }
 
 static void test_what_the_bootloader_refuses(void **state)
@@ -367,6 +370,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test_setup(test_an_image_checks_only_when_whole, setup),
         cmocka_unit_test_setup(test_an_update_by_packets, setup),
+        cmocka_unit_test_setup(test_the_header_matches_the_tool, setup),
         cmocka_unit_test_setup(test_what_the_bootloader_refuses, setup),
         cmocka_unit_test_setup(test_ping_and_status_find_the_bootloader, setup),
         cmocka_unit_test_setup(test_a_power_cut_at_every_step_never_bricks, setup),

@@ -14,6 +14,7 @@ import math
 import os
 import sys
 import time
+from pathlib import Path
 
 from . import __version__, group, ntc, outcome, registers, units
 from .profile import positions, velocity_timing
@@ -474,6 +475,64 @@ def _interrupt(signum, frame):
     raise KeyboardInterrupt
 
 
+def _version(v) -> str:
+    return "none" if v is None else f"0x{v:04x}"
+
+
+def cmd_update(bus, args):
+    from rich.progress import BarColumn, DownloadColumn, Progress, TextColumn, TimeRemainingColumn
+
+    from . import image as img
+    from . import update as upd
+
+    image = img.load(args.image)
+    failed = []
+    for servo_id in args.ids:
+        started = time.monotonic()
+        columns = [TextColumn(f"servo {servo_id}"), BarColumn(), DownloadColumn(), TimeRemainingColumn()]
+        try:
+            with Progress(*columns, transient=True, disable=not sys.stderr.isatty()) as progress:
+                task = progress.add_task("update", total=len(image.data))
+                before, after = upd.update(bus, servo_id, image,
+                                           lambda done, total: progress.update(task, completed=done,
+                                                                               total=total))
+        except ServoError as e:
+            print(f"servo {servo_id}: failed: {e}")
+            failed.append(e)
+            continue
+        print(f"servo {servo_id}: version {_version(before)} -> {_version(after)}, "
+              f"{len(image.data)} B in {time.monotonic() - started:.1f} s")
+    if failed:
+        return max(e.exit_code for e in failed)
+    return 0
+
+
+def cmd_image(args):
+    from . import image as img
+
+    board = img.BOARDS.get(args.board)
+    if board is None:
+        try:
+            board = int(args.board, 0)
+        except ValueError:
+            raise UsageError(f"board must be one of {', '.join(img.BOARDS)} or a number, "
+                             f"not {args.board!r}") from None
+    try:
+        code = Path(args.binary).read_bytes()
+        version = int(args.version, 0)
+    except OSError as e:
+        raise UsageError(f"cannot read {args.binary}: {e.strerror}") from e
+    except ValueError:
+        raise UsageError(f"version must be a number, not {args.version!r}") from None
+    data = img.build(code, version, board)
+    try:
+        Path(args.output).write_bytes(data)
+    except OSError as e:
+        raise UsageError(f"cannot write {args.output}: {e.strerror}") from e
+    print(f"{args.output}: {len(data)} B, version 0x{version:04x}, board 0x{board:04x}")
+    return 0
+
+
 def cmd_sim(args):
     """Runs servo_sim until Ctrl-C or SIGTERM; either stops it cleanly and
     removes a state folder it made."""
@@ -628,6 +687,19 @@ def build_parser():
     c.add_argument("--with-link", action="store_true", help="also set IDs and baud rates")
     c.set_defaults(run=cmd_restore)
 
+    c = sub.add_parser("update", help="write a firmware image into servos over the bus "
+                                      "(also recovers a servo left in its bootloader)")
+    c.add_argument("image", help="an update image (servoctl image)")
+    c.add_argument("ids", type=int, nargs="+", metavar="ID")
+    c.set_defaults(run=cmd_update)
+
+    c = sub.add_parser("image", help="make an update image from an application binary")
+    c.add_argument("binary", help="the application from its vector table (objcopy -O binary)")
+    c.add_argument("--version", required=True, help="firmware version, data item 7 (e.g. 0x0011)")
+    c.add_argument("--board", required=True, help="stm32f103, qemu_stm32vl, sim, or a number")
+    c.add_argument("-o", "--output", required=True)
+    c.set_defaults(run=None)
+
     c = sub.add_parser("sim", help="run the simulator")
     c.add_argument("--id", dest="ids", type=int, action="append")
     c.add_argument("--tcp", type=int, nargs="?", const=0, default=None, metavar="PORT",
@@ -654,6 +726,8 @@ def main(argv=None) -> int:
 def _run(args) -> int:
     if args.command == "sim":
         return cmd_sim(args)
+    if args.command == "image":
+        return cmd_image(args)
     if args.command == "config":
         need = {"get": 1, "set": 2, "dump": 0, "save": 1, "load": 1, "reset": 0}[args.action]
         if len(args.rest) != need:

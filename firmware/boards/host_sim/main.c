@@ -70,7 +70,8 @@ static void usage(FILE *out)
           "                 while the flash stalls the CPU\n"
           "Control commands, one per line, optional servo ID last:\n"
           "  supply MV | load NM | stop DEG | stop off | ambient DEGC | soak DEGC |\n"
-          "  hostbaud BAUD (a TCP host's rate; a pty's is what the host set) | state | help\n",
+          "  hostbaud BAUD (a TCP host's rate; a pty's is what the host set) |\n"
+          "  powercycle (the servo restarts through its bootloader) | state | help\n",
           out);
 }
 
@@ -221,7 +222,7 @@ static void state_of(const struct sim_servo *s, char *out, size_t size)
              "supply=%.3f "
              "load=%.3f stop=%s status=0x%02x reported=%d collisions=%lu dropped_ticks=%u "
              "most_behind_ms=%.1f baud=%u host_baud=%u baud_mismatches=%lu rx_overruns=%u "
-             "rx_lost=%u flash_stall_ms=%.2f saves=%u\n",
+             "rx_lost=%u flash_stall_ms=%.2f saves=%u mode=%s version=0x%04x\n",
              s->cmdline_id, plant_angle_deg(&s->plant), s->plant.velocity * 180.0 / M_PI,
              s->plant.current, s->thermal.winding_c, s->thermal.case_c, s->thermal.ambient_c,
              s->plant.p.supply_v,
@@ -229,7 +230,8 @@ static void state_of(const struct sim_servo *s, char *out, size_t size)
              a.multi_turn_decideg, bus.collisions, s->core.ticks_dropped,
              (double)most_behind_us / 1000.0, (unsigned)s->baud, (unsigned)bus.host_baud,
              bus.baud_mismatches, (unsigned)s->rx.overruns, (unsigned)s->core.rx_lost,
-             (double)s->flash_stall_us / 1000.0, (unsigned)s->core.store.sequence);
+             (double)s->flash_stall_us / 1000.0, (unsigned)s->core.store.sequence,
+             s->in_bootloader ? "bootloader" : "app", (unsigned)s->core.regs.status.firmware_version);
 }
 
 /* One control line: "command [value] [servo id]". */
@@ -244,7 +246,8 @@ static void control_command(int fd, char *line)
         return;
     }
     const char *cmd = words[0];
-    bool takes_value = strcmp(cmd, "state") != 0 && strcmp(cmd, "help") != 0;
+    bool takes_value = strcmp(cmd, "state") != 0 && strcmp(cmd, "help") != 0 &&
+                       strcmp(cmd, "powercycle") != 0;
     int id_word = takes_value ? 2 : 1;
     struct sim_servo *only = NULL;
     if (n > id_word) {
@@ -256,7 +259,7 @@ static void control_command(int fd, char *line)
     }
     if (strcmp(cmd, "help") == 0) {
         reply(fd, "ok supply MV | load NM | stop DEG | stop off | ambient DEGC | soak DEGC | "
-                  "hostbaud BAUD | state [ID]\n");
+                  "hostbaud BAUD | powercycle [ID] | state [ID]\n");
         return;
     }
     if (takes_value && n < 2) {
@@ -316,8 +319,10 @@ static void control_command(int fd, char *line)
         } else if (strcmp(cmd, "stop") == 0) {
             s->plant.has_stop = !off;
             s->plant.stop_angle = value * M_PI / 180.0;
+        } else if (strcmp(cmd, "powercycle") == 0) {
+            sim_servo_power_cycle(s);
         } else if (strcmp(cmd, "state") == 0) {
-            char one[512];
+            char one[768];
             state_of(s, one, sizeof one);
             strncat(out, one, sizeof out - strlen(out) - 1);
         } else {

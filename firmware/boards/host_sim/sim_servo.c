@@ -3,12 +3,15 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <string.h>
 #include <time.h>
 
 #include "calibration.h"
 #include "config_store.h"
+#include "crc32.h"
 #include "protocol/data_table.h"
 #include "sim_bus.h"
+#include "slot_write.h"
 
 uint64_t sim_now_us(void)
 {
@@ -24,7 +27,7 @@ uint64_t sim_now_us(void)
 
 /* Runs motor and winding up to now with the drive last set; the bus clock
  * moves in small steps, so dt stays near one control tick. */
-static void run_models(struct sim_servo *s)
+void sim_servo_run_models(struct sim_servo *s)
 {
     uint64_t now = s->bus->now_us;
     double dt = (double)(now - s->stepped_us) * 1e-6;
@@ -64,21 +67,21 @@ static void uart_set_baud(void *ctx, uint32_t baud)
 static void motor_drive(void *ctx, int16_t duty)
 {
     struct sim_servo *s = ctx;
-    run_models(s);
+    sim_servo_run_models(s);
     plant_drive(&s->plant, duty);
 }
 
 static void motor_coast(void *ctx)
 {
     struct sim_servo *s = ctx;
-    run_models(s);
+    sim_servo_run_models(s);
     plant_coast(&s->plant);
 }
 
 static uint16_t encoder_read(void *ctx)
 {
     struct sim_servo *s = ctx;
-    run_models(s);
+    sim_servo_run_models(s);
     return plant_encoder(&s->plant);
 }
 
@@ -113,16 +116,64 @@ static bool program_id(struct sim_flash *flash, uint8_t id)
     return config_store_save(&store, &cfg, 0) != CONFIG_WRITE_FAILED;
 }
 
+/* A slot without a valid image gets the factory's: a header for this
+ * firmware's version and 4 KB of stand-in code (the simulator runs the
+ * servo core, not the image). */
+static bool program_factory_image(struct sim_servo *s, uint16_t version)
+{
+    struct app_image_info info;
+    if (app_image_check(&s->slot, SIM_BOARD, &info) == APP_IMAGE_VALID) {
+        return true;
+    }
+    enum { CODE = 4096 };
+    static uint8_t image[APP_HEADER_SIZE + CODE];
+    for (uint32_t i = 0; i < CODE; i++) {
+        image[APP_HEADER_SIZE + i] = (uint8_t)(i * 13u + 7u);
+    }
+    app_image_make_header(image, &image[APP_HEADER_SIZE], CODE, version, SIM_BOARD);
+    for (uint32_t page = 0; page < (sizeof image + SIM_FLASH_PAGE - 1u) / SIM_FLASH_PAGE; page++) {
+        if (slot_erase_page(&s->slot, page) != SLOT_WRITE_OK) {
+            return false;
+        }
+    }
+    return slot_write(&s->slot, 0, image, sizeof image, crc32(image, sizeof image)) == SLOT_WRITE_OK;
+}
+
+static void enter_bootloader(void *ctx)
+{
+    sim_boot_reset(ctx, true);
+}
+
+void sim_servo_start_app(struct sim_servo *s)
+{
+    s->in_bootloader = false;
+    servo_init(&s->core, &s->port);
+    struct app_image_info info;
+    if (app_image_check(&s->slot, SIM_BOARD, &info) == APP_IMAGE_VALID) {
+        s->core.regs.status.firmware_version = info.version; /* the image "running" */
+    }
+}
+
+void sim_servo_power_cycle(struct sim_servo *s)
+{
+    sim_boot_reset(s, false);
+}
+
 bool sim_servo_start(struct sim_servo *s, struct sim_bus *bus, unsigned index, uint8_t id,
                      const char *state_dir, double supply_v, double ambient_c)
 {
     char path[300];
     snprintf(path, sizeof path, "%s/servo-%u.flash", state_dir, id);
-    if (!sim_flash_open(&s->flash, path)) {
-        fprintf(stderr, "servo_sim: cannot open the flash file %s: ", path);
+    char slot_path[300];
+    snprintf(slot_path, sizeof slot_path, "%s/servo-%u.slot", state_dir, id);
+    if (!sim_flash_open(&s->flash, path, SIM_CONFIG_BASE, 2, s->config_mem) ||
+        !sim_flash_open(&s->slot_flash, slot_path, SIM_SLOT_BASE, SIM_SLOT_PAGES, s->slot_mem)) {
+        fprintf(stderr, "servo_sim: cannot open the flash files %s, %s: ", path, slot_path);
         perror(NULL);
         return false;
     }
+    s->slot = (struct app_slot){.flash = &s->slot_flash.hal, .base = SIM_SLOT_BASE,
+                                .pages = SIM_SLOT_PAGES};
     if (!program_id(&s->flash, id)) {
         fprintf(stderr, "servo_sim: cannot write the flash file %s\n", path);
         return false;
@@ -148,9 +199,19 @@ bool sim_servo_start(struct sim_servo *s, struct sim_bus *bus, unsigned index, u
         .calibration = &calibration,
         .flash = &s->flash.hal,
         .serial_number = 0x51A00000u | id,
+        .enter_bootloader = enter_bootloader,
+        .board = SIM_BOARD,
     };
+    /* Powered long before the host connects: the application runs (the
+     * bootloader's listening window is modelled after a restart). */
     servo_init(&s->core, &s->port);
+    if (!program_factory_image(s, s->core.regs.status.firmware_version)) {
+        fprintf(stderr, "servo_sim: cannot write the slot file %s\n", slot_path);
+        return false;
+    }
+    sim_servo_start_app(s);
     s->flash.stall_us = 0; /* power-up, before the servo joins the bus */
+    s->slot_flash.stall_us = 0;
     return true;
 }
 
@@ -184,10 +245,14 @@ void sim_servo_poll(struct sim_servo *s, uint64_t now_us)
         s->uart_full = false;
         hal_rx_ring_put(&s->rx, s->uart_held, s->uart_held_at_us);
     }
-    servo_poll(&s->core);
-    if (s->flash.stall_us != 0u) {
-        s->cpu_free_us = now_us + s->flash.stall_us;
-        s->flash_stall_us += s->flash.stall_us;
+    if (!s->in_bootloader || !sim_boot_poll(s, now_us)) {
+        servo_poll(&s->core);
+    }
+    uint32_t stall = s->flash.stall_us + s->slot_flash.stall_us;
+    if (stall != 0u) {
+        s->cpu_free_us = now_us + stall;
+        s->flash_stall_us += stall;
         s->flash.stall_us = 0;
+        s->slot_flash.stall_us = 0;
     }
 }

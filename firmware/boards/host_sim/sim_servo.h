@@ -5,10 +5,33 @@
 
 #include <stdint.h>
 
+#include "app_image.h"
+#include "boot_flow.h"
+#include "boot_packets.h"
 #include "plant.h"
 #include "servo.h"
 #include "sim_flash.h"
 #include "thermal.h"
+
+/* The reference board's flash map: the bootloader's 4 KB, the application
+ * slot, the config store's two pages at the top of 64 KB. */
+#define SIM_SLOT_BASE 0x08001000u
+#define SIM_SLOT_PAGES 58u
+#define SIM_CONFIG_BASE 0x0800F800u
+/* The board the simulator's images are for (the header's board field). */
+#define SIM_BOARD 0x5100u
+
+/* The bootloader, as the simulator runs it (sim_boot.c): its answers are
+ * the bootloader core's; the image in the slot is not executed, its
+ * version is what the "application" then reports (data item 7). */
+struct sim_boot {
+    struct frame_rx rx;
+    struct bootloader core;
+    struct boot_flow flow;
+    uint64_t since_us;     /* reset */
+    uint8_t id;
+    uint8_t frame[RESPONSE_FRAME_MAX];
+};
 
 struct sim_bus;
 
@@ -17,7 +40,13 @@ struct sim_servo {
     struct hal_port port;
     struct plant plant;
     struct thermal thermal;
-    struct sim_flash flash;
+    struct sim_flash flash;      /* the config store's pages */
+    struct sim_flash slot_flash; /* the application slot */
+    struct app_slot slot;
+    uint8_t config_mem[2u * SIM_FLASH_PAGE];
+    uint8_t slot_mem[SIM_SLOT_PAGES * SIM_FLASH_PAGE];
+    bool in_bootloader;
+    struct sim_boot boot;
     struct hal_rx_ring rx;
     struct sim_bus *bus;
     unsigned index;       /* on the bus */
@@ -46,11 +75,26 @@ uint64_t sim_now_us(void);
 bool sim_servo_start(struct sim_servo *s, struct sim_bus *bus, unsigned index, uint8_t id,
                      const char *state_dir, double supply_v, double ambient_c);
 
+/* The motor and winding models up to the bus's now. */
+void sim_servo_run_models(struct sim_servo *s);
+
 /* A byte off the wire at at_us, as the port takes it. */
 void sim_servo_receive(struct sim_servo *s, uint8_t byte, uint64_t at_us);
 
 /* A main-loop pass, unless the flash stalls the CPU at now_us; the stall
  * of what it did to the flash starts at now_us. */
 void sim_servo_poll(struct sim_servo *s, uint64_t now_us);
+
+/* The power goes and comes back: the servo restarts through its
+ * bootloader (200 ms listening, or for good without a valid image). */
+void sim_servo_power_cycle(struct sim_servo *s);
+
+/* sim_boot.c: reset into the bootloader (stay: UpdateEnter asked), and its
+ * main-loop pass; false once it has started the application. */
+void sim_boot_reset(struct sim_servo *s, bool stay);
+bool sim_boot_poll(struct sim_servo *s, uint64_t now_us);
+/* The application starts: the servo core, reporting the slot image's
+ * version. */
+void sim_servo_start_app(struct sim_servo *s);
 
 #endif

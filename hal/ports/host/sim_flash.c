@@ -5,8 +5,6 @@
 #include <string.h>
 #include <unistd.h>
 
-#define BASE 0x0800F800u
-
 /* Writes len bytes of the chip at offset through to the file. */
 static bool save(const struct sim_flash *f, uint32_t offset, uint32_t len)
 {
@@ -16,29 +14,29 @@ static bool save(const struct sim_flash *f, uint32_t offset, uint32_t len)
 static bool erase_page(void *ctx, uint32_t addr)
 {
     struct sim_flash *f = ctx;
-    if (addr != BASE && addr != BASE + SIM_FLASH_PAGE) {
+    if (addr < f->base || addr - f->base >= f->size || (addr - f->base) % SIM_FLASH_PAGE != 0u) {
         return false;
     }
-    memset(&f->mem[addr - BASE], 0xFF, SIM_FLASH_PAGE);
+    memset(&f->mem[addr - f->base], 0xFF, SIM_FLASH_PAGE);
     f->stall_us += SIM_FLASH_ERASE_US;
-    return save(f, addr - BASE, SIM_FLASH_PAGE);
+    return save(f, addr - f->base, SIM_FLASH_PAGE);
 }
 
 /* Half-words, as the reference board's STM32F1. */
 static bool program(void *ctx, uint32_t addr, const uint8_t *data)
 {
     struct sim_flash *f = ctx;
-    if (addr < BASE || addr + 2u > BASE + sizeof f->mem || (addr & 1u)) {
+    if (addr < f->base || addr - f->base > f->size - 2u || (addr & 1u)) {
         return false;
     }
-    uint8_t *cell = &f->mem[addr - BASE];
+    uint8_t *cell = &f->mem[addr - f->base];
     if (cell[0] != 0xFF || cell[1] != 0xFF) {
         return false;
     }
     cell[0] = data[0];
     cell[1] = data[1];
     f->stall_us += SIM_FLASH_PROGRAM_US;
-    return save(f, addr - BASE, 2);
+    return save(f, addr - f->base, 2);
 }
 
 static void flash_read(void *ctx, uint32_t addr, uint8_t *dst, uint32_t len)
@@ -46,28 +44,29 @@ static void flash_read(void *ctx, uint32_t addr, uint8_t *dst, uint32_t len)
     struct sim_flash *f = ctx;
     for (uint32_t i = 0; i < len; i++) {
         uint32_t a = addr + i;
-        dst[i] = (a >= BASE && a < BASE + sizeof f->mem) ? f->mem[a - BASE] : 0xFF;
+        dst[i] = (a >= f->base && a - f->base < f->size) ? f->mem[a - f->base] : 0xFF;
     }
 }
 
-bool sim_flash_open(struct sim_flash *f, const char *path)
+bool sim_flash_open(struct sim_flash *f, const char *path, uint32_t base, uint32_t pages,
+                    uint8_t *mem)
 {
-    memset(f, 0, sizeof *f);
-    memset(f->mem, 0xFF, sizeof f->mem);
+    *f = (struct sim_flash){.mem = mem, .base = base, .size = pages * SIM_FLASH_PAGE};
+    memset(f->mem, 0xFF, f->size);
     f->fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC, 0644);
     if (f->fd < 0) {
         return false;
     }
-    if (pread(f->fd, f->mem, sizeof f->mem, 0) != (ssize_t)sizeof f->mem) {
-        memset(f->mem, 0xFF, sizeof f->mem); /* new or truncated: a blank chip */
-        if (!save(f, 0, sizeof f->mem)) {
+    if (pread(f->fd, f->mem, f->size, 0) != (ssize_t)f->size) {
+        memset(f->mem, 0xFF, f->size); /* new or truncated: a blank chip */
+        if (!save(f, 0, f->size)) {
             return false;
         }
     }
     f->hal = (struct hal_flash){
         .ctx = f,
         .page_size = SIM_FLASH_PAGE,
-        .page_addr = {BASE, BASE + SIM_FLASH_PAGE},
+        .page_addr = {base, base + SIM_FLASH_PAGE},
         .erase_page = erase_page,
         .write_block = 2,
         .program = program,

@@ -1,5 +1,6 @@
 /* Flash kept in a file, with the STM32F1's rules (erase to 0xFF, program
- * half-words that are erased), so the configuration survives a restart.
+ * half-words that are erased), so what the servo wrote survives a restart:
+ * the config store's two pages, and the application slot.
  *
  * It also keeps the time the CPU would have stalled: the F1 fetches code
  * from the flash it is writing, so nothing runs, the main loop and the
@@ -20,12 +21,17 @@
 
 struct sim_flash {
     struct hal_flash hal;
-    uint8_t mem[2 * SIM_FLASH_PAGE];
+    uint8_t *mem;      /* the caller's, pages x SIM_FLASH_PAGE bytes */
+    uint32_t base;     /* address of mem[0] */
+    uint32_t size;
     int fd; /* the file, kept open; each erase or program writes through */
     uint32_t stall_us; /* CPU stall owed by erases and programs since last taken */
 };
 
-/* Opens (or creates, erased) the file; false with errno on failure. */
-bool sim_flash_open(struct sim_flash *f, const char *path);
+/* Opens (or creates, erased) the file holding `pages` pages at `base`, kept
+ * in mem; false with errno on failure. hal.page_addr names the first two
+ * pages (the config store's). */
+bool sim_flash_open(struct sim_flash *f, const char *path, uint32_t base, uint32_t pages,
+                    uint8_t *mem);
 
 #endif

@@ -1,0 +1,124 @@
+"""Firmware update over the bus (docs/packets.md, 0x50-0x55): one servo at a
+time, the others on the bus untouched. From the application it asks for the
+bootloader (UpdateEnter); a servo already in its bootloader (an update cut
+short, a broken application) is updated the same way, which is the
+recovery."""
+import struct
+import time
+import zlib
+from dataclasses import dataclass
+
+from . import protocol as p
+from .image import HEADER_SIZE, CHECKED, Image
+from .protocol import NoReply, Refused
+
+UPDATE_ENTER, UPDATE_ERASE, UPDATE_WRITE, UPDATE_VERIFY, UPDATE_BOOT, UPDATE_STATUS = range(0x50, 0x56)
+MODE_APP, MODE_BOOTLOADER = 0, 1
+VERDICTS = {0: "valid", 1: "no image", 2: "header damaged", 3: "another board's image",
+            4: "image does not match its CRC"}
+WRITE_REASONS = {1: "damaged on the wire", 2: "outside the slot", 3: "the flash refused",
+                 4: "reads back otherwise"}
+RETRIES = 3
+SWITCH_TIMEOUT_S = 3.0  # a restart: the bootloader's 200 ms window, and the application's start
+
+
+@dataclass
+class Status:
+    mode: int
+    bootloader_version: int
+    verdict: int
+    version: int
+    board: int
+    page_size: int
+    pages: int
+    write_block: int
+    largest_write: int
+
+
+def status(bus, servo_id: int, timeout=None) -> Status:
+    c = bus.request(UPDATE_STATUS, bytes([servo_id]), timeout=timeout)
+    if len(c) != 16:
+        raise NoReply(f"servo {servo_id}: UpdateStatus answer of {len(c)} bytes: not this firmware")
+    return Status(c[1], *struct.unpack_from("<HBHHHHBH", c, 2))
+
+
+def _wait_for_mode(bus, servo_id: int, mode: int) -> Status:
+    deadline = time.monotonic() + SWITCH_TIMEOUT_S
+    while True:
+        try:
+            st = status(bus, servo_id, timeout=0.05)
+            if st.mode == mode:
+                return st
+        except NoReply:
+            pass
+        if time.monotonic() > deadline:
+            where = "its bootloader" if mode == MODE_BOOTLOADER else "the new application"
+            raise NoReply(f"servo {servo_id}: {where} did not answer within {SWITCH_TIMEOUT_S:.0f} s")
+        time.sleep(0.02)
+
+
+def _retry(what, fn):
+    """A request lost on the wire is sent again; a refusal is final."""
+    for attempt in range(RETRIES):
+        try:
+            return fn()
+        except NoReply:
+            if attempt == RETRIES - 1:
+                raise
+    raise AssertionError(what)
+
+
+def _write(bus, servo_id: int, offset: int, chunk: bytes):
+    content = bytes([servo_id]) + struct.pack("<I", offset) + chunk + struct.pack("<I", zlib.crc32(chunk))
+    for attempt in range(RETRIES):
+        c = _retry("write", lambda: bus.request(UPDATE_WRITE, content))
+        if c[1] == 1:
+            return
+        if c[2] != 1 or attempt == RETRIES - 1:  # 1: damaged on the wire, worth again
+            raise Refused(f"servo {servo_id}: writing offset {offset} refused: "
+                          f"{WRITE_REASONS.get(c[2], c[2])}")
+
+
+def update(bus, servo_id: int, image: Image, progress=lambda done, total: None) -> tuple:
+    """Writes `image` into servo `servo_id` and starts it. Returns the
+    version before (None if no application ran) and after."""
+    st = status(bus, servo_id)
+    if image.board != st.board:  # before anything changes
+        raise Refused(f"servo {servo_id} is board {st.board:#06x}; the image is for {image.board:#06x}")
+    before = st.version if st.mode == MODE_APP or st.verdict == 0 else None
+    if st.mode == MODE_APP:
+        c = bus.request(UPDATE_ENTER, bytes([servo_id]))
+        if c[1] != 1:
+            raise Refused(f"servo {servo_id} refused to enter its bootloader: a move runs, "
+                          "or it has none")
+        st = _wait_for_mode(bus, servo_id, MODE_BOOTLOADER)
+    if len(image.data) > st.page_size * st.pages:
+        if st.verdict == 0:  # nothing erased yet: back to the application
+            bus.request(UPDATE_BOOT, bytes([servo_id]))
+        raise Refused(f"the image ({len(image.data)} B) is larger than the slot "
+                      f"({st.page_size * st.pages} B)")
+    pages = (len(image.data) + st.page_size - 1) // st.page_size
+    step = st.largest_write - st.largest_write % st.write_block
+    data = image.data + b"\xff" * (-len(image.data) % st.write_block)
+    total = pages + len(data)
+    for page in range(pages):  # page 0 first: the old image is invalid from here
+        c = _retry("erase", lambda: bus.request(UPDATE_ERASE, bytes([servo_id]) + struct.pack("<H", page)))
+        if c[1] != 1:
+            raise Refused(f"servo {servo_id}: erasing page {page} refused: {WRITE_REASONS.get(c[2], c[2])}")
+        progress(page + 1, total)
+    head = -(-CHECKED // step) * step  # the checked header bytes go last
+    for offset in range(head, len(data), step):
+        _write(bus, servo_id, offset, data[offset:offset + step])
+        progress(min(pages + offset + step, total), total)
+    for offset in range(0, head, step):
+        _write(bus, servo_id, offset, data[offset:offset + step])
+    progress(total, total)
+    c = _retry("verify", lambda: bus.request(UPDATE_VERIFY, bytes([servo_id])))
+    verdict, size, crc, version, _board = struct.unpack_from("<BIIHH", c, 1)
+    if verdict != 0 or (size, crc, version) != (image.size, image.crc, image.version):
+        raise Refused(f"servo {servo_id}: the written image does not check: {VERDICTS.get(verdict, verdict)}")
+    c = _retry("boot", lambda: bus.request(UPDATE_BOOT, bytes([servo_id])))
+    if c[1] != 1:
+        raise Refused(f"servo {servo_id}: the bootloader would not start the image")
+    after = _wait_for_mode(bus, servo_id, MODE_APP).version
+    return before, after

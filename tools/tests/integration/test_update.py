@@ -1,0 +1,153 @@
+"""Issue 12: firmware update over the bus, on a simulated three-servo bus.
+
+The simulator runs the bootloader core on each servo (firmware/boards/
+host_sim/sim_boot.c): its answers, its boot decision and the slot in a
+flash file are the real ones; the image itself is not executed, its version
+is what the application then reports (data item 7). A power cut inside a
+flash step is the unit test's (test_bootloader.c, every erase and program
+step); here the power goes between the update's packets, and the host
+gives up with it."""
+import random
+
+import pytest
+
+from servoctl import image as img
+from servoctl import update as upd
+from servoctl.cli import main
+from servoctl.protocol import Bus, NoReply, Refused, UsageError
+from servoctl.servo import Servo
+
+OLD = 0x0010  # the simulator's factory image: this firmware's version
+NEW = 0x0042
+
+
+def make_image(version=NEW, size=3000, board=img.BOARDS["sim"], seed=1):
+    code = bytes(random.Random(seed).randrange(256) for _ in range(size))
+    return img.parse(img.build(code, version, board))
+
+
+def firmware(bus, servo_id):
+    return Servo(bus, servo_id).read("firmware")
+
+
+def test_an_update_on_a_shared_bus(sim3):
+    image = make_image()
+    others_answered = []
+
+    with Bus(sim3.url, timeout=0.2) as bus:
+        assert [firmware(bus, i) for i in (1, 2, 3)] == [OLD, OLD, OLD]
+
+        calls = []
+
+        def progress(done, total):
+            # The other servos keep working while servo 2 is in its bootloader.
+            calls.append(done)
+            if len(calls) % 20 == 0:
+                others_answered.append(Servo(bus, 1).ping() and Servo(bus, 3).ping())
+
+        before, after = upd.update(bus, 2, image, progress)
+        assert (before, after) == (OLD, NEW)
+        assert [firmware(bus, i) for i in (1, 2, 3)] == [OLD, NEW, OLD]
+        assert upd.status(bus, 2).mode == upd.MODE_APP
+    assert len(others_answered) > 5 and all(others_answered)
+    assert sim3.state(2)["mode"] == "app"
+
+
+@pytest.mark.parametrize("cut_at", ["enter", "first erase", "last erase", "a quarter",
+                                    "three quarters", "before the header", "before verify"])
+def test_a_power_cut_during_an_update_is_recovered(sim3, cut_at):
+    """The power goes at a point of the update and the host gives up; the
+    servo then runs the old image whole or waits in its bootloader, and
+    `servoctl update` again brings the new image."""
+    image = make_image(size=2000)
+    pages = (len(image.data) + 1023) // 1024
+    total = pages + len(image.data)
+    points = {"enter": 0, "first erase": 1, "last erase": pages, "a quarter": pages + total // 4,
+              "three quarters": pages + 3 * total // 4, "before the header": total - 24,
+              "before verify": total}
+
+    class Cut(Exception):
+        pass
+
+    def progress(done, _total):
+        if done >= points[cut_at]:
+            sim3.control("powercycle 2")
+            raise Cut()
+
+    with Bus(sim3.url, timeout=0.2) as bus:
+        if cut_at == "enter":
+            bus.request(upd.UPDATE_ENTER, bytes([2]))
+            sim3.control("powercycle 2")
+        else:
+            with pytest.raises(Cut):
+                upd.update(bus, 2, image, progress)
+        st = upd._wait_for_mode(bus, 2, upd.MODE_BOOTLOADER) if cut_at != "enter" else None
+        if st is not None:
+            assert st.verdict != 0  # no half image is started
+        before, after = upd.update(bus, 2, image)  # the recovery
+        assert after == NEW
+        assert before in (None, OLD)
+        assert [firmware(bus, i) for i in (1, 2, 3)] == [OLD, NEW, OLD]
+
+
+def test_the_bootloader_answers_ping_and_stays_without_an_image(sim):
+    with Bus(sim.url, timeout=0.2) as bus:
+        image = make_image(size=2000)
+
+        class HostGone(Exception):
+            pass
+
+        def erase_then_cut(done, total):
+            if done == 1:  # page 0, the header's, is gone
+                sim.control("powercycle 1")
+                raise HostGone()
+
+        with pytest.raises(HostGone):
+            upd.update(bus, 1, image, erase_then_cut)
+        st = upd._wait_for_mode(bus, 1, upd.MODE_BOOTLOADER)
+        assert st.verdict == 1  # no image
+        assert Servo(bus, 1).ping()  # tools find it
+        with pytest.raises(NoReply):
+            Servo(bus, 1).read("firmware")  # nothing else answers
+        assert (st.page_size, st.write_block, st.largest_write) == (1024, 2, 24)
+
+
+def run(sim, capsys, *args):
+    rc = main(["--port", sim.url, *args])
+    out = capsys.readouterr()
+    return rc, out.out, out.err
+
+
+def test_servoctl_image_and_update_several_servos(sim3, capsys, tmp_path):
+    binary = tmp_path / "app.bin"
+    binary.write_bytes(bytes(random.Random(2).randrange(256) for _ in range(1501)))
+    out = tmp_path / "app.img"
+    rc, text, _ = run(sim3, capsys, "image", str(binary), "--version", "0x0042", "--board", "sim",
+                      "-o", str(out))
+    assert rc == 0 and "version 0x0042" in text
+    rc, text, err = run(sim3, capsys, "update", str(out), "1", "3")
+    assert rc == 0, err
+    assert "servo 1: version 0x0010 -> 0x0042" in text
+    assert "servo 3: version 0x0010 -> 0x0042" in text
+    with Bus(sim3.url, timeout=0.2) as bus:
+        assert [firmware(bus, i) for i in (1, 2, 3)] == [NEW, OLD, NEW]
+
+
+def test_servoctl_update_refuses_what_cannot_be_right(sim, capsys, tmp_path):
+    foreign = tmp_path / "f103.img"
+    foreign.write_bytes(img.build(b"\x00" * 64, 0x0042, img.BOARDS["stm32f103"]))
+    rc, text, _ = run(sim, capsys, "update", str(foreign), "1")
+    assert rc == Refused.exit_code
+    assert "board" in text
+    not_an_image = tmp_path / "app.bin"
+    not_an_image.write_bytes(b"\x00" * 600)
+    rc, _, err = run(sim, capsys, "update", str(not_an_image), "1")
+    assert rc == UsageError.exit_code and "not an update image" in err
+    damaged = tmp_path / "damaged.img"
+    data = bytearray(img.build(b"\x01" * 600, 0x0042, img.BOARDS["sim"]))
+    data[400] ^= 1
+    damaged.write_bytes(bytes(data))
+    rc, _, err = run(sim, capsys, "update", str(damaged), "1")
+    assert rc == UsageError.exit_code and "does not match its CRC" in err
+    with Bus(sim.url, timeout=0.2) as bus:
+        assert firmware(bus, 1) == OLD  # nothing was written
