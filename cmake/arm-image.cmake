@@ -10,7 +10,9 @@ function(servo_arm_image name)
   set(I_LINKER ${SERVO_BOARD_LINKER})
   add_executable(${name}.elf ${I_SOURCES} ${SERVO_BOARD_STARTUP})
   target_link_libraries(${name}.elf PRIVATE ${I_LIBS} ${SERVO_BOARD_PORT} servo_app)
-  target_include_directories(${name}.elf PRIVATE ${PROJECT_SOURCE_DIR}/firmware/boards/stm32f103)
+  target_include_directories(${name}.elf PRIVATE ${PROJECT_SOURCE_DIR}/firmware/boards/stm32f103
+                             ${PROJECT_SOURCE_DIR}/firmware/bootloader)
+  target_compile_definitions(${name}.elf PRIVATE BOARD_ID=${SERVO_BOARD_ID}u)
   servo_firmware_target(${name}.elf)
   target_link_options(${name}.elf PRIVATE -L${PROJECT_SOURCE_DIR}/firmware/linker -T${I_LINKER}
                       -Wl,-Map=${CMAKE_CURRENT_BINARY_DIR}/${name}.map)
@@ -21,5 +23,40 @@ function(servo_arm_image name)
     COMMAND sh ${PROJECT_SOURCE_DIR}/cmake/check-image.sh $<TARGET_FILE:${name}.elf>
     COMMAND Python3::Interpreter ${PROJECT_SOURCE_DIR}/cmake/stack-report.py
             $<TARGET_FILE:${name}.elf> ${CMAKE_BINARY_DIR}
+    # The update image (header, then the application): what the bootloader
+    # starts, servoctl update writes, and the slot holds.
+    COMMAND ${CMAKE_COMMAND} -E env PYTHONPATH=${PROJECT_SOURCE_DIR}/tools
+            ${Python3_EXECUTABLE} -m servoctl.image ${CMAKE_CURRENT_BINARY_DIR}/${name}.bin
+            --version ${SERVO_FIRMWARE_VERSION} --board ${SERVO_BOARD_ID}
+            -o ${CMAKE_CURRENT_BINARY_DIR}/${name}.img
+    VERBATIM)
+endfunction()
+
+# servo_arm_bootloader(NAME SOURCES src...): the bootloader of the board
+# whose board.cmake was included last, at the start of flash, with its own
+# budget (4 KB) checked after every link.
+function(servo_arm_bootloader name)
+  cmake_parse_arguments(I "" "" "SOURCES" ${ARGN})
+  # Built for size (-Oz) into the image itself, so these objects come before
+  # the libraries' -Os ones: the bootloader core, the framer byte by byte
+  # (FRAME_RX_SMALL) and small mem* functions (firmware/bootloader/small_mem.c).
+  set(boot ${PROJECT_SOURCE_DIR}/firmware/bootloader)
+  set(small ${PROJECT_SOURCE_DIR}/protocol/frame_rx.c ${boot}/small_mem.c ${boot}/bootloader.c
+      ${boot}/boot_packets.c ${boot}/boot_flow.c ${boot}/app_image.c ${boot}/slot_write.c
+      ${PROJECT_SOURCE_DIR}/firmware/storage/config_peek.c)
+  add_executable(${name}.elf ${I_SOURCES} ${SERVO_BOARD_STARTUP} ${small})
+  target_compile_definitions(${name}.elf PRIVATE FRAME_RX_SMALL STARTUP_LAST_IRQ_DMA1_CHANNEL5)
+  target_compile_options(${name}.elf PRIVATE -Oz -flto -fno-tree-loop-distribute-patterns)
+  target_link_options(${name}.elf PRIVATE -Oz -flto)
+  target_link_libraries(${name}.elf PRIVATE ${SERVO_BOARD_PORT} servo_bootloader_core)
+  target_compile_definitions(${name}.elf PRIVATE BOARD_ID=${SERVO_BOARD_ID}u)
+  servo_firmware_target(${name}.elf)
+  target_link_options(${name}.elf PRIVATE -L${PROJECT_SOURCE_DIR}/firmware/linker
+                      -T${SERVO_BOARD_BOOT_LINKER} -Wl,-Map=${CMAKE_CURRENT_BINARY_DIR}/${name}.map)
+  set_target_properties(${name}.elf PROPERTIES
+    LINK_DEPENDS "${SERVO_BOARD_BOOT_LINKER};${PROJECT_SOURCE_DIR}/firmware/linker/sections_stm32f1.ld")
+  add_custom_command(TARGET ${name}.elf POST_BUILD
+    COMMAND ${CMAKE_OBJCOPY} -O binary $<TARGET_FILE:${name}.elf> ${CMAKE_CURRENT_BINARY_DIR}/${name}.bin
+    COMMAND sh ${PROJECT_SOURCE_DIR}/cmake/check-image.sh $<TARGET_FILE:${name}.elf> 4096
     VERBATIM)
 endfunction()

@@ -18,6 +18,15 @@ enum rx_state {
     RX_SKIP,      /* a frame not kept: remaining counts its checksum too */
 };
 
+/* The bursts' fast paths (a header, a run of content or garbage at once,
+ * the hot helpers inlined) buy the receive path its budget; the bootloader
+ * builds this file with FRAME_RX_SMALL, byte by byte, to fit its 4 KB. */
+#ifdef FRAME_RX_SMALL
+#define HOT static
+#else
+#define HOT static inline __attribute__((always_inline))
+#endif
+
 /* SyncCommand content: cmd, record_len, count, then the records. */
 enum { SYNC_HEADER_SIZE = 3 };
 
@@ -56,8 +65,7 @@ static void skip(struct frame_rx *rx, uint32_t bytes)
     rx->state = RX_SKIP;
 }
 
-static inline __attribute__((always_inline)) void start_content(struct frame_rx *rx,
-                                                                uint16_t length)
+HOT void start_content(struct frame_rx *rx, uint16_t length)
 {
     rx->remaining = length;
     rx->position = 0;
@@ -74,6 +82,7 @@ static inline __attribute__((always_inline)) void start_content(struct frame_rx 
     rx->state = length ? RX_CONTENT : RX_CHECKSUM;
 }
 
+#ifndef FRAME_RX_SMALL
 /* A byte of SyncCommand content: keep the 3-byte header and, of the records,
  * only the first one that starts with this servo's ID. */
 static void sync_content_byte(struct frame_rx *rx, struct rx_frame *f, uint8_t byte)
@@ -112,6 +121,7 @@ static void sync_content_byte(struct frame_rx *rx, struct rx_frame *f, uint8_t b
         rx->sync_capturing = 0;
     }
 }
+#endif
 
 /* A request addressed to another servo (unknown packets count as
  * addressed, as in the dispatcher): nothing of it is kept. */
@@ -124,7 +134,12 @@ static void content_byte(struct frame_rx *rx, uint8_t byte)
 {
     struct rx_frame *f = work_slot(rx);
     if (f->code == PKT_SYNC_COMMAND) {
+#ifdef FRAME_RX_SMALL
+        skip(rx, rx->remaining); /* the bootloader takes no SyncCommand */
+        return;
+#else
         sync_content_byte(rx, f, byte);
+#endif
     } else if (rx->position == 0u && for_another_servo(rx, f->code, byte)) {
         skip(rx, rx->remaining); /* the rest and the checksum */
         return;
@@ -141,7 +156,7 @@ static void content_byte(struct frame_rx *rx, uint8_t byte)
     }
 }
 
-static inline __attribute__((always_inline)) void finish_skipped(struct frame_rx *rx)
+HOT void finish_skipped(struct frame_rx *rx)
 {
     rx->state = RX_HDR0;
     if (!rx->is_request) {
@@ -249,6 +264,7 @@ static void step(struct frame_rx *rx, uint8_t byte)
 
 /* A kept request's plain content (not SyncCommand, past the ID, within
  * FRAME_CONTENT_MAX) in one run: copy and sum. Returns the bytes taken. */
+#ifndef FRAME_RX_SMALL
 static uint32_t content_run(struct frame_rx *rx, const uint8_t *data, uint32_t n)
 {
     struct rx_frame *f = work_slot(rx);
@@ -347,6 +363,14 @@ void frame_rx_feed_bytes(struct frame_rx *rx, const uint8_t *data, uint32_t n)
         n -= took;
     }
 }
+#else
+void frame_rx_feed_bytes(struct frame_rx *rx, const uint8_t *data, uint32_t n)
+{
+    for (uint32_t i = 0; i < n; i++) {
+        step(rx, data[i]);
+    }
+}
+#endif
 
 void frame_rx_feed(struct frame_rx *rx, uint8_t byte)
 {

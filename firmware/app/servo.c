@@ -30,6 +30,12 @@ void servo_init(struct servo *s, const struct hal_port *hal)
 {
     *s = (struct servo){.hal = hal};
     config_store_load(&s->store, hal->flash, &s->regs.user);
+    /* A store older firmware wrote (format 1) is rewritten in format 2, the
+     * one the bootloader reads the ID and baud rate from. */
+    if (s->store.legacy) {
+        s->store.saved[0] ^= 1u; /* differs from what is stored: it is written */
+        (void)config_store_save(&s->store, &s->regs.user, s->store.op_seconds);
+    }
     /* Erase ahead at power-up, before the control loop runs: saves need
      * no erase until the page in use is full. */
     if (config_store_spare_dirty(&s->store)) {

@@ -24,5 +24,10 @@ if sh "$root/cmake/check-image.sh" "$tmp/probe.elf" 2>"$tmp/err" >/dev/null; the
   echo "image over the RAM budget accepted"; fail=1
 fi
 grep -q "RAM .* exceeds 8192" "$tmp/err" || { echo "RAM overrun not reported"; fail=1; }
-[ $fail -eq 0 ] && echo "check-image: rejects soft float and RAM overrun, accepts a clean image"
+build
+if sh "$root/cmake/check-image.sh" "$tmp/probe.elf" 8 2>"$tmp/err" >/dev/null; then
+  echo "image over a bootloader-style flash budget accepted"; fail=1
+fi
+grep -q "flash .* exceeds 8 B" "$tmp/err" || { echo "flash overrun not reported"; fail=1; }
+[ $fail -eq 0 ] && echo "check-image: rejects soft float, RAM and flash overruns, accepts a clean image"
 exit $fail

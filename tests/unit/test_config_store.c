@@ -9,6 +9,7 @@
 
 #include <cmocka.h>
 
+#include "config_peek.h"
 #include "config_store.h"
 #include "crc32.h"
 #include "flash_double.h"
@@ -276,8 +277,13 @@ static void test_a_format_1_store_still_loads(void **state)
     struct user_config back = boot(&s);
     assert_config_equal(&back, &old);
     assert_int_equal(s.sequence, 5);
+    uint8_t id, baud;
+    config_peek_link(&flash.hal, &id, &baud); /* the bootloader reads format 2 only */
+    assert_int_equal(id, 0);
     struct user_config n = config_n(4);
     assert_int_equal(config_store_save(&s, &n, 77), CONFIG_SAVED);
+    config_peek_link(&flash.hal, &id, &baud); /* once rewritten in format 2 */
+    assert_int_equal(id, n.servo_id);
     assert_int_equal(flash.erases[0], 0); /* page 0 was blank: no erase spent */
     assert_int_equal(flash.erases[1], 0);
     back = boot(&s);
@@ -329,6 +335,27 @@ static void test_a_save_goes_in_steps_and_erases_only_ahead(void **state)
     assert_false(flash.misuse);
 }
 
+/* What the bootloader reads: the newest record's ID and baud rate, and
+ * factory values on a blank store. */
+static void test_the_bootloader_peeks_the_link_settings(void **state)
+{
+    (void)state;
+    uint8_t id = 99, baud = 99;
+    config_peek_link(&flash.hal, &id, &baud);
+    assert_int_equal(id, 0);
+    assert_int_equal(baud, 5);
+    struct config_store s;
+    boot(&s);
+    for (unsigned n = 1; n <= 30; n++) { /* across a page change */
+        struct user_config c = config_n(n);
+        c.baud_index = (uint8_t)(1u + n % 8u);
+        assert_int_equal(config_store_save(&s, &c, 0), CONFIG_SAVED);
+        config_peek_link(&flash.hal, &id, &baud);
+        assert_int_equal(id, c.servo_id);
+        assert_int_equal(baud, c.baud_index);
+    }
+}
+
 static void test_failed_flash_write_is_reported(void **state)
 {
     (void)state;
@@ -354,6 +381,7 @@ int main(void)
         cmocka_unit_test_setup(test_random_cuts_over_many_saves, setup),
         cmocka_unit_test_setup(test_a_format_1_store_still_loads, setup),
         cmocka_unit_test_setup(test_a_save_goes_in_steps_and_erases_only_ahead, setup),
+        cmocka_unit_test_setup(test_the_bootloader_peeks_the_link_settings, setup),
         cmocka_unit_test_setup(test_failed_flash_write_is_reported, setup),
     };
     return cmocka_run_group_tests_name("config_store", tests, NULL, NULL);

@@ -60,3 +60,30 @@ def load(path: str) -> Image:
         return parse(Path(path).read_bytes())
     except OSError as e:
         raise UsageError(f"cannot read {path}: {e.strerror}") from e
+
+
+def main(argv=None) -> int:
+    """python3 -m servoctl.image BIN --version V --board B -o OUT (the build's
+    post-link step; servoctl image is the same for users)."""
+    import argparse
+    import sys
+
+    ap = argparse.ArgumentParser(description=main.__doc__)
+    ap.add_argument("binary")
+    ap.add_argument("--version", required=True)
+    ap.add_argument("--board", required=True)
+    ap.add_argument("-o", "--output", required=True)
+    args = ap.parse_args(argv)
+    try:
+        board = BOARDS.get(args.board)
+        board = int(args.board, 0) if board is None else board
+        data = build(Path(args.binary).read_bytes(), int(args.version, 0), board)
+        Path(args.output).write_bytes(data)
+    except (OSError, ValueError, UsageError) as e:
+        print(f"servoctl.image: {e}", file=sys.stderr)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -164,25 +164,32 @@ def _free_port() -> int:
         return s.getsockname()[1]
 
 
-QEMU_IMAGE = REPO / "build" / "arm" / "firmware" / "boards" / "qemu_stm32vl" / "servo_qemu_stm32vl.elf"
+QEMU_BOARD = REPO / "build" / "arm" / "firmware" / "boards" / "qemu_stm32vl"
+QEMU_BOOTLOADER = QEMU_BOARD / "servo_qemu_stm32vl_boot.elf"
+QEMU_IMAGE = QEMU_BOARD / "servo_qemu_stm32vl.img"
+QEMU_SLOT = 0x08001000  # where the application's image goes (stm32f100xb.ld)
 
 
 class QemuBoard(_Child):
-    """The real ARM image on QEMU's stm32vldiscovery, its USART1 on a TCP
-    port (pyserial socket://)."""
+    """The real ARM images on QEMU's stm32vldiscovery: the bootloader at the
+    start of flash, the application's update image in its slot; USART1 on a
+    TCP port (pyserial socket://)."""
 
-    def __init__(self, image=None):
+    def __init__(self, image=None, bootloader=None):
         self.image = Path(image or os.environ.get("SERVO_QEMU_IMAGE", QEMU_IMAGE))
+        self.bootloader = Path(bootloader or QEMU_BOOTLOADER)
         self.process = None
         self.url = None
 
     def start(self) -> "QemuBoard":
-        if not self.image.exists():
-            raise ServoError(f"no image at {self.image}: build it with "
-                             f"'cmake --preset arm && cmake --build --preset arm'")
+        for path in (self.image, self.bootloader):
+            if not path.exists():
+                raise ServoError(f"no image at {path}: build it with "
+                                 f"'cmake --preset arm && cmake --build --preset arm'")
         port = _free_port()
         self.process = subprocess.Popen(
-            ["qemu-system-arm", "-M", "stm32vldiscovery", "-kernel", str(self.image),
+            ["qemu-system-arm", "-M", "stm32vldiscovery", "-kernel", str(self.bootloader),
+             "-device", f"loader,file={self.image},addr={QEMU_SLOT:#x}",
              "-nographic", "-monitor", "none",
              "-serial", f"tcp:127.0.0.1:{port},server=on,wait=off,nodelay=on"],
             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
@@ -200,8 +207,11 @@ class QemuBoard(_Child):
                 except ServoError:  # the port is not open yet
                     time.sleep(0.05)
                     continue
-                if Servo(bus, 0).ping():
+                try:  # the application, not the bootloader, answers ReadData
+                    Servo(bus, 0).read("serial")
                     return self
+                except ServoError:
+                    continue
         finally:
             if bus is not None:
                 bus.close()

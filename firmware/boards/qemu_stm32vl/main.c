@@ -3,6 +3,8 @@
  * the image, since QEMU has no ADC, timers or flash controller for it. */
 #include "calibration.h"
 #include "plant_fixed.h"
+#include "boot_flow.h"
+#include "boot_jump.h"
 #include "servo.h"
 #include "stm32f1_regs.h"
 #include "systick_clock.h"
@@ -78,6 +80,13 @@ static void ram_read(void *ctx, uint32_t addr, uint8_t *dst, uint32_t len)
     }
 }
 
+/* UpdateEnter: the word that keeps the bootloader, then a restart. */
+static void enter_bootloader(void *ctx)
+{
+    (void)ctx;
+    boot_restart_with(BOOT_STAY_WORD_ADDR(0x20002000u), BOOT_STAY_MAGIC);
+}
+
 int main(void)
 {
     for (uint32_t i = 0; i < sizeof flash_mem; i++) {
@@ -99,6 +108,8 @@ int main(void)
         .sensors_read = sensors_read,
         .calibration = &calibration,
         .flash = &flash,
+        .enter_bootloader = enter_bootloader,
+        .board = BOARD_ID,
         .serial_number = 0x0E3A0001u,
         .rx_gap_tolerance_us = 50000u, /* QEMU delivers a frame's bytes with jitter */
     };

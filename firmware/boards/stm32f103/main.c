@@ -2,6 +2,8 @@
 #include "board_f103.h"
 #include "calibration.h"
 #include "flash_f1.h"
+#include "boot_flow.h"
+#include "boot_jump.h"
 #include "servo.h"
 #include "stm32f1_regs.h"
 #include "systick_clock.h"
@@ -48,13 +50,18 @@ static const struct sensor_calibration calibration = BOARD_SENSOR_CALIBRATION;
 
 static void gpio_init(void)
 {
-    RCC_APB2ENR |= RCC_APB2ENR_GPIOA | RCC_APB2ENR_AFIO | RCC_APB2ENR_USART1;
+    bus_pins_init();
     /* PA0-PA3 analogue; PA6, PA7 TIM3 CH1/CH2 push-pull. */
     GPIOA_CRL = (GPIO_ANALOG << 0) | (GPIO_ANALOG << 4) | (GPIO_ANALOG << 8) |
                 (GPIO_ANALOG << 12) | (GPIO_AF_PUSH_PULL_50MHZ << 24) |
                 (GPIO_AF_PUSH_PULL_50MHZ << 28) | (0x4u << 16) | (0x4u << 20);
-    /* PA9 USART1 TX, open drain: the single bus wire (external pull-up). */
-    GPIOA_CRH = (GPIOA_CRH & ~(0xFu << 4)) | (GPIO_AF_OPEN_DRAIN_50MHZ << 4);
+}
+
+/* UpdateEnter: the word that keeps the bootloader, then a restart. */
+static void enter_bootloader(void *ctx)
+{
+    (void)ctx;
+    boot_restart_with(BOOT_STAY_WORD_ADDR(0x20005000u), BOOT_STAY_MAGIC);
 }
 
 int main(void)
@@ -72,6 +79,8 @@ int main(void)
         .sensors_read = sensors_read,
         .calibration = &calibration,
         .flash = &flash,
+        .enter_bootloader = enter_bootloader,
+        .board = BOARD_ID,
         .serial_number = unique_id_serial(),
     };
     port_uart_init(&port, &usart, PORT_UART_RX_DMA, F103_PCLK2_HZ);

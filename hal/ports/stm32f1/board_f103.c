@@ -95,3 +95,10 @@ uint32_t unique_id_serial(void)
 {
     return REG32(UID_ADDR) ^ REG32(UID_ADDR + 4u) ^ REG32(UID_ADDR + 8u);
 }
+
+void bus_pins_init(void)
+{
+    RCC_APB2ENR |= RCC_APB2ENR_GPIOA | RCC_APB2ENR_AFIO | RCC_APB2ENR_USART1;
+    /* PA9 USART1 TX, open drain: the single bus wire (external pull-up). */
+    GPIOA_CRH = (GPIOA_CRH & ~(0xFu << 4)) | (GPIO_AF_OPEN_DRAIN_50MHZ << 4);
+}

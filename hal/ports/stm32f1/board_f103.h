@@ -13,6 +13,10 @@
  * Gives up (stays on the 8 MHz HSI) if the crystal does not start. */
 void clock_f103_init(void);
 
+/* The bus: GPIOA, AFIO and USART1 clocked, PA9 the open-drain wire (the
+ * application and the bootloader alike). */
+void bus_pins_init(void);
+
 /* TIM3 CH1/CH2 (PA6/PA7) at 20 kHz into the bridge's IN1/IN2. */
 void pwm_bridge_init(void);
 /* Signed duty, Q15: positive drives IN1, negative IN2. */

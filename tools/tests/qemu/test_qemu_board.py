@@ -29,6 +29,28 @@ def test_ping(servo):
     assert servo.read("model") == 0x0F00
 
 
+def test_it_runs_from_its_slot_through_the_bootloader(servo):
+    """The application is linked after the bootloader and its image header:
+    QEMU starts the bootloader, which checks the image and jumps to it."""
+    from servoctl import update as upd
+    st = upd.status(servo.bus, 0)
+    assert (st.mode, st.board) == (upd.MODE_APP, 0x0100)
+
+
+def test_update_enter_and_boot_round_trip(servo):
+    """UpdateEnter: the application leaves the word in RAM and restarts;
+    the bootloader stays, answers Ping and UpdateStatus (the image checks),
+    and UpdateBoot starts the application again."""
+    from servoctl import update as upd
+    assert servo.bus.request(upd.UPDATE_ENTER, bytes([0]))[1] == 1
+    st = upd._wait_for_mode(servo.bus, 0, upd.MODE_BOOTLOADER)
+    assert (st.verdict, st.bootloader_version, st.page_size) == (0, 1, 1024)
+    assert servo.ping()
+    assert servo.bus.request(upd.UPDATE_BOOT, bytes([0]))[1] == 1
+    upd._wait_for_mode(servo.bus, 0, upd.MODE_APP)
+    assert servo.read("serial") == 0x0E3A0001
+
+
 def test_read_and_write_data(servo):
     assert servo.read("voltage") == pytest.approx(7400, abs=10)
     assert servo.read("temperature") == 2048

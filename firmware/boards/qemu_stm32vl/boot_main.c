@@ -1,0 +1,79 @@
+/* The bootloader on QEMU's stm32vldiscovery. QEMU models no flash
+ * controller, so the slot is read-only here: this image checks the
+ * application and starts it, as the board's does; updates are the
+ * simulator's and the reference board's. The application keeps its config
+ * store in RAM on this board, so the bootloader finds none there (QEMU's
+ * unwritten flash reads 0) and answers at the factory ID and baud rate. */
+#include "boot_flow.h"
+#include "boot_jump.h"
+#include "bootloader.h"
+#include "port_uart.h"
+#include "stm32f1_regs.h"
+#include "systick_clock.h"
+
+#define QEMU_CORE_HZ 24000000u
+#define RAM_END 0x20002000u
+#define SLOT_BASE 0x08001000u
+#define SLOT_PAGES 120u
+
+static struct hal_port port;
+static struct usart_hd usart;
+static struct hal_flash config_flash;
+static struct hal_flash slot_flash;
+static struct app_slot slot;
+
+static bool refuse_erase(void *ctx, uint32_t addr)
+{
+    (void)ctx;
+    (void)addr;
+    return false;
+}
+
+static bool refuse_program(void *ctx, uint32_t addr, const uint8_t *data)
+{
+    (void)ctx;
+    (void)addr;
+    (void)data;
+    return false;
+}
+
+static void flash_read(void *ctx, uint32_t addr, uint8_t *dst, uint32_t len)
+{
+    (void)ctx;
+    const volatile uint8_t *src = (const volatile uint8_t *)(uintptr_t)addr;
+    for (uint32_t i = 0; i < len; i++) {
+        dst[i] = src[i];
+    }
+}
+
+static void start_app(const struct app_slot *s)
+{
+    USART_CR1(USART1_BASE) = 0;
+    boot_jump(s->base + APP_HEADER_SIZE);
+}
+
+static void service(void)
+{
+    usart_hd_service(&usart); /* QEMU's USART raises no transmit interrupts */
+    usart_hd_irq(&usart);     /* and the receive interrupt is not in the table */
+}
+
+int main(void)
+{
+    uint32_t stay = boot_take_word(BOOT_STAY_WORD_ADDR(RAM_END));
+    systick_clock_init(QEMU_CORE_HZ);
+    slot_flash = (struct hal_flash){.page_size = 1024u, .erase_page = refuse_erase,
+                                    .write_block = 2, .program = refuse_program, .read = flash_read};
+    config_flash = slot_flash; /* the application's store is in its RAM: none here */
+    config_flash.page_addr[0] = 0x0801F800u;
+    config_flash.page_addr[1] = 0x0801FC00u;
+    slot = (struct app_slot){.flash = &slot_flash, .base = SLOT_BASE, .pages = SLOT_PAGES};
+    port = (struct hal_port){.flash = &config_flash};
+    port_uart_init(&port, &usart, PORT_UART_RX_INTERRUPT, QEMU_CORE_HZ);
+    usart_hd_tx_polled(&usart);
+    usart_hd_no_echo(&usart);
+    const struct boot_board board = {.port = &port, .slot = &slot, .board = BOARD_ID,
+                                     .stay_word = stay, .start_app = start_app, .service = service};
+    bootloader_run(&board);
+    return 0;
+}

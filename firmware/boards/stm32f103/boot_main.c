@@ -1,0 +1,56 @@
+/* The bootloader on the reference board: the clock, the bus wire and its
+ * USART with DMA receive, the flash, and the portable loop
+ * (firmware/bootloader/bootloader.c). */
+#include "board_f103.h"
+#include "boot_flow.h"
+#include "boot_jump.h"
+#include "bootloader.h"
+#include "flash_f1.h"
+#include "port_uart.h"
+#include "stm32f1_regs.h"
+#include "systick_clock.h"
+
+#define RAM_END 0x20005000u
+#define CONFIG_PAGE0 0x0800F800u
+#define CONFIG_PAGE1 0x0800FC00u
+#define SLOT_BASE 0x08001000u
+#define SLOT_PAGES 58u
+
+static struct hal_port port;
+static struct usart_hd usart;
+static struct hal_flash config_flash;
+static struct hal_flash slot_flash;
+static struct app_slot slot;
+
+/* The bootloader's peripherals stop before the application takes over:
+ * the DMA would go on writing into what is now the application's RAM. */
+static void start_app(const struct app_slot *s)
+{
+    USART_CR1(USART1_BASE) = 0;
+    REG32(DMA1_CCR5_ADDR) = 0;
+    boot_jump(s->base + APP_HEADER_SIZE);
+}
+
+static void service(void)
+{
+    usart_hd_service(&usart);
+}
+
+int main(void)
+{
+    uint32_t stay = boot_take_word(BOOT_STAY_WORD_ADDR(RAM_END));
+    clock_f103_init();
+    bus_pins_init();
+    systick_clock_init(F103_CORE_HZ);
+    flash_f1_init(&config_flash, 1024u, CONFIG_PAGE0, CONFIG_PAGE1);
+    slot_flash = config_flash; /* the same flash: any page by its address */
+    slot = (struct app_slot){.flash = &slot_flash, .base = SLOT_BASE, .pages = SLOT_PAGES};
+    port = (struct hal_port){.flash = &config_flash};
+    port_uart_init(&port, &usart, PORT_UART_RX_DMA, F103_PCLK2_HZ);
+    usart_hd_tx_polled(&usart); /* no USART interrupt: its vector is not in the table */
+    const struct boot_board board = {.port = &port, .slot = &slot, .board = BOARD_ID,
+                                     .stay_word = stay, .start_app = start_app,
+                                     .service = service};
+    bootloader_run(&board);
+    return 0;
+}
