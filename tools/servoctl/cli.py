@@ -485,9 +485,19 @@ def cmd_update(bus, args):
     from . import image as img
     from . import update as upd
 
-    image = img.load(args.image)
+    # `update IMAGE ID...` or `update ID... IMAGE`: the image is the one
+    # that is not a number.
+    ids, images = [], []
+    for arg in args.targets:
+        (ids if arg.isdigit() else images).append(arg)
+    if len(images) != 1 or not ids:
+        raise UsageError("update takes one image and one or more servo IDs")
+    for servo_id in ids:
+        if not 0 <= int(servo_id) <= 253:
+            raise UsageError(f"servo ID {servo_id} is not 0-253")
+    image = img.load(images[0])
     failed = []
-    for servo_id in args.ids:
+    for servo_id in map(int, ids):
         started = time.monotonic()
         columns = [TextColumn(f"servo {servo_id}"), BarColumn(), DownloadColumn(), TimeRemainingColumn()]
         try:
@@ -689,8 +699,8 @@ def build_parser():
 
     c = sub.add_parser("update", help="write a firmware image into servos over the bus "
                                       "(also recovers a servo left in its bootloader)")
-    c.add_argument("image", help="an update image (servoctl image)")
-    c.add_argument("ids", type=int, nargs="+", metavar="ID")
+    c.add_argument("targets", nargs="+", metavar="ID|IMAGE",
+                   help="the servo IDs and the update image (servoctl image), in either order")
     c.set_defaults(run=cmd_update)
 
     c = sub.add_parser("image", help="make an update image from an application binary")

@@ -90,6 +90,40 @@ def test_a_power_cut_during_an_update_is_recovered(sim3, cut_at):
         assert [firmware(bus, i) for i in (1, 2, 3)] == [OLD, NEW, OLD]
 
 
+def test_a_power_cut_after_every_step_of_an_update_is_recovered(sim3):
+    """The power goes after each step of an update in turn (UpdateEnter,
+    every erase, every write, before verify); each time `servoctl update`
+    again brings the image, and the other servos never stop answering."""
+    image = make_image(size=400)  # 1 page, 28 writes: every step in seconds
+
+    class Cut(Exception):
+        pass
+
+    with Bus(sim3.url, timeout=0.2) as bus:
+        steps = []
+        upd.update(bus, 2, image, lambda done, total: steps.append(done))
+        assert len(steps) > 20
+        for k in range(len(steps) + 1):  # k = 0: just after UpdateEnter
+            calls = []
+
+            def progress(done, total):
+                calls.append(done)
+                if len(calls) >= k:
+                    sim3.control("powercycle 2")
+                    raise Cut()
+
+            if k == 0:
+                bus.request(upd.UPDATE_ENTER, bytes([2]))
+                sim3.control("powercycle 2")
+            else:
+                with pytest.raises(Cut):
+                    upd.update(bus, 2, make_image(version=NEW + k, size=400, seed=k), progress)
+            before, after = upd.update(bus, 2, image)
+            assert after == NEW
+            assert Servo(bus, 1).ping() and Servo(bus, 3).ping()
+        assert [firmware(bus, i) for i in (1, 2, 3)] == [OLD, NEW, OLD]
+
+
 def test_the_bootloader_answers_ping_and_stays_without_an_image(sim):
     with Bus(sim.url, timeout=0.2) as bus:
         image = make_image(size=2000)
@@ -125,7 +159,7 @@ def test_servoctl_image_and_update_several_servos(sim3, capsys, tmp_path):
     rc, text, _ = run(sim3, capsys, "image", str(binary), "--version", "0x0042", "--board", "sim",
                       "-o", str(out))
     assert rc == 0 and "version 0x0042" in text
-    rc, text, err = run(sim3, capsys, "update", str(out), "1", "3")
+    rc, text, err = run(sim3, capsys, "update", "1", "3", str(out))  # IDs first, as in the issue
     assert rc == 0, err
     assert "servo 1: version 0x0010 -> 0x0042" in text
     assert "servo 3: version 0x0010 -> 0x0042" in text
@@ -143,6 +177,8 @@ def test_servoctl_update_refuses_what_cannot_be_right(sim, capsys, tmp_path):
     not_an_image.write_bytes(b"\x00" * 600)
     rc, _, err = run(sim, capsys, "update", str(not_an_image), "1")
     assert rc == UsageError.exit_code and "not an update image" in err
+    rc, _, err = run(sim, capsys, "update", "1", "2")
+    assert rc == UsageError.exit_code and "one image" in err
     damaged = tmp_path / "damaged.img"
     data = bytearray(img.build(b"\x01" * 600, 0x0042, img.BOARDS["sim"]))
     data[400] ^= 1
