@@ -520,26 +520,9 @@ def cmd_update(bus, args):
 def cmd_image(args):
     from . import image as img
 
-    board = img.BOARDS.get(args.board)
-    if board is None:
-        try:
-            board = int(args.board, 0)
-        except ValueError:
-            raise UsageError(f"board must be one of {', '.join(img.BOARDS)} or a number, "
-                             f"not {args.board!r}") from None
-    try:
-        code = Path(args.binary).read_bytes()
-        version = int(args.version, 0)
-    except OSError as e:
-        raise UsageError(f"cannot read {args.binary}: {e.strerror}") from e
-    except ValueError:
-        raise UsageError(f"version must be a number, not {args.version!r}") from None
-    data = img.build(code, version, board)
-    try:
-        Path(args.output).write_bytes(data)
-    except OSError as e:
-        raise UsageError(f"cannot write {args.output}: {e.strerror}") from e
-    print(f"{args.output}: {len(data)} B, version 0x{version:04x}, board 0x{board:04x}")
+    data = img.make(args.binary, args.version, args.board, args.output)
+    header = img.parse(data)
+    print(f"{args.output}: {len(data)} B, version 0x{header.version:04x}, board 0x{header.board:04x}")
     return 0
 
 

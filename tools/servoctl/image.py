@@ -62,6 +62,32 @@ def load(path: str) -> Image:
         raise UsageError(f"cannot read {path}: {e.strerror}") from e
 
 
+def make(binary: str, version: str, board: str, output: str) -> bytes:
+    """Reads an application binary, writes its update image; the image's
+    bytes. board: a name of BOARDS or a number; version: a number."""
+    number = BOARDS.get(board)
+    if number is None:
+        try:
+            number = int(board, 0)
+        except ValueError:
+            raise UsageError(f"board must be one of {', '.join(BOARDS)} or a number, "
+                             f"not {board!r}") from None
+    try:
+        version_number = int(version, 0)
+    except ValueError:
+        raise UsageError(f"version must be a number, not {version!r}") from None
+    try:
+        code = Path(binary).read_bytes()
+    except OSError as e:
+        raise UsageError(f"cannot read {binary}: {e.strerror}") from e
+    data = build(code, version_number, number)
+    try:
+        Path(output).write_bytes(data)
+    except OSError as e:
+        raise UsageError(f"cannot write {output}: {e.strerror}") from e
+    return data
+
+
 def main(argv=None) -> int:
     """python3 -m servoctl.image BIN --version V --board B -o OUT (the build's
     post-link step; servoctl image is the same for users)."""
@@ -75,11 +101,8 @@ def main(argv=None) -> int:
     ap.add_argument("-o", "--output", required=True)
     args = ap.parse_args(argv)
     try:
-        board = BOARDS.get(args.board)
-        board = int(args.board, 0) if board is None else board
-        data = build(Path(args.binary).read_bytes(), int(args.version, 0), board)
-        Path(args.output).write_bytes(data)
-    except (OSError, ValueError, UsageError) as e:
+        make(args.binary, args.version, args.board, args.output)
+    except UsageError as e:
         print(f"servoctl.image: {e}", file=sys.stderr)
         return 2
     return 0
