@@ -498,6 +498,10 @@ def cmd_update(bus, args):
     image = img.load(images[0])
     failed = []
     for servo_id in map(int, ids):
+        if args.catch:
+            print(f"servo {servo_id}: power it up now (waiting {args.catch:g} s for its bootloader)",
+                  file=sys.stderr)
+            upd.catch(bus, servo_id, args.catch)
         started = time.monotonic()
         columns = [TextColumn(f"servo {servo_id}"), BarColumn(), DownloadColumn(), TimeRemainingColumn()]
         try:
@@ -684,6 +688,9 @@ def build_parser():
                                       "(also recovers a servo left in its bootloader)")
     c.add_argument("targets", nargs="+", metavar="ID|IMAGE",
                    help="the servo IDs and the update image (servoctl image), in either order")
+    c.add_argument("--catch", type=float, default=0, metavar="SECONDS",
+                   help="first wait this long for the servo's bootloader: power the servo up "
+                        "meanwhile (recovers a servo whose application does not answer)")
     c.set_defaults(run=cmd_update)
 
     c = sub.add_parser("image", help="make an update image from an application binary")

@@ -57,6 +57,23 @@ def _wait_for_mode(bus, servo_id: int, mode: int) -> Status:
         time.sleep(0.02)
 
 
+def catch(bus, servo_id: int, seconds: float) -> Status:
+    """Waits up to `seconds` for servo `servo_id`'s bootloader, asking for
+    UpdateStatus all the while: power the servo up meanwhile, and its
+    bootloader stays for the update (an update packet in its 200 ms window)
+    instead of starting an application that may not answer."""
+    deadline = time.monotonic() + seconds
+    while time.monotonic() < deadline:
+        try:
+            st = status(bus, servo_id, timeout=0.02)
+            if st.mode == MODE_BOOTLOADER:
+                return st
+        except NoReply:
+            pass
+    raise NoReply(f"servo {servo_id}: no bootloader answered within {seconds:g} s "
+                  "(was it powered up meanwhile?)")
+
+
 def _retry(what, fn):
     """A request lost on the wire is sent again; a refusal is final."""
     for attempt in range(RETRIES):

@@ -124,6 +124,22 @@ def test_a_power_cut_after_every_step_of_an_update_is_recovered(sim3):
         assert [firmware(bus, i) for i in (1, 2, 3)] == [OLD, NEW, OLD]
 
 
+def test_a_servo_is_caught_in_its_bootloader_at_power_up(sim):
+    """An application that does not answer can still be updated: the tool
+    asks for UpdateStatus while the servo powers up, and the bootloader
+    stays instead of starting it."""
+    with Bus(sim.url, timeout=0.2) as bus:
+        sim.control("powercycle 1")
+        st = upd.catch(bus, 1, 2.0)
+        assert (st.mode, st.verdict) == (upd.MODE_BOOTLOADER, 0)  # a valid image, kept waiting
+        assert sim.state(1)["mode"] == "bootloader"
+        before, after = upd.update(bus, 1, make_image())
+        assert (before, after) == (OLD, NEW)
+    with Bus(sim.url, timeout=0.2) as bus:
+        with pytest.raises(NoReply, match="no bootloader answered"):
+            upd.catch(bus, 1, 0.3)  # the application answers, not a bootloader
+
+
 def test_the_bootloader_answers_ping_and_stays_without_an_image(sim):
     with Bus(sim.url, timeout=0.2) as bus:
         image = make_image(size=2000)
