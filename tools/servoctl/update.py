@@ -42,19 +42,27 @@ def status(bus, servo_id: int, timeout=None) -> Status:
     return Status(c[1], *struct.unpack_from("<HBHHHHBH", c, 2))
 
 
-def _wait_for_mode(bus, servo_id: int, mode: int) -> Status:
-    deadline = time.monotonic() + SWITCH_TIMEOUT_S
-    while True:
+def _poll_mode(bus, servo_id: int, mode: int, seconds: float, reply_s: float, pause_s: float):
+    """UpdateStatus until the servo answers in `mode`; the Status, or None
+    after `seconds`."""
+    deadline = time.monotonic() + seconds
+    while time.monotonic() < deadline:
         try:
-            st = status(bus, servo_id, timeout=0.05)
+            st = status(bus, servo_id, timeout=reply_s)
             if st.mode == mode:
                 return st
         except NoReply:
             pass
-        if time.monotonic() > deadline:
-            where = "its bootloader" if mode == MODE_BOOTLOADER else "the new application"
-            raise NoReply(f"servo {servo_id}: {where} did not answer within {SWITCH_TIMEOUT_S:.0f} s")
-        time.sleep(0.02)
+        time.sleep(pause_s)
+    return None
+
+
+def _wait_for_mode(bus, servo_id: int, mode: int) -> Status:
+    st = _poll_mode(bus, servo_id, mode, SWITCH_TIMEOUT_S, 0.05, 0.02)
+    if st is None:
+        where = "its bootloader" if mode == MODE_BOOTLOADER else "the new application"
+        raise NoReply(f"servo {servo_id}: {where} did not answer within {SWITCH_TIMEOUT_S:.0f} s")
+    return st
 
 
 def catch(bus, servo_id: int, seconds: float) -> Status:
@@ -62,16 +70,11 @@ def catch(bus, servo_id: int, seconds: float) -> Status:
     UpdateStatus all the while: power the servo up meanwhile, and its
     bootloader stays for the update (an update packet in its 200 ms window)
     instead of starting an application that may not answer."""
-    deadline = time.monotonic() + seconds
-    while time.monotonic() < deadline:
-        try:
-            st = status(bus, servo_id, timeout=0.02)
-            if st.mode == MODE_BOOTLOADER:
-                return st
-        except NoReply:
-            pass
-    raise NoReply(f"servo {servo_id}: no bootloader answered within {seconds:g} s "
-                  "(was it powered up meanwhile?)")
+    st = _poll_mode(bus, servo_id, MODE_BOOTLOADER, seconds, 0.02, 0.0)
+    if st is None:
+        raise NoReply(f"servo {servo_id}: no bootloader answered within {seconds:g} s "
+                      "(was it powered up meanwhile?)")
+    return st
 
 
 def _retry(what, fn):
