@@ -33,7 +33,6 @@ void servo_init(struct servo *s, const struct hal_port *hal)
     /* A store older firmware wrote (format 1) is rewritten in format 2, the
      * one the bootloader reads the ID and baud rate from. */
     if (s->store.legacy) {
-        s->store.saved[0] ^= 1u; /* differs from what is stored: it is written */
         (void)config_store_save(&s->store, &s->regs.user, s->store.op_seconds);
     }
     /* Erase ahead at power-up, before the control loop runs: saves need
@@ -198,8 +197,7 @@ static bool erase_may_stall(const struct servo *s, uint32_t now)
     uint32_t quiet = overdue ? STORE_ERASE_SHORT_QUIET_US : STORE_ERASE_QUIET_US;
     return !motion_is_moving(&s->motion) && !s->tx.sending && !s->tx.waiting &&
            ring->written == ring->read && now - ring->heard_us >= quiet &&
-           now - s->tx.ended_us >= quiet &&
-           (!s->store.failed || now - s->saver.failed_at_us >= SAVE_RETRY_US);
+           now - s->tx.ended_us >= quiet && save_policy_may_retry(&s->saver, &s->store, now);
 }
 
 /* The user area to flash when the save policy says so (checked once a
@@ -227,8 +225,7 @@ static void save_config(struct servo *s, uint32_t now, bool ticked)
         if (r == CONFIG_STARTED) {
             save_policy_started(&s->saver);
         } else if (r == CONFIG_NEEDS_ERASE) {
-            s->saver.awaits_erase = 1;
-            s->saver.awaits_erase_since_us = now;
+            save_policy_awaits_erase(&s->saver, now);
         } else {
             save_finished(s, r, now);
         }
@@ -297,7 +294,7 @@ static bool run_control_tick(struct servo *s, uint32_t now)
         servo_control_tick(s);
         s->next_tick_us += CONTROL_TICK_US;
     }
-    return n != 0u;
+    return true;
 }
 
 /* What the port has received since the last pass, to the framer; a line

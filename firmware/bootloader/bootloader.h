@@ -6,10 +6,15 @@
 #ifndef BOOTLOADER_BOOTLOADER_H
 #define BOOTLOADER_BOOTLOADER_H
 
+#include <stdbool.h>
 #include <stdint.h>
 
 #include "app_image.h"
+#include "boot_flow.h"
+#include "boot_packets.h"
 #include "hal/hal_port.h"
+#include "protocol/frame_rx.h"
+#include "protocol/frame_tx.h"
 
 struct boot_board {
     const struct hal_port *port; /* clock, UART and its ring, the config store's flash */
@@ -24,6 +29,25 @@ struct boot_board {
     void (*service)(void);
 };
 
+/* The loop's state, for a board's loop or the simulator's servos. */
+struct boot_loop {
+    const struct boot_board *board;
+    struct frame_rx rx;
+    struct bootloader core;
+    struct boot_flow flow;
+    uint8_t id;              /* the servo's stored ID */
+    uint8_t sending;         /* an answer is going out */
+    uint32_t started_us;
+    uint8_t frame[RESPONSE_FRAME_MAX];
+};
+
+/* After reset: the stored ID and baud rate (config_peek.c) to the UART,
+ * the image checked, the boot decision begun. */
+void boot_loop_start(struct boot_loop *l, const struct boot_board *b);
+/* One pass: true while the bootloader stays; false once the application
+ * is to start (and any answer has left the wire). */
+bool boot_loop_step(struct boot_loop *l);
+/* The board's: boot_loop_start, passes until false, start_app. */
 void bootloader_run(const struct boot_board *b);
 
 #endif

@@ -170,7 +170,9 @@ enum config_save_result config_store_begin(struct config_store *s, const struct 
 {
     uint8_t *rec = s->job;
     user_config_encode(cfg, &rec[REC_PAYLOAD]);
-    if (memcmp(&rec[REC_PAYLOAD], s->saved, USER_AREA_SIZE) == 0) {
+    /* A format-1 store is written again in format 2 even unchanged: the
+     * bootloader reads format 2 only (config_peek.c). */
+    if (!s->legacy && memcmp(&rec[REC_PAYLOAD], s->saved, USER_AREA_SIZE) == 0) {
         return CONFIG_UNCHANGED;
     }
     uint8_t page;

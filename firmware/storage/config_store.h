@@ -61,7 +61,8 @@ bool config_store_load(struct config_store *s, const struct hal_flash *flash,
                        struct user_config *cfg);
 
 /* Starts appending cfg, with the operating time so far: CONFIG_STARTED,
- * CONFIG_UNCHANGED when cfg equals what is stored, CONFIG_NEEDS_ERASE when
+ * CONFIG_UNCHANGED when cfg equals what is stored (and the store is in
+ * format 2), CONFIG_NEEDS_ERASE when
  * the record must start the other page and that is not erased yet. */
 enum config_save_result config_store_begin(struct config_store *s, const struct user_config *cfg,
                                            uint32_t op_seconds);

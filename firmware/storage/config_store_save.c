@@ -1,5 +1,7 @@
-/* All of a save at once, for tools and tests (the simulator programs a
- * blank chip's ID with it); the firmware saves in steps (servo.c). */
+/* All of a save at once, whatever the stall: where no control loop runs
+ * yet or any more (the servo's boot, its restart into the bootloader),
+ * the simulator's factory ID, and tests. The running servo saves in steps
+ * (servo.c). */
 #include "config_store.h"
 
 enum config_save_result config_store_save(struct config_store *s, const struct user_config *cfg,

@@ -40,7 +40,7 @@ bool save_policy_due(struct save_policy *p, const struct config_store *store, ui
     if (!p->pending) {
         return false;
     }
-    if (store->failed && now_us - p->failed_at_us < SAVE_RETRY_US) {
+    if (!save_policy_may_retry(p, store, now_us)) {
         return false;
     }
     bool settled = now_us - p->last_change_us >= SAVE_SETTLE_US ||
@@ -50,6 +50,18 @@ bool save_policy_due(struct save_policy *p, const struct config_store *store, ui
     }
     p->deferred = store->sequence >= save_policy_budget(p);
     return !p->deferred;
+}
+
+bool save_policy_may_retry(const struct save_policy *p, const struct config_store *store,
+                           uint32_t now_us)
+{
+    return !store->failed || now_us - p->failed_at_us >= SAVE_RETRY_US;
+}
+
+void save_policy_awaits_erase(struct save_policy *p, uint32_t now_us)
+{
+    p->awaits_erase = 1;
+    p->awaits_erase_since_us = now_us;
 }
 
 void save_policy_started(struct save_policy *p)

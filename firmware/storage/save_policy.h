@@ -52,6 +52,11 @@ void save_policy_init(struct save_policy *p, const struct config_store *store, u
 void save_policy_changed(struct save_policy *p, uint32_t now_us);
 /* Counts operating time; true when the pending change should be saved now. */
 bool save_policy_due(struct save_policy *p, const struct config_store *store, uint32_t now_us);
+/* The save save_policy_due asked for needs the other page erased first. */
+void save_policy_awaits_erase(struct save_policy *p, uint32_t now_us);
+/* Not within SAVE_RETRY_US of a failed flash step (a save or an erase). */
+bool save_policy_may_retry(const struct save_policy *p, const struct config_store *store,
+                           uint32_t now_us);
 /* The save save_policy_due asked for has taken the user area as it is now:
  * a change from here on is pending again. */
 void save_policy_started(struct save_policy *p);

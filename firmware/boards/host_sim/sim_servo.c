@@ -245,7 +245,7 @@ void sim_servo_poll(struct sim_servo *s, uint64_t now_us)
         s->uart_full = false;
         hal_rx_ring_put(&s->rx, s->uart_held, s->uart_held_at_us);
     }
-    if (!s->in_bootloader || !sim_boot_poll(s, now_us)) {
+    if (!s->in_bootloader || !sim_boot_poll(s)) {
         servo_poll(&s->core);
     }
     uint32_t stall = s->flash.stall_us + s->slot_flash.stall_us;

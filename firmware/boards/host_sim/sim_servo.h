@@ -6,8 +6,7 @@
 #include <stdint.h>
 
 #include "app_image.h"
-#include "boot_flow.h"
-#include "boot_packets.h"
+#include "bootloader.h"
 #include "plant.h"
 #include "servo.h"
 #include "sim_flash.h"
@@ -21,16 +20,13 @@
 /* The board the simulator's images are for (the header's board field). */
 #define SIM_BOARD 0x5100u
 
-/* The bootloader, as the simulator runs it (sim_boot.c): its answers are
- * the bootloader core's; the image in the slot is not executed, its
- * version is what the "application" then reports (data item 7). */
+/* The bootloader, as the simulator runs it (sim_boot.c): the boards' loop
+ * (bootloader.c) on the servo's port; the image in the slot is not
+ * executed, its version is what the "application" then reports (data
+ * item 7). */
 struct sim_boot {
-    struct frame_rx rx;
-    struct bootloader core;
-    struct boot_flow flow;
-    uint64_t since_us;     /* reset */
-    uint8_t id;
-    uint8_t frame[RESPONSE_FRAME_MAX];
+    struct boot_board board;
+    struct boot_loop loop;
 };
 
 struct sim_bus;
@@ -92,7 +88,7 @@ void sim_servo_power_cycle(struct sim_servo *s);
 /* sim_boot.c: reset into the bootloader (stay: UpdateEnter asked), and its
  * main-loop pass; false once it has started the application. */
 void sim_boot_reset(struct sim_servo *s, bool stay);
-bool sim_boot_poll(struct sim_servo *s, uint64_t now_us);
+bool sim_boot_poll(struct sim_servo *s);
 /* The application starts: the servo core, reporting the slot image's
  * version. */
 void sim_servo_start_app(struct sim_servo *s);
