@@ -14,7 +14,6 @@ import math
 import os
 import sys
 import time
-from pathlib import Path
 
 from . import __version__, group, ntc, outcome, registers, units
 from .profile import positions, velocity_timing

@@ -8,8 +8,7 @@ import time
 import zlib
 from dataclasses import dataclass
 
-from . import protocol as p
-from .image import HEADER_SIZE, CHECKED, Image
+from .image import CHECKED, Image
 from .protocol import NoReply, Refused
 
 UPDATE_ENTER, UPDATE_ERASE, UPDATE_WRITE, UPDATE_VERIFY, UPDATE_BOOT, UPDATE_STATUS = range(0x50, 0x56)
@@ -77,21 +76,20 @@ def catch(bus, servo_id: int, seconds: float) -> Status:
     return st
 
 
-def _retry(what, fn):
+def _retry(fn):
     """A request lost on the wire is sent again; a refusal is final."""
-    for attempt in range(RETRIES):
+    for _ in range(RETRIES - 1):
         try:
             return fn()
         except NoReply:
-            if attempt == RETRIES - 1:
-                raise
-    raise AssertionError(what)
+            pass
+    return fn()
 
 
 def _write(bus, servo_id: int, offset: int, chunk: bytes):
     content = bytes([servo_id]) + struct.pack("<I", offset) + chunk + struct.pack("<I", zlib.crc32(chunk))
     for attempt in range(RETRIES):
-        c = _retry("write", lambda: bus.request(UPDATE_WRITE, content))
+        c = _retry(lambda: bus.request(UPDATE_WRITE, content))
         if c[1] == 1:
             return
         if c[2] != 1 or attempt == RETRIES - 1:  # 1: damaged on the wire, worth again
@@ -122,7 +120,7 @@ def update(bus, servo_id: int, image: Image, progress=lambda done, total: None) 
     data = image.data + b"\xff" * (-len(image.data) % st.write_block)
     total = pages + len(data)
     for page in range(pages):  # page 0 first: the old image is invalid from here
-        c = _retry("erase", lambda: bus.request(UPDATE_ERASE, bytes([servo_id]) + struct.pack("<H", page)))
+        c = _retry(lambda: bus.request(UPDATE_ERASE, bytes([servo_id]) + struct.pack("<H", page)))
         if c[1] != 1:
             raise Refused(f"servo {servo_id}: erasing page {page} refused: {WRITE_REASONS.get(c[2], c[2])}")
         progress(page + 1, total)
@@ -133,11 +131,11 @@ def update(bus, servo_id: int, image: Image, progress=lambda done, total: None) 
     for offset in range(0, head, step):
         _write(bus, servo_id, offset, data[offset:offset + step])
     progress(total, total)
-    c = _retry("verify", lambda: bus.request(UPDATE_VERIFY, bytes([servo_id])))
+    c = _retry(lambda: bus.request(UPDATE_VERIFY, bytes([servo_id])))
     verdict, size, crc, version, _board = struct.unpack_from("<BIIHH", c, 1)
     if verdict != 0 or (size, crc, version) != (image.size, image.crc, image.version):
         raise Refused(f"servo {servo_id}: the written image does not check: {VERDICTS.get(verdict, verdict)}")
-    c = _retry("boot", lambda: bus.request(UPDATE_BOOT, bytes([servo_id])))
+    c = _retry(lambda: bus.request(UPDATE_BOOT, bytes([servo_id])))
     if c[1] != 1:
         raise Refused(f"servo {servo_id}: the bootloader would not start the image")
     after = _wait_for_mode(bus, servo_id, MODE_APP).version
