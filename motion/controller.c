@@ -5,10 +5,23 @@
 #include "motion/div64.h"
 #include "motion/gains.h"
 
-static inline int32_t clamp32(int64_t v, int32_t limit)
+/* v within [-limit, limit - 1], limit a power of two: one SSAT on the
+ * Cortex-M3. */
+static inline int32_t sat_q(int32_t v, int32_t limit)
 {
-    return v > limit ? limit : v < -limit ? -limit : (int32_t)v;
+    return v > limit - 1 ? limit - 1 : v < -limit ? -limit : v;
 }
+
+/* Input ranges that keep every product within int32 (the gains: kv +
+ * viscous < 2^15.3 down to GAIN_MIN_SUPPLY_MV, KP < 2^10, KD and DAMPING
+ * < 2^13); the output saturates far inside each. */
+enum {
+    ERROR_LIMIT_Q8 = 1 << 21,      /* 8192 decideg: KP x it is 4.4 x full duty */
+    VELOCITY_LIMIT_Q8 = 1 << 13,   /* 32 decideg per tick, 3200 deg/s */
+    SPEED_LIMIT_Q8 = 1 << 15,      /* measured: 128 decideg per tick */
+    SLIP_LIMIT_Q8 = 1 << 16,       /* planned - measured */
+    OUTPUT_LIMIT = 1 << 20,
+};
 
 void controller_reset(struct controller *c)
 {
@@ -18,11 +31,12 @@ void controller_reset(struct controller *c)
 
 static inline int16_t limit(int32_t duty, int32_t measured_velocity_q8, const struct drive_limits *lim)
 {
-    int32_t emf = clamp32(((int64_t)measured_velocity_q8 * lim->kv) >> 8, 32767);
+    int32_t emf = (sat_q(measured_velocity_q8, SPEED_LIMIT_Q8) * lim->kv) >> 8;
+    emf = emf > 32767 ? 32767 : emf < -32767 ? -32767 : emf;
     int32_t lo = emf - lim->duty_limit;
     int32_t hi = emf + lim->duty_limit;
     int32_t d = duty < lo ? lo : duty > hi ? hi : duty;
-    return (int16_t)clamp32(d, 32767);
+    return (int16_t)(d > 32767 ? 32767 : d < -32767 ? -32767 : d);
 }
 
 int16_t controller_limit(int32_t duty, int32_t measured_velocity_q8, const struct drive_limits *lim)
@@ -37,23 +51,25 @@ int16_t controller_position(struct controller *c, const struct controller_input 
         /* The setpoint waits for the horn: all the current the limit allows,
          * nothing integrated (the error is the motor's, no load's). */
         c->at_limit = in->push;
-        return limit(in->push > 0 ? 1 << 20 : -(1 << 20), in->measured_velocity_q8, lim);
+        return limit(in->push > 0 ? OUTPUT_LIMIT : -OUTPUT_LIMIT, in->measured_velocity_q8, lim);
     }
-    /* Beyond 2^22 (16 384 decideg) the output is saturated anyway. */
-    int32_t e = clamp32(in->error_q8, 1 << 22);
-    int64_t p = ((int64_t)e * GAIN_KP) >> 8;
+    int32_t e = sat_q(in->error_q8, ERROR_LIMIT_Q8);
+    int32_t p = (e * GAIN_KP) >> 8;
     /* Within one encoder count of the setpoint nothing is integrated: the
      * error there is the encoder's rounding, and integrating it would wind
      * the output up through static friction and back (a limit cycle). */
     bool in_count = e < INTEGRAL_DEADBAND_Q8 && e > -INTEGRAL_DEADBAND_Q8;
-    int32_t integral = in_count ? c->integral_q15
-                                : clamp32(c->integral_q15 + (((int64_t)e * GAIN_KI) >> 8),
-                                          INTEGRAL_LIMIT_Q15);
-    int32_t drag = in->velocity_q8 > 0 ? lim->friction : in->velocity_q8 < 0 ? -lim->friction : 0;
-    int64_t ff = (((int64_t)in->velocity_q8 * (lim->kv + lim->viscous)) >> 8) +
-                 (((int64_t)in->acceleration_q16 * lim->ka) >> 16) + drag;
-    int64_t d = ((int64_t)(in->velocity_q8 - in->measured_velocity_q8) * GAIN_KD) >> 8;
-    int32_t out = clamp32(p + integral + ff + d, 1 << 20);
+    int32_t integral = c->integral_q15;
+    if (!in_count) {
+        integral += (e * GAIN_KI) >> 8;
+        integral = integral > INTEGRAL_LIMIT_Q15 ? INTEGRAL_LIMIT_Q15
+                   : integral < -INTEGRAL_LIMIT_Q15 ? -INTEGRAL_LIMIT_Q15 : integral;
+    }
+    int32_t v = sat_q(in->velocity_q8, VELOCITY_LIMIT_Q8);
+    int32_t drag = v > 0 ? lim->friction : v < 0 ? -lim->friction : 0;
+    int32_t ff = ((v * (lim->kv + lim->viscous)) >> 8) + in->acceleration_duty + drag;
+    int32_t d = (sat_q(in->velocity_q8 - in->measured_velocity_q8, SLIP_LIMIT_Q8) * GAIN_KD) >> 8;
+    int32_t out = sat_q(p + integral + ff + d, OUTPUT_LIMIT);
     int16_t limited = limit(out, in->measured_velocity_q8, lim);
     /* Anti-windup: no integrating while the limit holds the output back in
      * the direction the error asks for. */
@@ -67,7 +83,7 @@ int16_t controller_position(struct controller *c, const struct controller_input 
 
 int16_t controller_damping(int32_t measured_velocity_q8, const struct drive_limits *lim)
 {
-    int32_t brake = clamp32(-(((int64_t)measured_velocity_q8 * GAIN_DAMPING) >> 8), 1 << 20);
+    int32_t brake = -((sat_q(measured_velocity_q8, SPEED_LIMIT_Q8) * GAIN_DAMPING) >> 8);
     return limit(brake, measured_velocity_q8, lim);
 }
 
@@ -75,6 +91,8 @@ void drive_limits_for_supply(struct drive_limits *lim, uint16_t supply_mv)
 {
     if (supply_mv == 0u) {
         supply_mv = NOMINAL_SUPPLY_MV;
+    } else if (supply_mv < GAIN_MIN_SUPPLY_MV) {
+        supply_mv = GAIN_MIN_SUPPLY_MV;
     }
     lim->kv = (int32_t)(((uint32_t)GAIN_KV * NOMINAL_SUPPLY_MV) / supply_mv);
     lim->ka = (int32_t)div64_u((uint64_t)GAIN_KA * NOMINAL_SUPPLY_MV, supply_mv);

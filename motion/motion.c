@@ -31,34 +31,47 @@ static uint32_t clamp_u32(uint32_t v, uint32_t lo, uint32_t hi)
 }
 
 /* ---- positions and the frames they are given in -------------------------
- * measured: Q32 decideg from the origin (SetOriginPoint, ResetMultiTurn).
+ * measured_q8: Q8 decideg from the origin (SetOriginPoint, ResetMultiTurn).
  * Protocol angles are that minus the center offset (53). */
 
-static int32_t q32_to_decideg(int64_t q32)
+static int32_t q8_to_decideg(int32_t q8)
 {
-    return (int32_t)((q32 + (DECIDEG_Q32 / 2)) >> 32); /* nearest */
+    return (q8 + 128) >> 8; /* nearest */
+}
+
+/* The tick's copies of the profile (Q8, saturated): at tick, at tick + 1,
+ * the target, and the setpoint between them at the clock's fraction. */
+static void take_profile_q8(struct motion *m)
+{
+    m->at_tick_q8 = motion_profile_q8(m, m->tick);
+    m->at_next_q8 = motion_profile_q8(m, m->tick < UINT32_MAX ? m->tick + 1u : m->tick);
+    m->target_q8 = q32_to_q8_sat(m->profile.target, TARGET_LIMIT_Q8);
+    m->setpoint_q8 = m->at_tick_q8 + (((m->at_next_q8 - m->at_tick_q8) * m->tick_frac) >> 8);
 }
 
 void motion_move_origin(struct motion *m, int32_t counts)
 {
-    int64_t shift = counts_to_q32(counts);
+    int32_t shift_q8 = counts_to_q8(counts);
+    int64_t shift = q8_to_q32(shift_q8);
     m->origin_counts += counts;
-    m->measured -= shift;
-    m->setpoint -= shift;
-    m->last_setpoint -= shift;
+    m->measured_q8 -= shift_q8;
     m->profile.start -= shift;
     m->profile.target -= shift;
     m->profile.cruise_start -= shift;
-    m->at_tick -= shift;
-    m->at_next -= shift;
+    /* The setpoint may be further from the horn than Q8 holds (a load has
+     * turned the horn back thousands of turns): it is taken from the
+     * profile again, which holds it exactly. */
+    int32_t step = m->setpoint_q8 - m->last_setpoint_q8;
+    take_profile_q8(m);
+    m->last_setpoint_q8 = m->setpoint_q8 - step;
     /* Whole turns of the origin come off the encoder's count too: the raw
-     * reading's place in the turn, and the difference, stay as they were. */
+     * reading's place in the turn, and the difference, stay as they were
+     * (the tracker follows the count's changes, not the count). */
     int32_t within = m->origin_counts % ENCODER_COUNTS;
     within = within < 0 ? within + ENCODER_COUNTS : within;
     int32_t whole = m->origin_counts - within;
     m->origin_counts = within;
     m->encoder.counts -= whole;
-    m->track_q32 -= counts_to_q32(whole);
 }
 
 static int32_t wrap_single_turn(int32_t decideg)
@@ -74,7 +87,7 @@ static int32_t wrap_single_turn(int32_t decideg)
 
 void motion_read_angle(const struct motion *m, struct motion_angle *out)
 {
-    int32_t angle = q32_to_decideg(m->measured - motion_center_offset_q32(m));
+    int32_t angle = q8_to_decideg(m->measured_q8 - motion_center_offset_q8(m));
     out->multi_turn_decideg = angle;
     out->turns = (int16_t)(angle / DECIDEG_PER_TURN);
     out->single_turn_decideg = (int16_t)wrap_single_turn(angle);
@@ -88,14 +101,15 @@ static int16_t saturate_i16(int32_t v)
 void motion_read_diagnostics(const struct motion *m, struct motion_diagnostics *out)
 {
     bool controlled = m->mode == MODE_POSITION;
-    int64_t offset = motion_center_offset_q32(m);
-    int64_t setpoint = controlled ? m->setpoint : m->measured;
+    int32_t offset = motion_center_offset_q8(m);
+    int32_t setpoint = controlled ? m->setpoint_q8 : m->measured_q8;
     /* decideg per tick Q8 to decideg per s: x 1000 / 256 = x 125 / 32. */
-    int32_t error_q8 = q32_to_q8_sat(setpoint - m->measured);
+    int32_t error_q8 = setpoint - m->measured_q8;
+    int64_t target = controlled ? m->profile.target : q8_to_q32(m->measured_q8);
     *out = (struct motion_diagnostics){
-        .angle_decideg = q32_to_decideg(m->measured - offset),
-        .setpoint_decideg = q32_to_decideg(setpoint - offset),
-        .target_decideg = q32_to_decideg((controlled ? m->profile.target : m->measured) - offset),
+        .angle_decideg = q8_to_decideg(m->measured_q8 - offset),
+        .setpoint_decideg = q8_to_decideg(setpoint - offset),
+        .target_decideg = (int32_t)((target - q8_to_q32(offset) + (DECIDEG_Q32 / 2)) >> 32),
         .velocity_decideg_s = saturate_i16(m->measured_velocity_q8 * 125 / 32),
         .tracking_error_centideg = saturate_i16((int32_t)(((int64_t)error_q8 * 10) / 256)),
         .flags = (uint8_t)((controlled && m->tick >= m->profile.total_ticks ? DIAG_PROFILE_ENDED : 0u) |
@@ -133,6 +147,7 @@ void motion_update_limits(struct motion *m)
     int16_t limit = (int16_t)(by_power < by_current ? by_power : by_current);
     m->drive.duty_limit = (int16_t)(m->derate ? limit / 2 : limit);
     drive_limits_for_supply(&m->drive, m->supply_mv_used);
+    m->phase_end = 0; /* the acceleration feed-forward follows ka */
 }
 
 static void set_power(struct motion *m, uint16_t power_mw)
@@ -157,20 +172,22 @@ void motion_clock_restart(struct motion *m)
     m->clock_rate = CLOCK_REAL_TIME;
     m->lead_q8 = 0;
     m->braking = 0;
-    m->at_tick = profile_position(&m->profile, 0);
-    m->at_next = profile_position(&m->profile, 1);
+    m->phase_end = 0; /* the next tick works out the phase's feed-forward */
+    m->at_tick_q8 = q32_to_q8_sat(m->profile.start, TARGET_LIMIT_Q8);
+    m->at_next_q8 = motion_profile_q8(m, 1);
+    m->target_q8 = q32_to_q8_sat(m->profile.target, TARGET_LIMIT_Q8);
+    m->setpoint_q8 = m->at_tick_q8;
 }
 
 /* Hold still where the setpoint is now (or where the servo is, if it was
  * released): a zero-length profile. */
 static void hold_here(struct motion *m)
 {
-    int64_t here = m->mode == MODE_POSITION ? m->setpoint : m->measured;
-    profile_plan(&m->profile, here, 0, here, (struct profile_timing){0, 0, 0});
+    int32_t here = m->mode == MODE_POSITION ? m->setpoint_q8 : m->measured_q8;
+    profile_plan(&m->profile, q8_to_q32(here), 0, q8_to_q32(here), (struct profile_timing){0, 0, 0});
     m->profile.total_ticks = 0;
     motion_clock_restart(m);
-    m->setpoint = here;
-    m->last_setpoint = here;
+    m->last_setpoint_q8 = m->setpoint_q8;
     if (m->mode != MODE_POSITION) {
         controller_reset(&m->controller);
     }
@@ -182,9 +199,9 @@ static void hold_here(struct motion *m)
  * of its speed. */
 static bool horn_follows(const struct motion *m)
 {
-    int64_t gap = m->setpoint - m->measured;
-    int64_t speed = ((m->setpoint - m->last_setpoint) >> 24) - m->measured_velocity_q8;
-    return gap < FOLLOW_GAP_Q32 && gap > -FOLLOW_GAP_Q32 && speed < FOLLOW_SPEED_Q8 &&
+    int32_t gap = m->setpoint_q8 - m->measured_q8;
+    int32_t speed = (m->setpoint_q8 - m->last_setpoint_q8) - m->measured_velocity_q8;
+    return gap < FOLLOW_GAP_Q8 && gap > -FOLLOW_GAP_Q8 && speed < FOLLOW_SPEED_Q8 &&
            speed > -FOLLOW_SPEED_Q8;
 }
 
@@ -196,13 +213,13 @@ static void start_state(const struct motion *m, int64_t *start, int64_t *v0)
     if (m->mode == MODE_POSITION && !horn_follows(m)) {
         /* The horn is elsewhere or moves otherwise than the setpoint (a
          * slowed clock, a load): take over from where it really is. */
-        *start = m->measured;
-        *v0 = (int64_t)m->measured_velocity_q8 * ((int64_t)1 << 24);
+        *start = q8_to_q32(m->measured_q8);
+        *v0 = q8_to_q32(m->measured_velocity_q8);
     } else if (m->mode == MODE_POSITION) {
-        *start = m->setpoint;
-        *v0 = m->setpoint - m->last_setpoint;
+        *start = q8_to_q32(m->setpoint_q8);
+        *v0 = q8_to_q32(m->setpoint_q8 - m->last_setpoint_q8);
     } else {
-        *start = m->measured;
+        *start = q8_to_q32(m->measured_q8);
         *v0 = 0;
     }
 }
@@ -212,10 +229,9 @@ static void begin_profile(struct motion *m, uint8_t end)
     if (m->mode != MODE_POSITION) {
         controller_reset(&m->controller);
     }
-    m->setpoint = m->profile.start;
-    m->last_setpoint = m->profile.start - m->profile.v0; /* moving at v0 */
     m->mode = MODE_POSITION;
     motion_clock_restart(m);
+    m->last_setpoint_q8 = m->setpoint_q8 - q32_to_q8_sat(m->profile.v0, TARGET_LIMIT_Q8); /* moving at v0 */
     m->end = end;
     m->running = 1;
 }
@@ -249,7 +265,7 @@ int32_t motion_brake_duty(const struct motion *m, int32_t dir)
  * least min_ticks): the target is where that ends. Plans: it divides. */
 static void plan_stop(struct motion *m, int64_t start, int64_t v0, uint32_t min_ticks)
 {
-    int32_t v = q32_to_q8_sat(v0);
+    int32_t v = q32_to_q8_sat(v0, INT32_MAX);
     uint64_t speed = (uint64_t)(v < 0 ? -(int64_t)v : v);
     uint64_t per_tick = (uint64_t)motion_brake_duty(m, v) << 8; /* x ka: decideg Q8 per tick^2 */
     uint64_t n = div64_u(speed * (uint64_t)m->drive.ka + per_tick - 1u, per_tick);
@@ -266,7 +282,7 @@ static int64_t angle_target(const struct motion *m, const struct motion_command 
     const struct user_config *cfg = &m->regs->user;
     if (cmd->multi_turn) {
         int32_t angle = clamp_i32(cmd->angle_decideg, -MULTI_TURN_LIMIT, MULTI_TURN_LIMIT);
-        return (int64_t)angle * DECIDEG_Q32 + motion_center_offset_q32(m);
+        return (int64_t)angle * DECIDEG_Q32 + q8_to_q32(motion_center_offset_q8(m));
     }
     int32_t angle = clamp_i32(cmd->angle_decideg, -SINGLE_TURN_LIMIT, SINGLE_TURN_LIMIT);
     if (cfg->angle_limit_on) {
@@ -276,7 +292,7 @@ static int64_t angle_target(const struct motion *m, const struct motion_command 
     struct motion_angle now;
     motion_read_angle(m, &now);
     int32_t turn_base = now.multi_turn_decideg - now.single_turn_decideg;
-    return ((int64_t)turn_base + angle) * DECIDEG_Q32 + motion_center_offset_q32(m);
+    return ((int64_t)turn_base + angle) * DECIDEG_Q32 + q8_to_q32(motion_center_offset_q8(m));
 }
 
 static void run_angle(struct motion *m, const struct motion_command *cmd)
@@ -348,10 +364,9 @@ static void run_stop(struct motion *m, const struct motion_command *cmd)
         /* Hold where the servo comes to rest, braking as hard as the motor
          * can from where it is, not where it aimed. */
         if (m->mode == MODE_POSITION) {
-            plan_stop(m, m->setpoint, m->setpoint - m->last_setpoint, 0);
+            plan_stop(m, q8_to_q32(m->setpoint_q8), q8_to_q32(m->setpoint_q8 - m->last_setpoint_q8), 0);
         } else {
-            int64_t v = (int64_t)m->measured_velocity_q8 * ((int64_t)1 << 24);
-            plan_stop(m, m->measured, v, 0);
+            plan_stop(m, q8_to_q32(m->measured_q8), q8_to_q32(m->measured_velocity_q8), 0);
         }
         begin_profile(m, END_HOLD);
         break;
@@ -517,8 +532,7 @@ void motion_init(struct motion *m, const struct registers *regs, const struct ha
     *m = (struct motion){.regs = regs, .hal = hal, .soft_start_pending = 1};
     encoder_start(&m->encoder, hal->encoder_read(hal->ctx));
     m->origin_counts = 0;
-    m->measured = counts_to_q32(m->encoder.counts);
-    m->track_q32 = m->measured;
+    m->measured_q8 = counts_to_q8(m->encoder.counts);
     set_power(m, 0);
     if (regs->user.power_on_lock) {
         hold_here(m);

@@ -1,6 +1,7 @@
 /* What motion.c (commands, state) and control_tick.c (the tick) share;
- * private to the motion layer. Positions are Q32 decidegrees, speeds Q32 or
- * Q8 decidegrees per tick, as in motion.h. */
+ * private to the motion layer. The tick's positions are Q8 decidegrees in
+ * int32, the profile's Q32 in int64; speeds are decidegrees per tick in the
+ * same formats (motion.h). */
 #ifndef MOTION_INTERNAL_H
 #define MOTION_INTERNAL_H
 
@@ -13,13 +14,20 @@ enum {
     DECIDEG_PER_TURN = 3600,
     SUPPLY_HYSTERESIS_MV = 128, /* the limits follow the supply past this */
     CLOCK_REAL_TIME = 256,      /* clock_rate, Q8 */
+    ACCEL_DUTY_LIMIT = 1 << 20, /* the controller's output range */
 };
 
 /* Setpoint and horn agree within these: 0.5 degree, 25 deg/s. A new profile
  * starts from the setpoint then, else from the horn; a move has arrived
  * only slower than FOLLOW_SPEED. */
-#define FOLLOW_GAP_Q32 (5 * DECIDEG_Q32)
-enum { FOLLOW_SPEED_Q8 = 64 };
+enum { FOLLOW_GAP_Q8 = 5 << 8, FOLLOW_SPEED_Q8 = 64 };
+
+/* The profile as the tick sees it: beyond the multi-turn range (a wheel run
+ * of many turns, a horn a load has turned back thousands of turns) a
+ * position counts as +-2^30, which no horn within the range reaches
+ * (3 686 400 x 256 < 2^30) and whose distance from the horn still fits
+ * int32, with the right sign. */
+#define TARGET_LIMIT_Q8 (1 << 30)
 
 /* The profile's clock (control_tick.c, "the profile's clock"). */
 enum {
@@ -30,22 +38,40 @@ enum {
     CLOCK_RECOVERY = 8,    /* a stopped clock is back to real time in 32 ticks */
 };
 
-static inline int64_t counts_to_q32(int32_t counts)
+/* v within [-limit, limit - 1], limit a power of two: one SSAT on the
+ * Cortex-M3. */
+static inline int32_t sat_q(int32_t v, int32_t limit)
 {
-    return (int64_t)counts * DECIDEG_Q8_PER_COUNT * ((int64_t)1 << 24);
+    return v > limit - 1 ? limit - 1 : v < -limit ? -limit : v;
 }
 
-/* Q32 to Q8 (decideg, or decideg per tick), saturated to int32. */
-static inline int32_t q32_to_q8_sat(int64_t v)
+static inline int32_t counts_to_q8(int32_t counts)
+{
+    return counts * DECIDEG_Q8_PER_COUNT;
+}
+
+static inline int64_t q8_to_q32(int32_t v)
+{
+    return (int64_t)v * ((int64_t)1 << 24);
+}
+
+/* Q32 to Q8 (decideg, or decideg per tick), saturated to +-limit. */
+static inline int32_t q32_to_q8_sat(int64_t v, int32_t limit)
 {
     int64_t q8 = v >> 24;
-    return q8 > INT32_MAX ? INT32_MAX : q8 < -INT32_MAX ? -INT32_MAX : (int32_t)q8;
+    return q8 > limit ? limit : q8 < -limit ? -limit : (int32_t)q8;
 }
 
-/* The center offset (53): protocol angles are measured minus this. */
-static inline int64_t motion_center_offset_q32(const struct motion *m)
+/* The profile's position at tick as the tick sees it. */
+static inline int32_t motion_profile_q8(const struct motion *m, uint32_t tick)
 {
-    return (int64_t)m->regs->user.center_offset_decideg * DECIDEG_Q32;
+    return q32_to_q8_sat(profile_position(&m->profile, tick), TARGET_LIMIT_Q8);
+}
+
+/* The center offset (53), decideg Q8: protocol angles are measured minus this. */
+static inline int32_t motion_center_offset_q8(const struct motion *m)
+{
+    return (int32_t)m->regs->user.center_offset_decideg * 256;
 }
 
 /* Moves the origin by counts the way the angle grows: every position the

@@ -59,8 +59,8 @@ static uint16_t encoder_model(void *model)
     (void)model;
     const struct motion *m = &live.servo.motion;
     if (encoder_mode == 1 && m->mode == MODE_POSITION) {
-        int64_t per_count = (int64_t)DECIDEG_Q8_PER_COUNT << 24;
-        int64_t sp = m->setpoint;
+        int64_t per_count = DECIDEG_Q8_PER_COUNT;
+        int64_t sp = m->setpoint_q8;
         encoder_counts = (int32_t)((sp >= 0 ? sp + per_count / 2 : sp - per_count / 2) / per_count) +
                          m->origin_counts;
     } else if (encoder_mode == 0) {

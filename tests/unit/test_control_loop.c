@@ -28,7 +28,7 @@ static int setup(void **state)
 
 static double setpoint_deg(void)
 {
-    return (double)servo.motion.setpoint / 4294967296.0 / 10.0;
+    return (double)servo.motion.setpoint_q8 / 256.0 / 10.0;
 }
 
 /* Runs ms milliseconds; the largest |setpoint - plant| seen, in degrees. */

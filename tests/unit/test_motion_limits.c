@@ -205,7 +205,7 @@ static void run_trial(unsigned trial, double inertia_scale)
                    "tick %u/%u (cruise to %u), rate %u, braking %u, duty %6d, limit %d, I %.2f A, "
                    "w %d int %d\n",
                    elapsed, plant_angle_deg(&plant), plant.velocity * 57.29578,
-                   (double)m->setpoint / 42949672960.0,
+                   (double)m->setpoint_q8 / 2560.0,
                    (double)m->profile.target / 42949672960.0, m->tick, m->profile.total_ticks,
                    m->profile.cruise_end, m->clock_rate, m->braking, hal.duty, m->drive.duty_limit,
                    plant.current, m->measured_velocity_q8, m->controller.integral_q15);
@@ -218,7 +218,7 @@ static void run_trial(unsigned trial, double inertia_scale)
     }
     limit_ms += planned_ms; /* the plan, and 20 s to be late by */
     if (elapsed >= limit_ms) {
-        printf("# trial %u never finished: packet %u to %d at %u mW, load %.3f N m, supply %.2f V, at %.2f deg, setpoint %.2f, status 0x%02x\n", trial, last.packet, (int)last.target_decideg, last.power_mw, plant.load_torque, plant.p.supply_v, plant_angle_deg(&plant), (double)servo.motion.setpoint / 42949672960.0, servo.regs.status.status);
+        printf("# trial %u never finished: packet %u to %d at %u mW, load %.3f N m, supply %.2f V, at %.2f deg, setpoint %.2f, status 0x%02x\n", trial, last.packet, (int)last.target_decideg, last.power_mw, plant.load_torque, plant.p.supply_v, plant_angle_deg(&plant), (double)servo.motion.setpoint_q8 / 2560.0, servo.regs.status.status);
     }
     assert_true(elapsed < limit_ms);
     double target = target_deg(&last);

@@ -146,7 +146,10 @@ static void test_the_error_saturates_instead_of_changing_sign(void **state)
     for (int ms = 0; ms < 12300; ms++) {
         harness_run_ms(1);
         assert_int_equal(motion_output_at_limit(&servo.motion), 1);
-        int64_t error = (servo.motion.setpoint - servo.motion.measured) >> 32;
+        /* The distance the profile holds exactly; the tick's Q8 copy of
+         * the setpoint saturates at 2^30 on the same side. */
+        int64_t error = ((servo.motion.profile.target >> 24) - servo.motion.measured_q8) >> 8;
+        assert_true(servo.motion.setpoint_q8 > servo.motion.measured_q8);
         assert_true(error > 0);
         furthest = error > furthest ? (int32_t)error : furthest;
     }

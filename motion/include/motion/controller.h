@@ -3,6 +3,10 @@
  * output a Q15 duty kept within the running command's power. Gains:
  * motion/gains.h.
  *
+ * All in int32: each input is saturated to a power of two (one SSAT on the
+ * Cortex-M3) that keeps its product with the gain within 31 bits, well
+ * beyond where the output saturates anyway.
+ *
  * The power limit is a current limit, |I| <= P / V: the winding current is
  * (V d - back-EMF) / R, so the duty may stray from the back-EMF duty of the
  * present speed by at most P R / V^2 either way. */
@@ -30,7 +34,7 @@ struct drive_limits {
 struct controller_input {
     int32_t error_q8;             /* setpoint - measured, decideg Q8 */
     int32_t velocity_q8;          /* planned velocity, decideg per tick Q8 */
-    int32_t acceleration_q16;     /* planned, decideg per tick^2 Q16 */
+    int32_t acceleration_duty;    /* the planned acceleration's feed-forward, duty */
     int32_t measured_velocity_q8; /* decideg per tick Q8 */
     int8_t push;                  /* +1/-1: drive at the limit that way (the
                                    * motor is the bottleneck); 0: control */
@@ -43,8 +47,8 @@ int16_t controller_position(struct controller *c, const struct controller_input 
 int16_t controller_damping(int32_t measured_velocity_q8, const struct drive_limits *lim);
 /* Keeps duty within the duty limit of the back-EMF duty at this speed. */
 int16_t controller_limit(int32_t duty, int32_t measured_velocity_q8, const struct drive_limits *lim);
-/* kv, ka and the drag at supply_mv (0: the nominal supply). Planning-time:
- * it divides. */
+/* kv, ka and the drag at supply_mv (0: the nominal supply; below
+ * GAIN_MIN_SUPPLY_MV, that). Planning-time: it divides. */
 void drive_limits_for_supply(struct drive_limits *lim, uint16_t supply_mv);
 /* The duty that drives the current limit P / V through the winding at
  * standstill: P R / V^2, Q15. Planning-time: it divides. */

@@ -21,17 +21,16 @@ static inline void encoder_start(struct encoder_track *e, uint16_t raw)
     e->counts = e->last;
 }
 
-static inline void encoder_update(struct encoder_track *e, uint16_t raw)
+/* Takes a raw reading; returns the counts moved since the last one,
+ * -2048..2047. */
+static inline int32_t encoder_update(struct encoder_track *e, uint16_t raw)
 {
     raw = (uint16_t)(raw & (ENCODER_COUNTS - 1));
-    int32_t delta = (int32_t)raw - (int32_t)e->last;
-    if (delta >= ENCODER_COUNTS / 2) {
-        delta -= ENCODER_COUNTS;
-    } else if (delta < -ENCODER_COUNTS / 2) {
-        delta += ENCODER_COUNTS;
-    }
+    uint32_t forward = ((uint32_t)raw - e->last + ENCODER_COUNTS / 2) & (ENCODER_COUNTS - 1);
+    int32_t delta = (int32_t)forward - ENCODER_COUNTS / 2;
     e->counts += delta;
     e->last = raw;
+    return delta;
 }
 
 #endif

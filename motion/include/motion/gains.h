@@ -49,5 +49,9 @@
 #define MOTOR_RESISTANCE_MOHM 2741u
 /* Supply the gains are given at, and assumed until the first reading. */
 #define NOMINAL_SUPPLY_MV 7400u
+/* The supply-scaled gains stop growing below this (kv, the largest, stays
+ * below 2^16 so the controller's products fit int32): nothing moves there
+ * anyway, under any sane low-voltage limit (39). */
+#define GAIN_MIN_SUPPLY_MV 2000u
 
 #endif

@@ -102,9 +102,12 @@ struct motion {
     const struct hal_port *hal;
     struct encoder_track encoder;
     int32_t origin_counts;     /* encoder counts of angle 0 (before offset 53) */
-    int64_t measured;          /* Q32 decideg, relative to the origin */
+    /* The tick works in Q8 decidegrees (int32): the multi-turn range, +-3 686 400
+     * decideg x 256, and a target saturated to +-2^30 stay within int32 in
+     * every difference the tick takes. The profile itself is planned in Q32. */
+    int32_t measured_q8;       /* the horn, relative to the origin */
     int32_t measured_velocity_q8; /* tracked, decideg per tick */
-    int64_t track_q32;         /* tracked encoder position, Q32 decideg, no origin */
+    int32_t track_residual_q12; /* tracked position less the encoder's, decideg Q12 */
     int32_t track_velocity_q12;
     struct profile profile;
     /* The profile's own clock: whole ticks and a Q8 fraction. It runs at
@@ -115,10 +118,16 @@ struct motion {
     uint16_t clock_rate;
     int32_t lead_q8;           /* setpoint ahead of the horn, low-passed, decideg Q8 */
     uint8_t braking;           /* the profile is the braking guard's: left alone */
-    int64_t at_tick;           /* profile position at tick, Q32 decideg */
-    int64_t at_next;           /* and at tick + 1 */
-    int64_t setpoint;          /* Q32 decideg */
-    int64_t last_setpoint;
+    int32_t at_tick_q8;        /* profile position at tick */
+    int32_t at_next_q8;        /* and at tick + 1 */
+    int32_t setpoint_q8;
+    int32_t last_setpoint_q8;
+    int32_t target_q8;         /* the profile's target, saturated to +-TARGET_LIMIT_Q8 */
+    /* The acceleration feed-forward of the profile's phase at tick, as a
+     * duty, until phase_end (a tick); worked out when a phase begins or the
+     * limits change. */
+    int32_t accel_duty;
+    uint32_t phase_end;
     struct controller controller;
     struct drive_limits drive; /* current margin (power, 43, protection), kv, ka */
     uint16_t power_mw;         /* the running command's power, 0 = 42's value */

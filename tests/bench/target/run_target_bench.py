@@ -16,7 +16,9 @@ count exactly 200 more instructions. Cycles are the plugin's model
 at 2 wait states for the M3 at 72 MHz; 0 wait states for the M0, as the
 issue asks), an estimate, not a measurement."""
 import argparse
+import bisect
 import json
+import re
 import subprocess
 import sys
 import tempfile
@@ -35,6 +37,7 @@ KNOWN_LOOP = 200  # 100 more iterations of a 2-instruction loop
 BUDGETS = {"rx_per_byte": 40, "tick": 150, "plan": 1000}
 NOT_YET_MET = {"tick"}
 RESPONSE_BUDGET_US = 20
+PROFILE_BY_LINE = [False]  # --lines
 
 
 def symbol(elf: Path, name: str) -> int:
@@ -59,23 +62,49 @@ def functions(elf: Path) -> list:
     return sorted(funcs)
 
 
-def print_profile(elf: Path, names: list, profile_file: Path, region: str) -> None:
-    """Instructions of one region per function, self only (not callees)."""
+def instruction_lines(elf: Path) -> dict:
+    """{instruction address: "file:line"} from the disassembly with line numbers."""
+    out = subprocess.run(["arm-none-eabi-objdump", "-d", "-l", "--no-show-raw-insn", str(elf)],
+                         capture_output=True, text=True, check=True).stdout
+    where, lines = "?", {}
+    for text in out.splitlines():
+        m = re.match(r"^(/\S+):(\d+)", text)
+        if m:
+            where = f"{Path(m.group(1)).name}:{m.group(2)}"
+            continue
+        m = re.match(r"^\s+([0-9a-f]+):\s", text)
+        if m:
+            lines[int(m.group(1), 16)] = where
+    return lines
+
+
+def print_profile(elf: Path, names: list, profile_file: Path, region: str, by_line: bool) -> None:
+    """Instructions of one region per function (or per source line), self only."""
     if region not in names:
         return
     indices = {i for i, name in enumerate(names) if name == region}
     funcs = functions(elf)
-    per_function = {}
+    addresses = sorted(instruction_lines(elf).items()) if by_line else []
+    starts = [a for a, _ in addresses]
+    per_key = {}
     for line in profile_file.read_text().splitlines():
-        r, start, count = line.split()[:3]
+        r, start, count, length = line.split()[:4]
         if int(r) not in indices:
             continue
         addr = int(start, 16)
-        name = next((n for s, e, n in funcs if s <= addr < e), f"{addr:#x}")
-        per_function[name] = per_function.get(name, 0) + int(count)
-    total = sum(per_function.values())
-    print(f"profile of {region} in {elf.name}: {total} instructions, self, by function")
-    for name, count in sorted(per_function.items(), key=lambda kv: -kv[1]):
+        if not by_line:
+            name = next((n for s, e, n in funcs if s <= addr < e), f"{addr:#x}")
+            per_key[name] = per_key.get(name, 0) + int(count)
+            continue
+        # A block's instructions each ran count / length times.
+        hits = int(count) // int(length)
+        first = bisect.bisect_left(starts, addr)
+        for _, where in addresses[first:first + int(length)]:
+            per_key[where] = per_key.get(where, 0) + hits
+    total = sum(per_key.values())
+    print(f"profile of {region} in {elf.name}: {total} instructions, self, "
+          f"by {'source line' if by_line else 'function'}")
+    for name, count in sorted(per_key.items(), key=lambda kv: -kv[1]):
         print(f"  {count:>10} {100 * count / total:5.1f} %  {name}")
 
 
@@ -97,7 +126,7 @@ def run(elf: Path, cpu: str, profile_region: str = "") -> tuple:
         lines = counts_file.read_text().splitlines()
         names = [line.split()[1] for line in proc.stdout.splitlines() if line.startswith("region ")]
         if profile_region:
-            print_profile(elf, names, profile_file, profile_region)
+            print_profile(elf, names, profile_file, profile_region, PROFILE_BY_LINE[0])
     counts = [tuple(int(x) for x in line.split()) for line in lines[1:]]  # after "total I C"
     stats = dict(line.split() for line in proc.stdout.splitlines()
                  if len(line.split()) == 2 and not line.startswith("region "))
@@ -140,7 +169,9 @@ def main():
                     help="fail when a figure is over its budget (those met so far)")
     ap.add_argument("--profile", metavar="REGION", default="",
                     help="print REGION's instructions by function (Cortex-M3)")
+    ap.add_argument("--lines", action="store_true", help="with --profile: by source line instead")
     args = ap.parse_args()
+    PROFILE_BY_LINE[0] = args.lines
     if not PLUGIN.exists():
         sys.exit(f"run_target_bench: {PLUGIN} is missing: cmake --build --preset host")
     results = {cpu: figures(cpu, args.profile if cpu == "cortex-m3" else "") for cpu in CPUS}
