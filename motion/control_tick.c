@@ -45,8 +45,15 @@ static void rebase_endless(struct motion *m)
 #define FRAME_SHIFT_COUNTS ((int32_t)(MULTI_TURN_LIMIT / DECIDEG_PER_TURN) * ENCODER_COUNTS)
 #define READING_LIMIT_Q8 (MULTI_TURN_LIMIT * 256)
 
+/* Within this of the origin, no center offset (53: +-1800) takes the
+ * reading past either end. */
+#define SURELY_IN_RANGE_Q8 ((MULTI_TURN_LIMIT - 1800) * 256)
+
 static void keep_in_range(struct motion *m)
 {
+    if ((uint32_t)(m->measured_q8 + SURELY_IN_RANGE_Q8) <= 2u * SURELY_IN_RANGE_Q8) {
+        return;
+    }
     int32_t reading = m->measured_q8 - motion_center_offset_q8(m);
     if (reading > READING_LIMIT_Q8) {
         motion_move_origin(m, FRAME_SHIFT_COUNTS);
@@ -89,7 +96,8 @@ enum { SUPPLY_CHECK_TICKS = 32 };
 static void follow_supply(struct motion *m)
 {
     uint16_t v = motion_supply_mv(m);
-    if (v > m->supply_mv_used + SUPPLY_HYSTERESIS_MV || v + SUPPLY_HYSTERESIS_MV < m->supply_mv_used) {
+    uint16_t used = m->drive_inputs.supply_mv;
+    if (v > used + SUPPLY_HYSTERESIS_MV || v + SUPPLY_HYSTERESIS_MV < used) {
         motion_update_limits(m);
     }
 }
@@ -126,31 +134,6 @@ static void govern_clock(struct motion *m, int32_t error_q8)
     m->clock_rate = (uint16_t)rate;
 }
 
-/* The acceleration feed-forward of the phase the profile's clock is in,
- * and the tick where that phase ends: worked out once a phase (64-bit), so
- * the tick needs no second difference of positions, which Q8 would make
- * too coarse. The second difference of k t^2 (Q40) is 2 k / 2^8 in Q32,
- * k >> 23 in Q16 decideg per tick^2. */
-static void enter_phase(struct motion *m)
-{
-    const struct profile *p = &m->profile;
-    int64_t k = 0;
-    if (m->tick < p->accel_ticks) {
-        k = p->accel_k;
-        m->phase_end = p->accel_ticks;
-    } else if (m->tick < p->cruise_end) {
-        m->phase_end = p->cruise_end;
-    } else if (m->tick < p->total_ticks) {
-        k = -p->decel_k;
-        m->phase_end = p->total_ticks;
-    } else {
-        m->phase_end = UINT32_MAX;
-    }
-    int64_t duty = ((k >> 23) * m->drive.ka) >> 16;
-    m->accel_duty = (int32_t)(duty > ACCEL_DUTY_LIMIT ? ACCEL_DUTY_LIMIT
-                              : duty < -ACCEL_DUTY_LIMIT ? -ACCEL_DUTY_LIMIT : duty);
-}
-
 /* Moves the setpoint on by clock_rate: between the profile's positions at
  * two whole ticks, linearly (the profile bends by far less than an encoder
  * count within one tick). A step is below 2^23 (PROFILE_MAX_VELOCITY), so
@@ -162,7 +145,10 @@ static void advance_clock(struct motion *m)
         frac -= CLOCK_REAL_TIME;
         m->tick++;
         m->at_tick_q8 = m->at_next_q8;
-        m->at_next_q8 = motion_profile_q8(m, m->tick + 1u);
+        if (profile_walk_next(&m->walk, &m->profile)) {
+            motion_take_accel_duty(m);
+        }
+        m->at_next_q8 = q32_to_q8_sat(m->walk.at, TARGET_LIMIT_Q8);
     }
     m->tick_frac = (uint16_t)frac;
     m->setpoint_q8 = m->at_tick_q8 + (((m->at_next_q8 - m->at_tick_q8) * (int32_t)frac) >> 8);
@@ -184,21 +170,26 @@ static void guard_braking(struct motion *m)
         return;
     }
     /* The faster of setpoint and horn must stop: in a slowed deceleration
-     * the setpoint moves slower than the horn still does. */
+     * the setpoint moves slower than the horn still does. (The horn's speed
+     * counts when it is beyond the setpoint's the same way; from rest, any
+     * way but forwards.) */
     int32_t v = m->setpoint_q8 - m->last_setpoint_q8;
     int32_t w = m->measured_velocity_q8;
-    if ((w > 0) == (v > 0) && (w > v) == (v > 0) && w != v) {
+    if (v > 0 ? w > v : w < v) {
         v = w;
     }
     int32_t r = m->target_q8 - m->measured_q8;
-    if (v == 0 || r == 0 || (v > 0) != (r > 0)) {
+    if (v == 0 || r == 0 || (v ^ r) < 0) {
         return;
     }
     uint32_t speed = v < 0 ? -(uint32_t)v : (uint32_t)v;
     uint32_t room = r < 0 ? -(uint32_t)r : (uint32_t)r;
     uint32_t capped = speed < 0xFFFFu ? speed : 0xFFFFu;
     uint64_t stopping = (uint64_t)(capped * capped) * (uint32_t)m->drive.ka;
-    if (stopping <= ((uint64_t)room * (uint32_t)motion_brake_duty(m, v)) << 9) {
+    /* The least braking the output can count on settles most ticks without
+     * working out the exact one. */
+    if (stopping <= ((uint64_t)room * (uint32_t)m->brake_floor_duty) << 9 ||
+        stopping <= ((uint64_t)room * (uint32_t)motion_brake_duty(m, v)) << 9) {
         return;
     }
     uint64_t n = div64_u(2u * (uint64_t)room + speed - 1u, speed);
@@ -236,9 +227,6 @@ void motion_tick(struct motion *m)
     m->last_setpoint_q8 = m->setpoint_q8;
     advance_clock(m);
     guard_braking(m);
-    if (m->tick >= m->phase_end) {
-        enter_phase(m);
-    }
     int32_t step = m->setpoint_q8 - m->last_setpoint_q8;
     /* The acceleration feed-forward only while the clock keeps real time
      * and the guard is not braking: a rate change is no acceleration the
@@ -247,19 +235,18 @@ void motion_tick(struct motion *m)
      * plant at half the rotor inertia (test_motion_limits, seeds 1, 4, 7)
      * the worst overshoot was 1.0 deg with it while braking, 0.53 without. */
     real_time = real_time && m->clock_rate == CLOCK_REAL_TIME && !m->braking;
-    const struct controller_input in = {
+    struct controller_input in = {
         .error_q8 = m->setpoint_q8 - m->measured_q8,
         .velocity_q8 = step,
         .acceleration_duty = real_time ? m->accel_duty : 0,
         .measured_velocity_q8 = m->measured_velocity_q8,
-        /* While the clock is slowed and the horn lags, the motor is the
-         * bottleneck: drive at the limit the way the profile goes (not
-         * while braking, nor once the horn has caught up). */
-        .push = real_time || m->braking || m->lead_q8 <= LEAD_FREE_Q8 ? 0
-                : m->at_next_q8 > m->at_tick_q8                       ? 1
-                : m->at_next_q8 < m->at_tick_q8                       ? -1
-                                                                      : 0,
     };
+    /* While the clock is slowed and the horn lags, the motor is the
+     * bottleneck: drive at the limit the way the profile goes (not while
+     * braking, nor once the horn has caught up). */
+    if (!real_time && !m->braking && m->lead_q8 > LEAD_FREE_Q8) {
+        in.push = m->at_next_q8 > m->at_tick_q8 ? 1 : m->at_next_q8 < m->at_tick_q8 ? -1 : 0;
+    }
     m->hal->motor_drive(m->hal->ctx, controller_position(&m->controller, &in, &m->drive));
     bool done = m->endless ? m->tick >= m->profile.accel_ticks
                            : profile_done(&m->profile, m->tick) && arrived(m);

@@ -58,6 +58,7 @@ void motion_move_origin(struct motion *m, int32_t counts)
     m->profile.start -= shift;
     m->profile.target -= shift;
     m->profile.cruise_start -= shift;
+    m->walk.at -= shift;
     /* The setpoint may be further from the horn than Q8 holds (a load has
      * turned the horn back thousands of turns): it is taken from the
      * profile again, which holds it exactly. */
@@ -141,13 +142,24 @@ void motion_update_limits(struct motion *m)
     if (m->power_cap_mw != 0u && power > m->power_cap_mw) {
         power = m->power_cap_mw;
     }
-    m->supply_mv_used = motion_supply_mv(m);
-    int16_t by_power = duty_limit_for_power(power, m->supply_mv_used);
-    int16_t by_current = duty_limit_for_current(cfg->current_limit_ma, m->supply_mv_used);
+    /* Every command asks; the divisions run only when what they depend on
+     * has changed (a write to 42 or 43, a derate, a new supply). */
+    struct drive_inputs now = {power, motion_supply_mv(m), cfg->current_limit_ma, m->derate};
+    if (now.power_mw == m->drive_inputs.power_mw && now.supply_mv == m->drive_inputs.supply_mv &&
+        now.current_limit_ma == m->drive_inputs.current_limit_ma && now.derate == m->drive_inputs.derate) {
+        return;
+    }
+    m->drive_inputs = now;
+    int16_t by_power = duty_limit_for_power(power, now.supply_mv);
+    int16_t by_current = duty_limit_for_current(cfg->current_limit_ma, now.supply_mv);
     int16_t limit = (int16_t)(by_power < by_current ? by_power : by_current);
     m->drive.duty_limit = (int16_t)(m->derate ? limit / 2 : limit);
-    drive_limits_for_supply(&m->drive, m->supply_mv_used);
-    m->phase_end = 0; /* the acceleration feed-forward follows ka */
+    drive_limits_for_supply(&m->drive, now.supply_mv);
+    motion_take_accel_duty(m);
+    /* motion_brake_duty with the most a load can take of the limit. */
+    int32_t floor = m->drive.duty_limit - m->drive.duty_limit / 2;
+    floor -= floor >> 2;
+    m->brake_floor_duty = floor > 1 ? floor : 1;
 }
 
 static void set_power(struct motion *m, uint16_t power_mw)
@@ -172,11 +184,22 @@ void motion_clock_restart(struct motion *m)
     m->clock_rate = CLOCK_REAL_TIME;
     m->lead_q8 = 0;
     m->braking = 0;
-    m->phase_end = 0; /* the next tick works out the phase's feed-forward */
+    profile_walk_start(&m->walk, &m->profile, 1);
+    motion_take_accel_duty(m);
     m->at_tick_q8 = q32_to_q8_sat(m->profile.start, TARGET_LIMIT_Q8);
-    m->at_next_q8 = motion_profile_q8(m, 1);
+    m->at_next_q8 = q32_to_q8_sat(m->walk.at, TARGET_LIMIT_Q8);
     m->target_q8 = q32_to_q8_sat(m->profile.target, TARGET_LIMIT_Q8);
     m->setpoint_q8 = m->at_tick_q8;
+}
+
+/* The second difference of the walk's phase is change_q40; in Q16 decideg
+ * per tick^2 that is >> 24, and ka turns it into a duty (64-bit: once a
+ * phase). */
+void motion_take_accel_duty(struct motion *m)
+{
+    int64_t duty = ((m->walk.change_q40 >> 24) * m->drive.ka) >> 16;
+    m->accel_duty = (int32_t)(duty > ACCEL_DUTY_LIMIT ? ACCEL_DUTY_LIMIT
+                              : duty < -ACCEL_DUTY_LIMIT ? -ACCEL_DUTY_LIMIT : duty);
 }
 
 /* Hold still where the setpoint is now (or where the servo is, if it was

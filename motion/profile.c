@@ -124,3 +124,29 @@ int64_t profile_position(const struct profile *p, uint32_t tick)
     }
     return p->target - quadratic(p->decel_k, p->total_ticks - tick);
 }
+
+void profile_walk_start(struct profile_walk *w, const struct profile *p, uint32_t tick)
+{
+    /* p(t + 1) - p(t) of each phase's closed form, in Q40: v0 + k (2t + 1)
+     * ramping up, V cruising, dk (2r - 1) ramping down (r = T - t). The
+     * products are those profile_position bounds. */
+    w->at = profile_position(p, tick);
+    w->tick = tick;
+    if (tick < p->accel_ticks) {
+        w->step_q40 = p->v0 * 256 + p->accel_k * (2 * (int64_t)tick + 1);
+        w->change_q40 = 2 * p->accel_k;
+        w->phase_end = p->accel_ticks;
+    } else if (tick < p->cruise_end) {
+        w->step_q40 = p->cruise * 256;
+        w->change_q40 = 0;
+        w->phase_end = p->cruise_end;
+    } else if (tick < p->total_ticks) {
+        w->step_q40 = p->decel_k * (2 * (int64_t)(p->total_ticks - tick) - 1);
+        w->change_q40 = -2 * p->decel_k;
+        w->phase_end = p->total_ticks;
+    } else {
+        w->step_q40 = 0;
+        w->change_q40 = 0;
+        w->phase_end = UINT32_MAX;
+    }
+}

@@ -4,8 +4,14 @@
  * Regions (bench_region.h):
  *   plan_interval, plan_velocity, plan_short_stroke, plan_preempt
  *       motion_submit() of one move: clamping, timing, profile planning
- *   ticks  MOTION_BENCH_TICKS control ticks of a move (encoder read,
- *          profile evaluation, controller, motor output) */
+ *   ticks_follow  MOTION_BENCH_TICKS control ticks of a move the horn
+ *          follows (the encoder replays the setpoint of a first run): real
+ *          time, the braking guard's full check, the whole controller
+ *   ticks_at_limit  MOTION_BENCH_TICKS ticks of a move faster than the horn
+ *          (the encoder turns 5 counts a tick): the slowed clock, then the
+ *          guard's braking
+ *   ticks_hal  the same loop's HAL double calls alone (encoder read, motor
+ *          output), which the tick figures leave out */
 #include <stdio.h>
 #include <string.h>
 
@@ -23,7 +29,9 @@ static void fresh(void)
 {
     hal_double_init(&hal);
     memset(&regs, 0, sizeof regs);
+    /* The data table's factory values where motion reads them. */
     regs.user = (struct user_config){.check_flag = 1, .baud_index = 5, .power_limit_mw = 10000,
+                                     .current_limit_ma = 4000,
                                      .low_voltage_mv = 4000, .high_voltage_mv = 8400,
                                      .angle_limit_on = 1, .angle_max_decideg = 1350,
                                      .angle_min_decideg = -1350};
@@ -38,6 +46,16 @@ static void plan(const char *name, const struct motion_command *cmd)
     bench_end(name);
 }
 
+/* The encoder readings of a horn that follows the setpoint exactly. */
+static uint16_t follow_raw[MOTION_BENCH_TICKS];
+
+static uint16_t setpoint_raw(void)
+{
+    int32_t counts = (motion.setpoint_q8 + DECIDEG_Q8_PER_COUNT / 2) / DECIDEG_Q8_PER_COUNT +
+                     motion.origin_counts;
+    return (uint16_t)((uint32_t)counts & (ENCODER_COUNTS - 1));
+}
+
 int main(void)
 {
     fresh();
@@ -45,15 +63,44 @@ int main(void)
     const struct motion_command interval = {.packet = 14, .kind = MOTION_ANGLE, .multi_turn = 1,
                                             .angle_decideg = 36000, .interval_ms = 3000,
                                             .acc_ms = 300, .dec_ms = 300};
-    plan("plan_interval", &interval);
+    /* A move the horn follows: its readings first, then the ticks again
+     * on them. The first 2000 ticks of the 3000 ms move (240 deg/s): the
+     * ramp and the cruise. */
+    const struct motion_command follow = {.packet = 14, .kind = MOTION_ANGLE, .multi_turn = 1,
+                                          .angle_decideg = 6000, .interval_ms = 3000,
+                                          .acc_ms = 500, .dec_ms = 500};
+    motion_submit(&motion, &follow);
+    for (unsigned i = 0; i < MOTION_BENCH_TICKS; i++) {
+        hal.encoder_raw = follow_raw[i] = setpoint_raw();
+        motion_tick(&motion);
+    }
+    fresh();
+    motion_submit(&motion, &follow);
+    bench_begin();
+    for (unsigned i = 0; i < MOTION_BENCH_TICKS; i++) {
+        hal.encoder_raw = follow_raw[i];
+        motion_tick(&motion);
+    }
+    bench_end("ticks_follow");
 
-    /* Ticks of that move: ramp and cruise, the encoder following. */
+    /* The HAL double's share of those ticks: the same loop, its calls alone. */
+    bench_begin();
+    for (unsigned i = 0; i < MOTION_BENCH_TICKS; i++) {
+        hal.encoder_raw = follow_raw[i];
+        hal.port.motor_drive(hal.port.ctx, (int16_t)hal.port.encoder_read(hal.port.ctx));
+    }
+    bench_end("ticks_hal");
+
+    fresh();
+    plan("plan_interval", &interval);
+    /* Ticks of a move faster than the horn: the encoder turns 5 counts a
+     * tick (440 deg/s) where the move asks 1200. */
     bench_begin();
     for (unsigned i = 0; i < MOTION_BENCH_TICKS; i++) {
         hal.encoder_raw = (uint16_t)(hal.encoder_raw + 5u);
         motion_tick(&motion);
     }
-    bench_end("ticks");
+    bench_end("ticks_at_limit");
 
     const struct motion_command preempt = {.packet = 12, .kind = MOTION_ANGLE,
                                            .profile = PROFILE_VELOCITY, .angle_decideg = -900,

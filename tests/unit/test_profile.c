@@ -312,6 +312,61 @@ static void test_randomized_moves(void **state)
     assert_true(short_strokes > 100);
 }
 
+/* The walk the tick takes through a profile (additions only) meets the
+ * closed form exactly where each phase starts and at the target. Between,
+ * each rounds differently (the walk a Q32 unit a tick, the closed form up
+ * to a unit per tick of the phase, as it floors before its last product),
+ * so they stay within two units per tick of the phase's length: below
+ * 2^-14 decideg for the longest ramp. Random moves, preempted ones among
+ * them (v0 != 0). */
+static void test_the_walk_follows_the_closed_form(void **state)
+{
+    (void)state;
+    srand(20261123);
+    unsigned walked = 0, phases = 0;
+    for (unsigned i = 0; i < 3000; i++) {
+        int64_t start = random_position(rand() % 2);
+        int64_t v0 = rand() % 2 ? 0 : ((int64_t)(rand() % 2001) - 1000) * ((int64_t)1 << 24);
+        struct profile p;
+        bool velocity_based;
+        double analytic;
+        random_move(&p, start, v0, &velocity_based, &analytic);
+        if (p.total_ticks > 200000u) {
+            continue;
+        }
+        struct profile_walk w;
+        profile_walk_start(&w, &p, 0);
+        uint32_t phase_start = 0;
+        for (uint32_t t = 1; t <= p.total_ticks + 2u; t++) {
+            bool started = profile_walk_next(&w, &p);
+            bool boundary = (t == p.accel_ticks || t == p.cruise_end || t == p.total_ticks);
+            int64_t exact = profile_position(&p, t);
+            if (started) {
+                phases++;
+                phase_start = t;
+                if (w.at != exact) {
+                    fail_msg("move %u tick %u: a phase starts at %lld, not %lld", i, t,
+                             (long long)w.at, (long long)exact);
+                }
+            }
+            if (boundary && t > 0 && !started && t != phase_start) {
+                fail_msg("move %u: no phase started at tick %u", i, t);
+            }
+            int64_t off = w.at - exact;
+            uint32_t length = w.phase_end == UINT32_MAX ? 1u : w.phase_end - phase_start;
+            int64_t bound = 2 * (int64_t)length + 1;
+            if (off > bound || off < -bound) {
+                fail_msg("move %u tick %u (phase from %u; %u/%u/%u): walk %lld, closed form %lld (%lld apart)", i, t, phase_start, p.accel_ticks, p.cruise_end, p.total_ticks,
+                         (long long)w.at, (long long)exact, (long long)off);
+            }
+        }
+        assert_true(w.at == p.target);
+        walked++;
+    }
+    printf("# %u moves walked, %u phases started\n", walked, phases);
+    assert_true(walked > 1000u);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -322,6 +377,7 @@ int main(void)
         cmocka_unit_test(test_endless),
         cmocka_unit_test(test_too_fast_moves_take_longer),
         cmocka_unit_test(test_randomized_moves),
+        cmocka_unit_test(test_the_walk_follows_the_closed_form),
     };
     return cmocka_run_group_tests_name("profile", tests, NULL, NULL);
 }

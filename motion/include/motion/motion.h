@@ -97,6 +97,15 @@ struct motion_queue {
     uint8_t count;
 };
 
+/* What the drive limits were last worked out for (the supply: within
+ * SUPPLY_HYSTERESIS_MV of the measured one). */
+struct drive_inputs {
+    uint16_t power_mw;
+    uint16_t supply_mv;
+    uint16_t current_limit_ma;
+    uint8_t derate;
+};
+
 struct motion {
     const struct registers *regs;
     const struct hal_port *hal;
@@ -123,15 +132,15 @@ struct motion {
     int32_t setpoint_q8;
     int32_t last_setpoint_q8;
     int32_t target_q8;         /* the profile's target, saturated to +-TARGET_LIMIT_Q8 */
-    /* The acceleration feed-forward of the profile's phase at tick, as a
-     * duty, until phase_end (a tick); worked out when a phase begins or the
-     * limits change. */
+    struct profile_walk walk;  /* the profile walked to tick + 1 */
+    /* The acceleration feed-forward of the walk's phase, as a duty; worked
+     * out when a phase begins or the limits change. */
     int32_t accel_duty;
-    uint32_t phase_end;
     struct controller controller;
     struct drive_limits drive; /* current margin (power, 43, protection), kv, ka */
+    int32_t brake_floor_duty;  /* the least braking duty a load leaves (motion_brake_duty) */
+    struct drive_inputs drive_inputs;
     uint16_t power_mw;         /* the running command's power, 0 = 42's value */
-    uint16_t supply_mv_used;   /* supply the duty limit was worked out for */
     uint8_t supply_check;      /* ticks since the supply was last looked at */
     uint8_t mode;              /* enum motion_mode */
     uint8_t end;               /* enum motion_end */

@@ -69,6 +69,35 @@ struct profile_timing profile_velocity_timing(int64_t distance, int64_t v0, int6
 
 int64_t profile_position(const struct profile *p, uint32_t tick);
 
+/* A profile walked tick by tick with additions only, for the control tick:
+ * within a phase the step between two ticks changes by a constant (Q40, so
+ * exact), and each phase starts from the closed form's position: the walk
+ * meets profile_position exactly at every phase's start and at the target,
+ * and between stays within two Q32 units per tick of the phase's length
+ * (both round; test_profile.c). */
+struct profile_walk {
+    int64_t at;         /* position at tick, Q32 */
+    int64_t step_q40;   /* to the position at tick + 1 (less rounding), Q40 */
+    int64_t change_q40; /* of step_q40 a tick: the phase's second difference */
+    uint32_t tick;
+    uint32_t phase_end; /* the tick the next phase starts */
+};
+
+/* Starts a walk at tick (also where a phase starts). */
+void profile_walk_start(struct profile_walk *w, const struct profile *p, uint32_t tick);
+
+/* Moves the walk on a tick; true when a phase started. */
+static inline bool profile_walk_next(struct profile_walk *w, const struct profile *p)
+{
+    w->at += w->step_q40 >> 8;
+    w->step_q40 += w->change_q40;
+    if (++w->tick < w->phase_end) {
+        return false;
+    }
+    profile_walk_start(w, p, w->tick);
+    return true;
+}
+
 static inline bool profile_done(const struct profile *p, uint32_t tick)
 {
     return tick >= p->total_ticks;
