@@ -146,9 +146,15 @@ static void advance_clock(struct motion *m)
         m->tick++;
         m->at_tick_q8 = m->at_next_q8;
         if (profile_walk_next(&m->walk, &m->profile)) {
-            motion_take_accel_duty(m);
+            motion_take_accel_duty(m, m->walk.tick + 1u);
         }
         m->at_next_q8 = q32_to_q8_sat(m->walk.at, TARGET_LIMIT_Q8);
+        if (m->tick == m->accel_from) {
+            m->accel_duty = m->accel_duty_next;
+        } else if (m->tick == 1u) {
+            /* p(1) - 2 p(0) + (p(0) - v0): half the first phase's. */
+            m->accel_duty = m->accel_duty_next / 2;
+        }
     }
     m->tick_frac = (uint16_t)frac;
     m->setpoint_q8 = m->at_tick_q8 + (((m->at_next_q8 - m->at_tick_q8) * (int32_t)frac) >> 8);
@@ -228,13 +234,10 @@ void motion_tick(struct motion *m)
     advance_clock(m);
     guard_braking(m);
     int32_t step = m->setpoint_q8 - m->last_setpoint_q8;
-    /* The acceleration feed-forward only while the clock keeps real time
-     * and the guard is not braking: a rate change is no acceleration the
-     * horn should be given, and a braking profile is planned at what the
-     * output can do; the output is at its limit in both anyway. On the
-     * plant at half the rotor inertia (test_motion_limits, seeds 1, 4, 7)
-     * the worst overshoot was 1.0 deg with it while braking, 0.53 without. */
-    real_time = real_time && m->clock_rate == CLOCK_REAL_TIME && !m->braking;
+    /* The acceleration feed-forward only while the clock keeps real time:
+     * a rate change is no acceleration the horn should be given (the
+     * output is at its limit then anyway). */
+    real_time = real_time && m->clock_rate == CLOCK_REAL_TIME;
     struct controller_input in = {
         .error_q8 = m->setpoint_q8 - m->measured_q8,
         .velocity_q8 = step,

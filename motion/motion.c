@@ -155,7 +155,7 @@ void motion_update_limits(struct motion *m)
     int16_t limit = (int16_t)(by_power < by_current ? by_power : by_current);
     m->drive.duty_limit = (int16_t)(m->derate ? limit / 2 : limit);
     drive_limits_for_supply(&m->drive, now.supply_mv);
-    motion_take_accel_duty(m);
+    motion_take_accel_duty(m, m->tick);
     /* motion_brake_duty with the most a load can take of the limit. */
     int32_t floor = m->drive.duty_limit - m->drive.duty_limit / 2;
     floor -= floor >> 2;
@@ -185,7 +185,11 @@ void motion_clock_restart(struct motion *m)
     m->lead_q8 = 0;
     m->braking = 0;
     profile_walk_start(&m->walk, &m->profile, 1);
-    motion_take_accel_duty(m);
+    /* The feed-forward is the second difference of the last three
+     * setpoints, and the setpoint moved at v0 until tick 0: 0 there, half
+     * the first phase's at tick 1 (control_tick.c), the phase's from 2. */
+    m->accel_duty = 0;
+    motion_take_accel_duty(m, 2);
     m->at_tick_q8 = q32_to_q8_sat(m->profile.start, TARGET_LIMIT_Q8);
     m->at_next_q8 = q32_to_q8_sat(m->walk.at, TARGET_LIMIT_Q8);
     m->target_q8 = q32_to_q8_sat(m->profile.target, TARGET_LIMIT_Q8);
@@ -195,11 +199,15 @@ void motion_clock_restart(struct motion *m)
 /* The second difference of the walk's phase is change_q40; in Q16 decideg
  * per tick^2 that is >> 24, and ka turns it into a duty (64-bit: once a
  * phase). */
-void motion_take_accel_duty(struct motion *m)
+void motion_take_accel_duty(struct motion *m, uint32_t tick)
 {
     int64_t duty = ((m->walk.change_q40 >> 24) * m->drive.ka) >> 16;
-    m->accel_duty = (int32_t)(duty > ACCEL_DUTY_LIMIT ? ACCEL_DUTY_LIMIT
-                              : duty < -ACCEL_DUTY_LIMIT ? -ACCEL_DUTY_LIMIT : duty);
+    m->accel_duty_next = (int32_t)(duty > ACCEL_DUTY_LIMIT ? ACCEL_DUTY_LIMIT
+                                   : duty < -ACCEL_DUTY_LIMIT ? -ACCEL_DUTY_LIMIT : duty);
+    m->accel_from = tick;
+    if (m->tick >= tick) {
+        m->accel_duty = m->accel_duty_next;
+    }
 }
 
 /* Hold still where the setpoint is now (or where the servo is, if it was

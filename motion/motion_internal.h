@@ -86,8 +86,9 @@ uint16_t motion_supply_mv(const struct motion *m);
 void motion_update_limits(struct motion *m);
 /* Starts the profile's clock at its tick 0, in real time. */
 void motion_clock_restart(struct motion *m);
-/* The acceleration feed-forward of the walk's phase at the present ka. */
-void motion_take_accel_duty(struct motion *m);
+/* The acceleration feed-forward of the walk's phase at the present ka,
+ * from tick on. */
+void motion_take_accel_duty(struct motion *m, uint32_t tick);
 /* The braking duty the output can count on moving in direction dir. */
 int32_t motion_brake_duty(const struct motion *m, int32_t dir);
 /* The running command has finished: answer, release or hold, next one. */

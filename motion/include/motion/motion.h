@@ -133,9 +133,14 @@ struct motion {
     int32_t last_setpoint_q8;
     int32_t target_q8;         /* the profile's target, saturated to +-TARGET_LIMIT_Q8 */
     struct profile_walk walk;  /* the profile walked to tick + 1 */
-    /* The acceleration feed-forward of the walk's phase, as a duty; worked
-     * out when a phase begins or the limits change. */
+    /* The acceleration feed-forward, as a duty: the profile's second
+     * difference over the last three setpoints, which is the walk's phase
+     * two ticks after the walk enters it (accel_from), as the closed form's
+     * differences were before. Worked out when a phase begins or the limits
+     * change. */
     int32_t accel_duty;
+    int32_t accel_duty_next;
+    uint32_t accel_from;       /* the tick accel_duty_next takes over */
     struct controller controller;
     struct drive_limits drive; /* current margin (power, 43, protection), kv, ka */
     int32_t brake_floor_duty;  /* the least braking duty a load leaves (motion_brake_duty) */

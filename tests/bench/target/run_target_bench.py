@@ -33,9 +33,10 @@ CLOCK_MHZ = {"cortex-m3": 72, "cortex-m0": 48}
 KNOWN_LOOP = 200  # 100 more iterations of a 2-instruction loop
 # Issue 10's budgets (Cortex-M3 instructions; responses in modelled us at
 # 72 MHz). Those met fail the run when exceeded; the tick's is not met yet
-# (README, "Performance") and is reported only.
+# (README, "Benchmark"): until it is, the run fails above its ceiling
+# (today's figure with a little room), so the tick cannot grow back.
 BUDGETS = {"rx_per_byte": 40, "tick": 150, "plan": 1000}
-NOT_YET_MET = {"tick"}
+NOT_YET_MET = {"tick": 300}
 RESPONSE_BUDGET_US = 20
 PROFILE_BY_LINE = [False]  # --lines
 
@@ -203,10 +204,15 @@ def main():
             mark = f"{RESPONSE_BUDGET_US} us"
         else:
             mark = ""
-        if exceeded:
-            mark += " (over, not yet met: reported only)" if key in NOT_YET_MET else " (OVER)"
-            if key not in NOT_YET_MET:
+        if exceeded and key in NOT_YET_MET:
+            ceiling = NOT_YET_MET[key]
+            mark += f" (not yet met; fails above {ceiling})"
+            if i3 > ceiling:
+                mark += " (OVER)"
                 over.append(key)
+        elif exceeded:
+            mark += " (OVER)"
+            over.append(key)
         print(f"{key:<22} {i3:>9.2f} {c3:>10.1f} {c3 / CLOCK_MHZ['cortex-m3']:>7.1f} {i0:>9.1f} "
               f"{c0:>10.1f} {c0 / CLOCK_MHZ['cortex-m0']:>7.1f}  {mark}")
     if args.json:
