@@ -4,13 +4,7 @@
 
 #include "motion/div64.h"
 #include "motion/gains.h"
-
-/* v within [-limit, limit - 1], limit a power of two: one SSAT on the
- * Cortex-M3. */
-static inline int32_t sat_q(int32_t v, int32_t limit)
-{
-    return v > limit - 1 ? limit - 1 : v < -limit ? -limit : v;
-}
+#include "saturate.h"
 
 /* Input ranges that keep every product within int32 (the gains: kv +
  * viscous < 2^15.3 down to GAIN_MIN_SUPPLY_MV, KP < 2^10, KD and DAMPING

@@ -8,6 +8,7 @@
 #include <stdint.h>
 
 #include "motion/motion.h"
+#include "saturate.h"
 
 enum {
     MULTI_TURN_LIMIT = 3686400, /* behaviour.md, "Motion" */
@@ -37,13 +38,6 @@ enum {
     CLOCK_SLOWING = 64,    /* the clock stops within 4 ticks */
     CLOCK_RECOVERY = 8,    /* a stopped clock is back to real time in 32 ticks */
 };
-
-/* v within [-limit, limit - 1], limit a power of two: one SSAT on the
- * Cortex-M3. */
-static inline int32_t sat_q(int32_t v, int32_t limit)
-{
-    return v > limit - 1 ? limit - 1 : v < -limit ? -limit : v;
-}
 
 static inline int32_t counts_to_q8(int32_t counts)
 {
