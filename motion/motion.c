@@ -39,12 +39,13 @@ static int32_t q8_to_decideg(int32_t q8)
     return (q8 + 128) >> 8; /* nearest */
 }
 
-/* The tick's copies of the profile (Q8, saturated): at tick, at tick + 1,
- * the target, and the setpoint between them at the clock's fraction. */
-static void take_profile_q8(struct motion *m)
+/* The tick's copies of the profile (Q8, saturated): at tick (at_tick, Q32),
+ * at tick + 1 (where the walk is), the target, and the setpoint between
+ * them at the clock's fraction. */
+static void take_profile_q8(struct motion *m, int64_t at_tick)
 {
-    m->at_tick_q8 = motion_profile_q8(m, m->tick);
-    m->at_next_q8 = motion_profile_q8(m, m->tick < UINT32_MAX ? m->tick + 1u : m->tick);
+    m->at_tick_q8 = q32_to_q8_sat(at_tick, TARGET_LIMIT_Q8);
+    m->at_next_q8 = q32_to_q8_sat(m->walk.at, TARGET_LIMIT_Q8);
     m->target_q8 = q32_to_q8_sat(m->profile.target, TARGET_LIMIT_Q8);
     m->setpoint_q8 = m->at_tick_q8 + (((m->at_next_q8 - m->at_tick_q8) * m->tick_frac) >> 8);
 }
@@ -63,7 +64,7 @@ void motion_move_origin(struct motion *m, int32_t counts)
      * turned the horn back thousands of turns): it is taken from the
      * profile again, which holds it exactly. */
     int32_t step = m->setpoint_q8 - m->last_setpoint_q8;
-    take_profile_q8(m);
+    take_profile_q8(m, profile_position(&m->profile, m->tick));
     m->last_setpoint_q8 = m->setpoint_q8 - step;
     /* Whole turns of the origin come off the encoder's count too: the raw
      * reading's place in the turn, and the difference, stay as they were
@@ -123,6 +124,15 @@ void motion_read_diagnostics(const struct motion *m, struct motion_diagnostics *
 
 /* ---- the output --------------------------------------------------------- */
 
+/* The braking duty of a current window limit when a load takes assisting
+ * of it, less the quarter kept for the controller (motion_brake_duty). */
+static int32_t brake_duty(int32_t limit, int32_t assisting)
+{
+    int32_t duty = limit - assisting;
+    duty -= duty >> 2;
+    return duty > 1 ? duty : 1;
+}
+
 uint16_t motion_supply_mv(const struct motion *m)
 {
     uint16_t v = m->regs->status.voltage_mv;
@@ -156,10 +166,8 @@ void motion_update_limits(struct motion *m)
     m->drive.duty_limit = (int16_t)(m->derate ? limit / 2 : limit);
     drive_limits_for_supply(&m->drive, now.supply_mv);
     motion_take_accel_duty(m, m->tick);
-    /* motion_brake_duty with the most a load can take of the limit. */
-    int32_t floor = m->drive.duty_limit - m->drive.duty_limit / 2;
-    floor -= floor >> 2;
-    m->brake_floor_duty = floor > 1 ? floor : 1;
+    /* The least of motion_brake_duty: a load taking all it may. */
+    m->brake_floor_duty = brake_duty(m->drive.duty_limit, m->drive.duty_limit / 2);
 }
 
 static void set_power(struct motion *m, uint16_t power_mw)
@@ -190,10 +198,7 @@ void motion_clock_restart(struct motion *m)
      * the first phase's at tick 1 (control_tick.c), the phase's from 2. */
     m->accel_duty = 0;
     motion_take_accel_duty(m, 2);
-    m->at_tick_q8 = q32_to_q8_sat(m->profile.start, TARGET_LIMIT_Q8);
-    m->at_next_q8 = q32_to_q8_sat(m->walk.at, TARGET_LIMIT_Q8);
-    m->target_q8 = q32_to_q8_sat(m->profile.target, TARGET_LIMIT_Q8);
-    m->setpoint_q8 = m->at_tick_q8;
+    take_profile_q8(m, m->profile.start);
 }
 
 /* The second difference of the walk's phase is change_q40; in Q16 decideg
@@ -286,9 +291,7 @@ int32_t motion_brake_duty(const struct motion *m, int32_t dir)
     int32_t limit = m->drive.duty_limit;
     int32_t assisting = dir > 0 ? -m->controller.integral_q15 : m->controller.integral_q15;
     assisting = assisting < 0 ? 0 : assisting > limit / 2 ? limit / 2 : assisting;
-    int32_t duty = limit - assisting;
-    duty -= duty >> 2;
-    return duty > 1 ? duty : 1;
+    return brake_duty(limit, assisting);
 }
 
 

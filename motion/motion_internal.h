@@ -56,12 +56,6 @@ static inline int32_t q32_to_q8_sat(int64_t v, int32_t limit)
     return q8 > limit ? limit : q8 < -limit ? -limit : (int32_t)q8;
 }
 
-/* The profile's position at tick as the tick sees it. */
-static inline int32_t motion_profile_q8(const struct motion *m, uint32_t tick)
-{
-    return q32_to_q8_sat(profile_position(&m->profile, tick), TARGET_LIMIT_Q8);
-}
-
 /* The center offset (53), decideg Q8: protocol angles are measured minus this. */
 static inline int32_t motion_center_offset_q8(const struct motion *m)
 {

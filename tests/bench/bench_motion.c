@@ -17,6 +17,7 @@
 
 #include "bench_region.h"
 #include "hal_double.h"
+#include "ideal_encoder.h"
 #include "motion/motion.h"
 
 #define MOTION_BENCH_TICKS 2000u
@@ -49,13 +50,6 @@ static void plan(const char *name, const struct motion_command *cmd)
 /* The encoder readings of a horn that follows the setpoint exactly. */
 static uint16_t follow_raw[MOTION_BENCH_TICKS];
 
-static uint16_t setpoint_raw(void)
-{
-    int32_t counts = (motion.setpoint_q8 + DECIDEG_Q8_PER_COUNT / 2) / DECIDEG_Q8_PER_COUNT +
-                     motion.origin_counts;
-    return (uint16_t)((uint32_t)counts & (ENCODER_COUNTS - 1));
-}
-
 int main(void)
 {
     fresh();
@@ -71,7 +65,7 @@ int main(void)
                                           .acc_ms = 500, .dec_ms = 500};
     motion_submit(&motion, &follow);
     for (unsigned i = 0; i < MOTION_BENCH_TICKS; i++) {
-        hal.encoder_raw = follow_raw[i] = setpoint_raw();
+        hal.encoder_raw = follow_raw[i] = ideal_encoder_raw(&motion);
         motion_tick(&motion);
     }
     fresh();

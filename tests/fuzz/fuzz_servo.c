@@ -28,6 +28,7 @@
 #include <string.h>
 
 #include "hal_double.h"
+#include "ideal_encoder.h"
 #include "protocol/data_table.h"
 #include "servo.h"
 
@@ -59,10 +60,7 @@ static uint16_t encoder_model(void *model)
     (void)model;
     const struct motion *m = &live.servo.motion;
     if (encoder_mode == 1 && m->mode == MODE_POSITION) {
-        int64_t per_count = DECIDEG_Q8_PER_COUNT;
-        int64_t sp = m->setpoint_q8;
-        encoder_counts = (int32_t)((sp >= 0 ? sp + per_count / 2 : sp - per_count / 2) / per_count) +
-                         m->origin_counts;
+        encoder_counts = ideal_encoder_counts(m);
     } else if (encoder_mode == 0) {
         encoder_counts += spin_per_tick;
     }

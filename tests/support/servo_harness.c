@@ -1,5 +1,7 @@
 #include "servo_harness.h"
 
+#include "ideal_encoder.h"
+
 #include <setjmp.h>
 #include <stdarg.h>
 #include <string.h>
@@ -66,11 +68,7 @@ static uint16_t ideal_encoder(void *model)
     (void)model;
     const struct motion *m = &servo.motion;
     if (m->mode == MODE_POSITION) {
-        /* Nearest count to the setpoint: decideg Q8 / 225. */
-        int64_t per_count = DECIDEG_Q8_PER_COUNT;
-        int64_t sp = m->setpoint_q8;
-        int64_t counts = (sp >= 0 ? sp + per_count / 2 : sp - per_count / 2) / per_count;
-        held_raw = (uint16_t)((counts + m->origin_counts) & (ENCODER_COUNTS - 1));
+        held_raw = ideal_encoder_raw(m);
     }
     return held_raw;
 }

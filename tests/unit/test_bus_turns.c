@@ -16,6 +16,7 @@
 
 #include "frames.h"
 #include "hal_double.h"
+#include "ideal_encoder.h"
 #include "servo.h"
 
 enum {
@@ -55,10 +56,7 @@ static uint16_t ideal_encoder(void *model)
     struct node *n = model;
     const struct motion *m = &n->servo.motion;
     if (m->mode == MODE_POSITION) {
-        int64_t per_count = DECIDEG_Q8_PER_COUNT;
-        int64_t sp = m->setpoint_q8;
-        int64_t counts = (sp >= 0 ? sp + per_count / 2 : sp - per_count / 2) / per_count;
-        n->hal.encoder_raw = (uint16_t)((counts + m->origin_counts) & (ENCODER_COUNTS - 1));
+        n->hal.encoder_raw = ideal_encoder_raw(m);
     }
     return n->hal.encoder_raw;
 }

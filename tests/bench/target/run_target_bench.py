@@ -38,7 +38,6 @@ KNOWN_LOOP = 200  # 100 more iterations of a 2-instruction loop
 BUDGETS = {"rx_per_byte": 40, "tick": 150, "plan": 1000}
 NOT_YET_MET = {"tick": 310}
 RESPONSE_BUDGET_US = 20
-PROFILE_BY_LINE = [False]  # --lines
 
 
 def symbol(elf: Path, name: str) -> int:
@@ -109,7 +108,7 @@ def print_profile(elf: Path, names: list, profile_file: Path, region: str, by_li
         print(f"  {count:>10} {100 * count / total:5.1f} %  {name}")
 
 
-def run(elf: Path, cpu: str, profile_region: str = "") -> tuple:
+def run(elf: Path, cpu: str, profile_region: str = "", by_line: bool = False) -> tuple:
     """{region: instructions less the markers' cost}, and the stats lines."""
     with tempfile.TemporaryDirectory() as tmp:
         counts_file = Path(tmp) / "counts.txt"
@@ -127,7 +126,7 @@ def run(elf: Path, cpu: str, profile_region: str = "") -> tuple:
         lines = counts_file.read_text().splitlines()
         names = [line.split()[1] for line in proc.stdout.splitlines() if line.startswith("region ")]
         if profile_region:
-            print_profile(elf, names, profile_file, profile_region, PROFILE_BY_LINE[0])
+            print_profile(elf, names, profile_file, profile_region, by_line)
     counts = [tuple(int(x) for x in line.split()) for line in lines[1:]]  # after "total I C"
     stats = dict(line.split() for line in proc.stdout.splitlines()
                  if len(line.split()) == 2 and not line.startswith("region "))
@@ -151,10 +150,10 @@ def per_tick(motion: dict, region: str, nticks: int) -> tuple:
     return tuple((x - h) / nticks for x, h in zip(motion[region], motion["ticks_hal"]))
 
 
-def figures(cpu: str, profile_region: str = "") -> dict:
+def figures(cpu: str, profile_region: str = "", by_line: bool = False) -> dict:
     """{figure: (instructions, cycles)}."""
-    proto, pstats = run(CPUS[cpu] / "bench_protocol.elf", cpu, profile_region)
-    motion, mstats = run(CPUS[cpu] / "bench_motion.elf", cpu, profile_region)
+    proto, pstats = run(CPUS[cpu] / "bench_protocol.elf", cpu, profile_region, by_line)
+    motion, mstats = run(CPUS[cpu] / "bench_motion.elf", cpu, profile_region, by_line)
     nbytes, nticks = int(pstats["stream_bytes"]), int(mstats["ticks"])
     plans = {k: v for k, v in motion.items() if k.startswith("plan_")}
     out = {
@@ -182,10 +181,9 @@ def main():
                     help="print REGION's instructions by function (Cortex-M3)")
     ap.add_argument("--lines", action="store_true", help="with --profile: by source line instead")
     args = ap.parse_args()
-    PROFILE_BY_LINE[0] = args.lines
     if not PLUGIN.exists():
         sys.exit(f"run_target_bench: {PLUGIN} is missing: cmake --build --preset host")
-    results = {cpu: figures(cpu, args.profile if cpu == "cortex-m3" else "") for cpu in CPUS}
+    results = {cpu: figures(cpu, args.profile if cpu == "cortex-m3" else "", args.lines) for cpu in CPUS}
     m3, m0 = results["cortex-m3"], results["cortex-m0"]
     print(f"target benchmark: Thumb instructions executed, exact (QEMU 7.2 + plugin; the "
           f"calibration loop's {KNOWN_LOOP} counted exactly on both), and modelled cycles")
