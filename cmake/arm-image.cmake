@@ -8,6 +8,10 @@ function(servo_arm_image name)
     message(FATAL_ERROR "${name}: the board is a ${SERVO_BOARD_CPU}; this build is for ${SERVO_CPU}")
   endif()
   set(I_LINKER ${SERVO_BOARD_LINKER})
+  if(NOT DEFINED SERVO_BOARD_FLASH_LIMIT)
+    set(SERVO_BOARD_FLASH_LIMIT 32768)
+    set(SERVO_BOARD_RAM_LIMIT 8192)
+  endif()
   add_executable(${name}.elf ${I_SOURCES} ${SERVO_BOARD_STARTUP})
   target_link_libraries(${name}.elf PRIVATE ${I_LIBS} ${SERVO_BOARD_PORT} servo_app)
   target_include_directories(${name}.elf PRIVATE ${PROJECT_SOURCE_DIR}/firmware/boards/stm32f103
@@ -17,10 +21,11 @@ function(servo_arm_image name)
   target_link_options(${name}.elf PRIVATE -L${PROJECT_SOURCE_DIR}/firmware/linker -T${I_LINKER}
                       -Wl,-Map=${CMAKE_CURRENT_BINARY_DIR}/${name}.map)
   set_target_properties(${name}.elf PROPERTIES
-    LINK_DEPENDS "${I_LINKER};${PROJECT_SOURCE_DIR}/firmware/linker/sections_stm32f1.ld")
+    LINK_DEPENDS "${I_LINKER};${PROJECT_SOURCE_DIR}/firmware/linker/sections_stm32.ld;${PROJECT_SOURCE_DIR}/cmake/check-image.sh")
   add_custom_command(TARGET ${name}.elf POST_BUILD
     COMMAND ${CMAKE_OBJCOPY} -O binary $<TARGET_FILE:${name}.elf> ${CMAKE_CURRENT_BINARY_DIR}/${name}.bin
     COMMAND sh ${PROJECT_SOURCE_DIR}/cmake/check-image.sh $<TARGET_FILE:${name}.elf>
+            ${SERVO_BOARD_FLASH_LIMIT} ${SERVO_BOARD_RAM_LIMIT}
     COMMAND Python3::Interpreter ${PROJECT_SOURCE_DIR}/cmake/stack-report.py
             $<TARGET_FILE:${name}.elf> ${CMAKE_BINARY_DIR}
     # The update image (header, then the application): what the bootloader
@@ -54,7 +59,7 @@ function(servo_arm_bootloader name)
   target_link_options(${name}.elf PRIVATE -L${PROJECT_SOURCE_DIR}/firmware/linker
                       -T${SERVO_BOARD_BOOT_LINKER} -Wl,-Map=${CMAKE_CURRENT_BINARY_DIR}/${name}.map)
   set_target_properties(${name}.elf PROPERTIES
-    LINK_DEPENDS "${SERVO_BOARD_BOOT_LINKER};${PROJECT_SOURCE_DIR}/firmware/linker/sections_stm32f1.ld")
+    LINK_DEPENDS "${SERVO_BOARD_BOOT_LINKER};${PROJECT_SOURCE_DIR}/firmware/linker/sections_stm32.ld")
   add_custom_command(TARGET ${name}.elf POST_BUILD
     COMMAND ${CMAKE_OBJCOPY} -O binary $<TARGET_FILE:${name}.elf> ${CMAKE_CURRENT_BINARY_DIR}/${name}.bin
     COMMAND sh ${PROJECT_SOURCE_DIR}/cmake/check-image.sh $<TARGET_FILE:${name}.elf> 4096

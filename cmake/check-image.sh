@@ -1,19 +1,26 @@
 #!/bin/sh
-# Prints the image's flash and RAM use and fails when it exceeds the budget
-# (the application: 32 KB flash, 8 KB RAM, the goal we track 16 KB / 4 KB;
-# the bootloader: check-image.sh ELF 4096, its 4 KB) or links any
-# soft-float helper: firmware code is fixed point.
+# Prints the image's flash and RAM use and fails when it exceeds its limits
+# or links any soft-float helper: firmware code is fixed point.
+#   check-image.sh ELF [FLASH_LIMIT [RAM_LIMIT]]
+# The application's limits default to 32 KB / 8 KB and it is measured
+# against issue 10's goal of 16 KB / 4 KB; a board whose part is that small
+# passes the goal as its limits (the Cortex-M0 board: its RAM, and a flash
+# ceiling until the goal is met: board.cmake). The bootloader:
+# check-image.sh ELF 4096, its 4 KB.
 set -eu
 elf=$1
 SIZE=${SIZE:-arm-none-eabi-size}
 NM=${NM:-arm-none-eabi-nm}
-FLASH_LIMIT=${2:-32768}; RAM_LIMIT=8192; FLASH_GOAL=${2:-16384}; RAM_GOAL=4096
+FLASH_LIMIT=${2:-32768}; RAM_LIMIT=${3:-8192}; FLASH_GOAL=16384; RAM_GOAL=4096
+if [ "$FLASH_LIMIT" -lt "$FLASH_GOAL" ]; then FLASH_GOAL=$FLASH_LIMIT; fi
 
 sizes=$($SIZE -A "$elf")
 section() { echo "$sizes" | awk -v s="$1" '$1 == s { print $2; f=1 } END { if (!f) print 0 }'; }
 flash=$(( $(section .isr_vector) + $(section .text) + $(section .ARM.exidx) + $(section .data) ))
-ram=$(( $(section .data) + $(section .bss) + $(section .stack) ))
-echo "image: flash $flash B of $FLASH_LIMIT (goal $FLASH_GOAL), RAM $ram B of $RAM_LIMIT (goal $RAM_GOAL; .data $(section .data) + .bss $(section .bss) + stack $(section .stack))"
+# .ram_vectors: a Cortex-M0 image's vector table, copied to RAM.
+ram=$(( $(section .ram_vectors) + $(section .data) + $(section .bss) + $(section .stack) ))
+verdict() { if [ "$1" -le "$2" ]; then echo "met"; else echo "NOT MET"; fi; }
+echo "image: flash $flash B of $FLASH_LIMIT (goal $FLASH_GOAL: $(verdict $flash $FLASH_GOAL)), RAM $ram B of $RAM_LIMIT (goal $RAM_GOAL: $(verdict $ram $RAM_GOAL); vectors $(section .ram_vectors) + .data $(section .data) + .bss $(section .bss) + stack $(section .stack))"
 
 status=0
 if [ "$flash" -gt "$FLASH_LIMIT" ]; then echo "error: flash $flash B exceeds $FLASH_LIMIT B" >&2; status=1; fi

@@ -1,7 +1,8 @@
 /* Reset handler and vector table for the STM32F103 (Cortex-M3). */
 #include <stdint.h>
 
-extern uint32_t _sidata, _sdata, _edata, _sbss, _ebss, _estack;
+#include "startup_memory.h"
+
 int main(void);
 void Reset_Handler(void);
 void Default_Handler(void);
@@ -11,13 +12,7 @@ void DMA1_Channel5_IRQHandler(void) __attribute__((weak, alias("Default_Handler"
 
 void Reset_Handler(void)
 {
-    uint32_t *src = &_sidata;
-    for (uint32_t *dst = &_sdata; dst < &_edata;) {
-        *dst++ = *src++;
-    }
-    for (uint32_t *dst = &_sbss; dst < &_ebss;) {
-        *dst++ = 0;
-    }
+    startup_memory();
     (void)main();
     for (;;) {
     }

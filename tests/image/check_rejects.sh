@@ -29,5 +29,9 @@ if sh "$root/cmake/check-image.sh" "$tmp/probe.elf" 8 2>"$tmp/err" >/dev/null; t
   echo "image over a bootloader-style flash budget accepted"; fail=1
 fi
 grep -q "flash .* exceeds 8 B" "$tmp/err" || { echo "flash overrun not reported"; fail=1; }
+if sh "$root/cmake/check-image.sh" "$tmp/probe.elf" 32768 64 2>"$tmp/err" >/dev/null; then
+  echo "image over a board's RAM limit (the Cortex-M0 board's style) accepted"; fail=1
+fi
+grep -q "RAM .* exceeds 64 B" "$tmp/err" || { echo "board RAM overrun not reported"; fail=1; }
 [ $fail -eq 0 ] && echo "check-image: rejects soft float, RAM and flash overruns, accepts a clean image"
 exit $fail

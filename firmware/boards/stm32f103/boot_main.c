@@ -5,7 +5,7 @@
 #include "boot_flow.h"
 #include "boot_jump.h"
 #include "bootloader.h"
-#include "flash_f1.h"
+#include "flash_f0f1.h"
 #include "port_uart.h"
 #include "stm32f1_regs.h"
 #include "systick_clock.h"
@@ -42,7 +42,7 @@ int main(void)
     clock_f103_init();
     bus_pins_init();
     systick_clock_init(F103_CORE_HZ);
-    flash_f1_init(&config_flash, 1024u, CONFIG_PAGE0, CONFIG_PAGE1);
+    flash_f0f1_init(&config_flash, 1024u, CONFIG_PAGE0, CONFIG_PAGE1);
     slot_flash = config_flash; /* the same flash: any page by its address */
     slot = (struct app_slot){.flash = &slot_flash, .base = SLOT_BASE, .pages = SLOT_PAGES};
     port = (struct hal_port){.flash = &config_flash};

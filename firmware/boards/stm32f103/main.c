@@ -1,7 +1,7 @@
 /* The reference board: STM32F103 servo controller (pin map: README.md). */
 #include "board_f103.h"
 #include "calibration.h"
-#include "flash_f1.h"
+#include "flash_f0f1.h"
 #include "boot_flow.h"
 #include "boot_jump.h"
 #include "servo.h"
@@ -19,32 +19,6 @@ static struct servo servo;
 static struct hal_port port;
 static struct usart_hd usart;
 static struct hal_flash flash;
-
-static void motor_drive(void *ctx, int16_t duty)
-{
-    (void)ctx;
-    pwm_bridge_drive(duty);
-}
-
-static void motor_coast(void *ctx)
-{
-    (void)ctx;
-    pwm_bridge_coast();
-}
-
-static uint16_t encoder_read(void *ctx)
-{
-    (void)ctx;
-    return adc_scan_values[ADC_POSITION];
-}
-
-static void sensors_read(void *ctx, struct sensor_raw *out)
-{
-    (void)ctx;
-    out->supply = adc_scan_values[ADC_SUPPLY];
-    out->current = adc_scan_values[ADC_CURRENT];
-    out->ntc = adc_scan_values[ADC_NTC];
-}
 
 static const struct sensor_calibration calibration = BOARD_SENSOR_CALIBRATION;
 
@@ -71,18 +45,15 @@ int main(void)
     systick_clock_init(F103_CORE_HZ);
     adc_scan_init();
     pwm_bridge_init();
-    flash_f1_init(&flash, 1024u, CONFIG_PAGE0, CONFIG_PAGE1);
+    flash_f0f1_init(&flash, 1024u, CONFIG_PAGE0, CONFIG_PAGE1);
     port = (struct hal_port){
-        .motor_drive = motor_drive,
-        .motor_coast = motor_coast,
-        .encoder_read = encoder_read,
-        .sensors_read = sensors_read,
         .calibration = &calibration,
         .flash = &flash,
         .enter_bootloader = enter_bootloader,
         .board = BOARD_ID,
         .serial_number = unique_id_serial(),
     };
+    board_port_motor_sensors(&port);
     port_uart_init(&port, &usart, PORT_UART_RX_DMA, F103_PCLK2_HZ);
     servo_init(&servo, &port);
     NVIC_ISER(USART1_IRQ / 32u) = 1u << (USART1_IRQ % 32u);

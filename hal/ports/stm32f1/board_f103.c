@@ -2,7 +2,7 @@
 
 #include "stm32f1_regs.h"
 
-enum { HSE_STARTUP_TRIES = 100000, PWM_HZ = 20000 };
+enum { HSE_STARTUP_TRIES = 100000 };
 
 void clock_f103_init(void)
 {
@@ -22,47 +22,20 @@ void clock_f103_init(void)
     }
 }
 
-static uint32_t pwm_top;
-
 void pwm_bridge_init(void)
 {
     RCC_APB1ENR |= RCC_APB1ENR_TIM3;
-    /* Timer clock is 2 x PCLK1 = 72 MHz. */
-    pwm_top = 2u * F103_PCLK1_HZ / PWM_HZ;
-    TIM_PSC(TIM3_BASE) = 0;
-    TIM_ARR(TIM3_BASE) = pwm_top - 1u;
-    TIM_CCMR1(TIM3_BASE) = TIM_CCMR1_PWM1_BOTH;
-    TIM_CCR1(TIM3_BASE) = 0;
-    TIM_CCR2(TIM3_BASE) = 0;
-    TIM_CCER(TIM3_BASE) = TIM_CCER_CC1E_CC2E;
-    TIM_EGR(TIM3_BASE) = 1u; /* load the preloaded values */
-    TIM_CR1(TIM3_BASE) = 1u | (1u << 7); /* CEN, ARPE */
+    pwm_bridge_start(2u * F103_PCLK1_HZ); /* the timer runs at 2 x PCLK1 */
 }
-
-void pwm_bridge_drive(int16_t duty_q15)
-{
-    uint32_t magnitude = (uint32_t)(duty_q15 < 0 ? -(int32_t)duty_q15 : duty_q15);
-    uint32_t compare = magnitude * pwm_top >> 15;
-    TIM_CCR1(TIM3_BASE) = duty_q15 > 0 ? compare : 0u;
-    TIM_CCR2(TIM3_BASE) = duty_q15 < 0 ? compare : 0u;
-}
-
-void pwm_bridge_coast(void)
-{
-    TIM_CCR1(TIM3_BASE) = 0;
-    TIM_CCR2(TIM3_BASE) = 0;
-}
-
-volatile uint16_t adc_scan_values[ADC_CHANNELS];
 
 void adc_scan_init(void)
 {
     RCC_AHBENR |= RCC_AHBENR_DMA1;
     RCC_APB2ENR |= RCC_APB2ENR_ADC1;
-    DMA1_CPAR1 = ADC_DR_ADDR;
-    DMA1_CMAR1 = (uint32_t)(uintptr_t)adc_scan_values;
-    DMA1_CNDTR1 = ADC_CHANNELS;
-    DMA1_CCR1 = DMA_CCR_ADC_CIRCULAR;
+    DMA_CPAR(DMA1_CCR_ADDR(1u)) = ADC_DR_ADDR;
+    DMA_CMAR(DMA1_CCR_ADDR(1u)) = (uint32_t)(uintptr_t)adc_scan_values;
+    DMA_CNDTR(DMA1_CCR_ADDR(1u)) = ADC_CHANNELS;
+    DMA_CCR(DMA1_CCR_ADDR(1u)) = DMA_CCR_ADC_CIRCULAR;
     /* Channels 0-3 (PA0-PA3), 55.5 cycles each: 4 x 5.8 us at 12 MHz. */
     ADC_SMPR2 = 5u | (5u << 3) | (5u << 6) | (5u << 9);
     ADC_SQR1 = (uint32_t)(ADC_CHANNELS - 1) << 20;
@@ -77,23 +50,9 @@ void adc_scan_init(void)
     ADC_CR2 |= ADC_CR2_SWSTART;
 }
 
-void iwdg_start(void)
-{
-    IWDG_KR = IWDG_KEY_START;
-    IWDG_KR = IWDG_KEY_ACCESS;
-    IWDG_PR = 0; /* 40 kHz / 4 */
-    IWDG_RLR = 1250u; /* 125 ms */
-    IWDG_KR = IWDG_KEY_RELOAD;
-}
-
-void iwdg_kick(void)
-{
-    IWDG_KR = IWDG_KEY_RELOAD;
-}
-
 uint32_t unique_id_serial(void)
 {
-    return REG32(UID_ADDR) ^ REG32(UID_ADDR + 4u) ^ REG32(UID_ADDR + 8u);
+    return unique_id_serial_at(UID_ADDR);
 }
 
 void bus_pins_init(void)

@@ -5,6 +5,8 @@
 
 #include <stdint.h>
 
+#include "board_common.h" /* the bridge PWM, the ADC scan, the watchdog */
+
 #define F103_CORE_HZ 72000000u
 #define F103_PCLK2_HZ 72000000u /* USART1, ADC (through /6), TIM on APB2 */
 #define F103_PCLK1_HZ 36000000u
@@ -19,19 +21,9 @@ void bus_pins_init(void);
 
 /* TIM3 CH1/CH2 (PA6/PA7) at 20 kHz into the bridge's IN1/IN2. */
 void pwm_bridge_init(void);
-/* Signed duty, Q15: positive drives IN1, negative IN2. */
-void pwm_bridge_drive(int16_t duty_q15);
-/* Both inputs low: the bridge's outputs float (coast). */
-void pwm_bridge_coast(void);
 
-/* Scan order of ADC1, converted continuously into adc_scan_values[]. */
-enum adc_channel { ADC_SUPPLY, ADC_CURRENT, ADC_NTC, ADC_POSITION, ADC_CHANNELS };
-extern volatile uint16_t adc_scan_values[ADC_CHANNELS];
+/* ADC1 scans channels 0-3 into adc_scan_values[] (board_common.h). */
 void adc_scan_init(void);
-
-/* Independent watchdog, about 125 ms: the main loop must come round. */
-void iwdg_start(void);
-void iwdg_kick(void);
 
 /* The 96-bit unique ID folded to the 32-bit serial number (data ID 8). */
 uint32_t unique_id_serial(void);

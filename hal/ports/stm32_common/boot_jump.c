@@ -1,18 +1,14 @@
 #include "boot_jump.h"
 
-#include "stm32f1_regs.h"
+#include "stm32_core_regs.h"
 
 #define SCB_VTOR REG32(0xE000ED08u)
-#define SCB_AIRCR REG32(0xE000ED0Cu)
-#define AIRCR_RESET (0x05FA0000u | (1u << 2)) /* VECTKEY, SYSRESETREQ */
-#define NVIC_ICER(n) REG32(0xE000E180u + 4u * (n))
-#define NVIC_ICPR(n) REG32(0xE000E280u + 4u * (n))
 
 void boot_restart_with(uint32_t addr, uint32_t word)
 {
     REG32(addr) = word;
     __asm__ volatile("dsb" ::: "memory");
-    SCB_AIRCR = AIRCR_RESET;
+    SCB_AIRCR = SCB_AIRCR_RESET;
     for (;;) {
     }
 }
@@ -30,11 +26,13 @@ void boot_jump(uint32_t vector_table)
     uint32_t entry = REG32(vector_table + 4u);
     __asm__ volatile("cpsid i" ::: "memory");
     SYSTICK_CTRL = 0;
-    for (uint32_t n = 0; n < 2u; n++) { /* the F1's 68 interrupt lines */
+    for (uint32_t n = 0; n < 2u; n++) { /* the F1's 68 interrupt lines, the F0's 32 */
         NVIC_ICER(n) = 0xFFFFFFFFu;
         NVIC_ICPR(n) = 0xFFFFFFFFu;
     }
+#if defined(__ARM_ARCH_7M__)
     SCB_VTOR = vector_table;
+#endif /* ARMv6-M has no VTOR: the image's startup maps its table (startup_stm32f030.c) */
     __asm__ volatile("dsb\n"
                      "isb\n"
                      "msr msp, %0\n"

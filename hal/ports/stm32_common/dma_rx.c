@@ -1,12 +1,7 @@
 #include "dma_rx.h"
 
-#include "stm32f1_regs.h"
+#include "stm32_core_regs.h"
 
-/* Channel registers from its CCR (RM0008 13.4.3-13.4.6). */
-#define DMA_CCR(ch) REG32((ch) + 0x0u)
-#define DMA_CNDTR(ch) REG32((ch) + 0x4u)
-#define DMA_CPAR(ch) REG32((ch) + 0x8u)
-#define DMA_CMAR(ch) REG32((ch) + 0xCu)
 /* MINC | CIRC | TCIE | EN; bytes both sides; priority very high (PL = 3). */
 #define DMA_CCR_RX_CIRCULAR ((1u << 7) | (1u << 5) | (1u << 1) | (1u << 0) | (3u << 12))
 

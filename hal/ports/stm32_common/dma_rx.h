@@ -1,4 +1,4 @@
-/* USART receive by DMA into the HAL's ring (RM0008 13, "DMA controller"):
+/* USART receive by DMA into the HAL's ring (RM0008 13 and RM0360 10, "DMA controller": the same channel on F1 and F0):
  * one channel in circular mode writes every received byte into
  * hal_rx_ring.data, with no code per byte; its counter (CNDTR, counting
  * down from the ring's size) is the write position, and a transfer-complete
@@ -11,8 +11,8 @@
  *
  * The channel's registers are found from `channel` (the address of its
  * CCR), so the benchmark can run this on registers in RAM. */
-#ifndef STM32F1_DMA_RX_H
-#define STM32F1_DMA_RX_H
+#ifndef STM32_DMA_RX_H
+#define STM32_DMA_RX_H
 
 #include <stdint.h>
 

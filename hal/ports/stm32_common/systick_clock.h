@@ -1,7 +1,7 @@
 /* A free-running microsecond clock from SysTick (1 ms interrupt plus the
  * counter in between); wraps at 2^32 us like hal_port.now_us wants. */
-#ifndef STM32F1_SYSTICK_CLOCK_H
-#define STM32F1_SYSTICK_CLOCK_H
+#ifndef STM32_SYSTICK_CLOCK_H
+#define STM32_SYSTICK_CLOCK_H
 
 #include <stdint.h>
 

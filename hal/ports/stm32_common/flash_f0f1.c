@@ -1,6 +1,6 @@
-#include "flash_f1.h"
+#include "flash_f0f1.h"
 
-#include "stm32f1_regs.h"
+#include "stm32_core_regs.h"
 
 static void unlock(void)
 {
@@ -35,7 +35,7 @@ static bool erase_page(void *ctx, uint32_t addr)
     return ok;
 }
 
-/* The F1 programs a half-word at a time (RM0008 3.3.3): the write block. */
+/* A half-word at a time (RM0008 3.3.3, RM0360 3.2.2): the write block. */
 static bool program(void *ctx, uint32_t addr, const uint8_t *data)
 {
     (void)ctx;
@@ -57,7 +57,7 @@ static void flash_read(void *ctx, uint32_t addr, uint8_t *dst, uint32_t len)
     }
 }
 
-void flash_f1_init(struct hal_flash *f, uint32_t page_size, uint32_t page0, uint32_t page1)
+void flash_f0f1_init(struct hal_flash *f, uint32_t page_size, uint32_t page0, uint32_t page1)
 {
     *f = (struct hal_flash){
         .ctx = f,

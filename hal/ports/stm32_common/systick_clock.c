@@ -1,9 +1,6 @@
 #include "systick_clock.h"
 
-#include "stm32f1_regs.h"
-
-#define SCB_ICSR REG32(0xE000ED04u)
-#define ICSR_PENDSTSET (1u << 26)
+#include "stm32_core_regs.h"
 
 static volatile uint32_t uptime_ms;
 static uint32_t reload;
@@ -34,7 +31,7 @@ uint32_t systick_now_us(void)
     do {
         ms = uptime_ms;
         val = SYSTICK_VAL;
-        pending = SCB_ICSR & ICSR_PENDSTSET;
+        pending = SCB_ICSR & SCB_ICSR_PENDSTSET;
     } while (ms != uptime_ms);
     /* Called from an interrupt that holds off SysTick: the counter may have
      * wrapped with the millisecond not yet counted. A value read near the

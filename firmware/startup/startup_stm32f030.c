@@ -1,0 +1,57 @@
+/* Reset handler and vector table for the STM32F030 (Cortex-M0). ARMv6-M
+ * has no VTOR: the core takes its vectors from address 0, which is the
+ * bootloader's flash. The application copies its table to the start of RAM
+ * and maps RAM there (SYSCFG MEM_MODE, RM0360 9.1.1) before any interrupt
+ * is enabled; the linker script keeps those 192 bytes out of .data/.bss. */
+#include <stdint.h>
+
+#include "startup_memory.h"
+
+extern uint32_t _ram_vectors;
+int main(void);
+void Reset_Handler(void);
+void Default_Handler(void);
+void SysTick_Handler(void) __attribute__((weak, alias("Default_Handler")));
+void USART1_IRQHandler(void) __attribute__((weak, alias("Default_Handler")));
+void DMA1_Channel2_3_IRQHandler(void) __attribute__((weak, alias("Default_Handler")));
+
+enum { CORE_VECTORS = 16, DMA1_CHANNEL2_3_IRQ = 10, USART1_IRQ = 27, VECTORS = CORE_VECTORS + 32 };
+
+#define REG32(addr) (*(volatile uint32_t *)(uintptr_t)(addr))
+#define RCC_APB2ENR REG32(0x40021018u)
+#define RCC_APB2ENR_SYSCFG (1u << 0)
+#define SYSCFG_CFGR1 REG32(0x40010000u)
+#define SYSCFG_CFGR1_MEM_MODE_SRAM 3u
+
+__attribute__((section(".isr_vector"), used))
+static void (*const vector_table[VECTORS])(void) = {
+    [0] = (void (*)(void))(uintptr_t)&_estack,
+    [1] = Reset_Handler,
+    [2] = Default_Handler,  /* NMI */
+    [3] = Default_Handler,  /* HardFault */
+    [11] = Default_Handler, /* SVCall */
+    [14] = Default_Handler, /* PendSV */
+    [15] = SysTick_Handler,
+    [CORE_VECTORS + DMA1_CHANNEL2_3_IRQ] = DMA1_Channel2_3_IRQHandler,
+    [CORE_VECTORS + USART1_IRQ] = USART1_IRQHandler,
+};
+
+void Reset_Handler(void)
+{
+    uint32_t *ram = &_ram_vectors;
+    for (uint32_t i = 0; i < VECTORS; i++) {
+        ram[i] = (uint32_t)(uintptr_t)vector_table[i];
+    }
+    RCC_APB2ENR |= RCC_APB2ENR_SYSCFG;
+    SYSCFG_CFGR1 = SYSCFG_CFGR1_MEM_MODE_SRAM;
+    startup_memory();
+    (void)main();
+    for (;;) {
+    }
+}
+
+void Default_Handler(void)
+{
+    for (;;) {
+    }
+}

@@ -1,0 +1,89 @@
+#include "board_common.h"
+
+#include "stm32_core_regs.h"
+
+enum { PWM_HZ = 20000 };
+
+static uint32_t pwm_top;
+
+volatile uint16_t adc_scan_values[ADC_CHANNELS];
+
+void pwm_bridge_start(uint32_t timer_hz)
+{
+    pwm_top = timer_hz / PWM_HZ;
+    TIM_PSC(TIM3_BASE) = 0;
+    TIM_ARR(TIM3_BASE) = pwm_top - 1u;
+    TIM_CCMR1(TIM3_BASE) = TIM_CCMR1_PWM1_BOTH;
+    TIM_CCR1(TIM3_BASE) = 0;
+    TIM_CCR2(TIM3_BASE) = 0;
+    TIM_CCER(TIM3_BASE) = TIM_CCER_CC1E_CC2E;
+    TIM_EGR(TIM3_BASE) = 1u; /* load the preloaded values */
+    TIM_CR1(TIM3_BASE) = 1u | (1u << 7); /* CEN, ARPE */
+}
+
+void pwm_bridge_drive(int16_t duty_q15)
+{
+    uint32_t magnitude = (uint32_t)(duty_q15 < 0 ? -(int32_t)duty_q15 : duty_q15);
+    uint32_t compare = magnitude * pwm_top >> 15;
+    TIM_CCR1(TIM3_BASE) = duty_q15 > 0 ? compare : 0u;
+    TIM_CCR2(TIM3_BASE) = duty_q15 < 0 ? compare : 0u;
+}
+
+void pwm_bridge_coast(void)
+{
+    TIM_CCR1(TIM3_BASE) = 0;
+    TIM_CCR2(TIM3_BASE) = 0;
+}
+
+void iwdg_start(void)
+{
+    IWDG_KR = IWDG_KEY_START;
+    IWDG_KR = IWDG_KEY_ACCESS;
+    IWDG_PR = 0; /* 40 kHz / 4 */
+    IWDG_RLR = 1250u; /* 125 ms */
+    IWDG_KR = IWDG_KEY_RELOAD;
+}
+
+void iwdg_kick(void)
+{
+    IWDG_KR = IWDG_KEY_RELOAD;
+}
+
+uint32_t unique_id_serial_at(uint32_t uid_addr)
+{
+    return REG32(uid_addr) ^ REG32(uid_addr + 4u) ^ REG32(uid_addr + 8u);
+}
+
+static void motor_drive(void *ctx, int16_t duty)
+{
+    (void)ctx;
+    pwm_bridge_drive(duty);
+}
+
+static void motor_coast(void *ctx)
+{
+    (void)ctx;
+    pwm_bridge_coast();
+}
+
+static uint16_t encoder_read(void *ctx)
+{
+    (void)ctx;
+    return adc_scan_values[ADC_POSITION];
+}
+
+static void sensors_read(void *ctx, struct sensor_raw *out)
+{
+    (void)ctx;
+    out->supply = adc_scan_values[ADC_SUPPLY];
+    out->current = adc_scan_values[ADC_CURRENT];
+    out->ntc = adc_scan_values[ADC_NTC];
+}
+
+void board_port_motor_sensors(struct hal_port *port)
+{
+    port->motor_drive = motor_drive;
+    port->motor_coast = motor_coast;
+    port->encoder_read = encoder_read;
+    port->sensors_read = sensors_read;
+}

@@ -1,0 +1,37 @@
+/* Board peripherals the same on the STM32F0 and F1 once the pins and
+ * clocks are set up: the H-bridge PWM on TIM3, the ADC scan's values and
+ * the hal_port operations on both, the watchdog, the serial number from
+ * the unique ID. */
+#ifndef STM32_BOARD_COMMON_H
+#define STM32_BOARD_COMMON_H
+
+#include <stdint.h>
+
+#include "hal/hal_port.h"
+
+/* The ADC's scan of channels 0-3 (PA0-PA3), converted continuously into
+ * adc_scan_values[] by DMA1 channel 1 (each family's adc_scan_init). */
+enum adc_channel { ADC_SUPPLY, ADC_CURRENT, ADC_NTC, ADC_POSITION, ADC_CHANNELS };
+extern volatile uint16_t adc_scan_values[ADC_CHANNELS];
+
+/* The hal_port's motor_drive, motor_coast, encoder_read and sensors_read
+ * on the bridge PWM and the ADC scan. */
+void board_port_motor_sensors(struct hal_port *port);
+
+/* TIM3 CH1/CH2 at 20 kHz from timer_hz, into the bridge's IN1/IN2 (the
+ * board has clocked TIM3 and routed its pins). */
+void pwm_bridge_start(uint32_t timer_hz);
+/* Signed duty, Q15: positive drives IN1, negative IN2. */
+void pwm_bridge_drive(int16_t duty_q15);
+/* Both inputs low: the bridge's outputs float (coast). */
+void pwm_bridge_coast(void);
+
+/* Independent watchdog, about 125 ms: the main loop must come round. */
+void iwdg_start(void);
+void iwdg_kick(void);
+
+/* The 96-bit unique ID at uid_addr folded to the 32-bit serial number
+ * (data ID 8). */
+uint32_t unique_id_serial_at(uint32_t uid_addr);
+
+#endif

@@ -1,0 +1,67 @@
+#include "usart_v2_hd.h"
+
+#include "stm32f0_regs.h"
+
+enum { RUNNING = USART_CR1_UE | USART_CR1_TE | USART_CR1_RE };
+
+void usart_v2_hd_set_baud(struct usart_v2_hd *u, uint32_t baud)
+{
+    /* BRR and the mode bits take writes only while the USART is off
+     * (RM0360 23.7.4): a byte on the wire now is lost, as with any
+     * baud change (data ID 36 answers first, then changes). */
+    uint32_t cr1 = USART_CR1(u->base);
+    USART_CR1(u->base) = 0;
+    USART_BRR(u->base) = (u->pclk_hz + baud / 2u) / baud;
+    USART_CR1(u->base) = cr1;
+}
+
+void usart_v2_hd_init(struct usart_v2_hd *u, uintptr_t base, uint32_t pclk_hz, uint32_t baud)
+{
+    *u = (struct usart_v2_hd){.base = base, .pclk_hz = pclk_hz};
+    USART_CR1(base) = 0;
+    USART_BRR(base) = (pclk_hz + baud / 2u) / baud;
+    /* An overrun cannot happen while the DMA takes every byte; were the
+     * bus's DMA ever held up, OVRDIS keeps the receiver going (the newest
+     * byte wins) instead of stopping it until the flag is cleared. */
+    USART_CR3(base) = USART_CR3_HDSEL | USART_CR3_DMAR | USART_CR3_OVRDIS;
+    USART_ICR(base) = USART_ICR_CLEAR;
+    USART_CR1(base) = RUNNING;
+}
+
+void usart_v2_hd_send(struct usart_v2_hd *u, const uint8_t *data, uint16_t len)
+{
+    if (len == 0u) {
+        return;
+    }
+    u->tx = data;
+    u->tx_left = len;
+    u->tx_busy = 1;
+    /* Turn the line around: stop listening, start talking. */
+    USART_CR1(u->base) = (RUNNING & ~USART_CR1_RE) | USART_CR1_TXEIE;
+}
+
+bool usart_v2_hd_tx_done(const struct usart_v2_hd *u)
+{
+    return !u->tx_busy;
+}
+
+/* The next byte while the transmit register is empty, then the stop bit
+ * of the last one, then the line turned around. */
+void usart_v2_hd_irq(struct usart_v2_hd *u)
+{
+    uint32_t isr = USART_ISR(u->base);
+    if (u->tx_left > 0u) {
+        if (isr & USART_ISR_TXE) {
+            USART_TDR(u->base) = *u->tx;
+            u->tx++;
+            u->tx_left--;
+            if (u->tx_left == 0u) {
+                USART_CR1(u->base) = (RUNNING & ~USART_CR1_RE) | USART_CR1_TCIE;
+            }
+        }
+    } else if (isr & USART_ISR_TC) {
+        USART_ICR(u->base) = USART_ICR_CLEAR;
+        USART_CR1(u->base) = RUNNING;
+        u->tx_busy = 0;
+    }
+}

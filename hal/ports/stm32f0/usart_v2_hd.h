@@ -1,0 +1,31 @@
+/* The F0's USART (RM0360 23: separate status, clear, receive and transmit
+ * registers) in single-wire half-duplex mode. It receives by DMA only
+ * (dma_rx.h, channel 3): no code runs per received byte. A send runs from
+ * the interrupt and turns the line around (receiver off while sending,
+ * back on after the last stop bit), so the servo never hears its own echo,
+ * as on the F1 (../stm32f1/usart_hd.h). */
+#ifndef STM32F0_USART_V2_HD_H
+#define STM32F0_USART_V2_HD_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+struct usart_v2_hd {
+    uintptr_t base;
+    uint32_t pclk_hz;
+    const uint8_t *volatile tx;
+    volatile uint16_t tx_left;
+    volatile uint8_t tx_busy;
+};
+
+/* Single wire, 16x oversampling, the receiver requesting DMA (the caller
+ * starts the channel on USART_RDR). */
+void usart_v2_hd_init(struct usart_v2_hd *u, uintptr_t base, uint32_t pclk_hz, uint32_t baud);
+void usart_v2_hd_set_baud(struct usart_v2_hd *u, uint32_t baud);
+/* Starts sending; data must stay valid until usart_v2_hd_tx_done(). */
+void usart_v2_hd_send(struct usart_v2_hd *u, const uint8_t *data, uint16_t len);
+bool usart_v2_hd_tx_done(const struct usart_v2_hd *u);
+/* The USART's interrupt handler calls this. */
+void usart_v2_hd_irq(struct usart_v2_hd *u);
+
+#endif
