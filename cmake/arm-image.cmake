@@ -14,6 +14,9 @@ function(servo_arm_image name)
   endif()
   add_executable(${name}.elf ${I_SOURCES} ${SERVO_BOARD_STARTUP})
   target_link_libraries(${name}.elf PRIVATE ${I_LIBS} ${SERVO_BOARD_PORT} servo_app)
+  if(SERVO_SIZE_FIRST)
+    target_sources(${name}.elf PRIVATE $<TARGET_OBJECTS:servo_small_runtime>)
+  endif()
   target_include_directories(${name}.elf PRIVATE ${PROJECT_SOURCE_DIR}/firmware/boards/stm32f103
                              ${PROJECT_SOURCE_DIR}/firmware/bootloader)
   target_compile_definitions(${name}.elf PRIVATE BOARD_ID=${SERVO_BOARD_ID}u)
@@ -44,9 +47,9 @@ function(servo_arm_bootloader name)
   cmake_parse_arguments(I "" "" "SOURCES" ${ARGN})
   # Built for size (-Oz) into the image itself, so these objects come before
   # the libraries' -Os ones: the bootloader core, the framer byte by byte
-  # (FRAME_RX_SMALL) and small mem* functions (firmware/bootloader/small_mem.c).
+  # (FRAME_RX_SMALL) and small mem* functions (firmware/runtime/small_mem.c).
   set(boot ${PROJECT_SOURCE_DIR}/firmware/bootloader)
-  set(small ${PROJECT_SOURCE_DIR}/protocol/frame_rx.c ${boot}/small_mem.c ${boot}/bootloader.c
+  set(small ${PROJECT_SOURCE_DIR}/protocol/frame_rx.c ${PROJECT_SOURCE_DIR}/firmware/runtime/small_mem.c ${boot}/bootloader.c
       ${boot}/boot_packets.c ${boot}/boot_flow.c ${boot}/app_image.c ${boot}/slot_write.c
       ${PROJECT_SOURCE_DIR}/firmware/storage/config_peek.c)
   add_executable(${name}.elf ${I_SOURCES} ${SERVO_BOARD_STARTUP} ${small})

@@ -13,8 +13,10 @@ MODULES = [  # (part of the object's path in the map, name)
     ("libservo_sensors.a", "sensors: scaling, NTC table"),
     ("libservo_protection.a", "protection monitors"),
     ("libservo_app.a", "servo core (servo.c)"),
-    ("libservo_stm32f1.a", "STM32F1 port (USART, SysTick, flash, clock, PWM, ADC, IWDG)"),
-    ("startup_stm32f103", "startup, vector table"),
+    ("libservo_stm32f1.a", "STM32F1 port (USART, clock, pins, ADC)"),
+    ("libservo_stm32f0.a", "STM32F0 port (USART, clock, pins, ADC)"),
+    ("libservo_stm32_common.a", "STM32 common (DMA receive, SysTick, flash, PWM, IWDG, boot jump)"),
+    ("startup_stm32", "startup, vector table"),
     ("boards/", "board (main, HAL ops, static servo state)"),
 ]
 

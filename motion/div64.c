@@ -34,10 +34,28 @@ static uint32_t div64_long(uint32_t u1, uint32_t u0, uint32_t v)
     return (q1 << 16) | q0;
 }
 
+/* n / d for d beyond 32 bits (the quotient fits 32): d normalised to its
+ * top 32 bits, one long division of n / 2, then at most one correction
+ * (Hacker's Delight 9-5, divdu). */
+static uint64_t div64_wide(uint64_t n, uint64_t d)
+{
+    unsigned s = (unsigned)__builtin_clz((uint32_t)(d >> 32));
+    uint32_t top = (uint32_t)((d << s) >> 32);
+    uint64_t half = n >> 1;
+    uint64_t q = ((uint64_t)div64_long((uint32_t)(half >> 32), (uint32_t)half, top) << s) >> 31;
+    if (q != 0u) {
+        q--;
+    }
+    if (n - q * d >= d) {
+        q++;
+    }
+    return q;
+}
+
 uint64_t div64_u(uint64_t n, uint64_t d)
 {
     if ((d >> 32) != 0u) {
-        return n / d;
+        return div64_wide(n, d);
     }
     uint32_t v = (uint32_t)d;
     uint32_t hi = (uint32_t)(n >> 32);

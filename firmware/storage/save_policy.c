@@ -2,9 +2,12 @@
 
 void save_policy_init(struct save_policy *p, const struct config_store *store, uint32_t now_us)
 {
-    uint64_t lifetime = 2ull * FLASH_RATED_CYCLES * config_store_slots_per_page(store);
-    uint64_t budget = lifetime * SAVE_BUDGET_PERCENT / 100u - SAVE_ALLOWANCE;
-    uint64_t per_save = (SAVE_LIFE_SECONDS + budget - 1u) / budget;
+    /* 32 bits do: 2 pages x 10 000 cycles x at most 65 535 slots is below
+     * 2^31, and a multiple of 100, so taking the percentage after the
+     * division is exact. */
+    uint32_t lifetime = 2u * FLASH_RATED_CYCLES * config_store_slots_per_page(store);
+    uint32_t budget = lifetime / 100u * SAVE_BUDGET_PERCENT - SAVE_ALLOWANCE;
+    uint32_t per_save = (SAVE_LIFE_SECONDS + budget - 1u) / budget;
     *p = (struct save_policy){
         .seconds_per_save = (uint32_t)per_save,
         .op_seconds_at_boot = store->op_seconds,
