@@ -11,7 +11,10 @@ the host preset's build/host/tests/libqemu_insn_count.so.
 Instructions are exact (QEMU's translator, one count per guest
 instruction), less the markers' own cost (the region "overhead"). The
 plugin is checked first: 100 more iterations of a 2-instruction loop must
-count exactly 200 more instructions. Cycles are the plugin's model
+count exactly 200 more instructions. QEMU runs with -icount shift=0: its
+clock follows the instruction count, so the SysTick interrupts fall at the
+same instructions every run, never where the host's load puts them.
+Cycles are the plugin's model
 (qemu_insn_count.c, thumb_cycles.h: ARM's timing tables, the STM32F1 flash
 at 2 wait states for the M3 at 72 MHz; 0 wait states for the M0, as the
 issue asks), an estimate, not a measurement."""
@@ -119,7 +122,7 @@ def run(elf: Path, cpu: str, profile_region: str = "", by_line: bool = False) ->
             plugin += f",profile={profile_file}"
         proc = subprocess.run(
             ["qemu-system-arm", "-M", "lm3s6965evb", "-cpu", cpu, "-nographic",
-             "-semihosting-config", "enable=on,target=native", "-kernel", str(elf), "-plugin", plugin],
+             "-semihosting-config", "enable=on,target=native", "-icount", "shift=0", "-kernel", str(elf), "-plugin", plugin],
             capture_output=True, text=True, timeout=600)
         if proc.returncode != 0:
             raise SystemExit(f"run_target_bench: {elf.name} on {cpu} failed: {proc.stderr.strip()}")
