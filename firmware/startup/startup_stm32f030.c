@@ -6,6 +6,7 @@
 #include <stdint.h>
 
 #include "startup_memory.h"
+#include "stm32f0_regs.h"
 
 extern uint32_t _ram_vectors;
 int main(void);
@@ -15,13 +16,7 @@ void SysTick_Handler(void) __attribute__((weak, alias("Default_Handler")));
 void USART1_IRQHandler(void) __attribute__((weak, alias("Default_Handler")));
 void DMA1_Channel2_3_IRQHandler(void) __attribute__((weak, alias("Default_Handler")));
 
-enum { CORE_VECTORS = 16, DMA1_CHANNEL2_3_IRQ = 10, USART1_IRQ = 27, VECTORS = CORE_VECTORS + 32 };
-
-#define REG32(addr) (*(volatile uint32_t *)(uintptr_t)(addr))
-#define RCC_APB2ENR REG32(0x40021018u)
-#define RCC_APB2ENR_SYSCFG (1u << 0)
-#define SYSCFG_CFGR1 REG32(0x40010000u)
-#define SYSCFG_CFGR1_MEM_MODE_SRAM 3u
+enum { CORE_VECTORS = 16, VECTORS = CORE_VECTORS + 32 };
 
 __attribute__((section(".isr_vector"), used))
 static void (*const vector_table[VECTORS])(void) = {
@@ -32,7 +27,7 @@ static void (*const vector_table[VECTORS])(void) = {
     [11] = Default_Handler, /* SVCall */
     [14] = Default_Handler, /* PendSV */
     [15] = SysTick_Handler,
-    [CORE_VECTORS + DMA1_CHANNEL2_3_IRQ] = DMA1_Channel2_3_IRQHandler,
+    [CORE_VECTORS + DMA1_CH3_IRQ] = DMA1_Channel2_3_IRQHandler,
     [CORE_VECTORS + USART1_IRQ] = USART1_IRQHandler,
 };
 

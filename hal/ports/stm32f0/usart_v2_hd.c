@@ -4,6 +4,12 @@
 
 enum { RUNNING = USART_CR1_UE | USART_CR1_TE | USART_CR1_RE };
 
+/* 16x oversampling: BRR is the divider in 1/16ths, i.e. pclk / baud. */
+static uint32_t brr(uint32_t pclk_hz, uint32_t baud)
+{
+    return (pclk_hz + baud / 2u) / baud;
+}
+
 void usart_v2_hd_set_baud(struct usart_v2_hd *u, uint32_t baud)
 {
     /* BRR and the mode bits take writes only while the USART is off
@@ -11,7 +17,7 @@ void usart_v2_hd_set_baud(struct usart_v2_hd *u, uint32_t baud)
      * baud change (data ID 36 answers first, then changes). */
     uint32_t cr1 = USART_CR1(u->base);
     USART_CR1(u->base) = 0;
-    USART_BRR(u->base) = (u->pclk_hz + baud / 2u) / baud;
+    USART_BRR(u->base) = brr(u->pclk_hz, baud);
     USART_CR1(u->base) = cr1;
 }
 
@@ -19,7 +25,7 @@ void usart_v2_hd_init(struct usart_v2_hd *u, uintptr_t base, uint32_t pclk_hz, u
 {
     *u = (struct usart_v2_hd){.base = base, .pclk_hz = pclk_hz};
     USART_CR1(base) = 0;
-    USART_BRR(base) = (pclk_hz + baud / 2u) / baud;
+    USART_BRR(base) = brr(pclk_hz, baud);
     /* An overrun cannot happen while the DMA takes every byte; were the
      * bus's DMA ever held up, OVRDIS keeps the receiver going (the newest
      * byte wins) instead of stopping it until the flag is cleared. */
