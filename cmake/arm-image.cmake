@@ -15,7 +15,8 @@ function(servo_arm_image name)
   add_executable(${name}.elf ${I_SOURCES} ${SERVO_BOARD_STARTUP})
   target_link_libraries(${name}.elf PRIVATE ${I_LIBS} ${SERVO_BOARD_PORT} servo_app)
   if(SERVO_SIZE_FIRST)
-    target_sources(${name}.elf PRIVATE $<TARGET_OBJECTS:servo_small_runtime>)
+    target_sources(${name}.elf PRIVATE $<TARGET_OBJECTS:servo_small_runtime>
+                   $<TARGET_OBJECTS:servo_small_div>)
   endif()
   target_include_directories(${name}.elf PRIVATE ${PROJECT_SOURCE_DIR}/firmware/boards/stm32f103
                              ${PROJECT_SOURCE_DIR}/firmware/bootloader)
@@ -42,18 +43,29 @@ endfunction()
 
 # servo_arm_bootloader(NAME SOURCES src...): the bootloader of the board
 # whose board.cmake was included last, at the start of flash, with its own
-# budget (4 KB) checked after every link.
+# budget (4 KB, and the part's RAM) checked after every link.
 function(servo_arm_bootloader name)
   cmake_parse_arguments(I "" "" "SOURCES" ${ARGN})
-  # Built for size (-Oz) into the image itself, so these objects come before
-  # the libraries' -Os ones: the bootloader core, the framer byte by byte
-  # (FRAME_RX_SMALL) and small mem* functions (firmware/runtime/small_mem.c).
+  # Built for size (-Oz, link-time optimised) into the image itself, so
+  # these objects come before the libraries' -Os ones: the bootloader core,
+  # the framer byte by byte (FRAME_RX_SMALL), small mem* functions
+  # (firmware/runtime/small_mem.c), and the board's port with the drivers
+  # it shares (unused ones drop out at the link).
   set(boot ${PROJECT_SOURCE_DIR}/firmware/bootloader)
   set(small ${PROJECT_SOURCE_DIR}/protocol/frame_rx.c ${PROJECT_SOURCE_DIR}/firmware/runtime/small_mem.c ${boot}/bootloader.c
       ${boot}/boot_packets.c ${boot}/boot_flow.c ${boot}/app_image.c ${boot}/slot_write.c
-      ${PROJECT_SOURCE_DIR}/firmware/storage/config_peek.c)
+      ${PROJECT_SOURCE_DIR}/firmware/storage/config_peek.c ${PROJECT_SOURCE_DIR}/firmware/storage/crc32.c)
+  foreach(lib ${SERVO_BOARD_PORT} servo_stm32_common)
+    get_target_property(dir ${lib} SOURCE_DIR)
+    get_target_property(sources ${lib} SOURCES)
+    list(TRANSFORM sources PREPEND ${dir}/)
+    list(APPEND small ${sources})
+  endforeach()
   add_executable(${name}.elf ${I_SOURCES} ${SERVO_BOARD_STARTUP} ${small})
-  target_compile_definitions(${name}.elf PRIVATE FRAME_RX_SMALL STARTUP_LAST_IRQ_DMA1_CHANNEL5)
+  if(SERVO_SIZE_FIRST)
+    target_sources(${name}.elf PRIVATE $<TARGET_OBJECTS:servo_small_div>)
+  endif()
+  target_compile_definitions(${name}.elf PRIVATE FRAME_RX_SMALL STARTUP_BOOTLOADER)
   target_compile_options(${name}.elf PRIVATE -Oz -flto -fno-tree-loop-distribute-patterns)
   target_link_options(${name}.elf PRIVATE -Oz -flto)
   target_link_libraries(${name}.elf PRIVATE ${SERVO_BOARD_PORT} servo_bootloader_core)
@@ -66,5 +78,6 @@ function(servo_arm_bootloader name)
   add_custom_command(TARGET ${name}.elf POST_BUILD
     COMMAND ${CMAKE_OBJCOPY} -O binary $<TARGET_FILE:${name}.elf> ${CMAKE_CURRENT_BINARY_DIR}/${name}.bin
     COMMAND sh ${PROJECT_SOURCE_DIR}/cmake/check-image.sh $<TARGET_FILE:${name}.elf> 4096
+            ${SERVO_BOARD_RAM_LIMIT}
     VERBATIM)
 endfunction()

@@ -194,32 +194,31 @@ static bool header_start(struct frame_rx *rx, uint8_t byte)
     return false;
 }
 
-/* One byte through the state machine. */
+/* One byte through the state machine. Every byte from the second header
+ * byte to the last of the content counts in the checksum: summed here
+ * once, for all those states (a second header byte that is not one
+ * restarts the sum anyway). */
 static void step(struct frame_rx *rx, uint8_t byte)
 {
+    if (rx->state >= RX_HDR1 && rx->state <= RX_CONTENT) {
+        rx->checksum = (uint8_t)(rx->checksum + byte);
+    }
     switch (rx->state) {
+    case RX_HDR1:
+        if (byte == (rx->is_request ? WIRE_REQUEST_HDR1 : WIRE_RESPONSE_HDR1)) {
+            rx->state = RX_CODE;
+            return;
+        }
+        /* Not a header after all: the byte may begin the real one. */
+        rx->stats.garbage_bytes++;
+        rx->state = RX_HDR0;
+        /* fall through */
     case RX_HDR0:
         if (!header_start(rx, byte)) {
             rx->stats.garbage_bytes++;
         }
         return;
-    case RX_HDR1: {
-        uint8_t want = rx->is_request ? WIRE_REQUEST_HDR1 : WIRE_RESPONSE_HDR1;
-        if (byte == want) {
-            rx->checksum = (uint8_t)(rx->checksum + byte);
-            rx->state = RX_CODE;
-        } else {
-            /* Not a header after all: the byte may begin the real one. */
-            rx->stats.garbage_bytes++;
-            rx->state = RX_HDR0;
-            if (!header_start(rx, byte)) {
-                rx->stats.garbage_bytes++;
-            }
-        }
-        return;
-    }
     case RX_CODE:
-        rx->checksum = (uint8_t)(rx->checksum + byte);
         if (rx->is_request) {
             rx->discard = next_slot(rx->head) == rx->tail;
             work_slot(rx)->code = byte;
@@ -227,7 +226,6 @@ static void step(struct frame_rx *rx, uint8_t byte)
         rx->state = RX_LENGTH;
         return;
     case RX_LENGTH:
-        rx->checksum = (uint8_t)(rx->checksum + byte);
         /* Only requests use the extended length (extensions.md). */
         if (rx->is_request && byte == WIRE_EXTENDED_LENGTH) {
             rx->state = RX_LENGTH_LO;
@@ -236,16 +234,13 @@ static void step(struct frame_rx *rx, uint8_t byte)
         }
         return;
     case RX_LENGTH_LO:
-        rx->checksum = (uint8_t)(rx->checksum + byte);
         rx->remaining = byte;
         rx->state = RX_LENGTH_HI;
         return;
     case RX_LENGTH_HI:
-        rx->checksum = (uint8_t)(rx->checksum + byte);
         start_content(rx, (uint16_t)(rx->remaining | (uint16_t)((uint16_t)byte << 8)));
         return;
     case RX_CONTENT:
-        rx->checksum = (uint8_t)(rx->checksum + byte);
         content_byte(rx, byte);
         return;
     case RX_CHECKSUM:

@@ -21,7 +21,7 @@ step "ARM images (STM32F103, and the QEMU board): budget and soft-float checks"
 cmake --preset arm >/dev/null
 cmake --build --preset arm
 
-step "Cortex-M0 image (STM32F030K6): 4 KB RAM, 16 KB flash goal (a ceiling until met), soft-float"
+step "Cortex-M0 image (STM32F030K6) and its bootloader: 4 KB RAM, 16 KB flash goal (a ceiling until met), 4 KB bootloader, soft-float"
 cmake --preset arm-m0 >/dev/null
 cmake --build --preset arm-m0
 

@@ -10,11 +10,10 @@ void boot_flow_heard(struct boot_flow *f)
     f->stay = true;
 }
 
-enum boot_choice boot_flow_step(struct boot_flow *f, uint32_t elapsed_ms)
+enum boot_choice boot_flow_step(const struct boot_flow *f, uint32_t elapsed_us)
 {
-    f->since_ms = elapsed_ms;
     if (f->stay || !f->app_valid) {
         return BOOT_STAY;
     }
-    return elapsed_ms >= BOOT_LISTEN_MS ? BOOT_START_APP : BOOT_WAIT;
+    return elapsed_us >= BOOT_LISTEN_MS * 1000u ? BOOT_START_APP : BOOT_WAIT;
 }

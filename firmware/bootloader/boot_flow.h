@@ -27,12 +27,13 @@ enum boot_choice {
 struct boot_flow {
     bool app_valid;     /* app_image_check said so at reset */
     bool stay;          /* asked to, or a request came in the window */
-    uint32_t since_ms;  /* since reset */
 };
 
 void boot_flow_start(struct boot_flow *f, bool app_valid, uint32_t stay_word);
 /* An update packet for this servo was answered. */
 void boot_flow_heard(struct boot_flow *f);
-enum boot_choice boot_flow_step(struct boot_flow *f, uint32_t elapsed_ms);
+/* elapsed_us: since reset (microseconds, so the caller needs no division;
+ * once the window has passed, no later time is asked about). */
+enum boot_choice boot_flow_step(const struct boot_flow *f, uint32_t elapsed_us);
 
 #endif

@@ -56,7 +56,7 @@ bool boot_loop_step(struct boot_loop *l)
         }
         return true;
     }
-    return boot_flow_step(&l->flow, (now - l->started_us) / 1000u) != BOOT_START_APP;
+    return boot_flow_step(&l->flow, now - l->started_us) != BOOT_START_APP;
 }
 
 void bootloader_run(const struct boot_board *b)

@@ -22,7 +22,10 @@ enum slot_write_result slot_write(const struct app_slot *slot, uint32_t offset,
     if (crc32(data, len) != crc) {
         return SLOT_WRITE_BAD_CRC;
     }
-    if (len == 0u || block == 0u || block > 8u || offset % block != 0u || len % block != 0u ||
+    /* A write block is a power of two up to 8 bytes: a mask finds what is
+     * off it (no division on the M0). */
+    if (len == 0u || block == 0u || block > 8u || (block & (block - 1u)) != 0u ||
+        ((offset | len) & (block - 1u)) != 0u ||
         offset > app_slot_size(slot) || len > app_slot_size(slot) - offset) {
         return SLOT_WRITE_OUT_OF_SLOT;
     }

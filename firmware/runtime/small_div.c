@@ -1,8 +1,8 @@
 /* 32-bit division for the size-first Cortex-M0 image, which has no divide
  * instruction: the run-time ABI's entry points (ARM IHI 0043, "The
  * Run-time ABI", 4.3.1) one quotient bit a step, about 100 bytes where
- * libgcc's unrolled ones take 726, and slower (a 16-bit quotient about 150
- * instructions): the M0 divides when it plans a move and scales a
+ * libgcc's unrolled ones take 726, and slower (a few instructions for each
+ * bit of the quotient): the M0 divides when it plans a move and scales a
  * reading, never in the control tick (README, "Benchmark", has the M0's
  * figures with it). Divided by zero, the quotient is 0 and the
  * remainder the dividend, as the Cortex-M3's UDIV/SDIV give (without the
@@ -16,19 +16,22 @@ uint64_t small_udivmod(uint32_t n, uint32_t d)
     if (d == 0u || d > n) {
         return (uint64_t)n << 32;
     }
-    /* Only the quotient's own bits: d lined up under n's top bit, then one
-     * compare and subtract a bit. No overflow: d << shift keeps d's top
-     * bit where n has its own. */
-    unsigned shift = (unsigned)(__builtin_clz(d) - __builtin_clz(n));
-    uint32_t step = d << shift;
+    /* Only the quotient's own bits: d doubled up to below n's top bit,
+     * then one compare and subtract a bit. No overflow: a step is doubled
+     * only while it is at most half of n. (No count of leading zeros: the
+     * M0 has no CLZ, and libgcc's takes 60 bytes.) */
+    uint32_t step = d;
+    uint32_t bit = 1u;
+    while (step <= n >> 1) {
+        step <<= 1;
+        bit <<= 1;
+    }
     uint32_t q = 0;
-    for (unsigned bit = shift + 1u; bit-- > 0u;) {
-        q <<= 1;
+    for (; bit != 0u; bit >>= 1, step >>= 1) {
         if (n >= step) {
             n -= step;
-            q |= 1u;
+            q |= bit;
         }
-        step >>= 1;
     }
     return ((uint64_t)n << 32) | q;
 }

@@ -29,7 +29,7 @@ enum { CORE_VECTORS = 16, DMA1_CHANNEL5_IRQ = 15, USART1_IRQ = 37 };
 /* Core exceptions, then device interrupts up to USART1; the bootloader,
  * which sends without interrupts, stops at DMA1 channel 5 (its table is
  * 88 bytes of its 4 KB shorter). */
-#ifdef STARTUP_LAST_IRQ_DMA1_CHANNEL5
+#ifdef STARTUP_BOOTLOADER
 #define LAST_IRQ DMA1_CHANNEL5_IRQ
 #else
 #define LAST_IRQ USART1_IRQ
@@ -47,7 +47,7 @@ static void (*const vector_table[CORE_VECTORS + LAST_IRQ + 1])(void) = {
     [14] = Default_Handler, /* PendSV */
     [15] = SysTick_Handler,
     [CORE_VECTORS + DMA1_CHANNEL5_IRQ] = DMA1_Channel5_IRQHandler,
-#ifndef STARTUP_LAST_IRQ_DMA1_CHANNEL5
+#ifndef STARTUP_BOOTLOADER
     [CORE_VECTORS + USART1_IRQ] = USART1_IRQHandler,
 #endif
 };

@@ -9,6 +9,8 @@
  * byte 4), CRC-32. The application rewrites a format-1 store in format 2
  * when it boots (servo.c), so the bootloader reads format 2 only. */
 enum { MAGIC = 0xC0F1, FORMAT = 2, PAYLOAD = 12, AREA = 32, AREA_ID = 2, AREA_BAUD = 4 };
+/* Magic, format and length in one little-endian word. */
+#define HEADER ((uint32_t)MAGIC | (uint32_t)FORMAT << 16 | (uint32_t)AREA << 24)
 
 void config_peek_link(const struct hal_flash *flash, uint8_t *id, uint8_t *baud_index)
 {
@@ -22,7 +24,7 @@ void config_peek_link(const struct hal_flash *flash, uint8_t *id, uint8_t *baud_
             uint32_t seq = wire_get_u32(&rec[4]);
             uint8_t record_id = rec[PAYLOAD + AREA_ID];
             uint8_t record_baud = rec[PAYLOAD + AREA_BAUD];
-            if (wire_get_u16(&rec[0]) == MAGIC && rec[2] == FORMAT && rec[3] == AREA &&
+            if (wire_get_u32(&rec[0]) == HEADER &&
                 seq > newest && wire_get_u32(&rec[PAYLOAD + AREA]) == crc32(rec, PAYLOAD + AREA) &&
                 record_id <= 254u && record_baud >= 1u && record_baud <= 8u) {
                 newest = seq;

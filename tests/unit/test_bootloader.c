@@ -305,11 +305,11 @@ static void test_a_power_cut_at_every_step_never_bricks(void **state)
              * (the steps left write padding that is 0xFF anyway). */
             assert_int_equal(info.version, 2);
             assert_memory_equal(chip.mem, new_image, new_n);
-            assert_int_equal(boot_flow_step(&flow, BOOT_LISTEN_MS), BOOT_START_APP);
+            assert_int_equal(boot_flow_step(&flow, BOOT_LISTEN_MS * 1000u), BOOT_START_APP);
             started_new++;
         } else {
             stayed++;
-            assert_int_equal(boot_flow_step(&flow, 60000), BOOT_STAY);
+            assert_int_equal(boot_flow_step(&flow, 60000u * 1000u), BOOT_STAY);
             assert_true(update(new_image, new_n)); /* the recovery */
             assert_int_equal(app_image_check(&slot, BOARD, &info), APP_IMAGE_VALID);
             assert_int_equal(info.version, 2);
@@ -354,15 +354,15 @@ static void test_the_boot_decision(void **state)
     struct boot_flow f;
     boot_flow_start(&f, true, 0);
     assert_int_equal(boot_flow_step(&f, 0), BOOT_WAIT);
-    assert_int_equal(boot_flow_step(&f, BOOT_LISTEN_MS - 1u), BOOT_WAIT);
-    assert_int_equal(boot_flow_step(&f, BOOT_LISTEN_MS), BOOT_START_APP);
+    assert_int_equal(boot_flow_step(&f, BOOT_LISTEN_MS * 1000u - 1u), BOOT_WAIT);
+    assert_int_equal(boot_flow_step(&f, BOOT_LISTEN_MS * 1000u), BOOT_START_APP);
     boot_flow_start(&f, true, 0);
     boot_flow_heard(&f); /* a request in the window: stay */
-    assert_int_equal(boot_flow_step(&f, 10 * BOOT_LISTEN_MS), BOOT_STAY);
+    assert_int_equal(boot_flow_step(&f, 10u * BOOT_LISTEN_MS * 1000u), BOOT_STAY);
     boot_flow_start(&f, true, BOOT_STAY_MAGIC); /* UpdateEnter */
     assert_int_equal(boot_flow_step(&f, 0), BOOT_STAY);
     boot_flow_start(&f, false, 0); /* nothing valid to start */
-    assert_int_equal(boot_flow_step(&f, 10 * BOOT_LISTEN_MS), BOOT_STAY);
+    assert_int_equal(boot_flow_step(&f, 10u * BOOT_LISTEN_MS * 1000u), BOOT_STAY);
 }
 
 int main(void)

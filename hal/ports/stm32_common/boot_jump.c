@@ -4,6 +4,14 @@
 
 #define SCB_VTOR REG32(0xE000ED08u)
 
+/* The F1's 68 interrupt lines take two words of ICER/ICPR; ARMv6-M has 32
+ * lines at most, and one word (the next is reserved: ARMv6-M ARM, B3.4). */
+#if defined(__ARM_ARCH_7M__)
+#define NVIC_LINE_WORDS 2u
+#else
+#define NVIC_LINE_WORDS 1u
+#endif
+
 void boot_restart_with(uint32_t addr, uint32_t word)
 {
     REG32(addr) = word;
@@ -26,7 +34,7 @@ void boot_jump(uint32_t vector_table)
     uint32_t entry = REG32(vector_table + 4u);
     __asm__ volatile("cpsid i" ::: "memory");
     SYSTICK_CTRL = 0;
-    for (uint32_t n = 0; n < 2u; n++) { /* the F1's 68 interrupt lines, the F0's 32 */
+    for (uint32_t n = 0; n < NVIC_LINE_WORDS; n++) {
         NVIC_ICER(n) = 0xFFFFFFFFu;
         NVIC_ICPR(n) = 0xFFFFFFFFu;
     }

@@ -32,6 +32,11 @@ static void uart_send(void *ctx, const uint8_t *data, uint16_t len)
     usart_v2_hd_send(ctx, data, len);
 }
 
+static void uart_send_polled(void *ctx, const uint8_t *data, uint16_t len)
+{
+    usart_v2_hd_send_polled(ctx, data, len);
+}
+
 static bool uart_tx_done(void *ctx)
 {
     return usart_v2_hd_tx_done(ctx);
@@ -42,7 +47,8 @@ static void uart_set_baud(void *ctx, uint32_t baud)
     usart_v2_hd_set_baud(ctx, baud);
 }
 
-void port_uart_init(struct hal_port *port, struct usart_v2_hd *usart, uint32_t pclk_hz)
+/* What both kinds of port share: all but the send. */
+static void start(struct hal_port *port, struct usart_v2_hd *usart, uint32_t pclk_hz)
 {
     bus_usart = usart;
     RCC_AHBENR |= RCC_AHBENR_DMA1;
@@ -50,11 +56,23 @@ void port_uart_init(struct hal_port *port, struct usart_v2_hd *usart, uint32_t p
     usart_v2_hd_init(usart, USART1_BASE, pclk_hz, 115200u);
     port->ctx = usart;
     port->now_us = now_us;
-    port->uart_send = uart_send;
     port->uart_tx_done = uart_tx_done;
     port->uart_set_baud = uart_set_baud;
     port->rx = &ring;
     port->rx_sync = dma_rx_sync;
     port->rx_ctx = &dma;
+}
+
+void port_uart_init(struct hal_port *port, struct usart_v2_hd *usart, uint32_t pclk_hz)
+{
+    start(port, usart, pclk_hz);
+    port->uart_send = uart_send;
     NVIC_ISER(0) = (1u << DMA1_CH3_IRQ) | (1u << USART1_IRQ);
+}
+
+void port_uart_init_polled(struct hal_port *port, struct usart_v2_hd *usart, uint32_t pclk_hz)
+{
+    start(port, usart, pclk_hz);
+    port->uart_send = uart_send_polled;
+    NVIC_ISER(0) = 1u << DMA1_CH3_IRQ;
 }

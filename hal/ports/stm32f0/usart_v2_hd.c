@@ -46,6 +46,20 @@ void usart_v2_hd_send(struct usart_v2_hd *u, const uint8_t *data, uint16_t len)
     USART_CR1(u->base) = (RUNNING & ~USART_CR1_RE) | USART_CR1_TXEIE;
 }
 
+void usart_v2_hd_send_polled(struct usart_v2_hd *u, const uint8_t *data, uint16_t len)
+{
+    USART_CR1(u->base) = RUNNING & ~USART_CR1_RE;
+    for (uint16_t i = 0; i < len; i++) {
+        while (!(USART_ISR(u->base) & USART_ISR_TXE)) {
+        }
+        USART_TDR(u->base) = data[i];
+    }
+    while (!(USART_ISR(u->base) & USART_ISR_TC)) {
+    }
+    USART_ICR(u->base) = USART_ICR_CLEAR;
+    USART_CR1(u->base) = RUNNING;
+}
+
 bool usart_v2_hd_tx_done(const struct usart_v2_hd *u)
 {
     return !u->tx_busy;

@@ -3,7 +3,8 @@
  * (dma_rx.h, channel 3): no code runs per received byte. A send runs from
  * the interrupt and turns the line around (receiver off while sending,
  * back on after the last stop bit), so the servo never hears its own echo,
- * as on the F1 (../stm32f1/usart_hd.h). */
+ * as on the F1 (../stm32f1/usart_hd.h). The bootloader sends from its
+ * main loop instead (usart_v2_hd_send_polled). */
 #ifndef STM32F0_USART_V2_HD_H
 #define STM32F0_USART_V2_HD_H
 
@@ -27,5 +28,9 @@ void usart_v2_hd_send(struct usart_v2_hd *u, const uint8_t *data, uint16_t len);
 bool usart_v2_hd_tx_done(const struct usart_v2_hd *u);
 /* The USART's interrupt handler calls this. */
 void usart_v2_hd_irq(struct usart_v2_hd *u);
+/* The whole of data, waiting for each byte and for the last stop bit, so
+ * no interrupt is needed: for a main loop that has nothing else to do
+ * meanwhile (the bootloader's; its 4 KB have no room for more). */
+void usart_v2_hd_send_polled(struct usart_v2_hd *u, const uint8_t *data, uint16_t len);
 
 #endif
