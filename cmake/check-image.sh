@@ -6,7 +6,7 @@
 # against issue 10's goal of 16 KB / 4 KB; a board whose part is that small
 # passes the goal as its limits (the Cortex-M0 board: its RAM, and a flash
 # ceiling until the goal is met: board.cmake). The bootloader:
-# check-image.sh ELF 4096, its 4 KB.
+# check-image.sh ELF 4096 [RAM_LIMIT], its 4 KB (and a small part's RAM).
 set -eu
 elf=$1
 SIZE=${SIZE:-arm-none-eabi-size}
