@@ -52,6 +52,26 @@ def load(ci_files, linked):
             {t: qualifier[t] for t in keep})
 
 
+def image_call_graphs(elf, build_dir):
+    """The .ci files of the objects the image links, from its linker map
+    (NAME.map beside NAME.elf): the objects given to the link and the
+    archive members it took. A build holds the other board family's port
+    too, whose functions have the same names (USART1_IRQHandler); only the
+    image's own may count. Archive lib<target>.a's members are built in
+    CMakeFiles/<target>.dir below the archive's folder."""
+    text = pathlib.Path(elf).with_suffix(".map").read_text()
+    build = pathlib.Path(build_dir)
+    files = set()
+    for obj in re.findall(r"^LOAD (\S+\.obj)$", text, re.M):
+        files.add(build / obj)
+    for folder, target, member in set(re.findall(r"^(\S+)/lib([^/\s]+)\.a\((\S+\.obj)\)$", text, re.M)):
+        found = list((build / folder / "CMakeFiles" / f"{target}.dir").rglob(member))
+        if not found:
+            raise SystemExit(f"stack-report: no object {member} of lib{target}.a under {folder}")
+        files.update(found)
+    return [f.with_suffix(".ci") for f in files if f.with_suffix(".ci").exists()]
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("elf")
@@ -69,7 +89,7 @@ def main() -> int:
     args.stack_size = int(stack_line[0][1])
     nm = subprocess.run([args.nm, args.elf], capture_output=True, text=True, check=True).stdout
     linked = {line.split()[-1] for line in nm.splitlines() if re.match(r"\S+ [tT] ", line)}
-    ci_files = list(pathlib.Path(args.build_dir).rglob("*.ci"))
+    ci_files = image_call_graphs(args.elf, args.build_dir)
     stack, calls, qualifier = load(ci_files, linked)
     dynamic = [t for t, q in qualifier.items() if q != "static"]
     roots = [t for t in stack if t.split(":")[-1] == "main" or (
