@@ -48,6 +48,9 @@ void usart_v2_hd_send(struct usart_v2_hd *u, const uint8_t *data, uint16_t len)
 
 void usart_v2_hd_send_polled(struct usart_v2_hd *u, const uint8_t *data, uint16_t len)
 {
+    if (len == 0u) {
+        return; /* TC, cleared after the last send, would never come */
+    }
     USART_CR1(u->base) = RUNNING & ~USART_CR1_RE;
     for (uint16_t i = 0; i < len; i++) {
         while (!(USART_ISR(u->base) & USART_ISR_TXE)) {
