@@ -139,7 +139,7 @@ enum packet_outcome handle_read_angle(const struct packet_call *c, struct respon
 }
 
 /* ReadMotion (0x40): one instant of the motion state, docs/packets.md. */
-enum { READ_MOTION_ANSWER_LENGTH = 21 };
+enum { READ_MOTION_ANSWER_LENGTH = 25 };
 
 enum packet_outcome handle_read_motion(const struct packet_call *c, struct response *r)
 {
@@ -155,6 +155,9 @@ enum packet_outcome handle_read_motion(const struct packet_call *c, struct respo
     wire_put_u16(&p[17], c->d->regs->status.current_ma);
     p[19] = c->d->regs->status.status;
     p[20] = d.flags;
+    /* The snapshot is the last tick's: it ran one period before the next. */
+    const uint32_t *next_tick = c->d->next_tick_us;
+    wire_put_u32(&p[21], next_tick != NULL ? *next_tick - 1000000u / MOTION_TICK_HZ : 0u);
     r->length = READ_MOTION_ANSWER_LENGTH;
     return OUTCOME_OK;
 }

@@ -52,6 +52,7 @@ void servo_init(struct servo *s, const struct hal_port *hal)
     dispatcher_init(&s->dispatcher, &s->regs, &s->motion, &s->active_id);
     s->dispatcher.bootloader_present = hal->enter_bootloader != NULL;
     s->dispatcher.board = hal->board;
+    s->dispatcher.next_tick_us = &s->next_tick_us;
     s->active_baud_index = 0; /* forces the first apply to set the UART */
     apply_link_settings(s);
 }

@@ -193,6 +193,7 @@ struct motion_snapshot {
     int32_t angle, setpoint, target;
     int16_t speed, tracking_error;
     uint8_t status, flags;
+    uint32_t tick_us; /* the servo's clock at the tick the values are from */
 };
 
 static int32_t le(const uint8_t *p, unsigned size)
@@ -207,12 +208,12 @@ static int32_t le(const uint8_t *p, unsigned size)
 static struct motion_snapshot read_motion(void)
 {
     REQUEST(0x40, 0);
-    assert_int_equal(hal.sent_length, 4u + 21u + 1u);
+    assert_int_equal(hal.sent_length, 4u + 25u + 1u);
     assert_int_equal(hal.sent[2], 0x40);
     const uint8_t *c = &hal.sent[4];
     return (struct motion_snapshot){le(&c[1], 4), le(&c[5], 4), le(&c[9], 4),
                                     (int16_t)le(&c[13], 2), (int16_t)le(&c[15], 2), c[19],
-                                    c[20]};
+                                    c[20], (uint32_t)le(&c[21], 4)};
 }
 
 /* ReadMotion: angle, setpoint, target, the servo's own speed and tracking
@@ -225,6 +226,12 @@ static void test_read_motion_snapshot(void **state)
     REQUEST(12, 0, 0x84, 0x03, 0xE8, 0x03, 0x14, 0x00, 0x14, 0x00, 0x00, 0x00); /* 100 deg/s */
     harness_run_ms(400);
     struct motion_snapshot moving = read_motion();
+    /* Stamped with the servo's clock: the last tick ran within a period of
+     * the request, a whole number of ticks after the first snapshot's (400
+     * ms and two requests' byte times). */
+    assert_in_range(moving.tick_us, hal.now_us - 1000u, hal.now_us);
+    assert_in_range(moving.tick_us - at_rest.tick_us, 400000u, 403000u);
+    assert_int_equal((moving.tick_us - at_rest.tick_us) % 1000u, 0u);
     /* 0.1 deg/s. The encoder counts 1.14 per tick here; the tracker's
      * share of a half-count miss leaves about +-55 of noise. */
     assert_in_range(moving.speed, 940, 1060);

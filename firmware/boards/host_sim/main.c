@@ -71,7 +71,12 @@ static void usage(FILE *out)
           "Control commands, one per line, optional servo ID last:\n"
           "  supply MV | load NM | stop DEG | stop off | ambient DEGC | soak DEGC |\n"
           "  hostbaud BAUD (a TCP host's rate; a pty's is what the host set) |\n"
-          "  powercycle (the servo restarts through its bootloader) | state | help\n",
+          "  powercycle (the servo restarts through its bootloader) | state | help |\n"
+          "  clock (the simulated clock, sim_ms, and how far it is behind the wall clock)\n"
+          "The servos run on the simulated clock: it follows the wall clock, and falls\n"
+          "behind it on a busy PC. state gives each servo's sim_ms with its models,\n"
+          "last_move_ms (how long status bit 0 was last set) and last_sent_ms (when its\n"
+          "last answer started), all on that clock.\n",
           out);
 }
 
@@ -218,12 +223,15 @@ static void state_of(const struct sim_servo *s, char *out, size_t size)
     struct motion_angle a;
     motion_read_angle(&s->core.motion, &a);
     snprintf(out, size,
-             "id=%u angle=%.3f velocity=%.2f current=%.3f winding=%.2f case=%.2f ambient=%.1f "
+             "id=%u sim_ms=%.3f last_move_ms=%.3f last_sent_ms=%.3f "
+             "angle=%.3f velocity=%.2f current=%.3f winding=%.2f case=%.2f ambient=%.1f "
              "supply=%.3f "
              "load=%.3f stop=%s status=0x%02x reported=%d collisions=%lu dropped_ticks=%u "
              "most_behind_ms=%.1f baud=%u host_baud=%u baud_mismatches=%lu rx_overruns=%u "
              "rx_lost=%u flash_stall_ms=%.2f saves=%u mode=%s version=0x%04x\n",
-             s->cmdline_id, plant_angle_deg(&s->plant), s->plant.velocity * 180.0 / M_PI,
+             s->cmdline_id, (double)bus.now_us / 1000.0, (double)s->last_execution_us / 1000.0,
+             (double)s->last_sent_us / 1000.0, plant_angle_deg(&s->plant),
+             s->plant.velocity * 180.0 / M_PI,
              s->plant.current, s->thermal.winding_c, s->thermal.case_c, s->thermal.ambient_c,
              s->plant.p.supply_v,
              s->plant.load_torque, s->plant.has_stop ? "on" : "off", s->core.regs.status.status,
@@ -246,6 +254,13 @@ static void control_command(int fd, char *line)
         return;
     }
     const char *cmd = words[0];
+    if (strcmp(cmd, "clock") == 0) {
+        char out[96];
+        snprintf(out, sizeof out, "sim_ms=%.3f behind_ms=%.1f\n", (double)bus.now_us / 1000.0,
+                 (double)(sim_now_us() - bus.now_us) / 1000.0);
+        reply(fd, out);
+        return;
+    }
     bool takes_value = strcmp(cmd, "state") != 0 && strcmp(cmd, "help") != 0 &&
                        strcmp(cmd, "powercycle") != 0;
     int id_word = takes_value ? 2 : 1;
@@ -259,7 +274,7 @@ static void control_command(int fd, char *line)
     }
     if (strcmp(cmd, "help") == 0) {
         reply(fd, "ok supply MV | load NM | stop DEG | stop off | ambient DEGC | soak DEGC | "
-                  "hostbaud BAUD | powercycle [ID] | state [ID]\n");
+                  "hostbaud BAUD | powercycle [ID] | state [ID] | clock\n");
         return;
     }
     if (takes_value && n < 2) {

@@ -50,6 +50,7 @@ static uint32_t now_us(void *ctx)
 static void uart_send(void *ctx, const uint8_t *data, uint16_t len)
 {
     struct sim_servo *s = ctx;
+    s->last_sent_us = s->bus->now_us;
     s->tx_done_us = sim_bus_send(s->bus, s->index, data, len, s->baud, s->bus->now_us);
 }
 
@@ -248,6 +249,13 @@ void sim_servo_poll(struct sim_servo *s, uint64_t now_us)
     if (!s->in_bootloader || !sim_boot_poll(s)) {
         servo_poll(&s->core);
     }
+    bool executing = !s->in_bootloader && (s->core.regs.status.status & STATUS_EXECUTING) != 0u;
+    if (executing && !s->executing) {
+        s->executing_from_us = now_us;
+    } else if (!executing && s->executing) {
+        s->last_execution_us = now_us - s->executing_from_us;
+    }
+    s->executing = executing;
     uint32_t stall = s->flash.stall_us + s->slot_flash.stall_us;
     if (stall != 0u) {
         s->cpu_free_us = now_us + stall;

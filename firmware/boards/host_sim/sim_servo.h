@@ -61,6 +61,13 @@ struct sim_servo {
     uint8_t uart_held;
     uint32_t uart_held_at_us;
     uint64_t flash_stall_us; /* in all */
+    /* Status bit 0 as the simulator's clock saw it: when the current
+     * execution began, and how long the last one lasted (tests judge moves
+     * in simulated time, not the host's). */
+    bool executing;
+    uint64_t executing_from_us;
+    uint64_t last_execution_us;
+    uint64_t last_sent_us;   /* its last frame started onto the wire */
 };
 
 /* Monotonic microseconds since the simulator started. */

@@ -23,6 +23,10 @@ struct dispatcher {
      * images are built for (UpdateStatus). */
     uint8_t bootloader_present;
     uint16_t board;
+    /* The control loop's schedule (servo.c's next_tick_us): ReadMotion
+     * stamps its snapshot with the time of the tick that computed it.
+     * NULL where no control loop runs (time 0). */
+    const uint32_t *next_tick_us;
 };
 
 struct dispatch_result {
