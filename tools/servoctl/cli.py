@@ -279,7 +279,7 @@ def cmd_origin(bus, args):
         s.reset_multi_turn()
     else:
         s.set_origin()
-    time.sleep(0.01)
+    bus.sleep(0.01)
     try:
         outcome.taken(s, "a new origin")
     except Refused:
@@ -382,16 +382,19 @@ def cmd_record(bus, args):
         interval = max(kw["interval_ms"], acc + dec)
         n1, nc, n3 = acc, interval - acc - dec, dec
     plan = positions(start, target, n1, nc, n3)
-    t0 = time.monotonic()
+    # Samples are stamped with the servo's own clock (ReadMotion's time), so
+    # a host or simulator that falls behind does not bend the time axis.
+    before = s.read_motion()
     s.move(target, **kw)
     samples = []
     done_at = None
     # A move the motor cannot follow arrives late; soft start (49/50) can
     # stretch the first one too.
     limit = 2.0 * len(plan) / 1000.0 + 10.0
-    while time.monotonic() - t0 < limit:
+    now = 0.0
+    while now < limit:
         m = s.read_motion()  # one instant: angle, setpoint, speed, error, current, status
-        now = time.monotonic() - t0
+        now = m.seconds_since(before)
         samples.append((now, m))
         if done_at is None and now > 0.02 and not m.status & 1:
             done_at = now
@@ -709,11 +712,13 @@ def build_parser():
     return ap
 
 
-def main(argv=None) -> int:
-    """The one boundary where every error becomes a line and an exit code."""
+def main(argv=None, clock=None) -> int:
+    """The one boundary where every error becomes a line and an exit code.
+    clock: the bus's clock (protocol.Bus), the host's if None; a simulator
+    passes its own (servoctl.sim.Simulator.clock_s)."""
     args = build_parser().parse_args(argv)
     try:
-        return _run(args)
+        return _run(args, clock)
     except ServoError as e:
         print(f"servoctl: error: {e}", file=sys.stderr)
         return e.exit_code
@@ -722,7 +727,7 @@ def main(argv=None) -> int:
         return EXIT_INTERRUPTED
 
 
-def _run(args) -> int:
+def _run(args, clock=None) -> int:
     if args.command == "sim":
         return cmd_sim(args)
     if args.command == "image":
@@ -736,7 +741,7 @@ def _run(args) -> int:
         args.file = args.rest[0] if args.action in ("save", "load") else None
     if not args.port:
         raise UsageError("no port: give --port or set SERVOCTL_PORT")
-    with Bus(args.port, args.baud, args.timeout) as bus:
+    with Bus(args.port, args.baud, args.timeout, clock=clock) as bus:
         return args.run(bus, args)
 
 

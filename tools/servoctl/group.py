@@ -57,9 +57,10 @@ def end_async(bus: p.Bus, cancel: bool = False) -> None:
     bus.send(p.END_ASYNC, bytes([1 if cancel else 0]))
 
 
-def sync_monitor(bus: p.Bus, ids: list, timeout_s: float = None) -> dict:
+def sync_monitor(bus: p.Bus, ids: list, timeout_s: float = None, arrivals: dict = None) -> dict:
     """One SyncCommand Monitor: each listed servo answers in list order.
-    {id: Monitor} of those that answered."""
+    {id: Monitor} of those that answered; arrivals, if given, gets {id:
+    the bus clock when its answer arrived}."""
     for servo_id in ids:
         _check("servo ID", servo_id, 0, 253)
     if not ids or len(ids) > MAX_SYNC_RECORDS:
@@ -73,6 +74,8 @@ def sync_monitor(bus: p.Bus, ids: list, timeout_s: float = None) -> dict:
             out[servo_id] = Monitor.decode(bus.read_response(p.MONITOR, servo_id, timeout=wait))
         except NoReply:
             continue
+        if arrivals is not None:
+            arrivals[servo_id] = bus.arrived_at
     return out
 
 

@@ -5,7 +5,6 @@ and temperature against time (matplotlib), or a plot file at the end."""
 from dataclasses import dataclass, asdict
 import json
 import sys
-import time
 
 from . import group, ntc, registers
 from .protocol import NoReply
@@ -36,12 +35,15 @@ class Sampler:
     def __init__(self, bus, ids, sync: bool):
         self.bus, self.ids, self.sync = bus, list(ids), sync
         self.last = {}
-        self.t0 = time.monotonic()
+        self.t0 = bus.clock()
 
     def take(self) -> list:
-        """One sample of every servo that answered; absent ones are left out."""
+        """One sample of every servo that answered; absent ones are left out.
+        Each is stamped with the time its answer arrived, so a host that
+        falls behind bends neither the time axis nor the speed."""
+        arrivals = {}
         if self.sync:
-            monitors = group.sync_monitor(self.bus, self.ids)
+            monitors = group.sync_monitor(self.bus, self.ids, arrivals=arrivals)
         else:
             monitors = {}
             for servo_id in self.ids:
@@ -49,9 +51,10 @@ class Sampler:
                     monitors[servo_id] = Servo(self.bus, servo_id).monitor()
                 except NoReply:
                     continue
-        now = time.monotonic() - self.t0
+                arrivals[servo_id] = self.bus.arrived_at
         out = []
         for servo_id, m in monitors.items():
+            now = arrivals[servo_id] - self.t0
             angle = m.angle_decideg / 10.0
             before = self.last.get(servo_id)
             speed = (angle - before[1]) / (now - before[0]) if before and now > before[0] else 0.0
@@ -137,7 +140,10 @@ class Plot:
 def monitor(bus, ids, every_s: float, count: int, sync: bool, as_json: bool,
             plot: bool, plot_file: str):
     sampler = Sampler(bus, ids, sync)
-    figure = Plot(live=plot) if plot or plot_file else None
+    # A live plot needs its window first; a plot file is drawn at the end,
+    # so sampling does not wait for the plotting library to load.
+    figure = Plot(live=True) if plot else None
+    taken = []
     tty = sys.stdout.isatty() and not as_json
     latest = {}
     n = 0
@@ -165,10 +171,14 @@ def monitor(bus, ids, every_s: float, count: int, sync: bool, as_json: bool,
                 live.update(_table(latest))
             if figure is not None:
                 figure.add(samples)
+            taken.extend(samples)
             n += 1
-            time.sleep(every_s)
+            bus.sleep(every_s)
     finally:
         if live is not None:
             live.stop()
-        if figure is not None and plot_file:
+        if plot_file:
+            if figure is None:
+                figure = Plot(live=False)
+                figure.add(taken)
             figure.save(plot_file)

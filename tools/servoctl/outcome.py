@@ -1,7 +1,6 @@
 """What became of a motion command: did the servo take it, and did the horn
 arrive where it was asked to go, or why not."""
 from dataclasses import dataclass
-import time
 
 from . import registers
 from .profile import velocity_timing
@@ -87,17 +86,18 @@ def wait_for_arrival(s: Servo, plan: Plan, tolerance_deg: float = TOLERANCE_DEG,
     has arrived, nearly still) within a timeout that follows the plan, and
     judges the result against the asked angle."""
     limit = timeout_s if timeout_s is not None else 2.0 * plan.planned_s + plan.soft_start_s + 2.0
-    start = time.monotonic()
+    clock = s.bus.clock
+    start = clock()
     seen = 0
     status = EXECUTING
-    time.sleep(0.01)
-    while time.monotonic() - start < limit:
+    s.bus.sleep(0.01)
+    while clock() - start < limit:
         status = s.status()
         seen |= status
         if not status & EXECUTING:
             break
-        time.sleep(0.01)
-    took = time.monotonic() - start
+        s.bus.sleep(0.01)
+    took = clock() - start
     angle, _ = s.multi_turn_angle()
     off = abs(angle - plan.target_abs) / 10.0
     if status & EXECUTING:

@@ -89,12 +89,18 @@ def response_frame(code: int, content: bytes) -> bytes:
 
 class Bus:
     """A serial port (or pyserial URL such as socket://127.0.0.1:5000) with
-    the request/response discipline of the protocol."""
+    the request/response discipline of the protocol.
 
-    def __init__(self, port: str, baud: int = 115200, timeout: float = 0.1):
+    Every wait (reply timeouts, Bus.sleep, servoctl's waits for a move) is
+    measured on `clock`, seconds: the host's monotonic clock for a real
+    bus; for the simulator its own clock (Simulator.clock_s), which falls
+    behind the wall clock on a busy PC while the servos keep their timing."""
+
+    def __init__(self, port: str, baud: int = 115200, timeout: float = 0.1, clock=None):
         import serial  # pyserial
 
         self.timeout = timeout
+        self.clock = clock or time.monotonic
         self.port = port
         try:
             self.serial = serial.serial_for_url(port, baudrate=baud, timeout=0.005)
@@ -106,9 +112,22 @@ class Bus:
 
             sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
         self._buffer = b""
+        self._read_at = 0.0
+        # The bus clock when the bytes that completed the last response
+        # returned were read: when the answer arrived, not when it was used.
+        self.arrived_at = 0.0
 
     def close(self):
         self.serial.close()
+
+    def sleep(self, seconds: float) -> None:
+        """Waits until the bus's clock has moved on by seconds."""
+        if self.clock is time.monotonic:
+            time.sleep(seconds)
+            return
+        end = self.clock() + seconds
+        while (left := end - self.clock()) > 0:
+            time.sleep(min(left, 0.005))
 
     def __enter__(self):
         return self
@@ -131,16 +150,23 @@ class Bus:
         self._buffer = b""
         self._link(self.serial.write, request_frame(code, content))
 
-    def _fill(self) -> None:
-        data = self._link(self.serial.read, 256)
+    def _fill(self, wait: bool = True) -> None:
+        """Reads what has arrived; with wait, up to the port's 5 ms for it."""
+        if wait:
+            data = self._link(self.serial.read, 256)
+        else:
+            waiting = self._link(lambda: self.serial.in_waiting)
+            data = self._link(self.serial.read, waiting) if waiting else b""
         if data:
+            self._read_at = self.clock()
             self._buffer += data
 
     def read_response(self, code: int, servo_id: int, timeout=None):
         """Content of the next response with this packet number from this
         servo; other frames on the wire are skipped."""
-        deadline = time.monotonic() + (self.timeout if timeout is None else timeout)
+        deadline = self.clock() + (self.timeout if timeout is None else timeout)
         bad = None
+        last_look = False
         while True:
             frame = self._take_frame()
             if frame is not None:
@@ -148,14 +174,18 @@ class Bus:
                 if not ok:
                     bad = fcode
                 elif fcode == code and content[:1] == bytes([servo_id]):
+                    self.arrived_at = self._read_at
                     return content
                 continue
-            if time.monotonic() > deadline:
+            # A host that was not scheduled until after the deadline reads
+            # what arrived meanwhile once more before it gives up.
+            if last_look:
                 if bad is not None:
                     raise BadChecksum(f"servo {servo_id}: response to packet {code} had a bad checksum")
                 raise NoReply(f"servo {servo_id}: no reply to packet {code} within "
                               f"{(self.timeout if timeout is None else timeout) * 1000:.0f} ms")
-            self._fill()
+            last_look = self.clock() > deadline
+            self._fill(wait=not last_look)
 
     def _take_frame(self):
         """(code, content, checksum_ok) of a complete response frame at the

@@ -36,12 +36,22 @@ class MotionSnapshot:
     current_ma: int
     status: int
     flags: int
+    time_us: int  # the servo's clock at the tick the values are from; wraps at 2**32
 
     PROFILE_ENDED, CLOCK_SLOWED, BRAKING, AT_LIMIT, RELEASED = 1, 2, 4, 8, 16
+    LENGTH = 25
 
     @classmethod
     def decode(cls, content: bytes) -> "MotionSnapshot":
-        return cls(*struct.unpack("<BiiihhHBB", content))
+        if len(content) != cls.LENGTH:
+            raise ServoError(f"servo {content[:1].hex() or '?'}: a ReadMotion answer of "
+                             f"{len(content)} bytes, not {cls.LENGTH} (older firmware?)")
+        return cls(*struct.unpack("<BiiihhHBBI", content))
+
+    def seconds_since(self, earlier: "MotionSnapshot") -> float:
+        """Servo time from an earlier snapshot to this one (less than 71
+        minutes apart: the clock wraps)."""
+        return ((self.time_us - earlier.time_us) % 2**32) / 1e6
 
 
 def _check(name: str, value: int, low: int, high: int, unit: str = "") -> int:

@@ -8,11 +8,14 @@ import subprocess
 import tempfile
 import time
 
-from .protocol import Bus, ServoError
+from .protocol import Bus, LinkError, ServoError
 from .servo import Servo
 
 REPO = Path(__file__).resolve().parents[2]
 BOOT_TIMEOUT_S = 10
+# Host seconds a simulator's clock may stand still before a wait gives up
+# on it (a simulator falls behind on a busy PC; it does not stop).
+STALLED_S = 30.0
 DEFAULT_BINARY = REPO / "build" / "host" / "firmware" / "boards" / "host_sim" / "servo_sim"
 
 
@@ -71,6 +74,7 @@ class Simulator(_Child):
         self.process = None
         self.url = None
         self.control_port = None
+        self._clock_seen, self._clock_moved_at = None, 0.0
 
     def start(self) -> "Simulator":
         cmd = [str(find_binary()), "--state", self.state_dir]
@@ -111,34 +115,81 @@ class Simulator(_Child):
             shutil.rmtree(self.state_dir, ignore_errors=True)
         return err
 
+    def bus(self, **kw) -> Bus:
+        """A Bus to the simulated servos that waits on the simulated clock."""
+        return Bus(self.url, clock=self.clock_s, **kw)
+
     def control(self, line: str) -> str:
         """Sends one control command; returns the reply."""
         return control_command(self.control_port, line)
 
+    def clock_s(self) -> float:
+        """The simulated clock, seconds. The servos and their models run on
+        it; it follows the wall clock and falls behind it on a busy PC. A
+        clock that stands still for STALLED_S host seconds is a hung
+        simulator (a loaded PC slows it, it never stops it): ServoError."""
+        now = _fields(self.control("clock"))["sim_ms"] / 1000.0
+        if now != self._clock_seen:
+            self._clock_seen, self._clock_moved_at = now, time.monotonic()
+        elif time.monotonic() - self._clock_moved_at > STALLED_S:
+            raise ServoError(f"servo_sim's clock stood still for {STALLED_S:.0f} s")
+        return now
+
+    def sleep(self, seconds: float) -> None:
+        """Returns once the simulated clock has moved on by seconds: what
+        time.sleep would be on an idle PC, whatever the load."""
+        self._wait(lambda: False, seconds, 0.005)
+
+    def wait_until(self, predicate, timeout_s: float, step_s: float = 0.005) -> float:
+        """Polls predicate until it is true; returns the simulated seconds
+        waited, or fails once timeout_s of simulated time have passed."""
+        met, waited = self._wait(predicate, timeout_s, step_s)
+        if not met:
+            raise AssertionError(f"not within {timeout_s} s of simulated time")
+        return waited
+
+    def _wait(self, predicate, timeout_s: float, step_s: float):
+        """(predicate met, simulated seconds waited)."""
+        start = self.clock_s()
+        while True:
+            if predicate():
+                return True, self.clock_s() - start
+            waited = self.clock_s() - start
+            if waited >= timeout_s:
+                return False, waited
+            time.sleep(min(step_s, timeout_s - waited))
+
     def state(self, servo_id: int) -> dict:
         """The models' state of one servo: angle (deg), velocity, current,
         winding temperature, supply, status, collisions, ..."""
-        line = self.control(f"state {servo_id}").strip()
-        out = {}
-        for pair in line.split():
-            key, value = pair.split("=", 1)
-            try:
-                out[key] = float(value) if "." in value else int(value, 0)
-            except ValueError:
-                out[key] = value
-        return out
+        return _fields(self.control(f"state {servo_id}"))
 
+
+def _fields(line: str) -> dict:
+    """key=value pairs of a control reply: numbers as numbers."""
+    out = {}
+    for pair in line.split():
+        key, value = pair.split("=", 1)
+        try:
+            out[key] = float(value) if "." in value else int(value, 0)
+        except ValueError:
+            out[key] = value
+    return out
 
 
 def control_command(port: int, line: str, timeout: float = 2.0) -> str:
     """One line to servo_sim's control port on 127.0.0.1:port; its reply.
     An "error: ..." reply raises ServoError."""
-    with socket.create_connection(("127.0.0.1", port), timeout=timeout) as s:
-        s.sendall(line.encode() + b"\n")
-        s.shutdown(socket.SHUT_WR)
-        reply = b""
-        while chunk := s.recv(4096):
-            reply += chunk
+    try:
+        with socket.create_connection(("127.0.0.1", port), timeout=timeout) as s:
+            s.sendall(line.encode() + b"\n")
+            s.shutdown(socket.SHUT_WR)
+            reply = b""
+            while chunk := s.recv(4096):
+                reply += chunk
+    except OSError as e:
+        raise LinkError(f"servo_sim's control port 127.0.0.1:{port}: {e.strerror or e} "
+                        f"(has the simulator stopped?)") from None
     text = reply.decode()
     if text.startswith("error"):
         raise ServoError(f"servo_sim: {text.strip()}")
@@ -181,6 +232,21 @@ class QemuBoard(_Child):
         self.process = None
         self.url = None
 
+    def cpu_s(self) -> float:
+        """The CPU seconds QEMU has had: the emulated board's progress (its
+        firmware never sleeps, so QEMU runs whenever the host lets it). A
+        Bus on this clock gives a starved QEMU the time it needs."""
+        try:
+            with open(f"/proc/{self.process.pid}/stat") as f:
+                fields = f.read().rsplit(")", 1)[1].split()
+        except OSError as e:
+            raise LinkError(f"qemu is gone: {e.strerror}") from None
+        return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+    def bus(self, **kw) -> Bus:
+        """A Bus to the board that waits on QEMU's progress (cpu_s)."""
+        return Bus(self.url, clock=self.cpu_s, **kw)
+
     def start(self) -> "QemuBoard":
         for path in (self.image, self.bootloader):
             if not path.exists():
@@ -195,15 +261,16 @@ class QemuBoard(_Child):
             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         self.url = f"socket://127.0.0.1:{port}"
         # QEMU opens the port before the guest has booted, so the board is
-        # ready only once the firmware answers (slow on a loaded machine).
-        deadline = time.monotonic() + BOOT_TIMEOUT_S
+        # ready only once the firmware answers: within BOOT_TIMEOUT_S of
+        # QEMU's own CPU time, however long a loaded machine takes for it.
         bus = None
+        hung_at = time.monotonic() + 30 * BOOT_TIMEOUT_S  # QEMU itself stuck
         try:
-            while time.monotonic() < deadline:
+            while self.cpu_s() < BOOT_TIMEOUT_S and time.monotonic() < hung_at:
                 if self.process.poll() is not None:
                     raise ServoError(f"qemu exited: {self.process.stderr.read().strip()}")
                 try:
-                    bus = bus or Bus(self.url, timeout=0.2)
+                    bus = bus or self.bus(timeout=0.2)
                 except ServoError:  # the port is not open yet
                     time.sleep(0.05)
                     continue
@@ -216,5 +283,5 @@ class QemuBoard(_Child):
             if bus is not None:
                 bus.close()
         self.stop()
-        raise ServoError(f"the firmware on qemu did not answer a ping within {BOOT_TIMEOUT_S} s")
+        raise ServoError(f"the firmware on qemu did not answer within {BOOT_TIMEOUT_S} s of QEMU's CPU time")
 

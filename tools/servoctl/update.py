@@ -4,7 +4,6 @@ bootloader (UpdateEnter); a servo already in its bootloader (an update cut
 short, a broken application) is updated the same way, which is the
 recovery."""
 import struct
-import time
 import zlib
 from dataclasses import dataclass
 
@@ -44,15 +43,15 @@ def status(bus, servo_id: int, timeout=None) -> Status:
 def _poll_mode(bus, servo_id: int, mode: int, seconds: float, reply_s: float, pause_s: float):
     """UpdateStatus until the servo answers in `mode`; the Status, or None
     after `seconds`."""
-    deadline = time.monotonic() + seconds
-    while time.monotonic() < deadline:
+    deadline = bus.clock() + seconds
+    while bus.clock() < deadline:
         try:
             st = status(bus, servo_id, timeout=reply_s)
             if st.mode == mode:
                 return st
         except NoReply:
             pass
-        time.sleep(pause_s)
+        bus.sleep(pause_s)
     return None
 
 

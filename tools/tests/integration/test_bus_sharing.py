@@ -30,8 +30,9 @@ def test_finished_moves_answer_in_turn_with_other_traffic(sim3):
     """Servos 1 and 2 finish moves about a millisecond apart while the host
     keeps servo 3 busy answering pings; then the host listens. Every answer
     arrives whole: the finished answers in their slots once the line is
-    quiet (docs/decisions.md, "Sharing the bus")."""
-    with p.Bus(sim3.url) as bus:
+    quiet (docs/decisions.md, "Sharing the bus"). Time is the simulator's:
+    the pings go on for 0.4 s of it, and at least 50 of them."""
+    with sim3.bus() as bus:
         for i in (1, 2):
             Servo(bus, i).write("soft_start_on", 0)
             Servo(bus, i).write("control_response", 1)
@@ -41,12 +42,14 @@ def test_finished_moves_answer_in_turn_with_other_traffic(sim3):
             for i in (1, 2):
                 bus.serial.write(request_frame(p.ANGLE, struct.pack("<BhHH", i, angle, 150, 0)))
             data = b""
-            deadline = time.monotonic() + 0.4
-            while time.monotonic() < deadline:
+            pinged = 0
+            until = sim3.clock_s() + 0.4
+            while pinged < 50 or sim3.clock_s() < until:
                 bus.serial.write(request_frame(p.PING, bytes([3])))
+                pinged += 1
                 time.sleep(0.002)
                 data += bus.serial.read(4096)
-            time.sleep(0.4)
+            sim3.sleep(0.4)
             data += bus.serial.read(4096)
             frames, stray = frames_in(data)
             assert stray == 0, f"trial {trial}: {stray} bytes outside any frame"
@@ -54,5 +57,7 @@ def test_finished_moves_answer_in_turn_with_other_traffic(sim3):
             finished = sorted(c[0] for code, c, _ in frames if code == p.ANGLE)
             assert finished == [1, 2], f"trial {trial}: finished answers from {finished}"
             pings = [c[0] for code, c, _ in frames if code == p.PING]
-            assert len(pings) > 50 and set(pings) == {3}
+            assert set(pings) == {3}
+            # Every ping was answered except one the line's quiet cut short.
+            assert len(pings) >= pinged - 1, f"trial {trial}: {len(pings)} of {pinged} pings answered"
             assert sim3.state(1)["collisions"] == 0, f"trial {trial}"

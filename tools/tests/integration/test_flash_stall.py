@@ -23,11 +23,11 @@ def write_while_moving(tmp_path, rx, writes, run=0):
     sim = Simulator(ids=[1, 2], state_dir=str(tmp_path / f"{rx}-{run}"), rx=rx)
     sim.start()
     try:
-        with Bus(sim.url, timeout=0.2) as bus:
+        with sim.bus(timeout=0.2) as bus:
             for i in (1, 2):
                 Servo(bus, i).write("baud", BAUD_INDEX_1M)  # answered at 115200
         sim.control("hostbaud 1000000")
-        with Bus(sim.url, baud=1000000, timeout=0.2) as bus:
+        with sim.bus(baud=1000000, timeout=0.2) as bus:
             one, two = Servo(bus, 1), Servo(bus, 2)
             one.write("soft_start_on", 0)
             before = sim.state(1)

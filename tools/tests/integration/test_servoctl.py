@@ -8,7 +8,7 @@ from servoctl.servo import Servo
 
 
 def run(sim, capsys, *args):
-    rc = main(["--port", sim.url, *args])
+    rc = main(["--port", sim.url, *args], clock=sim.clock_s)
     out = capsys.readouterr()
     return rc, out.out, out.err
 
@@ -61,8 +61,7 @@ def test_motion_commands(sim, capsys):
     rc, out, _ = run(sim, capsys, "origin", "1")
     assert "now 0.0 deg" in out and "refused" not in out
     run(sim, capsys, "wheel", "1", "run", "--speed", "90")
-    import time
-    time.sleep(0.5)
+    sim.sleep(0.5)
     assert sim.state(1)["velocity"] > 80
     run(sim, capsys, "wheel", "1", "stop")
     run(sim, capsys, "damping", "1", "--power", "500")
@@ -84,7 +83,7 @@ def test_motion_commands(sim, capsys):
 
 
 def test_record_writes_csv_and_plot(sim, capsys, tmp_path):
-    with Bus(sim.url) as bus:
+    with sim.bus() as bus:
         Servo(bus, 1).write("soft_start_on", 0)
     prefix = str(tmp_path / "rec")
     rc, out, _ = run(sim, capsys, "record", "1", "60", "--velocity", "200", "--acc", "100",

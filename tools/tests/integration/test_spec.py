@@ -2,7 +2,6 @@
 status bits under injected faults and their clearing, configuration across
 a restart, broadcast and sync behaviour, queueing with control response."""
 import struct
-import time
 
 import pytest
 
@@ -12,20 +11,19 @@ from servoctl.protocol import Bus, NoReply
 from servoctl.servo import Servo
 from servoctl.sim import Simulator
 
-from .conftest import wait_until
-
 EXECUTING, COMMAND_ERROR, STALL, HIGH_V, LOW_V = 1, 2, 4, 8, 16
 OVER_TEMPERATURE = 128
 
 
 def timed_move(servo, sim, **move):
-    """Sends a move; returns (seconds until status bit 0 fell, plant angle)."""
+    """Sends a move; returns (seconds status bit 0 was set, in simulated
+    time as the simulator saw the bit, and the plant's angle once settled)."""
     servo.move(**move)
-    t0 = time.monotonic()
-    time.sleep(0.02)
-    took = wait_until(lambda: not servo.status() & EXECUTING, 30, step=0.002) + 0.02
-    time.sleep(0.3)  # settle
-    return took, sim.state(1)["angle"]
+    sim.sleep(0.02)
+    sim.wait_until(lambda: not servo.status() & EXECUTING, 30)
+    sim.sleep(0.3)  # settle
+    state = sim.state(1)
+    return state["last_move_ms"] / 1000.0, state["angle"]
 
 
 @pytest.mark.parametrize("move, expected_ms", [
@@ -52,15 +50,19 @@ def test_a_move_faster_than_the_motor_arrives_late_without_overshoot(servo, sim)
     """720 deg in 1 s asks 800 deg/s of a servo that makes 312: it takes longer,
     status bit 0 stays set until the horn is there, and it does not overshoot."""
     servo.move(angle_decideg=7200, interval_ms=1000, multi_turn=True)
-    t0 = time.monotonic()
     furthest = 0.0
-    while servo.status() & EXECUTING and time.monotonic() - t0 < 10:
+
+    def finished():
+        nonlocal furthest
         furthest = max(furthest, sim.state(1)["angle"])
-    took = time.monotonic() - t0
+        return not servo.status() & EXECUTING
+
+    sim.wait_until(finished, 10)
+    took = sim.state(1)["last_move_ms"] / 1000.0
     angle = sim.state(1)["angle"]
     for _ in range(20):
         furthest = max(furthest, sim.state(1)["angle"])
-        time.sleep(0.01)
+        sim.sleep(0.01)
     assert took > 2.0, f"finished after {took:.2f} s: 720 deg at 312 deg/s take at least 2.3 s"
     assert abs(angle - 720.0) <= 0.5
     assert furthest - 720.0 <= 1.0
@@ -75,17 +77,17 @@ def test_protocol_worked_example_timing(servo, sim):
 
 def test_supply_faults_release_and_clear(servo, sim):
     servo.move(angle_decideg=300, interval_ms=200)
-    time.sleep(0.4)
+    sim.sleep(0.4)
     sim.control("supply 9000")
-    wait_until(lambda: servo.status() & HIGH_V, 1)
+    sim.wait_until(lambda: servo.status() & HIGH_V, 1)
     assert abs(sim.state(1)["current"]) < 1e-6  # released
     servo.move(angle_decideg=0, interval_ms=200)  # refused while it lasts
-    time.sleep(0.3)
+    sim.sleep(0.3)
     assert servo.status() == HIGH_V | COMMAND_ERROR
     sim.control("supply 3500")
-    wait_until(lambda: servo.status() & LOW_V and not servo.status() & HIGH_V, 1)
+    sim.wait_until(lambda: servo.status() & LOW_V and not servo.status() & HIGH_V, 1)
     sim.control("supply 7400")
-    wait_until(lambda: servo.status() & (LOW_V | HIGH_V) == 0, 1)
+    sim.wait_until(lambda: servo.status() & (LOW_V | HIGH_V) == 0, 1)
     took, angle = timed_move(servo, sim, angle_decideg=0, interval_ms=300)
     assert abs(angle) <= 0.5
     assert servo.status() == 0
@@ -96,15 +98,15 @@ def test_heat_trips_and_clears(servo, sim):
     # servo is soaked at each temperature. 41 = 651 is about 75.6 degC; it
     # trips after 10 ms beyond, and clears 5 degC cooler after 100 ms.
     sim.control("soak 74")
-    time.sleep(0.3)
+    sim.sleep(0.3)
     assert not servo.status() & OVER_TEMPERATURE
     sim.control("soak 77")
-    wait_until(lambda: servo.status() & OVER_TEMPERATURE, 2, step=0.02)
+    sim.wait_until(lambda: servo.status() & OVER_TEMPERATURE, 2)
     sim.control("soak 72")  # inside the hysteresis band: still tripped
-    time.sleep(0.3)
+    sim.sleep(0.3)
     assert servo.status() & OVER_TEMPERATURE
     sim.control("soak 69")
-    wait_until(lambda: not servo.status() & OVER_TEMPERATURE, 2, step=0.02)
+    sim.wait_until(lambda: not servo.status() & OVER_TEMPERATURE, 2)
     sim.control("soak 25")
 
 
@@ -114,8 +116,8 @@ def test_stall_in_both_modes(servo, sim, release):
     servo.write("stall_power", 2000)
     sim.control("stop 30")
     servo.move(angle_decideg=900, interval_ms=300)
-    wait_until(lambda: servo.status() & STALL, 3, step=0.02)
-    time.sleep(0.2)
+    sim.wait_until(lambda: servo.status() & STALL, 3)
+    sim.sleep(0.2)
     state = sim.state(1)
     assert abs(state["angle"] - 30.0) < 0.5
     if release:
@@ -125,19 +127,19 @@ def test_stall_in_both_modes(servo, sim, release):
     sim.control("stop off")
     if release:
         servo.move(angle_decideg=900, interval_ms=300)  # the next command clears it
-    wait_until(lambda: not servo.status() & STALL, 3, step=0.02)
-    wait_until(lambda: abs(sim.state(1)["angle"] - 90.0) < 0.5, 3, step=0.05)
+    sim.wait_until(lambda: not servo.status() & STALL, 3)
+    sim.wait_until(lambda: abs(sim.state(1)["angle"] - 90.0) < 0.5, 3)
 
 
 def test_config_survives_a_restart(tmp_path):
     state = str(tmp_path / "state")
-    with Simulator(ids=[5], state_dir=state) as sim, Bus(sim.url) as bus:
+    with Simulator(ids=[5], state_dir=state) as sim, sim.bus() as bus:
         s = Servo(bus, 5)
         s.write("stall_power", 1234)
         s.write("angle_max", 900)
         s.write("servo_id", 6)
-        time.sleep(0.05)
-    with Simulator(ids=[5], state_dir=state) as sim, Bus(sim.url) as bus:
+        sim.sleep(0.05)
+    with Simulator(ids=[5], state_dir=state) as sim, sim.bus() as bus:
         assert not Servo(bus, 5).ping()
         s = Servo(bus, 6)
         assert s.read("stall_power") == 1234
@@ -145,64 +147,67 @@ def test_config_survives_a_restart(tmp_path):
 
 
 def test_broadcast_move_moves_every_servo_and_nothing_answers(sim3):
-    with Bus(sim3.url) as bus:
+    with sim3.bus() as bus:
         for i in (1, 2, 3):
             Servo(bus, i).write("soft_start_on", 0)
             Servo(bus, i).write("control_response", 1)
         bus.send(p.ANGLE, struct.pack("<BhHH", p.BROADCAST, 450, 300, 0))
-        time.sleep(0.6)
+        sim3.sleep(0.6)
         assert bus.serial.read(4096) == b""  # silence, control response on or not
         for i in (1, 2, 3):
             assert abs(sim3.state(i)["angle"] - 45.0) <= 0.5
 
 
 def test_sync_monitor_answers_in_list_order(sim3):
-    with Bus(sim3.url) as bus:
+    with sim3.bus() as bus:
         order = [3, 1, 2]
         bus.send(p.SYNC, bytes([p.MONITOR, 1, len(order)] + order))
-        time.sleep(0.2)
+        sim3.sleep(0.2)
         data = bus.serial.read(4096)
         ids = [data[i + 4] for i in range(0, len(data), 21)]
         assert len(data) == 21 * 3
         assert ids == order
         # A listed servo that is absent is waited for only briefly.
         bus.send(p.SYNC, bytes([p.MONITOR, 1, 3, 9, 2, 1]))
-        time.sleep(0.2)
+        sim3.sleep(0.2)
         data = bus.serial.read(4096)
         assert [data[i + 4] for i in range(0, len(data), 21)] == [2, 1]
 
 
 def test_sync_move_starts_every_listed_servo(sim3):
-    with Bus(sim3.url) as bus:
+    with sim3.bus() as bus:
         for i in (1, 2, 3):
             Servo(bus, i).write("soft_start_on", 0)
         records = b"".join(struct.pack("<BhHH", i, 100 * i, 400, 0) for i in (1, 2, 3))
         bus.send(p.SYNC, bytes([p.ANGLE, 7, 3]) + records)
-        time.sleep(0.7)
+        sim3.sleep(0.7)
         for i in (1, 2, 3):
             assert abs(sim3.state(i)["angle"] - 10.0 * i) <= 0.5
 
 
 def test_queueing_with_control_response(servo, sim, bus):
     servo.write("control_response", 1)
-    t0 = time.monotonic()
     for angle in (200, 400, 600):
         servo.move(angle_decideg=angle, interval_ms=300)
+    # The first move started by now (on the simulated clock: the simulator
+    # takes the bus's bytes before it reads the control port).
+    t0 = sim.clock_s()
     # Each answer goes out in the servo's slot on the bus, up to one cycle of
     # slots (133 ms at 115200 baud) after its move ends (docs/decisions.md,
-    # "Sharing the bus"); the next move does not wait for it.
+    # "Sharing the bus"); the next move does not wait for it. When it went
+    # out is the simulator's record, in simulated time.
     for k in range(3):
         bus.read_response(p.ANGLE_BY_INTERVAL, 1, timeout=1.0)
-        late = time.monotonic() - t0 - 0.3 * (k + 1)
+        late = sim.state(1)["last_sent_ms"] / 1000.0 - t0 - 0.3 * (k + 1)
         assert -0.05 < late < 0.05 + 0.133, f"answer {k + 1} {late * 1000:.0f} ms after its move"
     assert abs(sim.state(1)["angle"] - 60.0) <= 0.5
 
 
-def test_bad_checksum_and_other_ids_stay_silent(servo, bus):
+def test_bad_checksum_and_other_ids_stay_silent(servo, sim, bus):
     frame = bytearray(p.request_frame(p.PING, bytes([1])))
     frame[-1] ^= 0xFF
     bus.serial.write(bytes(frame))
     bus.serial.write(p.request_frame(p.PING, bytes([42])))
-    time.sleep(0.1)
+    sim.sleep(0.1)
     assert bus.serial.read(100) == b""
     assert servo.ping()

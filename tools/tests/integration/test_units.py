@@ -15,7 +15,7 @@ ROOT = Path(__file__).resolve().parents[3]
 
 
 def run(sim, capsys, *args):
-    rc = main(["--port", sim.url, *args])
+    rc = main(["--port", sim.url, *args], clock=sim.clock_s)
     out = capsys.readouterr()
     return rc, out.out, out.err
 

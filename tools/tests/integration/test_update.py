@@ -34,7 +34,7 @@ def test_an_update_on_a_shared_bus(sim3):
     image = make_image()
     others_answered = []
 
-    with Bus(sim3.url, timeout=0.2) as bus:
+    with sim3.bus(timeout=0.2) as bus:
         assert [firmware(bus, i) for i in (1, 2, 3)] == [OLD, OLD, OLD]
 
         calls = []
@@ -74,7 +74,7 @@ def test_a_power_cut_during_an_update_is_recovered(sim3, cut_at):
             sim3.control("powercycle 2")
             raise Cut()
 
-    with Bus(sim3.url, timeout=0.2) as bus:
+    with sim3.bus(timeout=0.2) as bus:
         if cut_at == "enter":
             bus.request(upd.UPDATE_ENTER, bytes([2]))
             sim3.control("powercycle 2")
@@ -99,7 +99,7 @@ def test_a_power_cut_after_every_step_of_an_update_is_recovered(sim3):
     class Cut(Exception):
         pass
 
-    with Bus(sim3.url, timeout=0.2) as bus:
+    with sim3.bus(timeout=0.2) as bus:
         steps = []
         upd.update(bus, 2, image, lambda done, total: steps.append(done))
         assert len(steps) > 20
@@ -128,20 +128,20 @@ def test_a_servo_is_caught_in_its_bootloader_at_power_up(sim):
     """An application that does not answer can still be updated: the tool
     asks for UpdateStatus while the servo powers up, and the bootloader
     stays instead of starting it."""
-    with Bus(sim.url, timeout=0.2) as bus:
+    with sim.bus(timeout=0.2) as bus:
         sim.control("powercycle 1")
         st = upd.catch(bus, 1, 2.0)
         assert (st.mode, st.verdict) == (upd.MODE_BOOTLOADER, 0)  # a valid image, kept waiting
         assert sim.state(1)["mode"] == "bootloader"
         before, after = upd.update(bus, 1, make_image())
         assert (before, after) == (OLD, NEW)
-    with Bus(sim.url, timeout=0.2) as bus:
+    with sim.bus(timeout=0.2) as bus:
         with pytest.raises(NoReply, match="no bootloader answered"):
             upd.catch(bus, 1, 0.3)  # the application answers, not a bootloader
 
 
 def test_the_bootloader_answers_ping_and_stays_without_an_image(sim):
-    with Bus(sim.url, timeout=0.2) as bus:
+    with sim.bus(timeout=0.2) as bus:
         image = make_image(size=2000)
 
         class HostGone(Exception):
@@ -163,7 +163,7 @@ def test_the_bootloader_answers_ping_and_stays_without_an_image(sim):
 
 
 def run(sim, capsys, *args):
-    rc = main(["--port", sim.url, *args])
+    rc = main(["--port", sim.url, *args], clock=sim.clock_s)
     out = capsys.readouterr()
     return rc, out.out, out.err
 
@@ -179,7 +179,7 @@ def test_servoctl_image_and_update_several_servos(sim3, capsys, tmp_path):
     assert rc == 0, err
     assert "servo 1: version 0x0010 -> 0x0042" in text
     assert "servo 3: version 0x0010 -> 0x0042" in text
-    with Bus(sim3.url, timeout=0.2) as bus:
+    with sim3.bus(timeout=0.2) as bus:
         assert [firmware(bus, i) for i in (1, 2, 3)] == [NEW, OLD, NEW]
 
 
@@ -201,5 +201,5 @@ def test_servoctl_update_refuses_what_cannot_be_right(sim, capsys, tmp_path):
     damaged.write_bytes(bytes(data))
     rc, _, err = run(sim, capsys, "update", str(damaged), "1")
     assert rc == UsageError.exit_code and "does not match its CRC" in err
-    with Bus(sim.url, timeout=0.2) as bus:
+    with sim.bus(timeout=0.2) as bus:
         assert firmware(bus, 1) == OLD  # nothing was written
