@@ -1,67 +1,128 @@
 #!/usr/bin/env bash
 # Runs every test: unit tests under ASan + UBSan; the ARM images with their
-# flash/RAM budget and soft-float checks; pytest: the PC tool, the firmware on
-# simulated servos (servoctl and the maker's SDK), the real ARM image under
-# QEMU; a bounded fuzz run (at least 5000 executions per second) and the
-# corpus's line coverage (at least 90 %).
+# flash/RAM budget and soft-float checks; the target benchmark; pytest: the
+# PC tool, the firmware on simulated servos (servoctl and the maker's SDK),
+# the real ARM image under QEMU; a bounded fuzz run (at least 5000
+# executions per second) and the corpus's line coverage (at least 90 %).
+# Every step runs whatever an earlier one did; each failure is named at the
+# end, and the last line counts the checks: "summary: N passed, N failed"
+# (each CTest program and pytest test, and each other step as one).
 # FUZZ_SECONDS sets the fuzz run's length (default 60).
-set -euo pipefail
+set -uo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/setup.sh
+bash scripts/setup.sh || { echo "setup failed: nothing was tested" >&2; exit 1; }
+mkdir -p build
 
-step() { printf '\n== %s\n' "$*"; }
+passed=0
+failed=0
+failures=()
+count() { passed=$((passed + $1)); failed=$((failed + $2)); }
 
-step "unit tests (host, AddressSanitizer + UndefinedBehaviorSanitizer)"
-cmake --preset host >/dev/null
-cmake --build --preset host
-ctest --preset host | tee build/host/ctest.log
-unit=$(sed -nE 's/.*tests passed, 0 tests failed out of ([0-9]+).*/\1/p' build/host/ctest.log)
-
-step "ARM images (STM32F103, and the QEMU board): budget and soft-float checks"
-cmake --preset arm >/dev/null
-cmake --build --preset arm
-
-step "Cortex-M0 image (STM32F030K6) and its bootloader: 4 KB RAM, 16 KB flash goal (a ceiling until met), 4 KB bootloader, soft-float"
-cmake --preset arm-m0 >/dev/null
-cmake --build --preset arm-m0
-
-step "target benchmark: Thumb instructions on the Cortex-M3 and M0 under QEMU, against issue 10's budgets"
-for cpu in m3 m0; do
-  cmake --preset "target-bench-$cpu" >/dev/null
-  cmake --build --preset "target-bench-$cpu" >/dev/null
-done
-python3 tests/bench/target/run_target_bench.py --check --json build/target-bench.json
-
-step "PC tool, simulator, maker's SDK and QEMU board tests (pytest)"
-(cd tools && ../.venv/bin/python -m pytest -q) | tee build/host/pytest.log
-tools_passed=$(sed -nE 's/^([0-9]+) passed.*/\1/p' build/host/pytest.log)
-
-step "fuzzing the whole servo for ${FUZZ_SECONDS:-60} s (libFuzzer, ASan + UBSan, -O2)"
-cmake --preset fuzz >/dev/null
-cmake --build --preset fuzz --target fuzz_servo
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-# New inputs go to the scratch folder; the committed seeds stay as they are.
-# Inputs up to 256 bytes: a dozen requests and as many clock, horn, sensor,
-# flash and power events.
-./build/fuzz/tests/fuzz/fuzz_servo -max_total_time="${FUZZ_SECONDS:-60}" -seed=1 -max_len=256 \
-  -print_final_stats=1 "$work" tests/fuzz/corpus 2>"$work/log" || {
-  tail -n 60 "$work/log" >&2
-  echo "fuzzing found a failure (crash input saved in the working directory)" >&2
-  exit 1
+# step NAME COMMAND...: runs the command (with set -e inside), counts it as
+# one check, and names it if it failed.
+step() {
+  local name=$1
+  shift
+  printf '\n== %s\n' "$name"
+  # Not in an if: bash ignores set -e in a condition's subshell.
+  (set -e; "$@")
+  if [ $? -eq 0 ]; then
+    count 1 0
+  else
+    count 0 1
+    failures+=("$name")
+  fi
 }
-grep -E '^(#[0-9]+\s+DONE|stat::number_of_executed_units|stat::average_exec_per_sec)' "$work/log"
-rate=$(sed -nE 's/^stat::average_exec_per_sec:\s+([0-9]+)/\1/p' "$work/log")
-if [ "${rate:-0}" -lt "${FUZZ_MIN_EXEC_PER_S:-5000}" ]; then
-  echo "the fuzzer ran ${rate:-0} executions per second, below ${FUZZ_MIN_EXEC_PER_S:-5000}" >&2
-  exit 1
+
+unit_tests() {
+  cmake --preset host >/dev/null
+  cmake --build --preset host
+  ctest --preset host | tee build/host/ctest.log
+}
+
+arm_m3_images() {
+  cmake --preset arm >/dev/null
+  cmake --build --preset arm
+}
+
+arm_m0_images() {
+  cmake --preset arm-m0 >/dev/null
+  cmake --build --preset arm-m0
+}
+
+target_bench() {
+  for cpu in m3 m0; do
+    cmake --preset "target-bench-$cpu" >/dev/null
+    cmake --build --preset "target-bench-$cpu" >/dev/null
+  done
+  python3 tests/bench/target/run_target_bench.py --check --json build/target-bench.json
+}
+
+fuzz_run() {
+  cmake --preset fuzz >/dev/null
+  cmake --build --preset fuzz --target fuzz_servo
+  local work
+  work=$(mktemp -d)
+  # New inputs go to the scratch folder; the committed seeds stay as they
+  # are. Inputs up to 256 bytes: a dozen requests and as many clock, horn,
+  # sensor, flash and power events.
+  if ! ./build/fuzz/tests/fuzz/fuzz_servo -max_total_time="${FUZZ_SECONDS:-60}" -seed=1 -max_len=256 \
+       -print_final_stats=1 "$work" tests/fuzz/corpus 2>"$work/log"; then
+    tail -n 60 "$work/log" >&2
+    echo "fuzzing found a failure (crash input saved in the working directory)" >&2
+    rm -rf "$work"
+    return 1
+  fi
+  grep -E '^(#[0-9]+\s+DONE|stat::number_of_executed_units|stat::average_exec_per_sec)' "$work/log"
+  local rate
+  rate=$(sed -nE 's/^stat::average_exec_per_sec:\s+([0-9]+)/\1/p' "$work/log")
+  rm -rf "$work"
+  if [ "${rate:-0}" -lt "${FUZZ_MIN_EXEC_PER_S:-5000}" ]; then
+    echo "the fuzzer ran ${rate:-0} executions per second, below ${FUZZ_MIN_EXEC_PER_S:-5000}" >&2
+    return 1
+  fi
+}
+
+# Unit tests count each CTest program.
+printf '\n== %s\n' "unit tests (host, AddressSanitizer + UndefinedBehaviorSanitizer)"
+rm -f build/host/ctest.log
+(set -e; unit_tests)
+unit_rc=$?
+unit_passed=$(sed -nE 's/.*tests passed, ([0-9]+) tests failed out of ([0-9]+).*/\2 \1/p' build/host/ctest.log 2>/dev/null)
+if [ -n "$unit_passed" ]; then
+  read -r total bad <<<"$unit_passed"
+  count $((total - bad)) "$bad"
+  [ "$bad" -eq 0 ] && [ "$unit_rc" -eq 0 ] || failures+=("unit tests")
+else
+  count 0 1
+  failures+=("unit tests (did not build or run)")
 fi
 
-step "line coverage of motion, protection and the config store by the fuzz corpus (>= 90 %)"
-bash scripts/fuzz_coverage.sh
+step "ARM images (STM32F103, and the QEMU board): budget and soft-float checks" arm_m3_images
+step "Cortex-M0 image (STM32F030K6) and its bootloader: 4 KB RAM, 20 KB flash ceiling, 4 KB bootloader, soft-float" \
+  arm_m0_images
+step "target benchmark: Thumb instructions on the Cortex-M3 and M0 under QEMU, against issue 10's budgets" \
+  target_bench
+
+# pytest counts each test.
+printf '\n== %s\n' "PC tool, simulator, maker's SDK and QEMU board tests (pytest)"
+(cd tools && ../.venv/bin/python -m pytest -q -p no:cacheprovider) | tee build/pytest.log
+tools_rc=${PIPESTATUS[0]}
+tools_passed=$(grep -oE '[0-9]+ passed' build/pytest.log | tail -1 | cut -d' ' -f1)
+tools_failed=$(tail -1 build/pytest.log | grep -oE '[0-9]+ (failed|errors?)\b' | awk '{n += $1} END {print n + 0}')
+count "${tools_passed:-0}" "${tools_failed:-0}"
+if [ "$tools_rc" -ne 0 ]; then
+  failures+=("pytest (exit $tools_rc)")
+  [ "${tools_failed:-0}" -gt 0 ] || count 0 1
+fi
+
+step "fuzzing the whole servo for ${FUZZ_SECONDS:-60} s (libFuzzer, ASan + UBSan, -O2)" fuzz_run
+step "line coverage of motion, protection and the config store by the fuzz corpus (>= 90 %)" \
+  bash scripts/fuzz_coverage.sh
 
 echo
-# CTest programs, pytest tests, the fuzz run, its coverage, the ARM image
-# checks (Cortex-M3 boards, the Cortex-M0 board) and the target benchmark
-# (its calibration).
-echo "summary: $((unit + tools_passed + 5)) passed, 0 failed"
+for f in "${failures[@]}"; do
+  echo "FAILED: $f"
+done
+echo "summary: $passed passed, $failed failed"
+[ "$failed" -eq 0 ]
