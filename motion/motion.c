@@ -506,6 +506,12 @@ bool motion_is_released(const struct motion *m)
     return m->mode != MODE_POSITION;
 }
 
+bool motion_is_idle(const struct motion *m)
+{
+    return m->mode == MODE_RELEASED && !motion_is_moving(m) && m->queue.count == 0u &&
+           m->async.count == 0u;
+}
+
 bool motion_reset_multi_turn(struct motion *m)
 {
     if (!motion_is_released(m)) {

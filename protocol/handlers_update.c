@@ -5,13 +5,28 @@
 
 enum { UPDATE_STATUS_ANSWER_LENGTH = 16, MODE_APPLICATION = 0 };
 
+/* UpdateEnter's reason byte (docs/packets.md). */
+enum update_enter_reason {
+    ENTER_RESTARTING = 0,
+    ENTER_OUTPUT_DRIVEN = 1, /* a move, the wheel, hold, damping or a queued move */
+    ENTER_NO_BOOTLOADER = 2,
+};
+
 enum packet_outcome handle_update_enter(const struct packet_call *c, struct response *r)
 {
-    /* Not while a move runs: the restart lets go of the output. The
-     * restart itself waits for the answer to leave (servo.c). */
-    bool ok = c->d->bootloader_present != 0u && !motion_is_moving(c->d->motion);
+    /* Only a released servo: the restart lets go of the output, and a
+     * held load would fall. The restart itself waits for the answer to
+     * leave (servo.c). */
+    enum update_enter_reason reason =
+        c->d->bootloader_present == 0u       ? ENTER_NO_BOOTLOADER
+        : !motion_is_idle(c->d->motion)      ? ENTER_OUTPUT_DRIVEN
+                                             : ENTER_RESTARTING;
+    bool ok = reason == ENTER_RESTARTING;
     c->result->enter_bootloader = ok;
-    return answer_result(c, r, ok);
+    enum packet_outcome outcome = answer_result(c, r, ok);
+    r->content[2] = (uint8_t)reason;
+    r->length = 3;
+    return outcome;
 }
 
 enum packet_outcome handle_update_status(const struct packet_call *c, struct response *r)

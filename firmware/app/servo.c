@@ -7,8 +7,7 @@
 
 static uint32_t idle_timeout_us(const struct servo *s, uint32_t baud)
 {
-    uint32_t us = frame_rx_idle_us(baud);
-    return us > s->hal->rx_gap_tolerance_us ? us : s->hal->rx_gap_tolerance_us;
+    return frame_rx_port_idle_us(frame_rx_idle_us(baud), s->hal->rx_gap_tolerance_us);
 }
 
 static void apply_link_settings(struct servo *s)
@@ -306,10 +305,7 @@ static void receive(struct servo *s, uint32_t now)
     if (s->hal->rx_sync != NULL) {
         s->hal->rx_sync(s->hal->rx_ctx, now);
     }
-    if (!frame_rx_take_ring(&s->rx, ring, &s->rx_lost) && frame_rx_in_frame(&s->rx) &&
-        (int32_t)(now - ring->heard_us) >= (int32_t)s->rx_idle_us) {
-        frame_rx_line_idle(&s->rx);
-    }
+    frame_rx_receive(&s->rx, ring, &s->rx_lost, now, s->rx_idle_us);
 }
 
 /* UpdateEnter, its answer gone: the user area to flash first, whatever the

@@ -15,21 +15,19 @@ struct call {
     uint16_t length;
 };
 
-static uint8_t answer(struct response *r, const struct call *c, uint8_t length)
-{
-    r->content[0] = c->content[0];
-    return length;
-}
-
 static uint8_t on_ping(const struct call *c, struct response *r)
 {
-    return answer(r, c, 1);
+    (void)c;
+    (void)r;
+    return 1;
 }
 
 static uint8_t on_enter(const struct call *c, struct response *r)
 {
+    (void)c;
     r->content[1] = 1; /* here already */
-    return answer(r, c, 2);
+    r->content[2] = 0;
+    return 3;
 }
 
 static uint8_t on_erase(const struct call *c, struct response *r)
@@ -37,7 +35,7 @@ static uint8_t on_erase(const struct call *c, struct response *r)
     enum slot_write_result w = slot_erase_page(c->b->slot, wire_get_u16(&c->content[1]));
     r->content[1] = w == SLOT_WRITE_OK;
     r->content[2] = (uint8_t)w;
-    return answer(r, c, 3);
+    return 3;
 }
 
 static uint8_t on_write(const struct call *c, struct response *r)
@@ -47,7 +45,7 @@ static uint8_t on_write(const struct call *c, struct response *r)
                                           n, wire_get_u32(&c->content[5u + n]));
     r->content[1] = w == SLOT_WRITE_OK;
     r->content[2] = (uint8_t)w;
-    return answer(r, c, 3);
+    return 3;
 }
 
 static uint8_t on_verify(const struct call *c, struct response *r)
@@ -58,7 +56,7 @@ static uint8_t on_verify(const struct call *c, struct response *r)
     wire_put_u32(&r->content[6], info.crc);
     wire_put_u16(&r->content[10], info.version);
     wire_put_u16(&r->content[12], info.board);
-    return answer(r, c, 14);
+    return 14;
 }
 
 static uint8_t on_boot(const struct call *c, struct response *r)
@@ -67,7 +65,7 @@ static uint8_t on_boot(const struct call *c, struct response *r)
     bool valid = app_image_check(c->b->slot, c->b->board, &info) == APP_IMAGE_VALID;
     c->b->boot_now = valid;
     r->content[1] = valid;
-    return answer(r, c, 2);
+    return 2;
 }
 
 static uint8_t on_status(const struct call *c, struct response *r)
@@ -83,24 +81,25 @@ static uint8_t on_status(const struct call *c, struct response *r)
     wire_put_u16(&r->content[11], (uint16_t)slot->pages);
     r->content[13] = (uint8_t)slot->flash->write_block;
     wire_put_u16(&r->content[14], UPDATE_WRITE_MAX);
-    return answer(r, c, 16);
+    return 16;
 }
 
+/* Eight bytes a row: every length here fits a byte. */
 struct boot_packet_desc {
-    uint8_t code;
-    uint16_t min_length;
-    uint16_t max_length;
     uint8_t (*handle)(const struct call *c, struct response *r); /* answer length */
+    uint8_t code;
+    uint8_t min_length;
+    uint8_t max_length;
 };
 
 static const struct boot_packet_desc packets[] = {
-    {PKT_PING, 1, 1, on_ping},
-    {PKT_UPDATE_ENTER, 1, 1, on_enter},
-    {PKT_UPDATE_ERASE, 3, 3, on_erase},
-    {PKT_UPDATE_WRITE, 9u + 1u, 9u + UPDATE_WRITE_MAX, on_write},
-    {PKT_UPDATE_VERIFY, 1, 1, on_verify},
-    {PKT_UPDATE_BOOT, 1, 1, on_boot},
-    {PKT_UPDATE_STATUS, 1, 1, on_status},
+    {on_ping, PKT_PING, 1, 1},
+    {on_enter, PKT_UPDATE_ENTER, 1, 1},
+    {on_erase, PKT_UPDATE_ERASE, 3, 3},
+    {on_write, PKT_UPDATE_WRITE, 9u + 1u, 9u + UPDATE_WRITE_MAX},
+    {on_verify, PKT_UPDATE_VERIFY, 1, 1},
+    {on_boot, PKT_UPDATE_BOOT, 1, 1},
+    {on_status, PKT_UPDATE_STATUS, 1, 1},
 };
 
 bool boot_packet(struct bootloader *b, uint8_t code, const uint8_t *content, uint16_t length,
@@ -114,6 +113,7 @@ bool boot_packet(struct bootloader *b, uint8_t code, const uint8_t *content, uin
         if (d->code == code && length >= d->min_length && length <= d->max_length) {
             const struct call c = {.b = b, .content = content, .length = length};
             r->code = code;
+            r->content[0] = content[0]; /* every answer starts with the ID */
             r->length = d->handle(&c, r);
             return true;
         }

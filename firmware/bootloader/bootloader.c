@@ -11,7 +11,9 @@ void boot_loop_start(struct boot_loop *l, const struct boot_board *b)
     const struct hal_port *port = b->port;
     uint8_t baud_index;
     config_peek_link(port->flash, &l->id, &baud_index);
-    port->uart_set_baud(port->ctx, baud_rate_of_index(baud_index));
+    uint32_t baud = baud_rate_of_index(baud_index);
+    port->uart_set_baud(port->ctx, baud);
+    l->idle_us = frame_rx_port_idle_us(frame_rx_idle_us(baud), port->rx_gap_tolerance_us);
     l->board = b;
     l->sending = 0;
     frame_rx_init(&l->rx, &l->id);
@@ -30,7 +32,7 @@ bool boot_loop_step(struct boot_loop *l)
         port->rx_sync(port->rx_ctx, now);
     }
     uint32_t lost = 0;
-    (void)frame_rx_take_ring(&l->rx, port->rx, &lost);
+    frame_rx_receive(&l->rx, port->rx, &lost, now, l->idle_us);
     if (l->sending) {
         if (!port->uart_tx_done(port->ctx)) {
             return true; /* half duplex */

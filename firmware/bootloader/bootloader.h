@@ -38,6 +38,7 @@ struct boot_loop {
     uint8_t id;              /* the servo's stored ID */
     uint8_t sending;         /* an answer is going out */
     uint32_t started_us;
+    uint32_t idle_us;        /* a partial frame is dropped after this silence */
     uint8_t frame[RESPONSE_FRAME_MAX];
 };
 

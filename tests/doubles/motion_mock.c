@@ -54,3 +54,10 @@ void motion_end_async(struct motion *m, bool cancel)
     (void)m;
     check_expected(cancel);
 }
+
+bool motion_is_idle(const struct motion *m)
+{
+    (void)m;
+    function_called();
+    return (bool)mock();
+}

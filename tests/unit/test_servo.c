@@ -486,15 +486,16 @@ static void test_the_flash_is_erased_only_while_no_move_runs(void **state)
     EXPECT_RESPONSE(3, 0, 43, 0x55, 0x06);
 }
 
-/* UpdateEnter (0x50): refused without a bootloader or while a move runs;
- * otherwise answered, and the restart waits for the answer to leave and
- * for the user area to be in flash. UpdateStatus says the application
- * answers, with its version. */
+/* UpdateEnter (0x50): refused without a bootloader, and while the output
+ * is driven (a move, holding its end, damping, a buffered move), each with
+ * its reason; a released servo answers, and the restart waits for the
+ * answer to leave and for the user area to be in flash. UpdateStatus says
+ * the application answers, with its version. */
 static void test_update_enter_restarts_into_the_bootloader(void **state)
 {
     (void)state;
     REQUEST(0x50, 0);
-    EXPECT_RESPONSE(0x50, 0, 0); /* no bootloader on this port */
+    EXPECT_RESPONSE(0x50, 0, 0, 2); /* no bootloader on this port */
     hal.port.enter_bootloader = hal_double_enter_bootloader;
     hal.port.board = 0x0103;
     servo_init(&servo, &hal.port);
@@ -506,12 +507,23 @@ static void test_update_enter_restarts_into_the_bootloader(void **state)
     REQUEST(4, 0, 49, 0); /* soft start off: the move starts at once */
     REQUEST(11, 0, 0xE8, 0x03, 0xE8, 0x03, 0x64, 0, 0xC8, 0, 0, 0);
     REQUEST(0x50, 0);
-    EXPECT_RESPONSE(0x50, 0, 0); /* a move runs */
+    EXPECT_RESPONSE(0x50, 0, 0, 1); /* a move runs */
     harness_run_ms(1200);
+    REQUEST(0x50, 0);
+    EXPECT_RESPONSE(0x50, 0, 0, 1); /* it holds the end: a load would fall */
+    REQUEST(9, 0, 0xF4, 0x01);
+    REQUEST(0x50, 0);
+    EXPECT_RESPONSE(0x50, 0, 0, 1); /* damping */
+    REQUEST(24, 0, 0x10, 0, 0); /* released */
+    harness_request(18, NULL, 0); /* a move buffered for EndAsync */
+    REQUEST(11, 0, 0xE8, 0x03, 0xE8, 0x03, 0x64, 0, 0xC8, 0, 0, 0);
+    REQUEST(0x50, 0);
+    EXPECT_RESPONSE(0x50, 0, 0, 1);
+    REQUEST(19, 1); /* the buffer dropped */
     REQUEST(4, 0, 43, 0x55, 0x06); /* a change not yet saved */
     hal.tx_busy = true;
     REQUEST(0x50, 0);
-    EXPECT_RESPONSE(0x50, 0, 1);
+    EXPECT_RESPONSE(0x50, 0, 1, 0);
     harness_poll(4);
     assert_int_equal(hal.bootloader_entries, 0); /* the answer is still on the wire */
     hal.tx_busy = false;

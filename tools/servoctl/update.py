@@ -16,6 +16,7 @@ VERDICTS = {0: "valid", 1: "no image", 2: "header damaged", 3: "another board's 
             4: "image does not match its CRC"}
 WRITE_REASONS = {1: "damaged on the wire", 2: "outside the slot", 3: "the flash refused",
                  4: "reads back otherwise"}
+ENTER_OUTPUT_DRIVEN, ENTER_NO_BOOTLOADER = 1, 2  # UpdateEnter's reasons (docs/packets.md)
 RETRIES = 3
 SWITCH_TIMEOUT_S = 3.0  # a restart: the bootloader's 200 ms window, and the application's start
 
@@ -38,6 +39,17 @@ def status(bus, servo_id: int, timeout=None) -> Status:
     if len(c) != 16:
         raise NoReply(f"servo {servo_id}: UpdateStatus answer of {len(c)} bytes: not this firmware")
     return Status(c[1], *struct.unpack_from("<HBHHHHBH", c, 2))
+
+
+def enter_refusal(servo_id: int, reason) -> str:
+    """What a refused UpdateEnter means, and what to do about it."""
+    if reason == ENTER_OUTPUT_DRIVEN:
+        return (f"servo {servo_id} refused to enter its bootloader: its output is driven (a move, "
+                f"the wheel, hold or damping), and the restart would let go of any load it holds. "
+                f"Support the load, release the servo ('servoctl stop {servo_id}'), then update")
+    if reason == ENTER_NO_BOOTLOADER:
+        return f"servo {servo_id} has no bootloader: it cannot be updated over the bus"
+    return f"servo {servo_id} refused to enter its bootloader (driven, or it has none)"
 
 
 def _poll_mode(bus, servo_id: int, mode: int, seconds: float, reply_s: float, pause_s: float):
@@ -106,8 +118,7 @@ def update(bus, servo_id: int, image: Image, progress=lambda done, total: None) 
     if st.mode == MODE_APP:
         c = bus.request(UPDATE_ENTER, bytes([servo_id]))
         if c[1] != 1:
-            raise Refused(f"servo {servo_id} refused to enter its bootloader: a move runs, "
-                          "or it has none")
+            raise Refused(enter_refusal(servo_id, c[2] if len(c) > 2 else None))
         st = _wait_for_mode(bus, servo_id, MODE_BOOTLOADER)
     if len(image.data) > st.page_size * st.pages:
         if st.verdict == 0:  # nothing erased yet: back to the application

@@ -219,6 +219,10 @@ static inline bool motion_is_moving(const struct motion *m)
     return m->running != 0u || m->endless != 0u;
 }
 
+/* Released, nothing running, queued or buffered: letting go of the output
+ * (a restart) changes nothing. */
+bool motion_is_idle(const struct motion *m);
+
 /* What the protection monitors require of the output: inhibit releases it
  * and refuses motion until lifted; derate halves the current it may draw;
  * power_cap_mw (0 = none) bounds every move's power. */

@@ -129,4 +129,24 @@ static inline bool frame_rx_take_ring(struct frame_rx *rx, struct hal_rx_ring *r
  * do not cut a frame. */
 uint32_t frame_rx_idle_us(uint32_t baud);
 
+/* The idle timeout a port uses: the documented one (idle_us), or the
+ * port's own gap tolerance where that is longer (hal_port.rx_gap_tolerance_us). */
+static inline uint32_t frame_rx_port_idle_us(uint32_t idle_us, uint32_t gap_tolerance_us)
+{
+    return idle_us > gap_tolerance_us ? idle_us : gap_tolerance_us;
+}
+
+/* A main-loop pass's receiving, the application's and the bootloader's
+ * alike: the ring framed, and a partial frame dropped once the line has
+ * been silent for idle_us, so no byte sequence leaves the framer waiting
+ * for bytes that never come. */
+static inline void frame_rx_receive(struct frame_rx *rx, struct hal_rx_ring *ring, uint32_t *lost,
+                                    uint32_t now_us, uint32_t idle_us)
+{
+    if (!frame_rx_take_ring(rx, ring, lost) && frame_rx_in_frame(rx) &&
+        (int32_t)(now_us - ring->heard_us) >= (int32_t)idle_us) {
+        frame_rx_line_idle(rx);
+    }
+}
+
 #endif

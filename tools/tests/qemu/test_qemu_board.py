@@ -51,6 +51,24 @@ def test_update_enter_and_boot_round_trip(servo):
     assert servo.read("serial") == 0x0E3A0001
 
 
+def test_the_bootloader_drops_a_partial_frame(servo):
+    """The real ARM bootloader: the start of a frame whose length says
+    65535, then a frame cut short, each dropped after the idle gap (this
+    board's 50 ms tolerance of QEMU's jitter), not waited on for good."""
+    from servoctl import update as upd
+    assert servo.bus.request(upd.UPDATE_ENTER, bytes([0]))[1] == 1
+    upd._wait_for_mode(servo.bus, 0, upd.MODE_BOOTLOADER)
+    servo.bus.serial.write(bytes([0x12, 0x4C, 0x55, 0xFF, 0xFF, 0xFF]))
+    servo.bus.sleep(0.2)
+    assert servo.ping()
+    whole = p.request_frame(upd.UPDATE_WRITE, bytes([0]) + bytes(4) + b"\xff" * 8 + bytes(4))
+    servo.bus.serial.write(whole[:10])
+    servo.bus.sleep(0.2)
+    assert upd.status(servo.bus, 0).mode == upd.MODE_BOOTLOADER
+    assert servo.bus.request(upd.UPDATE_BOOT, bytes([0]))[1] == 1
+    upd._wait_for_mode(servo.bus, 0, upd.MODE_APP)
+
+
 def test_read_and_write_data(servo):
     assert servo.read("voltage") == pytest.approx(7400, abs=10)
     assert servo.read("temperature") == 2048
