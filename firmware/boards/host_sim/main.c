@@ -71,6 +71,8 @@ static void usage(FILE *out)
           "Control commands, one per line, optional servo ID last:\n"
           "  supply MV | load NM | stop DEG | stop off | ambient DEGC | soak DEGC |\n"
           "  hostbaud BAUD (a TCP host's rate; a pty's is what the host set) |\n"
+          "  failerase N | failprogram N (the next N flash erases, or half-word\n"
+          "  programs, of the config store and the slot fail, as a worn page's do) |\n"
           "  powercycle (the servo restarts through its bootloader) | state | help |\n"
           "  clock (the simulated clock, sim_ms, and how far it is behind the wall clock)\n"
           "The servos run on the simulated clock: it follows the wall clock, and falls\n"
@@ -274,7 +276,8 @@ static void control_command(int fd, char *line)
     }
     if (strcmp(cmd, "help") == 0) {
         reply(fd, "ok supply MV | load NM | stop DEG | stop off | ambient DEGC | soak DEGC | "
-                  "hostbaud BAUD | powercycle [ID] | state [ID] | clock\n");
+                  "hostbaud BAUD | failerase N | failprogram N | powercycle [ID] | state [ID] | "
+                  "clock\n");
         return;
     }
     if (takes_value && n < 2) {
@@ -298,6 +301,7 @@ static void control_command(int fd, char *line)
         {"supply", 0, 30000, "mV"},   {"load", -50, 50, "N m"},
         {"ambient", -40, 150, "degC"}, {"soak", -40, 150, "degC"},
         {"stop", -1e6, 1e6, "deg"},    {"hostbaud", 1200, 4000000, "baud"},
+        {"failerase", 0, 1000000, "erases"}, {"failprogram", 0, 1000000, "programs"},
     };
     for (size_t r = 0; takes_value && !off && r < sizeof ranges / sizeof ranges[0]; r++) {
         if (strcmp(cmd, ranges[r].cmd) == 0 && !(value >= ranges[r].lo && value <= ranges[r].hi)) {
@@ -334,6 +338,10 @@ static void control_command(int fd, char *line)
         } else if (strcmp(cmd, "stop") == 0) {
             s->plant.has_stop = !off;
             s->plant.stop_angle = value * M_PI / 180.0;
+        } else if (strcmp(cmd, "failerase") == 0) {
+            s->flash.fail_erases = s->slot_flash.fail_erases = (uint32_t)value;
+        } else if (strcmp(cmd, "failprogram") == 0) {
+            s->flash.fail_programs = s->slot_flash.fail_programs = (uint32_t)value;
         } else if (strcmp(cmd, "powercycle") == 0) {
             sim_servo_power_cycle(s);
         } else if (strcmp(cmd, "state") == 0) {

@@ -117,15 +117,11 @@ static bool program_id(struct sim_flash *flash, uint8_t id)
     return config_store_save(&store, &cfg, 0) != CONFIG_WRITE_FAILED;
 }
 
-/* A slot without a valid image gets the factory's: a header for this
+/* A blank chip's slot gets the factory's image: a header for this
  * firmware's version and 4 KB of stand-in code (the simulator runs the
  * servo core, not the image). */
 static bool program_factory_image(struct sim_servo *s, uint16_t version)
 {
-    struct app_image_info info;
-    if (app_image_check(&s->slot, SIM_BOARD, &info) == APP_IMAGE_VALID) {
-        return true;
-    }
     enum { CODE = 4096 };
     static uint8_t image[APP_HEADER_SIZE + CODE];
     for (uint32_t i = 0; i < CODE; i++) {
@@ -204,13 +200,21 @@ bool sim_servo_start(struct sim_servo *s, struct sim_bus *bus, unsigned index, u
         .board = SIM_BOARD,
     };
     /* Powered long before the host connects: the application runs (the
-     * bootloader's listening window is modelled after a restart). */
+     * bootloader's listening window is modelled after a restart), if its
+     * slot holds a valid image. Only a blank chip gets the factory image:
+     * a slot an update left invalid stays so, and the servo waits in its
+     * bootloader, as a real one would. */
     servo_init(&s->core, &s->port);
-    if (!program_factory_image(s, s->core.regs.status.firmware_version)) {
+    if (s->slot_flash.created && !program_factory_image(s, s->core.regs.status.firmware_version)) {
         fprintf(stderr, "servo_sim: cannot write the slot file %s\n", slot_path);
         return false;
     }
-    sim_servo_start_app(s);
+    struct app_image_info info;
+    if (app_image_check(&s->slot, SIM_BOARD, &info) == APP_IMAGE_VALID) {
+        sim_servo_start_app(s);
+    } else {
+        sim_boot_reset(s, false);
+    }
     s->flash.stall_us = 0; /* power-up, before the servo joins the bus */
     s->slot_flash.stall_us = 0;
     return true;

@@ -17,8 +17,12 @@ static bool erase_page(void *ctx, uint32_t addr)
     if (addr < f->base || addr - f->base >= f->size || (addr - f->base) % SIM_FLASH_PAGE != 0u) {
         return false;
     }
-    memset(&f->mem[addr - f->base], 0xFF, SIM_FLASH_PAGE);
     f->stall_us += SIM_FLASH_ERASE_US;
+    if (f->fail_erases != 0u) {
+        f->fail_erases--;
+        return false;
+    }
+    memset(&f->mem[addr - f->base], 0xFF, SIM_FLASH_PAGE);
     return save(f, addr - f->base, SIM_FLASH_PAGE);
 }
 
@@ -33,9 +37,13 @@ static bool program(void *ctx, uint32_t addr, const uint8_t *data)
     if (cell[0] != 0xFF || cell[1] != 0xFF) {
         return false;
     }
+    f->stall_us += SIM_FLASH_PROGRAM_US;
+    if (f->fail_programs != 0u) {
+        f->fail_programs--;
+        return false;
+    }
     cell[0] = data[0];
     cell[1] = data[1];
-    f->stall_us += SIM_FLASH_PROGRAM_US;
     return save(f, addr - f->base, 2);
 }
 
@@ -58,6 +66,7 @@ bool sim_flash_open(struct sim_flash *f, const char *path, uint32_t base, uint32
         return false;
     }
     if (pread(f->fd, f->mem, f->size, 0) != (ssize_t)f->size) {
+        f->created = true;
         memset(f->mem, 0xFF, f->size); /* new or truncated: a blank chip */
         if (!save(f, 0, f->size)) {
             return false;

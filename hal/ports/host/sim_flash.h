@@ -26,6 +26,12 @@ struct sim_flash {
     uint32_t size;
     int fd; /* the file, kept open; each erase or program writes through */
     uint32_t stall_us; /* CPU stall owed by erases and programs since last taken */
+    bool created;      /* the file was new (or short): a blank chip */
+    /* Injected faults: this many of the next erases, or half-word programs,
+     * fail as a worn page does (FLASH_SR's PGERR or a read-back that does
+     * not match): the cells keep what they held, the driver gets false. */
+    uint32_t fail_erases;
+    uint32_t fail_programs;
 };
 
 /* Opens (or creates, erased) the file holding `pages` pages at `base`, kept

@@ -249,3 +249,39 @@ def test_the_bootloader_drops_a_partial_frame_after_an_idle_gap(sim):
         sim.sleep(0.01)
         assert upd.status(bus, 1).mode == upd.MODE_BOOTLOADER
         assert Servo(bus, 1).ping()
+
+
+def test_a_slot_left_invalid_stays_invalid_across_a_kill(tmp_path):
+    """Killed during an update (the old image erased, the new one not yet
+    written), a servo comes back waiting in its bootloader, not as the
+    factory application: only a blank state folder gets that."""
+    from servoctl.sim import Simulator
+
+    state = str(tmp_path / "state")
+    with Simulator(ids=[1], state_dir=state) as sim, sim.bus(timeout=0.2) as bus:
+        assert bus.request(upd.UPDATE_ENTER, bytes([1]))[1] == 1
+        upd._wait_for_mode(bus, 1, upd.MODE_BOOTLOADER)
+        assert bus.request(upd.UPDATE_ERASE, bytes([1, 0, 0]))[1] == 1
+        sim.process.kill()  # kill -9: no clean stop
+        sim.process.wait()
+    with Simulator(ids=[1], state_dir=state) as sim, sim.bus(timeout=0.2) as bus:
+        st = upd.status(bus, 1)
+        assert (st.mode, st.verdict) == (upd.MODE_BOOTLOADER, 1)  # no image
+        assert sim.state(1)["mode"] == "bootloader"
+        with pytest.raises(NoReply):
+            Servo(bus, 1).read("firmware")
+        assert upd.update(bus, 1, make_image()) == (None, NEW)
+
+
+def test_flash_faults_are_reported_not_hidden(sim):
+    """The control port's failerase and failprogram make the next erases or
+    programs fail as a worn page's do: the update says which step the
+    flash refused, and a retry once the fault is gone succeeds."""
+    with sim.bus(timeout=0.2) as bus:
+        sim.control("failerase 1 1")
+        with pytest.raises(Refused, match="erasing page 0 refused: the flash refused"):
+            upd.update(bus, 1, make_image())
+        sim.control("failprogram 1 1")
+        with pytest.raises(Refused, match="the flash refused"):
+            upd.update(bus, 1, make_image())
+        assert upd.update(bus, 1, make_image()) == (None, NEW)
