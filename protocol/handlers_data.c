@@ -61,7 +61,8 @@ enum packet_outcome handle_write_batch(const struct packet_call *c, struct respo
     return answer_result(c, r, ok);
 }
 
-enum { READ_STORE_ANSWER_LENGTH = 26 };
+enum { READ_STORE_ANSWER_LENGTH = 34 };
+_Static_assert(READ_STORE_ANSWER_LENGTH <= RESPONSE_CONTENT_MAX, "ReadStore fits a response");
 
 enum packet_outcome handle_read_store(const struct packet_call *c, struct response *r)
 {
@@ -75,6 +76,8 @@ enum packet_outcome handle_read_store(const struct packet_call *c, struct respon
     wire_put_u32(&p[14], h->budget);
     wire_put_u32(&p[18], h->op_seconds);
     wire_put_u32(&p[22], h->failures);
+    wire_put_u32(&p[26], h->answers_dropped);
+    wire_put_u32(&p[30], h->bytes_lost);
     r->length = READ_STORE_ANSWER_LENGTH;
     return OUTCOME_OK;
 }

@@ -2,12 +2,13 @@
 # Runs every test: unit tests under ASan + UBSan; the ARM images with their
 # flash/RAM budget and soft-float checks; the target benchmark; pytest: the
 # PC tool, the firmware on simulated servos (servoctl and the maker's SDK),
-# the real ARM image under QEMU; a bounded fuzz run (at least 5000
-# executions per second) and the corpus's line coverage (at least 90 %).
+# the real ARM image under QEMU; a fuzz run of a fixed number of inputs and
+# the corpus's line coverage (at least 90 %).
 # Every step runs whatever an earlier one did; each failure is named at the
 # end, and the last line counts the checks: "summary: N passed, N failed"
 # (each CTest program and pytest test, and each other step as one).
-# FUZZ_SECONDS sets the fuzz run's length (default 60).
+# FUZZ_RUNS sets the fuzz run's length in inputs (default 200000): a fixed
+# amount of fuzzing, which a busy machine makes slower, not smaller.
 set -uo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh || { echo "setup failed: nothing was tested" >&2; exit 1; }
@@ -66,7 +67,8 @@ fuzz_run() {
   # New inputs go to the scratch folder; the committed seeds stay as they
   # are. Inputs up to 256 bytes: a dozen requests and as many clock, horn,
   # sensor, flash and power events.
-  if ! ./build/fuzz/tests/fuzz/fuzz_servo -max_total_time="${FUZZ_SECONDS:-60}" -seed=1 -max_len=256 \
+  local started=$SECONDS
+  if ! ./build/fuzz/tests/fuzz/fuzz_servo -runs="${FUZZ_RUNS:-200000}" -seed=1 -max_len=256 \
        -print_final_stats=1 "$work" tests/fuzz/corpus 2>"$work/log"; then
     tail -n 60 "$work/log" >&2
     echo "fuzzing found a failure (crash input saved in the working directory)" >&2
@@ -74,11 +76,14 @@ fuzz_run() {
     return 1
   fi
   grep -E '^(#[0-9]+\s+DONE|stat::number_of_executed_units|stat::average_exec_per_sec)' "$work/log"
-  local rate
-  rate=$(sed -nE 's/^stat::average_exec_per_sec:\s+([0-9]+)/\1/p' "$work/log")
+  local units
+  units=$(sed -nE 's/^stat::number_of_executed_units:\s+([0-9]+)/\1/p' "$work/log")
   rm -rf "$work"
-  if [ "${rate:-0}" -lt "${FUZZ_MIN_EXEC_PER_S:-5000}" ]; then
-    echo "the fuzzer ran ${rate:-0} executions per second, below ${FUZZ_MIN_EXEC_PER_S:-5000}" >&2
+  echo "fuzzing: $units inputs in $((SECONDS - started)) s"
+  # The speed is a benchmark's figure (README, "Fuzzing"), not a gate: a
+  # busy machine runs the same inputs, slower.
+  if [ "${units:-0}" -lt "${FUZZ_RUNS:-200000}" ]; then
+    echo "the fuzzer ran ${units:-0} inputs, not ${FUZZ_RUNS:-200000}" >&2
     return 1
   fi
 }
@@ -116,7 +121,7 @@ if [ "$tools_rc" -ne 0 ]; then
   [ "${tools_failed:-0}" -gt 0 ] || count 0 1
 fi
 
-step "fuzzing the whole servo for ${FUZZ_SECONDS:-60} s (libFuzzer, ASan + UBSan, -O2)" fuzz_run
+step "fuzzing the whole servo: ${FUZZ_RUNS:-200000} inputs (libFuzzer, ASan + UBSan, -O2)" fuzz_run
 step "line coverage of motion, protection and the config store by the fuzz corpus (>= 90 %)" \
   bash scripts/fuzz_coverage.sh
 

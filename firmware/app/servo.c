@@ -138,6 +138,11 @@ static void handle_next_frame(struct servo *s, uint32_t now)
     if (frame == NULL) {
         return;
     }
+    /* A request that arrived while a page erase stalled the CPU is carried
+     * out, but its answer, tens of milliseconds late, could fall in another
+     * servo's slot: it is not sent, and ReadStore counts it. */
+    bool late = s->stale_frames != 0u;
+    s->stale_frames = (uint8_t)(s->stale_frames - late);
     struct response r;
     struct dispatch_result result;
     dispatch(&s->dispatcher, frame, &r, &result);
@@ -149,7 +154,9 @@ static void handle_next_frame(struct servo *s, uint32_t now)
         s->link_check = 1;
     }
     s->enter_bootloader |= result.enter_bootloader;
-    if (result.answer) {
+    if (result.answer && late) {
+        s->answers_dropped++;
+    } else if (result.answer) {
         queue_response(s, &r, result.wait_responses, responses_base, now);
     }
 }
@@ -164,6 +171,8 @@ static void report_store(struct servo *s)
                               (s->saver.pending || s->store.job_active ? STORE_PENDING : 0u) |
                               (s->saver.awaits_erase ? STORE_AWAITS_ERASE : 0u));
     uint32_t op_seconds = save_policy_op_seconds(&s->saver);
+    h->answers_dropped = s->answers_dropped;
+    h->bytes_lost = s->rx_lost;
     if (flags == h->flags && op_seconds == h->op_seconds && h->rated_cycles != 0u &&
         s->store.sequence == h->records && s->store.write_failures == h->failures) {
         return;
@@ -216,6 +225,12 @@ static void save_config(struct servo *s, uint32_t now, bool ticked)
     if (!ticked) {
         return;
     }
+    /* The first pass after an erase has ticks due (it stalled 20-40 ms): the
+     * frames its receive took arrived during the erase. */
+    if (s->erase_passed) {
+        s->erase_passed = 0;
+        s->stale_frames = frame_rx_pending(&s->rx);
+    }
     /* The policy counts operating time, so it is asked every tick; a save
      * that needs the erase is not tried again before that is done. */
     bool due = save_policy_due(&s->saver, &s->store, now);
@@ -230,9 +245,11 @@ static void save_config(struct servo *s, uint32_t now, bool ticked)
             save_finished(s, r, now);
         }
     }
-    if (config_store_spare_dirty(&s->store) && erase_may_stall(s, now) &&
-        !config_store_erase_spare(&s->store)) {
-        save_finished(s, CONFIG_WRITE_FAILED, now);
+    if (config_store_spare_dirty(&s->store) && erase_may_stall(s, now)) {
+        s->erase_passed = 1;
+        if (!config_store_erase_spare(&s->store)) {
+            save_finished(s, CONFIG_WRITE_FAILED, now);
+        }
     }
     report_store(s);
 }

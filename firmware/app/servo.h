@@ -80,6 +80,9 @@ struct servo {
     uint8_t active_baud_index;
     uint8_t link_check;          /* the user area changed: ID or baud may have */
     uint8_t enter_bootloader;    /* UpdateEnter taken: restart once the answer is out */
+    uint8_t erase_passed;        /* a page erase stalled the CPU in the last pass */
+    uint8_t stale_frames;        /* frames that arrived during it: not answered */
+    uint32_t answers_dropped;    /* answers not sent: they would have left late */
     uint32_t unsolicited_slot_us;  /* slot length at this baud */
     uint32_t unsolicited_first_us; /* quiet before this ID's first slot */
     struct save_policy saver;

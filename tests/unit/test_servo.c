@@ -250,7 +250,7 @@ static void test_config_survives_restart(void **state)
 static uint32_t store_field(size_t at)
 {
     REQUEST(0x41, 0);
-    assert_int_equal(hal.sent_length, 4 + 26 + 1);
+    assert_int_equal(hal.sent_length, 4 + 34 + 1);
     const uint8_t *c = &hal.sent[4];
     if (at == 1) {
         return c[1];
@@ -486,6 +486,42 @@ static void test_the_flash_is_erased_only_while_no_move_runs(void **state)
     EXPECT_RESPONSE(3, 0, 43, 0x55, 0x06);
 }
 
+/* A request that arrives while a page erase stalls the CPU is carried out
+ * in the first pass after it, but not answered: 20-40 ms late, the answer
+ * could fall in another servo's slot. ReadStore counts it; the next
+ * request is answered as usual. */
+static void test_an_answer_that_would_leave_late_is_dropped(void **state)
+{
+    (void)state;
+    const unsigned slots = config_store_slots_per_page(&servo.store);
+    for (unsigned i = 0; i < 2u * slots; i++) {
+        REQUEST(4, 0, 43, (uint8_t)(100u + i), 0x07);
+        harness_run_ms(70);
+    }
+    uint32_t erases = hal.flash.erases[0] + hal.flash.erases[1];
+    while (hal.flash.erases[0] + hal.flash.erases[1] == erases) {
+        hal.now_us += 250u; /* the line quiet until the erase runs */
+        servo_poll(&servo);
+    }
+    /* A WriteData lands in the ring during the 40 ms the CPU stalled. */
+    uint8_t wire[16];
+    size_t n = make_request(wire, 4, (const uint8_t[]){0, 38, 0xD2, 0x04}, 4);
+    hal_double_clear_sent(&hal);
+    for (size_t i = 0; i < n; i++) {
+        servo_on_rx_byte(&servo, wire[i], hal.now_us + 1000u + 87u * (uint32_t)i);
+    }
+    hal.now_us += 40000u;
+    harness_poll(4);
+    assert_int_equal(hal.sent_length, 0u);       /* not answered */
+    assert_int_equal(servo.regs.user.stall_power_mw, 1234); /* but carried out */
+    assert_int_equal(servo.answers_dropped, 1u);
+    harness_run_ms(2);
+    assert_int_equal(store_field(26), 1u);       /* ReadStore: answers dropped */
+    assert_int_equal(store_field(30), 0u);       /* bytes lost */
+    REQUEST(1, 0);
+    EXPECT_RESPONSE(1, 0);
+}
+
 /* UpdateEnter (0x50): refused without a bootloader, and while the output
  * is driven (a move, holding its end, damping, a buffered move), each with
  * its reason; a released servo answers, and the restart waits for the
@@ -575,6 +611,7 @@ int main(void)
         cmocka_unit_test_setup(test_a_burst_of_writes_is_one_save, setup),
         cmocka_unit_test_setup(test_writes_in_a_loop_stay_within_the_wear_budget, setup),
         cmocka_unit_test_setup(test_the_flash_is_erased_only_while_no_move_runs, setup),
+        cmocka_unit_test_setup(test_an_answer_that_would_leave_late_is_dropped, setup),
         cmocka_unit_test_setup(test_update_enter_restarts_into_the_bootloader, setup),
         cmocka_unit_test_setup(test_garbage_between_frames_and_responses_of_others, setup),
     };

@@ -151,6 +151,29 @@ def cmd_info(bus, args):
     return 0
 
 
+def cmd_store(bus, args):
+    """ReadStore: the config store's health, and what flash work cost the
+    bus (answers dropped, bytes lost): a host that missed an answer, or
+    whose broadcast a servo may have missed, learns it here."""
+    h = Servo(bus, args.id).read_store()
+    if args.json:
+        print(json.dumps({"id": h.id, "flags": h.flag_names(), "records": h.records,
+                          "page_erases": h.page_erases, "rated_cycles": h.rated_cycles,
+                          "budget": h.budget, "op_seconds": h.op_seconds, "failures": h.failures,
+                          "answers_dropped": h.answers_dropped, "bytes_lost": h.bytes_lost}))
+        return 0
+    print(f"servo {args.id}: config store")
+    print(f"  state            {', '.join(h.flag_names()) or 'saved'}")
+    print(f"  records          {h.records} (wear budget {h.budget} by now)")
+    print(f"  page erases      {h.page_erases} of {h.rated_cycles} rated")
+    print(f"  operating time   {h.op_seconds} s")
+    print(f"  failed saves     {h.failures}")
+    print(f"  answers dropped  {h.answers_dropped} (requests that arrived during a flash erase: "
+          f"carried out, not answered)")
+    print(f"  bytes lost       {h.bytes_lost}")
+    return 0
+
+
 def _shown(item, raw: int, as_raw: bool) -> str:
     if as_raw:
         return f"{raw}{' ' + item.unit if item.unit else ''}"
@@ -587,6 +610,12 @@ def build_parser():
     c.add_argument("id", type=int)
     c.add_argument("--json", action="store_true", help="as one JSON object, SI units")
     c.set_defaults(run=cmd_info)
+
+    c = sub.add_parser("store", help="the config store's health; answers dropped and bytes lost "
+                                     "to flash work")
+    c.add_argument("id", type=int)
+    c.add_argument("--json", action="store_true", help="as one JSON object")
+    c.set_defaults(run=cmd_store)
 
     c = sub.add_parser("config", help="the user area by name: get, set, dump, save, load, reset")
     c.add_argument("action", choices=["get", "set", "dump", "save", "load", "reset"])

@@ -31,6 +31,7 @@ SET_ORIGIN = 23
 STOP_ON_CONTROL = 24
 SYNC = 25
 READ_MOTION = 0x40  # this firmware's own (docs/packets.md)
+READ_STORE = 0x41
 
 
 class ServoError(Exception):

@@ -54,6 +54,35 @@ class MotionSnapshot:
         return ((self.time_us - earlier.time_us) % 2**32) / 1e6
 
 
+@dataclass
+class StoreHealth:
+    """ReadStore (0x41): whether the user area is safely in flash, how worn
+    the flash is, and what flash work cost the bus (docs/packets.md)."""
+    id: int
+    flags: int
+    records: int
+    page_erases: int
+    rated_cycles: int
+    budget: int
+    op_seconds: int
+    failures: int
+    answers_dropped: int  # requests that arrived during an erase: carried out, not answered
+    bytes_lost: int       # received bytes overwritten before the servo took them
+
+    FLAGS = ("save_failed", "waits_for_wear_budget", "not_saved_yet", "waits_for_erase")
+    LENGTH = 34
+
+    @classmethod
+    def decode(cls, content: bytes) -> "StoreHealth":
+        if len(content) != cls.LENGTH:
+            raise ServoError(f"servo {content[:1].hex() or '?'}: a ReadStore answer of "
+                             f"{len(content)} bytes, not {cls.LENGTH} (older firmware?)")
+        return cls(*struct.unpack("<BB8I", content))
+
+    def flag_names(self) -> list:
+        return [name for bit, name in enumerate(self.FLAGS) if self.flags >> bit & 1]
+
+
 def _check(name: str, value: int, low: int, high: int, unit: str = "") -> int:
     if isinstance(value, bool) or not isinstance(value, int):
         raise ValueOutOfRange(f"{name} takes a whole number{' of ' + unit if unit else ''}, not {value!r}"
@@ -119,6 +148,10 @@ class Servo:
     def read_motion(self) -> MotionSnapshot:
         """Needs this firmware: the maker's servos do not know packet 0x40."""
         return MotionSnapshot.decode(self.bus.request(p.READ_MOTION, bytes([self.id])))
+
+    def read_store(self) -> StoreHealth:
+        """Needs this firmware: the maker's servos do not know packet 0x41."""
+        return StoreHealth.decode(self.bus.request(p.READ_STORE, bytes([self.id])))
 
     def status(self) -> int:
         return self.read("status")

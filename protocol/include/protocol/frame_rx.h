@@ -96,6 +96,11 @@ static inline const struct rx_frame *frame_rx_peek(const struct frame_rx *rx)
     return rx->tail == rx->head ? (const struct rx_frame *)0 : &rx->slots[rx->tail];
 }
 void frame_rx_release(struct frame_rx *rx);
+/* Complete frames waiting for frame_rx_peek. */
+static inline uint8_t frame_rx_pending(const struct frame_rx *rx)
+{
+    return (uint8_t)((rx->head + FRAME_QUEUE_SLOTS - rx->tail) % FRAME_QUEUE_SLOTS);
+}
 
 /* Everything waiting in the port's ring, framed: false when nothing was.
  * Bytes the port wrote over before they were taken (its DMA lapped the

@@ -4,8 +4,9 @@
 
 #include <stdint.h>
 
-/* Largest response content: ReadBatchData, 1 + 32 bytes. */
-#define RESPONSE_CONTENT_MAX 33u
+/* Largest response content: ReadStore (0x41), 34 bytes (ReadBatchData's
+ * is 1 + 32). */
+#define RESPONSE_CONTENT_MAX 34u
 #define RESPONSE_FRAME_MAX (RESPONSE_CONTENT_MAX + 5u)
 
 struct response {

@@ -73,6 +73,12 @@ struct store_health {
     uint32_t budget;        /* records the wear budget allows by now */
     uint32_t op_seconds;    /* operating time, as recorded with the saves */
     uint32_t failures;      /* failed saves since power-up */
+    /* What flash work cost the bus since power-up (ReadStore): answers not
+     * sent because their request arrived while an erase stalled the CPU
+     * (they would have left outside their slot), and received bytes the
+     * port's ring overwrote before the main loop took them. */
+    uint32_t answers_dropped;
+    uint32_t bytes_lost;
 };
 
 struct registers {

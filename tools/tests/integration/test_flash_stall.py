@@ -69,3 +69,53 @@ def test_a_port_without_dma_would_lose_bytes(tmp_path):
         if after["rx_overruns"] > 0:
             return
     raise AssertionError("no overrun in three runs: the flash stall model does not bite")
+
+
+def test_an_answer_that_would_leave_late_is_dropped_and_counted(tmp_path, capsys):
+    """A request that lands in a config-store page erase (40 ms, the line
+    quiet for 100 ms before it) is carried out, but not answered late: the
+    host gets no answer, and ReadStore, and `servoctl store`, count it. A
+    host cannot time its request into the erase exactly, so the test tries
+    until one lands there, and checks every round that a missing answer is
+    counted and an answered one is not."""
+    import json
+
+    from servoctl.cli import main
+
+    sim = Simulator(ids=[1], state_dir=str(tmp_path / "state"))
+    sim.start()
+    try:
+        with sim.bus(timeout=0.2) as bus:
+            one = Servo(bus, 1)
+            landed, n = 0, 0
+            for _ in range(6):
+                # Records until one starts the other page: the old page is
+                # then erased ahead once the line is quiet for 100 ms.
+                while True:
+                    n += 1
+                    one.write("current_limit", 3000 + n % 2)
+                    sim.sleep(0.07)  # saved 50 ms after the change
+                    state = sim.state(1)
+                    if state["saves"] % 21 == 1 and state["saves"] > 1:
+                        answered_at = state["last_sent_ms"] / 1000.0  # simulated time
+                        break
+                stalled = sim.state(1)["flash_stall_ms"]
+                # Into the erase that starts 100 ms after the last answer.
+                sim.sleep(answered_at + 0.12 - sim.clock_s())
+                answered = one.ping(timeout=0.2)
+                sim.sleep(0.1)
+                erased = sim.state(1)["flash_stall_ms"] - stalled >= 40.0
+                dropped = one.read_store().answers_dropped
+                assert erased, "no erase ran: the test proves nothing"
+                assert dropped == landed + (not answered), (answered, dropped, landed)
+                landed = dropped
+                if landed:
+                    break
+            assert landed >= 1, "no request landed in an erase in six rounds"
+        assert main(["--port", sim.url, "store", "1", "--json"], clock=sim.clock_s) == 0
+        report = json.loads(capsys.readouterr().out)
+        assert report["answers_dropped"] == landed and report["bytes_lost"] == 0
+        assert sim.state(1)["collisions"] == 0
+    finally:
+        err = sim.stop()
+        assert "runtime error" not in err and "AddressSanitizer" not in err, err
