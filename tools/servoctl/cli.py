@@ -425,6 +425,11 @@ def cmd_record(bus, args):
             break
     if done_at is None:
         raise Refused(f"servo {args.id} still moving after {limit:.1f} s (the samples are not written)")
+    # Time 0 is when the servo's profile started, not when the host sent the
+    # move: a host that was slow to send it does not shift the plan.
+    began = _profile_start(samples, plan)
+    samples = [(t - began, m) for t, m in samples]
+    done_at -= began
     rows = []
     profile_end = None
     for t, m in samples:
@@ -456,6 +461,21 @@ def cmd_record(bus, args):
     print(f"csv  {os.path.abspath(csv_path)}")
     print(f"plot {os.path.abspath(png_path)}")
     return 0
+
+
+def _profile_start(samples, plan) -> float:
+    """The servo time its profile started at: from the first sample whose
+    setpoint has left the start, less the plan's time to that setpoint
+    (the setpoint is the profile's own, so no host delay enters). 0 when
+    no sample caught the setpoint between start and target."""
+    start, end = plan[0], plan[-1]
+    sign = 1 if end >= start else -1
+    for t, m in samples:
+        setpoint = m.setpoint_decideg
+        if sign * (setpoint - start) > 0 and sign * (end - setpoint) > 0:
+            k = next(i for i, p in enumerate(plan) if sign * (p - setpoint) >= 0)
+            return t - k / 1000.0
+    return 0.0
 
 
 def _plot(rows, plan, path, title, profile_end, finished):

@@ -24,6 +24,15 @@ class Monitor:
         return cls(*struct.unpack("<BHHHHBih", content))
 
 
+def _unpack(fmt: str, content: bytes, packet: str) -> tuple:
+    """An answer of this firmware's own packets, whose length says which
+    firmware answered: another length is an error that says so."""
+    if len(content) != struct.calcsize(fmt):
+        raise ServoError(f"servo {content[:1].hex() or '?'}: a {packet} answer of {len(content)} "
+                         f"bytes, not {struct.calcsize(fmt)} (older firmware?)")
+    return struct.unpack(fmt, content)
+
+
 @dataclass
 class MotionSnapshot:
     """ReadMotion (0x40): one instant of the motion state, docs/packets.md."""
@@ -39,14 +48,10 @@ class MotionSnapshot:
     time_us: int  # the servo's clock at the tick the values are from; wraps at 2**32
 
     PROFILE_ENDED, CLOCK_SLOWED, BRAKING, AT_LIMIT, RELEASED = 1, 2, 4, 8, 16
-    LENGTH = 25
 
     @classmethod
     def decode(cls, content: bytes) -> "MotionSnapshot":
-        if len(content) != cls.LENGTH:
-            raise ServoError(f"servo {content[:1].hex() or '?'}: a ReadMotion answer of "
-                             f"{len(content)} bytes, not {cls.LENGTH} (older firmware?)")
-        return cls(*struct.unpack("<BiiihhHBBI", content))
+        return cls(*_unpack("<BiiihhHBBI", content, "ReadMotion"))
 
     def seconds_since(self, earlier: "MotionSnapshot") -> float:
         """Servo time from an earlier snapshot to this one (less than 71
@@ -70,14 +75,10 @@ class StoreHealth:
     bytes_lost: int       # received bytes overwritten before the servo took them
 
     FLAGS = ("save_failed", "waits_for_wear_budget", "not_saved_yet", "waits_for_erase")
-    LENGTH = 34
 
     @classmethod
     def decode(cls, content: bytes) -> "StoreHealth":
-        if len(content) != cls.LENGTH:
-            raise ServoError(f"servo {content[:1].hex() or '?'}: a ReadStore answer of "
-                             f"{len(content)} bytes, not {cls.LENGTH} (older firmware?)")
-        return cls(*struct.unpack("<BB8I", content))
+        return cls(*_unpack("<BB8I", content, "ReadStore"))
 
     def flag_names(self) -> list:
         return [name for bit, name in enumerate(self.FLAGS) if self.flags >> bit & 1]
