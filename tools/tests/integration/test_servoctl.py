@@ -91,7 +91,9 @@ def test_record_writes_csv_and_plot(sim, capsys, tmp_path):
     assert rc == 0
     with open(prefix + ".csv") as f:
         rows = list(csv.DictReader(f))
-    assert len(rows) > 50
+    # What was sampled, however often a busy host managed to: the move under
+    # way (status bit 0), then settled on target.
+    assert any(int(r["status"]) & 1 for r in rows) and not int(rows[-1]["status"]) & 1
     assert abs(float(rows[-1]["angle_deg"]) - 60.0) <= 0.5
     assert max(abs(float(r["angle_deg"]) - float(r["planned_deg"])) for r in rows) < 5.0
     # What the servo itself reports: its setpoint and speed follow the plan.
