@@ -433,10 +433,7 @@ def cmd_record(bus, args):
     rows = []
     profile_end = None
     for t, m in samples:
-        ms = int(t * 1000)
-        k = min(ms, len(plan) - 2)
-        planned = plan[min(ms, len(plan) - 1)] / 10.0
-        planned_speed = (plan[k + 1] - plan[k]) * 100.0 if ms < len(plan) - 1 else 0.0
+        planned, planned_speed = _planned_at(plan, t)
         if profile_end is None and m.flags & m.PROFILE_ENDED:
             profile_end = round(t * 1000, 1)
         rows.append((round(t * 1000, 1), m.angle_decideg / 10.0, m.velocity_decideg_s / 10.0,
@@ -461,6 +458,18 @@ def cmd_record(bus, args):
     print(f"csv  {os.path.abspath(csv_path)}")
     print(f"plot {os.path.abspath(png_path)}")
     return 0
+
+
+def _planned_at(plan, t_s: float) -> tuple:
+    """(degrees, degrees per second) the plan gives at t_s: its start
+    before the profile began (a sample taken before the servo's first tick
+    of the move has t < 0), its end after."""
+    ms = math.floor(t_s * 1000)
+    if ms < 0:
+        return plan[0] / 10.0, 0.0
+    if ms >= len(plan) - 1:
+        return plan[-1] / 10.0, 0.0
+    return plan[ms] / 10.0, (plan[ms + 1] - plan[ms]) * 100.0
 
 
 def _profile_start(samples, plan) -> float:
