@@ -152,12 +152,15 @@ class Bus:
         self._link(self.serial.write, request_frame(code, content))
 
     def _fill(self, wait: bool = True) -> None:
-        """Reads what has arrived; with wait, up to the port's 5 ms for it."""
+        """Reads what has arrived; with wait, up to the port's 5 ms for it.
+        Without, everything already there: pyserial's socket:// says 1 for
+        in_waiting whatever is waiting, so it is read until none is."""
         if wait:
             data = self._link(self.serial.read, 256)
         else:
-            waiting = self._link(lambda: self.serial.in_waiting)
-            data = self._link(self.serial.read, waiting) if waiting else b""
+            data = b""
+            while waiting := self._link(lambda: self.serial.in_waiting):
+                data += self._link(self.serial.read, waiting)
         if data:
             self._read_at = self.clock()
             self._buffer += data
