@@ -8,10 +8,10 @@
 #include "boot_jump.h"
 #include "bootloader.h"
 #include "port_uart.h"
+#include "qemu_board.h"
 #include "stm32f1_regs.h"
 #include "systick_clock.h"
 
-#define QEMU_CORE_HZ 24000000u
 #define RAM_END 0x20002000u
 #define SLOT_BASE 0x08001000u
 #define SLOT_PAGES 120u
@@ -68,7 +68,8 @@ int main(void)
     config_flash.page_addr[0] = 0x0801F800u;
     config_flash.page_addr[1] = 0x0801FC00u;
     slot = (struct app_slot){.flash = &slot_flash, .base = SLOT_BASE, .pages = SLOT_PAGES};
-    port = (struct hal_port){.flash = &config_flash};
+    port = (struct hal_port){.flash = &config_flash,
+                             .rx_gap_tolerance_us = QEMU_RX_GAP_TOLERANCE_US};
     port_uart_init(&port, &usart, PORT_UART_RX_INTERRUPT, QEMU_CORE_HZ);
     usart_hd_tx_polled(&usart);
     usart_hd_no_echo(&usart);

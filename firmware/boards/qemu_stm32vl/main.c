@@ -3,6 +3,7 @@
  * the image, since QEMU has no ADC, timers or flash controller for it. */
 #include "calibration.h"
 #include "plant_fixed.h"
+#include "qemu_board.h"
 #include "boot_flow.h"
 #include "boot_jump.h"
 #include "servo.h"
@@ -11,7 +12,6 @@
 #include "port_uart.h"
 #include "usart_hd.h"
 
-#define QEMU_CORE_HZ 24000000u /* QEMU's fixed sysclk for this board */
 #define FLASH_PAGE 1024u
 #define RAM_FLASH_BASE 0x0801F800u /* where the pages would be; kept in RAM */
 
@@ -111,7 +111,7 @@ int main(void)
         .enter_bootloader = enter_bootloader,
         .board = BOARD_ID,
         .serial_number = 0x0E3A0001u,
-        .rx_gap_tolerance_us = 50000u, /* QEMU delivers a frame's bytes with jitter */
+        .rx_gap_tolerance_us = QEMU_RX_GAP_TOLERANCE_US,
     };
     port_uart_init(&port, &usart, PORT_UART_RX_INTERRUPT, QEMU_CORE_HZ);
     usart_hd_tx_polled(&usart); /* QEMU 7.2's USART raises no transmit interrupts */
