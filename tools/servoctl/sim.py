@@ -209,6 +209,11 @@ def _stop(process) -> str:
     return err
 
 
+def _read(path: str) -> str:
+    with open(path) as f:
+        return f.read()
+
+
 def _free_port() -> int:
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
@@ -231,17 +236,36 @@ class QemuBoard(_Child):
         self.bootloader = Path(bootloader or QEMU_BOOTLOADER)
         self.process = None
         self.url = None
+        self._vcpu = ""  # the vCPU thread's task id; "" for the whole process
 
     def cpu_s(self) -> float:
-        """The CPU seconds QEMU has had: the emulated board's progress (its
-        firmware never sleeps, so QEMU runs whenever the host lets it). A
-        Bus on this clock gives a starved QEMU the time it needs."""
+        """The CPU seconds QEMU's vCPU thread has had: the emulated board's
+        progress (its firmware never sleeps, so the vCPU runs whenever the
+        host lets it). QEMU's main loop thread spins too, so the whole
+        process's time would run ahead of the guest by up to two. A Bus on
+        this clock gives a starved QEMU the time it needs."""
         try:
-            with open(f"/proc/{self.process.pid}/stat") as f:
-                fields = f.read().rsplit(")", 1)[1].split()
+            stat = _read(f"/proc/{self.process.pid}/task/{self._vcpu}/stat" if self._vcpu
+                         else f"/proc/{self.process.pid}/stat")
         except OSError as e:
             raise LinkError(f"qemu is gone: {e.strerror}") from None
+        fields = stat.rsplit(")", 1)[1].split()
         return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+    def _find_vcpu(self) -> str:
+        """The task id of QEMU's vCPU thread ("CPU 0/TCG"), which QEMU starts
+        before it runs the guest; "" if none shows within 5 s."""
+        task = f"/proc/{self.process.pid}/task"
+        give_up = time.monotonic() + 5.0
+        while time.monotonic() < give_up and self.process.poll() is None:
+            try:
+                for t in os.listdir(task):
+                    if _read(f"{task}/{t}/comm").startswith("CPU "):
+                        return t
+            except OSError:
+                pass
+            time.sleep(0.01)
+        return ""
 
     def bus(self, **kw) -> Bus:
         """A Bus to the board that waits on QEMU's progress (cpu_s)."""
@@ -255,11 +279,13 @@ class QemuBoard(_Child):
         port = _free_port()
         self.process = subprocess.Popen(
             ["qemu-system-arm", "-M", "stm32vldiscovery", "-kernel", str(self.bootloader),
+             "-name", "servo,debug-threads=on",  # the vCPU thread by name: cpu_s
              "-device", f"loader,file={self.image},addr={QEMU_SLOT:#x}",
              "-nographic", "-monitor", "none",
              "-serial", f"tcp:127.0.0.1:{port},server=on,wait=off,nodelay=on"],
             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         self.url = f"socket://127.0.0.1:{port}"
+        self._vcpu = self._find_vcpu()
         # QEMU opens the port before the guest has booted, so the board is
         # ready only once the firmware answers: within BOOT_TIMEOUT_S of
         # QEMU's own CPU time, however long a loaded machine takes for it.
