@@ -15,7 +15,7 @@ import os
 import sys
 import time
 
-from . import __version__, group, ntc, outcome, registers, units
+from . import __version__, frame, group, ntc, outcome, registers, units
 from .profile import positions, velocity_timing
 from .protocol import Bus, NoReply, Refused, ServoError, UsageError
 from .servo import Servo
@@ -262,7 +262,8 @@ def cmd_move(bus, args):
     s = Servo(bus, args.id)
     kw = _move_args(args)
     asked = decideg(args.angle)
-    plan = outcome.plan_move(s, asked, kw) if args.wait else None
+    where = frame.check_target(s, asked, args.multi_turn)
+    plan = outcome.plan_move(s, asked, kw, where) if args.wait else None
     s.move(asked, **kw)
     outcome.taken(s, "the move")
     if not args.wait:
@@ -325,8 +326,12 @@ def _target(text: str):
 
 
 def cmd_sync_move(bus, args):
+    ids = [servo_id for servo_id, _ in args.targets]
+    twice = sorted({i for i in ids if ids.count(i) > 1})
+    if twice:
+        raise UsageError(f"servo {', '.join(map(str, twice))} is given more than one target")
     targets = dict(args.targets)
-    group.sync_move(bus, targets, args.interval / 1000.0, args.power / 1000.0)
+    group.sync_move(bus, targets, args.interval / 1000.0, args.power / 1000.0, args.multi_turn)
     for servo_id in targets:
         outcome.taken(Servo(bus, servo_id), "the sync move")
     print(f"{len(targets)} servo(s) moving together")
@@ -334,7 +339,9 @@ def cmd_sync_move(bus, args):
 
 
 def cmd_broadcast_move(bus, args):
-    group.broadcast_move(bus, args.angle, args.interval / 1000.0, args.power / 1000.0)
+    ids = _ids_on_bus(bus, args.ids)
+    group.broadcast_move(bus, args.angle, args.interval / 1000.0, args.power / 1000.0, ids)
+    print(f"{len(ids)} servo(s) moving to {args.angle:.1f} deg")
     return 0
 
 
@@ -394,8 +401,9 @@ def cmd_record(bus, args):
     instant); CSV and a PNG with the plan, the tracking error and the speeds."""
     _writable(args.out + ".csv")
     s = Servo(bus, args.id)
-    start = s.monitor().angle_decideg
     target = decideg(args.angle)
+    frame.check_target(s, target, args.multi_turn)
+    start = s.monitor().angle_decideg
     kw = _move_args(args)
     acc = max(kw["acc_ms"], 20)
     dec = max(kw["dec_ms"], 20)
@@ -722,12 +730,16 @@ def build_parser():
     c.add_argument("targets", type=_target, nargs="+", metavar="ID:DEGREES")
     c.add_argument("--interval", type=int, default=1000, help="ms to get there (default 1000)")
     c.add_argument("--power", type=int, default=0, help="mW; 0 = each servo's power limit")
+    c.add_argument("--multi-turn", action="store_true",
+                   help="every target is a multi-turn angle (without it, each is within -180..180)")
     c.set_defaults(run=cmd_sync_move)
 
     c = sub.add_parser("broadcast-move", help="every servo on the bus to one angle")
     c.add_argument("angle", type=finite, help="degrees, -180..180")
     c.add_argument("--interval", type=int, default=1000, help="ms to get there (default 1000)")
     c.add_argument("--power", type=int, default=0, help="mW; 0 = each servo's power limit")
+    c.add_argument("--ids", type=id_number, nargs="+",
+                   help="the servos on the bus, each checked before the broadcast (default: scan)")
     c.set_defaults(run=cmd_broadcast_move)
 
     c = sub.add_parser("async", help="begin: servos buffer moves; end: all start; cancel: drop")

@@ -6,6 +6,7 @@ import struct
 
 from . import protocol as p
 from . import registers
+from .frame import check_target
 from .protocol import NoReply, UsageError, ValueOutOfRange
 from .servo import Monitor, Servo, _check, _ms, _scaled
 
@@ -15,13 +16,16 @@ _MULTI_TURN_RECORD = "<BiIH"  # packet 13
 MAX_SYNC_RECORDS = 255
 
 
-def sync_move(bus: p.Bus, targets: dict, duration_s: float, power_w: float = 0.0) -> None:
+def sync_move(bus: p.Bus, targets: dict, duration_s: float, power_w: float = 0.0,
+              multi_turn: bool = False) -> None:
     """Every servo in targets ({id: degrees}) starts its move in the same
-    frame. Multi-turn records when any target is beyond +-180 degrees. No
-    servo answers a sync move (behaviour.md)."""
+    frame: single-turn records, or multi-turn ones if multi_turn. Each
+    target is checked against its servo first (frame.check_target: one
+    frame of reference, the angle limits), and nothing is sent unless all
+    pass. No servo answers a sync move (behaviour.md)."""
     if not targets or len(targets) > MAX_SYNC_RECORDS:
         raise UsageError(f"a sync move takes 1..{MAX_SYNC_RECORDS} servos, not {len(targets)}")
-    multi = any(abs(deg) > 180.0 for deg in targets.values())
+    multi = multi_turn
     interval = _ms(duration_s, "duration_s")
     power = _check("power", _scaled(power_w, 1000, "power_w"), 0, 65535, "mW")
     if multi:
@@ -34,16 +38,25 @@ def sync_move(bus: p.Bus, targets: dict, duration_s: float, power_w: float = 0.0
     for servo_id, degrees in targets.items():
         _check("servo ID", servo_id, 0, 253)
         angle = _scaled(degrees, 10, "degrees")
-        _check("angle", angle, -3686400, 3686400) if multi else _check("angle", angle, -1800, 1800)
+        _check("angle", angle, -3686400, 3686400, "x0.1 deg")
+        check_target(Servo(bus, servo_id), angle, multi)
         records += struct.pack(fmt, servo_id, angle, interval, power)
     bus.send(p.SYNC, bytes([code, struct.calcsize(fmt), len(targets)]) + records)
 
 
-def broadcast_move(bus: p.Bus, degrees: float, duration_s: float, power_w: float = 0.0) -> None:
-    """Every servo on the bus moves to one single-turn angle; none answers."""
+def broadcast_move(bus: p.Bus, degrees: float, duration_s: float, power_w: float = 0.0,
+                   ids: list = ()) -> None:
+    """Every servo on the bus moves to one single-turn angle; none answers.
+    ids are the servos on the bus: each is checked first (frame.check_target:
+    in turn 0, the angle within its limits), and nothing is sent unless all
+    pass."""
     angle = _check("angle", _scaled(degrees, 10, "degrees"), -1800, 1800, "x0.1 deg")
     interval = _check("interval", _ms(duration_s, "duration_s"), 0, 65535, "ms")
     power = _check("power", _scaled(power_w, 1000, "power_w"), 0, 65535, "mW")
+    if not ids:
+        raise NoReply("no servo on the bus answered: nothing to move")
+    for servo_id in ids:
+        check_target(Servo(bus, servo_id), angle, False)
     bus.send(p.ANGLE, struct.pack(_ANGLE_RECORD, p.BROADCAST, angle, interval, power))
 
 

@@ -3,6 +3,7 @@ arrive where it was asked to go, or why not."""
 from dataclasses import dataclass
 
 from . import registers
+from .frame import Where, turn_base
 from .profile import velocity_timing
 from .protocol import NoReply, Refused
 from .servo import Servo
@@ -42,26 +43,19 @@ class Plan:
     soft_start_s: float
 
 
-def _turn_base(multi_turn: int) -> int:
-    """The whole turns of a multi-turn angle, as the firmware counts them
-    for a single-turn target (ReadAngle wraps into -180.0 .. 179.9)."""
-    within = multi_turn % 3600
-    if within >= 1800:
-        within -= 3600
-    return multi_turn - within
-
-
-def plan_move(s: Servo, asked: int, kw: dict) -> Plan:
+def plan_move(s: Servo, asked: int, kw: dict, where: Where = None) -> Plan:
     """Where the move will end and how long it is planned to take, from the
-    servo's own settings: angle limits (48, 51, 52) clamp a single-turn
-    target; soft start (49, 50) may stretch it."""
-    cfg = s.read_all()
-    start, _ = s.multi_turn_angle()
+    servo's own settings (as frame.check_target read them, or read now):
+    angle limits (48, 51, 52) clamp a single-turn target; soft start (49,
+    50) may stretch it."""
+    if where is None:
+        where = Where(s.read_all(), s.multi_turn_angle()[0])
+    cfg, start = where.cfg, where.at
     target = asked
     if not kw.get("multi_turn") and cfg["angle_limit_on"]:
         target = min(max(asked, cfg["angle_min"]), cfg["angle_max"])
     # A single-turn target is taken within the turn the servo is in.
-    target_abs = target if kw.get("multi_turn") else _turn_base(start) + target
+    target_abs = target if kw.get("multi_turn") else turn_base(start) + target
     acc, dec = max(kw["acc_ms"], 20), max(kw["dec_ms"], 20)
     if "velocity" in kw:
         n1, nc, n3 = velocity_timing(target_abs - start, 0.0, kw["velocity"] / 1000.0, acc, dec)

@@ -171,7 +171,8 @@ class Servo:
              wait=False, ramps: bool = True):
         """An angle move: by interval with ramps (packets 11, 14) or without
         (ramps=False: 8, 13, which ramp 20 ms), or by velocity in 0.1 deg/s
-        (12, 15)."""
+        (12, 15). The packet as it is: the firmware takes a single-turn
+        angle within the turn the horn is in. move_to checks first."""
         _check("power", power_mw, 0, 65535, "mW")
         _check("acceleration time", acc_ms, 0, 65535, "ms")
         _check("deceleration time", dec_ms, 0, 65535, "ms")
@@ -224,16 +225,17 @@ class Servo:
     # ---- engineering units: the documented Python API (README) -------------
     def move_to(self, degrees: float, duration_s: float = None, speed_dps: float = None,
                 accel_s: float = 0.02, decel_s: float = 0.02, power_w: float = 0.0,
-                multi_turn: bool = None, wait: bool = False, tolerance_deg: float = 0.5):
-        """Moves to an angle in degrees, in duration_s seconds or at
-        speed_dps degrees per second (one of them; default 1 s). Beyond
-        +-180 degrees it is a multi-turn move. With wait, returns when the
-        horn has arrived within tolerance_deg, and raises Refused saying
-        why when it does not (stalled, a protection, clamped, timed out)."""
-        from . import outcome
+                multi_turn: bool = False, wait: bool = False, tolerance_deg: float = 0.5):
+        """Moves to an angle in degrees from the origin, in duration_s
+        seconds or at speed_dps degrees per second (one of them; default
+        1 s). Single-turn (-180..180) unless multi_turn: a target the move
+        would not reach as asked (beyond a single turn, outside the angle
+        limits, or a servo in another turn) raises before anything is sent
+        (frame.py). With wait, returns when the horn has arrived within
+        tolerance_deg, and raises Refused saying why when it does not
+        (stalled, a protection, timed out)."""
+        from . import frame, outcome
 
-        if multi_turn is None:
-            multi_turn = abs(degrees) > 180.0
         if duration_s is not None and speed_dps is not None:
             raise ValueOutOfRange("give a duration or a speed, not both")
         kw = dict(acc_ms=_ms(accel_s, "accel_s"), dec_ms=_ms(decel_s, "decel_s"),
@@ -243,7 +245,8 @@ class Servo:
         else:
             kw["interval_ms"] = _ms(1.0 if duration_s is None else duration_s, "duration_s")
         asked = _scaled(degrees, 10, "degrees")
-        plan = outcome.plan_move(self, asked, kw) if wait else None
+        where = frame.check_target(self, asked, multi_turn)
+        plan = outcome.plan_move(self, asked, kw, where) if wait else None
         self.move(asked, **kw)
         outcome.taken(self, "the move")
         if not wait:

@@ -51,10 +51,11 @@ def test_a_move_refused_by_a_protection_fails(ready, capsys):
     ready.control("soak 25")
 
 
-def test_a_clamped_move_says_so(ready, capsys):
+def test_a_move_past_the_limits_is_refused_before_sending(ready, capsys):
     rc, _, err = run(ready, capsys, "move", "1", "170", "--interval", "300", "--wait")
-    assert rc == 1 and "clamped by the angle limits" in err and "not 170.0 deg" in err, err
-    assert abs(float(err.split(" at ")[1].split(" deg")[0]) - 135.0) <= 0.5, err
+    assert rc == 2 and "limits its angle to -135.0 deg..135.0 deg" in err and "170.0 deg is outside" in err, err
+    ready.sleep(0.4)
+    assert abs(ready.state(1)["angle"]) < 0.5
 
 
 def test_the_wait_follows_the_plan(ready, capsys):
@@ -214,13 +215,13 @@ def test_servo_sim_is_found_on_the_path_outside_the_repository(tmp_path, monkeyp
 def test_sync_broadcast_and_async_moves(sim3, capsys):
     for i in (1, 2, 3):
         assert run(sim3, capsys, "config", "set", str(i), "soft_start_on", "0")[0] == 0
-    rc, out, _ = run(sim3, capsys, "sync-move", "1:30", "2:-20", "3:400", "--interval", "1500")
+    rc, out, _ = run(sim3, capsys, "sync-move", "1:30", "2:-20", "3:100", "--interval", "1500")
     assert rc == 0 and "3 servo(s) moving together" in out
     sim3.sleep(2.0)
-    assert [round(sim3.state(i)["angle"]) for i in (1, 2, 3)] == [30, -20, 400]
-    assert run(sim3, capsys, "broadcast-move", "10", "--interval", "300")[0] == 0
+    assert [round(sim3.state(i)["angle"]) for i in (1, 2, 3)] == [30, -20, 100]
+    assert run(sim3, capsys, "broadcast-move", "10", "--interval", "300", "--ids", "1", "2", "3")[0] == 0
     sim3.sleep(0.6)
-    assert [round(sim3.state(i)["angle"]) for i in (1, 2)] == [10, 10]
+    assert [round(sim3.state(i)["angle"]) for i in (1, 2, 3)] == [10, 10, 10]
     assert run(sim3, capsys, "async", "begin")[0] == 0
     assert run(sim3, capsys, "move", "1", "-45", "--interval", "200")[0] == 0
     sim3.sleep(0.3)

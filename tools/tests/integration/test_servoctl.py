@@ -65,6 +65,7 @@ def test_motion_commands(sim, capsys):
     assert sim.state(1)["velocity"] > 80
     run(sim, capsys, "wheel", "1", "stop")
     run(sim, capsys, "damping", "1", "--power", "500")
+    run(sim, capsys, "config", "set", "1", "angle_limit_on", "0")  # multi-turn moves below
     # Every angle mode: plain 8 and 13 (interval alone), 11 and 14 (with
     # ramps), 12 and 15 (velocity).
     for argv, target in [(["30", "--interval", "300"], 30.0),
