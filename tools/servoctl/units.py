@@ -1,13 +1,19 @@
 """Data items in engineering units: what the user types and reads. Each
 item's quantity (registers.py) says how its raw protocol value is shown and
-which units it takes; a plain number is in the unit it is shown in.
+which units it takes.
+
+A plain number is taken only where the item has one natural unit (an angle
+in deg, a temperature in degC, a baud rate, a count); where two are common
+(V and mV, A and mA, W and mW, s and ms) the unit must be written, since
+"2.5" meant 2 mW to someone who meant 2.5 W. A value the wire cannot carry
+exactly is refused with the nearest ones it can, never rounded silently.
 
     angle        0.1 deg on the wire; deg ("90", "90deg", "-45.5°")
     temperature  NTC ADC on the wire; degC ("75", "75C", "75degC")
-    voltage      mV ("7400", "7400mV", "7.4V")
-    current      mA ("4000", "4000mA", "4A")
-    power        mW ("2500", "2500mW", "2.5W")
-    time         ms ("3000", "3000ms", "3s")
+    voltage      mV ("7400mV", "7.4V")
+    current      mA ("4000mA", "4A")
+    power        mW ("2500mW", "2.5W")
+    time         ms ("3000ms", "3s")
     baud         the index 1..8 on the wire; the rate ("115200", "1000000baud")
 """
 import math
@@ -18,12 +24,15 @@ from .protocol import UsageError, ValueOutOfRange
 
 # quantity: (unit shown, {suffix: factor to the raw unit})
 SCALES = {
-    "voltage": ("mV", {"": 1, "mv": 1, "v": 1000}),
-    "current": ("mA", {"": 1, "ma": 1, "a": 1000}),
-    "power": ("mW", {"": 1, "mw": 1, "w": 1000}),
-    "time": ("ms", {"": 1, "ms": 1, "s": 1000}),
+    "voltage": ("mV", {"mv": 1, "v": 1000}),
+    "current": ("mA", {"ma": 1, "a": 1000}),
+    "power": ("mW", {"mw": 1, "w": 1000}),
+    "time": ("ms", {"ms": 1, "s": 1000}),
     "angle": ("deg", {"": 10, "deg": 10, "°": 10}),
 }
+# How a suffix is written (the user's may be in any case).
+_SPELLING = {"mv": "mV", "v": "V", "ma": "mA", "a": "A", "mw": "mW", "w": "W", "ms": "ms", "s": "s",
+             "deg": "deg", "°": "°"}
 _NUMBER = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*([A-Za-z°]*)\s*$")
 
 
@@ -39,7 +48,7 @@ def _split(item, text: str):
 
 def _units_hint(item) -> str:
     if item.quantity in SCALES:
-        return " in " + " or ".join(s for s in SCALES[item.quantity][1] if s)
+        return " in " + " or ".join(_SPELLING[s] for s in SCALES[item.quantity][1] if s)
     return {"temperature": " in degC", "baud": " (a baud rate)"}.get(item.quantity, "")
 
 
@@ -51,8 +60,11 @@ def to_raw(item, text) -> int:
     if q in SCALES:
         shown, factors = SCALES[q]
         if suffix not in factors:
-            raise UsageError(f"{item.name} takes{_units_hint(item)}, not {text!r}")
-        raw = round(value * factors[suffix])
+            if suffix == "":
+                both = " or ".join(f"{value:g}{_SPELLING[s]}" for s in factors)
+                raise UsageError(f"{item.name} takes a unit: {text!r} could mean {both}")
+            raise UsageError(f"{item.name} takes a number{_units_hint(item)}, not {text!r}")
+        raw = _exact(item, value, factors[suffix], text)
     elif q == "temperature":
         if suffix not in ("", "c", "degc", "°c"):
             raise UsageError(f"{item.name} takes degC, not {text!r}")
@@ -72,6 +84,18 @@ def to_raw(item, text) -> int:
     if not item.low <= raw <= item.high:
         raise ValueOutOfRange(f"{item.name} ({item.id}) must be {show(item, item.low)}.."
                               f"{show(item, item.high)}, not {text}")
+    return raw
+
+
+def _exact(item, value: float, factor: int, text) -> int:
+    """value x factor as a whole raw number, or a refusal naming the two
+    nearest values the wire can carry."""
+    scaled = value * factor
+    raw = round(scaled)
+    if abs(scaled - raw) > 1e-6 * max(1.0, abs(scaled)):
+        low, high = math.floor(scaled), math.ceil(scaled)
+        raise ValueOutOfRange(f"{item.name} ({item.id}) is set in steps of {show(item, 1)}: {text} "
+                              f"would be rounded; give {show(item, low)} or {show(item, high)}")
     return raw
 
 

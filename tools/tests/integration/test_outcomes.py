@@ -233,7 +233,7 @@ def test_sync_broadcast_and_async_moves(sim3, capsys):
 
 def test_backup_and_restore_a_whole_bus(sim3, capsys, tmp_path):
     for i in (1, 2, 3):
-        run(sim3, capsys, "config", "set", str(i), "stall_power", str(1000 * i))
+        run(sim3, capsys, "config", "set", str(i), "stall_power", f"{i}W")
     backup = tmp_path / "bus.json"
     rc, out, _ = run(sim3, capsys, "backup", str(backup))
     assert rc == 0 and "saved 3 servo(s) (1, 2, 3)" in out

@@ -28,7 +28,7 @@ def test_scan_ping_info(sim, capsys):
 
 
 def test_config(sim, capsys, tmp_path):
-    assert run(sim, capsys, "config", "set", "1", "stall_power", "2500")[1] == "stall_power = 2500 mW\n"
+    assert run(sim, capsys, "config", "set", "1", "stall_power", "2500mW")[1] == "stall_power = 2500 mW\n"
     assert run(sim, capsys, "config", "get", "1", "38")[1] == "stall_power = 2500 mW\n"
     rc, _, err = run(sim, capsys, "config", "set", "1", "angle_max", "200")
     assert rc == 2 and "angle_max (51) must be -180.0 deg..180.0 deg" in err

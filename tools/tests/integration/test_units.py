@@ -35,7 +35,25 @@ def test_config_takes_and_shows_engineering_units(sim, capsys):
     rc, _, err = run(sim, capsys, "config", "set", "1", "baud", "123456")
     assert rc == 2 and "9600, 19200" in err
     rc, _, err = run(sim, capsys, "config", "set", "1", "angle_max", "90V")
-    assert rc == 2 and "takes in deg" in err
+    assert rc == 2 and "takes a number in deg" in err
+
+
+@pytest.mark.parametrize("name,text,said", [
+    # Each was taken in the base unit and rounded: 2 mW, 4 mV, 2 ms, and
+    # every move after it "stalled".
+    ("power_limit", "2.5", "power_limit takes a unit: '2.5' could mean 2.5mW or 2.5W"),
+    ("low_voltage", "4.5", "low_voltage takes a unit: '4.5' could mean 4.5mV or 4.5V"),
+    ("soft_start_time", "1.5", "soft_start_time takes a unit: '1.5' could mean 1.5ms or 1.5s"),
+    ("stall_power", "70", "could mean 70mW or 70W"),
+    ("soft_start_time", "1.5ms", "is set in steps of 1 ms: 1.5ms would be rounded; give 1 ms or 2 ms"),
+    ("angle_max", "45.25", "is set in steps of 0.1 deg: 45.25 would be rounded; give 45.2 deg or 45.3 deg"),
+    ("current_limit", "1.2345A", "give 1234 mA or 1235 mA"),
+])
+def test_an_ambiguous_or_rounded_value_is_refused(sim, capsys, name, text, said):
+    before = run(sim, capsys, "config", "get", "1", name, "--raw")[1]
+    rc, _, err = run(sim, capsys, "config", "set", "1", name, text)
+    assert rc == 2 and said in err, err
+    assert run(sim, capsys, "config", "get", "1", name, "--raw")[1] == before
 
 
 @pytest.mark.parametrize("name,text,raw", [
