@@ -14,7 +14,7 @@ one pass them; servoctl refuses a target outside the limits in both modes,
 so that a limit set on a servo holds for every move servoctl makes."""
 from dataclasses import dataclass
 
-from .protocol import NoReply, Refused, ValueOutOfRange
+from .protocol import BadAnswer, NoReply, Refused, ValueOutOfRange
 
 SINGLE_TURN = (-1800, 1800)  # 0.1 deg
 TURN = 3600
@@ -52,6 +52,8 @@ def check_target(s, angle: int, multi_turn: bool) -> Where:
             f"move: add --multi-turn (move_to(..., multi_turn=True))")
     try:
         where = Where(s.read_all(), s.multi_turn_angle()[0])
+    except BadAnswer:
+        raise
     except NoReply:
         raise NoReply(f"servo {s.id} did not answer: is it on the bus, at this baud rate? "
                       f"Nothing was sent") from None

@@ -37,19 +37,22 @@ class Sampler:
         self.last = {}
         self.t0 = bus.clock()
 
-    def take(self) -> list:
-        """One sample of every servo that answered; absent ones are left out.
-        Each is stamped with the time its answer arrived, so a host that
-        falls behind bends neither the time axis nor the speed."""
-        arrivals = {}
+    def take(self) -> tuple:
+        """One sample of every servo that answered, and {id: why} of those
+        that did not (silent). Each sample is stamped with the time its
+        answer arrived, so a host that falls behind bends neither the time
+        axis nor the speed."""
+        arrivals, silent = {}, {}
         if self.sync:
             monitors = group.sync_monitor(self.bus, self.ids, arrivals=arrivals)
+            silent = {i: f"servo {i}: no answer in its Sync Monitor slot" for i in self.ids if i not in monitors}
         else:
             monitors = {}
             for servo_id in self.ids:
                 try:
                     monitors[servo_id] = Servo(self.bus, servo_id).monitor()
-                except NoReply:
+                except NoReply as e:  # a short answer (BadAnswer) too
+                    silent[servo_id] = str(e)
                     continue
                 arrivals[servo_id] = self.bus.arrived_at
         out = []
@@ -62,7 +65,9 @@ class Sampler:
             out.append(Sample(round(now, 3), servo_id, angle, round(speed, 1), m.voltage_mv / 1000.0,
                               m.current_ma / 1000.0, m.power_mw / 1000.0, _celsius(m.temperature_adc),
                               registers.status_names(m.status)))
-        return out
+        for servo_id in silent:
+            self.last.pop(servo_id, None)  # a speed needs two answers in a row
+        return out, silent
 
 
 def _table(samples: dict):
@@ -73,6 +78,9 @@ def _table(samples: dict):
         t.add_column(name, justify="right" if name != "status" else "left")
     for servo_id in sorted(samples):
         s = samples[servo_id]
+        if isinstance(s, str):  # silent: why, and no stale values
+            t.add_row(str(servo_id), *[""] * 6, f"silent: {s}")
+            continue
         t.add_row(str(s.id), f"{s.angle_deg:.1f}", f"{s.velocity_dps:.0f}", f"{s.voltage_v:.2f}",
                   f"{s.current_a:.3f}", f"{s.power_w:.2f}", f"{s.temperature_c:.1f}",
                   ", ".join(s.status) or "ok")
@@ -137,15 +145,26 @@ class Plot:
         self.fig.savefig(path, dpi=100)
 
 
+def has_display() -> bool:
+    """A live plot window can open: a display server, or not Linux/BSD."""
+    import os
+
+    return not sys.platform.startswith(("linux", "freebsd")) or bool(
+        os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
+
+
 def monitor(bus, ids, every_s: float, count: int, sync: bool, as_json: bool,
             plot: bool, plot_file: str):
+    """Samples until count (0: until Ctrl-C). Returns {id: why} of the
+    servos that never answered."""
     sampler = Sampler(bus, ids, sync)
     # A live plot needs its window first; a plot file is drawn at the end,
     # so sampling does not wait for the plotting library to load.
     figure = Plot(live=True) if plot else None
     taken = []
     tty = sys.stdout.isatty() and not as_json
-    latest = {}
+    latest = {}  # id: the last Sample, or why it is silent
+    never = {i: "" for i in ids}  # servos not heard yet: why
     n = 0
     live = None
     if tty:
@@ -157,16 +176,23 @@ def monitor(bus, ids, every_s: float, count: int, sync: bool, as_json: bool,
         print(f"{'id':>3} {'angle deg':>10} {'deg/s':>7} {'V':>6} {'A':>6} {'W':>6} {'degC':>6}  status")
     try:
         while count == 0 or n < count:
-            samples = sampler.take()
+            samples, silent = sampler.take()
+            at = round(bus.clock() - sampler.t0, 3)
             for s in samples:
                 latest[s.id] = s
+                never.pop(s.id, None)
                 if as_json:
                     print(json.dumps(asdict(s)), flush=True)
                 elif not tty:
                     print(_row(s), flush=True)
-            missing = set(ids) - {s.id for s in samples}
-            if missing and not as_json and not tty:
-                print(f"    no reply from {', '.join(map(str, sorted(missing)))}", flush=True)
+            for servo_id, why in sorted(silent.items()):
+                latest[servo_id] = why
+                if servo_id in never:
+                    never[servo_id] = why
+                if as_json:
+                    print(json.dumps({"t_s": at, "id": servo_id, "silent": True, "why": why}), flush=True)
+                elif not tty:
+                    print(f"{servo_id:>3} silent: {why}", flush=True)
             if live is not None:
                 live.update(_table(latest))
             if figure is not None:
@@ -182,3 +208,4 @@ def monitor(bus, ids, every_s: float, count: int, sync: bool, as_json: bool,
                 figure = Plot(live=False)
                 figure.add(taken)
             figure.save(plot_file)
+    return never

@@ -5,7 +5,7 @@ from dataclasses import dataclass
 from . import registers
 from .frame import Where, turn_base
 from .profile import velocity_timing
-from .protocol import NoReply, Refused
+from .protocol import BadAnswer, NoReply, Refused
 from .servo import Servo
 
 TOLERANCE_DEG = 0.5
@@ -22,6 +22,8 @@ def taken(s: Servo, what: str) -> int:
     and did not refuse it. Returns the status byte."""
     try:
         status = s.status()
+    except BadAnswer:
+        raise
     except NoReply:
         raise NoReply(f"servo {s.id} did not answer: is it on the bus, at this baud rate?") from None
     if status & INHIBITING:

@@ -64,6 +64,12 @@ class BadChecksum(NoReply):
     pass
 
 
+class BadAnswer(NoReply):
+    """An answer came with a good checksum but not the length its packet
+    has: garbled on the wire, another firmware, or two servos on one ID.
+    No usable reply, so the same exit code as none."""
+
+
 class LinkError(ServoError):
     """The serial port or socket failed: cannot open, gone, write error."""
     exit_code = 4
@@ -88,6 +94,14 @@ def response_frame(code: int, content: bytes) -> bytes:
     return body + bytes([checksum(body)])
 
 
+try:  # a pty whose other end is gone fails in termios, which is not an OSError
+    import termios
+
+    _TERMIOS_ERRORS = (termios.error,)
+except ImportError:  # not on Windows
+    _TERMIOS_ERRORS = ()
+
+
 class Bus:
     """A serial port (or pyserial URL such as socket://127.0.0.1:5000) with
     the request/response discipline of the protocol.
@@ -105,7 +119,7 @@ class Bus:
         self.port = port
         try:
             self.serial = serial.serial_for_url(port, baudrate=baud, timeout=0.005)
-        except (serial.SerialException, ValueError, OSError) as e:
+        except (serial.SerialException, ValueError, OSError, *_TERMIOS_ERRORS) as e:
             raise LinkError(f"cannot open {port}: {e}") from None
         sock = getattr(self.serial, "_socket", None)
         if sock is not None:  # socket://: no Nagle delay on small frames
@@ -119,7 +133,10 @@ class Bus:
         self.arrived_at = 0.0
 
     def close(self):
-        self.serial.close()
+        try:
+            self.serial.close()
+        except (OSError, *_TERMIOS_ERRORS):
+            pass  # a link already gone has nothing left to close
 
     def sleep(self, seconds: float) -> None:
         """Waits until the bus's clock has moved on by seconds."""
@@ -143,8 +160,8 @@ class Bus:
 
         try:
             return what(*args)
-        except (serial.SerialException, OSError) as e:
-            raise LinkError(f"{self.port}: {e}") from None
+        except (serial.SerialException, OSError, *_TERMIOS_ERRORS) as e:
+            raise LinkError(f"{self.port}: the link failed: {e}") from None
 
     def send(self, code: int, content: bytes) -> None:
         self._link(self.serial.reset_input_buffer)

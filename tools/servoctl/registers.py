@@ -73,6 +73,7 @@ USER = [
     Item(52, "angle_min", 2, signed=True, unit="0.1deg", low=-1800, high=1800, default=-1350, quantity="angle"),
     Item(53, "center_offset", 2, signed=True, unit="0.1deg", low=-1800, high=1800, default=0, quantity="angle"),
 ]
+USER_AREA_SIZE = sum(item.size for item in USER)  # 32: the WriteBatchData block
 ITEMS = STATUS + USER
 BY_ID = {i.id: i for i in ITEMS}
 BY_NAME = {i.name: i for i in ITEMS}

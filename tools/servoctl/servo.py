@@ -5,7 +5,7 @@ import struct
 
 from . import protocol as p
 from . import registers
-from .protocol import Refused, ServoError, ValueOutOfRange
+from .protocol import BadAnswer, Refused, ServoError, ValueOutOfRange
 
 
 @dataclass
@@ -21,15 +21,16 @@ class Monitor:
 
     @classmethod
     def decode(cls, content: bytes) -> "Monitor":
-        return cls(*struct.unpack("<BHHHHBih", content))
+        return cls(*_unpack("<BHHHHBih", content, "Monitor"))
 
 
 def _unpack(fmt: str, content: bytes, packet: str) -> tuple:
-    """An answer of this firmware's own packets, whose length says which
-    firmware answered: another length is an error that says so."""
+    """An answer's fields, once its length is the packet's: any other
+    length is an error that says so, never a traceback."""
     if len(content) != struct.calcsize(fmt):
-        raise ServoError(f"servo {content[:1].hex() or '?'}: a {packet} answer of {len(content)} "
-                         f"bytes, not {struct.calcsize(fmt)} (older firmware?)")
+        who = content[0] if content else "?"
+        raise BadAnswer(f"servo {who}: a {packet} answer of {len(content)} bytes, not "
+                        f"{struct.calcsize(fmt)} (garbled, another firmware, or two servos on one ID)")
     return struct.unpack(fmt, content)
 
 
@@ -110,6 +111,8 @@ class Servo:
     def read(self, key) -> int:
         item = registers.find(key)
         content = self.bus.request(p.READ_DATA, bytes([self.id, item.id]))
+        if len(content) < 2:
+            raise BadAnswer(f"servo {self.id}: a ReadData answer of {len(content)} bytes, not 2 or more")
         data = content[2:]
         if len(data) != item.size:
             raise ServoError(f"servo {self.id} has no readable {item.name} ({item.id})")
@@ -119,29 +122,30 @@ class Servo:
         item = registers.find(key)
         item.check(value)
         content = self.bus.request(p.WRITE_DATA, bytes([self.id, item.id]) + item.pack(value))
-        if content[2] != 1:
+        if _unpack("<BBB", content, "WriteData")[2] != 1:
             raise Refused(f"servo {self.id} refused {item.name} = {value}")
 
     def read_all(self) -> dict:
         content = self.bus.request(p.READ_BATCH, bytes([self.id]))
-        return registers.decode_user_area(content[1:])
+        return registers.decode_user_area(_unpack(f"<B{registers.USER_AREA_SIZE}s", content,
+                                                  "ReadBatchData")[1])
 
     def write_all(self, values: dict) -> None:
         block = registers.encode_user_area(values)
         content = self.bus.request(p.WRITE_BATCH, bytes([self.id]) + block)
-        if content[1] != 1:
+        if _unpack("<BB", content, "WriteBatchData")[1] != 1:
             raise Refused(f"servo {self.id} refused the user area block")
 
     def reset_user_data(self) -> None:
-        if self.bus.request(p.RESET_USER_DATA, bytes([self.id]))[1] != 1:
+        if _unpack("<BB", self.bus.request(p.RESET_USER_DATA, bytes([self.id])), "ResetUserData")[1] != 1:
             raise Refused(f"servo {self.id} refused the reset")
 
     def angle(self) -> int:
-        return struct.unpack("<h", self.bus.request(p.READ_ANGLE, bytes([self.id]))[1:3])[0]
+        return _unpack("<Bh", self.bus.request(p.READ_ANGLE, bytes([self.id])), "ReadAngle")[1]
 
     def multi_turn_angle(self):
         """(angle in 0.1 degree, turns)."""
-        return struct.unpack("<ih", self.bus.request(p.READ_MULTI_TURN, bytes([self.id]))[1:7])
+        return _unpack("<Bih", self.bus.request(p.READ_MULTI_TURN, bytes([self.id])), "ReadMultiTurn")[1:]
 
     def monitor(self) -> Monitor:
         return Monitor.decode(self.bus.request(p.MONITOR, bytes([self.id])))

@@ -8,7 +8,7 @@ import zlib
 from dataclasses import dataclass
 
 from .image import CHECKED, Image
-from .protocol import NoReply, Refused
+from .protocol import BadAnswer, NoReply, Refused
 
 UPDATE_ENTER, UPDATE_ERASE, UPDATE_WRITE, UPDATE_VERIFY, UPDATE_BOOT, UPDATE_STATUS = range(0x50, 0x56)
 MODE_APP, MODE_BOOTLOADER = 0, 1
@@ -37,7 +37,7 @@ class Status:
 def status(bus, servo_id: int, timeout=None) -> Status:
     c = bus.request(UPDATE_STATUS, bytes([servo_id]), timeout=timeout)
     if len(c) != 16:
-        raise NoReply(f"servo {servo_id}: UpdateStatus answer of {len(c)} bytes: not this firmware")
+        raise BadAnswer(f"servo {servo_id}: an UpdateStatus answer of {len(c)} bytes, not 16: not this firmware")
     return Status(c[1], *struct.unpack_from("<HBHHHHBH", c, 2))
 
 
@@ -87,6 +87,17 @@ def catch(bus, servo_id: int, seconds: float) -> Status:
     return st
 
 
+def _answer(c: bytes, least: int, servo_id: int, packet: str) -> bytes:
+    """An update answer with the fields the caller reads, or BadAnswer."""
+    if len(c) < least:
+        raise BadAnswer(f"servo {servo_id}: an {packet} answer of {len(c)} bytes, not {least} or more")
+    return c
+
+
+def _reason(c: bytes, reasons: dict):
+    return reasons.get(c[2], c[2]) if len(c) > 2 else "no reason given"
+
+
 def _retry(fn):
     """A request lost on the wire is sent again; a refusal is final."""
     for _ in range(RETRIES - 1):
@@ -100,12 +111,11 @@ def _retry(fn):
 def _write(bus, servo_id: int, offset: int, chunk: bytes):
     content = bytes([servo_id]) + struct.pack("<I", offset) + chunk + struct.pack("<I", zlib.crc32(chunk))
     for attempt in range(RETRIES):
-        c = _retry(lambda: bus.request(UPDATE_WRITE, content))
+        c = _answer(_retry(lambda: bus.request(UPDATE_WRITE, content)), 2, servo_id, "UpdateWrite")
         if c[1] == 1:
             return
-        if c[2] != 1 or attempt == RETRIES - 1:  # 1: damaged on the wire, worth again
-            raise Refused(f"servo {servo_id}: writing offset {offset} refused: "
-                          f"{WRITE_REASONS.get(c[2], c[2])}")
+        if c[2:3] != b"\x01" or attempt == RETRIES - 1:  # 1: damaged on the wire, worth again
+            raise Refused(f"servo {servo_id}: writing offset {offset} refused: {_reason(c, WRITE_REASONS)}")
 
 
 def update(bus, servo_id: int, image: Image, progress=lambda done, total: None) -> tuple:
@@ -116,7 +126,7 @@ def update(bus, servo_id: int, image: Image, progress=lambda done, total: None) 
         raise Refused(f"servo {servo_id} is board {st.board:#06x}; the image is for {image.board:#06x}")
     before = st.version if st.mode == MODE_APP or st.verdict == 0 else None
     if st.mode == MODE_APP:
-        c = bus.request(UPDATE_ENTER, bytes([servo_id]))
+        c = _answer(bus.request(UPDATE_ENTER, bytes([servo_id])), 2, servo_id, "UpdateEnter")
         if c[1] != 1:
             raise Refused(enter_refusal(servo_id, c[2] if len(c) > 2 else None))
         st = _wait_for_mode(bus, servo_id, MODE_BOOTLOADER)
@@ -130,9 +140,10 @@ def update(bus, servo_id: int, image: Image, progress=lambda done, total: None) 
     data = image.data + b"\xff" * (-len(image.data) % st.write_block)
     total = pages + len(data)
     for page in range(pages):  # page 0 first: the old image is invalid from here
-        c = _retry(lambda: bus.request(UPDATE_ERASE, bytes([servo_id]) + struct.pack("<H", page)))
+        c = _answer(_retry(lambda: bus.request(UPDATE_ERASE, bytes([servo_id]) + struct.pack("<H", page))),
+                    2, servo_id, "UpdateErase")
         if c[1] != 1:
-            raise Refused(f"servo {servo_id}: erasing page {page} refused: {WRITE_REASONS.get(c[2], c[2])}")
+            raise Refused(f"servo {servo_id}: erasing page {page} refused: {_reason(c, WRITE_REASONS)}")
         progress(page + 1, total)
     head = -(-CHECKED // step) * step  # the checked header bytes go last
     for offset in range(head, len(data), step):
@@ -141,11 +152,11 @@ def update(bus, servo_id: int, image: Image, progress=lambda done, total: None) 
     for offset in range(0, head, step):
         _write(bus, servo_id, offset, data[offset:offset + step])
     progress(total, total)
-    c = _retry(lambda: bus.request(UPDATE_VERIFY, bytes([servo_id])))
+    c = _answer(_retry(lambda: bus.request(UPDATE_VERIFY, bytes([servo_id]))), 14, servo_id, "UpdateVerify")
     verdict, size, crc, version, _board = struct.unpack_from("<BIIHH", c, 1)
     if verdict != 0 or (size, crc, version) != (image.size, image.crc, image.version):
         raise Refused(f"servo {servo_id}: the written image does not check: {VERDICTS.get(verdict, verdict)}")
-    c = _retry(lambda: bus.request(UPDATE_BOOT, bytes([servo_id])))
+    c = _answer(_retry(lambda: bus.request(UPDATE_BOOT, bytes([servo_id]))), 2, servo_id, "UpdateBoot")
     if c[1] != 1:
         raise Refused(f"servo {servo_id}: the bootloader would not start the image")
     after = _wait_for_mode(bus, servo_id, MODE_APP).version

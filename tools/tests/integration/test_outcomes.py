@@ -277,10 +277,16 @@ def test_monitor_live_views(sim3, capsys, tmp_path):
     assert run(sim3, capsys, "wheel", "2", "run", "--speed", "90", "--cw")[0] == 0
     sim3.sleep(0.3)  # up to speed
     png = tmp_path / "monitor.png"
-    rc, out, _ = run(sim3, capsys, "monitor", "1", "2", "9", "--sync", "--json", "--every", "0.05",
-                     "--count", "20", "--plot-file", str(png))
-    assert rc == 0
-    rows = [json.loads(line) for line in out.splitlines()]
+    rc = main(["--port", sim3.url, "monitor", "1", "2", "9", "--sync", "--json", "--every", "0.05",
+               "--count", "20", "--plot-file", str(png)], clock=sim3.clock_s)
+    out, err = capsys.readouterr()
+    assert err.splitlines() == [f"plot {png}", "servoctl: error: servo 9: no answer in its Sync Monitor slot"]
+    # Servo 9 is absent: a record that says so each round, and exit 3.
+    assert rc == 3
+    records = [json.loads(line) for line in out.splitlines()]
+    silent = [r for r in records if r.get("silent")]
+    assert len(silent) == 20 and {r["id"] for r in silent} == {9} and all(r["why"] for r in silent)
+    rows = [r for r in records if not r.get("silent")]
     assert {r["id"] for r in rows} == {1, 2} and len(rows) == 40
     for servo_id, sign in ((1, 1), (2, -1)):
         mine = [r for r in rows if r["id"] == servo_id]
@@ -295,8 +301,9 @@ def test_monitor_live_views(sim3, capsys, tmp_path):
         assert abs(sign * mean - 90.0) < 9.0, (servo_id, mean)
     assert all(20 < r["temperature_c"] < 30 and 7.0 < r["voltage_v"] < 7.8 for r in rows)
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    rc, out, _ = run(sim3, capsys, "monitor", "1", "9", "--count", "1")
-    assert "no reply from 9" in out
+    rc, out, err = run(sim3, capsys, "monitor", "1", "9", "--count", "1")
+    assert rc == 3 and "  9 silent: servo 9: no reply to packet 22" in out, out
+    assert "servo 9: no reply" in err
 
 
 def test_read_commands_speak_json(sim, capsys):
@@ -318,3 +325,13 @@ def test_ctrl_c_during_a_wait_releases_nothing(ready):
     assert proc.returncode == 130 and "Traceback" not in err and "interrupted" in err, err
     ready.wait_until(lambda: ready.state(1)["status"] & 1 == 0, 5)
     assert abs(ready.state(1)["angle"] - 90.0) <= 0.5  # the move went on to its end
+
+
+def test_a_live_plot_without_a_display_says_so(sim, capsys, monkeypatch):
+    """--plot on a machine with no display opened nothing and said nothing."""
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    rc = main(["--port", sim.url, "monitor", "1", "--count", "2", "--plot"], clock=sim.clock_s)
+    out, err = capsys.readouterr()
+    assert rc == 0 and "warning: --plot: no display" in err and "--plot-file" in err, err
+    assert len([line for line in out.splitlines() if line.strip().startswith("1 ")]) == 2, out
