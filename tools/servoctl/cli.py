@@ -16,6 +16,7 @@ import sys
 import time
 
 from . import __version__, frame, group, ntc, outcome, registers, units
+from . import protocol as p
 from .profile import positions, velocity_timing
 from .protocol import Bus, NoReply, Refused, ServoError, UsageError
 from .servo import Servo
@@ -33,8 +34,8 @@ def id_number(text: str) -> int:
         value = int(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"not a servo ID: {text!r}") from None
-    if not 0 <= value <= 254:
-        raise argparse.ArgumentTypeError(f"servo IDs are 0..254, not {value}")
+    if not 0 <= value <= p.MAX_ID:
+        raise argparse.ArgumentTypeError(f"servo IDs are 0..{p.MAX_ID}, not {value}")
     return value
 
 
@@ -73,7 +74,7 @@ def describe_temperature(adc: int) -> str:
 def scan_timeout_s(baud: int) -> float:
     """How long to wait for one ID's ping answer: the request and the answer
     (6 bytes each, 10 bits a byte) at this baud rate, and 3 ms for the servo
-    and the link to turn around. 0-253 take about a second at 115200."""
+    and the link to turn around. 0-254 take about a second at 115200."""
     return 12 * 10 / baud + 0.003
 
 
@@ -204,6 +205,8 @@ def cmd_config(bus, args):
                                  f"not {args.value!r}") from None
         else:
             value = units.to_raw(item, args.value)
+        if item.name == "servo_id":
+            group.id_is_free(bus, args.id, value)
         s.write(item.id, value)
         print(f"{item.name} = {_shown(item, value, args.raw)}")
     elif args.action == "dump":
@@ -357,7 +360,7 @@ def _ids_on_bus(bus, ids):
     if ids:
         return ids
     timeout = scan_timeout_s(bus.serial.baudrate)
-    return [i for i in range(254) if Servo(bus, i).ping(timeout=timeout)]
+    return [i for i in range(p.MAX_ID + 1) if Servo(bus, i).ping(timeout=timeout)]
 
 
 def cmd_backup(bus, args):
@@ -563,8 +566,8 @@ def cmd_update(bus, args):
     if len(images) != 1 or not ids:
         raise UsageError("update takes one image and one or more servo IDs")
     for servo_id in ids:
-        if not 0 <= int(servo_id) <= 253:
-            raise UsageError(f"servo ID {servo_id} is not 0-253")
+        if not 0 <= int(servo_id) <= p.MAX_ID:
+            raise UsageError(f"servo ID {servo_id} is not 0-{p.MAX_ID}")
     image = img.load(images[0])
     failed = []
     for servo_id in map(int, ids):
@@ -639,7 +642,7 @@ def build_parser():
 
     c = sub.add_parser("scan", help="find servos by pinging IDs")
     c.add_argument("--first", type=id_number, default=0)
-    c.add_argument("--last", type=id_number, default=253)
+    c.add_argument("--last", type=id_number, default=p.MAX_ID)
     c.add_argument("--all-bauds", action="store_true", help="every baud rate of item 36 in turn")
     c.add_argument("--reply-timeout", type=finite, default=None,
                    help="seconds per ID (default: from the baud rate, about 4 ms at 115200)")

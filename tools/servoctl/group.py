@@ -7,7 +7,7 @@ import struct
 from . import protocol as p
 from . import registers
 from .frame import check_target
-from .protocol import NoReply, UsageError, ValueOutOfRange
+from .protocol import NoReply, Refused, UsageError, ValueOutOfRange
 from .servo import Monitor, Servo, _check, _ms, _scaled
 
 # SyncCommand records (servo-protocol.md 3.25): the packet's own content.
@@ -36,7 +36,7 @@ def sync_move(bus: p.Bus, targets: dict, duration_s: float, power_w: float = 0.0
         _check("interval", interval, 0, 65535, "ms")
     records = b""
     for servo_id, degrees in targets.items():
-        _check("servo ID", servo_id, 0, 253)
+        _check("servo ID", servo_id, 0, p.MAX_ID)
         angle = _scaled(degrees, 10, "degrees")
         _check("angle", angle, -3686400, 3686400, "x0.1 deg")
         check_target(Servo(bus, servo_id), angle, multi)
@@ -75,7 +75,7 @@ def sync_monitor(bus: p.Bus, ids: list, timeout_s: float = None, arrivals: dict 
     {id: Monitor} of those that answered; arrivals, if given, gets {id:
     the bus clock when its answer arrived}."""
     for servo_id in ids:
-        _check("servo ID", servo_id, 0, 253)
+        _check("servo ID", servo_id, 0, p.MAX_ID)
     if not ids or len(ids) > MAX_SYNC_RECORDS:
         raise UsageError(f"a sync monitor takes 1..{MAX_SYNC_RECORDS} servos")
     bus.send(p.SYNC, bytes([p.MONITOR, 1, len(ids)] + list(ids)))
@@ -115,11 +115,23 @@ def read_json_file(path: str, what: str):
         raise UsageError(f"{path} is not {what} (JSON): {e}") from None
 
 
+def id_is_free(bus: p.Bus, servo_id: int, new_id: int) -> None:
+    """Refuses to give servo_id the ID new_id when another servo answers
+    at new_id: two servos on one ID cannot be told apart again (every
+    request to it is answered twice, and collides)."""
+    if new_id != servo_id and Servo(bus, new_id).ping():
+        raise Refused(f"ID {new_id} already answers on this bus: servo {servo_id} keeps its ID. "
+                      f"Pick a free one ('servoctl scan' lists those in use)")
+
+
 def write_user_area(s: Servo, values: dict, with_link: bool = False) -> list:
     """Writes values (all or some items, by name) over the servo's own.
     The ID and baud rate stay unless with_link: another servo's file must
-    not put two servos on one ID. Returns the items kept that differed."""
+    not put two servos on one ID; with it, an ID already answering is
+    refused. Returns the items kept that differed."""
     current = s.read_all()
+    if with_link and "servo_id" in values:
+        id_is_free(s.bus, s.id, values["servo_id"])
     keep = [] if with_link else ["servo_id", "baud"]
     s.write_all(dict(current, **{k: v for k, v in values.items() if k not in keep}))
     return [k for k in keep if k in values and values[k] != current[k]]

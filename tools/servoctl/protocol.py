@@ -6,6 +6,7 @@ import time
 REQUEST_HEADER = b"\x12\x4c"
 RESPONSE_HEADER = b"\x05\x1c"
 BROADCAST = 0xFF
+MAX_ID = 254  # behaviour.md: servo IDs are 0..254; 0xFF is broadcast
 
 PING = 1
 RESET_USER_DATA = 2

@@ -335,3 +335,37 @@ def test_a_live_plot_without_a_display_says_so(sim, capsys, monkeypatch):
     out, err = capsys.readouterr()
     assert rc == 0 and "warning: --plot: no display" in err and "--plot-file" in err, err
     assert len([line for line in out.splitlines() if line.strip().startswith("1 ")]) == 2, out
+
+
+def test_a_new_id_already_on_the_bus_is_refused(sim3, capsys):
+    """'config set 4 servo_id 2' on a bus with servo 2 made two servos
+    answer at 2, silently, exit 0."""
+    rc, _, err = run(sim3, capsys, "config", "set", "3", "servo_id", "2")
+    assert rc == 1 and "ID 2 already answers on this bus: servo 3 keeps its ID" in err, err
+    rc, out, _ = run(sim3, capsys, "scan", "--last", "5")
+    assert "3 servo(s) found" in out and "servo 3 at" in out
+    assert sim3.state(1)["collisions"] == 0
+    rc, out, _ = run(sim3, capsys, "config", "set", "3", "servo_id", "7")
+    assert rc == 0 and run(sim3, capsys, "ping", "7")[0] == 0 and run(sim3, capsys, "ping", "3")[0] == 3
+
+
+def test_id_254_is_a_servo_id(tmp_path, capsys):
+    """254 was skipped by scan and backup, refused by sync-move, monitor
+    and update (behaviour.md: IDs are 0..254)."""
+    from servoctl.sim import Simulator
+
+    sim = Simulator(ids=[254], tcp=True, state_dir=str(tmp_path / "state"))
+    sim.start()
+    try:
+        rc, out, _ = run(sim, capsys, "scan", "--first", "250")
+        assert rc == 0 and "servo 254 at 115200 baud" in out, out
+        rc, out, _ = run(sim, capsys, "monitor", "254", "--count", "1", "--json")
+        assert rc == 0 and '"id": 254' in out
+        rc, out, _ = run(sim, capsys, "backup", str(tmp_path / "b.json"))
+        assert rc == 0 and "(254)" in out, out
+        assert run(sim, capsys, "config", "set", "254", "soft_start_on", "0")[0] == 0
+        assert run(sim, capsys, "sync-move", "254:10", "--interval", "200")[0] == 0
+        sim.sleep(0.5)
+        assert abs(sim.state(254)["angle"] - 10.0) < 0.5
+    finally:
+        sim.stop()
