@@ -12,7 +12,7 @@
 #include "app_image.h"
 #include "protocol/frame_tx.h"
 
-#define BOOTLOADER_VERSION 1u
+#define BOOTLOADER_VERSION 2u /* 2: a repeated UpdateWrite succeeds */
 /* Largest data in one UpdateWrite: the request (9 + 24 bytes) fits the
  * framer every build shares (FRAME_CONTENT_MAX, 34), so the bootloader
  * needs no framer of its own. */

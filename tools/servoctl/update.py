@@ -2,7 +2,9 @@
 time, the others on the bus untouched. From the application it asks for the
 bootloader (UpdateEnter); a servo already in its bootloader (an update cut
 short, a broken application) is updated the same way, which is the
-recovery."""
+recovery. Every step survives a lost answer: erase, write (bootloader
+version 2 on) and verify are sent again; after UpdateEnter and UpdateBoot,
+the mode the servo answers in says whether the request was carried out."""
 import struct
 import zlib
 from dataclasses import dataclass
@@ -15,7 +17,7 @@ MODE_APP, MODE_BOOTLOADER = 0, 1
 VERDICTS = {0: "valid", 1: "no image", 2: "header damaged", 3: "another board's image",
             4: "image does not match its CRC"}
 WRITE_REASONS = {1: "damaged on the wire", 2: "outside the slot", 3: "the flash refused",
-                 4: "reads back otherwise"}
+                 4: "reads back otherwise"}  # 4: bootloader version 1 only
 ENTER_OUTPUT_DRIVEN, ENTER_NO_BOOTLOADER = 1, 2  # UpdateEnter's reasons (docs/packets.md)
 RETRIES = 3
 SWITCH_TIMEOUT_S = 3.0  # a restart: the bootloader's 200 ms window, and the application's start
@@ -53,18 +55,50 @@ def enter_refusal(servo_id: int, reason) -> str:
 
 
 def _poll_mode(bus, servo_id: int, mode: int, seconds: float, reply_s: float, pause_s: float):
-    """UpdateStatus until the servo answers in `mode`; the Status, or None
-    after `seconds`."""
+    """UpdateStatus until the servo answers in `mode` (any mode if None);
+    the Status, or None after `seconds`."""
     deadline = bus.clock() + seconds
     while bus.clock() < deadline:
         try:
             st = status(bus, servo_id, timeout=reply_s)
-            if st.mode == mode:
+            if mode is None or st.mode == mode:
                 return st
         except NoReply:
             pass
         bus.sleep(pause_s)
     return None
+
+
+def _answering(bus, servo_id: int) -> Status:
+    """The servo's UpdateStatus once it answers again after a restart it may
+    or may not have made (a request whose answer was lost): who answers
+    says whether the request was carried out."""
+    st = _poll_mode(bus, servo_id, None, SWITCH_TIMEOUT_S, 0.05, 0.02)
+    if st is None:
+        raise NoReply(f"servo {servo_id}: neither its application nor its bootloader answered "
+                      f"within {SWITCH_TIMEOUT_S:.0f} s")
+    return st
+
+
+def _switch(bus, servo_id: int, code: int, packet: str, to_mode: int, refusal) -> Status:
+    """UpdateEnter or UpdateBoot, and the servo's Status once it answers in
+    to_mode. An answer that is lost is not a failure: the servo answering
+    in to_mode shows the request was carried out; in its old mode, that the
+    request was lost, and it is sent again."""
+    for _ in range(RETRIES):
+        try:
+            c = _answer(bus.request(code, bytes([servo_id])), 2, servo_id, packet)
+        except BadAnswer:  # garbled, not lost: nothing to learn by asking again
+            raise
+        except NoReply:
+            st = _answering(bus, servo_id)
+            if st.mode == to_mode:
+                return st
+            continue
+        if c[1] != 1:
+            raise Refused(refusal(c))
+        return _wait_for_mode(bus, servo_id, to_mode)
+    raise NoReply(f"servo {servo_id}: no answer to {packet} in {RETRIES} tries")
 
 
 def _wait_for_mode(bus, servo_id: int, mode: int) -> Status:
@@ -126,10 +160,8 @@ def update(bus, servo_id: int, image: Image, progress=lambda done, total: None) 
         raise Refused(f"servo {servo_id} is board {st.board:#06x}; the image is for {image.board:#06x}")
     before = st.version if st.mode == MODE_APP or st.verdict == 0 else None
     if st.mode == MODE_APP:
-        c = _answer(bus.request(UPDATE_ENTER, bytes([servo_id])), 2, servo_id, "UpdateEnter")
-        if c[1] != 1:
-            raise Refused(enter_refusal(servo_id, c[2] if len(c) > 2 else None))
-        st = _wait_for_mode(bus, servo_id, MODE_BOOTLOADER)
+        st = _switch(bus, servo_id, UPDATE_ENTER, "UpdateEnter", MODE_BOOTLOADER,
+                     lambda c: enter_refusal(servo_id, c[2] if len(c) > 2 else None))
     if len(image.data) > st.page_size * st.pages:
         if st.verdict == 0:  # nothing erased yet: back to the application
             bus.request(UPDATE_BOOT, bytes([servo_id]))
@@ -156,8 +188,6 @@ def update(bus, servo_id: int, image: Image, progress=lambda done, total: None) 
     verdict, size, crc, version, _board = struct.unpack_from("<BIIHH", c, 1)
     if verdict != 0 or (size, crc, version) != (image.size, image.crc, image.version):
         raise Refused(f"servo {servo_id}: the written image does not check: {VERDICTS.get(verdict, verdict)}")
-    c = _answer(_retry(lambda: bus.request(UPDATE_BOOT, bytes([servo_id]))), 2, servo_id, "UpdateBoot")
-    if c[1] != 1:
-        raise Refused(f"servo {servo_id}: the bootloader would not start the image")
-    after = _wait_for_mode(bus, servo_id, MODE_APP).version
+    after = _switch(bus, servo_id, UPDATE_BOOT, "UpdateBoot", MODE_APP,
+                    lambda c: f"servo {servo_id}: the bootloader would not start the image").version
     return before, after

@@ -14,7 +14,8 @@ struct hal_flash {
     /* Sets every byte of the page at addr to 0xFF. */
     bool (*erase_page)(void *ctx, uint32_t addr);
     uint32_t write_block;   /* bytes one program step writes: 2, 4 or 8 */
-    /* Programs write_block bytes from data at an aligned, erased address. */
+    /* Programs write_block bytes from data at an aligned, erased address;
+     * true only if the block then reads back as data. */
     bool (*program)(void *ctx, uint32_t addr, const uint8_t *data);
     void (*read)(void *ctx, uint32_t addr, uint8_t *dst, uint32_t len);
 };

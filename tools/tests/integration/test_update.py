@@ -285,3 +285,32 @@ def test_flash_faults_are_reported_not_hidden(sim):
         with pytest.raises(Refused, match="the flash refused"):
             upd.update(bus, 1, make_image())
         assert upd.update(bus, 1, make_image()) == (None, NEW)
+
+
+@pytest.mark.parametrize("lost", [upd.UPDATE_ENTER, upd.UPDATE_ERASE, upd.UPDATE_WRITE,
+                                  upd.UPDATE_VERIFY, upd.UPDATE_BOOT])
+def test_every_step_survives_a_lost_answer(sim, lost):
+    """Issue 23: the servo carries out a request whose answer the host
+    never sees (the answer is read off the wire and thrown away). The update
+    still ends with the new version running and exit 0: a repeated write
+    finds its bytes in place, and after UpdateEnter or UpdateBoot the mode
+    the servo answers in shows the request was done."""
+    image = make_image(seed=7)
+    with sim.bus(timeout=0.2) as bus:
+        read_response = bus.read_response
+        dropped = []
+
+        def lossy(code, servo_id, timeout=None):
+            content = read_response(code, servo_id, timeout)
+            if code == lost and len(dropped) < 2:  # the first two of that packet
+                dropped.append(code)
+                raise NoReply(f"servo {servo_id}: answer to packet {code} lost (test)")
+            return content
+
+        bus.read_response = lossy
+        before, after = upd.update(bus, 1, image)
+        bus.read_response = read_response
+        # Enter and Boot are not sent again: the servo answers in its new mode.
+        assert dropped == [lost] * (1 if lost in (upd.UPDATE_ENTER, upd.UPDATE_BOOT) else 2)
+        assert (before, after) == (OLD, NEW)
+        assert firmware(bus, 1) == NEW
