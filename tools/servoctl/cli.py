@@ -15,10 +15,10 @@ import os
 import sys
 import time
 
-from . import __version__, frame, group, ntc, outcome, registers, units
+from . import __version__, frame, group, ntc, outcome, registers, scan, units
 from . import protocol as p
 from .profile import positions, velocity_timing
-from .protocol import Bus, NoReply, Refused, ServoError, UsageError
+from .protocol import BadAnswer, Bus, NoReply, Refused, ServoError, UsageError
 from .servo import Servo
 
 EXIT_INTERRUPTED = 130
@@ -71,28 +71,14 @@ def describe_temperature(adc: int) -> str:
 
 # ---- commands --------------------------------------------------------------
 
-def scan_timeout_s(baud: int) -> float:
-    """How long to wait for one ID's ping answer: the request and the answer
-    (6 bytes each, 10 bits a byte) at this baud rate, and 3 ms for the servo
-    and the link to turn around. 0-254 take about a second at 115200."""
-    return 12 * 10 / baud + 0.003
-
-
-def _scan_one_rate(bus, first: int, last: int, timeout: float, found: list, progress, task,
-                   quiet: bool):
-    for servo_id in range(first, last + 1):
-        if Servo(bus, servo_id).ping(timeout=timeout):
-            found.append((servo_id, bus.serial.baudrate))
-            if not quiet:
-                progress.console.print(f"servo {servo_id} at {bus.serial.baudrate} baud")
-        progress.advance(task)
-
-
 def cmd_scan(bus, args):
     from rich.progress import Progress
 
     rates = [bus.serial.baudrate]  # the one asked for first
-    if args.all_bauds:
+    if args.all_bauds and bus.port.startswith("socket://"):
+        print("servoctl: socket:// carries no baud rate (the far end sets it): scanning once",
+              file=sys.stderr)
+    elif args.all_bauds:
         rates += [r for r in sorted(registers.BAUD_RATES.values()) if r != rates[0]]
     found = []
     interrupted = False
@@ -101,18 +87,28 @@ def cmd_scan(bus, args):
         try:
             for rate in rates:
                 bus.serial.baudrate = rate
-                timeout = args.reply_timeout or scan_timeout_s(rate)
-                _scan_one_rate(bus, args.first, args.last, timeout, found, progress, task, args.json)
+                window = args.reply_timeout or scan.reply_window_s(rate)
+                for servo_id in range(args.first, args.last + 1):
+                    if (f := scan.probe(bus, servo_id, window)) is not None:
+                        found.append(f)
+                        if not args.json:
+                            progress.console.print(f.describe(), soft_wrap=True, markup=False,
+                                                   highlight=False)
+                    progress.advance(task)
         except KeyboardInterrupt:
             interrupted = True
     if args.json:
-        print(json.dumps([{"id": i, "baud": b} for i, b in found]))
+        print(json.dumps([f.as_json() for f in found]))
     else:
         print(f"{len(found)} servo(s) found" if found else "no servo answered",
               "(interrupted)" if interrupted else "")
     if interrupted:
         print("servoctl: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
+    if any(f.shared for f in found):
+        print(f"servoctl: error: IDs held by two or more servos: "
+              f"{', '.join(str(f.id) for f in found if f.shared)}", file=sys.stderr)
+        return Refused.exit_code
     return 0 if found else 3
 
 
@@ -359,7 +355,7 @@ def cmd_async(bus, args):
 def _ids_on_bus(bus, ids):
     if ids:
         return ids
-    timeout = scan_timeout_s(bus.serial.baudrate)
+    timeout = scan.reply_window_s(bus.serial.baudrate)
     return [i for i in range(p.MAX_ID + 1) if Servo(bus, i).ping(timeout=timeout)]
 
 
@@ -823,7 +819,19 @@ def _run(args, clock=None) -> int:
     if not args.port:
         raise UsageError("no port: give --port or set SERVOCTL_PORT")
     with Bus(args.port, args.baud, args.timeout, clock=clock) as bus:
-        return args.run(bus, args)
+        try:
+            return args.run(bus, args)
+        except BadAnswer:
+            raise
+        except NoReply:
+            # A servo in its bootloader answers Ping and the update packets
+            # only: say so, and what recovers it, instead of "no reply".
+            servo_id = getattr(args, "id", None)
+            if isinstance(servo_id, int) and args.command not in ("update", "ping"):
+                why = scan.in_bootloader(bus, servo_id)
+                if why:
+                    raise NoReply(why) from None
+            raise
 
 
 if __name__ == "__main__":

@@ -119,8 +119,16 @@ class Bus:
         self.clock = clock or time.monotonic
         self.port = port
         try:
-            self.serial = serial.serial_for_url(port, baudrate=baud, timeout=0.005)
-        except (serial.SerialException, ValueError, OSError, *_TERMIOS_ERRORS) as e:
+            # Exclusive: a second program on the port would take answers
+            # meant for this one (a flock on a serial device; other URLs
+            # ignore it).
+            self.serial = serial.serial_for_url(port, baudrate=baud, timeout=0.005, exclusive=True)
+        except serial.SerialException as e:
+            if "exclusively lock" in str(e):
+                raise LinkError(f"{port} is in use by another program (another servoctl, a "
+                                f"terminal, the maker's tool): close it, then try again") from None
+            raise LinkError(f"cannot open {port}: {e}") from None
+        except (ValueError, OSError, *_TERMIOS_ERRORS) as e:
             raise LinkError(f"cannot open {port}: {e}") from None
         sock = getattr(self.serial, "_socket", None)
         if sock is not None:  # socket://: no Nagle delay on small frames
@@ -128,6 +136,7 @@ class Bus:
 
             sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
         self._buffer = b""
+        self.stray_bytes = 0  # bytes outside any frame: noise, or answers that collided
         self._read_at = 0.0
         # The bus clock when the bytes that completed the last response
         # returned were read: when the answer arrived, not when it was used.
@@ -209,14 +218,38 @@ class Bus:
             last_look = self.clock() > deadline
             self._fill(wait=not last_look)
 
+    def gather(self, code: int, content: bytes, window_s: float) -> tuple:
+        """Sends a request and keeps listening window_s after it: two servos
+        on one ID both answer. (contents of the good answers from that
+        servo, frames with a bad checksum, bytes outside any frame)."""
+        self.send(code, content)
+        self.stray_bytes = 0
+        good, bad = [], 0
+        deadline = self.clock() + window_s
+        last_look = False
+        while True:
+            while (frame := self._take_frame()) is not None:
+                fcode, answer, ok = frame
+                if not ok:
+                    bad += 1
+                elif fcode == code and answer[:1] == content[:1]:
+                    good.append(answer)
+            if last_look:
+                return good, bad, self.stray_bytes + len(self._buffer)
+            last_look = self.clock() > deadline
+            self._fill(wait=not last_look)
+
     def _take_frame(self):
         """(code, content, checksum_ok) of a complete response frame at the
         head of the buffer, or None; garbage before a header is dropped."""
         buf = self._buffer
         start = buf.find(RESPONSE_HEADER)
         if start < 0:
-            self._buffer = buf[-1:] if buf[-1:] == RESPONSE_HEADER[:1] else b""
+            keep = buf[-1:] if buf[-1:] == RESPONSE_HEADER[:1] else b""
+            self.stray_bytes += len(buf) - len(keep)
+            self._buffer = keep
             return None
+        self.stray_bytes += start
         buf = buf[start:]
         self._buffer = buf
         if len(buf) < 5:

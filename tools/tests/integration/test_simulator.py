@@ -35,6 +35,19 @@ def test_a_servo_at_another_baud_rate_is_not_heard(pty_sim):
             bus.request(p.PING, bytes([1]))
 
 
+def test_a_second_program_on_the_port_is_refused_not_let_in(pty_sim, capsys):
+    """Issue 23: servoctl opens the port exclusively. A second servoctl gets
+    a one-line 'in use' and exit 4, and the first keeps its answers."""
+    from servoctl.cli import main
+
+    with pty_sim.bus() as bus:
+        assert main(["--port", pty_sim.url, "ping", "1"]) == 4
+        err = capsys.readouterr().err
+        assert "in use by another program" in err and len(err.strip().splitlines()) == 1, err
+        assert Servo(bus, 1).ping() and Servo(bus, 2).ping()
+    assert main(["--port", pty_sim.url, "ping", "1"]) == 0  # free again
+
+
 def test_a_flood_is_held_back_not_queued_for_hours(pty_sim):
     """Two seconds of garbage written as fast as the pty takes it: at
     115200 baud the line carries about 23 kB of it; the rest waits in the

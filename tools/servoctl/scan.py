@@ -1,0 +1,94 @@
+"""Who is on the bus: for each ID, whether anything answers, whether it is
+an application or a bootloader waiting for an image, and whether one ID is
+held by two servos (their answers arrive twice, or collide and arrive
+garbled). A collision on the wire cannot be avoided, only noticed: every
+probe keeps listening for its whole window."""
+import struct
+from dataclasses import dataclass, field
+
+from . import protocol as p
+from . import registers
+from . import update
+from .protocol import BadAnswer, NoReply
+
+_SERIAL = registers.find("serial")
+
+
+def reply_window_s(baud: int) -> float:
+    """How long to listen after a request: the request and a short answer
+    (12 bytes, 10 bits a byte) and 3 ms for the servo and the link to turn
+    around. IDs 0-254 take about a second at 115200."""
+    return 12 * 10 / baud + 0.003
+
+
+@dataclass
+class Found:
+    id: int
+    baud: int
+    mode: str = "application"  # or "bootloader": no application runs
+    verdict: str = ""          # a bootloader's word on the image in its slot
+    serials: list = field(default_factory=list)  # every serial number heard at this ID
+    answers: int = 1           # good answers to one Ping
+    garbled: int = 0           # answers that arrived damaged
+
+    @property
+    def shared(self) -> bool:
+        """Two or more servos hold this ID."""
+        return self.answers > 1 or len(self.serials) > 1 or self.garbled > 0
+
+    def describe(self) -> str:
+        where = f"servo {self.id} at {self.baud} baud"
+        if self.shared:
+            heard = (f"serials {', '.join(f'0x{s:08x}' for s in self.serials)}" if len(self.serials) > 1
+                     else f"{self.answers} good and {self.garbled} garbled answers")
+            return (f"{where}: TWO OR MORE SERVOS hold this ID ({heard}). Disconnect all but one "
+                    f"and give it a free ID ('servoctl config set {self.id} servo_id N')")
+        if self.mode == "bootloader":
+            return (f"{where}: in its bootloader, no application runs ({self.verdict}): "
+                    f"'servoctl update {self.id} IMAGE' installs one")
+        serial = f", serial 0x{self.serials[0]:08x}" if self.serials else ""
+        return f"{where}{serial}"
+
+    def as_json(self) -> dict:
+        return {"id": self.id, "baud": self.baud, "mode": self.mode, "serials": self.serials,
+                "shared": self.shared}
+
+
+def probe(bus: p.Bus, servo_id: int, window_s: float):
+    """What answers at servo_id (a Found), or None if nothing does."""
+    pings, garbled, stray = bus.gather(p.PING, bytes([servo_id]), window_s)
+    if not pings and not garbled and not stray:
+        return None
+    found = Found(servo_id, bus.serial.baudrate, answers=len(pings), garbled=garbled + (stray > 0))
+    try:
+        st = update.status(bus, servo_id, timeout=window_s)
+    except BadAnswer:
+        st = None  # garbled: shared, or another firmware
+    except NoReply:
+        st = None  # a firmware without UpdateStatus: an application
+    if st is not None and st.mode == update.MODE_BOOTLOADER:
+        found.mode = "bootloader"
+        found.verdict = update.VERDICTS.get(st.verdict, f"verdict {st.verdict}")
+        return found  # a bootloader answers no ReadData
+    answers, bad, stray = bus.gather(p.READ_DATA, bytes([servo_id, _SERIAL.id]), window_s)
+    found.garbled += bad + (stray > 0)
+    for content in answers:
+        if len(content) == 2 + _SERIAL.size:
+            found.serials.append(struct.unpack_from("<I", content, 2)[0])
+        else:
+            found.garbled += 1
+    return found
+
+
+def in_bootloader(bus: p.Bus, servo_id: int):
+    """Why a servo that does not answer as an application may be silent:
+    a sentence if its bootloader answers instead, else None."""
+    try:
+        st = update.status(bus, servo_id)
+    except NoReply:
+        return None
+    if st.mode != update.MODE_BOOTLOADER:
+        return None
+    return (f"servo {servo_id} is in its bootloader, not its application (its slot: "
+            f"{update.VERDICTS.get(st.verdict, st.verdict)}): 'servoctl update {servo_id} IMAGE' "
+            f"installs an application")

@@ -1,0 +1,102 @@
+"""scan and the servos it finds (issue 23): two servos on one ID are
+noticed (their answers arrive twice, or garbled), a servo waiting in its
+bootloader is named as such with the command that recovers it, and a
+socket:// link, which carries no baud rate, is scanned once."""
+import json
+import socket
+import threading
+
+from servoctl import protocol as p
+from servoctl import update as upd
+from servoctl.cli import main
+from servoctl.servo import Servo
+from servoctl.sim import Simulator
+
+
+def run(sim, capsys, *args):
+    rc = main(["--port", sim.url, *args], clock=sim.clock_s)
+    out = capsys.readouterr()
+    return rc, out.out, out.err
+
+
+def test_two_servos_on_one_id_are_found_out(tmp_path, capsys):
+    """Servo 3 is given ID 2 behind servoctl's back (a raw WriteData). Both
+    answer at 2 from then on: scan names both serial numbers and exits 1.
+    (Not the sim3 fixture: this bus collides on purpose.)"""
+    with Simulator(ids=[1, 2, 3], state_dir=str(tmp_path / "state")) as sim:
+        with sim.bus() as bus:
+            Servo(bus, 3).write("servo_id", 2)
+        rc, out, err = run(sim, capsys, "scan", "--last", "5")
+        assert rc == 1, out + err
+        assert ("servo 2 at 115200 baud: TWO OR MORE SERVOS hold this ID "
+                "(serials 0x51a00002, 0x51a00003)") in out, out
+        assert "servo 1 at 115200 baud, serial 0x51a00001" in out
+        assert "IDs held by two or more servos: 2" in err
+        rc, out, _ = run(sim, capsys, "scan", "--last", "5", "--json")
+        found = {f["id"]: f for f in json.loads(out)}
+        assert rc == 1 and found[2]["shared"] and not found[1]["shared"]
+        assert found[2]["serials"] == [0x51A00002, 0x51A00003]
+
+
+class GarbledTwins:
+    """Two servos on one ID as a real wire delivers them: their answers
+    overlap and arrive as one damaged frame (a bad checksum)."""
+
+    def __init__(self):
+        self.server = socket.socket()
+        self.server.bind(("127.0.0.1", 0))
+        self.server.listen(1)
+        self.url = f"socket://127.0.0.1:{self.server.getsockname()[1]}"
+        threading.Thread(target=self._serve, daemon=True).start()
+
+    def _serve(self):
+        try:
+            peer, _ = self.server.accept()
+        except OSError:
+            return
+        with peer:
+            while data := peer.recv(4096):
+                if data[:2] == p.REQUEST_HEADER and len(data) > 5 and data[4] == 7:
+                    frame = bytearray(p.response_frame(data[2], data[4:-1]))
+                    frame[-1] ^= 0x55  # two answers on top of each other
+                    peer.sendall(bytes(frame))
+
+    def close(self):
+        self.server.close()
+
+
+def test_garbled_answers_at_one_id_are_reported_as_shared(capsys):
+    twins = GarbledTwins()
+    try:
+        rc = main(["--port", twins.url, "--timeout", "1", "scan", "--first", "5", "--last", "9",
+                   "--reply-timeout", "0.3"])
+    finally:
+        twins.close()
+    out, err = capsys.readouterr()
+    assert rc == 1, out + err
+    assert "servo 7 at 115200 baud: TWO OR MORE SERVOS hold this ID" in out and "garbled" in out, out
+
+
+def test_a_servo_in_its_bootloader_is_named_with_its_cure(sim, capsys):
+    """Page 0 of its slot erased (an update cut short): the servo waits in
+    its bootloader. scan says so; info, config and move say so instead of
+    'no reply', each with the command that recovers it."""
+    with sim.bus(timeout=0.2) as bus:
+        bus.request(upd.UPDATE_ENTER, bytes([1]))
+        upd._wait_for_mode(bus, 1, upd.MODE_BOOTLOADER)
+        assert bus.request(upd.UPDATE_ERASE, bytes([1, 0, 0]))[1] == 1
+    rc, out, _ = run(sim, capsys, "scan", "--last", "3")
+    assert rc == 0 and ("servo 1 at 115200 baud: in its bootloader, no application runs "
+                        "(no image): 'servoctl update 1 IMAGE' installs one") in out, out
+    for argv in (["info", "1"], ["config", "get", "1", "angle_max"], ["move", "1", "10"]):
+        rc, _, err = run(sim, capsys, *argv)
+        assert rc == 3 and "servo 1 is in its bootloader, not its application (its slot: no image)" in err, err
+        assert "'servoctl update 1 IMAGE'" in err and len(err.strip().splitlines()) == 1
+
+
+def test_all_bauds_over_a_socket_scans_once(sim, capsys):
+    """socket:// has no baud rate: the far end decides. A scan at every
+    rate found the one servo at each of them (8 for 1)."""
+    rc, out, err = run(sim, capsys, "scan", "--all-bauds", "--last", "3")
+    assert rc == 0 and "1 servo(s) found" in out, out
+    assert "socket:// carries no baud rate" in err
