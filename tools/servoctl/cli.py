@@ -775,7 +775,7 @@ def build_parser():
     c = sub.add_parser("image", help="make an update image from an application binary")
     c.add_argument("binary", help="the application from its vector table (objcopy -O binary)")
     c.add_argument("--version", required=True, help="firmware version, data item 7 (e.g. 0x0011)")
-    c.add_argument("--board", required=True, help="stm32f103, qemu_stm32vl, sim, or a number")
+    c.add_argument("--board", required=True, help="a board of firmware/boards (stm32f103, stm32f030k6, qemu_stm32vl, host_sim) or its number")
     c.add_argument("-o", "--output", required=True)
     c.set_defaults(run=None)
 

@@ -1,6 +1,7 @@
 """Application images for the bootloader (docs/packets.md, "Firmware
 update"): a 256-byte header, then the application from its vector table on.
 The layout is firmware/bootloader/app_image.h's."""
+import re
 import struct
 import zlib
 from dataclasses import dataclass
@@ -13,8 +14,81 @@ FORMAT = 1
 HEADER_SIZE = 256
 CHECKED = 24  # bytes the header's own CRC covers
 
-# Boards images are built for (the header's board field).
-BOARDS = {"stm32f103": 0x0103, "qemu_stm32vl": 0x0100, "sim": 0x5100}
+# The build's boards: each folder with a board.cmake (SERVO_BOARD_ID, the
+# header's board field; SERVO_BOARD_LINKER, the application's memory map).
+BOARDS_DIR = Path(__file__).resolve().parents[2] / "firmware" / "boards"
+
+
+@dataclass(frozen=True)
+class Board:
+    name: str
+    id: int
+    flash: tuple = None  # (first, end) of the application's code; None: not executed (host_sim)
+    ram: tuple = None    # (first, end) of its RAM
+
+
+def _size(expr: str) -> int:
+    """A linker script's ORIGIN or LENGTH: numbers with K or M, + and -."""
+    total, sign = 0, 1
+    for number, unit, op in re.findall(r"(0x[0-9a-fA-F]+|\d+)\s*([KM]?)|([+-])", expr):
+        if op:
+            sign = 1 if op == "+" else -1
+        else:
+            total += sign * int(number, 0) * {"": 1, "K": 1024, "M": 1024 * 1024}[unit]
+    return total
+
+
+def _memory_map(linker_script: Path) -> tuple:
+    """(flash, ram) spans of a linker script's MEMORY: FLASH, and the RAM
+    regions (RAM, VECTORS) from the lowest to the highest end."""
+    regions = {}
+    for name, origin, length in re.findall(r"^\s*(\w+)\s*\([rwx]+\)\s*:\s*ORIGIN\s*=\s*([^,]+),"
+                                           r"\s*LENGTH\s*=\s*(.+)$", linker_script.read_text(), re.M):
+        regions[name] = (_size(origin), _size(origin) + _size(length))
+    ram = [span for name, span in regions.items() if name in ("RAM", "VECTORS")]
+    return regions.get("FLASH"), (min(a for a, _ in ram), max(b for _, b in ram)) if ram else None
+
+
+def _read_board(folder: Path):
+    text = (folder / "board.cmake").read_text()
+    board_id = re.search(r"set\(SERVO_BOARD_ID\s+(0x[0-9a-fA-F]+|\d+)\)", text)
+    if board_id is None:
+        return None
+    linker = re.search(r"set\(SERVO_BOARD_LINKER\s+\$\{CMAKE_CURRENT_LIST_DIR\}/(\S+)\)", text)
+    flash, ram = _memory_map(folder / linker.group(1)) if linker else (None, None)
+    return Board(folder.name, int(board_id.group(1), 0), flash, ram)
+
+
+def boards() -> dict:
+    """{name: Board} of every board the build knows."""
+    found = (_read_board(f) for f in sorted(BOARDS_DIR.iterdir()) if (f / "board.cmake").is_file())
+    return {b.name: b for b in found if b is not None}
+
+
+BOARDS = {name: b.id for name, b in boards().items()}
+
+
+def check_code(code: bytes, board: Board) -> None:
+    """Refuses what cannot be this board's application from its vector
+    table: an ELF file, or a first two words that are not a stack pointer
+    in its RAM and a Thumb reset handler in its code."""
+    if code[:4] == b"\x7fELF":
+        raise UsageError("that is an ELF file: give the application's raw binary (the build's "
+                         f"servo_{board.name}.bin, or 'arm-none-eabi-objcopy -O binary')")
+    if board.flash is None:
+        return  # the simulator's slot holds bytes it never executes
+    if len(code) < 8:
+        raise UsageError(f"{len(code)} bytes cannot be an application: it starts with a vector table")
+    sp, reset = struct.unpack_from("<II", code)
+    first, end = board.flash
+    if not board.ram[0] < sp <= board.ram[1] or sp % 4:
+        raise UsageError(f"not a {board.name} application: its stack pointer 0x{sp:08x} is not in "
+                         f"RAM (0x{board.ram[0]:08x}..0x{board.ram[1]:08x}); is it the bootloader, "
+                         f"another board's binary, or not a binary at all?")
+    if not reset & 1 or not first <= (reset & ~1) < first + len(code):
+        raise UsageError(f"not a {board.name} application: its reset handler 0x{reset:08x} is not "
+                         f"Thumb code in the image (0x{first:08x}..0x{first + len(code):08x}); "
+                         f"is it the bootloader, or linked for another address?")
 
 
 @dataclass
@@ -65,13 +139,16 @@ def load(path: str) -> Image:
 def make(binary: str, version: str, board: str, output: str) -> bytes:
     """Reads an application binary, writes its update image; the image's
     bytes. board: a name of BOARDS or a number; version: a number."""
-    number = BOARDS.get(board)
-    if number is None:
+    known = boards()
+    found = known.get(board)
+    if found is None:
         try:
             number = int(board, 0)
         except ValueError:
-            raise UsageError(f"board must be one of {', '.join(BOARDS)} or a number, "
-                             f"not {board!r}") from None
+            number = None
+        found = next((b for b in known.values() if b.id == number), None)
+    if found is None:
+        raise UsageError(f"board must be one of {', '.join(known)} (or its number), not {board!r}")
     try:
         version_number = int(version, 0)
     except ValueError:
@@ -80,7 +157,8 @@ def make(binary: str, version: str, board: str, output: str) -> bytes:
         code = Path(binary).read_bytes()
     except OSError as e:
         raise UsageError(f"cannot read {binary}: {e.strerror}") from e
-    data = build(code, version_number, number)
+    check_code(code, found)
+    data = build(code, version_number, found.id)
     try:
         Path(output).write_bytes(data)
     except OSError as e:

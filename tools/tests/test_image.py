@@ -20,7 +20,7 @@ def test_the_header_matches_the_firmware():
 
 
 def test_parse_takes_what_build_makes_and_refuses_damage():
-    data = img.build(b"\x01\x02\x03", 7, img.BOARDS["sim"])
+    data = img.build(b"\x01\x02\x03", 7, img.BOARDS["host_sim"])
     image = img.parse(data)
     assert (image.size, image.version, image.board) == (4, 7, 0x5100)  # padded to half-words
     with pytest.raises(UsageError, match="not an update image"):
@@ -31,3 +31,43 @@ def test_parse_takes_what_build_makes_and_refuses_damage():
         img.parse(bytes(broken))
     with pytest.raises(UsageError, match="does not match its CRC"):
         img.parse(data[:-1])
+
+
+def test_the_boards_are_the_builds():
+    """Every folder of firmware/boards with a board.cmake, the M0 included,
+    with the ID and the memory map the build uses."""
+    folders = {f.name for f in img.BOARDS_DIR.iterdir() if (f / "board.cmake").is_file()}
+    boards = img.boards()
+    assert set(boards) == folders >= {"stm32f103", "stm32f030k6", "qemu_stm32vl", "host_sim"}
+    assert boards["stm32f030k6"].id == 0x0030 and boards["stm32f103"].id == 0x0103
+    assert boards["stm32f030k6"].flash == (0x08001100, 0x08007800)  # 26 KB less the header
+    assert boards["stm32f103"].ram == (0x20000000, 0x20005000 - 16)
+
+
+def vectors(sp, reset, size=64):
+    return struct.pack("<II", sp, reset) + b"\x00" * (size - 8)
+
+
+@pytest.mark.parametrize("code, why", [
+    (b"\x7fELF\x01\x01\x01" + b"\x00" * 100, "that is an ELF file"),
+    (b"hello, world, this is not firmware", "stack pointer 0x6c6c6568 is not in RAM"),
+    (vectors(0x20000700, 0x0800074D), "reset handler 0x0800074d is not Thumb code in the image"),
+    (vectors(0x20001000, 0x08001141), "stack pointer 0x20001000 is not in RAM"),  # the F030 has 4 KB
+    (vectors(0x20000D20, 0x08001140), "is not Thumb code"),  # an even address: ARM state
+])
+def test_image_refuses_what_cannot_be_the_boards_application(tmp_path, code, why):
+    binary = tmp_path / "app.bin"
+    binary.write_bytes(code)
+    with pytest.raises(UsageError, match=why):
+        img.make(str(binary), "1", "stm32f030k6", str(tmp_path / "app.img"))
+    assert not (tmp_path / "app.img").exists()
+
+
+def test_image_takes_an_application_by_board_name_or_number(tmp_path):
+    binary = tmp_path / "app.bin"
+    binary.write_bytes(vectors(0x20000D20, 0x08001341, size=0x300))
+    for board in ("stm32f030k6", "0x0030", "48"):
+        img.make(str(binary), "0x0011", board, str(tmp_path / "app.img"))
+        assert img.load(str(tmp_path / "app.img")).board == 0x0030
+    with pytest.raises(UsageError, match="board must be one of host_sim, qemu_stm32vl, stm32f030k6, stm32f103"):
+        img.make(str(binary), "1", "0x0777", str(tmp_path / "x.img"))

@@ -17,8 +17,11 @@
 #define SIM_SLOT_BASE 0x08001000u
 #define SIM_SLOT_PAGES 58u
 #define SIM_CONFIG_BASE 0x0800F800u
-/* The board the simulator's images are for (the header's board field). */
-#define SIM_BOARD 0x5100u
+/* SIM_BOARD, the board the simulator's images are for (the header's board
+ * field), comes from board.cmake, as every board's does. */
+#ifndef SIM_BOARD
+#error "SIM_BOARD comes from firmware/boards/host_sim/board.cmake"
+#endif
 
 /* The bootloader, as the simulator runs it (sim_boot.c): the boards' loop
  * (bootloader.c) on the servo's port; the image in the slot is not

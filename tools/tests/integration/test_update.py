@@ -22,7 +22,7 @@ OLD = 0x0010  # the simulator's factory image: this firmware's version
 NEW = 0x0042
 
 
-def make_image(version=NEW, size=3000, board=img.BOARDS["sim"], seed=1):
+def make_image(version=NEW, size=3000, board=img.BOARDS["host_sim"], seed=1):
     code = bytes(random.Random(seed).randrange(256) for _ in range(size))
     return img.parse(img.build(code, version, board))
 
@@ -173,7 +173,7 @@ def test_servoctl_image_and_update_several_servos(sim3, capsys, tmp_path):
     binary = tmp_path / "app.bin"
     binary.write_bytes(bytes(random.Random(2).randrange(256) for _ in range(1501)))
     out = tmp_path / "app.img"
-    rc, text, _ = run(sim3, capsys, "image", str(binary), "--version", "0x0042", "--board", "sim",
+    rc, text, _ = run(sim3, capsys, "image", str(binary), "--version", "0x0042", "--board", "host_sim",
                       "-o", str(out))
     assert rc == 0 and "version 0x0042" in text
     rc, text, err = run(sim3, capsys, "update", "1", "3", str(out))  # IDs first, as in the issue
@@ -197,7 +197,7 @@ def test_servoctl_update_refuses_what_cannot_be_right(sim, capsys, tmp_path):
     rc, _, err = run(sim, capsys, "update", "1", "2")
     assert rc == UsageError.exit_code and "one image" in err
     damaged = tmp_path / "damaged.img"
-    data = bytearray(img.build(b"\x01" * 600, 0x0042, img.BOARDS["sim"]))
+    data = bytearray(img.build(b"\x01" * 600, 0x0042, img.BOARDS["host_sim"]))
     data[400] ^= 1
     damaged.write_bytes(bytes(data))
     rc, _, err = run(sim, capsys, "update", str(damaged), "1")
@@ -221,7 +221,7 @@ def test_update_enter_is_refused_while_a_load_is_held(sim, capsys, tmp_path):
         assert abs(held - 44.0) < 1.5
         assert bus.request(upd.UPDATE_ENTER, bytes([1]))[1:] == bytes([0, upd.ENTER_OUTPUT_DRIVEN])
     path = tmp_path / "app.img"
-    path.write_bytes(img.build(b"\x02" * 600, NEW, img.BOARDS["sim"]))
+    path.write_bytes(img.build(b"\x02" * 600, NEW, img.BOARDS["host_sim"]))
     rc, out, err = run(sim, capsys, "update", "1", str(path))
     said = out + err
     assert rc == Refused.exit_code and "output is driven" in said and "servoctl stop 1" in said, said
