@@ -19,9 +19,27 @@ from . import __version__, frame, group, ntc, outcome, registers, scan, units
 from . import protocol as p
 from .profile import positions, velocity_timing
 from .protocol import BadAnswer, Bus, NoReply, Refused, ServoError, UsageError
-from .servo import Servo
+from .servo import Servo, check_profile
 
 EXIT_INTERRUPTED = 130
+
+
+def _baud(text: str) -> int:
+    """--baud: a rate the servos speak (data item 36)."""
+    rates = registers.BAUD_RATES.values()
+    if text.isdigit() and int(text) in rates:
+        return int(text)
+    raise argparse.ArgumentTypeError(f"a servo speaks {', '.join(map(str, rates))} bits/s, not {text}")
+
+
+def _reply_timeout(text: str) -> float:
+    try:
+        seconds = float(text)
+    except ValueError:
+        seconds = math.nan
+    if not 0.001 <= seconds <= 10:
+        raise argparse.ArgumentTypeError(f"a reply timeout is 0.001..10 s, not {text}")
+    return seconds
 
 
 def decideg(degrees: float) -> int:
@@ -254,6 +272,7 @@ def _move_args(args):
     else:
         kw["interval_ms"] = args.interval if args.interval is not None else 1000
         kw["ramps"] = args.acc is not None or args.dec is not None
+    check_profile(acc, dec, kw.get("interval_ms"), kw.get("velocity"))
     return kw
 
 
@@ -271,7 +290,7 @@ def cmd_move(bus, args):
     if not result.arrived:
         raise Refused(f"servo {args.id}: {result.reason}")
     print(f"servo {args.id}: at {result.angle / 10:.1f} deg after {result.took_s * 1000:.0f} ms "
-          f"(planned {plan.planned_s * 1000:.0f} ms)")
+          f"({outcome.planned_text(plan, result.took_s)})")
     return 0
 
 
@@ -472,6 +491,17 @@ def cmd_record(bus, args):
           f"{worst:.2f} deg; final {rows[-1][1]:.1f} deg")
     print(f"csv  {os.path.abspath(csv_path)}")
     print(f"plot {os.path.abspath(png_path)}")
+    off = abs(rows[-1][1] - target / 10.0)
+    if off > args.tolerance:
+        seen = 0
+        for _, m in samples:
+            seen |= m.status
+        why = (f"a protection ({', '.join(registers.status_names(seen & outcome.INHIBITING))})"
+               if seen & outcome.INHIBITING else "a stall (status bit 2)" if seen & outcome.STALL
+               else "nothing the servo reported")
+        raise Refused(f"servo {args.id} did not arrive: {off:.1f} deg from {target / 10:.1f} deg "
+                      f"(tolerance {args.tolerance} deg); stopped by {why}")
+    print(f"arrived: {off:.2f} deg from {target / 10:.1f} deg")
     return 0
 
 
@@ -631,8 +661,10 @@ def build_parser():
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--port", default=os.environ.get("SERVOCTL_PORT"),
                     help="serial port or pyserial URL (socket://HOST:PORT); env SERVOCTL_PORT")
-    ap.add_argument("--baud", type=int, default=115200)
-    ap.add_argument("--timeout", type=float, default=0.1, help="reply timeout, seconds")
+    ap.add_argument("--baud", type=_baud, default=115200,
+                    help=f"bits/s, one of item 36's: {', '.join(map(str, registers.BAUD_RATES.values()))}")
+    ap.add_argument("--timeout", type=_reply_timeout, default=0.1,
+                    help="reply timeout, seconds (0.001..10)")
     ap.add_argument("--version", action="version", version=f"servoctl {__version__}")
     sub = ap.add_subparsers(dest="command", required=True)
 
@@ -683,12 +715,15 @@ def build_parser():
         c.add_argument("--power", type=int, default=0, help="mW; 0 = the power limit (42)")
         c.add_argument("--multi-turn", action="store_true")
 
+    def tolerance_option(c):
+        c.add_argument("--tolerance", type=finite, default=outcome.TOLERANCE_DEG,
+                       help=f"degrees the horn may be off (default {outcome.TOLERANCE_DEG})")
+
     c = sub.add_parser("move", help="an angle move (every angle mode)")
     motion_options(c)
     c.add_argument("--wait", action="store_true",
                    help="wait until the horn has arrived; exit 1 and say why if it does not")
-    c.add_argument("--tolerance", type=finite, default=outcome.TOLERANCE_DEG,
-                   help=f"degrees the horn may be off (default {outcome.TOLERANCE_DEG})")
+    tolerance_option(c)
     c.add_argument("--timeout-s", type=finite, default=None,
                    help="give up after this (default: twice the plan, soft start, 2 s)")
     c.set_defaults(run=cmd_move)
@@ -731,6 +766,7 @@ def build_parser():
     motion_options(c)
     c.add_argument("--out", default="record", help="file name prefix (default: record)")
     c.add_argument("--settle", type=int, default=300, help="ms to keep sampling after the plan")
+    tolerance_option(c)
     c.set_defaults(run=cmd_record)
 
     c = sub.add_parser("sync-move", help="several servos start their moves in one frame")

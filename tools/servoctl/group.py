@@ -8,7 +8,7 @@ from . import protocol as p
 from . import registers
 from .frame import check_target
 from .protocol import NoReply, Refused, UsageError, ValueOutOfRange
-from .servo import Monitor, Servo, _check, _ms, _scaled
+from .servo import MIN_RAMP_MS, Monitor, Servo, _check, _ms, _scaled, check_profile
 
 # SyncCommand records (servo-protocol.md 3.25): the packet's own content.
 _ANGLE_RECORD = "<BhHH"       # packet 8: id, angle, interval, power
@@ -27,6 +27,7 @@ def sync_move(bus: p.Bus, targets: dict, duration_s: float, power_w: float = 0.0
         raise UsageError(f"a sync move takes 1..{MAX_SYNC_RECORDS} servos, not {len(targets)}")
     multi = multi_turn
     interval = _ms(duration_s, "duration_s")
+    check_profile(MIN_RAMP_MS, MIN_RAMP_MS, interval)  # packets 8 and 13 ramp 20 ms
     power = _check("power", _scaled(power_w, 1000, "power_w"), 0, 65535, "mW")
     if multi:
         fmt, code = _MULTI_TURN_RECORD, p.MULTI_TURN
@@ -38,7 +39,7 @@ def sync_move(bus: p.Bus, targets: dict, duration_s: float, power_w: float = 0.0
     for servo_id, degrees in targets.items():
         _check("servo ID", servo_id, 0, p.MAX_ID)
         angle = _scaled(degrees, 10, "degrees")
-        _check("angle", angle, -3686400, 3686400, "x0.1 deg")
+        _check("angle", angle, -3686400, 3686400, "deg", 10)
         check_target(Servo(bus, servo_id), angle, multi)
         records += struct.pack(fmt, servo_id, angle, interval, power)
     bus.send(p.SYNC, bytes([code, struct.calcsize(fmt), len(targets)]) + records)
@@ -50,8 +51,9 @@ def broadcast_move(bus: p.Bus, degrees: float, duration_s: float, power_w: float
     ids are the servos on the bus: each is checked first (frame.check_target:
     in turn 0, the angle within its limits), and nothing is sent unless all
     pass."""
-    angle = _check("angle", _scaled(degrees, 10, "degrees"), -1800, 1800, "x0.1 deg")
+    angle = _check("angle", _scaled(degrees, 10, "degrees"), -1800, 1800, "deg", 10)
     interval = _check("interval", _ms(duration_s, "duration_s"), 0, 65535, "ms")
+    check_profile(MIN_RAMP_MS, MIN_RAMP_MS, interval)
     power = _check("power", _scaled(power_w, 1000, "power_w"), 0, 65535, "mW")
     if not ids:
         raise NoReply("no servo on the bus answered: nothing to move")

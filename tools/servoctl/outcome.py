@@ -68,6 +68,17 @@ def plan_move(s: Servo, asked: int, kw: dict, where: Where = None) -> Plan:
     return Plan(start, asked, target, target_abs, target != asked, planned, soft)
 
 
+def planned_text(plan: Plan, took_s: float) -> str:
+    """'planned N ms', and soft start named when it can explain a move that
+    took longer: it stretches the first angle move after power-up (items
+    49/50)."""
+    text = f"planned {plan.planned_s * 1000:.0f} ms"
+    if plan.soft_start_s and took_s > plan.planned_s + 0.1:
+        text += (f"; soft start is on ({plan.soft_start_s * 1000:.0f} ms, soft_start_on/soft_start_time)"
+                 f" and stretches the first move after power-up")
+    return text
+
+
 @dataclass
 class Outcome:
     arrived: bool
@@ -97,7 +108,7 @@ def wait_for_arrival(s: Servo, plan: Plan, tolerance_deg: float = TOLERANCE_DEG,
     angle, _ = s.multi_turn_angle()
     off = abs(angle - plan.target_abs) / 10.0
     if status & EXECUTING:
-        why = f"did not arrive within {limit:.1f} s (planned {plan.planned_s:.2f} s)"
+        why = f"did not arrive within {limit:.1f} s ({planned_text(plan, took)})"
         if seen & STALL:
             why = f"blocked: it stalled (status bit 2) and {why}"
         return Outcome(False, angle, took, f"{why}; at {angle / 10:.1f} deg")

@@ -85,13 +85,35 @@ class StoreHealth:
         return [name for bit, name in enumerate(self.FLAGS) if self.flags >> bit & 1]
 
 
-def _check(name: str, value: int, low: int, high: int, unit: str = "") -> int:
+def _check(name: str, value: int, low: int, high: int, unit: str = "", per_unit: int = 1) -> int:
+    """value, a whole number of 1/per_unit unit, within low..high; the
+    message speaks unit (an angle in 0.1 deg is checked with "deg", 10)."""
     if isinstance(value, bool) or not isinstance(value, int):
         raise ValueOutOfRange(f"{name} takes a whole number{' of ' + unit if unit else ''}, not {value!r}"
                               f"{' (move_to() takes degrees)' if name == 'angle' else ''}")
     if not low <= value <= high:
-        raise ValueOutOfRange(f"{name} must be {low}..{high}{' ' + unit if unit else ''}, not {value}")
+        def show(v):
+            return f"{v / per_unit:g}" if per_unit != 1 else str(v)
+        raise ValueOutOfRange(f"{name} must be {show(low)}..{show(high)}{' ' + unit if unit else ''}, "
+                              f"not {show(value)}")
     return value
+
+
+MIN_RAMP_MS = 20  # behaviour.md: acc >= 20, dec >= 20, interval >= acc + dec
+
+
+def check_profile(acc_ms: int, dec_ms: int, interval_ms: int = None, velocity: int = None) -> None:
+    """Refuses a profile the firmware would clamp (behaviour.md, Motion):
+    the move would run, but not as asked."""
+    for name, ramp in (("acceleration time", acc_ms), ("deceleration time", dec_ms)):
+        if ramp < MIN_RAMP_MS:
+            raise ValueOutOfRange(f"{name} must be {MIN_RAMP_MS} ms or more, not {ramp} ms "
+                                  f"(the servo would stretch it to {MIN_RAMP_MS} ms)")
+    if interval_ms is not None and interval_ms < acc_ms + dec_ms:
+        raise ValueOutOfRange(f"a move of {interval_ms} ms cannot hold its ramps ({acc_ms} + {dec_ms} ms): "
+                              f"give {acc_ms + dec_ms} ms or more (the servo would stretch it)")
+    if velocity is not None:
+        _check("speed", velocity, 10, 7500, "deg/s", 10)
 
 
 class Servo:
@@ -181,13 +203,13 @@ class Servo:
         _check("acceleration time", acc_ms, 0, 65535, "ms")
         _check("deceleration time", dec_ms, 0, 65535, "ms")
         if multi_turn:
-            _check("angle", angle_decideg, -3686400, 3686400, "x0.1 deg")
+            _check("angle", angle_decideg, -3686400, 3686400, "deg", 10)
         else:
-            _check("angle", angle_decideg, -1800, 1800, "x0.1 deg")
+            _check("angle", angle_decideg, -1800, 1800, "deg", 10)
         if (interval_ms is None) == (velocity is None):
             raise ValueOutOfRange("give either an interval or a velocity")
         if velocity is not None:
-            _check("velocity", velocity, 10, 7500, "x0.1 deg/s")
+            _check("speed", velocity, 10, 7500, "deg/s", 10)
             fmt, code = ("<BiHHHH", p.MULTI_TURN_BY_VELOCITY) if multi_turn else ("<BhHHHH", p.ANGLE_BY_VELOCITY)
             content = struct.pack(fmt, self.id, angle_decideg, velocity, acc_ms, dec_ms, power_mw)
         elif not ramps:
@@ -248,6 +270,7 @@ class Servo:
             kw["velocity"] = _scaled(speed_dps, 10, "speed_dps")
         else:
             kw["interval_ms"] = _ms(1.0 if duration_s is None else duration_s, "duration_s")
+        check_profile(kw["acc_ms"], kw["dec_ms"], kw.get("interval_ms"), kw.get("velocity"))
         asked = _scaled(degrees, 10, "degrees")
         where = frame.check_target(self, asked, multi_turn)
         plan = outcome.plan_move(self, asked, kw, where) if wait else None

@@ -89,3 +89,56 @@ def test_the_tool_table_matches_the_firmware_table():
         assert int(factory) == item.default, field
         if item.writable:
             assert (int(low), int(high)) == (item.low, item.high), field
+
+
+@pytest.mark.parametrize("argv, said", [
+    (["move", "1", "10", "--acc", "5"], "acceleration time must be 20 ms or more, not 5 ms"),
+    (["move", "1", "10", "--interval", "30"], "a move of 30 ms cannot hold its ramps (20 + 20 ms): give 40 ms"),
+    (["move", "1", "10", "--velocity", "900"], "speed must be 1..750 deg/s, not 900"),
+    (["sync-move", "1:10", "--interval", "10"], "give 40 ms or more"),
+])
+def test_a_value_the_servo_would_clamp_is_refused_in_the_users_units(sim, capsys, argv, said):
+    """Issue 23: --acc 5 was accepted (the servo takes 20), and a range was
+    said in protocol units (-1800..1800 x0.1 deg) after the user typed
+    degrees. Nothing is sent."""
+    rc, _, err = run(sim, capsys, *argv)
+    assert rc == 2 and said in err, err
+    assert sim.state(1)["last_move_ms"] == 0
+
+
+def test_the_python_api_speaks_degrees_in_its_ranges(sim):
+    from servoctl.servo import Servo
+
+    with sim.bus() as bus:
+        with pytest.raises(ValueOutOfRange, match=r"angle must be -180\.\.180 deg, not 200"):
+            Servo(bus, 1).move(2000, interval_ms=500)
+
+
+@pytest.mark.parametrize("option, value, said", [
+    ("--baud", "12345", "a servo speaks 9600, 19200"),
+    ("--timeout", "-1", "a reply timeout is 0.001..10 s, not -1"),
+    ("--timeout", "nan", "a reply timeout is 0.001..10 s, not nan"),
+])
+def test_link_options_are_checked(capsys, option, value, said):
+    with pytest.raises(SystemExit) as e:
+        main(["--port", "loop://", option, value, "ping", "1"])
+    assert e.value.code == 2 and said in capsys.readouterr().err
+
+
+def test_soft_start_is_named_when_it_stretches_a_move(sim, capsys):
+    """The factory soft start (on, 3 s) stretched the first move to about
+    3 s against 1 s planned, and nothing said why."""
+    rc, out, _ = run(sim, capsys, "move", "1", "20", "--wait")
+    assert rc == 0 and "soft start is on (3000 ms, soft_start_on/soft_start_time)" in out, out
+    rc, out, _ = run(sim, capsys, "move", "1", "-20", "--wait")
+    assert rc == 0 and "soft start" not in out, out  # the second move is not stretched
+
+
+def test_record_gives_a_verdict(sim, capsys, tmp_path):
+    assert run(sim, capsys, "config", "set", "1", "soft_start_on", "0")[0] == 0
+    rc, out, _ = run(sim, capsys, "record", "1", "30", "--interval", "400", "--out", str(tmp_path / "a"))
+    assert rc == 0 and "arrived: " in out and "from 30.0 deg" in out, out
+    rc, out, err = run(sim, capsys, "record", "1", "-30", "--interval", "400", "--out", str(tmp_path / "b"),
+                       "--tolerance", "0.001")
+    assert rc == 1 and "servo 1 did not arrive:" in err and "(tolerance 0.001 deg)" in err, err
+    assert (tmp_path / "b.csv").exists()  # the samples are kept either way
