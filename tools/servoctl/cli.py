@@ -15,7 +15,7 @@ import os
 import sys
 import time
 
-from . import __version__, frame, group, ntc, outcome, registers, scan, units
+from . import __version__, config_diff, config_file, frame, group, ntc, outcome, registers, scan, units
 from . import protocol as p
 from .profile import positions, velocity_timing
 from .protocol import BadAnswer, Bus, NoReply, Refused, ServoError, UsageError
@@ -200,7 +200,27 @@ def _print_config(values: dict, as_raw: bool):
         print(f"  {item.id:2d} {item.name:<18} {_shown(item, values[item.name], as_raw)}")
 
 
+def cmd_config_diff(bus, args):
+    pairs = config_diff.pair(config_diff.resolve(bus, args.target), config_diff.resolve(bus, args.other))
+    if not pairs:
+        raise UsageError("nothing to compare: no entry of one side has a serial number or ID of the other")
+    found = []
+    for a, b in pairs:
+        differ = config_diff.differences(a, b)
+        found.append(differ)
+        if args.json:
+            print(json.dumps({"a": a.label, "b": b.label, "differ": {
+                k: [config_diff.shown(k, x), config_diff.shown(k, y)] for k, (x, y) in differ.items()}}))
+            continue
+        print(f"{a.label} | {b.label}: " + (f"{len(differ)} item(s) differ" if differ else "the same"))
+        for name, (x, y) in differ.items():
+            print(f"  {name:<18} {config_diff.shown(name, x):>14} | {config_diff.shown(name, y)}")
+    return 1 if any(found) else 0
+
+
 def cmd_config(bus, args):
+    if args.action == "diff":
+        return cmd_config_diff(bus, args)
     s = Servo(bus, args.id)
     if args.action == "get":
         item = registers.find(args.name)
@@ -226,39 +246,26 @@ def cmd_config(bus, args):
     elif args.action == "dump":
         values = s.read_all()
         if args.json:
-            print(json.dumps(values))
+            print(json.dumps(values if args.raw else config_file.config_json(values, config_file.servo_of(s))))
         else:
             _print_config(values, args.raw)
     elif args.action == "save":
-        values = s.read_all()
-        try:
-            with open(args.file, "w") as f:
-                json.dump(values, f, indent=2)
-        except OSError as e:
-            raise UsageError(f"cannot write {args.file}: {e.strerror}") from None
+        config_file.write(args.file, config_file.config_json(s.read_all(), config_file.servo_of(s)))
         print(f"saved the user area of servo {args.id} to {args.file}")
     elif args.action == "load":
-        values = _read_config_file(args.file)
-        kept = group.write_user_area(s, values, args.with_link)  # validated before sending
-        note = f" (kept {', '.join(f'{k} {s.read(k)}' for k in kept)}; --with-link to change)" if kept else ""
-        print(f"loaded {len(values)} item(s) from {args.file} into servo {args.id}{note}")
+        entry = config_file.parse_config(config_file.read(args.file), args.file, args.raw)
+        kept = group.write_user_area(s, entry.values, args.with_link)  # validated before sending
+        notes = [f"kept {', '.join(f'{k} {s.read(k)}' for k in kept)}; --with-link to change"] if kept else []
+        if entry.raw:
+            notes.append("a raw file: protocol units")
+        if entry.serial is not None and entry.serial != s.read("serial"):
+            notes.append(f"the file is servo serial 0x{entry.serial:08x}'s")
+        note = f" ({'; '.join(notes)})" if notes else ""
+        print(f"loaded {len(entry.values)} item(s) from {args.file} into servo {args.id}{note}")
     elif args.action == "reset":
         s.reset_user_data()
         print(f"servo {args.id}: user area reset (ID and baud rate kept)")
     return 0
-
-
-def _read_config_file(path: str) -> dict:
-    values = group.read_json_file(path, "a config file")
-    if not isinstance(values, dict):
-        raise UsageError(f"{path} is not a config file: expected {{name: value}}")
-    unknown = [k for k in values if k not in {i.name for i in registers.USER}]
-    if unknown:
-        raise UsageError(f"{path}: unknown item(s) {', '.join(unknown)}")
-    bad = [k for k, v in values.items() if not isinstance(v, int) or isinstance(v, bool)]
-    if bad:
-        raise UsageError(f"{path}: {', '.join(bad)} must be whole numbers")
-    return values
 
 
 def _move_args(args):
@@ -693,15 +700,18 @@ def build_parser():
     c.add_argument("--json", action="store_true", help="as one JSON object")
     c.set_defaults(run=cmd_store)
 
-    c = sub.add_parser("config", help="the user area by name: get, set, dump, save, load, reset")
-    c.add_argument("action", choices=["get", "set", "dump", "save", "load", "reset"])
-    c.add_argument("id", type=int)
-    c.add_argument("rest", nargs="*", help="get NAME | set NAME VALUE | save FILE | load FILE")
+    c = sub.add_parser("config", help="the user area by name: get, set, dump, save, load, reset, diff")
+    c.add_argument("action", choices=["get", "set", "dump", "save", "load", "reset", "diff"])
+    c.add_argument("id", help="a servo ID (diff: an ID, a config or backup file, or 'factory')")
+    c.add_argument("rest", nargs="*",
+                   help="get NAME | set NAME VALUE | save FILE | load FILE | diff ID|FILE|factory")
     c.add_argument("--with-link", action="store_true",
                    help="config load: also set the ID and baud rate from the file")
     c.add_argument("--raw", action="store_true",
-                   help="get/set/dump in protocol units (0.1 deg, NTC ADC, baud code)")
-    c.add_argument("--json", action="store_true", help="get/dump as JSON (raw values)")
+                   help="get/set/dump in protocol units (0.1 deg, NTC ADC, baud code); "
+                        "load: a file of plain protocol numbers")
+    c.add_argument("--json", action="store_true",
+                   help="get/dump/diff as JSON (dump: the config file's form; raw with --raw)")
     c.set_defaults(run=cmd_config)
 
     def motion_options(c):
@@ -846,9 +856,15 @@ def _run(args, clock=None) -> int:
     if args.command == "image":
         return cmd_image(args)
     if args.command == "config":
-        need = {"get": 1, "set": 2, "dump": 0, "save": 1, "load": 1, "reset": 0}[args.action]
+        need = {"get": 1, "set": 2, "dump": 0, "save": 1, "load": 1, "reset": 0, "diff": 1}[args.action]
         if len(args.rest) != need:
             raise UsageError(f"config {args.action} takes {need} argument(s)")
+        args.target, args.other = args.id, args.rest[0] if args.action == "diff" else None
+        if args.action != "diff":
+            try:
+                args.id = id_number(args.id)
+            except argparse.ArgumentTypeError as e:
+                raise UsageError(str(e)) from None
         args.name = args.rest[0] if args.action in ("get", "set") else None
         args.value = args.rest[1] if args.action == "set" else None
         args.file = args.rest[0] if args.action in ("save", "load") else None

@@ -1,11 +1,10 @@
 """Several servos at once: a sync move (SyncCommand, one frame for every
 listed servo), a broadcast move, async begin and end, Sync Monitor, and the
 backup and restore of a whole bus. Angles in degrees, times in seconds."""
-import json
 import struct
 
 from . import protocol as p
-from . import registers
+from . import config_file
 from .frame import check_target
 from .protocol import NoReply, Refused, UsageError, ValueOutOfRange
 from .servo import MIN_RAMP_MS, Monitor, Servo, _check, _ms, _scaled, check_profile
@@ -94,27 +93,14 @@ def sync_monitor(bus: p.Bus, ids: list, timeout_s: float = None, arrivals: dict 
     return out
 
 
-def backup(bus: p.Bus, ids: list, path: str) -> dict:
-    """Every listed servo's user area, by ID, to one JSON file (protocol
-    units, as `config save` writes)."""
-    data = {str(servo_id): Servo(bus, servo_id).read_all() for servo_id in ids}
-    try:
-        with open(path, "w") as f:
-            json.dump({"servoctl_backup": 1, "servos": data}, f, indent=2)
-    except OSError as e:
-        raise UsageError(f"cannot write {path}: {e.strerror}") from None
-    return data
-
-
-def read_json_file(path: str, what: str):
-    """A JSON file's contents; a UsageError naming the file otherwise."""
-    try:
-        with open(path) as f:
-            return json.load(f)
-    except OSError as e:
-        raise UsageError(f"cannot read {path}: {e.strerror}") from None
-    except json.JSONDecodeError as e:
-        raise UsageError(f"{path} is not {what} (JSON): {e}") from None
+def backup(bus: p.Bus, ids: list, path: str) -> None:
+    """Every listed servo's user area, in engineering units, with who it is
+    (model, firmware, serial), to one file (config_file.py)."""
+    entries = []
+    for servo_id in ids:
+        s = Servo(bus, servo_id)
+        entries.append((s.read_all(), config_file.servo_of(s)))
+    config_file.write(path, config_file.backup_json(entries))
 
 
 def id_is_free(bus: p.Bus, servo_id: int, new_id: int) -> None:
@@ -140,18 +126,10 @@ def write_user_area(s: Servo, values: dict, with_link: bool = False) -> list:
 
 
 def restore(bus: p.Bus, path: str, with_link: bool = False) -> list:
-    """Writes each servo's saved user area back to the servo with that ID.
-    IDs and baud rates stay as they are unless with_link. Returns the IDs."""
-    data = read_json_file(path, "a backup")
-    if not isinstance(data, dict) or data.get("servoctl_backup") != 1:
-        raise UsageError(f"{path} is not a servoctl backup")
-    servos = data.get("servos", {})
-    names = {i.name for i in registers.USER}
-    for key, values in servos.items():
-        if not key.isdigit() or not isinstance(values, dict) or set(values) - names:
-            raise ValueOutOfRange(f"{path}: servo {key!r} has no valid user area")
-    done = []
-    for key, values in servos.items():
-        write_user_area(Servo(bus, int(key)), values, with_link)
-        done.append(int(key))
-    return done
+    """Writes each servo's saved user area back to the servo with that ID
+    (every entry checked first). IDs and baud rates stay as they are unless
+    with_link. Returns the IDs."""
+    entries = config_file.parse_backup(config_file.read(path), path)
+    for entry in entries:
+        write_user_area(Servo(bus, entry.servo_id), entry.values, with_link)
+    return [entry.servo_id for entry in entries]

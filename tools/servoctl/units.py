@@ -9,7 +9,7 @@ in deg, a temperature in degC, a baud rate, a count); where two are common
 exactly is refused with the nearest ones it can, never rounded silently.
 
     angle        0.1 deg on the wire; deg ("90", "90deg", "-45.5°")
-    temperature  NTC ADC on the wire; degC ("75", "75C", "75degC")
+    temperature  NTC ADC on the wire; degC ("75", "75C", "75degC"), or the ADC ("651ADC")
     voltage      mV ("7400mV", "7.4V")
     current      mA ("4000mA", "4A")
     power        mW ("2500mW", "2.5W")
@@ -65,9 +65,13 @@ def to_raw(item, text) -> int:
                 raise UsageError(f"{item.name} takes a unit: {text!r} could mean {both}")
             raise UsageError(f"{item.name} takes a number{_units_hint(item)}, not {text!r}")
         raw = _exact(item, value, factors[suffix], text)
+    elif q == "temperature" and suffix == "adc":  # the NTC's ADC value itself: exact
+        if value != int(value):
+            raise UsageError(f"{item.name} takes a whole ADC value, not {text!r}")
+        raw = int(value)
     elif q == "temperature":
         if suffix not in ("", "c", "degc", "°c"):
-            raise UsageError(f"{item.name} takes degC, not {text!r}")
+            raise UsageError(f"{item.name} takes degC (or the NTC's ADC value, '651ADC'), not {text!r}")
         if not -40 <= value <= 150:
             raise ValueOutOfRange(f"{item.name} ({item.id}) must be -40..150 degC, not {value:g}")
         raw = ntc.celsius_to_adc(value)
@@ -99,8 +103,9 @@ def _exact(item, value: float, factor: int, text) -> int:
     return raw
 
 
-def show(item, raw: int) -> str:
-    """A raw protocol value in the item's engineering unit."""
+def exact(item, raw: int) -> str:
+    """raw in the item's unit, written so that to_raw gives raw back: what
+    config and backup files hold ("135.0 deg", "4000 mW", "75.3 degC")."""
     q = item.quantity
     if q == "angle":
         return f"{raw / 10:.1f} deg"
@@ -108,9 +113,30 @@ def show(item, raw: int) -> str:
         return f"{raw} {SCALES[q][0]}"
     if q == "temperature":
         try:
+            celsius = ntc.adc_to_celsius(raw)
+        except ValueError:
+            celsius = None
+        for places in (1, 2, 3, 4):
+            if celsius is not None and -40 <= round(celsius, places) <= 150 \
+                    and ntc.celsius_to_adc(round(celsius, places)) == raw:
+                return f"{celsius:.{places}f} degC"
+        return f"{raw} ADC"
+    if q == "baud":
+        return f"{registers.BAUD_RATES[raw]} baud"
+    return str(raw)
+
+
+def show(item, raw: int) -> str:
+    """A raw protocol value in the item's engineering unit, for people: a
+    temperature with its ADC value, a baud rate with its code."""
+    q = item.quantity
+    if q == "temperature":
+        try:
             return f"{ntc.adc_to_celsius(raw):.1f} degC (ADC {raw})"
         except ValueError:
             return f"ADC {raw}"
     if q == "baud":
         return f"{registers.BAUD_RATES.get(raw, '?')} baud (code {raw})"
+    if q in SCALES:
+        return exact(item, raw)
     return f"{raw}{' ' + item.unit if item.unit else ''}"

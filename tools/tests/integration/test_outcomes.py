@@ -99,12 +99,12 @@ def test_config_files_that_cannot_be_loaded(sim, capsys, tmp_path):
     bad = tmp_path / "bad.json"
     bad.write_text("{stall_power: 1")
     rc, _, err = run(sim, capsys, "config", "load", "1", str(bad))
-    assert rc == 2 and "is not a config file" in err
+    assert rc == 2 and "is not JSON" in err
 
 
 def test_config_load_keeps_the_link_and_takes_part_of_a_file(sim, capsys, tmp_path):
     other = tmp_path / "other.json"
-    other.write_text(json.dumps({"servo_id": 5, "baud": 8, "stall_power": 1234}))
+    other.write_text(json.dumps({"servo_id": "5", "baud": "1000000 baud", "stall_power": "1234 mW"}))
     rc, out, _ = run(sim, capsys, "config", "load", "1", str(other))
     assert rc == 0 and "kept servo_id 1" in out, out
     assert run(sim, capsys, "config", "get", "1", "stall_power")[1] == "stall_power = 1234 mW\n"
@@ -312,7 +312,10 @@ def test_read_commands_speak_json(sim, capsys):
     item = json.loads(run(sim, capsys, "config", "get", "1", "angle_max", "--json")[1])
     assert item == {"id": 51, "name": "angle_max", "raw": 1350, "value": "135.0 deg"}
     dump = json.loads(run(sim, capsys, "config", "dump", "1", "--json")[1])
-    assert dump["servo_id"] == 1 and len(dump) == 22
+    assert dump["items"]["servo_id"] == "1" and len(dump["items"]) == 22
+    assert dump["items"]["angle_max"] == "135.0 deg" and dump["servo"]["serial"] == "0x51a00001"
+    raw = json.loads(run(sim, capsys, "config", "dump", "1", "--json", "--raw")[1])
+    assert raw["angle_max"] == 1350 and len(raw) == 22
 
 
 def test_ctrl_c_during_a_wait_releases_nothing(ready):

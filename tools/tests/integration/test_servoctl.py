@@ -38,12 +38,14 @@ def test_config(sim, capsys, tmp_path):
     saved = tmp_path / "cfg.json"
     run(sim, capsys, "config", "save", "1", str(saved))
     values = json.loads(saved.read_text())
-    assert values["stall_power"] == 2500
+    assert values["items"]["stall_power"] == "2500 mW" and values["items"]["angle_max"] == "135.0 deg"
+    assert values["servo"] == {"id": 1, "model": values["servo"]["model"], "firmware": "0x0010",
+                               "serial": "0x51a00001"}
     assert run(sim, capsys, "config", "reset", "1")[0] == 0
     assert run(sim, capsys, "config", "get", "1", "stall_power")[1] == "stall_power = 10000 mW\n"
     assert run(sim, capsys, "config", "load", "1", str(saved))[0] == 0
     assert run(sim, capsys, "config", "get", "1", "stall_power")[1] == "stall_power = 2500 mW\n"
-    values["high_voltage"] = 100  # below low_voltage: refused before sending
+    values["items"]["high_voltage"] = "100 mV"  # below low_voltage: refused before sending
     saved.write_text(json.dumps(values))
     rc, _, err = run(sim, capsys, "config", "load", "1", str(saved))
     assert rc == 2 and "must be below high_voltage" in err

@@ -1,0 +1,85 @@
+"""Config and backup files say what they mean (issue 23): units on every
+value, the servo they came from; raw files load only when marked as raw;
+config diff compares servos, files and factory values, by serial number
+where known."""
+import json
+
+import pytest
+
+from servoctl import registers
+from servoctl.cli import main
+from servoctl.sim import Simulator
+
+
+def run(sim, capsys, *args):
+    rc = main(["--port", sim.url, *args], clock=sim.clock_s)
+    out = capsys.readouterr()
+    return rc, out.out, out.err
+
+
+def test_a_hand_written_file_means_what_it_says(sim, capsys, tmp_path):
+    """{"angle_max": 45} loaded as 4.5 deg. A plain number now needs --raw
+    (the old files' protocol units); written with a unit it is taken."""
+    f = tmp_path / "hand.json"
+    f.write_text(json.dumps({"angle_max": 45}))
+    rc, _, err = run(sim, capsys, "config", "load", "1", str(f))
+    assert rc == 2 and "plain numbers: a raw file in protocol units" in err and "--raw" in err, err
+    assert run(sim, capsys, "config", "get", "1", "angle_max")[1] == "angle_max = 135.0 deg\n"
+    f.write_text(json.dumps({"angle_max": "45 deg", "power_limit": "2.5W"}))
+    rc, out, _ = run(sim, capsys, "config", "load", "1", str(f))
+    assert rc == 0 and "loaded 2 item(s)" in out
+    assert run(sim, capsys, "config", "get", "1", "angle_max")[1] == "angle_max = 45.0 deg\n"
+    assert run(sim, capsys, "config", "get", "1", "power_limit")[1] == "power_limit = 2500 mW\n"
+    f.write_text(json.dumps({"servoctl_config": 2, "items": {"power_limit": 2.5}}))
+    rc, _, err = run(sim, capsys, "config", "load", "1", str(f))
+    assert rc == 2 and "could mean 2.5mW or 2.5W" in err, err
+
+
+def test_an_old_raw_file_loads_when_marked_raw(sim, capsys, tmp_path):
+    f = tmp_path / "old.json"
+    f.write_text(json.dumps({"angle_max": 450, "stall_power": 1234}))
+    rc, out, _ = run(sim, capsys, "config", "load", "1", str(f), "--raw")
+    assert rc == 0 and "a raw file: protocol units" in out, out
+    assert run(sim, capsys, "config", "get", "1", "angle_max")[1] == "angle_max = 45.0 deg\n"
+
+
+def test_every_value_survives_the_file_exactly(sim, capsys, tmp_path):
+    """A file written by save reads back as the same protocol values, the
+    temperature's NTC value included (written in degC to enough places)."""
+    for name, text in (("temperature_limit", "652ADC"), ("angle_min", "-90.5"), ("baud", "115200"),
+                       ("soft_start_time", "1234ms"), ("low_voltage", "5.1V")):
+        assert run(sim, capsys, "config", "set", "1", name, text)[0] == 0
+    before = json.loads(run(sim, capsys, "config", "dump", "1", "--json", "--raw")[1])
+    f = tmp_path / "cfg.json"
+    assert run(sim, capsys, "config", "save", "1", str(f))[0] == 0
+    assert run(sim, capsys, "config", "reset", "1")[0] == 0
+    assert run(sim, capsys, "config", "load", "1", str(f))[0] == 0
+    assert json.loads(run(sim, capsys, "config", "dump", "1", "--json", "--raw")[1]) == before
+    assert json.loads(f.read_text())["items"]["baud"] == "115200 baud"
+
+
+def test_config_diff(tmp_path, capsys):
+    with Simulator(ids=[1, 2], state_dir=str(tmp_path / "state")) as sim:
+        assert run(sim, capsys, "config", "set", "2", "stall_power", "2.5W")[0] == 0
+        rc, out, _ = run(sim, capsys, "config", "diff", "1", "2")
+        assert rc == 1, out
+        assert "servo 1 (serial 0x51a00001) | servo 2 (serial 0x51a00002)" in out
+        assert "stall_power" in out and "10000 mW" in out and "2500 mW" in out
+        assert "servo_id" in out  # 1 and 2
+        rc, out, _ = run(sim, capsys, "config", "diff", "1", "factory")
+        assert rc == 1 and "servo_id" in out and "stall_power" not in out, out
+        # A backup is matched by serial: servo 2's entry, although the file
+        # lists it under another ID.
+        backup = tmp_path / "bus.json"
+        assert run(sim, capsys, "backup", str(backup))[0] == 0
+        data = json.loads(backup.read_text())
+        data["servos"][1]["servo"]["id"] = 7
+        backup.write_text(json.dumps(data))
+        rc, out, _ = run(sim, capsys, "config", "diff", "2", str(backup))
+        assert rc == 0 and "the same" in out and "serial 0x51a00002" in out, out
+        rc, out, _ = run(sim, capsys, "config", "diff", "2", str(backup), "--json")
+        assert rc == 0 and json.loads(out)["differ"] == {}
+        rc, out, _ = run(sim, capsys, "config", "diff", str(backup), "factory")
+        assert rc == 1 and "stall_power" in out
+        rc, _, err = run(sim, capsys, "config", "diff", "1", "nonsense")
+        assert rc == 2 and "an ID, a config or backup file, or 'factory'" in err
