@@ -35,12 +35,13 @@
 #define UNSOLICITED_DRIFT_GUARD_US 50u
 #define UNSOLICITED_SLOTS 254u
 /* The other flash page is erased ahead of need only when the 20-40 ms the
- * CPU stalls for it (DS5319, tERASE) cost nothing: no move running, and
- * the line quiet for STORE_ERASE_QUIET_US. A change that has waited
- * STORE_ERASE_OVERDUE_US for it (a host that never pauses) gets it after
- * STORE_ERASE_SHORT_QUIET_US of quiet: the answer to a request sent
- * meanwhile is up to 40 ms late, its bytes wait in the DMA ring
- * (docs/decisions.md, "Flash and the real-time budget"). */
+ * CPU stalls for it (DS5319, tERASE) cost nothing: the output released
+ * (nothing is held against a load) and the line quiet for
+ * STORE_ERASE_QUIET_US. A change refused for want of it (a host that never
+ * pauses) makes STORE_ERASE_SHORT_QUIET_US of quiet enough after
+ * STORE_ERASE_OVERDUE_US: a request sent meanwhile waits in the DMA ring
+ * and is not answered (docs/decisions.md, "Flash and the real-time
+ * budget"). */
 #define STORE_ERASE_QUIET_US 100000u
 #define STORE_ERASE_OVERDUE_US 5000000u
 #define STORE_ERASE_SHORT_QUIET_US 2000u
