@@ -14,18 +14,21 @@ enum packet_outcome handle_ping(const struct packet_call *c, struct response *r)
 
 /* A change to the user area is kept only once it is durable (the store's
  * persist hook); otherwise the user area goes back to what it was. */
-static bool commit_user(const struct packet_call *c, const struct user_config *before)
+static bool keep_change(const struct packet_call *c, const struct user_config *before)
 {
     struct dispatcher *d = c->d;
-    if (memcmp(before, &d->regs->user, sizeof *before) == 0) {
-        return true; /* nothing changed: nothing to store */
-    }
     if (d->persist != NULL && !d->persist(d->persist_ctx, &d->regs->user)) {
         d->regs->user = *before;
         return false;
     }
     c->result->config_changed = true;
     return true;
+}
+
+/* The same for a change of many items, which may have changed nothing. */
+static bool commit_user(const struct packet_call *c, const struct user_config *before)
+{
+    return memcmp(before, &c->d->regs->user, sizeof *before) == 0 || keep_change(c, before);
 }
 
 enum packet_outcome handle_reset_user_data(const struct packet_call *c, struct response *r)
@@ -49,7 +52,7 @@ enum packet_outcome handle_write_data(const struct packet_call *c, struct respon
     uint8_t data_length = (uint8_t)(c->length - 2u);
     const struct user_config before = c->d->regs->user;
     enum data_write_result w = data_table_write(c->d->regs, c->content[1], &c->content[2], data_length);
-    bool ok = w != DATA_WRITE_REFUSED && commit_user(c, &before);
+    bool ok = w == DATA_WRITE_SAME || (w == DATA_WRITE_CHANGED && keep_change(c, &before));
     r->content[0] = c->content[0];
     r->content[1] = c->content[1];
     r->content[2] = ok ? 1u : 0u;

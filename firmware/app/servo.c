@@ -205,7 +205,7 @@ static bool persist_user(void *ctx, const struct user_config *cfg)
     enum config_save_result r =
         config_store_begin(&s->store, cfg, save_policy_op_seconds(&s->saver));
     if (r == CONFIG_NEEDS_ERASE) {
-        save_policy_awaits_erase(&s->saver, now);
+        s->saver.awaits_erase = 1;
         return false;
     }
     while (r == CONFIG_STARTED || r == CONFIG_BUSY) {
@@ -222,9 +222,7 @@ static bool persist_user(void *ctx, const struct user_config *cfg)
 static bool erase_may_stall(const struct servo *s, uint32_t now)
 {
     const struct hal_rx_ring *ring = s->hal->rx;
-    bool overdue = s->saver.awaits_erase &&
-                   now - s->saver.awaits_erase_since_us >= STORE_ERASE_OVERDUE_US;
-    uint32_t quiet = overdue ? STORE_ERASE_SHORT_QUIET_US : STORE_ERASE_QUIET_US;
+    const uint32_t quiet = STORE_ERASE_QUIET_US;
     return motion_is_idle(&s->motion) && !s->tx.sending && !s->tx.waiting &&
            ring->written == ring->read && now - ring->heard_us >= quiet &&
            now - s->tx.ended_us >= quiet && save_policy_may_retry(&s->saver, &s->store, now);

@@ -44,14 +44,6 @@ bool save_policy_may_retry(const struct save_policy *p, const struct config_stor
     return !store->failed || now_us - p->failed_at_us >= SAVE_RETRY_US;
 }
 
-void save_policy_awaits_erase(struct save_policy *p, uint32_t now_us)
-{
-    if (!p->awaits_erase) {
-        p->awaits_erase = 1;
-        p->awaits_erase_since_us = now_us;
-    }
-}
-
 void save_policy_outcome(struct save_policy *p, bool ok, uint32_t now_us)
 {
     if (!ok) {

@@ -34,7 +34,6 @@ struct save_policy {
     uint32_t failed_at_us;    /* the last failed flash step */
     uint8_t over_budget;      /* the last change was refused: wear budget */
     uint8_t awaits_erase;     /* the last change was refused: no erased slot */
-    uint32_t awaits_erase_since_us;
 };
 
 /* After config_store_load. Divides (once). */
@@ -43,8 +42,6 @@ void save_policy_init(struct save_policy *p, const struct config_store *store, u
 void save_policy_count_time(struct save_policy *p, uint32_t now_us);
 /* One more record is within the wear budget. */
 bool save_policy_allows(const struct save_policy *p, const struct config_store *store);
-/* A change was refused because the store needs the other page erased. */
-void save_policy_awaits_erase(struct save_policy *p, uint32_t now_us);
 /* The outcome of a save or an erase: a failure is not retried (an erase)
  * within SAVE_RETRY_US. */
 void save_policy_outcome(struct save_policy *p, bool ok, uint32_t now_us);

@@ -304,8 +304,8 @@ static void test_every_change_is_in_flash_before_its_answer(void **state)
     assert_int_equal(hal.flash.steps, steps);
 }
 
-/* A host toggling item 44 every 61 ms, for 2 hours of operation with a
- * power cycle every 20 minutes: after the allowance the servo takes one
+/* A host toggling item 44 every 150 ms (quiet long enough for the erase),
+ * for 2 hours of operation with a power cycle every 20 minutes: after the allowance the servo takes one
  * change per seconds_per_save of operating time, the budget that keeps 10
  * years of this within the pages' rated cycles, and refuses the rest
  * (result 0, ReadStore bit 1) rather than keep them in RAM. The operating
@@ -323,21 +323,21 @@ static void test_writes_in_a_loop_stay_within_the_wear_budget(void **state)
         uint8_t flip = (uint8_t)(servo.regs.user.start_force ^ 1u);
         REQUEST(4, 0, 44, flip);
         refused += hal.sent[6] == 0u;
-        hal.now_us += 60000u; /* no motion: ticks beyond the catch-up drop */
+        hal.now_us += 149000u; /* no motion: ticks beyond the catch-up drop */
         harness_poll(2);
-        ms += 61;
-        if (i % 20000u == 19999u) {
+        ms += 150;
+        if (i % 8000u == 7999u) {
             harness_restart();
         }
         assert_true(servo.store.sequence <= save_policy_budget(&servo.saver));
     }
     uint32_t op = save_policy_op_seconds(&servo.saver);
-    printf("# 2 h of writes every 61 ms: %u saves, %u refused, %u page erases; budget %u (1 per %u s)\n",
+    printf("# 2 h of writes every 150 ms: %u saves, %u refused, %u page erases; budget %u (1 per %u s)\n",
            (unsigned)servo.store.sequence, (unsigned)refused,
            (unsigned)config_store_page_erases(&servo.store),
            (unsigned)save_policy_budget(&servo.saver), (unsigned)per_save);
     assert_true(op > 3600u && op <= 7200u);
-    assert_true(refused > 100000u);
+    assert_true(refused > 40000u);
     assert_int_equal(servo.store.sequence, save_policy_budget(&servo.saver));
     uint8_t held = servo.regs.user.start_force;
     REQUEST(4, 0, 44, (uint8_t)(held ^ 1u));

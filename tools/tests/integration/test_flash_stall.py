@@ -168,3 +168,35 @@ def test_an_answer_that_would_leave_late_is_dropped_and_counted(tmp_path, capsys
     finally:
         err = sim.stop()
         assert "runtime error" not in err and "AddressSanitizer" not in err, err
+
+
+def test_a_driven_servo_refuses_a_change_it_cannot_store_and_says_why(tmp_path):
+    """While the wheel turns the servo erases nothing, so once the free
+    slots are spent a change is refused (result 0, nothing kept in RAM),
+    and servoctl says why and what to do. Released, with the line quiet,
+    the servo erases the next page and takes the change."""
+    import pytest
+
+    sim = Simulator(ids=[1], state_dir=str(tmp_path / "state"))
+    sim.start()
+    try:
+        with sim.bus(timeout=0.2) as bus:
+            one = Servo(bus, 1)
+            one.write("soft_start_on", 0)
+            one.wheel("run", speed_dps=90)
+            with pytest.raises(Refused) as refused:
+                for n in range(100):  # at most 2 pages of 21 records
+                    one.write("current_limit", 3000 + n % 2)
+                    bus.sleep(0.15)  # quiet, but the output is driven
+            assert "release it" in str(refused.value), refused.value
+            assert one.read_store().flag_names() == ["needs_erase"]
+            held = one.read("current_limit")
+            one.release()
+            bus.sleep(0.3)  # 100 ms of quiet, then the 40 ms erase
+            one.write("current_limit", held ^ 1)
+            assert one.read("current_limit") == held ^ 1
+            assert one.read_store().flag_names() == []
+        assert sim.state(1)["collisions"] == 0
+    finally:
+        err = sim.stop()
+        assert "runtime error" not in err and "AddressSanitizer" not in err, err
