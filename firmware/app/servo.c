@@ -228,29 +228,34 @@ static bool erase_may_stall(const struct servo *s, uint32_t now)
            now - s->tx.ended_us >= quiet && save_policy_may_retry(&s->saver, &s->store, now);
 }
 
-/* Once a control tick: counts operating time, erases the spare page when
- * that costs nothing, and marks the frames that arrived during an erase. */
+/* The spare page's erase: 20-40 ms with the CPU stalled, the output
+ * released. The pass after it resumes the control loop on a fresh
+ * schedule (released, it has nothing to catch up on: these ticks are not
+ * dropped ones), and carries out the frames that arrived meanwhile
+ * without answering them: an answer that late could fall in another
+ * servo's slot. */
+static void erase_spare(struct servo *s, uint32_t now)
+{
+    bool ok = config_store_erase_spare(&s->store);
+    save_policy_outcome(&s->saver, ok, now);
+    if (ok) {
+        s->saver.awaits_erase = 0;
+    } else {
+        s->regs.status.status |= STATUS_COMMAND_ERROR;
+    }
+    s->erase_passed = 1;
+}
+
+/* Once a control tick: counts operating time and erases the spare page
+ * when that costs nothing. */
 static void tend_store(struct servo *s, uint32_t now, bool ticked)
 {
     if (!ticked) {
         return;
     }
-    /* The first pass after an erase has ticks due (it stalled 20-40 ms): the
-     * frames its receive took arrived during the erase. */
-    if (s->erase_passed) {
-        s->erase_passed = 0;
-        s->stale_frames = frame_rx_pending(&s->rx);
-    }
     save_policy_count_time(&s->saver, now);
     if (config_store_spare_dirty(&s->store) && erase_may_stall(s, now)) {
-        s->erase_passed = 1;
-        bool ok = config_store_erase_spare(&s->store);
-        save_policy_outcome(&s->saver, ok, now);
-        if (ok) {
-            s->saver.awaits_erase = 0;
-        } else {
-            s->regs.status.status |= STATUS_COMMAND_ERROR;
-        }
+        erase_spare(s, now);
     }
     report_store(s);
 }
@@ -337,6 +342,9 @@ void servo_poll(struct servo *s)
 {
     /* One reading of the clock per pass: the ticks due by then run now. */
     uint32_t now = s->hal->now_us(s->hal->ctx);
+    if (s->erase_passed) {
+        s->next_tick_us = now + CONTROL_TICK_US;
+    }
     bool ticked = run_control_tick(s, now);
     if (s->tx.sending && s->hal->uart_tx_done(s->hal->ctx)) {
         s->tx.sending = 0;
@@ -356,6 +364,10 @@ void servo_poll(struct servo *s)
         }
     }
     receive(s, now);
+    if (s->erase_passed) { /* what was framed now arrived during the erase */
+        s->erase_passed = 0;
+        s->stale_frames = frame_rx_pending(&s->rx);
+    }
     tend_store(s, now, ticked);
     if (s->tx.sending) {
         return; /* half duplex: nothing else goes out meanwhile */
