@@ -82,7 +82,7 @@ class StoreHealth:
         "over_wear_budget": "its flash wear budget allows no more saves yet (one per "
                             "so many seconds of operation; see 'servoctl store')",
         "needs_erase": "its config page is full and the next is erased only while the servo "
-                       "is released: release it (torque off), leave the bus quiet for 0.1 s, "
+                       "is released: release it ('servoctl stop ID'), leave the bus quiet for 0.1 s, "
                        "and write again",
     }
 
