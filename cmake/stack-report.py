@@ -8,6 +8,7 @@ looks like; the firmware has three kinds of function pointer, and an
 indirect call is bounded by the worst target of its kind:
   in dispatch_packet   the packet handlers (handle_*)
   in usart_hd_irq      the clock that stamps received bytes (systick_now_us)
+  in a packet handler  the store's persist hook (persist_user), or a HAL op
   anywhere else        the port's HAL operations (everything else)
 Recursion is an error, but for one bounded case: handle_sync runs its
 record through dispatch_packet, and a record is never itself a sync
@@ -107,7 +108,9 @@ def main() -> int:
         # systick_now_us is also called directly, so it is no pointer target.
         "usart_hd_irq": [t for t in stack if short(t) == "systick_now_us"],
     }
-    hal_ops = [t for t in pointer_targets if not short(t).startswith("handle_")]
+    persist = [t for t in pointer_targets if short(t) == "persist_user"]
+    hal_ops = [t for t in pointer_targets
+               if not short(t).startswith("handle_") and short(t) != "persist_user"]
     memo = {}
     indirect_below = {}
 
@@ -136,6 +139,8 @@ def main() -> int:
         for callee in calls[title]:
             if callee == "__indirect_call":
                 targets = kinds.get(short(title), hal_ops)
+                if short(title).startswith(("handle_", "commit_user")):
+                    targets = hal_ops + persist  # WriteData, WriteBatchData, ResetUserData
                 if short(title) == "dispatch_packet" and title in path:
                     targets = [t for t in targets if short(t) != "handle_sync"]  # a record is no sync
                 for c in targets:

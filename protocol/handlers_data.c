@@ -12,14 +12,30 @@ enum packet_outcome handle_ping(const struct packet_call *c, struct response *r)
     return OUTCOME_OK;
 }
 
+/* A change to the user area is kept only once it is durable (the store's
+ * persist hook); otherwise the user area goes back to what it was. */
+static bool keep_change(const struct packet_call *c, const struct user_config *before)
+{
+    struct dispatcher *d = c->d;
+    if (d->persist != NULL && !d->persist(d->persist_ctx, &d->regs->user)) {
+        d->regs->user = *before;
+        return false;
+    }
+    c->result->config_changed = true;
+    return true;
+}
+
+/* The same for a change of many items, which may have changed nothing. */
+static bool commit_user(const struct packet_call *c, const struct user_config *before)
+{
+    return memcmp(before, &c->d->regs->user, sizeof *before) == 0 || keep_change(c, before);
+}
+
 enum packet_outcome handle_reset_user_data(const struct packet_call *c, struct response *r)
 {
-    if (c->d->store_failed) {
-        return answer_result(c, r, false);
-    }
+    const struct user_config before = c->d->regs->user;
     user_config_reset(&c->d->regs->user);
-    c->result->config_changed = true;
-    return answer_result(c, r, true);
+    return answer_result(c, r, commit_user(c, &before));
 }
 
 enum packet_outcome handle_read_data(const struct packet_call *c, struct response *r)
@@ -34,11 +50,9 @@ enum packet_outcome handle_read_data(const struct packet_call *c, struct respons
 enum packet_outcome handle_write_data(const struct packet_call *c, struct response *r)
 {
     uint8_t data_length = (uint8_t)(c->length - 2u);
-    enum data_write_result w =
-        c->d->store_failed ? DATA_WRITE_REFUSED
-                           : data_table_write(c->d->regs, c->content[1], &c->content[2], data_length);
-    bool ok = w != DATA_WRITE_REFUSED;
-    c->result->config_changed = w == DATA_WRITE_CHANGED;
+    const struct user_config before = c->d->regs->user;
+    enum data_write_result w = data_table_write(c->d->regs, c->content[1], &c->content[2], data_length);
+    bool ok = w == DATA_WRITE_SAME || (w == DATA_WRITE_CHANGED && keep_change(c, &before));
     r->content[0] = c->content[0];
     r->content[1] = c->content[1];
     r->content[2] = ok ? 1u : 0u;
@@ -56,8 +70,8 @@ enum packet_outcome handle_read_batch(const struct packet_call *c, struct respon
 
 enum packet_outcome handle_write_batch(const struct packet_call *c, struct response *r)
 {
-    bool ok = !c->d->store_failed && user_config_decode(&c->d->regs->user, &c->content[1]);
-    c->result->config_changed = ok;
+    const struct user_config before = c->d->regs->user;
+    bool ok = user_config_decode(&c->d->regs->user, &c->content[1]) && commit_user(c, &before);
     return answer_result(c, r, ok);
 }
 

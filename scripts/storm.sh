@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
 # A long mixed storm against three simulated servos (the ASan + UBSan build
 # of servo_sim): garbage at line rate, preempting moves, answered moves,
-# Sync Monitor rounds, config writes, injected faults and power cuts by
-# SIGKILL. Prints a summary (frames lost, collisions, ticks dropped, configs
-# corrupted, sanitizer findings) and fails unless every count is 0.
+# Sync Monitor rounds, config writes alone and in bursts that fill the
+# store's pages, releases and quiet (so the spare page is erased), injected
+# faults and power cuts by SIGKILL. Prints a summary (frames lost,
+# collisions, ticks dropped, configs corrupted, acknowledged changes lost,
+# sanitizer findings) and fails unless every count is 0.
 # Not part of the test command: it takes MINUTES (default 30).
 #   bash scripts/storm.sh [MINUTES] [SEED]
 # Output: build/storm/summary.txt, summary.json, events.log, servo_sim.stderr

@@ -10,6 +10,8 @@ static uint32_t idle_timeout_us(const struct servo *s, uint32_t baud)
     return frame_rx_port_idle_us(frame_rx_idle_us(baud), s->hal->rx_gap_tolerance_us);
 }
 
+static bool persist_user(void *ctx, const struct user_config *cfg);
+
 static void apply_link_settings(struct servo *s)
 {
     s->active_id = s->regs.user.servo_id;
@@ -52,6 +54,8 @@ void servo_init(struct servo *s, const struct hal_port *hal)
     s->dispatcher.bootloader_present = hal->enter_bootloader != NULL;
     s->dispatcher.board = hal->board;
     s->dispatcher.next_tick_us = &s->next_tick_us;
+    s->dispatcher.persist = persist_user;
+    s->dispatcher.persist_ctx = s;
     s->active_baud_index = 0; /* forces the first apply to set the UART */
     apply_link_settings(s);
 }
@@ -150,7 +154,6 @@ static void handle_next_frame(struct servo *s, uint32_t now)
     frame_rx_release(&s->rx);
     show_executing(s);
     if (result.config_changed) {
-        save_policy_changed(&s->saver, now);
         s->link_check = 1;
     }
     s->enter_bootloader |= result.enter_bootloader;
@@ -167,8 +170,7 @@ static void report_store(struct servo *s)
 {
     struct store_health *h = &s->regs.store;
     uint8_t flags = (uint8_t)((s->store.failed ? STORE_FAILED : 0u) |
-                              (s->saver.deferred ? STORE_DEFERRED : 0u) |
-                              (s->saver.pending || s->store.job_active ? STORE_PENDING : 0u) |
+                              (s->saver.over_budget ? STORE_OVER_BUDGET : 0u) |
                               (s->saver.awaits_erase ? STORE_AWAITS_ERASE : 0u));
     uint32_t op_seconds = save_policy_op_seconds(&s->saver);
     h->answers_dropped = s->answers_dropped;
@@ -186,70 +188,74 @@ static void report_store(struct servo *s)
     h->failures = s->store.write_failures;
 }
 
-static void save_finished(struct servo *s, enum config_save_result r, uint32_t now)
+/* The dispatcher's persist hook: a changed user area goes to flash before
+ * the write is answered, all its write blocks at once (24 half-words,
+ * 1.3-1.7 ms on the STM32F1; the ticks catch up after, the DMA ring holds
+ * what arrives). A change that cannot be made durable now is refused, and
+ * ReadStore says why: past the wear budget, no erased slot until the
+ * output is released, or the flash refused. */
+static bool persist_user(void *ctx, const struct user_config *cfg)
 {
-    save_policy_saved(&s->saver, r, now);
-    if (r == CONFIG_WRITE_FAILED) {
-        s->regs.status.status |= STATUS_COMMAND_ERROR;
+    struct servo *s = ctx;
+    uint32_t now = s->hal->now_us(s->hal->ctx);
+    s->saver.over_budget = !save_policy_allows(&s->saver, &s->store);
+    if (s->saver.over_budget) {
+        return false;
     }
-    s->dispatcher.store_failed = s->store.failed;
+    enum config_save_result r =
+        config_store_begin(&s->store, cfg, save_policy_op_seconds(&s->saver));
+    if (r == CONFIG_NEEDS_ERASE) {
+        s->saver.awaits_erase = 1;
+        return false;
+    }
+    while (r == CONFIG_STARTED || r == CONFIG_BUSY) {
+        r = config_store_step(&s->store);
+    }
+    bool ok = r != CONFIG_WRITE_FAILED;
+    save_policy_outcome(&s->saver, ok, now);
+    return ok;
 }
 
 /* A page erase stalls the CPU for 20-40 ms: bytes wait in the DMA ring,
- * ticks do not run. Only while no move runs and the line is quiet (servo.h,
- * STORE_ERASE_*). */
+ * ticks do not run. Only while the output is released and the line is
+ * quiet (servo.h, STORE_ERASE_*). */
 static bool erase_may_stall(const struct servo *s, uint32_t now)
 {
     const struct hal_rx_ring *ring = s->hal->rx;
-    bool overdue = s->saver.awaits_erase &&
-                   now - s->saver.awaits_erase_since_us >= STORE_ERASE_OVERDUE_US;
-    uint32_t quiet = overdue ? STORE_ERASE_SHORT_QUIET_US : STORE_ERASE_QUIET_US;
-    return !motion_is_moving(&s->motion) && !s->tx.sending && !s->tx.waiting &&
+    const uint32_t quiet = STORE_ERASE_QUIET_US;
+    return motion_is_idle(&s->motion) && !s->tx.sending && !s->tx.waiting &&
            ring->written == ring->read && now - ring->heard_us >= quiet &&
            now - s->tx.ended_us >= quiet && save_policy_may_retry(&s->saver, &s->store, now);
 }
 
-/* The user area to flash when the save policy says so (checked once a
- * control tick), one write block a main-loop pass, so no stall is longer
- * than one block's programming (52.5 us on the STM32F1). A failed save
- * sets status bit 1 and refuses further writes until a retry succeeds. */
-static void save_config(struct servo *s, uint32_t now, bool ticked)
+/* The spare page's erase: 20-40 ms with the CPU stalled, the output
+ * released. The pass after it resumes the control loop on a fresh
+ * schedule (released, it has nothing to catch up on: these ticks are not
+ * dropped ones), and carries out the frames that arrived meanwhile
+ * without answering them: an answer that late could fall in another
+ * servo's slot. */
+static void erase_spare(struct servo *s, uint32_t now)
 {
-    if (s->store.job_active) {
-        enum config_save_result r = config_store_step(&s->store);
-        if (r != CONFIG_BUSY) {
-            save_finished(s, r, now);
-        }
-        return;
+    bool ok = config_store_erase_spare(&s->store);
+    save_policy_outcome(&s->saver, ok, now);
+    if (ok) {
+        s->saver.awaits_erase = 0;
+    } else {
+        s->regs.status.status |= STATUS_COMMAND_ERROR;
     }
+    s->erase_passed = 1;
+}
+
+/* Once a control tick: counts operating time and erases the spare page
+ * when that costs nothing. */
+static void tend_store(struct servo *s, uint32_t now, bool ticked)
+{
     if (!ticked) {
         return;
     }
-    /* The first pass after an erase has ticks due (it stalled 20-40 ms): the
-     * frames its receive took arrived during the erase. */
-    if (s->erase_passed) {
-        s->erase_passed = 0;
-        s->stale_frames = frame_rx_pending(&s->rx);
-    }
-    /* The policy counts operating time, so it is asked every tick; a save
-     * that needs the erase is not tried again before that is done. */
-    bool due = save_policy_due(&s->saver, &s->store, now);
-    if (due && !(s->saver.awaits_erase && config_store_spare_dirty(&s->store))) {
-        enum config_save_result r =
-            config_store_begin(&s->store, &s->regs.user, save_policy_op_seconds(&s->saver));
-        if (r == CONFIG_STARTED) {
-            save_policy_started(&s->saver);
-        } else if (r == CONFIG_NEEDS_ERASE) {
-            save_policy_awaits_erase(&s->saver, now);
-        } else {
-            save_finished(s, r, now);
-        }
-    }
+    save_policy_count_time(&s->saver, now);
     if (config_store_spare_dirty(&s->store) && erase_may_stall(s, now)) {
-        s->erase_passed = 1;
-        if (!config_store_erase_spare(&s->store)) {
-            save_finished(s, CONFIG_WRITE_FAILED, now);
-        }
+        erase_spare(s, now);
     }
     report_store(s);
 }
@@ -325,17 +331,10 @@ static void receive(struct servo *s, uint32_t now)
     frame_rx_receive(&s->rx, ring, &s->rx_lost, now, s->rx_idle_us);
 }
 
-/* UpdateEnter, its answer gone: the user area to flash first, whatever the
- * stall (the servo restarts anyway), so no change is lost. */
+/* UpdateEnter, its answer gone: every accepted change is in flash already. */
 static void restart_into_bootloader(struct servo *s)
 {
     s->enter_bootloader = 0;
-    while (s->store.job_active) {
-        (void)config_store_step(&s->store);
-    }
-    if (s->saver.pending) {
-        (void)config_store_save(&s->store, &s->regs.user, save_policy_op_seconds(&s->saver));
-    }
     s->hal->enter_bootloader(s->hal->ctx);
 }
 
@@ -343,6 +342,9 @@ void servo_poll(struct servo *s)
 {
     /* One reading of the clock per pass: the ticks due by then run now. */
     uint32_t now = s->hal->now_us(s->hal->ctx);
+    if (s->erase_passed) {
+        s->next_tick_us = now + CONTROL_TICK_US;
+    }
     bool ticked = run_control_tick(s, now);
     if (s->tx.sending && s->hal->uart_tx_done(s->hal->ctx)) {
         s->tx.sending = 0;
@@ -362,7 +364,11 @@ void servo_poll(struct servo *s)
         }
     }
     receive(s, now);
-    save_config(s, now, ticked);
+    if (s->erase_passed) { /* what was framed now arrived during the erase */
+        s->erase_passed = 0;
+        s->stale_frames = frame_rx_pending(&s->rx);
+    }
+    tend_store(s, now, ticked);
     if (s->tx.sending) {
         return; /* half duplex: nothing else goes out meanwhile */
     }

@@ -34,16 +34,12 @@
 #define UNSOLICITED_WINDOW_US 300u
 #define UNSOLICITED_DRIFT_GUARD_US 50u
 #define UNSOLICITED_SLOTS 254u
-/* The other flash page is erased ahead of need only when the 20-40 ms the
- * CPU stalls for it (DS5319, tERASE) cost nothing: no move running, and
- * the line quiet for STORE_ERASE_QUIET_US. A change that has waited
- * STORE_ERASE_OVERDUE_US for it (a host that never pauses) gets it after
- * STORE_ERASE_SHORT_QUIET_US of quiet: the answer to a request sent
- * meanwhile is up to 40 ms late, its bytes wait in the DMA ring
- * (docs/decisions.md, "Flash and the real-time budget"). */
+/* The other flash page is erased, a 20-40 ms CPU stall (DS5319, tERASE),
+ * only at power-up and while the output is released (nothing held against
+ * a load) and the line has been quiet for STORE_ERASE_QUIET_US; never on a
+ * host's schedule. A change that needs it meanwhile is refused with its
+ * reason (docs/decisions.md, "The config store"). */
 #define STORE_ERASE_QUIET_US 100000u
-#define STORE_ERASE_OVERDUE_US 5000000u
-#define STORE_ERASE_SHORT_QUIET_US 2000u
 /* Ticks a late main loop catches up before it drops the rest. */
 #define SERVO_MAX_CATCH_UP 4u
 /* Control tick period. */

@@ -130,6 +130,9 @@ bool config_store_load(struct config_store *s, const struct hal_flash *flash,
     *cfg = newest;
     user_config_encode(&newest, s->saved);
     s->spare_erased = page_erased(s, spare_page(s));
+    /* A blank store's first record goes to page 0 and makes page 1 the
+     * spare: look at it now, not while a write waits for its answer. */
+    s->blank_page1_erased = s->sequence == 0u && page_erased(s, 1);
     return s->sequence != 0u;
 }
 
@@ -229,8 +232,8 @@ enum config_save_result config_store_step(struct config_store *s)
     s->slot = s->job_slot;
     if (new_page) {
         /* The old page is the spare now: it holds records, unless this was
-         * the first record of a blank store (then look). */
-        s->spare_erased = was_blank && page_erased(s, spare_page(s));
+         * the first record of a blank store (page 1, looked at on load). */
+        s->spare_erased = was_blank && s->blank_page1_erased;
     }
     s->legacy = 0;
     s->failed = 0;

@@ -46,6 +46,7 @@ struct config_store {
     uint8_t failed;      /* the last save failed (and nothing saved since) */
     uint8_t legacy;      /* the newest record is format 1: the next starts a page */
     uint8_t spare_erased; /* the page without the newest record is all 0xFF */
+    uint8_t blank_page1_erased; /* a blank store's page 1 was all 0xFF on load */
     /* The save in progress: its record, where it goes, the next block. */
     uint8_t job[CONFIG_RECORD_SIZE];
     uint8_t job_active;

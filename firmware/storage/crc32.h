@@ -4,9 +4,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
-/* CRC-32/ISO-HDLC (the zlib CRC). Bitwise: it runs once per config save or
- * slot scanned, or over an application image before it boots, so 1 KB of
- * table would buy nothing. */
+/* CRC-32/ISO-HDLC (the zlib CRC). A nibble a step from a 64-byte table; the
+ * bootloader builds it bitwise (CRC32_BITWISE), for size. */
 uint32_t crc32(const uint8_t *data, size_t len);
 
 /* The same in pieces: state starts at CRC32_START, crc32 = ~state at the end. */

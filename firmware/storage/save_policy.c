@@ -15,15 +15,6 @@ void save_policy_init(struct save_policy *p, const struct config_store *store, u
     };
 }
 
-void save_policy_changed(struct save_policy *p, uint32_t now_us)
-{
-    if (!p->pending) {
-        p->pending = 1;
-        p->first_change_us = now_us;
-    }
-    p->last_change_us = now_us;
-}
-
 uint32_t save_policy_op_seconds(const struct save_policy *p)
 {
     return p->op_seconds_at_boot + p->uptime_s;
@@ -34,25 +25,17 @@ uint32_t save_policy_budget(const struct save_policy *p)
     return SAVE_ALLOWANCE + save_policy_op_seconds(p) / p->seconds_per_save;
 }
 
-bool save_policy_due(struct save_policy *p, const struct config_store *store, uint32_t now_us)
+void save_policy_count_time(struct save_policy *p, uint32_t now_us)
 {
     while (now_us - p->second_mark_us >= 1000000u) {
         p->second_mark_us += 1000000u;
         p->uptime_s++;
     }
-    if (!p->pending) {
-        return false;
-    }
-    if (!save_policy_may_retry(p, store, now_us)) {
-        return false;
-    }
-    bool settled = now_us - p->last_change_us >= SAVE_SETTLE_US ||
-                   now_us - p->first_change_us >= SAVE_LATEST_US;
-    if (!settled) {
-        return false;
-    }
-    p->deferred = store->sequence >= save_policy_budget(p);
-    return !p->deferred;
+}
+
+bool save_policy_allows(const struct save_policy *p, const struct config_store *store)
+{
+    return store->sequence < save_policy_budget(p);
 }
 
 bool save_policy_may_retry(const struct save_policy *p, const struct config_store *store,
@@ -61,28 +44,9 @@ bool save_policy_may_retry(const struct save_policy *p, const struct config_stor
     return !store->failed || now_us - p->failed_at_us >= SAVE_RETRY_US;
 }
 
-void save_policy_awaits_erase(struct save_policy *p, uint32_t now_us)
+void save_policy_outcome(struct save_policy *p, bool ok, uint32_t now_us)
 {
-    p->awaits_erase = 1;
-    p->awaits_erase_since_us = now_us;
-}
-
-void save_policy_started(struct save_policy *p)
-{
-    p->pending = 0;
-    p->awaits_erase = 0;
-}
-
-void save_policy_saved(struct save_policy *p, enum config_save_result result, uint32_t now_us)
-{
-    if (result == CONFIG_WRITE_FAILED) {
-        p->failed_at_us = now_us; /* pending again: tried after SAVE_RETRY_US */
-        if (!p->pending) {
-            p->pending = 1;
-            p->first_change_us = now_us;
-            p->last_change_us = now_us;
-        }
-        return;
+    if (!ok) {
+        p->failed_at_us = now_us;
     }
-    p->pending = 0;
 }

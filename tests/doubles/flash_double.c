@@ -37,6 +37,9 @@ static bool erase_page(void *ctx, uint32_t addr)
     uint8_t *page = f->mem[p];
     uint32_t size = f->hal.page_size;
     if (!cut_now(f)) {
+        if (f->during_erase != NULL) {
+            f->during_erase(f->during_erase_ctx);
+        }
         memset(page, 0xFF, size);
         f->erases[p]++;
         return true;

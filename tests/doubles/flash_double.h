@@ -30,6 +30,10 @@ struct flash_double {
     bool dead;         /* power is gone: nothing more changes */
     uint32_t erases[2];
     bool misuse;       /* programmed a non-erased or odd address */
+    /* Called while an erase stalls the CPU: a test lets time pass and
+     * bytes arrive there. */
+    void (*during_erase)(void *ctx);
+    void *during_erase_ctx;
 };
 
 void flash_double_init(struct flash_double *f, uint32_t page_size);

@@ -132,8 +132,7 @@ static void write_item(uint8_t item, uint16_t value, uint8_t size)
     memcpy(f.content, content, sizeof content);
     struct response r;
     struct dispatch_result res;
-    dispatch(&live.servo.dispatcher, &f, &r, &res);
-    save_policy_changed(&live.servo.saver, live.hal.now_us);
+    dispatch(&live.servo.dispatcher, &f, &r, &res); /* written through to flash */
 }
 
 static void run_ms(uint32_t ms)
@@ -145,7 +144,7 @@ static void run_ms(uint32_t ms)
 }
 
 /* The flash images: a store that has been used, and one whose page is a
- * record from full, so the next save erases the other page. */
+ * record from full, so the second change after it needs the other page. */
 static void make_snapshot(int image)
 {
     memset(&live, 0, sizeof live);

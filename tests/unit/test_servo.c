@@ -232,9 +232,7 @@ static void test_config_survives_restart(void **state)
     REQUEST(4, 0, 34, 9);
     REQUEST(4, 9, 43, 0xD0, 0x07);
     EXPECT_RESPONSE(4, 9, 43, 1);
-    /* Saved once nothing changes for 50 ms, a write block a main-loop pass
-     * (the harness makes 4 passes a millisecond, silicon hundreds). */
-    harness_run_ms(SAVE_SETTLE_US / 1000u + 8u);
+    /* In flash before the answer: a power cut right after it keeps it. */
     harness_restart();
     REQUEST(3, 9, 43);
     EXPECT_RESPONSE(3, 9, 43, 0xD0, 0x07);
@@ -259,63 +257,59 @@ static uint32_t store_field(size_t at)
            (uint32_t)c[at + 3] << 24;
 }
 
-/* Every flash write fails (a dead or worn page). The first write is
- * answered before its save runs, so it says 1; the failed save then sets
- * bit 1, and every later write is refused with 0 and changes nothing, so
- * what the host reads is never more than the servo keeps. Once the flash
- * works again, the retry saves and writes are taken again. */
-static void test_a_failed_save_is_reported_and_refuses_writes(void **state)
+/* Every flash write fails (a dead or worn page): a change is answered 0
+ * and not made, so what the host reads is what the servo keeps; ReadStore
+ * says why. Once the flash works again, writes are taken again. */
+static void test_a_write_the_flash_refuses_is_not_made(void **state)
 {
     (void)state;
+    const uint16_t kept = servo.regs.user.current_limit_ma;
     hal.flash.dead = true;
     REQUEST(4, 0, 43, 0xD0, 0x07);
-    EXPECT_RESPONSE(4, 0, 43, 1);
-    harness_run_ms(60);
-    assert_int_equal(servo.store.write_failures, 1);
-    REQUEST(3, 0, 5);
-    EXPECT_RESPONSE(3, 0, 5, STATUS_COMMAND_ERROR);
-    assert_int_equal(store_field(1), STORE_FAILED | STORE_PENDING);
-    assert_int_equal(store_field(22), 1); /* failures */
-    REQUEST(4, 0, 43, 0xB8, 0x0B);
     EXPECT_RESPONSE(4, 0, 43, 0);
+    assert_int_equal(servo.store.write_failures, 1);
     REQUEST(3, 0, 43);
-    EXPECT_RESPONSE(3, 0, 43, 0xD0, 0x07);
+    EXPECT_RESPONSE(3, 0, 43, (uint8_t)kept, (uint8_t)(kept >> 8));
+    assert_int_equal(store_field(1), STORE_FAILED);
+    assert_int_equal(store_field(22), 1); /* failures */
     uint8_t batch[1 + USER_AREA_SIZE] = {0};
     user_config_encode(&servo.regs.user, &batch[1]);
+    batch[1 + 43 - 32] = 0xB8; /* a real change: stored or refused */
+    batch[1 + 44 - 32] = 0x0B;
     harness_request(6, batch, sizeof batch);
     EXPECT_RESPONSE(6, 0, 0);
-    REQUEST(2, 0);
-    EXPECT_RESPONSE(2, 0, 0);
-    harness_run_ms(2000); /* retries once a second, all failing */
-    assert_true(servo.store.write_failures >= 2);
     hal.flash.dead = false;
-    harness_run_ms(1100);
     REQUEST(4, 0, 43, 0xB8, 0x0B);
     EXPECT_RESPONSE(4, 0, 43, 1);
-    harness_run_ms(60);
     assert_int_equal(store_field(1), 0);
     harness_restart();
     REQUEST(3, 0, 43);
     EXPECT_RESPONSE(3, 0, 43, 0xB8, 0x0B);
 }
 
-/* A burst of writes at line rate is one save. */
-static void test_a_burst_of_writes_is_one_save(void **state)
+/* Every accepted change is a record of its own, written before its
+ * answer; a write of the value already held writes nothing. */
+static void test_every_change_is_in_flash_before_its_answer(void **state)
 {
     (void)state;
-    for (int i = 0; i < 200; i++) {
-        REQUEST(4, 0, 44, (uint8_t)(i & 1)); /* 44 toggled, a write each ms */
+    const uint32_t first = servo.store.sequence;
+    for (unsigned i = 0; i < 10u; i++) {
+        REQUEST(4, 0, 44, (uint8_t)(100u + i));
+        EXPECT_RESPONSE(4, 0, 44, 1);
+        assert_int_equal(servo.store.sequence, first + i + 1u);
     }
-    harness_run_ms(60);
-    assert_int_equal(servo.store.sequence, 1);
+    long steps = hal.flash.steps;
+    REQUEST(4, 0, 44, 109);
+    EXPECT_RESPONSE(4, 0, 44, 1);
+    assert_int_equal(hal.flash.steps, steps);
 }
 
-/* A host toggling item 44 as fast as saves settle, for 2 hours of
- * operation with a power cycle every 20 minutes: after the allowance the
- * servo saves once per seconds_per_save of operating time, the budget that
- * keeps 10 years of this within the pages' rated cycles, and the operating
- * time recorded with each save keeps power cycles from refilling it (time
- * since the last save is lost at each cut, so it only under-counts). */
+/* A host toggling item 44 every 150 ms (quiet long enough for the erase),
+ * for 2 hours of operation with a power cycle every 20 minutes: after the allowance the servo takes one
+ * change per seconds_per_save of operating time, the budget that keeps 10
+ * years of this within the pages' rated cycles, and refuses the rest
+ * (result 0, ReadStore bit 1) rather than keep them in RAM. The operating
+ * time recorded with each save keeps power cycles from refilling it. */
 static void test_writes_in_a_loop_stay_within_the_wear_budget(void **state)
 {
     (void)state;
@@ -324,25 +318,32 @@ static void test_writes_in_a_loop_stay_within_the_wear_budget(void **state)
     /* 10 years at this rate, and the allowance, within 90 % of the rating */
     assert_true(SAVE_ALLOWANCE + SAVE_LIFE_SECONDS / per_save <= records / 10u * 9u);
     uint32_t ms = 0;
+    uint32_t refused = 0;
     for (uint32_t i = 0; ms < 2u * 3600u * 1000u; i++) {
-        REQUEST(4, 0, 44, (uint8_t)(i & 1));
-        hal.now_us += 60000u; /* no motion: ticks beyond the catch-up drop */
+        uint8_t flip = (uint8_t)(servo.regs.user.start_force ^ 1u);
+        REQUEST(4, 0, 44, flip);
+        refused += hal.sent[6] == 0u;
+        hal.now_us += 149000u; /* no motion: ticks beyond the catch-up drop */
         harness_poll(2);
-        ms += 61;
-        if (i % 20000u == 19999u) {
+        ms += 150;
+        if (i % 8000u == 7999u) {
             harness_restart();
         }
         assert_true(servo.store.sequence <= save_policy_budget(&servo.saver));
     }
     uint32_t op = save_policy_op_seconds(&servo.saver);
-    printf("# 2 h of writes every 61 ms: %u saves, %u page erases; budget %u (1 per %u s)\n",
-           (unsigned)servo.store.sequence, (unsigned)config_store_page_erases(&servo.store),
+    printf("# 2 h of writes every 150 ms: %u saves, %u refused, %u page erases; budget %u (1 per %u s)\n",
+           (unsigned)servo.store.sequence, (unsigned)refused,
+           (unsigned)config_store_page_erases(&servo.store),
            (unsigned)save_policy_budget(&servo.saver), (unsigned)per_save);
     assert_true(op > 3600u && op <= 7200u);
-    REQUEST(4, 0, 44, 1);
-    REQUEST(4, 0, 44, 0);
-    harness_run_ms(60);
-    assert_int_equal(store_field(1), STORE_DEFERRED | STORE_PENDING);
+    assert_true(refused > 40000u);
+    assert_int_equal(servo.store.sequence, save_policy_budget(&servo.saver));
+    uint8_t held = servo.regs.user.start_force;
+    REQUEST(4, 0, 44, (uint8_t)(held ^ 1u));
+    EXPECT_RESPONSE(4, 0, 44, 0);
+    assert_int_equal(servo.regs.user.start_force, held);
+    assert_int_equal(store_field(1), STORE_OVER_BUDGET);
     assert_int_equal(store_field(2), servo.store.sequence);
     uint32_t pages_started = (servo.store.sequence + 20u) / 21u; /* 21 records a page */
     assert_int_equal(store_field(6), (pages_started + 1u) / 2u);
@@ -453,43 +454,63 @@ static void test_a_new_request_ends_the_wait_for_a_sync_turn(void **state)
 }
 
 /* A page erase stalls the CPU for 20-40 ms, so the other page is erased
- * only while no move runs and the line is quiet. With both pages full,
- * a change made during a move waits (ReadStore flags bit 3) until the
- * move has ended; then the erase runs and the save lands. */
-static void test_the_flash_is_erased_only_while_no_move_runs(void **state)
+ * only while the output is released and the line is quiet. With both
+ * pages full, a change made while the servo moves or holds is refused
+ * (ReadStore bit 3) and not made; once the servo is released and the line
+ * quiet, the erase runs and the same change is taken. */
+static void test_the_flash_is_erased_only_while_released(void **state)
 {
     (void)state;
     harness_ideal_tracking();
+    REQUEST(4, 0, 49, 0); /* soft start off: the move starts at once */
     const unsigned slots = config_store_slots_per_page(&servo.store);
-    for (unsigned i = 0; i < 2u * slots; i++) {
+    const uint32_t first = servo.store.sequence;
+    for (unsigned i = 0; servo.store.sequence < first + 2u * slots - 1u; i++) {
         REQUEST(4, 0, 43, (uint8_t)(100u + i), 0x07); /* a new value each time */
-        harness_run_ms(70); /* saved; too short a pause for an erase */
+        EXPECT_RESPONSE(4, 0, 43, 1);
+        harness_run_ms(70); /* too short a pause for an erase */
     }
-    assert_int_equal(servo.store.sequence, 2u * slots);
     uint32_t erases = hal.flash.erases[0] + hal.flash.erases[1];
-    /* A 3 s move to 100 degrees, and a change during it. */
-    REQUEST(11, 0, 0xE8, 0x03, 0xB8, 0x0B, 0x64, 0, 0xC8, 0, 0, 0);
+    /* A 1 s move to 100 degrees; a change during it, and while it holds. */
+    REQUEST(11, 0, 0xE8, 0x03, 0xE8, 0x03, 0x64, 0, 0xC8, 0, 0, 0);
+    const uint16_t kept = servo.regs.user.current_limit_ma;
     REQUEST(4, 0, 43, 0x55, 0x06);
-    harness_run_ms(2000);
-    assert_true(motion_is_executing(&servo.motion));
+    EXPECT_RESPONSE(4, 0, 43, 0);
+    assert_int_equal(servo.regs.user.current_limit_ma, kept);
+    assert_int_equal(store_field(1), STORE_AWAITS_ERASE);
+    harness_run_ms(2000); /* the move ends and holds; the line is quiet */
     assert_int_equal(hal.flash.erases[0] + hal.flash.erases[1], erases);
-    assert_int_equal(store_field(1), STORE_PENDING | STORE_AWAITS_ERASE);
-    harness_run_ms(1200); /* the move ends, then the line is quiet for 100 ms */
-    assert_false(motion_is_executing(&servo.motion));
-    /* The page the save needed, then, ahead, the one it left. */
-    assert_int_equal(hal.flash.erases[0] + hal.flash.erases[1], erases + 2u);
+    REQUEST(4, 0, 43, 0x55, 0x06);
+    EXPECT_RESPONSE(4, 0, 43, 0);
+    REQUEST(24, 0, 0x10, 0, 0); /* released */
+    harness_run_ms(150);
+    assert_int_equal(hal.flash.erases[0] + hal.flash.erases[1], erases + 1u);
     assert_false(config_store_spare_dirty(&servo.store));
-    assert_int_equal(servo.store.sequence, 2u * slots + 1u);
     assert_int_equal(store_field(1), 0);
+    REQUEST(4, 0, 43, 0x55, 0x06);
+    EXPECT_RESPONSE(4, 0, 43, 1);
     harness_restart();
     REQUEST(3, 0, 43);
     EXPECT_RESPONSE(3, 0, 43, 0x55, 0x06);
 }
 
+/* A WriteData that arrives in the ring while an erase stalls the CPU. */
+static void write_arrives_during_erase(void *ctx)
+{
+    (void)ctx;
+    uint8_t wire[16];
+    size_t n = make_request(wire, 4, (const uint8_t[]){0, 38, 0xD2, 0x04}, 4);
+    for (size_t i = 0; i < n; i++) {
+        servo_on_rx_byte(&servo, wire[i], hal.now_us + 1000u + 87u * (uint32_t)i);
+    }
+    hal.now_us += 40000u;
+}
+
 /* A request that arrives while a page erase stalls the CPU is carried out
- * in the first pass after it, but not answered: 20-40 ms late, the answer
- * could fall in another servo's slot. ReadStore counts it; the next
- * request is answered as usual. */
+ * right after it, but not answered: 20-40 ms late, the answer could fall
+ * in another servo's slot. ReadStore counts it; the next request is
+ * answered as usual. The control loop resumes on a fresh schedule: the
+ * output is released, and no tick counts as dropped. */
 static void test_an_answer_that_would_leave_late_is_dropped(void **state)
 {
     (void)state;
@@ -499,22 +520,19 @@ static void test_an_answer_that_would_leave_late_is_dropped(void **state)
         harness_run_ms(70);
     }
     uint32_t erases = hal.flash.erases[0] + hal.flash.erases[1];
+    uint32_t dropped_ticks = servo.ticks_dropped;
+    hal.flash.during_erase = write_arrives_during_erase;
+    hal_double_clear_sent(&hal);
     while (hal.flash.erases[0] + hal.flash.erases[1] == erases) {
         hal.now_us += 250u; /* the line quiet until the erase runs */
         servo_poll(&servo);
     }
-    /* A WriteData lands in the ring during the 40 ms the CPU stalled. */
-    uint8_t wire[16];
-    size_t n = make_request(wire, 4, (const uint8_t[]){0, 38, 0xD2, 0x04}, 4);
-    hal_double_clear_sent(&hal);
-    for (size_t i = 0; i < n; i++) {
-        servo_on_rx_byte(&servo, wire[i], hal.now_us + 1000u + 87u * (uint32_t)i);
-    }
-    hal.now_us += 40000u;
+    hal.flash.during_erase = NULL;
     harness_poll(4);
     assert_int_equal(hal.sent_length, 0u);       /* not answered */
     assert_int_equal(servo.regs.user.stall_power_mw, 1234); /* but carried out */
     assert_int_equal(servo.answers_dropped, 1u);
+    assert_int_equal(servo.ticks_dropped, dropped_ticks);
     harness_run_ms(2);
     assert_int_equal(store_field(26), 1u);       /* ReadStore: answers dropped */
     assert_int_equal(store_field(30), 0u);       /* bytes lost */
@@ -556,7 +574,7 @@ static void test_update_enter_restarts_into_the_bootloader(void **state)
     REQUEST(0x50, 0);
     EXPECT_RESPONSE(0x50, 0, 0, 1);
     REQUEST(19, 1); /* the buffer dropped */
-    REQUEST(4, 0, 43, 0x55, 0x06); /* a change not yet saved */
+    REQUEST(4, 0, 43, 0x55, 0x06); /* in flash before its answer */
     hal.tx_busy = true;
     REQUEST(0x50, 0);
     EXPECT_RESPONSE(0x50, 0, 1, 0);
@@ -607,10 +625,10 @@ int main(void)
         cmocka_unit_test_setup(test_sync_monitor_waits_its_turn, setup),
         cmocka_unit_test_setup(test_sync_monitor_passes_a_silent_servo, setup),
         cmocka_unit_test_setup(test_a_new_request_ends_the_wait_for_a_sync_turn, setup),
-        cmocka_unit_test_setup(test_a_failed_save_is_reported_and_refuses_writes, setup),
-        cmocka_unit_test_setup(test_a_burst_of_writes_is_one_save, setup),
+        cmocka_unit_test_setup(test_a_write_the_flash_refuses_is_not_made, setup),
+        cmocka_unit_test_setup(test_every_change_is_in_flash_before_its_answer, setup),
         cmocka_unit_test_setup(test_writes_in_a_loop_stay_within_the_wear_budget, setup),
-        cmocka_unit_test_setup(test_the_flash_is_erased_only_while_no_move_runs, setup),
+        cmocka_unit_test_setup(test_the_flash_is_erased_only_while_released, setup),
         cmocka_unit_test_setup(test_an_answer_that_would_leave_late_is_dropped, setup),
         cmocka_unit_test_setup(test_update_enter_restarts_into_the_bootloader, setup),
         cmocka_unit_test_setup(test_garbage_between_frames_and_responses_of_others, setup),

@@ -75,14 +75,24 @@ class StoreHealth:
     answers_dropped: int  # requests that arrived during an erase: carried out, not answered
     bytes_lost: int       # received bytes overwritten before the servo took them
 
-    FLAGS = ("save_failed", "waits_for_wear_budget", "not_saved_yet", "waits_for_erase")
+    # The last change refused, and why (bit 2 is unused).
+    FLAGS = ("flash_refused", "over_wear_budget", "", "needs_erase")
+    # What the host can do about each (docs/decisions.md, "The config store").
+    ADVICE = {
+        "flash_refused": "its flash refused the write (a worn or failing page)",
+        "over_wear_budget": "its flash wear budget allows no more saves yet (one per "
+                            "so many seconds of operation; see 'servoctl store')",
+        "needs_erase": "its config page is full and the next is erased only while the servo "
+                       "is released: release it ('servoctl stop ID'), leave the bus quiet for 0.1 s, "
+                       "and write again",
+    }
 
     @classmethod
     def decode(cls, content: bytes) -> "StoreHealth":
         return cls(*_unpack("<BB8I", content, "ReadStore"))
 
     def flag_names(self) -> list:
-        return [name for bit, name in enumerate(self.FLAGS) if self.flags >> bit & 1]
+        return [name for bit, name in enumerate(self.FLAGS) if name and self.flags >> bit & 1]
 
 
 def _check(name: str, value: int, low: int, high: int, unit: str = "", per_unit: int = 1) -> int:
@@ -145,7 +155,7 @@ class Servo:
         item.check(value)
         content = self.bus.request(p.WRITE_DATA, bytes([self.id, item.id]) + item.pack(value))
         if _unpack("<BBB", content, "WriteData")[2] != 1:
-            raise Refused(f"servo {self.id} refused {item.name} = {value}")
+            raise Refused(f"servo {self.id} refused {item.name} = {value}{self._why_refused()}")
 
     def read_all(self) -> dict:
         content = self.bus.request(p.READ_BATCH, bytes([self.id]))
@@ -156,11 +166,24 @@ class Servo:
         block = registers.encode_user_area(values)
         content = self.bus.request(p.WRITE_BATCH, bytes([self.id]) + block)
         if _unpack("<BB", content, "WriteBatchData")[1] != 1:
-            raise Refused(f"servo {self.id} refused the user area block")
+            raise Refused(f"servo {self.id} refused the user area block{self._why_refused()}")
 
     def reset_user_data(self) -> None:
         if _unpack("<BB", self.bus.request(p.RESET_USER_DATA, bytes([self.id])), "ResetUserData")[1] != 1:
-            raise Refused(f"servo {self.id} refused the reset")
+            raise Refused(f"servo {self.id} refused the reset{self._why_refused()}")
+
+    def _why_refused(self) -> str:
+        """Why the servo's store refused the last change, from ReadStore:
+        ": <reason>", or "" when the store took no part (a value out of range,
+        a read-only item) or the servo has no ReadStore (the maker's)."""
+        try:
+            health = self.read_store()
+        except p.LinkError:
+            raise
+        except ServoError:  # no answer, or not one this tool knows
+            return ""
+        reasons = [StoreHealth.ADVICE[name] for name in health.flag_names()]
+        return ": " + "; ".join(reasons) if reasons else ""
 
     def angle(self) -> int:
         return _unpack("<Bh", self.bus.request(p.READ_ANGLE, bytes([self.id])), "ReadAngle")[1]

@@ -74,7 +74,8 @@ static void usage(FILE *out)
           "  failerase N | failprogram N (the next N flash erases, or half-word\n"
           "  programs, of the config store and the slot fail, as a worn page's do) |\n"
           "  powercycle (the servo restarts through its bootloader) | state | help |\n"
-          "  clock (the simulated clock, sim_ms, and how far it is behind the wall clock)\n"
+          "  clock (the simulated clock, sim_ms, and how far it is behind the wall clock) |\n"
+          "  hostsend MS HEX (the host's bytes on the wire from simulated time MS)\n"
           "The servos run on the simulated clock: it follows the wall clock, and falls\n"
           "behind it on a busy PC. state gives each servo's sim_ms with its models,\n"
           "last_move_ms (how long status bit 0 was last set) and last_sent_ms (when its\n"
@@ -244,6 +245,34 @@ static void state_of(const struct sim_servo *s, char *out, size_t size)
              s->in_bootloader ? "bootloader" : "app", (unsigned)s->core.regs.status.firmware_version);
 }
 
+/* "hostsend MS HEX": the host's bytes on the wire from simulated time MS
+ * on (or at once, if that has passed), as the host's UART would send them.
+ * A test times a frame into a window of a few milliseconds this way,
+ * which a host process on a loaded PC cannot. */
+static void host_send(int fd, int n, char **words)
+{
+    uint8_t data[100]; /* 200 hex digits: a control line holds 255 characters */
+    size_t len = n == 3 ? strlen(words[2]) / 2u : 0u;
+    char *end = NULL;
+    double at_ms = n == 3 ? strtod(words[1], &end) : -1.0;
+    if (n != 3 || end == words[1] || *end != '\0' || !(at_ms >= 0.0) || len == 0u ||
+        len > sizeof data || strlen(words[2]) % 2u != 0u) {
+        reply(fd, "error: hostsend takes a time in ms and 1 to 100 bytes in hex\n");
+        return;
+    }
+    for (size_t i = 0; i < len; i++) {
+        unsigned byte;
+        if (sscanf(&words[2][2u * i], "%2x", &byte) != 1) {
+            reply(fd, "error: hostsend takes a time in ms and 1 to 100 bytes in hex\n");
+            return;
+        }
+        data[i] = (uint8_t)byte;
+    }
+    uint64_t at_us = (uint64_t)(at_ms * 1000.0);
+    sim_bus_from_host(&bus, data, (unsigned)len, at_us > bus.now_us ? at_us : bus.now_us);
+    reply(fd, "ok\n");
+}
+
 /* One control line: "command [value] [servo id]". */
 static void control_command(int fd, char *line)
 {
@@ -263,6 +292,10 @@ static void control_command(int fd, char *line)
         reply(fd, out);
         return;
     }
+    if (strcmp(cmd, "hostsend") == 0) {
+        host_send(fd, n, words);
+        return;
+    }
     bool takes_value = strcmp(cmd, "state") != 0 && strcmp(cmd, "help") != 0 &&
                        strcmp(cmd, "powercycle") != 0;
     int id_word = takes_value ? 2 : 1;
@@ -277,7 +310,7 @@ static void control_command(int fd, char *line)
     if (strcmp(cmd, "help") == 0) {
         reply(fd, "ok supply MV | load NM | stop DEG | stop off | ambient DEGC | soak DEGC | "
                   "hostbaud BAUD | failerase N | failprogram N | powercycle [ID] | state [ID] | "
-                  "clock\n");
+                  "clock | hostsend MS HEX\n");
         return;
     }
     if (takes_value && n < 2) {

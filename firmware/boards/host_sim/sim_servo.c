@@ -238,7 +238,18 @@ void sim_servo_receive(struct sim_servo *s, uint8_t byte, uint64_t at_us)
             hal_rx_ring_put(&s->rx, s->uart_held, s->uart_held_at_us);
         }
     }
-    servo_on_rx_byte(&s->core, byte, (uint32_t)at_us);
+    if (s->rx_interrupt) {
+        servo_on_rx_byte(&s->core, byte, (uint32_t)at_us);
+        return;
+    }
+    /* The reference board's DMA writes each byte whatever the CPU does; a
+     * ring the main loop has not emptied (a page erase stalls it 40 ms) is
+     * written over, oldest bytes first (RM0008 13.3.6, circular mode), and
+     * the main loop counts what it lost by the write counter. */
+    uint32_t w = s->rx.written;
+    s->rx.data[w & (HAL_RX_RING_SIZE - 1u)] = byte;
+    s->rx.written = w + 1u;
+    s->rx.heard_us = (uint32_t)at_us;
 }
 
 void sim_servo_poll(struct sim_servo *s, uint64_t now_us)

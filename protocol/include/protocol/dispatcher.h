@@ -16,9 +16,12 @@ struct dispatcher {
     struct registers *regs;
     struct motion *motion;
     const volatile uint8_t *own_id; /* the ID the servo answers to right now */
-    /* The config store failed its last save: writes to the user area are
-     * refused (result 0), so what the host reads is what a boot loads. */
-    uint8_t store_failed;
+    /* Makes a changed user area durable before the write is answered:
+     * false refuses the write (result 0) and the user area stays as it
+     * was, so what the host reads is what a boot loads. NULL where nothing
+     * is stored (the change is kept in RAM). */
+    bool (*persist)(void *ctx, const struct user_config *cfg);
+    void *persist_ctx;
     /* A bootloader is there to restart into (UpdateEnter), and the board
      * images are built for (UpdateStatus). */
     uint8_t bootloader_present;
@@ -31,7 +34,7 @@ struct dispatcher {
 
 struct dispatch_result {
     bool answer;            /* response holds a frame to send */
-    bool config_changed;    /* the user area may have changed: save it */
+    bool config_changed;    /* the user area changed (and is durable) */
     /* Sync Monitor: let this many other servos' responses pass first. */
     uint8_t wait_responses;
     /* UpdateEnter: restart into the bootloader once the answer has left. */

@@ -59,10 +59,9 @@ struct user_config {
 /* How the config store is doing (ReadStore, 0x41, docs/packets.md): kept
  * up to date by the application, read by the dispatcher. */
 enum store_flag {
-    STORE_FAILED = 1u << 0,   /* the last save failed; writes are refused */
-    STORE_DEFERRED = 1u << 1, /* a change waits for the wear budget */
-    STORE_PENDING = 1u << 2,  /* a change is not saved yet */
-    STORE_AWAITS_ERASE = 1u << 3, /* it waits for the other page to be erased */
+    STORE_FAILED = 1u << 0,      /* the flash refused the last save or erase */
+    STORE_OVER_BUDGET = 1u << 1, /* the last change was refused: wear budget */
+    STORE_AWAITS_ERASE = 1u << 3, /* the last change was refused: no erased slot */
 };
 
 struct store_health {

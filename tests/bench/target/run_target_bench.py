@@ -41,6 +41,10 @@ KNOWN_LOOP = 200  # 100 more iterations of a 2-instruction loop
 BUDGETS = {"rx_per_byte": 40, "tick": 150, "plan": 1000}
 NOT_YET_MET = {"tick": 310}
 RESPONSE_BUDGET_US = 20
+# A write that changes the user area is answered once its record is
+# programmed (issue 22): this budget is the CPU's part; the flash's own
+# 24 half-words x 40-70 us (DS5319) come on top (docs/decisions.md).
+DURABLE_WRITE_BUDGET_US = {"latency_write_data": 200}
 
 
 def symbol(elf: Path, name: str) -> int:
@@ -201,8 +205,9 @@ def main():
             exceeded = i3 > budget
             mark = f"{budget} instr"
         elif key.startswith("latency_"):
-            exceeded = c3 / CLOCK_MHZ["cortex-m3"] > RESPONSE_BUDGET_US
-            mark = f"{RESPONSE_BUDGET_US} us"
+            limit = DURABLE_WRITE_BUDGET_US.get(key, RESPONSE_BUDGET_US)
+            exceeded = c3 / CLOCK_MHZ["cortex-m3"] > limit
+            mark = f"{limit} us" + (" + flash" if key in DURABLE_WRITE_BUDGET_US else "")
         else:
             mark = ""
         if exceeded and key in NOT_YET_MET:

@@ -1,4 +1,5 @@
-"""Issue 10: a config save costs no byte and no tick.
+"""A config save costs no byte and no tick, and every acknowledged change
+survives a power cut.
 
 The simulator stalls a servo's CPU for every flash operation the firmware
 makes, as the STM32F1 does (it runs from the flash it writes): 40 ms a
@@ -8,19 +9,25 @@ the DMA ring of the reference board's port, while a port that takes each
 byte in its receive interrupt overruns. Two servos share a 1 Mbaud bus;
 the host writes a changed setting to servo 1 a thousand times while it
 turns in wheel mode, and reads servo 2's monitor in between, so bytes are
-on the wire while servo 1 programs its saves."""
-from servoctl.protocol import Bus, NoReply
-from servoctl.servo import Servo
+on the wire while servo 1 programs. A turning servo never erases, so once
+its free slots are spent it refuses changes (result 0) rather than keep
+them in RAM."""
+from servoctl import protocol as p
+from servoctl.protocol import NoReply
+from servoctl.servo import Refused, Servo
 from servoctl.sim import Simulator
 
 WRITES = 1000
 BAUD_INDEX_1M = 8
 
 
-def write_while_moving(tmp_path, rx, writes, run=0):
+def write_while_moving(tmp_path, rx, writes, run=0, cut=False):
     """Servo 1's state after `writes` config writes at 1 Mbaud while it
-    turns, and the writes that were answered."""
-    sim = Simulator(ids=[1, 2], state_dir=str(tmp_path / f"{rx}-{run}"), rx=rx)
+    turns, the writes answered, and the last value it accepted. With `cut`,
+    the simulator is killed (kill -9, a power cut) right after the last
+    answer and started again; the state is then the restarted servo's."""
+    state_dir = str(tmp_path / f"{rx}-{run}")
+    sim = Simulator(ids=[1, 2], state_dir=state_dir, rx=rx)
     sim.start()
     try:
         with sim.bus(timeout=0.2) as bus:
@@ -32,23 +39,36 @@ def write_while_moving(tmp_path, rx, writes, run=0):
             one.write("soft_start_on", 0)
             before = sim.state(1)
             one.wheel("run", speed_dps=90)
-            answered = 0
+            answered, accepted = 0, None
             try:
                 for n in range(writes):
-                    one.write("current_limit", 3000 + n % 2)  # a change every time
+                    try:
+                        one.write("current_limit", 3000 + n % 2)  # a change every time
+                        accepted = 3000 + n % 2
+                    except Refused:
+                        pass
                     answered += 1
                     two.monitor()
             except NoReply:
                 pass  # a request lost: counted by `answered`
             assert abs(sim.state(1)["velocity"]) > 45, "servo 1 stopped turning"
-        return before, sim.state(1), answered
+        after = sim.state(1)
+        if cut:
+            sim.process.kill()
+            sim.process.wait()
+            sim = Simulator(ids=[1, 2], state_dir=state_dir, rx=rx)
+            sim.start()
+            sim.control("hostbaud 1000000")
+            with sim.bus(baud=1000000, timeout=0.2) as bus:
+                after = dict(after, current_limit=Servo(bus, 1).read("current_limit"))
+        return before, after, answered, accepted
     finally:
         err = sim.stop()
         assert "runtime error" not in err and "AddressSanitizer" not in err, err
 
 
 def test_a_thousand_writes_cost_no_byte_and_no_tick(tmp_path):
-    before, after, answered = write_while_moving(tmp_path, "dma", WRITES)
+    before, after, answered, accepted = write_while_moving(tmp_path, "dma", WRITES, cut=True)
     assert answered == WRITES
     assert after["saves"] > before["saves"], "no save ran: the test proves nothing"
     assert after["flash_stall_ms"] > before["flash_stall_ms"]
@@ -56,17 +76,47 @@ def test_a_thousand_writes_cost_no_byte_and_no_tick(tmp_path):
     assert after["rx_overruns"] == 0
     assert after["rx_lost"] == 0
     assert after["collisions"] == 0
+    assert accepted is not None
+    assert after["current_limit"] == accepted, "an acknowledged change was lost at the cut"
+
+
+def overruns_while_programming(tmp_path, rx, run):
+    """Servo 1's receive overruns after writes at 1 Mbaud, each followed at
+    once, without waiting for its answer, by a ping to servo 2: servo 1
+    programs its record (24 half-words, 1.7 ms) while the ping and servo
+    2's answer are on the wire."""
+    sim = Simulator(ids=[1, 2], state_dir=str(tmp_path / f"{rx}-{run}"), rx=rx)
+    sim.start()
+    try:
+        with sim.bus(timeout=0.2) as bus:
+            for i in (1, 2):
+                Servo(bus, i).write("baud", BAUD_INDEX_1M)
+        sim.control("hostbaud 1000000")
+        with sim.bus(baud=1000000, timeout=0.2) as bus:
+            for n in range(30):  # within the free slots: every write programs
+                value = (3000 + n % 2).to_bytes(2, "little")
+                bus.send(p.WRITE_DATA, bytes([1, 43]) + value)
+                bus.send(p.PING, bytes([2]))
+                for code, servo_id in ((p.PING, 2), (p.WRITE_DATA, 1)):
+                    try:
+                        bus.read_response(code, servo_id)
+                    except NoReply:
+                        pass
+        return sim.state(1)
+    finally:
+        err = sim.stop()
+        assert "runtime error" not in err and "AddressSanitizer" not in err, err
 
 
 def test_a_port_without_dma_would_lose_bytes(tmp_path):
-    """The model bites: the same traffic with a byte per receive interrupt
-    overruns while a half-word programs (70 us, 7 bytes at 1 Mbaud). Bytes
-    must be on the wire during a program step for that; a simulator that
-    falls behind the wall clock (a loaded machine) catches up with none in
-    flight, so up to three runs are given."""
+    """The model bites: bytes that arrive while a record programs wait in
+    the DMA ring, and overrun a port that takes each byte in its receive
+    interrupt (70 us a half-word, 7 bytes at 1 Mbaud). A simulator that
+    falls behind the wall clock (a loaded machine) may catch up with none
+    in flight, so up to three runs are given."""
+    assert overruns_while_programming(tmp_path, "dma", 0)["rx_overruns"] == 0
     for attempt in range(3):
-        _, after, _ = write_while_moving(tmp_path, "interrupt", WRITES, attempt)
-        if after["rx_overruns"] > 0:
+        if overruns_while_programming(tmp_path, "interrupt", attempt)["rx_overruns"] > 0:
             return
     raise AssertionError("no overrun in three runs: the flash stall model does not bite")
 
@@ -93,8 +143,7 @@ def test_an_answer_that_would_leave_late_is_dropped_and_counted(tmp_path, capsys
                 # then erased ahead once the line is quiet for 100 ms.
                 while True:
                     n += 1
-                    one.write("current_limit", 3000 + n % 2)
-                    sim.sleep(0.07)  # saved 50 ms after the change
+                    one.write("current_limit", 3000 + n % 2)  # saved before the answer
                     state = sim.state(1)
                     if state["saves"] % 21 == 1 and state["saves"] > 1:
                         answered_at = state["last_sent_ms"] / 1000.0  # simulated time
@@ -115,6 +164,38 @@ def test_an_answer_that_would_leave_late_is_dropped_and_counted(tmp_path, capsys
         assert main(["--port", sim.url, "store", "1", "--json"], clock=sim.clock_s) == 0
         report = json.loads(capsys.readouterr().out)
         assert report["answers_dropped"] == landed and report["bytes_lost"] == 0
+        assert sim.state(1)["collisions"] == 0
+    finally:
+        err = sim.stop()
+        assert "runtime error" not in err and "AddressSanitizer" not in err, err
+
+
+def test_a_driven_servo_refuses_a_change_it_cannot_store_and_says_why(tmp_path):
+    """While the wheel turns the servo erases nothing, so once the free
+    slots are spent a change is refused (result 0, nothing kept in RAM),
+    and servoctl says why and what to do. Released, with the line quiet,
+    the servo erases the next page and takes the change."""
+    import pytest
+
+    sim = Simulator(ids=[1], state_dir=str(tmp_path / "state"))
+    sim.start()
+    try:
+        with sim.bus(timeout=0.2) as bus:
+            one = Servo(bus, 1)
+            one.write("soft_start_on", 0)
+            one.wheel("run", speed_dps=90)
+            with pytest.raises(Refused) as refused:
+                for n in range(100):  # at most 2 pages of 21 records
+                    one.write("current_limit", 3000 + n % 2)
+                    bus.sleep(0.15)  # quiet, but the output is driven
+            assert "release it" in str(refused.value), refused.value
+            assert one.read_store().flag_names() == ["needs_erase"]
+            held = one.read("current_limit")
+            one.release()
+            bus.sleep(0.3)  # 100 ms of quiet, then the 40 ms erase
+            one.write("current_limit", held ^ 1)
+            assert one.read("current_limit") == held ^ 1
+            assert one.read_store().flag_names() == []
         assert sim.state(1)["collisions"] == 0
     finally:
         err = sim.stop()
