@@ -47,12 +47,17 @@ enum packet_outcome handle_read_data(const struct packet_call *c, struct respons
     return OUTCOME_OK;
 }
 
+/* One item written as WriteData does: true once it holds the value, durably. */
+static bool write_item(const struct packet_call *c, uint8_t id, const uint8_t *data, uint8_t length)
+{
+    const struct user_config before = c->d->regs->user;
+    enum data_write_result w = data_table_write(c->d->regs, id, data, length);
+    return w == DATA_WRITE_SAME || (w == DATA_WRITE_CHANGED && keep_change(c, &before));
+}
+
 enum packet_outcome handle_write_data(const struct packet_call *c, struct response *r)
 {
-    uint8_t data_length = (uint8_t)(c->length - 2u);
-    const struct user_config before = c->d->regs->user;
-    enum data_write_result w = data_table_write(c->d->regs, c->content[1], &c->content[2], data_length);
-    bool ok = w == DATA_WRITE_SAME || (w == DATA_WRITE_CHANGED && keep_change(c, &before));
+    bool ok = write_item(c, c->content[1], &c->content[2], (uint8_t)(c->length - 2u));
     r->content[0] = c->content[0];
     r->content[1] = c->content[1];
     r->content[2] = ok ? 1u : 0u;
@@ -112,4 +117,21 @@ enum packet_outcome handle_monitor(const struct packet_call *c, struct response 
     wire_put_u16(&p[14], (uint16_t)angle.turns);
     r->length = 16;
     return OUTCOME_OK;
+}
+
+enum { ITEM_SERVO_ID = 34 };
+
+/* AssignId (docs/packets.md): addressed by serial number, not by ID, so
+ * it reaches one servo among several that share an ID; the others stay
+ * silent. The ID is written as WriteData of item 34 writes it. */
+enum packet_outcome handle_assign_id(const struct packet_call *c, struct response *r)
+{
+    if (wire_get_u32(c->content) != c->d->regs->status.serial_number) {
+        return OUTCOME_NONE;
+    }
+    bool ok = write_item(c, ITEM_SERVO_ID, &c->content[4], 1u);
+    r->content[0] = c->d->regs->user.servo_id;
+    r->content[1] = ok ? 1u : 0u;
+    r->length = 2;
+    return ok ? OUTCOME_OK : OUTCOME_FAILED;
 }

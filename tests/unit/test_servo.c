@@ -244,6 +244,27 @@ static void test_config_survives_restart(void **state)
     assert_int_equal(hal.flash.steps, steps);
 }
 
+/* AssignId (0x42): only the servo with the serial number takes the ID and
+ * answers, whatever its ID; the ID is durable as WriteData's; an ID above
+ * 254 is refused. */
+static void test_assign_id_by_serial_number(void **state)
+{
+    (void)state;
+    REQUEST(0x42, 0x79, 0x56, 0x34, 0x12, 7); /* another servo's serial number */
+    EXPECT_SILENCE();
+    assert_int_equal(servo.regs.user.servo_id, 0);
+    assert_int_equal(servo.regs.status.status & STATUS_COMMAND_ERROR, 0);
+    REQUEST(0x42, 0x78, 0x56, 0x34, 0x12, 255);
+    EXPECT_RESPONSE(0x42, 0, 0);
+    REQUEST(0x42, 0x78, 0x56, 0x34, 0x12, 7);
+    EXPECT_RESPONSE(0x42, 7, 1);
+    harness_restart();
+    REQUEST(1, 7);
+    EXPECT_RESPONSE(1, 7);
+    REQUEST(0x42, 0x78, 0x56, 0x34, 0x12); /* short: a malformed frame, no answer */
+    EXPECT_SILENCE();
+}
+
 /* ReadStore (0x41): field at offset `at` of the answer's content. */
 static uint32_t store_field(size_t at)
 {
@@ -632,6 +653,7 @@ int main(void)
         cmocka_unit_test_setup(test_an_answer_that_would_leave_late_is_dropped, setup),
         cmocka_unit_test_setup(test_update_enter_restarts_into_the_bootloader, setup),
         cmocka_unit_test_setup(test_garbage_between_frames_and_responses_of_others, setup),
+        cmocka_unit_test_setup(test_assign_id_by_serial_number, setup),
     };
     return cmocka_run_group_tests_name("servo", tests, NULL, NULL);
 }

@@ -15,7 +15,7 @@ import os
 import sys
 import time
 
-from . import __version__, config_diff, config_file, frame, group, ntc, outcome, registers, scan, units
+from . import __version__, config_diff, config_file, frame, group, ids, ntc, outcome, registers, scan, units
 from . import protocol as p
 from .profile import positions, velocity_timing
 from .protocol import BadAnswer, Bus, NoReply, Refused, ServoError, UsageError
@@ -163,6 +163,22 @@ def cmd_info(bus, args):
     print(f"  model        0x{s.read('model'):04x}")
     print(f"  firmware     0x{s.read('firmware'):04x}")
     print(f"  serial       0x{s.read('serial'):08x}")
+    return 0
+
+
+def cmd_id(bus, args):
+    if args.action == "assign":
+        if len(args.rest) != 2:
+            raise UsageError("id assign takes SERIAL ID (scan shows serial numbers)")
+        serial, new_id = ids.serial_number(args.rest[0]), id_number(args.rest[1])
+        ids.assign(bus, serial, new_id)
+        print(f"servo serial 0x{serial:08x} is now ID {new_id}")
+        return 0
+    if args.rest:
+        raise UsageError("id bringup takes no arguments: --from-id, --first, --count, --wait-s")
+    done = ids.bring_up(bus, args.from_id, args.first, args.count, args.wait_s,
+                        lambda line: print(line, flush=True))
+    print(f"{len(done)} servo(s) numbered: " + ", ".join(f"0x{s:08x} -> {i}" for s, i in done))
     return 0
 
 
@@ -693,6 +709,17 @@ def build_parser():
     c.add_argument("id", type=int)
     c.add_argument("--json", action="store_true", help="as one JSON object, SI units")
     c.set_defaults(run=cmd_info)
+
+    c = sub.add_parser("id", help="IDs by serial number: assign SERIAL ID; bringup numbers new "
+                                  "servos connected one at a time")
+    c.add_argument("action", choices=["assign", "bringup"])
+    c.add_argument("rest", nargs="*", help="assign: SERIAL ID")
+    c.add_argument("--from-id", type=id_number, default=0, help="bringup: the new servos' ID (default 0)")
+    c.add_argument("--first", type=id_number, default=1, help="bringup: the first ID to give (default 1)")
+    c.add_argument("--count", type=int, default=1, help="bringup: how many servos (default 1)")
+    c.add_argument("--wait-s", type=finite, default=60.0,
+                   help="bringup: seconds to wait for each servo (default 60)")
+    c.set_defaults(run=cmd_id)
 
     c = sub.add_parser("store", help="the config store's health; answers dropped and bytes lost "
                                      "to flash work")

@@ -33,6 +33,7 @@ STOP_ON_CONTROL = 24
 SYNC = 25
 READ_MOTION = 0x40  # this firmware's own (docs/packets.md)
 READ_STORE = 0x41
+ASSIGN_ID = 0x42
 
 
 class ServoError(Exception):
@@ -192,9 +193,10 @@ class Bus:
             self._read_at = self.clock()
             self._buffer += data
 
-    def read_response(self, code: int, servo_id: int, timeout=None):
+    def read_response(self, code: int, servo_id, timeout=None):
         """Content of the next response with this packet number from this
-        servo; other frames on the wire are skipped."""
+        servo (any servo if servo_id is None); other frames on the wire are
+        skipped."""
         deadline = self.clock() + (self.timeout if timeout is None else timeout)
         bad = None
         last_look = False
@@ -204,16 +206,17 @@ class Bus:
                 fcode, content, ok = frame
                 if not ok:
                     bad = fcode
-                elif fcode == code and content[:1] == bytes([servo_id]):
+                elif fcode == code and (servo_id is None or content[:1] == bytes([servo_id])):
                     self.arrived_at = self._read_at
                     return content
                 continue
             # A host that was not scheduled until after the deadline reads
             # what arrived meanwhile once more before it gives up.
             if last_look:
+                who = "no servo" if servo_id is None else f"servo {servo_id}"
                 if bad is not None:
-                    raise BadChecksum(f"servo {servo_id}: response to packet {code} had a bad checksum")
-                raise NoReply(f"servo {servo_id}: no reply to packet {code} within "
+                    raise BadChecksum(f"{who}: response to packet {code} had a bad checksum")
+                raise NoReply(f"{who}: no reply to packet {code} within "
                               f"{(self.timeout if timeout is None else timeout) * 1000:.0f} ms")
             last_look = self.clock() > deadline
             self._fill(wait=not last_look)

@@ -38,11 +38,14 @@ class Found:
 
     def describe(self) -> str:
         where = f"servo {self.id} at {self.baud} baud"
+        if self.shared and len(self.serials) > 1:
+            return (f"{where}: TWO OR MORE SERVOS hold this ID (serials "
+                    f"{', '.join(f'0x{s:08x}' for s in self.serials)}). Give one a free ID by its "
+                    f"serial number: 'servoctl id assign 0x{self.serials[-1]:08x} N'")
         if self.shared:
-            heard = (f"serials {', '.join(f'0x{s:08x}' for s in self.serials)}" if len(self.serials) > 1
-                     else f"{self.answers} good and {self.garbled} garbled answers")
-            return (f"{where}: TWO OR MORE SERVOS hold this ID ({heard}). Disconnect all but one "
-                    f"and give it a free ID ('servoctl config set {self.id} servo_id N')")
+            return (f"{where}: TWO OR MORE SERVOS hold this ID ({self.answers} good and "
+                    f"{self.garbled} garbled answers). Connect them one at a time to learn their "
+                    f"serial numbers ('servoctl scan'), then 'servoctl id assign SERIAL N'")
         if self.mode == "bootloader":
             return (f"{where}: in its bootloader, no application runs ({self.verdict}): "
                     f"'servoctl update {self.id} IMAGE' installs one")

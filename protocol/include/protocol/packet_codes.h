@@ -35,6 +35,7 @@ enum packet_code {
 enum firmware_packet_code {
     PKT_READ_MOTION = 0x40, /* a snapshot of the motion state, for tuning */
     PKT_READ_STORE = 0x41,  /* the config store's health and wear */
+    PKT_ASSIGN_ID = 0x42,   /* a new ID for the servo with a serial number */
     /* Firmware update over the bus (docs/packets.md, firmware/bootloader/). */
     PKT_UPDATE_ENTER = 0x50,  /* the application restarts into the bootloader */
     PKT_UPDATE_ERASE = 0x51,  /* erase one page of the application slot */

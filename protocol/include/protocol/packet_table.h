@@ -58,10 +58,10 @@ const struct packet_desc *packet_find(uint8_t code);
 
 /* The packet's content starts with the servo ID: PF_ADDRESSED, or unknown
  * (judged by the ID position every addressed packet uses). The framer asks
- * for every request on the bus. */
+ * for every request on the bus. AssignId is addressed by serial number. */
 static inline bool packet_is_addressed(uint8_t code)
 {
-    return code >= 32u || !((PACKETS_UNADDRESSED_BELOW_32 >> code) & 1u);
+    return code >= 32u ? code != PKT_ASSIGN_ID : !((PACKETS_UNADDRESSED_BELOW_32 >> code) & 1u);
 }
 
 /* Handlers, grouped by what they touch. */
@@ -74,6 +74,7 @@ enum packet_outcome handle_write_batch(const struct packet_call *c, struct respo
 enum packet_outcome handle_monitor(const struct packet_call *c, struct response *r);
 enum packet_outcome handle_read_motion(const struct packet_call *c, struct response *r);
 enum packet_outcome handle_read_store(const struct packet_call *c, struct response *r);
+enum packet_outcome handle_assign_id(const struct packet_call *c, struct response *r);
 enum packet_outcome handle_update_enter(const struct packet_call *c, struct response *r);
 enum packet_outcome handle_update_status(const struct packet_call *c, struct response *r);
 

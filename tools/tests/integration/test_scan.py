@@ -29,13 +29,41 @@ def test_two_servos_on_one_id_are_found_out(tmp_path, capsys):
         rc, out, err = run(sim, capsys, "scan", "--last", "5")
         assert rc == 1, out + err
         assert ("servo 2 at 115200 baud: TWO OR MORE SERVOS hold this ID "
-                "(serials 0x51a00002, 0x51a00003)") in out, out
+                "(serials 0x51a00002, 0x51a00003). Give one a free ID by its serial number: "
+                "'servoctl id assign 0x51a00003 N'") in out, out
         assert "servo 1 at 115200 baud, serial 0x51a00001" in out
         assert "IDs held by two or more servos: 2" in err
         rc, out, _ = run(sim, capsys, "scan", "--last", "5", "--json")
         found = {f["id"]: f for f in json.loads(out)}
         assert rc == 1 and found[2]["shared"] and not found[1]["shared"]
         assert found[2]["serials"] == [0x51A00002, 0x51A00003]
+        # AssignId reaches one of them by its serial number.
+        rc, _, err = run(sim, capsys, "id", "assign", "0x51a00003", "1")
+        assert rc == 1 and "ID 1 already answers on this bus" in err, err
+        rc, out, _ = run(sim, capsys, "id", "assign", "0x51a00003", "7")
+        assert rc == 0 and "servo serial 0x51a00003 is now ID 7" in out
+        rc, out, _ = run(sim, capsys, "scan", "--last", "9", "--json")
+        assert rc == 0 and [(f["id"], f["serials"], f["shared"]) for f in json.loads(out)] == [
+            (1, [0x51A00001], False), (2, [0x51A00002], False), (7, [0x51A00003], False)]
+        sim.control("powercycle")  # durable: still 7 after a restart
+        sim.sleep(0.5)
+        with sim.bus() as bus:
+            assert Servo(bus, 7).read("serial") == 0x51A00003
+        rc, _, err = run(sim, capsys, "id", "assign", "0x51a00009", "9")
+        assert rc == 3 and "no servo with serial 0x51a00009 answered AssignId" in err, err
+
+
+def test_bringup_numbers_new_servos_one_at_a_time(tmp_path, capsys):
+    """A new servo answers at the factory ID 0; bringup gives it the first
+    free ID from --first on (5 is taken) and waits for the next, which,
+    here, never comes."""
+    with Simulator(ids=[0, 5], state_dir=str(tmp_path / "state")) as sim:
+        rc, out, _ = run(sim, capsys, "id", "bringup", "--first", "5", "--count", "1")
+        assert rc == 0 and "servo serial 0x51a00000 is now ID 6" in out, out
+        rc, out, err = run(sim, capsys, "id", "bringup", "--count", "1", "--wait-s", "1")
+        assert rc == 3 and "no servo alone at ID 0 within 1 s; 0 numbered" in err, out + err
+        with sim.bus() as bus:
+            assert Servo(bus, 6).read("serial") == 0x51A00000
 
 
 class GarbledTwins:
