@@ -182,6 +182,20 @@ def cmd_id(bus, args):
     return 0
 
 
+def cmd_bench(bus, args):
+    from . import bench, image as img
+
+    figures = [bench.sync_monitor_rounds(bus, args.ids, args.seconds)]
+    if args.update_id is not None:
+        image = (img.load(args.image) if args.image else
+                 bench.image_of_size(args.image_size, 0x0010, img.BOARDS["host_sim"]))
+        figures.append(bench.update_time(bus, args.update_id, image))
+    for f in figures:
+        print(json.dumps({"what": f.what, "measured": f.measured, "limit": f.limit, "unit": f.unit,
+                          "ratio": f.ratio}) if args.json else f.line())
+    return 0
+
+
 def cmd_store(bus, args):
     """ReadStore: the config store's health, and what flash work cost the
     bus (answers dropped, bytes lost): a host that missed an answer, or
@@ -720,6 +734,16 @@ def build_parser():
     c.add_argument("--wait-s", type=finite, default=60.0,
                    help="bringup: seconds to wait for each servo (default 60)")
     c.set_defaults(run=cmd_id)
+
+    c = sub.add_parser("bench", help="Sync Monitor rounds a second and update time, against the "
+                                     "wire's limit")
+    c.add_argument("--ids", type=id_number, nargs="+", required=True, help="the servos to monitor")
+    c.add_argument("--seconds", type=finite, default=3.0, help="of Sync Monitor rounds (default 3)")
+    c.add_argument("--update-id", type=id_number, help="also time an update of this servo")
+    c.add_argument("--image", help="the update image (default: a stand-in for the simulator)")
+    c.add_argument("--image-size", type=int, default=20480, help="the stand-in's code bytes")
+    c.add_argument("--json", action="store_true", help="one JSON object per figure")
+    c.set_defaults(run=cmd_bench)
 
     c = sub.add_parser("store", help="the config store's health; answers dropped and bytes lost "
                                      "to flash work")

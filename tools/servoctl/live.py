@@ -4,6 +4,7 @@ rows or JSON lines otherwise, and as a live plot of angle, speed, current
 and temperature against time (matplotlib), or a plot file at the end."""
 from dataclasses import dataclass, asdict
 import json
+import math
 import sys
 
 from . import group, ntc, registers
@@ -16,7 +17,7 @@ class Sample:
     t_s: float
     id: int
     angle_deg: float
-    velocity_dps: float  # from two successive angles
+    velocity_dps: float  # from two successive angles; NaN for a servo's first (JSON null)
     voltage_v: float
     current_a: float
     power_w: float
@@ -60,13 +61,14 @@ class Sampler:
             now = arrivals[servo_id] - self.t0
             angle = m.angle_decideg / 10.0
             before = self.last.get(servo_id)
-            speed = (angle - before[1]) / (now - before[0]) if before and now > before[0] else 0.0
+            # A speed needs two answers in a row: none is better than a false 0.
+            speed = (angle - before[1]) / (now - before[0]) if before and now > before[0] else math.nan
             self.last[servo_id] = (now, angle)
             out.append(Sample(round(now, 3), servo_id, angle, round(speed, 1), m.voltage_mv / 1000.0,
                               m.current_ma / 1000.0, m.power_mw / 1000.0, _celsius(m.temperature_adc),
                               registers.status_names(m.status)))
         for servo_id in silent:
-            self.last.pop(servo_id, None)  # a speed needs two answers in a row
+            self.last.pop(servo_id, None)
         return out, silent
 
 
@@ -81,15 +83,26 @@ def _table(samples: dict):
         if isinstance(s, str):  # silent: why, and no stale values
             t.add_row(str(servo_id), *[""] * 6, f"silent: {s}")
             continue
-        t.add_row(str(s.id), f"{s.angle_deg:.1f}", f"{s.velocity_dps:.0f}", f"{s.voltage_v:.2f}",
-                  f"{s.current_a:.3f}", f"{s.power_w:.2f}", f"{s.temperature_c:.1f}",
+        t.add_row(str(s.id), f"{s.angle_deg:.1f}", _num(s.velocity_dps, ".0f"), f"{s.voltage_v:.2f}",
+                  f"{s.current_a:.3f}", f"{s.power_w:.2f}", _num(s.temperature_c, ".1f"),
                   ", ".join(s.status) or "ok")
     return t
 
 
+def _num(value: float, fmt: str) -> str:
+    """A value, or '-' where there is none (NaN)."""
+    return "-" if math.isnan(value) else format(value, fmt)
+
+
+def sample_json(s: Sample) -> str:
+    """One JSON line; a value there is none of (NaN) is null."""
+    return json.dumps({k: None if isinstance(v, float) and math.isnan(v) else v
+                       for k, v in asdict(s).items()})
+
+
 def _row(s: Sample) -> str:
-    return (f"{s.id:>3} {s.angle_deg:>10.1f} {s.velocity_dps:>7.0f} {s.voltage_v:>6.2f} "
-            f"{s.current_a:>6.3f} {s.power_w:>6.2f} {s.temperature_c:>6.1f}  "
+    return (f"{s.id:>3} {s.angle_deg:>10.1f} {_num(s.velocity_dps, '.0f'):>7} {s.voltage_v:>6.2f} "
+            f"{s.current_a:>6.3f} {s.power_w:>6.2f} {_num(s.temperature_c, '.1f'):>6}  "
             f"{', '.join(s.status) or 'ok'}")
 
 
@@ -182,7 +195,7 @@ def monitor(bus, ids, every_s: float, count: int, sync: bool, as_json: bool,
                 latest[s.id] = s
                 never.pop(s.id, None)
                 if as_json:
-                    print(json.dumps(asdict(s)), flush=True)
+                    print(sample_json(s), flush=True)
                 elif not tty:
                     print(_row(s), flush=True)
             for servo_id, why in sorted(silent.items()):

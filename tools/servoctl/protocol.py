@@ -123,7 +123,7 @@ class Bus:
             # Exclusive: a second program on the port would take answers
             # meant for this one (a flock on a serial device; other URLs
             # ignore it).
-            self.serial = serial.serial_for_url(port, baudrate=baud, timeout=0.005, exclusive=True)
+            self.serial = serial.serial_for_url(port, baudrate=baud, timeout=0, exclusive=True)
         except serial.SerialException as e:
             if "exclusively lock" in str(e):
                 raise LinkError(f"{port} is in use by another program (another servoctl, a "
@@ -136,6 +136,9 @@ class Bus:
             import socket
 
             sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        # Reads never block (timeout 0); a wait for bytes is a select on
+        # the port, which returns the moment one arrives.
+        self._fd = sock.fileno() if sock is not None else getattr(self.serial, "fd", None)
         self._buffer = b""
         self.stray_bytes = 0  # bytes outside any frame: noise, or answers that collided
         self._read_at = 0.0
@@ -180,15 +183,17 @@ class Bus:
         self._link(self.serial.write, request_frame(code, content))
 
     def _fill(self, wait: bool = True) -> None:
-        """Reads what has arrived; with wait, up to the port's 5 ms for it.
-        Without, everything already there: pyserial's socket:// says 1 for
-        in_waiting whatever is waiting, so it is read until none is."""
+        """Reads what has arrived; with wait, first waits up to 5 ms for a
+        byte, returning as soon as one is there, so an answer is taken the
+        moment its last byte is."""
         if wait:
-            data = self._link(self.serial.read, 256)
-        else:
-            data = b""
-            while waiting := self._link(lambda: self.serial.in_waiting):
-                data += self._link(self.serial.read, waiting)
+            if self._fd is not None:
+                import select
+
+                select.select([self._fd], [], [], 0.005)
+            else:  # loop:// and other ports without a descriptor
+                time.sleep(0.0005)
+        data = self._link(self.serial.read, 4096)
         if data:
             self._read_at = self.clock()
             self._buffer += data

@@ -63,12 +63,16 @@ def probe(bus: p.Bus, servo_id: int, window_s: float):
     if not pings and not garbled and not stray:
         return None
     found = Found(servo_id, bus.serial.baudrate, answers=len(pings), garbled=garbled + (stray > 0))
+    # Every request listens long enough for two whole answers (21 bytes
+    # each at most): a second servo's late answer must not run into the
+    # next request's.
+    window_s += 2 * 21 * 10 / bus.serial.baudrate
+    statuses, bad, stray = bus.gather(update.UPDATE_STATUS, bytes([servo_id]), window_s)
+    found.garbled += bad + (stray > 0)
     try:
-        st = update.status(bus, servo_id, timeout=window_s)
+        st = update.decode_status(servo_id, statuses[0]) if statuses else None
     except BadAnswer:
-        st = None  # garbled: shared, or another firmware
-    except NoReply:
-        st = None  # a firmware without UpdateStatus: an application
+        st = None  # another firmware's
     if st is not None and st.mode == update.MODE_BOOTLOADER:
         found.mode = "bootloader"
         found.verdict = update.VERDICTS.get(st.verdict, f"verdict {st.verdict}")

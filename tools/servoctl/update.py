@@ -37,7 +37,10 @@ class Status:
 
 
 def status(bus, servo_id: int, timeout=None) -> Status:
-    c = bus.request(UPDATE_STATUS, bytes([servo_id]), timeout=timeout)
+    return decode_status(servo_id, bus.request(UPDATE_STATUS, bytes([servo_id]), timeout=timeout))
+
+
+def decode_status(servo_id: int, c: bytes) -> Status:
     if len(c) != 16:
         raise BadAnswer(f"servo {servo_id}: an UpdateStatus answer of {len(c)} bytes, not 16: not this firmware")
     return Status(c[1], *struct.unpack_from("<HBHHHHBH", c, 2))
@@ -152,16 +155,9 @@ def _write(bus, servo_id: int, offset: int, chunk: bytes):
             raise Refused(f"servo {servo_id}: writing offset {offset} refused: {_reason(c, WRITE_REASONS)}")
 
 
-def update(bus, servo_id: int, image: Image, progress=lambda done, total: None) -> tuple:
-    """Writes `image` into servo `servo_id` and starts it. Returns the
-    version before (None if no application ran) and after."""
-    st = status(bus, servo_id)
-    if image.board != st.board:  # before anything changes
-        raise Refused(f"servo {servo_id} is board {st.board:#06x}; the image is for {image.board:#06x}")
-    before = st.version if st.mode == MODE_APP or st.verdict == 0 else None
-    if st.mode == MODE_APP:
-        st = _switch(bus, servo_id, UPDATE_ENTER, "UpdateEnter", MODE_BOOTLOADER,
-                     lambda c: enter_refusal(servo_id, c[2] if len(c) > 2 else None))
+def write_image(bus, servo_id: int, image: Image, st: Status, progress=lambda done, total: None):
+    """In the bootloader (st its UpdateStatus): erases the slot's pages,
+    writes the image (the header's checked bytes last) and verifies it."""
     if len(image.data) > st.page_size * st.pages:
         if st.verdict == 0:  # nothing erased yet: back to the application
             bus.request(UPDATE_BOOT, bytes([servo_id]))
@@ -188,6 +184,28 @@ def update(bus, servo_id: int, image: Image, progress=lambda done, total: None) 
     verdict, size, crc, version, _board = struct.unpack_from("<BIIHH", c, 1)
     if verdict != 0 or (size, crc, version) != (image.size, image.crc, image.version):
         raise Refused(f"servo {servo_id}: the written image does not check: {VERDICTS.get(verdict, verdict)}")
-    after = _switch(bus, servo_id, UPDATE_BOOT, "UpdateBoot", MODE_APP,
-                    lambda c: f"servo {servo_id}: the bootloader would not start the image").version
-    return before, after
+
+
+def update(bus, servo_id: int, image: Image, progress=lambda done, total: None) -> tuple:
+    """Writes `image` into servo `servo_id` and starts it. Returns the
+    version before (None if no application ran) and after."""
+    st = status(bus, servo_id)
+    if image.board != st.board:  # before anything changes
+        raise Refused(f"servo {servo_id} is board {st.board:#06x}; the image is for {image.board:#06x}")
+    before = st.version if st.mode == MODE_APP or st.verdict == 0 else None
+    if st.mode == MODE_APP:
+        st = enter_bootloader(bus, servo_id)
+    write_image(bus, servo_id, image, st, progress)
+    return before, start_application(bus, servo_id).version
+
+
+def enter_bootloader(bus, servo_id: int) -> Status:
+    """UpdateEnter; the bootloader's Status once it answers."""
+    return _switch(bus, servo_id, UPDATE_ENTER, "UpdateEnter", MODE_BOOTLOADER,
+                   lambda c: enter_refusal(servo_id, c[2] if len(c) > 2 else None))
+
+
+def start_application(bus, servo_id: int) -> Status:
+    """UpdateBoot; the new application's Status once it answers."""
+    return _switch(bus, servo_id, UPDATE_BOOT, "UpdateBoot", MODE_APP,
+                   lambda c: f"servo {servo_id}: the bootloader would not start the image")

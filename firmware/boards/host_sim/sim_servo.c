@@ -47,11 +47,15 @@ static uint32_t now_us(void *ctx)
     return (uint32_t)s->bus->now_us;
 }
 
+/* The CPU sends after the flash work it did earlier in this pass: a flash
+ * step stalls it (RM0008 3.3.3), so an answer to a write that programmed
+ * flash leaves once the programming is done, not before. */
 static void uart_send(void *ctx, const uint8_t *data, uint16_t len)
 {
     struct sim_servo *s = ctx;
-    s->last_sent_us = s->bus->now_us;
-    s->tx_done_us = sim_bus_send(s->bus, s->index, data, len, s->baud, s->bus->now_us);
+    uint64_t at = s->bus->now_us + s->flash.stall_us + s->slot_flash.stall_us;
+    s->last_sent_us = at;
+    s->tx_done_us = sim_bus_send(s->bus, s->index, data, len, s->baud, at);
 }
 
 static bool uart_tx_done(void *ctx)

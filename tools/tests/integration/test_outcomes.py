@@ -294,6 +294,7 @@ def test_monitor_live_views(sim3, capsys, tmp_path):
         speeds = [(b["angle_deg"] - a["angle_deg"]) / (b["t_s"] - a["t_s"]) for a, b in zip(mine, mine[1:])]
         # t_s is rounded to the millisecond, the speed is not.
         assert [r["velocity_dps"] for r in mine[1:]] == pytest.approx(speeds, rel=0.03)
+        assert mine[0]["velocity_dps"] is None  # no speed from one answer (it read 0)
         assert all(sign * v > 0 for v in speeds), (servo_id, speeds)
         # A stamp is late by however long the host took to read the answer:
         # over the whole run that is within a few per cent.
