@@ -26,7 +26,11 @@ An answer the servo did not send because the request arrived during its
 erase is counted apart (answers missed, reported): the host learns of it
 from ReadStore, as docs/decisions.md tells it to.
 
-    python tests/storm/storm.py --minutes 30 --out build/storm
+Every wait for an answer is in simulated time (the control port's clock):
+on a loaded PC the simulator falls behind the host, and a late answer is
+not a lost one. The storm's length and its pacing are the host's.
+
+    python tests/storm/storm.py --minutes 30 --seed 1 --out build/storm-1
 """
 import argparse
 import json
@@ -79,7 +83,7 @@ class Sim:
             [str(self.binary), "--state", str(self.state), "--tcp", str(port),
              *sum((["--id", str(i)] for i in IDS), [])],
             stdout=subprocess.PIPE, stderr=self.errors, text=True)
-        self.url = self.control = None
+        self.url = self.control = self.clock_sock = None
         for line in self.process.stdout:
             words = line.split()
             if words[1:2] == ["bus"]:
@@ -96,6 +100,23 @@ class Sim:
     def command(self, line: str) -> str:
         return control_command(self.control, line, timeout=5)
 
+    def clock_s(self) -> float:
+        """The simulated clock, seconds, over a control connection kept
+        open. Every wait for an answer is judged on it: on a loaded PC the
+        simulator falls behind the host, and a host-time deadline would
+        call a late answer lost."""
+        if self.clock_sock is None:
+            self.clock_sock = socket.create_connection(("127.0.0.1", self.control), timeout=5)
+            self.clock_sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        self.clock_sock.sendall(b"clock\n")
+        reply = b""
+        while not reply.endswith(b"\n"):
+            chunk = self.clock_sock.recv(256)
+            if not chunk:
+                raise ConnectionError("servo_sim closed its control port")
+            reply += chunk
+        return float(re.search(rb"sim_ms=([0-9.]+)", reply).group(1)) / 1000.0
+
     def state_of(self, servo_id: int) -> dict:
         out = {}
         for pair in self.command(f"state {servo_id}").split():
@@ -103,14 +124,19 @@ class Sim:
             out[key] = value
         return out
 
-    def kill(self):
+    def _close(self):
         self.sock.close()
+        if self.clock_sock is not None:
+            self.clock_sock.close()
+
+    def kill(self):
+        self._close()
         self.process.send_signal(signal.SIGKILL)
         self.process.wait()
         self.errors.close()
 
     def stop(self):
-        self.sock.close()
+        self._close()
         self.process.send_signal(signal.SIGTERM)
         self.process.wait(timeout=10)
         self.errors.close()
@@ -184,9 +210,9 @@ class Host:
             yield frame[2], frame[4:-1]
 
     def listen(self, seconds: float, want=None):
-        """Reads for up to `seconds`; returns the first frame `want` accepts,
-        counting finished-move answers on the way."""
-        deadline = time.monotonic() + seconds
+        """Reads for up to `seconds` of simulated time; returns the first
+        frame `want` accepts, counting finished-move answers on the way."""
+        deadline = self.sim.clock_s() + seconds
         while True:
             for code, content in self._frames():
                 if code in (p.ANGLE, p.MULTI_TURN_BY_INTERVAL) and content[:1] and content[0] in ANSWERING \
@@ -195,7 +221,7 @@ class Host:
                     continue
                 if want is not None and want(code, content):
                     return code, content
-            if time.monotonic() > deadline:
+            if self.sim.clock_s() > deadline:
                 return None
             try:
                 data = self.sim.sock.recv(4096)
@@ -327,8 +353,8 @@ def run(minutes: float, out: Path, seed: int):
     def settle_answers():
         """Leave the line quiet until every finished move has answered
         (each goes out in its slot once the host pauses)."""
-        deadline = time.monotonic() + 3.0
-        while time.monotonic() < deadline:
+        deadline = sim.clock_s() + 3.0
+        while sim.clock_s() < deadline:
             if all(host.finished[i] - seen_base[i] >= expected[i] for i in ANSWERING):
                 return
             host.listen(0.05)
