@@ -10,5 +10,5 @@ set(SERVO_BOARD_ID 0x0030)                                 # the update image he
 # meets it (README, "Footprint"), it fails above this ceiling, so it cannot
 # grow back.
 set(SERVO_BOARD_RAM_LIMIT 4096)
-set(SERVO_BOARD_FLASH_LIMIT 20480) # 19988 B on 2026-11-23
+set(SERVO_BOARD_FLASH_LIMIT 20480) # the application: README, "Footprint"
 set(SERVO_BOARD_BOOT_LINKER ${CMAKE_CURRENT_LIST_DIR}/stm32f030k6_boot.ld)
