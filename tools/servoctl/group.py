@@ -82,14 +82,19 @@ def sync_monitor(bus: p.Bus, ids: list, timeout_s: float = None, arrivals: dict 
     bus.send(p.SYNC, bytes([p.MONITOR, 1, len(ids)] + list(ids)))
     # Each answer is 21 bytes; an absent servo costs 3 ms of silence.
     wait = timeout_s if timeout_s is not None else 0.05 + len(ids) * (0.004 + 210 / bus.serial.baudrate)
+    deadline = bus.clock() + wait  # one for the round: the clock is read as little as can be
     out = {}
-    for servo_id in ids:
-        try:
-            out[servo_id] = Monitor.decode(bus.read_response(p.MONITOR, servo_id, timeout=wait))
-        except NoReply:
-            continue
-        if arrivals is not None:
-            arrivals[servo_id] = bus.arrived_at
+    stamping, bus.stamp_arrivals = bus.stamp_arrivals, arrivals is not None
+    try:
+        for servo_id in ids:
+            try:
+                out[servo_id] = Monitor.decode(bus.read_response(p.MONITOR, servo_id, deadline=deadline))
+            except NoReply:
+                continue
+            if arrivals is not None:
+                arrivals[servo_id] = bus.arrived_at
+    finally:
+        bus.stamp_arrivals = stamping
     return out
 
 
