@@ -63,7 +63,8 @@ void dispatch_packet(struct dispatcher *d, const struct packet_desc *desc,
         break;
     }
     /* Sync records answer only where the packet always answers (Monitor). */
-    bool may_answer = alone || (origin.from_sync && (desc->flags & PF_ANSWERS));
+    bool may_answer = alone || (origin.from_sync && (desc->flags & PF_ANSWERS)) ||
+                      (origin.broadcast && (desc->flags & PF_ONE_ANSWERS));
     result->answer = may_answer && answers(d, desc->flags) &&
                      (outcome == OUTCOME_OK || outcome == OUTCOME_FAILED);
     if (origin.from_sync) {

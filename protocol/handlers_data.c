@@ -121,15 +121,16 @@ enum packet_outcome handle_monitor(const struct packet_call *c, struct response 
 
 enum { ITEM_SERVO_ID = 34 };
 
-/* AssignId (docs/packets.md): addressed by serial number, not by ID, so
- * it reaches one servo among several that share an ID; the others stay
- * silent. The ID is written as WriteData of item 34 writes it. */
+/* AssignId (docs/packets.md): sent to every servo (ID 0xFF) and taken by
+ * the one with the serial number, so it reaches one servo among several
+ * that share an ID; the others stay silent. The ID is written as WriteData
+ * of item 34 writes it. */
 enum packet_outcome handle_assign_id(const struct packet_call *c, struct response *r)
 {
-    if (wire_get_u32(c->content) != c->d->regs->status.serial_number) {
+    if (wire_get_u32(&c->content[1]) != c->d->regs->status.serial_number) {
         return OUTCOME_NONE;
     }
-    bool ok = write_item(c, ITEM_SERVO_ID, &c->content[4], 1u);
+    bool ok = write_item(c, ITEM_SERVO_ID, &c->content[5], 1u);
     r->content[0] = c->d->regs->user.servo_id;
     r->content[1] = ok ? 1u : 0u;
     r->length = 2;

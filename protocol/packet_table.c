@@ -49,7 +49,7 @@ _Static_assert(sizeof packets / sizeof packets[0] == PKT_SYNC_COMMAND,
 static const struct packet_desc firmware_packets[] = {
     {PKT_READ_MOTION, QUERY, LEN(1), handle_read_motion},
     {PKT_READ_STORE, QUERY, LEN(1), handle_read_store},
-    {PKT_ASSIGN_ID, PF_ANSWERS, LEN(5), handle_assign_id},
+    {PKT_ASSIGN_ID, SETTING | PF_BROADCAST | PF_ONE_ANSWERS, LEN(6), handle_assign_id},
 };
 
 enum { FIRMWARE_PACKETS = sizeof firmware_packets / sizeof firmware_packets[0] };

@@ -175,8 +175,8 @@ SERVO_SEEDS = {
                      + wire(write(50, 600, 2)) + ms(80) + POWER_CYCLE + wire(req(3, b"\x00\x32"))),
     "power_on_lock": (USED, wire(write(46, 1)) + ms(80) + POWER_CYCLE + ms(20)),
     # AssignId (0x42) to the harness's serial number (hal_double.c), then to another.
-    "assign_id_by_serial": (USED, wire(req(0x42, bytes.fromhex("7856341207"))) + ms(80)
-                            + wire(req(0x42, bytes.fromhex("7956341208")) + req(1, b"\x07")) + ms(5)),
+    "assign_id_by_serial": (USED, wire(req(0x42, bytes.fromhex("ff7856341207"))) + ms(80)
+                            + wire(req(0x42, bytes.fromhex("ff7956341208")) + req(1, b"\x07")) + ms(5)),
     "main_loop_stalled": (USED, wire(move(900, 300)) + ms(50) + stall_main_loop(200) + ms(50)),
     "async_then_go": (USED, wire(req(18, b"") + move(900, 100) + req(19, b"\x00")) + ms(200)
                       + wire(req(18, b"") + move(0, 100) + req(19, b"\x01")) + ms(20)),

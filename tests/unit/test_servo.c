@@ -250,18 +250,20 @@ static void test_config_survives_restart(void **state)
 static void test_assign_id_by_serial_number(void **state)
 {
     (void)state;
-    REQUEST(0x42, 0x79, 0x56, 0x34, 0x12, 7); /* another servo's serial number */
+    REQUEST(0x42, 0xFF, 0x79, 0x56, 0x34, 0x12, 7); /* another servo's serial number */
     EXPECT_SILENCE();
     assert_int_equal(servo.regs.user.servo_id, 0);
     assert_int_equal(servo.regs.status.status & STATUS_COMMAND_ERROR, 0);
-    REQUEST(0x42, 0x78, 0x56, 0x34, 0x12, 255);
+    REQUEST(0x42, 0xFF, 0x78, 0x56, 0x34, 0x12, 255);
     EXPECT_RESPONSE(0x42, 0, 0);
-    REQUEST(0x42, 0x78, 0x56, 0x34, 0x12, 7);
+    REQUEST(0x42, 0xFF, 0x78, 0x56, 0x34, 0x12, 7);
     EXPECT_RESPONSE(0x42, 7, 1);
     harness_restart();
     REQUEST(1, 7);
     EXPECT_RESPONSE(1, 7);
-    REQUEST(0x42, 0x78, 0x56, 0x34, 0x12); /* short: a malformed frame, no answer */
+    REQUEST(0x42, 0x07, 0x78, 0x56, 0x34, 0x12, 9); /* to its own ID: taken too */
+    EXPECT_RESPONSE(0x42, 9, 1);
+    REQUEST(0x42, 0xFF, 0x78, 0x56, 0x34, 0x12); /* short: a malformed frame, no answer */
     EXPECT_SILENCE();
 }
 

@@ -30,7 +30,7 @@ def assign(bus: p.Bus, serial: int, new_id: int) -> None:
     holder = scan.probe(bus, new_id, scan.reply_window_s(bus.serial.baudrate))
     if holder is not None and serial not in holder.serials:
         raise Refused(f"ID {new_id} already answers on this bus ({holder.describe()}): pick a free one")
-    bus.send(p.ASSIGN_ID, struct.pack("<IB", serial, new_id))
+    bus.send(p.ASSIGN_ID, struct.pack("<BIB", p.BROADCAST, serial, new_id))
     try:
         answer = bus.read_response(p.ASSIGN_ID, None)
     except NoReply:

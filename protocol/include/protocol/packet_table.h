@@ -16,6 +16,9 @@ enum packet_flags {
     PF_BROADCAST = 1u << 3,   /* runs on every servo when sent to 0xFF */
     PF_QUERY = 1u << 4,       /* reads only: leaves the command-error bit */
     PF_SYNCABLE = 1u << 5,    /* may be a SyncCommand record */
+    /* Broadcast, and answered by the one servo it selects (AssignId, by
+     * serial number): one answer at most. */
+    PF_ONE_ANSWERS = 1u << 6,
 };
 
 enum packet_outcome {
@@ -58,10 +61,10 @@ const struct packet_desc *packet_find(uint8_t code);
 
 /* The packet's content starts with the servo ID: PF_ADDRESSED, or unknown
  * (judged by the ID position every addressed packet uses). The framer asks
- * for every request on the bus. AssignId is addressed by serial number. */
+ * for every request on the bus. */
 static inline bool packet_is_addressed(uint8_t code)
 {
-    return code >= 32u ? code != PKT_ASSIGN_ID : !((PACKETS_UNADDRESSED_BELOW_32 >> code) & 1u);
+    return code >= 32u || !((PACKETS_UNADDRESSED_BELOW_32 >> code) & 1u);
 }
 
 /* Handlers, grouped by what they touch. */
