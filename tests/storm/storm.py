@@ -406,10 +406,21 @@ def run(minutes: float, out: Path, seed: int):
             rng.shuffle(order)
             host.send(request_frame(p.SYNC, bytes([p.MONITOR, 1, len(order)] + order)))
             stats["sync_rounds"] += 1
-            for sid in [s for s in order if s in IDS]:
-                stats["requests"] += 1
-                got = host.listen(0.3 + 0.004 * len(order), lambda c, body, sid=sid: c == p.MONITOR and body[:1] == bytes([sid]))
-                if got is None:
+            # One listen for the whole round: a servo that stays silent (its
+            # request fell in an erase) must not make the host skip past
+            # the answers that follow it.
+            present = [s for s in order if s in IDS]
+            heard = set()
+
+            def round_done(c, body):
+                if c == p.MONITOR and body[:1] and body[0] in present:
+                    heard.add(body[0])
+                return heard >= set(present)
+
+            stats["requests"] += len(present)
+            host.listen(0.3 + 0.004 * len(order), round_done)
+            for sid in present:
+                if sid not in heard:
                     host.missed(sid, f"sync monitor answer of {sid} in {order}")
         elif action == "config" and time.monotonic() >= next_config:
             next_config = time.monotonic() + rng.uniform(1.0, 3.0)
