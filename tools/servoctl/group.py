@@ -6,7 +6,7 @@ import struct
 from . import protocol as p
 from . import config_file
 from .frame import check_target
-from .protocol import NoReply, Refused, UsageError, ValueOutOfRange
+from .protocol import NoReply, Refused, UsageError
 from .servo import MIN_RAMP_MS, Monitor, Servo, _check, _ms, _scaled, check_profile
 
 # SyncCommand records (servo-protocol.md 3.25): the packet's own content.
