@@ -80,7 +80,7 @@ struct servo {
     uint8_t stale_frames;        /* frames that arrived during it: not answered */
     uint32_t answers_dropped;    /* answers not sent: they would have left late */
     uint32_t unsolicited_slot_us;  /* slot length at this baud */
-    uint32_t unsolicited_first_us; /* quiet before this ID's first slot */
+    uint32_t unsolicited_first_us; /* quiet ahead of this ID's first slot */
     struct save_policy saver;
 };
 

@@ -135,9 +135,9 @@ struct motion {
     struct profile_walk walk;  /* the profile walked to tick + 1 */
     /* The acceleration feed-forward, as a duty: the profile's second
      * difference over the last three setpoints, which is the walk's phase
-     * two ticks after the walk enters it (accel_from), as the closed form's
-     * differences were before. Worked out when a phase begins or the limits
-     * change. */
+     * two ticks after the walk enters it (accel_from), which equals the
+     * closed form's second difference. Worked out when a phase begins or the
+     * limits change. */
     int32_t accel_duty;
     int32_t accel_duty_next;
     uint32_t accel_from;       /* the tick accel_duty_next takes over */
