@@ -115,7 +115,7 @@ static void follow_supply(struct motion *m)
 
 static void govern_clock(struct motion *m, int32_t error_q8)
 {
-    int32_t step = m->at_next_q8 - m->at_tick_q8;
+    int32_t step = m->profile_at_next_tick_q8 - m->profile_at_tick_q8;
     int32_t lead = step > 0 ? error_q8 : step < 0 ? -error_q8 : 0;
     m->lead_q8 += (lead - m->lead_q8) >> LEAD_FILTER_SHIFT;
     uint32_t target = CLOCK_REAL_TIME;
@@ -144,11 +144,11 @@ static void advance_clock(struct motion *m)
     if (frac >= CLOCK_REAL_TIME && m->tick < UINT32_MAX) {
         frac -= CLOCK_REAL_TIME;
         m->tick++;
-        m->at_tick_q8 = m->at_next_q8;
+        m->profile_at_tick_q8 = m->profile_at_next_tick_q8;
         if (profile_walk_next(&m->walk, &m->profile)) {
             motion_take_accel_duty(m, m->walk.tick + 1u);
         }
-        m->at_next_q8 = q32_to_q8_sat(m->walk.at, TARGET_LIMIT_Q8);
+        m->profile_at_next_tick_q8 = q32_to_q8_sat(m->walk.at, TARGET_LIMIT_Q8);
         if (m->tick == m->accel_from) {
             m->accel_duty = m->accel_duty_next;
         } else if (m->tick == 1u) {
@@ -157,7 +157,7 @@ static void advance_clock(struct motion *m)
         }
     }
     m->tick_frac = (uint16_t)frac;
-    m->setpoint_q8 = m->at_tick_q8 + (((m->at_next_q8 - m->at_tick_q8) * (int32_t)frac) >> 8);
+    m->setpoint_q8 = m->profile_at_tick_q8 + (((m->profile_at_next_tick_q8 - m->profile_at_tick_q8) * (int32_t)frac) >> 8);
 }
 
 /* A profile whose horn could no longer stop on the target at the output's
@@ -248,7 +248,7 @@ void motion_tick(struct motion *m)
      * bottleneck: drive at the limit the way the profile goes (not while
      * braking, nor once the horn has caught up). */
     if (!real_time && !m->braking && m->lead_q8 > LEAD_FREE_Q8) {
-        in.push = m->at_next_q8 > m->at_tick_q8 ? 1 : m->at_next_q8 < m->at_tick_q8 ? -1 : 0;
+        in.push = m->profile_at_next_tick_q8 > m->profile_at_tick_q8 ? 1 : m->profile_at_next_tick_q8 < m->profile_at_tick_q8 ? -1 : 0;
     }
     m->hal->motor_drive(m->hal->ctx, controller_position(&m->controller, &in, &m->drive));
     bool done = m->endless ? m->tick >= m->profile.accel_ticks

@@ -44,10 +44,10 @@ static int32_t q8_to_decideg(int32_t q8)
  * them at the clock's fraction. */
 static void take_profile_q8(struct motion *m, int64_t at_tick)
 {
-    m->at_tick_q8 = q32_to_q8_sat(at_tick, TARGET_LIMIT_Q8);
-    m->at_next_q8 = q32_to_q8_sat(m->walk.at, TARGET_LIMIT_Q8);
+    m->profile_at_tick_q8 = q32_to_q8_sat(at_tick, TARGET_LIMIT_Q8);
+    m->profile_at_next_tick_q8 = q32_to_q8_sat(m->walk.at, TARGET_LIMIT_Q8);
     m->target_q8 = q32_to_q8_sat(m->profile.target, TARGET_LIMIT_Q8);
-    m->setpoint_q8 = m->at_tick_q8 + (((m->at_next_q8 - m->at_tick_q8) * m->tick_frac) >> 8);
+    m->setpoint_q8 = m->profile_at_tick_q8 + (((m->profile_at_next_tick_q8 - m->profile_at_tick_q8) * m->tick_frac) >> 8);
 }
 
 void motion_move_origin(struct motion *m, int32_t counts)

@@ -74,7 +74,7 @@ void dispatch_packet(struct dispatcher *d, const struct packet_desc *desc,
 
 static bool length_ok(const struct packet_desc *desc, const struct rx_frame *frame)
 {
-    return frame->length >= desc->min_length && frame->length <= desc->max_length &&
+    return frame->length >= desc->length.min && frame->length <= desc->length.max &&
            !(frame->flags & (FRAME_TRUNCATED | FRAME_BAD_SYNC));
 }
 
@@ -128,7 +128,7 @@ enum packet_outcome handle_sync(const struct packet_call *c, struct response *r)
         return OUTCOME_NONE; /* no record for this servo */
     }
     const struct packet_desc *inner = packet_find(c->content[0]);
-    if (inner == NULL || !(inner->flags & PF_SYNCABLE) || c->content[1] != inner->min_length) {
+    if (inner == NULL || !(inner->flags & PF_SYNCABLE) || c->content[1] != inner->length.min) {
         return OUTCOME_ERROR;
     }
     struct packet_origin origin = {.from_sync = true, .sync_index = c->sync_index};

@@ -22,9 +22,9 @@ enum rx_state {
  * the hot helpers inlined) buy the receive path its budget; the bootloader
  * builds this file with FRAME_RX_SMALL, byte by byte, to fit its 4 KB. */
 #ifdef FRAME_RX_SMALL
-#define HOT static
+#define INLINE_IN_FAST_BUILD static
 #else
-#define HOT static inline __attribute__((always_inline))
+#define INLINE_IN_FAST_BUILD static inline __attribute__((always_inline))
 #endif
 
 /* SyncCommand content: cmd, record_len, count, then the records. */
@@ -65,7 +65,7 @@ static void skip(struct frame_rx *rx, uint32_t bytes)
     rx->state = RX_SKIP;
 }
 
-HOT void start_content(struct frame_rx *rx, uint16_t length)
+INLINE_IN_FAST_BUILD void start_content(struct frame_rx *rx, uint16_t length)
 {
     rx->remaining = length;
     rx->position = 0;
@@ -156,7 +156,7 @@ static void content_byte(struct frame_rx *rx, uint8_t byte)
     }
 }
 
-HOT void finish_skipped(struct frame_rx *rx)
+INLINE_IN_FAST_BUILD void finish_skipped(struct frame_rx *rx)
 {
     rx->state = RX_HDR0;
     if (!rx->is_request) {

@@ -154,7 +154,7 @@ static void handle_next_frame(struct servo *s, uint32_t now)
     frame_rx_release(&s->rx);
     show_executing(s);
     if (result.config_changed) {
-        s->link_check = 1;
+        s->link_settings_pending = 1;
     }
     s->enter_bootloader |= result.enter_bootloader;
     if (result.answer && late) {
@@ -356,8 +356,8 @@ void servo_poll(struct servo *s)
     }
     /* A new ID or baud rate takes effect once the response has left, and
      * before the next request is read. */
-    if (s->link_check && !s->tx.sending && !s->tx.waiting) {
-        s->link_check = 0;
+    if (s->link_settings_pending && !s->tx.sending && !s->tx.waiting) {
+        s->link_settings_pending = 0;
         if (s->active_id != s->regs.user.servo_id ||
             s->active_baud_index != s->regs.user.baud_index) {
             apply_link_settings(s);

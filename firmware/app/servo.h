@@ -74,7 +74,7 @@ struct servo {
     uint32_t rx_idle_us;         /* line idle this long drops a partial frame */
     volatile uint8_t active_id;  /* the ID answered to now */
     uint8_t active_baud_index;
-    uint8_t link_check;          /* the user area changed: ID or baud may have */
+    uint8_t link_settings_pending; /* the user area changed: ID or baud may have */
     uint8_t enter_bootloader;    /* UpdateEnter taken: restart once the answer is out */
     uint8_t erase_passed;        /* a page erase stalled the CPU in the last pass */
     uint8_t stale_frames;        /* frames that arrived during it: not answered */

@@ -194,7 +194,7 @@ static void fresh_servo(void)
     servo_init(&servo, &hal.port);
     hal.port.serial_number = 0;
     servo.regs.user.servo_id = OWN_ID;
-    servo.link_check = 1; /* set directly, not by a request */
+    servo.link_settings_pending = 1; /* set directly, not by a request */
     servo_poll(&servo); /* applies the ID */
 }
 

@@ -141,7 +141,7 @@ static int setup(void **state)
         n->phase_us = (uint32_t)(i * 70u) / STEP_US * STEP_US;
         servo_init(&n->servo, &n->hal.port);
         n->servo.regs.user.servo_id = (uint8_t)(i + 1);
-        n->servo.link_check = 1; /* set directly, not by a request */
+        n->servo.link_settings_pending = 1; /* set directly, not by a request */
         n->servo.regs.user.soft_start_on = 0;
         n->servo.regs.user.control_response = 1;
         n->servo.regs.user.power_limit_mw = 0xFFFF;

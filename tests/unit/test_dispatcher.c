@@ -79,7 +79,7 @@ static void test_table_rows_are_in_packet_order(void **state)
         const struct packet_desc *p = packet_find((uint8_t)code);
         assert_non_null(p);
         assert_int_equal(p->code, code);
-        assert_true(p->min_length <= p->max_length);
+        assert_true(p->length.min <= p->length.max);
     }
     assert_null(packet_find(0));
     assert_null(packet_find(26));

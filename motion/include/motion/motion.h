@@ -127,8 +127,8 @@ struct motion {
     uint16_t clock_rate;
     int32_t lead_q8;           /* setpoint ahead of the horn, low-passed, decideg Q8 */
     uint8_t braking;           /* the profile is the braking guard's: left alone */
-    int32_t at_tick_q8;        /* profile position at tick */
-    int32_t at_next_q8;        /* and at tick + 1 */
+    int32_t profile_at_tick_q8;      /* profile position at tick */
+    int32_t profile_at_next_tick_q8; /* and at tick + 1 */
     int32_t setpoint_q8;
     int32_t last_setpoint_q8;
     int32_t target_q8;         /* the profile's target, saturated to +-TARGET_LIMIT_Q8 */

@@ -43,11 +43,15 @@ struct packet_call {
 typedef enum packet_outcome (*packet_handler)(const struct packet_call *call,
                                               struct response *response);
 
+struct length_rule { /* a request's content length, inclusive both ends */
+    uint16_t min;
+    uint16_t max;
+};
+
 struct packet_desc {
     uint8_t code;
-    uint8_t flags;       /* enum packet_flags */
-    uint16_t min_length; /* content length rule, inclusive */
-    uint16_t max_length;
+    uint8_t flags; /* enum packet_flags */
+    struct length_rule length;
     packet_handler handler;
 };
 
