@@ -32,15 +32,20 @@ void servo_init(struct servo *s, const struct hal_port *hal)
     *s = (struct servo){.hal = hal};
     config_store_load(&s->store, hal->flash, &s->regs.user);
     /* A store older firmware wrote (format 1) is rewritten in format 2, the
-     * one the bootloader reads the ID and baud rate from. */
+     * one the bootloader reads the ID and baud rate from. Then the spare
+     * page is erased ahead, before the control loop runs: saves need no
+     * erase until the page in use is full. A failure of either stays in the
+     * store (ReadStore reports it, the next save tries again): at power-up
+     * nobody waits for an answer. */
+    bool stored = true;
     if (s->store.legacy) {
-        (void)config_store_save(&s->store, &s->regs.user, s->store.op_seconds);
+        stored = config_store_save(&s->store, &s->regs.user, s->store.op_seconds) ==
+                 CONFIG_SAVED;
     }
-    /* Erase ahead at power-up, before the control loop runs: saves need
-     * no erase until the page in use is full. */
     if (config_store_spare_dirty(&s->store)) {
-        (void)config_store_erase_spare(&s->store); /* a failure shows at the next save */
+        stored = config_store_erase_spare(&s->store);
     }
+    (void)stored;
     save_policy_init(&s->saver, &s->store, hal->now_us(hal->ctx));
     s->regs.status.model = SERVO_MODEL;
     s->regs.status.firmware_version = FIRMWARE_VERSION;

@@ -22,6 +22,7 @@
 #include <stdint.h>
 
 #include "hal/hal_flash.h"
+#include "hal/must_check.h"
 
 #define APP_IMAGE_MAGIC 0x50415653u
 #define APP_IMAGE_FORMAT 1u
@@ -59,7 +60,7 @@ void app_image_make_header(uint8_t header[APP_HEADER_SIZE], const uint8_t *code,
 
 /* Reads and checks the image in the slot; info is filled from the header
  * whenever it checks (also when the image's CRC does not). */
-enum app_image_verdict app_image_check(const struct app_slot *slot, uint16_t board,
+MUST_CHECK enum app_image_verdict app_image_check(const struct app_slot *slot, uint16_t board,
                                        struct app_image_info *info);
 
 #endif

@@ -11,6 +11,7 @@
 
 #include "app_image.h"
 #include "protocol/frame_tx.h"
+#include "hal/must_check.h"
 
 #define BOOTLOADER_VERSION 2u /* 2: a repeated UpdateWrite succeeds */
 /* Largest data in one UpdateWrite: the request (9 + 24 bytes) fits the
@@ -28,7 +29,7 @@ struct bootloader {
 /* A request's packet code and content; true with r filled when it is
  * answered. An answered update packet (not a Ping) keeps the bootloader
  * from starting the application (boot_flow_heard). */
-bool boot_packet(struct bootloader *b, uint8_t code, const uint8_t *content, uint16_t length,
+MUST_CHECK bool boot_packet(struct bootloader *b, uint8_t code, const uint8_t *content, uint16_t length,
                  struct response *r);
 
 #endif

@@ -9,6 +9,7 @@
 #include <stdint.h>
 
 #include "app_image.h"
+#include "hal/must_check.h"
 
 enum slot_write_result {
     SLOT_WRITE_OK = 0,
@@ -20,11 +21,11 @@ enum slot_write_result {
 };
 
 /* Erases page `page` of the slot. */
-enum slot_write_result slot_erase_page(const struct app_slot *slot, uint32_t page);
+MUST_CHECK enum slot_write_result slot_erase_page(const struct app_slot *slot, uint32_t page);
 
 /* Programs len bytes at offset into the slot if crc32(data) == crc; blocks
  * that already hold their bytes are skipped, so a repeated write succeeds. */
-enum slot_write_result slot_write(const struct app_slot *slot, uint32_t offset,
+MUST_CHECK enum slot_write_result slot_write(const struct app_slot *slot, uint32_t offset,
                                   const uint8_t *data, uint32_t len, uint32_t crc);
 
 #endif

@@ -23,6 +23,7 @@
 
 #include "hal/hal_flash.h"
 #include "registers/registers.h"
+#include "hal/must_check.h"
 
 #define CONFIG_RECORD_SIZE 48u
 
@@ -65,20 +66,20 @@ bool config_store_load(struct config_store *s, const struct hal_flash *flash,
  * CONFIG_UNCHANGED when cfg equals what is stored (and the store is in
  * format 2), CONFIG_NEEDS_ERASE when
  * the record must start the other page and that is not erased yet. */
-enum config_save_result config_store_begin(struct config_store *s, const struct user_config *cfg,
+MUST_CHECK enum config_save_result config_store_begin(struct config_store *s, const struct user_config *cfg,
                                            uint32_t op_seconds);
 /* Programs the next write block of the save begun (only after
  * CONFIG_STARTED or CONFIG_BUSY): CONFIG_BUSY, then CONFIG_SAVED or
  * CONFIG_WRITE_FAILED. */
-enum config_save_result config_store_step(struct config_store *s);
+MUST_CHECK enum config_save_result config_store_step(struct config_store *s);
 /* The page without the newest record holds something: erase it ahead. */
 bool config_store_spare_dirty(const struct config_store *s);
 /* Erases that page (a 20-40 ms stall on the STM32F1). False on failure. */
-bool config_store_erase_spare(struct config_store *s);
+MUST_CHECK bool config_store_erase_spare(struct config_store *s);
 
 /* All of a save at once: begin, erase if needed, every step
  * (config_store_save.c). */
-enum config_save_result config_store_save(struct config_store *s, const struct user_config *cfg,
+MUST_CHECK enum config_save_result config_store_save(struct config_store *s, const struct user_config *cfg,
                                           uint32_t op_seconds);
 
 /* Erases of the more worn page so far, from the records written (every

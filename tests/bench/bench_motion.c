@@ -13,6 +13,7 @@
  *   ticks_hal  the same loop's HAL double calls alone (encoder read, motor
  *          output), which the tick figures leave out */
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "bench_region.h"
@@ -40,11 +41,21 @@ static void fresh(void)
     motion.soft_start_pending = 0;
 }
 
+/* A refused move would measure nothing: the run stops and says so. */
+static void must_accept(enum motion_submit_result result, const char *what)
+{
+    if (result != MOTION_ACCEPTED) {
+        printf("bench: %s refused (result %d)\n", what, (int)result);
+        exit(1);
+    }
+}
+
 static void plan(const char *name, const struct motion_command *cmd)
 {
     bench_begin();
-    motion_submit(&motion, cmd);
+    enum motion_submit_result result = motion_submit(&motion, cmd);
     bench_end(name);
+    must_accept(result, name);
 }
 
 /* The encoder readings of a horn that follows the setpoint exactly. */
@@ -63,13 +74,13 @@ int main(void)
     const struct motion_command follow = {.packet = 14, .kind = MOTION_ANGLE, .multi_turn = 1,
                                           .angle_decideg = 6000, .interval_ms = 3000,
                                           .acc_ms = 500, .dec_ms = 500};
-    motion_submit(&motion, &follow);
+    must_accept(motion_submit(&motion, &follow), "the followed move");
     for (unsigned i = 0; i < MOTION_BENCH_TICKS; i++) {
         hal.encoder_raw = follow_raw[i] = ideal_encoder_raw(&motion);
         motion_tick(&motion);
     }
     fresh();
-    motion_submit(&motion, &follow);
+    must_accept(motion_submit(&motion, &follow), "the followed move");
     bench_begin();
     for (unsigned i = 0; i < MOTION_BENCH_TICKS; i++) {
         hal.encoder_raw = follow_raw[i];

@@ -13,6 +13,7 @@
 #include "motion/encoder.h"
 #include "motion/profile.h"
 #include "registers/registers.h"
+#include "hal/must_check.h"
 
 enum motion_kind {
     MOTION_ANGLE,    /* packets 8, 11-15 */
@@ -171,7 +172,7 @@ void motion_init(struct motion *m, const struct registers *regs, const struct ha
 /* One control tick (1/MOTION_TICK_HZ s): encoder, profile, controller, motor. */
 void motion_tick(struct motion *m);
 
-enum motion_submit_result motion_submit(struct motion *m, const struct motion_command *cmd);
+MUST_CHECK enum motion_submit_result motion_submit(struct motion *m, const struct motion_command *cmd);
 bool motion_is_released(const struct motion *m);
 void motion_read_angle(const struct motion *m, struct motion_angle *out);
 /* ResetMultiTurnAngle (17), SetOriginPoint (23): false unless released. */
