@@ -52,7 +52,7 @@ function(servo_arm_bootloader name)
   # (firmware/runtime/small_mem.c), and the board's port with the drivers
   # it shares (unused ones drop out at the link).
   set(boot ${PROJECT_SOURCE_DIR}/firmware/bootloader)
-  set(small ${PROJECT_SOURCE_DIR}/protocol/frame_rx.c ${PROJECT_SOURCE_DIR}/firmware/runtime/small_mem.c ${boot}/bootloader.c
+  set(small ${PROJECT_SOURCE_DIR}/protocol/wire/frame_rx.c ${PROJECT_SOURCE_DIR}/firmware/runtime/small_mem.c ${boot}/bootloader.c
       ${boot}/boot_packets.c ${boot}/boot_flow.c ${boot}/app_image.c ${boot}/slot_write.c
       ${PROJECT_SOURCE_DIR}/firmware/storage/config_peek.c ${PROJECT_SOURCE_DIR}/firmware/storage/crc32.c)
   foreach(lib ${SERVO_BOARD_PORT} servo_stm32_common)

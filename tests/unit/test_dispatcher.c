@@ -463,10 +463,23 @@ static void test_sync_bad_records_are_errors(void **state)
     assert_true(command_error());
 }
 
+/* The framer's list of unaddressed packets (packet_codes.h) agrees with
+ * the packet table's PF_ADDRESSED rows. */
+static void test_the_framer_knows_which_packets_are_addressed(void **state)
+{
+    (void)state;
+    for (unsigned code = 0; code < 256u; code++) {
+        const struct packet_desc *desc = packet_find((uint8_t)code);
+        bool addressed = desc == NULL || (desc->flags & PF_ADDRESSED);
+        assert_int_equal(packet_is_addressed((uint8_t)code), addressed);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test_setup(test_table_rows_are_in_packet_order, setup),
+        cmocka_unit_test(test_the_framer_knows_which_packets_are_addressed),
         cmocka_unit_test_setup(test_ping_own_other_broadcast, setup),
         cmocka_unit_test_setup(test_answering_packets_are_not_executed_on_broadcast, setup),
         cmocka_unit_test_setup(test_unknown_packet_sets_command_error, setup),

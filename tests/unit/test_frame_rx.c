@@ -9,7 +9,7 @@
 
 #include "frames.h"
 #include "protocol/frame_rx.h"
-#include "protocol/packet_table.h"
+#include "protocol/packet_codes.h"
 
 struct fixture {
     struct frame_rx rx;
@@ -424,16 +424,6 @@ static void test_sync_record_too_long_is_flagged(void **state)
     assert_true(fr->flags & FRAME_BAD_SYNC);
 }
 
-static void test_the_framer_knows_which_packets_are_addressed(void **state)
-{
-    (void)state;
-    for (unsigned code = 0; code < 256u; code++) {
-        const struct packet_desc *desc = packet_find((uint8_t)code);
-        bool addressed = desc == NULL || (desc->flags & PF_ADDRESSED);
-        assert_int_equal(packet_is_addressed((uint8_t)code), addressed);
-    }
-}
-
 static void test_idle_time_per_baud(void **state)
 {
     (void)state;
@@ -464,7 +454,6 @@ int main(void)
         cmocka_unit_test_setup(test_sync_without_own_record, setup),
         cmocka_unit_test_setup(test_sync_with_inconsistent_length_is_flagged, setup),
         cmocka_unit_test_setup(test_sync_record_too_long_is_flagged, setup),
-        cmocka_unit_test_setup(test_the_framer_knows_which_packets_are_addressed, setup),
         cmocka_unit_test_setup(test_idle_time_per_baud, setup),
     };
     return cmocka_run_group_tests_name("frame_rx", tests, NULL, NULL);

@@ -56,21 +56,6 @@ struct packet_desc {
 };
 
 const struct packet_desc *packet_find(uint8_t code);
-/* Packets 0-31 whose content does not start with the servo ID: the rows of
- * packet_table.c without PF_ADDRESSED (test_frame_rx checks every code
- * against packet_find). */
-#define PACKETS_UNADDRESSED_BELOW_32                                                       \
-    ((1u << PKT_BEGIN_ASYNC) | (1u << PKT_END_ASYNC) | (1u << PKT_START_MONITOR) |        \
-     (1u << PKT_STOP_MONITOR) | (1u << PKT_SYNC_COMMAND))
-
-/* The packet's content starts with the servo ID: PF_ADDRESSED, or unknown
- * (judged by the ID position every addressed packet uses). The framer asks
- * for every request on the bus. */
-static inline bool packet_is_addressed(uint8_t code)
-{
-    return code >= 32u || !((PACKETS_UNADDRESSED_BELOW_32 >> code) & 1u);
-}
-
 /* Handlers, grouped by what they touch. */
 enum packet_outcome handle_ping(const struct packet_call *c, struct response *r);
 enum packet_outcome handle_reset_user_data(const struct packet_call *c, struct response *r);

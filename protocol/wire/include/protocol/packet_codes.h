@@ -4,6 +4,9 @@
 #ifndef PROTOCOL_PACKET_CODES_H
 #define PROTOCOL_PACKET_CODES_H
 
+#include <stdbool.h>
+#include <stdint.h>
+
 enum packet_code {
     PKT_PING = 1,
     PKT_RESET_USER_DATA = 2,
@@ -44,5 +47,20 @@ enum firmware_packet_code {
     PKT_UPDATE_BOOT = 0x54,   /* start the image, if it checks */
     PKT_UPDATE_STATUS = 0x55, /* who answers: application or bootloader, versions */
 };
+
+/* Packets 0-31 whose content does not start with the servo ID: the rows of
+ * packet_table.c without PF_ADDRESSED (test_dispatcher checks every code
+ * against packet_find). */
+#define PACKETS_UNADDRESSED_BELOW_32                                                       \
+    ((1u << PKT_BEGIN_ASYNC) | (1u << PKT_END_ASYNC) | (1u << PKT_START_MONITOR) |        \
+     (1u << PKT_STOP_MONITOR) | (1u << PKT_SYNC_COMMAND))
+
+/* The packet's content starts with the servo ID: PF_ADDRESSED, or unknown
+ * (judged by the ID position every addressed packet uses). The framer asks
+ * for every request on the bus. */
+static inline bool packet_is_addressed(uint8_t code)
+{
+    return code >= 32u || !((PACKETS_UNADDRESSED_BELOW_32 >> code) & 1u);
+}
 
 #endif

@@ -3,7 +3,6 @@
 #include <stddef.h>
 
 #include "protocol/packet_codes.h"
-#include "protocol/packet_table.h"
 #include "protocol/wire.h"
 
 enum rx_state {
