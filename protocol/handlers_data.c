@@ -1,7 +1,7 @@
 /* Packets that read or write the register file: 1-6 and Monitor (22). */
 #include <string.h>
 
-#include "protocol/data_table.h"
+#include "registers/data_table.h"
 #include "protocol/packet_table.h"
 #include "protocol/wire.h"
 
@@ -89,14 +89,14 @@ enum packet_outcome handle_read_store(const struct packet_call *c, struct respon
     uint8_t *p = r->content;
     p[0] = c->content[0];
     p[1] = h->flags;
-    wire_put_u32(&p[2], h->records);
-    wire_put_u32(&p[6], h->page_erases);
-    wire_put_u32(&p[10], h->rated_cycles);
-    wire_put_u32(&p[14], h->budget);
-    wire_put_u32(&p[18], h->op_seconds);
-    wire_put_u32(&p[22], h->failures);
-    wire_put_u32(&p[26], h->answers_dropped);
-    wire_put_u32(&p[30], h->bytes_lost);
+    le_put_u32(&p[2], h->records);
+    le_put_u32(&p[6], h->page_erases);
+    le_put_u32(&p[10], h->rated_cycles);
+    le_put_u32(&p[14], h->budget);
+    le_put_u32(&p[18], h->op_seconds);
+    le_put_u32(&p[22], h->failures);
+    le_put_u32(&p[26], h->answers_dropped);
+    le_put_u32(&p[30], h->bytes_lost);
     r->length = READ_STORE_ANSWER_LENGTH;
     return OUTCOME_OK;
 }
@@ -108,13 +108,13 @@ enum packet_outcome handle_monitor(const struct packet_call *c, struct response 
     motion_read_angle(c->d->motion, &angle);
     uint8_t *p = r->content;
     p[0] = c->content[0];
-    wire_put_u16(&p[1], s->voltage_mv);
-    wire_put_u16(&p[3], s->current_ma);
-    wire_put_u16(&p[5], s->power_mw);
-    wire_put_u16(&p[7], s->temperature_adc);
+    le_put_u16(&p[1], s->voltage_mv);
+    le_put_u16(&p[3], s->current_ma);
+    le_put_u16(&p[5], s->power_mw);
+    le_put_u16(&p[7], s->temperature_adc);
     p[9] = s->status;
-    wire_put_u32(&p[10], (uint32_t)angle.multi_turn_decideg);
-    wire_put_u16(&p[14], (uint16_t)angle.turns);
+    le_put_u32(&p[10], (uint32_t)angle.multi_turn_decideg);
+    le_put_u16(&p[14], (uint16_t)angle.turns);
     r->length = 16;
     return OUTCOME_OK;
 }
@@ -127,7 +127,7 @@ enum { ITEM_SERVO_ID = 34 };
  * of item 34 writes it. */
 enum packet_outcome handle_assign_id(const struct packet_call *c, struct response *r)
 {
-    if (wire_get_u32(&c->content[1]) != c->d->regs->status.serial_number) {
+    if (le_get_u32(&c->content[1]) != c->d->regs->status.serial_number) {
         return OUTCOME_NONE;
     }
     bool ok = write_item(c, ITEM_SERVO_ID, &c->content[5], 1u);

@@ -66,31 +66,31 @@ enum packet_outcome handle_move_angle(const struct packet_call *c, struct respon
     const uint8_t *p = &c->content[1];
     struct motion_command cmd = command_for(c, MOTION_ANGLE);
     cmd.multi_turn = layout->angle_size == 4u;
-    cmd.angle_decideg = cmd.multi_turn ? wire_get_i32(p) : wire_get_i16(p);
+    cmd.angle_decideg = cmd.multi_turn ? le_get_i32(p) : le_get_i16(p);
     p += layout->angle_size;
     switch (layout->time_field) {
     case TIME_INTERVAL_U16:
-        cmd.interval_ms = wire_get_u16(p);
+        cmd.interval_ms = le_get_u16(p);
         p += 2;
         break;
     case TIME_INTERVAL_U32:
-        cmd.interval_ms = wire_get_u32(p);
+        cmd.interval_ms = le_get_u32(p);
         p += 4;
         break;
     default:
         cmd.profile = PROFILE_VELOCITY;
-        cmd.velocity_decideg_s = wire_get_u16(p);
+        cmd.velocity_decideg_s = le_get_u16(p);
         p += 2;
         break;
     }
     cmd.acc_ms = DEFAULT_RAMP_MS;
     cmd.dec_ms = DEFAULT_RAMP_MS;
     if (layout->has_ramps) {
-        cmd.acc_ms = wire_get_u16(p);
-        cmd.dec_ms = wire_get_u16(p + 2);
+        cmd.acc_ms = le_get_u16(p);
+        cmd.dec_ms = le_get_u16(p + 2);
         p += 4;
     }
-    cmd.power_mw = wire_get_u16(p);
+    cmd.power_mw = le_get_u16(p);
     return submit(c, &cmd);
 }
 
@@ -99,15 +99,15 @@ enum packet_outcome handle_move_wheel(const struct packet_call *c, struct respon
     (void)r;
     struct motion_command cmd = command_for(c, MOTION_WHEEL);
     cmd.method = c->content[1];
-    cmd.wheel_speed_deg_s = wire_get_u16(&c->content[2]);
-    cmd.wheel_value = wire_get_u16(&c->content[4]);
+    cmd.wheel_speed_deg_s = le_get_u16(&c->content[2]);
+    cmd.wheel_value = le_get_u16(&c->content[4]);
     return submit(c, &cmd);
 }
 
 enum packet_outcome handle_move_damping(const struct packet_call *c, struct response *r)
 {
     struct motion_command cmd = command_for(c, MOTION_DAMPING);
-    cmd.power_mw = wire_get_u16(&c->content[1]);
+    cmd.power_mw = le_get_u16(&c->content[1]);
     cmd.answer_when_done = 0; /* nothing to finish: answered at once */
     if (motion_submit(c->d->motion, &cmd) != MOTION_ACCEPTED) {
         return OUTCOME_ERROR;
@@ -120,7 +120,7 @@ enum packet_outcome handle_stop(const struct packet_call *c, struct response *r)
     (void)r;
     struct motion_command cmd = command_for(c, MOTION_STOP);
     cmd.method = c->content[1];
-    cmd.power_mw = wire_get_u16(&c->content[2]);
+    cmd.power_mw = le_get_u16(&c->content[2]);
     cmd.answer_when_done = 0;
     if (cmd.method < STOP_RELEASE || cmd.method > STOP_DAMPING) {
         return OUTCOME_ERROR;
@@ -133,7 +133,7 @@ enum packet_outcome handle_read_angle(const struct packet_call *c, struct respon
     struct motion_angle angle;
     motion_read_angle(c->d->motion, &angle);
     r->content[0] = c->content[0];
-    wire_put_u16(&r->content[1], (uint16_t)angle.single_turn_decideg);
+    le_put_u16(&r->content[1], (uint16_t)angle.single_turn_decideg);
     r->length = 3;
     return OUTCOME_OK;
 }
@@ -147,17 +147,17 @@ enum packet_outcome handle_read_motion(const struct packet_call *c, struct respo
     motion_read_diagnostics(c->d->motion, &d);
     uint8_t *p = r->content;
     p[0] = c->content[0];
-    wire_put_u32(&p[1], (uint32_t)d.angle_decideg);
-    wire_put_u32(&p[5], (uint32_t)d.setpoint_decideg);
-    wire_put_u32(&p[9], (uint32_t)d.target_decideg);
-    wire_put_u16(&p[13], (uint16_t)d.velocity_decideg_s);
-    wire_put_u16(&p[15], (uint16_t)d.tracking_error_centideg);
-    wire_put_u16(&p[17], c->d->regs->status.current_ma);
+    le_put_u32(&p[1], (uint32_t)d.angle_decideg);
+    le_put_u32(&p[5], (uint32_t)d.setpoint_decideg);
+    le_put_u32(&p[9], (uint32_t)d.target_decideg);
+    le_put_u16(&p[13], (uint16_t)d.velocity_decideg_s);
+    le_put_u16(&p[15], (uint16_t)d.tracking_error_centideg);
+    le_put_u16(&p[17], c->d->regs->status.current_ma);
     p[19] = c->d->regs->status.status;
     p[20] = d.flags;
     /* The snapshot is the last tick's: it ran one period before the next. */
     const uint32_t *next_tick = c->d->next_tick_us;
-    wire_put_u32(&p[21], next_tick != NULL ? *next_tick - 1000000u / MOTION_TICK_HZ : 0u);
+    le_put_u32(&p[21], next_tick != NULL ? *next_tick - 1000000u / MOTION_TICK_HZ : 0u);
     r->length = READ_MOTION_ANSWER_LENGTH;
     return OUTCOME_OK;
 }
@@ -167,8 +167,8 @@ enum packet_outcome handle_read_multi_turn(const struct packet_call *c, struct r
     struct motion_angle angle;
     motion_read_angle(c->d->motion, &angle);
     r->content[0] = c->content[0];
-    wire_put_u32(&r->content[1], (uint32_t)angle.multi_turn_decideg);
-    wire_put_u16(&r->content[5], (uint16_t)angle.turns);
+    le_put_u32(&r->content[1], (uint32_t)angle.multi_turn_decideg);
+    le_put_u16(&r->content[5], (uint16_t)angle.turns);
     r->length = 7;
     return OUTCOME_OK;
 }

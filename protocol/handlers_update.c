@@ -37,8 +37,8 @@ enum packet_outcome handle_update_status(const struct packet_call *c, struct res
     }
     p[0] = c->content[0];
     p[1] = MODE_APPLICATION;
-    wire_put_u16(&p[5], c->d->regs->status.firmware_version);
-    wire_put_u16(&p[7], c->d->board);
+    le_put_u16(&p[5], c->d->regs->status.firmware_version);
+    le_put_u16(&p[7], c->d->board);
     r->length = UPDATE_STATUS_ANSWER_LENGTH;
     return OUTCOME_OK;
 }

@@ -3,7 +3,7 @@
 #include <string.h>
 
 #include "identity.h"
-#include "protocol/data_table.h"
+#include "registers/data_table.h"
 
 static uint32_t idle_timeout_us(const struct servo *s, uint32_t baud)
 {

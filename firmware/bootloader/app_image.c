@@ -9,14 +9,14 @@ void app_image_make_header(uint8_t header[APP_HEADER_SIZE], const uint8_t *code,
                            uint16_t version, uint16_t board)
 {
     memset(header, 0xFF, APP_HEADER_SIZE);
-    wire_put_u32(&header[0], APP_IMAGE_MAGIC);
-    wire_put_u16(&header[4], APP_IMAGE_FORMAT);
-    wire_put_u16(&header[6], board);
-    wire_put_u32(&header[8], size);
-    wire_put_u32(&header[12], crc32(code, size));
-    wire_put_u16(&header[16], version);
+    le_put_u32(&header[0], APP_IMAGE_MAGIC);
+    le_put_u16(&header[4], APP_IMAGE_FORMAT);
+    le_put_u16(&header[6], board);
+    le_put_u32(&header[8], size);
+    le_put_u32(&header[12], crc32(code, size));
+    le_put_u16(&header[16], version);
     memset(&header[18], 0, 6);
-    wire_put_u32(&header[APP_HEADER_CHECKED], crc32(header, APP_HEADER_CHECKED));
+    le_put_u32(&header[APP_HEADER_CHECKED], crc32(header, APP_HEADER_CHECKED));
 }
 
 uint32_t app_slot_size(const struct app_slot *slot)
@@ -30,17 +30,17 @@ enum app_image_verdict app_image_check(const struct app_slot *slot, uint16_t boa
     const struct hal_flash *f = slot->flash;
     uint8_t h[APP_HEADER_CHECKED + 4u];
     f->read(f->ctx, slot->base, h, sizeof h);
-    if (wire_get_u32(&h[0]) != APP_IMAGE_MAGIC) {
+    if (le_get_u32(&h[0]) != APP_IMAGE_MAGIC) {
         return APP_IMAGE_NO_HEADER;
     }
-    uint32_t size = wire_get_u32(&h[8]);
-    if (wire_get_u32(&h[APP_HEADER_CHECKED]) != crc32(h, APP_HEADER_CHECKED) ||
-        wire_get_u16(&h[4]) != APP_IMAGE_FORMAT || size == 0u ||
+    uint32_t size = le_get_u32(&h[8]);
+    if (le_get_u32(&h[APP_HEADER_CHECKED]) != crc32(h, APP_HEADER_CHECKED) ||
+        le_get_u16(&h[4]) != APP_IMAGE_FORMAT || size == 0u ||
         size > app_slot_size(slot) - APP_HEADER_SIZE) {
         return APP_IMAGE_BAD_HEADER;
     }
-    *info = (struct app_image_info){.size = size, .crc = wire_get_u32(&h[12]),
-                                    .version = wire_get_u16(&h[16]), .board = wire_get_u16(&h[6])};
+    *info = (struct app_image_info){.size = size, .crc = le_get_u32(&h[12]),
+                                    .version = le_get_u16(&h[16]), .board = le_get_u16(&h[6])};
     if (info->board != board) {
         return APP_IMAGE_WRONG_BOARD;
     }

@@ -32,7 +32,7 @@ static uint8_t on_enter(const struct call *c, struct response *r)
 
 static uint8_t on_erase(const struct call *c, struct response *r)
 {
-    enum slot_write_result w = slot_erase_page(c->b->slot, wire_get_u16(&c->content[1]));
+    enum slot_write_result w = slot_erase_page(c->b->slot, le_get_u16(&c->content[1]));
     r->content[1] = w == SLOT_WRITE_OK;
     r->content[2] = (uint8_t)w;
     return 3;
@@ -41,8 +41,8 @@ static uint8_t on_erase(const struct call *c, struct response *r)
 static uint8_t on_write(const struct call *c, struct response *r)
 {
     uint16_t n = (uint16_t)(c->length - 9u);
-    enum slot_write_result w = slot_write(c->b->slot, wire_get_u32(&c->content[1]), &c->content[5],
-                                          n, wire_get_u32(&c->content[5u + n]));
+    enum slot_write_result w = slot_write(c->b->slot, le_get_u32(&c->content[1]), &c->content[5],
+                                          n, le_get_u32(&c->content[5u + n]));
     r->content[1] = w == SLOT_WRITE_OK;
     r->content[2] = (uint8_t)w;
     return 3;
@@ -52,10 +52,10 @@ static uint8_t on_verify(const struct call *c, struct response *r)
 {
     struct app_image_info info = {0};
     r->content[1] = (uint8_t)app_image_check(c->b->slot, c->b->board, &info);
-    wire_put_u32(&r->content[2], info.size);
-    wire_put_u32(&r->content[6], info.crc);
-    wire_put_u16(&r->content[10], info.version);
-    wire_put_u16(&r->content[12], info.board);
+    le_put_u32(&r->content[2], info.size);
+    le_put_u32(&r->content[6], info.crc);
+    le_put_u16(&r->content[10], info.version);
+    le_put_u16(&r->content[12], info.board);
     return 14;
 }
 
@@ -73,14 +73,14 @@ static uint8_t on_status(const struct call *c, struct response *r)
     const struct app_slot *slot = c->b->slot;
     struct app_image_info info = {0};
     r->content[1] = MODE_BOOTLOADER;
-    wire_put_u16(&r->content[2], BOOTLOADER_VERSION);
+    le_put_u16(&r->content[2], BOOTLOADER_VERSION);
     r->content[4] = (uint8_t)app_image_check(slot, c->b->board, &info);
-    wire_put_u16(&r->content[5], info.version);
-    wire_put_u16(&r->content[7], c->b->board);
-    wire_put_u16(&r->content[9], (uint16_t)slot->flash->page_size);
-    wire_put_u16(&r->content[11], (uint16_t)slot->pages);
+    le_put_u16(&r->content[5], info.version);
+    le_put_u16(&r->content[7], c->b->board);
+    le_put_u16(&r->content[9], (uint16_t)slot->flash->page_size);
+    le_put_u16(&r->content[11], (uint16_t)slot->pages);
     r->content[13] = (uint8_t)slot->flash->write_block;
-    wire_put_u16(&r->content[14], UPDATE_WRITE_MAX);
+    le_put_u16(&r->content[14], UPDATE_WRITE_MAX);
     return 16;
 }
 

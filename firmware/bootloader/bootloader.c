@@ -3,7 +3,7 @@
 #include <stddef.h>
 
 #include "config_peek.h"
-#include "protocol/data_table.h"
+#include "registers/data_table.h"
 #include "protocol/packet_codes.h"
 
 void boot_loop_start(struct boot_loop *l, const struct boot_board *b)

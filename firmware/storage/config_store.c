@@ -2,30 +2,10 @@
 
 #include <string.h>
 
+#include "config_record.h"
 #include "crc32.h"
-#include "protocol/data_table.h"
-#include "protocol/wire.h"
-
-/* Record layout, little-endian. Format 2 adds the operating time; format 1
- * records (44 bytes, no operating time) from older firmware still load. */
-enum {
-    REC_MAGIC = 0,      /* u16 */
-    REC_FORMAT = 2,     /* u8 */
-    REC_LENGTH = 3,     /* u8: payload bytes */
-    REC_SEQUENCE = 4,   /* u32 */
-    REC_OP_SECONDS = 8, /* u32, format 2 */
-    REC_PAYLOAD = 12,   /* USER_AREA_SIZE bytes */
-    REC_CRC = REC_PAYLOAD + USER_AREA_SIZE, /* u32 over bytes 0..REC_CRC-1 */
-    RECORD_MAGIC = 0xC0F1,
-    RECORD_FORMAT = 2,
-    V1_PAYLOAD = 8,
-    V1_CRC = V1_PAYLOAD + USER_AREA_SIZE,
-    V1_RECORD_SIZE = V1_CRC + 4,
-    V1_FORMAT = 1,
-};
-
-_Static_assert(REC_CRC + 4 == CONFIG_RECORD_SIZE, "record layout");
-_Static_assert(CONFIG_RECORD_SIZE % 8 == 0, "a record is whole write blocks of 2, 4 or 8 bytes");
+#include "registers/byte_order.h"
+#include "registers/data_table.h"
 
 uint16_t config_store_slots_per_page(const struct config_store *s)
 {
@@ -52,9 +32,9 @@ static const struct record_layout FORMAT_1 = {V1_FORMAT, V1_RECORD_SIZE, V1_PAYL
  * record from a firmware with other ranges is not loaded half-valid. */
 static bool record_valid(const uint8_t *rec, const struct record_layout *l, struct user_config *out)
 {
-    if (wire_get_u16(&rec[REC_MAGIC]) != RECORD_MAGIC || rec[REC_FORMAT] != l->format ||
-        rec[REC_LENGTH] != USER_AREA_SIZE || wire_get_u32(&rec[REC_SEQUENCE]) == 0u ||
-        wire_get_u32(&rec[l->crc]) != crc32(rec, l->crc)) {
+    if (le_get_u16(&rec[REC_MAGIC]) != RECORD_MAGIC || rec[REC_FORMAT] != l->format ||
+        rec[REC_LENGTH] != USER_AREA_SIZE || le_get_u32(&rec[REC_SEQUENCE]) == 0u ||
+        le_get_u32(&rec[l->crc]) != crc32(rec, l->crc)) {
         return false;
     }
     return user_config_decode(out, &rec[l->payload]);
@@ -84,12 +64,12 @@ static bool scan(struct config_store *s, const struct record_layout *l, struct u
             uint8_t rec[CONFIG_RECORD_SIZE];
             struct user_config candidate;
             s->flash->read(s->flash->ctx, slot_addr(s, page, slot, l->size), rec, l->size);
-            uint32_t seq = wire_get_u32(&rec[REC_SEQUENCE]);
+            uint32_t seq = le_get_u32(&rec[REC_SEQUENCE]);
             if (seq > s->sequence && record_valid(rec, l, &candidate)) {
                 s->sequence = seq;
                 s->page = page;
                 s->slot = slot;
-                s->op_seconds = l == &FORMAT_2 ? wire_get_u32(&rec[REC_OP_SECONDS]) : 0u;
+                s->op_seconds = l == &FORMAT_2 ? le_get_u32(&rec[REC_OP_SECONDS]) : 0u;
                 *newest = candidate;
                 found = true;
             }
@@ -183,12 +163,12 @@ enum config_save_result config_store_begin(struct config_store *s, const struct 
     if (!next_slot(s, &page, &slot) && page == spare_page(s) && !s->spare_erased) {
         return CONFIG_NEEDS_ERASE;
     }
-    wire_put_u16(&rec[REC_MAGIC], RECORD_MAGIC);
+    le_put_u16(&rec[REC_MAGIC], RECORD_MAGIC);
     rec[REC_FORMAT] = RECORD_FORMAT;
     rec[REC_LENGTH] = USER_AREA_SIZE;
-    wire_put_u32(&rec[REC_SEQUENCE], s->sequence + 1u);
-    wire_put_u32(&rec[REC_OP_SECONDS], op_seconds);
-    wire_put_u32(&rec[REC_CRC], crc32(rec, REC_CRC));
+    le_put_u32(&rec[REC_SEQUENCE], s->sequence + 1u);
+    le_put_u32(&rec[REC_OP_SECONDS], op_seconds);
+    le_put_u32(&rec[REC_CRC], crc32(rec, REC_CRC));
     s->job_active = 1;
     s->job_page = page;
     s->job_slot = slot;

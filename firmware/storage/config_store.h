@@ -21,11 +21,10 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "config_record.h"
 #include "hal/hal_flash.h"
-#include "registers/registers.h"
 #include "hal/must_check.h"
-
-#define CONFIG_RECORD_SIZE 48u
+#include "registers/registers.h"
 
 enum config_save_result {
     CONFIG_UNCHANGED,    /* identical to the stored record: nothing written */

@@ -29,7 +29,7 @@
 
 #include "hal_double.h"
 #include "ideal_encoder.h"
-#include "protocol/data_table.h"
+#include "registers/data_table.h"
 #include "servo.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);

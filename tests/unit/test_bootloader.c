@@ -125,7 +125,7 @@ static bool request(uint8_t code, const uint8_t *content, uint16_t length)
 static bool erase_page_request(uint16_t page)
 {
     uint8_t c[3] = {ID};
-    wire_put_u16(&c[1], page);
+    le_put_u16(&c[1], page);
     assert_true(request(PKT_UPDATE_ERASE, c, sizeof c));
     return last.content[1] == 1u;
 }
@@ -133,9 +133,9 @@ static bool erase_page_request(uint16_t page)
 static uint8_t write_request(uint32_t offset, const uint8_t *data, uint16_t n)
 {
     uint8_t c[9 + UPDATE_WRITE_MAX] = {ID};
-    wire_put_u32(&c[1], offset);
+    le_put_u32(&c[1], offset);
     memcpy(&c[5], data, n);
-    wire_put_u32(&c[5 + n], crc32(data, n));
+    le_put_u32(&c[5 + n], crc32(data, n));
     assert_true(request(PKT_UPDATE_WRITE, c, (uint16_t)(9u + n)));
     return last.content[2];
 }
@@ -201,8 +201,8 @@ static void test_an_update_by_packets(void **state)
     assert_true(request(PKT_UPDATE_VERIFY, (const uint8_t[]){ID}, 1));
     assert_int_equal(last.length, 14);
     assert_int_equal(last.content[1], APP_IMAGE_VALID);
-    assert_int_equal(wire_get_u32(&last.content[2]), 5000);
-    assert_int_equal(wire_get_u16(&last.content[10]), 0x0203);
+    assert_int_equal(le_get_u32(&last.content[2]), 5000);
+    assert_int_equal(le_get_u16(&last.content[10]), 0x0203);
     assert_true(request(PKT_UPDATE_BOOT, (const uint8_t[]){ID}, 1));
     assert_int_equal(last.content[1], 1);
     assert_true(boot.boot_now);
@@ -217,8 +217,8 @@ static void test_the_header_matches_the_tool(void **state)
     uint8_t code[8] = {1, 2, 3, 4, 5, 6, 7, 8};
     uint8_t header[APP_HEADER_SIZE];
     app_image_make_header(header, code, sizeof code, 0x0011, 0x0103);
-    assert_int_equal(wire_get_u32(&header[12]), 0x3FCA88C5u); /* zlib.crc32(bytes(1..8)) */
-    assert_int_equal(wire_get_u32(&header[24]), 0x790C7AB0u);
+    assert_int_equal(le_get_u32(&header[12]), 0x3FCA88C5u); /* zlib.crc32(bytes(1..8)) */
+    assert_int_equal(le_get_u32(&header[24]), 0x790C7AB0u);
 }
 
 static void test_what_the_bootloader_refuses(void **state)
@@ -232,9 +232,9 @@ static void test_what_the_bootloader_refuses(void **state)
     assert_false(request(PKT_READ_DATA, (const uint8_t[]){ID, 5}, 2));
     /* Damaged on the wire: nothing written. */
     uint8_t c[9 + 16] = {ID};
-    wire_put_u32(&c[1], 512);
+    le_put_u32(&c[1], 512);
     memcpy(&c[5], data, 16);
-    wire_put_u32(&c[21], crc32(data, 16) ^ 1u);
+    le_put_u32(&c[21], crc32(data, 16) ^ 1u);
     assert_true(request(PKT_UPDATE_WRITE, c, sizeof c));
     assert_int_equal(last.content[1], 0);
     assert_int_equal(last.content[2], SLOT_WRITE_BAD_CRC);
@@ -272,12 +272,12 @@ static void test_ping_and_status_find_the_bootloader(void **state)
     assert_true(request(PKT_UPDATE_STATUS, (const uint8_t[]){ID}, 1));
     assert_int_equal(last.length, 16);
     assert_int_equal(last.content[1], 1); /* the bootloader answers */
-    assert_int_equal(wire_get_u16(&last.content[2]), BOOTLOADER_VERSION);
+    assert_int_equal(le_get_u16(&last.content[2]), BOOTLOADER_VERSION);
     assert_int_equal(last.content[4], APP_IMAGE_NO_HEADER);
-    assert_int_equal(wire_get_u16(&last.content[9]), PAGE);
-    assert_int_equal(wire_get_u16(&last.content[11]), PAGES);
+    assert_int_equal(le_get_u16(&last.content[9]), PAGE);
+    assert_int_equal(le_get_u16(&last.content[11]), PAGES);
     assert_int_equal(last.content[13], 2);
-    assert_int_equal(wire_get_u16(&last.content[14]), UPDATE_WRITE_MAX);
+    assert_int_equal(le_get_u16(&last.content[14]), UPDATE_WRITE_MAX);
 }
 
 /* From an old image to a new one, the power cut at every erase and program

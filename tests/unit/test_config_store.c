@@ -13,7 +13,7 @@
 #include "config_store.h"
 #include "crc32.h"
 #include "flash_double.h"
-#include "protocol/data_table.h"
+#include "registers/data_table.h"
 
 static struct flash_double flash;
 /* Bytes one program step writes: the STM32F1's half-word, or 8 for parts

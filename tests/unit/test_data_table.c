@@ -8,7 +8,7 @@
 
 #include <cmocka.h>
 
-#include "protocol/data_table.h"
+#include "registers/data_table.h"
 
 static struct registers regs;
 

@@ -10,7 +10,7 @@
 #include <cmocka.h>
 
 #include "motion_mock.h"
-#include "protocol/data_table.h"
+#include "registers/data_table.h"
 #include "protocol/dispatcher.h"
 #include "protocol/packet_table.h"
 

@@ -11,7 +11,7 @@
 
 #include "ntc.h"
 #include "protection.h"
-#include "protocol/data_table.h"
+#include "registers/data_table.h"
 
 static struct protection prot;
 static struct user_config cfg;

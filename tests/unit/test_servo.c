@@ -11,7 +11,7 @@
 
 #include <cmocka.h>
 
-#include "protocol/data_table.h"
+#include "registers/data_table.h"
 #include "servo_harness.h"
 
 static int setup(void **state)

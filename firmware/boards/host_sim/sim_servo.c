@@ -9,7 +9,7 @@
 #include "calibration.h"
 #include "config_store.h"
 #include "crc32.h"
-#include "protocol/data_table.h"
+#include "registers/data_table.h"
 #include "sim_bus.h"
 #include "slot_write.h"
 

@@ -90,4 +90,11 @@ struct registers {
  * the config store: every item at its own size, in ID order. */
 #define USER_AREA_SIZE 32u
 
+/* The link settings' ranges and factory baud rate (items 34 and 36), which
+ * the bootloader checks without the data table. */
+#define SERVO_ID_MAX 254u
+#define BAUD_INDEX_MIN 1u
+#define BAUD_INDEX_MAX 8u
+#define BAUD_INDEX_FACTORY 5u
+
 #endif

@@ -76,9 +76,13 @@ def test_to_raw_refuses(name, text, error):
 
 
 def test_the_tool_table_matches_the_firmware_table():
-    """protocol/data_table.c's USER(...) rows: ID, size, signedness, range
+    """registers/data_table.c's USER(...) rows: ID, size, signedness, range
     and factory value of every user item, item for item."""
-    source = (ROOT / "protocol/data_table.c").read_text()
+    source = (ROOT / "registers/data_table.c").read_text()
+    # Values a row names (SERVO_ID_MAX, ...) are registers.h's defines.
+    header = (ROOT / "registers/include/registers/registers.h").read_text()
+    defines = dict(re.findall(r"#define (\w+) (-?\d+)u?\b", header))
+    source = re.sub(r"\b[A-Z][A-Z0-9_]+\b", lambda m: defines.get(m.group(0), m.group(0)), source)
     rows = re.findall(r"USER\((\d+), (\w+), (\d), (\w+), (-?\d+), (-?\d+), (-?\d+)\)", source)
     assert len(rows) == len(registers.USER) == 22
     for (ident, field, size, access, low, high, factory), item in zip(rows, registers.USER):

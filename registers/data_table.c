@@ -1,4 +1,4 @@
-#include "protocol/data_table.h"
+#include "registers/data_table.h"
 
 #include <stddef.h>
 #include <string.h>
@@ -24,9 +24,9 @@ static const struct data_item items[] = {
     RO_STATUS(8, serial_number, 4),
     USER(32, check_flag, 1, RW, 1, 1, 1),
     USER(33, control_response, 1, RW, 0, 1, 0),
-    USER(34, servo_id, 1, RW, 0, 254, 0),
+    USER(34, servo_id, 1, RW, 0, SERVO_ID_MAX, 0),
     USER(35, reserved_35, 1, RESERVED, 0, 255, 0),
-    USER(36, baud_index, 1, RW, 1, 8, 5),
+    USER(36, baud_index, 1, RW, BAUD_INDEX_MIN, BAUD_INDEX_MAX, BAUD_INDEX_FACTORY),
     USER(37, stall_release, 1, RW, 0, 1, 0),
     USER(38, stall_power_mw, 2, RW, 0, 65535, 10000),
     USER(39, low_voltage_mv, 2, RW, 0, 65535, 4000),
