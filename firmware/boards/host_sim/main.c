@@ -197,7 +197,7 @@ static int open_pty(const char *link, char *name, size_t name_size, int *slave_f
 
 static struct sim_servo *servo_by_id(int id)
 {
-    for (unsigned i = 0; i < bus.servo_count; i++) {
+    for (unsigned i = 0; i < bus.station_count; i++) {
         if (servos[i].cmdline_id == id) {
             return &servos[i];
         }
@@ -355,7 +355,7 @@ static void control_command(int fd, char *line)
         return;
     }
     char out[4096] = "";
-    for (unsigned i = 0; i < bus.servo_count; i++) {
+    for (unsigned i = 0; i < bus.station_count; i++) {
         struct sim_servo *s = &servos[i];
         if (only != NULL && s != only) {
             continue;
@@ -424,8 +424,7 @@ int main(int argc, char **argv)
             return 1;
         }
         servos[i].rx_interrupt = o.rx_interrupt;
-        bus.servos[i] = &servos[i];
-        bus.servo_count++;
+        sim_bus_attach(&bus, sim_servo_station(&servos[i]));
     }
 
     int listen_fd = -1;
@@ -537,7 +536,7 @@ int main(int argc, char **argv)
         if (wall_now - bus.now_us > most_behind_us) {
             most_behind_us = wall_now - bus.now_us;
         }
-        for (unsigned i = 0; i < bus.servo_count; i++) {
+        for (unsigned i = 0; i < bus.station_count; i++) {
             sim_servo_poll(&servos[i], bus.now_us);
         }
     }

@@ -1,10 +1,9 @@
 #include "sim_bus.h"
 
 #include <errno.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <unistd.h>
-
-#include "sim_servo.h"
 
 void sim_bus_init(struct sim_bus *b, uint64_t now_us)
 {
@@ -44,7 +43,7 @@ uint64_t sim_bus_send(struct sim_bus *b, unsigned sender, const uint8_t *data, u
     if (now_us < b->servo_until_us && b->last_sender != (int)sender) {
         b->collisions++;
         fprintf(stderr, "servo_sim: collision: servo %u started while servo %d was sending\n",
-                b->servos[sender]->cmdline_id, b->servos[b->last_sender]->cmdline_id);
+                b->stations[sender].log_id, b->stations[b->last_sender].log_id);
     }
     uint64_t t = enqueue(b, (uint8_t)sender, data, len, baud, now_us);
     b->servo_until_us = t;
@@ -77,9 +76,10 @@ void sim_bus_deliver(struct sim_bus *b, uint64_t now_us)
          * interrupt would stamp it: a stalled simulator loop does not look
          * like an idle line. The queue's times never run backwards. */
         bool received = false;
-        for (unsigned s = 0; s < b->servo_count; s++) {
-            if (s != e->sender && b->servos[s]->baud == e->baud) {
-                sim_servo_receive(b->servos[s], e->byte, e->at_us);
+        for (unsigned s = 0; s < b->station_count; s++) {
+            const struct sim_station *st = &b->stations[s];
+            if (s != e->sender && *st->baud == e->baud) {
+                st->receive(st->ctx, e->byte, e->at_us);
                 received = true;
             }
         }
@@ -98,6 +98,13 @@ void sim_bus_deliver(struct sim_bus *b, uint64_t now_us)
     write_host(b, out, n);
     if (now_us > b->now_us) {
         b->now_us = now_us;
+    }
+}
+
+void sim_bus_attach(struct sim_bus *b, struct sim_station station)
+{
+    if (b->station_count < SIM_MAX_SERVOS) {
+        b->stations[b->station_count++] = station;
     }
 }
 

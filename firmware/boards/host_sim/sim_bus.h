@@ -30,7 +30,15 @@
 #define SIM_BUS_STEP_US 250u /* most the bus clock moves in one pass */
 #define SIM_HOST 0xFFu /* sender of the host's bytes */
 
-struct sim_servo;
+/* What the bus needs of a station (a simulated servo): its UART's rate,
+ * where its received bytes go, and the ID the log names it by. The bus
+ * calls stations through this, so it knows nothing of what they are. */
+struct sim_station {
+    void *ctx;
+    const uint32_t *baud; /* the station's rate now */
+    void (*receive)(void *ctx, uint8_t byte, uint64_t at_us);
+    uint8_t log_id;
+};
 
 struct sim_bus_byte {
     uint64_t at_us;
@@ -49,8 +57,8 @@ struct sim_bus {
     int last_sender;          /* servo that queued it */
     int host_fd;              /* -1: no host connected */
     uint32_t host_baud;       /* the host's UART rate */
-    struct sim_servo *servos[SIM_MAX_SERVOS];
-    unsigned servo_count;
+    struct sim_station stations[SIM_MAX_SERVOS];
+    unsigned station_count;
     unsigned long collisions;
     unsigned long dropped;    /* queue overflow (servo bytes; the host is held back) */
     unsigned long baud_mismatches; /* bytes no station at that rate received */
@@ -60,6 +68,8 @@ struct sim_bus {
 unsigned sim_bus_room(const struct sim_bus *b);
 
 void sim_bus_init(struct sim_bus *b, uint64_t now_us);
+/* Adds a station; its index is its sender number in sim_bus_send. */
+void sim_bus_attach(struct sim_bus *b, struct sim_station station);
 /* Queues len bytes from servo `sender`; returns when the last stop bit ends. */
 uint64_t sim_bus_send(struct sim_bus *b, unsigned sender, const uint8_t *data, unsigned len,
                       uint32_t baud, uint64_t now_us);

@@ -224,8 +224,9 @@ bool sim_servo_start(struct sim_servo *s, struct sim_bus *bus, unsigned index, u
     return true;
 }
 
-void sim_servo_receive(struct sim_servo *s, uint8_t byte, uint64_t at_us)
+static void receive(void *ctx, uint8_t byte, uint64_t at_us)
 {
+    struct sim_servo *s = ctx;
     if (s->rx_interrupt) {
         if (at_us < s->cpu_free_us) {
             if (s->uart_full) {
@@ -282,4 +283,10 @@ void sim_servo_poll(struct sim_servo *s, uint64_t now_us)
         s->flash.stall_us = 0;
         s->slot_flash.stall_us = 0;
     }
+}
+
+struct sim_station sim_servo_station(struct sim_servo *s)
+{
+    return (struct sim_station){.ctx = s, .baud = &s->baud, .receive = receive,
+                                .log_id = s->cmdline_id};
 }

@@ -9,6 +9,7 @@
 #include "bootloader.h"
 #include "plant.h"
 #include "servo.h"
+#include "sim_bus.h"
 #include "sim_flash.h"
 #include "thermal.h"
 
@@ -32,7 +33,6 @@ struct sim_boot {
     struct boot_loop loop;
 };
 
-struct sim_bus;
 
 struct sim_servo {
     struct servo core;
@@ -85,7 +85,8 @@ bool sim_servo_start(struct sim_servo *s, struct sim_bus *bus, unsigned index, u
 void sim_servo_run_models(struct sim_servo *s);
 
 /* A byte off the wire at at_us, as the port takes it. */
-void sim_servo_receive(struct sim_servo *s, uint8_t byte, uint64_t at_us);
+/* The servo as a station of the bus: its UART. */
+struct sim_station sim_servo_station(struct sim_servo *s);
 
 /* A main-loop pass, unless the flash stalls the CPU at now_us; the stall
  * of what it did to the flash starts at now_us. */
