@@ -6,8 +6,9 @@ import struct
 from . import protocol as p
 from . import config_file
 from .frame import check_target
-from .protocol import NoReply, Refused, UsageError
-from .servo import MIN_RAMP_MS, Monitor, Servo, _check, _ms, _scaled, check_profile
+from .errors import NoReply, Refused, UsageError
+from .checks import MIN_RAMP_MS, check_profile, check_range, scaled, to_ms
+from .servo import Monitor, Servo
 
 # SyncCommand records (servo-protocol.md 3.25): the packet's own content.
 _ANGLE_RECORD = "<BhHH"       # packet 8: id, angle, interval, power
@@ -25,20 +26,20 @@ def sync_move(bus: p.Bus, targets: dict, duration_s: float, power_w: float = 0.0
     if not targets or len(targets) > MAX_SYNC_RECORDS:
         raise UsageError(f"a sync move takes 1..{MAX_SYNC_RECORDS} servos, not {len(targets)}")
     multi = multi_turn
-    interval = _ms(duration_s, "duration_s")
+    interval = to_ms(duration_s, "duration_s")
     check_profile(MIN_RAMP_MS, MIN_RAMP_MS, interval)  # packets 8 and 13 ramp 20 ms
-    power = _check("power", _scaled(power_w, 1000, "power_w"), 0, 65535, "mW")
+    power = check_range("power", scaled(power_w, 1000, "power_w"), 0, 65535, "mW")
     if multi:
         fmt, code = _MULTI_TURN_RECORD, p.MULTI_TURN
-        _check("interval", interval, 0, 4096000, "ms")
+        check_range("interval", interval, 0, 4096000, "ms")
     else:
         fmt, code = _ANGLE_RECORD, p.ANGLE
-        _check("interval", interval, 0, 65535, "ms")
+        check_range("interval", interval, 0, 65535, "ms")
     records = b""
     for servo_id, degrees in targets.items():
-        _check("servo ID", servo_id, 0, p.MAX_ID)
-        angle = _scaled(degrees, 10, "degrees")
-        _check("angle", angle, -3686400, 3686400, "deg", 10)
+        check_range("servo ID", servo_id, 0, p.MAX_ID)
+        angle = scaled(degrees, 10, "degrees")
+        check_range("angle", angle, -3686400, 3686400, "deg", 10)
         check_target(Servo(bus, servo_id), angle, multi)
         records += struct.pack(fmt, servo_id, angle, interval, power)
     bus.send(p.SYNC, bytes([code, struct.calcsize(fmt), len(targets)]) + records)
@@ -50,10 +51,10 @@ def broadcast_move(bus: p.Bus, degrees: float, duration_s: float, power_w: float
     ids are the servos on the bus: each is checked first (frame.check_target:
     in turn 0, the angle within its limits), and nothing is sent unless all
     pass."""
-    angle = _check("angle", _scaled(degrees, 10, "degrees"), -1800, 1800, "deg", 10)
-    interval = _check("interval", _ms(duration_s, "duration_s"), 0, 65535, "ms")
+    angle = check_range("angle", scaled(degrees, 10, "degrees"), -1800, 1800, "deg", 10)
+    interval = check_range("interval", to_ms(duration_s, "duration_s"), 0, 65535, "ms")
     check_profile(MIN_RAMP_MS, MIN_RAMP_MS, interval)
-    power = _check("power", _scaled(power_w, 1000, "power_w"), 0, 65535, "mW")
+    power = check_range("power", scaled(power_w, 1000, "power_w"), 0, 65535, "mW")
     if not ids:
         raise NoReply("no servo on the bus answered: nothing to move")
     for servo_id in ids:
@@ -76,7 +77,7 @@ def sync_monitor(bus: p.Bus, ids: list, timeout_s: float = None, arrivals: dict 
     {id: Monitor} of those that answered; arrivals, if given, gets {id:
     the bus clock when its answer arrived}."""
     for servo_id in ids:
-        _check("servo ID", servo_id, 0, p.MAX_ID)
+        check_range("servo ID", servo_id, 0, p.MAX_ID)
     if not ids or len(ids) > MAX_SYNC_RECORDS:
         raise UsageError(f"a sync monitor takes 1..{MAX_SYNC_RECORDS} servos")
     bus.send(p.SYNC, bytes([p.MONITOR, 1, len(ids)] + list(ids)))

@@ -26,10 +26,8 @@ class Sample:
 
 
 def _celsius(adc: int) -> float:
-    try:
-        return round(ntc.adc_to_celsius(adc), 1)
-    except ValueError:
-        return float("nan")
+    celsius = ntc.celsius_or_none(adc)
+    return float("nan") if celsius is None else celsius
 
 
 class Sampler:

@@ -29,3 +29,18 @@ def celsius_to_adc(celsius: float) -> int:
         raise ValueError(f"{celsius} degC is below absolute zero")
     rt = R25 * math.exp(B * (1.0 / (K + celsius) - 1.0 / (K + 25.0)))
     return round(rt * FULL_SCALE / (rt + R1))
+
+
+def celsius_or_none(adc: int, places: int = 1):
+    """degC rounded to places, or None for a reading no NTC gives (0, 4095 and
+    beyond: no sensor, or a short)."""
+    try:
+        return round(adc_to_celsius(adc), places)
+    except ValueError:
+        return None
+
+
+def describe(adc: int) -> str:
+    """A temperature reading for people: degC with the ADC value it came from."""
+    celsius = celsius_or_none(adc)
+    return f"{celsius:.1f} degC (ADC {adc})" if celsius is not None else f"ADC {adc} (no sensor?)"

@@ -1,12 +1,12 @@
 """What became of a motion command: did the servo take it, and did the horn
-arrive where it was asked to go, or why not."""
+arrive where it was asked to go, or why not. `s` is a servo.Servo (this
+module is below it: Servo.move_to waits with it)."""
 from dataclasses import dataclass
 
 from . import registers
 from .frame import Where, turn_base
-from .profile import velocity_timing
-from .protocol import BadAnswer, NoReply, Refused
-from .servo import Servo
+from .errors import BadAnswer, NoReply, Refused
+from .move_request import MoveRequest
 
 TOLERANCE_DEG = 0.5
 # Status bits under which the servo refuses motion (behaviour.md,
@@ -17,7 +17,7 @@ COMMAND_ERROR = 1 << 1
 EXECUTING = 1 << 0
 
 
-def taken(s: Servo, what: str) -> int:
+def taken(s, what: str) -> int:
     """After a command that has no answer of its own: the servo is there
     and did not refuse it. Returns the status byte."""
     try:
@@ -45,7 +45,7 @@ class Plan:
     soft_start_s: float
 
 
-def plan_move(s: Servo, asked: int, kw: dict, where: Where = None) -> Plan:
+def plan_move(s, asked: int, request: MoveRequest, where: Where = None) -> Plan:
     """Where the move will end and how long it is planned to take, from the
     servo's own settings (as frame.check_target read them, or read now):
     angle limits (48, 51, 52) clamp a single-turn target; soft start (49,
@@ -54,16 +54,11 @@ def plan_move(s: Servo, asked: int, kw: dict, where: Where = None) -> Plan:
         where = Where(s.read_all(), s.multi_turn_angle()[0])
     cfg, start = where.cfg, where.at
     target = asked
-    if not kw.get("multi_turn") and cfg["angle_limit_on"]:
+    if not request.multi_turn and cfg["angle_limit_on"]:
         target = min(max(asked, cfg["angle_min"]), cfg["angle_max"])
     # A single-turn target is taken within the turn the servo is in.
-    target_abs = target if kw.get("multi_turn") else turn_base(start) + target
-    acc, dec = max(kw["acc_ms"], 20), max(kw["dec_ms"], 20)
-    if "velocity" in kw:
-        n1, nc, n3 = velocity_timing(target_abs - start, 0.0, kw["velocity"] / 1000.0, acc, dec)
-        planned = (n1 + nc + n3) / 1000.0
-    else:
-        planned = max(kw["interval_ms"], acc + dec if kw.get("ramps", True) else 40) / 1000.0
+    target_abs = target if request.multi_turn else turn_base(start) + target
+    planned = request.planned_s(target_abs - start)
     soft = cfg["soft_start_time"] / 1000.0 if cfg["soft_start_on"] else 0.0
     return Plan(start, asked, target, target_abs, target != asked, planned, soft)
 
@@ -87,7 +82,7 @@ class Outcome:
     reason: str
 
 
-def wait_for_arrival(s: Servo, plan: Plan, tolerance_deg: float = TOLERANCE_DEG,
+def wait_for_arrival(s, plan: Plan, tolerance_deg: float = TOLERANCE_DEG,
                      timeout_s: float = None) -> Outcome:
     """Waits for status bit 0 to fall (the firmware clears it once the horn
     has arrived, nearly still) within a timeout that follows the plan, and

@@ -3,6 +3,10 @@ that sends requests and waits for the matching response."""
 import struct
 import time
 
+# The errors are errors.py's; named here too, as p.NoReply and the like.
+from .errors import (BadAnswer, BadChecksum, LinkError, NoReply, Refused,  # noqa: F401
+                     ServoError, UsageError, ValueOutOfRange)
+
 REQUEST_HEADER = b"\x12\x4c"
 RESPONSE_HEADER = b"\x05\x1c"
 BROADCAST = 0xFF
@@ -34,47 +38,6 @@ SYNC = 25
 READ_MOTION = 0x40  # this firmware's own (docs/packets.md)
 READ_STORE = 0x41
 ASSIGN_ID = 0x42
-
-
-class ServoError(Exception):
-    """Base of every error servoctl reports. exit_code is the command
-    line's (README, "Exit codes")."""
-    exit_code = 1
-
-
-class Refused(ServoError):
-    """The servo answered but did not do it (result 0, status bit 1, a
-    protection), or a move did not arrive."""
-    exit_code = 1
-
-
-class UsageError(ServoError):
-    """A value, name, file or option the tool cannot use: nothing was sent."""
-    exit_code = 2
-
-
-class ValueOutOfRange(UsageError):
-    pass
-
-
-class NoReply(ServoError):
-    """No servo answered (absent, another ID, another baud rate)."""
-    exit_code = 3
-
-
-class BadChecksum(NoReply):
-    pass
-
-
-class BadAnswer(NoReply):
-    """An answer came with a good checksum but not the length its packet
-    has: garbled on the wire, another firmware, or two servos on one ID.
-    No usable reply, so the same exit code as none."""
-
-
-class LinkError(ServoError):
-    """The serial port or socket failed: cannot open, gone, write error."""
-    exit_code = 4
 
 
 def checksum(data: bytes) -> int:
@@ -178,9 +141,15 @@ class Bus:
             raise LinkError(f"{self.port}: the link failed: {e}") from None
 
     def send(self, code: int, content: bytes) -> None:
+        self.send_burst([(code, content)])
+
+    def send_burst(self, requests) -> None:
+        """Requests (code, content) back to back in one write, so they reach
+        the line as one burst, without the gap a host may leave between two
+        writes."""
         self._link(self.serial.reset_input_buffer)
         self._buffer = b""
-        self._link(self.serial.write, request_frame(code, content))
+        self._link(self.serial.write, b"".join(request_frame(c, content) for c, content in requests))
 
     def _fill(self, wait: bool = True) -> bool:
         """Reads what has arrived; with wait, first waits up to 5 ms for a

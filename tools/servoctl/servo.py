@@ -3,9 +3,12 @@ protocol units (0.1 degree, ms, mW) unless the name says otherwise."""
 from dataclasses import dataclass
 import struct
 
+from . import frame, outcome
 from . import protocol as p
 from . import registers
-from .protocol import BadAnswer, Refused, ServoError, ValueOutOfRange
+from .checks import check_range, scaled, to_ms
+from .errors import BadAnswer, Refused, ServoError, ValueOutOfRange
+from .move_request import MoveRequest
 
 
 @dataclass
@@ -95,41 +98,10 @@ class StoreHealth:
         return [name for bit, name in enumerate(self.FLAGS) if name and self.flags >> bit & 1]
 
 
-def _check(name: str, value: int, low: int, high: int, unit: str = "", per_unit: int = 1) -> int:
-    """value, a whole number of 1/per_unit unit, within low..high; the
-    message speaks unit (an angle in 0.1 deg is checked with "deg", 10)."""
-    if isinstance(value, bool) or not isinstance(value, int):
-        raise ValueOutOfRange(f"{name} takes a whole number{' of ' + unit if unit else ''}, not {value!r}"
-                              f"{' (move_to() takes degrees)' if name == 'angle' else ''}")
-    if not low <= value <= high:
-        def show(v):
-            return f"{v / per_unit:g}" if per_unit != 1 else str(v)
-        raise ValueOutOfRange(f"{name} must be {show(low)}..{show(high)}{' ' + unit if unit else ''}, "
-                              f"not {show(value)}")
-    return value
-
-
-MIN_RAMP_MS = 20  # behaviour.md: acc >= 20, dec >= 20, interval >= acc + dec
-
-
-def check_profile(acc_ms: int, dec_ms: int, interval_ms: int = None, velocity: int = None) -> None:
-    """Refuses a profile the firmware would clamp (behaviour.md, Motion):
-    the move would run, but not as asked."""
-    for name, ramp in (("acceleration time", acc_ms), ("deceleration time", dec_ms)):
-        if ramp < MIN_RAMP_MS:
-            raise ValueOutOfRange(f"{name} must be {MIN_RAMP_MS} ms or more, not {ramp} ms "
-                                  f"(the servo would stretch it to {MIN_RAMP_MS} ms)")
-    if interval_ms is not None and interval_ms < acc_ms + dec_ms:
-        raise ValueOutOfRange(f"a move of {interval_ms} ms cannot hold its ramps ({acc_ms} + {dec_ms} ms): "
-                              f"give {acc_ms + dec_ms} ms or more (the servo would stretch it)")
-    if velocity is not None:
-        _check("speed", velocity, 10, 7500, "deg/s", 10)
-
-
 class Servo:
     def __init__(self, bus: p.Bus, servo_id: int):
         self.bus = bus
-        self.id = _check("servo ID", servo_id, 0, 254)
+        self.id = check_range("servo ID", servo_id, 0, 254)
 
     # ---- queries -------------------------------------------------------
     def ping(self, timeout=None) -> bool:
@@ -222,41 +194,47 @@ class Servo:
         (ramps=False: 8, 13, which ramp 20 ms), or by velocity in 0.1 deg/s
         (12, 15). The packet as it is: the firmware takes a single-turn
         angle within the turn the horn is in. move_to checks first."""
-        _check("power", power_mw, 0, 65535, "mW")
-        _check("acceleration time", acc_ms, 0, 65535, "ms")
-        _check("deceleration time", dec_ms, 0, 65535, "ms")
+        check_range("power", power_mw, 0, 65535, "mW")
+        check_range("acceleration time", acc_ms, 0, 65535, "ms")
+        check_range("deceleration time", dec_ms, 0, 65535, "ms")
         if multi_turn:
-            _check("angle", angle_decideg, -3686400, 3686400, "deg", 10)
+            check_range("angle", angle_decideg, -3686400, 3686400, "deg", 10)
         else:
-            _check("angle", angle_decideg, -1800, 1800, "deg", 10)
+            check_range("angle", angle_decideg, -1800, 1800, "deg", 10)
         if (interval_ms is None) == (velocity is None):
             raise ValueOutOfRange("give either an interval or a velocity")
         if velocity is not None:
-            _check("speed", velocity, 10, 7500, "deg/s", 10)
+            check_range("speed", velocity, 10, 7500, "deg/s", 10)
             fmt, code = ("<BiHHHH", p.MULTI_TURN_BY_VELOCITY) if multi_turn else ("<BhHHHH", p.ANGLE_BY_VELOCITY)
             content = struct.pack(fmt, self.id, angle_decideg, velocity, acc_ms, dec_ms, power_mw)
         elif not ramps:
-            _check("interval", interval_ms, 0, 4096000 if multi_turn else 65535, "ms")
+            check_range("interval", interval_ms, 0, 4096000 if multi_turn else 65535, "ms")
             fmt, code = ("<BiIH", p.MULTI_TURN) if multi_turn else ("<BhHH", p.ANGLE)
             content = struct.pack(fmt, self.id, angle_decideg, interval_ms, power_mw)
         else:
-            _check("interval", interval_ms, 0, 4096000 if multi_turn else 65535, "ms")
+            check_range("interval", interval_ms, 0, 4096000 if multi_turn else 65535, "ms")
             fmt, code = ("<BiIHHH", p.MULTI_TURN_BY_INTERVAL) if multi_turn else ("<BhHHHH", p.ANGLE_BY_INTERVAL)
             content = struct.pack(fmt, self.id, angle_decideg, interval_ms, acc_ms, dec_ms, power_mw)
         return self._move(code, content, wait)
+
+    def send_move(self, angle_decideg: int, request: MoveRequest, wait=False):
+        """move() with its profile and options as one MoveRequest."""
+        return self.move(angle_decideg, interval_ms=request.interval_ms, velocity=request.velocity,
+                         acc_ms=request.acc_ms, dec_ms=request.dec_ms, power_mw=request.power_mw,
+                         multi_turn=request.multi_turn, wait=wait, ramps=request.ramps)
 
     def wheel(self, action: str, speed_dps: int = 0, value: int = 0, clockwise: bool = False, wait=False):
         """Wheel mode: action stop, run, turns (value turns) or time (value ms)."""
         actions = {"stop": 0, "run": 1, "turns": 2, "time": 3}
         if action not in actions:
             raise ValueOutOfRange(f"wheel action must be one of {', '.join(actions)}, not {action!r}")
-        _check("wheel speed", speed_dps, 0, 65535, "deg/s")
-        _check("wheel value", value, 0, 65535)
+        check_range("wheel speed", speed_dps, 0, 65535, "deg/s")
+        check_range("wheel value", value, 0, 65535)
         method = actions[action] | (0x80 if clockwise else 0)
         return self._move(p.WHEEL, struct.pack("<BBHH", self.id, method, speed_dps, value), wait)
 
     def damping(self, power_mw: int = 0) -> None:
-        _check("power", power_mw, 0, 65535, "mW")
+        check_range("power", power_mw, 0, 65535, "mW")
         self.bus.send(p.DAMPING, struct.pack("<BH", self.id, power_mw))
 
     def stop(self, mode: str = "release", power_mw: int = 0) -> None:
@@ -283,21 +261,18 @@ class Servo:
         (frame.py). With wait, returns when the horn has arrived within
         tolerance_deg, and raises Refused saying why when it does not
         (stalled, a protection, timed out)."""
-        from . import frame, outcome
-
         if duration_s is not None and speed_dps is not None:
             raise ValueOutOfRange("give a duration or a speed, not both")
-        kw = dict(acc_ms=_ms(accel_s, "accel_s"), dec_ms=_ms(decel_s, "decel_s"),
-                  power_mw=_scaled(power_w, 1000, "power_w"), multi_turn=multi_turn)
-        if speed_dps is not None:
-            kw["velocity"] = _scaled(speed_dps, 10, "speed_dps")
-        else:
-            kw["interval_ms"] = _ms(1.0 if duration_s is None else duration_s, "duration_s")
-        check_profile(kw["acc_ms"], kw["dec_ms"], kw.get("interval_ms"), kw.get("velocity"))
-        asked = _scaled(degrees, 10, "degrees")
+        by_speed = speed_dps is not None
+        request = MoveRequest(
+            acc_ms=to_ms(accel_s, "accel_s"), dec_ms=to_ms(decel_s, "decel_s"),
+            power_mw=scaled(power_w, 1000, "power_w"), multi_turn=multi_turn,
+            velocity=scaled(speed_dps, 10, "speed_dps") if by_speed else None,
+            interval_ms=None if by_speed else to_ms(1.0 if duration_s is None else duration_s, "duration_s"))
+        asked = scaled(degrees, 10, "degrees")
         where = frame.check_target(self, asked, multi_turn)
-        plan = outcome.plan_move(self, asked, kw, where) if wait else None
-        self.move(asked, **kw)
+        plan = outcome.plan_move(self, asked, request, where) if wait else None
+        self.send_move(asked, request)
         outcome.taken(self, "the move")
         if not wait:
             return None
@@ -337,15 +312,3 @@ class Servo:
 
     def hold(self) -> None:
         self.stop("hold")
-
-
-def _scaled(value: float, factor: int, name: str) -> int:
-    import math
-
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise ValueOutOfRange(f"{name} takes a finite number, not {value!r}")
-    return int(round(value * factor))
-
-
-def _ms(seconds: float, name: str) -> int:
-    return _scaled(seconds, 1000, name)

@@ -131,10 +131,7 @@ def show(item, raw: int) -> str:
     temperature with its ADC value, a baud rate with its code."""
     q = item.quantity
     if q == "temperature":
-        try:
-            return f"{ntc.adc_to_celsius(raw):.1f} degC (ADC {raw})"
-        except ValueError:
-            return f"ADC {raw}"
+        return ntc.describe(raw)
     if q == "baud":
         return f"{registers.BAUD_RATES.get(raw, '?')} baud (code {raw})"
     if q in SCALES:

@@ -95,8 +95,9 @@ def overruns_while_programming(tmp_path, rx, run):
         with sim.bus(baud=1000000, timeout=0.2) as bus:
             for n in range(30):  # within the free slots: every write programs
                 value = (3000 + n % 2).to_bytes(2, "little")
-                bus.send(p.WRITE_DATA, bytes([1, 43]) + value)
-                bus.send(p.PING, bytes([2]))
+                # One burst: the ping follows the write on the wire at once,
+                # however the host schedules its writes.
+                bus.send_burst([(p.WRITE_DATA, bytes([1, 43]) + value), (p.PING, bytes([2]))])
                 for code, servo_id in ((p.PING, 2), (p.WRITE_DATA, 1)):
                     try:
                         bus.read_response(code, servo_id)
@@ -111,9 +112,9 @@ def overruns_while_programming(tmp_path, rx, run):
 def test_a_port_without_dma_would_lose_bytes(tmp_path):
     """The model bites: bytes that arrive while a record programs wait in
     the DMA ring, and overrun a port that takes each byte in its receive
-    interrupt (70 us a half-word, 7 bytes at 1 Mbaud). A simulator that
-    falls behind the wall clock (a loaded machine) may catch up with none
-    in flight, so up to three runs are given."""
+    interrupt (70 us a half-word, 7 bytes at 1 Mbaud). The ping is sent
+    in one burst with the write, so it is on the wire while the record
+    programs whatever the host's timing; three runs are still given."""
     assert overruns_while_programming(tmp_path, "dma", 0)["rx_overruns"] == 0
     for attempt in range(3):
         if overruns_while_programming(tmp_path, "interrupt", attempt)["rx_overruns"] > 0:

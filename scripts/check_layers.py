@@ -1,0 +1,219 @@
+#!/usr/bin/env python3
+"""The firmware's layers and circles, checked from its #include lines.
+
+Each source folder is a layer; a layer may include only the layers below it
+(LAYERS). A file may not reach itself through its includes (a circle), and
+no source file outside the tests may pass LINE_LIMIT lines. servoctl's
+modules may not import one another in a circle either.
+
+Exit 1 with one line per breach; `--graph` prints the layer graph found."""
+import argparse
+import ast
+import re
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+
+# Folder (most specific first) -> layer.
+FOLDERS = [
+    ("hal/include", "hal"),
+    ("hal/ports", "ports"),
+    ("registers", "registers"),
+    ("protocol/wire", "wire"),
+    ("protocol", "dispatch"),
+    ("motion", "motion"),
+    ("firmware/storage", "storage"),
+    ("firmware/sensors", "sensors"),
+    ("firmware/protection", "protection"),
+    ("firmware/bootloader", "bootloader"),
+    ("firmware/runtime", "runtime"),
+    ("firmware/startup", "startup"),
+    ("firmware/app", "app"),
+    ("firmware/boards", "boards"),
+]
+
+# Layer -> the layers it may include (below it).
+LAYERS = {
+    "hal": set(),
+    "registers": set(),
+    "runtime": set(),
+    "startup": {"ports", "hal"},  # a family's vector table names its port's handlers
+    "sensors": {"hal"},
+    "wire": {"registers", "hal"},
+    "storage": {"registers", "hal"},
+    "motion": {"registers", "hal"},
+    "protection": {"registers", "sensors", "hal"},
+    "dispatch": {"wire", "registers", "motion", "hal"},
+    "bootloader": {"wire", "storage", "registers", "hal"},
+    "ports": {"hal", "runtime"},
+    "app": {"dispatch", "wire", "registers", "motion", "storage", "sensors", "protection", "hal"},
+    "boards": None,  # a board puts everything together
+}
+
+LINE_LIMIT = 550
+# The one cohesive hub the limit spares (issue 24).
+LINE_LIMIT_SPARED = {"motion/motion.c"}
+
+INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"', re.M)
+
+
+def layer_of(rel):
+    for folder, layer in FOLDERS:
+        if rel == folder or rel.startswith(folder + "/"):
+            return layer
+    return None
+
+
+def sources(root):
+    for path in sorted(root.rglob("*.[ch]")):
+        rel = path.relative_to(root).as_posix()
+        if rel.startswith(("build/", "tests/", ".")) or layer_of(rel) is None:
+            continue
+        yield rel
+
+
+def resolve(root, including, name, by_suffix):
+    """The file an #include names: beside the including file, else the one
+    file whose path ends in the name (include/<lib>/x.h or a folder's x.h)."""
+    beside = (Path(including).parent / name).as_posix()
+    if (root / beside).is_file():
+        return beside
+    found = by_suffix.get(name, [])
+    if len(found) == 1:
+        return found[0]
+    # Two ports' headers of one name: the one in the including file's folder tree.
+    top = including.split("/")[0]
+    near = [f for f in found if f.split("/")[0] == top]
+    return near[0] if len(near) == 1 else None
+
+
+def include_graph(root):
+    files = list(sources(root))
+    by_suffix = {}
+    for rel in files:
+        parts = rel.split("/")
+        for i in range(len(parts)):
+            by_suffix.setdefault("/".join(parts[i:]), []).append(rel)
+    graph = {}
+    for rel in files:
+        text = (root / rel).read_text(errors="replace")
+        graph[rel] = [t for t in (resolve(root, rel, n, by_suffix) for n in INCLUDE.findall(text)) if t]
+    return graph
+
+
+def circles(graph):
+    """Every circle once, as a list of nodes (Tarjan's strongly connected
+    components of more than one node, or a node that reaches itself)."""
+    index, low, stack, on, out = {}, {}, [], set(), []
+    counter = [0]
+
+    def visit(v):
+        index[v] = low[v] = counter[0]
+        counter[0] += 1
+        stack.append(v)
+        on.add(v)
+        for w in graph.get(v, []):
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            comp = []
+            while True:
+                w = stack.pop()
+                on.discard(w)
+                comp.append(w)
+                if w == v:
+                    break
+            if len(comp) > 1 or v in graph.get(v, []):
+                out.append(sorted(comp))
+
+    sys.setrecursionlimit(10000)
+    for v in sorted(graph):
+        if v not in index:
+            visit(v)
+    return out
+
+
+def python_imports(root):
+    """servoctl's module graph: module -> the servoctl modules it imports."""
+    pkg = root / "tools" / "servoctl"
+    graph = {}
+    for path in sorted(pkg.glob("*.py")):
+        tree = ast.parse(path.read_text(), str(path))
+        deps = set()
+        for node in ast.walk(tree):
+            if isinstance(node, ast.ImportFrom):
+                if node.level == 1 and node.module:
+                    deps.add(node.module.split(".")[0])
+                elif node.level == 1:
+                    deps.update(a.name for a in node.names)
+                elif node.module and node.module.startswith("servoctl."):
+                    deps.add(node.module.split(".")[1])
+            elif isinstance(node, ast.Import):
+                deps.update(a.name.split(".")[1] for a in node.names if a.name.startswith("servoctl."))
+        graph[path.stem] = sorted(d for d in deps if (pkg / f"{d}.py").is_file() and d != path.stem)
+    return graph
+
+
+def long_files(root):
+    for path in sorted(root.rglob("*")):
+        rel = path.relative_to(root).as_posix()
+        if not path.is_file() or path.suffix not in (".c", ".h", ".py"):
+            continue
+        if rel.startswith(("build/", ".", "tests/", "tools/tests/")) or rel in LINE_LIMIT_SPARED:
+            continue
+        n = len(path.read_text(errors="replace").splitlines())
+        if n > LINE_LIMIT:
+            yield rel, n
+
+
+def check(root):
+    breaches = []
+    graph = include_graph(root)
+    for rel, targets in graph.items():
+        mine = layer_of(rel)
+        allowed = LAYERS[mine]
+        for t in targets:
+            theirs = layer_of(t)
+            if allowed is not None and theirs != mine and theirs not in allowed:
+                breaches.append(f"layer: {rel} ({mine}) includes {t} ({theirs})")
+    # A module is its .c and its .h: sim_bus.c calling into sim_servo.h
+    # while sim_servo.c calls into sim_bus.h is a circle of modules.
+    modules = {}
+    for rel, targets in graph.items():
+        deps = modules.setdefault(rel.rsplit(".", 1)[0], set())
+        deps.update(t.rsplit(".", 1)[0] for t in targets)
+    for m, deps in modules.items():
+        deps.discard(m)
+    for c in circles({m: sorted(d) for m, d in modules.items()}):
+        breaches.append("circle of modules: " + " <-> ".join(c))
+    for c in circles(python_imports(root)):
+        breaches.append("circle of imports in servoctl: " + " -> ".join(c))
+    for rel, n in long_files(root):
+        breaches.append(f"long file: {rel} has {n} lines (limit {LINE_LIMIT})")
+    return breaches, graph
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--root", type=Path, default=ROOT)
+    ap.add_argument("--graph", action="store_true", help="print which layer includes which")
+    args = ap.parse_args()
+    breaches, graph = check(args.root)
+    if args.graph:
+        edges = sorted({(layer_of(a), layer_of(b)) for a, ts in graph.items() for b in ts
+                        if layer_of(a) != layer_of(b)})
+        for a, b in edges:
+            print(f"{a} -> {b}")
+    for b in breaches:
+        print(b)
+    files = len(graph)
+    print(f"layers: {files} files, {len(breaches)} breaches")
+    return 1 if breaches else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,43 @@
+"""Every error servoctl reports, each with the exit code of the command line
+(README, "Exit codes"). The lowest module: every other may raise these."""
+
+
+class ServoError(Exception):
+    """Base of every error servoctl reports. exit_code is the command
+    line's (README, "Exit codes")."""
+    exit_code = 1
+
+
+class Refused(ServoError):
+    """The servo answered but did not do it (result 0, status bit 1, a
+    protection), or a move did not arrive."""
+    exit_code = 1
+
+
+class UsageError(ServoError):
+    """A value, name, file or option the tool cannot use: nothing was sent."""
+    exit_code = 2
+
+
+class ValueOutOfRange(UsageError):
+    pass
+
+
+class NoReply(ServoError):
+    """No servo answered (absent, another ID, another baud rate)."""
+    exit_code = 3
+
+
+class BadChecksum(NoReply):
+    pass
+
+
+class BadAnswer(NoReply):
+    """An answer came with a good checksum but not the length its packet
+    has: garbled on the wire, another firmware, or two servos on one ID.
+    No usable reply, so the same exit code as none."""
+
+
+class LinkError(ServoError):
+    """The serial port or socket failed: cannot open, gone, write error."""
+    exit_code = 4
