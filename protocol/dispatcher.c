@@ -47,6 +47,9 @@ void dispatch_packet(struct dispatcher *d, const struct packet_desc *desc,
     };
     response->code = desc->code;
     response->length = 0;
+    /* Every answer starts with the ID its request carried (content points
+     * into a frame or a sync record, never at less than one byte). */
+    response->content[0] = content[0];
 
     enum packet_outcome outcome = desc->handler(&call, response);
     switch (outcome) {
@@ -107,9 +110,8 @@ void dispatch(struct dispatcher *d, const struct rx_frame *frame, struct respons
     dispatch_packet(d, desc, frame->content, frame->length, origin, response, result);
 }
 
-enum packet_outcome answer_result(const struct packet_call *c, struct response *r, bool ok)
+enum packet_outcome answer_result(struct response *r, bool ok)
 {
-    r->content[0] = c->content[0];
     r->content[1] = ok ? 1u : 0u;
     r->length = 2;
     return ok ? OUTCOME_OK : OUTCOME_FAILED;

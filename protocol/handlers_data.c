@@ -7,7 +7,7 @@
 
 enum packet_outcome handle_ping(const struct packet_call *c, struct response *r)
 {
-    r->content[0] = c->content[0];
+    (void)c;
     r->length = 1;
     return OUTCOME_OK;
 }
@@ -35,12 +35,11 @@ enum packet_outcome handle_reset_user_data(const struct packet_call *c, struct r
 {
     const struct user_config before = c->d->regs->user;
     user_config_reset(&c->d->regs->user);
-    return answer_result(c, r, commit_user(c, &before));
+    return answer_result(r, commit_user(c, &before));
 }
 
 enum packet_outcome handle_read_data(const struct packet_call *c, struct response *r)
 {
-    r->content[0] = c->content[0];
     r->content[1] = c->content[1];
     uint8_t size = data_table_read(c->d->regs, c->content[1], &r->content[2]);
     r->length = (uint8_t)(2u + size);
@@ -58,7 +57,6 @@ static bool write_item(const struct packet_call *c, uint8_t id, const uint8_t *d
 enum packet_outcome handle_write_data(const struct packet_call *c, struct response *r)
 {
     bool ok = write_item(c, c->content[1], &c->content[2], (uint8_t)(c->length - 2u));
-    r->content[0] = c->content[0];
     r->content[1] = c->content[1];
     r->content[2] = ok ? 1u : 0u;
     r->length = 3;
@@ -67,7 +65,6 @@ enum packet_outcome handle_write_data(const struct packet_call *c, struct respon
 
 enum packet_outcome handle_read_batch(const struct packet_call *c, struct response *r)
 {
-    r->content[0] = c->content[0];
     user_config_encode(&c->d->regs->user, &r->content[1]);
     r->length = 1u + USER_AREA_SIZE;
     return OUTCOME_OK;
@@ -77,7 +74,7 @@ enum packet_outcome handle_write_batch(const struct packet_call *c, struct respo
 {
     const struct user_config before = c->d->regs->user;
     bool ok = user_config_decode(&c->d->regs->user, &c->content[1]) && commit_user(c, &before);
-    return answer_result(c, r, ok);
+    return answer_result(r, ok);
 }
 
 enum { READ_STORE_ANSWER_LENGTH = 34 };
@@ -87,7 +84,6 @@ enum packet_outcome handle_read_store(const struct packet_call *c, struct respon
 {
     const struct store_health *h = &c->d->regs->store;
     uint8_t *p = r->content;
-    p[0] = c->content[0];
     p[1] = h->flags;
     le_put_u32(&p[2], h->records);
     le_put_u32(&p[6], h->page_erases);
@@ -107,7 +103,6 @@ enum packet_outcome handle_monitor(const struct packet_call *c, struct response 
     struct motion_angle angle;
     motion_read_angle(c->d->motion, &angle);
     uint8_t *p = r->content;
-    p[0] = c->content[0];
     le_put_u16(&p[1], s->voltage_mv);
     le_put_u16(&p[3], s->current_ma);
     le_put_u16(&p[5], s->power_mw);

@@ -112,7 +112,7 @@ enum packet_outcome handle_move_damping(const struct packet_call *c, struct resp
     if (motion_submit(c->d->motion, &cmd) != MOTION_ACCEPTED) {
         return OUTCOME_ERROR;
     }
-    return answer_result(c, r, true);
+    return answer_result(r, true);
 }
 
 enum packet_outcome handle_stop(const struct packet_call *c, struct response *r)
@@ -132,7 +132,6 @@ enum packet_outcome handle_read_angle(const struct packet_call *c, struct respon
 {
     struct motion_angle angle;
     motion_read_angle(c->d->motion, &angle);
-    r->content[0] = c->content[0];
     le_put_u16(&r->content[1], (uint16_t)angle.single_turn_decideg);
     r->length = 3;
     return OUTCOME_OK;
@@ -146,7 +145,6 @@ enum packet_outcome handle_read_motion(const struct packet_call *c, struct respo
     struct motion_diagnostics d;
     motion_read_diagnostics(c->d->motion, &d);
     uint8_t *p = r->content;
-    p[0] = c->content[0];
     le_put_u32(&p[1], (uint32_t)d.angle_decideg);
     le_put_u32(&p[5], (uint32_t)d.setpoint_decideg);
     le_put_u32(&p[9], (uint32_t)d.target_decideg);
@@ -166,7 +164,6 @@ enum packet_outcome handle_read_multi_turn(const struct packet_call *c, struct r
 {
     struct motion_angle angle;
     motion_read_angle(c->d->motion, &angle);
-    r->content[0] = c->content[0];
     le_put_u32(&r->content[1], (uint32_t)angle.multi_turn_decideg);
     le_put_u16(&r->content[5], (uint16_t)angle.turns);
     r->length = 7;
@@ -175,7 +172,7 @@ enum packet_outcome handle_read_multi_turn(const struct packet_call *c, struct r
 
 enum packet_outcome handle_reset_multi_turn(const struct packet_call *c, struct response *r)
 {
-    return answer_result(c, r, motion_reset_multi_turn(c->d->motion));
+    return answer_result(r, motion_reset_multi_turn(c->d->motion));
 }
 
 enum packet_outcome handle_set_origin(const struct packet_call *c, struct response *r)

@@ -1,9 +1,8 @@
 /* The application's part of a firmware update (docs/packets.md, 0x50-0x55):
  * restarting into the bootloader, and saying who answers. */
 #include "protocol/packet_table.h"
+#include "protocol/update_status.h"
 #include "protocol/wire.h"
-
-enum { UPDATE_STATUS_ANSWER_LENGTH = 16, MODE_APPLICATION = 0 };
 
 /* UpdateEnter's reason byte (docs/packets.md). */
 enum update_enter_reason {
@@ -23,7 +22,7 @@ enum packet_outcome handle_update_enter(const struct packet_call *c, struct resp
                                              : ENTER_RESTARTING;
     bool ok = reason == ENTER_RESTARTING;
     c->result->enter_bootloader = ok;
-    enum packet_outcome outcome = answer_result(c, r, ok);
+    enum packet_outcome outcome = answer_result(r, ok);
     r->content[2] = (uint8_t)reason;
     r->length = 3;
     return outcome;
@@ -31,14 +30,9 @@ enum packet_outcome handle_update_enter(const struct packet_call *c, struct resp
 
 enum packet_outcome handle_update_status(const struct packet_call *c, struct response *r)
 {
-    uint8_t *p = r->content;
-    for (unsigned i = 0; i < UPDATE_STATUS_ANSWER_LENGTH; i++) {
-        p[i] = 0; /* the slot's geometry is the bootloader's to tell */
-    }
-    p[0] = c->content[0];
-    p[1] = MODE_APPLICATION;
-    le_put_u16(&p[5], c->d->regs->status.firmware_version);
-    le_put_u16(&p[7], c->d->board);
-    r->length = UPDATE_STATUS_ANSWER_LENGTH;
+    const struct update_status status = {.mode = UPDATE_MODE_APPLICATION,
+                                         .app_version = c->d->regs->status.firmware_version,
+                                         .board = c->d->board};
+    r->length = update_status_encode(&status, r->content);
     return OUTCOME_OK;
 }

@@ -3,11 +3,9 @@
 #include <stddef.h>
 
 #include "protocol/packet_codes.h"
+#include "protocol/update_status.h"
 #include "protocol/wire.h"
 #include "slot_write.h"
-
-/* Mode in UpdateStatus: who answers. */
-enum { MODE_BOOTLOADER = 1 };
 
 struct call {
     struct bootloader *b;
@@ -72,16 +70,20 @@ static uint8_t on_status(const struct call *c, struct response *r)
 {
     const struct app_slot *slot = c->b->slot;
     struct app_image_info info = {0};
-    r->content[1] = MODE_BOOTLOADER;
-    le_put_u16(&r->content[2], BOOTLOADER_VERSION);
-    r->content[4] = (uint8_t)app_image_check(slot, c->b->board, &info);
-    le_put_u16(&r->content[5], info.version);
-    le_put_u16(&r->content[7], c->b->board);
-    le_put_u16(&r->content[9], (uint16_t)slot->flash->page_size);
-    le_put_u16(&r->content[11], (uint16_t)slot->pages);
-    r->content[13] = (uint8_t)slot->flash->write_block;
-    le_put_u16(&r->content[14], UPDATE_WRITE_MAX);
-    return 16;
+    /* Before the answer's fields: the check fills info. */
+    enum app_image_verdict verdict = app_image_check(slot, c->b->board, &info);
+    const struct update_status status = {
+        .mode = UPDATE_MODE_BOOTLOADER,
+        .bootloader_version = BOOTLOADER_VERSION,
+        .image_verdict = (uint8_t)verdict,
+        .app_version = info.version,
+        .board = c->b->board,
+        .page_size = (uint16_t)slot->flash->page_size,
+        .pages = (uint16_t)slot->pages,
+        .write_block = (uint8_t)slot->flash->write_block,
+        .write_max = UPDATE_WRITE_MAX,
+    };
+    return update_status_encode(&status, r->content);
 }
 
 /* Eight bytes a row: every length here fits a byte. */

@@ -95,7 +95,8 @@ void dispatch_packet(struct dispatcher *d, const struct packet_desc *desc,
                      const uint8_t *content, uint16_t length, struct packet_origin origin,
                      struct response *response, struct dispatch_result *result);
 
-/* The "id, result" answer most packets give. */
-enum packet_outcome answer_result(const struct packet_call *c, struct response *r, bool ok);
+/* The "id, result" answer most packets give (dispatch_packet has put the
+ * ID in already). */
+enum packet_outcome answer_result(struct response *r, bool ok);
 
 #endif
