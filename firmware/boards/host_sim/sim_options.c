@@ -1,0 +1,104 @@
+#include "sim_options.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static void usage(FILE *out)
+{
+    fputs("usage: servo_sim [--id N]... [--tcp PORT | --link PATH] [--control PORT]\n"
+          "                 [--state DIR] [--supply MV] [--ambient DEGC]\n"
+          "Runs the servo firmware on simulated servos sharing one bus.\n"
+          "  --id N         a servo with ID N (repeat for more; default 1)\n"
+          "  --tcp PORT     the bus on 127.0.0.1:PORT (pyserial socket://) instead of a pty\n"
+          "  --link PATH    also make PATH a symlink to the pty\n"
+          "  --control PORT fault injection on 127.0.0.1:PORT (default: any free port)\n"
+          "  --state DIR    where each servo's flash file lives (default ./sim-state)\n"
+          "  --supply MV    supply voltage (default 7400)\n"
+          "  --ambient DEGC ambient temperature (default 25)\n"
+          "  --rx dma|interrupt  how the port receives: DMA into a ring (the reference\n"
+          "                 board, default) or a byte per interrupt, which overruns\n"
+          "                 while the flash stalls the CPU\n"
+          "Control commands, one per line, optional servo ID last:\n"
+          "  supply MV | load NM | stop DEG | stop off | ambient DEGC | soak DEGC |\n"
+          "  hostbaud BAUD (a TCP host's rate; a pty's is what the host set) |\n"
+          "  failerase N | failprogram N (the next N flash erases, or half-word\n"
+          "  programs, of the config store and the slot fail, as a worn page's do) |\n"
+          "  powercycle (the servo restarts through its bootloader) | state | help |\n"
+          "  clock (the simulated clock, sim_ms, and how far it is behind the wall clock) |\n"
+          "  hostsend MS HEX (the host's bytes on the wire from simulated time MS)\n"
+          "The servos run on the simulated clock: it follows the wall clock, and falls\n"
+          "behind it on a busy PC. state gives each servo's sim_ms with its models,\n"
+          "last_move_ms (how long status bit 0 was last set) and last_sent_ms (when its\n"
+          "last answer started), all on that clock.\n",
+          out);
+}
+
+static int parse_int(const char *s, const char *what, long lo, long hi)
+{
+    char *end;
+    long v = strtol(s, &end, 10);
+    if (*s == '\0' || *end != '\0' || v < lo || v > hi) {
+        fprintf(stderr, "servo_sim: %s must be a whole number from %ld to %ld, not '%s'\n", what,
+                lo, hi, s);
+        exit(2);
+    }
+    return (int)v;
+}
+
+void sim_options_parse(int argc, char **argv, struct sim_options *o)
+{
+    *o = (struct sim_options){.state_dir = "sim-state", .supply_v = 7.4, .ambient_c = 25.0};
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+            usage(stdout);
+            exit(0);
+        }
+        if (i + 1 >= argc) {
+            fprintf(stderr, "servo_sim: %s needs a value\n", a);
+            usage(stderr);
+            exit(2);
+        }
+        const char *v = argv[++i];
+        if (strcmp(a, "--id") == 0) {
+            if (o->id_count == SIM_MAX_SERVOS) {
+                fprintf(stderr, "servo_sim: at most %u servos\n", SIM_MAX_SERVOS);
+                exit(2);
+            }
+            uint8_t id = (uint8_t)parse_int(v, "--id", 0, 254);
+            for (unsigned k = 0; k < o->id_count; k++) {
+                if (o->ids[k] == id) {
+                    fprintf(stderr, "servo_sim: ID %u given twice\n", id);
+                    exit(2);
+                }
+            }
+            o->ids[o->id_count++] = id;
+        } else if (strcmp(a, "--tcp") == 0) {
+            o->tcp_port = parse_int(v, "--tcp", 1, 65535);
+        } else if (strcmp(a, "--control") == 0) {
+            o->control_port = parse_int(v, "--control", 1, 65535);
+        } else if (strcmp(a, "--link") == 0) {
+            o->link = v;
+        } else if (strcmp(a, "--state") == 0) {
+            o->state_dir = v;
+        } else if (strcmp(a, "--supply") == 0) {
+            o->supply_v = parse_int(v, "--supply", 0, 30000) / 1000.0;
+        } else if (strcmp(a, "--ambient") == 0) {
+            o->ambient_c = parse_int(v, "--ambient", -40, 150);
+        } else if (strcmp(a, "--rx") == 0) {
+            if (strcmp(v, "dma") != 0 && strcmp(v, "interrupt") != 0) {
+                fprintf(stderr, "servo_sim: --rx is dma or interrupt, not '%s'\n", v);
+                exit(2);
+            }
+            o->rx_interrupt = strcmp(v, "interrupt") == 0;
+        } else {
+            fprintf(stderr, "servo_sim: unknown option %s\n", a);
+            usage(stderr);
+            exit(2);
+        }
+    }
+    if (o->id_count == 0) {
+        o->ids[o->id_count++] = 1;
+    }
+}

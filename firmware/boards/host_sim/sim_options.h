@@ -1,0 +1,26 @@
+/* servo_sim's command line: which servos, where the bus and the control port
+ * are, where the flash files live, the supply and the ambient. */
+#ifndef SIM_OPTIONS_H
+#define SIM_OPTIONS_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "sim_bus.h"
+
+struct sim_options {
+    uint8_t ids[SIM_MAX_SERVOS];
+    unsigned id_count;
+    int tcp_port;          /* 0: a pseudo-terminal */
+    int control_port;      /* 0: any free port */
+    const char *link;      /* symlink to the pty */
+    const char *state_dir;
+    double supply_v;
+    double ambient_c;
+    bool rx_interrupt;
+};
+
+/* Parses argv; prints the usage and exits on --help or a bad option. */
+void sim_options_parse(int argc, char **argv, struct sim_options *o);
+
+#endif
