@@ -1,13 +1,33 @@
+# servo_board_linker_script(OUT TEMPLATE): the board's linker script, made
+# from firmware/linker/TEMPLATE.ld.in and the board's board.h by the C
+# preprocessor (the board is the folder whose CMakeLists.txt calls this).
+function(servo_board_linker_script out template)
+  set(in ${PROJECT_SOURCE_DIR}/firmware/linker/${template}.ld.in)
+  set(ld ${CMAKE_CURRENT_BINARY_DIR}/${template}.ld)
+  add_custom_command(
+    OUTPUT ${ld}
+    COMMAND ${CMAKE_C_COMPILER} -E -P -x c -I${CMAKE_CURRENT_SOURCE_DIR} ${in} -o ${ld}
+    DEPENDS ${in} ${CMAKE_CURRENT_SOURCE_DIR}/board.h ${PROJECT_SOURCE_DIR}/firmware/boards/board_derived.h
+    COMMENT "Linker script ${template}.ld from ${CMAKE_CURRENT_SOURCE_DIR}/board.h")
+  get_filename_component(board ${CMAKE_CURRENT_SOURCE_DIR} NAME)
+  if(NOT TARGET ${board}_${template}_ld)
+    add_custom_target(${board}_${template}_ld DEPENDS ${ld})
+  endif()
+  set(${out} ${ld} PARENT_SCOPE)
+endfunction()
+
 # servo_arm_image(NAME SOURCES src... [LIBS lib...]): the image of the board
-# whose board.cmake was included last (its startup code, port library and
-# linker script), a .bin beside it, a map, and the budget / soft-float and
-# stack checks after every link.
+# whose folder calls it (board.cmake: its startup code and port library;
+# board.h: its flash map, read by the linker script made from it), a .bin
+# beside it, a map, and the budget / soft-float and stack checks after every
+# link.
 function(servo_arm_image name)
   cmake_parse_arguments(I "" "" "SOURCES;LIBS" ${ARGN})
   if(NOT SERVO_BOARD_CPU STREQUAL SERVO_CPU)
     message(FATAL_ERROR "${name}: the board is a ${SERVO_BOARD_CPU}; this build is for ${SERVO_CPU}")
   endif()
-  set(I_LINKER ${SERVO_BOARD_LINKER})
+  servo_board_linker_script(I_LINKER app)
+  get_filename_component(board ${CMAKE_CURRENT_SOURCE_DIR} NAME)
   if(NOT DEFINED SERVO_BOARD_FLASH_LIMIT)
     set(SERVO_BOARD_FLASH_LIMIT 32768)
     set(SERVO_BOARD_RAM_LIMIT 8192)
@@ -18,9 +38,9 @@ function(servo_arm_image name)
     target_sources(${name}.elf PRIVATE $<TARGET_OBJECTS:servo_small_runtime>
                    $<TARGET_OBJECTS:servo_small_div>)
   endif()
-  target_include_directories(${name}.elf PRIVATE ${PROJECT_SOURCE_DIR}/firmware/boards/stm32f103
+  target_include_directories(${name}.elf PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}
                              ${PROJECT_SOURCE_DIR}/firmware/bootloader)
-  target_compile_definitions(${name}.elf PRIVATE BOARD_ID=${SERVO_BOARD_ID}u)
+  add_dependencies(${name}.elf ${board}_app_ld)
   servo_firmware_target(${name}.elf)
   target_link_options(${name}.elf PRIVATE -L${PROJECT_SOURCE_DIR}/firmware/linker -T${I_LINKER}
                       -Wl,-Map=${CMAKE_CURRENT_BINARY_DIR}/${name}.map)
@@ -36,7 +56,7 @@ function(servo_arm_image name)
     # starts, servoctl update writes, and the slot holds.
     COMMAND ${CMAKE_COMMAND} -E env PYTHONPATH=${PROJECT_SOURCE_DIR}/tools
             ${Python3_EXECUTABLE} -m servoctl.image ${CMAKE_CURRENT_BINARY_DIR}/${name}.bin
-            --version ${SERVO_FIRMWARE_VERSION} --board ${SERVO_BOARD_ID}
+            --version ${SERVO_FIRMWARE_VERSION} --board ${board}
             -o ${CMAKE_CURRENT_BINARY_DIR}/${name}.img
     VERBATIM)
 endfunction()
@@ -69,12 +89,15 @@ function(servo_arm_bootloader name)
   target_compile_options(${name}.elf PRIVATE -Oz -flto -fno-tree-loop-distribute-patterns)
   target_link_options(${name}.elf PRIVATE -Oz -flto)
   target_link_libraries(${name}.elf PRIVATE ${SERVO_BOARD_PORT} servo_bootloader_core)
-  target_compile_definitions(${name}.elf PRIVATE BOARD_ID=${SERVO_BOARD_ID}u)
+  target_include_directories(${name}.elf PRIVATE ${CMAKE_CURRENT_SOURCE_DIR})
   servo_firmware_target(${name}.elf)
+  servo_board_linker_script(boot_ld boot)
+  get_filename_component(board ${CMAKE_CURRENT_SOURCE_DIR} NAME)
+  add_dependencies(${name}.elf ${board}_boot_ld)
   target_link_options(${name}.elf PRIVATE -L${PROJECT_SOURCE_DIR}/firmware/linker
-                      -T${SERVO_BOARD_BOOT_LINKER} -Wl,-Map=${CMAKE_CURRENT_BINARY_DIR}/${name}.map)
+                      -T${boot_ld} -Wl,-Map=${CMAKE_CURRENT_BINARY_DIR}/${name}.map)
   set_target_properties(${name}.elf PROPERTIES
-    LINK_DEPENDS "${SERVO_BOARD_BOOT_LINKER};${PROJECT_SOURCE_DIR}/firmware/linker/sections_stm32.ld")
+    LINK_DEPENDS "${boot_ld};${PROJECT_SOURCE_DIR}/firmware/linker/sections_stm32.ld")
   add_custom_command(TARGET ${name}.elf POST_BUILD
     COMMAND ${CMAKE_OBJCOPY} -O binary $<TARGET_FILE:${name}.elf> ${CMAKE_CURRENT_BINARY_DIR}/${name}.bin
     COMMAND sh ${PROJECT_SOURCE_DIR}/cmake/check-image.sh $<TARGET_FILE:${name}.elf> 4096

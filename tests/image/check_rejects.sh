@@ -6,9 +6,12 @@ set -u
 root=$(cd "$(dirname "$0")/../.." && pwd)
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
+# The reference board's application memory map, as the build makes it.
+arm-none-eabi-gcc -E -P -x c -I "$root/firmware/boards/stm32f103" "$root/firmware/linker/app.ld.in" \
+  -o "$tmp/app.ld" || exit 1
 build() {
   arm-none-eabi-gcc -mcpu=cortex-m3 -mthumb -Os -nostartfiles --specs=nano.specs \
-    --specs=nosys.specs -L "$root/firmware/linker" -T "$root/firmware/boards/stm32f103/stm32f103x8.ld" "$@" \
+    --specs=nosys.specs -L "$root/firmware/linker" -T "$tmp/app.ld" "$@" \
     "$root/tests/image/probe.c" -o "$tmp/probe.elf" || exit 1
 }
 fail=0

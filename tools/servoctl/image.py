@@ -14,9 +14,12 @@ FORMAT = 1
 HEADER_SIZE = 256
 CHECKED = 24  # bytes the header's own CRC covers
 
-# The build's boards: each folder with a board.cmake (SERVO_BOARD_ID, the
-# header's board field; SERVO_BOARD_LINKER, the application's memory map).
+# The build's boards: each folder with a board.h (BOARD_ID, the header's
+# board field; the flash map and RAM the application's linker script is made
+# from: firmware/linker/app.ld.in).
 BOARDS_DIR = Path(__file__).resolve().parents[2] / "firmware" / "boards"
+HEADER_SIZE_IN_SLOT = 256  # the image header before the application (app.ld.in)
+STAY_WORD_BYTES = 16       # RAM's last bytes, left out of the application's
 
 
 @dataclass(frozen=True)
@@ -27,41 +30,27 @@ class Board:
     ram: tuple = None    # (first, end) of its RAM
 
 
-def _size(expr: str) -> int:
-    """A linker script's ORIGIN or LENGTH: numbers with K or M, + and -."""
-    total, sign = 0, 1
-    for number, unit, op in re.findall(r"(0x[0-9a-fA-F]+|\d+)\s*([KM]?)|([+-])", expr):
-        if op:
-            sign = 1 if op == "+" else -1
-        else:
-            total += sign * int(number, 0) * {"": 1, "K": 1024, "M": 1024 * 1024}[unit]
-    return total
-
-
-def _memory_map(linker_script: Path) -> tuple:
-    """(flash, ram) spans of a linker script's MEMORY: FLASH, and the RAM
-    regions (RAM, VECTORS) from the lowest to the highest end."""
-    regions = {}
-    for name, origin, length in re.findall(r"^\s*(\w+)\s*\([rwx]+\)\s*:\s*ORIGIN\s*=\s*([^,]+),"
-                                           r"\s*LENGTH\s*=\s*(.+)$", linker_script.read_text(), re.M):
-        regions[name] = (_size(origin), _size(origin) + _size(length))
-    ram = [span for name, span in regions.items() if name in ("RAM", "VECTORS")]
-    return regions.get("FLASH"), (min(a for a, _ in ram), max(b for _, b in ram)) if ram else None
+def _defines(board_h: Path) -> dict:
+    """board.h's plain numbers: #define BOARD_X 0x... or decimal."""
+    return {name: int(value, 0) for name, value in
+            re.findall(r"^#define (BOARD_\w+) (0x[0-9a-fA-F]+|\d+)\b", board_h.read_text(), re.M)}
 
 
 def _read_board(folder: Path):
-    text = (folder / "board.cmake").read_text()
-    board_id = re.search(r"set\(SERVO_BOARD_ID\s+(0x[0-9a-fA-F]+|\d+)\)", text)
-    if board_id is None:
+    d = _defines(folder / "board.h")
+    if "BOARD_ID" not in d:
         return None
-    linker = re.search(r"set\(SERVO_BOARD_LINKER\s+\$\{CMAKE_CURRENT_LIST_DIR\}/(\S+)\)", text)
-    flash, ram = _memory_map(folder / linker.group(1)) if linker else (None, None)
-    return Board(folder.name, int(board_id.group(1), 0), flash, ram)
+    if d.get("BOARD_SIMULATED"):
+        return Board(folder.name, d["BOARD_ID"])
+    slot = d["BOARD_SLOT_BASE"]
+    flash = (slot + HEADER_SIZE_IN_SLOT, slot + d["BOARD_SLOT_PAGES"] * d["BOARD_FLASH_PAGE"])
+    ram = (d["BOARD_RAM_BASE"], d["BOARD_RAM_BASE"] + d["BOARD_RAM_SIZE"] - STAY_WORD_BYTES)
+    return Board(folder.name, d["BOARD_ID"], flash, ram)
 
 
 def boards() -> dict:
     """{name: Board} of every board the build knows."""
-    found = (_read_board(f) for f in sorted(BOARDS_DIR.iterdir()) if (f / "board.cmake").is_file())
+    found = (_read_board(f) for f in sorted(BOARDS_DIR.iterdir()) if (f / "board.h").is_file())
     return {b.name: b for b in found if b is not None}
 
 

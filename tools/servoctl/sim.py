@@ -256,7 +256,7 @@ def _free_port() -> int:
 QEMU_BOARD = REPO / "build" / "arm" / "firmware" / "boards" / "qemu_stm32vl"
 QEMU_BOOTLOADER = QEMU_BOARD / "servo_qemu_stm32vl_boot.elf"
 QEMU_IMAGE = QEMU_BOARD / "servo_qemu_stm32vl.img"
-QEMU_SLOT = 0x08001000  # where the application's image goes (stm32f100xb.ld)
+QEMU_SLOT = 0x08001000  # where the application's image goes (qemu_stm32vl/board.h)
 
 
 class QemuBoard(_Child):

@@ -34,14 +34,15 @@ def test_parse_takes_what_build_makes_and_refuses_damage():
 
 
 def test_the_boards_are_the_builds():
-    """Every folder of firmware/boards with a board.cmake, the M0 included,
-    with the ID and the memory map the build uses."""
-    folders = {f.name for f in img.BOARDS_DIR.iterdir() if (f / "board.cmake").is_file()}
+    """Every folder of firmware/boards with a board.h, the M0 included, with
+    the ID and the memory map the build makes its linker scripts from."""
+    folders = {f.name for f in img.BOARDS_DIR.iterdir() if (f / "board.h").is_file()}
     boards = img.boards()
     assert set(boards) == folders >= {"stm32f103", "stm32f030k6", "qemu_stm32vl", "host_sim"}
     assert boards["stm32f030k6"].id == 0x0030 and boards["stm32f103"].id == 0x0103
     assert boards["stm32f030k6"].flash == (0x08001100, 0x08007800)  # 26 KB less the header
     assert boards["stm32f103"].ram == (0x20000000, 0x20005000 - 16)
+    assert boards["host_sim"].id == 0x5100 and boards["host_sim"].flash is None  # never executed
 
 
 def vectors(sp, reset, size=64):

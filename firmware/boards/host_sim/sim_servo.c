@@ -6,7 +6,6 @@
 #include <string.h>
 #include <time.h>
 
-#include "calibration.h"
 #include "config_store.h"
 #include "crc32.h"
 #include "registers/data_table.h"

@@ -6,6 +6,7 @@
 #include <stdint.h>
 
 #include "app_image.h"
+#include "board.h"
 #include "bootloader.h"
 #include "plant.h"
 #include "servo.h"
@@ -13,17 +14,11 @@
 #include "sim_flash.h"
 #include "thermal.h"
 
-/* The reference board's flash map: the bootloader's 4 KB, the application
- * slot, the config store's two pages at the top of 64 KB. */
-#define SIM_SLOT_BASE 0x08001000u
-#define SIM_SLOT_PAGES 58u
-#define SIM_CONFIG_BASE 0x0800F800u
-/* SIM_BOARD, the board the simulator's images are for (the header's board
- * field), comes from board.cmake, as every board's does. */
-#ifndef SIM_BOARD
-#error "SIM_BOARD comes from firmware/boards/host_sim/board.cmake"
-#endif
-
+/* The simulated servo's flash map and board ID (board.h), in C's types. */
+#define SIM_SLOT_BASE ((uint32_t)BOARD_SLOT_BASE)
+#define SIM_SLOT_PAGES ((uint32_t)BOARD_SLOT_PAGES)
+#define SIM_CONFIG_BASE ((uint32_t)BOARD_CONFIG_PAGE0)
+#define SIM_BOARD ((uint16_t)BOARD_ID)
 /* The bootloader, as the simulator runs it (sim_boot.c): the boards' loop
  * (bootloader.c) on the servo's port; the image in the slot is not
  * executed, its version is what the "application" then reports (data

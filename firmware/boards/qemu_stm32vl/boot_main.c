@@ -4,6 +4,7 @@
  * simulator's and the reference board's. The application keeps its config
  * store in RAM on this board, so the bootloader finds none there (QEMU's
  * unwritten flash reads 0) and answers at the factory ID and baud rate. */
+#include "board.h"
 #include "boot_flow.h"
 #include "boot_jump.h"
 #include "bootloader.h"
@@ -11,10 +12,6 @@
 #include "qemu_board.h"
 #include "stm32f1_regs.h"
 #include "systick_clock.h"
-
-#define RAM_END 0x20002000u
-#define SLOT_BASE 0x08001000u
-#define SLOT_PAGES 120u
 
 static struct hal_port port;
 static struct usart_hd usart;
@@ -60,14 +57,14 @@ static void service(void)
 
 int main(void)
 {
-    uint32_t stay = boot_take_word(BOOT_STAY_WORD_ADDR(RAM_END));
+    uint32_t stay = boot_take_word(BOOT_STAY_WORD_ADDR(BOARD_RAM_END));
     systick_clock_init(QEMU_CORE_HZ);
     slot_flash = (struct hal_flash){.page_size = 1024u, .erase_page = refuse_erase,
                                     .write_block = 2, .program = refuse_program, .read = flash_read};
     config_flash = slot_flash; /* the application's store is in its RAM: none here */
     config_flash.page_addr[0] = 0x0801F800u;
     config_flash.page_addr[1] = 0x0801FC00u;
-    slot = (struct app_slot){.flash = &slot_flash, .base = SLOT_BASE, .pages = SLOT_PAGES};
+    slot = (struct app_slot){.flash = &slot_flash, .base = BOARD_SLOT_BASE, .pages = BOARD_SLOT_PAGES};
     port = (struct hal_port){.flash = &config_flash,
                              .rx_gap_tolerance_us = QEMU_RX_GAP_TOLERANCE_US};
     port_uart_init(&port, &usart, PORT_UART_RX_INTERRUPT, QEMU_CORE_HZ);

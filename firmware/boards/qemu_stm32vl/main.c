@@ -1,7 +1,7 @@
 /* The servo on QEMU's stm32vldiscovery (STM32F100): the real USART driver
  * and the real core; motor, sensors and flash come from models compiled into
  * the image, since QEMU has no ADC, timers or flash controller for it. */
-#include "calibration.h"
+#include "board.h"
 #include "plant_fixed.h"
 #include "qemu_board.h"
 #include "boot_flow.h"
@@ -12,8 +12,9 @@
 #include "port_uart.h"
 #include "usart_hd.h"
 
-#define FLASH_PAGE 1024u
-#define RAM_FLASH_BASE 0x0801F800u /* where the pages would be; kept in RAM */
+/* The config store's pages, kept in RAM at the addresses they would have. */
+#define FLASH_PAGE ((uint32_t)BOARD_FLASH_PAGE)
+#define RAM_FLASH_BASE ((uint32_t)BOARD_RAM_CONFIG_BASE)
 
 static struct servo servo;
 static struct hal_port port;
@@ -84,7 +85,7 @@ static void ram_read(void *ctx, uint32_t addr, uint8_t *dst, uint32_t len)
 static void enter_bootloader(void *ctx)
 {
     (void)ctx;
-    boot_restart_with(BOOT_STAY_WORD_ADDR(0x20002000u), BOOT_STAY_MAGIC);
+    boot_restart_with(BOOT_STAY_WORD_ADDR(BOARD_RAM_END), BOOT_STAY_MAGIC);
 }
 
 int main(void)

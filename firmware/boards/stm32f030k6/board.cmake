@@ -1,12 +1,9 @@
 # The Cortex-M0 servo board: STM32F030K6 (48 MHz, 32 KB flash, 4 KB RAM),
-# its pins in README.md, the reference board's front end (calibration.h).
+# its pins in README.md; ID, flash map and front end in board.h.
 # Budgets (cmake/check-image.sh): the part's 4 KB RAM; 20 KB flash for the
 # application, so the 4 KB bootloader, the application and the 2 KB store fit 32 KB.
 set(SERVO_BOARD_CPU cortex-m0)
 set(SERVO_BOARD_PORT servo_stm32f0)                      # hal/ports/stm32f0
 set(SERVO_BOARD_STARTUP ${PROJECT_SOURCE_DIR}/firmware/startup/startup_stm32f030.c)
-set(SERVO_BOARD_LINKER ${CMAKE_CURRENT_LIST_DIR}/stm32f030k6.ld)
-set(SERVO_BOARD_ID 0x0030)                                 # the update image header's board
 set(SERVO_BOARD_RAM_LIMIT 4096)
 set(SERVO_BOARD_FLASH_LIMIT 20480) # the application: README, "Footprint"
-set(SERVO_BOARD_BOOT_LINKER ${CMAKE_CURRENT_LIST_DIR}/stm32f030k6_boot.ld)

@@ -1,19 +1,13 @@
 /* The Cortex-M0 board: STM32F030K6 servo controller (pin map: README.md). */
+#include "board.h"
 #include "board_f030.h"
 #include "boot_flow.h"
 #include "boot_jump.h"
-#include "calibration.h"
 #include "flash_f0f1.h"
 #include "port_uart.h"
 #include "servo.h"
 #include "stm32f0_regs.h"
 #include "systick_clock.h"
-
-/* The last two 1 KB pages of the 32 KB part hold the config store (kept out
- * of the image by the linker script). */
-#define CONFIG_PAGE0 0x08007800u
-#define CONFIG_PAGE1 0x08007C00u
-#define RAM_END 0x20001000u
 
 static struct servo servo;
 static struct hal_port port;
@@ -26,7 +20,7 @@ static const struct sensor_calibration calibration = BOARD_SENSOR_CALIBRATION;
 static void enter_bootloader(void *ctx)
 {
     (void)ctx;
-    boot_restart_with(BOOT_STAY_WORD_ADDR(RAM_END), BOOT_STAY_MAGIC);
+    boot_restart_with(BOOT_STAY_WORD_ADDR(BOARD_RAM_END), BOOT_STAY_MAGIC);
 }
 
 int main(void)
@@ -36,7 +30,7 @@ int main(void)
     systick_clock_init(F030_CORE_HZ);
     adc_scan_init();
     pwm_bridge_init();
-    flash_f0f1_init(&flash, 1024u, CONFIG_PAGE0, CONFIG_PAGE1);
+    flash_f0f1_init(&flash, BOARD_FLASH_PAGE, BOARD_CONFIG_PAGE0, BOARD_CONFIG_PAGE1);
     port = (struct hal_port){
         .calibration = &calibration,
         .flash = &flash,

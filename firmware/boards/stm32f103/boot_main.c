@@ -1,6 +1,7 @@
 /* The bootloader on the reference board: the clock, the bus wire and its
  * USART with DMA receive, the flash, and the portable loop
  * (firmware/bootloader/bootloader.c). */
+#include "board.h"
 #include "board_f103.h"
 #include "boot_flow.h"
 #include "boot_jump.h"
@@ -9,12 +10,6 @@
 #include "port_uart.h"
 #include "stm32f1_regs.h"
 #include "systick_clock.h"
-
-#define RAM_END 0x20005000u
-#define CONFIG_PAGE0 0x0800F800u
-#define CONFIG_PAGE1 0x0800FC00u
-#define SLOT_BASE 0x08001000u
-#define SLOT_PAGES 58u
 
 static struct hal_port port;
 static struct usart_hd usart;
@@ -38,13 +33,13 @@ static void service(void)
 
 int main(void)
 {
-    uint32_t stay = boot_take_word(BOOT_STAY_WORD_ADDR(RAM_END));
+    uint32_t stay = boot_take_word(BOOT_STAY_WORD_ADDR(BOARD_RAM_END));
     clock_f103_init();
     bus_pins_init();
     systick_clock_init(F103_CORE_HZ);
-    flash_f0f1_init(&config_flash, 1024u, CONFIG_PAGE0, CONFIG_PAGE1);
+    flash_f0f1_init(&config_flash, BOARD_FLASH_PAGE, BOARD_CONFIG_PAGE0, BOARD_CONFIG_PAGE1);
     slot_flash = config_flash; /* the same flash: any page by its address */
-    slot = (struct app_slot){.flash = &slot_flash, .base = SLOT_BASE, .pages = SLOT_PAGES};
+    slot = (struct app_slot){.flash = &slot_flash, .base = BOARD_SLOT_BASE, .pages = BOARD_SLOT_PAGES};
     port = (struct hal_port){.flash = &config_flash};
     port_uart_init(&port, &usart, PORT_UART_RX_DMA, F103_PCLK2_HZ);
     usart_hd_tx_polled(&usart); /* no USART interrupt: its vector is not in the table */

@@ -1,6 +1,6 @@
 /* The reference board: STM32F103 servo controller (pin map: README.md). */
+#include "board.h"
 #include "board_f103.h"
-#include "calibration.h"
 #include "flash_f0f1.h"
 #include "boot_flow.h"
 #include "boot_jump.h"
@@ -9,11 +9,6 @@
 #include "systick_clock.h"
 #include "port_uart.h"
 #include "usart_hd.h"
-
-/* The last two 1 KB pages of the 64 KB part hold the config store (kept out
- * of the image by the linker script). */
-#define CONFIG_PAGE0 0x0800F800u
-#define CONFIG_PAGE1 0x0800FC00u
 
 static struct servo servo;
 static struct hal_port port;
@@ -35,7 +30,7 @@ static void gpio_init(void)
 static void enter_bootloader(void *ctx)
 {
     (void)ctx;
-    boot_restart_with(BOOT_STAY_WORD_ADDR(0x20005000u), BOOT_STAY_MAGIC);
+    boot_restart_with(BOOT_STAY_WORD_ADDR(BOARD_RAM_END), BOOT_STAY_MAGIC);
 }
 
 int main(void)
@@ -45,7 +40,7 @@ int main(void)
     systick_clock_init(F103_CORE_HZ);
     adc_scan_init();
     pwm_bridge_init();
-    flash_f0f1_init(&flash, 1024u, CONFIG_PAGE0, CONFIG_PAGE1);
+    flash_f0f1_init(&flash, BOARD_FLASH_PAGE, BOARD_CONFIG_PAGE0, BOARD_CONFIG_PAGE1);
     port = (struct hal_port){
         .calibration = &calibration,
         .flash = &flash,

@@ -1,0 +1,32 @@
+/* What a board's C code derives from its board.h, which holds plain numbers
+ * so that the linker scripts (firmware/linker/app.ld.in and boot.ld.in,
+ * through the C preprocessor) and servoctl can read it too. Checked here,
+ * at build time: the map must fit together. */
+#ifndef BOARD_DERIVED_H
+#define BOARD_DERIVED_H
+
+#ifndef BOARD_FOR_LINKER
+#include <stdint.h>
+
+/* The end of RAM: the word below it keeps the bootloader (boot_jump.h). */
+#define BOARD_RAM_END ((uint32_t)BOARD_RAM_BASE + (uint32_t)BOARD_RAM_SIZE)
+
+/* Initialiser of a struct sensor_calibration for the board's front end. */
+#define BOARD_SENSOR_CALIBRATION                                    \
+    {                                                               \
+        .supply_uv_per_count = BOARD_SUPPLY_UV_PER_COUNT,           \
+        .current_ua_per_count = BOARD_CURRENT_UA_PER_COUNT,         \
+        .current_zero_counts = BOARD_CURRENT_ZERO_COUNTS,           \
+    }
+
+_Static_assert(BOARD_SLOT_BASE == BOARD_FLASH_BASE + BOARD_BOOT_SIZE,
+               "board.h: the slot starts where the bootloader ends");
+#ifdef BOARD_CONFIG_PAGE0
+_Static_assert(BOARD_SLOT_BASE + BOARD_SLOT_PAGES * BOARD_FLASH_PAGE <= BOARD_CONFIG_PAGE0,
+               "board.h: the slot ends before the config store");
+_Static_assert(BOARD_CONFIG_PAGE1 == BOARD_CONFIG_PAGE0 + BOARD_FLASH_PAGE,
+               "board.h: the config store is two adjacent pages");
+#endif
+#endif
+
+#endif

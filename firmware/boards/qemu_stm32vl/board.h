@@ -1,0 +1,30 @@
+/* QEMU's stm32vldiscovery (STM32F100RB: 128 KB flash, 8 KB RAM), which
+ * models the USART only. Its main.c and boot_main.c, its linker scripts
+ * (made from firmware/linker/app.ld.in and boot.ld.in) and servoctl read
+ * this file: plain numbers, one per line. */
+#ifndef BOARD_H
+#define BOARD_H
+
+#define BOARD_ID 0x0100 /* the update image header's board field */
+
+/* Flash: the 4 KB bootloader, then the slot. QEMU has no flash controller:
+ * the application keeps its config store in RAM, standing for the last two
+ * pages (BOARD_RAM_CONFIG_BASE). */
+#define BOARD_FLASH_BASE 0x08000000
+#define BOARD_FLASH_PAGE 1024
+#define BOARD_BOOT_SIZE 4096
+#define BOARD_SLOT_BASE 0x08001000
+#define BOARD_SLOT_PAGES 120
+#define BOARD_RAM_CONFIG_BASE 0x0801F800
+
+#define BOARD_RAM_BASE 0x20000000
+#define BOARD_RAM_SIZE 8192
+
+/* The modelled front end: the reference board's (stm32f103/board.h). */
+#define BOARD_SUPPLY_UV_PER_COUNT 8862
+#define BOARD_CURRENT_UA_PER_COUNT 1611
+#define BOARD_CURRENT_ZERO_COUNTS 0
+
+#include "../board_derived.h"
+
+#endif

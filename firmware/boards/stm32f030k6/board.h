@@ -1,0 +1,37 @@
+/* The Cortex-M0 servo board: STM32F030K6 (48 MHz, 32 KB flash, 4 KB RAM;
+ * RM0360). Its main.c and boot_main.c, its linker scripts (made from
+ * firmware/linker/app.ld.in and boot.ld.in) and servoctl's image command
+ * read this file: plain numbers, one per line. */
+#ifndef BOARD_H
+#define BOARD_H
+
+#define BOARD_ID 0x0030 /* the update image header's board field */
+
+/* Flash (RM0360 3.2: 1 KB pages): the 4 KB bootloader, the application
+ * slot up to the config store's two pages at the end. */
+#define BOARD_FLASH_BASE 0x08000000
+#define BOARD_FLASH_PAGE 1024
+#define BOARD_BOOT_SIZE 4096
+#define BOARD_SLOT_BASE 0x08001000
+#define BOARD_SLOT_PAGES 26
+#define BOARD_CONFIG_PAGE0 0x08007800
+#define BOARD_CONFIG_PAGE1 0x08007C00
+
+/* RAM; its last 16 bytes are the word that keeps the bootloader. The M0 has
+ * no vector table offset register: the application copies its table to the
+ * start of RAM and maps RAM at 0 (RM0360 9.1.1, MEM_MODE). */
+#define BOARD_RAM_BASE 0x20000000
+#define BOARD_RAM_SIZE 4096
+#define BOARD_RAM_VECTORS_SIZE 192
+#define BOARD_APP_STACK_SIZE 1344
+
+/* The analogue front end: the reference board's (stm32f103/board.h). */
+#define BOARD_SUPPLY_UV_PER_COUNT 8862
+#define BOARD_CURRENT_UA_PER_COUNT 1611
+#define BOARD_CURRENT_ZERO_COUNTS 0
+
+/* Pins: README.md, "Pin map"; the port (hal/ports/stm32f0) drives them. */
+
+#include "../board_derived.h"
+
+#endif

@@ -1,0 +1,37 @@
+/* The reference servo board: STM32F103C8 (Cortex-M3, 72 MHz, 64 KB flash,
+ * 20 KB RAM; RM0008). Its main.c and boot_main.c, its linker scripts
+ * (made from firmware/linker/app.ld.in and boot.ld.in) and servoctl's image
+ * command read this file: plain numbers, one per line. */
+#ifndef BOARD_H
+#define BOARD_H
+
+#define BOARD_ID 0x0103 /* the update image header's board field */
+
+/* Flash (RM0008 3.3.3: 1 KB pages): the 4 KB bootloader, the application
+ * slot, the config store's two pages at the end. */
+#define BOARD_FLASH_BASE 0x08000000
+#define BOARD_FLASH_PAGE 1024
+#define BOARD_BOOT_SIZE 4096
+#define BOARD_SLOT_BASE 0x08001000
+#define BOARD_SLOT_PAGES 58
+#define BOARD_CONFIG_PAGE0 0x0800F800
+#define BOARD_CONFIG_PAGE1 0x0800FC00
+
+/* RAM; its last 16 bytes are the word that keeps the bootloader (boot_jump.h). */
+#define BOARD_RAM_BASE 0x20000000
+#define BOARD_RAM_SIZE 20480
+
+/* The analogue front end: 3.3 V ADC reference; supply through a 100k/10k
+ * divider (11:1); 25 mOhm shunt into a gain-of-20 amplifier (0.5 V/A); the
+ * NTC divider of servo-protocol.md appendix 5.1. */
+#define BOARD_SUPPLY_UV_PER_COUNT 8862  /* 3.3 V x 11 / 4096 */
+#define BOARD_CURRENT_UA_PER_COUNT 1611 /* 3.3 V / 0.5 V/A / 4096 */
+#define BOARD_CURRENT_ZERO_COUNTS 0
+
+/* Pins (README.md, "Pin map"): PA9 the bus (USART1, half duplex); PA0-PA3
+ * the ADC channels 0-3 (supply, current, NTC, spare); PA6/PA7 TIM3 CH1/CH2,
+ * the bridge; PB6/PB7 the encoder. The port (hal/ports/stm32f1) drives them. */
+
+#include "../board_derived.h"
+
+#endif
