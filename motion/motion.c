@@ -124,52 +124,6 @@ void motion_read_diagnostics(const struct motion *m, struct motion_diagnostics *
 
 /* ---- the output --------------------------------------------------------- */
 
-/* The braking duty of a current window limit when a load takes assisting
- * of it, less the quarter kept for the controller (motion_brake_duty). */
-static int32_t brake_duty(int32_t limit, int32_t assisting)
-{
-    int32_t duty = limit - assisting;
-    duty -= duty >> 2;
-    return duty > 1 ? duty : 1;
-}
-
-uint16_t motion_supply_mv(const struct motion *m)
-{
-    uint16_t v = m->regs->status.voltage_mv;
-    return v ? v : NOMINAL_SUPPLY_MV;
-}
-
-/* The current the output may draw: the move's power (0 or above 42 means
- * 42), capped by a stall, within the current protection (43), halved while
- * over-current or over-power lasts. Divides: on changes only. */
-void motion_update_limits(struct motion *m)
-{
-    const struct user_config *cfg = &m->regs->user;
-    uint16_t power = m->power_mw;
-    if (power == 0u || power > cfg->power_limit_mw) {
-        power = cfg->power_limit_mw;
-    }
-    if (m->power_cap_mw != 0u && power > m->power_cap_mw) {
-        power = m->power_cap_mw;
-    }
-    /* Every command asks; the divisions run only when what they depend on
-     * has changed (a write to 42 or 43, a derate, a new supply). */
-    struct drive_inputs now = {power, motion_supply_mv(m), cfg->current_limit_ma, m->derate};
-    if (now.power_mw == m->drive_inputs.power_mw && now.supply_mv == m->drive_inputs.supply_mv &&
-        now.current_limit_ma == m->drive_inputs.current_limit_ma && now.derate == m->drive_inputs.derate) {
-        return;
-    }
-    m->drive_inputs = now;
-    int16_t by_power = duty_limit_for_power(power, now.supply_mv);
-    int16_t by_current = duty_limit_for_current(cfg->current_limit_ma, now.supply_mv);
-    int16_t limit = (int16_t)(by_power < by_current ? by_power : by_current);
-    m->drive.duty_limit = (int16_t)(m->derate ? limit / 2 : limit);
-    drive_limits_for_supply(&m->drive, now.supply_mv);
-    motion_take_accel_duty(m, m->tick);
-    /* The least of motion_brake_duty: a load taking all it may. */
-    m->brake_floor_duty = brake_duty(m->drive.duty_limit, m->drive.duty_limit / 2);
-}
-
 static void set_power(struct motion *m, uint16_t power_mw)
 {
     m->power_mw = power_mw;
@@ -278,21 +232,6 @@ static int64_t velocity_q32(uint32_t decideg_per_s)
     return (int64_t)div64_u((uint64_t)decideg_per_s << 32, MOTION_TICK_HZ);
 }
 
-/* ---- braking within what the motor can do --------------------------------
- * The deceleration the output can count on moving in direction dir: the
- * duty margin of the current limit, less what holding a load that pushes
- * the way the horn turns takes (the integral term carries it; counted up
- * to half the margin, since in motion it also holds transient errors: a
- * load of 0.8 of the stall torque at this power takes 0.8 x efficiency^2 =
- * 0.26, plant.c), and a quarter of that kept for the controller to correct
- * errors with. As a duty; duty / ka is decideg per tick^2. */
-int32_t motion_brake_duty(const struct motion *m, int32_t dir)
-{
-    int32_t limit = m->drive.duty_limit;
-    int32_t assisting = dir > 0 ? -m->controller.integral_q15 : m->controller.integral_q15;
-    assisting = assisting < 0 ? 0 : assisting > limit / 2 ? limit / 2 : assisting;
-    return brake_duty(limit, assisting);
-}
 
 
 /* From start moving at v0, come to rest at the output's braking (in at
@@ -603,9 +542,4 @@ void motion_release(struct motion *m)
     m->queue.count = 0;
     m->answer_packet = 0;
     release(m);
-}
-
-int8_t motion_output_at_limit(const struct motion *m)
-{
-    return m->mode == MODE_POSITION ? m->controller.at_limit : 0;
 }
