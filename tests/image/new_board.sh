@@ -7,7 +7,9 @@ set -u
 root=$(cd "$(dirname "$0")/../.." && pwd)
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-(cd "$root" && git ls-files -z | xargs -0 tar -cf - 2>/dev/null) | (cd "$tmp" && tar -xf -) || exit 1
+# The working tree as it is (new files included), without builds or caches.
+(cd "$root" && tar --exclude=./build --exclude=./.git --exclude=./.venv --exclude='__pycache__' \
+  -cf - .) | (cd "$tmp" && tar -xf -) || exit 1
 cp -r "$tmp/firmware/boards/stm32f103" "$tmp/firmware/boards/my_servo"
 sed -i 's/^#define BOARD_ID 0x0103\b/#define BOARD_ID 0x0777/' "$tmp/firmware/boards/my_servo/board.h"
 grep -q '^#define BOARD_ID 0x0777' "$tmp/firmware/boards/my_servo/board.h" || { echo "board ID not set"; exit 1; }
