@@ -7,7 +7,9 @@ import sys
 from collections import defaultdict
 
 MODULES = [  # (part of the object's path in the map, name)
-    ("libservo_protocol.a", "protocol: framer, dispatcher, handlers, data table"),
+    ("libservo_protocol.a", "protocol: dispatcher, handlers"),
+    ("libservo_wire.a", "wire layer: framer, encoder"),
+    ("libservo_registers.a", "registers: data table"),
     ("libservo_motion.a", "motion: profile, controller, commands"),
     ("libservo_storage.a", "config store and CRC"),
     ("libservo_sensors.a", "sensors: scaling, NTC table"),
@@ -17,6 +19,8 @@ MODULES = [  # (part of the object's path in the map, name)
     ("libservo_stm32f0.a", "STM32F0 port (USART, clock, pins, ADC)"),
     ("libservo_stm32_common.a", "STM32 common (DMA receive, SysTick, flash, PWM, IWDG, boot jump)"),
     ("startup_stm32", "startup, vector table"),
+    ("small_div.c", "the small run-time: mem*, 32-bit division (size first)"),
+    ("small_mem.c", "the small run-time: mem*, 32-bit division (size first)"),
     ("boards/", "board (main, HAL ops, static servo state)"),
 ]
 
@@ -25,7 +29,9 @@ def module_of(obj):
     for prefix, name in MODULES:
         if prefix in obj:
             return name
-    return "libc, libgcc"
+    if re.search(r"lib(c|c_nano|gcc|m|nosys)\.a|/newlib/|/arm-none-eabi/", obj):
+        return "libc, libgcc"
+    return "other: " + obj.rsplit("/", 1)[-1]  # a project object no row names: add one
 
 
 def main() -> int:

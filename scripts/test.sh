@@ -80,7 +80,7 @@ fuzz_run() {
   units=$(sed -nE 's/^stat::number_of_executed_units:\s+([0-9]+)/\1/p' "$work/log")
   rm -rf "$work"
   echo "fuzzing: $units inputs in $((SECONDS - started)) s"
-  # The speed is a benchmark's figure (README, "Fuzzing"), not a gate: a
+  # The speed is a benchmark's figure (docs/fuzzing.md), not a gate: a
   # busy machine runs the same inputs, slower.
   if [ "${units:-0}" -lt "${FUZZ_RUNS:-200000}" ]; then
     echo "the fuzzer ran ${units:-0} inputs, not ${FUZZ_RUNS:-200000}" >&2

@@ -3,7 +3,7 @@
  * Run-time ABI", 4.3.1) one quotient bit a step, about 100 bytes where
  * libgcc's unrolled ones take 726, and slower (a few instructions for each
  * bit of the quotient): the M0 divides when it plans a move and scales a
- * reading, never in the control tick (README, "Benchmark", has the M0's
+ * reading, never in the control tick (docs/benchmark.md has the M0's
  * figures with it). Divided by zero, the quotient is 0 and the
  * remainder the dividend, as the Cortex-M3's UDIV/SDIV give (without the
  * divide-by-zero trap). */

@@ -30,7 +30,7 @@
 #define BOARD_CURRENT_UA_PER_COUNT 1611
 #define BOARD_CURRENT_ZERO_COUNTS 0
 
-/* Pins: README.md, "Pin map"; the port (hal/ports/stm32f0) drives them. */
+/* Pins: this folder's README.md; the port (hal/ports/stm32f0) drives them. */
 
 #include "../board_derived.h"
 

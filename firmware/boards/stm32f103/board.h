@@ -28,9 +28,9 @@
 #define BOARD_CURRENT_UA_PER_COUNT 1611 /* 3.3 V / 0.5 V/A / 4096 */
 #define BOARD_CURRENT_ZERO_COUNTS 0
 
-/* Pins (README.md, "Pin map"): PA9 the bus (USART1, half duplex); PA0-PA3
- * the ADC channels 0-3 (supply, current, NTC, spare); PA6/PA7 TIM3 CH1/CH2,
- * the bridge; PB6/PB7 the encoder. The port (hal/ports/stm32f1) drives them. */
+/* Pins (this folder's README.md): PA9 the bus (USART1, half duplex); PA6/PA7
+ * TIM3 CH1/CH2, the bridge; PA0-PA3 ADC1 IN0-IN3: supply, current, NTC and
+ * the encoder's analogue output. The port (hal/ports/stm32f1) drives them. */
 
 #include "../board_derived.h"
 

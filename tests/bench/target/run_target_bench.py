@@ -36,7 +36,7 @@ CLOCK_MHZ = {"cortex-m3": 72, "cortex-m0": 48}
 KNOWN_LOOP = 200  # 100 more iterations of a 2-instruction loop
 # Issue 10's budgets (Cortex-M3 instructions; responses in modelled us at
 # 72 MHz). Those met fail the run when exceeded; the tick's is not met yet
-# (README, "Benchmark"): until it is, the run fails above its ceiling
+# (docs/benchmark.md): until it is, the run fails above its ceiling
 # (today's figure with a little room), so the tick cannot grow back.
 BUDGETS = {"rx_per_byte": 40, "tick": 150, "plan": 1000}
 NOT_YET_MET = {"tick": 310}
