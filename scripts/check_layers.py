@@ -2,10 +2,10 @@
 """The firmware's layers and circles, checked from its #include lines.
 
 Each source folder is a layer; a layer may include only the layers below it
-(LAYERS). A file may not reach itself through its includes (a circle), and
-no file people read (source, build files, documents) outside the tests may
-pass LINE_LIMIT lines. servoctl's
-modules may not import one another in a circle either.
+(LAYERS). No module (a .c with its .h) may reach itself through the
+includes of others (a circle), nor may servoctl's modules through their
+imports; and no file people read (source, build files, documents) outside
+the tests may pass LINE_LIMIT lines.
 
 Exit 1 with one line per breach; `--graph` prints the layer graph found."""
 import argparse
