@@ -28,6 +28,7 @@ enum app_image_verdict app_image_check(const struct app_slot *slot, uint16_t boa
                                        struct app_image_info *info)
 {
     const struct hal_flash *f = slot->flash;
+    *info = (struct app_image_info){0}; /* what a refused header tells: nothing */
     uint8_t h[APP_HEADER_CHECKED + 4u];
     f->read(f->ctx, slot->base, h, sizeof h);
     if (le_get_u32(&h[0]) != APP_IMAGE_MAGIC) {

@@ -59,7 +59,8 @@ void app_image_make_header(uint8_t header[APP_HEADER_SIZE], const uint8_t *code,
                            uint16_t version, uint16_t board);
 
 /* Reads and checks the image in the slot; info is filled from the header
- * whenever it checks (also when the image's CRC does not). */
+ * whenever it checks (also when the image's CRC does not), and all 0 when
+ * it does not. */
 MUST_CHECK enum app_image_verdict app_image_check(const struct app_slot *slot, uint16_t board,
                                        struct app_image_info *info);
 

@@ -48,7 +48,7 @@ static uint8_t on_write(const struct call *c, struct response *r)
 
 static uint8_t on_verify(const struct call *c, struct response *r)
 {
-    struct app_image_info info = {0};
+    struct app_image_info info;
     r->content[1] = (uint8_t)app_image_check(c->b->slot, c->b->board, &info);
     le_put_u32(&r->content[2], info.size);
     le_put_u32(&r->content[6], info.crc);
@@ -69,7 +69,7 @@ static uint8_t on_boot(const struct call *c, struct response *r)
 static uint8_t on_status(const struct call *c, struct response *r)
 {
     const struct app_slot *slot = c->b->slot;
-    struct app_image_info info = {0};
+    struct app_image_info info;
     /* Before the answer's fields: the check fills info. */
     enum app_image_verdict verdict = app_image_check(slot, c->b->board, &info);
     const struct update_status status = {

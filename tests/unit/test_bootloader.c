@@ -173,8 +173,12 @@ static void test_an_image_checks_only_when_whole(void **state)
 {
     (void)state;
     static uint8_t image[PAGES * PAGE + 16u];
-    struct app_image_info info;
+    struct app_image_info info = {.size = 1, .crc = 1, .version = 1, .board = 1};
     assert_int_equal(app_image_check(&slot, BOARD, &info), APP_IMAGE_NO_HEADER);
+    /* A refused header tells nothing: UpdateStatus and UpdateVerify answer 0s. */
+    assert_int_equal(info.size, 0);
+    assert_int_equal(info.version, 0);
+    assert_int_equal(info.board, 0);
     size_t n = make_image(image, 3000, 7, BOARD, 1);
     memcpy(chip.mem, image, n);
     assert_int_equal(app_image_check(&slot, BOARD, &info), APP_IMAGE_VALID);
