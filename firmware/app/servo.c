@@ -49,7 +49,7 @@ void servo_init(struct servo *s, const struct hal_port *hal)
     save_policy_init(&s->saver, &s->store, hal->now_us(hal->ctx));
     s->regs.status.model = SERVO_MODEL;
     s->regs.status.firmware_version = FIRMWARE_VERSION;
-    s->regs.status.serial_number = hal->serial_number;
+    s->regs.status.serial_number = hal->serial_number(hal->ctx);
     protection_init(&s->protection);
     motion_init(&s->motion, &s->regs, hal);
     s->next_tick_us = hal->now_us(hal->ctx) + CONTROL_TICK_US;
@@ -330,9 +330,7 @@ static bool run_control_tick(struct servo *s, uint32_t now)
 static void receive(struct servo *s, uint32_t now)
 {
     struct hal_rx_ring *ring = s->hal->rx;
-    if (s->hal->rx_sync != NULL) {
-        s->hal->rx_sync(s->hal->rx_ctx, now);
-    }
+    hal_rx_sync(s->hal, now);
     frame_rx_receive(&s->rx, ring, &s->rx_lost, now, s->rx_idle_us);
 }
 
@@ -340,7 +338,7 @@ static void receive(struct servo *s, uint32_t now)
 static void restart_into_bootloader(struct servo *s)
 {
     s->enter_bootloader = 0;
-    s->hal->enter_bootloader(s->hal->ctx);
+    hal_enter_bootloader(s->hal);
 }
 
 void servo_poll(struct servo *s)

@@ -28,9 +28,7 @@ bool boot_loop_step(struct boot_loop *l)
 {
     const struct hal_port *port = l->board->port;
     uint32_t now = port->now_us(port->ctx);
-    if (port->rx_sync != NULL) {
-        port->rx_sync(port->rx_ctx, now);
-    }
+    hal_rx_sync(port, now);
     uint32_t lost = 0;
     frame_rx_receive(&l->rx, port->rx, &lost, now, l->idle_us);
     if (l->sending) {

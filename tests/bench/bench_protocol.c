@@ -192,7 +192,6 @@ static void fresh_servo(void)
     hal.port.uart_send = port_uart_send;
     hal.port.uart_tx_done = port_uart_tx_done;
     servo_init(&servo, &hal.port);
-    hal.port.serial_number = 0;
     servo.regs.user.servo_id = OWN_ID;
     servo.link_settings_pending = 1; /* set directly, not by a request */
     servo_poll(&servo); /* applies the ID */

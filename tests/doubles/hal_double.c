@@ -52,6 +52,12 @@ static uint16_t encoder_read(void *ctx)
     return h->encoder_model ? h->encoder_model(h->model) : h->encoder_raw;
 }
 
+static uint32_t serial_number(void *ctx)
+{
+    (void)ctx;
+    return 0x12345678u;
+}
+
 static void sensors_read(void *ctx, struct sensor_raw *out)
 {
     *out = ((struct hal_double *)ctx)->sensors;
@@ -82,7 +88,7 @@ void hal_double_init(struct hal_double *h)
         .sensors_read = sensors_read,
         .calibration = &h->calibration,
         .flash = &h->flash.hal,
-        .serial_number = 0x12345678u,
+        .serial_number = serial_number,
     };
 }
 

@@ -139,6 +139,13 @@ static bool program_factory_image(struct sim_servo *s, uint16_t version)
     return slot_write(&s->slot, 0, image, sizeof image, crc32(image, sizeof image)) == SLOT_WRITE_OK;
 }
 
+/* One serial number per simulated servo, from the ID it was started with. */
+static uint32_t serial_number(void *ctx)
+{
+    const struct sim_servo *s = ctx;
+    return 0x51A00000u | s->cmdline_id;
+}
+
 static void enter_bootloader(void *ctx)
 {
     sim_boot_reset(ctx, true);
@@ -198,7 +205,7 @@ bool sim_servo_start(struct sim_servo *s, struct sim_bus *bus, unsigned index, u
         .sensors_read = sensors_read,
         .calibration = &calibration,
         .flash = &s->flash.hal,
-        .serial_number = 0x51A00000u | id,
+        .serial_number = serial_number,
         .enter_bootloader = enter_bootloader,
         .board = SIM_BOARD,
     };

@@ -13,11 +13,22 @@
 #include "stm32f1_regs.h"
 #include "systick_clock.h"
 
-static struct hal_port port;
 static struct usart_hd usart;
+static struct hal_rx_ring rx_ring;
 static struct hal_flash config_flash;
 static struct hal_flash slot_flash;
 static struct app_slot slot;
+/* The board's wiring for the bootloader: which driver does what. */
+static const struct hal_port port = {
+    .ctx = &usart,
+    .now_us = port_now_us,
+    .uart_send = port_uart_send,
+    .uart_tx_done = port_uart_tx_done,
+    .uart_set_baud = port_uart_set_baud,
+    .rx = &rx_ring,
+    .flash = &config_flash,
+    .rx_gap_tolerance_us = QEMU_RX_GAP_TOLERANCE_US,
+};
 
 static bool refuse_erase(void *ctx, uint32_t addr)
 {
@@ -65,9 +76,7 @@ int main(void)
     config_flash.page_addr[0] = 0x0801F800u;
     config_flash.page_addr[1] = 0x0801FC00u;
     slot = (struct app_slot){.flash = &slot_flash, .base = BOARD_SLOT_BASE, .pages = BOARD_SLOT_PAGES};
-    port = (struct hal_port){.flash = &config_flash,
-                             .rx_gap_tolerance_us = QEMU_RX_GAP_TOLERANCE_US};
-    port_uart_init(&port, &usart, PORT_UART_RX_INTERRUPT, QEMU_CORE_HZ);
+    port_uart_init(&usart, &rx_ring, NULL, QEMU_CORE_HZ); /* no DMA model: by interrupt */
     usart_hd_tx_polled(&usart);
     usart_hd_no_echo(&usart);
     const struct boot_board board = {.port = &port, .slot = &slot, .board = BOARD_ID,

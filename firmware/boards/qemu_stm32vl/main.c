@@ -17,8 +17,8 @@
 #define RAM_FLASH_BASE ((uint32_t)BOARD_RAM_CONFIG_BASE)
 
 static struct servo servo;
-static struct hal_port port;
 static struct usart_hd usart;
+static struct hal_rx_ring rx_ring;
 static struct plant_fixed plant;
 static uint8_t flash_mem[2 * FLASH_PAGE];
 static struct hal_flash flash;
@@ -81,12 +81,39 @@ static void ram_read(void *ctx, uint32_t addr, uint8_t *dst, uint32_t len)
     }
 }
 
+/* QEMU's part has no unique ID: a fixed serial number. */
+static uint32_t serial_number(void *ctx)
+{
+    (void)ctx;
+    return 0x0E3A0001u;
+}
+
 /* UpdateEnter: the word that keeps the bootloader, then a restart. */
 static void enter_bootloader(void *ctx)
 {
     (void)ctx;
     boot_restart_with(BOOT_STAY_WORD_ADDR(BOARD_RAM_END), BOOT_STAY_MAGIC);
 }
+
+/* The board's wiring: which driver or model does what, in one place. */
+static const struct hal_port port = {
+    .ctx = &usart,
+    .now_us = port_now_us,
+    .uart_send = port_uart_send,
+    .uart_tx_done = port_uart_tx_done,
+    .uart_set_baud = port_uart_set_baud,
+    .rx = &rx_ring,
+    .motor_drive = motor_drive,
+    .motor_coast = motor_coast,
+    .encoder_read = encoder_read,
+    .sensors_read = sensors_read,
+    .calibration = &calibration,
+    .flash = &flash,
+    .enter_bootloader = enter_bootloader,
+    .board = BOARD_ID,
+    .serial_number = serial_number,
+    .rx_gap_tolerance_us = QEMU_RX_GAP_TOLERANCE_US,
+};
 
 int main(void)
 {
@@ -102,19 +129,7 @@ int main(void)
         .read = ram_read,
     };
     systick_clock_init(QEMU_CORE_HZ);
-    port = (struct hal_port){
-        .motor_drive = motor_drive,
-        .motor_coast = motor_coast,
-        .encoder_read = encoder_read,
-        .sensors_read = sensors_read,
-        .calibration = &calibration,
-        .flash = &flash,
-        .enter_bootloader = enter_bootloader,
-        .board = BOARD_ID,
-        .serial_number = 0x0E3A0001u,
-        .rx_gap_tolerance_us = QEMU_RX_GAP_TOLERANCE_US,
-    };
-    port_uart_init(&port, &usart, PORT_UART_RX_INTERRUPT, QEMU_CORE_HZ);
+    port_uart_init(&usart, &rx_ring, NULL, QEMU_CORE_HZ); /* no DMA model: by interrupt */
     usart_hd_tx_polled(&usart); /* QEMU 7.2's USART raises no transmit interrupts */
     usart_hd_no_echo(&usart);   /* and its socket does not echo our bytes */
     servo_init(&servo, &port);

@@ -11,11 +11,24 @@
 #include "stm32f1_regs.h"
 #include "systick_clock.h"
 
-static struct hal_port port;
 static struct usart_hd usart;
+static struct hal_rx_ring rx_ring;
+static struct dma_rx rx_dma;
 static struct hal_flash config_flash;
 static struct hal_flash slot_flash;
 static struct app_slot slot;
+/* The board's wiring for the bootloader: which driver does what. */
+static const struct hal_port port = {
+    .ctx = &usart,
+    .now_us = port_now_us,
+    .uart_send = port_uart_send,
+    .uart_tx_done = port_uart_tx_done,
+    .uart_set_baud = port_uart_set_baud,
+    .rx = &rx_ring,
+    .rx_sync = dma_rx_sync,
+    .rx_ctx = &rx_dma,
+    .flash = &config_flash,
+};
 
 /* The bootloader's peripherals stop before the application takes over:
  * the DMA would go on writing into what is now the application's RAM. */
@@ -40,8 +53,7 @@ int main(void)
     flash_f0f1_init(&config_flash, BOARD_FLASH_PAGE, BOARD_CONFIG_PAGE0, BOARD_CONFIG_PAGE1);
     slot_flash = config_flash; /* the same flash: any page by its address */
     slot = (struct app_slot){.flash = &slot_flash, .base = BOARD_SLOT_BASE, .pages = BOARD_SLOT_PAGES};
-    port = (struct hal_port){.flash = &config_flash};
-    port_uart_init(&port, &usart, PORT_UART_RX_DMA, F103_PCLK2_HZ);
+    port_uart_init(&usart, &rx_ring, &rx_dma, F103_PCLK2_HZ);
     usart_hd_tx_polled(&usart); /* no USART interrupt: its vector is not in the table */
     const struct boot_board board = {.port = &port, .slot = &slot, .board = BOARD_ID,
                                      .stay_word = stay, .start_app = start_app,

@@ -11,8 +11,9 @@
 #include "usart_hd.h"
 
 static struct servo servo;
-static struct hal_port port;
 static struct usart_hd usart;
+static struct hal_rx_ring rx_ring;
+static struct dma_rx rx_dma;
 static struct hal_flash flash;
 
 static const struct sensor_calibration calibration = BOARD_SENSOR_CALIBRATION;
@@ -33,6 +34,27 @@ static void enter_bootloader(void *ctx)
     boot_restart_with(BOOT_STAY_WORD_ADDR(BOARD_RAM_END), BOOT_STAY_MAGIC);
 }
 
+/* The board's wiring: which driver does what, in one place. */
+static const struct hal_port port = {
+    .ctx = &usart,
+    .now_us = port_now_us,
+    .uart_send = port_uart_send,
+    .uart_tx_done = port_uart_tx_done,
+    .uart_set_baud = port_uart_set_baud,
+    .rx = &rx_ring,
+    .rx_sync = dma_rx_sync,
+    .rx_ctx = &rx_dma,
+    .motor_drive = board_motor_drive,
+    .motor_coast = board_motor_coast,
+    .encoder_read = board_encoder_read,
+    .sensors_read = board_sensors_read,
+    .calibration = &calibration,
+    .flash = &flash,
+    .serial_number = unique_id_serial,
+    .enter_bootloader = enter_bootloader,
+    .board = BOARD_ID,
+};
+
 int main(void)
 {
     clock_f103_init();
@@ -41,15 +63,7 @@ int main(void)
     adc_scan_init();
     pwm_bridge_init();
     flash_f0f1_init(&flash, BOARD_FLASH_PAGE, BOARD_CONFIG_PAGE0, BOARD_CONFIG_PAGE1);
-    port = (struct hal_port){
-        .calibration = &calibration,
-        .flash = &flash,
-        .enter_bootloader = enter_bootloader,
-        .board = BOARD_ID,
-        .serial_number = unique_id_serial(),
-    };
-    board_port_motor_sensors(&port);
-    port_uart_init(&port, &usart, PORT_UART_RX_DMA, F103_PCLK2_HZ);
+    port_uart_init(&usart, &rx_ring, &rx_dma, F103_PCLK2_HZ);
     servo_init(&servo, &port);
     NVIC_ISER(USART1_IRQ / 32u) = 1u << (USART1_IRQ % 32u);
     iwdg_start();

@@ -1,10 +1,14 @@
-/* What the servo core needs of its hardware. Each port (MCU, host
- * simulator, test double) fills one; the core never touches hardware
- * otherwise. Functions are called from the main loop only. */
+/* What the servo core needs of its hardware. Each board fills one in one
+ * place (its main.c: one initialiser naming its ports' operations; the
+ * simulator's sim_servo_start; the test double's init), and nothing
+ * changes it after; the core never touches hardware otherwise. Functions
+ * are called from the main loop only; the optional ones through the inline
+ * wrappers at the end. */
 #ifndef HAL_HAL_PORT_H
 #define HAL_HAL_PORT_H
 
 #include <stdbool.h>
+#include <stddef.h>
 #include <stdint.h>
 
 #include "hal/hal_flash.h"
@@ -40,8 +44,9 @@ struct hal_port {
     void (*sensors_read)(void *ctx, struct sensor_raw *out);
     const struct sensor_calibration *calibration;
     const struct hal_flash *flash;
-    /* Data ID 8: derived by the port from the MCU's unique ID. */
-    uint32_t serial_number;
+    /* Data ID 8: derived by the port from the MCU's unique ID; read once,
+     * at start. An operation, so a board's hal_port can be all constant. */
+    uint32_t (*serial_number)(void *ctx);
     /* Restarts into the bootloader, which then stays (UpdateEnter); NULL
      * where there is none. Does not return on silicon. */
     void (*enter_bootloader)(void *ctx);
@@ -52,5 +57,21 @@ struct hal_port {
      * emulated UART delivers bytes with the host's scheduling jitter. */
     uint32_t rx_gap_tolerance_us;
 };
+
+/* Brings the receive ring up to date (a port whose DMA fills it). */
+static inline void hal_rx_sync(const struct hal_port *h, uint32_t now_us)
+{
+    if (h->rx_sync != NULL) {
+        h->rx_sync(h->rx_ctx, now_us);
+    }
+}
+
+/* UpdateEnter's restart; nothing where the board has no bootloader. */
+static inline void hal_enter_bootloader(const struct hal_port *h)
+{
+    if (h->enter_bootloader != NULL) {
+        h->enter_bootloader(h->ctx);
+    }
+}
 
 #endif

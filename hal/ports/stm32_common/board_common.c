@@ -54,36 +54,28 @@ uint32_t unique_id_serial_at(uint32_t uid_addr)
     return REG32(uid_addr) ^ REG32(uid_addr + 4u) ^ REG32(uid_addr + 8u);
 }
 
-static void motor_drive(void *ctx, int16_t duty)
+void board_motor_drive(void *ctx, int16_t duty)
 {
     (void)ctx;
     pwm_bridge_drive(duty);
 }
 
-static void motor_coast(void *ctx)
+void board_motor_coast(void *ctx)
 {
     (void)ctx;
     pwm_bridge_coast();
 }
 
-static uint16_t encoder_read(void *ctx)
+uint16_t board_encoder_read(void *ctx)
 {
     (void)ctx;
     return adc_scan_values[ADC_POSITION];
 }
 
-static void sensors_read(void *ctx, struct sensor_raw *out)
+void board_sensors_read(void *ctx, struct sensor_raw *out)
 {
     (void)ctx;
     out->supply = adc_scan_values[ADC_SUPPLY];
     out->current = adc_scan_values[ADC_CURRENT];
     out->ntc = adc_scan_values[ADC_NTC];
-}
-
-void board_port_motor_sensors(struct hal_port *port)
-{
-    port->motor_drive = motor_drive;
-    port->motor_coast = motor_coast;
-    port->encoder_read = encoder_read;
-    port->sensors_read = sensors_read;
 }

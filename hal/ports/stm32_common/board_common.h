@@ -14,9 +14,13 @@
 enum adc_channel { ADC_SUPPLY, ADC_CURRENT, ADC_NTC, ADC_POSITION, ADC_CHANNELS };
 extern volatile uint16_t adc_scan_values[ADC_CHANNELS];
 
-/* The hal_port's motor_drive, motor_coast, encoder_read and sensors_read
- * on the bridge PWM and the ADC scan. */
-void board_port_motor_sensors(struct hal_port *port);
+/* A hal_port's motor_drive, motor_coast, encoder_read and sensors_read on
+ * the bridge PWM and the ADC scan (ctx unused): the board's main.c names
+ * them in its hal_port. */
+void board_motor_drive(void *ctx, int16_t duty);
+void board_motor_coast(void *ctx);
+uint16_t board_encoder_read(void *ctx);
+void board_sensors_read(void *ctx, struct sensor_raw *out);
 
 /* TIM3 CH1/CH2 at 20 kHz from timer_hz, into the bridge's IN1/IN2 (the
  * board has clocked TIM3 and routed its pins). */

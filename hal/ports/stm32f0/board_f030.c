@@ -85,7 +85,8 @@ void adc_scan_init(void)
     ADC_CR = ADC_CR_ADEN | ADC_CR_ADSTART;
 }
 
-uint32_t unique_id_serial(void)
+uint32_t unique_id_serial(void *ctx)
 {
+    (void)ctx;
     return unique_id_serial_at(UID_ADDR);
 }

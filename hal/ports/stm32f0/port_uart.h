@@ -1,20 +1,31 @@
-/* The UART and clock operations of a hal_port on an STM32F0: the servo's
- * bus on USART1 (usart_v2_hd.h) received by DMA1 channel 3, its clock from
- * SysTick. */
+/* The bus and the clock of a hal_port on an STM32F0: the servo's bus on
+ * USART1 (usart_v2_hd.h) received by DMA1 channel 3, its clock from
+ * SysTick. The board's main.c names these operations in its hal_port (ctx:
+ * the usart_v2_hd; rx_sync: dma_rx_sync on the dma). */
 #ifndef STM32F0_PORT_UART_H
 #define STM32F0_PORT_UART_H
 
+#include "dma_rx.h"
 #include "hal/hal_port.h"
 #include "usart_v2_hd.h"
 
+enum port_uart_send {
+    PORT_UART_SEND_INTERRUPT, /* port_uart_send: from the USART's interrupt */
+    /* port_uart_send_polled: whole, from the main loop, for the bootloader,
+     * whose vector table has no USART entry */
+    PORT_UART_SEND_POLLED,
+};
+
+uint32_t port_now_us(void *ctx);
+void port_uart_send(void *ctx, const uint8_t *data, uint16_t len);
+void port_uart_send_polled(void *ctx, const uint8_t *data, uint16_t len);
+bool port_uart_tx_done(void *ctx);
+void port_uart_set_baud(void *ctx, uint32_t baud);
+
 /* Starts USART1 for the bus (single wire, 115200 until data ID 36 says
- * otherwise) receiving into the port's ring, and fills the port's now_us,
- * uart_*, rx, rx_sync and rx_ctx (ctx: the usart). Sends from the USART's
- * interrupt; enables it and the DMA's. */
-void port_uart_init(struct hal_port *port, struct usart_v2_hd *usart, uint32_t pclk_hz);
-/* The same for the bootloader, whose vector table has no USART entry: an
- * answer goes out whole from its main loop (usart_v2_hd_send_polled); only
- * the DMA's interrupt. */
-void port_uart_init_polled(struct hal_port *port, struct usart_v2_hd *usart, uint32_t pclk_hz);
+ * otherwise) receiving into ring by dma; enables the DMA's interrupt, and
+ * the USART's when it sends from it. */
+void port_uart_init(struct usart_v2_hd *usart, struct hal_rx_ring *ring, struct dma_rx *dma,
+                    uint32_t pclk_hz, enum port_uart_send send);
 
 #endif

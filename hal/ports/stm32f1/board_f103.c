@@ -50,8 +50,9 @@ void adc_scan_init(void)
     ADC_CR2 |= ADC_CR2_SWSTART;
 }
 
-uint32_t unique_id_serial(void)
+uint32_t unique_id_serial(void *ctx)
 {
+    (void)ctx;
     return unique_id_serial_at(UID_ADDR);
 }
 

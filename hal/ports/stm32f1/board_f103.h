@@ -26,6 +26,6 @@ void pwm_bridge_init(void);
 void adc_scan_init(void);
 
 /* The 96-bit unique ID folded to the 32-bit serial number (data ID 8). */
-uint32_t unique_id_serial(void);
+uint32_t unique_id_serial(void *ctx); /* a hal_port's serial_number (ctx unused) */
 
 #endif

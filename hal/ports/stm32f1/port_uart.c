@@ -2,13 +2,11 @@
 
 #include <stddef.h>
 
-#include "dma_rx.h"
 #include "stm32f1_regs.h"
 #include "systick_clock.h"
 
 static struct usart_hd *bus_usart;
-static struct hal_rx_ring ring;
-static struct dma_rx dma;
+static struct dma_rx *bus_dma;
 
 void USART1_IRQHandler(void);
 void USART1_IRQHandler(void)
@@ -20,48 +18,40 @@ void DMA1_Channel5_IRQHandler(void);
 void DMA1_Channel5_IRQHandler(void)
 {
     DMA1_IFCR = DMA1_CH5_FLAGS;
-    dma_rx_lap(&dma);
+    dma_rx_lap(bus_dma);
 }
 
-static uint32_t now_us(void *ctx)
+uint32_t port_now_us(void *ctx)
 {
     (void)ctx;
     return systick_now_us();
 }
 
-static void uart_send(void *ctx, const uint8_t *data, uint16_t len)
+void port_uart_send(void *ctx, const uint8_t *data, uint16_t len)
 {
     usart_hd_send(ctx, data, len);
 }
 
-static bool uart_tx_done(void *ctx)
+bool port_uart_tx_done(void *ctx)
 {
     return usart_hd_tx_done(ctx);
 }
 
-static void uart_set_baud(void *ctx, uint32_t baud)
+void port_uart_set_baud(void *ctx, uint32_t baud)
 {
     usart_hd_set_baud(ctx, baud);
 }
 
-void port_uart_init(struct hal_port *port, struct usart_hd *usart, enum port_uart_rx rx,
+void port_uart_init(struct usart_hd *usart, struct hal_rx_ring *ring, struct dma_rx *dma,
                     uint32_t pclk_hz)
 {
     bus_usart = usart;
-    usart_hd_init(usart, USART1_BASE, pclk_hz, 115200u, true, &ring, systick_now_us);
-    port->ctx = usart;
-    port->now_us = now_us;
-    port->uart_send = uart_send;
-    port->uart_tx_done = uart_tx_done;
-    port->uart_set_baud = uart_set_baud;
-    port->rx = &ring;
-    port->rx_sync = NULL;
-    if (rx == PORT_UART_RX_DMA) {
+    usart_hd_init(usart, USART1_BASE, pclk_hz, 115200u, true, ring, systick_now_us);
+    if (dma != NULL) {
+        bus_dma = dma;
         RCC_AHBENR |= RCC_AHBENR_DMA1;
-        dma_rx_start(&dma, DMA1_CCR5_ADDR, USART1_BASE + 0x04u, &ring);
+        dma_rx_start(dma, DMA1_CCR5_ADDR, USART1_BASE + 0x04u, ring);
         usart_hd_rx_dma(usart);
-        port->rx_sync = dma_rx_sync;
-        port->rx_ctx = &dma;
         NVIC_ISER(DMA1_CH5_IRQ / 32u) = 1u << (DMA1_CH5_IRQ % 32u);
     }
 }

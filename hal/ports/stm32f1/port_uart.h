@@ -1,20 +1,24 @@
-/* The UART and clock operations of a hal_port on an STM32F1: the servo's
- * bus on a usart_hd, its clock from SysTick. Shared by every F1 board. */
+/* The bus and the clock of a hal_port on an STM32F1: the servo's bus on
+ * USART1 (usart_hd.h), received by DMA1 channel 5 or byte by byte, its
+ * clock from SysTick. Shared by every F1 board; the board's main.c names
+ * these operations in its hal_port (ctx: the usart_hd). */
 #ifndef STM32F1_PORT_UART_H
 #define STM32F1_PORT_UART_H
 
+#include "dma_rx.h"
 #include "hal/hal_port.h"
 #include "usart_hd.h"
 
-enum port_uart_rx {
-    PORT_UART_RX_DMA,       /* DMA1 channel 5 into the ring (silicon) */
-    PORT_UART_RX_INTERRUPT, /* a byte per interrupt (QEMU has no F1 DMA model) */
-};
+uint32_t port_now_us(void *ctx);
+void port_uart_send(void *ctx, const uint8_t *data, uint16_t len);
+bool port_uart_tx_done(void *ctx);
+void port_uart_set_baud(void *ctx, uint32_t baud);
 
 /* Starts USART1 for the bus (single wire, 115200 until data ID 36 says
- * otherwise) receiving into the port's ring, and fills the port's now_us,
- * uart_*, rx and rx_sync (ctx: the usart). */
-void port_uart_init(struct hal_port *port, struct usart_hd *usart, enum port_uart_rx rx,
+ * otherwise) receiving into ring: by dma (DMA1 channel 5, its interrupt
+ * enabled; the hal_port's rx_sync is dma_rx_sync on it), or, with dma NULL,
+ * a byte per interrupt (QEMU has no F1 DMA model). */
+void port_uart_init(struct usart_hd *usart, struct hal_rx_ring *ring, struct dma_rx *dma,
                     uint32_t pclk_hz);
 
 #endif
