@@ -76,7 +76,7 @@ enum { TRACK_POSITION_SHIFT = 1, TRACK_VELOCITY_SHIFT = 3, TRACK_LIMIT_Q12 = 1 <
 
 static void measure(struct motion *m)
 {
-    int32_t moved = encoder_update(&m->encoder, m->hal->encoder_read(m->hal->ctx));
+    int32_t moved = encoder_update(&m->encoder, m->hal->motor.read_encoder(m->hal->ctx));
     m->measured_q8 = counts_to_q8(m->encoder.counts - m->origin_counts);
     /* Where the tracker expects the horn, less where the encoder says it is:
      * minus the miss. */
@@ -218,7 +218,7 @@ void motion_tick(struct motion *m)
     }
     switch (m->mode) {
     case MODE_DAMPING:
-        m->hal->motor_drive(m->hal->ctx, controller_damping(m->measured_velocity_q8, &m->drive));
+        m->hal->motor.drive(m->hal->ctx, controller_damping(m->measured_velocity_q8, &m->drive));
         return;
     case MODE_POSITION:
         break;
@@ -250,7 +250,7 @@ void motion_tick(struct motion *m)
     if (!real_time && !m->braking && m->lead_q8 > LEAD_FREE_Q8) {
         in.push = m->profile_at_next_tick_q8 > m->profile_at_tick_q8 ? 1 : m->profile_at_next_tick_q8 < m->profile_at_tick_q8 ? -1 : 0;
     }
-    m->hal->motor_drive(m->hal->ctx, controller_position(&m->controller, &in, &m->drive));
+    m->hal->motor.drive(m->hal->ctx, controller_position(&m->controller, &in, &m->drive));
     bool done = m->endless ? m->tick >= m->profile.accel_ticks
                            : profile_done(&m->profile, m->tick) && arrived(m);
     if (m->running && done) {

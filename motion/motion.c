@@ -135,7 +135,7 @@ static void release(struct motion *m)
     m->mode = MODE_RELEASED;
     m->running = 0;
     m->controller.at_limit = 0;
-    m->hal->motor_coast(m->hal->ctx);
+    m->hal->motor.coast(m->hal->ctx);
 }
 
 /* Starts the profile's clock at its tick 0. */
@@ -509,7 +509,7 @@ void motion_finish(struct motion *m)
 void motion_init(struct motion *m, const struct registers *regs, const struct hal_port *hal)
 {
     *m = (struct motion){.regs = regs, .hal = hal, .soft_start_pending = 1};
-    encoder_start(&m->encoder, hal->encoder_read(hal->ctx));
+    encoder_start(&m->encoder, hal->motor.read_encoder(hal->ctx));
     m->origin_counts = 0;
     m->measured_q8 = counts_to_q8(m->encoder.counts);
     set_power(m, 0);

@@ -18,7 +18,7 @@ static void apply_link_settings(struct servo *s)
     uint32_t baud = baud_rate_of_index(s->regs.user.baud_index);
     if (s->active_baud_index != s->regs.user.baud_index) {
         s->active_baud_index = s->regs.user.baud_index;
-        s->hal->uart_set_baud(s->hal->ctx, baud);
+        s->hal->bus.set_baud(s->hal->ctx, baud);
         s->rx_idle_us = idle_timeout_us(s, baud);
     }
     /* Divides: on a change of link settings only. */
@@ -46,13 +46,13 @@ void servo_init(struct servo *s, const struct hal_port *hal)
         stored = config_store_erase_spare(&s->store);
     }
     (void)stored;
-    save_policy_init(&s->saver, &s->store, hal->now_us(hal->ctx));
+    save_policy_init(&s->saver, &s->store, hal->bus.now_us(hal->ctx));
     s->regs.status.model = SERVO_MODEL;
     s->regs.status.firmware_version = FIRMWARE_VERSION;
     s->regs.status.serial_number = hal->serial_number(hal->ctx);
     protection_init(&s->protection);
     motion_init(&s->motion, &s->regs, hal);
-    s->next_tick_us = hal->now_us(hal->ctx) + CONTROL_TICK_US;
+    s->next_tick_us = hal->bus.now_us(hal->ctx) + CONTROL_TICK_US;
     frame_rx_init(&s->rx, &s->active_id);
     s->rx_idle_us = idle_timeout_us(s, 0);
     dispatcher_init(&s->dispatcher, &s->regs, &s->motion, &s->active_id);
@@ -69,7 +69,7 @@ static void start_send(struct servo *s)
 {
     s->tx.waiting = 0;
     s->tx.sending = 1;
-    s->hal->uart_send(s->hal->ctx, s->tx.frame, s->tx.size);
+    s->hal->bus.send(s->hal->ctx, s->tx.frame, s->tx.size);
 }
 
 /* Sync Monitor: each listed servo answers after the ones listed before it.
@@ -202,7 +202,7 @@ static void report_store(struct servo *s)
 static bool persist_user(void *ctx, const struct user_config *cfg)
 {
     struct servo *s = ctx;
-    uint32_t now = s->hal->now_us(s->hal->ctx);
+    uint32_t now = s->hal->bus.now_us(s->hal->ctx);
     s->saver.over_budget = !save_policy_allows(&s->saver, &s->store);
     if (s->saver.over_budget) {
         return false;
@@ -272,7 +272,7 @@ static void sense_and_protect(struct servo *s)
     struct sensor_raw raw;
     struct sensor_readings now;
     struct sensor_readings filtered;
-    s->hal->sensors_read(s->hal->ctx, &raw);
+    s->hal->motor.read_sensors(s->hal->ctx, &raw);
     sensors_scale(s->hal->calibration, &raw, &now);
     sensors_filter(&s->sensors, &now, &filtered);
     struct status_area *st = &s->regs.status;
@@ -344,12 +344,12 @@ static void restart_into_bootloader(struct servo *s)
 void servo_poll(struct servo *s)
 {
     /* One reading of the clock per pass: the ticks due by then run now. */
-    uint32_t now = s->hal->now_us(s->hal->ctx);
+    uint32_t now = s->hal->bus.now_us(s->hal->ctx);
     if (s->erase_passed) {
         s->next_tick_us = now + CONTROL_TICK_US;
     }
     bool ticked = run_control_tick(s, now);
-    if (s->tx.sending && s->hal->uart_tx_done(s->hal->ctx)) {
+    if (s->tx.sending && s->hal->bus.tx_done(s->hal->ctx)) {
         s->tx.sending = 0;
         s->tx.ended_us = now;
         if (s->enter_bootloader) { /* UpdateEnter's answer has left */

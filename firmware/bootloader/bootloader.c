@@ -12,7 +12,7 @@ void boot_loop_start(struct boot_loop *l, const struct boot_board *b)
     uint8_t baud_index;
     config_peek_link(port->flash, &l->id, &baud_index);
     uint32_t baud = baud_rate_of_index(baud_index);
-    port->uart_set_baud(port->ctx, baud);
+    port->bus.set_baud(port->ctx, baud);
     l->idle_us = frame_rx_port_idle_us(frame_rx_idle_us(baud), port->rx_gap_tolerance_us);
     l->board = b;
     l->sending = 0;
@@ -21,18 +21,18 @@ void boot_loop_start(struct boot_loop *l, const struct boot_board *b)
     struct app_image_info info;
     boot_flow_start(&l->flow, app_image_check(b->slot, b->board, &info) == APP_IMAGE_VALID,
                     b->stay_word);
-    l->started_us = port->now_us(port->ctx);
+    l->started_us = port->bus.now_us(port->ctx);
 }
 
 bool boot_loop_step(struct boot_loop *l)
 {
     const struct hal_port *port = l->board->port;
-    uint32_t now = port->now_us(port->ctx);
+    uint32_t now = port->bus.now_us(port->ctx);
     hal_rx_sync(port, now);
     uint32_t lost = 0;
     frame_rx_receive(&l->rx, port->rx, &lost, now, l->idle_us);
     if (l->sending) {
-        if (!port->uart_tx_done(port->ctx)) {
+        if (!port->bus.tx_done(port->ctx)) {
             return true; /* half duplex */
         }
         l->sending = 0;
@@ -51,7 +51,7 @@ bool boot_loop_step(struct boot_loop *l)
             if (code != PKT_PING) {
                 boot_flow_heard(&l->flow);
             }
-            port->uart_send(port->ctx, l->frame, frame_tx_encode(&r, l->frame));
+            port->bus.send(port->ctx, l->frame, frame_tx_encode(&r, l->frame));
             l->sending = 1;
         }
         return true;

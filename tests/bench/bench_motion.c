@@ -92,7 +92,7 @@ int main(void)
     bench_begin();
     for (unsigned i = 0; i < MOTION_BENCH_TICKS; i++) {
         hal.encoder_raw = follow_raw[i];
-        hal.port.motor_drive(hal.port.ctx, (int16_t)hal.port.encoder_read(hal.port.ctx));
+        hal.port.motor.drive(hal.port.ctx, (int16_t)hal.port.motor.read_encoder(hal.port.ctx));
     }
     bench_end("ticks_hal");
 

@@ -186,11 +186,11 @@ static void fresh_servo(void)
     dma_rx_start(&dma, (uintptr_t)dma_regs, (uintptr_t)&usart_regs[1], &hal.rx);
     usart_hd_rx_dma(&usart);
     laps_due = 0;
-    hal.port.now_us = port_now_us;
-    hal.port.rx_sync = dma_rx_sync;
+    hal.port.bus.now_us = port_now_us;
+    hal.port.bus.rx_sync = dma_rx_sync;
     hal.port.rx_ctx = &dma;
-    hal.port.uart_send = port_uart_send;
-    hal.port.uart_tx_done = port_uart_tx_done;
+    hal.port.bus.send = port_uart_send;
+    hal.port.bus.tx_done = port_uart_tx_done;
     servo_init(&servo, &hal.port);
     servo.regs.user.servo_id = OWN_ID;
     servo.link_settings_pending = 1; /* set directly, not by a request */

@@ -21,10 +21,7 @@ static struct app_slot slot;
 /* The board's wiring for the bootloader: which driver does what. */
 static const struct hal_port port = {
     .ctx = &usart,
-    .now_us = port_now_us,
-    .uart_send = port_uart_send,
-    .uart_tx_done = port_uart_tx_done,
-    .uart_set_baud = port_uart_set_baud,
+    .bus = PORT_UART_BUS_INTERRUPT,
     .rx = &rx_ring,
     .flash = &config_flash,
     .rx_gap_tolerance_us = QEMU_RX_GAP_TOLERANCE_US,

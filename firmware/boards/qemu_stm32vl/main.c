@@ -98,15 +98,10 @@ static void enter_bootloader(void *ctx)
 /* The board's wiring: which driver or model does what, in one place. */
 static const struct hal_port port = {
     .ctx = &usart,
-    .now_us = port_now_us,
-    .uart_send = port_uart_send,
-    .uart_tx_done = port_uart_tx_done,
-    .uart_set_baud = port_uart_set_baud,
+    .bus = PORT_UART_BUS_INTERRUPT,
     .rx = &rx_ring,
-    .motor_drive = motor_drive,
-    .motor_coast = motor_coast,
-    .encoder_read = encoder_read,
-    .sensors_read = sensors_read,
+    .motor = {.drive = motor_drive, .coast = motor_coast, .read_encoder = encoder_read,
+              .read_sensors = sensors_read},
     .calibration = &calibration,
     .flash = &flash,
     .enter_bootloader = enter_bootloader,

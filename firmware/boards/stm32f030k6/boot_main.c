@@ -20,12 +20,8 @@ static struct app_slot slot;
 /* The board's wiring for the bootloader: which driver does what. */
 static const struct hal_port port = {
     .ctx = &usart,
-    .now_us = port_now_us,
-    .uart_send = port_uart_send_polled,
-    .uart_tx_done = port_uart_tx_done,
-    .uart_set_baud = port_uart_set_baud,
+    .bus = PORT_UART_BUS_POLLED,
     .rx = &rx_ring,
-    .rx_sync = dma_rx_sync,
     .rx_ctx = &rx_dma,
     .flash = &config_flash,
 };

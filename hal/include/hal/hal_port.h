@@ -15,33 +15,45 @@
 #include "hal/hal_rx_ring.h"
 #include "hal/hal_sensors.h"
 
-struct hal_port {
-    void *ctx;
+/* The servo's bus: the half-duplex UART and the clock its bytes are
+ * stamped by. One port provides all of it (its port_uart.h names it as one
+ * initialiser); ctx is the hal_port's. */
+struct hal_bus {
     /* Free-running microsecond clock; wraps at 2^32. */
     uint32_t (*now_us)(void *ctx);
     /* Starts sending len bytes and returns at once; data stays valid until
-     * uart_tx_done() says true. The port turns the half-duplex line around. */
-    void (*uart_send)(void *ctx, const uint8_t *data, uint16_t len);
+     * tx_done() says true. The port turns the half-duplex line around. */
+    void (*send)(void *ctx, const uint8_t *data, uint16_t len);
     /* True once the last stop bit of the last send has left the wire. */
-    bool (*uart_tx_done)(void *ctx);
-    void (*uart_set_baud)(void *ctx, uint32_t baud);
-    /* Received bytes, in the ring the port owns and fills. */
-    struct hal_rx_ring *rx;
+    bool (*tx_done)(void *ctx);
+    void (*set_baud)(void *ctx, uint32_t baud);
     /* Brings rx->written and rx->heard_us up to date, for a port whose DMA
-     * fills the ring (called with rx_ctx); NULL when its receive interrupt
-     * does. */
+     * fills the ring (called with the hal_port's rx_ctx); NULL when its
+     * receive interrupt does. Optional: hal_rx_sync(). */
     void (*rx_sync)(void *rx_ctx, uint32_t now_us);
-    void *rx_ctx;
+};
+
+/* The motor and what the servo measures of it; ctx is the hal_port's. */
+struct hal_motor {
     /* H-bridge: signed duty, Q15 (32767 = full supply; positive turns the
      * output towards increasing angle, counter-clockwise seen from the horn). */
-    void (*motor_drive)(void *ctx, int16_t duty_q15);
+    void (*drive)(void *ctx, int16_t duty_q15);
     /* Both bridge halves off: the output turns freely (release). */
-    void (*motor_coast)(void *ctx);
+    void (*coast)(void *ctx);
     /* Output-shaft angle from the 12-bit absolute magnetic encoder, 0..4095,
      * increasing counter-clockwise. */
-    uint16_t (*encoder_read)(void *ctx);
+    uint16_t (*read_encoder)(void *ctx);
     /* Samples the analogue sensors (called once per control tick). */
-    void (*sensors_read)(void *ctx, struct sensor_raw *out);
+    void (*read_sensors)(void *ctx, struct sensor_raw *out);
+};
+
+struct hal_port {
+    void *ctx;
+    struct hal_bus bus;
+    /* Received bytes, in the ring the board owns and the port fills. */
+    struct hal_rx_ring *rx;
+    void *rx_ctx;
+    struct hal_motor motor;
     const struct sensor_calibration *calibration;
     const struct hal_flash *flash;
     /* Data ID 8: derived by the port from the MCU's unique ID; read once,
@@ -61,8 +73,8 @@ struct hal_port {
 /* Brings the receive ring up to date (a port whose DMA fills it). */
 static inline void hal_rx_sync(const struct hal_port *h, uint32_t now_us)
 {
-    if (h->rx_sync != NULL) {
-        h->rx_sync(h->rx_ctx, now_us);
+    if (h->bus.rx_sync != NULL) {
+        h->bus.rx_sync(h->rx_ctx, now_us);
     }
 }
 

@@ -1,7 +1,7 @@
 /* Bytes off the wire, in arrival order, from the port to the main loop.
  *
  * The port writes: its DMA channel, whose counter is the write position
- * (the STM32F1 port; hal_port.rx_sync turns it into `written`), or its
+ * (the STM32F1 port; hal_port.bus.rx_sync turns it into `written`), or its
  * receive interrupt, one byte at a time (hal_rx_ring_put). The main loop
  * takes what has arrived in bursts, so no code runs per byte in interrupt
  * context, and a main loop held up (a flash program step) loses nothing

@@ -21,6 +21,9 @@ void board_motor_drive(void *ctx, int16_t duty);
 void board_motor_coast(void *ctx);
 uint16_t board_encoder_read(void *ctx);
 void board_sensors_read(void *ctx, struct sensor_raw *out);
+#define BOARD_MOTOR                                                                    \
+    {.drive = board_motor_drive, .coast = board_motor_coast,                           \
+     .read_encoder = board_encoder_read, .read_sensors = board_sensors_read}
 
 /* TIM3 CH1/CH2 at 20 kHz from timer_hz, into the bridge's IN1/IN2 (the
  * board has clocked TIM3 and routed its pins). */

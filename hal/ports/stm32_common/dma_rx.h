@@ -31,7 +31,7 @@ void dma_rx_start(struct dma_rx *d, uintptr_t channel, uintptr_t data_register,
 /* From the channel's interrupt, after its transfer-complete flag is clear. */
 void dma_rx_lap(struct dma_rx *d);
 /* Brings ring->written up to date; bytes new since the last call mark the
- * line busy at now_us. Main loop. Shaped as hal_port.rx_sync (dma: the
+ * line busy at now_us. Main loop. Shaped as hal_port.bus.rx_sync (dma: the
  * struct dma_rx). */
 void dma_rx_sync(void *dma, uint32_t now_us);
 

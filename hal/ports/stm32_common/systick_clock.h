@@ -1,5 +1,5 @@
 /* A free-running microsecond clock from SysTick (1 ms interrupt plus the
- * counter in between); wraps at 2^32 us like hal_port.now_us wants. */
+ * counter in between); wraps at 2^32 us like hal_port.bus.now_us wants. */
 #ifndef STM32_SYSTICK_CLOCK_H
 #define STM32_SYSTICK_CLOCK_H
 

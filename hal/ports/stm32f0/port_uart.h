@@ -28,4 +28,13 @@ void port_uart_set_baud(void *ctx, uint32_t baud);
 void port_uart_init(struct usart_v2_hd *usart, struct hal_rx_ring *ring, struct dma_rx *dma,
                     uint32_t pclk_hz, enum port_uart_send send);
 
+/* A hal_port's bus on this port (rx_ctx: the dma_rx), sending from the
+ * USART's interrupt or, for the bootloader, whole from the main loop. */
+#define PORT_UART_BUS                                                                  \
+    {.now_us = port_now_us, .send = port_uart_send, .tx_done = port_uart_tx_done,     \
+     .set_baud = port_uart_set_baud, .rx_sync = dma_rx_sync}
+#define PORT_UART_BUS_POLLED                                                           \
+    {.now_us = port_now_us, .send = port_uart_send_polled, .tx_done = port_uart_tx_done, \
+     .set_baud = port_uart_set_baud, .rx_sync = dma_rx_sync}
+
 #endif
