@@ -15,13 +15,13 @@ MODULES = [  # (part of the object's path in the map, name)
     ("libservo_sensors.a", "sensors: scaling, NTC table"),
     ("libservo_protection.a", "protection monitors"),
     ("libservo_app.a", "servo core (servo.c)"),
-    ("libservo_stm32f1.a", "STM32F1 port (USART, clock, pins, ADC)"),
-    ("libservo_stm32f0.a", "STM32F0 port (USART, clock, pins, ADC)"),
+    ("libservo_stm32f1.a", "STM32F1 port (USART)"),
+    ("libservo_stm32f0.a", "STM32F0 port (USART)"),
     ("libservo_stm32_common.a", "STM32 common (DMA receive, SysTick, flash, PWM, IWDG, boot jump)"),
     ("startup_stm32", "startup, vector table"),
     ("small_div.c", "the small run-time: mem*, 32-bit division (size first)"),
     ("small_mem.c", "the small run-time: mem*, 32-bit division (size first)"),
-    ("boards/", "board (main, HAL ops, static servo state)"),
+    ("boards/", "board (main, wiring, board_io: clocks, pins, ADC; the static servo state)"),
 ]
 
 

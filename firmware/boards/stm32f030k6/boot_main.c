@@ -2,7 +2,7 @@
  * USART with DMA receive (an answer goes out whole before the loop goes
  * on), the flash, and the portable loop (firmware/bootloader/bootloader.c). */
 #include "board.h"
-#include "board_f030.h"
+#include "board_io.h"
 #include "boot_flow.h"
 #include "boot_jump.h"
 #include "bootloader.h"

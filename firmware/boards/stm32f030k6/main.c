@@ -1,6 +1,6 @@
 /* The Cortex-M0 board: STM32F030K6 servo controller (pin map: README.md). */
 #include "board.h"
-#include "board_f030.h"
+#include "board_io.h"
 #include "boot_flow.h"
 #include "boot_jump.h"
 #include "flash_f0f1.h"

@@ -2,7 +2,7 @@
  * USART with DMA receive, the flash, and the portable loop
  * (firmware/bootloader/bootloader.c). */
 #include "board.h"
-#include "board_f103.h"
+#include "board_io.h"
 #include "boot_flow.h"
 #include "boot_jump.h"
 #include "bootloader.h"

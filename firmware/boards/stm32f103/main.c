@@ -1,6 +1,6 @@
 /* The reference board: STM32F103 servo controller (pin map: README.md). */
 #include "board.h"
-#include "board_f103.h"
+#include "board_io.h"
 #include "flash_f0f1.h"
 #include "boot_flow.h"
 #include "boot_jump.h"

@@ -1,4 +1,4 @@
-#include "board_f030.h"
+#include "board_io.h"
 
 #include "stm32f0_regs.h"
 

@@ -1,7 +1,8 @@
-/* The reference board's peripherals on the STM32F103: clock tree, H-bridge
- * PWM, ADC scan, watchdog. Pin map: firmware/boards/stm32f103/README.md. */
-#ifndef STM32F1_BOARD_F103_H
-#define STM32F1_BOARD_F103_H
+/* The reference board's own use of the STM32F103: clock tree, the bus pin,
+ * H-bridge PWM pins and timer, the ADC channels it scans. A board on other
+ * pins changes this file (pin map: this folder's README.md). */
+#ifndef BOARD_IO_H
+#define BOARD_IO_H
 
 #include <stdint.h>
 

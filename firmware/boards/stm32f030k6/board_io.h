@@ -1,9 +1,9 @@
-/* A servo board's peripherals on the STM32F030K6 (Cortex-M0, 48 MHz,
- * 32 KB flash, 4 KB RAM): clock tree, bus pin, H-bridge pins, ADC scan.
- * The reference board's pins and front end
- * (firmware/boards/stm32f030k6/README.md). */
-#ifndef STM32F0_BOARD_F030_H
-#define STM32F0_BOARD_F030_H
+/* The Cortex-M0 board's own use of the STM32F030K6 (48 MHz, 32 KB flash,
+ * 4 KB RAM): clock tree, the bus pin, H-bridge pins, the ADC channels it
+ * scans. A board on other pins changes this file (pin map: this folder's
+ * README.md). */
+#ifndef BOARD_IO_H
+#define BOARD_IO_H
 
 #include <stdint.h>
 

@@ -1,4 +1,4 @@
-#include "board_f103.h"
+#include "board_io.h"
 
 #include "stm32f1_regs.h"
 
