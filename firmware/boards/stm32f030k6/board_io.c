@@ -53,7 +53,7 @@ void pwm_bridge_init(void)
     RCC_APB1ENR |= RCC_APB1ENR_TIM3;
     pin_af1(6u);
     pin_af1(7u);
-    pwm_bridge_start(F030_PCLK_HZ);
+    pwm_bridge_start(TIM3_BASE, F030_PCLK_HZ);
 }
 
 void adc_scan_init(void)

@@ -25,7 +25,7 @@ void clock_f103_init(void)
 void pwm_bridge_init(void)
 {
     RCC_APB1ENR |= RCC_APB1ENR_TIM3;
-    pwm_bridge_start(2u * F103_PCLK1_HZ); /* the timer runs at 2 x PCLK1 */
+    pwm_bridge_start(TIM3_BASE, 2u * F103_PCLK1_HZ); /* the timer runs at 2 x PCLK1 */
 }
 
 void adc_scan_init(void)

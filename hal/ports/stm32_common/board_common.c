@@ -5,34 +5,36 @@
 enum { PWM_HZ = 20000 };
 
 static uint32_t pwm_top;
+static uint32_t pwm_timer; /* the board's choice of timer */
 
 volatile uint16_t adc_scan_values[ADC_CHANNELS];
 
-void pwm_bridge_start(uint32_t timer_hz)
+void pwm_bridge_start(uint32_t timer_base, uint32_t timer_hz)
 {
+    pwm_timer = timer_base;
     pwm_top = timer_hz / PWM_HZ;
-    TIM_PSC(TIM3_BASE) = 0;
-    TIM_ARR(TIM3_BASE) = pwm_top - 1u;
-    TIM_CCMR1(TIM3_BASE) = TIM_CCMR1_PWM1_BOTH;
-    TIM_CCR1(TIM3_BASE) = 0;
-    TIM_CCR2(TIM3_BASE) = 0;
-    TIM_CCER(TIM3_BASE) = TIM_CCER_CC1E_CC2E;
-    TIM_EGR(TIM3_BASE) = 1u; /* load the preloaded values */
-    TIM_CR1(TIM3_BASE) = 1u | (1u << 7); /* CEN, ARPE */
+    TIM_PSC(timer_base) = 0;
+    TIM_ARR(timer_base) = pwm_top - 1u;
+    TIM_CCMR1(timer_base) = TIM_CCMR1_PWM1_BOTH;
+    TIM_CCR1(timer_base) = 0;
+    TIM_CCR2(timer_base) = 0;
+    TIM_CCER(timer_base) = TIM_CCER_CC1E_CC2E;
+    TIM_EGR(timer_base) = 1u; /* load the preloaded values */
+    TIM_CR1(timer_base) = 1u | (1u << 7); /* CEN, ARPE */
 }
 
 void pwm_bridge_drive(int16_t duty_q15)
 {
     uint32_t magnitude = (uint32_t)(duty_q15 < 0 ? -(int32_t)duty_q15 : duty_q15);
     uint32_t compare = magnitude * pwm_top >> 15;
-    TIM_CCR1(TIM3_BASE) = duty_q15 > 0 ? compare : 0u;
-    TIM_CCR2(TIM3_BASE) = duty_q15 < 0 ? compare : 0u;
+    TIM_CCR1(pwm_timer) = duty_q15 > 0 ? compare : 0u;
+    TIM_CCR2(pwm_timer) = duty_q15 < 0 ? compare : 0u;
 }
 
 void pwm_bridge_coast(void)
 {
-    TIM_CCR1(TIM3_BASE) = 0;
-    TIM_CCR2(TIM3_BASE) = 0;
+    TIM_CCR1(pwm_timer) = 0;
+    TIM_CCR2(pwm_timer) = 0;
 }
 
 void iwdg_start(void)

@@ -1,7 +1,7 @@
-/* Board peripherals the same on the STM32F0 and F1 once the pins and
- * clocks are set up: the H-bridge PWM on TIM3, the ADC scan's values and
- * the hal_port operations on both, the watchdog, the serial number from
- * the unique ID. */
+/* Board peripherals the same on the STM32F0 and F1 once the board has set
+ * up its pins and clocks (its board_io.c): the H-bridge PWM on the timer it
+ * chose, the ADC scan's values and the hal_port operations on both, the
+ * watchdog, the serial number from the unique ID. */
 #ifndef STM32_BOARD_COMMON_H
 #define STM32_BOARD_COMMON_H
 
@@ -9,8 +9,9 @@
 
 #include "hal/hal_port.h"
 
-/* The ADC's scan of channels 0-3 (PA0-PA3), converted continuously into
- * adc_scan_values[] by DMA1 channel 1 (each family's adc_scan_init). */
+/* What the ADC scan holds, in this order: the board's adc_scan_init
+ * programs its channels so (the reference board: channels 0-3 on PA0-PA3),
+ * converted continuously into adc_scan_values[] by DMA1 channel 1. */
 enum adc_channel { ADC_SUPPLY, ADC_CURRENT, ADC_NTC, ADC_POSITION, ADC_CHANNELS };
 extern volatile uint16_t adc_scan_values[ADC_CHANNELS];
 
@@ -25,9 +26,11 @@ void board_sensors_read(void *ctx, struct sensor_raw *out);
     {.drive = board_motor_drive, .coast = board_motor_coast,                           \
      .read_encoder = board_encoder_read, .read_sensors = board_sensors_read}
 
-/* TIM3 CH1/CH2 at 20 kHz from timer_hz, into the bridge's IN1/IN2 (the
- * board has clocked TIM3 and routed its pins). */
-void pwm_bridge_start(uint32_t timer_hz);
+/* CH1/CH2 of the general-purpose timer at timer_base (the reference
+ * board's TIM3) at 20 kHz from timer_hz, into the bridge's IN1/IN2 (the
+ * board has clocked the timer and routed its pins); before any drive or
+ * coast. */
+void pwm_bridge_start(uint32_t timer_base, uint32_t timer_hz);
 /* Signed duty, Q15: positive drives IN1, negative IN2. */
 void pwm_bridge_drive(int16_t duty_q15);
 /* Both inputs low: the bridge's outputs float (coast). */
