@@ -37,15 +37,12 @@ void servo_init(struct servo *s, const struct hal_port *hal)
      * erase until the page in use is full. A failure of either stays in the
      * store (ReadStore reports it, the next save tries again): at power-up
      * nobody waits for an answer. */
-    bool stored = true;
-    if (s->store.legacy) {
-        stored = config_store_save(&s->store, &s->regs.user, s->store.op_seconds) ==
-                 CONFIG_SAVED;
-    }
-    if (config_store_spare_dirty(&s->store)) {
-        stored = config_store_erase_spare(&s->store);
-    }
-    (void)stored;
+    bool rewritten = !s->store.legacy ||
+                     config_store_save(&s->store, &s->regs.user, s->store.op_seconds) ==
+                         CONFIG_SAVED;
+    bool spare_ready = !config_store_spare_dirty(&s->store) || config_store_erase_spare(&s->store);
+    (void)rewritten;
+    (void)spare_ready;
     save_policy_init(&s->saver, &s->store, hal->bus.now_us(hal->ctx));
     s->regs.status.model = SERVO_MODEL;
     s->regs.status.firmware_version = FIRMWARE_VERSION;

@@ -19,18 +19,18 @@ struct hal_double {
     uint32_t now_us;
     uint8_t sent[HAL_DOUBLE_SENT_MAX];
     size_t sent_length;
-    unsigned sends;       /* uart_send calls */
-    bool tx_busy;         /* uart_tx_done answers !tx_busy */
-    uint32_t baud;        /* last uart_set_baud */
+    unsigned sends;       /* bus.send calls */
+    bool tx_busy;         /* bus.tx_done answers !tx_busy */
+    uint32_t baud;        /* last bus.set_baud */
     unsigned baud_changes;
-    int16_t duty;         /* last motor_drive */
+    int16_t duty;         /* last motor.drive */
     int16_t max_abs_duty; /* largest |duty| since the test last cleared it */
-    bool coasting;        /* motor_coast since the last motor_drive */
-    uint16_t encoder_raw; /* what encoder_read answers without a model */
-    /* If set, encoder_read answers this (a plant, an ideal tracker). */
+    bool coasting;        /* motor.coast since the last motor.drive */
+    uint16_t encoder_raw; /* what motor.read_encoder answers without a model */
+    /* If set, motor.read_encoder answers this (a plant, an ideal tracker). */
     uint16_t (*encoder_model)(void *model);
     void *model;
-    /* What sensors_read answers; with the double's calibration, supply in
+    /* What motor.read_sensors answers; with the double's calibration, supply in
      * mV, current in mA, NTC as the protocol's ADC value. Healthy at init:
      * 7400 mV, 0 mA, 2048 (25 degC). */
     struct sensor_raw sensors;

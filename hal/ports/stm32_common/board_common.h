@@ -15,9 +15,9 @@
 enum adc_channel { ADC_SUPPLY, ADC_CURRENT, ADC_NTC, ADC_POSITION, ADC_CHANNELS };
 extern volatile uint16_t adc_scan_values[ADC_CHANNELS];
 
-/* A hal_port's motor_drive, motor_coast, encoder_read and sensors_read on
- * the bridge PWM and the ADC scan (ctx unused): the board's main.c names
- * them in its hal_port. */
+/* A hal_port's motor group (hal_motor: drive, coast, read_encoder,
+ * read_sensors) on the bridge PWM and the ADC scan (ctx unused), named whole
+ * by BOARD_MOTOR in the board's hal_port. */
 void board_motor_drive(void *ctx, int16_t duty);
 void board_motor_coast(void *ctx);
 uint16_t board_encoder_read(void *ctx);
