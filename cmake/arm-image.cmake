@@ -68,7 +68,8 @@ function(servo_arm_bootloader name)
   cmake_parse_arguments(I "" "" "SOURCES" ${ARGN})
   # Built for size (-Oz, link-time optimised) into the image itself, so
   # these objects come before the libraries' -Os ones: the bootloader core,
-  # the framer byte by byte (FRAME_RX_SMALL), small mem* functions
+  # the framer byte by byte and deaf to SyncCommand (FRAME_RX_SMALL,
+  # FRAME_RX_NO_SYNC), small mem* functions
   # (firmware/runtime/small_mem.c), and the board's port with the drivers
   # it shares (unused ones drop out at the link).
   set(boot ${PROJECT_SOURCE_DIR}/firmware/bootloader)
@@ -85,7 +86,7 @@ function(servo_arm_bootloader name)
   if(SERVO_SIZE_FIRST)
     target_sources(${name}.elf PRIVATE $<TARGET_OBJECTS:servo_small_div>)
   endif()
-  target_compile_definitions(${name}.elf PRIVATE FRAME_RX_SMALL STARTUP_BOOTLOADER CRC32_BITWISE)
+  target_compile_definitions(${name}.elf PRIVATE FRAME_RX_SMALL FRAME_RX_NO_SYNC STARTUP_BOOTLOADER CRC32_BITWISE)
   target_compile_options(${name}.elf PRIVATE -Oz -flto -fno-tree-loop-distribute-patterns)
   target_link_options(${name}.elf PRIVATE -Oz -flto)
   target_link_libraries(${name}.elf PRIVATE ${SERVO_BOARD_PORT} servo_bootloader_core)

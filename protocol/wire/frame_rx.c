@@ -18,8 +18,10 @@ enum rx_state {
 };
 
 /* The bursts' fast paths (a header, a run of content or garbage at once,
- * the hot helpers inlined) buy the receive path its budget; the bootloader
- * builds this file with FRAME_RX_SMALL, byte by byte, to fit its 4 KB. */
+ * the hot helpers inlined) buy the receive path its budget. FRAME_RX_SMALL
+ * (the Cortex-M0 application, every bootloader) takes bytes one by one, for
+ * size; FRAME_RX_NO_SYNC (the bootloaders only, which answer no
+ * SyncCommand) skips SyncCommand by its length. */
 #ifdef FRAME_RX_SMALL
 #define INLINE_IN_FAST_BUILD static
 #else
@@ -81,7 +83,7 @@ INLINE_IN_FAST_BUILD void start_content(struct frame_rx *rx, uint16_t length)
     rx->state = length ? RX_CONTENT : RX_CHECKSUM;
 }
 
-#ifndef FRAME_RX_SMALL
+#ifndef FRAME_RX_NO_SYNC
 /* A byte of SyncCommand content: keep the 3-byte header and, of the records,
  * only the first one that starts with this servo's ID. */
 static void sync_content_byte(struct frame_rx *rx, struct rx_frame *f, uint8_t byte)
@@ -133,8 +135,8 @@ static void content_byte(struct frame_rx *rx, uint8_t byte)
 {
     struct rx_frame *f = work_slot(rx);
     if (f->code == PKT_SYNC_COMMAND) {
-#ifdef FRAME_RX_SMALL
-        skip(rx, rx->remaining); /* the bootloader takes no SyncCommand */
+#ifdef FRAME_RX_NO_SYNC
+        skip(rx, rx->remaining);
         return;
 #else
         sync_content_byte(rx, f, byte);

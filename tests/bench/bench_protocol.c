@@ -16,14 +16,18 @@
  *               message the interrupts it raised and one main-loop pass
  *               (no control tick falls due: bench_motion counts those)
  *   idle_poll   one main-loop pass with nothing to do
- *   latency_*   from a request's last byte (in the ring by DMA) to its
- *               response handed to the UART (one main-loop pass) */
+ *   answer_*    every packet that is answered: from the request's last byte
+ *               (in the ring by DMA) to its answer handed to the UART (the
+ *               main-loop pass that takes it)
+ *   request_*   every packet that is not: the main-loop pass that takes it */
+#include <stdbool.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "bench_region.h"
+#include "registers/data_table.h"
 #include "dma_rx.h"
 #include "frames.h"
 #include "hal_double.h"
@@ -155,11 +159,16 @@ static void transmission_ends(void)
 
 /* What the CPU runs after a message: the interrupts it raised, then a
  * main-loop pass. */
-static void cpu_runs(void)
+static inline __attribute__((always_inline)) void lap_interrupts(void)
 {
     for (; laps_due > 0u; laps_due--) {
         dma_rx_lap(&dma);
     }
+}
+
+static inline __attribute__((always_inline)) void cpu_runs(void)
+{
+    lap_interrupts();
     servo_poll(&servo);
 }
 
@@ -197,24 +206,100 @@ static void fresh_servo(void)
     servo_poll(&servo); /* applies the ID */
 }
 
-/* One request: all but its last byte outside the measurement. */
-static void latency(const char *name, uint8_t code, const uint8_t *content, size_t length)
+/* One request: all but its last byte outside the measurement. The image
+ * must keep it (the framer hands it on) and answer it exactly when the
+ * protocol says it answers: a packet dropped by this CPU's build of the
+ * framer or dispatcher stops the benchmark. */
+static void latency(const char *name, uint8_t code, const uint8_t *content, size_t length,
+                    bool answers)
 {
-    uint8_t frame[64];
+    uint8_t frame[80];
     size_t n = make_request(frame, code, content, length);
+    uint32_t frames_before = servo.rx.stats.frames;
     dma_writes(frame, n - 1u);
-    servo_poll(&servo); /* the main loop takes all but the last byte */
+    cpu_runs(); /* the main loop takes all but the last byte */
     dma_writes(&frame[n - 1u], 1);
+    lap_interrupts(); /* rare (one a ring), and not the answer's path */
     servo.next_tick_us = hal.now_us + 0x7FFFFFFFu; /* no control tick inside */
     bench_begin();
     servo_poll(&servo);
     bench_end(name);
-    if (!usart.tx_busy) {
-        fprintf(stderr, "%s: no response was sent\n", name);
+    if (servo.rx.stats.frames != frames_before + 1u) {
+        fprintf(stderr, "%s: the framer dropped packet %u\n", name, code);
+        exit(1);
+    }
+    if (answers != (usart.tx_busy != 0u)) {
+        fprintf(stderr, "%s: %s\n", name, answers ? "no response was sent" : "answered a packet that has no answer");
+        exit(1);
+    }
+    if (!answers && (servo.regs.status.status & STATUS_COMMAND_ERROR)) {
+        fprintf(stderr, "%s: refused (command error)\n", name);
         exit(1);
     }
     transmission_ends();
     servo_poll(&servo);
+}
+
+#define ID OWN_ID
+#define BYTES(...) (const uint8_t[]){__VA_ARGS__}, sizeof((const uint8_t[]){__VA_ARGS__})
+/* A packet the protocol answers, and one it does not. */
+#define ANSWER(name, code, ...) latency("answer_" name, code, BYTES(__VA_ARGS__), true)
+#define QUIET(name, code, ...) latency("request_" name, code, BYTES(__VA_ARGS__), false)
+
+/* Every packet of servo-protocol.md, extensions.md and docs/packets.md, in
+ * the order a session might send them. */
+static void every_packet(void)
+{
+    ANSWER("ping", 1, ID);
+    ANSWER("read_status", 3, ID, 5);
+    ANSWER("read_batch", 5, ID);
+    ANSWER("monitor", 22, ID);
+    ANSWER("read_angle", 10, ID);
+    ANSWER("read_multi_turn", 16, ID);
+    ANSWER("read_motion", 0x40, ID);
+    ANSWER("read_store", 0x41, ID);
+    ANSWER("update_status", 0x55, ID);
+    /* A change is programmed before its answer (docs/decisions.md); the
+     * same value again writes nothing. */
+    ANSWER("write_data", 4, ID, 50, 0xE8, 0x03);
+    ANSWER("write_same", 4, ID, 50, 0xE8, 0x03);
+    uint8_t batch[1u + USER_AREA_SIZE] = {ID};
+    user_config_encode(&servo.regs.user, &batch[1]);
+    batch[1u + 50u - 32u] = 0xD0; /* item 50 (2 bytes) 1000 -> 2000 */
+    batch[2u + 50u - 32u] = 0x07;
+    latency("answer_write_batch", 6, batch, sizeof batch, true);
+    /* Valid while released. */
+    QUIET("set_origin", 23, ID, 0);
+    QUIET("reset_multi_turn", 17, ID);
+    QUIET("move_angle", 8, ID, 0x84, 0x03, 0xF4, 0x01, 0, 0);
+    QUIET("move_interval", 11, ID, 0x08, 0x07, 0xE8, 0x03, 0x64, 0, 0x64, 0, 0, 0);
+    QUIET("move_velocity", 12, ID, 0x84, 0x03, 0xE8, 0x03, 0x64, 0, 0x64, 0, 0, 0);
+    QUIET("move_multi_turn", 13, ID, 0x10, 0x0E, 0, 0, 0xE8, 0x03, 0, 0, 0, 0);
+    QUIET("move_multi_interval", 14, ID, 0x20, 0x1C, 0, 0, 0xD0, 0x07, 0, 0, 0x64, 0, 0x64, 0, 0, 0);
+    QUIET("move_multi_velocity", 15, ID, 0x10, 0x0E, 0, 0, 0xE8, 0x03, 0x64, 0, 0x64, 0, 0, 0);
+    QUIET("move_wheel", 7, ID, 0x01, 0x64, 0, 0, 0);
+    QUIET("move_damping", 9, ID, 0xE8, 0x03);
+    QUIET("stop", 24, ID, 0x11, 0, 0);
+    latency("request_begin_async", 18, NULL, 0, false);
+    QUIET("move_angle_async", 8, ID, 0x00, 0x00, 0xF4, 0x01, 0, 0);
+    QUIET("end_async", 19, 0);
+    /* SyncCommand: a move for another servo and this one; Sync Monitor
+     * with this servo first (it answers at once). */
+    QUIET("sync_move", 25, 8, 7, 2, 9, 0x84, 0x03, 0xF4, 0x01, 0, 0, ID, 0x84, 0x03, 0xF4, 0x01, 0, 0);
+    ANSWER("sync_monitor", 25, 22, 1, 2, ID, 9);
+    QUIET("start_monitor", 20, 0);
+    QUIET("stop_monitor", 21, 0);
+    /* The bootloader's update packets: an application keeps them unanswered. */
+    QUIET("update_erase", 0x51, ID, 0);
+    QUIET("update_write", 0x52, ID, 0);
+    QUIET("update_verify", 0x53, ID, 0);
+    QUIET("update_boot", 0x54, ID, 0);
+    ANSWER("reset_user_data", 2, ID);
+    uint32_t serial = servo.regs.status.serial_number;
+    ANSWER("assign_id", 0x42, 0xFF, (uint8_t)serial, (uint8_t)(serial >> 8), (uint8_t)(serial >> 16),
+        (uint8_t)(serial >> 24), ID);
+    /* Refused while the servo holds, but answered. */
+    ANSWER("update_enter", 0x50, ID);
 }
 
 int main(void)
@@ -237,13 +322,6 @@ int main(void)
     bench_end("idle_poll");
 
     fresh_servo();
-    latency("latency_ping", 1, (uint8_t[]){OWN_ID}, 1);
-    latency("latency_read_status", 3, (uint8_t[]){OWN_ID, 5}, 2);
-    latency("latency_read_batch", 5, (uint8_t[]){OWN_ID}, 1);
-    latency("latency_monitor", 22, (uint8_t[]){OWN_ID}, 1);
-    /* A change is programmed before its answer (docs/decisions.md); the
-     * same value again writes nothing. */
-    latency("latency_write_data", 4, (uint8_t[]){OWN_ID, 50, 0xE8, 0x03}, 4);
-    latency("latency_write_same", 4, (uint8_t[]){OWN_ID, 50, 0xE8, 0x03}, 4);
+    every_packet();
     return 0;
 }

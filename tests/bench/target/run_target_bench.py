@@ -44,7 +44,8 @@ RESPONSE_BUDGET_US = 20
 # A write that changes the user area is answered once its record is
 # programmed (issue 22): this budget is the CPU's part; the flash's own
 # 24 half-words x 40-70 us (DS5319) come on top (docs/decisions.md).
-DURABLE_WRITE_BUDGET_US = {"latency_write_data": 200}
+DURABLE_WRITE_BUDGET_US = {"answer_write_data": 200, "answer_write_batch": 200,
+                           "answer_reset_user_data": 200}
 
 
 def symbol(elf: Path, name: str) -> int:
@@ -174,7 +175,7 @@ def figures(cpu: str, profile_region: str = "", by_line: bool = False) -> dict:
         "tick_hal": tuple(x / nticks for x in motion["ticks_hal"]),
         "plan": max(plans.values()),
     }
-    out.update({k: v for k, v in proto.items() if k.startswith("latency_")})
+    out.update({k: v for k, v in proto.items() if k.startswith(("answer_", "request_"))})
     out.update(plans)
     return out
 
@@ -204,7 +205,7 @@ def main():
         if budget is not None:
             exceeded = i3 > budget
             mark = f"{budget} instr"
-        elif key.startswith("latency_"):
+        elif key.startswith("answer_"):
             limit = DURABLE_WRITE_BUDGET_US.get(key, RESPONSE_BUDGET_US)
             exceeded = c3 / CLOCK_MHZ["cortex-m3"] > limit
             mark = f"{limit} us" + (" + flash" if key in DURABLE_WRITE_BUDGET_US else "")
