@@ -91,6 +91,84 @@ static void test_load_is_held(void **state)
     assert_true(fabs(plant_angle_deg(&plant)) < 0.14);
 }
 
+/* A hold under a steady load: an interval move to 30 deg with power 0
+ * (the user area's limit, 42: 10 W), the load 0.8 s later. The limit lifts
+ * a load through the gears while I_lim n kt - n drag > load / efficiency
+ * (plant.c); a load the limit lifts settles within 0.2 deg of the target
+ * however it arrives, and the status stays clear. One it cannot lift is
+ * held where the gears' friction holds it, and the status says the output
+ * is held back by its limit (bit 2, after its second at the limit). */
+struct load_arrival {
+    const char *how;
+    double fractions[21]; /* of the load, one per step */
+    int steps;
+    uint32_t ms_per_step;
+};
+
+static const struct load_arrival arrivals[] = {
+    {"a step", {1.0}, 1, 1},
+    {"a step of the other sign", {-1.0}, 1, 1},
+    {"two half steps", {0.5, 1.0}, 2, 500},
+    {"a ramp over 1 s", {0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.35, 0.4, 0.45, 0.5, 0.55, 0.6, 0.65, 0.7, 0.75,
+                         0.8, 0.85, 0.9, 0.95, 1.0}, 20, 50},
+    {"a step, then its reverse", {1.0, -1.0}, 2, 1000},
+};
+
+static double lift_limit_nm(void)
+{
+    const struct plant_params *p = &plant.p;
+    double amps = 10.0 / p->supply_v; /* 42's 10 W as a current limit */
+    return (p->gear_ratio * p->kt * amps - p->gear_ratio * p->drag_coulomb) * p->efficiency;
+}
+
+static void hold_30_under(double load_nm, const struct load_arrival *a, double *at_deg, uint8_t *status)
+{
+    plant_init(&plant);
+    harness_init();
+    plant_harness_attach();
+    REQUEST(4, 0, 49, 0); /* no soft start */
+    REQUEST(8, 0, 0x2C, 0x01, 0xF4, 0x01, 0x00, 0x00);
+    harness_run_ms(800);
+    for (int i = 0; i < a->steps; i++) {
+        plant.load_torque = a->fractions[i] * load_nm;
+        harness_run_ms(a->ms_per_step);
+    }
+    harness_run_ms(2000);
+    *at_deg = plant_angle_deg(&plant);
+    REQUEST(3, 0, 5);
+    *status = hal.sent[6];
+}
+
+static void test_a_hold_does_not_sag(void **state)
+{
+    (void)state;
+    double lift = lift_limit_nm();
+    printf("# the 10 W limit lifts %.3f N m through the gears\n", lift);
+    const double liftable[] = {0.3, 0.6, 0.8, 0.9, 0.95 * lift};
+    for (size_t l = 0; l < sizeof liftable / sizeof liftable[0]; l++) {
+        for (size_t i = 0; i < sizeof arrivals / sizeof arrivals[0]; i++) {
+            double at;
+            uint8_t status;
+            hold_30_under(liftable[l], &arrivals[i], &at, &status);
+            printf("# %.3f N m as %s: held at %.3f deg, status %02x\n", liftable[l], arrivals[i].how, at, status);
+            assert_true(fabs(at - 30.0) < 0.2);
+            assert_int_equal(status, 0);
+        }
+    }
+    /* Beyond: the 1 N m, and 1.5 N m. */
+    const double beyond[] = {1.0, 1.5};
+    for (size_t l = 0; l < sizeof beyond / sizeof beyond[0]; l++) {
+        assert_true(beyond[l] > lift);
+        for (size_t i = 0; i < sizeof arrivals / sizeof arrivals[0]; i++) {
+            double at;
+            uint8_t status;
+            hold_30_under(beyond[l], &arrivals[i], &at, &status);
+            printf("# %.3f N m as %s: held at %.3f deg, status %02x\n", beyond[l], arrivals[i].how, at, status);
+            assert_true(fabs(at - 30.0) < 0.2 || (status & STATUS_STALL));
+        }
+    }
+}
+
 /* The move's power is a bound on the current drawn: |I| <= P / V. */
 static void test_power_bounds_the_current(void **state)
 {
@@ -310,6 +388,7 @@ int main(void)
         cmocka_unit_test_setup(test_interval_move_tracks_and_settles, setup),
         cmocka_unit_test_setup(test_velocity_move_and_return, setup),
         cmocka_unit_test_setup(test_load_is_held, setup),
+        cmocka_unit_test_setup(test_a_hold_does_not_sag, setup),
         cmocka_unit_test_setup(test_power_bounds_the_current, setup),
         cmocka_unit_test_setup(test_holding_has_no_limit_cycle, setup),
         cmocka_unit_test_setup(test_wheel_stop_brakes_within_the_motor, setup),
