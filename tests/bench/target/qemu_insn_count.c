@@ -2,7 +2,7 @@
  * marker addresses, region after region, and models their cycles.
  *
  *   -plugin libqemu_insn_count.so,begin=0xADDR,end=0xADDR,out=FILE[,core=m3|m0][,ws=N]
- *           [,profile=PFILE]
+ *           [,line=BYTES][,profile=PFILE]
  *
  * Instructions: every instruction adds one to a counter (an inline op, no
  * call); the first instruction of each marker function takes a snapshot.
@@ -12,9 +12,11 @@
  * block that does not start where the last one ended follows a taken
  * branch: + 2 for the pipeline refill (M3 TRM 18.2: "P", 1-3; M0: a taken
  * branch is 3 cycles) + the flash's wait states (ws; STM32F1 at 72 MHz: 2,
- * RM0008 3.3.3), which the prefetch buffer cannot hide after a jump. A
- * literal load from flash pays the wait states too, and straight-line code
- * runs no faster than the prefetch buffer fills: 8 bytes per 1 + ws cycles.
+ * RM0008 3.3.3; STM32F030 at 48 MHz: 1, RM0360 3.5.1), which the prefetch
+ * buffer cannot hide after a jump. A literal load from flash pays the wait
+ * states too, and straight-line code runs no faster than the prefetch
+ * buffer fills: one flash line per 1 + ws cycles (line: the F1's flash
+ * reads 64 bits, RM0008 3.3.3: 8 bytes; the F0's 32, RM0360 3.2.1: 4).
  *
  * With profile=PFILE, each region's blocks go to PFILE as they end:
  * "region start_address instructions block_length" lines, for a breakdown
@@ -43,6 +45,7 @@ static uint64_t begin_addr, end_addr;
 static char out_path[512];
 static enum core core = CORE_M3;
 static unsigned wait_states = 2;
+static unsigned line_bytes = 8;
 static FILE *profile;
 static int in_region;
 
@@ -106,6 +109,7 @@ static void on_translate(qemu_plugin_id_t id, struct qemu_plugin_tb *tb)
     uint32_t own = 0;
     uint32_t bytes = 0;
     uint64_t end = qemu_plugin_tb_vaddr(tb);
+    bool after_ldst = false;
     for (size_t i = 0; i < n; i++) {
         struct qemu_plugin_insn *insn = qemu_plugin_tb_get_insn(tb, i);
         uint64_t at = qemu_plugin_insn_vaddr(insn);
@@ -115,6 +119,10 @@ static void on_translate(qemu_plugin_id_t id, struct qemu_plugin_tb *tb)
         uint16_t hw2 = size == 4u ? (uint16_t)(code[2] | code[3] << 8) : 0u;
         struct insn_cost c = thumb_cost(core, hw, hw2, (unsigned)size);
         own += c.cycles + (c.literal_load ? wait_states : 0u);
+        if (core == CORE_M3 && c.single_ldst && after_ldst && c.cycles > 1u) {
+            own -= 1u; /* pipelined behind the previous load or store */
+        }
+        after_ldst = c.single_ldst;
         bytes += (uint32_t)size;
         end = at + size;
         if (at == begin_addr) {
@@ -125,8 +133,8 @@ static void on_translate(qemu_plugin_id_t id, struct qemu_plugin_tb *tb)
         qemu_plugin_register_vcpu_insn_exec_inline(insn, QEMU_PLUGIN_INLINE_ADD_U64, &executed, 1);
     }
     /* Straight-line code runs no faster than the flash fills the prefetch
-     * buffer: 8 bytes per 1 + ws cycles. */
-    uint32_t fetch = (bytes + 7u) / 8u * (1u + wait_states);
+     * buffer: a line per 1 + ws cycles. */
+    uint32_t fetch = (bytes + line_bytes - 1u) / line_bytes * (1u + wait_states);
     if (block_count < MAX_BLOCKS) {
         struct block *b = &blocks[block_count++];
         *b = (struct block){qemu_plugin_tb_vaddr(tb), end, own > fetch ? own : fetch, (uint32_t)n, 0};
@@ -175,9 +183,11 @@ PLUGIN_EXPORT int qemu_plugin_install(qemu_plugin_id_t id, const qemu_info_t *in
             }
         } else if (strncmp(argv[i], "ws=", 3) == 0) {
             wait_states = (unsigned)strtoul(argv[i] + 3, NULL, 0);
+        } else if (strncmp(argv[i], "line=", 5) == 0) {
+            line_bytes = (unsigned)strtoul(argv[i] + 5, NULL, 0);
         }
     }
-    if (begin_addr == 0 || end_addr == 0 || out_path[0] == '\0') {
+    if (begin_addr == 0 || end_addr == 0 || out_path[0] == '\0' || line_bytes == 0u) {
         fprintf(stderr, "qemu_insn_count: needs begin=, end= and out=\n");
         return 1;
     }

@@ -11,7 +11,12 @@ static unsigned bits_set(uint32_t v)
 
 static struct insn_cost cost(uint8_t cycles, bool literal, bool pc)
 {
-    return (struct insn_cost){cycles, literal, pc};
+    return (struct insn_cost){cycles, literal, pc, false};
+}
+
+static struct insn_cost ldst(uint8_t cycles, bool literal, bool pc)
+{
+    return (struct insn_cost){cycles, literal, pc, true};
 }
 
 static struct insn_cost thumb16(enum core core, uint16_t hw)
@@ -19,13 +24,13 @@ static struct insn_cost thumb16(enum core core, uint16_t hw)
     uint8_t load = 2;                       /* M3 and M0 alike */
     uint8_t store = core == CORE_M3 ? 1 : 2; /* the M3 buffers a store */
     if ((hw >> 11) == 0x09) {               /* LDR Rt, [PC, #imm] */
-        return cost(load, true, false);
+        return ldst(load, true, false);
     }
     if ((hw >> 12) == 0x5) {                /* load/store, register offset */
-        return cost(((hw >> 9) & 7u) <= 2u ? store : load, false, false);
+        return ldst(((hw >> 9) & 7u) <= 2u ? store : load, false, false);
     }
     if ((hw >> 13) == 0x3 || (hw >> 12) == 0x8 || (hw >> 12) == 0x9) { /* imm, halfword, SP */
-        return cost((hw & 0x0800u) ? load : store, false, false);
+        return ldst((hw & 0x0800u) ? load : store, false, false);
     }
     if ((hw & 0xFE00u) == 0xB400u) {        /* PUSH */
         return cost((uint8_t)(1u + bits_set(hw & 0x1FFu)), false, false);
@@ -66,7 +71,7 @@ static struct insn_cost thumb32(uint16_t hw, uint16_t hw2)
         bool load = (hw & 0x0010u) != 0u;
         bool literal = load && (hw & 0x000Fu) == 0xFu;
         bool to_pc = load && (hw2 >> 12) == 0xFu;
-        return cost(load ? 2 : 1, literal, to_pc);
+        return ldst(load ? 2 : 1, literal, to_pc);
     }
     if ((hw & 0xFF80u) == 0xFB00u) {       /* MUL, MLA, MLS */
         return cost((hw2 & 0x00F0u) == 0u && (hw2 >> 12) == 0xFu ? 1 : 2, false, false);

@@ -8,7 +8,11 @@
  * branch's pipeline refill and the flash's wait states are added by the
  * plugin where they happen (thumb_cycles.c). Where a table gives a range
  * the middle is used (a multiply-long 3-5: 4; a divide 2-12: 7), and an
- * IT instruction, which the M3 folds into its neighbour (0-1), counts 1. */
+ * IT instruction, which the M3 folds into its neighbour (0-1), counts 1.
+ * The M3 pipelines neighbouring single loads and stores (TRM 18.3, "Load-
+ * store timings": LDR after LDR/STR takes 1 cycle, its address phase
+ * overlapping the previous data phase); the plugin takes that cycle off
+ * where two follow each other. The M0's table gives a load 2 cycles flat. */
 #ifndef THUMB_CYCLES_H
 #define THUMB_CYCLES_H
 
@@ -21,6 +25,7 @@ struct insn_cost {
     uint8_t cycles;        /* the instruction's own, not taken */
     bool literal_load;     /* LDR from a PC-relative literal: a flash read */
     bool writes_pc;        /* a branch, or a POP / LDM / LDR of the PC */
+    bool single_ldst;      /* one LDR/STR (any size): pipelines with the next on the M3 */
 };
 
 /* hw: the instruction's first half-word; hw2 its second (32-bit ones). */
