@@ -251,7 +251,10 @@ def build_parser():
     c.add_argument("--board", required=True, help="a board of firmware/boards (stm32f103, stm32f030k6, qemu_stm32vl, host_sim) or its number")
     c.add_argument("-o", "--output", required=True)
 
-    c = sub.add_parser("sim", help="run the simulator")
+    c = sub.add_parser("sim", help="run the simulator, or a virtual board (--board)")
+    c.add_argument("--board", default="host", choices=["host", "stm32f103", "stm32f030k6"],
+                   help="host: servo_sim (the firmware built for the PC); stm32f103, stm32f030k6: "
+                        "the board's shipped images on its emulated chip (tools/vboard)")
     c.add_argument("--id", dest="ids", type=int, action="append")
     c.add_argument("--tcp", type=int, nargs="?", const=0, default=None, metavar="PORT",
                    help="a TCP port instead of a pty (any free port if none given)")

@@ -5,6 +5,7 @@ from pathlib import Path
 import shutil
 import socket
 import subprocess
+import sys
 import tempfile
 import threading
 import time
@@ -62,7 +63,7 @@ class Simulator(_Child):
     socket://) unless tcp=False, then a pseudo-terminal (optionally linked)."""
 
     def __init__(self, ids=(1,), tcp=True, link=None, state_dir=None, supply_mv=None,
-                 ambient_c=None, tcp_port=None, rx=None):
+                 ambient_c=None, tcp_port=None, rx=None, board=None):
         self.ids = list(ids)
         self.tcp = tcp or tcp_port is not None
         self.tcp_port = tcp_port
@@ -72,6 +73,7 @@ class Simulator(_Child):
         self.supply_mv = supply_mv
         self.ambient_c = ambient_c
         self.rx = rx  # "dma" (default) or "interrupt": how the servos' port receives
+        self.board = board  # None: servo_sim; else a virtual board (tools/vboard)
         self.process = None
         self.url = None
         self.control_port = None
@@ -80,7 +82,12 @@ class Simulator(_Child):
         self._clock_lock = threading.Lock()
 
     def start(self) -> "Simulator":
-        cmd = [str(find_binary()), "--state", self.state_dir]
+        if self.board is not None:
+            if self.rx is not None:
+                raise ServoError("a virtual board receives as its port does: --rx is servo_sim's")
+            cmd = [sys.executable, "-m", "vboard", "--board", self.board, "--state", self.state_dir]
+        else:
+            cmd = [str(find_binary()), "--state", self.state_dir]
         for i in self.ids:
             cmd += ["--id", str(i)]
         if self.tcp:
@@ -93,14 +100,16 @@ class Simulator(_Child):
             cmd += ["--ambient", str(self.ambient_c)]
         if self.rx is not None:
             cmd += ["--rx", self.rx]
+        env = dict(os.environ, PYTHONPATH=os.pathsep.join(
+            [str(REPO / "tools")] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]))
         self.process = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                                        text=True)
+                                        text=True, env=env)
         deadline = time.monotonic() + 20
         while time.monotonic() < deadline:
             line = self.process.stdout.readline()
             if not line:
                 err = self.process.stderr.read()
-                raise ServoError(f"servo_sim exited: {err.strip()}")
+                raise ServoError(f"{cmd[0] if self.board is None else 'vboard'} exited: {err.strip()}")
             words = line.split()
             if words[1:2] == ["bus"]:
                 self.url = words[2]

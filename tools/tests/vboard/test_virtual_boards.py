@@ -1,0 +1,183 @@
+"""The shipped images (bootloader and application, as flashed) on both
+virtual boards (tools/vboard: the STM32F103 and the STM32F030 emulated,
+their peripherals laid out from ST's SVD files), driven through servoctl and
+the maker's SDK exactly as the simulator is. Time is the boards' simulated
+time (sim.sleep, sim.wait_until)."""
+import struct
+
+import pytest
+import serial
+from fashionstar_uart_sdk import UartServoManager
+
+from servoctl import group
+from servoctl import image as img
+from servoctl import protocol as p
+from servoctl import update as upd
+from servoctl.registers import ITEMS
+from servoctl.servo import Servo
+from servoctl.sim import Simulator
+from vboard.board import board_h, images
+
+BOARDS = ["stm32f103", "stm32f030k6"]
+
+
+def start(tmp_path, board, ids=(1,), tcp=True):
+    return Simulator(ids=ids, tcp=tcp, state_dir=str(tmp_path / "state"), board=board).start()
+
+
+def finish(sim, ids):
+    for i in ids:
+        state = sim.state(i)
+        assert state["collisions"] == 0, "answers collided on the bus"
+        assert state["resets_watchdog"] == 0, f"board {i} was reset by its watchdog"
+    sim.stop()
+
+
+@pytest.fixture(params=BOARDS)
+def board(request):
+    return request.param
+
+
+@pytest.fixture
+def one(tmp_path, board):
+    sim = start(tmp_path, board)
+    with sim.bus(timeout=0.3) as bus:
+        servo = Servo(bus, 1)
+        servo.write("soft_start_on", 0)
+        yield sim, bus, servo
+    finish(sim, [1])
+
+
+def test_ping_and_the_data_table(one):
+    sim, bus, servo = one
+    assert servo.ping()
+    assert not Servo(bus, 7).ping(timeout=0.1)
+    readable = {item.name: servo.read(item.name) for item in ITEMS if item.public}
+    assert readable["voltage"] == pytest.approx(7400, abs=20)  # the ADC reading the supply
+    assert readable["temperature"] == pytest.approx(2048, abs=40)  # 25 degC through the NTC
+    assert readable["serial"] != 0  # from the chip's unique ID
+    user = servo.read_all()  # ReadBatchData: the user area as the data table has it
+    assert all(user[name] == readable[name] for name in user if name in readable)
+    servo.write("angle_max", 1200)  # a write goes to flash: read back after a power cut
+    sim.control("powercycle 1")
+    sim.sleep(0.5)  # the bootloader's window, then the application
+    assert servo.read("angle_max") == 1200
+    assert servo.read("soft_start_on") == 0
+
+
+def test_every_motion_packet(one):
+    sim, bus, servo = one
+    servo.move(450, interval_ms=300)                                   # 11
+    sim.sleep(0.6)
+    assert servo.angle() == pytest.approx(450, abs=2)
+    servo.move(-300, velocity=1500, acc_ms=50, dec_ms=50)              # 12
+    sim.sleep(0.7)
+    assert servo.angle() == pytest.approx(-300, abs=2)
+    servo.move(100, interval_ms=200, ramps=False)                       # 8
+    sim.sleep(0.5)
+    assert servo.angle() == pytest.approx(100, abs=2)
+    servo.move(4500, interval_ms=2000, multi_turn=True)                 # 14
+    sim.sleep(2.4)
+    angle, turns = servo.multi_turn_angle()                              # 16
+    assert angle == pytest.approx(4500, abs=3) and turns == 1
+    servo.move(3600, velocity=2000, multi_turn=True)                    # 15
+    sim.sleep(0.8)
+    servo.move(3000, interval_ms=300, multi_turn=True, ramps=False)     # 13
+    sim.sleep(0.7)
+    assert servo.multi_turn_angle()[0] == pytest.approx(3000, abs=3)
+    assert sim.state(1)["angle"] == pytest.approx(300.0, abs=0.5)
+    servo.wheel("run", 120)                                             # 7
+    sim.sleep(0.5)
+    assert abs(sim.state(1)["velocity"]) > 60
+    servo.stop("hold")                                                  # 24
+    sim.sleep(0.3)
+    held = sim.state(1)["angle"]
+    sim.sleep(0.3)
+    assert sim.state(1)["angle"] == pytest.approx(held, abs=0.2)
+    servo.damping(1000)                                                 # 9
+    servo.stop("release")
+    sim.sleep(0.1)
+    servo.reset_multi_turn()                                            # 17
+    servo.set_origin()                                                  # 23
+    sim.sleep(0.1)
+    assert abs(servo.angle()) <= 2
+    bus.send(p.BEGIN_ASYNC, b"")                                        # 18, 19
+    servo.move(-200, interval_ms=200)
+    sim.sleep(0.3)
+    assert abs(servo.angle()) <= 2  # buffered, not started
+    bus.send(p.END_ASYNC, b"\x00")
+    sim.sleep(0.5)
+    assert servo.angle() == pytest.approx(-200, abs=2)
+
+
+def test_protections_under_injected_faults(one):
+    sim, bus, servo = one
+    sim.control("supply 3500")  # below 39's 4 V default
+    sim.sleep(0.3)
+    assert servo.read("status") & (1 << 4)
+    sim.control("supply 7400")
+    sim.sleep(0.3)
+    assert not servo.read("status") & (1 << 4)
+    sim.control("soak 90")  # beyond 41's limit
+    sim.sleep(0.3)
+    assert servo.read("status") & (1 << 7)
+
+
+def test_sync_monitor_and_sync_moves_on_a_bus(tmp_path, board):
+    sim = start(tmp_path, board, ids=(1, 2, 3))
+    with sim.bus(timeout=0.3) as bus:
+        for i in (1, 2, 3):
+            Servo(bus, i).write("soft_start_on", 0)
+        answers = group.sync_monitor(bus, [1, 2, 3])
+        assert sorted(answers) == [1, 2, 3]
+        group.sync_move(bus, {1: 30.0, 2: -30.0, 3: 60.0}, duration_s=0.4)
+        sim.sleep(0.8)
+        answers = group.sync_monitor(bus, [1, 2, 3])
+        assert [round(answers[i].angle_decideg / 10) for i in (1, 2, 3)] == [30, -30, 60]
+    finish(sim, [1, 2, 3])
+
+
+def test_the_makers_sdk(tmp_path, board):
+    sim = start(tmp_path, board, tcp=False)
+    uart = serial.Serial(sim.url, 115200, timeout=0)
+    m = UartServoManager(uart)
+    assert m.write_data(1, 49, b"\x00")
+    assert m.ping(1) is True and m.ping(2) is False
+    m.set_servo_angle(1, 45.0, interval=400)
+    sim.sleep(0.7)
+    assert m.query_servo_angle(1) == pytest.approx(45.0, abs=0.2)
+    assert m.query_voltage(1) == pytest.approx(7.4, abs=0.05)
+    uart.close()
+    finish(sim, [1])
+
+
+def test_an_update_through_the_bootloader_survives_a_power_cut(tmp_path, board):
+    """The board's own application, as a new version, written by the real
+    bootloader into the modelled flash; the power goes a third of the way
+    through; the servo waits in its bootloader, and a second update brings
+    the image, which then runs."""
+    _, _, app = images(board)
+    new = img.parse(img.build(app.read_bytes(), 0x0042, img.boards()[board].id))
+    sim = start(tmp_path, board)
+
+    class Cut(Exception):
+        pass
+
+    def progress(done, total):
+        if done > total // 3:
+            sim.control("powercycle 1")
+            raise Cut()
+
+    with sim.bus(timeout=0.5) as bus:
+        with pytest.raises(Cut):
+            upd.update(bus, 1, new, progress)
+        status = upd._wait_for_mode(bus, 1, upd.MODE_BOOTLOADER)
+        assert status.verdict != 0  # a half-written image is not started
+        before, after = upd.update(bus, 1, new)
+        assert upd.status(bus, 1).mode == upd.MODE_APP
+        assert after == Servo(bus, 1).read("firmware")  # the binary's own version runs
+    finish(sim, [1])
+    h = board_h(board)
+    flash = (tmp_path / "state" / f"{board}-1.flash").read_bytes()
+    slot = flash[h["BOARD_SLOT_BASE"] - h["BOARD_FLASH_BASE"]:]
+    assert img.parse(slot[:img.HEADER_SIZE + new.size]).version == 0x0042  # the new image, whole

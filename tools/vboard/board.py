@@ -1,0 +1,303 @@
+"""A virtual servo board: the shipped images on a Cortex-M core with the
+part's peripherals, its analogue inputs and bridge wired to the
+simulator's motor (the host build's plant and thermal models).
+
+A board is one folder of firmware/boards/ (its board.h: the flash map, RAM,
+the analogue front end) and one entry of PARTS (the silicon: core, SVD,
+clock tree, pins, the DMA channel its USART receives on). Its flash holds
+what a factory would program into a blank chip: the bootloader, the
+application's update image in the slot and a config record with the
+board's ID; a --state folder keeps it across runs, as on a real chip."""
+import ctypes
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+from unicorn import arm_const as arm
+
+from . import svd
+from .adc import AdcF0, AdcF1
+from .clocks import Rcc
+from .core import Core, Stop
+from .dma import Dma
+from .flash import Flash
+from .model import Model
+from .native import Motor, factory_config
+from .timers import BridgeTimer, Watchdog
+from .usart import Usart
+
+REPO = Path(__file__).resolve().parents[2]
+SYSTEM_MEMORY = 0x1FFFF000
+
+
+@dataclass(frozen=True)
+class Part:
+    svd: str
+    cpu: int
+    has_vtor: bool
+    irq_words: int
+    cpi: float          # cycles an instruction: the target benchmark's model for this firmware
+    names: dict         # role -> the SVD's peripheral name
+    usart_rx_dma: int   # DMA channel of USART1_RX (RM0008 table 78, RM0360 table 26)
+    dma_irqs: dict      # channel -> the SVD's interrupt name
+    uid: int            # 96-bit unique ID (RM0008 30.2, RM0360 29.1)
+    program_s: float    # tPROG, the datasheet's longest
+    erase_s: float      # tERASE, the datasheet's longest
+    build: str          # the CMake preset that builds its images
+
+
+PARTS = {
+    # DS5319 (STM32F103x8/xB) "Flash memory characteristics": tPROG 40-70 us, tERASE 20-40 ms.
+    # CPI 2.0: docs/benchmark.md (72 MHz, 2 wait states; the whole tick 1506 cycles / 762).
+    "stm32f103": Part("STM32F103xx", arm.UC_CPU_ARM_CORTEX_M3, True, 2, 2.0,
+                      {"rcc": "RCC", "flash": "FLASH", "dma": "DMA1", "usart": "USART1", "adc": "ADC1",
+                       "tim": "TIM3", "iwdg": "IWDG", "gpio": "GPIOA"},
+                      5, {1: "DMA1_Channel1", 5: "DMA1_Channel5"}, 0x1FFFF7E8, 70e-6, 40e-3, "arm"),
+    # DS9773 (STM32F030x4/6/8/C) "Flash memory characteristics": tPROG 53.5 us max, tERASE 40 ms max.
+    # CPI 1.9: docs/benchmark.md (48 MHz, 1 wait state; the whole tick 4004 cycles / 2091).
+    "stm32f030k6": Part("STM32F030", arm.UC_CPU_ARM_CORTEX_M0, False, 1, 1.9,
+                        {"rcc": "RCC", "flash": "Flash", "dma": "DMA", "usart": "USART1", "adc": "ADC",
+                         "tim": "TIM3", "iwdg": "IWDG", "gpio": "GPIOA", "syscfg": "SYSCFG"},
+                        3, {1: "DMA_CH1", 3: "DMA_CH2_3"}, 0x1FFFF7AC, 53.5e-6, 40e-3, "arm-m0"),
+}
+HSE_HZ = 8_000_000  # the boards' crystal (firmware/boards/*/board_io.h)
+ADC_INPUTS = {0: "supply", 1: "current", 2: "ntc", 3: "encoder"}  # firmware/boards/*/README.md
+
+
+def board_h(board: str) -> dict:
+    text = (REPO / "firmware/boards" / board / "board.h").read_text()
+    return {k: int(v, 0) for k, v in re.findall(r"^#define (BOARD_\w+) (0x[0-9a-fA-F]+|\d+)\b", text, re.M)}
+
+
+def images(board: str) -> tuple:
+    """(bootloader .bin, application update image .img, application .bin)
+    of the board's build."""
+    folder = REPO / "build" / PARTS[board].build / "firmware/boards" / board
+    return folder / f"servo_{board}_boot.bin", folder / f"servo_{board}.img", folder / f"servo_{board}.bin"
+
+
+class Memory:
+    """Host memory the core maps (mem_map_ptr), so two addresses can share it."""
+
+    def __init__(self, size: int, fill: int):
+        self.size = size
+        self.buf = (ctypes.c_ubyte * size)(*([fill] * size))
+
+    def read(self, offset: int, n: int) -> bytes:
+        return bytes(self.buf[offset:offset + n])
+
+    def write(self, offset: int, data: bytes) -> None:
+        self.buf[offset:offset + len(data)] = data
+
+    def ptr(self) -> int:
+        return ctypes.addressof(self.buf)
+
+
+class Board:
+    def __init__(self, board: str, servo_id: int, bus, state_dir=None, supply_v=7.4, ambient_c=25.0,
+                 boot_image=None, app_image=None):
+        self.name, self.servo_id, self.bus = board, servo_id, bus
+        self.part = PARTS[board]
+        self.h = board_h(board)
+        h, part = self.h, self.part
+        self.core = Core(part.cpu, 8_000_000, part.cpi, part.has_vtor, part.irq_words)
+        uc = self.core.uc
+        self.flash_base = h["BOARD_FLASH_BASE"]
+        self.flash_size = h["BOARD_CONFIG_PAGE1"] + h["BOARD_FLASH_PAGE"] - self.flash_base
+        self.flash_mem = Memory(self.flash_size, 0xFF)
+        self.ram = Memory(h["BOARD_RAM_SIZE"], 0)
+        self.core.map_host(self.flash_base, self.flash_size, self.flash_mem.buf)
+        self.core.map_host(h["BOARD_RAM_BASE"], self.ram.size, self.ram.buf)
+        self._alias = None
+        self.alias_zero(self.flash_mem, self.flash_size)
+        self.core.map_host(0x40000000, 0x30000)
+        kr = svd.device(part.svd)["IWDG"].address("KR")  # the watchdog watches its own key
+        self.core.watch_writes(0x40000000, kr - 1)
+        self.core.watch_writes(kr + 4, 0x4002FFFF)
+        if "syscfg" in part.names:  # the F0's GPIO ports sit on AHB2
+            self.core.map_host(0x48000000, 0x2000)
+            self.core.watch_writes(0x48000000, 0x48001FFF)
+        self.core.map_host(SYSTEM_MEMORY, 0x1000)
+        self.core.watch_writes(0xE000E000, 0xE000EFFF)
+        self.core.watch_writes(self.flash_base, self.flash_base + self.flash_size - 1)
+        dev = svd.device(part.svd)
+        irqs = svd.interrupts(part.svd)
+        n = part.names
+        self.motor = Motor(supply_v, ambient_c)
+        self.rcc = Rcc(self, dev[n["rcc"]], HSE_HZ, 1)
+        path = None if state_dir is None else Path(state_dir) / f"{board}-{servo_id}.flash"
+        self.flash = Flash(self, dev[n["flash"]], self.flash_mem, self.flash_base, self.flash_size,
+                           h["BOARD_FLASH_PAGE"], path, part.program_s, part.erase_s)
+        self.dma = Dma(self, dev[n["dma"]], {ch: irqs[name] for ch, name in part.dma_irqs.items()})
+        self.gpio = Model(self, dev[n["gpio"]])
+        self.usart = Usart(self, dev[n["usart"]], self.pclk_hz, irqs["USART1"], self.dma,
+                           part.usart_rx_dma, self.bus_pin_ok)
+        adc_class = AdcF0 if "syscfg" in n else AdcF1
+        self.adc = adc_class(self, dev[n["adc"]], self.adc_hz, self.dma, self.adc_input)
+        self.tim = BridgeTimer(self, dev[n["tim"]], self.bridge_pins_ok)
+        self.iwdg = Watchdog(self, dev[n["iwdg"]])
+        self.models = [self.rcc, self.flash, self.dma, self.gpio, self.usart, self.adc, self.tim, self.iwdg]
+        if "syscfg" in n:
+            self.syscfg = Model(self, dev[n["syscfg"]])
+            self.syscfg.watch("CFGR1", self._mem_mode)
+            self.models.append(self.syscfg)
+        self.station = bus.attach(self.usart)
+        self.usart.bus_station = self.station
+        self.resets = {"power": 0, "software": 0, "watchdog": 0}
+        self.last_reset = None
+        self.powered = True
+        if self.flash.blank:
+            self._factory(boot_image, app_image)
+        self._write_uid()
+        self.reset("power")
+
+    # ---- the chip ---------------------------------------------------------
+    def _factory(self, boot_image, app_image) -> None:
+        boot, app, _ = images(self.name)
+        boot = Path(boot_image or boot).read_bytes()
+        app = Path(app_image or app).read_bytes()
+        self.flash_mem.write(0, boot)
+        self.flash_mem.write(self.h["BOARD_SLOT_BASE"] - self.flash_base, app)
+        page = self.h["BOARD_FLASH_PAGE"]
+        offset = self.h["BOARD_CONFIG_PAGE0"] - self.flash_base
+        pages = ctypes.create_string_buffer(b"\xff" * 2 * page, 2 * page)
+        if not factory_config(pages, page, self.h["BOARD_CONFIG_PAGE0"], self.servo_id):
+            raise RuntimeError("the config store refused the factory record")
+        self.flash_mem.write(offset, pages.raw)
+        self.flash._persist(0, self.flash_size)
+
+    def _write_uid(self) -> None:
+        """A unique ID per board: lot and wafer words, and the ID."""
+        uid = (0x00310042 + self.servo_id, 0x31353033, 0x4E000000 | self.servo_id << 8)
+        self.core.write(self.part.uid, b"".join(w.to_bytes(4, "little") for w in uid))
+
+    def alias_zero(self, memory: Memory, size: int) -> None:
+        """What address 0 shows: flash from reset (BOOT0 low), or SRAM on
+        the F0 once SYSCFG's MEM_MODE says so (RM0360 9.1.1)."""
+        if self._alias is not None:
+            self.core.uc.mem_unmap(0, self._alias)
+        self.core.uc.mem_map_ptr(0, size, 7, memory.ptr())
+        self._alias = size
+
+    def _mem_mode(self, value, old, size):
+        if value & 3 == 3:
+            self.core.defer(lambda: self.alias_zero(self.ram, self.ram.size))
+        else:
+            self.core.defer(lambda: self.alias_zero(self.flash_mem, self.flash_size))
+
+    def set_core_hz(self, hz: int) -> None:
+        self.core.hz = hz
+
+    def pclk_hz(self) -> int:
+        cfgr = self.rcc.get("CFGR")
+        field = "PPRE2" if "PPRE2" in self.rcc.p.registers["CFGR"][2] else "PPRE"
+        code = (cfgr & self.rcc.bit("CFGR", field)) >> self.rcc.p.shift("CFGR", field)
+        return self.core.hz >> (0 if code < 4 else code - 3)
+
+    def adc_hz(self) -> float:
+        if "syscfg" in self.part.names:
+            return 14e6  # the F0's asynchronous HSI14 (CKMODE 0, RM0360 12.3.3)
+        code = (self.rcc.get("CFGR") >> 14) & 3  # ADCPRE: /2, /4, /6, /8
+        return self.pclk_hz() / (2 * (code + 1))
+
+    # ---- pins ---------------------------------------------------------------
+    def _f1_pin_af_output(self, pin: int) -> bool:
+        reg = self.gpio.get("CRL" if pin < 8 else "CRH")
+        nibble = reg >> (4 * (pin % 8)) & 0xF
+        return nibble & 3 != 0 and nibble >> 2 in (2, 3)
+
+    def _f0_pin_af(self, pin: int, af: int) -> bool:
+        mode = self.gpio.get("MODER") >> (2 * pin) & 3
+        afr = self.gpio.get("AFRL" if pin < 8 else "AFRH") >> (4 * (pin % 8)) & 0xF
+        return mode == 2 and afr == af
+
+    def bus_pin_ok(self) -> bool:
+        """PA9 is USART1_TX (F1: alternate-function output; F0: AF1)."""
+        return self._f0_pin_af(9, 1) if "syscfg" in self.part.names else self._f1_pin_af_output(9)
+
+    def bridge_pins_ok(self) -> bool:
+        """PA6/PA7 are TIM3_CH1/CH2."""
+        if "syscfg" in self.part.names:
+            return self._f0_pin_af(6, 1) and self._f0_pin_af(7, 1)
+        return self._f1_pin_af_output(6) and self._f1_pin_af_output(7)
+
+    def adc_input(self, channel: int) -> int:
+        """The front end's reading of the models (board.h's scaling; no noise)."""
+        what = ADC_INPUTS.get(channel)
+        h = self.h
+        if what == "supply":
+            counts = self.motor.get("supply_v") * 1e6 / h["BOARD_SUPPLY_UV_PER_COUNT"]
+        elif what == "current":
+            counts = abs(self.motor.get("current_a")) * 1e6 / h["BOARD_CURRENT_UA_PER_COUNT"] + \
+                h["BOARD_CURRENT_ZERO_COUNTS"]
+        elif what == "ntc":
+            counts = self.motor.ntc_adc()
+        elif what == "encoder":
+            counts = self.motor.encoder()
+        else:
+            counts = 0
+        return max(0, min(4095, int(counts + 0.5)))
+
+    # ---- running --------------------------------------------------------
+    def reset(self, cause: str) -> None:
+        self.resets[cause] += 1
+        self.last_reset = cause
+        for m in self.models:
+            m.reset()
+        self.rcc.reset_with(cause)
+        if "syscfg" in self.part.names:
+            self.alias_zero(self.flash_mem, self.flash_size)
+        self.core.reset(self.flash_base)
+        self.motor.coast()
+
+    def power_cycle(self, off_s: float = 0.1) -> None:
+        """Power off (the motor coasts, RAM is lost), then on."""
+        self.ram.write(0, bytes(self.ram.size))
+        self.core.idle(off_s)
+        self._write_uid()
+        self.reset("power")
+
+    def run_until(self, t_s: float) -> None:
+        core = self.core
+        while core.now_s() < t_s:
+            wanted = t_s - core.now_s()
+            soon = min([m.next_event_s(core.now_s()) for m in self.models] + [core.now_s() + wanted])
+            systick = core.now_s() + core.cycles_to_systick() / core.hz
+            step = max(min(soon, systick) - core.now_s(), 1e-6)
+            try:
+                passed = core.run(step)
+            except Stop as stop:
+                self.reset(stop.args[0])
+                continue
+            self.motor.step(passed)
+            now = core.now_s()
+            if not self.flash.check_wait_states(core.hz):
+                core.pending.add(3)  # reads at this clock return garbage: a fault
+            for m in self.models:
+                m.step(now)
+            duty = self.tim.duty()
+            if duty is None:
+                self.motor.coast()
+            else:
+                self.motor.drive(duty)
+            if self.iwdg.expired(now):
+                self.reset("watchdog")
+
+    def in_application(self) -> bool:
+        pc = self.core.uc.reg_read(arm.UC_ARM_REG_PC)
+        return self.h["BOARD_SLOT_BASE"] <= pc < self.h["BOARD_CONFIG_PAGE0"]
+
+    def state(self) -> dict:
+        m = self.motor
+        return {"id": self.servo_id, "board": self.name, "sim_ms": round(self.core.now_s() * 1000, 3),
+                "angle": round(m.get("angle_deg"), 3), "velocity": round(m.get("velocity_dps"), 2),
+                "current": round(m.get("current_a"), 3), "winding": round(m.get("winding_c"), 2),
+                "case": round(m.get("case_c"), 2), "ambient": round(m.get("ambient_c"), 1),
+                "supply": round(m.get("supply_v"), 3), "load": round(m.get("load_nm"), 3),
+                "core_mhz": round(self.core.hz / 1e6, 3), "resets_power": self.resets["power"],
+                "resets_software": self.resets["software"], "resets_watchdog": self.resets["watchdog"],
+                "last_reset": self.last_reset, "mode": "app" if self.in_application() else "bootloader",
+                "locked_up": int(self.core.locked_up),
+                "rx_bytes": self.usart.rx_bytes,
+                "framing_errors": self.usart.framing_errors, "overruns": self.usart.overruns,
+                "pc": f"{self.core.uc.reg_read(arm.UC_ARM_REG_PC):#010x}"}

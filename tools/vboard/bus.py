@@ -1,0 +1,146 @@
+"""The half-duplex bus wire between the host and the virtual boards, in
+simulated time (as servo_sim's, firmware/boards/host_sim/sim_bus.h).
+
+A byte takes 10 bit times at its sender's rate and reaches every receiver
+(the sender's own USART too: it hears itself unless its receiver is off)
+when its stop bit ends. A board that starts a byte while another's is on
+the wire is a collision, counted. The host's bytes go out paced at the
+host's rate (115200 until `hostbaud` says otherwise) after whatever is on
+the wire; the bus reads the host only while less than 10 ms of its bytes
+wait, as behind a real UART. The host is a TCP client (pyserial
+socket://) or a pseudo-terminal."""
+import heapq
+import os
+import pty
+import socket
+import tty
+
+FRAME_BITS = 10
+HOST = -1
+BACKLOG_S = 0.01
+
+
+class Bus:
+    def __init__(self):
+        self.stations = []        # USART models
+        self.events = []          # (end_s, seq, byte, baud, sender)
+        self.seq = 0
+        self.wire_until_s = 0.0
+        self.last_sender = None
+        self.host_baud = 115200
+        self.host_queue_until_s = 0.0
+        self.to_host = bytearray()
+        self.collisions = 0
+        self.host_fd = None
+        self.listen = None
+        self.master_fd = None
+        self.link_path = None
+
+    def attach(self, usart) -> int:
+        self.stations.append(usart)
+        return len(self.stations) - 1
+
+    # ---- the host's side ----------------------------------------------------
+    def serve_tcp(self, port: int) -> str:
+        self.listen = socket.socket()
+        self.listen.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        self.listen.bind(("127.0.0.1", port))
+        self.listen.listen(1)
+        self.listen.setblocking(False)
+        return f"socket://127.0.0.1:{self.listen.getsockname()[1]}"
+
+    def serve_pty(self, link=None) -> str:
+        master, slave = pty.openpty()
+        tty.setraw(slave)
+        os.set_blocking(master, False)
+        self.master_fd, self.host_fd = master, master
+        name = os.ttyname(slave)
+        self._slave = slave
+        if link:
+            if os.path.lexists(link):
+                os.unlink(link)
+            os.symlink(name, link)
+            self.link_path = link
+        return name
+
+    def fds(self) -> list:
+        """What to wait on for the host."""
+        out = []
+        if self.host_fd is not None:
+            out.append(self.host_fd)
+        elif self.listen is not None:
+            out.append(self.listen)
+        return out
+
+    def poll_host(self, now_s: float) -> None:
+        """Accepts a client; reads what the wire can take; writes what has
+        reached the host."""
+        if self.host_fd is None and self.listen is not None:
+            try:
+                conn, _ = self.listen.accept()
+            except BlockingIOError:
+                return
+            conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+            conn.setblocking(False)
+            self._conn = conn
+            self.host_fd = conn.fileno()
+        if self.host_fd is None:
+            return
+        if self.host_queue_until_s - now_s < BACKLOG_S:
+            try:
+                data = os.read(self.host_fd, 256)
+            except BlockingIOError:
+                data = None
+            except OSError:
+                data = b""
+            if data == b"" and self.listen is not None:
+                self._drop_client()
+                return
+            for byte in data or b"":
+                self._queue_host(byte, now_s)
+        if self.to_host:
+            try:
+                n = os.write(self.host_fd, bytes(self.to_host))
+                del self.to_host[:n]
+            except (BlockingIOError, OSError):
+                pass
+
+    def _drop_client(self) -> None:
+        self._conn.close()
+        self.host_fd = None
+        self.to_host.clear()
+
+    def _queue_host(self, byte: int, now_s: float) -> None:
+        start = max(now_s, self.host_queue_until_s, self.wire_until_s)
+        end = start + FRAME_BITS / self.host_baud
+        self.host_queue_until_s = end
+        self.wire_until_s = max(self.wire_until_s, end)
+        self._push(end, byte, self.host_baud, HOST)
+
+    # ---- the boards' side -------------------------------------------------
+    def send(self, station: int, byte: int, baud: int, start_s: float) -> None:
+        if start_s < self.wire_until_s - 1e-9 and self.last_sender not in (None, station):
+            self.collisions += 1
+        end = start_s + FRAME_BITS / baud
+        self.wire_until_s = max(self.wire_until_s, end)
+        self.last_sender = station
+        self._push(end, byte, baud, station)
+
+    def _push(self, end_s, byte, baud, sender) -> None:
+        self.seq += 1
+        heapq.heappush(self.events, (end_s, self.seq, byte, baud, sender))
+
+    def next_event_s(self) -> float:
+        return self.events[0][0] if self.events else float("inf")
+
+    def deliver_until(self, t_s: float) -> None:
+        while self.events and self.events[0][0] <= t_s:
+            _, _, byte, baud, sender = heapq.heappop(self.events)
+            for usart in self.stations:
+                usart.receive(byte, baud)
+            if sender != HOST and abs(baud - self.host_baud) <= 0.03 * self.host_baud:
+                self.to_host.append(byte)
+
+    def close(self) -> None:
+        if self.link_path and os.path.lexists(self.link_path):
+            os.unlink(self.link_path)

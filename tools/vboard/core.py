@@ -1,0 +1,414 @@
+"""A Cortex-M core on Unicorn, with what ARM puts beside it in the system
+control space: SysTick, the NVIC and the SCB registers the firmware uses.
+
+Unicorn runs the Thumb code; it has no NVIC, so exceptions are entered and
+left here as the architecture says (ARMv7-M ARM B1.5.6, ARMv6-M ARM B1.5.6):
+entry pushes r0-r3, r12, lr, pc and xPSR on the main stack (8-byte aligned,
+bit 9 of the stacked xPSR saying so), sets IPSR and LR = EXC_RETURN and
+jumps through the vector table; the handler's return to EXC_RETURN reaches
+Unicorn as interrupt 8 (QEMU's EXCP_EXCEPTION_EXIT), and the frame is popped
+here. Every interrupt this firmware enables has the reset priority, so none
+preempts another: an exception is taken only in thread mode, with PRIMASK
+clear, the lowest number first (B1.5.4: equal priority, lower number wins).
+
+Time is the CPU's: each instruction costs the board's cycles per
+instruction (its cycle model, docs/benchmark.md), and peripherals move on
+between runs of at most a slice. A slice cut short by a peripheral that
+stalls the CPU (a flash program or erase) is counted as half run.
+
+Peripheral registers are RAM to the CPU, so reading them costs no Python;
+writes call the peripheral's handler before the value lands. A handler that
+makes the register read other than what was written (a write-1-to-clear
+flag, a ready bit) or that stalls or resets the CPU stops it after the
+store; the register then takes its value before the next instruction runs.
+The CPU resumes after the store (a plain STR/STRH/STRB, which is what the
+compiler makes of a register write), or, for any other store instruction
+and for any store inside an IT block (whose state a jump over it would
+break), runs it again, that second time past the handler, and the register
+takes its value at the end of that slice."""
+import ctypes
+import os
+import struct
+import sys
+
+from unicorn import UC_ARCH_ARM, UC_HOOK_INTR, UC_HOOK_MEM_WRITE, UC_MODE_MCLASS, UC_MODE_THUMB, Uc, UcError
+from unicorn import arm_const as arm
+
+EXC_RETURN_THREAD_MSP = 0xFFFFFFF9
+EXCP_EXCEPTION_EXIT = 8  # QEMU's, as Unicorn reports it
+HARD_FAULT = 3
+SYSTICK = 15
+FIRST_IRQ = 16
+FRAME_REGS = (arm.UC_ARM_REG_R0, arm.UC_ARM_REG_R1, arm.UC_ARM_REG_R2, arm.UC_ARM_REG_R3,
+              arm.UC_ARM_REG_R12, arm.UC_ARM_REG_LR)
+
+# System control space (ARMv7-M ARM B3.2, B3.3, B3.4)
+SYST_CSR, SYST_RVR, SYST_CVR = 0xE000E010, 0xE000E014, 0xE000E018
+NVIC_ISER, NVIC_ICER, NVIC_ISPR, NVIC_ICPR = 0xE000E100, 0xE000E180, 0xE000E200, 0xE000E280
+SCB_ICSR, SCB_VTOR, SCB_AIRCR = 0xE000ED04, 0xE000ED08, 0xE000ED0C
+ICSR_PENDSTSET, ICSR_PENDSTCLR = 1 << 26, 1 << 25
+AIRCR_VECTKEY, AIRCR_SYSRESETREQ = 0x05FA0000, 1 << 2
+CSR_ENABLE, CSR_TICKINT, CSR_COUNTFLAG = 1, 2, 1 << 16
+
+
+def plain_store_size(hw: int, hw2: int) -> int:
+    """The size of a single store without writeback at this Thumb
+    instruction (2 or 4), or 0 for any other instruction."""
+    if hw >> 11 in (0x0C, 0x0E, 0x10, 0x12) or hw >> 9 in (0x28, 0x29, 0x2A):
+        return 2  # STR/STRB/STRH immediate, STR SP-relative, STR/STRH/STRB register
+    if hw & 0xFFF0 in (0xF8C0, 0xF880, 0xF8A0):
+        return 4  # STR/STRB/STRH imm12
+    if hw & 0xFFF0 in (0xF840, 0xF800, 0xF820):
+        register_form = hw2 & 0x0FC0 == 0
+        offset_no_writeback = hw2 & 0x0800 and hw2 & 0x0400 and not hw2 & 0x0100
+        return 4 if register_form or offset_no_writeback else 0
+    return 0
+
+
+class Stop(Exception):
+    """Raised by run() when the board must reset (cause in .args[0])."""
+
+
+class Core:
+    def __init__(self, cpu_model: int, hz: int, cpi: float, has_vtor: bool, irq_words: int):
+        self.uc = Uc(UC_ARCH_ARM, UC_MODE_THUMB | UC_MODE_MCLASS)
+        self.uc.ctl_set_cpu_model(cpu_model)
+        self.hz, self.cpi, self.has_vtor, self.irq_words = hz, cpi, has_vtor, irq_words
+        self.cycles = 0.0            # HCLK cycles since power-up (SysTick counts these)
+        self.time_s = 0.0            # since power-up
+        self.handlers = {}           # register address -> handler(value, old, size)
+        self.ranges = []             # (begin, end, handler(address, value, size))
+        self.fixes = []              # (address, bytes) the registers read once the store has landed
+        self.late_fixes = []         # ... after the next slice (a store that runs again)
+        self.stall_s = 0.0           # the CPU stands still this long, peripherals do not
+        self.reset_cause = None
+        self._stopping = None        # the address whose store stopped the CPU
+        self._passthrough = None     # ... and runs again without its handler
+        self._stop_pc = None
+        self.locked_up = False
+        self.fault = None
+        self.deferred = []           # what may not happen inside Unicorn (remapping memory)
+        self.enabled = set()         # IRQ numbers
+        self.pending = set()         # exception numbers
+        self.systick_base = 0.0      # cycle at which the counter last loaded
+        self.regions = []            # (base, end, memoryview) of memory mapped from the host
+        self.map_host(0xE000E000, 0x1000)
+        self.on_write(SYST_CSR, self._syst_csr)
+        self.on_write(SYST_CVR, self._syst_cvr)
+        self.on_write(SCB_ICSR, self._icsr)
+        self.on_write(SCB_AIRCR, self._aircr)
+        for w in range(irq_words):
+            self.on_write(NVIC_ISER + 4 * w, self._nvic(w, enable=True))
+            self.on_write(NVIC_ICER + 4 * w, self._nvic(w, enable=False))
+            self.on_write(NVIC_ISPR + 4 * w, self._nvic_pend(w, True))
+            self.on_write(NVIC_ICPR + 4 * w, self._nvic_pend(w, False))
+        self.uc.hook_add(UC_HOOK_INTR, self._interrupt)
+
+    # ---- memory ---------------------------------------------------------
+    def map_host(self, base: int, size: int, buf=None):
+        """Maps host memory at base (a new zeroed buffer unless given): the
+        models read and write it directly, without going through Unicorn."""
+        if buf is None:
+            buf = (ctypes.c_ubyte * size)()
+        self.uc.mem_map_ptr(base, size, 7, ctypes.addressof(buf))
+        self.regions.append((base, base + size, memoryview(buf).cast("B")))
+        return buf
+
+    def _view(self, address: int):
+        for base, end, view in self.regions:
+            if base <= address < end:
+                return view, address - base
+        raise KeyError(f"{address:#010x} is not host-mapped")
+
+    def watch_writes(self, begin: int, end: int) -> None:
+        """Writes in [begin, end] go to their registers' handlers."""
+        self.uc.hook_add(UC_HOOK_MEM_WRITE, self._write_hook, begin=begin, end=end)
+
+    def on_write(self, address: int, handler) -> None:
+        self.handlers[address] = handler
+
+    def on_write_range(self, begin: int, end: int, handler) -> None:
+        """Stores into [begin, end) (memory, not registers) go to
+        handler(address, value, size) before they land."""
+        self.ranges.append((begin, end, handler))
+
+    def rd32(self, address: int) -> int:
+        for base, end, view in self.regions:
+            if base <= address < end:
+                return struct.unpack_from("<I", view, address - base)[0]
+        return struct.unpack("<I", self.uc.mem_read(address, 4))[0]  # an alias (address 0)
+
+    def wr32(self, address: int, value: int) -> None:
+        view, at = self._view(address)
+        struct.pack_into("<I", view, at, value & 0xFFFFFFFF)
+
+    def rd16(self, address: int) -> int:
+        for base, end, view in self.regions:
+            if base <= address < end:
+                return struct.unpack_from("<H", view, address - base)[0]
+        return struct.unpack("<H", self.uc.mem_read(address, 2))[0]
+
+    def write(self, address: int, data: bytes) -> None:
+        view, at = self._view(address)
+        view[at:at + len(data)] = data
+
+    def fix(self, address: int, value, size: int = 4) -> None:
+        """The register (or memory) reads value (an int of size bytes, or
+        bytes) from the instruction after the current store on."""
+        data = value if isinstance(value, bytes) else (value & ((1 << 8 * size) - 1)).to_bytes(size, "little")
+        self.fixes.append((address, data))
+        self.uc.emu_stop()
+
+    def defer(self, action) -> None:
+        """From a handler: action() runs once the CPU has stopped after this
+        store (before the next instruction)."""
+        self.deferred.append(action)
+        self.uc.emu_stop()
+
+    def stop(self, stall_s: float = 0.0, reset: str = None) -> None:
+        """From a handler: the CPU stops after this store, stalled for
+        stall_s, or resets."""
+        self.stall_s += stall_s
+        if reset:
+            self.reset_cause = reset
+        self.uc.emu_stop()
+
+    def _write_hook(self, uc, access, address, size, value, data):
+        if self._passthrough == address:
+            self._passthrough = None
+            return
+        word = address & ~3
+        handler = self.handlers.get(word)
+        if handler is None:
+            for begin, end, memory_handler in self.ranges:
+                if begin <= address < end:
+                    memory_handler(address, value, size)
+                    if self.fixes or self.stall_s or self.reset_cause or self.deferred:
+                        self._stopping = address
+                        self._stop_pc = uc.reg_read(arm.UC_ARM_REG_PC)
+            return
+        shift = 8 * (address & 3)
+        old = self.rd32(word)
+        if size < 4:  # a byte or half-word store into a word register
+            mask = ((1 << (8 * size)) - 1) << shift
+            value = (old & ~mask) | ((value << shift) & mask)
+        handler(value & 0xFFFFFFFF, old, size)
+        if self.fixes or self.stall_s or self.reset_cause or self.deferred:
+            self._stopping = address
+            self._stop_pc = uc.reg_read(arm.UC_ARM_REG_PC)
+
+    # ---- time -------------------------------------------------------------
+    def now_s(self) -> float:
+        return self.time_s
+
+    def run(self, max_s: float) -> float:
+        """Runs the CPU for at most max_s of its time; returns the time that
+        passed (a stall included). Raises Stop when the board must reset."""
+        if self.locked_up:
+            self.idle(max_s)
+            self.cycles += max_s * self.hz
+            return max_s
+        self._take_exception()
+        self._update_systick()
+        pc = self.uc.reg_read(arm.UC_ARM_REG_PC) | 1
+        count = max(1, int(max_s * self.hz / self.cpi))
+        try:
+            self.uc.emu_start(pc, 0xFFFFFFFF, count=count)
+        except UcError as e:
+            if os.environ.get("VBOARD_TRACE"):
+                r = {n: hex(self.uc.reg_read(getattr(arm, "UC_ARM_REG_" + n))) for n in ("PC", "LR", "SP", "IPSR", "XPSR")}
+                print(f"vboard: fault {e} at {self.time_s:.4f} s: {r}", file=sys.stderr, flush=True)
+            self._fault(str(e))
+        ran = count * self.cpi
+        for action in self.deferred:
+            action()
+        self.deferred = []
+        for address, data in self.late_fixes:
+            self.write(address, data)
+        self.late_fixes = []
+        if self._stopping is not None:
+            ran /= 2
+            pc = self.uc.reg_read(arm.UC_ARM_REG_PC)
+            xpsr = self.uc.reg_read(arm.UC_ARM_REG_XPSR)
+            in_it_block = (xpsr >> 10) & 0x3F or (xpsr >> 25) & 3  # ITSTATE (B1.4.2)
+            size = 0 if in_it_block else plain_store_size(self.rd16(pc & ~1), self.rd16((pc & ~1) + 2))
+            if pc != self._stop_pc:  # the store completed and the CPU moved on
+                for address, data in self.fixes:
+                    self.write(address, data)
+            elif size:
+                for address, data in self.fixes:
+                    self.write(address, data)
+                self.uc.reg_write(arm.UC_ARM_REG_PC, (pc + size) | 1)
+            else:
+                self._passthrough = self._stopping
+                self.late_fixes = self.fixes
+            self._stopping, self.fixes = None, []
+        else:
+            for address, data in self.fixes:  # from a passed-over store
+                self.write(address, data)
+            self.fixes = []
+        cycles = ran + self.stall_s * self.hz
+        passed = cycles / self.hz
+        self.stall_s = 0.0
+        self.cycles += cycles
+        self.time_s += passed
+        self._systick_after(cycles)
+        if self.reset_cause:
+            cause, self.reset_cause = self.reset_cause, None
+            raise Stop(cause)
+        return passed
+
+    def idle(self, seconds: float) -> None:
+        """Time passes with the CPU held (in reset, or powered off)."""
+        self.time_s += seconds
+
+    # ---- exceptions -------------------------------------------------------
+    def raise_irq(self, irq: int) -> None:
+        self.pending.add(FIRST_IRQ + irq)
+
+    def _fault(self, why: str) -> None:
+        """A bus fault or undefined instruction: HardFault, as on silicon
+        (the firmware's handler then spins until the watchdog resets). A
+        fault that cannot be taken (the stack pointer is not in RAM) locks
+        the core up (ARMv7-M ARM B1.5.15): it runs nothing until a reset."""
+        self.fault = why
+        self.pending.add(HARD_FAULT)
+        try:
+            self._take_exception(force=True)
+        except KeyError:
+            self.locked_up = True
+
+    def _take_exception(self, force: bool = False) -> None:
+        uc = self.uc
+        if uc.reg_read(arm.UC_ARM_REG_IPSR) != 0 and not force:
+            return
+        if uc.reg_read(arm.UC_ARM_REG_PRIMASK) & 1 and not force:
+            return
+        ready = sorted(e for e in self.pending
+                       if e < FIRST_IRQ or (e - FIRST_IRQ) in self.enabled)
+        if not ready:
+            return
+        exc = ready[0]
+        self.pending.discard(exc)
+        if exc == SYSTICK:
+            self.wr32(SCB_ICSR, self.rd32(SCB_ICSR) & ~ICSR_PENDSTSET)
+        sp = uc.reg_read(arm.UC_ARM_REG_SP)
+        xpsr = uc.reg_read(arm.UC_ARM_REG_XPSR)
+        pc = uc.reg_read(arm.UC_ARM_REG_PC)
+        realign = sp & 4
+        sp = (sp - 32) & ~7
+        frame = [uc.reg_read(r) for r in FRAME_REGS] + [pc & ~1, (xpsr | (1 << 24)) | (realign << 7)]
+        self.write(sp, struct.pack("<8I", *frame))
+        uc.reg_write(arm.UC_ARM_REG_SP, sp)
+        uc.reg_write(arm.UC_ARM_REG_LR, EXC_RETURN_THREAD_MSP)
+        uc.reg_write(arm.UC_ARM_REG_IPSR, exc)
+        base = self.rd32(SCB_VTOR) if self.has_vtor else 0
+        uc.reg_write(arm.UC_ARM_REG_PC, self.rd32(base + 4 * exc))
+
+    def _interrupt(self, uc, intno, data):
+        if intno != EXCP_EXCEPTION_EXIT:
+            uc.emu_stop()
+            self._fault(f"CPU exception {intno}")
+            return
+        sp = uc.reg_read(arm.UC_ARM_REG_SP)
+        view, at = self._view(sp)
+        frame = struct.unpack_from("<8I", view, at)
+        for reg, v in zip(FRAME_REGS, frame[:6]):
+            uc.reg_write(reg, v)
+        xpsr = frame[7]
+        uc.reg_write(arm.UC_ARM_REG_SP, sp + 32 + (4 if xpsr & (1 << 9) else 0))
+        uc.reg_write(arm.UC_ARM_REG_XPSR, xpsr & ~(1 << 9))
+        uc.reg_write(arm.UC_ARM_REG_IPSR, 0)
+        uc.reg_write(arm.UC_ARM_REG_PC, frame[6] | 1)
+
+    def reset(self, vector_table: int) -> None:
+        """The core's reset: registers, the system control space; memory
+        (RAM and flash) keeps what it holds."""
+        uc = self.uc
+        self.pending.clear()
+        self.enabled.clear()
+        self.fixes, self.late_fixes = [], []
+        self._stopping = self._passthrough = None
+        self.stall_s = 0.0
+        self.reset_cause = None
+        self.locked_up = False
+        self.write(0xE000E000, bytes(0x1000))
+        uc.reg_write(arm.UC_ARM_REG_PRIMASK, 0)
+        uc.reg_write(arm.UC_ARM_REG_IPSR, 0)
+        uc.reg_write(arm.UC_ARM_REG_CONTROL, 0)
+        uc.reg_write(arm.UC_ARM_REG_MSP, self.rd32(vector_table))
+        uc.reg_write(arm.UC_ARM_REG_SP, self.rd32(vector_table))
+        uc.reg_write(arm.UC_ARM_REG_LR, 0xFFFFFFFF)
+        uc.reg_write(arm.UC_ARM_REG_PC, self.rd32(vector_table + 4) | 1)
+
+    # ---- NVIC and SCB -----------------------------------------------------
+    def _nvic(self, word: int, enable: bool):
+        def handler(value, old, size):
+            for bit in range(32):
+                if value >> bit & 1:
+                    (self.enabled.add if enable else self.enabled.discard)(32 * word + bit)
+            mask = sum(1 << (b - 32 * word) for b in self.enabled if 32 * word <= b < 32 * word + 32)
+            self.fix(NVIC_ISER + 4 * word, mask)
+            self.fix(NVIC_ICER + 4 * word, mask)
+        return handler
+
+    def _nvic_pend(self, word: int, pend: bool):
+        def handler(value, old, size):
+            for bit in range(32):
+                if value >> bit & 1:
+                    exc = FIRST_IRQ + 32 * word + bit
+                    (self.pending.add if pend else self.pending.discard)(exc)
+            self.fix(NVIC_ISPR + 4 * word, 0)
+            self.fix(NVIC_ICPR + 4 * word, 0)
+        return handler
+
+    def _icsr(self, value, old, size):
+        if value & ICSR_PENDSTSET:
+            self.pending.add(SYSTICK)
+        if value & ICSR_PENDSTCLR:
+            self.pending.discard(SYSTICK)
+        self.fix(SCB_ICSR, ICSR_PENDSTSET if SYSTICK in self.pending else 0)
+
+    def _aircr(self, value, old, size):
+        if (value & 0xFFFF0000) == AIRCR_VECTKEY and value & AIRCR_SYSRESETREQ:
+            self.stop(reset="software")
+        self.fix(SCB_AIRCR, 0xFA050000)
+
+    # ---- SysTick (ARMv7-M ARM B3.3) ---------------------------------------
+    def _syst_csr(self, value, old, size):
+        if value & CSR_ENABLE and not old & CSR_ENABLE:
+            self.systick_base = self.cycles
+        self.fix(SYST_CSR, value & ~CSR_COUNTFLAG)
+
+    def _syst_cvr(self, value, old, size):
+        self.systick_base = self.cycles  # any write clears the counter
+        self.fix(SYST_CVR, 0)
+
+    def _update_systick(self) -> None:
+        csr = self.rd32(SYST_CSR)
+        if not csr & CSR_ENABLE:
+            return
+        period = (self.rd32(SYST_RVR) & 0xFFFFFF) + 1
+        into = int(self.cycles - self.systick_base) % period
+        self.wr32(SYST_CVR, period - 1 - into)
+
+    def _systick_after(self, passed: float) -> None:
+        """Wraps in the cycles that passed pend SysTick (one pending at most)."""
+        csr = self.rd32(SYST_CSR)
+        if not csr & CSR_ENABLE:
+            return
+        period = (self.rd32(SYST_RVR) & 0xFFFFFF) + 1
+        before = int(self.cycles - passed - self.systick_base) // period
+        after = int(self.cycles - self.systick_base) // period
+        if after > before:
+            self.wr32(SYST_CSR, csr | CSR_COUNTFLAG)
+            if csr & CSR_TICKINT:
+                self.pending.add(SYSTICK)
+                self.wr32(SCB_ICSR, self.rd32(SCB_ICSR) | ICSR_PENDSTSET)
+
+    def cycles_to_systick(self) -> float:
+        """Cycles until the counter next wraps (inf when it is off)."""
+        if not self.rd32(SYST_CSR) & CSR_ENABLE:
+            return float("inf")
+        period = (self.rd32(SYST_RVR) & 0xFFFFFF) + 1
+        return period - (self.cycles - self.systick_base) % period

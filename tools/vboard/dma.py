@@ -1,0 +1,65 @@
+"""The DMA controller's channels (RM0008 13, RM0360 10; the same registers
+on both parts): a peripheral's request moves one item to memory (or from
+it), the counter counts down, half and full transfer set their flags and,
+where enabled, raise the channel's interrupt; a circular channel reloads
+its counter and starts over, overwriting what the CPU has not yet taken."""
+from .model import Model
+
+
+class Dma(Model):
+    def __init__(self, board, periph, irqs: dict):
+        super().__init__(board, periph)
+        self.irqs = irqs  # channel -> IRQ line
+        self.reload = {}
+        self.channels = [n for n in range(1, 8) if f"CCR{n}" in periph.registers]
+        for n in self.channels:
+            self.watch(f"CCR{n}", self._ccr(n))
+        self.watch("IFCR", self._ifcr)
+
+    def reset(self) -> None:
+        super().reset()
+        self.reload = {}
+
+    def _ccr(self, n: int):
+        def handler(value, old, size):
+            if value & 1 and not old & 1:  # EN: the counter's start value is its reload
+                self.reload[n] = self.get(f"CNDTR{n}") & 0xFFFF
+        return handler
+
+    def _ifcr(self, value, old, size):
+        self.put("ISR", self.get("ISR") & ~value)
+        self.core.fix(self.addr("IFCR"), 0)
+
+    def enabled(self, n: int) -> bool:
+        return bool(self.get(f"CCR{n}") & 1)
+
+    def peripheral_address(self, n: int) -> int:
+        return self.get(f"CPAR{n}")
+
+    def transfer(self, n: int, value: int) -> bool:
+        """One item from a peripheral to memory; False if the channel is off
+        or finished (non-circular, counter at 0)."""
+        ccr = self.get(f"CCR{n}")
+        left = self.get(f"CNDTR{n}") & 0xFFFF
+        if not ccr & 1 or left == 0:
+            return False
+        total = self.reload.get(n, left)
+        msize = 1 << ((ccr >> 10) & 3)
+        position = (total - left) if ccr & (1 << 7) else 0  # MINC
+        address = self.get(f"CMAR{n}") + position * msize
+        self.core.write(address, (value & ((1 << 8 * msize) - 1)).to_bytes(msize, "little"))
+        left -= 1
+        shift = 4 * (n - 1)
+        flags = 0
+        if left == total // 2:
+            flags |= 0b0101  # GIF, HTIF
+        if left == 0:
+            flags |= 0b0011  # GIF, TCIF
+            if ccr & (1 << 5):  # CIRC
+                left = total
+        self.put(f"CNDTR{n}", left)
+        if flags:
+            self.put("ISR", self.get("ISR") | flags << shift)
+            if (flags & 2 and ccr & 2) or (flags & 4 and ccr & 4):  # TCIE, HTIE
+                self.core.raise_irq(self.irqs[n])
+        return True

@@ -1,0 +1,129 @@
+"""The embedded flash and its interface (RM0008 3.3, RM0360 3.2; the same
+registers on both parts): unlocked by the two keys, programmed a half-word
+at a time into erased cells, erased a page at a time. The CPU fetches its
+code from this flash, so it stands still while a half-word programs or a
+page erases, for the datasheets' longest times (DS5319 and DS9773, "Flash
+memory characteristics": tPROG 70 us and 53.5 us, tERASE 40 ms); the
+peripherals and the DMA go on meanwhile.
+
+Errors as the interface reports them: a write to a cell not erased (other
+than 0x0000) sets PGERR and programs nothing; a write while locked or
+without PG programs nothing. The wait states must cover the clock (RM0008
+3.3.3: 0 up to 24 MHz, 1 up to 48, 2 up to 72; RM0360 3.5.1: 0 up to 24,
+1 up to 48): a CPU faster than its flash reads garbage, here a HardFault.
+
+The contents live in a file (--state): each program and erase writes
+through, so a power cut keeps exactly what was programmed."""
+import os
+
+from .model import Model
+
+KEY1, KEY2 = 0x45670123, 0xCDEF89AB
+
+
+class Flash(Model):
+    def __init__(self, board, periph, memory, base: int, size: int, page: int, path,
+                 program_s: float, erase_s: float, ws_per_24mhz: bool = True):
+        super().__init__(board, periph)
+        self.memory, self.base, self.size, self.page = memory, base, size, page
+        self.program_s, self.erase_s = program_s, erase_s
+        self.path = path
+        self.keys_seen = 0
+        self.fail_programs = self.fail_erases = 0
+        self.fd = None
+        self.blank = True
+        if path is not None:
+            self._open(path)
+        self.watch("KEYR", self._keyr)
+        self.watch("CR", self._cr)
+        self.watch("SR", self._sr)
+        self.core.on_write_range(base, base + size, self._store)
+
+    def _open(self, path) -> None:
+        fresh = not os.path.exists(path) or os.path.getsize(path) != self.size
+        self.fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
+        if fresh:
+            self.blank = True
+            os.ftruncate(self.fd, 0)
+            os.write(self.fd, bytes(self.memory.read(0, self.size)))
+        else:
+            self.blank = False
+            self.memory.write(0, os.pread(self.fd, self.size, 0))
+
+    def _persist(self, offset: int, length: int) -> None:
+        if self.fd is not None:
+            os.pwrite(self.fd, bytes(self.memory.read(offset, length)), offset)
+
+    def reset(self) -> None:
+        super().reset()
+        self.keys_seen = 0
+
+    def check_wait_states(self, hz: int) -> bool:
+        latency = self.get("ACR") & self.bit("ACR", "LATENCY")
+        return hz <= 24_000_000 * (latency + 1)
+
+    def _flag(self, name: str) -> int:
+        fields = self.p.registers["SR"][2]
+        return self.bit("SR", name if name in fields else {"WRPRTERR": "WRPRT"}[name])
+
+    def _keyr(self, value, old, size):
+        if self.keys_seen == 0 and value == KEY1:
+            self.keys_seen = 1
+        elif self.keys_seen == 1 and value == KEY2:
+            self.keys_seen = 2
+            self.put("CR", self.get("CR") & ~self.bit("CR", "LOCK"))
+        else:
+            self.keys_seen = 3  # a wrong key locks it until reset (RM0008 3.3.1)
+        self.core.fix(self.addr("KEYR"), 0)
+
+    def _cr(self, value, old, size):
+        if value & self.bit("CR", "LOCK") and self.keys_seen == 2:
+            self.keys_seen = 0  # locked again: the keys open it again
+        locked = old & self.bit("CR", "LOCK")
+        if locked:
+            value = old | (value & self.bit("CR", "LOCK"))
+        elif value & self.bit("CR", "STRT") and value & self.bit("CR", "PER"):
+            self._erase(self.get("AR"))
+            value &= ~self.bit("CR", "STRT")
+        self.core.fix(self.addr("CR"), value)
+
+    def _sr(self, value, old, size):
+        clear = value & (self._flag("EOP") | self._flag("PGERR") | self._flag("WRPRTERR"))
+        self.core.fix(self.addr("SR"), old & ~clear)
+
+    def _erase(self, address: int) -> None:
+        start = (address - self.base) // self.page * self.page
+        if 0 <= start < self.size and self.fail_erases == 0:
+            self.memory.write(start, b"\xff" * self.page)
+            self._persist(start, self.page)
+            self.put("SR", self.get("SR") | self._flag("EOP"))
+        else:
+            self.fail_erases = max(0, self.fail_erases - 1)
+            self.put("SR", self.get("SR") | self._flag("PGERR"))
+        self.core.stop(stall_s=self.erase_s)
+
+    def _store(self, address: int, value: int, size: int) -> None:
+        """A store into flash: a program step when PG is set, else nothing
+        (the cells keep what they hold either way, set right after it)."""
+        offset = address - self.base
+        old = bytes(self.memory.read(offset, size))
+        cr = self.get("CR")
+        programmed = old
+        if not cr & self.bit("CR", "LOCK") and cr & self.bit("CR", "PG"):
+            new = value.to_bytes(size, "little")
+            cells = []
+            for i in range(0, size, 2):
+                was = int.from_bytes(old[i:i + 2], "little")
+                want = int.from_bytes(new[i:i + 2], "little")
+                if (was != 0xFFFF and want != 0) or self.fail_programs:
+                    self.fail_programs = max(0, self.fail_programs - 1)
+                    self.put("SR", self.get("SR") | self._flag("PGERR"))
+                    cells.append(old[i:i + 2])
+                else:
+                    cells.append(want.to_bytes(2, "little"))
+                    self.put("SR", self.get("SR") | self._flag("EOP"))
+            programmed = b"".join(cells)
+            self.core.stop(stall_s=self.program_s * max(1, size // 2))
+        self.memory.write(offset, programmed)
+        self._persist(offset, size)
+        self.core.fix(address, programmed)

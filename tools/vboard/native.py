@@ -1,0 +1,75 @@
+"""The host build's models through ctypes (native/vboard_native.c): the
+simulator's motor and winding, and the config store's factory record."""
+import ctypes
+import os
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[2]
+DEFAULT = REPO / "build/host/tools/vboard/native/libvboard_native.so"
+QUANTITIES = {"angle_deg": 0, "velocity_dps": 1, "current_a": 2, "supply_v": 3, "load_nm": 4,
+              "winding_c": 5, "case_c": 6, "ambient_c": 7, "stop_deg": 8, "soak_c": 9}
+
+
+def _library():
+    path = Path(os.environ.get("VBOARD_NATIVE", DEFAULT))
+    if not path.exists():
+        raise FileNotFoundError(f"no {path}: build it with 'cmake --preset host && cmake --build --preset host'")
+    lib = ctypes.CDLL(str(path))
+    lib.vboard_motor_size.restype = ctypes.c_uint32
+    lib.vboard_motor_init.argtypes = [ctypes.c_void_p, ctypes.c_double, ctypes.c_double]
+    lib.vboard_motor_step.argtypes = [ctypes.c_void_p, ctypes.c_double]
+    lib.vboard_motor_drive.argtypes = [ctypes.c_void_p, ctypes.c_double]
+    lib.vboard_motor_coast.argtypes = [ctypes.c_void_p]
+    lib.vboard_motor_encoder.argtypes = [ctypes.c_void_p]
+    lib.vboard_motor_encoder.restype = ctypes.c_uint16
+    lib.vboard_motor_get.argtypes = [ctypes.c_void_p, ctypes.c_int]
+    lib.vboard_motor_get.restype = ctypes.c_double
+    lib.vboard_motor_set.argtypes = [ctypes.c_void_p, ctypes.c_int, ctypes.c_double]
+    lib.vboard_motor_ntc_adc.argtypes = [ctypes.c_void_p]
+    lib.vboard_motor_ntc_adc.restype = ctypes.c_uint
+    lib.vboard_factory_config.argtypes = [ctypes.c_char_p, ctypes.c_uint32, ctypes.c_uint32, ctypes.c_uint8]
+    return lib
+
+
+_lib = None
+
+
+def lib():
+    global _lib
+    if _lib is None:
+        _lib = _library()
+    return _lib
+
+
+class Motor:
+    """plant.c and thermal.c: the motor, gears, horn and winding."""
+
+    def __init__(self, supply_v: float, ambient_c: float):
+        self.buf = ctypes.create_string_buffer(lib().vboard_motor_size())
+        lib().vboard_motor_init(self.buf, supply_v, ambient_c)
+
+    def step(self, dt: float) -> None:
+        if dt > 0:
+            lib().vboard_motor_step(self.buf, dt)
+
+    def drive(self, duty: float) -> None:
+        lib().vboard_motor_drive(self.buf, duty)
+
+    def coast(self) -> None:
+        lib().vboard_motor_coast(self.buf)
+
+    def encoder(self) -> int:
+        return lib().vboard_motor_encoder(self.buf)
+
+    def ntc_adc(self) -> int:
+        return lib().vboard_motor_ntc_adc(self.buf)
+
+    def get(self, what: str) -> float:
+        return lib().vboard_motor_get(self.buf, QUANTITIES[what])
+
+    def set(self, what: str, value: float) -> None:
+        lib().vboard_motor_set(self.buf, QUANTITIES[what], value)
+
+
+def factory_config(pages, page_size: int, page0: int, servo_id: int) -> bool:
+    return bool(lib().vboard_factory_config(pages, page_size, page0, servo_id))

@@ -1,0 +1,205 @@
+"""Runs virtual boards on one bus with a control port, as servo_sim does:
+
+    python -m vboard --board stm32f103 [--id N ...] [--tcp PORT | --link PATH]
+                     [--state DIR] [--supply MV] [--ambient DEGC]
+
+prints `vboard: bus URL`, `vboard: control 127.0.0.1:PORT`, `vboard: servos
+...` and `vboard: ready`, so servoctl and the tests drive it as they drive
+servo_sim. The control port takes servo_sim's commands (help lists them).
+
+Simulated time follows the wall clock when the boards keep up, and falls
+behind it when they do not (the emulated CPUs are slower than silicon on
+most PCs); the bus's byte timing is simulated time either way."""
+import argparse
+import os
+import select
+import socket
+import sys
+import tempfile
+import time
+
+from .board import PARTS, Board
+from .bus import Bus
+
+MAX_SLICE_S = 1e-3  # longest the CPUs run between two looks at the host and the models
+RANGES = {"supply": (0, 30000, "mV"), "load": (-50, 50, "N m"), "ambient": (-40, 150, "degC"),
+          "soak": (-40, 150, "degC"), "stop": (-1e6, 1e6, "deg"), "hostbaud": (1200, 4000000, "baud"),
+          "failerase": (0, 1e6, "erases"), "failprogram": (0, 1e6, "programs")}
+HELP = ("ok supply MV | load NM | stop DEG | stop off | ambient DEGC | soak DEGC | hostbaud BAUD | "
+        "failerase N | failprogram N | powercycle [ID] | state [ID] | clock")
+
+
+class Runner:
+    def __init__(self, args):
+        self.bus = Bus()
+        self.state_dir = args.state or tempfile.mkdtemp(prefix="vboard-")
+        os.makedirs(self.state_dir, exist_ok=True)
+        self.boards = [Board(args.board, i, self.bus, self.state_dir, args.supply / 1000.0, args.ambient)
+                       for i in args.id]
+        self.url = self.bus.serve_tcp(args.tcp) if args.tcp is not None else self.bus.serve_pty(args.link)
+        self.control = socket.socket()
+        self.control.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        self.control.bind(("127.0.0.1", 0))
+        self.control.listen(8)
+        self.control.setblocking(False)
+        self.clients = {}
+        self.now_s = 0.0
+        self.wall0 = time.monotonic()
+        self.most_behind_s = 0.0
+
+    # ---- control port -----------------------------------------------------
+    def command(self, line: str) -> str:
+        words = line.split()
+        if not words:
+            return ""
+        cmd = words[0]
+        if cmd == "clock":
+            return f"sim_ms={self.now_s * 1000:.3f} behind_ms={(self._wall() - self.now_s) * 1000:.1f}"
+        if cmd == "help":
+            return HELP
+        takes_value = cmd not in ("state", "powercycle")
+        id_word = 2 if takes_value else 1
+        boards = self.boards
+        if len(words) > id_word:
+            boards = [b for b in self.boards if str(b.servo_id) == words[id_word]]
+            if not boards:
+                return "error: no servo with that ID"
+        value = 0.0
+        if takes_value:
+            if cmd not in RANGES:
+                return "error: unknown command (try help)"
+            if len(words) < 2:
+                return "error: missing value"
+            if not (cmd == "stop" and words[1] == "off"):
+                try:
+                    value = float(words[1])
+                except ValueError:
+                    return "error: the value must be a number"
+                lo, hi, unit = RANGES[cmd]
+                if not lo <= value <= hi:
+                    return f"error: {cmd} takes {lo:g} to {hi:g} {unit}, not {words[1]}"
+        if cmd == "hostbaud":
+            self.bus.host_baud = int(value)
+            return "ok"
+        out = []
+        for b in boards:
+            if cmd == "supply":
+                b.motor.set("supply_v", value / 1000.0)
+            elif cmd == "load":
+                b.motor.set("load_nm", value)
+            elif cmd == "ambient":
+                b.motor.set("ambient_c", value)
+            elif cmd == "soak":
+                b.motor.set("soak_c", value)
+            elif cmd == "stop":
+                b.motor.set("stop_deg", 1e9 if words[1] == "off" else value)
+            elif cmd == "failerase":
+                b.flash.fail_erases = int(value)
+            elif cmd == "failprogram":
+                b.flash.fail_programs = int(value)
+            elif cmd == "powercycle":
+                b.power_cycle()
+            elif cmd == "state":
+                s = b.state()
+                s.update(collisions=self.bus.collisions, host_baud=self.bus.host_baud,
+                         most_behind_ms=round(self.most_behind_s * 1000, 1))
+                out.append(" ".join(f"{k}={v}" for k, v in s.items()))
+            else:
+                return "error: unknown command (try help)"
+        return "\n".join(out) if out else "ok"
+
+    def serve_control(self, readable) -> None:
+        if self.control in readable:
+            try:
+                conn, _ = self.control.accept()
+                conn.setblocking(False)
+                self.clients[conn] = b""
+            except BlockingIOError:
+                pass
+        for conn in [c for c in self.clients if c in readable]:
+            try:
+                data = conn.recv(4096)
+            except BlockingIOError:
+                continue
+            except OSError:
+                data = b""
+            if not data:
+                conn.close()
+                del self.clients[conn]
+                continue
+            self.clients[conn] += data
+            while b"\n" in self.clients[conn]:
+                line, self.clients[conn] = self.clients[conn].split(b"\n", 1)
+                reply = self.command(line.decode(errors="replace"))
+                try:
+                    conn.sendall((reply + "\n").encode())
+                except OSError:
+                    pass
+
+    # ---- the loop ---------------------------------------------------------
+    def _wall(self) -> float:
+        return time.monotonic() - self.wall0
+
+    def power_up(self, limit_s: float = 1.0, settle_s: float = 0.1) -> None:
+        """Runs until every board's bootloader has handed over (or has not
+        within limit_s: no valid application) and the applications have done
+        their power-up work (an erase of the store's spare page stalls the
+        CPU 40 ms), as servo_sim is ready with its servos running."""
+        until = limit_s
+        while self.now_s < until:
+            self.now_s += MAX_SLICE_S
+            for b in self.boards:
+                b.run_until(self.now_s)
+            if until == limit_s and all(b.in_application() for b in self.boards):
+                until = self.now_s + settle_s
+        self.wall0 = time.monotonic() - self.now_s
+
+    def run(self) -> None:
+        while True:
+            ahead = self.now_s - self._wall()
+            timeout = min(ahead, 0.002) if ahead > 0 else 0
+            fds = [self.control] + list(self.clients) + self.bus.fds()
+            readable, _, _ = select.select(fds, [], [], timeout)
+            self.serve_control(readable)
+            self.bus.poll_host(self.now_s)
+            if self.now_s > self._wall():
+                continue
+            target = min(self.now_s + MAX_SLICE_S, max(self.bus.next_event_s(), self.now_s + 1e-7))
+            for b in self.boards:
+                b.run_until(target)
+            self.now_s = target
+            self.bus.deliver_until(self.now_s)
+            self.most_behind_s = max(self.most_behind_s, self._wall() - self.now_s)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="vboard", description=__doc__.split("\n\n")[0])
+    ap.add_argument("--board", choices=sorted(PARTS), required=True)
+    ap.add_argument("--id", type=int, action="append", help="a board with this servo ID (repeat for a bus)")
+    ap.add_argument("--tcp", type=int, help="the bus on 127.0.0.1:PORT (0: any free port)")
+    ap.add_argument("--link", help="the bus's pseudo-terminal, linked here")
+    ap.add_argument("--state", help="the boards' flash files live here (kept across runs)")
+    ap.add_argument("--supply", type=float, default=7400.0, help="supply, mV")
+    ap.add_argument("--ambient", type=float, default=25.0, help="ambient temperature, degC")
+    args = ap.parse_args(argv)
+    args.id = args.id or [1]
+    runner = Runner(args)
+    runner.power_up()
+    print(f"vboard: bus {runner.url}")
+    if args.link:
+        print(f"vboard: link {args.link}")
+    print(f"vboard: control 127.0.0.1:{runner.control.getsockname()[1]}")
+    print("vboard: servos " + " ".join(str(i) for i in args.id))
+    print("vboard: ready", flush=True)
+    try:
+        runner.run()
+    except KeyboardInterrupt:
+        pass
+    finally:
+        runner.bus.close()
+        print(f"vboard: stopped ({runner.bus.collisions} collisions)", flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,127 @@
+"""A USART in single-wire half-duplex (RM0008 27, RM0360 23), on the bus.
+
+Transmit: a byte written to the data register goes to the shift register
+when it is free (TXE stays set), else waits there (TXE clear); each byte is
+10 bit times on the wire at the rate BRR sets (PCLK / BRR, 16x
+oversampling, 8N1); TC sets when the last has left. Only with TE, and only
+when the TX pin is the USART's (the board's pin check), does it reach the
+wire.
+
+Receive: a byte on the wire reaches the USART if UE and RE are set, at its
+rate (3 % off: a framing error, the byte lost). With DMAR the DMA channel
+takes it (a circular channel overwrites what the CPU has not taken); else
+it waits in the data register with RXNE, and the next one overruns it (ORE;
+the F0's OVRDIS keeps the old byte, as here). In half-duplex mode the
+receiver hears the USART's own bytes unless the firmware clears RE.
+
+The interrupt line is level: TXEIE with TXE, TCIE with TC, RXNEIE with RXNE
+or ORE. Registers by the part: the F1's SR/DR (status cleared by writing 0
+to RXNE/TC) and the F0's ISR/ICR/RDR/TDR."""
+from .model import Model
+
+FRAME_BITS = 10
+MISMATCH = 0.03
+
+
+class Usart(Model):
+    def __init__(self, board, periph, pclk_hz, irq: int, dma, dma_channel: int, tx_pin_ok):
+        super().__init__(board, periph)
+        self.v2 = "ISR" in periph.registers
+        self.status = "ISR" if self.v2 else "SR"
+        self.pclk_hz, self.irq, self.dma, self.dma_channel = pclk_hz, irq, dma, dma_channel
+        self.tx_pin_ok = tx_pin_ok
+        self.bus_station = None
+        self.shift_until_s = 0.0
+        self.shifting = False
+        self.tdr = None
+        self.rx_bytes = self.rx_lost = self.overruns = self.framing_errors = 0
+        self.watch("TDR" if self.v2 else "DR", self._write_data)
+        self.watch("ICR" if self.v2 else "SR", self._clear_flags)
+        s = self.status
+        self.RXNE, self.TC, self.TXE = self.bit(s, "RXNE"), self.bit(s, "TC"), self.bit(s, "TXE")
+        self.ORE, self.FE = self.bit(s, "ORE"), self.bit(s, "FE")
+
+    def reset(self) -> None:
+        super().reset()
+        self.shifting, self.tdr = False, None
+
+    def cr1(self, field: str) -> bool:
+        return bool(self.get("CR1") & self.bit("CR1", field))
+
+    def baud(self) -> int:
+        brr = self.get("BRR") & 0xFFFF
+        return self.pclk_hz() // brr if brr else 0
+
+    def _set(self, flag: int, on: bool) -> None:
+        sr = self.get(self.status)
+        self.put(self.status, (sr | flag) if on else (sr & ~flag))
+
+    def _write_data(self, value, old, size):
+        if not (self.cr1("UE") and self.cr1("TE")):
+            return
+        if not self.shifting:
+            self._start(value & 0xFF)
+        else:
+            self.tdr = value & 0xFF
+            self._set(self.TXE, False)
+
+    def _start(self, byte: int) -> None:
+        now = self.core.now_s()
+        baud = self.baud()
+        self.shifting = True
+        self.shift_until_s = now + FRAME_BITS / max(baud, 1)
+        self._set(self.TC, False)
+        self._set(self.TXE, True)
+        if self.tx_pin_ok() and baud:
+            self.board.bus.send(self.bus_station, byte, baud, now)
+
+    def _clear_flags(self, value, old, size):
+        sr = self.get(self.status)
+        if self.v2:  # ICR: write 1 to clear (PECF, FECF, NCF, ORECF, IDLECF, TCCF)
+            for name, flag in (("ORECF", self.ORE), ("FECF", self.FE), ("TCCF", self.TC)):
+                if value & self.bit("ICR", name):
+                    sr &= ~flag
+            self.put(self.status, sr)
+            self.core.fix(self.addr("ICR"), 0)
+        else:  # SR: RXNE and TC clear when written 0 (rc_w0)
+            keep = value | ~(self.RXNE | self.TC)
+            self.core.fix(self.addr("SR"), old & keep)
+
+    def receive(self, byte: int, baud: int) -> None:
+        """A byte off the wire, at the time it ends."""
+        if not (self.cr1("UE") and self.cr1("RE")):
+            return
+        own = self.baud()
+        if not own or abs(own - baud) > MISMATCH * own:
+            self.framing_errors += 1
+            self._set(self.FE, True)
+            return
+        self.rx_bytes += 1
+        cr3 = self.get("CR3")
+        if cr3 & self.bit("CR3", "DMAR") and self.dma.enabled(self.dma_channel):
+            self.dma.transfer(self.dma_channel, byte)
+            return
+        sr = self.get(self.status)
+        if sr & self.RXNE:
+            self.overruns += 1
+            self._set(self.ORE, True)
+            return
+        self.put("RDR" if self.v2 else "DR", byte)
+        self._set(self.RXNE, True)
+
+    def step(self, now_s: float) -> None:
+        if self.shifting and now_s >= self.shift_until_s:
+            self.shifting = False
+            if self.tdr is not None:
+                byte, self.tdr = self.tdr, None
+                self._start(byte)
+            else:
+                self._set(self.TC, True)
+        sr, cr1 = self.get(self.status), self.get("CR1")
+        if ((cr1 & self.bit("CR1", "TXEIE") and sr & self.TXE) or
+                (cr1 & self.bit("CR1", "TCIE") and sr & self.TC) or
+                (cr1 & self.bit("CR1", "RXNEIE") and sr & (self.RXNE | self.ORE))):
+            self.core.raise_irq(self.irq)
+
+    def next_event_s(self, now_s: float) -> float:
+        return self.shift_until_s if self.shifting else float("inf")
