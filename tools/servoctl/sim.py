@@ -63,7 +63,7 @@ class Simulator(_Child):
     socket://) unless tcp=False, then a pseudo-terminal (optionally linked)."""
 
     def __init__(self, ids=(1,), tcp=True, link=None, state_dir=None, supply_mv=None,
-                 ambient_c=None, tcp_port=None, rx=None, board=None):
+                 ambient_c=None, tcp_port=None, rx=None, board=None, app_image=None):
         self.ids = list(ids)
         self.tcp = tcp or tcp_port is not None
         self.tcp_port = tcp_port
@@ -74,6 +74,7 @@ class Simulator(_Child):
         self.ambient_c = ambient_c
         self.rx = rx  # "dma" (default) or "interrupt": how the servos' port receives
         self.board = board  # None: servo_sim; else a virtual board (tools/vboard)
+        self.app_image = app_image  # a virtual board's slot, if not the build's image
         self.process = None
         self.url = None
         self.control_port = None
@@ -86,6 +87,8 @@ class Simulator(_Child):
             if self.rx is not None:
                 raise ServoError("a virtual board receives as its port does: --rx is servo_sim's")
             cmd = [sys.executable, "-m", "vboard", "--board", self.board, "--state", self.state_dir]
+            if self.app_image is not None:
+                cmd += ["--app", str(self.app_image)]
         else:
             cmd = [str(find_binary()), "--state", self.state_dir]
         for i in self.ids:

@@ -267,7 +267,10 @@ class Board:
             try:
                 passed = core.run(step)
             except Stop as stop:
-                self.reset(stop.args[0])
+                if stop.args[0] == "power":
+                    self.power_cycle()
+                else:
+                    self.reset(stop.args[0])
                 continue
             self.motor.step(passed)
             now = core.now_s()

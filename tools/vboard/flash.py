@@ -30,6 +30,7 @@ class Flash(Model):
         self.path = path
         self.keys_seen = 0
         self.fail_programs = self.fail_erases = 0
+        self.cut_after_programs = 0  # the power goes as the Nth program step from now begins
         self.fd = None
         self.blank = True
         if path is not None:
@@ -110,6 +111,12 @@ class Flash(Model):
         cr = self.get("CR")
         programmed = old
         if not cr & self.bit("CR", "LOCK") and cr & self.bit("CR", "PG"):
+            if self.cut_after_programs:
+                self.cut_after_programs -= 1
+                if self.cut_after_programs == 0:  # the cell keeps what it held
+                    self.core.fix(address, old)
+                    self.core.stop(reset="power")
+                    return
             new = value.to_bytes(size, "little")
             cells = []
             for i in range(0, size, 2):

@@ -24,9 +24,10 @@ from .bus import Bus
 MAX_SLICE_S = 1e-3  # longest the CPUs run between two looks at the host and the models
 RANGES = {"supply": (0, 30000, "mV"), "load": (-50, 50, "N m"), "ambient": (-40, 150, "degC"),
           "soak": (-40, 150, "degC"), "stop": (-1e6, 1e6, "deg"), "hostbaud": (1200, 4000000, "baud"),
-          "failerase": (0, 1e6, "erases"), "failprogram": (0, 1e6, "programs")}
+          "failerase": (0, 1e6, "erases"), "failprogram": (0, 1e6, "programs"),
+          "cutprogram": (1, 1e6, "programs")}
 HELP = ("ok supply MV | load NM | stop DEG | stop off | ambient DEGC | soak DEGC | hostbaud BAUD | "
-        "failerase N | failprogram N | powercycle [ID] | state [ID] | clock")
+        "failerase N | failprogram N | cutprogram N | powercycle [ID] | state [ID] | clock")
 
 
 class Runner:
@@ -34,7 +35,8 @@ class Runner:
         self.bus = Bus()
         self.state_dir = args.state or tempfile.mkdtemp(prefix="vboard-")
         os.makedirs(self.state_dir, exist_ok=True)
-        self.boards = [Board(args.board, i, self.bus, self.state_dir, args.supply / 1000.0, args.ambient)
+        self.boards = [Board(args.board, i, self.bus, self.state_dir, args.supply / 1000.0, args.ambient,
+                             app_image=args.app)
                        for i in args.id]
         self.url = self.bus.serve_tcp(args.tcp) if args.tcp is not None else self.bus.serve_pty(args.link)
         self.control = socket.socket()
@@ -97,6 +99,8 @@ class Runner:
                 b.flash.fail_erases = int(value)
             elif cmd == "failprogram":
                 b.flash.fail_programs = int(value)
+            elif cmd == "cutprogram":
+                b.flash.cut_after_programs = int(value)
             elif cmd == "powercycle":
                 b.power_cycle()
             elif cmd == "state":
@@ -181,6 +185,7 @@ def main(argv=None) -> int:
     ap.add_argument("--state", help="the boards' flash files live here (kept across runs)")
     ap.add_argument("--supply", type=float, default=7400.0, help="supply, mV")
     ap.add_argument("--ambient", type=float, default=25.0, help="ambient temperature, degC")
+    ap.add_argument("--app", help="the update image a blank board's slot gets (default: the build's)")
     args = ap.parse_args(argv)
     args.id = args.id or [1]
     runner = Runner(args)

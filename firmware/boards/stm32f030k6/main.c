@@ -8,6 +8,7 @@
 #include "servo.h"
 #include "stm32f0_regs.h"
 #include "systick_clock.h"
+#include "../test_build.h"
 
 static struct servo servo;
 static struct usart_v2_hd usart;
@@ -51,6 +52,7 @@ int main(void)
     iwdg_start();
     for (;;) {
         servo_poll(&servo);
+        test_build_main_loop();
         iwdg_kick();
     }
 }

@@ -7,6 +7,7 @@
 #include "servo.h"
 #include "stm32f1_regs.h"
 #include "systick_clock.h"
+#include "../test_build.h"
 #include "port_uart.h"
 #include "usart_hd.h"
 
@@ -62,6 +63,7 @@ int main(void)
     iwdg_start();
     for (;;) {
         servo_poll(&servo);
+        test_build_main_loop();
         iwdg_kick();
     }
 }

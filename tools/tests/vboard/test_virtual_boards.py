@@ -181,3 +181,37 @@ def test_an_update_through_the_bootloader_survives_a_power_cut(tmp_path, board):
     flash = (tmp_path / "state" / f"{board}-1.flash").read_bytes()
     slot = flash[h["BOARD_SLOT_BASE"] - h["BOARD_FLASH_BASE"]:]
     assert img.parse(slot[:img.HEADER_SIZE + new.size]).version == 0x0042  # the new image, whole
+
+
+@pytest.mark.parametrize("cut_at", [1, 13, 24])
+def test_a_config_save_survives_a_power_cut_at_any_step(tmp_path, board, cut_at):
+    """The power goes as the cut_at-th half-word of a change's record is
+    programmed (a record is 24): after the restart the servo has the old
+    value or the new one, never another, and saves again."""
+    sim = start(tmp_path, board)
+    with sim.bus(timeout=0.3) as bus:
+        servo = Servo(bus, 1)
+        old = servo.read("angle_max")
+        sim.control(f"cutprogram {cut_at} 1")
+        bus.send(p.WRITE_DATA, bytes([1, 51]) + struct.pack("<h", 1000))  # no answer: the power goes
+        sim.sleep(0.6)  # the bootloader's window, then the application
+        assert sim.state(1)["resets_power"] == 2
+        assert servo.read("angle_max") in (old, 1000)
+        servo.write("angle_max", 900)
+        sim.control("powercycle 1")
+        sim.sleep(0.6)
+        assert servo.read("angle_max") == 900
+    finish(sim, [1])
+
+
+def test_the_watchdog_resets_a_firmware_stuck_in_a_loop(tmp_path, board):
+    """The test build servo_BOARD_stuck stops reloading the watchdog 300 ms
+    after each reset; the IWDG (125 ms) resets the chip, again and again,
+    and in between it answers."""
+    stuck = images(board)[1].with_name(f"servo_{board}_stuck.img")
+    sim = Simulator(ids=[1], state_dir=str(tmp_path / "state"), board=board, app_image=stuck).start()
+    sim.sleep(1.5)
+    state = sim.state(1)
+    assert state["resets_watchdog"] >= 2
+    assert state["last_reset"] == "watchdog"
+    sim.stop()
