@@ -257,10 +257,13 @@ class Board:
         self._write_uid()
         self.reset("power")
 
-    def run_until(self, t_s: float) -> None:
+    def run_until(self, t_s: float, max_step_s: float = 1e-3) -> None:
+        """Runs the board to t_s, in steps of at most max_step_s (a step
+        that a store stops is counted as half run: short steps where that
+        matters, while bytes are on the bus)."""
         core = self.core
         while core.now_s() < t_s:
-            wanted = t_s - core.now_s()
+            wanted = min(t_s - core.now_s(), max_step_s)
             soon = min([m.next_event_s(core.now_s()) for m in self.models] + [core.now_s() + wanted])
             systick = core.now_s() + core.cycles_to_systick() / core.hz
             step = max(min(soon, systick) - core.now_s(), 1e-6)

@@ -31,6 +31,7 @@ class Bus:
         self.host_queue_until_s = 0.0
         self.to_host = bytearray()
         self.collisions = 0
+        self.last_activity_s = -1.0   # end of the last byte queued
         self.host_fd = None
         self.listen = None
         self.master_fd = None
@@ -98,7 +99,10 @@ class Bus:
                 return
             for byte in data or b"":
                 self._queue_host(byte, now_s)
-        if self.to_host:
+        self.flush_to_host()
+
+    def flush_to_host(self) -> None:
+        if self.to_host and self.host_fd is not None:
             try:
                 n = os.write(self.host_fd, bytes(self.to_host))
                 del self.to_host[:n]
@@ -127,6 +131,7 @@ class Bus:
         self._push(end, byte, baud, station)
 
     def _push(self, end_s, byte, baud, sender) -> None:
+        self.last_activity_s = max(self.last_activity_s, end_s)
         self.seq += 1
         heapq.heappush(self.events, (end_s, self.seq, byte, baud, sender))
 

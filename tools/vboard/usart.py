@@ -36,6 +36,7 @@ class Usart(Model):
         self.tdr = None
         self.rx_bytes = self.rx_lost = self.overruns = self.framing_errors = 0
         self.watch("TDR" if self.v2 else "DR", self._write_data)
+        self.watch("CR1", self._write_cr1)
         self.watch("ICR" if self.v2 else "SR", self._clear_flags)
         s = self.status
         self.RXNE, self.TC, self.TXE = self.bit(s, "RXNE"), self.bit(s, "TC"), self.bit(s, "TXE")
@@ -74,6 +75,19 @@ class Usart(Model):
         self._set(self.TXE, True)
         if self.tx_pin_ok() and baud:
             self.board.bus.send(self.bus_station, byte, baud, now)
+
+    def _write_cr1(self, value, old, size):
+        """An interrupt enabled while its flag is set fires at once (the
+        driver starts a transmission by setting TXEIE): the CPU stops after
+        the store and takes it."""
+        if self._interrupt_due(self.get(self.status), value):
+            self.core.raise_irq(self.irq)
+            self.core.defer(lambda: None)
+
+    def _interrupt_due(self, sr: int, cr1: int) -> bool:
+        return bool((cr1 & self.bit("CR1", "TXEIE") and sr & self.TXE) or
+                    (cr1 & self.bit("CR1", "TCIE") and sr & self.TC) or
+                    (cr1 & self.bit("CR1", "RXNEIE") and sr & (self.RXNE | self.ORE)))
 
     def _clear_flags(self, value, old, size):
         sr = self.get(self.status)
@@ -117,10 +131,7 @@ class Usart(Model):
                 self._start(byte)
             else:
                 self._set(self.TC, True)
-        sr, cr1 = self.get(self.status), self.get("CR1")
-        if ((cr1 & self.bit("CR1", "TXEIE") and sr & self.TXE) or
-                (cr1 & self.bit("CR1", "TCIE") and sr & self.TC) or
-                (cr1 & self.bit("CR1", "RXNEIE") and sr & (self.RXNE | self.ORE))):
+        if self._interrupt_due(self.get(self.status), self.get("CR1")):
             self.core.raise_irq(self.irq)
 
     def next_event_s(self, now_s: float) -> float:
