@@ -7,9 +7,11 @@ entry pushes r0-r3, r12, lr, pc and xPSR on the main stack (8-byte aligned,
 bit 9 of the stacked xPSR saying so), sets IPSR and LR = EXC_RETURN and
 jumps through the vector table; the handler's return to EXC_RETURN reaches
 Unicorn as interrupt 8 (QEMU's EXCP_EXCEPTION_EXIT), and the frame is popped
-here. Every interrupt this firmware enables has the reset priority, so none
-preempts another: an exception is taken only in thread mode, with PRIMASK
-clear, the lowest number first (B1.5.4: equal priority, lower number wins).
+here. Priorities come from the NVIC's IPR bytes and the SCB's SHPR3 for
+SysTick (B3.2.11, B3.4): a pending, enabled exception is taken when PRIMASK
+is clear and its priority is higher (a lower number) than the running
+handler's, which it then preempts (EXC_RETURN to handler mode); at equal
+priority the lower exception number goes first (B1.5.4). HardFault's is -1.
 
 Time is the CPU's: each instruction costs the board's cycles per
 instruction (its cycle model, docs/benchmark.md), and peripherals move on
@@ -46,6 +48,8 @@ FRAME_REGS = (arm.UC_ARM_REG_R0, arm.UC_ARM_REG_R1, arm.UC_ARM_REG_R2, arm.UC_AR
 SYST_CSR, SYST_RVR, SYST_CVR = 0xE000E010, 0xE000E014, 0xE000E018
 NVIC_ISER, NVIC_ICER, NVIC_ISPR, NVIC_ICPR = 0xE000E100, 0xE000E180, 0xE000E200, 0xE000E280
 SCB_ICSR, SCB_VTOR, SCB_AIRCR = 0xE000ED04, 0xE000ED08, 0xE000ED0C
+NVIC_IPR, SCB_SHPR3 = 0xE000E400, 0xE000ED20
+EXC_RETURN_HANDLER = 0xFFFFFFF1
 ICSR_PENDSTSET, ICSR_PENDSTCLR = 1 << 26, 1 << 25
 AIRCR_VECTKEY, AIRCR_SYSRESETREQ = 0x05FA0000, 1 << 2
 CSR_ENABLE, CSR_TICKINT, CSR_COUNTFLAG = 1, 2, 1 << 16
@@ -90,6 +94,7 @@ class Core:
         self.deferred = []           # what may not happen inside Unicorn (remapping memory)
         self.enabled = set()         # IRQ numbers
         self.pending = set()         # exception numbers
+        self.active = []             # (exception, priority) of the handlers running, innermost last
         self.systick_base = 0.0      # cycle at which the counter last loaded
         self.regions = []            # (base, end, memoryview) of memory mapped from the host
         self.map_host(0xE000E000, 0x1000)
@@ -278,18 +283,29 @@ class Core:
         except KeyError:
             self.locked_up = True
 
+    def priority(self, exc: int) -> int:
+        if exc == HARD_FAULT:
+            return -1
+        if exc == SYSTICK:
+            return self.rd32(SCB_SHPR3) >> 24
+        if exc >= FIRST_IRQ:
+            irq = exc - FIRST_IRQ
+            return self.rd32(NVIC_IPR + (irq & ~3)) >> (8 * (irq & 3)) & 0xFF
+        return 0
+
     def _take_exception(self, force: bool = False) -> None:
         uc = self.uc
-        if uc.reg_read(arm.UC_ARM_REG_IPSR) != 0 and not force:
-            return
         if uc.reg_read(arm.UC_ARM_REG_PRIMASK) & 1 and not force:
             return
-        ready = sorted(e for e in self.pending
+        running = self.active[-1][1] if self.active else 256
+        ready = sorted((self.priority(e), e) for e in self.pending
                        if e < FIRST_IRQ or (e - FIRST_IRQ) in self.enabled)
-        if not ready:
+        if not ready or (ready[0][0] >= running and not force):
             return
-        exc = ready[0]
+        prio, exc = ready[0]
         self.pending.discard(exc)
+        nested = bool(self.active)
+        self.active.append((exc, prio))
         if exc == SYSTICK:
             self.wr32(SCB_ICSR, self.rd32(SCB_ICSR) & ~ICSR_PENDSTSET)
         sp = uc.reg_read(arm.UC_ARM_REG_SP)
@@ -300,7 +316,7 @@ class Core:
         frame = [uc.reg_read(r) for r in FRAME_REGS] + [pc & ~1, (xpsr | (1 << 24)) | (realign << 7)]
         self.write(sp, struct.pack("<8I", *frame))
         uc.reg_write(arm.UC_ARM_REG_SP, sp)
-        uc.reg_write(arm.UC_ARM_REG_LR, EXC_RETURN_THREAD_MSP)
+        uc.reg_write(arm.UC_ARM_REG_LR, EXC_RETURN_HANDLER if nested else EXC_RETURN_THREAD_MSP)
         uc.reg_write(arm.UC_ARM_REG_IPSR, exc)
         base = self.rd32(SCB_VTOR) if self.has_vtor else 0
         uc.reg_write(arm.UC_ARM_REG_PC, self.rd32(base + 4 * exc))
@@ -318,8 +334,11 @@ class Core:
         xpsr = frame[7]
         uc.reg_write(arm.UC_ARM_REG_SP, sp + 32 + (4 if xpsr & (1 << 9) else 0))
         uc.reg_write(arm.UC_ARM_REG_XPSR, xpsr & ~(1 << 9))
-        uc.reg_write(arm.UC_ARM_REG_IPSR, 0)
+        uc.reg_write(arm.UC_ARM_REG_IPSR, xpsr & 0x1FF)  # the interrupted handler's, or 0
         uc.reg_write(arm.UC_ARM_REG_PC, frame[6] | 1)
+        if self.active:
+            self.active.pop()
+        self._take_exception()  # one waiting follows at once (tail-chaining, B1.5.12)
 
     def reset(self, vector_table: int) -> None:
         """The core's reset: registers, the system control space; memory
@@ -327,6 +346,7 @@ class Core:
         uc = self.uc
         self.pending.clear()
         self.enabled.clear()
+        self.active = []
         self.fixes, self.late_fixes = [], []
         self._stopping = self._passthrough = None
         self.stall_s = 0.0
