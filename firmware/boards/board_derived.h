@@ -12,12 +12,14 @@
 #define BOARD_RAM_END ((uint32_t)BOARD_RAM_BASE + (uint32_t)BOARD_RAM_SIZE)
 
 /* Initialiser of a struct sensor_calibration for the board's front end. */
-#define BOARD_SENSOR_CALIBRATION                                    \
-    {                                                               \
-        .supply_uv_per_count = BOARD_SUPPLY_UV_PER_COUNT,           \
-        .current_ua_per_count = BOARD_CURRENT_UA_PER_COUNT,         \
-        .current_zero_counts = BOARD_CURRENT_ZERO_COUNTS,           \
+#define BOARD_SENSOR_CALIBRATION                                           \
+    {                                                                      \
+        .supply_mv_q12 = SENSOR_Q12_FROM_MICRO(BOARD_SUPPLY_UV_PER_COUNT),  \
+        .current_ma_q12 = SENSOR_Q12_FROM_MICRO(BOARD_CURRENT_UA_PER_COUNT), \
+        .current_zero_counts = BOARD_CURRENT_ZERO_COUNTS,                  \
     }
+_Static_assert(BOARD_SUPPLY_UV_PER_COUNT < 16000 && BOARD_CURRENT_UA_PER_COUNT < 16000,
+               "board.h: a count is worth less than 16 mV (16 mA), the Q12 scale's range");
 
 _Static_assert(BOARD_SLOT_BASE == BOARD_FLASH_BASE + BOARD_BOOT_SIZE,
                "board.h: the slot starts where the bootloader ends");

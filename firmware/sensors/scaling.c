@@ -5,9 +5,22 @@ static uint16_t saturate16(uint32_t v)
     return v > 0xFFFFu ? 0xFFFFu : (uint16_t)v;
 }
 
+/* mV x mA / 1000 without a division: the volts in Q10 (mV x 1.024, to
+ * within 1/1024 V), times the mA. A supply above 64 V counts as 64 V (the
+ * power saturates there anyway), so both products fit 32 bits. */
+enum { POWER_MV_MAX = 64000 };
+
 static uint16_t power_mw(uint16_t mv, uint16_t ma)
 {
-    return saturate16((uint32_t)mv * ma / 1000u);
+    uint32_t v = mv < POWER_MV_MAX ? mv : POWER_MV_MAX;
+    uint32_t volts_q10 = (v * 67109u + 32768u) >> 16;
+    return saturate16((volts_q10 * ma + 512u) >> 10);
+}
+
+/* counts x a Q12 scale: at most 65535 x 65535, within 32 bits. */
+static uint16_t scale_q12(uint16_t counts, uint16_t q12)
+{
+    return saturate16(((uint32_t)counts * q12 + 2048u) >> 12);
 }
 
 void sensors_scale(const struct sensor_calibration *cal, const struct sensor_raw *raw,
@@ -16,10 +29,10 @@ void sensors_scale(const struct sensor_calibration *cal, const struct sensor_raw
     uint16_t current = raw->current > cal->current_zero_counts
                            ? (uint16_t)(raw->current - cal->current_zero_counts)
                            : 0u;
-    out->voltage_mv = saturate16(raw->supply * cal->supply_uv_per_count / 1000u);
-    out->current_ma = saturate16(current * cal->current_ua_per_count / 1000u);
+    out->voltage_mv = scale_q12(raw->supply, cal->supply_mv_q12);
+    out->current_ma = scale_q12(current, cal->current_ma_q12);
     out->temperature_adc = raw->ntc;
-    out->power_mw = power_mw(out->voltage_mv, out->current_ma);
+    out->power_mw = 0; /* the filter's, from the filtered readings */
 }
 
 enum { FILTER_SHIFT = 3 };

@@ -23,6 +23,7 @@ struct sensor_filter {
     uint8_t primed;
 };
 
+/* Voltage, current and the NTC reading; power is the filter's. */
 void sensors_scale(const struct sensor_calibration *cal, const struct sensor_raw *raw,
                    struct sensor_readings *out);
 /* Filters voltage, current and temperature (time constant 8 samples; the

@@ -73,8 +73,8 @@ void hal_double_init(struct hal_double *h)
     memset(h, 0, sizeof *h);
     flash_double_init(&h->flash, 1024);
     h->sensors = (struct sensor_raw){.supply = 7400, .current = 0, .ntc = 2048};
-    h->calibration = (struct sensor_calibration){.supply_uv_per_count = 1000,
-                                                 .current_ua_per_count = 1000};
+    h->calibration = (struct sensor_calibration){.supply_mv_q12 = SENSOR_Q12_FROM_MICRO(1000u),
+                                                 .current_ma_q12 = SENSOR_Q12_FROM_MICRO(1000u)};
     h->port = (struct hal_port){
         .ctx = h,
         .bus = {.now_us = now_us, .send = uart_send, .tx_done = uart_tx_done,

@@ -62,22 +62,49 @@ static void test_protocol_reference_points(void **state)
 }
 
 /* The reference board: 3.3 V, 11:1 supply divider, 0.5 V/A current sense. */
-static const struct sensor_calibration board = {
-    .supply_uv_per_count = 8862, .current_ua_per_count = 1611, .current_zero_counts = 12};
+static const struct sensor_calibration board = {.supply_mv_q12 = SENSOR_Q12_FROM_MICRO(8862u),
+                                                .current_ma_q12 = SENSOR_Q12_FROM_MICRO(1611u),
+                                                .current_zero_counts = 12};
 
 static void test_scaling_to_units(void **state)
 {
     (void)state;
     struct sensor_readings r;
     sensors_scale(&board, &(struct sensor_raw){.supply = 835, .current = 632, .ntc = 1500}, &r);
-    assert_int_equal(r.voltage_mv, 7399);  /* 835 x 8.862 mV */
-    assert_int_equal(r.current_ma, 998);   /* (632 - 12) x 1.611 mA */
-    assert_int_equal(r.power_mw, 7384);    /* 7399 mV x 998 mA */
+    assert_int_equal(r.voltage_mv, 7400);  /* 835 x 8.862 mV = 7399.8, rounded */
+    assert_int_equal(r.current_ma, 999);   /* (632 - 12) x 1.611 mA = 998.8, rounded */
+    struct sensor_filter f = {0};
+    struct sensor_readings filtered;
+    sensors_filter(&f, &r, &filtered);     /* primed: the readings as they are */
+    assert_int_equal(filtered.power_mw, 7393); /* 7400 mV x 999 mA = 7392.6, to within 1/1024 V */
     assert_int_equal(r.temperature_adc, 1500);
     /* Below the amplifier's zero: no current, not a wrap-around. */
     sensors_scale(&board, &(struct sensor_raw){.supply = 4095, .current = 3, .ntc = 0}, &r);
     assert_int_equal(r.current_ma, 0);
-    assert_int_equal(r.voltage_mv, 36289);
+    assert_int_equal(r.voltage_mv, 36290); /* 4095 x 8.862 mV = 36289.9 */
+}
+
+/* Power without a division: within 1 mW per ampere, plus rounding, of
+ * mV x mA / 1000 across the supplies and currents a servo sees. */
+static void test_power_is_the_product_to_within_a_milliwatt_an_ampere(void **state)
+{
+    (void)state;
+    const struct sensor_calibration unit = {.supply_mv_q12 = 4096, .current_ma_q12 = 4096};
+    for (uint32_t mv = 0; mv <= 30000; mv += 97) {
+        for (uint32_t ma = 0; ma <= 6000; ma += 61) {
+            struct sensor_readings r;
+            struct sensor_filter f = {0};
+            sensors_scale(&unit, &(struct sensor_raw){.supply = (uint16_t)mv, .current = (uint16_t)ma}, &r);
+            sensors_filter(&f, &r, &r); /* primed: power from the readings as they are */
+            double exact = (double)mv * ma / 1000.0;
+            double allowed = ma / 1000.0 + 0.5;
+            if (exact >= 65535.0) {
+                assert_int_equal(r.power_mw, 65535); /* saturates */
+            } else if (r.power_mw < exact - allowed - 1e-9 || r.power_mw > exact + allowed + 1e-9) {
+                fail_msg("%u mV x %u mA: %u mW, not %.1f", mv, ma, r.power_mw, exact);
+            }
+        }
+    }
 }
 
 static void test_filter_tames_one_sample(void **state)
@@ -105,6 +132,7 @@ int main(void)
         cmocka_unit_test(test_table_falls_and_matches_the_formula),
         cmocka_unit_test(test_protocol_reference_points),
         cmocka_unit_test(test_scaling_to_units),
+        cmocka_unit_test(test_power_is_the_product_to_within_a_milliwatt_an_ampere),
         cmocka_unit_test(test_filter_tames_one_sample),
     };
     return cmocka_run_group_tests_name("sensors", tests, NULL, NULL);

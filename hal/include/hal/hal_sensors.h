@@ -12,11 +12,16 @@ struct sensor_raw {
 };
 
 /* Everything a board's analogue front end needs to turn counts into units.
- * The NTC divider is the protocol's own, so its reading is reported as is. */
+ * The NTC divider is the protocol's own, so its reading is reported as is.
+ * The scales are Q12 (1/4096 units a count, below 16 a count): a reading
+ * is a multiply and a shift, no division (the Cortex-M0 has no divider). */
 struct sensor_calibration {
-    uint32_t supply_uv_per_count;  /* uV at the supply per count (divider, reference) */
-    uint32_t current_ua_per_count; /* uA in the shunt per count (shunt, gain, reference) */
-    uint16_t current_zero_counts;  /* reading at zero current (amplifier offset) */
+    uint16_t supply_mv_q12;       /* mV at the supply per count (divider, reference), Q12 */
+    uint16_t current_ma_q12;      /* mA in the shunt per count (shunt, gain, reference), Q12 */
+    uint16_t current_zero_counts; /* reading at zero current (amplifier offset) */
 };
+
+/* A count's worth in uV (or uA) as the Q12 of mV (mA), rounded. */
+#define SENSOR_Q12_FROM_MICRO(micro_per_count) ((uint16_t)(((micro_per_count) * 4096u + 500u) / 1000u))
 
 #endif
