@@ -1,7 +1,6 @@
 #include "protection.h"
 
 #include <stddef.h>
-#include <string.h>
 
 #include "ntc.h"
 
@@ -65,19 +64,24 @@ static const struct threshold thresholds[] = {
                          STATUS_OVER_TEMPERATURE, 0, 1, cooler_temperature},
 };
 
+/* The uint16_t member at offset (the table's offsetof): a load, where a
+ * memcpy is a call on the size-first Cortex-M0 build. */
 static uint16_t field_u16(const void *base, uint8_t offset)
 {
-    uint16_t v;
-    memcpy(&v, (const uint8_t *)base + offset, sizeof v);
-    return v;
+    return *(const uint16_t *)(const void *)((const uint8_t *)base + offset);
+}
+
+/* One comparison for every kind: a monitor that trips below compares the
+ * values turned over (x ^ 0xFFFF reverses their order), and an inclusive
+ * one compares against the limit less one. */
+static int32_t facing(const struct threshold *t, uint16_t x)
+{
+    return t->trips_above ? (int32_t)x : (int32_t)(x ^ 0xFFFFu);
 }
 
 static bool beyond(const struct threshold *t, uint16_t value, uint16_t limit)
 {
-    if (t->trips_above) {
-        return t->inclusive ? value >= limit : value > limit;
-    }
-    return t->inclusive ? value <= limit : value < limit;
+    return facing(t, value) > facing(t, limit) - (int32_t)t->inclusive;
 }
 
 /* Never true while the value is still beyond the limit: at the ends of the
@@ -91,16 +95,15 @@ static bool back_inside(const struct threshold *t, struct monitor *m, uint16_t v
         m->clear_level = t->clear_level(limit);
         m->level_known = 1;
     }
-    uint16_t level = m->clear_level;
-    bool inside = t->trips_above ? value <= level : value >= level;
-    return inside && !beyond(t, value, limit);
+    return facing(t, value) <= facing(t, m->clear_level) && !beyond(t, value, limit);
 }
 
 /* Debounce: trip after PROTECT_TRIP_TICKS (or trip_ticks) samples beyond,
- * clear after PROTECT_CLEAR_TICKS samples back inside. */
-static void step(struct monitor *m, bool out, bool in, uint16_t trip_ticks)
+ * clear after PROTECT_CLEAR_TICKS samples back inside. towards: the
+ * sample counts towards the other state (beyond while clear, back inside
+ * while set); the caller works out only that one. */
+static void step(struct monitor *m, bool towards, uint16_t trip_ticks)
 {
-    bool towards = m->active ? in : out;
     m->count = towards ? (uint16_t)(m->count + 1u) : 0u;
     if (m->count >= (m->active ? PROTECT_CLEAR_TICKS : trip_ticks)) {
         m->active = (uint8_t)!m->active;
@@ -116,8 +119,8 @@ uint8_t protection_update(struct protection *p, const struct user_config *cfg,
         const struct threshold *t = &thresholds[i];
         uint16_t value = field_u16(&in->readings, t->reading);
         uint16_t limit = field_u16(cfg, t->limit);
-        step(&p->mon[i], beyond(t, value, limit), back_inside(t, &p->mon[i], value, limit),
-             PROTECT_TRIP_TICKS);
+        struct monitor *m = &p->mon[i];
+        step(m, m->active ? back_inside(t, m, value, limit) : beyond(t, value, limit), PROTECT_TRIP_TICKS);
         bits = (uint8_t)(bits | (p->mon[i].active ? t->bit : 0u));
     }
 
@@ -126,9 +129,10 @@ uint8_t protection_update(struct protection *p, const struct user_config *cfg,
                        (in->output_at_limit < 0 && in->speed_q8 >= STALL_SPEED_Q8);
     bool stalled = in->output_at_limit != 0 && (speed < STALL_SPEED_Q8 || overpowered);
     bool was_stalled = p->mon[MON_STALL].active;
-    step(&p->mon[MON_STALL], stalled, !stalled, STALL_TICKS);
+    step(&p->mon[MON_STALL], was_stalled ? !stalled : stalled, STALL_TICKS);
     bool tripped = p->mon[MON_STALL].active && !was_stalled;
-    *act = (struct protection_action){0};
+    act->release_now = false;
+    act->power_cap_mw = 0;
     if (cfg->stall_release) {
         /* Released, nothing pushes and the stall cannot be seen to end: the
          * bit holds until the next motion command. */
