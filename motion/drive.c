@@ -68,8 +68,3 @@ int32_t motion_brake_duty(const struct motion *m, int32_t dir)
     assisting = assisting < 0 ? 0 : assisting > limit / 2 ? limit / 2 : assisting;
     return brake_duty(limit, assisting);
 }
-
-int8_t motion_output_at_limit(const struct motion *m)
-{
-    return m->mode == MODE_POSITION ? m->controller.at_limit : 0;
-}

@@ -268,22 +268,20 @@ static void sense_and_protect(struct servo *s)
 {
     struct sensor_raw raw;
     struct sensor_readings now;
-    struct sensor_readings filtered;
+    struct protection_input in;
     s->hal->motor.read_sensors(s->hal->ctx, &raw);
     sensors_scale(s->hal->calibration, &raw, &now);
-    sensors_filter(&s->sensors, &now, &filtered);
+    /* Filtered into the monitors' input itself: no copy of it (a call on
+     * the size-first M0 build). */
+    sensors_filter(&s->sensors, &now, &in.readings);
     struct status_area *st = &s->regs.status;
-    st->voltage_mv = filtered.voltage_mv;
-    st->current_ma = filtered.current_ma;
-    st->power_mw = filtered.power_mw;
-    st->temperature_adc = filtered.temperature_adc;
-
-    const struct protection_input in = {
-        .readings = filtered,
-        .output_at_limit = motion_output_at_limit(&s->motion),
-        .speed_q8 = s->motion.measured_velocity_q8,
-        .motion_commands = s->motion.commands,
-    };
+    st->voltage_mv = in.readings.voltage_mv;
+    st->current_ma = in.readings.current_ma;
+    st->power_mw = in.readings.power_mw;
+    st->temperature_adc = in.readings.temperature_adc;
+    in.output_at_limit = motion_output_at_limit(&s->motion);
+    in.speed_q8 = s->motion.measured_velocity_q8;
+    in.motion_commands = s->motion.commands;
     struct protection_action act;
     uint8_t bits = protection_update(&s->protection, &s->regs.user, &in, &act);
     st->status = (uint8_t)((st->status & (STATUS_EXECUTING | STATUS_COMMAND_ERROR)) | bits);

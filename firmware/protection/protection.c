@@ -124,10 +124,11 @@ uint8_t protection_update(struct protection *p, const struct user_config *cfg,
         bits = (uint8_t)(bits | (p->mon[i].active ? t->bit : 0u));
     }
 
-    int32_t speed = in->speed_q8 < 0 ? -in->speed_q8 : in->speed_q8;
-    bool overpowered = (in->output_at_limit > 0 && in->speed_q8 <= -STALL_SPEED_Q8) ||
-                       (in->output_at_limit < 0 && in->speed_q8 >= STALL_SPEED_Q8);
-    bool stalled = in->output_at_limit != 0 && (speed < STALL_SPEED_Q8 || overpowered);
+    /* Stalled: at the limit and slower than STALL_SPEED_Q8 the way it
+     * pushes, which takes in turning the other way (a load stronger than
+     * the motor) as well as standing still. */
+    int32_t pushed_way = in->output_at_limit > 0 ? in->speed_q8 : -in->speed_q8;
+    bool stalled = in->output_at_limit != 0 && pushed_way < STALL_SPEED_Q8;
     bool was_stalled = p->mon[MON_STALL].active;
     step(&p->mon[MON_STALL], was_stalled ? !stalled : stalled, STALL_TICKS);
     bool tripped = p->mon[MON_STALL].active && !was_stalled;

@@ -58,9 +58,14 @@ static uint32_t serial_number(void *ctx)
     return 0x12345678u;
 }
 
+/* Field by field: a structure copy is a memcpy call on the size-first M0
+ * build, which the target benchmark would count as the firmware's. */
 static void sensors_read(void *ctx, struct sensor_raw *out)
 {
-    *out = ((struct hal_double *)ctx)->sensors;
+    const struct hal_double *h = ctx;
+    out->supply = h->sensors.supply;
+    out->current = h->sensors.current;
+    out->ntc = h->sensors.ntc;
 }
 
 void hal_double_enter_bootloader(void *ctx)

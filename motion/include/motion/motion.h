@@ -231,7 +231,10 @@ void motion_guard(struct motion *m, bool inhibit, bool derate, uint16_t power_ca
 /* Releases the output now (a stall in release mode). */
 void motion_release(struct motion *m);
 /* The controller's output was held back by its limit on the last tick:
- * the way it wanted to drive (+1/-1), else 0. */
-int8_t motion_output_at_limit(const struct motion *m);
+ * the way it wanted to drive (+1/-1), else 0. Every tick asks: inline. */
+static inline int8_t motion_output_at_limit(const struct motion *m)
+{
+    return m->mode == MODE_POSITION ? m->controller.at_limit : 0;
+}
 
 #endif
