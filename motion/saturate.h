@@ -4,11 +4,17 @@
 
 #include <stdint.h>
 
-/* v within [-limit, limit - 1], limit a power of two: one SSAT on the
- * Cortex-M3. */
+/* v within [-limit, limit - 1], limit a power of two (a constant). On the
+ * Cortex-M3 one SSAT, through GCC's builtin for ACLE's __ssat: the
+ * compiler finds it for most of these, not for all (the negated one in the
+ * tracker). */
+#if defined(__ARM_FEATURE_SAT)
+#define sat_q(v, limit) ((int32_t)__builtin_arm_ssat((int)(v), (unsigned)__builtin_ctz((unsigned)(limit)) + 1u))
+#else
 static inline int32_t sat_q(int32_t v, int32_t limit)
 {
     return v > limit - 1 ? limit - 1 : v < -limit ? -limit : v;
 }
+#endif
 
 #endif
