@@ -216,7 +216,7 @@ def check_part(svd_name: str, header_dir: Path) -> list:
         value, is_reg = values[name]
         if is_reg or name.endswith(("_ADDR", "_OFFSET")):
             continue  # a register that failed above
-        if name.endswith("_BASE") and name != "FLASH_BASE_REG" or name == "FLASH_BASE_REG":
+        if name.endswith("_BASE") or name == "FLASH_BASE_REG":
             periph = part.bases.get(value)
             want = name.replace("_BASE_REG", "").replace("_BASE", "")
             if periph is None or periph.upper().rstrip("1") != want.upper().rstrip("1"):

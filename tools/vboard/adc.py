@@ -14,8 +14,8 @@ scan's worth at each slice boundary past it (the scans in between would
 read the same models), with the values the models give at that time."""
 from .model import Model
 
-F1_SAMPLE_CYCLES = (1.5, 7.5, 13.5, 28.5, 41.5, 55.5, 71.5, 239.5)  # RM0008 11.12.4
-F0_SAMPLE_CYCLES = (1.5, 7.5, 13.5, 28.5, 41.5, 55.5, 71.5, 239.5)  # RM0360 12.12.6
+# Sampling times by SMPx code, the same on both parts (RM0008 11.12.4, RM0360 12.12.6).
+SAMPLE_CYCLES = (1.5, 7.5, 13.5, 28.5, 41.5, 55.5, 71.5, 239.5)
 
 
 class Adc(Model):
@@ -74,7 +74,7 @@ class AdcF1(Adc):
 
     def scan_s(self) -> float:
         smpr = (self.get("SMPR2"), self.get("SMPR1"))
-        cycles = sum(F1_SAMPLE_CYCLES[(smpr[c // 10] >> (3 * (c % 10))) & 7] + 12.5 for c in self.sequence())
+        cycles = sum(SAMPLE_CYCLES[(smpr[c // 10] >> (3 * (c % 10))) & 7] + 12.5 for c in self.sequence())
         return cycles / self.adc_hz()
 
 
@@ -104,5 +104,5 @@ class AdcF0(Adc):
         return [c for c in range(19) if selected >> c & 1]
 
     def scan_s(self) -> float:
-        sample = F0_SAMPLE_CYCLES[self.get("SMPR") & 7]
+        sample = SAMPLE_CYCLES[self.get("SMPR") & 7]
         return len(self.sequence()) * (sample + 12.5) / self.adc_hz()

@@ -164,7 +164,7 @@ class Board:
         if not factory_config(pages, page, self.h["BOARD_CONFIG_PAGE0"], self.servo_id):
             raise RuntimeError("the config store refused the factory record")
         self.flash_mem.write(offset, pages.raw)
-        self.flash._persist(0, self.flash_size)
+        self.flash.persist(0, self.flash_size)
 
     def _write_uid(self) -> None:
         """A unique ID per board: lot and wafer words, and the ID."""

@@ -137,21 +137,21 @@ class Core:
         handler(address, value, size) before they land."""
         self.ranges.append((begin, end, handler))
 
-    def rd32(self, address: int) -> int:
+    def _read(self, address: int, fmt: str) -> int:
         for base, end, view in self.regions:
             if base <= address < end:
-                return struct.unpack_from("<I", view, address - base)[0]
-        return struct.unpack("<I", self.uc.mem_read(address, 4))[0]  # an alias (address 0)
+                return struct.unpack_from(fmt, view, address - base)[0]
+        return struct.unpack(fmt, self.uc.mem_read(address, struct.calcsize(fmt)))[0]  # an alias (address 0)
+
+    def rd32(self, address: int) -> int:
+        return self._read(address, "<I")
+
+    def rd16(self, address: int) -> int:
+        return self._read(address, "<H")
 
     def wr32(self, address: int, value: int) -> None:
         view, at = self._view(address)
         struct.pack_into("<I", view, at, value & 0xFFFFFFFF)
-
-    def rd16(self, address: int) -> int:
-        for base, end, view in self.regions:
-            if base <= address < end:
-                return struct.unpack_from("<H", view, address - base)[0]
-        return struct.unpack("<H", self.uc.mem_read(address, 2))[0]
 
     def write(self, address: int, data: bytes) -> None:
         view, at = self._view(address)

@@ -23,7 +23,7 @@ KEY1, KEY2 = 0x45670123, 0xCDEF89AB
 
 class Flash(Model):
     def __init__(self, board, periph, memory, base: int, size: int, page: int, path,
-                 program_s: float, erase_s: float, ws_per_24mhz: bool = True):
+                 program_s: float, erase_s: float):
         super().__init__(board, periph)
         self.memory, self.base, self.size, self.page = memory, base, size, page
         self.program_s, self.erase_s = program_s, erase_s
@@ -51,7 +51,7 @@ class Flash(Model):
             self.blank = False
             self.memory.write(0, os.pread(self.fd, self.size, 0))
 
-    def _persist(self, offset: int, length: int) -> None:
+    def persist(self, offset: int, length: int) -> None:
         if self.fd is not None:
             os.pwrite(self.fd, bytes(self.memory.read(offset, length)), offset)
 
@@ -96,7 +96,7 @@ class Flash(Model):
         start = (address - self.base) // self.page * self.page
         if 0 <= start < self.size and self.fail_erases == 0:
             self.memory.write(start, b"\xff" * self.page)
-            self._persist(start, self.page)
+            self.persist(start, self.page)
             self.put("SR", self.get("SR") | self._flag("EOP"))
         else:
             self.fail_erases = max(0, self.fail_erases - 1)
@@ -132,5 +132,5 @@ class Flash(Model):
             programmed = b"".join(cells)
             self.core.stop(stall_s=self.program_s * max(1, size // 2))
         self.memory.write(offset, programmed)
-        self._persist(offset, size)
+        self.persist(offset, size)
         self.core.fix(address, programmed)

@@ -45,12 +45,11 @@ class Watchdog(Model):
         self.kr = self.addr("KR")
         self.hook = None
         self.running = False
-        self.unlocked = False
         self.kicked_s = 0.0
 
     def reset(self) -> None:
         super().reset()
-        self.running, self.unlocked, self.kicked_s = False, False, 0.0
+        self.running, self.kicked_s = False, 0.0
         if self.hook is None:
             self.hook = self.core.uc.hook_add(UC_HOOK_MEM_WRITE, self._hook, begin=self.kr, end=self.kr + 3)
 
@@ -71,7 +70,6 @@ class Watchdog(Model):
         elif key == 0xCCCC:
             self.running = True
             self.kicked_s = self.core.time_s
-        self.unlocked = key == 0x5555
 
     def step(self, now_s: float) -> None:
         if not self.running:
