@@ -262,40 +262,42 @@ static void tend_store(struct servo *s, uint32_t now, bool ticked)
     report_store(s);
 }
 
-/* Sensors to the status area (IDs 1-4), monitors to status bits 2-7 and
- * to what the output may do. */
-static void sense_and_protect(struct servo *s)
+/* Sensors to the status area (IDs 1-4), monitors to what the output may
+ * do; returns status bits 2-7. */
+static uint8_t sense_and_protect(struct servo *s)
 {
     struct sensor_raw raw;
-    struct sensor_readings now;
-    struct protection_input in;
     s->hal->motor.read_sensors(s->hal->ctx, &raw);
-    sensors_scale(s->hal->calibration, &raw, &now);
-    /* Filtered into the monitors' input itself: no copy of it (a call on
-     * the size-first M0 build). */
-    sensors_filter(&s->sensors, &now, &in.readings);
+    struct protection_input in;
+    in.slot = sensors_update(&s->sensors, s->hal->calibration, &raw);
+    const struct sensor_readings *now = &s->sensors.out;
+    in.readings = now;
     struct status_area *st = &s->regs.status;
-    st->voltage_mv = in.readings.voltage_mv;
-    st->current_ma = in.readings.current_ma;
-    st->power_mw = in.readings.power_mw;
-    st->temperature_adc = in.readings.temperature_adc;
+    st->voltage_mv = now->voltage_mv;
+    st->current_ma = now->current_ma;
+    st->power_mw = now->power_mw;
+    st->temperature_adc = now->temperature_adc;
     in.output_at_limit = motion_output_at_limit(&s->motion);
     in.speed_q8 = s->motion.measured_velocity_q8;
     in.motion_commands = s->motion.commands;
     struct protection_action act;
     uint8_t bits = protection_update(&s->protection, &s->regs.user, &in, &act);
-    st->status = (uint8_t)((st->status & (STATUS_EXECUTING | STATUS_COMMAND_ERROR)) | bits);
     if (act.release_now) {
         motion_release(&s->motion);
     }
     motion_guard(&s->motion, act.inhibit, act.derate, act.power_cap_mw);
+    return bits;
 }
 
+/* The status byte once a tick: the monitors' bits, the motion's (bit 0),
+ * the dispatcher's (bit 1) as it stands. */
 void servo_control_tick(struct servo *s)
 {
-    sense_and_protect(s);
+    uint8_t bits = sense_and_protect(s);
     motion_tick(&s->motion);
-    show_executing(s);
+    struct status_area *st = &s->regs.status;
+    st->status = (uint8_t)((st->status & STATUS_COMMAND_ERROR) | bits |
+                           (motion_is_executing(&s->motion) ? STATUS_EXECUTING : 0u));
 }
 
 /* The control loop runs from the main loop, so commands and ticks never

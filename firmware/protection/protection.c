@@ -15,10 +15,12 @@ struct threshold {
     uint8_t reading; /* offset in struct sensor_readings */
     uint8_t limit;   /* offset in struct user_config */
     uint8_t bit;
-    uint8_t trips_above;   /* else below */
     uint8_t inclusive;     /* the limit itself trips */
+    uint16_t turn;         /* TRIPS_ABOVE or TRIPS_BELOW: see facing() */
     uint16_t (*clear_level)(uint16_t limit);
 };
+
+enum { TRIPS_ABOVE = 0x0000, TRIPS_BELOW = 0xFFFF };
 
 /* Saturates: a limit near 65535 must not wrap its clear level to near 0. */
 static uint16_t up_voltage(uint16_t limit)
@@ -53,16 +55,33 @@ static uint16_t cooler_temperature(uint16_t limit)
 #define LIMIT(field) (uint8_t) offsetof(struct user_config, field)
 
 static const struct threshold thresholds[] = {
-    [MON_LOW_VOLTAGE] = {READING(voltage_mv), LIMIT(low_voltage_mv), STATUS_LOW_VOLTAGE, 0, 0,
-                         up_voltage},
-    [MON_HIGH_VOLTAGE] = {READING(voltage_mv), LIMIT(high_voltage_mv), STATUS_HIGH_VOLTAGE, 1, 0,
-                          down_voltage},
-    [MON_CURRENT] = {READING(current_ma), LIMIT(current_limit_ma), STATUS_OVER_CURRENT, 1, 0,
-                     down_current},
-    [MON_POWER] = {READING(power_mw), LIMIT(power_limit_mw), STATUS_OVER_POWER, 1, 0, down_power},
+    [MON_CURRENT] = {READING(current_ma), LIMIT(current_limit_ma), STATUS_OVER_CURRENT, 0,
+                     TRIPS_ABOVE, down_current},
+    [MON_LOW_VOLTAGE] = {READING(voltage_mv), LIMIT(low_voltage_mv), STATUS_LOW_VOLTAGE, 0,
+                         TRIPS_BELOW, up_voltage},
+    [MON_HIGH_VOLTAGE] = {READING(voltage_mv), LIMIT(high_voltage_mv), STATUS_HIGH_VOLTAGE, 0,
+                          TRIPS_ABOVE, down_voltage},
+    [MON_POWER] = {READING(power_mw), LIMIT(power_limit_mw), STATUS_OVER_POWER, 0, TRIPS_ABOVE,
+                   down_power},
     [MON_TEMPERATURE] = {READING(temperature_adc), LIMIT(temperature_limit_adc),
-                         STATUS_OVER_TEMPERATURE, 0, 1, cooler_temperature},
+                         STATUS_OVER_TEMPERATURE, 1, TRIPS_BELOW, cooler_temperature},
 };
+
+/* The rows each slow slot judges, [first, end) of thresholds[]; a slot
+ * without rows judges the current alone. */
+static const uint8_t slot_rows[SENSE_ROUND_TICKS][2] = {
+    [SENSE_VOLTAGE] = {MON_LOW_VOLTAGE, MON_HIGH_VOLTAGE + 1},
+    [SENSE_POWER] = {MON_POWER, MON_POWER + 1},
+    [SENSE_TEMPERATURE] = {MON_TEMPERATURE, MON_TEMPERATURE + 1},
+};
+
+/* Samples in a row that trip and clear: every tick, or once a round. */
+_Static_assert(PROTECT_TRIP_TICKS % SENSE_ROUND_TICKS == 0 &&
+                   PROTECT_CLEAR_TICKS % SENSE_ROUND_TICKS == 0,
+               "a slow monitor's debounce is whole rounds");
+static const uint16_t samples_every_tick[2] = {PROTECT_TRIP_TICKS, PROTECT_CLEAR_TICKS};
+static const uint16_t samples_once_a_round[2] = {PROTECT_TRIP_TICKS / SENSE_ROUND_TICKS,
+                                                 PROTECT_CLEAR_TICKS / SENSE_ROUND_TICKS};
 
 /* The uint16_t member at offset (the table's offsetof): a load, where a
  * memcpy is a call on the size-first Cortex-M0 build. */
@@ -72,11 +91,11 @@ static uint16_t field_u16(const void *base, uint8_t offset)
 }
 
 /* One comparison for every kind: a monitor that trips below compares the
- * values turned over (x ^ 0xFFFF reverses their order), and an inclusive
- * one compares against the limit less one. */
+ * values turned over (x ^ 0xFFFF reverses their order, without a branch),
+ * and an inclusive one compares against the limit less one. */
 static int32_t facing(const struct threshold *t, uint16_t x)
 {
-    return t->trips_above ? (int32_t)x : (int32_t)(x ^ 0xFFFFu);
+    return (int32_t)(uint16_t)(x ^ t->turn);
 }
 
 static bool beyond(const struct threshold *t, uint16_t value, uint16_t limit)
@@ -98,63 +117,88 @@ static bool back_inside(const struct threshold *t, struct monitor *m, uint16_t v
     return facing(t, value) <= facing(t, m->clear_level) && !beyond(t, value, limit);
 }
 
-/* Debounce: trip after PROTECT_TRIP_TICKS (or trip_ticks) samples beyond,
- * clear after PROTECT_CLEAR_TICKS samples back inside. towards: the
- * sample counts towards the other state (beyond while clear, back inside
- * while set); the caller works out only that one. */
-static void step(struct monitor *m, bool towards, uint16_t trip_ticks)
+/* Debounce: trip after samples[0] samples beyond, clear after samples[1]
+ * back inside. towards: the sample counts towards the other state (beyond
+ * while clear, back inside while set); the caller works out only that one.
+ * Returns whether the state changed. */
+static bool step(struct monitor *m, bool towards, const uint16_t samples[2])
 {
-    m->count = towards ? (uint16_t)(m->count + 1u) : 0u;
-    if (m->count >= (m->active ? PROTECT_CLEAR_TICKS : trip_ticks)) {
-        m->active = (uint8_t)!m->active;
+    if (!towards) { /* most ticks */
         m->count = 0;
+        return false;
     }
+    m->count = (uint16_t)(m->count + 1u);
+    if (m->count < samples[m->active]) {
+        return false;
+    }
+    m->active = (uint8_t)!m->active;
+    m->count = 0;
+    return true;
+}
+
+static void judge(struct protection *p, const struct user_config *cfg,
+                  const struct sensor_readings *readings, unsigned row, const uint16_t samples[2])
+{
+    const struct threshold *t = &thresholds[row];
+    uint16_t value = field_u16(readings, t->reading);
+    uint16_t limit = field_u16(cfg, t->limit);
+    struct monitor *m = &p->mon[row];
+    if (step(m, m->active ? back_inside(t, m, value, limit) : beyond(t, value, limit), samples)) {
+        p->threshold_bits = (uint8_t)(p->threshold_bits ^ t->bit);
+    }
+}
+
+/* Stalled: at the limit and slower than STALL_SPEED_Q8 the way it pushes,
+ * which takes in turning the other way (a load stronger than the motor) as
+ * well as standing still. Returns the stall bit. */
+static uint8_t watch_stall(struct protection *p, const struct user_config *cfg,
+                           const struct protection_input *in, struct protection_action *act)
+{
+    static const uint16_t stall_samples[2] = {STALL_TICKS, PROTECT_CLEAR_TICKS};
+    int32_t pushed_way = in->output_at_limit > 0 ? in->speed_q8 : -in->speed_q8;
+    bool stalled = in->output_at_limit != 0 && pushed_way < STALL_SPEED_Q8;
+    struct monitor *stall = &p->mon[MON_STALL];
+    bool was_stalled = stall->active;
+    bool tripped = step(stall, was_stalled ? !stalled : stalled, stall_samples) && !was_stalled;
+    if (!cfg->stall_release) {
+        p->stall_latched = 0;
+        if (!stall->active) {
+            return 0;
+        }
+        act->power_cap_mw = cfg->stall_power_mw;
+        return STATUS_STALL;
+    }
+    /* Released, nothing pushes and the stall cannot be seen to end: the bit
+     * holds until the next motion command. */
+    if (tripped) {
+        p->stall_latched = 1;
+        p->commands_at_stall = in->motion_commands;
+        act->release_now = true;
+    }
+    if (p->stall_latched && in->motion_commands != p->commands_at_stall) {
+        p->stall_latched = 0;
+        *stall = (struct monitor){0};
+    }
+    return p->stall_latched ? STATUS_STALL : 0u;
 }
 
 uint8_t protection_update(struct protection *p, const struct user_config *cfg,
                           const struct protection_input *in, struct protection_action *act)
 {
-    uint8_t bits = 0;
-    for (int i = 0; i < MON_STALL; i++) {
-        const struct threshold *t = &thresholds[i];
-        uint16_t value = field_u16(&in->readings, t->reading);
-        uint16_t limit = field_u16(cfg, t->limit);
-        struct monitor *m = &p->mon[i];
-        step(m, m->active ? back_inside(t, m, value, limit) : beyond(t, value, limit), PROTECT_TRIP_TICKS);
-        bits = (uint8_t)(bits | (p->mon[i].active ? t->bit : 0u));
+    judge(p, cfg, in->readings, MON_CURRENT, samples_every_tick);
+    const uint8_t *rows = slot_rows[in->slot];
+    for (unsigned row = rows[0]; row < rows[1]; row++) {
+        judge(p, cfg, in->readings, row, samples_once_a_round);
     }
+    uint8_t bits = p->threshold_bits;
 
-    /* Stalled: at the limit and slower than STALL_SPEED_Q8 the way it
-     * pushes, which takes in turning the other way (a load stronger than
-     * the motor) as well as standing still. */
-    int32_t pushed_way = in->output_at_limit > 0 ? in->speed_q8 : -in->speed_q8;
-    bool stalled = in->output_at_limit != 0 && pushed_way < STALL_SPEED_Q8;
-    bool was_stalled = p->mon[MON_STALL].active;
-    step(&p->mon[MON_STALL], was_stalled ? !stalled : stalled, STALL_TICKS);
-    bool tripped = p->mon[MON_STALL].active && !was_stalled;
     act->release_now = false;
     act->power_cap_mw = 0;
-    if (cfg->stall_release) {
-        /* Released, nothing pushes and the stall cannot be seen to end: the
-         * bit holds until the next motion command. */
-        if (tripped) {
-            p->stall_latched = 1;
-            p->commands_at_stall = in->motion_commands;
-            act->release_now = true;
-        }
-        if (p->stall_latched && in->motion_commands != p->commands_at_stall) {
-            p->stall_latched = 0;
-            p->mon[MON_STALL] = (struct monitor){0};
-        }
-        bits = (uint8_t)(bits | (p->stall_latched ? STATUS_STALL : 0u));
-    } else {
-        p->stall_latched = 0;
-        if (p->mon[MON_STALL].active) {
-            bits |= STATUS_STALL;
-            act->power_cap_mw = cfg->stall_power_mw;
-        }
+    struct monitor *stall = &p->mon[MON_STALL];
+    /* Most ticks: not at the limit, no stall counted, none set. */
+    if (in->output_at_limit != 0 || (stall->count | stall->active | p->stall_latched) != 0u) {
+        bits = (uint8_t)(bits | watch_stall(p, cfg, in, act));
     }
-
     act->inhibit = (bits & (STATUS_LOW_VOLTAGE | STATUS_HIGH_VOLTAGE | STATUS_OVER_TEMPERATURE)) != 0;
     act->derate = (bits & (STATUS_OVER_CURRENT | STATUS_OVER_POWER)) != 0;
     return bits;

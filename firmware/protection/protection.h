@@ -1,14 +1,17 @@
 /* Protection monitors: supply voltage (39/40), current (43), power (42),
- * temperature (41) and stall (37/38). Fed one sample per control tick, they
- * set status bits 2-7 while a condition lasts and say what the output must
- * do (behaviour.md, "Protection"):
+ * temperature (41) and stall (37/38). Fed once per control tick, they set
+ * status bits 2-7 while a condition lasts and say what the output must do
+ * (behaviour.md, "Protection"):
  *   voltage out of range, over-temperature: release, refuse motion
  *   over-current, over-power: halve the current the output may draw
  *   stall: limit the power to 38 (37 = 0), or release once (37 = 1)
  *
- * A condition trips after PROTECT_TRIP_TICKS samples in a row beyond its
- * limit and clears after PROTECT_CLEAR_TICKS samples in a row back inside
- * its hysteresis band, so no single sample trips or clears it. */
+ * The current and the stall are judged every tick; the supply, the power
+ * and the temperature when their reading is refreshed (scaling.h's round,
+ * every SENSE_ROUND_TICKS). A condition trips once it has lasted
+ * PROTECT_TRIP_TICKS in samples in a row beyond its limit and clears after
+ * PROTECT_CLEAR_TICKS back inside its hysteresis band, so no single sample
+ * trips or clears it. */
 #ifndef PROTECTION_PROTECTION_H
 #define PROTECTION_PROTECTION_H
 
@@ -32,7 +35,8 @@
 #define STALL_TICKS 1000u         /* 1 s */
 
 struct protection_input {
-    struct sensor_readings readings;  /* filtered */
+    const struct sensor_readings *readings; /* filtered */
+    enum sense_slot slot;             /* the slow reading refreshed this tick */
     int8_t output_at_limit;           /* the controller is saturated, driving
                                        * this way (+1/-1); 0: it is not */
     int32_t speed_q8;                 /* measured, decideg per tick Q8 */
@@ -47,10 +51,12 @@ struct protection_action {
     uint16_t power_cap_mw; /* 0: none; else the most power any move may use */
 };
 
+/* The threshold monitors every tick first, then in the order of their
+ * readings' slots. */
 enum monitor_id {
+    MON_CURRENT,
     MON_LOW_VOLTAGE,
     MON_HIGH_VOLTAGE,
-    MON_CURRENT,
     MON_POWER,
     MON_TEMPERATURE,
     MON_STALL,
@@ -68,6 +74,7 @@ struct monitor {
 
 struct protection {
     struct monitor mon[MON_COUNT];
+    uint8_t threshold_bits;     /* of the threshold monitors set now */
     uint8_t stall_latched;      /* release mode: held until the next command */
     uint32_t commands_at_stall;
 };

@@ -10,9 +10,10 @@
  *   ticks_at_limit  MOTION_BENCH_TICKS ticks of a move faster than the horn
  *          (the encoder turns 5 counts a tick): the slowed clock, then the
  *          guard's braking
- *   servo_ticks  MOTION_BENCH_TICKS of servo_control_tick as the firmware
- *          runs it (sensors, protection monitors, motion, status) on the
- *          same followed move, sensors at their healthy readings
+ *   servo_tick  each of MOTION_BENCH_TICKS servo_control_tick calls as the
+ *          firmware runs them (sensors, protection monitors, motion,
+ *          status) on the same followed move, sensors at their healthy
+ *          readings: one region per tick, for the worst tick
  * The runner takes the HAL double's own instructions (hal_double.c, found
  * by the plugin's per-block profile) off every tick region; the firmware's
  * calls to it stay in. */
@@ -101,12 +102,12 @@ int main(void)
     servo_init(&servo, &hal.port);
     servo.motion.soft_start_pending = 0;
     must_accept(motion_submit(&servo.motion, &follow), "the servo's followed move");
-    bench_begin();
     for (unsigned i = 0; i < MOTION_BENCH_TICKS; i++) {
         hal.encoder_raw = follow_raw[i];
+        bench_begin();
         servo_control_tick(&servo);
+        bench_end("servo_tick");
     }
-    bench_end("servo_ticks");
     if (servo.regs.status.status & ~STATUS_EXECUTING) {
         printf("bench: the servo's monitors tripped (status %#x)\n", servo.regs.status.status);
         exit(1);

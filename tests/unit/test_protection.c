@@ -15,8 +15,10 @@
 
 static struct protection prot;
 static struct user_config cfg;
+static struct sensor_readings readings;
 static struct protection_input in;
 static struct protection_action act;
+static unsigned ticks; /* since setup: the slot of the next sample */
 
 static int setup(void **state)
 {
@@ -24,47 +26,72 @@ static int setup(void **state)
     protection_init(&prot);
     user_config_factory(&cfg);
     /* Healthy: 7.4 V, 0.5 A, 3.7 W, 25 degC, moving freely. */
-    in = (struct protection_input){
-        .readings = {.voltage_mv = 7400, .current_ma = 500, .power_mw = 3700, .temperature_adc = 2048},
-    };
+    readings = (struct sensor_readings){
+        .voltage_mv = 7400, .current_ma = 500, .power_mw = 3700, .temperature_adc = 2048};
+    in = (struct protection_input){.readings = &readings};
+    ticks = 0;
     return 0;
 }
 
-/* n samples of the current input; the status bits after the last. */
+/* n ticks of the current readings, each slow one judged in its turn, as
+ * sensors_update hands them over; the status bits after the last. */
 static uint8_t run(unsigned n)
 {
     uint8_t bits = 0;
     for (unsigned i = 0; i < n; i++) {
+        in.slot = (enum sense_slot)(ticks++ % SENSE_ROUND_TICKS);
         bits = protection_update(&prot, &cfg, &in, &act);
     }
     return bits;
+}
+
+/* Ticks until the status bits are want (at most 1000). */
+static unsigned ticks_until(uint8_t want)
+{
+    for (unsigned n = 1; n <= 1000; n++) {
+        if (run(1) == want) {
+            return n;
+        }
+    }
+    fail_msg("the status bits never became %#x", want);
+    return 0;
+}
+
+/* A condition trips when it has lasted PROTECT_TRIP_TICKS (clears after
+ * PROTECT_CLEAR_TICKS) in samples: exactly then for a monitor judged every
+ * tick, within its last round for one judged once a round. */
+static void assert_lasted(unsigned taken, unsigned ticks_wanted, unsigned period)
+{
+    assert_in_range(taken, ticks_wanted - period + 1u, ticks_wanted);
 }
 
 /* A threshold monitor, generically: value pointer, limit, the first value
  * that trips, a value inside the hysteresis band (does not clear), the first
  * value that clears, and the expected bit. */
 static void check_threshold(uint16_t *value, uint16_t healthy, uint16_t at_limit_ok,
-                            uint16_t trips, uint16_t in_band, uint16_t clears, uint8_t bit)
+                            uint16_t trips, uint16_t in_band, uint16_t clears, uint8_t bit,
+                            unsigned period)
 {
     *value = at_limit_ok;
     assert_int_equal(run(1000), 0); /* at (or just inside) the limit: fine */
-    *value = trips;
-    assert_int_equal(run(PROTECT_TRIP_TICKS - 1), 0); /* not yet */
-    assert_int_equal(run(1), bit);                    /* tripped */
-    *value = in_band;
-    assert_int_equal(run(1000), bit); /* inside the band: still set */
-    *value = clears;
-    assert_int_equal(run(PROTECT_CLEAR_TICKS - 1), bit);
-    assert_int_equal(run(1), 0); /* cleared */
-    *value = healthy;
-    assert_int_equal(run(10), 0);
+    for (unsigned phase = 0; phase < period; phase++) { /* wherever the round stands */
+        run(phase);
+        *value = trips;
+        assert_lasted(ticks_until(bit), PROTECT_TRIP_TICKS, period);
+        *value = in_band;
+        assert_int_equal(run(1000), bit); /* inside the band: still set */
+        *value = clears;
+        assert_lasted(ticks_until(0), PROTECT_CLEAR_TICKS, period);
+        *value = healthy;
+        assert_int_equal(run(10), 0);
+    }
 }
 
 static void test_low_voltage(void **state)
 {
     (void)state;
-    uint16_t *v = &in.readings.voltage_mv;
-    check_threshold(v, 7400, 4000, 3999, 4199, 4200, STATUS_LOW_VOLTAGE);
+    uint16_t *v = &readings.voltage_mv;
+    check_threshold(v, 7400, 4000, 3999, 4199, 4200, STATUS_LOW_VOLTAGE, SENSE_ROUND_TICKS);
     *v = 3999;
     run(PROTECT_TRIP_TICKS);
     assert_true(act.inhibit);
@@ -74,8 +101,9 @@ static void test_low_voltage(void **state)
 static void test_high_voltage(void **state)
 {
     (void)state;
-    check_threshold(&in.readings.voltage_mv, 7400, 8400, 8401, 8201, 8200, STATUS_HIGH_VOLTAGE);
-    in.readings.voltage_mv = 8401;
+    check_threshold(&readings.voltage_mv, 7400, 8400, 8401, 8201, 8200, STATUS_HIGH_VOLTAGE,
+                    SENSE_ROUND_TICKS);
+    readings.voltage_mv = 8401;
     run(PROTECT_TRIP_TICKS);
     assert_true(act.inhibit);
 }
@@ -83,8 +111,8 @@ static void test_high_voltage(void **state)
 static void test_over_current(void **state)
 {
     (void)state;
-    check_threshold(&in.readings.current_ma, 500, 4000, 4001, 3901, 3900, STATUS_OVER_CURRENT);
-    in.readings.current_ma = 4001;
+    check_threshold(&readings.current_ma, 500, 4000, 4001, 3901, 3900, STATUS_OVER_CURRENT, 1);
+    readings.current_ma = 4001;
     run(PROTECT_TRIP_TICKS);
     assert_true(act.derate);
     assert_false(act.inhibit);
@@ -93,8 +121,9 @@ static void test_over_current(void **state)
 static void test_over_power(void **state)
 {
     (void)state;
-    check_threshold(&in.readings.power_mw, 3700, 10000, 10001, 9501, 9500, STATUS_OVER_POWER);
-    in.readings.power_mw = 10001;
+    check_threshold(&readings.power_mw, 3700, 10000, 10001, 9501, 9500, STATUS_OVER_POWER,
+                    SENSE_ROUND_TICKS);
+    readings.power_mw = 10001;
     run(PROTECT_TRIP_TICKS);
     assert_true(act.derate);
 }
@@ -106,9 +135,9 @@ static void test_over_temperature_trips_at_or_below(void **state)
      * trips; clearing needs 5 degC cooler. */
     uint16_t cool = ntc_adc((int16_t)(ntc_decicelsius(651) - 50));
     assert_true(cool > 700 && cool < 800);
-    check_threshold(&in.readings.temperature_adc, 2048, 652, 651, (uint16_t)(cool - 1), cool,
-                    STATUS_OVER_TEMPERATURE);
-    in.readings.temperature_adc = 600;
+    check_threshold(&readings.temperature_adc, 2048, 652, 651, (uint16_t)(cool - 1), cool,
+                    STATUS_OVER_TEMPERATURE, SENSE_ROUND_TICKS);
+    readings.temperature_adc = 600;
     run(PROTECT_TRIP_TICKS);
     assert_true(act.inhibit);
 }
@@ -116,14 +145,17 @@ static void test_over_temperature_trips_at_or_below(void **state)
 static void test_one_noisy_sample_neither_trips_nor_clears(void **state)
 {
     (void)state;
-    for (int i = 0; i < 50; i++) {
-        in.readings.voltage_mv = (i % 5 == 0) ? 2000 : 7400; /* spikes, never 10 in a row */
+    /* Spikes in one sample of the supply's (once a round), never two in a
+     * row, and in the current, judged every tick, never 10 in a row. */
+    for (unsigned i = 0; i < 100; i++) {
+        readings.voltage_mv = (i % (2 * SENSE_ROUND_TICKS) == 0) ? 2000 : 7400;
+        readings.current_ma = (i % PROTECT_TRIP_TICKS == 0) ? 5000 : 500;
         assert_int_equal(run(1), 0);
     }
-    in.readings.voltage_mv = 2000;
+    readings.voltage_mv = 2000;
     assert_int_equal(run(PROTECT_TRIP_TICKS), STATUS_LOW_VOLTAGE);
     for (int i = 0; i < 500; i++) {
-        in.readings.voltage_mv = (i % 50 == 0) ? 7400 : 2000;
+        readings.voltage_mv = (i % 50 == 0) ? 7400 : 2000;
         assert_int_equal(run(1), STATUS_LOW_VOLTAGE);
     }
 }
@@ -131,18 +163,18 @@ static void test_one_noisy_sample_neither_trips_nor_clears(void **state)
 static void test_several_faults_at_once(void **state)
 {
     (void)state;
-    in.readings.voltage_mv = 3000;
-    in.readings.current_ma = 5000;
-    in.readings.temperature_adc = 500;
+    readings.voltage_mv = 3000;
+    readings.current_ma = 5000;
+    readings.temperature_adc = 500;
     assert_int_equal(run(PROTECT_TRIP_TICKS),
                      STATUS_LOW_VOLTAGE | STATUS_OVER_CURRENT | STATUS_OVER_TEMPERATURE);
     assert_int_equal(STATUS_LOW_VOLTAGE | STATUS_OVER_CURRENT | STATUS_OVER_TEMPERATURE, 0xB0);
     assert_true(act.inhibit && act.derate);
-    in.readings.voltage_mv = 7400; /* one clears, the others stay */
+    readings.voltage_mv = 7400; /* one clears, the others stay */
     assert_int_equal(run(PROTECT_CLEAR_TICKS), STATUS_OVER_CURRENT | STATUS_OVER_TEMPERATURE);
     assert_true(act.inhibit); /* still hot */
-    in.readings.temperature_adc = 2048;
-    in.readings.current_ma = 100;
+    readings.temperature_adc = 2048;
+    readings.current_ma = 100;
     assert_int_equal(run(PROTECT_CLEAR_TICKS), 0);
     assert_false(act.inhibit || act.derate);
 }
@@ -151,7 +183,7 @@ static void test_limits_follow_the_user_area(void **state)
 {
     (void)state;
     cfg.low_voltage_mv = 6000;
-    in.readings.voltage_mv = 5999;
+    readings.voltage_mv = 5999;
     assert_int_equal(run(PROTECT_TRIP_TICKS), STATUS_LOW_VOLTAGE);
 }
 
@@ -169,11 +201,11 @@ static void test_no_monitor_flaps_at_the_ends_of_its_range(void **state)
         int trips_above;
         int inclusive;
     } const rows[] = {
-        {&cfg.low_voltage_mv, &in.readings.voltage_mv, STATUS_LOW_VOLTAGE, 0, 0},
-        {&cfg.high_voltage_mv, &in.readings.voltage_mv, STATUS_HIGH_VOLTAGE, 1, 0},
-        {&cfg.current_limit_ma, &in.readings.current_ma, STATUS_OVER_CURRENT, 1, 0},
-        {&cfg.power_limit_mw, &in.readings.power_mw, STATUS_OVER_POWER, 1, 0},
-        {&cfg.temperature_limit_adc, &in.readings.temperature_adc, STATUS_OVER_TEMPERATURE, 0, 1},
+        {&cfg.low_voltage_mv, &readings.voltage_mv, STATUS_LOW_VOLTAGE, 0, 0},
+        {&cfg.high_voltage_mv, &readings.voltage_mv, STATUS_HIGH_VOLTAGE, 1, 0},
+        {&cfg.current_limit_ma, &readings.current_ma, STATUS_OVER_CURRENT, 1, 0},
+        {&cfg.power_limit_mw, &readings.power_mw, STATUS_OVER_POWER, 1, 0},
+        {&cfg.temperature_limit_adc, &readings.temperature_adc, STATUS_OVER_TEMPERATURE, 0, 1},
     };
     const uint16_t ends[] = {0, 1, 99, 100, 199, 200, 201, 4095, 65334, 65335, 65336, 65400, 65534, 65535};
     for (size_t r = 0; r < sizeof rows / sizeof rows[0]; r++) {
@@ -185,7 +217,7 @@ static void test_no_monitor_flaps_at_the_ends_of_its_range(void **state)
                 cfg.current_limit_ma = UINT16_MAX;
                 cfg.power_limit_mw = UINT16_MAX;
                 cfg.temperature_limit_adc = 0;
-                in.readings.temperature_adc = 4095;
+                readings.temperature_adc = 4095;
                 *rows[r].limit = ends[l];
                 *rows[r].value = ends[v];
                 uint16_t value = ends[v];

@@ -25,7 +25,7 @@ static void test_status_area_is_live(void **state)
 {
     (void)state;
     hal.sensors = (struct sensor_raw){.supply = 7800, .current = 650, .ntc = 1700};
-    harness_run_ms(100); /* the low-pass settles */
+    harness_run_ms(200); /* the low-passes settle (the supply's in 115 ms) */
     REQUEST(3, 0, 1);
     EXPECT_RESPONSE(3, 0, 1, 0x78, 0x1E); /* 7800 mV */
     REQUEST(3, 0, 2);

@@ -1,4 +1,4 @@
-/* Sensor scaling and the generated NTC table, against appendix 5.1's exact
+/* Sensor scaling, filtering and turns, and the generated NTC table, against appendix 5.1's exact
  * formula (floating point only here, in the test). */
 #include <math.h>
 #include <setjmp.h>
@@ -66,20 +66,24 @@ static const struct sensor_calibration board = {.supply_mv_q12 = SENSOR_Q12_FROM
                                                 .current_ma_q12 = SENSOR_Q12_FROM_MICRO(1611u),
                                                 .current_zero_counts = 12};
 
+/* A filter primed by one tick of raw: the readings as they are, in units. */
+static struct sensor_readings primed(const struct sensor_calibration *cal, struct sensor_raw raw)
+{
+    struct sensor_filter f = {0};
+    sensors_update(&f, cal, &raw);
+    return f.out;
+}
+
 static void test_scaling_to_units(void **state)
 {
     (void)state;
-    struct sensor_readings r;
-    sensors_scale(&board, &(struct sensor_raw){.supply = 835, .current = 632, .ntc = 1500}, &r);
+    struct sensor_readings r = primed(&board, (struct sensor_raw){.supply = 835, .current = 632, .ntc = 1500});
     assert_int_equal(r.voltage_mv, 7400);  /* 835 x 8.862 mV = 7399.8, rounded */
     assert_int_equal(r.current_ma, 999);   /* (632 - 12) x 1.611 mA = 998.8, rounded */
-    struct sensor_filter f = {0};
-    struct sensor_readings filtered;
-    sensors_filter(&f, &r, &filtered);     /* primed: the readings as they are */
-    assert_int_equal(filtered.power_mw, 7393); /* 7400 mV x 999 mA = 7392.6, to within 1/1024 V */
+    assert_int_equal(r.power_mw, 7393); /* 7400 mV x 999 mA = 7392.6, to within 1/1024 V */
     assert_int_equal(r.temperature_adc, 1500);
     /* Below the amplifier's zero: no current, not a wrap-around. */
-    sensors_scale(&board, &(struct sensor_raw){.supply = 4095, .current = 3, .ntc = 0}, &r);
+    r = primed(&board, (struct sensor_raw){.supply = 4095, .current = 3, .ntc = 0});
     assert_int_equal(r.current_ma, 0);
     assert_int_equal(r.voltage_mv, 36290); /* 4095 x 8.862 mV = 36289.9 */
 }
@@ -92,10 +96,8 @@ static void test_power_is_the_product_to_within_a_milliwatt_an_ampere(void **sta
     const struct sensor_calibration unit = {.supply_mv_q12 = 4096, .current_ma_q12 = 4096};
     for (uint32_t mv = 0; mv <= 30000; mv += 97) {
         for (uint32_t ma = 0; ma <= 6000; ma += 61) {
-            struct sensor_readings r;
-            struct sensor_filter f = {0};
-            sensors_scale(&unit, &(struct sensor_raw){.supply = (uint16_t)mv, .current = (uint16_t)ma}, &r);
-            sensors_filter(&f, &r, &r); /* primed: power from the readings as they are */
+            struct sensor_readings r =
+                primed(&unit, (struct sensor_raw){.supply = (uint16_t)mv, .current = (uint16_t)ma});
             double exact = (double)mv * ma / 1000.0;
             double allowed = ma / 1000.0 + 0.5;
             if (exact >= 65535.0) {
@@ -107,23 +109,58 @@ static void test_power_is_the_product_to_within_a_milliwatt_an_ampere(void **sta
     }
 }
 
+static const struct sensor_calibration unit = {.supply_mv_q12 = 4096, .current_ma_q12 = 4096};
+
+/* A tick of raw samples; the slot it served. */
+static enum sense_slot tick(struct sensor_filter *f, uint16_t mv, uint16_t ma, uint16_t ntc)
+{
+    return sensors_update(f, &unit, &(struct sensor_raw){.supply = mv, .current = ma, .ntc = ntc});
+}
+
+/* The current every tick; the supply, the power and the temperature each
+ * in its own tick of a round, once a round. */
+static void test_each_reading_in_its_turn(void **state)
+{
+    (void)state;
+    struct sensor_filter f = {0};
+    assert_int_equal(tick(&f, 7400, 800, 2000), SENSE_VOLTAGE); /* primes */
+    unsigned voltage_turns = 0, power_turns = 0, temperature_turns = 0;
+    for (unsigned i = 1; i <= 10 * SENSE_ROUND_TICKS; i++) {
+        struct sensor_readings before = f.out;
+        enum sense_slot slot = tick(&f, 6400, (uint16_t)(i % 2 ? 1200 : 400), 1000);
+        assert_int_equal(slot, i % SENSE_ROUND_TICKS);
+        assert_int_not_equal(f.out.current_ma, before.current_ma); /* moves every tick */
+        voltage_turns += f.out.voltage_mv != before.voltage_mv;
+        power_turns += f.out.power_mw != before.power_mw;
+        temperature_turns += f.out.temperature_adc != before.temperature_adc;
+        assert_true(f.out.voltage_mv == before.voltage_mv || slot == SENSE_VOLTAGE);
+        assert_true(f.out.power_mw == before.power_mw || slot == SENSE_POWER);
+        assert_true(f.out.temperature_adc == before.temperature_adc || slot == SENSE_TEMPERATURE);
+    }
+    assert_true(voltage_turns >= 8 && power_turns >= 8 && temperature_turns >= 8);
+}
+
+/* One noisy sample moves the current by an eighth of its jump and a slow
+ * reading by a quarter; steady samples bring both back exactly. */
 static void test_filter_tames_one_sample(void **state)
 {
     (void)state;
     struct sensor_filter f = {0};
-    struct sensor_readings in = {.voltage_mv = 7400, .current_ma = 800, .temperature_adc = 2000};
-    struct sensor_readings out;
-    sensors_filter(&f, &in, &out); /* primes */
-    assert_int_equal(out.voltage_mv, 7400);
-    assert_int_equal(out.power_mw, 5920);
-    in.voltage_mv = 3400; /* one sample 4 V low */
-    sensors_filter(&f, &in, &out);
-    assert_int_equal(out.voltage_mv, 6900); /* an eighth of the jump */
-    in.voltage_mv = 7400;
-    for (int i = 0; i < 100; i++) {
-        sensors_filter(&f, &in, &out);
+    tick(&f, 7400, 800, 2000); /* primes */
+    assert_int_equal(f.out.voltage_mv, 7400);
+    assert_int_equal(f.out.power_mw, 5920);
+    for (unsigned i = 1; i < SENSE_ROUND_TICKS; i++) {
+        tick(&f, 7400, 800, 2000);
     }
-    assert_int_equal(out.voltage_mv, 7400); /* settles exactly */
+    tick(&f, 3400, 1600, 2000); /* the supply's turn: one sample 4 V low, 0.8 A high */
+    assert_int_equal(f.out.voltage_mv, 6400); /* a quarter of the jump */
+    assert_int_equal(f.out.current_ma, 900);  /* an eighth */
+    for (unsigned i = 0; i < 100 * SENSE_ROUND_TICKS; i++) {
+        tick(&f, 7400, 800, 2000);
+    }
+    assert_int_equal(f.out.voltage_mv, 7400); /* settles exactly */
+    assert_int_equal(f.out.current_ma, 800);
+    assert_int_equal(f.out.power_mw, 5920);
 }
 
 int main(void)
@@ -133,6 +170,7 @@ int main(void)
         cmocka_unit_test(test_protocol_reference_points),
         cmocka_unit_test(test_scaling_to_units),
         cmocka_unit_test(test_power_is_the_product_to_within_a_milliwatt_an_ampere),
+        cmocka_unit_test(test_each_reading_in_its_turn),
         cmocka_unit_test(test_filter_tames_one_sample),
     };
     return cmocka_run_group_tests_name("sensors", tests, NULL, NULL);

@@ -53,7 +53,7 @@ DURABLE_WRITE_BUDGET_US = {"cortex-m3": 200, "cortex-m0": 600}
 DURABLE_WRITES = ("answer_write_data", "answer_write_batch", "answer_reset_user_data")
 NOT_YET_MET = {
     # the whole tick and the M0 (docs/benchmark.md, "Not met yet")
-    ("cortex-m3", "servo_tick"): 615,
+    ("cortex-m3", "servo_tick"): 520,
     ("cortex-m0", "plan"): 3850,
     ("cortex-m0", "answer_read_batch"): 50, ("cortex-m0", "answer_monitor"): 38,
     ("cortex-m0", "answer_read_angle"): 32, ("cortex-m0", "answer_read_multi_turn"): 34,
@@ -219,14 +219,18 @@ def run(elf: Path, cpu: str, profile_region: str = "", by_line: bool = False) ->
     # Each region less the harness's instructions in it (its cycles in the
     # same proportion: the profile counts instructions), then less the
     # markers' firmware-free remainder (the empty region "overhead").
-    per_name = {}
+    per_name, largest = {}, {}
     for index, (name, (i, c)) in enumerate(zip(names, counts)):
         h = 0 if name.startswith("calibration_") else harness.get(index, 0)  # the loop is the harness's
         own = (i - h, c * (i - h) / i if i else 0)
         total = per_name.get(name, (0, 0, 0))
         per_name[name] = (total[0] + own[0], total[1] + own[1], total[2] + 1)
+        largest[name] = max(largest.get(name, own), own)
     oi, oc, _ = per_name.pop("overhead")
     regions = {name: (i - n * oi, c - n * oc) for name, (i, c, n) in per_name.items()}
+    # A region measured more than once: its worst instance too.
+    regions.update({f"{name}.worst": (i - oi, c - oc) for name, (i, c) in largest.items()
+                    if per_name.get(name, (0, 0, 1))[2] > 1})
     extra = regions.pop("calibration_200")[0] - regions.pop("calibration_100")[0]
     if extra != KNOWN_LOOP:
         raise SystemExit(f"run_target_bench: 100 more iterations of a 2-instruction loop counted {extra} "
@@ -254,8 +258,11 @@ def figures(cpu: str, profile_region: str = "", by_line: bool = False) -> dict:
                     per_tick(motion, "ticks_at_limit", nticks)),
         "tick_follow": per_tick(motion, "ticks_follow", nticks),
         "tick_at_limit": per_tick(motion, "ticks_at_limit", nticks),
-        # The whole control tick (servo_control_tick) on the followed move.
-        "servo_tick": per_tick(motion, "servo_ticks", nticks),
+        # The whole control tick (servo_control_tick) on the followed move:
+        # the mean of its ticks, as the motion tick's, and the worst one
+        # (each tick is a region): a slow reading's turn, a profile segment.
+        "servo_tick": per_tick(motion, "servo_tick", nticks),
+        "servo_tick_worst": motion["servo_tick.worst"],
         "plan": max(plans.values()),
     }
     out.update({k: v for k, v in proto.items() if k.startswith(("answer_", "request_"))})
