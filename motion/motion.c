@@ -522,7 +522,7 @@ void motion_init(struct motion *m, const struct registers *regs, const struct ha
 
 /* ---- what the protection monitors ask of the output --------------------- */
 
-void motion_guard_change(struct motion *m, bool inhibit, bool derate, uint16_t power_cap_mw)
+void motion_guard(struct motion *m, bool inhibit, bool derate, uint16_t power_cap_mw)
 {
     if (inhibit && !m->inhibit) {
         m->queue.count = 0;

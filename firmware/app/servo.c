@@ -1,5 +1,6 @@
 #include "servo.h"
 
+#include <stddef.h>
 #include <string.h>
 
 #include "identity.h"
@@ -262,30 +263,38 @@ static void tend_store(struct servo *s, uint32_t now, bool ticked)
     report_store(s);
 }
 
+_Static_assert(offsetof(struct status_area, current_ma) - offsetof(struct status_area, voltage_mv) ==
+                   offsetof(struct sensor_readings, current_ma) &&
+               offsetof(struct status_area, power_mw) - offsetof(struct status_area, voltage_mv) ==
+                   offsetof(struct sensor_readings, power_mw) &&
+               offsetof(struct status_area, temperature_adc) - offsetof(struct status_area, voltage_mv) ==
+                   offsetof(struct sensor_readings, temperature_adc) &&
+               offsetof(struct sensor_readings, voltage_mv) == 0 &&
+               sizeof(struct sensor_readings) == 8,
+               "the status area's IDs 1-4 lie as struct sensor_readings");
+
 /* Sensors to the status area (IDs 1-4), monitors to what the output may
  * do; returns status bits 2-7. */
 static uint8_t sense_and_protect(struct servo *s)
 {
     struct sensor_raw raw;
     s->hal->motor.read_sensors(s->hal->ctx, &raw);
-    struct protection_input in;
-    in.slot = sensors_update(&s->sensors, s->hal->calibration, &raw);
+    enum sense_slot slot = sensors_update(&s->sensors, s->hal->calibration, &raw);
     const struct sensor_readings *now = &s->sensors.out;
-    in.readings = now;
-    struct status_area *st = &s->regs.status;
-    st->voltage_mv = now->voltage_mv;
-    st->current_ma = now->current_ma;
-    st->power_mw = now->power_mw;
-    st->temperature_adc = now->temperature_adc;
-    in.output_at_limit = motion_output_at_limit(&s->motion);
-    in.speed_q8 = s->motion.measured_velocity_q8;
-    in.motion_commands = s->motion.commands;
-    struct protection_action act;
-    uint8_t bits = protection_update(&s->protection, &s->regs.user, &in, &act);
-    if (act.release_now) {
+    /* IDs 1-4 lie as the readings do: one copy (ldrd/strd on the M3). */
+    memcpy((uint8_t *)&s->regs.status + offsetof(struct status_area, voltage_mv), now, sizeof *now);
+    struct protection *p = &s->protection;
+    uint8_t bits = (uint8_t)(protection_update(p, &s->regs.user, now, slot) |
+                             protection_stall(p, &s->regs.user, motion_output_at_limit(&s->motion),
+                                              s->motion.measured_velocity_q8, s->motion.commands));
+    if (p->act.release_now) {
         motion_release(&s->motion);
     }
-    motion_guard(&s->motion, act.inhibit, act.derate, act.power_cap_mw);
+    if (p->act_changes != s->guard_seen) {
+        s->guard_seen = p->act_changes;
+        motion_guard(&s->motion, protection_inhibits(p->threshold_bits),
+                     protection_derates(p->threshold_bits), p->act.power_cap_mw);
+    }
     return bits;
 }
 

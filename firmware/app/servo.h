@@ -67,6 +67,7 @@ struct servo {
     struct servo_tx tx;
     struct sensor_filter sensors;
     struct protection protection;
+    uint8_t guard_seen;          /* protection.act_changes the motion has */
     uint32_t next_tick_us;       /* when the next control tick is due */
     uint32_t ticks_dropped;      /* control ticks skipped by a late main loop */
     uint32_t sync_turns_abandoned; /* Sync Monitor answers dropped for a new request */

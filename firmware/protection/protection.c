@@ -145,61 +145,77 @@ static void judge(struct protection *p, const struct user_config *cfg,
     struct monitor *m = &p->mon[row];
     if (step(m, m->active ? back_inside(t, m, value, limit) : beyond(t, value, limit), samples)) {
         p->threshold_bits = (uint8_t)(p->threshold_bits ^ t->bit);
+        p->act_changes++;
     }
 }
 
 /* Stalled: at the limit and slower than STALL_SPEED_Q8 the way it pushes,
  * which takes in turning the other way (a load stronger than the motor) as
- * well as standing still. Returns the stall bit. */
-static uint8_t watch_stall(struct protection *p, const struct user_config *cfg,
-                           const struct protection_input *in, struct protection_action *act)
+ * well as standing still. */
+uint8_t protection_watch_stall(struct protection *p, const struct user_config *cfg,
+                               int8_t output_at_limit, int32_t speed_q8, uint32_t motion_commands)
 {
     static const uint16_t stall_samples[2] = {STALL_TICKS, PROTECT_CLEAR_TICKS};
-    int32_t pushed_way = in->output_at_limit > 0 ? in->speed_q8 : -in->speed_q8;
-    bool stalled = in->output_at_limit != 0 && pushed_way < STALL_SPEED_Q8;
-    struct monitor *stall = &p->mon[MON_STALL];
+    int32_t pushed_way = output_at_limit > 0 ? speed_q8 : -speed_q8;
+    bool stalled = output_at_limit != 0 && pushed_way < STALL_SPEED_Q8;
+    if (!stalled && !p->stall_busy) {
+        return 0; /* at the limit and moving: nothing counted, set or latched */
+    }
+    struct monitor *stall = &p->stall;
     bool was_stalled = stall->active;
     bool tripped = step(stall, was_stalled ? !stalled : stalled, stall_samples) && !was_stalled;
+    p->act.release_now = false; /* once */
+    uint16_t cap = 0;
     if (!cfg->stall_release) {
         p->stall_latched = 0;
-        if (!stall->active) {
-            return 0;
-        }
-        act->power_cap_mw = cfg->stall_power_mw;
-        return STATUS_STALL;
-    }
-    /* Released, nothing pushes and the stall cannot be seen to end: the bit
-     * holds until the next motion command. */
-    if (tripped) {
+        cap = stall->active ? cfg->stall_power_mw : 0u;
+    } else if (tripped) {
+        /* Released, nothing pushes and the stall cannot be seen to end: the
+         * bit holds until the next motion command. */
         p->stall_latched = 1;
-        p->commands_at_stall = in->motion_commands;
-        act->release_now = true;
-    }
-    if (p->stall_latched && in->motion_commands != p->commands_at_stall) {
+        p->commands_at_stall = motion_commands;
+        p->act.release_now = true;
+    } else if (p->stall_latched && motion_commands != p->commands_at_stall) {
         p->stall_latched = 0;
         *stall = (struct monitor){0};
     }
-    return p->stall_latched ? STATUS_STALL : 0u;
+    if (p->act.power_cap_mw != cap) {
+        p->act.power_cap_mw = cap;
+        p->act_changes++;
+    }
+    p->stall_busy = (stall->count | stall->active | p->stall_latched) != 0u;
+    bool shown = cfg->stall_release ? p->stall_latched : stall->active;
+    return shown ? STATUS_STALL : 0u;
 }
 
-uint8_t protection_update(struct protection *p, const struct user_config *cfg,
-                          const struct protection_input *in, struct protection_action *act)
+/* The quiet case inline where speed comes first (a clear monitor, its
+ * reading within the limit: most ticks), the rest in judge(); all of it in
+ * judge() where size does (PROTECTION_SMALL: the Cortex-M0). */
+#ifdef PROTECTION_SMALL
+#define watch judge
+#else
+static inline __attribute__((always_inline)) void watch(struct protection *p,
+                                                        const struct user_config *cfg,
+                                                        const struct sensor_readings *readings,
+                                                        unsigned row, const uint16_t samples[2])
 {
-    judge(p, cfg, in->readings, MON_CURRENT, samples_every_tick);
-    const uint8_t *rows = slot_rows[in->slot];
-    for (unsigned row = rows[0]; row < rows[1]; row++) {
-        judge(p, cfg, in->readings, row, samples_once_a_round);
+    const struct threshold *t = &thresholds[row];
+    struct monitor *m = &p->mon[row];
+    if (!m->active && !beyond(t, field_u16(readings, t->reading), field_u16(cfg, t->limit))) {
+        m->count = 0;
+        return;
     }
-    uint8_t bits = p->threshold_bits;
+    judge(p, cfg, readings, row, samples);
+}
+#endif
 
-    act->release_now = false;
-    act->power_cap_mw = 0;
-    struct monitor *stall = &p->mon[MON_STALL];
-    /* Most ticks: not at the limit, no stall counted, none set. */
-    if (in->output_at_limit != 0 || (stall->count | stall->active | p->stall_latched) != 0u) {
-        bits = (uint8_t)(bits | watch_stall(p, cfg, in, act));
+uint8_t protection_update(struct protection *p, const struct user_config *cfg,
+                          const struct sensor_readings *readings, enum sense_slot slot)
+{
+    watch(p, cfg, readings, MON_CURRENT, samples_every_tick);
+    const uint8_t *rows = slot_rows[slot];
+    for (unsigned row = rows[0]; row < rows[1]; row++) {
+        watch(p, cfg, readings, row, samples_once_a_round);
     }
-    act->inhibit = (bits & (STATUS_LOW_VOLTAGE | STATUS_HIGH_VOLTAGE | STATUS_OVER_TEMPERATURE)) != 0;
-    act->derate = (bits & (STATUS_OVER_CURRENT | STATUS_OVER_POWER)) != 0;
-    return bits;
+    return p->threshold_bits;
 }

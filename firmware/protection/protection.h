@@ -34,24 +34,27 @@
 #define STALL_SPEED_Q8 13
 #define STALL_TICKS 1000u         /* 1 s */
 
-struct protection_input {
-    const struct sensor_readings *readings; /* filtered */
-    enum sense_slot slot;             /* the slow reading refreshed this tick */
-    int8_t output_at_limit;           /* the controller is saturated, driving
-                                       * this way (+1/-1); 0: it is not */
-    int32_t speed_q8;                 /* measured, decideg per tick Q8 */
-    uint32_t motion_commands;         /* count of motion commands so far */
-};
-
-/* What the output must do now. */
+/* What the output must do now, besides what the status bits say
+ * (protection_inhibits, protection_derates): struct protection's act, kept
+ * up to date by the monitors. */
 struct protection_action {
-    bool inhibit;          /* release and refuse motion while set */
     bool release_now;      /* release once (stall in release mode) */
-    bool derate;           /* halve the current the output may draw */
     uint16_t power_cap_mw; /* 0: none; else the most power any move may use */
 };
 
-/* The threshold monitors every tick first, then in the order of their
+/* Release and refuse motion while set: the supply out of range, heat. */
+static inline bool protection_inhibits(uint8_t bits)
+{
+    return (bits & (STATUS_LOW_VOLTAGE | STATUS_HIGH_VOLTAGE | STATUS_OVER_TEMPERATURE)) != 0u;
+}
+
+/* Halve the current the output may draw: over-current, over-power. */
+static inline bool protection_derates(uint8_t bits)
+{
+    return (bits & (STATUS_OVER_CURRENT | STATUS_OVER_POWER)) != 0u;
+}
+
+/* The threshold monitors: every tick first, then in the order of their
  * readings' slots. */
 enum monitor_id {
     MON_CURRENT,
@@ -59,7 +62,6 @@ enum monitor_id {
     MON_HIGH_VOLTAGE,
     MON_POWER,
     MON_TEMPERATURE,
-    MON_STALL,
     MON_COUNT,
 };
 
@@ -72,16 +74,46 @@ struct monitor {
                            * conversion searches a table) */
 };
 
+/* The fields every tick touches first: within the Cortex-M0's short
+ * offsets (a byte's load reaches 31). */
 struct protection {
-    struct monitor mon[MON_COUNT];
     uint8_t threshold_bits;     /* of the threshold monitors set now */
+    uint8_t act_changes;        /* counts changes of the threshold bits and
+                                 * the power cap; wraps: compare for inequality */
+    uint8_t stall_busy;         /* a stall counted, set or latched */
     uint8_t stall_latched;      /* release mode: held until the next command */
+    struct protection_action act;
     uint32_t commands_at_stall;
+    struct monitor stall;
+    struct monitor mon[MON_COUNT];
 };
 
 void protection_init(struct protection *p);
-/* One sample; returns status bits 2-7. */
+/* The threshold monitors, once a tick: the current, and those of the slow
+ * reading refreshed this tick (slot). Returns status bits 3-7. */
 uint8_t protection_update(struct protection *p, const struct user_config *cfg,
-                          const struct protection_input *in, struct protection_action *act);
+                          const struct sensor_readings *readings, enum sense_slot slot);
+
+/* The stall monitor's tick where there is something to watch; returns
+ * status bit 2. output_at_limit: the controller is saturated, driving this
+ * way (+1/-1), 0: it is not; speed_q8 measured, decideg per tick Q8;
+ * motion_commands the count of motion commands so far. */
+uint8_t protection_watch_stall(struct protection *p, const struct user_config *cfg,
+                               int8_t output_at_limit, int32_t speed_q8, uint32_t motion_commands);
+
+/* The stall monitor, once a tick: most ticks (not at the limit, nothing
+ * counted, set or latched) it has nothing to do, which is told without a
+ * call where speed comes first (PROTECTION_SMALL: the Cortex-M0 calls). */
+static inline uint8_t protection_stall(struct protection *p, const struct user_config *cfg,
+                                       int8_t output_at_limit, int32_t speed_q8,
+                                       uint32_t motion_commands)
+{
+#ifndef PROTECTION_SMALL
+    if (output_at_limit == 0 && !p->stall_busy) {
+        return 0;
+    }
+#endif
+    return protection_watch_stall(p, cfg, output_at_limit, speed_q8, motion_commands);
+}
 
 #endif

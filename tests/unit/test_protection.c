@@ -16,8 +16,12 @@
 static struct protection prot;
 static struct user_config cfg;
 static struct sensor_readings readings;
-static struct protection_input in;
-static struct protection_action act;
+/* The stall monitor's inputs from the motion layer. */
+static struct {
+    int8_t output_at_limit;
+    int32_t speed_q8;
+    uint32_t motion_commands;
+} in;
 static unsigned ticks; /* since setup: the slot of the next sample */
 
 static int setup(void **state)
@@ -28,7 +32,9 @@ static int setup(void **state)
     /* Healthy: 7.4 V, 0.5 A, 3.7 W, 25 degC, moving freely. */
     readings = (struct sensor_readings){
         .voltage_mv = 7400, .current_ma = 500, .power_mw = 3700, .temperature_adc = 2048};
-    in = (struct protection_input){.readings = &readings};
+    in.output_at_limit = 0;
+    in.speed_q8 = 0;
+    in.motion_commands = 0;
     ticks = 0;
     return 0;
 }
@@ -39,8 +45,16 @@ static uint8_t run(unsigned n)
 {
     uint8_t bits = 0;
     for (unsigned i = 0; i < n; i++) {
-        in.slot = (enum sense_slot)(ticks++ % SENSE_ROUND_TICKS);
-        bits = protection_update(&prot, &cfg, &in, &act);
+        enum sense_slot slot = (enum sense_slot)(ticks++ % SENSE_ROUND_TICKS);
+        uint8_t changes = prot.act_changes;
+        uint8_t before_bits = prot.threshold_bits;
+        uint16_t before_cap = prot.act.power_cap_mw;
+        bits = (uint8_t)(protection_update(&prot, &cfg, &readings, slot) |
+                         protection_stall(&prot, &cfg, in.output_at_limit, in.speed_q8,
+                                          in.motion_commands));
+        /* act_changes counts every change the output must follow. */
+        bool changed = before_bits != prot.threshold_bits || before_cap != prot.act.power_cap_mw;
+        assert_true(!changed || prot.act_changes != changes);
     }
     return bits;
 }
@@ -94,8 +108,8 @@ static void test_low_voltage(void **state)
     check_threshold(v, 7400, 4000, 3999, 4199, 4200, STATUS_LOW_VOLTAGE, SENSE_ROUND_TICKS);
     *v = 3999;
     run(PROTECT_TRIP_TICKS);
-    assert_true(act.inhibit);
-    assert_false(act.derate);
+    assert_true(protection_inhibits(prot.threshold_bits));
+    assert_false(protection_derates(prot.threshold_bits));
 }
 
 static void test_high_voltage(void **state)
@@ -105,7 +119,7 @@ static void test_high_voltage(void **state)
                     SENSE_ROUND_TICKS);
     readings.voltage_mv = 8401;
     run(PROTECT_TRIP_TICKS);
-    assert_true(act.inhibit);
+    assert_true(protection_inhibits(prot.threshold_bits));
 }
 
 static void test_over_current(void **state)
@@ -114,8 +128,8 @@ static void test_over_current(void **state)
     check_threshold(&readings.current_ma, 500, 4000, 4001, 3901, 3900, STATUS_OVER_CURRENT, 1);
     readings.current_ma = 4001;
     run(PROTECT_TRIP_TICKS);
-    assert_true(act.derate);
-    assert_false(act.inhibit);
+    assert_true(protection_derates(prot.threshold_bits));
+    assert_false(protection_inhibits(prot.threshold_bits));
 }
 
 static void test_over_power(void **state)
@@ -125,7 +139,7 @@ static void test_over_power(void **state)
                     SENSE_ROUND_TICKS);
     readings.power_mw = 10001;
     run(PROTECT_TRIP_TICKS);
-    assert_true(act.derate);
+    assert_true(protection_derates(prot.threshold_bits));
 }
 
 static void test_over_temperature_trips_at_or_below(void **state)
@@ -139,7 +153,7 @@ static void test_over_temperature_trips_at_or_below(void **state)
                     STATUS_OVER_TEMPERATURE, SENSE_ROUND_TICKS);
     readings.temperature_adc = 600;
     run(PROTECT_TRIP_TICKS);
-    assert_true(act.inhibit);
+    assert_true(protection_inhibits(prot.threshold_bits));
 }
 
 static void test_one_noisy_sample_neither_trips_nor_clears(void **state)
@@ -169,14 +183,14 @@ static void test_several_faults_at_once(void **state)
     assert_int_equal(run(PROTECT_TRIP_TICKS),
                      STATUS_LOW_VOLTAGE | STATUS_OVER_CURRENT | STATUS_OVER_TEMPERATURE);
     assert_int_equal(STATUS_LOW_VOLTAGE | STATUS_OVER_CURRENT | STATUS_OVER_TEMPERATURE, 0xB0);
-    assert_true(act.inhibit && act.derate);
+    assert_true(protection_inhibits(prot.threshold_bits) && protection_derates(prot.threshold_bits));
     readings.voltage_mv = 7400; /* one clears, the others stay */
     assert_int_equal(run(PROTECT_CLEAR_TICKS), STATUS_OVER_CURRENT | STATUS_OVER_TEMPERATURE);
-    assert_true(act.inhibit); /* still hot */
+    assert_true(protection_inhibits(prot.threshold_bits)); /* still hot */
     readings.temperature_adc = 2048;
     readings.current_ma = 100;
     assert_int_equal(run(PROTECT_CLEAR_TICKS), 0);
-    assert_false(act.inhibit || act.derate);
+    assert_false(protection_inhibits(prot.threshold_bits) || protection_derates(prot.threshold_bits));
 }
 
 static void test_limits_follow_the_user_area(void **state)
@@ -246,17 +260,17 @@ static void test_stall_limits_power_in_mode_0(void **state)
     in.output_at_limit = 1;
     in.speed_q8 = STALL_SPEED_Q8 - 1; /* just below 5 deg/s */
     assert_int_equal(run(STALL_TICKS - 1), 0);
-    assert_int_equal(act.power_cap_mw, 0);
+    assert_int_equal(prot.act.power_cap_mw, 0);
     assert_int_equal(run(1), STATUS_STALL);
-    assert_int_equal(act.power_cap_mw, 2500);
-    assert_false(act.release_now);
+    assert_int_equal(prot.act.power_cap_mw, 2500);
+    assert_false(prot.act.release_now);
     /* Still pushing at the (now lower) limit: stays. */
     assert_int_equal(run(1000), STATUS_STALL);
     /* It moves again: clears after the clear time. */
     in.speed_q8 = STALL_SPEED_Q8; /* at the speed limit, the way it pushes */
     assert_int_equal(run(PROTECT_CLEAR_TICKS - 1), STATUS_STALL);
     assert_int_equal(run(1), 0);
-    assert_int_equal(act.power_cap_mw, 0);
+    assert_int_equal(prot.act.power_cap_mw, 0);
 }
 
 static void test_no_stall_while_moving_or_not_pushing(void **state)
@@ -297,10 +311,10 @@ static void test_stall_releases_in_mode_1(void **state)
     in.output_at_limit = 1;
     in.motion_commands = 7;
     assert_int_equal(run(STALL_TICKS), STATUS_STALL);
-    assert_true(act.release_now); /* once */
+    assert_true(prot.act.release_now); /* once */
     in.output_at_limit = 0;    /* released: nothing pushes */
     assert_int_equal(run(1), STATUS_STALL);
-    assert_false(act.release_now);
+    assert_false(prot.act.release_now);
     assert_int_equal(run(5000), STATUS_STALL); /* held until a new command */
     in.motion_commands = 8;
     assert_int_equal(run(1), 0);

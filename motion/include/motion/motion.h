@@ -226,20 +226,8 @@ bool motion_is_idle(const struct motion *m);
 
 /* What the protection monitors require of the output: inhibit releases it
  * and refuses motion until lifted; derate halves the current it may draw;
- * power_cap_mw (0 = none) bounds every move's power. Called every tick:
- * where speed comes first the comparison is inline and only a change costs
- * a call; the Cortex-M0 (size first) makes the call, which compares too. */
-void motion_guard_change(struct motion *m, bool inhibit, bool derate, uint16_t power_cap_mw);
-static inline void motion_guard(struct motion *m, bool inhibit, bool derate, uint16_t power_cap_mw)
-{
-#if defined(__ARM_ARCH_6M__)
-    motion_guard_change(m, inhibit, derate, power_cap_mw);
-#else
-    if (inhibit != m->inhibit || derate != m->derate || power_cap_mw != m->power_cap_mw) {
-        motion_guard_change(m, inhibit, derate, power_cap_mw);
-    }
-#endif
-}
+ * power_cap_mw (0 = none) bounds every move's power. */
+void motion_guard(struct motion *m, bool inhibit, bool derate, uint16_t power_cap_mw);
 /* Releases the output now (a stall in release mode). */
 void motion_release(struct motion *m);
 /* The controller's output was held back by its limit on the last tick:

@@ -52,8 +52,7 @@ RESPONSE_BUDGET_US = {"cortex-m3": 20, "cortex-m0": 30}
 DURABLE_WRITE_BUDGET_US = {"cortex-m3": 200, "cortex-m0": 600}
 DURABLE_WRITES = ("answer_write_data", "answer_write_batch", "answer_reset_user_data")
 NOT_YET_MET = {
-    # the whole tick and the M0 (docs/benchmark.md, "Not met yet")
-    ("cortex-m3", "servo_tick"): 520,
+    # the M0 (docs/benchmark.md, "Not met yet")
     ("cortex-m0", "plan"): 3850,
     ("cortex-m0", "answer_read_batch"): 50, ("cortex-m0", "answer_monitor"): 38,
     ("cortex-m0", "answer_read_angle"): 32, ("cortex-m0", "answer_read_multi_turn"): 34,
