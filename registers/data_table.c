@@ -81,44 +81,33 @@ static const uint8_t *field_of(const struct registers *regs, const struct data_i
     return base + it->offset;
 }
 
+/* Fields are naturally aligned members (offset a multiple of size, checked
+ * by test_data_table): plain loads and stores, where a memcpy of unknown
+ * alignment is a call on the size-first Cortex-M0 build. */
+
 /* The value of a field as a signed 32-bit number (u32 items are never
  * range-checked, so their reinterpretation is harmless). */
 static int32_t field_get(const uint8_t *field, const struct data_item *it)
 {
+    const void *at = field;
     switch (it->size) {
-    case 1: {
-        uint8_t v;
-        memcpy(&v, field, 1);
-        return v;
-    }
+    case 1:
+        return *field;
     case 2:
-        if (it->access & DATA_SIGNED) {
-            int16_t v;
-            memcpy(&v, field, 2);
-            return v;
-        } else {
-            uint16_t v;
-            memcpy(&v, field, 2);
-            return v;
-        }
-    default: {
-        uint32_t v;
-        memcpy(&v, field, 4);
-        return (int32_t)v;
-    }
+        return (it->access & DATA_SIGNED) ? *(const int16_t *)at : *(const uint16_t *)at;
+    default:
+        return (int32_t)*(const uint32_t *)at;
     }
 }
 
 /* Only user-area items are ever written. */
 static void field_set(struct user_config *cfg, const struct data_item *it, int32_t value)
 {
-    uint8_t *field = (uint8_t *)cfg + it->offset;
+    void *field = (uint8_t *)cfg + it->offset;
     if (it->size == 1) {
-        uint8_t v = (uint8_t)value;
-        memcpy(field, &v, 1);
+        *(uint8_t *)field = (uint8_t)value;
     } else if (it->size == 2) {
-        uint16_t v = (uint16_t)value;
-        memcpy(field, &v, 2);
+        *(uint16_t *)field = (uint16_t)value;
     }
 }
 

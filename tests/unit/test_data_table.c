@@ -255,6 +255,22 @@ static void test_the_user_area_is_its_wire_image(void **state)
     }
 }
 
+/* Fields are read and written with plain loads and stores of their size:
+ * each must be naturally aligned in its area. */
+static void test_every_field_is_naturally_aligned(void **state)
+{
+    (void)state;
+    unsigned found = 0;
+    for (unsigned id = 0; id <= 255u; id++) {
+        const struct data_item *it = data_table_find((uint8_t)id);
+        if (it != NULL) {
+            found++;
+            assert_int_equal(it->offset % it->size, 0);
+        }
+    }
+    assert_true(found >= 30u);
+}
+
 static void test_reset_keeps_id_and_baud(void **state)
 {
     (void)state;
@@ -294,6 +310,7 @@ int main(void)
         cmocka_unit_test_setup(test_cross_item_rules, setup),
         cmocka_unit_test_setup(test_batch_decode_is_all_or_nothing, setup),
         cmocka_unit_test_setup(test_the_user_area_is_its_wire_image, setup),
+        cmocka_unit_test_setup(test_every_field_is_naturally_aligned, setup),
         cmocka_unit_test_setup(test_reset_keeps_id_and_baud, setup),
         cmocka_unit_test_setup(test_baud_rates, setup),
     };

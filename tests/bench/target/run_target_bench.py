@@ -54,11 +54,9 @@ DURABLE_WRITES = ("answer_write_data", "answer_write_batch", "answer_reset_user_
 NOT_YET_MET = {
     # the M0 (docs/benchmark.md, "Not met yet")
     ("cortex-m0", "plan"): 3850,
-    ("cortex-m0", "answer_read_batch"): 50, ("cortex-m0", "answer_monitor"): 38,
-    ("cortex-m0", "answer_read_angle"): 32, ("cortex-m0", "answer_read_multi_turn"): 34,
-    ("cortex-m0", "answer_read_motion"): 45, ("cortex-m0", "answer_read_store"): 45,
-    ("cortex-m0", "answer_update_status"): 33, ("cortex-m0", "answer_write_same"): 34,
-    ("cortex-m0", "answer_sync_monitor"): 42, ("cortex-m0", "answer_assign_id"): 33,
+    ("cortex-m0", "answer_read_batch"): 45, ("cortex-m0", "answer_monitor"): 35,
+    ("cortex-m0", "answer_read_motion"): 40, ("cortex-m0", "answer_read_store"): 40,
+    ("cortex-m0", "answer_sync_monitor"): 38,
 }
 
 
