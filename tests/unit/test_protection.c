@@ -304,6 +304,29 @@ static void test_pushed_backwards_at_the_limit_is_a_stall(void **state)
     assert_int_equal(run(3 * STALL_TICKS), 0);
 }
 
+/* Settings changed while a stall is set reach the output: a new stall power
+ * (38) while capped, and release mode (37) switched on mid-stall, which
+ * shows only a stall it latched itself. */
+static void test_stall_settings_change_mid_stall(void **state)
+{
+    (void)state;
+    cfg.stall_release = 0;
+    cfg.stall_power_mw = 2500;
+    in.output_at_limit = 1;
+    in.speed_q8 = 0;
+    assert_int_equal(run(STALL_TICKS), STATUS_STALL);
+    assert_int_equal(prot.act.power_cap_mw, 2500);
+    uint8_t changes = prot.act_changes;
+    cfg.stall_power_mw = 1500;
+    assert_int_equal(run(1), STATUS_STALL);
+    assert_int_equal(prot.act.power_cap_mw, 1500);
+    assert_int_not_equal(prot.act_changes, changes);
+    cfg.stall_release = 1;
+    assert_int_equal(run(1), 0);
+    assert_int_equal(prot.act.power_cap_mw, 0);
+    assert_false(prot.act.release_now);
+}
+
 static void test_stall_releases_in_mode_1(void **state)
 {
     (void)state;
@@ -335,6 +358,7 @@ int main(void)
         cmocka_unit_test_setup(test_stall_limits_power_in_mode_0, setup),
         cmocka_unit_test_setup(test_no_stall_while_moving_or_not_pushing, setup),
         cmocka_unit_test_setup(test_pushed_backwards_at_the_limit_is_a_stall, setup),
+        cmocka_unit_test_setup(test_stall_settings_change_mid_stall, setup),
         cmocka_unit_test_setup(test_stall_releases_in_mode_1, setup),
     };
     return cmocka_run_group_tests_name("protection", tests, NULL, NULL);
