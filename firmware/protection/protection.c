@@ -190,8 +190,8 @@ uint8_t protection_watch_stall(struct protection *p, const struct user_config *c
 
 /* The quiet case inline where speed comes first (a clear monitor, its
  * reading within the limit: most ticks), the rest in judge(); all of it in
- * judge() where size does (PROTECTION_SMALL: the Cortex-M0). */
-#ifdef PROTECTION_SMALL
+ * judge() where size does (SERVO_SIZE_FIRST: the Cortex-M0). */
+#ifdef SERVO_SIZE_FIRST
 #define watch judge
 #else
 static inline __attribute__((always_inline)) void watch(struct protection *p,

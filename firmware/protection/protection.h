@@ -103,12 +103,12 @@ uint8_t protection_watch_stall(struct protection *p, const struct user_config *c
 
 /* The stall monitor, once a tick: most ticks (not at the limit, nothing
  * counted, set or latched) it has nothing to do, which is told without a
- * call where speed comes first (PROTECTION_SMALL: the Cortex-M0 calls). */
+ * call where speed comes first (SERVO_SIZE_FIRST: the Cortex-M0 calls). */
 static inline uint8_t protection_stall(struct protection *p, const struct user_config *cfg,
                                        int8_t output_at_limit, int32_t speed_q8,
                                        uint32_t motion_commands)
 {
-#ifndef PROTECTION_SMALL
+#ifndef SERVO_SIZE_FIRST
     if (output_at_limit == 0 && !p->stall_busy) {
         return 0;
     }

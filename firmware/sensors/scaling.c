@@ -2,8 +2,8 @@
 
 
 /* The per-tick helpers inline where speed comes first; one copy of each
- * where size does (SENSORS_SMALL: the Cortex-M0). */
-#ifdef SENSORS_SMALL
+ * where size does (SERVO_SIZE_FIRST: the Cortex-M0). */
+#ifdef SERVO_SIZE_FIRST
 #define TICK_HELPER static
 #else
 #define TICK_HELPER static inline __attribute__((always_inline))

@@ -4,7 +4,7 @@
 
 #include "protocol/wire.h"
 
-#ifndef FRAME_TX_SMALL
+#ifndef SERVO_SIZE_FIRST
 /* The byte sum, four bytes a pass: a response is up to 40 bytes, and its
  * encoding is on the path from request to answer. */
 static uint8_t byte_sum(const uint8_t *p, uint32_t n)
@@ -28,8 +28,8 @@ uint8_t frame_tx_encode(const struct response *r, uint8_t out[RESPONSE_FRAME_MAX
     out[1] = WIRE_RESPONSE_HDR1;
     out[2] = r->code;
     out[3] = length;
-#ifdef FRAME_TX_SMALL
-    /* Copied and summed in one pass: the size-first image (FRAME_TX_SMALL,
+#ifdef SERVO_SIZE_FIRST
+    /* Copied and summed in one pass: the size-first image (SERVO_SIZE_FIRST,
      * the Cortex-M0) copies a byte at a time anyway. */
     uint32_t sum = (uint32_t)WIRE_RESPONSE_HDR0 + WIRE_RESPONSE_HDR1 + r->code + length;
     for (uint32_t i = 0; i < length; i++) {
