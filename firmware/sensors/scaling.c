@@ -1,6 +1,5 @@
 #include "scaling.h"
 
-
 /* The per-tick helpers inline where speed comes first; one copy of each
  * where size does (SERVO_SIZE_FIRST: the Cortex-M0). */
 #ifdef SERVO_SIZE_FIRST
