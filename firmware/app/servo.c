@@ -67,7 +67,7 @@ static void start_send(struct servo *s)
 {
     s->tx.waiting = 0;
     s->tx.sending = 1;
-    s->hal->bus.send(s->hal->ctx, s->tx.frame, s->tx.size);
+    s->hal->bus.send(s->hal->ctx, frame_tx_bytes(&s->tx.frame), s->tx.size);
 }
 
 /* Sync Monitor: each listed servo answers after the ones listed before it.
@@ -88,10 +88,10 @@ static void wait_for_turn(struct servo *s, uint32_t now)
     }
 }
 
-static void queue_response(struct servo *s, const struct response *r, uint8_t wait,
-                           uint32_t responses_base, uint32_t now)
+/* s->tx.frame holds the response. */
+static void queue_response(struct servo *s, uint8_t wait, uint32_t responses_base, uint32_t now)
 {
-    s->tx.size = frame_tx_encode(r, s->tx.frame);
+    s->tx.size = frame_tx_seal(&s->tx.frame);
     s->tx.turns_left = wait;
     s->tx.responses_base = responses_base;
     s->tx.requests_base = s->rx.stats.requests_seen;
@@ -127,8 +127,12 @@ static void answer_finished_move(struct servo *s, uint32_t now)
     if (packet == 0u) {
         return;
     }
-    struct response r = {.code = packet, .length = 2, .content = {s->active_id, 1}};
-    queue_response(s, &r, 0, 0, now);
+    struct response *r = &s->tx.frame;
+    r->code = packet;
+    r->length = 2;
+    r->content[0] = s->active_id;
+    r->content[1] = 1;
+    queue_response(s, 0, 0, now);
 }
 
 /* Status bit 0 follows the motion: after each tick and each command. */
@@ -150,9 +154,10 @@ static void handle_next_frame(struct servo *s, uint32_t now)
      * servo's slot: it is not sent, and ReadStore counts it. */
     bool late = s->stale_frames != 0u;
     s->stale_frames = (uint8_t)(s->stale_frames - late);
-    struct response r;
+    /* Nothing is being sent or waits to be (servo_poll): the response is
+     * built in the transmit frame. */
     struct dispatch_result result;
-    dispatch(&s->dispatcher, frame, &r, &result);
+    dispatch(&s->dispatcher, frame, &s->tx.frame, &result);
     uint32_t responses_base = frame->responses_seen;
     frame_rx_release(&s->rx);
     show_executing(s);
@@ -163,7 +168,7 @@ static void handle_next_frame(struct servo *s, uint32_t now)
     if (result.answer && late) {
         s->answers_dropped++;
     } else if (result.answer) {
-        queue_response(s, &r, result.wait_responses, responses_base, now);
+        queue_response(s, result.wait_responses, responses_base, now);
     }
 }
 

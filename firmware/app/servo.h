@@ -46,7 +46,7 @@
 #define CONTROL_TICK_US (1000000u / MOTION_TICK_HZ)
 
 struct servo_tx {
-    uint8_t frame[RESPONSE_FRAME_MAX];
+    struct response frame;     /* built in place, sent from here */
     uint8_t size;
     uint8_t sending;           /* handed to the UART, not yet off the wire */
     uint8_t waiting;           /* ready, waiting for its turn (sync Monitor) */

@@ -42,16 +42,16 @@ bool boot_loop_step(struct boot_loop *l)
     }
     const struct rx_frame *f = frame_rx_peek(&l->rx);
     if (f != NULL) {
-        struct response r;
         uint8_t code = f->code;
         bool answered = !(f->flags & FRAME_TRUNCATED) && f->stored == f->length &&
-                        boot_packet(&l->core, code, f->content, f->length, &r);
+                        boot_packet(&l->core, code, f->content, f->length, &l->frame);
         frame_rx_release(&l->rx);
         if (answered) {
             if (code != PKT_PING) {
                 boot_flow_heard(&l->flow);
             }
-            port->bus.send(port->ctx, l->frame, frame_tx_encode(&r, l->frame));
+            uint8_t size = frame_tx_seal(&l->frame);
+            port->bus.send(port->ctx, frame_tx_bytes(&l->frame), size);
             l->sending = 1;
         }
         return true;

@@ -39,7 +39,7 @@ struct boot_loop {
     uint8_t sending;         /* an answer is going out */
     uint32_t started_us;
     uint32_t idle_us;        /* a partial frame is dropped after this silence */
-    uint8_t frame[RESPONSE_FRAME_MAX];
+    struct response frame;   /* built in place, sent from here */
 };
 
 /* After reset: the stored ID and baud rate (config_peek.c) to the UART,

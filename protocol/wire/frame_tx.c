@@ -1,46 +1,31 @@
 #include "protocol/frame_tx.h"
 
-#include <string.h>
-
 #include "protocol/wire.h"
 
-#ifndef SERVO_SIZE_FIRST
-/* The byte sum, four bytes a pass: a response is up to 40 bytes, and its
- * encoding is on the path from request to answer. */
-static uint8_t byte_sum(const uint8_t *p, uint32_t n)
+/* Two bytes of a word into each 16-bit lane: 20 bytes a lane at most, so
+ * no lane carries into the other. */
+static uint32_t byte_pairs(uint32_t word)
 {
-    uint32_t sum = 0;
-    uint32_t i = 0;
-    for (; i + 4u <= n; i += 4u) {
-        sum += (uint32_t)p[i] + p[i + 1u] + p[i + 2u] + p[i + 3u];
-    }
-    for (; i < n; i++) {
-        sum += p[i];
-    }
-    return (uint8_t)sum;
+    return (word & 0x00FF00FFu) + ((word >> 8) & 0x00FF00FFu);
 }
-#endif
 
-uint8_t frame_tx_encode(const struct response *r, uint8_t out[RESPONSE_FRAME_MAX])
+uint8_t frame_tx_seal(struct response *r)
 {
-    uint8_t length = r->length <= RESPONSE_CONTENT_MAX ? r->length : RESPONSE_CONTENT_MAX;
-    out[0] = WIRE_RESPONSE_HDR0;
-    out[1] = WIRE_RESPONSE_HDR1;
-    out[2] = r->code;
-    out[3] = length;
-#ifdef SERVO_SIZE_FIRST
-    /* Copied and summed in one pass: the size-first image (SERVO_SIZE_FIRST,
-     * the Cortex-M0) copies a byte at a time anyway. */
-    uint32_t sum = (uint32_t)WIRE_RESPONSE_HDR0 + WIRE_RESPONSE_HDR1 + r->code + length;
-    for (uint32_t i = 0; i < length; i++) {
-        uint8_t byte = r->content[i];
-        out[WIRE_HEADER_SIZE + i] = byte;
-        sum += byte;
-    }
-    out[WIRE_HEADER_SIZE + length] = (uint8_t)sum;
-#else
-    memcpy(&out[WIRE_HEADER_SIZE], r->content, length);
-    out[WIRE_HEADER_SIZE + length] = byte_sum(out, WIRE_HEADER_SIZE + (uint32_t)length);
-#endif
+    uint32_t length = r->length <= RESPONSE_CONTENT_MAX ? r->length : RESPONSE_CONTENT_MAX;
+    r->header[0] = WIRE_RESPONSE_HDR0;
+    r->header[1] = WIRE_RESPONSE_HDR1;
+    r->length = (uint8_t)length;
+    /* The checksum is the low byte of the sum of every byte before it;
+     * the bytes after the content are zeroed so that whole words sum. */
+    r->content[length] = 0;
+    r->content[length + 1u] = 0;
+    r->content[length + 2u] = 0;
+    const uint32_t *word = r->words;
+    const uint32_t *end = &r->words[(WIRE_HEADER_SIZE + length + 3u) / 4u];
+    uint32_t lanes = 0;
+    do { /* the header is a word at least */
+        lanes += byte_pairs(*word++);
+    } while (word != end);
+    r->content[length] = (uint8_t)(lanes + (lanes >> 16));
     return (uint8_t)(WIRE_HEADER_SIZE + length + 1u);
 }
