@@ -7,10 +7,30 @@
 #include <stdint.h>
 #include <string.h>
 
+#ifndef STARTUP_BOOTLOADER
+/* A word that may alias any object (memcpy copies any type). */
+typedef uint32_t __attribute__((may_alias)) any_word;
+#endif
+
 void *memcpy(void *restrict dst, const void *restrict src, size_t n)
 {
     uint8_t *d = dst;
     const uint8_t *s = src;
+#ifndef STARTUP_BOOTLOADER
+    /* The application's longest copies (ReadBatchData's 32 bytes, on the
+     * way to an answer) come from word-aligned registers: read a word at a
+     * time, stored a byte at a time, since the destination may be at any
+     * byte and the Cortex-M0 faults on an unaligned word. */
+    if (((uintptr_t)s & 3u) == 0u) {
+        for (; n >= 4u; n -= 4u, s += 4u, d += 4u) {
+            uint32_t w = *(const any_word *)(const void *)s;
+            d[0] = (uint8_t)w;
+            d[1] = (uint8_t)(w >> 8);
+            d[2] = (uint8_t)(w >> 16);
+            d[3] = (uint8_t)(w >> 24);
+        }
+    }
+#endif
     while (n--) {
         *d++ = *s++;
     }
