@@ -27,47 +27,36 @@ static bool answers(const struct dispatcher *d, uint8_t flags)
            ((flags & PF_ANSWERS_IF_CONTROL_RESPONSE) && d->regs->user.control_response);
 }
 
-void dispatch_packet(struct dispatcher *d, const struct packet_desc *desc,
-                     const uint8_t *content, uint16_t length, struct packet_origin origin,
-                     struct response *response, struct dispatch_result *result)
+void dispatch_packet(const struct packet_desc *desc, struct packet_call *call,
+                     struct response *response)
 {
+    struct dispatcher *d = call->d;
+    struct packet_origin origin = call->origin;
     /* Answering packets would make every servo talk at once. */
     if (origin.broadcast && !(desc->flags & PF_BROADCAST)) {
         return;
     }
     bool alone = !origin.broadcast && !origin.from_sync;
-    const struct packet_call call = {
-        .d = d,
-        .content = content,
-        .length = length,
-        .code = desc->code,
-        .answer_when_done = alone && d->regs->user.control_response,
-        .sync_index = origin.sync_index,
-        .result = result,
-    };
+    call->code = desc->code;
+    call->answer_when_done = alone && d->regs->user.control_response;
     response->code = desc->code;
     response->length = 0;
     /* Every answer starts with the ID its request carried (content points
      * into a frame or a sync record, never at less than one byte). */
-    response->content[0] = content[0];
+    response->content[0] = call->content[0];
 
-    enum packet_outcome outcome = desc->handler(&call, response);
-    switch (outcome) {
-    case OUTCOME_NONE:
+    enum packet_outcome outcome = desc->handler(call, response);
+    if (outcome == OUTCOME_NONE) {
         return;
-    case OUTCOME_FAILED:
-    case OUTCOME_ERROR:
-        set_command_error(d, true);
-        break;
-    default:
-        if (!(desc->flags & PF_QUERY)) {
-            set_command_error(d, false);
-        }
-        break;
+    }
+    bool failed = outcome == OUTCOME_FAILED || outcome == OUTCOME_ERROR;
+    if (failed || !(desc->flags & PF_QUERY)) {
+        set_command_error(d, failed);
     }
     /* Sync records answer only where the packet always answers (Monitor). */
     bool may_answer = alone || (origin.from_sync && (desc->flags & PF_ANSWERS)) ||
                       (origin.broadcast && (desc->flags & PF_ONE_ANSWERS));
+    struct dispatch_result *result = call->result;
     result->answer = may_answer && answers(d, desc->flags) &&
                      (outcome == OUTCOME_OK || outcome == OUTCOME_FAILED);
     if (origin.from_sync) {
@@ -107,7 +96,15 @@ void dispatch(struct dispatcher *d, const struct rx_frame *frame, struct respons
         set_command_error(d, true);
         return;
     }
-    dispatch_packet(d, desc, frame->content, frame->length, origin, response, result);
+    /* Field by field: an initializer would clear the rest by a call to
+     * memset (the M0), and dispatch_packet() sets the rest. */
+    struct packet_call call;
+    call.d = d;
+    call.content = frame->content;
+    call.length = frame->length;
+    call.origin = origin;
+    call.result = result;
+    dispatch_packet(desc, &call, response);
 }
 
 enum packet_outcome answer_result(struct response *r, bool ok)
@@ -126,14 +123,17 @@ enum packet_outcome handle_ignored(const struct packet_call *c, struct response 
 
 enum packet_outcome handle_sync(const struct packet_call *c, struct response *r)
 {
-    if (c->sync_index == FRAME_SYNC_NO_RECORD) {
+    if (c->origin.sync_index == FRAME_SYNC_NO_RECORD) {
         return OUTCOME_NONE; /* no record for this servo */
     }
     const struct packet_desc *inner = packet_find(c->content[0]);
     if (inner == NULL || !(inner->flags & PF_SYNCABLE) || c->content[1] != inner->length.min) {
         return OUTCOME_ERROR;
     }
-    struct packet_origin origin = {.from_sync = true, .sync_index = c->sync_index};
-    dispatch_packet(c->d, inner, &c->content[3], c->content[1], origin, r, c->result);
+    struct packet_call record = *c;
+    record.content = &c->content[3];
+    record.length = c->content[1];
+    record.origin.from_sync = true;
+    dispatch_packet(inner, &record, r);
     return OUTCOME_NONE;
 }

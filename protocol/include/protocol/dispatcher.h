@@ -33,7 +33,8 @@ struct dispatcher {
 };
 
 struct dispatch_result {
-    bool answer;            /* response holds a frame to send */
+    /* Word-aligned: cleared by one store, not a call (the M0's memset). */
+    _Alignas(uint32_t) bool answer; /* response holds a frame to send */
     bool config_changed;    /* the user area changed (and is durable) */
     /* Sync Monitor: let this many other servos' responses pass first. */
     uint8_t wait_responses;

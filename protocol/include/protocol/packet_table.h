@@ -29,14 +29,22 @@ enum packet_outcome {
     OUTCOME_NONE,     /* not for this servo, or already handled: nothing */
 };
 
+/* Where a request came from. */
+struct packet_origin {
+    bool broadcast;     /* sent to 0xFF */
+    bool from_sync;     /* a SyncCommand record */
+    uint8_t sync_index; /* SyncCommand: position of this servo's record */
+};
+
 /* What a handler sees of the request it runs. */
 struct packet_call {
     struct dispatcher *d;
     const uint8_t *content;
     uint16_t length;
+    struct packet_origin origin;
+    /* Set by dispatch_packet(): */
     uint8_t code;
     bool answer_when_done; /* control response on and addressed to us alone */
-    uint8_t sync_index;    /* SyncCommand: position of this servo's record */
     struct dispatch_result *result;
 };
 
@@ -85,15 +93,10 @@ enum packet_outcome handle_sync(const struct packet_call *c, struct response *r)
 enum packet_outcome handle_ignored(const struct packet_call *c, struct response *r);
 
 /* Runs one packet for this servo, as dispatch() does for a whole frame;
- * SyncCommand runs its record through it. */
-struct packet_origin {
-    bool broadcast;      /* sent to 0xFF */
-    bool from_sync;      /* a SyncCommand record */
-    uint8_t sync_index;
-};
-void dispatch_packet(struct dispatcher *d, const struct packet_desc *desc,
-                     const uint8_t *content, uint16_t length, struct packet_origin origin,
-                     struct response *response, struct dispatch_result *result);
+ * SyncCommand runs its record through it. The caller fills in call's
+ * request (d, content, length, origin, result). */
+void dispatch_packet(const struct packet_desc *desc, struct packet_call *call,
+                     struct response *response);
 
 /* The "id, result" answer most packets give (dispatch_packet has put the
  * ID in already). */
