@@ -76,9 +76,10 @@ void motion_move_origin(struct motion *m, int32_t counts)
     m->encoder.counts -= whole;
 }
 
-static int32_t wrap_single_turn(int32_t decideg)
+/* The angle within its turn, [-180, 180) degrees. */
+static int32_t wrap_single_turn(int32_t decideg, int32_t turns)
 {
-    int32_t r = decideg % DECIDEG_PER_TURN;
+    int32_t r = decideg - turns * DECIDEG_PER_TURN;
     if (r >= DECIDEG_PER_TURN / 2) {
         r -= DECIDEG_PER_TURN;
     } else if (r < -DECIDEG_PER_TURN / 2) {
@@ -91,14 +92,19 @@ void motion_read_angle(const struct motion *m, struct motion_angle *out)
 {
     int32_t angle = q8_to_decideg(m->measured_q8 - motion_center_offset_q8(m));
     out->multi_turn_decideg = angle;
-    out->turns = (int16_t)(angle / DECIDEG_PER_TURN);
-    out->single_turn_decideg = (int16_t)wrap_single_turn(angle);
+    int32_t turns = decideg_whole_turns(angle);
+    out->turns = (int16_t)turns;
+    out->single_turn_decideg = (int16_t)wrap_single_turn(angle, turns);
 }
 
 static int16_t saturate_i16(int32_t v)
 {
     return (int16_t)(v > INT16_MAX ? INT16_MAX : v < -INT16_MAX ? -INT16_MAX : v);
 }
+
+/* Errors this large (1638 deg) already saturate the answer's centidegrees;
+ * clamped to it, x 10 stays in 32 bits (no 64-bit multiply on the M0). */
+#define TRACKING_ERROR_SPAN_Q8 (INT32_C(1) << 22)
 
 void motion_read_diagnostics(const struct motion *m, struct motion_diagnostics *out)
 {
@@ -113,7 +119,7 @@ void motion_read_diagnostics(const struct motion *m, struct motion_diagnostics *
         .setpoint_decideg = q8_to_decideg(setpoint - offset),
         .target_decideg = (int32_t)((target - q8_to_q32(offset) + (DECIDEG_Q32 / 2)) >> 32),
         .velocity_decideg_s = saturate_i16(m->measured_velocity_q8 * 125 / 32),
-        .tracking_error_centideg = saturate_i16((int32_t)(((int64_t)error_q8 * 10) / 256)),
+        .tracking_error_centideg = saturate_i16(sat_q(error_q8, TRACKING_ERROR_SPAN_Q8) * 10 / 256),
         .flags = (uint8_t)((controlled && m->tick >= m->profile.total_ticks ? DIAG_PROFILE_ENDED : 0u) |
                            (controlled && m->clock_rate != CLOCK_REAL_TIME ? DIAG_CLOCK_SLOWED : 0u) |
                            (controlled && m->braking ? DIAG_BRAKING : 0u) |

@@ -1,5 +1,6 @@
 /* The planner's 64-bit division (motion/div64.h) against the compiler's,
- * on edge cases and a million random pairs. */
+ * on edge cases and a million random pairs; the whole turns of an angle
+ * against C's division. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -96,6 +97,23 @@ static void test_rounding(void **state_)
     }
 }
 
+/* Every angle in the fast range, both signs, and the slow path's edges and
+ * extremes, against C's division. */
+static void test_whole_turns(void **state_)
+{
+    (void)state_;
+    for (int32_t a = -(1 << 23) - 4; a <= (1 << 23) + 4; a++) {
+        if (decideg_whole_turns(a) != a / 3600) {
+            fail_msg("%ld / 3600: %ld, not %ld", (long)a, (long)decideg_whole_turns(a),
+                     (long)(a / 3600));
+        }
+    }
+    const int32_t far[] = {INT32_MAX, INT32_MIN, INT32_MIN + 1, 14743472, -14743472, 1 << 30};
+    for (size_t i = 0; i < sizeof far / sizeof far[0]; i++) {
+        assert_int_equal(decideg_whole_turns(far[i]), far[i] / 3600);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -103,6 +121,7 @@ int main(void)
         cmocka_unit_test(test_random),
         cmocka_unit_test(test_rounding),
         cmocka_unit_test(test_multiply_by_halves),
+        cmocka_unit_test(test_whole_turns),
     };
     return cmocka_run_group_tests_name("div64", tests, NULL, NULL);
 }
