@@ -54,9 +54,6 @@ DURABLE_WRITES = ("answer_write_data", "answer_write_batch", "answer_reset_user_
 NOT_YET_MET = {
     # the M0 (docs/benchmark.md, "Not met yet")
     ("cortex-m0", "plan"): 3850,
-    ("cortex-m0", "answer_read_batch"): 45, ("cortex-m0", "answer_monitor"): 35,
-    ("cortex-m0", "answer_read_motion"): 40, ("cortex-m0", "answer_read_store"): 40,
-    ("cortex-m0", "answer_sync_monitor"): 38,
 }
 
 
