@@ -22,17 +22,24 @@ uint64_t small_udivmod(uint32_t n, uint32_t d)
      * M0 has no CLZ, and libgcc's takes 60 bytes.) */
     uint32_t step = d;
     uint32_t bit = 1u;
-    while (step <= n >> 1) {
+    uint32_t half = n >> 1;
+    while (step <= half >> 4) { /* four bits a step, then one */
+        step <<= 4;
+        bit <<= 4;
+    }
+    while (step <= half) {
         step <<= 1;
         bit <<= 1;
     }
     uint32_t q = 0;
-    for (; bit != 0u; bit >>= 1, step >>= 1) {
+    do {
         if (n >= step) {
             n -= step;
             q |= bit;
         }
-    }
+        step >>= 1;
+        bit >>= 1;
+    } while (bit != 0u);
     return ((uint64_t)n << 32) | q;
 }
 

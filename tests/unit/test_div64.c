@@ -97,20 +97,15 @@ static void test_rounding(void **state_)
     }
 }
 
-/* Every angle in the fast range, both signs, and the slow path's edges and
- * extremes, against C's division. */
+/* Every angle in its range, both signs, against C's division. */
 static void test_whole_turns(void **state_)
 {
     (void)state_;
-    for (int32_t a = -(1 << 23) - 4; a <= (1 << 23) + 4; a++) {
+    for (int32_t a = -(1 << 23); a <= (1 << 23); a++) {
         if (decideg_whole_turns(a) != a / 3600) {
             fail_msg("%ld / 3600: %ld, not %ld", (long)a, (long)decideg_whole_turns(a),
                      (long)(a / 3600));
         }
-    }
-    const int32_t far[] = {INT32_MAX, INT32_MIN, INT32_MIN + 1, 14743472, -14743472, 1 << 30};
-    for (size_t i = 0; i < sizeof far / sizeof far[0]; i++) {
-        assert_int_equal(decideg_whole_turns(far[i]), far[i] / 3600);
     }
 }
 

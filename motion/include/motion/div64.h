@@ -38,16 +38,14 @@ static inline uint64_t mul_u32(uint32_t a, uint32_t b)
 /* num / den rounded to nearest, halves away from zero; den > 0. */
 int64_t div64_round(int64_t num, int64_t den);
 
-/* decideg / 3600 (whole turns), truncated as C divides, without the M0's
- * software division for |decideg| < 2^23 (every angle a Q8 int32 holds):
- * 3600 = 16 x 225, and 4661 / 2^20 is 1/225 by a little over, so the
- * product is the quotient or one more (test_div64 checks the range). */
+/* decideg / 3600 (whole turns), truncated as C divides, for
+ * |decideg| <= 2^23 (every angle a Q8 int32 holds, what q8_to_decideg
+ * gives), without the M0's software division: 3600 = 16 x 225, and
+ * 4661 / 2^20 is 1/225 by a little over, so the product is the quotient or
+ * one more (test_div64 checks the whole range). */
 static inline int32_t decideg_whole_turns(int32_t decideg)
 {
     uint32_t size = decideg < 0 ? 0u - (uint32_t)decideg : (uint32_t)decideg;
-    if (size >= (UINT32_C(1) << 23)) {
-        return decideg / 3600;
-    }
     uint32_t turns = ((size >> 4) * 4661u) >> 20;
     turns -= turns * 3600u > size ? 1u : 0u;
     return decideg < 0 ? -(int32_t)turns : (int32_t)turns;
