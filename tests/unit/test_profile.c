@@ -153,6 +153,41 @@ static void test_short_stroke_example(void **state)
     check_profile(&p);
 }
 
+/* A stroke too short for its ramps shrinks both by distance / ramps: each
+ * ramp's ticks the exact floor, their sum the exact rounded quotient. */
+static void test_short_strokes_count_exactly(void **state)
+{
+    (void)state;
+    srand(7);
+    unsigned checked = 0;
+    for (int i = 0; i < 20000; i++) {
+        uint32_t accel = 1u + (uint32_t)rand() % 3000u;
+        uint32_t decel = 1u + (uint32_t)rand() % 3000u;
+        int64_t vmax = velocity_q32(1u + (uint32_t)rand() % 40000u);
+        int64_t v0 = rand() % 2 ? 0 : velocity_q32((uint32_t)rand() % 20000u) * (rand() % 2 ? 1 : -1);
+        int64_t distance = (int64_t)(rand() % 36000 - 18000) * DECIDEG_Q32 + rand();
+        int64_t v = distance >= 0 ? vmax : -vmax;
+        int64_t ramps = ((v0 + v) * (int64_t)accel + v * (int64_t)decel) / 2;
+        int64_t rest = distance - ramps;
+        if (distance == 0 || rest == 0 || (rest > 0) == (v > 0) || (ramps > 0) != (distance > 0)) {
+            continue; /* not a short stroke */
+        }
+        uint64_t d16 = (uint64_t)llabs(distance) >> 16;
+        uint64_t r16 = (uint64_t)llabs(ramps) >> 16;
+        if (r16 == 0u) {
+            continue;
+        }
+        struct profile_timing t = profile_velocity_timing(distance, v0, vmax, accel, decel);
+        __extension__ typedef unsigned __int128 u128;
+        assert_int_equal(t.accel, (uint64_t)((u128)accel * d16 / r16));
+        assert_int_equal(t.decel, (uint64_t)((u128)decel * d16 / r16));
+        u128 sum = (u128)(accel + decel) * d16;
+        assert_int_equal(t.accel + t.cruise + t.decel, (uint64_t)((sum + r16 / 2u) / r16));
+        checked++;
+    }
+    assert_true(checked > 1000u);
+}
+
 static void test_negative_and_multi_turn(void **state)
 {
     (void)state;
@@ -373,6 +408,7 @@ int main(void)
         cmocka_unit_test(test_interval_example),
         cmocka_unit_test(test_velocity_example),
         cmocka_unit_test(test_short_stroke_example),
+        cmocka_unit_test(test_short_strokes_count_exactly),
         cmocka_unit_test(test_negative_and_multi_turn),
         cmocka_unit_test(test_endless),
         cmocka_unit_test(test_too_fast_moves_take_longer),
