@@ -75,3 +75,13 @@ int64_t div64_round(int64_t num, int64_t den)
     return -(int64_t)div64_u((uint64_t)-num + d / 2u, d);
 }
 
+
+/* x = 125 a + b; each / 125 is a multiply by 33 555 / 2^22, exact for
+ * what it divides here (x < 59 074, and 37 b < 9 250 with a one short). */
+uint64_t thousandth_q32(uint32_t x)
+{
+    uint32_t a = (x * 33555u) >> 22;
+    uint32_t b = x - 125u * a;
+    /* 2^29 / 125 = 4 294 967 + 37 / 125 */
+    return ((uint64_t)a << 29) + b * 4294967u + ((b * 37u * 33555u) >> 22);
+}

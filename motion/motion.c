@@ -235,7 +235,8 @@ static void begin_profile(struct motion *m, uint8_t end)
 /* Q32 decideg per tick for a velocity in 0.1 deg/s. */
 static int64_t velocity_q32(uint32_t decideg_per_s)
 {
-    return (int64_t)div64_u((uint64_t)decideg_per_s << 32, MOTION_TICK_HZ);
+    _Static_assert(MOTION_TICK_HZ == 1000u && MAX_VELOCITY < 59074, "thousandth_q32's range");
+    return (int64_t)thousandth_q32(decideg_per_s);
 }
 
 

@@ -109,6 +109,17 @@ static void test_whole_turns(void **state_)
     }
 }
 
+static void test_thousandths(void **state_)
+{
+    (void)state_;
+    for (uint32_t x = 0; x < 59074u; x++) {
+        if (thousandth_q32(x) != ((uint64_t)x << 32) / 1000u) {
+            fail_msg("%lu x 2^32 / 1000: %llu", (unsigned long)x,
+                     (unsigned long long)thousandth_q32(x));
+        }
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -117,6 +128,7 @@ int main(void)
         cmocka_unit_test(test_rounding),
         cmocka_unit_test(test_multiply_by_halves),
         cmocka_unit_test(test_whole_turns),
+        cmocka_unit_test(test_thousandths),
     };
     return cmocka_run_group_tests_name("div64", tests, NULL, NULL);
 }

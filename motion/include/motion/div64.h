@@ -38,6 +38,11 @@ static inline uint64_t mul_u32(uint32_t a, uint32_t b)
 /* num / den rounded to nearest, halves away from zero; den > 0. */
 int64_t div64_round(int64_t num, int64_t den);
 
+/* x 2^32 / 1000, rounded down, for x < 59 074 (a speed in 0.1 deg/s to
+ * Q32 decideg per 1 ms tick), without a division (test_div64 checks every
+ * x). */
+uint64_t thousandth_q32(uint32_t x);
+
 /* decideg / 3600 (whole turns), truncated as C divides, for
  * |decideg| <= 2^23 (every angle a Q8 int32 holds, what q8_to_decideg
  * gives), without the M0's software division: 3600 = 16 x 225, and
@@ -45,10 +50,11 @@ int64_t div64_round(int64_t num, int64_t den);
  * one more (test_div64 checks the whole range). */
 static inline int32_t decideg_whole_turns(int32_t decideg)
 {
-    uint32_t size = decideg < 0 ? 0u - (uint32_t)decideg : (uint32_t)decideg;
+    uint32_t negative = decideg < 0 ? UINT32_MAX : 0u; /* signs by xor: no branch */
+    uint32_t size = ((uint32_t)decideg ^ negative) - negative;
     uint32_t turns = ((size >> 4) * 4661u) >> 20;
     turns -= turns * 3600u > size ? 1u : 0u;
-    return decideg < 0 ? -(int32_t)turns : (int32_t)turns;
+    return (int32_t)((turns ^ negative) - negative);
 }
 
 #endif
