@@ -16,13 +16,14 @@ void *memcpy(void *restrict dst, const void *restrict src, size_t n)
 {
     uint8_t *d = dst;
     const uint8_t *s = src;
+    const uint8_t *end = s + n;
 #ifndef STARTUP_BOOTLOADER
     /* The application's longest copies (ReadBatchData's 32 bytes, on the
      * way to an answer) come from word-aligned registers: read a word at a
      * time, stored a byte at a time, since the destination may be at any
      * byte and the Cortex-M0 faults on an unaligned word. */
     if (((uintptr_t)s & 3u) == 0u) {
-        for (; n >= 4u; n -= 4u, s += 4u, d += 4u) {
+        for (; end - s >= 4; s += 4, d += 4) {
             uint32_t w = *(const any_word *)(const void *)s;
             d[0] = (uint8_t)w;
             d[1] = (uint8_t)(w >> 8);
@@ -31,7 +32,7 @@ void *memcpy(void *restrict dst, const void *restrict src, size_t n)
         }
     }
 #endif
-    while (n--) {
+    while (s != end) {
         *d++ = *s++;
     }
     return dst;
