@@ -10,8 +10,7 @@ set(SERVO_FIRMWARE_WARNINGS
 set(SERVO_TEST_WARNINGS -Wall -Wextra -Werror -Wshadow -Wno-unused-parameter)
 
 # A firmware target: its warnings, and on a size-first image (the Cortex-M0)
-# SERVO_SIZE_FIRST, where the per-tick helpers are called rather than inlined
-# and the response is copied and summed in one pass.
+# SERVO_SIZE_FIRST, where the per-tick helpers are called rather than inlined.
 function(servo_firmware_target target)
   target_compile_options(${target} PRIVATE ${SERVO_FIRMWARE_WARNINGS})
   if(SERVO_SIZE_FIRST)
