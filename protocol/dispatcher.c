@@ -130,6 +130,8 @@ enum packet_outcome handle_sync(const struct packet_call *c, struct response *r)
     if (inner == NULL || !(inner->flags & PF_SYNCABLE) || c->content[1] != inner->length.min) {
         return OUTCOME_ERROR;
     }
+    /* SyncCommand carries no ID (packet_table.c), so c's origin is never a
+     * broadcast: the record's is c's, from a sync. */
     struct packet_call record = *c;
     record.content = &c->content[3];
     record.length = c->content[1];

@@ -126,3 +126,13 @@ int64_t sim_bus_next_due(const struct sim_bus *b, uint64_t now_us)
     uint64_t at = b->queue[b->head].at_us;
     return at > now_us ? (int64_t)(at - now_us) : 0;
 }
+
+uint64_t sim_bus_next_at(const struct sim_bus *b, uint64_t until_us)
+{
+    if (b->count == 0) {
+        return until_us;
+    }
+    uint64_t at = b->queue[b->head].at_us;
+    at = at > b->now_us ? at : b->now_us;
+    return at < until_us ? at : until_us;
+}

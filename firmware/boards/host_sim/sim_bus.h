@@ -19,7 +19,9 @@
  * microseconds; a PC that preempts the simulator for milliseconds must not
  * let a servo see time it has not reacted in (it would take the line for
  * silent and talk over a Sync Monitor answer). A preempted simulator falls
- * behind the wall clock instead, and catches up at full speed. */
+ * behind the wall clock instead, and catches up at full speed, a byte time
+ * at a time with the servos' main loops run between (main.c): what a servo
+ * does between two bytes it does whatever the PC's load. */
 #ifndef SIM_BUS_H
 #define SIM_BUS_H
 
@@ -80,5 +82,8 @@ void sim_bus_deliver(struct sim_bus *b, uint64_t now_us);
 void sim_bus_from_host(struct sim_bus *b, const uint8_t *data, unsigned len, uint64_t now_us);
 /* Microseconds until the next queued byte is due; -1 if none. */
 int64_t sim_bus_next_due(const struct sim_bus *b, uint64_t now_us);
+/* When the bus clock next has something to do on the way to until_us: the
+ * next byte's time (not before now), or until_us. */
+uint64_t sim_bus_next_at(const struct sim_bus *b, uint64_t until_us);
 
 #endif
