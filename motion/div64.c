@@ -1,6 +1,56 @@
 #include "motion/div64.h"
 
 /* (u1:u0) / v for u1 < v, v != 0: the quotient fits 32 bits. */
+#if defined(__ARM_ARCH_6M__)
+/* The ARMv6-M has no divide instruction and no count of leading zeros, so
+ * Knuth's digits below would cost four software divisions: restoring
+ * division a bit a step instead, the dividend shifted through the carry
+ * into the remainder and the quotient's bits in where it leaves (about 6
+ * instructions a bit; tests/bench/target/check_arith.c runs it). */
+/* One quotient bit, the remainder below 2^31 (its double fits): label is
+ * the step's end. */
+#define DIV_STEP(label)                                                                      \
+    "adds %[lo], %[lo], %[lo]\n\t"                                                         \
+    "adcs %[hi], %[hi], %[hi]\n\t"                                                         \
+    "cmp %[hi], %[v]\n\t"                                                                  \
+    "bcc " label "f\n\t"                                                                   \
+    "subs %[hi], %[hi], %[v]\n\t"                                                          \
+    "adds %[lo], %[lo], #1\n" label ":\n\t"
+
+static uint32_t div64_long(uint32_t u1, uint32_t u0, uint32_t v)
+{
+    uint32_t i;
+    if (v >> 31 != 0u) {
+        /* The doubled remainder may pass 2^32: its carry out subtracts. */
+        i = 32;
+        __asm__(".syntax unified\n"
+                "1:\n\t"
+                "adds %[lo], %[lo], %[lo]\n\t"
+                "adcs %[hi], %[hi], %[hi]\n\t"
+                "bcs 2f\n\t"
+                "cmp %[hi], %[v]\n\t"
+                "bcc 3f\n"
+                "2:\n\t"
+                "subs %[hi], %[hi], %[v]\n\t"
+                "adds %[lo], %[lo], #1\n"
+                "3:\n\t"
+                "subs %[i], %[i], #1\n\t"
+                "bne 1b"
+                : [hi] "+l"(u1), [lo] "+l"(u0), [i] "+l"(i)
+                : [v] "l"(v)
+                : "cc");
+    } else {
+        i = 16; /* two bits a pass */
+        __asm__(".syntax unified\n"
+                "1:\n\t" DIV_STEP("2") DIV_STEP("3") "subs %[i], %[i], #1\n\t"
+                "bne 1b"
+                : [hi] "+l"(u1), [lo] "+l"(u0), [i] "+l"(i)
+                : [v] "l"(v)
+                : "cc");
+    }
+    return u0;
+}
+#else
 static uint32_t div64_long(uint32_t u1, uint32_t u0, uint32_t v)
 {
     const uint32_t b = 65536u;
@@ -33,6 +83,7 @@ static uint32_t div64_long(uint32_t u1, uint32_t u0, uint32_t v)
     }
     return (q1 << 16) | q0;
 }
+#endif
 
 /* n / d for d beyond 32 bits (the quotient fits 32): d normalised to its
  * top 32 bits, one long division of n / 2, then at most one correction

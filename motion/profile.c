@@ -103,9 +103,13 @@ struct profile_timing profile_velocity_timing(int64_t distance, int64_t v0, int6
         t.decel = 0;
         return t;
     }
-    t.accel = (uint32_t)div64_u((uint64_t)accel * (uint64_t)d16, (uint64_t)r16);
-    t.decel = (uint32_t)div64_u((uint64_t)decel * (uint64_t)d16, (uint64_t)r16);
-    int64_t total = div_round((int64_t)(accel + decel) * d16, r16);
+    /* The tick count second: the Cortex-M0's multiply is quicker by one
+     * below 2^16 (firmware/runtime/small_mul.c). */
+    uint64_t accel_part = (uint64_t)d16 * accel;
+    uint64_t decel_part = (uint64_t)d16 * decel;
+    t.accel = (uint32_t)div64_u(accel_part, (uint64_t)r16);
+    t.decel = (uint32_t)div64_u(decel_part, (uint64_t)r16);
+    int64_t total = div_round((int64_t)(accel_part + decel_part), r16);
     int64_t cruise = total - (int64_t)t.accel - (int64_t)t.decel;
     t.cruise = (uint32_t)(cruise > 0 ? cruise : 0);
     return t;

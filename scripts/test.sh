@@ -59,6 +59,18 @@ target_bench() {
   python3 tests/bench/target/run_target_bench.py --check --json build/target-bench.json
 }
 
+# The planner's division and multiplication as each CPU runs them
+# (tests/bench/target/check_arith.c): the M0's are assembly and its own.
+target_arith() {
+  for cpu in m3 m0; do
+    cmake --preset "target-bench-$cpu" >/dev/null
+    cmake --build --preset "target-bench-$cpu" --target check_arith.elf >/dev/null
+    qemu-system-arm -M lm3s6965evb -cpu "cortex-$cpu" -nographic \
+      -semihosting-config enable=on,target=native \
+      -kernel "build/target-bench-$cpu/bench/check_arith.elf" 2>/dev/null
+  done
+}
+
 fuzz_run() {
   cmake --preset fuzz >/dev/null
   cmake --build --preset fuzz --target fuzz_servo
@@ -108,10 +120,12 @@ step "layers: no include from a lower layer to a higher one, no circle, no file 
 step "registers: every definition of hal/ports against ST's SVD files (STM32F103xx, STM32F030)" \
   .venv/bin/python scripts/check_regs_svd.py
 step "ARM images (STM32F103, and the QEMU board): budget and soft-float checks" arm_m3_images
-step "Cortex-M0 image (STM32F030K6) and its bootloader: 4 KB RAM, 20 KB flash ceiling, 4 KB bootloader, soft-float" \
+step "Cortex-M0 image (STM32F030K6) and its bootloader: 4 KB RAM, 20 KB flash budget, 4 KB bootloader, soft-float" \
   arm_m0_images
 step "target benchmark: every packet and the control tick in Thumb instructions on the Cortex-M3 and M0 under QEMU, against the budgets" \
   target_bench
+step "target arithmetic: the planner's 64-bit division and the run-time's division and multiplication on the Cortex-M3 and M0 under QEMU, against products" \
+  target_arith
 
 # pytest counts each test.
 printf '\n== %s\n' "PC tool, simulator, maker's SDK and QEMU board tests (pytest)"

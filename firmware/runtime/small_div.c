@@ -60,21 +60,13 @@ uint64_t small_idivmod(int32_t n, int32_t d)
 }
 
 #ifdef SMALL_DIV_AEABI
-/* The quotient in r0 and the remainder in r1: a 64-bit result's halves. */
-uint64_t __aeabi_uidivmod(uint32_t n, uint32_t d);
-uint32_t __aeabi_uidiv(uint32_t n, uint32_t d);
+/* The quotient in r0 and the remainder in r1: small_udivmod's own result,
+ * so the unsigned entry points are small_udivmod itself (__aeabi_uidiv's
+ * callers read r0 only). The signed ones take the signs off first. */
+uint64_t __aeabi_uidivmod(uint32_t n, uint32_t d) __attribute__((alias("small_udivmod")));
+uint64_t __aeabi_uidiv(uint32_t n, uint32_t d) __attribute__((alias("small_udivmod")));
 uint64_t __aeabi_idivmod(int32_t n, int32_t d);
 int32_t __aeabi_idiv(int32_t n, int32_t d);
-
-uint64_t __aeabi_uidivmod(uint32_t n, uint32_t d)
-{
-    return small_udivmod(n, d);
-}
-
-uint32_t __aeabi_uidiv(uint32_t n, uint32_t d)
-{
-    return (uint32_t)small_udivmod(n, d);
-}
 
 uint64_t __aeabi_idivmod(int32_t n, int32_t d)
 {

@@ -9,14 +9,12 @@
 #include <cmocka.h>
 
 #include "motion/div64.h"
+#include "xorshift.h"
 
 static uint64_t state = 0x9E3779B97F4A7C15u;
 static uint64_t rnd(void)
 {
-    state ^= state << 13;
-    state ^= state >> 7;
-    state ^= state << 17;
-    return state;
+    return xorshift64(&state);
 }
 
 static void check(uint64_t n, uint64_t d)

@@ -8,14 +8,12 @@
 #include <cmocka.h>
 
 #include "small_div.h"
+#include "xorshift.h"
 
 static uint64_t state = 0x2545F4914F6CDD1Du;
 static uint32_t rnd(void)
 {
-    state ^= state << 13;
-    state ^= state >> 7;
-    state ^= state << 17;
-    return (uint32_t)(state >> 16);
+    return (uint32_t)(xorshift64(&state) >> 16);
 }
 
 static void check_u(uint32_t n, uint32_t d)

@@ -1,5 +1,5 @@
 /* The Cortex-M0's 64-bit multiplication (firmware/runtime/small_mul.c)
- * against C's, on edge values and a million random pairs. */
+ * against C's, on edge values, a million random pairs and short factors. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -8,14 +8,12 @@
 #include <cmocka.h>
 
 #include "small_mul.h"
+#include "xorshift.h"
 
 static uint64_t state = 0x9E3779B97F4A7C15u;
 static uint64_t rnd(void)
 {
-    state ^= state << 13;
-    state ^= state >> 7;
-    state ^= state << 17;
-    return state;
+    return xorshift64(&state);
 }
 
 static void check(uint64_t a, uint64_t b)
@@ -51,11 +49,27 @@ static void test_random(void **unused)
     }
 }
 
+/* A factor below 2^16 on either side (three products instead of six),
+ * and the values either side of 2^16. */
+static void test_short_factor(void **unused)
+{
+    (void)unused;
+    for (int i = 0; i < 200000; i++) {
+        uint64_t a = rnd() >> (rnd() % 64u);
+        uint64_t s = rnd() & 0xFFFFu;
+        check(a, s);
+        check(s, a);
+        check(a, (uint64_t)-(int64_t)s);
+        check(a, 0x10000u + s);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_edges),
         cmocka_unit_test(test_random),
+        cmocka_unit_test(test_short_factor),
     };
     return cmocka_run_group_tests_name("small_mul", tests, NULL, NULL);
 }

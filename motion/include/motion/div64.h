@@ -2,9 +2,11 @@
  * routine (about 150 Thumb-2 instructions a call on the Cortex-M3, many
  * more on the M0). The planner's divisors are tick counts and small
  * quantities: when one fits 32 bits, two 32-bit hardware divisions do it
- * (Knuth's algorithm D on 16-bit digits, as in Hacker's Delight, divlu);
- * a divisor beyond 32 bits takes one of them and a correction. So no image
- * links the library's 64-bit division (408 bytes on the Cortex-M0). */
+ * (Knuth's algorithm D on 16-bit digits, as in Hacker's Delight, divlu),
+ * or on the Cortex-M0, which has no divide instruction, 32 steps of a
+ * restoring division in assembly (div64.c); a divisor beyond 32 bits takes
+ * one of them and a correction. So no image links the library's 64-bit
+ * division (408 bytes on the Cortex-M0). */
 #ifndef MOTION_DIV64_H
 #define MOTION_DIV64_H
 
