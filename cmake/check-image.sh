@@ -3,15 +3,16 @@
 # or links any soft-float helper: firmware code is fixed point.
 #   check-image.sh ELF [FLASH_LIMIT [RAM_LIMIT]]
 # The application's limits default to 32 KB / 8 KB and it is measured
-# against issue 10's goal of 16 KB / 4 KB; a board whose part is that small
-# passes the goal as its limits (the Cortex-M0 board: its RAM, and a flash
-# ceiling until the goal is met: board.cmake). The bootloader:
-# check-image.sh ELF 4096 [RAM_LIMIT], its 4 KB (and a small part's RAM).
+# against the budget of 20 KB / 4 KB (issues 10 and 26: the 4 KB
+# bootloader, the application and the 2 KB store fit a 32 KB part); a board
+# whose part is that small passes the budget as its limits (the Cortex-M0
+# board: board.cmake). The bootloader: check-image.sh ELF 4096 [RAM_LIMIT],
+# its 4 KB (and a small part's RAM).
 set -eu
 elf=$1
 SIZE=${SIZE:-arm-none-eabi-size}
 NM=${NM:-arm-none-eabi-nm}
-FLASH_LIMIT=${2:-32768}; RAM_LIMIT=${3:-8192}; FLASH_GOAL=16384; RAM_GOAL=4096
+FLASH_LIMIT=${2:-32768}; RAM_LIMIT=${3:-8192}; FLASH_GOAL=20480; RAM_GOAL=4096
 if [ "$FLASH_LIMIT" -lt "$FLASH_GOAL" ]; then FLASH_GOAL=$FLASH_LIMIT; fi
 
 sizes=$($SIZE -A "$elf")
@@ -20,7 +21,7 @@ flash=$(( $(section .isr_vector) + $(section .text) + $(section .ARM.exidx) + $(
 # .ram_vectors: a Cortex-M0 image's vector table, copied to RAM.
 ram=$(( $(section .ram_vectors) + $(section .data) + $(section .bss) + $(section .stack) ))
 verdict() { if [ "$1" -le "$2" ]; then echo "met"; else echo "NOT MET"; fi; }
-echo "image: flash $flash B of $FLASH_LIMIT (goal $FLASH_GOAL: $(verdict $flash $FLASH_GOAL)), RAM $ram B of $RAM_LIMIT (goal $RAM_GOAL: $(verdict $ram $RAM_GOAL); vectors $(section .ram_vectors) + .data $(section .data) + .bss $(section .bss) + stack $(section .stack))"
+echo "image: flash $flash B of $FLASH_LIMIT (budget $FLASH_GOAL: $(verdict $flash $FLASH_GOAL)), RAM $ram B of $RAM_LIMIT (budget $RAM_GOAL: $(verdict $ram $RAM_GOAL); vectors $(section .ram_vectors) + .data $(section .data) + .bss $(section .bss) + stack $(section .stack))"
 
 status=0
 if [ "$flash" -gt "$FLASH_LIMIT" ]; then echo "error: flash $flash B exceeds $FLASH_LIMIT B" >&2; status=1; fi
