@@ -1,10 +1,10 @@
 """Every error servoctl reports, each with the exit code of the command line
-(README, "Exit codes"). The lowest module: every other may raise these."""
+(docs/servoctl.md, the exit codes). The lowest module: every other may raise these."""
 
 
 class ServoError(Exception):
     """Base of every error servoctl reports. exit_code is the command
-    line's (README, "Exit codes")."""
+    line's (docs/servoctl.md, the exit codes)."""
     exit_code = 1
 
 
