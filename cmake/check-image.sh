@@ -12,8 +12,8 @@ set -eu
 elf=$1
 SIZE=${SIZE:-arm-none-eabi-size}
 NM=${NM:-arm-none-eabi-nm}
-FLASH_LIMIT=${2:-32768}; RAM_LIMIT=${3:-8192}; FLASH_GOAL=20480; RAM_GOAL=4096
-if [ "$FLASH_LIMIT" -lt "$FLASH_GOAL" ]; then FLASH_GOAL=$FLASH_LIMIT; fi
+FLASH_LIMIT=${2:-32768}; RAM_LIMIT=${3:-8192}; FLASH_BUDGET=20480; RAM_BUDGET=4096
+if [ "$FLASH_LIMIT" -lt "$FLASH_BUDGET" ]; then FLASH_BUDGET=$FLASH_LIMIT; fi
 
 sizes=$($SIZE -A "$elf")
 section() { echo "$sizes" | awk -v s="$1" '$1 == s { print $2; f=1 } END { if (!f) print 0 }'; }
@@ -21,7 +21,7 @@ flash=$(( $(section .isr_vector) + $(section .text) + $(section .ARM.exidx) + $(
 # .ram_vectors: a Cortex-M0 image's vector table, copied to RAM.
 ram=$(( $(section .ram_vectors) + $(section .data) + $(section .bss) + $(section .stack) ))
 verdict() { if [ "$1" -le "$2" ]; then echo "met"; else echo "NOT MET"; fi; }
-echo "image: flash $flash B of $FLASH_LIMIT (budget $FLASH_GOAL: $(verdict $flash $FLASH_GOAL)), RAM $ram B of $RAM_LIMIT (budget $RAM_GOAL: $(verdict $ram $RAM_GOAL); vectors $(section .ram_vectors) + .data $(section .data) + .bss $(section .bss) + stack $(section .stack))"
+echo "image: flash $flash B of $FLASH_LIMIT (budget $FLASH_BUDGET: $(verdict $flash $FLASH_BUDGET)), RAM $ram B of $RAM_LIMIT (budget $RAM_BUDGET: $(verdict $ram $RAM_BUDGET); vectors $(section .ram_vectors) + .data $(section .data) + .bss $(section .bss) + stack $(section .stack))"
 
 status=0
 if [ "$flash" -gt "$FLASH_LIMIT" ]; then echo "error: flash $flash B exceeds $FLASH_LIMIT B" >&2; status=1; fi

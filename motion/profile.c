@@ -103,8 +103,7 @@ struct profile_timing profile_velocity_timing(int64_t distance, int64_t v0, int6
         t.decel = 0;
         return t;
     }
-    /* The tick count second: the Cortex-M0's multiply is quicker by one
-     * below 2^16 (firmware/runtime/small_mul.c). */
+    /* The total's product is the two ramps' sum: one multiply fewer. */
     uint64_t accel_part = (uint64_t)d16 * accel;
     uint64_t decel_part = (uint64_t)d16 * decel;
     t.accel = (uint32_t)div64_u(accel_part, (uint64_t)r16);
