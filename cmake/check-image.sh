@@ -2,18 +2,21 @@
 # Prints the image's flash and RAM use and fails when it exceeds its limits
 # or links any soft-float helper: firmware code is fixed point.
 #   check-image.sh ELF [FLASH_LIMIT [RAM_LIMIT]]
-# The application's limits default to 32 KB / 8 KB and it is measured
-# against the budget of 20 KB / 4 KB (issues 10 and 26: the 4 KB
-# bootloader, the application and the 2 KB store fit a 32 KB part); a board
-# whose part is that small passes the budget as its limits (the Cortex-M0
-# board: board.cmake). The bootloader: check-image.sh ELF 4096 [RAM_LIMIT],
+# The application's limits default to 32 KB / 8 KB, and it is measured
+# against the small part's budget of 24 KB / 4 KB (the 4 KB bootloader, the
+# application, the 2 KB store and 2 KB spare fit a 32 KB part with 4 KB of
+# RAM): a board whose part is that small passes the budget as its limits
+# (the Cortex-M0 board: board.cmake). A board with more RAM may spend it
+# (the reference board's 4 KB receive ring), and the line says it would not
+# fit the small part. The bootloader: check-image.sh ELF 4096 [RAM_LIMIT],
 # its 4 KB (and a small part's RAM).
 set -eu
 elf=$1
 SIZE=${SIZE:-arm-none-eabi-size}
 NM=${NM:-arm-none-eabi-nm}
-FLASH_LIMIT=${2:-32768}; RAM_LIMIT=${3:-8192}; FLASH_BUDGET=20480; RAM_BUDGET=4096
+FLASH_LIMIT=${2:-32768}; RAM_LIMIT=${3:-8192}; FLASH_BUDGET=24576; RAM_BUDGET=4096
 if [ "$FLASH_LIMIT" -lt "$FLASH_BUDGET" ]; then FLASH_BUDGET=$FLASH_LIMIT; fi
+if [ "$RAM_LIMIT" -lt "$RAM_BUDGET" ]; then RAM_BUDGET=$RAM_LIMIT; fi
 
 sizes=$($SIZE -A "$elf")
 section() { echo "$sizes" | awk -v s="$1" '$1 == s { print $2; f=1 } END { if (!f) print 0 }'; }

@@ -46,7 +46,8 @@ void servo_init(struct servo *s, const struct hal_port *hal)
     (void)spare_ready;
     save_policy_init(&s->saver, &s->store, hal->bus.now_us(hal->ctx));
     s->regs.status.model = SERVO_MODEL;
-    s->regs.status.firmware_version = FIRMWARE_VERSION;
+    uint16_t image_version = hal->image_version != NULL ? hal->image_version(hal->ctx) : 0u;
+    s->regs.status.firmware_version = image_version != 0u ? image_version : FIRMWARE_VERSION;
     s->regs.status.serial_number = hal->serial_number(hal->ctx);
     protection_init(&s->protection);
     motion_init(&s->motion, &s->regs, hal);

@@ -23,6 +23,10 @@ _Static_assert(BOARD_SUPPLY_UV_PER_COUNT < 16000 && BOARD_CURRENT_UA_PER_COUNT <
 
 _Static_assert(BOARD_SLOT_BASE == BOARD_FLASH_BASE + BOARD_BOOT_SIZE,
                "board.h: the slot starts where the bootloader ends");
+_Static_assert(BOARD_RX_RING_BYTES >= 256 && (BOARD_RX_RING_BYTES & (BOARD_RX_RING_BYTES - 1)) == 0 &&
+                   BOARD_BOOT_RX_RING_BYTES >= 256 &&
+                   (BOARD_BOOT_RX_RING_BYTES & (BOARD_BOOT_RX_RING_BYTES - 1)) == 0,
+               "board.h: the receive rings are powers of two, 256 bytes or more");
 #ifdef BOARD_CONFIG_PAGE0
 _Static_assert(BOARD_SLOT_BASE + BOARD_SLOT_PAGES * BOARD_FLASH_PAGE <= BOARD_CONFIG_PAGE0,
                "board.h: the slot ends before the config store");

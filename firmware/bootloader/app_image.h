@@ -28,6 +28,7 @@
 #define APP_IMAGE_FORMAT 1u
 #define APP_HEADER_SIZE 256u  /* the vector table follows */
 #define APP_HEADER_CHECKED 24u /* bytes the header's own CRC covers */
+#define APP_HEADER_VERSION_AT 16u
 
 /* The flash the application lives in: whole pages of `flash` from base. */
 struct app_slot {
@@ -63,5 +64,15 @@ void app_image_make_header(uint8_t header[APP_HEADER_SIZE], const uint8_t *code,
  * it does not. */
 MUST_CHECK enum app_image_verdict app_image_check(const struct app_slot *slot, uint16_t board,
                                        struct app_image_info *info);
+
+/* The version in the header at slot_base of memory-mapped flash, 0 if no
+ * image header is there: what the application the bootloader started from
+ * that slot reports as data item 7 (the bootloader checked the header). */
+static inline uint16_t app_image_version_in_place(uintptr_t slot_base)
+{
+    const volatile uint32_t *magic = (const volatile uint32_t *)slot_base;
+    const volatile uint16_t *version = (const volatile uint16_t *)(slot_base + APP_HEADER_VERSION_AT);
+    return *magic == APP_IMAGE_MAGIC ? *version : 0u;
+}
 
 #endif

@@ -8,6 +8,7 @@
  * USART's interrupt (84 bytes of its 4 KB shorter). */
 #include <stdint.h>
 
+#include "board_mark.h"
 #include "startup_memory.h"
 #include "stm32f0_regs.h"
 
@@ -31,6 +32,7 @@ static void (*const vector_table[VECTORS])(void) = {
     [1] = Reset_Handler,
     [2] = Default_Handler,  /* NMI */
     [3] = Default_Handler,  /* HardFault */
+    [BOARD_MARK_VECTOR] = BOARD_MARK,
     [11] = Default_Handler, /* SVCall */
     [14] = Default_Handler, /* PendSV */
     [15] = SysTick_Handler,

@@ -1,6 +1,7 @@
 /* Reset handler and vector table for the STM32F103 (Cortex-M3). */
 #include <stdint.h>
 
+#include "board_mark.h"
 #include "startup_memory.h"
 
 int main(void);
@@ -43,6 +44,7 @@ static void (*const vector_table[CORE_VECTORS + LAST_IRQ + 1])(void) = {
     [4] = Default_Handler,  /* MemManage */
     [5] = Default_Handler,  /* BusFault */
     [6] = Default_Handler,  /* UsageFault */
+    [BOARD_MARK_VECTOR] = BOARD_MARK,
     [11] = Default_Handler, /* SVCall */
     [14] = Default_Handler, /* PendSV */
     [15] = SysTick_Handler,

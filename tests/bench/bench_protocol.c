@@ -143,8 +143,8 @@ static void dma_writes(const uint8_t *bytes, size_t n)
     for (size_t i = 0; i < n; i++) {
         hal.now_us += 87u;
         uint32_t left = dma_regs[1];
-        hal.rx.data[HAL_RX_RING_SIZE - left] = bytes[i];
-        dma_regs[1] = left == 1u ? HAL_RX_RING_SIZE : left - 1u;
+        hal.rx.data[hal_rx_ring_size(&hal.rx) - left] = bytes[i];
+        dma_regs[1] = left == 1u ? hal_rx_ring_size(&hal.rx) : left - 1u;
         laps_due += left == 1u;
     }
 }

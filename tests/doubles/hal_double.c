@@ -76,6 +76,7 @@ void hal_double_enter_bootloader(void *ctx)
 void hal_double_init(struct hal_double *h)
 {
     memset(h, 0, sizeof *h);
+    h->rx = (struct hal_rx_ring)HAL_RX_RING_OVER(h->rx_bytes);
     flash_double_init(&h->flash, 1024);
     h->sensors = (struct sensor_raw){.supply = 7400, .current = 0, .ntc = 2048};
     h->calibration = (struct sensor_calibration){.supply_mv_q12 = SENSOR_Q12_FROM_MICRO(1000u),

@@ -38,7 +38,7 @@ void harness_poll(unsigned n)
 void harness_feed(const uint8_t *bytes, size_t n)
 {
     for (size_t i = 0; i < n; i++) {
-        if (hal.rx.written - hal.rx.read == HAL_RX_RING_SIZE) {
+        if (hal.rx.written - hal.rx.read == hal_rx_ring_size(&hal.rx)) {
             servo_poll(&servo);
         }
         hal.now_us += HARNESS_BYTE_US;

@@ -85,18 +85,27 @@ def sync_monitor(bus: p.Bus, ids: list, timeout_s: float = None, arrivals: dict 
     wait = timeout_s if timeout_s is not None else 0.05 + len(ids) * (0.004 + 210 / bus.serial.baudrate)
     deadline = bus.clock() + wait  # one for the round: the clock is read as little as can be
     out = {}
+    waiting = set(ids)
     stamping, bus.stamp_arrivals = bus.stamp_arrivals, arrivals is not None
     try:
-        for servo_id in ids:
+        # Answers are taken as they come, whoever sent them: waiting for
+        # one absent servo must not throw away the answers of the servos
+        # after it, which arrive during that wait.
+        while waiting:
             try:
-                out[servo_id] = Monitor.decode(bus.read_response(p.MONITOR, servo_id, deadline=deadline))
+                content = bus.read_response(p.MONITOR, None, deadline=deadline)
             except NoReply:
-                continue
+                break
+            servo_id = content[0] if content else None
+            if servo_id not in waiting:
+                continue  # not asked for in this round: another host's, or a stale one
+            waiting.discard(servo_id)
+            out[servo_id] = Monitor.decode(content)
             if arrivals is not None:
                 arrivals[servo_id] = bus.arrived_at
     finally:
         bus.stamp_arrivals = stamping
-    return out
+    return {servo_id: out[servo_id] for servo_id in ids if servo_id in out}
 
 
 def backup(bus: p.Bus, ids: list, path: str) -> None:

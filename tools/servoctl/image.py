@@ -20,6 +20,11 @@ CHECKED = 24  # bytes the header's own CRC covers
 BOARDS_DIR = Path(__file__).resolve().parents[2] / "firmware" / "boards"
 HEADER_SIZE_IN_SLOT = 256  # the image header before the application (app.ld.in)
 STAY_WORD_BYTES = 16       # RAM's last bytes, left out of the application's
+# Vector 7 (reserved by the core) carries "SB" and the board's ID
+# (firmware/startup/board_mark.h): boards that share a link address and a
+# RAM size are told apart by it.
+BOARD_MARK_OFFSET = 7 * 4
+BOARD_MARK_TAG = 0x5342
 
 
 @dataclass(frozen=True)
@@ -57,10 +62,17 @@ def boards() -> dict:
 BOARDS = {name: b.id for name, b in boards().items()}
 
 
+def board_named(board_id: int) -> str:
+    """A board ID as people know it: its folder's name, and the number."""
+    name = next((b.name for b in boards().values() if b.id == board_id), None)
+    return f"{name} (0x{board_id:04x})" if name else f"an unknown board (0x{board_id:04x})"
+
+
 def check_code(code: bytes, board: Board) -> None:
     """Refuses what cannot be this board's application from its vector
-    table: an ELF file, or a first two words that are not a stack pointer
-    in its RAM and a Thumb reset handler in its code."""
+    table: an ELF file, a first two words that are not a stack pointer in
+    its RAM and a Thumb reset handler in its code, or a board mark (vector
+    7) that is not this board's."""
     if code[:4] == b"\x7fELF":
         raise UsageError("that is an ELF file: give the application's raw binary (the build's "
                          f"servo_{board.name}.bin, or 'arm-none-eabi-objcopy -O binary')")
@@ -78,6 +90,15 @@ def check_code(code: bytes, board: Board) -> None:
         raise UsageError(f"not a {board.name} application: its reset handler 0x{reset:08x} is not "
                          f"Thumb code in the image (0x{first:08x}..0x{first + len(code):08x}); "
                          f"is it the bootloader, or linked for another address?")
+    if len(code) < BOARD_MARK_OFFSET + 4:
+        raise UsageError(f"{len(code)} bytes cannot be an application: its vector table is longer")
+    (mark,) = struct.unpack_from("<I", code, BOARD_MARK_OFFSET)
+    if mark >> 16 != BOARD_MARK_TAG:
+        raise UsageError(f"not a {board.name} application: its vector table has no board mark "
+                         f"(vector 7 is 0x{mark:08x}); was it built by this project's build?")
+    if mark & 0xFFFF != board.id:
+        raise UsageError(f"not a {board.name} application: it was built for "
+                         f"{board_named(mark & 0xFFFF)}")
 
 
 @dataclass

@@ -9,7 +9,7 @@ import struct
 import zlib
 from dataclasses import dataclass
 
-from .image import CHECKED, Image
+from .image import CHECKED, Image, board_named
 from .protocol import BadAnswer, NoReply, Refused
 
 UPDATE_ENTER, UPDATE_ERASE, UPDATE_WRITE, UPDATE_VERIFY, UPDATE_BOOT, UPDATE_STATUS = range(0x50, 0x56)
@@ -191,7 +191,8 @@ def update(bus, servo_id: int, image: Image, progress=lambda done, total: None) 
     version before (None if no application ran) and after."""
     st = status(bus, servo_id)
     if image.board != st.board:  # before anything changes
-        raise Refused(f"servo {servo_id} is board {st.board:#06x}; the image is for {image.board:#06x}")
+        raise Refused(f"servo {servo_id} is {board_named(st.board)}; the image is for "
+                      f"{board_named(image.board)}")
     before = st.version if st.mode == MODE_APP or st.verdict == 0 else None
     if st.mode == MODE_APP:
         st = enter_bootloader(bus, servo_id)

@@ -45,8 +45,12 @@ def test_the_boards_are_the_builds():
     assert boards["host_sim"].id == 0x5100 and boards["host_sim"].flash is None  # never executed
 
 
-def vectors(sp, reset, size=64):
-    return struct.pack("<II", sp, reset) + b"\x00" * (size - 8)
+def vectors(sp, reset, size=64, board=0x0030):
+    """A vector table: stack pointer, reset handler, vector 7's board mark."""
+    code = bytearray(struct.pack("<II", sp, reset) + b"\x00" * (size - 8))
+    if board is not None:
+        struct.pack_into("<I", code, img.BOARD_MARK_OFFSET, 0x53420000 | board)
+    return bytes(code)
 
 
 @pytest.mark.parametrize("code, why", [
@@ -55,6 +59,9 @@ def vectors(sp, reset, size=64):
     (vectors(0x20000700, 0x0800074D), "reset handler 0x0800074d is not Thumb code in the image"),
     (vectors(0x20001000, 0x08001141), "stack pointer 0x20001000 is not in RAM"),  # the F030 has 4 KB
     (vectors(0x20000D20, 0x08001140), "is not Thumb code"),  # an even address: ARM state
+    (vectors(0x20000D20, 0x08001141, size=0x300, board=None), "has no board mark"),
+    (vectors(0x20000D20, 0x08001141, size=0x300, board=0x0103), r"built for stm32f103 \(0x0103\)"),
+    (vectors(0x20000D20, 0x08001141, size=0x300, board=0x0777), r"built for an unknown board \(0x0777\)"),
 ])
 def test_image_refuses_what_cannot_be_the_boards_application(tmp_path, code, why):
     binary = tmp_path / "app.bin"
@@ -72,3 +79,19 @@ def test_image_takes_an_application_by_board_name_or_number(tmp_path):
         assert img.load(str(tmp_path / "app.img")).board == 0x0030
     with pytest.raises(UsageError, match="board must be one of host_sim, qemu_stm32vl, stm32f030k6, stm32f103"):
         img.make(str(binary), "1", "0x0777", str(tmp_path / "x.img"))
+
+
+@pytest.mark.parametrize("built, packed_as, why", [
+    ("stm32f103", "stm32f030k6", "not a stm32f030k6 application: its stack pointer"),  # 4 KB ring
+    ("stm32f030k6", "stm32f103", r"not a stm32f103 application: it was built for stm32f030k6 \(0x0030\)"),
+])
+def test_one_boards_application_is_not_packed_for_another(tmp_path, built, packed_as, why):
+    """Both applications link at 0x08001100; the F030's stack pointer lies
+    in the F103's RAM as well: only the board mark tells that one apart.
+    The build's own binaries (scripts/test.sh builds both before pytest)."""
+    preset = "arm-m0" if built == "stm32f030k6" else "arm"
+    binary = img.BOARDS_DIR.parents[1] / "build" / preset / "firmware" / "boards" / built / f"servo_{built}.bin"
+    img.make(str(binary), "0x0011", built, str(tmp_path / "own.img"))  # its own board takes it
+    with pytest.raises(UsageError, match=why):
+        img.make(str(binary), "0x0011", packed_as, str(tmp_path / "other.img"))
+    assert not (tmp_path / "other.img").exists()

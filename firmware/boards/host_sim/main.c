@@ -44,7 +44,8 @@ int main(int argc, char **argv)
 
     sim_bus_init(&bus, sim_now_us());
     for (unsigned i = 0; i < o.id_count; i++) {
-        if (!sim_servo_start(&servos[i], &bus, i, o.ids[i], o.state_dir, o.supply_v, o.ambient_c)) {
+        if (!sim_servo_start(&servos[i], &bus, i, o.ids[i], o.units[i], o.state_dir, o.supply_v,
+                             o.ambient_c)) {
             return 1;
         }
         servos[i].rx_interrupt = o.rx_interrupt;

@@ -11,14 +11,20 @@
 
 #include "sim_link.h"
 
-static struct sim_servo *servo_by_id(const struct sim_control *c, int id)
+/* A command's servo: its bus ID as it is now (0..254: every servo that
+ * holds it), or its serial number; -1 when the word is neither. */
+static long servo_address(const char *word)
 {
-    for (unsigned i = 0; i < c->bus->station_count; i++) {
-        if (c->servos[i].cmdline_id == id) {
-            return &c->servos[i];
-        }
-    }
-    return NULL;
+    char *end = NULL;
+    bool hex = word[0] == '0' && (word[1] == 'x' || word[1] == 'X');
+    long v = strtol(word, &end, hex ? 16 : 10);
+    return end != word && *end == '\0' && v >= 0 && v <= 0xFFFFFFFFL && v != 255 ? v : -1;
+}
+
+static bool addressed(const struct sim_servo *s, long address)
+{
+    return address < 0 || (address <= 254 ? sim_servo_bus_id(s) == address
+                                           : sim_servo_serial(s) == (uint32_t)address);
 }
 
 static void reply(int fd, const char *text)
@@ -44,8 +50,8 @@ static void state_of(const struct sim_control *c, const struct sim_servo *s, cha
              "supply=%.3f "
              "load=%.3f stop=%s status=0x%02x reported=%d collisions=%lu dropped_ticks=%u "
              "most_behind_ms=%.1f baud=%u host_baud=%u baud_mismatches=%lu rx_overruns=%u "
-             "rx_lost=%u flash_stall_ms=%.2f saves=%u mode=%s version=0x%04x\n",
-             s->cmdline_id, (double)c->bus->now_us / 1000.0, (double)s->last_execution_us / 1000.0,
+             "rx_lost=%u flash_stall_ms=%.2f saves=%u mode=%s version=0x%04x serial=0x%08x\n",
+             sim_servo_bus_id(s), (double)c->bus->now_us / 1000.0, (double)s->last_execution_us / 1000.0,
              (double)s->last_sent_us / 1000.0, plant_angle_deg(&s->plant),
              s->plant.velocity * 180.0 / M_PI,
              s->plant.current, s->thermal.winding_c, s->thermal.case_c, s->thermal.ambient_c,
@@ -55,7 +61,8 @@ static void state_of(const struct sim_control *c, const struct sim_servo *s, cha
              (double)*c->most_behind_us / 1000.0, (unsigned)s->baud, (unsigned)c->bus->host_baud,
              c->bus->baud_mismatches, (unsigned)s->rx.overruns, (unsigned)s->core.rx_lost,
              (double)s->flash_stall_us / 1000.0, (unsigned)s->core.store.sequence,
-             s->in_bootloader ? "bootloader" : "app", (unsigned)s->core.regs.status.firmware_version);
+             s->in_bootloader ? "bootloader" : "app", (unsigned)s->core.regs.status.firmware_version,
+             (unsigned)sim_servo_serial(s));
 }
 
 /* "hostsend MS HEX": the host's bytes on the wire from simulated time MS
@@ -112,11 +119,15 @@ static void control_command(const struct sim_control *c, int fd, char *line)
     bool takes_value = strcmp(cmd, "state") != 0 && strcmp(cmd, "help") != 0 &&
                        strcmp(cmd, "powercycle") != 0;
     int id_word = takes_value ? 2 : 1;
-    struct sim_servo *only = NULL;
+    long only = -1; /* every servo */
     if (n > id_word) {
-        only = servo_by_id(c, atoi(words[id_word]));
-        if (only == NULL) {
-            reply(fd, "error: no servo with that ID\n");
+        only = servo_address(words[id_word]);
+        unsigned found = 0;
+        for (unsigned i = 0; only >= 0 && i < c->bus->station_count; i++) {
+            found += addressed(&c->servos[i], only);
+        }
+        if (found == 0u) {
+            reply(fd, "error: no servo holds that ID or serial number\n");
             return;
         }
     }
@@ -167,10 +178,25 @@ static void control_command(const struct sim_control *c, int fd, char *line)
         reply(fd, "ok\n");
         return;
     }
-    char out[4096] = "";
+    static const char *const known[] = {"supply", "load", "ambient", "soak", "stop", "failerase",
+                                        "failprogram", "powercycle", "state"};
+    bool is_known = false;
+    for (size_t k = 0; k < sizeof known / sizeof known[0]; k++) {
+        is_known = is_known || strcmp(cmd, known[k]) == 0;
+    }
+    if (!is_known) {
+        reply(fd, "error: unknown command (try help)\n");
+        return;
+    }
+    /* Who is addressed is decided before any servo is touched: a power
+     * cycle does not move another servo into the set. */
+    bool chosen[SIM_MAX_SERVOS];
+    for (unsigned i = 0; i < c->bus->station_count; i++) {
+        chosen[i] = addressed(&c->servos[i], only);
+    }
     for (unsigned i = 0; i < c->bus->station_count; i++) {
         struct sim_servo *s = &c->servos[i];
-        if (only != NULL && s != only) {
+        if (!chosen[i]) {
             continue;
         }
         if (strcmp(cmd, "supply") == 0) {
@@ -190,16 +216,15 @@ static void control_command(const struct sim_control *c, int fd, char *line)
             s->flash.fail_programs = s->slot_flash.fail_programs = (uint32_t)value;
         } else if (strcmp(cmd, "powercycle") == 0) {
             sim_servo_power_cycle(s);
-        } else if (strcmp(cmd, "state") == 0) {
+        } else { /* state: a line a servo, however many (no buffer to outgrow) */
             char one[768];
             state_of(c, s, one, sizeof one);
-            strncat(out, one, sizeof out - strlen(out) - 1);
-        } else {
-            reply(fd, "error: unknown command (try help)\n");
-            return;
+            reply(fd, one);
         }
     }
-    reply(fd, out[0] ? out : "ok\n");
+    if (strcmp(cmd, "state") != 0) {
+        reply(fd, "ok\n");
+    }
 }
 
 static void control_read(const struct sim_control *ctl, struct sim_control_client *c)

@@ -9,7 +9,9 @@ static void usage(FILE *out)
     fputs("usage: servo_sim [--id N]... [--tcp PORT | --link PATH] [--control PORT]\n"
           "                 [--state DIR] [--supply MV] [--ambient DEGC]\n"
           "Runs the servo firmware on simulated servos sharing one bus.\n"
-          "  --id N         a servo with ID N (repeat for more; default 1)\n"
+          "  --id N         a servo with ID N (repeat for more; default 1). An ID given\n"
+          "                 again is one more servo at it, as new servos all hold ID 0\n"
+          "                 (serial 0x51a0UUNN: NN the ID given, UU the servos given it before)\n"
           "  --tcp PORT     the bus on 127.0.0.1:PORT (pyserial socket://) instead of a pty\n"
           "  --link PATH    also make PATH a symlink to the pty\n"
           "  --control PORT fault injection on 127.0.0.1:PORT (default: any free port)\n"
@@ -19,7 +21,8 @@ static void usage(FILE *out)
           "  --rx dma|interrupt  how the port receives: DMA into a ring (the reference\n"
           "                 board, default) or a byte per interrupt, which overruns\n"
           "                 while the flash stalls the CPU\n"
-          "Control commands, one per line, optional servo ID last:\n"
+          "Control commands, one per line, optional servo last: its bus ID as it is now\n"
+          "(every servo that holds it), or its serial number (0x51a0UUNN):\n"
           "  supply MV | load NM | stop DEG | stop off | ambient DEGC | soak DEGC |\n"
           "  hostbaud BAUD (a TCP host's rate; a pty's is what the host set) |\n"
           "  failerase N | failprogram N (the next N flash erases, or half-word\n"
@@ -67,12 +70,13 @@ void sim_options_parse(int argc, char **argv, struct sim_options *o)
                 exit(2);
             }
             uint8_t id = (uint8_t)parse_int(v, "--id", 0, 254);
+            /* An ID given again is another servo at it (a new bus of
+             * servos at the factory ID 0): its unit tells it apart. */
+            uint8_t unit = 0;
             for (unsigned k = 0; k < o->id_count; k++) {
-                if (o->ids[k] == id) {
-                    fprintf(stderr, "servo_sim: ID %u given twice\n", id);
-                    exit(2);
-                }
+                unit = (uint8_t)(unit + (o->ids[k] == id));
             }
+            o->units[o->id_count] = unit;
             o->ids[o->id_count++] = id;
         } else if (strcmp(a, "--tcp") == 0) {
             o->tcp_port = parse_int(v, "--tcp", 1, 65535);

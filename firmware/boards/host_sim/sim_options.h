@@ -10,6 +10,7 @@
 
 struct sim_options {
     uint8_t ids[SIM_MAX_SERVOS];
+    uint8_t units[SIM_MAX_SERVOS]; /* earlier servos given the same ID */
     unsigned id_count;
     int tcp_port;          /* 0: a pseudo-terminal */
     int control_port;      /* 0: any free port */

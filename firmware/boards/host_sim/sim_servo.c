@@ -139,11 +139,27 @@ static bool program_factory_image(struct sim_servo *s, uint16_t version)
     return slot_write(&s->slot, 0, image, sizeof image, crc32(image, sizeof image)) == SLOT_WRITE_OK;
 }
 
-/* One serial number per simulated servo, from the ID it was started with. */
+uint32_t sim_servo_serial(const struct sim_servo *s)
+{
+    return 0x51A00000u | (uint32_t)s->unit << 8 | s->cmdline_id;
+}
+
+uint8_t sim_servo_bus_id(const struct sim_servo *s)
+{
+    return s->in_bootloader ? s->boot.loop.id : s->core.active_id;
+}
+
 static uint32_t serial_number(void *ctx)
 {
-    const struct sim_servo *s = ctx;
-    return 0x51A00000u | s->cmdline_id;
+    return sim_servo_serial(ctx);
+}
+
+/* The image "running": its header's version, as on a board. */
+static uint16_t image_version(void *ctx)
+{
+    struct sim_servo *s = ctx;
+    struct app_image_info info;
+    return app_image_check(&s->slot, SIM_BOARD, &info) == APP_IMAGE_VALID ? info.version : 0u;
 }
 
 static void enter_bootloader(void *ctx)
@@ -155,10 +171,6 @@ void sim_servo_start_app(struct sim_servo *s)
 {
     s->in_bootloader = false;
     servo_init(&s->core, &s->port);
-    struct app_image_info info;
-    if (app_image_check(&s->slot, SIM_BOARD, &info) == APP_IMAGE_VALID) {
-        s->core.regs.status.firmware_version = info.version; /* the image "running" */
-    }
 }
 
 void sim_servo_power_cycle(struct sim_servo *s)
@@ -167,12 +179,19 @@ void sim_servo_power_cycle(struct sim_servo *s)
 }
 
 bool sim_servo_start(struct sim_servo *s, struct sim_bus *bus, unsigned index, uint8_t id,
-                     const char *state_dir, double supply_v, double ambient_c)
+                     uint8_t unit, const char *state_dir, double supply_v, double ambient_c)
 {
+    /* servo-ID.flash; the second servo given that ID servo-ID-2.flash. */
+    char name[32];
+    if (unit == 0u) {
+        snprintf(name, sizeof name, "servo-%u", id);
+    } else {
+        snprintf(name, sizeof name, "servo-%u-%u", id, unit + 1u);
+    }
     char path[300];
-    snprintf(path, sizeof path, "%s/servo-%u.flash", state_dir, id);
+    snprintf(path, sizeof path, "%s/%s.flash", state_dir, name);
     char slot_path[300];
-    snprintf(slot_path, sizeof slot_path, "%s/servo-%u.slot", state_dir, id);
+    snprintf(slot_path, sizeof slot_path, "%s/%s.slot", state_dir, name);
     if (!sim_flash_open(&s->flash, path, SIM_CONFIG_BASE, 2, s->config_mem) ||
         !sim_flash_open(&s->slot_flash, slot_path, SIM_SLOT_BASE, SIM_SLOT_PAGES, s->slot_mem)) {
         fprintf(stderr, "servo_sim: cannot open the flash files %s, %s: ", path, slot_path);
@@ -188,6 +207,8 @@ bool sim_servo_start(struct sim_servo *s, struct sim_bus *bus, unsigned index, u
     s->bus = bus;
     s->index = index;
     s->cmdline_id = id;
+    s->unit = unit;
+    s->rx = (struct hal_rx_ring)HAL_RX_RING_OVER(s->rx_bytes);
     plant_init(&s->plant);
     s->plant.p.supply_v = supply_v;
     thermal_init(&s->thermal, ambient_c);
@@ -202,6 +223,7 @@ bool sim_servo_start(struct sim_servo *s, struct sim_bus *bus, unsigned index, u
         .calibration = &calibration,
         .flash = &s->flash.hal,
         .serial_number = serial_number,
+        .image_version = image_version,
         .enter_bootloader = enter_bootloader,
         .board = SIM_BOARD,
     };
@@ -254,7 +276,7 @@ static void receive(void *ctx, uint8_t byte, uint64_t at_us)
      * written over, oldest bytes first (RM0008 13.3.6, circular mode), and
      * the main loop counts what it lost by the write counter. */
     uint32_t w = s->rx.written;
-    s->rx.data[w & (HAL_RX_RING_SIZE - 1u)] = byte;
+    s->rx.data[w & s->rx.mask] = byte;
     s->rx.written = w + 1u;
     s->rx.heard_us = (uint32_t)at_us;
 }

@@ -42,9 +42,11 @@ struct sim_servo {
     bool in_bootloader;
     struct sim_boot boot;
     struct hal_rx_ring rx;
+    uint8_t rx_bytes[BOARD_RX_RING_BYTES];
     struct sim_bus *bus;
     unsigned index;       /* on the bus */
-    uint8_t cmdline_id;   /* the ID it was started with (names its flash file) */
+    uint8_t cmdline_id;   /* the ID it was started with */
+    uint8_t unit;         /* servos started before it with the same ID */
     uint32_t baud;
     uint64_t tx_done_us;
     uint64_t stepped_us;  /* the models have run up to here */
@@ -71,10 +73,20 @@ struct sim_servo {
 /* Monotonic microseconds since the simulator started. */
 uint64_t sim_now_us(void);
 
-/* Opens the servo's flash file in state_dir (giving a blank chip the ID
- * `id`) and starts its core. False, with a message, on failure. */
+/* Opens the servo's flash files in state_dir (giving a blank chip the ID
+ * `id`) and starts its core. unit counts the servos started before it with
+ * the same ID: it names its files and its serial number apart from theirs.
+ * False, with a message, on failure. */
 bool sim_servo_start(struct sim_servo *s, struct sim_bus *bus, unsigned index, uint8_t id,
-                     const char *state_dir, double supply_v, double ambient_c);
+                     uint8_t unit, const char *state_dir, double supply_v, double ambient_c);
+
+/* Data item 8 of this servo: 0x51A0UUNN (UU its unit, NN the ID it was
+ * started with), the same at every start. */
+uint32_t sim_servo_serial(const struct sim_servo *s);
+
+/* The ID the servo answers at now: its application's, or its
+ * bootloader's (the stored one). */
+uint8_t sim_servo_bus_id(const struct sim_servo *s);
 
 /* The motor and winding models up to the bus's now. */
 void sim_servo_run_models(struct sim_servo *s);

@@ -25,6 +25,11 @@
 #define BOARD_CURRENT_UA_PER_COUNT 1611
 #define BOARD_CURRENT_ZERO_COUNTS 0
 
+/* The receive ring (hal/hal_rx_ring.h): QEMU's board has no flash
+ * controller, so nothing stalls the CPU for longer than a main-loop pass. */
+#define BOARD_RX_RING_BYTES 256
+#define BOARD_BOOT_RX_RING_BYTES 256
+
 #include "../board_derived.h"
 
 #endif

@@ -4,6 +4,7 @@
 #include "board.h"
 #include "plant_fixed.h"
 #include "qemu_board.h"
+#include "app_image.h"
 #include "boot_flow.h"
 #include "boot_jump.h"
 #include "servo.h"
@@ -18,7 +19,8 @@
 
 static struct servo servo;
 static struct usart_hd usart;
-static struct hal_rx_ring rx_ring;
+static uint8_t rx_bytes[BOARD_RX_RING_BYTES];
+static struct hal_rx_ring rx_ring = HAL_RX_RING_OVER(rx_bytes);
 static struct plant_fixed plant;
 static uint8_t flash_mem[2 * FLASH_PAGE];
 static struct hal_flash flash;
@@ -88,6 +90,13 @@ static uint32_t serial_number(void *ctx)
     return 0x0E3A0001u;
 }
 
+/* Data ID 7: the version of the image the bootloader started. */
+static uint16_t image_version(void *ctx)
+{
+    (void)ctx;
+    return app_image_version_in_place(BOARD_SLOT_BASE);
+}
+
 /* UpdateEnter: the word that keeps the bootloader, then a restart. */
 static void enter_bootloader(void *ctx)
 {
@@ -104,6 +113,7 @@ static const struct hal_port port = {
               .read_sensors = sensors_read},
     .calibration = &calibration,
     .flash = &flash,
+    .image_version = image_version,
     .enter_bootloader = enter_bootloader,
     .board = BOARD_ID,
     .serial_number = serial_number,

@@ -25,6 +25,15 @@
 #define BOARD_RAM_VECTORS_SIZE 192
 #define BOARD_APP_STACK_SIZE 1344
 
+
+/* The receive ring (hal/hal_rx_ring.h): a page erase stalls the CPU up
+ * to 40 ms (DS9773, "Flash memory characteristics", tERASE) while the DMA
+ * goes on writing; 40 ms at 115200 baud is 460 bytes. 4 KB of RAM covers
+ * that rate, not 1 Mbaud (4000 bytes): above 115200 what an erase overruns
+ * is counted (ReadStore), not prevented. The bootloader erases only while
+ * no request waits. */
+#define BOARD_RX_RING_BYTES 512
+#define BOARD_BOOT_RX_RING_BYTES 256
 /* The analogue front end: the reference board's (stm32f103/board.h). */
 #define BOARD_SUPPLY_UV_PER_COUNT 8862
 #define BOARD_CURRENT_UA_PER_COUNT 1611

@@ -1,6 +1,7 @@
 /* The Cortex-M0 board: STM32F030K6 servo controller (pin map: README.md). */
 #include "board.h"
 #include "board_io.h"
+#include "app_image.h"
 #include "boot_flow.h"
 #include "boot_jump.h"
 #include "flash_f0f1.h"
@@ -12,11 +13,19 @@
 
 static struct servo servo;
 static struct usart_v2_hd usart;
-static struct hal_rx_ring rx_ring;
+static uint8_t rx_bytes[BOARD_RX_RING_BYTES];
+static struct hal_rx_ring rx_ring = HAL_RX_RING_OVER(rx_bytes);
 static struct dma_rx rx_dma;
 static struct hal_flash flash;
 
 static const struct sensor_calibration calibration = BOARD_SENSOR_CALIBRATION;
+
+/* Data ID 7: the version of the image the bootloader started. */
+static uint16_t image_version(void *ctx)
+{
+    (void)ctx;
+    return app_image_version_in_place(BOARD_SLOT_BASE);
+}
 
 /* UpdateEnter: the word that keeps the bootloader, then a restart. */
 static void enter_bootloader(void *ctx)
@@ -35,6 +44,7 @@ static const struct hal_port port = {
     .calibration = &calibration,
     .flash = &flash,
     .serial_number = unique_id_serial,
+    .image_version = image_version,
     .enter_bootloader = enter_bootloader,
     .board = BOARD_ID,
 };

@@ -21,6 +21,15 @@
 #define BOARD_RAM_BASE 0x20000000
 #define BOARD_RAM_SIZE 20480
 
+
+/* The receive ring (hal/hal_rx_ring.h): a page erase stalls the CPU up
+ * to 40 ms (DS5319, "Flash memory characteristics", tERASE) while the DMA
+ * goes on writing; 40 ms at 1 Mbaud is 4000 bytes, so no frame is lost to
+ * flash work at any rate. The bootloader erases only while no request
+ * waits: 256 bytes. */
+#define BOARD_RX_RING_BYTES 4096
+#define BOARD_BOOT_RX_RING_BYTES 256
+
 /* The analogue front end: 3.3 V ADC reference; supply through a 100k/10k
  * divider (11:1); 25 mOhm shunt into a gain-of-20 amplifier (0.5 V/A); the
  * NTC divider of servo-protocol.md appendix 5.1. */

@@ -12,7 +12,8 @@
 #include "systick_clock.h"
 
 static struct usart_hd usart;
-static struct hal_rx_ring rx_ring;
+static uint8_t rx_bytes[BOARD_BOOT_RX_RING_BYTES];
+static struct hal_rx_ring rx_ring = HAL_RX_RING_OVER(rx_bytes);
 static struct dma_rx rx_dma;
 static struct hal_flash config_flash;
 static struct hal_flash slot_flash;

@@ -2,6 +2,7 @@
 #include "board.h"
 #include "board_io.h"
 #include "flash_f0f1.h"
+#include "app_image.h"
 #include "boot_flow.h"
 #include "boot_jump.h"
 #include "servo.h"
@@ -13,7 +14,8 @@
 
 static struct servo servo;
 static struct usart_hd usart;
-static struct hal_rx_ring rx_ring;
+static uint8_t rx_bytes[BOARD_RX_RING_BYTES];
+static struct hal_rx_ring rx_ring = HAL_RX_RING_OVER(rx_bytes);
 static struct dma_rx rx_dma;
 static struct hal_flash flash;
 
@@ -26,6 +28,13 @@ static void gpio_init(void)
     GPIOA_CRL = (GPIO_ANALOG << 0) | (GPIO_ANALOG << 4) | (GPIO_ANALOG << 8) |
                 (GPIO_ANALOG << 12) | (GPIO_AF_PUSH_PULL_50MHZ << 24) |
                 (GPIO_AF_PUSH_PULL_50MHZ << 28) | (0x4u << 16) | (0x4u << 20);
+}
+
+/* Data ID 7: the version of the image the bootloader started. */
+static uint16_t image_version(void *ctx)
+{
+    (void)ctx;
+    return app_image_version_in_place(BOARD_SLOT_BASE);
 }
 
 /* UpdateEnter: the word that keeps the bootloader, then a restart. */
@@ -45,6 +54,7 @@ static const struct hal_port port = {
     .calibration = &calibration,
     .flash = &flash,
     .serial_number = unique_id_serial,
+    .image_version = image_version,
     .enter_bootloader = enter_bootloader,
     .board = BOARD_ID,
 };

@@ -59,6 +59,10 @@ struct hal_port {
     /* Data ID 8: derived by the port from the MCU's unique ID; read once,
      * at start. An operation, so a board's hal_port can be all constant. */
     uint32_t (*serial_number)(void *ctx);
+    /* Data ID 7: the version in the header of the update image this
+     * application was started from, read once at start; 0 where there is
+     * none (the core then reports the version it was built as). Optional. */
+    uint16_t (*image_version)(void *ctx);
     /* Restarts into the bootloader, which then stays (UpdateEnter); NULL
      * where there is none. Does not return on silicon. */
     void (*enter_bootloader)(void *ctx);

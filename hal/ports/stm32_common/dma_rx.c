@@ -12,7 +12,7 @@ void dma_rx_start(struct dma_rx *d, uintptr_t channel, uintptr_t data_register,
     DMA_CCR(channel) = 0;
     DMA_CPAR(channel) = (uint32_t)data_register;
     DMA_CMAR(channel) = (uint32_t)(uintptr_t)ring->data;
-    DMA_CNDTR(channel) = HAL_RX_RING_SIZE;
+    DMA_CNDTR(channel) = hal_rx_ring_size(ring); /* up to 65535 (RM0008 13.4.4) */
     DMA_CCR(channel) = DMA_CCR_RX_CIRCULAR;
 }
 
@@ -33,7 +33,8 @@ void dma_rx_sync(void *dma, uint32_t now_us)
     if (laps != d->laps) {
         return;
     }
-    uint32_t written = laps * HAL_RX_RING_SIZE + (HAL_RX_RING_SIZE - left);
+    uint32_t size = hal_rx_ring_size(d->ring);
+    uint32_t written = laps * size + (size - left);
     if ((int32_t)(written - d->written) > 0) {
         d->written = written;
         d->ring->written = written;

@@ -373,3 +373,18 @@ def test_id_254_is_a_servo_id(tmp_path, capsys):
         assert abs(sim.state(254)["angle"] - 10.0) < 0.5
     finally:
         sim.stop()
+
+
+def test_a_sync_monitor_keeps_the_answers_after_an_absent_servo(tmp_path, capsys):
+    """IDs 1, 3, 5 on the bus: servo 2's turn passes in silence and servo
+    3 answers after it. The answers that came while servoctl waited for 2
+    were thrown away, so 3 was reported silent."""
+    from servoctl import group
+    from servoctl.sim import Simulator
+
+    with Simulator(ids=[1, 3, 5], state_dir=str(tmp_path / "state")) as sim:
+        with sim.bus(timeout=0.2) as bus:
+            assert sorted(group.sync_monitor(bus, [1, 2, 3])) == [1, 3]
+            assert list(group.sync_monitor(bus, [5, 4, 3, 2, 1])) == [5, 3, 1]
+        rc, out, _ = run(sim, capsys, "monitor", "1", "2", "3", "--sync", "--count", "1")
+        assert rc == 3 and "  2 silent" in out and "3 silent" not in out, out

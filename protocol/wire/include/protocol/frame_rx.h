@@ -114,13 +114,14 @@ static inline bool frame_rx_take_ring(struct frame_rx *rx, struct hal_rx_ring *r
     if (waiting == 0u) {
         return false;
     }
-    if (waiting > HAL_RX_RING_SIZE) {
-        *lost += waiting - HAL_RX_RING_SIZE;
-        read = written - HAL_RX_RING_SIZE;
-        waiting = HAL_RX_RING_SIZE;
+    uint32_t size = ring->mask + 1u;
+    if (waiting > size) {
+        *lost += waiting - size;
+        read = written - size;
+        waiting = size;
     }
-    uint32_t at = read & (HAL_RX_RING_SIZE - 1u);
-    uint32_t first = HAL_RX_RING_SIZE - at < waiting ? HAL_RX_RING_SIZE - at : waiting;
+    uint32_t at = read & ring->mask;
+    uint32_t first = size - at < waiting ? size - at : waiting;
     frame_rx_feed_bytes(rx, &ring->data[at], first);
     if (waiting > first) { /* the rest, from the ring's start */
         frame_rx_feed_bytes(rx, ring->data, waiting - first);
