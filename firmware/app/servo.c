@@ -144,7 +144,7 @@ static void show_executing(struct servo *s)
         motion_is_executing(&s->motion) ? (uint8_t)(status | STATUS_EXECUTING) : status;
 }
 
-static void handle_next_frame(struct servo *s, uint32_t now)
+static inline __attribute__((always_inline)) void handle_next_frame(struct servo *s, uint32_t now)
 {
     const struct rx_frame *frame = frame_rx_peek(&s->rx);
     if (frame == NULL) {
@@ -238,11 +238,10 @@ static bool erase_may_stall(const struct servo *s, uint32_t now)
 }
 
 /* The spare page's erase: 20-40 ms with the CPU stalled, the output
- * released. The pass after it resumes the control loop on a fresh
- * schedule (released, it has nothing to catch up on: these ticks are not
- * dropped ones), and carries out the frames that arrived meanwhile
- * without answering them: an answer that late could fall in another
- * servo's slot. */
+ * released. The pass after it (after_erase) resumes the control loop on a
+ * fresh schedule (these ticks are not dropped ones), and carries out the
+ * frames that arrived meanwhile without answering them: an answer that
+ * late could fall in another servo's slot. */
 static void erase_spare(struct servo *s, uint32_t now)
 {
     bool ok = config_store_erase_spare(&s->store);
@@ -346,6 +345,30 @@ static void receive(struct servo *s, uint32_t now)
     frame_rx_receive(&s->rx, ring, &s->rx_lost, now, s->rx_idle_us);
 }
 
+/* The pass after a page erase: the control loop resumes on a fresh
+ * schedule (released, it has nothing to catch up on), and what arrived
+ * during the erase is carried out now, none of it answered
+ * (handle_next_frame). The ring may hold more frames than the framer's
+ * queue: they are framed a queue at a time. Kept out of servo_poll, which
+ * then checks for it once a pass. */
+__attribute__((noinline, cold)) static void after_erase(struct servo *s, uint32_t now)
+{
+    s->erase_passed = 0;
+    s->next_tick_us = now + CONTROL_TICK_US;
+    struct hal_rx_ring *ring = s->hal->rx;
+    hal_rx_sync(s->hal, now);
+    for (;;) {
+        frame_rx_receive(&s->rx, ring, &s->rx_lost, now, s->rx_idle_us);
+        s->stale_frames = frame_rx_pending(&s->rx);
+        while (s->stale_frames != 0u) {
+            handle_next_frame(s, now);
+        }
+        if (ring->read == ring->written) {
+            return;
+        }
+    }
+}
+
 /* UpdateEnter, its answer gone: every accepted change is in flash already. */
 static void restart_into_bootloader(struct servo *s)
 {
@@ -358,7 +381,7 @@ void servo_poll(struct servo *s)
     /* One reading of the clock per pass: the ticks due by then run now. */
     uint32_t now = s->hal->bus.now_us(s->hal->ctx);
     if (s->erase_passed) {
-        s->next_tick_us = now + CONTROL_TICK_US;
+        after_erase(s, now);
     }
     bool ticked = run_control_tick(s, now);
     if (s->tx.sending && s->hal->bus.tx_done(s->hal->ctx)) {
@@ -379,10 +402,6 @@ void servo_poll(struct servo *s)
         }
     }
     receive(s, now);
-    if (s->erase_passed) { /* what was framed now arrived during the erase */
-        s->erase_passed = 0;
-        s->stale_frames = frame_rx_pending(&s->rx);
-    }
     tend_store(s, now, ticked);
     if (s->tx.sending) {
         return; /* half duplex: nothing else goes out meanwhile */

@@ -170,7 +170,7 @@ INLINE_IN_FAST_BUILD void finish_skipped(struct frame_rx *rx)
     }
 }
 
-static void finish_frame(struct frame_rx *rx, uint8_t checksum)
+INLINE_IN_FAST_BUILD void finish_frame(struct frame_rx *rx, uint8_t checksum)
 {
     rx->state = RX_HDR0;
     rx->stats.requests_seen++;
@@ -199,7 +199,7 @@ static bool header_start(struct frame_rx *rx, uint8_t byte)
  * byte to the last of the content counts in the checksum: summed here
  * once, for all those states (a second header byte that is not one
  * restarts the sum anyway). */
-static void step(struct frame_rx *rx, uint8_t byte)
+INLINE_IN_FAST_BUILD void step(struct frame_rx *rx, uint8_t byte)
 {
     if (rx->state >= RX_HDR1 && rx->state <= RX_CONTENT) {
         rx->checksum = (uint8_t)(rx->checksum + byte);
@@ -261,7 +261,7 @@ static void step(struct frame_rx *rx, uint8_t byte)
 /* A kept request's plain content (not SyncCommand, past the ID, within
  * FRAME_CONTENT_MAX) in one run: copy and sum. Returns the bytes taken. */
 #ifndef FRAME_RX_SMALL
-static uint32_t content_run(struct frame_rx *rx, const uint8_t *data, uint32_t n)
+INLINE_IN_FAST_BUILD uint32_t content_run(struct frame_rx *rx, const uint8_t *data, uint32_t n)
 {
     struct rx_frame *f = work_slot(rx);
     if (f->code == PKT_SYNC_COMMAND || rx->position == 0u || rx->position >= FRAME_CONTENT_MAX) {
@@ -287,7 +287,7 @@ static uint32_t content_run(struct frame_rx *rx, const uint8_t *data, uint32_t n
 }
 
 /* Bytes outside any frame up to the next that may start a header. */
-static uint32_t garbage_run(struct frame_rx *rx, const uint8_t *data, uint32_t n)
+INLINE_IN_FAST_BUILD uint32_t garbage_run(struct frame_rx *rx, const uint8_t *data, uint32_t n)
 {
     uint32_t i = 0;
     while (i < n && data[i] != WIRE_REQUEST_HDR0 && data[i] != WIRE_RESPONSE_HDR0) {
@@ -299,7 +299,7 @@ static uint32_t garbage_run(struct frame_rx *rx, const uint8_t *data, uint32_t n
 
 /* A whole plain header (both header bytes, code, a one-byte length) when
  * all four have arrived: what step() would do in four calls. */
-static uint32_t header_run(struct frame_rx *rx, const uint8_t *data, uint32_t n)
+INLINE_IN_FAST_BUILD uint32_t header_run(struct frame_rx *rx, const uint8_t *data, uint32_t n)
 {
     if (n < WIRE_HEADER_SIZE) {
         return 0;
@@ -327,26 +327,39 @@ static uint32_t header_run(struct frame_rx *rx, const uint8_t *data, uint32_t n)
     return WIRE_HEADER_SIZE;
 }
 
-void frame_rx_feed_bytes(struct frame_rx *rx, const uint8_t *data, uint32_t n)
+/* Runs through the bytes; with stop_when_full, returns after the frame
+ * that fills the queue. Returns the bytes taken. Specialised at each call
+ * (stop_when_full a constant), so the receive path pays for the check
+ * only where a frame ends. */
+static inline __attribute__((always_inline)) uint32_t feed(struct frame_rx *rx, const uint8_t *data,
+                                                           uint32_t n, bool stop_when_full)
 {
-    while (n > 0u) {
+    uint32_t left = n;
+    while (left > 0u) {
         uint32_t took = 0;
         switch (rx->state) {
         case RX_SKIP:
-            took = rx->skip_left < n ? rx->skip_left : n;
+            took = rx->skip_left < left ? rx->skip_left : left;
             rx->skip_left -= took;
             if (rx->skip_left == 0u) {
                 finish_skipped(rx);
             }
             break;
         case RX_CONTENT:
-            took = content_run(rx, data, n);
+            took = content_run(rx, data, left);
             break;
         case RX_HDR0:
-            took = garbage_run(rx, data, n);
+            took = garbage_run(rx, data, left);
             if (took == 0u) {
-                took = header_run(rx, data, n);
+                took = header_run(rx, data, left);
             }
+            break;
+        case RX_CHECKSUM:
+            finish_frame(rx, *data);
+            if (stop_when_full && next_slot(rx->head) == rx->tail) {
+                return n - left + 1u;
+            }
+            took = 1;
             break;
         default:
             break;
@@ -356,8 +369,21 @@ void frame_rx_feed_bytes(struct frame_rx *rx, const uint8_t *data, uint32_t n)
             took = 1;
         }
         data += took;
-        n -= took;
+        left -= took;
     }
+    return n;
+}
+
+void frame_rx_feed_bytes(struct frame_rx *rx, const uint8_t *data, uint32_t n)
+{
+    (void)feed(rx, data, n, false);
+}
+
+/* The queue fills only at the end of a frame, where feed() stops: full,
+ * the framer is between frames. */
+uint32_t frame_rx_feed_until_full(struct frame_rx *rx, const uint8_t *data, uint32_t n)
+{
+    return next_slot(rx->head) == rx->tail ? 0u : feed(rx, data, n, true);
 }
 #else
 void frame_rx_feed_bytes(struct frame_rx *rx, const uint8_t *data, uint32_t n)
@@ -365,6 +391,30 @@ void frame_rx_feed_bytes(struct frame_rx *rx, const uint8_t *data, uint32_t n)
     for (uint32_t i = 0; i < n; i++) {
         step(rx, data[i]);
     }
+}
+
+/* Full between frames: the bytes after wait where they are (the port's
+ * ring) until the dispatcher has taken a frame. */
+static bool must_wait(const struct frame_rx *rx)
+{
+    return rx->state == RX_HDR0 && next_slot(rx->head) == rx->tail;
+}
+
+/* A byte at a time. A burst too short to fill an empty queue (nearly every
+ * main-loop pass's) needs no check between its bytes. */
+uint32_t frame_rx_feed_until_full(struct frame_rx *rx, const uint8_t *data, uint32_t n)
+{
+    uint32_t i = 0;
+    if (n <= FRAME_RX_SAFE_BURST && rx->head == rx->tail) {
+        for (; i < n; i++) {
+            step(rx, data[i]);
+        }
+        return n;
+    }
+    for (; i < n && !must_wait(rx); i++) {
+        step(rx, data[i]);
+    }
+    return i;
 }
 #endif
 

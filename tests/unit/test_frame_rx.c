@@ -237,27 +237,75 @@ static size_t outcome(struct fixture *f, uint8_t *out)
     return n + sizeof f->rx.stats;
 }
 
+/* As the main loop does with its ring: a burst fed; what the framer did
+ * not take (its queue full) is fed again once the waiting frames are
+ * taken, each appended to out. Returns out's new length. */
+static size_t feed_draining(struct fixture *f, const uint8_t *bytes, size_t n, uint8_t *out,
+                            size_t out_n)
+{
+    for (;;) {
+        uint32_t took = frame_rx_feed_until_full(&f->rx, bytes, (uint32_t)n);
+        bytes += took;
+        n -= took;
+        if (n == 0u) {
+            return out_n;
+        }
+        for (const struct rx_frame *fr; (fr = take(f)) != NULL;) {
+            memcpy(out + out_n, fr, sizeof *fr);
+            out_n += sizeof *fr;
+        }
+    }
+}
+
 static void test_bursts_split_anywhere_give_the_same_frames(void **state)
 {
     struct fixture *f = *state;
     static uint8_t wire[512];
     size_t n = mixed_stream(wire);
-    static uint8_t expected[2048], got[2048];
-    for (size_t i = 0; i < n; i++) {
-        frame_rx_feed(&f->rx, wire[i]);
+    static uint8_t expected[4096], got[4096];
+    size_t expected_n = 0;
+    for (size_t i = 0; i < n; i++) { /* a byte a pass */
+        expected_n = feed_draining(f, &wire[i], 1, expected, expected_n);
     }
-    size_t expected_n = outcome(f, expected);
-    assert_int_equal(f->rx.stats.frames, 3); /* the queue holds three */
+    expected_n += outcome(f, expected + expected_n);
+    assert_int_equal(f->rx.stats.frames, 5); /* more than the queue holds: none lost */
+    assert_int_equal(f->rx.stats.queue_overflows, 0);
     for (size_t cut = 0; cut <= n; cut++) {
         for (size_t cut2 = cut; cut2 <= n; cut2 += 5) {
             frame_rx_init(&f->rx, &f->id);
-            feed(f, wire, cut);
-            feed(f, wire + cut, cut2 - cut);
-            feed(f, wire + cut2, n - cut2);
-            assert_int_equal(outcome(f, got), expected_n);
+            size_t got_n = feed_draining(f, wire, cut, got, 0);
+            got_n = feed_draining(f, wire + cut, cut2 - cut, got, got_n);
+            got_n = feed_draining(f, wire + cut2, n - cut2, got, got_n);
+            got_n += outcome(f, got + got_n);
+            assert_int_equal(got_n, expected_n);
             assert_memory_equal(got, expected, expected_n);
         }
     }
+}
+
+/* A burst of more frames than the queue holds: the framer stops at the
+ * end of the frame that fills it, and the rest waits in the ring. */
+static void test_a_full_queue_leaves_the_rest_of_a_burst_unread(void **state)
+{
+    struct fixture *f = *state;
+    uint8_t wire[64];
+    size_t n = 0, ends[FRAME_QUEUE_SLOTS];
+    for (uint8_t i = 0; i < FRAME_QUEUE_SLOTS; i++) {
+        const uint8_t read[] = {3, i};
+        n += make_request(wire + n, 3, read, 2);
+        ends[i] = n;
+    }
+    uint32_t took = frame_rx_feed_until_full(&f->rx, wire, (uint32_t)n);
+    assert_int_equal(took, ends[FRAME_QUEUE_SLOTS - 2u]);
+    assert_int_equal(frame_rx_feed_until_full(&f->rx, wire + took, (uint32_t)(n - took)), 0);
+    assert_non_null(take(f));
+    assert_int_equal(frame_rx_feed_until_full(&f->rx, wire + took, (uint32_t)(n - took)), n - took);
+    for (uint8_t i = 1; i < FRAME_QUEUE_SLOTS; i++) {
+        const struct rx_frame *fr = take(f);
+        assert_non_null(fr);
+        assert_int_equal(fr->content[1], i);
+    }
+    assert_int_equal(f->rx.stats.queue_overflows, 0);
 }
 
 static void test_without_idle_gap_truncated_frame_swallows_next(void **state)
@@ -308,6 +356,8 @@ static void test_extended_length_short_frame(void **state)
     assert_int_equal(fr->flags, 0);
 }
 
+/* frame_rx_feed_bytes takes every byte: a frame that starts with the
+ * queue full is dropped, and counted. */
 static void test_queue_overflow_is_counted(void **state)
 {
     struct fixture *f = *state;
@@ -449,6 +499,7 @@ int main(void)
         cmocka_unit_test_setup(test_extended_length, setup),
         cmocka_unit_test_setup(test_extended_length_short_frame, setup),
         cmocka_unit_test_setup(test_queue_overflow_is_counted, setup),
+        cmocka_unit_test_setup(test_a_full_queue_leaves_the_rest_of_a_burst_unread, setup),
         cmocka_unit_test_setup(test_sync_keeps_only_own_record, setup),
         cmocka_unit_test_setup(test_sync_record_data_matching_id_is_not_a_record_start, setup),
         cmocka_unit_test_setup(test_sync_without_own_record, setup),

@@ -563,6 +563,52 @@ static void test_an_answer_that_would_leave_late_is_dropped(void **state)
     EXPECT_RESPONSE(1, 0);
 }
 
+/* Six ReadData and a WriteData arrive in the ring while an erase stalls
+ * the CPU: more frames than the framer's queue holds. */
+static void a_burst_arrives_during_erase(void *ctx)
+{
+    (void)ctx;
+    uint8_t wire[96];
+    size_t n = 0;
+    for (int i = 0; i < 6; i++) {
+        n += make_request(wire + n, 3, (const uint8_t[]){0, 38}, 2);
+    }
+    n += make_request(wire + n, 4, (const uint8_t[]){0, 38, 0xD2, 0x04}, 4);
+    for (size_t i = 0; i < n; i++) {
+        servo_on_rx_byte(&servo, wire[i], hal.now_us + 1000u + 87u * (uint32_t)i);
+    }
+    hal.now_us += 40000u;
+}
+
+/* The ring holds what the framer's queue cannot: every frame of the burst
+ * is carried out (the write, last, too), and none is answered late, the
+ * ones framed passes after the erase included. */
+static void test_a_burst_during_an_erase_is_carried_out_and_never_answered_late(void **state)
+{
+    (void)state;
+    const unsigned slots = config_store_slots_per_page(&servo.store);
+    for (unsigned i = 0; i < 2u * slots; i++) {
+        REQUEST(4, 0, 43, (uint8_t)(100u + i), 0x07);
+        harness_run_ms(70);
+    }
+    uint32_t erases = hal.flash.erases[0] + hal.flash.erases[1];
+    hal.flash.during_erase = a_burst_arrives_during_erase;
+    hal_double_clear_sent(&hal);
+    while (hal.flash.erases[0] + hal.flash.erases[1] == erases) {
+        hal.now_us += 250u;
+        servo_poll(&servo);
+    }
+    hal.flash.during_erase = NULL;
+    harness_poll(20);
+    assert_int_equal(hal.sent_length, 0u);
+    assert_int_equal(servo.regs.user.stall_power_mw, 1234);
+    assert_int_equal(servo.answers_dropped, 7u);
+    assert_int_equal(servo.rx.stats.queue_overflows, 0u);
+    assert_int_equal(servo.rx_lost, 0u);
+    REQUEST(1, 0);
+    EXPECT_RESPONSE(1, 0);
+}
+
 /* UpdateEnter (0x50): refused without a bootloader, and while the output
  * is driven (a move, holding its end, damping, a buffered move), each with
  * its reason; a released servo answers, and the restart waits for the
@@ -653,6 +699,7 @@ int main(void)
         cmocka_unit_test_setup(test_writes_in_a_loop_stay_within_the_wear_budget, setup),
         cmocka_unit_test_setup(test_the_flash_is_erased_only_while_released, setup),
         cmocka_unit_test_setup(test_an_answer_that_would_leave_late_is_dropped, setup),
+        cmocka_unit_test_setup(test_a_burst_during_an_erase_is_carried_out_and_never_answered_late, setup),
         cmocka_unit_test_setup(test_update_enter_restarts_into_the_bootloader, setup),
         cmocka_unit_test_setup(test_garbage_between_frames_and_responses_of_others, setup),
         cmocka_unit_test_setup(test_assign_id_by_serial_number, setup),

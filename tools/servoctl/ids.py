@@ -44,27 +44,33 @@ def assign(bus: p.Bus, serial: int, new_id: int) -> None:
 
 
 def bring_up(bus: p.Bus, from_id: int, first_id: int, count: int, wait_s: float, say) -> list:
-    """Numbers new servos connected one at a time: each time one servo
-    alone answers at from_id (the factory ID), it gets the next free ID from
-    first_id on, and say() asks for the next. Returns [(serial, id)]."""
+    """Numbers new servos: each servo answering at from_id (the factory ID)
+    whose serial number is known gets the next free ID from first_id on.
+    Several new servos on the bus at once are numbered in turn when each
+    one's answer came through whole; when they collide, say() asks for one
+    at a time. Returns [(serial, id)]."""
     window = scan.reply_window_s(bus.serial.baudrate)
     done = []
     next_id = first_id
     while len(done) < count:
-        say(f"connect new servo {len(done) + 1} of {count} (it answers at ID {from_id}) ...")
         deadline = bus.clock() + wait_s
         found = None
+        asked = False
         while found is None:
             if bus.clock() > deadline:
                 raise NoReply(f"no servo alone at ID {from_id} within {wait_s:g} s; "
                               f"{len(done)} numbered")
             f = scan.probe(bus, from_id, window)
-            if f is not None and f.shared:
-                say(f"two or more servos answer at ID {from_id}: connect one new servo at a time")
+            if f is not None and f.mode == "application" and f.serials and f.serials_complete:
+                found = f  # alone, or several whose serial numbers all came through
+            elif f is not None and f.shared:
+                say(f"two or more servos answer at ID {from_id} and their answers collide: "
+                    f"connect one new servo at a time")
                 bus.sleep(1.0)
-            elif f is not None and f.serials and f.mode == "application":
-                found = f
             else:
+                if not asked:
+                    say(f"connect new servo {len(done) + 1} of {count} (it answers at ID {from_id}) ...")
+                    asked = True
                 bus.sleep(0.2)
         while next_id == from_id or scan.probe(bus, next_id, window) is not None:
             next_id += 1

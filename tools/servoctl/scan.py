@@ -36,6 +36,16 @@ class Found:
         """Two or more servos hold this ID."""
         return self.answers > 1 or len(self.serials) > 1 or self.garbled > 0
 
+    @property
+    def serials_complete(self) -> bool:
+        """Every servo at this ID told its serial number: none garbled."""
+        return self.garbled == 0 and len(self.serials) >= self.answers
+
+    @property
+    def servos(self) -> int:
+        """How many servos hold this ID, as far as their answers tell."""
+        return max(1, self.answers, len(self.serials), 2 if self.shared else 1)
+
     def describe(self) -> str:
         where = f"servo {self.id} at {self.baud} baud"
         if self.shared and len(self.serials) > 1:
@@ -55,6 +65,15 @@ class Found:
     def as_json(self) -> dict:
         return {"id": self.id, "baud": self.baud, "mode": self.mode, "serials": self.serials,
                 "shared": self.shared}
+
+
+def count_line(found: list) -> str:
+    """scan's last line: servos, not IDs (a new bus holds them all at ID 0)."""
+    if not found:
+        return "no servo answered"
+    n = sum(f.servos for f in found)
+    at_least = any(f.shared and not f.serials_complete for f in found)
+    return f"{'at least ' if at_least else ''}{n} servo(s) found"
 
 
 def probe(bus: p.Bus, servo_id: int, window_s: float):

@@ -175,6 +175,7 @@ void sim_servo_start_app(struct sim_servo *s)
 
 void sim_servo_power_cycle(struct sim_servo *s)
 {
+    s->power_ups++;
     sim_boot_reset(s, false);
 }
 
@@ -208,6 +209,7 @@ bool sim_servo_start(struct sim_servo *s, struct sim_bus *bus, unsigned index, u
     s->index = index;
     s->cmdline_id = id;
     s->unit = unit;
+    s->power_ups = 1;
     s->rx = (struct hal_rx_ring)HAL_RX_RING_OVER(s->rx_bytes);
     plant_init(&s->plant);
     s->plant.p.supply_v = supply_v;

@@ -47,6 +47,7 @@ struct sim_servo {
     unsigned index;       /* on the bus */
     uint8_t cmdline_id;   /* the ID it was started with */
     uint8_t unit;         /* servos started before it with the same ID */
+    unsigned power_ups;   /* the first, then one a power cycle */
     uint32_t baud;
     uint64_t tx_done_us;
     uint64_t stepped_us;  /* the models have run up to here */

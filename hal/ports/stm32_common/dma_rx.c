@@ -8,7 +8,7 @@
 void dma_rx_start(struct dma_rx *d, uintptr_t channel, uintptr_t data_register,
                   struct hal_rx_ring *ring)
 {
-    *d = (struct dma_rx){.channel = channel, .ring = ring};
+    *d = (struct dma_rx){.channel = channel, .ring = ring, .lap_end = hal_rx_ring_size(ring)};
     DMA_CCR(channel) = 0;
     DMA_CPAR(channel) = (uint32_t)data_register;
     DMA_CMAR(channel) = (uint32_t)(uintptr_t)ring->data;
@@ -18,23 +18,22 @@ void dma_rx_start(struct dma_rx *d, uintptr_t channel, uintptr_t data_register,
 
 void dma_rx_lap(struct dma_rx *d)
 {
-    d->laps++;
+    d->lap_end += hal_rx_ring_size(d->ring);
 }
 
 void dma_rx_sync(void *dma, uint32_t now_us)
 {
     struct dma_rx *d = dma;
-    /* Laps, counter, laps: a lap that ended in between waits for the next
+    /* Lap end, counter, lap end: a lap that ended in between waits for the next
      * call, as does a counter that has reloaded at the end of a lap a
      * moment before the interrupt counts it (a position behind the last
      * one seen). */
-    uint32_t laps = d->laps;
+    uint32_t lap_end = d->lap_end;
     uint32_t left = DMA_CNDTR(d->channel);
-    if (laps != d->laps) {
+    if (lap_end != d->lap_end) {
         return;
     }
-    uint32_t size = hal_rx_ring_size(d->ring);
-    uint32_t written = laps * size + (size - left);
+    uint32_t written = lap_end - left;
     if ((int32_t)(written - d->written) > 0) {
         d->written = written;
         d->ring->written = written;

@@ -21,8 +21,8 @@
 struct dma_rx {
     uintptr_t channel;       /* address of the channel's CCR */
     struct hal_rx_ring *ring;
-    volatile uint32_t laps;  /* transfer-complete interrupts */
-    uint32_t written;        /* bytes written as last seen */
+    volatile uint32_t lap_end; /* bytes written when the lap under way ends */
+    uint32_t written;          /* bytes written as last seen */
 };
 
 /* Starts the channel on the peripheral's data register. */

@@ -6,6 +6,8 @@ import json
 import socket
 import threading
 
+import pytest
+
 from servoctl import protocol as p
 from servoctl import update as upd
 from servoctl.cli import main
@@ -128,3 +130,44 @@ def test_all_bauds_over_a_socket_scans_once(sim, capsys):
     rc, out, err = run(sim, capsys, "scan", "--all-bauds", "--last", "3")
     assert rc == 0 and "1 servo(s) found" in out, out
     assert "socket:// carries no baud rate" in err
+
+
+def test_a_bus_of_new_servos_is_counted_numbered_and_addressed_by_bus_id(tmp_path, capsys):
+    """Four servos as they leave the factory, all at ID 0 (servo_sim
+    refused an ID given twice). Their answers come through whole on the
+    simulated wire, so their serial numbers are known: scan counts four
+    servos, not one ID, and bringup numbers all four without asking for
+    them one at a time. The control port then addresses a servo by the ID
+    it holds now, or by its serial number, not by the ID it started with."""
+    with Simulator(ids=[0, 0, 0, 0], state_dir=str(tmp_path / "state")) as sim:
+        serials = [0x51A00000, 0x51A00100, 0x51A00200, 0x51A00300]
+        rc, out, err = run(sim, capsys, "scan", "--last", "3")
+        assert rc == 1 and "4 servo(s) found" in out and "IDs held by two or more servos: 0" in err, out + err
+        rc, out, err = run(sim, capsys, "id", "bringup", "--first", "1", "--count", "4", "--wait-s", "5")
+        assert rc == 0, out + err
+        assert "one new servo at a time" not in out and "4 servo(s) numbered" in out, out
+        rc, out, _ = run(sim, capsys, "scan", "--last", "5", "--json")
+        found = json.loads(out)
+        assert rc == 0 and [f["id"] for f in found] == [1, 2, 3, 4]
+        assert sorted(s for f in found for s in f["serials"]) == serials
+        for f in found:  # the control port by bus ID and by serial: the same servo
+            assert sim.state(f["id"])["serial"] == f["serials"][0]
+            assert sim.state(f"0x{f['serials'][0]:08x}")["id"] == f["id"]
+        sim.control("powercycle 2")  # the servo that holds 2 now restarts, the others do not
+        sim.sleep(0.6)
+        with sim.bus() as bus:
+            assert all(Servo(bus, i).ping() for i in (1, 2, 3, 4))
+        assert [sim.state(i)["resets_power"] for i in (1, 2, 3, 4)] == [1, 2, 1, 1]
+        assert sim.state(2)["mode"] == "app"
+        with pytest.raises(p.ServoError, match="no servo holds that ID"):
+            sim.control("state 0")
+        lines = sim.control("state").splitlines()
+        assert len(lines) == 4 and all(line.startswith("id=") for line in lines)
+
+
+def test_state_of_a_full_bus_is_every_line(tmp_path):
+    """state with 254 servos stopped at 4095 bytes, mid-line."""
+    with Simulator(ids=list(range(254)), state_dir=str(tmp_path / "state")) as sim:
+        lines = sim.control("state").splitlines()
+        assert [int(line.split()[0].split("=")[1]) for line in lines] == list(range(254))
+        assert all(line.split()[-1].startswith("serial=") for line in lines)

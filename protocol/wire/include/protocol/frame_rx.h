@@ -51,8 +51,9 @@ struct frame_rx_stats {
     uint32_t garbage_bytes;     /* bytes outside any frame */
 };
 
+/* The framer's state first: on the Cortex-M0 a byte field is reached by
+ * an immediate offset only within the first 32 bytes. */
 struct frame_rx {
-    struct rx_frame slots[FRAME_QUEUE_SLOTS];
     uint8_t head;               /* next slot the framer fills */
     uint8_t tail;               /* next slot the dispatcher reads */
     uint8_t state;
@@ -68,16 +69,27 @@ struct frame_rx {
     uint32_t skip_left;         /* RX_SKIP: bytes to pass over, checksum included */
     const volatile uint8_t *own_id; /* the servo's active ID, for sync records */
     struct frame_rx_stats stats;
+    struct rx_frame slots[FRAME_QUEUE_SLOTS];
 };
 
 /* own_id must stay valid for the framer's lifetime; the framer reads it when
  * a sync record starts. */
 void frame_rx_init(struct frame_rx *rx, const volatile uint8_t *own_id);
 
-/* Received bytes, in order. */
+/* Received bytes, in order, every one taken: a frame that starts while
+ * the queue is full is dropped and counted (stats.queue_overflows). */
 void frame_rx_feed_bytes(struct frame_rx *rx, const uint8_t *data, uint32_t n);
 /* One received byte. */
 void frame_rx_feed(struct frame_rx *rx, uint8_t byte);
+
+/* Bytes that cannot fill an empty queue: a request is 5 bytes or more,
+ * so 10 complete at most two frames (the one under way and one more) of
+ * the FRAME_QUEUE_SLOTS - 1 it holds (the byte-by-byte framer's shortcut). */
+#define FRAME_RX_SAFE_BURST 10u
+/* Received bytes, in order, until the queue is full: returns how many were
+ * taken, all of them unless it stopped at the end of the frame that filled
+ * it. The rest waits where it is (the port's ring) for the next call. */
+uint32_t frame_rx_feed_until_full(struct frame_rx *rx, const uint8_t *data, uint32_t n);
 
 
 /* The line has been idle for the idle timeout (frame_rx_idle_us): a partial
@@ -102,11 +114,14 @@ static inline uint8_t frame_rx_pending(const struct frame_rx *rx)
     return (uint8_t)((rx->head + FRAME_QUEUE_SLOTS - rx->tail) % FRAME_QUEUE_SLOTS);
 }
 
-/* Everything waiting in the port's ring, framed: false when nothing was.
+/* What waits in the port's ring, framed: false when nothing was. A full
+ * frame queue leaves the rest in the ring for the next pass, after the
+ * dispatcher has taken a frame: a burst of frames is kept, not dropped.
  * Bytes the port wrote over before they were taken (its DMA lapped the
  * reader) are added to *lost. Inline: it runs every main-loop pass. */
-static inline bool frame_rx_take_ring(struct frame_rx *rx, struct hal_rx_ring *ring,
-                                      uint32_t *lost)
+static inline __attribute__((always_inline)) bool frame_rx_take_ring(struct frame_rx *rx,
+                                                                      struct hal_rx_ring *ring,
+                                                                      uint32_t *lost)
 {
     uint32_t written = ring->written;
     uint32_t read = ring->read;
@@ -122,11 +137,11 @@ static inline bool frame_rx_take_ring(struct frame_rx *rx, struct hal_rx_ring *r
     }
     uint32_t at = read & ring->mask;
     uint32_t first = size - at < waiting ? size - at : waiting;
-    frame_rx_feed_bytes(rx, &ring->data[at], first);
-    if (waiting > first) { /* the rest, from the ring's start */
-        frame_rx_feed_bytes(rx, ring->data, waiting - first);
+    uint32_t took = frame_rx_feed_until_full(rx, &ring->data[at], first);
+    if (waiting > first && took == first) { /* the rest, from the ring's start */
+        took += frame_rx_feed_until_full(rx, ring->data, waiting - first);
     }
-    ring->read = written;
+    ring->read = read + took;
     return true;
 }
 
@@ -146,8 +161,10 @@ static inline uint32_t frame_rx_port_idle_us(uint32_t idle_us, uint32_t gap_tole
  * alike: the ring framed, and a partial frame dropped once the line has
  * been silent for idle_us, so no byte sequence leaves the framer waiting
  * for bytes that never come. */
-static inline void frame_rx_receive(struct frame_rx *rx, struct hal_rx_ring *ring, uint32_t *lost,
-                                    uint32_t now_us, uint32_t idle_us)
+static inline __attribute__((always_inline)) void frame_rx_receive(struct frame_rx *rx,
+                                                                   struct hal_rx_ring *ring,
+                                                                   uint32_t *lost, uint32_t now_us,
+                                                                   uint32_t idle_us)
 {
     if (!frame_rx_take_ring(rx, ring, lost) && frame_rx_in_frame(rx) &&
         (int32_t)(now_us - ring->heard_us) >= (int32_t)idle_us) {
