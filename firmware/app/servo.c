@@ -24,6 +24,7 @@ static void apply_link_settings(struct servo *s)
     }
     /* Divides: on a change of link settings only. */
     uint32_t byte_us = baud != 0u ? (10000000u + baud - 1u) / baud : 0u;
+    s->ring_covers_erase = hal_rx_ring_size(s->hal->rx) * byte_us >= STORE_ERASE_MAX_US;
     s->unsolicited_slot_us = UNSOLICITED_WINDOW_US + 2u * byte_us + UNSOLICITED_DRIFT_GUARD_US;
     s->unsolicited_first_us = UNSOLICITED_QUIET_US + (uint32_t)s->active_id * s->unsolicited_slot_us;
 }
@@ -244,6 +245,7 @@ static bool erase_may_stall(const struct servo *s, uint32_t now)
  * late could fall in another servo's slot. */
 static void erase_spare(struct servo *s, uint32_t now)
 {
+    s->erase_from = s->hal->rx->written;
     bool ok = config_store_erase_spare(&s->store);
     save_policy_outcome(&s->saver, ok, now);
     if (ok) {
@@ -357,6 +359,15 @@ __attribute__((noinline, cold)) static void after_erase(struct servo *s, uint32_
     s->next_tick_us = now + CONTROL_TICK_US;
     struct hal_rx_ring *ring = s->hal->rx;
     hal_rx_sync(s->hal, now);
+    uint32_t came = ring->written - s->erase_from;
+    if (!s->ring_covers_erase && (s->erase_from & ring->mask) + came > ring->mask) {
+        /* The ring wrapped during the stall at a rate it cannot cover: how
+         * many laps, nobody counted. All of it is dropped, and counted. */
+        s->rx_lost += came;
+        ring->read = ring->written;
+        frame_rx_line_idle(&s->rx);
+        return;
+    }
     for (;;) {
         frame_rx_receive(&s->rx, ring, &s->rx_lost, now, s->rx_idle_us);
         s->stale_frames = frame_rx_pending(&s->rx);

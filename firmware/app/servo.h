@@ -38,8 +38,13 @@
  * only at power-up and while the output is released (nothing held against
  * a load) and the line has been quiet for STORE_ERASE_QUIET_US; never on a
  * host's schedule. A change that needs it meanwhile is refused with its
- * reason (docs/decisions.md, "The config store"). */
+ * reason (docs/decisions.md, "The config store"). The DMA goes on writing
+ * through the stall, but the laps it completes then cannot be counted: at
+ * a baud rate whose STORE_ERASE_MAX_US of bytes the ring cannot hold (the
+ * Cortex-M0 board above 115200), what came in is dropped and counted as
+ * lost once the ring has wrapped (after_erase). */
 #define STORE_ERASE_QUIET_US 100000u
+#define STORE_ERASE_MAX_US 40000u
 /* Ticks a late main loop catches up before it drops the rest. */
 #define SERVO_MAX_CATCH_UP 4u
 /* Control tick period. */
@@ -78,6 +83,8 @@ struct servo {
     uint8_t link_settings_pending; /* the user area changed: ID or baud may have */
     uint8_t enter_bootloader;    /* UpdateEnter taken: restart once the answer is out */
     uint8_t erase_passed;        /* a page erase stalled the CPU in the last pass */
+    uint8_t ring_covers_erase;   /* the ring holds an erase's bytes at this baud */
+    uint32_t erase_from;         /* the ring's written count as the erase began */
     uint8_t stale_frames;        /* frames that arrived during it: not answered */
     uint32_t answers_dropped;    /* answers not sent: they would have left late */
     uint32_t unsolicited_slot_us;  /* slot length at this baud */

@@ -16,7 +16,7 @@ struct hal_double {
     struct hal_port port;
     struct flash_double flash;
     struct hal_rx_ring rx; /* servo_on_rx_byte puts received bytes here */
-    uint8_t rx_bytes[256];  /* the bootloader's ring, and the smallest a board has */
+    uint8_t rx_bytes[512];  /* the smallest an application has (the Cortex-M0 board) */
     uint32_t now_us;
     uint8_t sent[HAL_DOUBLE_SENT_MAX];
     size_t sent_length;

@@ -563,6 +563,61 @@ static void test_an_answer_that_would_leave_late_is_dropped(void **state)
     EXPECT_RESPONSE(1, 0);
 }
 
+/* 90 ReadData (540 bytes) and a WriteData in the ring while an erase
+ * stalls the CPU: at 1 Mbaud more than a 512-byte ring's lap. */
+static void a_lap_arrives_during_erase(void *ctx)
+{
+    (void)ctx;
+    uint8_t wire[16];
+    uint32_t at = hal.now_us + 1000u;
+    for (int i = 0; i < 90; i++) {
+        size_t n = make_request(wire, 3, (const uint8_t[]){0, 38}, 2);
+        for (size_t k = 0; k < n; k++) {
+            servo_on_rx_byte(&servo, wire[k], at += 10u);
+        }
+    }
+    size_t n = make_request(wire, 4, (const uint8_t[]){0, 38, 0xD2, 0x04}, 4);
+    for (size_t k = 0; k < n; k++) {
+        servo_on_rx_byte(&servo, wire[k], at += 10u);
+    }
+    hal.now_us += 40000u;
+}
+
+/* A ring that cannot hold an erase's worth of bytes at the baud rate (512
+ * bytes at 1 Mbaud: 5 ms of a 40 ms erase) and wrapped during it: the DMA
+ * laps in a stall go uncounted, so nothing that came is trusted. It is
+ * dropped, counted as lost (ReadStore), and not carried out; the next
+ * request is answered as usual. */
+static void test_a_ring_that_wrapped_during_an_erase_is_dropped_and_counted(void **state)
+{
+    (void)state;
+    assert_int_equal(hal_rx_ring_size(&hal.rx), 512u);
+    REQUEST(4, 0, 36, 8); /* 1 Mbaud */
+    harness_poll(2);
+    assert_int_equal(hal.baud, 1000000);
+    const unsigned slots = config_store_slots_per_page(&servo.store);
+    for (unsigned i = 0; i < 2u * slots; i++) {
+        REQUEST(4, 0, 43, (uint8_t)(100u + i), 0x07);
+        harness_run_ms(70);
+    }
+    uint32_t erases = hal.flash.erases[0] + hal.flash.erases[1];
+    const uint16_t stall_power = servo.regs.user.stall_power_mw;
+    hal.flash.during_erase = a_lap_arrives_during_erase;
+    hal_double_clear_sent(&hal);
+    while (hal.flash.erases[0] + hal.flash.erases[1] == erases) {
+        hal.now_us += 250u;
+        servo_poll(&servo);
+    }
+    hal.flash.during_erase = NULL;
+    harness_poll(20);
+    assert_int_equal(hal.sent_length, 0u);
+    assert_int_equal(servo.regs.user.stall_power_mw, stall_power); /* not carried out */
+    assert_true(servo.rx_lost >= 512u);
+    assert_int_equal(servo.answers_dropped, 0u);
+    REQUEST(1, 0);
+    EXPECT_RESPONSE(1, 0);
+}
+
 /* Six ReadData and a WriteData arrive in the ring while an erase stalls
  * the CPU: more frames than the framer's queue holds. */
 static void a_burst_arrives_during_erase(void *ctx)
@@ -700,6 +755,7 @@ int main(void)
         cmocka_unit_test_setup(test_the_flash_is_erased_only_while_released, setup),
         cmocka_unit_test_setup(test_an_answer_that_would_leave_late_is_dropped, setup),
         cmocka_unit_test_setup(test_a_burst_during_an_erase_is_carried_out_and_never_answered_late, setup),
+        cmocka_unit_test_setup(test_a_ring_that_wrapped_during_an_erase_is_dropped_and_counted, setup),
         cmocka_unit_test_setup(test_update_enter_restarts_into_the_bootloader, setup),
         cmocka_unit_test_setup(test_garbage_between_frames_and_responses_of_others, setup),
         cmocka_unit_test_setup(test_assign_id_by_serial_number, setup),

@@ -22,7 +22,7 @@ from .core import Core, Stop
 from .dma import Dma
 from .flash import Flash
 from .model import Model
-from .native import Motor, factory_config
+from .native import Motor, factory_config, stored_id
 from .timers import BridgeTimer, Watchdog
 from .usart import Usart
 
@@ -95,8 +95,11 @@ class Memory:
 
 class Board:
     def __init__(self, board: str, servo_id: int, bus, state_dir=None, supply_v=7.4, ambient_c=25.0,
-                 boot_image=None, app_image=None):
-        self.name, self.servo_id, self.bus = board, servo_id, bus
+                 boot_image=None, app_image=None, unit=0):
+        # unit: boards started before this one with the same ID (a bus of
+        # new servos all at ID 0): it names the flash file and the chip's
+        # unique ID apart from theirs.
+        self.name, self.servo_id, self.bus, self.unit = board, servo_id, bus, unit
         self.part = PARTS[board]
         self.h = board_h(board)
         h, part = self.h, self.part
@@ -111,21 +114,16 @@ class Board:
         self._alias = None
         self.alias_zero(self.flash_mem, self.flash_size)
         self.core.map_host(0x40000000, 0x30000)
-        kr = svd.device(part.svd)["IWDG"].address("KR")  # the watchdog watches its own key
-        self.core.watch_writes(0x40000000, kr - 1)
-        self.core.watch_writes(kr + 4, 0x4002FFFF)
         if "syscfg" in part.names:  # the F0's GPIO ports sit on AHB2
             self.core.map_host(0x48000000, 0x2000)
-            self.core.watch_writes(0x48000000, 0x48001FFF)
         self.core.map_host(SYSTEM_MEMORY, 0x1000)
-        self.core.watch_writes(0xE000E000, 0xE000EFFF)
-        self.core.watch_writes(self.flash_base, self.flash_base + self.flash_size - 1)
         dev = svd.device(part.svd)
         irqs = svd.interrupts(part.svd)
         n = part.names
         self.motor = Motor(supply_v, ambient_c)
         self.rcc = Rcc(self, dev[n["rcc"]], HSE_HZ, 1)
-        path = None if state_dir is None else Path(state_dir) / f"{board}-{servo_id}.flash"
+        file = f"{board}-{servo_id}" + (f"-{unit + 1}" if unit else "") + ".flash"
+        path = None if state_dir is None else Path(state_dir) / file
         self.flash = Flash(self, dev[n["flash"]], self.flash_mem, self.flash_base, self.flash_size,
                            h["BOARD_FLASH_PAGE"], path, part.program_s, part.erase_s)
         self.dma = Dma(self, dev[n["dma"]], {ch: irqs[name] for ch, name in part.dma_irqs.items()})
@@ -168,7 +166,7 @@ class Board:
 
     def _write_uid(self) -> None:
         """A unique ID per board: lot and wafer words, and the ID."""
-        uid = (0x00310042 + self.servo_id, 0x31353033, 0x4E000000 | self.servo_id << 8)
+        uid = (0x00310042 + self.servo_id, 0x31353033, 0x4E000000 | self.unit << 16 | self.servo_id << 8)
         self.core.write(self.part.uid, b"".join(w.to_bytes(4, "little") for w in uid))
 
     def alias_zero(self, memory: Memory, size: int) -> None:
@@ -289,13 +287,21 @@ class Board:
             if self.iwdg.expired(now):
                 self.reset("watchdog")
 
+    def bus_id(self) -> int:
+        """The ID the board answers at: its config store's (as its
+        bootloader reads it; the application takes a new one as it
+        stores it)."""
+        page = self.h["BOARD_FLASH_PAGE"]
+        page0 = self.h["BOARD_CONFIG_PAGE0"]
+        return stored_id(self.flash_mem.read(page0 - self.flash_base, 2 * page), page, page0)
+
     def in_application(self) -> bool:
         pc = self.core.uc.reg_read(arm.UC_ARM_REG_PC)
         return self.h["BOARD_SLOT_BASE"] <= pc < self.h["BOARD_CONFIG_PAGE0"]
 
     def state(self) -> dict:
         m = self.motor
-        return {"id": self.servo_id, "board": self.name, "sim_ms": round(self.core.now_s() * 1000, 3),
+        return {"id": self.bus_id(), "board": self.name, "sim_ms": round(self.core.now_s() * 1000, 3),
                 "angle": round(m.get("angle_deg"), 3), "velocity": round(m.get("velocity_dps"), 2),
                 "current": round(m.get("current_a"), 3), "winding": round(m.get("winding_c"), 2),
                 "case": round(m.get("case_c"), 2), "ambient": round(m.get("ambient_c"), 1),
@@ -305,5 +311,7 @@ class Board:
                 "last_reset": self.last_reset, "mode": "app" if self.in_application() else "bootloader",
                 "locked_up": int(self.core.locked_up),
                 "rx_bytes": self.usart.rx_bytes,
+                "page_erases": self.flash.erases, "flash_stall_ms": round(self.flash.stalled_s * 1000, 3),
+                "last_sent_ms": round(self.bus.last_sent_s.get(self.station, 0.0) * 1000, 3),
                 "framing_errors": self.usart.framing_errors, "overruns": self.usart.overruns,
                 "pc": f"{self.core.uc.reg_read(arm.UC_ARM_REG_PC):#010x}"}

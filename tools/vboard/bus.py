@@ -32,6 +32,7 @@ class Bus:
         self.to_host = bytearray()
         self.collisions = 0
         self.last_activity_s = -1.0   # end of the last byte queued
+        self.last_sent_s = {}         # station -> when its last byte started
         self.host_fd = None
         self.listen = None
         self.master_fd = None
@@ -98,7 +99,7 @@ class Bus:
                 self._drop_client()
                 return
             for byte in data or b"":
-                self._queue_host(byte, now_s)
+                self.queue_host(byte, now_s)
         self.flush_to_host()
 
     def flush_to_host(self) -> None:
@@ -114,7 +115,9 @@ class Bus:
         self.host_fd = None
         self.to_host.clear()
 
-    def _queue_host(self, byte: int, now_s: float) -> None:
+    def queue_host(self, byte: int, now_s: float) -> None:
+        """A host byte on the wire from now_s, after the host's earlier
+        bytes and whatever is on the wire."""
         start = max(now_s, self.host_queue_until_s, self.wire_until_s)
         end = start + FRAME_BITS / self.host_baud
         self.host_queue_until_s = end
@@ -128,6 +131,7 @@ class Bus:
         end = start_s + FRAME_BITS / baud
         self.wire_until_s = max(self.wire_until_s, end)
         self.last_sender = station
+        self.last_sent_s[station] = start_s
         self._push(end, byte, baud, station)
 
     def _push(self, end_s, byte, baud, sender) -> None:

@@ -82,6 +82,8 @@ class Core:
         self.time_s = 0.0            # since power-up
         self.handlers = {}           # register address -> handler(value, old, size)
         self.ranges = []             # (begin, end, handler(address, value, size))
+        self._write_hooks = []       # installed by _hook_writes
+        self._hooks_stale = True
         self.fixes = []              # (address, bytes) the registers read once the store has landed
         self.late_fixes = []         # ... after the next slice (a store that runs again)
         self.stall_s = 0.0           # the CPU stands still this long, peripherals do not
@@ -125,17 +127,35 @@ class Core:
                 return view, address - base
         raise KeyError(f"{address:#010x} is not host-mapped")
 
-    def watch_writes(self, begin: int, end: int) -> None:
-        """Writes in [begin, end] go to their registers' handlers."""
-        self.uc.hook_add(UC_HOOK_MEM_WRITE, self._write_hook, begin=begin, end=end)
-
     def on_write(self, address: int, handler) -> None:
+        """Stores into the register (word) at address go to
+        handler(value, old, size) before they land."""
         self.handlers[address] = handler
+        self._hooks_stale = True
 
     def on_write_range(self, begin: int, end: int, handler) -> None:
         """Stores into [begin, end) (memory, not registers) go to
         handler(address, value, size) before they land."""
         self.ranges.append((begin, end, handler))
+        self._hooks_stale = True
+
+    def _hook_writes(self) -> None:
+        """One write hook per peripheral block (1 KB) from its first
+        handled register to its last, and one per memory range: Unicorn
+        runs a store that a write hook watches outside the IT block it is in
+        (the block's state is lost), so stores to a peripheral without
+        handlers (the PWM compares, set under IT) are not watched at all;
+        and few hooks keep every other store cheap."""
+        for h in self._write_hooks:
+            self.uc.hook_del(h)
+        blocks = {}
+        for address in self.handlers:
+            lo, hi = blocks.get(address >> 10, (address, address))
+            blocks[address >> 10] = (min(lo, address), max(hi, address))
+        spans = [(lo, hi + 3) for lo, hi in blocks.values()] + [(b, e - 1) for b, e, _ in self.ranges]
+        self._write_hooks = [self.uc.hook_add(UC_HOOK_MEM_WRITE, self._write_hook, begin=b, end=e)
+                             for b, e in spans]
+        self._hooks_stale = False
 
     def _read(self, address: int, fmt: str) -> int:
         for base, end, view in self.regions:
@@ -213,6 +233,8 @@ class Core:
             self.idle(max_s)
             self.cycles += max_s * self.hz
             return max_s
+        if self._hooks_stale:
+            self._hook_writes()
         self._take_exception()
         self._update_systick()
         pc = self.uc.reg_read(arm.UC_ARM_REG_PC) | 1

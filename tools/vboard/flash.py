@@ -30,6 +30,8 @@ class Flash(Model):
         self.path = path
         self.keys_seen = 0
         self.fail_programs = self.fail_erases = 0
+        self.erases = 0          # page erases, ever: the state's page_erases
+        self.stalled_s = 0.0     # the CPU's stalls for them and for program steps
         self.cut_after_programs = 0  # the power goes as the Nth program step from now begins
         self.fd = None
         self.blank = True
@@ -101,6 +103,8 @@ class Flash(Model):
         else:
             self.fail_erases = max(0, self.fail_erases - 1)
             self.put("SR", self.get("SR") | self._flag("PGERR"))
+        self.erases += 1
+        self.stalled_s += self.erase_s
         self.core.stop(stall_s=self.erase_s)
 
     def _store(self, address: int, value: int, size: int) -> None:
@@ -130,6 +134,7 @@ class Flash(Model):
                     cells.append(want.to_bytes(2, "little"))
                     self.put("SR", self.get("SR") | self._flag("EOP"))
             programmed = b"".join(cells)
+            self.stalled_s += self.program_s * max(1, size // 2)
             self.core.stop(stall_s=self.program_s * max(1, size // 2))
         self.memory.write(offset, programmed)
         self.persist(offset, size)

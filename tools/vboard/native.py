@@ -28,6 +28,7 @@ def _library():
     lib.vboard_motor_ntc_adc.argtypes = [ctypes.c_void_p]
     lib.vboard_motor_ntc_adc.restype = ctypes.c_uint
     lib.vboard_factory_config.argtypes = [ctypes.c_char_p, ctypes.c_uint32, ctypes.c_uint32, ctypes.c_uint8]
+    lib.vboard_stored_id.argtypes = [ctypes.c_char_p, ctypes.c_uint32, ctypes.c_uint32]
     return lib
 
 
@@ -73,3 +74,8 @@ class Motor:
 
 def factory_config(pages, page_size: int, page0: int, servo_id: int) -> bool:
     return bool(lib().vboard_factory_config(pages, page_size, page0, servo_id))
+
+
+def stored_id(pages: bytes, page_size: int, page0: int) -> int:
+    """The servo ID the config pages hold (the firmware's config_peek)."""
+    return lib().vboard_stored_id(pages, page_size, page0)

@@ -29,7 +29,8 @@ RANGES = {"supply": (0, 30000, "mV"), "load": (-50, 50, "N m"), "ambient": (-40,
           "failerase": (0, 1e6, "erases"), "failprogram": (0, 1e6, "programs"),
           "cutprogram": (1, 1e6, "programs")}
 HELP = ("ok supply MV | load NM | stop DEG | stop off | ambient DEGC | soak DEGC | hostbaud BAUD | "
-        "failerase N | failprogram N | cutprogram N | powercycle [ID] | state [ID] | clock")
+        "failerase N | failprogram N | cutprogram N | powercycle [ID] | state [ID] | clock | "
+        "hostsend MS HEX")
 
 
 class Runner:
@@ -38,8 +39,8 @@ class Runner:
         self.state_dir = args.state or tempfile.mkdtemp(prefix="vboard-")
         os.makedirs(self.state_dir, exist_ok=True)
         self.boards = [Board(args.board, i, self.bus, self.state_dir, args.supply / 1000.0, args.ambient,
-                             app_image=args.app)
-                       for i in args.id]
+                             app_image=args.app, unit=args.id[:k].count(i))
+                       for k, i in enumerate(args.id)]
         self.url = self.bus.serve_tcp(args.tcp) if args.tcp is not None else self.bus.serve_pty(args.link)
         self.control = socket.socket()
         self.control.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
@@ -61,13 +62,19 @@ class Runner:
             return f"sim_ms={self.now_s * 1000:.3f} behind_ms={(self._wall() - self.now_s) * 1000:.1f}"
         if cmd == "help":
             return HELP
+        if cmd == "hostsend":
+            return self.host_send(words)
         takes_value = cmd not in ("state", "powercycle")
         id_word = 2 if takes_value else 1
         boards = self.boards
-        if len(words) > id_word:
-            boards = [b for b in self.boards if str(b.servo_id) == words[id_word]]
+        if len(words) > id_word:  # the ID a board holds now, not the one it started with
+            try:
+                wanted = int(words[id_word])
+            except ValueError:
+                wanted = None
+            boards = [b for b in self.boards if b.bus_id() == wanted]
             if not boards:
-                return "error: no servo with that ID"
+                return "error: no servo holds that ID"
         value = 0.0
         if takes_value:
             if cmd not in RANGES:
@@ -113,6 +120,24 @@ class Runner:
             else:
                 return "error: unknown command (try help)"
         return "\n".join(out) if out else "ok"
+
+    def host_send(self, words) -> str:
+        """hostsend MS HEX: the host's bytes on the wire from simulated time
+        MS on (or at once, if that has passed), paced at the host's rate, as
+        servo_sim's: a test times a frame into a window of milliseconds."""
+        usage = "error: hostsend takes a time in ms and 1 to 100 bytes in hex"
+        if len(words) != 3:
+            return usage
+        try:
+            at_s = float(words[1]) / 1000.0
+            data = bytes.fromhex(words[2])
+        except ValueError:
+            return usage
+        if not 0 < len(data) <= 100 or not at_s >= 0:
+            return usage
+        for byte in data:
+            self.bus.queue_host(byte, max(at_s, self.now_s))
+        return "ok"
 
     def serve_control(self, readable) -> None:
         if self.control in readable:

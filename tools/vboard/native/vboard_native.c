@@ -8,6 +8,7 @@
 #include <stdint.h>
 #include <string.h>
 
+#include "config_peek.h"
 #include "config_store.h"
 #include "plant.h"
 #include "registers/data_table.h"
@@ -28,6 +29,7 @@ double vboard_motor_get(const struct vboard_motor *m, int what);
 void vboard_motor_set(struct vboard_motor *m, int what, double value);
 unsigned vboard_motor_ntc_adc(const struct vboard_motor *m);
 int vboard_factory_config(uint8_t *pages, uint32_t page_size, uint32_t page0_addr, uint8_t id);
+int vboard_stored_id(uint8_t *pages, uint32_t page_size, uint32_t page0_addr);
 
 enum { ANGLE_DEG, VELOCITY_DPS, CURRENT_A, SUPPLY_V, LOAD_NM, WINDING_C, CASE_C, AMBIENT_C, STOP_DEG,
        SOAK_C };
@@ -131,13 +133,10 @@ static void ram_read(void *ctx, uint32_t addr, uint8_t *dst, uint32_t len)
     memcpy(dst, &f->mem[addr - f->base], len);
 }
 
-/* pages: the two config pages, erased, page0_addr first: the record of the
- * factory user area with servo ID id. 1 when written. */
-int vboard_factory_config(uint8_t *pages, uint32_t page_size, uint32_t page0_addr, uint8_t id)
+static struct hal_flash ram_flash_of(struct ram_flash *ram, uint32_t page_size, uint32_t page0_addr)
 {
-    struct ram_flash ram = {pages, page0_addr, 2u * page_size};
-    const struct hal_flash flash = {
-        .ctx = &ram,
+    return (struct hal_flash){
+        .ctx = ram,
         .page_size = page_size,
         .page_addr = {page0_addr, page0_addr + page_size},
         .erase_page = ram_erase,
@@ -145,9 +144,31 @@ int vboard_factory_config(uint8_t *pages, uint32_t page_size, uint32_t page0_add
         .program = ram_program,
         .read = ram_read,
     };
+}
+
+/* pages: the two config pages, erased, page0_addr first: the record of the
+ * factory user area with servo ID id. 1 when the store holds it: written,
+ * or, for the factory defaults' own ID (0), a blank store, which the
+ * firmware reads as its factory defaults. */
+int vboard_factory_config(uint8_t *pages, uint32_t page_size, uint32_t page0_addr, uint8_t id)
+{
+    struct ram_flash ram = {pages, page0_addr, 2u * page_size};
+    const struct hal_flash flash = ram_flash_of(&ram, page_size, page0_addr);
     struct config_store store;
     struct user_config cfg;
     (void)config_store_load(&store, &flash, &cfg);
     cfg.servo_id = id;
-    return config_store_save(&store, &cfg, 0) == CONFIG_SAVED;
+    return config_store_save(&store, &cfg, 0) != CONFIG_WRITE_FAILED;
+}
+
+/* The ID a board's store holds, as its bootloader reads it (config_peek):
+ * the ID the board answers at. */
+int vboard_stored_id(uint8_t *pages, uint32_t page_size, uint32_t page0_addr)
+{
+    struct ram_flash ram = {pages, page0_addr, 2u * page_size};
+    const struct hal_flash flash = ram_flash_of(&ram, page_size, page0_addr);
+    uint8_t id = 0;
+    uint8_t baud_index = 0;
+    config_peek_link(&flash, &id, &baud_index);
+    return id;
 }
