@@ -19,8 +19,11 @@ def _start(tmp_path, ids, tcp=True):
 
 
 def finish(sim, ids):
-    state = sim.state(ids[0])
-    err = sim.stop()
+    """Stops the simulator whatever happens, then judges what it said."""
+    try:
+        state = sim.state(ids[0])
+    finally:
+        err = sim.stop()
     assert state["collisions"] == 0, f"responses collided on the bus: {err}"
     # A real-time simulator that fell far behind would stretch every move.
     assert state["dropped_ticks"] == 0, f"the simulator dropped {state['dropped_ticks']} ticks"

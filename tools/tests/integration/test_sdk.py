@@ -16,18 +16,23 @@ from servoctl.sim import Simulator
 from .conftest import finish
 
 IDS = (0, 1, 2)
+# The SDK waits on the wall clock (100 ms an answer): the simulator gets the
+# priority of a real-time twin, so it keeps up on a loaded PC (root only).
+SIMULATOR_NICE = -10
 
 
 @pytest.fixture
 def rig(tmp_path):
-    sim = Simulator(ids=IDS, tcp=False, state_dir=str(tmp_path / "state")).start()
-    uart = serial.Serial(sim.url, 115200, timeout=0)
-    manager = UartServoManager(uart)
-    for i in IDS:
-        assert manager.write_data(i, 49, b"\x00")  # soft start off
-    yield sim, manager
-    uart.close()
-    finish(sim, IDS)
+    sim = Simulator(ids=IDS, tcp=False, state_dir=str(tmp_path / "state"), nice=SIMULATOR_NICE).start()
+    try:
+        uart = serial.Serial(sim.url, 115200, timeout=0)
+        manager = UartServoManager(uart)
+        for i in IDS:
+            assert manager.write_data(i, 49, b"\x00")  # soft start off
+        yield sim, manager
+        uart.close()
+    finally:
+        finish(sim, IDS)
 
 
 def angle_of(sim, servo_id):

@@ -1,0 +1,95 @@
+"""Every process the suite starts is stopped, whatever the test did.
+
+The run marks itself in its environment (SERVO_TEST_RUN), which every
+process it starts inherits: servo_sim, a virtual board, QEMU, a servoctl
+child and what they start in turn, also one whose parent is gone. After
+each test, any such process still alive is killed; if the test had passed,
+that is a leak, and the run fails at its end naming the test and the
+process. At the end of the run any that escaped is killed and fails the run
+too."""
+import os
+import signal
+import time
+import uuid
+
+import pytest
+
+MARK = "SERVO_TEST_RUN"
+os.environ.setdefault(MARK, uuid.uuid4().hex)
+_RUN = os.environ[MARK]
+_leaks = []
+
+
+def _marked() -> dict:
+    """{pid: command line} of this run's processes, this one excepted."""
+    found = {}
+    needle = f"{MARK}={_RUN}".encode()
+    for name in os.listdir("/proc"):
+        if not name.isdigit() or int(name) == os.getpid():
+            continue
+        try:
+            with open(f"/proc/{name}/environ", "rb") as f:
+                if needle not in f.read().split(b"\0"):
+                    continue
+            with open(f"/proc/{name}/cmdline", "rb") as f:
+                cmd = f.read().replace(b"\0", b" ").decode(errors="replace").strip()
+            with open(f"/proc/{name}/stat") as f:
+                if f.read().rsplit(")", 1)[1].split()[0] == "Z":
+                    continue  # a zombie: gone, waiting for its parent
+        except OSError:
+            continue  # gone meanwhile, or not ours to read
+        found[int(name)] = cmd
+    return found
+
+
+def _kill(pids) -> None:
+    for pid in pids:
+        try:
+            os.kill(pid, signal.SIGKILL)
+        except OSError:
+            pass
+    deadline = time.monotonic() + 5.0
+    while time.monotonic() < deadline and any(os.path.exists(f"/proc/{p}") for p in pids):
+        for pid in pids:
+            try:
+                os.waitpid(pid, os.WNOHANG)  # our own children: reaped here
+            except ChildProcessError:
+                pass
+        time.sleep(0.02)
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_makereport(item, call):
+    outcome = yield
+    report = outcome.get_result()
+    if report.when == "call":
+        item.passed_call = report.passed
+
+
+@pytest.fixture(autouse=True)
+def _no_process_outlives_its_test(request):
+    """Torn down after every other fixture of the test (autouse fixtures
+    are set up first)."""
+    before = set(_marked())
+    yield
+    left = {pid: cmd for pid, cmd in _marked().items() if pid not in before}
+    if left:
+        _kill(left)
+        if getattr(request.node, "passed_call", False):
+            _leaks.append((request.node.nodeid, sorted(left.values())))
+
+
+def pytest_sessionfinish(session, exitstatus):
+    escaped = _marked()
+    if escaped:
+        _kill(escaped)
+        _leaks.append(("the run", sorted(escaped.values())))
+    if _leaks:
+        for where, cmds in _leaks:
+            print(f"\nprocess guard: {where} left running: {'; '.join(cmds)}")
+        session.exitstatus = pytest.ExitCode.TESTS_FAILED
+
+
+def pytest_terminal_summary(terminalreporter):
+    if _leaks:
+        terminalreporter.write_line(f"process guard: {len(_leaks)} leak(s), listed above", red=True)

@@ -1,0 +1,31 @@
+"""The suite's process guard (conftest.py) can fail: a passing test that
+leaves a process running fails the run, names the test, and the process is
+gone afterwards; a failing test's process is stopped too."""
+from pathlib import Path
+
+pytest_plugins = ["pytester"]
+
+GUARD = (Path(__file__).parent / "conftest.py").read_text()
+
+
+def test_a_process_left_running_fails_the_run_and_is_stopped(pytester, monkeypatch, tmp_path):
+    marker = tmp_path / "sleeper.pid"
+    pytester.makeconftest(GUARD)
+    pytester.makepyfile(test_leaks=f"""
+import subprocess, sys
+
+def test_passes_but_leaks():
+    p = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(120)"])
+    open({str(marker)!r}, "w").write(str(p.pid))
+
+def test_fails_and_leaks():
+    subprocess.Popen([sys.executable, "-c", "import time; time.sleep(120)"])
+    assert False
+""")
+    monkeypatch.delenv("SERVO_TEST_RUN")  # the inner run marks its own processes
+    result = pytester.runpytest_subprocess("-p", "no:cacheprovider")
+    assert result.ret == 1
+    result.stdout.fnmatch_lines(["*process guard: test_leaks.py::test_passes_but_leaks left running*"])
+    assert "test_fails_and_leaks left running" not in result.stdout.str()
+    pid = int(marker.read_text())
+    assert not Path(f"/proc/{pid}").exists() or "Z" in Path(f"/proc/{pid}/stat").read_text().split()[2]
