@@ -1,10 +1,11 @@
 """The command line of servoctl: its parser, and the argparse types that
 check a value before anything is sent."""
 import argparse
+import dataclasses
 import math
 import os
 
-from . import __version__, outcome, registers
+from . import __version__, outcome, registers, units
 from . import protocol as p
 from .checks import MIN_RAMP_MS
 from .move_request import MoveRequest
@@ -24,7 +25,7 @@ serial link failed; 130 interrupted (Ctrl-C)."""
 def _baud(text: str) -> int:
     """--baud: a rate the servos speak (data item 36)."""
     rates = registers.BAUD_RATES.values()
-    if text.isdigit() and int(text) in rates:
+    if text.isascii() and text.isdigit() and int(text) in rates:
         return int(text)
     raise argparse.ArgumentTypeError(f"a servo speaks {', '.join(map(str, rates))} bits/s, not {text}")
 
@@ -65,6 +66,19 @@ def id_number(text: str) -> int:
     if not 0 <= value <= p.MAX_ID:
         raise argparse.ArgumentTypeError(f"servo IDs are 0..{p.MAX_ID}, not {value}")
     return value
+
+
+def power_mw(text: str) -> int:
+    """argparse type: a power with its unit, as config set takes data item
+    42 ("2.5W", "2500mW"); 0 alone is the servo's power limit. A bare
+    number is refused: 3 meant 3 mW to the tool and 3 W to its user."""
+    if text.strip() in ("0", "0.0"):
+        return 0
+    item = dataclasses.replace(registers.find("power_limit"), name="--power")
+    try:
+        return units.to_raw(item, text)
+    except p.ServoError as e:
+        raise argparse.ArgumentTypeError(str(e)) from None
 
 
 def finite(text: str) -> float:
@@ -162,7 +176,7 @@ def build_parser():
         g.add_argument("--velocity", type=finite, help="peak speed, deg/s")
         c.add_argument("--acc", type=int, help="acceleration ramp, ms (>= 20; default 20)")
         c.add_argument("--dec", type=int, help="deceleration ramp, ms (>= 20; default 20)")
-        c.add_argument("--power", type=int, default=0, help="mW; 0 = the power limit (42)")
+        c.add_argument("--power", type=power_mw, default=0, help="2.5W or 2500mW; 0 = the power limit (42)")
         c.add_argument("--multi-turn", action="store_true")
 
     def tolerance_option(c):
@@ -186,12 +200,12 @@ def build_parser():
 
     c = sub.add_parser("damping", help="damping mode")
     c.add_argument("id", type=int)
-    c.add_argument("--power", type=int, default=0, help="mW")
+    c.add_argument("--power", type=power_mw, default=0, help="2.5W or 2500mW; 0 = the power limit (42)")
 
     c = sub.add_parser("stop", help="stop: release, hold or damping")
     c.add_argument("id", type=int)
     c.add_argument("--mode", choices=["release", "hold", "damping"], default="release")
-    c.add_argument("--power", type=int, default=0, help="mW, for damping")
+    c.add_argument("--power", type=power_mw, default=0, help="for damping: 2.5W or 2500mW")
 
     c = sub.add_parser("origin", help="make here angle 0 (only while released)")
     c.add_argument("id", type=int)
@@ -215,14 +229,14 @@ def build_parser():
     c = sub.add_parser("sync-move", help="several servos start their moves in one frame")
     c.add_argument("targets", type=_target, nargs="+", metavar="ID:DEGREES")
     c.add_argument("--interval", type=int, default=1000, help="ms to get there (default 1000)")
-    c.add_argument("--power", type=int, default=0, help="mW; 0 = each servo's power limit")
+    c.add_argument("--power", type=power_mw, default=0, help="2.5W or 2500mW; 0 = each servo's power limit")
     c.add_argument("--multi-turn", action="store_true",
                    help="every target is a multi-turn angle (without it, each is within -180..180)")
 
     c = sub.add_parser("broadcast-move", help="every servo on the bus to one angle")
     c.add_argument("angle", type=finite, help="degrees, -180..180")
     c.add_argument("--interval", type=int, default=1000, help="ms to get there (default 1000)")
-    c.add_argument("--power", type=int, default=0, help="mW; 0 = each servo's power limit")
+    c.add_argument("--power", type=power_mw, default=0, help="2.5W or 2500mW; 0 = each servo's power limit")
     c.add_argument("--ids", type=id_number, nargs="+",
                    help="the servos on the bus, each checked before the broadcast (default: scan)")
 

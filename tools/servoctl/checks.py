@@ -45,3 +45,20 @@ def scaled(value: float, factor: int, name: str) -> int:
 
 def to_ms(seconds: float, name: str) -> int:
     return scaled(seconds, 1000, name)
+
+
+# The reference servo's motor turns its output at 312 deg/s unloaded from
+# 7.4 V (motion/include/motion/gains.h: its datasheet's constants), and in
+# proportion to the supply.
+NO_LOAD_DPS_PER_V = 312.0 / 7.4
+
+
+def speed_warning(speed_dps: float, supply_mv: int):
+    """A line for the user when speed_dps is beyond what the reference
+    motor reaches unloaded at this supply (the move then arrives late, as
+    the servo's profile clock waits for the horn), else None."""
+    reach = NO_LOAD_DPS_PER_V * supply_mv / 1000.0
+    if abs(speed_dps) <= reach:
+        return None
+    return (f"warning: {abs(speed_dps):g} deg/s is more than the motor turns unloaded at "
+            f"{supply_mv / 1000.0:.1f} V (about {reach:.0f} deg/s): the move will arrive late")

@@ -8,7 +8,7 @@ import sys
 import time
 
 from . import args as args_
-from . import config_diff, config_file, frame, group, ids, ntc, outcome, registers, scan, units
+from . import checks, config_diff, config_file, frame, group, ids, ntc, outcome, registers, scan, units
 from . import protocol as p
 from .args import build_parser
 from .errors import BadAnswer, NoReply, Refused, ServoError, UsageError
@@ -239,6 +239,8 @@ def cmd_move(bus, args):
     request = args_.move_request(args)
     asked = args_.decideg(args.angle)
     where = frame.check_target(s, asked, args.multi_turn)
+    if args.velocity is not None and (why := checks.speed_warning(args.velocity, s.read("voltage"))):
+        print(f"servoctl: {why}", file=sys.stderr)
     plan = outcome.plan_move(s, asked, request, where) if args.wait else None
     s.send_move(asked, request)
     outcome.taken(s, "the move")
@@ -380,7 +382,7 @@ def cmd_update(bus, args):
     # that is not a number.
     ids, images = [], []
     for arg in args.targets:
-        (ids if arg.isdigit() else images).append(arg)
+        (ids if arg.isascii() and arg.isdigit() else images).append(arg)
     if len(images) != 1 or not ids:
         raise UsageError("update takes one image and one or more servo IDs")
     for servo_id in ids:
@@ -480,13 +482,23 @@ def main(argv=None, clock=None) -> int:
     passes its own (servoctl.sim.Simulator.clock_s)."""
     args = build_parser().parse_args(argv)
     try:
-        return _run(args, clock)
+        code = _run(args, clock)
+        sys.stdout.flush()  # a reader that stopped reading is met here, not at exit
+        return code
     except ServoError as e:
         print(f"servoctl: error: {e}", file=sys.stderr)
         return e.exit_code
+    except argparse.ArgumentTypeError as e:  # a value checked after parsing (id assign's ID)
+        print(f"servoctl: error: {e}", file=sys.stderr)
+        return UsageError.exit_code
     except KeyboardInterrupt:
         print("servoctl: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
+    except BrokenPipeError:
+        # `servoctl info 2 | head -3`: the reader has what it wanted. What
+        # is left to print goes nowhere, quietly, as with any Unix filter.
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
 
 
 def _run(args, clock=None) -> int:

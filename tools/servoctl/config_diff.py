@@ -52,7 +52,7 @@ def resolve(bus, text: str) -> list:
     """The sides one argument names: an ID, a file, or 'factory'."""
     if text == FACTORY:
         return [_factory()]
-    if text.isdigit():
+    if text.isascii() and text.isdigit():
         return [_from_servo(bus, int(text))]
     if os.path.exists(text):
         return _file_sides(text)

@@ -113,7 +113,7 @@ def parse_backup(data, path: str) -> list:
         raise UsageError(f"{path} is not a servoctl backup")
     servos = data.get("servos")
     if data["servoctl_backup"] == 1:
-        if not isinstance(servos, dict) or not all(k.isdigit() for k in servos):
+        if not isinstance(servos, dict) or not all(k.isascii() and k.isdigit() for k in servos):
             raise ValueOutOfRange(f"{path}: no valid servos")
         return [Entry(_items(path, v, True), {"id": int(k)}, raw=True) for k, v in servos.items()]
     if not isinstance(servos, list):

@@ -84,7 +84,7 @@ BAUD_RATES = {1: 9600, 2: 19200, 3: 38400, 4: 57600, 5: 115200, 6: 250000, 7: 50
 
 def find(key) -> Item:
     """An item by data ID or name."""
-    if isinstance(key, int) or str(key).isdigit():
+    if isinstance(key, int) or (str(key).isascii() and str(key).isdigit()):
         item = BY_ID.get(int(key))
     else:
         item = BY_NAME.get(str(key))

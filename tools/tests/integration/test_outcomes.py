@@ -39,7 +39,7 @@ def test_a_blocked_move_fails_and_says_so(ready, capsys):
 
 
 def test_a_move_without_power_fails(ready, capsys):
-    rc, _, err = run(ready, capsys, "move", "1", "90", "--power", "1", "--wait")
+    rc, _, err = run(ready, capsys, "move", "1", "90", "--power", "1mW", "--wait")
     assert rc == 1 and "servo 1:" in err and ("stalled" in err or "did not arrive" in err), err
 
 
@@ -388,3 +388,37 @@ def test_a_sync_monitor_keeps_the_answers_after_an_absent_servo(tmp_path, capsys
             assert list(group.sync_monitor(bus, [5, 4, 3, 2, 1])) == [5, 3, 1]
         rc, out, _ = run(sim, capsys, "monitor", "1", "2", "3", "--sync", "--count", "1")
         assert rc == 3 and "  2 silent" in out and "3 silent" not in out, out
+
+
+def test_what_a_new_user_types_gets_a_line_not_a_traceback(ready, capsys):
+    """Tracebacks and units met by trying servoctl as a new user: IDs and
+    serials checked after parsing, Unicode digits, --power's unit (a bare
+    number meant mW to the tool and W to its user), a speed the motor
+    cannot reach."""
+    rc, _, err = run(ready, capsys, "id", "assign", "0x51a00003", "255")
+    assert rc == 2 and "servo IDs are 0..254, not 255" in err, err
+    rc, _, err = run(ready, capsys, "id", "assign", "0x51a00003", "abc")
+    assert rc == 2 and "not a servo ID" in err, err
+    rc, _, err = run(ready, capsys, "update", "\u00b2", "new.img")
+    assert rc == 2 and "Traceback" not in err, err
+    with pytest.raises(SystemExit) as e:
+        main(["--port", ready.url, "move", "1", "10", "--power", "3"])
+    assert e.value.code == 2 and "--power takes a unit: '3' could mean 3mW or 3W" in capsys.readouterr().err
+    assert run(ready, capsys, "move", "1", "10", "--power", "3W")[0] == 0
+    rc, _, err = run(ready, capsys, "config", "set", "1", "power_limit", "2.5W")
+    assert rc == 0, err
+    rc, _, err = run(ready, capsys, "move", "1", "0", "--multi-turn", "--velocity", "500")
+    assert rc == 0 and "500 deg/s is more than the motor turns unloaded at 7.4 V (about 312 deg/s)" in err
+
+
+def test_a_reader_that_stops_reading_gets_no_traceback(ready):
+    """`servoctl monitor 1 | head -1`: the pipe closes under servoctl, which
+    goes on writing rows until it meets the closed pipe."""
+    reader = subprocess.Popen(["head", "-1"], stdin=subprocess.PIPE, stdout=subprocess.DEVNULL)
+    proc = subprocess.Popen([sys.executable, "-m", "servoctl.cli", "--port", ready.url, "monitor", "1",
+                             "--every", "0.01", "--count", "100000"],
+                            cwd=TOOLS, stdout=reader.stdin, stderr=subprocess.PIPE, text=True)
+    reader.stdin.close()
+    _, err = proc.communicate(timeout=120)
+    reader.wait(timeout=30)
+    assert proc.returncode == 0 and "Traceback" not in err and "BrokenPipe" not in err, err

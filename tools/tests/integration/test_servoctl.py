@@ -66,7 +66,7 @@ def test_motion_commands(sim, capsys):
     sim.sleep(0.5)
     assert sim.state(1)["velocity"] > 80
     run(sim, capsys, "wheel", "1", "stop")
-    run(sim, capsys, "damping", "1", "--power", "500")
+    run(sim, capsys, "damping", "1", "--power", "500mW")
     run(sim, capsys, "config", "set", "1", "angle_limit_on", "0")  # multi-turn moves below
     # Every angle mode: plain 8 and 13 (interval alone), 11 and 14 (with
     # ramps), 12 and 15 (velocity).
