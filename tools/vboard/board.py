@@ -144,7 +144,9 @@ class Board:
         self.resets = {"power": 0, "software": 0, "watchdog": 0}
         self.last_reset = None
         self.powered = True
-        if self.flash.blank:
+        # A flash file without a bootloader (a start that failed before the
+        # factory's programming) is a blank chip too.
+        if self.flash.blank or self.flash_mem.read(0, 8) == b"\xff" * 8:
             self._factory(boot_image, app_image)
         self._write_uid()
         self.reset("power")

@@ -18,7 +18,7 @@ import sys
 import tempfile
 import time
 
-from .board import PARTS, Board
+from .board import PARTS, Board, images
 from .bus import Bus
 
 MAX_SLICE_S = 1e-3  # longest the CPUs run between two looks at the host and the models
@@ -217,8 +217,21 @@ def main(argv=None) -> int:
     ap.add_argument("--app", help="the update image a blank board's slot gets (default: the build's)")
     args = ap.parse_args(argv)
     args.id = args.id or [1]
+    build = PARTS[args.board].build
+    wanted = [images(args.board)[0]] + ([] if args.app else [images(args.board)[1]])
+    missing = [str(path) for path in wanted if not path.exists()]
+    if missing:
+        print(f"vboard: no {' or '.join(missing)}: build the {args.board}'s images first "
+              f"('cmake --preset {build} && cmake --build --preset {build}')", file=sys.stderr)
+        return 2
     runner = Runner(args)
     runner.power_up()
+    stuck = [b for b in runner.boards if b.core.locked_up]
+    if stuck:
+        for b in stuck:
+            print(f"vboard: board {b.servo_id} locked up at power-up ({b.state()['pc']}): its flash "
+                  f"file in {runner.state_dir} holds no bootloader that runs", file=sys.stderr)
+        return 1
     print(f"vboard: bus {runner.url}")
     if args.link:
         print(f"vboard: link {args.link}")

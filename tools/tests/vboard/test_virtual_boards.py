@@ -315,3 +315,33 @@ def test_a_board_at_the_factory_id_starts_and_is_addressed_by_the_id_it_holds(tm
             sim.control("state 0")
     finally:
         sim.stop()
+
+
+def test_a_board_without_its_images_says_which_and_leaves_no_flash_file(tmp_path, monkeypatch, capsys):
+    """After the demo (which builds only the host and the M3 boards) the
+    F030 board failed with a traceback, and left a blank flash file behind."""
+    import vboard.run as run
+
+    monkeypatch.setattr(run, "images", lambda board: (tmp_path / "no_boot.bin", tmp_path / "no_app.img", None))
+    state = tmp_path / "state"
+    assert run.main(["--board", "stm32f030k6", "--state", str(state), "--tcp", "0"]) == 2
+    err = capsys.readouterr().err
+    assert "vboard: no " in err and "no_boot.bin" in err and "cmake --preset arm-m0" in err, err
+    assert not state.exists() or not any(state.iterdir())
+
+
+def test_a_blank_flash_file_gets_the_factory_images(tmp_path, board):
+    """A flash file a failed start left erased (all 0xFF) ran a board that
+    locked up at once and never answered, and nothing said so."""
+    h = board_h(board)
+    state = tmp_path / "state"
+    state.mkdir()
+    size = h["BOARD_CONFIG_PAGE1"] + h["BOARD_FLASH_PAGE"] - h["BOARD_FLASH_BASE"]
+    (state / f"{board}-1.flash").write_bytes(b"\xff" * size)
+    sim = start(tmp_path, board)
+    try:
+        with sim.bus(timeout=0.3) as bus:
+            assert Servo(bus, 1).ping()
+        assert sim.state(1)["locked_up"] == 0
+    finally:
+        sim.stop()
