@@ -40,6 +40,11 @@ READ_STORE = 0x41
 ASSIGN_ID = 0x42
 
 
+# What servo_sim and the virtual boards tell a second TCP client while
+# another holds the bus (one program on a port at a time, as on a serial one).
+BUS_IN_USE = b"the bus is in use by another client"
+
+
 def checksum(data: bytes) -> int:
     return sum(data) % 256
 
@@ -147,7 +152,12 @@ class Bus:
         """Requests (code, content) back to back in one write, so they reach
         the line as one burst, without the gap a host may leave between two
         writes."""
-        self._link(self.serial.reset_input_buffer)
+        # What waits unread is dropped, as reset_input_buffer would, but
+        # looked at first: it may say the bus is not ours. (Bounded: a line
+        # that never stops talking is not waited out.)
+        for _ in range(64):
+            if not self._fill(wait=False):
+                break
         self._buffer = b""
         self._link(self.serial.write, b"".join(request_frame(c, content) for c, content in requests))
 
@@ -163,6 +173,9 @@ class Bus:
             else:  # loop:// and other ports without a descriptor
                 time.sleep(0.0005)
         data = self._link(self.serial.read, 4096)
+        if BUS_IN_USE in data:
+            raise LinkError(f"{self.port} is in use by another program (another servoctl, a "
+                            f"terminal, the maker's tool): close it, then try again")
         self._buffer += data
         return bool(data)
 

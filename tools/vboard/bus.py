@@ -18,6 +18,9 @@ import tty
 FRAME_BITS = 10
 HOST = -1
 BACKLOG_S = 0.01
+# A second TCP client while one holds the bus is told so (servo_sim's
+# words, which servoctl recognises) and ignored until it leaves.
+BUS_IN_USE = b"vboard: the bus is in use by another client\n"
 
 
 class Bus:
@@ -37,6 +40,7 @@ class Bus:
         self.listen = None
         self.master_fd = None
         self.link_path = None
+        self.refused = []
 
     def attach(self, usart) -> int:
         self.stations.append(usart)
@@ -67,27 +71,53 @@ class Bus:
 
     def fds(self) -> list:
         """What to wait on for the host."""
-        out = []
-        if self.host_fd is not None:
-            out.append(self.host_fd)
-        elif self.listen is not None:
+        out = [] if self.host_fd is None else [self.host_fd]
+        if self.listen is not None:
             out.append(self.listen)
-        return out
+        return out + self.refused
+
+    def _refused_leave(self) -> None:
+        """A refused client is told again at every request it sends (one
+        that flushes its input as it opens missed the first telling), and
+        forgotten when it leaves."""
+        for conn in list(self.refused):
+            try:
+                if conn.recv(256) != b"":
+                    conn.send(BUS_IN_USE)
+                    continue
+            except BlockingIOError:
+                continue
+            except OSError:
+                pass
+            conn.close()
+            self.refused.remove(conn)
 
     def poll_host(self, now_s: float) -> None:
-        """Accepts a client; reads what the wire can take; writes what has
-        reached the host."""
-        if self.host_fd is None and self.listen is not None:
+        """Reads what the wire can take; takes a client, or tells a second
+        one the bus is in use; writes what has reached the host."""
+        self._refused_leave()
+        if self.host_fd is not None:
+            self._read_host(now_s)
+        if self.listen is not None:
             try:
                 conn, _ = self.listen.accept()
             except BlockingIOError:
-                return
-            conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-            conn.setblocking(False)
-            self._conn = conn
-            self.host_fd = conn.fileno()
-        if self.host_fd is None:
-            return
+                conn = None
+            if conn is not None and self.host_fd is not None:
+                conn.setblocking(False)
+                try:
+                    conn.send(BUS_IN_USE)
+                except OSError:
+                    pass
+                self.refused.append(conn)
+            elif conn is not None:
+                conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+                conn.setblocking(False)
+                self._conn = conn
+                self.host_fd = conn.fileno()
+        self.flush_to_host()
+
+    def _read_host(self, now_s: float) -> None:
         if self.host_queue_until_s - now_s < BACKLOG_S:
             try:
                 data = os.read(self.host_fd, 256)
@@ -100,7 +130,6 @@ class Bus:
                 return
             for byte in data or b"":
                 self.queue_host(byte, now_s)
-        self.flush_to_host()
 
     def flush_to_host(self) -> None:
         if self.to_host and self.host_fd is not None:

@@ -26,6 +26,34 @@ static struct sim_bus bus;
 static uint64_t most_behind_us;
 static struct sim_servo servos[SIM_MAX_SERVOS];
 static volatile sig_atomic_t stop_requested;
+/* A second TCP client while one holds the bus is told so and then ignored
+ * until it leaves: a serial port has one program at a time, and two hosts
+ * on a half-duplex bus would talk over each other. The words are what
+ * servoctl recognises (protocol.py, BUS_IN_USE). */
+#define BUS_IN_USE "servo_sim: the bus is in use by another client\n"
+enum { REFUSED_MAX = 4 };
+static int refused[REFUSED_MAX] = {-1, -1, -1, -1};
+
+static void tell_in_use(int fd)
+{
+    ssize_t w = write(fd, BUS_IN_USE, sizeof BUS_IN_USE - 1u);
+    (void)w; /* a client already gone needs no reason */
+}
+
+/* Told at once and at every request it sends: a client that flushes its
+ * input as it opens (pyserial) would miss the first telling. */
+static void refuse(int fd)
+{
+    tell_in_use(fd);
+    for (int i = 0; i < REFUSED_MAX; i++) {
+        if (refused[i] < 0) {
+            fcntl(fd, F_SETFL, O_NONBLOCK);
+            refused[i] = fd; /* kept open: closed at once, its words could be lost */
+            return;
+        }
+    }
+    close(fd);
+}
 
 static void on_signal(int sig)
 {
@@ -78,18 +106,23 @@ int main(int argc, char **argv)
     fflush(stdout);
 
     while (!stop_requested) {
-        struct pollfd fds[2 + SIM_CONTROL_FDS];
+        struct pollfd fds[2 + REFUSED_MAX + SIM_CONTROL_FDS];
         int nfds = 0;
-        int host_slot = -1, listen_slot = -1, control_slot;
+        int host_slot = -1, listen_slot = -1, refused_slot, control_slot;
         /* A host that writes faster than the line waits (it is not read),
          * as behind its own UART. */
         if (bus.host_fd >= 0) {
             host_slot = nfds;
             short events = sim_bus_room(&bus) >= 512u ? POLLIN : 0;
             fds[nfds++] = (struct pollfd){.fd = bus.host_fd, .events = events};
-        } else if (listen_fd >= 0) {
+        }
+        if (listen_fd >= 0) {
             listen_slot = nfds;
             fds[nfds++] = (struct pollfd){.fd = listen_fd, .events = POLLIN};
+        }
+        refused_slot = nfds;
+        for (int i = 0; i < REFUSED_MAX; i++) {
+            fds[nfds++] = (struct pollfd){.fd = refused[i], .events = POLLIN};
         }
         control_slot = nfds;
         sim_control_fds(&control, &fds[control_slot]);
@@ -122,9 +155,25 @@ int main(int argc, char **argv)
                 bus.host_fd = -1;
             }
         }
+        for (int i = 0; i < REFUSED_MAX; i++) { /* a refused client left, or wrote: drained */
+            if (refused[i] >= 0 && (fds[refused_slot + i].revents & (POLLIN | POLLHUP | POLLERR))) {
+                uint8_t drop[256];
+                ssize_t n = read(refused[i], drop, sizeof drop);
+                if (n == 0 || (n < 0 && errno != EAGAIN)) {
+                    close(refused[i]);
+                    refused[i] = -1;
+                } else if (n > 0) {
+                    tell_in_use(refused[i]);
+                }
+            }
+        }
+        /* After the host's read: a client that left and one that came in
+         * its place are seen in that order. */
         if (listen_slot >= 0 && (fds[listen_slot].revents & POLLIN)) {
             int fd = accept(listen_fd, NULL, NULL);
-            if (fd >= 0) {
+            if (fd >= 0 && bus.host_fd >= 0) {
+                refuse(fd);
+            } else if (fd >= 0) {
                 int one = 1; /* a UART does not wait to fill packets */
                 setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
                 fcntl(fd, F_SETFL, O_NONBLOCK);

@@ -48,6 +48,26 @@ def test_a_second_program_on_the_port_is_refused_not_let_in(pty_sim, capsys):
     assert main(["--port", pty_sim.url, "ping", "1"]) == 0  # free again
 
 
+@pytest.mark.parametrize("board", [None, "stm32f103"])
+def test_a_second_client_of_the_tcp_bus_is_told_it_is_in_use(tmp_path, capsys, board):
+    """Watching in one terminal while commanding from another: on the
+    simulator's TCP port the second servoctl waited, and said "no reply"
+    (exit 3). One client at a time, as on a serial port: the second hears
+    the bus is in use (exit 4), the first keeps its answers, and once it
+    leaves the next one is served."""
+    from servoctl.cli import main
+    from servoctl.sim import Simulator
+
+    with Simulator(ids=[1], state_dir=str(tmp_path / "state"), board=board) as sim:
+        with sim.bus() as bus:
+            assert main(["--port", sim.url, "ping", "1"], clock=sim.clock_s) == 4
+            err = capsys.readouterr().err
+            assert "is in use by another program" in err and len(err.strip().splitlines()) == 1, err
+            assert Servo(bus, 1).ping()
+        assert main(["--port", sim.url, "ping", "1"], clock=sim.clock_s) == 0  # free again
+        assert main(["--port", sim.url, "ping", "1"], clock=sim.clock_s) == 0  # and again at once
+
+
 def test_a_flood_is_held_back_not_queued_for_hours(pty_sim):
     """Two seconds of garbage written as fast as the pty takes it: at
     115200 baud the line carries about 23 kB of it; the rest waits in the
