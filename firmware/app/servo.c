@@ -392,7 +392,12 @@ void servo_poll(struct servo *s)
     /* One reading of the clock per pass: the ticks due by then run now. */
     uint32_t now = s->hal->bus.now_us(s->hal->ctx);
     if (s->erase_passed) {
+        /* Framing what came during the erase takes a while on the M0 (2 ms
+         * for 500 bytes): this pass's clock reading is stale after it, and
+         * would stamp new bytes as heard that long ago, so that the next
+         * pass took the line for idle mid-frame. The next pass reads anew. */
         after_erase(s, now);
+        return;
     }
     bool ticked = run_control_tick(s, now);
     if (s->tx.sending && s->hal->bus.tx_done(s->hal->ctx)) {

@@ -30,7 +30,7 @@ RANGES = {"supply": (0, 30000, "mV"), "load": (-50, 50, "N m"), "ambient": (-40,
           "cutprogram": (1, 1e6, "programs")}
 HELP = ("ok supply MV | load NM | stop DEG | stop off | ambient DEGC | soak DEGC | hostbaud BAUD | "
         "failerase N | failprogram N | cutprogram N | powercycle [ID] | state [ID] | clock | "
-        "hostsend MS HEX")
+        "hostsend MS HEX | peek ADDR N ID")
 
 
 class Runner:
@@ -64,6 +64,13 @@ class Runner:
             return HELP
         if cmd == "hostsend":
             return self.host_send(words)
+        if cmd == "peek":  # peek ADDR N ID: a board's memory, in hex (for debugging)
+            try:
+                address, n, wanted = int(words[1], 0), int(words[2], 0), int(words[3])
+                board = next(b for b in self.boards if b.bus_id() == wanted)
+                return bytes(board.core.uc.mem_read(address, min(n, 256))).hex()
+            except (IndexError, ValueError, StopIteration) as e:
+                return f"error: peek takes ADDR N ID ({e})"
         takes_value = cmd not in ("state", "powercycle")
         id_word = 2 if takes_value else 1
         boards = self.boards
