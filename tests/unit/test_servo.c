@@ -529,6 +529,26 @@ static void write_arrives_during_erase(void *ctx)
     hal.now_us += 40000u;
 }
 
+/* Both config pages filled, then the line left quiet until the spare
+ * page's erase runs, with arrive() putting bytes in the ring during it;
+ * the answers sent so far cleared. */
+static void erase_with_bytes_arriving(void (*arrive)(void *ctx))
+{
+    const unsigned slots = config_store_slots_per_page(&servo.store);
+    for (unsigned i = 0; i < 2u * slots; i++) {
+        REQUEST(4, 0, 43, (uint8_t)(100u + i), 0x07);
+        harness_run_ms(70);
+    }
+    uint32_t erases = hal.flash.erases[0] + hal.flash.erases[1];
+    hal.flash.during_erase = arrive;
+    hal_double_clear_sent(&hal);
+    while (hal.flash.erases[0] + hal.flash.erases[1] == erases) {
+        hal.now_us += 250u; /* the line quiet until the erase runs */
+        servo_poll(&servo);
+    }
+    hal.flash.during_erase = NULL;
+}
+
 /* A request that arrives while a page erase stalls the CPU is carried out
  * right after it, but not answered: 20-40 ms late, the answer could fall
  * in another servo's slot. ReadStore counts it; the next request is
@@ -537,20 +557,8 @@ static void write_arrives_during_erase(void *ctx)
 static void test_an_answer_that_would_leave_late_is_dropped(void **state)
 {
     (void)state;
-    const unsigned slots = config_store_slots_per_page(&servo.store);
-    for (unsigned i = 0; i < 2u * slots; i++) {
-        REQUEST(4, 0, 43, (uint8_t)(100u + i), 0x07);
-        harness_run_ms(70);
-    }
-    uint32_t erases = hal.flash.erases[0] + hal.flash.erases[1];
     uint32_t dropped_ticks = servo.ticks_dropped;
-    hal.flash.during_erase = write_arrives_during_erase;
-    hal_double_clear_sent(&hal);
-    while (hal.flash.erases[0] + hal.flash.erases[1] == erases) {
-        hal.now_us += 250u; /* the line quiet until the erase runs */
-        servo_poll(&servo);
-    }
-    hal.flash.during_erase = NULL;
+    erase_with_bytes_arriving(write_arrives_during_erase);
     harness_poll(4);
     assert_int_equal(hal.sent_length, 0u);       /* not answered */
     assert_int_equal(servo.regs.user.stall_power_mw, 1234); /* but carried out */
@@ -595,20 +603,8 @@ static void test_a_ring_that_wrapped_during_an_erase_is_dropped_and_counted(void
     REQUEST(4, 0, 36, 8); /* 1 Mbaud */
     harness_poll(2);
     assert_int_equal(hal.baud, 1000000);
-    const unsigned slots = config_store_slots_per_page(&servo.store);
-    for (unsigned i = 0; i < 2u * slots; i++) {
-        REQUEST(4, 0, 43, (uint8_t)(100u + i), 0x07);
-        harness_run_ms(70);
-    }
-    uint32_t erases = hal.flash.erases[0] + hal.flash.erases[1];
     const uint16_t stall_power = servo.regs.user.stall_power_mw;
-    hal.flash.during_erase = a_lap_arrives_during_erase;
-    hal_double_clear_sent(&hal);
-    while (hal.flash.erases[0] + hal.flash.erases[1] == erases) {
-        hal.now_us += 250u;
-        servo_poll(&servo);
-    }
-    hal.flash.during_erase = NULL;
+    erase_with_bytes_arriving(a_lap_arrives_during_erase);
     harness_poll(20);
     assert_int_equal(hal.sent_length, 0u);
     assert_int_equal(servo.regs.user.stall_power_mw, stall_power); /* not carried out */
@@ -641,19 +637,7 @@ static void a_burst_arrives_during_erase(void *ctx)
 static void test_a_burst_during_an_erase_is_carried_out_and_never_answered_late(void **state)
 {
     (void)state;
-    const unsigned slots = config_store_slots_per_page(&servo.store);
-    for (unsigned i = 0; i < 2u * slots; i++) {
-        REQUEST(4, 0, 43, (uint8_t)(100u + i), 0x07);
-        harness_run_ms(70);
-    }
-    uint32_t erases = hal.flash.erases[0] + hal.flash.erases[1];
-    hal.flash.during_erase = a_burst_arrives_during_erase;
-    hal_double_clear_sent(&hal);
-    while (hal.flash.erases[0] + hal.flash.erases[1] == erases) {
-        hal.now_us += 250u;
-        servo_poll(&servo);
-    }
-    hal.flash.during_erase = NULL;
+    erase_with_bytes_arriving(a_burst_arrives_during_erase);
     harness_poll(20);
     assert_int_equal(hal.sent_length, 0u);
     assert_int_equal(servo.regs.user.stall_power_mw, 1234);
