@@ -314,6 +314,7 @@ class Board:
                 "locked_up": int(self.core.locked_up),
                 "rx_bytes": self.usart.rx_bytes,
                 "page_erases": self.flash.erases, "flash_stall_ms": round(self.flash.stalled_s * 1000, 3),
+                "erase_began_ms": round(self.flash.erase_began_s * 1000, 3),
                 "last_sent_ms": round(self.bus.last_sent_s.get(self.station, 0.0) * 1000, 3),
                 "framing_errors": self.usart.framing_errors, "overruns": self.usart.overruns,
                 "pc": f"{self.core.uc.reg_read(arm.UC_ARM_REG_PC):#010x}"}

@@ -31,6 +31,7 @@ class Flash(Model):
         self.keys_seen = 0
         self.fail_programs = self.fail_erases = 0
         self.erases = 0          # page erases, ever: the state's page_erases
+        self.erase_began_s = 0.0  # when the last one began: the state's erase_began_ms
         self.stalled_s = 0.0     # the CPU's stalls for them and for program steps
         self.cut_after_programs = 0  # the power goes as the Nth program step from now begins
         self.fd = None
@@ -104,6 +105,7 @@ class Flash(Model):
             self.fail_erases = max(0, self.fail_erases - 1)
             self.put("SR", self.get("SR") | self._flag("PGERR"))
         self.erases += 1
+        self.erase_began_s = self.core.now_s()
         self.stalled_s += self.erase_s
         self.core.stop(stall_s=self.erase_s)
 

@@ -105,8 +105,9 @@ BAUD_INDEX = {115200: 5, 1000000: 8}
 def test_sync_commands_sent_into_an_erase_are_carried_out(tmp_path, baud):
     """Both servos have a dirty spare page. Servo 2 holds its position, so
     it never erases, and takes the SyncCommands. Servo 1 is released: 100
-    ms after the line fell quiet it erases, and the SyncCommands go on the
-    wire 1.5 ms into that erase: one (707 bytes, 61 ms) at 115200; at 1
+    ms after the line fell quiet it erases (at the next 1 ms control tick),
+    and the SyncCommands go on the wire 103 ms after the quiet began, 2 to
+    3 ms into that erase: one (707 bytes, 61 ms) at 115200; at 1
     Mbaud five back to back (3535 bytes in 35 ms, nearly an erase's worth),
     the last to 30 degrees. The reference board's 4 KB ring holds every
     byte the 40 ms erase brings in at either rate (its board.h): servo 1
@@ -130,7 +131,7 @@ def test_sync_commands_sent_into_an_erase_are_carried_out(tmp_path, baud):
             quiet_from = sim.state(1)["last_sent_ms"] / 1000.0
             stalled = sim.state(1)["flash_stall_ms"]
             angles = [300] if baud == 115200 else [-300, 200, -100, 100, 300]
-            send_at(sim, quiet_from + 0.1015, b"".join(sync_move_frame(a) for a in angles))
+            send_at(sim, quiet_from + 0.103, b"".join(sync_move_frame(a) for a in angles))
             sim.sleep(quiet_from + 1.3 - sim.clock_s())
             assert sim.state(1)["flash_stall_ms"] - stalled >= 40.0, "no erase: the test proves nothing"
             assert abs(sim.state(2)["angle"] - 30.0) < 1.0, "the holding servo missed it"

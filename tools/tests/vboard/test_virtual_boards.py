@@ -253,9 +253,11 @@ def sync_move_frame(angle_decideg):
 def test_sync_commands_sent_into_an_erase(tmp_path, board, baud):
     """The shipped images, as test_store_durability's simulator test: servo
     2 holds (it never erases), servo 1 is released and erases its spare
-    page 100 ms after the line fell quiet; 1.5 ms into that erase the host
-    sends one 707-byte SyncCommand at 115200, five back to back (3535
-    bytes in 35 ms) at 1 Mbaud, the last to 30 degrees. A board whose ring
+    page at the first control tick 100 ms after the line fell quiet (100.9
+    to 101.7 ms after its answer's last byte, measured); 103 ms after that
+    byte, inside the 40 ms erase, the host sends one 707-byte SyncCommand
+    at 115200, five back to back (3535 bytes in 35 ms) at 1 Mbaud, the last
+    to 30 degrees. A board whose ring
     holds an erase's worth of bytes at that rate (board.h: the F103's 4 KB
     at any rate, the F030's 512 B up to 115200) carries them out and loses
     nothing; the F030 at 1 Mbaud loses bytes and counts them (ReadStore),
@@ -281,11 +283,15 @@ def test_sync_commands_sent_into_an_erase(tmp_path, board, baud):
             erases = sim.state(1)["page_erases"]
             angles = [300] if baud == 115200 else [-300, 200, -100, 100, 300]
             frames = b"".join(sync_move_frame(a) for a in angles)
+            send_at_ms = (quiet_from + 0.103) * 1000
             for k in range(0, len(frames), 100):
-                assert sim.control(f"hostsend {(quiet_from + 0.1015) * 1000:.3f} "
-                                   f"{frames[k:k + 100].hex()}").startswith("ok")
+                assert sim.control(f"hostsend {send_at_ms:.3f} {frames[k:k + 100].hex()}").startswith("ok")
             sim.sleep(quiet_from + 1.3 - sim.clock_s())
-            assert sim.state(1)["page_erases"] == erases + 1, "no erase: the test proves nothing"
+            after = sim.state(1)
+            assert after["page_erases"] == erases + 1, "no erase: the test proves nothing"
+            assert after["erase_began_ms"] < send_at_ms, (
+                f"the erase began {after['erase_began_ms'] - send_at_ms:.3f} ms after the frames: "
+                "the test proves nothing")
             assert abs(sim.state(2)["angle"] - 30.0) < 1.0, "the holding servo missed it"
             assert two.read_store().bytes_lost == 0
             lost = one.read_store().bytes_lost
