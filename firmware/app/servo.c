@@ -440,3 +440,29 @@ void servo_poll(struct servo *s)
         answer_finished_move(s, now);
     }
 }
+
+/* The interrupts that end a sleep: the control tick (SysTick), a line gone
+ * idle after bytes (the bus USART's IDLE), a transmission's end, a lap of
+ * the receive DMA. The DMA takes a request's bytes without waking the CPU,
+ * so a request is framed once the line has been idle for a byte time
+ * after it (or at the next tick, when another frame follows at once);
+ * what is timed finer than the tick (a Sync Monitor turn, the finished
+ * move's slot, the link settings after an answer) keeps the loop awake. */
+bool servo_may_sleep(struct servo *s)
+{
+    if (s->erase_passed || s->tx.waiting || s->link_settings_pending || s->enter_bootloader ||
+        frame_rx_pending(&s->rx) != 0u ||
+        motion_has_finished(&s->motion)) {
+        return false;
+    }
+    if (s->tx.sending && s->hal->bus.tx_done(s->hal->ctx)) {
+        return false;
+    }
+    uint32_t now = s->hal->bus.now_us(s->hal->ctx);
+    if ((int32_t)(now - s->next_tick_us) >= 0) {
+        return false;
+    }
+    const struct hal_rx_ring *ring = s->hal->rx;
+    hal_rx_sync(s->hal, now);
+    return ring->written == ring->read;
+}

@@ -105,6 +105,12 @@ static inline void servo_on_rx_byte(struct servo *s, uint8_t byte, uint32_t now_
  * due among them. Never blocks. */
 void servo_poll(struct servo *s);
 
+/* Whether the main loop may sleep until the next interrupt: nothing left
+ * for a pass to do before one comes. Call it with interrupts masked and
+ * sleep (WFI) in the same masked stretch, so that an interrupt after the
+ * check still ends the sleep. */
+bool servo_may_sleep(struct servo *s);
+
 /* One control tick: sensors, protection, motion. servo_poll runs it every
  * CONTROL_TICK_US. */
 void servo_control_tick(struct servo *s);

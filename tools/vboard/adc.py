@@ -11,7 +11,9 @@ ascending order; DMAEN (DMACFG: circular) hands each to DMA channel 1.
 A scan's results move to memory at the end of each scan time (12.5 cycles
 of conversion plus each channel's sampling time, at the ADC clock), one
 scan's worth at each slice boundary past it (the scans in between would
-read the same models), with the values the models give at that time."""
+read the same models), with the values the models give at that time; none
+while the CPU sleeps, the only reader of that memory (the last scan before
+it wakes is written as it wakes)."""
 from .model import Model
 
 # Sampling times by SMPx code, the same on both parts (RM0008 11.12.4, RM0360 12.12.6).
@@ -33,19 +35,24 @@ class Adc(Model):
         self.running, self.next_scan_s = False, float("inf")
 
     def start(self) -> None:
+        """The sequence and its timing as set when the conversions start
+        (both parts take a new sequence at the next start)."""
         self.running = True
-        self.next_scan_s = self.core.now_s() + self.scan_s()
+        self.channels, self.period_s = self.sequence(), self.scan_s()
+        self.next_scan_s = self.core.now_s() + self.period_s
 
     def step(self, now_s: float) -> None:
         if not self.running or now_s < self.next_scan_s:
             return
+        if self.core.asleep and not self.core.wake_pending():
+            return  # only the CPU reads the results: the scan before it wakes is the one it sees
         dma_on = self.dma_requests()
-        for channel in self.sequence():
+        for channel in self.channels:
             value = self.channel_value(channel)
             self.put("DR", value)
             if dma_on:
                 self.dma.transfer(1, value)
-        period = self.scan_s()
+        period = self.period_s
         self.next_scan_s += period * max(1, int((now_s - self.next_scan_s) / period) + 1)
 
 

@@ -139,6 +139,9 @@ class Board:
             self.syscfg = Model(self, dev[n["syscfg"]])
             self.syscfg.watch("CFGR1", self._mem_mode)
             self.models.append(self.syscfg)
+        # The ones with something to do between runs, asked once a step.
+        self.timed = [m for m in self.models if type(m).next_event_s is not Model.next_event_s]
+        self.stepped = [m for m in self.models if type(m).step is not Model.step]
         self.station = bus.attach(self.usart)
         self.usart.bus_station = self.station
         self.resets = {"power": 0, "software": 0, "watchdog": 0}
@@ -258,15 +261,14 @@ class Board:
         self.reset("power")
 
     def run_until(self, t_s: float, max_step_s: float = 1e-3) -> None:
-        """Runs the board to t_s, in steps of at most max_step_s (a step
-        that a store stops is counted as half run: short steps where that
-        matters, while bytes are on the bus)."""
+        """Runs the board to t_s, in steps of at most max_step_s, each
+        ending where a model or SysTick next has something to do."""
         core = self.core
-        while core.now_s() < t_s:
-            wanted = min(t_s - core.now_s(), max_step_s)
-            soon = min([m.next_event_s(core.now_s()) for m in self.models] + [core.now_s() + wanted])
-            systick = core.now_s() + core.cycles_to_systick() / core.hz
-            step = max(min(soon, systick) - core.now_s(), 1e-6)
+        while (now := core.now_s()) < t_s:
+            soon = min(t_s, now + max_step_s, now + core.cycles_to_systick() / core.hz)
+            for m in self.timed:
+                soon = min(soon, m.next_event_s(now))
+            step = max(soon - now, 1e-6)
             try:
                 passed = core.run(step)
             except Stop as stop:
@@ -279,7 +281,7 @@ class Board:
             now = core.now_s()
             if not self.flash.check_wait_states(core.hz):
                 core.pending.add(3)  # reads at this clock return garbage: a fault
-            for m in self.models:
+            for m in self.stepped:
                 m.step(now)
             duty = self.tim.duty()
             if duty is None:
@@ -311,7 +313,7 @@ class Board:
                 "core_mhz": round(self.core.hz / 1e6, 3), "resets_power": self.resets["power"],
                 "resets_software": self.resets["software"], "resets_watchdog": self.resets["watchdog"],
                 "last_reset": self.last_reset, "mode": "app" if self.in_application() else "bootloader",
-                "locked_up": int(self.core.locked_up),
+                "locked_up": int(self.core.locked_up), "asleep_ms": round(self.core.slept_s * 1000, 3),
                 "rx_bytes": self.usart.rx_bytes,
                 "page_erases": self.flash.erases, "flash_stall_ms": round(self.flash.stalled_s * 1000, 3),
                 "erase_began_ms": round(self.flash.erase_began_s * 1000, 3),

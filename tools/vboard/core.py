@@ -14,9 +14,13 @@ handler's, which it then preempts (EXC_RETURN to handler mode); at equal
 priority the lower exception number goes first (B1.5.4). HardFault's is -1.
 
 Time is the CPU's: each instruction costs the board's cycles per
-instruction (its cycle model, docs/benchmark.md), and peripherals move on
-between runs of at most a slice. A slice cut short by a peripheral that
-stalls the CPU (a flash program or erase) is counted as half run.
+instruction (its cycle model, docs/benchmark.md), counted as it runs (a
+code hook in C, native/instruction_count.c), and peripherals move on
+between runs of at most a slice. A WFI ends the run and the core sleeps
+(B1.5.19): time then passes without running code until an enabled
+exception is pending, which wakes it whatever PRIMASK says; with PRIMASK
+set, a CPSIE I right after the WFI is carried out here and the exception
+taken, or else a few instructions run before it is.
 
 Peripheral registers are RAM to the CPU, so reading them costs no Python;
 writes call the peripheral's handler before the value lands. A handler that
@@ -33,8 +37,12 @@ import os
 import struct
 import sys
 
-from unicorn import UC_ARCH_ARM, UC_HOOK_INTR, UC_HOOK_MEM_WRITE, UC_MODE_MCLASS, UC_MODE_THUMB, Uc, UcError
+from unicorn import UC_ARCH_ARM, UC_HOOK_CODE, UC_HOOK_INTR, UC_HOOK_MEM_WRITE, UC_MODE_MCLASS, UC_MODE_THUMB
+from unicorn import Uc, UcError
 from unicorn import arm_const as arm
+from unicorn.unicorn_py3.unicorn import uclib
+
+from .native import lib as native_lib
 
 EXC_RETURN_THREAD_MSP = 0xFFFFFFF9
 EXCP_EXCEPTION_EXIT = 8  # QEMU's, as Unicorn reports it
@@ -53,6 +61,13 @@ EXC_RETURN_HANDLER = 0xFFFFFFF1
 ICSR_PENDSTSET, ICSR_PENDSTCLR = 1 << 26, 1 << 25
 AIRCR_VECTKEY, AIRCR_SYSRESETREQ = 0x05FA0000, 1 << 2
 CSR_ENABLE, CSR_TICKINT, CSR_COUNTFLAG = 1, 2, 1 << 16
+WFI, CPSIE_I = 0xBF30, 0xB662
+WAKE_RUN = 16  # instructions run after a wake with PRIMASK set before the exception is taken
+
+
+class InstructionCount(ctypes.Structure):
+    """native/instruction_count.c's struct vboard_count."""
+    _fields_ = [("executed", ctypes.c_uint64), ("limit", ctypes.c_uint64), ("stop", ctypes.c_void_p)]
 
 
 def plain_store_size(hw: int, hw2: int) -> int:
@@ -110,6 +125,28 @@ class Core:
             self.on_write(NVIC_ISPR + 4 * w, self._nvic_pend(w, True))
             self.on_write(NVIC_ICPR + 4 * w, self._nvic_pend(w, False))
         self.uc.hook_add(UC_HOOK_INTR, self._interrupt)
+        self._uch = self.uc._uch
+        self._regbuf = ctypes.c_uint32()
+        self._regbuf_ref = ctypes.byref(self._regbuf)
+        self.running = False         # inside emu_start
+        self.asleep = False          # after a WFI, until an exception is pending
+        self.slept_s = 0.0           # time spent asleep since power-up
+        self.count = InstructionCount(0, 0, ctypes.cast(uclib.uc_emu_stop, ctypes.c_void_p))
+        self._count_hook = ctypes.c_size_t()
+        counter = ctypes.cast(native_lib().vboard_count_instruction, ctypes.c_void_p)
+        if uclib.uc_hook_add(self.uc._uch, ctypes.byref(self._count_hook), UC_HOOK_CODE, counter,
+                             ctypes.addressof(self.count), 1, 0):
+            raise RuntimeError("Unicorn refused the instruction counter")
+
+    # ---- registers: Unicorn's C API directly (its Python wrapper costs more
+    # than the call, and exceptions touch a dozen registers) ----------------
+    def reg(self, register: int) -> int:
+        uclib.uc_reg_read(self._uch, register, self._regbuf_ref)
+        return self._regbuf.value
+
+    def set_reg(self, register: int, value: int) -> None:
+        self._regbuf.value = value & 0xFFFFFFFF
+        uclib.uc_reg_write(self._uch, register, self._regbuf_ref)
 
     # ---- memory ---------------------------------------------------------
     def map_host(self, base: int, size: int, buf=None):
@@ -190,6 +227,13 @@ class Core:
         self.deferred.append(action)
         self.uc.emu_stop()
 
+    def new_event(self) -> None:
+        """From a handler: the peripheral has something to do sooner than
+        this run was planned to last (a byte now shifting out): the CPU
+        stops after this store, so the next run ends in time for it."""
+        if self.running:
+            self.defer(lambda: None)
+
     def stop(self, stall_s: float = 0.0, reset: str = None) -> None:
         """From a handler: the CPU stops after this store, stalled for
         stall_s, or resets."""
@@ -210,7 +254,7 @@ class Core:
                     memory_handler(address, value, size)
                     if self.fixes or self.stall_s or self.reset_cause or self.deferred:
                         self._stopping = address
-                        self._stop_pc = uc.reg_read(arm.UC_ARM_REG_PC)
+                        self._stop_pc = self.reg(arm.UC_ARM_REG_PC)
             return
         shift = 8 * (address & 3)
         old = self.rd32(word)
@@ -220,7 +264,7 @@ class Core:
         handler(value & 0xFFFFFFFF, old, size)
         if self.fixes or self.stall_s or self.reset_cause or self.deferred:
             self._stopping = address
-            self._stop_pc = uc.reg_read(arm.UC_ARM_REG_PC)
+            self._stop_pc = self.reg(arm.UC_ARM_REG_PC)
 
     # ---- time -------------------------------------------------------------
     def now_s(self) -> float:
@@ -233,20 +277,42 @@ class Core:
             self.idle(max_s)
             self.cycles += max_s * self.hz
             return max_s
+        count = max(1, int(max_s * self.hz / self.cpi))
+        if self.asleep:
+            if not self.wake_pending():
+                return self._sleep(max_s)
+            self.asleep = False
+            if self.reg(arm.UC_ARM_REG_PRIMASK) & 1:
+                pc = self.reg(arm.UC_ARM_REG_PC)
+                if self.rd16(pc & ~1) == CPSIE_I:  # the usual WFI; CPSIE: run it here, one run less
+                    self.set_reg(arm.UC_ARM_REG_PRIMASK, 0)
+                    self.set_reg(arm.UC_ARM_REG_PC, (pc + 2) | 1)
+                    self.cycles += self.cpi
+                    self.time_s += self.cpi / self.hz
+                else:
+                    count = min(count, WAKE_RUN)
         if self._hooks_stale:
             self._hook_writes()
         self._take_exception()
         self._update_systick()
-        pc = self.uc.reg_read(arm.UC_ARM_REG_PC) | 1
-        count = max(1, int(max_s * self.hz / self.cpi))
+        pc = self.reg(arm.UC_ARM_REG_PC) | 1
+        self.count.executed, self.count.limit = 0, count
+        faulted = False
+        self.running = True
         try:
-            self.uc.emu_start(pc, 0xFFFFFFFF, count=count)
+            self.uc.emu_start(pc, 0xFFFFFFFF)
         except UcError as e:
+            faulted = True
             if os.environ.get("VBOARD_TRACE"):
                 r = {n: hex(self.uc.reg_read(getattr(arm, "UC_ARM_REG_" + n))) for n in ("PC", "LR", "SP", "IPSR", "XPSR")}
                 print(f"vboard: fault {e} at {self.time_s:.4f} s: {r}", file=sys.stderr, flush=True)
             self._fault(str(e))
-        ran = count * self.cpi
+        self.running = False
+        executed = self.count.executed
+        ran = executed * self.cpi
+        if executed < count and not (faulted or self.fixes or self.stall_s or self.reset_cause or self.deferred):
+            pc = self.reg(arm.UC_ARM_REG_PC)
+            self.asleep = self.rd16((pc & ~1) - 2) == WFI
         for action in self.deferred:
             action()
         self.deferred = []
@@ -254,9 +320,8 @@ class Core:
             self.write(address, data)
         self.late_fixes = []
         if self._stopping is not None:
-            ran /= 2
-            pc = self.uc.reg_read(arm.UC_ARM_REG_PC)
-            xpsr = self.uc.reg_read(arm.UC_ARM_REG_XPSR)
+            pc = self.reg(arm.UC_ARM_REG_PC)
+            xpsr = self.reg(arm.UC_ARM_REG_XPSR)
             in_it_block = (xpsr >> 10) & 0x3F or (xpsr >> 25) & 3  # ITSTATE (B1.4.2)
             size = 0 if in_it_block else plain_store_size(self.rd16(pc & ~1), self.rd16((pc & ~1) + 2))
             if pc != self._stop_pc:  # the store completed and the CPU moved on
@@ -265,7 +330,7 @@ class Core:
             elif size:
                 for address, data in self.fixes:
                     self.write(address, data)
-                self.uc.reg_write(arm.UC_ARM_REG_PC, (pc + size) | 1)
+                self.set_reg(arm.UC_ARM_REG_PC, (pc + size) | 1)
             else:
                 self._passthrough = self._stopping
                 self.late_fixes = self.fixes
@@ -283,7 +348,22 @@ class Core:
         if self.reset_cause:
             cause, self.reset_cause = self.reset_cause, None
             raise Stop(cause)
+        if self.asleep and passed < max_s and not self.wake_pending():
+            passed += self._sleep(max_s - passed)  # the rest of the slice: one call, not two
         return passed
+
+    def wake_pending(self) -> bool:
+        """An exception that ends a WFI: pending and enabled (B1.5.19)."""
+        return any(e < FIRST_IRQ or (e - FIRST_IRQ) in self.enabled for e in self.pending)
+
+    def _sleep(self, seconds: float) -> float:
+        """Asleep: the clocks run, the code does not."""
+        cycles = seconds * self.hz
+        self.cycles += cycles
+        self.time_s += seconds
+        self.slept_s += seconds
+        self._systick_after(cycles)
+        return seconds
 
     def idle(self, seconds: float) -> None:
         """Time passes with the CPU held (in reset, or powered off)."""
@@ -316,8 +396,9 @@ class Core:
         return 0
 
     def _take_exception(self, force: bool = False) -> None:
-        uc = self.uc
-        if uc.reg_read(arm.UC_ARM_REG_PRIMASK) & 1 and not force:
+        if not self.pending:
+            return
+        if self.reg(arm.UC_ARM_REG_PRIMASK) & 1 and not force:
             return
         running = self.active[-1][1] if self.active else 256
         ready = sorted((self.priority(e), e) for e in self.pending
@@ -330,34 +411,34 @@ class Core:
         self.active.append((exc, prio))
         if exc == SYSTICK:
             self.wr32(SCB_ICSR, self.rd32(SCB_ICSR) & ~ICSR_PENDSTSET)
-        sp = uc.reg_read(arm.UC_ARM_REG_SP)
-        xpsr = uc.reg_read(arm.UC_ARM_REG_XPSR)
-        pc = uc.reg_read(arm.UC_ARM_REG_PC)
+        sp = self.reg(arm.UC_ARM_REG_SP)
+        xpsr = self.reg(arm.UC_ARM_REG_XPSR)
+        pc = self.reg(arm.UC_ARM_REG_PC)
         realign = sp & 4
         sp = (sp - 32) & ~7
-        frame = [uc.reg_read(r) for r in FRAME_REGS] + [pc & ~1, (xpsr | (1 << 24)) | (realign << 7)]
+        frame = [self.reg(r) for r in FRAME_REGS] + [pc & ~1, (xpsr | (1 << 24)) | (realign << 7)]
         self.write(sp, struct.pack("<8I", *frame))
-        uc.reg_write(arm.UC_ARM_REG_SP, sp)
-        uc.reg_write(arm.UC_ARM_REG_LR, EXC_RETURN_HANDLER if nested else EXC_RETURN_THREAD_MSP)
-        uc.reg_write(arm.UC_ARM_REG_IPSR, exc)
+        self.set_reg(arm.UC_ARM_REG_SP, sp)
+        self.set_reg(arm.UC_ARM_REG_LR, EXC_RETURN_HANDLER if nested else EXC_RETURN_THREAD_MSP)
+        self.set_reg(arm.UC_ARM_REG_IPSR, exc)
         base = self.rd32(SCB_VTOR) if self.has_vtor else 0
-        uc.reg_write(arm.UC_ARM_REG_PC, self.rd32(base + 4 * exc))
+        self.set_reg(arm.UC_ARM_REG_PC, self.rd32(base + 4 * exc))
 
     def _interrupt(self, uc, intno, data):
         if intno != EXCP_EXCEPTION_EXIT:
             uc.emu_stop()
             self._fault(f"CPU exception {intno}")
             return
-        sp = uc.reg_read(arm.UC_ARM_REG_SP)
+        sp = self.reg(arm.UC_ARM_REG_SP)
         view, at = self._view(sp)
         frame = struct.unpack_from("<8I", view, at)
         for reg, v in zip(FRAME_REGS, frame[:6]):
-            uc.reg_write(reg, v)
+            self.set_reg(reg, v)
         xpsr = frame[7]
-        uc.reg_write(arm.UC_ARM_REG_SP, sp + 32 + (4 if xpsr & (1 << 9) else 0))
-        uc.reg_write(arm.UC_ARM_REG_XPSR, xpsr & ~(1 << 9))
-        uc.reg_write(arm.UC_ARM_REG_IPSR, xpsr & 0x1FF)  # the interrupted handler's, or 0
-        uc.reg_write(arm.UC_ARM_REG_PC, frame[6] | 1)
+        self.set_reg(arm.UC_ARM_REG_SP, sp + 32 + (4 if xpsr & (1 << 9) else 0))
+        self.set_reg(arm.UC_ARM_REG_XPSR, xpsr & ~(1 << 9))
+        self.set_reg(arm.UC_ARM_REG_IPSR, xpsr & 0x1FF)  # the interrupted handler's, or 0
+        self.set_reg(arm.UC_ARM_REG_PC, frame[6] | 1)
         if self.active:
             self.active.pop()
         self._take_exception()  # one waiting follows at once (tail-chaining, B1.5.12)
@@ -374,14 +455,15 @@ class Core:
         self.stall_s = 0.0
         self.reset_cause = None
         self.locked_up = False
+        self.asleep = False
         self.write(0xE000E000, bytes(0x1000))
-        uc.reg_write(arm.UC_ARM_REG_PRIMASK, 0)
-        uc.reg_write(arm.UC_ARM_REG_IPSR, 0)
-        uc.reg_write(arm.UC_ARM_REG_CONTROL, 0)
-        uc.reg_write(arm.UC_ARM_REG_MSP, self.rd32(vector_table))
-        uc.reg_write(arm.UC_ARM_REG_SP, self.rd32(vector_table))
-        uc.reg_write(arm.UC_ARM_REG_LR, 0xFFFFFFFF)
-        uc.reg_write(arm.UC_ARM_REG_PC, self.rd32(vector_table + 4) | 1)
+        self.set_reg(arm.UC_ARM_REG_PRIMASK, 0)
+        self.set_reg(arm.UC_ARM_REG_IPSR, 0)
+        self.set_reg(arm.UC_ARM_REG_CONTROL, 0)
+        self.set_reg(arm.UC_ARM_REG_MSP, self.rd32(vector_table))
+        self.set_reg(arm.UC_ARM_REG_SP, self.rd32(vector_table))
+        self.set_reg(arm.UC_ARM_REG_LR, 0xFFFFFFFF)
+        self.set_reg(arm.UC_ARM_REG_PC, self.rd32(vector_table + 4) | 1)
 
     # ---- NVIC and SCB -----------------------------------------------------
     def _nvic(self, word: int, enable: bool):

@@ -1,23 +1,41 @@
 """What every peripheral model shares: its registers from the SVD, in the
 core's memory, reset to the SVD's reset values."""
+import struct
+
 from .svd import Peripheral
+
+WORD = struct.Struct("<I")
 
 
 class Model:
     def __init__(self, board, periph: Peripheral):
         self.board, self.core, self.p = board, board.core, periph
+        self._at = {}  # register -> (memory view, offset): models touch registers often
+        self._bits = {}  # (register, field) -> mask
 
     def addr(self, register: str) -> int:
         return self.p.address(register)
 
+    def _where(self, register: str):
+        at = self._at.get(register)
+        if at is None:
+            at = self._at[register] = self.core._view(self.p.address(register))
+        return at
+
     def get(self, register: str) -> int:
-        return self.core.rd32(self.p.address(register))
+        view, offset = self._where(register)
+        return WORD.unpack_from(view, offset)[0]
 
     def put(self, register: str, value: int) -> None:
-        self.core.wr32(self.p.address(register), value)
+        view, offset = self._where(register)
+        WORD.pack_into(view, offset, value & 0xFFFFFFFF)
 
     def bit(self, register: str, field: str) -> int:
-        return self.p.mask(register, field)
+        key = (register, field)
+        mask = self._bits.get(key)
+        if mask is None:
+            mask = self._bits[key] = self.p.mask(register, field)
+        return mask
 
     def watch(self, register: str, handler) -> None:
         self.core.on_write(self.p.address(register), handler)

@@ -22,8 +22,6 @@ from .board import PARTS, Board, images
 from .bus import Bus
 
 MAX_SLICE_S = 1e-3  # longest the CPUs run between two looks at the host and the models
-BUSY_STEP_S = 100e-6  # ... while the bus is busy: a step cut short is timed to within half of this
-BUSY_FOR_S = 5e-3    # the bus counts as busy this long after its last byte
 RANGES = {"supply": (0, 30000, "mV"), "load": (-50, 50, "N m"), "ambient": (-40, 150, "degC"),
           "soak": (-40, 150, "degC"), "stop": (-1e6, 1e6, "deg"), "hostbaud": (1200, 4000000, "baud"),
           "failerase": (0, 1e6, "erases"), "failprogram": (0, 1e6, "programs"),
@@ -202,14 +200,18 @@ class Runner:
             self.bus.poll_host(self.now_s)
             if self.now_s > self._wall():
                 continue
-            target = min(self.now_s + MAX_SLICE_S, max(self.bus.next_event_s(), self.now_s + 1e-7))
-            busy = self.now_s - self.bus.last_activity_s < BUSY_FOR_S
-            for b in self.boards:
-                b.run_until(target, BUSY_STEP_S if busy else MAX_SLICE_S)
-            self.now_s = target
-            self.bus.deliver_until(self.now_s)
+            self.step()
             self.bus.flush_to_host()  # an answer leaves as its last byte ends, not a loop later
             self.most_behind_s = max(self.most_behind_s, self._wall() - self.now_s)
+
+    def step(self) -> None:
+        """One slice: every board on to the next byte's end on the bus, or
+        MAX_SLICE_S, and the bytes that ended by then delivered."""
+        target = min(self.now_s + MAX_SLICE_S, max(self.bus.next_event_s(), self.now_s + 1e-7))
+        for b in self.boards:
+            b.run_until(target, MAX_SLICE_S)
+        self.now_s = target
+        self.bus.deliver_until(self.now_s)
 
 
 def main(argv=None) -> int:

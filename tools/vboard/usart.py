@@ -14,9 +14,16 @@ it waits in the data register with RXNE, and the next one overruns it (ORE;
 the F0's OVRDIS keeps the old byte, as here). In half-duplex mode the
 receiver hears the USART's own bytes unless the firmware clears RE.
 
+IDLE sets when the line has stayed quiet for a frame after a received
+byte, once per burst (RM0008 27.6.1, RM0360 23.8.1), cleared on the F1 by
+reading DR after SR (here: by any read of DR by the CPU) and on the F0 by
+ICR's IDLECF.
+
 The interrupt line is level: TXEIE with TXE, TCIE with TC, RXNEIE with RXNE
-or ORE. Registers by the part: the F1's SR/DR (status cleared by writing 0
+or ORE, IDLEIE with IDLE. Registers by the part: the F1's SR/DR (status cleared by writing 0
 to RXNE/TC) and the F0's ISR/ICR/RDR/TDR."""
+from unicorn import UC_HOOK_MEM_READ
+
 from .model import Model
 
 FRAME_BITS = 10
@@ -35,16 +42,21 @@ class Usart(Model):
         self.shifting = False
         self.tdr = None
         self.rx_bytes = self.rx_lost = self.overruns = self.framing_errors = 0
+        self.idle_at_s = None     # when IDLE sets unless another byte comes first
         self.watch("TDR" if self.v2 else "DR", self._write_data)
         self.watch("CR1", self._write_cr1)
         self.watch("ICR" if self.v2 else "SR", self._clear_flags)
         s = self.status
         self.RXNE, self.TC, self.TXE = self.bit(s, "RXNE"), self.bit(s, "TC"), self.bit(s, "TXE")
-        self.ORE, self.FE = self.bit(s, "ORE"), self.bit(s, "FE")
+        self.ORE, self.FE, self.IDLE = self.bit(s, "ORE"), self.bit(s, "FE"), self.bit(s, "IDLE")
+        if not self.v2:  # the F1's DR read clears IDLE: one narrow read hook
+            dr = self.addr("DR")
+            self.core.uc.hook_add(UC_HOOK_MEM_READ, lambda *a: self._set(self.IDLE, False), begin=dr, end=dr + 3)
 
     def reset(self) -> None:
         super().reset()
         self.shifting, self.tdr = False, None
+        self.idle_at_s = None
 
     def cr1(self, field: str) -> bool:
         return bool(self.get("CR1") & self.bit("CR1", field))
@@ -75,6 +87,7 @@ class Usart(Model):
         self._set(self.TXE, True)
         if self.tx_pin_ok() and baud:
             self.board.bus.send(self.bus_station, byte, baud, now)
+        self.core.new_event()
 
     def _write_cr1(self, value, old, size):
         """An interrupt enabled while its flag is set fires at once (the
@@ -87,12 +100,13 @@ class Usart(Model):
     def _interrupt_due(self, sr: int, cr1: int) -> bool:
         return bool((cr1 & self.bit("CR1", "TXEIE") and sr & self.TXE) or
                     (cr1 & self.bit("CR1", "TCIE") and sr & self.TC) or
-                    (cr1 & self.bit("CR1", "RXNEIE") and sr & (self.RXNE | self.ORE)))
+                    (cr1 & self.bit("CR1", "RXNEIE") and sr & (self.RXNE | self.ORE)) or
+                    (cr1 & self.bit("CR1", "IDLEIE") and sr & self.IDLE))
 
     def _clear_flags(self, value, old, size):
         sr = self.get(self.status)
         if self.v2:  # ICR: write 1 to clear (PECF, FECF, NCF, ORECF, IDLECF, TCCF)
-            for name, flag in (("ORECF", self.ORE), ("FECF", self.FE), ("TCCF", self.TC)):
+            for name, flag in (("ORECF", self.ORE), ("FECF", self.FE), ("TCCF", self.TC), ("IDLECF", self.IDLE)):
                 if value & self.bit("ICR", name):
                     sr &= ~flag
             self.put(self.status, sr)
@@ -111,6 +125,7 @@ class Usart(Model):
             self._set(self.FE, True)
             return
         self.rx_bytes += 1
+        self.idle_at_s = self.core.now_s() + FRAME_BITS / own
         cr3 = self.get("CR3")
         if cr3 & self.bit("CR3", "DMAR") and self.dma.enabled(self.dma_channel):
             self.dma.transfer(self.dma_channel, byte)
@@ -124,6 +139,9 @@ class Usart(Model):
         self._set(self.RXNE, True)
 
     def step(self, now_s: float) -> None:
+        if self.idle_at_s is not None and now_s >= self.idle_at_s:
+            self.idle_at_s = None
+            self._set(self.IDLE, True)
         if self.shifting and now_s >= self.shift_until_s:
             self.shifting = False
             if self.tdr is not None:
@@ -135,4 +153,5 @@ class Usart(Model):
             self.core.raise_irq(self.irq)
 
     def next_event_s(self, now_s: float) -> float:
-        return self.shift_until_s if self.shifting else float("inf")
+        idle = float("inf") if self.idle_at_s is None else self.idle_at_s
+        return min(self.shift_until_s if self.shifting else float("inf"), idle)

@@ -4,6 +4,7 @@
 #include "app_image.h"
 #include "boot_flow.h"
 #include "boot_jump.h"
+#include "cortex_sleep.h"
 #include "flash_f0f1.h"
 #include "port_uart.h"
 #include "servo.h"
@@ -64,5 +65,6 @@ int main(void)
         servo_poll(&servo);
         test_build_main_loop();
         iwdg_kick();
+        CORTEX_SLEEP_IF(servo_may_sleep(&servo));
     }
 }

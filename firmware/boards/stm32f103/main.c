@@ -5,6 +5,7 @@
 #include "app_image.h"
 #include "boot_flow.h"
 #include "boot_jump.h"
+#include "cortex_sleep.h"
 #include "servo.h"
 #include "stm32f1_regs.h"
 #include "systick_clock.h"
@@ -75,5 +76,6 @@ int main(void)
         servo_poll(&servo);
         test_build_main_loop();
         iwdg_kick();
+        CORTEX_SLEEP_IF(servo_may_sleep(&servo));
     }
 }

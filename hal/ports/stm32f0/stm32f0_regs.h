@@ -39,14 +39,17 @@
 #define USART_CR1_UE (1u << 0)
 #define USART_CR1_RE (1u << 2)
 #define USART_CR1_TE (1u << 3)
+#define USART_CR1_IDLEIE (1u << 4)
 #define USART_CR1_TCIE (1u << 6)
 #define USART_CR1_TXEIE (1u << 7)
 #define USART_CR3_HDSEL (1u << 3)
 #define USART_CR3_DMAR (1u << 6)
 #define USART_CR3_OVRDIS (1u << 12)
+#define USART_ISR_IDLE (1u << 4)
 #define USART_ISR_TC (1u << 6)
 #define USART_ISR_TXE (1u << 7)
 #define USART_ICR_CLEAR 0x5Fu /* PE, FE, NF, ORE, IDLE, TC */
+#define USART_ICR_IDLECF (1u << 4)
 #define USART1_IRQ 27u
 
 

@@ -2,7 +2,10 @@
 
 #include "stm32f0_regs.h"
 
-enum { RUNNING = USART_CR1_UE | USART_CR1_TE | USART_CR1_RE };
+/* Receiving: the DMA takes the bytes, the line going idle after them
+ * wakes a sleeping main loop to frame them. */
+enum { RUNNING = USART_CR1_UE | USART_CR1_TE | USART_CR1_RE | USART_CR1_IDLEIE };
+enum { SENDING = RUNNING & ~(USART_CR1_RE | USART_CR1_IDLEIE) };
 
 /* 16x oversampling: BRR is the divider in 1/16ths, i.e. pclk / baud. */
 static uint32_t brr(uint32_t pclk_hz, uint32_t baud)
@@ -43,7 +46,7 @@ void usart_v2_hd_send(struct usart_v2_hd *u, const uint8_t *data, uint16_t len)
     u->tx_left = len;
     u->tx_busy = 1;
     /* Turn the line around: stop listening, start talking. */
-    USART_CR1(u->base) = (RUNNING & ~USART_CR1_RE) | USART_CR1_TXEIE;
+    USART_CR1(u->base) = SENDING | USART_CR1_TXEIE;
 }
 
 void usart_v2_hd_send_polled(struct usart_v2_hd *u, const uint8_t *data, uint16_t len)
@@ -51,7 +54,7 @@ void usart_v2_hd_send_polled(struct usart_v2_hd *u, const uint8_t *data, uint16_
     if (len == 0u) {
         return; /* TC, cleared after the last send, would never come */
     }
-    USART_CR1(u->base) = RUNNING & ~USART_CR1_RE;
+    USART_CR1(u->base) = SENDING;
     for (uint16_t i = 0; i < len; i++) {
         while (!(USART_ISR(u->base) & USART_ISR_TXE)) {
         }
@@ -73,13 +76,16 @@ bool usart_v2_hd_tx_done(const struct usart_v2_hd *u)
 void usart_v2_hd_irq(struct usart_v2_hd *u)
 {
     uint32_t isr = USART_ISR(u->base);
+    if (isr & USART_ISR_IDLE) {
+        USART_ICR(u->base) = USART_ICR_IDLECF; /* it has woken the main loop */
+    }
     if (u->tx_left > 0u) {
         if (isr & USART_ISR_TXE) {
             USART_TDR(u->base) = *u->tx;
             u->tx++;
             u->tx_left--;
             if (u->tx_left == 0u) {
-                USART_CR1(u->base) = (RUNNING & ~USART_CR1_RE) | USART_CR1_TCIE;
+                USART_CR1(u->base) = SENDING | USART_CR1_TCIE;
             }
         }
     } else if (isr & USART_ISR_TC) {

@@ -35,7 +35,9 @@ void usart_hd_rx_dma(struct usart_hd *u)
 {
     u->rx_dma = true;
     USART_CR3(u->base) |= USART_CR3_DMAR;
-    USART_CR1(u->base) &= ~USART_CR1_RXNEIE;
+    /* The DMA takes the bytes; the line going idle after them is what
+     * wakes a sleeping main loop to frame them. */
+    USART_CR1(u->base) = (USART_CR1(u->base) & ~USART_CR1_RXNEIE) | USART_CR1_IDLEIE;
 }
 
 void usart_hd_tx_polled(struct usart_hd *u)
@@ -133,6 +135,11 @@ void usart_hd_irq(struct usart_hd *u)
     uint32_t cr1 = USART_CR1(u->base);
     if (!u->rx_dma) {
         sr = receive_bytes(u, sr, cr1);
+    } else if ((sr & USART_SR_IDLE) && !(sr & USART_SR_RXNE)) {
+        /* Cleared by SR then DR read (RM0008 27.6.1). Not while a byte
+         * waits for the DMA: that read would take it; the flag then stays
+         * and the interrupt comes again once the DMA has it. */
+        (void)USART_DR(u->base);
     }
     if (u->tx_irq && (cr1 & (USART_CR1_TXEIE | USART_CR1_TCIE))) {
         transmit_step(u, sr);

@@ -7,6 +7,7 @@ program:
     thread  0x100: adds r0,#1; b 0x100
     IRQ 0   0x200: adds r1,#1; cmp r1,#200; bne 0x200; bx lr
     SysTick 0x300: adds r4,#1; bx lr  (r4 is not stacked: the count stays)
+    sleeper 0x400: cpsid i; wfi; cpsie i; adds r5,#1; b 0x400
 """
 import struct
 
@@ -31,6 +32,7 @@ def core():
     c.write(FLASH + 0x100, bytes.fromhex("0130" "fde7"))
     c.write(FLASH + 0x200, bytes.fromhex("0131" "c829" "fcd1" "7047"))
     c.write(FLASH + 0x300, bytes.fromhex("0134" "7047"))
+    c.write(FLASH + 0x400, bytes.fromhex("72b6" "30bf" "62b6" "0135" "f9e7"))
     c.reset(FLASH)
     c.wr32(SCB_VTOR, FLASH)
     c.wr32(NVIC_IPR, 0x80)           # IRQ 0 at 0x80
@@ -92,3 +94,35 @@ def test_a_fault_that_cannot_be_stacked_locks_the_core_up(core):
     assert reg(core, "R0") == r0  # runs nothing until a reset
     core.reset(FLASH)
     assert not core.locked_up
+
+
+def sleeper(core):
+    core.set_reg(arm.UC_ARM_REG_PC, FLASH + 0x401)
+
+
+def test_wfi_sleeps_until_an_enabled_interrupt_then_takes_it_after_cpsie(core):
+    sleeper(core)
+    core.run(10e-6)
+    assert core.asleep and reg(core, "PRIMASK") == 1
+    r5, executed = reg(core, "R5"), core.count.executed
+    assert executed == 2  # cpsid, wfi: the rest of the slice slept
+    core.run(1e-3)
+    assert core.asleep and reg(core, "R5") == r5 and core.slept_s > 1e-3
+    core.raise_irq(1)  # not enabled: no wake
+    core.run(10e-6)
+    assert core.asleep
+    core.raise_irq(0)  # enabled, PRIMASK set: it wakes, CPSIE, the handler runs
+    core.run(1e-3)
+    assert FIRST_IRQ not in core.pending and reg(core, "IPSR") == 0  # taken, and returned
+    assert reg(core, "PRIMASK") == 1 and reg(core, "R5") == r5 + 1 and core.asleep  # one pass, asleep again
+
+
+def test_the_instructions_a_run_executes_are_what_it_costs(core):
+    core.run(50e-6)  # the thread loop: 50 instructions at one a microsecond
+    assert core.count.executed == 50
+    assert core.now_s() == pytest.approx(50e-6)
+    sleeper(core)
+    before = core.now_s()
+    core.run(100e-6)  # two instructions, then 98 us asleep
+    assert core.count.executed == 2
+    assert core.now_s() - before == pytest.approx(100e-6) and core.slept_s == pytest.approx(98e-6)
