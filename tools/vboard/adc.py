@@ -46,12 +46,10 @@ class Adc(Model):
             return
         if self.core.asleep and not self.core.wake_pending():
             return  # only the CPU reads the results: the scan before it wakes is the one it sees
-        dma_on = self.dma_requests()
-        for channel in self.channels:
-            value = self.channel_value(channel)
-            self.put("DR", value)
-            if dma_on:
-                self.dma.transfer(1, value)
+        values = [self.channel_value(channel) for channel in self.channels]
+        self.put("DR", values[-1])
+        if self.dma_requests():
+            self.dma.transfer_many(1, values)
         period = self.period_s
         self.next_scan_s += period * max(1, int((now_s - self.next_scan_s) / period) + 1)
 

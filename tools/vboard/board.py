@@ -117,6 +117,7 @@ class Board:
         if "syscfg" in part.names:  # the F0's GPIO ports sit on AHB2
             self.core.map_host(0x48000000, 0x2000)
         self.core.map_host(SYSTEM_MEMORY, 0x1000)
+        self.core.map_system_control_space()  # last: see there
         dev = svd.device(part.svd)
         irqs = svd.interrupts(part.svd)
         n = part.names
@@ -279,15 +280,16 @@ class Board:
                 continue
             self.motor.step(passed)
             now = core.now_s()
-            if not self.flash.check_wait_states(core.hz):
+            if core.ran and not self.flash.check_wait_states(core.hz):
                 core.pending.add(3)  # reads at this clock return garbage: a fault
             for m in self.stepped:
                 m.step(now)
-            duty = self.tim.duty()
-            if duty is None:
-                self.motor.coast()
-            else:
-                self.motor.drive(duty)
+            if core.ran:  # the clock, the bridge and its pins change only by the code's stores
+                duty = self.tim.duty()
+                if duty is None:
+                    self.motor.coast()
+                else:
+                    self.motor.drive(duty)
             if self.iwdg.expired(now):
                 self.reset("watchdog")
 

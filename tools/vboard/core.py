@@ -51,6 +51,9 @@ SYSTICK = 15
 FIRST_IRQ = 16
 FRAME_REGS = (arm.UC_ARM_REG_R0, arm.UC_ARM_REG_R1, arm.UC_ARM_REG_R2, arm.UC_ARM_REG_R3,
               arm.UC_ARM_REG_R12, arm.UC_ARM_REG_LR)
+ENTRY_READ = FRAME_REGS + (arm.UC_ARM_REG_SP, arm.UC_ARM_REG_XPSR, arm.UC_ARM_REG_PC)
+ENTRY_WRITE = (arm.UC_ARM_REG_SP, arm.UC_ARM_REG_LR, arm.UC_ARM_REG_IPSR, arm.UC_ARM_REG_PC)
+EXIT_WRITE = FRAME_REGS + (arm.UC_ARM_REG_SP, arm.UC_ARM_REG_XPSR, arm.UC_ARM_REG_IPSR, arm.UC_ARM_REG_PC)
 
 # System control space (ARMv7-M ARM B3.2, B3.3, B3.4)
 SYST_CSR, SYST_RVR, SYST_CVR = 0xE000E010, 0xE000E014, 0xE000E018
@@ -114,7 +117,7 @@ class Core:
         self.active = []             # (exception, priority) of the handlers running, innermost last
         self.systick_base = 0.0      # cycle at which the counter last loaded
         self.regions = []            # (base, end, memoryview) of memory mapped from the host
-        self.map_host(0xE000E000, 0x1000)
+        self._pages = {}             # 1 KB page -> (base, view): _region's cache
         self.on_write(SYST_CSR, self._syst_csr)
         self.on_write(SYST_CVR, self._syst_cvr)
         self.on_write(SCB_ICSR, self._icsr)
@@ -128,7 +131,9 @@ class Core:
         self._uch = self.uc._uch
         self._regbuf = ctypes.c_uint32()
         self._regbuf_ref = ctypes.byref(self._regbuf)
+        self._batches = {}
         self.running = False         # inside emu_start
+        self.ran = False             # the last run() ran code (else it slept or was locked up)
         self.asleep = False          # after a WFI, until an exception is pending
         self.slept_s = 0.0           # time spent asleep since power-up
         self.count = InstructionCount(0, 0, ctypes.cast(uclib.uc_emu_stop, ctypes.c_void_p))
@@ -148,6 +153,27 @@ class Core:
         self._regbuf.value = value & 0xFFFFFFFF
         uclib.uc_reg_write(self._uch, register, self._regbuf_ref)
 
+    def _batch(self, registers: tuple):
+        batch = self._batches.get(registers)
+        if batch is None:
+            values = (ctypes.c_uint32 * len(registers))()
+            pointers = (ctypes.c_void_p * len(registers))(
+                *[ctypes.addressof(values) + 4 * i for i in range(len(registers))])
+            batch = self._batches[registers] = ((ctypes.c_int32 * len(registers))(*registers), pointers, values)
+        return batch
+
+    def regs(self, registers: tuple) -> list:
+        """Several registers in one call."""
+        ids, pointers, values = self._batch(registers)
+        uclib.uc_reg_read_batch(self._uch, ids, pointers, len(registers))
+        return list(values)
+
+    def set_regs(self, registers: tuple, new_values) -> None:
+        ids, pointers, values = self._batch(registers)
+        for i, v in enumerate(new_values):
+            values[i] = v & 0xFFFFFFFF
+        uclib.uc_reg_write_batch(self._uch, ids, pointers, len(registers))
+
     # ---- memory ---------------------------------------------------------
     def map_host(self, base: int, size: int, buf=None):
         """Maps host memory at base (a new zeroed buffer unless given): the
@@ -156,13 +182,36 @@ class Core:
             buf = (ctypes.c_ubyte * size)()
         self.uc.mem_map_ptr(base, size, 7, ctypes.addressof(buf))
         self.regions.append((base, base + size, memoryview(buf).cast("B")))
+        self._pages = {}
         return buf
 
+    def map_system_control_space(self) -> None:
+        """SysTick, the NVIC and the SCB, mapped after the board's memory:
+        Unicorn 2.1 gives a host-memory block mapped after a smaller one the
+        offset of the block before it in its RAM list, so with this 4 KB
+        block first the flash and the SRAM shared offsets, and every store
+        to the stack over the bytes of the hot code in flash threw its
+        translation away (the F103's control tick ran 4 to 10 times slower).
+        Mapped last, no two blocks share an offset (both boards' layouts,
+        checked store by store)."""
+        self.map_host(0xE000E000, 0x1000)
+
+    def _region(self, address: int):
+        """(base, view) of the host-mapped region holding address, by its
+        1 KB page (the models touch a few pages very often), or None."""
+        page = address >> 10
+        hit = self._pages.get(page)
+        if hit is None:
+            hit = next(((base, view) for base, end, view in self.regions if base <= address < end), None)
+            if hit is not None:
+                self._pages[page] = hit
+        return hit
+
     def _view(self, address: int):
-        for base, end, view in self.regions:
-            if base <= address < end:
-                return view, address - base
-        raise KeyError(f"{address:#010x} is not host-mapped")
+        hit = self._region(address)
+        if hit is None:
+            raise KeyError(f"{address:#010x} is not host-mapped")
+        return hit[1], address - hit[0]
 
     def on_write(self, address: int, handler) -> None:
         """Stores into the register (word) at address go to
@@ -195,9 +244,9 @@ class Core:
         self._hooks_stale = False
 
     def _read(self, address: int, fmt: str) -> int:
-        for base, end, view in self.regions:
-            if base <= address < end:
-                return struct.unpack_from(fmt, view, address - base)[0]
+        hit = self._region(address)
+        if hit is not None:
+            return struct.unpack_from(fmt, hit[1], address - hit[0])[0]
         return struct.unpack(fmt, self.uc.mem_read(address, struct.calcsize(fmt)))[0]  # an alias (address 0)
 
     def rd32(self, address: int) -> int:
@@ -278,6 +327,7 @@ class Core:
             self.cycles += max_s * self.hz
             return max_s
         count = max(1, int(max_s * self.hz / self.cpi))
+        self.ran = False
         if self.asleep:
             if not self.wake_pending():
                 return self._sleep(max_s)
@@ -298,7 +348,7 @@ class Core:
         pc = self.reg(arm.UC_ARM_REG_PC) | 1
         self.count.executed, self.count.limit = 0, count
         faulted = False
-        self.running = True
+        self.running = self.ran = True
         try:
             self.uc.emu_start(pc, 0xFFFFFFFF)
         except UcError as e:
@@ -311,8 +361,7 @@ class Core:
         executed = self.count.executed
         ran = executed * self.cpi
         if executed < count and not (faulted or self.fixes or self.stall_s or self.reset_cause or self.deferred):
-            pc = self.reg(arm.UC_ARM_REG_PC)
-            self.asleep = self.rd16((pc & ~1) - 2) == WFI
+            self.asleep = self._after_wfi()
         for action in self.deferred:
             action()
         self.deferred = []
@@ -351,6 +400,17 @@ class Core:
         if self.asleep and passed < max_s and not self.wake_pending():
             passed += self._sleep(max_s - passed)  # the rest of the slice: one call, not two
         return passed
+
+    def _after_wfi(self) -> bool:
+        """Whether a run that ended early ended on a WFI (Unicorn stops
+        there, the PC past it), not on a hook's stop or a fault."""
+        pc = self.reg(arm.UC_ARM_REG_PC) & ~1
+        try:
+            return self.rd16(pc - 2) == WFI
+        except (KeyError, UcError):
+            if os.environ.get("VBOARD_TRACE"):
+                print(f"vboard: a run ended early at {pc:#010x}", file=sys.stderr, flush=True)
+            return False
 
     def wake_pending(self) -> bool:
         """An exception that ends a WFI: pending and enabled (B1.5.19)."""
@@ -411,18 +471,14 @@ class Core:
         self.active.append((exc, prio))
         if exc == SYSTICK:
             self.wr32(SCB_ICSR, self.rd32(SCB_ICSR) & ~ICSR_PENDSTSET)
-        sp = self.reg(arm.UC_ARM_REG_SP)
-        xpsr = self.reg(arm.UC_ARM_REG_XPSR)
-        pc = self.reg(arm.UC_ARM_REG_PC)
+        *stacked, sp, xpsr, pc = self.regs(ENTRY_READ)
         realign = sp & 4
         sp = (sp - 32) & ~7
-        frame = [self.reg(r) for r in FRAME_REGS] + [pc & ~1, (xpsr | (1 << 24)) | (realign << 7)]
+        frame = stacked + [pc & ~1, (xpsr | (1 << 24)) | (realign << 7)]
         self.write(sp, struct.pack("<8I", *frame))
-        self.set_reg(arm.UC_ARM_REG_SP, sp)
-        self.set_reg(arm.UC_ARM_REG_LR, EXC_RETURN_HANDLER if nested else EXC_RETURN_THREAD_MSP)
-        self.set_reg(arm.UC_ARM_REG_IPSR, exc)
         base = self.rd32(SCB_VTOR) if self.has_vtor else 0
-        self.set_reg(arm.UC_ARM_REG_PC, self.rd32(base + 4 * exc))
+        self.set_regs(ENTRY_WRITE, (sp, EXC_RETURN_HANDLER if nested else EXC_RETURN_THREAD_MSP, exc,
+                                    self.rd32(base + 4 * exc)))
 
     def _interrupt(self, uc, intno, data):
         if intno != EXCP_EXCEPTION_EXIT:
@@ -432,13 +488,10 @@ class Core:
         sp = self.reg(arm.UC_ARM_REG_SP)
         view, at = self._view(sp)
         frame = struct.unpack_from("<8I", view, at)
-        for reg, v in zip(FRAME_REGS, frame[:6]):
-            self.set_reg(reg, v)
         xpsr = frame[7]
-        self.set_reg(arm.UC_ARM_REG_SP, sp + 32 + (4 if xpsr & (1 << 9) else 0))
-        self.set_reg(arm.UC_ARM_REG_XPSR, xpsr & ~(1 << 9))
-        self.set_reg(arm.UC_ARM_REG_IPSR, xpsr & 0x1FF)  # the interrupted handler's, or 0
-        self.set_reg(arm.UC_ARM_REG_PC, frame[6] | 1)
+        # the interrupted handler's IPSR, or 0
+        self.set_regs(EXIT_WRITE, frame[:6] + (sp + 32 + (4 if xpsr & (1 << 9) else 0), xpsr & ~(1 << 9),
+                                               xpsr & 0x1FF, frame[6] | 1))
         if self.active:
             self.active.pop()
         self._take_exception()  # one waiting follows at once (tail-chaining, B1.5.12)

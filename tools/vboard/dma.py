@@ -36,30 +36,39 @@ class Dma(Model):
     def peripheral_address(self, n: int) -> int:
         return self.get(f"CPAR{n}")
 
-    def transfer(self, n: int, value: int) -> bool:
-        """One item from a peripheral to memory; False if the channel is off
-        or finished (non-circular, counter at 0)."""
+    def transfer_many(self, n: int, values) -> int:
+        """Items from a peripheral to memory, one request each; returns how
+        many moved (none while the channel is off, or once a non-circular
+        one has counted down to 0)."""
         ccr = self.get(f"CCR{n}")
         left = self.get(f"CNDTR{n}") & 0xFFFF
-        if not ccr & 1 or left == 0:
-            return False
+        if not ccr & 1:
+            return 0
         total = self.reload.get(n, left)
         msize = 1 << ((ccr >> 10) & 3)
-        position = (total - left) if ccr & (1 << 7) else 0  # MINC
-        address = self.get(f"CMAR{n}") + position * msize
-        self.core.write(address, (value & ((1 << 8 * msize) - 1)).to_bytes(msize, "little"))
-        left -= 1
-        shift = 4 * (n - 1)
-        flags = 0
-        if left == total // 2:
-            flags |= 0b0101  # GIF, HTIF
-        if left == 0:
-            flags |= 0b0011  # GIF, TCIF
-            if ccr & (1 << 5):  # CIRC
-                left = total
+        base, minc, circular = self.get(f"CMAR{n}"), ccr & (1 << 7), ccr & (1 << 5)
+        mask = (1 << 8 * msize) - 1
+        flags = moved = 0
+        for value in values:
+            if left == 0:
+                break
+            position = (total - left) if minc else 0
+            self.core.write(base + position * msize, (value & mask).to_bytes(msize, "little"))
+            left -= 1
+            moved += 1
+            if left == total // 2:
+                flags |= 0b0101  # GIF, HTIF
+            if left == 0:
+                flags |= 0b0011  # GIF, TCIF
+                if circular:
+                    left = total
         self.put(f"CNDTR{n}", left)
         if flags:
-            self.put("ISR", self.get("ISR") | flags << shift)
+            self.put("ISR", self.get("ISR") | flags << 4 * (n - 1))
             if (flags & 2 and ccr & 2) or (flags & 4 and ccr & 4):  # TCIE, HTIE
                 self.core.raise_irq(self.irqs[n])
-        return True
+        return moved
+
+    def transfer(self, n: int, value: int) -> bool:
+        """One item from a peripheral to memory."""
+        return self.transfer_many(n, (value,)) == 1

@@ -51,7 +51,8 @@ class Usart(Model):
         self.ORE, self.FE, self.IDLE = self.bit(s, "ORE"), self.bit(s, "FE"), self.bit(s, "IDLE")
         if not self.v2:  # the F1's DR read clears IDLE: one narrow read hook
             dr = self.addr("DR")
-            self.core.uc.hook_add(UC_HOOK_MEM_READ, lambda *a: self._set(self.IDLE, False), begin=dr, end=dr + 3)
+            self.dr_read_hook = self.core.uc.hook_add(UC_HOOK_MEM_READ, lambda *a: self._set(self.IDLE, False),
+                                                      begin=dr, end=dr + 3)
 
     def reset(self) -> None:
         super().reset()

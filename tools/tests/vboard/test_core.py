@@ -25,6 +25,7 @@ def core():
     c = Core(arm.UC_CPU_ARM_CORTEX_M3, HZ, 1.0, True, 1)
     c.map_host(FLASH, 0x1000)
     c.map_host(RAM, 0x1000)
+    c.map_system_control_space()
     vectors = [0] * 32
     vectors[0], vectors[1] = RAM + 0x800, FLASH + 0x101
     vectors[SYSTICK], vectors[FIRST_IRQ] = FLASH + 0x301, FLASH + 0x201
