@@ -2,10 +2,10 @@
  * dispatcher. Run it through tests/bench/target/run_target_bench.py (the
  * Thumb-2 build under QEMU).
  *
- * The servo receives as on the reference board: the STM32F1 port's code
- * (usart_hd.c, dma_rx.c) on registers in RAM. The benchmark plays the DMA
- * channel (bytes into the ring, the counter down, a lap interrupt per
- * ring); what the CPU runs is counted: the lap interrupt and the main loop
+ * The servo receives and sends as on the reference board: the STM32F1
+ * port's code (usart_hd.c, dma_rx.c; answers by DMA, dma_tx.h) on registers
+ * in RAM. The benchmark plays the DMA channels (bytes into the ring, the
+ * counter down, a lap interrupt per ring); what the CPU runs is counted: the lap interrupt and the main loop
  * (the port raises no receive interrupt). Each reading of the clock runs
  * the port's SysTick clock too (QEMU has SysTick), though the benchmark's
  * own clock is what the servo sees.
@@ -47,6 +47,7 @@ static struct servo servo;
 /* The USART's and the DMA channel's registers, in RAM. */
 static uint32_t usart_regs[8];
 static uint32_t dma_regs[4];
+static uint32_t dma_tx_regs[4];
 static struct usart_hd usart;
 static struct dma_rx dma;
 static unsigned laps_due; /* transfer-complete interrupts the DMA raised */
@@ -128,7 +129,7 @@ static uint32_t port_now_us(void *ctx)
 static void port_uart_send(void *ctx, const uint8_t *data, uint16_t len)
 {
     (void)ctx;
-    usart_hd_send(&usart, data, len);
+    usart_hd_send_dma(&usart, data, len);
 }
 
 static bool port_uart_tx_done(void *ctx)
@@ -152,7 +153,6 @@ static void dma_writes(const uint8_t *bytes, size_t n)
 /* The USART's part, not counted: the frame left the wire. */
 static void transmission_ends(void)
 {
-    usart.tx_left = 0;
     usart.tx_busy = 0;
     usart_regs[3] = (usart_regs[3] & ~(USART_CR1_TXEIE | USART_CR1_TCIE)) | USART_CR1_RE;
 }
@@ -194,6 +194,7 @@ static void fresh_servo(void)
     usart_hd_init(&usart, (uintptr_t)usart_regs, 72000000u, 115200u, true, &hal.rx, clock_us);
     dma_rx_start(&dma, (uintptr_t)dma_regs, (uintptr_t)&usart_regs[1], &hal.rx);
     usart_hd_rx_dma(&usart);
+    usart_hd_tx_dma(&usart, (uintptr_t)dma_tx_regs);
     laps_due = 0;
     hal.port.bus.now_us = port_now_us;
     hal.port.bus.rx_sync = dma_rx_sync;

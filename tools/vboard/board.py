@@ -18,7 +18,7 @@ from unicorn import arm_const as arm
 from . import svd
 from .adc import AdcF0, AdcF1
 from .clocks import Rcc
-from .core import Core, Stop
+from .core import FIRST_IRQ, Core, Stop
 from .dma import Dma
 from .flash import Flash
 from .model import Model
@@ -39,6 +39,7 @@ class Part:
     cpi: float          # cycles an instruction: the target benchmark's model for this firmware
     names: dict         # role -> the SVD's peripheral name
     usart_rx_dma: int   # DMA channel of USART1_RX (RM0008 table 78, RM0360 table 26)
+    usart_tx_dma: int   # ... and of USART1_TX
     dma_irqs: dict      # channel -> the SVD's interrupt name
     uid: int            # 96-bit unique ID (RM0008 30.2, RM0360 29.1)
     program_s: float    # tPROG, the datasheet's longest
@@ -52,13 +53,13 @@ PARTS = {
     "stm32f103": Part("STM32F103xx", arm.UC_CPU_ARM_CORTEX_M3, True, 2, 2.0,
                       {"rcc": "RCC", "flash": "FLASH", "dma": "DMA1", "usart": "USART1", "adc": "ADC1",
                        "tim": "TIM3", "iwdg": "IWDG", "gpio": "GPIOA"},
-                      5, {1: "DMA1_Channel1", 5: "DMA1_Channel5"}, 0x1FFFF7E8, 70e-6, 40e-3, "arm"),
+                      5, 4, {1: "DMA1_Channel1", 5: "DMA1_Channel5"}, 0x1FFFF7E8, 70e-6, 40e-3, "arm"),
     # DS9773 (STM32F030x4/6/8/C) "Flash memory characteristics": tPROG 53.5 us max, tERASE 40 ms max.
     # CPI 1.9: docs/benchmark.md (48 MHz, 1 wait state; the whole tick 4004 cycles / 2091).
     "stm32f030k6": Part("STM32F030", arm.UC_CPU_ARM_CORTEX_M0, False, 1, 1.9,
                         {"rcc": "RCC", "flash": "Flash", "dma": "DMA", "usart": "USART1", "adc": "ADC",
                          "tim": "TIM3", "iwdg": "IWDG", "gpio": "GPIOA", "syscfg": "SYSCFG"},
-                        3, {1: "DMA_CH1", 3: "DMA_CH2_3"}, 0x1FFFF7AC, 53.5e-6, 40e-3, "arm-m0"),
+                        3, 2, {1: "DMA_CH1", 3: "DMA_CH2_3"}, 0x1FFFF7AC, 53.5e-6, 40e-3, "arm-m0"),
 }
 HSE_HZ = 8_000_000  # the boards' crystal (firmware/boards/*/board_io.h)
 ADC_INPUTS = {0: "supply", 1: "current", 2: "ntc", 3: "encoder"}  # firmware/boards/*/README.md
@@ -130,7 +131,7 @@ class Board:
         self.dma = Dma(self, dev[n["dma"]], {ch: irqs[name] for ch, name in part.dma_irqs.items()})
         self.gpio = Model(self, dev[n["gpio"]])
         self.usart = Usart(self, dev[n["usart"]], self.pclk_hz, irqs["USART1"], self.dma,
-                           part.usart_rx_dma, self.bus_pin_ok)
+                           part.usart_rx_dma, part.usart_tx_dma, self.bus_pin_ok)
         adc_class = AdcF0 if "syscfg" in n else AdcF1
         self.adc = adc_class(self, dev[n["adc"]], self.adc_hz, self.dma, self.adc_input)
         self.tim = BridgeTimer(self, dev[n["tim"]], self.bridge_pins_ok)
@@ -263,9 +264,12 @@ class Board:
 
     def run_until(self, t_s: float, max_step_s: float = 1e-3) -> None:
         """Runs the board to t_s, in steps of at most max_step_s, each
-        ending where a model or SysTick next has something to do."""
+        ending where a model or SysTick next has something to do, and no
+        further than the end of a byte it starts sending: the runner
+        delivers it then, to the host and to the other boards."""
         core = self.core
         while (now := core.now_s()) < t_s:
+            t_s = min(t_s, self.bus.next_event_s())
             soon = min(t_s, now + max_step_s, now + core.cycles_to_systick() / core.hz)
             for m in self.timed:
                 soon = min(soon, m.next_event_s(now))
@@ -316,9 +320,10 @@ class Board:
                 "resets_software": self.resets["software"], "resets_watchdog": self.resets["watchdog"],
                 "last_reset": self.last_reset, "mode": "app" if self.in_application() else "bootloader",
                 "locked_up": int(self.core.locked_up), "asleep_ms": round(self.core.slept_s * 1000, 3),
+                "usart_interrupts": self.core.taken.get(FIRST_IRQ + self.usart.irq, 0),
                 "rx_bytes": self.usart.rx_bytes,
                 "page_erases": self.flash.erases, "flash_stall_ms": round(self.flash.stalled_s * 1000, 3),
                 "erase_began_ms": round(self.flash.erase_began_s * 1000, 3),
                 "last_sent_ms": round(self.bus.last_sent_s.get(self.station, 0.0) * 1000, 3),
-                "framing_errors": self.usart.framing_errors, "overruns": self.usart.overruns,
+                "framing_errors": self.usart.framing_errors, "begun_deaf": self.usart.begun_deaf, "overruns": self.usart.overruns,
                 "pc": f"{self.core.uc.reg_read(arm.UC_ARM_REG_PC):#010x}"}

@@ -18,6 +18,12 @@ import tty
 FRAME_BITS = 10
 HOST = -1
 BACKLOG_S = 0.01
+# The fastest a host answers a byte it has heard: a USB adapter hands it
+# over at the next high-speed microframe, 125 us (USB 2.0, 8.4.2.1). A
+# host faster than the servo's turnaround (its receiver back on a few us
+# after its last stop bit) would not exist; without this the runner, ahead
+# of the wall clock, stamped a reply at the very instant the answer ended.
+HOST_TURNAROUND_S = 125e-6
 # A second TCP client while one holds the bus is told so (servo_sim's
 # words, which servoctl recognises) and ignored until it leaves.
 BUS_IN_USE = b"vboard: the bus is in use by another client\n"
@@ -35,6 +41,7 @@ class Bus:
         self.to_host = bytearray()
         self.collisions = 0
         self.last_activity_s = -1.0   # end of the last byte queued
+        self.heard_by_host_s = -1.0   # when the host last got a byte (HOST_TURNAROUND_S)
         self.last_sent_s = {}         # station -> when its last byte started
         self.host_fd = None
         self.listen = None
@@ -129,7 +136,7 @@ class Bus:
                 self._drop_client()
                 return
             for byte in data or b"":
-                self.queue_host(byte, now_s)
+                self.queue_host(byte, max(now_s, self.heard_by_host_s + HOST_TURNAROUND_S))
 
     def flush_to_host(self) -> None:
         if self.to_host and self.host_fd is not None:
@@ -173,11 +180,12 @@ class Bus:
 
     def deliver_until(self, t_s: float) -> None:
         while self.events and self.events[0][0] <= t_s:
-            _, _, byte, baud, sender = heapq.heappop(self.events)
+            end_s, _, byte, baud, sender = heapq.heappop(self.events)
             for usart in self.stations:
                 usart.receive(byte, baud)
             if sender != HOST and abs(baud - self.host_baud) <= 0.03 * self.host_baud:
                 self.to_host.append(byte)
+                self.heard_by_host_s = end_s
 
     def close(self) -> None:
         if self.link_path and os.path.lexists(self.link_path):

@@ -43,27 +43,21 @@ from unicorn import arm_const as arm
 from unicorn.unicorn_py3.unicorn import uclib
 
 from .native import lib as native_lib
+from .system_space import (FIRST_IRQ, ICSR_PENDSTSET, NVIC_ICER, NVIC_ICPR, NVIC_IPR, NVIC_ISER, NVIC_ISPR,
+                           SCB_AIRCR, SCB_ICSR, SCB_SHPR3, SCB_VTOR, SYST_CSR, SYST_CVR, SYSTICK,
+                           SystemControlSpace)
 
 EXC_RETURN_THREAD_MSP = 0xFFFFFFF9
 EXCP_EXCEPTION_EXIT = 8  # QEMU's, as Unicorn reports it
 HARD_FAULT = 3
-SYSTICK = 15
-FIRST_IRQ = 16
 FRAME_REGS = (arm.UC_ARM_REG_R0, arm.UC_ARM_REG_R1, arm.UC_ARM_REG_R2, arm.UC_ARM_REG_R3,
               arm.UC_ARM_REG_R12, arm.UC_ARM_REG_LR)
 ENTRY_READ = FRAME_REGS + (arm.UC_ARM_REG_SP, arm.UC_ARM_REG_XPSR, arm.UC_ARM_REG_PC)
 ENTRY_WRITE = (arm.UC_ARM_REG_SP, arm.UC_ARM_REG_LR, arm.UC_ARM_REG_IPSR, arm.UC_ARM_REG_PC)
 EXIT_WRITE = FRAME_REGS + (arm.UC_ARM_REG_SP, arm.UC_ARM_REG_XPSR, arm.UC_ARM_REG_IPSR, arm.UC_ARM_REG_PC)
 
-# System control space (ARMv7-M ARM B3.2, B3.3, B3.4)
-SYST_CSR, SYST_RVR, SYST_CVR = 0xE000E010, 0xE000E014, 0xE000E018
-NVIC_ISER, NVIC_ICER, NVIC_ISPR, NVIC_ICPR = 0xE000E100, 0xE000E180, 0xE000E200, 0xE000E280
-SCB_ICSR, SCB_VTOR, SCB_AIRCR = 0xE000ED04, 0xE000ED08, 0xE000ED0C
-NVIC_IPR, SCB_SHPR3 = 0xE000E400, 0xE000ED20
 EXC_RETURN_HANDLER = 0xFFFFFFF1
-ICSR_PENDSTSET, ICSR_PENDSTCLR = 1 << 26, 1 << 25
-AIRCR_VECTKEY, AIRCR_SYSRESETREQ = 0x05FA0000, 1 << 2
-CSR_ENABLE, CSR_TICKINT, CSR_COUNTFLAG = 1, 2, 1 << 16
+CORE_REGS = tuple(getattr(arm, f"UC_ARM_REG_R{n}") for n in range(13)) + (arm.UC_ARM_REG_SP, arm.UC_ARM_REG_LR)
 WFI, CPSIE_I = 0xBF30, 0xB662
 WAKE_RUN = 16  # instructions run after a wake with PRIMASK set before the exception is taken
 
@@ -73,25 +67,31 @@ class InstructionCount(ctypes.Structure):
     _fields_ = [("executed", ctypes.c_uint64), ("limit", ctypes.c_uint64), ("stop", ctypes.c_void_p)]
 
 
-def plain_store_size(hw: int, hw2: int) -> int:
-    """The size of a single store without writeback at this Thumb
-    instruction (2 or 4), or 0 for any other instruction."""
+def plain_store_size(hw: int, hw2: int) -> tuple:
+    """(size, writeback) of a single store at this Thumb instruction: its
+    size (2 or 4, 0 for any other instruction) and, for STR/STRB/STRH with
+    an 8-bit offset and writeback (ARMv7-M A7.7.158 T4, the compiler's
+    `str.w r6, [r0], #4`), (Rn, what it adds to Rn), else None."""
     if hw >> 11 in (0x0C, 0x0E, 0x10, 0x12) or hw >> 9 in (0x28, 0x29, 0x2A):
-        return 2  # STR/STRB/STRH immediate, STR SP-relative, STR/STRH/STRB register
+        return 2, None  # STR/STRB/STRH immediate, STR SP-relative, STR/STRH/STRB register
     if hw & 0xFFF0 in (0xF8C0, 0xF880, 0xF8A0):
-        return 4  # STR/STRB/STRH imm12
+        return 4, None  # STR/STRB/STRH imm12
     if hw & 0xFFF0 in (0xF840, 0xF800, 0xF820):
-        register_form = hw2 & 0x0FC0 == 0
-        offset_no_writeback = hw2 & 0x0800 and hw2 & 0x0400 and not hw2 & 0x0100
-        return 4 if register_form or offset_no_writeback else 0
-    return 0
+        if hw2 & 0x0FC0 == 0:
+            return 4, None  # register offset
+        if hw2 & 0x0800 and hw2 & 0x0400 and not hw2 & 0x0100:
+            return 4, None  # offset, no writeback
+        if hw2 & 0x0800 and hw2 & 0x0100:  # pre- or post-indexed, writeback
+            imm8 = hw2 & 0xFF
+            return 4, (hw & 0xF, imm8 if hw2 & 0x0200 else -imm8)
+    return 0, None
 
 
 class Stop(Exception):
     """Raised by run() when the board must reset (cause in .args[0])."""
 
 
-class Core:
+class Core(SystemControlSpace):
     def __init__(self, cpu_model: int, hz: int, cpi: float, has_vtor: bool, irq_words: int):
         self.uc = Uc(UC_ARCH_ARM, UC_MODE_THUMB | UC_MODE_MCLASS)
         self.uc.ctl_set_cpu_model(cpu_model)
@@ -135,6 +135,8 @@ class Core:
         self.running = False         # inside emu_start
         self.ran = False             # the last run() ran code (else it slept or was locked up)
         self.asleep = False          # after a WFI, until an exception is pending
+        self.taken = {}              # exception number -> how many times it was taken
+        self.lines = {}              # exception number -> its level-sensitive line (assert_irq)
         self.slept_s = 0.0           # time spent asleep since power-up
         self.count = InstructionCount(0, 0, ctypes.cast(uclib.uc_emu_stop, ctypes.c_void_p))
         self._count_hook = ctypes.c_size_t()
@@ -255,6 +257,9 @@ class Core:
     def rd16(self, address: int) -> int:
         return self._read(address, "<H")
 
+    def rd_bytes(self, address: int, size: int) -> int:
+        return self._read(address, {1: "<B", 2: "<H", 4: "<I"}[size])
+
     def wr32(self, address: int, value: int) -> None:
         view, at = self._view(address)
         struct.pack_into("<I", view, at, value & 0xFFFFFFFF)
@@ -372,13 +377,17 @@ class Core:
             pc = self.reg(arm.UC_ARM_REG_PC)
             xpsr = self.reg(arm.UC_ARM_REG_XPSR)
             in_it_block = (xpsr >> 10) & 0x3F or (xpsr >> 25) & 3  # ITSTATE (B1.4.2)
-            size = 0 if in_it_block else plain_store_size(self.rd16(pc & ~1), self.rd16((pc & ~1) + 2))
+            size, writeback = (0, None) if in_it_block else plain_store_size(self.rd16(pc & ~1),
+                                                                               self.rd16((pc & ~1) + 2))
             if pc != self._stop_pc:  # the store completed and the CPU moved on
                 for address, data in self.fixes:
                     self.write(address, data)
             elif size:
                 for address, data in self.fixes:
                     self.write(address, data)
+                if writeback:
+                    rn = CORE_REGS[writeback[0]]
+                    self.set_reg(rn, self.reg(rn) + writeback[1])
                 self.set_reg(arm.UC_ARM_REG_PC, (pc + size) | 1)
             else:
                 self._passthrough = self._stopping
@@ -433,6 +442,15 @@ class Core:
     def raise_irq(self, irq: int) -> None:
         self.pending.add(FIRST_IRQ + irq)
 
+    def assert_irq(self, irq: int, line) -> None:
+        """A level-sensitive line (line() says whether it is high): pending
+        now unless its handler is running; a handler that returns with the
+        line still high has it pending again (B1.5.4), one that cleared it
+        does not run twice."""
+        self.lines[FIRST_IRQ + irq] = line
+        if not any(e == FIRST_IRQ + irq for e, _ in self.active):
+            self.pending.add(FIRST_IRQ + irq)
+
     def _fault(self, why: str) -> None:
         """A bus fault or undefined instruction: HardFault, as on silicon
         (the firmware's handler then spins until the watchdog resets). A
@@ -467,6 +485,7 @@ class Core:
             return
         prio, exc = ready[0]
         self.pending.discard(exc)
+        self.taken[exc] = self.taken.get(exc, 0) + 1
         nested = bool(self.active)
         self.active.append((exc, prio))
         if exc == SYSTICK:
@@ -493,7 +512,10 @@ class Core:
         self.set_regs(EXIT_WRITE, frame[:6] + (sp + 32 + (4 if xpsr & (1 << 9) else 0), xpsr & ~(1 << 9),
                                                xpsr & 0x1FF, frame[6] | 1))
         if self.active:
-            self.active.pop()
+            done, _ = self.active.pop()
+            line = self.lines.get(done)
+            if line is not None and line():
+                self.pending.add(done)
         self._take_exception()  # one waiting follows at once (tail-chaining, B1.5.12)
 
     def reset(self, vector_table: int) -> None:
@@ -517,75 +539,3 @@ class Core:
         self.set_reg(arm.UC_ARM_REG_SP, self.rd32(vector_table))
         self.set_reg(arm.UC_ARM_REG_LR, 0xFFFFFFFF)
         self.set_reg(arm.UC_ARM_REG_PC, self.rd32(vector_table + 4) | 1)
-
-    # ---- NVIC and SCB -----------------------------------------------------
-    def _nvic(self, word: int, enable: bool):
-        def handler(value, old, size):
-            for bit in range(32):
-                if value >> bit & 1:
-                    (self.enabled.add if enable else self.enabled.discard)(32 * word + bit)
-            mask = sum(1 << (b - 32 * word) for b in self.enabled if 32 * word <= b < 32 * word + 32)
-            self.fix(NVIC_ISER + 4 * word, mask)
-            self.fix(NVIC_ICER + 4 * word, mask)
-        return handler
-
-    def _nvic_pend(self, word: int, pend: bool):
-        def handler(value, old, size):
-            for bit in range(32):
-                if value >> bit & 1:
-                    exc = FIRST_IRQ + 32 * word + bit
-                    (self.pending.add if pend else self.pending.discard)(exc)
-            self.fix(NVIC_ISPR + 4 * word, 0)
-            self.fix(NVIC_ICPR + 4 * word, 0)
-        return handler
-
-    def _icsr(self, value, old, size):
-        if value & ICSR_PENDSTSET:
-            self.pending.add(SYSTICK)
-        if value & ICSR_PENDSTCLR:
-            self.pending.discard(SYSTICK)
-        self.fix(SCB_ICSR, ICSR_PENDSTSET if SYSTICK in self.pending else 0)
-
-    def _aircr(self, value, old, size):
-        if (value & 0xFFFF0000) == AIRCR_VECTKEY and value & AIRCR_SYSRESETREQ:
-            self.stop(reset="software")
-        self.fix(SCB_AIRCR, 0xFA050000)
-
-    # ---- SysTick (ARMv7-M ARM B3.3) ---------------------------------------
-    def _syst_csr(self, value, old, size):
-        if value & CSR_ENABLE and not old & CSR_ENABLE:
-            self.systick_base = self.cycles
-        self.fix(SYST_CSR, value & ~CSR_COUNTFLAG)
-
-    def _syst_cvr(self, value, old, size):
-        self.systick_base = self.cycles  # any write clears the counter
-        self.fix(SYST_CVR, 0)
-
-    def _update_systick(self) -> None:
-        csr = self.rd32(SYST_CSR)
-        if not csr & CSR_ENABLE:
-            return
-        period = (self.rd32(SYST_RVR) & 0xFFFFFF) + 1
-        into = int(self.cycles - self.systick_base) % period
-        self.wr32(SYST_CVR, period - 1 - into)
-
-    def _systick_after(self, passed: float) -> None:
-        """Wraps in the cycles that passed pend SysTick (one pending at most)."""
-        csr = self.rd32(SYST_CSR)
-        if not csr & CSR_ENABLE:
-            return
-        period = (self.rd32(SYST_RVR) & 0xFFFFFF) + 1
-        before = int(self.cycles - passed - self.systick_base) // period
-        after = int(self.cycles - self.systick_base) // period
-        if after > before:
-            self.wr32(SYST_CSR, csr | CSR_COUNTFLAG)
-            if csr & CSR_TICKINT:
-                self.pending.add(SYSTICK)
-                self.wr32(SCB_ICSR, self.rd32(SCB_ICSR) | ICSR_PENDSTSET)
-
-    def cycles_to_systick(self) -> float:
-        """Cycles until the counter next wraps (inf when it is off)."""
-        if not self.rd32(SYST_CSR) & CSR_ENABLE:
-            return float("inf")
-        period = (self.rd32(SYST_RVR) & 0xFFFFFF) + 1
-        return period - (self.cycles - self.systick_base) % period

@@ -11,6 +11,7 @@ class Dma(Model):
         super().__init__(board, periph)
         self.irqs = irqs  # channel -> IRQ line
         self.reload = {}
+        self.on_enable = {}  # channel -> the peripheral whose requests it serves: its pull()
         self.channels = [n for n in range(1, 8) if f"CCR{n}" in periph.registers]
         for n in self.channels:
             self.watch(f"CCR{n}", self._ccr(n))
@@ -24,6 +25,8 @@ class Dma(Model):
         def handler(value, old, size):
             if value & 1 and not old & 1:  # EN: the counter's start value is its reload
                 self.reload[n] = self.get(f"CNDTR{n}") & 0xFFFF
+                if n in self.on_enable:  # a request already waiting is served at once
+                    self.core.defer(self.on_enable[n])
         return handler
 
     def _ifcr(self, value, old, size):
@@ -54,20 +57,43 @@ class Dma(Model):
                 break
             position = (total - left) if minc else 0
             self.core.write(base + position * msize, (value & mask).to_bytes(msize, "little"))
-            left -= 1
+            left, flags = self._counted(left - 1, total, circular, flags)
             moved += 1
-            if left == total // 2:
-                flags |= 0b0101  # GIF, HTIF
-            if left == 0:
-                flags |= 0b0011  # GIF, TCIF
-                if circular:
-                    left = total
+        self._done(n, ccr, left, flags)
+        return moved
+
+    def take(self, n: int):
+        """One item from memory for a peripheral (a channel with DIR set),
+        or None while the channel is off or has counted down to 0."""
+        ccr = self.get(f"CCR{n}")
+        left = self.get(f"CNDTR{n}") & 0xFFFF
+        if not ccr & 1 or left == 0:
+            return None
+        total = self.reload.get(n, left)
+        msize = 1 << ((ccr >> 10) & 3)
+        position = (total - left) if ccr & (1 << 7) else 0
+        value = self.core.rd_bytes(self.get(f"CMAR{n}") + position * msize, msize)
+        left, flags = self._counted(left - 1, total, ccr & (1 << 5), 0)
+        self._done(n, ccr, left, flags)
+        return value
+
+    @staticmethod
+    def _counted(left: int, total: int, circular: int, flags: int) -> tuple:
+        """The counter after one item, and the flags that sets."""
+        if left == total // 2:
+            flags |= 0b0101  # GIF, HTIF
+        if left == 0:
+            flags |= 0b0011  # GIF, TCIF
+            if circular:
+                left = total
+        return left, flags
+
+    def _done(self, n: int, ccr: int, left: int, flags: int) -> None:
         self.put(f"CNDTR{n}", left)
         if flags:
             self.put("ISR", self.get("ISR") | flags << 4 * (n - 1))
             if (flags & 2 and ccr & 2) or (flags & 4 and ccr & 4):  # TCIE, HTIE
                 self.core.raise_irq(self.irqs[n])
-        return moved
 
     def transfer(self, n: int, value: int) -> bool:
         """One item from a peripheral to memory."""

@@ -205,11 +205,15 @@ class Runner:
             self.most_behind_s = max(self.most_behind_s, self._wall() - self.now_s)
 
     def step(self) -> None:
-        """One slice: every board on to the next byte's end on the bus, or
-        MAX_SLICE_S, and the bytes that ended by then delivered."""
+        """One slice: every board on to the next byte's end on the bus
+        (one a board starts sending included), or MAX_SLICE_S, and the
+        bytes that ended by then delivered."""
         target = min(self.now_s + MAX_SLICE_S, max(self.bus.next_event_s(), self.now_s + 1e-7))
         for b in self.boards:
             b.run_until(target, MAX_SLICE_S)
+            # A byte sent: the boards after this one stop at its end; those
+            # before it ran on and hear it late, by at most the slice.
+            target = min(target, self.bus.next_event_s())
         self.now_s = target
         self.bus.deliver_until(self.now_s)
 

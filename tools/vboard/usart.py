@@ -3,9 +3,10 @@
 Transmit: a byte written to the data register goes to the shift register
 when it is free (TXE stays set), else waits there (TXE clear); each byte is
 10 bit times on the wire at the rate BRR sets (PCLK / BRR, 16x
-oversampling, 8N1); TC sets when the last has left. Only with TE, and only
-when the TX pin is the USART's (the board's pin check), does it reach the
-wire.
+oversampling, 8N1); TC sets when the last has left. With DMAT the transmit
+DMA channel fills the data register whenever it is empty. Only with TE, and
+only when the TX pin is the USART's (the board's pin check), does it reach
+the wire.
 
 Receive: a byte on the wire reaches the USART if UE and RE are set, at its
 rate (3 % off: a framing error, the byte lost). With DMAR the DMA channel
@@ -31,11 +32,13 @@ MISMATCH = 0.03
 
 
 class Usart(Model):
-    def __init__(self, board, periph, pclk_hz, irq: int, dma, dma_channel: int, tx_pin_ok):
+    def __init__(self, board, periph, pclk_hz, irq: int, dma, dma_channel: int, tx_dma_channel: int, tx_pin_ok):
         super().__init__(board, periph)
         self.v2 = "ISR" in periph.registers
         self.status = "ISR" if self.v2 else "SR"
         self.pclk_hz, self.irq, self.dma, self.dma_channel = pclk_hz, irq, dma, dma_channel
+        self.tx_dma_channel = tx_dma_channel
+        dma.on_enable[tx_dma_channel] = self.pull
         self.tx_pin_ok = tx_pin_ok
         self.bus_station = None
         self.shift_until_s = 0.0
@@ -43,12 +46,15 @@ class Usart(Model):
         self.tdr = None
         self.rx_bytes = self.rx_lost = self.overruns = self.framing_errors = 0
         self.idle_at_s = None     # when IDLE sets unless another byte comes first
+        self.re_since_s = 0.0     # when the receiver was last turned on
+        self.begun_deaf = 0       # bytes that began before it was: not heard
         self.watch("TDR" if self.v2 else "DR", self._write_data)
         self.watch("CR1", self._write_cr1)
         self.watch("ICR" if self.v2 else "SR", self._clear_flags)
         s = self.status
         self.RXNE, self.TC, self.TXE = self.bit(s, "RXNE"), self.bit(s, "TC"), self.bit(s, "TXE")
         self.ORE, self.FE, self.IDLE = self.bit(s, "ORE"), self.bit(s, "FE"), self.bit(s, "IDLE")
+        self.DMAT = self.bit("CR3", "DMAT")
         if not self.v2:  # the F1's DR read clears IDLE: one narrow read hook
             dr = self.addr("DR")
             self.dr_read_hook = self.core.uc.hook_add(UC_HOOK_MEM_READ, lambda *a: self._set(self.IDLE, False),
@@ -89,14 +95,30 @@ class Usart(Model):
         if self.tx_pin_ok() and baud:
             self.board.bus.send(self.bus_station, byte, baud, now)
         self.core.new_event()
+        self.pull()
+
+    def pull(self) -> None:
+        """With DMAT, an empty data register asks the transmit channel for
+        the next byte (RM0008 27.3.13, RM0360 23.5.15)."""
+        if self.tdr is None and self.get("CR3") & self.DMAT:
+            byte = self.dma.take(self.tx_dma_channel)
+            if byte is not None:
+                self._write_data(byte, 0, 1)
 
     def _write_cr1(self, value, old, size):
         """An interrupt enabled while its flag is set fires at once (the
         driver starts a transmission by setting TXEIE): the CPU stops after
         the store and takes it."""
+        re = self.bit("CR1", "RE")
+        if value & re and not old & re:
+            self.re_since_s = self.core.now_s()
         if self._interrupt_due(self.get(self.status), value):
-            self.core.raise_irq(self.irq)
+            self.core.assert_irq(self.irq, self.line)
             self.core.defer(lambda: None)
+
+    def line(self) -> bool:
+        """The USART's interrupt line, as its flags and enables set it now."""
+        return self._interrupt_due(self.get(self.status), self.get("CR1"))
 
     def _interrupt_due(self, sr: int, cr1: int) -> bool:
         return bool((cr1 & self.bit("CR1", "TXEIE") and sr & self.TXE) or
@@ -117,8 +139,13 @@ class Usart(Model):
             self.core.fix(self.addr("SR"), old & keep)
 
     def receive(self, byte: int, baud: int) -> None:
-        """A byte off the wire, at the time it ends."""
+        """A byte off the wire, at the time it ends; heard only by a
+        receiver that was on when it began (the line turned around at the
+        last stop bit of the USART's own answer does not hear that byte)."""
         if not (self.cr1("UE") and self.cr1("RE")):
+            return
+        if self.re_since_s > self.core.now_s() - FRAME_BITS / baud:
+            self.begun_deaf += 1
             return
         own = self.baud()
         if not own or abs(own - baud) > MISMATCH * own:
@@ -126,7 +153,9 @@ class Usart(Model):
             self._set(self.FE, True)
             return
         self.rx_bytes += 1
-        self.idle_at_s = self.core.now_s() + FRAME_BITS / own
+        # A whole idle frame after this stop bit: a byte that starts right
+        # at its end (back to back) is no idle line, so half a bit more.
+        self.idle_at_s = self.core.now_s() + (FRAME_BITS + 0.5) / own
         cr3 = self.get("CR3")
         if cr3 & self.bit("CR3", "DMAR") and self.dma.enabled(self.dma_channel):
             self.dma.transfer(self.dma_channel, byte)
@@ -151,7 +180,7 @@ class Usart(Model):
             else:
                 self._set(self.TC, True)
         if self._interrupt_due(self.get(self.status), self.get("CR1")):
-            self.core.raise_irq(self.irq)
+            self.core.assert_irq(self.irq, self.line)
 
     def next_event_s(self, now_s: float) -> float:
         idle = float("inf") if self.idle_at_s is None else self.idle_at_s

@@ -58,7 +58,7 @@ int main(void)
     adc_scan_init();
     pwm_bridge_init();
     flash_f0f1_init(&flash, BOARD_FLASH_PAGE, BOARD_CONFIG_PAGE0, BOARD_CONFIG_PAGE1);
-    port_uart_init(&usart, &rx_ring, &rx_dma, F030_PCLK_HZ, PORT_UART_SEND_INTERRUPT);
+    port_uart_init(&usart, &rx_ring, &rx_dma, F030_PCLK_HZ, PORT_UART_SEND_DMA);
     servo_init(&servo, &port);
     iwdg_start();
     for (;;) {

@@ -48,7 +48,7 @@ static void enter_bootloader(void *ctx)
 /* The board's wiring: which driver does what, in one place. */
 static const struct hal_port port = {
     .ctx = &usart,
-    .bus = PORT_UART_BUS_DMA,
+    .bus = PORT_UART_BUS_ALL_DMA,
     .rx = &rx_ring,
     .rx_ctx = &rx_dma,
     .motor = BOARD_MOTOR,
@@ -69,6 +69,7 @@ int main(void)
     pwm_bridge_init();
     flash_f0f1_init(&flash, BOARD_FLASH_PAGE, BOARD_CONFIG_PAGE0, BOARD_CONFIG_PAGE1);
     port_uart_init(&usart, &rx_ring, &rx_dma, F103_PCLK2_HZ);
+    port_uart_send_by_dma(&usart);
     servo_init(&servo, &port);
     NVIC_ISER(USART1_IRQ / 32u) = 1u << (USART1_IRQ % 32u);
     iwdg_start();

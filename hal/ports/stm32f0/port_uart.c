@@ -52,7 +52,7 @@ void port_uart_init(struct usart_v2_hd *usart, struct hal_rx_ring *ring, struct 
     bus_dma = dma;
     RCC_AHBENR |= RCC_AHBENR_DMA1;
     dma_rx_start(dma, DMA1_CCR_ADDR(3u), USART1_BASE + USART_RDR_OFFSET, ring);
-    usart_v2_hd_init(usart, USART1_BASE, pclk_hz, 115200u);
-    NVIC_ISER(0) = send == PORT_UART_SEND_INTERRUPT ? (1u << DMA1_CH3_IRQ) | (1u << USART1_IRQ)
-                                                     : 1u << DMA1_CH3_IRQ;
+    bool by_dma = send == PORT_UART_SEND_DMA;
+    usart_v2_hd_init(usart, USART1_BASE, pclk_hz, 115200u, by_dma ? DMA1_CCR2_ADDR : 0u);
+    NVIC_ISER(0) = by_dma ? (1u << DMA1_CH3_IRQ) | (1u << USART1_IRQ) : 1u << DMA1_CH3_IRQ;
 }

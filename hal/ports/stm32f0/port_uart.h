@@ -10,7 +10,7 @@
 #include "usart_v2_hd.h"
 
 enum port_uart_send {
-    PORT_UART_SEND_INTERRUPT, /* port_uart_send: from the USART's interrupt */
+    PORT_UART_SEND_DMA, /* port_uart_send: by DMA1 channel 2, the USART's interrupt at the end */
     /* port_uart_send_polled: whole, from the main loop, for the bootloader,
      * whose vector table has no USART entry */
     PORT_UART_SEND_POLLED,
@@ -24,12 +24,12 @@ void port_uart_set_baud(void *ctx, uint32_t baud);
 
 /* Starts USART1 for the bus (single wire, 115200 until data ID 36 says
  * otherwise) receiving into ring by dma; enables the DMA's interrupt, and
- * the USART's when it sends from it. */
+ * the USART's when it sends by DMA. */
 void port_uart_init(struct usart_v2_hd *usart, struct hal_rx_ring *ring, struct dma_rx *dma,
                     uint32_t pclk_hz, enum port_uart_send send);
 
-/* A hal_port's bus on this port (rx_ctx: the dma_rx), sending from the
- * USART's interrupt or, for the bootloader, whole from the main loop. */
+/* A hal_port's bus on this port (rx_ctx: the dma_rx), sending by DMA or,
+ * for the bootloader, whole from the main loop. */
 #define PORT_UART_BUS                                                                  \
     {.now_us = port_now_us, .send = port_uart_send, .tx_done = port_uart_tx_done,     \
      .set_baud = port_uart_set_baud, .rx_sync = dma_rx_sync}

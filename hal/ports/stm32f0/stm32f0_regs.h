@@ -35,7 +35,8 @@
 #define USART_ISR(b) REG32((b) + 0x1Cu)
 #define USART_ICR(b) REG32((b) + 0x20u)
 #define USART_RDR_OFFSET 0x24u
-#define USART_TDR(b) REG32((b) + 0x28u)
+#define USART_TDR_OFFSET 0x28u
+#define USART_TDR(b) REG32((b) + USART_TDR_OFFSET)
 #define USART_CR1_UE (1u << 0)
 #define USART_CR1_RE (1u << 2)
 #define USART_CR1_TE (1u << 3)
@@ -44,12 +45,14 @@
 #define USART_CR1_TXEIE (1u << 7)
 #define USART_CR3_HDSEL (1u << 3)
 #define USART_CR3_DMAR (1u << 6)
+#define USART_CR3_DMAT (1u << 7)
 #define USART_CR3_OVRDIS (1u << 12)
 #define USART_ISR_IDLE (1u << 4)
 #define USART_ISR_TC (1u << 6)
 #define USART_ISR_TXE (1u << 7)
 #define USART_ICR_CLEAR 0x5Fu /* PE, FE, NF, ORE, IDLE, TC */
 #define USART_ICR_IDLECF (1u << 4)
+#define USART_ICR_TCCF (1u << 6)
 #define USART1_IRQ 27u
 
 
@@ -70,8 +73,9 @@
 #define ADC_CFGR1_DMACFG (1u << 1) /* circular */
 #define ADC_CFGR1_CONT (1u << 13)
 
-/* DMA1 channel 3 serves USART1_RX (RM0360 table 26, no remap); channels
- * 2 and 3 share one interrupt. */
+/* DMA1 channel 2 serves USART1_TX, channel 3 USART1_RX (RM0360 table 26,
+ * no remap); the two share one interrupt. */
+#define DMA1_CCR2_ADDR DMA1_CCR_ADDR(2u)
 #define DMA1_CH3_IRQ 10u
 
 

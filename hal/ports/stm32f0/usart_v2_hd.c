@@ -1,5 +1,6 @@
 #include "usart_v2_hd.h"
 
+#include "dma_tx.h"
 #include "stm32f0_regs.h"
 
 /* Receiving: the DMA takes the bytes, the line going idle after them
@@ -24,16 +25,20 @@ void usart_v2_hd_set_baud(struct usart_v2_hd *u, uint32_t baud)
     USART_CR1(u->base) = cr1;
 }
 
-void usart_v2_hd_init(struct usart_v2_hd *u, uintptr_t base, uint32_t pclk_hz, uint32_t baud)
+void usart_v2_hd_init(struct usart_v2_hd *u, uintptr_t base, uint32_t pclk_hz, uint32_t baud,
+                      uintptr_t tx_dma)
 {
-    *u = (struct usart_v2_hd){.base = base, .pclk_hz = pclk_hz};
+    *u = (struct usart_v2_hd){.base = base, .pclk_hz = pclk_hz, .tx_dma = tx_dma};
     USART_CR1(base) = 0;
     USART_BRR(base) = brr(pclk_hz, baud);
     /* An overrun cannot happen while the DMA takes every byte; were the
      * bus's DMA ever held up, OVRDIS keeps the receiver going (the newest
      * byte wins) instead of stopping it until the flag is cleared. */
-    USART_CR3(base) = USART_CR3_HDSEL | USART_CR3_DMAR | USART_CR3_OVRDIS;
+    USART_CR3(base) = USART_CR3_HDSEL | USART_CR3_DMAR | USART_CR3_OVRDIS | (tx_dma != 0u ? USART_CR3_DMAT : 0u);
     USART_ICR(base) = USART_ICR_CLEAR;
+    if (tx_dma != 0u) {
+        dma_tx_init(tx_dma, base + USART_TDR_OFFSET);
+    }
     USART_CR1(base) = RUNNING;
 }
 
@@ -42,11 +47,12 @@ void usart_v2_hd_send(struct usart_v2_hd *u, const uint8_t *data, uint16_t len)
     if (len == 0u) {
         return;
     }
-    u->tx = data;
-    u->tx_left = len;
     u->tx_busy = 1;
-    /* Turn the line around: stop listening, start talking. */
-    USART_CR1(u->base) = SENDING | USART_CR1_TXEIE;
+    /* Turn the line around: stop listening, then talk. TC is cleared
+     * first, so it sets only after the last byte's stop bit. */
+    USART_ICR(u->base) = USART_ICR_TCCF;
+    USART_CR1(u->base) = SENDING | USART_CR1_TCIE;
+    dma_tx_start(u->tx_dma, data, len);
 }
 
 void usart_v2_hd_send_polled(struct usart_v2_hd *u, const uint8_t *data, uint16_t len)
@@ -71,26 +77,18 @@ bool usart_v2_hd_tx_done(const struct usart_v2_hd *u)
     return !u->tx_busy;
 }
 
-/* The next byte while the transmit register is empty, then the stop bit
- * of the last one, then the line turned around. */
+/* The line gone idle after a request (it woke the main loop), and the last
+ * byte of an answer sent: the line turned around. */
 void usart_v2_hd_irq(struct usart_v2_hd *u)
 {
     uint32_t isr = USART_ISR(u->base);
     if (isr & USART_ISR_IDLE) {
-        USART_ICR(u->base) = USART_ICR_IDLECF; /* it has woken the main loop */
+        USART_ICR(u->base) = USART_ICR_IDLECF;
     }
-    if (u->tx_left > 0u) {
-        if (isr & USART_ISR_TXE) {
-            USART_TDR(u->base) = *u->tx;
-            u->tx++;
-            u->tx_left--;
-            if (u->tx_left == 0u) {
-                USART_CR1(u->base) = SENDING | USART_CR1_TCIE;
-            }
-        }
-    } else if (isr & USART_ISR_TC) {
+    if (u->tx_busy && (isr & USART_ISR_TC)) {
         USART_ICR(u->base) = USART_ICR_CLEAR;
         USART_CR1(u->base) = RUNNING;
+        dma_tx_stop(u->tx_dma);
         u->tx_busy = 0;
     }
 }

@@ -14,16 +14,17 @@
 struct usart_v2_hd {
     uintptr_t base;
     uint32_t pclk_hz;
-    const uint8_t *volatile tx;
-    volatile uint16_t tx_left;
+    uintptr_t tx_dma; /* the DMA channel that sends (dma_tx.h) */
     volatile uint8_t tx_busy;
 };
 
 /* Single wire, 16x oversampling, the receiver requesting DMA (the caller
- * starts the channel on USART_RDR). */
-void usart_v2_hd_init(struct usart_v2_hd *u, uintptr_t base, uint32_t pclk_hz, uint32_t baud);
+ * starts the channel on USART_RDR), the transmitter served by the DMA
+ * channel tx_dma (0: none, usart_v2_hd_send_polled only). */
+void usart_v2_hd_init(struct usart_v2_hd *u, uintptr_t base, uint32_t pclk_hz, uint32_t baud,
+                      uintptr_t tx_dma);
 void usart_v2_hd_set_baud(struct usart_v2_hd *u, uint32_t baud);
-/* Starts sending; data must stay valid until usart_v2_hd_tx_done(). */
+/* Starts sending by DMA; data must stay valid until usart_v2_hd_tx_done(). */
 void usart_v2_hd_send(struct usart_v2_hd *u, const uint8_t *data, uint16_t len);
 bool usart_v2_hd_tx_done(const struct usart_v2_hd *u);
 /* The USART's interrupt handler calls this. */

@@ -42,6 +42,16 @@ void port_uart_set_baud(void *ctx, uint32_t baud)
     usart_hd_set_baud(ctx, baud);
 }
 
+void port_uart_send_by_dma(struct usart_hd *usart)
+{
+    usart_hd_tx_dma(usart, DMA1_CCR4_ADDR);
+}
+
+void port_uart_send_dma(void *ctx, const uint8_t *data, uint16_t len)
+{
+    usart_hd_send_dma(ctx, data, len);
+}
+
 void port_uart_init(struct usart_hd *usart, struct hal_rx_ring *ring, struct dma_rx *dma,
                     uint32_t pclk_hz)
 {
@@ -50,7 +60,7 @@ void port_uart_init(struct usart_hd *usart, struct hal_rx_ring *ring, struct dma
     if (dma != NULL) {
         bus_dma = dma;
         RCC_AHBENR |= RCC_AHBENR_DMA1;
-        dma_rx_start(dma, DMA1_CCR5_ADDR, USART1_BASE + 0x04u, ring);
+        dma_rx_start(dma, DMA1_CCR5_ADDR, USART1_BASE + USART_DR_OFFSET, ring);
         usart_hd_rx_dma(usart);
         NVIC_ISER(DMA1_CH5_IRQ / 32u) = 1u << (DMA1_CH5_IRQ % 32u);
     }

@@ -21,10 +21,19 @@ void port_uart_set_baud(void *ctx, uint32_t baud);
 void port_uart_init(struct usart_hd *usart, struct hal_rx_ring *ring, struct dma_rx *dma,
                     uint32_t pclk_hz);
 
+/* Sends by DMA1 channel 4 (after port_uart_init with a dma), for a hal_port
+ * whose bus is PORT_UART_BUS_ALL_DMA. */
+void port_uart_send_by_dma(struct usart_hd *usart);
+void port_uart_send_dma(void *ctx, const uint8_t *data, uint16_t len);
+
 /* A hal_port's bus on this port: received by DMA (rx_ctx: the dma_rx), or
  * byte by byte in the USART's interrupt. */
 #define PORT_UART_BUS_DMA                                                              \
     {.now_us = port_now_us, .send = port_uart_send, .tx_done = port_uart_tx_done,     \
+     .set_baud = port_uart_set_baud, .rx_sync = dma_rx_sync}
+/* ... and sent by DMA (port_uart_send_by_dma). */
+#define PORT_UART_BUS_ALL_DMA                                                          \
+    {.now_us = port_now_us, .send = port_uart_send_dma, .tx_done = port_uart_tx_done, \
      .set_baud = port_uart_set_baud, .rx_sync = dma_rx_sync}
 #define PORT_UART_BUS_INTERRUPT                                                        \
     {.now_us = port_now_us, .send = port_uart_send, .tx_done = port_uart_tx_done,     \

@@ -27,7 +27,8 @@
 /* USART1 */
 #define USART1_BASE 0x40013800u
 #define USART_SR(b) REG32((b) + 0x00u)
-#define USART_DR(b) REG32((b) + 0x04u)
+#define USART_DR_OFFSET 0x04u
+#define USART_DR(b) REG32((b) + USART_DR_OFFSET)
 #define USART_BRR(b) REG32((b) + 0x08u)
 #define USART_CR1(b) REG32((b) + 0x0Cu)
 #define USART_CR3(b) REG32((b) + 0x14u)
@@ -37,6 +38,7 @@
 #define USART_SR_ORE (1u << 3)
 #define USART_SR_IDLE (1u << 4)
 #define USART_CR3_DMAR (1u << 6)
+#define USART_CR3_DMAT (1u << 7)
 #define USART_CR1_RE (1u << 2)
 #define USART_CR1_IDLEIE (1u << 4)
 #define USART_CR1_TE (1u << 3)
@@ -65,7 +67,9 @@
 #define ADC_CR2_EXTSEL_SWSTART (7u << 17)
 #define ADC_CR2_EXTTRIG (1u << 20)
 #define ADC_CR2_SWSTART (1u << 22)
-/* DMA1 channel 1 serves ADC1, channel 5 USART1_RX (RM0008 table 78). */
+/* DMA1 channel 1 serves ADC1, channel 4 USART1_TX, channel 5 USART1_RX
+ * (RM0008 table 78). */
+#define DMA1_CCR4_ADDR DMA1_CCR_ADDR(4u)
 #define DMA1_CCR5_ADDR DMA1_CCR_ADDR(5u)
 #define DMA1_CH5_FLAGS DMA1_FLAGS(5u)
 #define DMA1_CH5_IRQ 15u

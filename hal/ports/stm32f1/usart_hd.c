@@ -1,5 +1,6 @@
 #include "usart_hd.h"
 
+#include "dma_tx.h"
 #include "stm32f1_regs.h"
 
 void usart_hd_set_baud(struct usart_hd *u, uint32_t baud)
@@ -19,6 +20,7 @@ void usart_hd_init(struct usart_hd *u, uintptr_t base, uint32_t pclk_hz, uint32_
     u->tx_left = 0;
     u->tx_busy = 0;
     u->rx_dma = false;
+    u->tx_dma = 0;
     u->rx = rx;
     u->clock_us = clock_us;
     USART_CR1(base) = 0;
@@ -38,6 +40,17 @@ void usart_hd_rx_dma(struct usart_hd *u)
     /* The DMA takes the bytes; the line going idle after them is what
      * wakes a sleeping main loop to frame them. */
     USART_CR1(u->base) = (USART_CR1(u->base) & ~USART_CR1_RXNEIE) | USART_CR1_IDLEIE;
+}
+
+void usart_hd_tx_dma(struct usart_hd *u, uintptr_t channel)
+{
+    u->tx_dma = channel;
+    dma_tx_init(channel, u->base + USART_DR_OFFSET);
+    USART_CR3(u->base) |= USART_CR3_DMAT;
+    /* What CR1 holds while sending, worked out once: an answer's path is
+     * short on the Cortex-M0 (30 us). Nothing else changes CR1 meanwhile. */
+    uint32_t cr1 = USART_CR1(u->base) | USART_CR1_TCIE;
+    u->cr1_sending = u->hears_own_bytes ? cr1 & ~USART_CR1_RE : cr1;
 }
 
 void usart_hd_tx_polled(struct usart_hd *u)
@@ -67,6 +80,19 @@ void usart_hd_send(struct usart_hd *u, const uint8_t *data, uint16_t len)
     USART_CR1(u->base) = u->tx_irq ? (cr1 | USART_CR1_TXEIE) : cr1;
 }
 
+void usart_hd_send_dma(struct usart_hd *u, const uint8_t *data, uint16_t len)
+{
+    if (len == 0u) {
+        return;
+    }
+    u->tx_busy = 1;
+    /* TC cleared (rc_w0; the other flags ignore a 1), so that it sets only
+     * after the last byte's stop bit, and the interrupt comes then. */
+    USART_SR(u->base) = ~USART_SR_TC;
+    USART_CR1(u->base) = u->cr1_sending;
+    dma_tx_start(u->tx_dma, data, len);
+}
+
 /* One step of a transmission: the next byte while the data register is
  * empty, then the stop bit of the last one, then the line turned around. */
 static void transmit_step(struct usart_hd *u, uint32_t sr)
@@ -84,6 +110,9 @@ static void transmit_step(struct usart_hd *u, uint32_t sr)
         }
     } else if (sr & USART_SR_TC) {
         USART_CR1(u->base) = (cr1 & ~(USART_CR1_TCIE | USART_CR1_TXEIE)) | USART_CR1_RE;
+        if (u->tx_dma != 0u) {
+            dma_tx_stop(u->tx_dma);
+        }
         u->tx_busy = 0;
     }
 }

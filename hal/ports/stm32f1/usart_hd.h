@@ -21,6 +21,8 @@ struct usart_hd {
     volatile uint16_t tx_left;
     volatile uint8_t tx_busy;
     bool rx_dma;                 /* a DMA channel receives: the interrupt marks idle lines */
+    uintptr_t tx_dma;            /* a DMA channel sends (dma_tx.h), or 0 */
+    uint32_t cr1_sending;        /* CR1 while it does */
     struct hal_rx_ring *rx;
     uint32_t (*clock_us)(void);  /* stamps bytes the receive interrupt takes */
 };
@@ -30,6 +32,11 @@ void usart_hd_init(struct usart_hd *u, uintptr_t base, uint32_t pclk_hz, uint32_
 /* Receive by DMA from now on (the caller starts the channel, dma_rx.h):
  * the USART requests DMA and raises no receive interrupt. */
 void usart_hd_rx_dma(struct usart_hd *u);
+/* Transmit by DMA (usart_hd_send_dma) on this channel: it moves the bytes,
+ * the interrupt comes once, when the last has left (TC). */
+void usart_hd_tx_dma(struct usart_hd *u, uintptr_t channel);
+/* Starts sending by DMA; data must stay valid until usart_hd_tx_done(). */
+void usart_hd_send_dma(struct usart_hd *u, const uint8_t *data, uint16_t len);
 /* Transmit from the main loop instead (usart_hd_service), for USART models
  * that raise no transmit interrupts (QEMU 7.2). Receive stays on the
  * interrupt. */
