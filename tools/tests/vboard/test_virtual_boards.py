@@ -18,6 +18,8 @@ from servoctl.servo import Servo
 from servoctl.sim import Simulator
 from vboard.board import board_h, images
 
+from ..erase_rule import again_if_unanswered
+
 BOARDS = ["stm32f103", "stm32f030k6"]
 
 
@@ -237,8 +239,8 @@ def fill_until_the_spare_page_is_dirty(servo):
     n = 0
     while True:
         n += 1
-        servo.write("current_limit", 3000 + n % 2)
-        records = servo.read_store().records
+        again_if_unanswered(lambda: servo.write("current_limit", 3000 + n % 2))
+        records = again_if_unanswered(servo.read_store).records
         if records % SLOTS == 1 and records > 1:
             return
 
@@ -257,7 +259,10 @@ def test_sync_commands_sent_into_an_erase(tmp_path, board, baud):
     to 101.7 ms after its answer's last byte, measured); 103 ms after that
     byte, inside the 40 ms erase, the host sends one 707-byte SyncCommand
     at 115200, five back to back (3535 bytes in 35 ms) at 1 Mbaud, the last
-    to 30 degrees. A board whose ring
+    to 30 degrees. Both servos hold while their pages fill, and the ping
+    that starts the quiet and the frames are scheduled together on the
+    simulated clock, so a host paused by a loaded PC changes nothing (one
+    paused 0.1 s mid-fill had let the erase come early). A board whose ring
     holds an erase's worth of bytes at that rate (board.h: the F103's 4 KB
     at any rate, the F030's 512 B up to 115200) carries them out and loses
     nothing; the F030 at 1 Mbaud loses bytes and counts them (ReadStore),
@@ -273,21 +278,26 @@ def test_sync_commands_sent_into_an_erase(tmp_path, board, baud):
             one, two = Servo(bus, 1), Servo(bus, 2)
             for s in (one, two):
                 s.write("soft_start_on", 0)
+                s.hold()  # a held servo never erases
             fill_until_the_spare_page_is_dirty(two)
             two.move(0, interval_ms=100)
-            two.hold()
             fill_until_the_spare_page_is_dirty(one)
-            one.release()
-            assert one.ping()
-            quiet_from = sim.state(1)["last_sent_ms"] / 1000.0
             erases = sim.state(1)["page_erases"]
+            one.release()
+            # The ping 50 ms on; its answer ends two frames and the turnaround
+            # (under 0.2 ms) after it starts: the quiet begins there.
+            ping = p.request_frame(p.PING, bytes([1]))
+            ping_at_ms = (sim.clock_s() + 0.05) * 1000
+            quiet_from_ms = ping_at_ms + (2 * len(ping) * 10 / baud + 0.2e-3) * 1000
+            send_at_ms = quiet_from_ms + 103
             angles = [300] if baud == 115200 else [-300, 200, -100, 100, 300]
             frames = b"".join(sync_move_frame(a) for a in angles)
-            send_at_ms = (quiet_from + 0.103) * 1000
+            assert sim.control(f"hostsend {ping_at_ms:.3f} {ping.hex()}").startswith("ok")
             for k in range(0, len(frames), 100):
                 assert sim.control(f"hostsend {send_at_ms:.3f} {frames[k:k + 100].hex()}").startswith("ok")
-            sim.sleep(quiet_from + 1.3 - sim.clock_s())
+            sim.sleep(send_at_ms / 1000 + 1.2 - sim.clock_s())
             after = sim.state(1)
+            assert ping_at_ms < after["last_sent_ms"] < quiet_from_ms, "the ping was not answered in time"
             assert after["page_erases"] == erases + 1, "no erase: the test proves nothing"
             assert after["erase_began_ms"] < send_at_ms, (
                 f"the erase began {after['erase_began_ms'] - send_at_ms:.3f} ms after the frames: "
