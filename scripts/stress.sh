@@ -2,7 +2,7 @@
 # Runs the pytest suite (simulator, maker's SDK, QEMU board) RUNS times while
 # BUSY processes spin on the CPUs, as on a shared CI machine. Timing-dependent
 # tests that pass on an idle PC and fail here are bugs. Not part of the test
-# command: it takes RUNS x about 300 s with 8 spinners on 2 cores. Brings the
+# command: it takes RUNS x about 1100 s with 8 spinners on 2 cores. Brings the
 # host and ARM builds up to date first (configured by bash scripts/test.sh).
 #   bash scripts/stress.sh [RUNS] [BUSY]      defaults: 5 runs, 2 x nproc busy
 set -euo pipefail
