@@ -105,6 +105,7 @@ class Board:
         self.h = board_h(board)
         h, part = self.h, self.part
         self.core = Core(part.cpu, 8_000_000, part.cpi, part.has_vtor, part.irq_words)
+        self.clock_setting = 0  # counts the firmware's clock switches
         uc = self.core.uc
         self.flash_base = h["BOARD_FLASH_BASE"]
         self.flash_size = h["BOARD_CONFIG_PAGE1"] + h["BOARD_FLASH_PAGE"] - self.flash_base
@@ -191,7 +192,10 @@ class Board:
             self.core.defer(lambda: self.alias_zero(self.flash_mem, self.flash_size))
 
     def set_core_hz(self, hz: int) -> None:
+        """The firmware switched its clocks (RCC's CFGR): what depends on
+        them (the USART's baud rate) is worked out again."""
         self.core.hz = hz
+        self.clock_setting += 1
 
     def pclk_hz(self) -> int:
         cfgr = self.rcc.get("CFGR")

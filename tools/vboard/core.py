@@ -43,7 +43,7 @@ from unicorn import arm_const as arm
 from unicorn.unicorn_py3.unicorn import uclib
 
 from .native import lib as native_lib
-from .system_space import (FIRST_IRQ, ICSR_PENDSTSET, NVIC_ICER, NVIC_ICPR, NVIC_IPR, NVIC_ISER, NVIC_ISPR,
+from .system_space import (FIRST_IRQ, SCS_BASE, ICSR_PENDSTSET, NVIC_ICER, NVIC_ICPR, NVIC_IPR, NVIC_ISER, NVIC_ISPR,
                            SCB_AIRCR, SCB_ICSR, SCB_SHPR3, SCB_VTOR, SYST_CSR, SYST_CVR, SYSTICK,
                            SystemControlSpace)
 
@@ -118,6 +118,7 @@ class Core(SystemControlSpace):
         self.systick_base = 0.0      # cycle at which the counter last loaded
         self.regions = []            # (base, end, memoryview) of memory mapped from the host
         self._pages = {}             # 1 KB page -> (base, view): _region's cache
+        self._words = {}             # region base -> its memory as 32-bit words
         self.on_write(SYST_CSR, self._syst_csr)
         self.on_write(SYST_CVR, self._syst_cvr)
         self.on_write(SCB_ICSR, self._icsr)
@@ -183,9 +184,17 @@ class Core(SystemControlSpace):
         if buf is None:
             buf = (ctypes.c_ubyte * size)()
         self.uc.mem_map_ptr(base, size, 7, ctypes.addressof(buf))
-        self.regions.append((base, base + size, memoryview(buf).cast("B")))
+        view = memoryview(buf).cast("B")
+        self.regions.append((base, base + size, view))
+        self._words[base] = view.cast("I")
         self._pages = {}
         return buf
+
+    def words(self, address: int):
+        """(the host-mapped region holding the word at address, as 32-bit
+        words, that word's index in it)."""
+        base, _ = self._region(address)
+        return self._words[base], (address - base) // 4
 
     def map_system_control_space(self) -> None:
         """SysTick, the NVIC and the SCB, mapped after the board's memory:
@@ -196,7 +205,8 @@ class Core(SystemControlSpace):
         translation away (the F103's control tick ran 4 to 10 times slower).
         Mapped last, no two blocks share an offset (both boards' layouts,
         checked store by store)."""
-        self.map_host(0xE000E000, 0x1000)
+        self.map_host(SCS_BASE, 0x1000)
+        self.scs = self._words[SCS_BASE]
 
     def _region(self, address: int):
         """(base, view) of the host-mapped region holding address, by its
@@ -531,7 +541,7 @@ class Core(SystemControlSpace):
         self.reset_cause = None
         self.locked_up = False
         self.asleep = False
-        self.write(0xE000E000, bytes(0x1000))
+        self.write(SCS_BASE, bytes(0x1000))
         self.set_reg(arm.UC_ARM_REG_PRIMASK, 0)
         self.set_reg(arm.UC_ARM_REG_IPSR, 0)
         self.set_reg(arm.UC_ARM_REG_CONTROL, 0)

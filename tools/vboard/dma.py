@@ -13,6 +13,9 @@ class Dma(Model):
         self.reload = {}
         self.on_enable = {}  # channel -> the peripheral whose requests it serves: its pull()
         self.channels = [n for n in range(1, 8) if f"CCR{n}" in periph.registers]
+        # channel -> the indices of its CCR, CNDTR, CPAR and CMAR
+        self.regs = {n: tuple(self.i[f"{r}{n}"] for r in ("CCR", "CNDTR", "CPAR", "CMAR")) for n in self.channels}
+        self.i_isr = self.i["ISR"]
         for n in self.channels:
             self.watch(f"CCR{n}", self._ccr(n))
         self.watch("IFCR", self._ifcr)
@@ -24,7 +27,7 @@ class Dma(Model):
     def _ccr(self, n: int):
         def handler(value, old, size):
             if value & 1 and not old & 1:  # EN: the counter's start value is its reload
-                self.reload[n] = self.get(f"CNDTR{n}") & 0xFFFF
+                self.reload[n] = self.w[self.regs[n][1]] & 0xFFFF
                 if n in self.on_enable:  # a request already waiting is served at once
                     self.core.defer(self.on_enable[n])
         return handler
@@ -34,22 +37,23 @@ class Dma(Model):
         self.core.fix(self.addr("IFCR"), 0)
 
     def enabled(self, n: int) -> bool:
-        return bool(self.get(f"CCR{n}") & 1)
+        return bool(self.w[self.regs[n][0]] & 1)
 
     def peripheral_address(self, n: int) -> int:
-        return self.get(f"CPAR{n}")
+        return self.w[self.regs[n][2]]
 
     def transfer_many(self, n: int, values) -> int:
         """Items from a peripheral to memory, one request each; returns how
         many moved (none while the channel is off, or once a non-circular
         one has counted down to 0)."""
-        ccr = self.get(f"CCR{n}")
-        left = self.get(f"CNDTR{n}") & 0xFFFF
+        w, (i_ccr, i_cndtr, _, i_cmar) = self.w, self.regs[n]
+        ccr = w[i_ccr]
+        left = w[i_cndtr] & 0xFFFF
         if not ccr & 1:
             return 0
         total = self.reload.get(n, left)
         msize = 1 << ((ccr >> 10) & 3)
-        base, minc, circular = self.get(f"CMAR{n}"), ccr & (1 << 7), ccr & (1 << 5)
+        base, minc, circular = w[i_cmar], ccr & (1 << 7), ccr & (1 << 5)
         mask = (1 << 8 * msize) - 1
         flags = moved = 0
         for value in values:
@@ -65,14 +69,15 @@ class Dma(Model):
     def take(self, n: int):
         """One item from memory for a peripheral (a channel with DIR set),
         or None while the channel is off or has counted down to 0."""
-        ccr = self.get(f"CCR{n}")
-        left = self.get(f"CNDTR{n}") & 0xFFFF
+        w, (i_ccr, i_cndtr, _, i_cmar) = self.w, self.regs[n]
+        ccr = w[i_ccr]
+        left = w[i_cndtr] & 0xFFFF
         if not ccr & 1 or left == 0:
             return None
         total = self.reload.get(n, left)
         msize = 1 << ((ccr >> 10) & 3)
         position = (total - left) if ccr & (1 << 7) else 0
-        value = self.core.rd_bytes(self.get(f"CMAR{n}") + position * msize, msize)
+        value = self.core.rd_bytes(w[i_cmar] + position * msize, msize)
         left, flags = self._counted(left - 1, total, ccr & (1 << 5), 0)
         self._done(n, ccr, left, flags)
         return value
@@ -89,9 +94,9 @@ class Dma(Model):
         return left, flags
 
     def _done(self, n: int, ccr: int, left: int, flags: int) -> None:
-        self.put(f"CNDTR{n}", left)
+        self.w[self.regs[n][1]] = left
         if flags:
-            self.put("ISR", self.get("ISR") | flags << 4 * (n - 1))
+            self.w[self.i_isr] |= flags << 4 * (n - 1)
             if (flags & 2 and ccr & 2) or (flags & 4 and ccr & 4):  # TCIE, HTIE
                 self.core.raise_irq(self.irqs[n])
 

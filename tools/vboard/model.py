@@ -1,34 +1,26 @@
 """What every peripheral model shares: its registers from the SVD, in the
 core's memory, reset to the SVD's reset values."""
-import struct
-
 from .svd import Peripheral
-
-WORD = struct.Struct("<I")
 
 
 class Model:
     def __init__(self, board, periph: Peripheral):
         self.board, self.core, self.p = board, board.core, periph
-        self._at = {}  # register -> (memory view, offset): models touch registers often
+        # The registers as words of the core's memory: w[i[name]] reads or
+        # writes one (a memoryview index, the cheapest access Python has;
+        # models touch registers at every slice).
+        self.w, first = self.core.words(periph.base)
+        self.i = {name: first + offset // 4 for name, (offset, _, _) in periph.registers.items()}
         self._bits = {}  # (register, field) -> mask
 
     def addr(self, register: str) -> int:
         return self.p.address(register)
 
-    def _where(self, register: str):
-        at = self._at.get(register)
-        if at is None:
-            at = self._at[register] = self.core._view(self.p.address(register))
-        return at
-
     def get(self, register: str) -> int:
-        view, offset = self._where(register)
-        return WORD.unpack_from(view, offset)[0]
+        return self.w[self.i[register]]
 
     def put(self, register: str, value: int) -> None:
-        view, offset = self._where(register)
-        WORD.pack_into(view, offset, value & 0xFFFFFFFF)
+        self.w[self.i[register]] = value & 0xFFFFFFFF
 
     def bit(self, register: str, field: str) -> int:
         key = (register, field)

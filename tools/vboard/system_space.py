@@ -14,12 +14,21 @@ AIRCR_VECTKEY, AIRCR_SYSRESETREQ = 0x05FA0000, 1 << 2
 CSR_ENABLE, CSR_TICKINT, CSR_COUNTFLAG = 1, 2, 1 << 16
 SYSTICK = 15
 FIRST_IRQ = 16
+SCS_BASE = 0xE000E000
+
+
+def scs_word(address: int) -> int:
+    """A system control space register's index among the block's words."""
+    return (address - SCS_BASE) >> 2
+
+
+CSR_W, RVR_W, ICSR_W = scs_word(SYST_CSR), scs_word(SYST_RVR), scs_word(SCB_ICSR)
 
 
 class SystemControlSpace:
     """The handlers of the system control space's registers; the class that
-    mixes this in has rd32, wr32, fix, stop, cycles, systick_base, enabled
-    and pending."""
+    mixes this in has scs (the block's words), fix, stop, cycles,
+    systick_base, enabled, pending and lines."""
 
     # ---- NVIC and SCB -----------------------------------------------------
     def _nvic(self, word: int, enable: bool):
@@ -37,7 +46,11 @@ class SystemControlSpace:
             for bit in range(32):
                 if value >> bit & 1:
                     exc = FIRST_IRQ + 32 * word + bit
-                    (self.pending.add if pend else self.pending.discard)(exc)
+                    line = self.lines.get(exc)
+                    if pend or (line is not None and line()):
+                        self.pending.add(exc)  # a level line still high pends again at once
+                    else:
+                        self.pending.discard(exc)
             self.fix(NVIC_ISPR + 4 * word, 0)
             self.fix(NVIC_ICPR + 4 * word, 0)
         return handler
@@ -65,30 +78,32 @@ class SystemControlSpace:
         self.fix(SYST_CVR, 0)
 
     def _update_systick(self) -> None:
-        csr = self.rd32(SYST_CSR)
-        if not csr & CSR_ENABLE:
+        scs = self.scs
+        if not scs[CSR_W] & CSR_ENABLE:
             return
-        period = (self.rd32(SYST_RVR) & 0xFFFFFF) + 1
+        period = (scs[RVR_W] & 0xFFFFFF) + 1
         into = int(self.cycles - self.systick_base) % period
         self.wr32(SYST_CVR, period - 1 - into)
 
     def _systick_after(self, passed: float) -> None:
         """Wraps in the cycles that passed pend SysTick (one pending at most)."""
-        csr = self.rd32(SYST_CSR)
+        scs = self.scs
+        csr = scs[CSR_W]
         if not csr & CSR_ENABLE:
             return
-        period = (self.rd32(SYST_RVR) & 0xFFFFFF) + 1
+        period = (scs[RVR_W] & 0xFFFFFF) + 1
         before = int(self.cycles - passed - self.systick_base) // period
         after = int(self.cycles - self.systick_base) // period
         if after > before:
-            self.wr32(SYST_CSR, csr | CSR_COUNTFLAG)
+            scs[CSR_W] = csr | CSR_COUNTFLAG
             if csr & CSR_TICKINT:
                 self.pending.add(SYSTICK)
-                self.wr32(SCB_ICSR, self.rd32(SCB_ICSR) | ICSR_PENDSTSET)
+                scs[ICSR_W] |= ICSR_PENDSTSET
 
     def cycles_to_systick(self) -> float:
         """Cycles until the counter next wraps (inf when it is off)."""
-        if not self.rd32(SYST_CSR) & CSR_ENABLE:
+        scs = self.scs
+        if not scs[CSR_W] & CSR_ENABLE:
             return float("inf")
-        period = (self.rd32(SYST_RVR) & 0xFFFFFF) + 1
+        period = (scs[RVR_W] & 0xFFFFFF) + 1
         return period - (self.cycles - self.systick_base) % period

@@ -43,13 +43,15 @@ class Watchdog(Model):
     def __init__(self, board, periph):
         super().__init__(board, periph)
         self.kr = self.addr("KR")
+        self.i_kr = self.i["KR"]
         self.hook = None
         self.running = False
         self.kicked_s = 0.0
+        self.bites_s = float("inf")  # when it resets the chip unless reloaded first
 
     def reset(self) -> None:
         super().reset()
-        self.running, self.kicked_s = False, 0.0
+        self.running, self.kicked_s, self.bites_s = False, 0.0, float("inf")
         if self.hook is None:
             self.hook = self.core.uc.hook_add(UC_HOOK_MEM_WRITE, self._hook, begin=self.kr, end=self.kr + 3)
 
@@ -66,23 +68,29 @@ class Watchdog(Model):
         never reads it.)"""
         key = value & 0xFFFF
         if key == 0xAAAA:
-            self.kicked_s = self.core.time_s
+            self._kick(self.core.time_s)
         elif key == 0xCCCC:
             self.running = True
-            self.kicked_s = self.core.time_s
+            self._kick(self.core.time_s)
+
+    def _kick(self, now_s: float) -> None:
+        """A reload: the counter starts over from RLR, at PR's rate, as
+        they are at the reload (RM0008 19.3, RM0360 18.3)."""
+        self.kicked_s = now_s
+        self.bites_s = now_s + self._period_s()
 
     def step(self, now_s: float) -> None:
-        if not self.running:
+        if not self.running or not self.core.ran:  # a key comes only from code that ran
             return
         if self.hook is not None:
             self.core.uc.hook_del(self.hook)
             self.hook = None
-        if self.core.rd32(self.kr) & 0xFFFF == 0xAAAA:
-            self.kicked_s = now_s
-            self.core.wr32(self.kr, 0)
+        if self.w[self.i_kr] & 0xFFFF == 0xAAAA:
+            self._kick(now_s)
+            self.w[self.i_kr] = 0
 
     def next_event_s(self, now_s: float) -> float:
-        return self.kicked_s + self._period_s() if self.running else float("inf")
+        return self.bites_s
 
     def expired(self, now_s: float) -> bool:
-        return self.running and now_s >= self.kicked_s + self._period_s()
+        return now_s >= self.bites_s

@@ -21,7 +21,9 @@ reading DR after SR (here: by any read of DR by the CPU) and on the F0 by
 ICR's IDLECF.
 
 The interrupt line is level: TXEIE with TXE, TCIE with TC, RXNEIE with RXNE
-or ORE, IDLEIE with IDLE. Registers by the part: the F1's SR/DR (status cleared by writing 0
+or ORE, IDLEIE with IDLE. It rises when a flag or an enable is set, which
+is when the model sets one or the CPU writes CR1; the core takes it again
+after a handler that left it high. Registers by the part: the F1's SR/DR (status cleared by writing 0
 to RXNE/TC) and the F0's ISR/ICR/RDR/TDR."""
 from unicorn import UC_HOOK_MEM_READ
 
@@ -54,7 +56,14 @@ class Usart(Model):
         s = self.status
         self.RXNE, self.TC, self.TXE = self.bit(s, "RXNE"), self.bit(s, "TC"), self.bit(s, "TXE")
         self.ORE, self.FE, self.IDLE = self.bit(s, "ORE"), self.bit(s, "FE"), self.bit(s, "IDLE")
-        self.DMAT = self.bit("CR3", "DMAT")
+        self.DMAT, self.DMAR = self.bit("CR3", "DMAT"), self.bit("CR3", "DMAR")
+        self.UE_RE = self.bit("CR1", "UE") | self.bit("CR1", "RE")
+        self.UE_TE = self.bit("CR1", "UE") | self.bit("CR1", "TE")
+        self.TXEIE, self.TCIE = self.bit("CR1", "TXEIE"), self.bit("CR1", "TCIE")
+        self.RXNEIE, self.IDLEIE = self.bit("CR1", "RXNEIE"), self.bit("CR1", "IDLEIE")
+        self.i_sr, self.i_cr1, self.i_cr3, self.i_brr = self.i[s], self.i["CR1"], self.i["CR3"], self.i["BRR"]
+        self._baud_for = None     # (BRR, the board's clock setting) the cached baud rate is for
+        self._baud = 0
         if not self.v2:  # the F1's DR read clears IDLE: one narrow read hook
             dr = self.addr("DR")
             self.dr_read_hook = self.core.uc.hook_add(UC_HOOK_MEM_READ, lambda *a: self._set(self.IDLE, False),
@@ -66,18 +75,27 @@ class Usart(Model):
         self.idle_at_s = None
 
     def cr1(self, field: str) -> bool:
-        return bool(self.get("CR1") & self.bit("CR1", field))
+        return bool(self.w[self.i_cr1] & self.bit("CR1", field))
 
     def baud(self) -> int:
-        brr = self.get("BRR") & 0xFFFF
-        return self.pclk_hz() // brr if brr else 0
+        """PCLK / BRR: worked out again only when BRR or the clocks change."""
+        key = (self.w[self.i_brr] & 0xFFFF, self.board.clock_setting)
+        if key != self._baud_for:
+            brr = key[0]
+            self._baud_for, self._baud = key, (self.pclk_hz() // brr if brr else 0)
+        return self._baud
 
     def _set(self, flag: int, on: bool) -> None:
-        sr = self.get(self.status)
-        self.put(self.status, (sr | flag) if on else (sr & ~flag))
+        w, i = self.w, self.i_sr
+        if on:
+            w[i] |= flag
+            if self._interrupt_due(w[i], w[self.i_cr1]):
+                self.core.assert_irq(self.irq, self.line)
+        else:
+            w[i] &= ~flag
 
     def _write_data(self, value, old, size):
-        if not (self.cr1("UE") and self.cr1("TE")):
+        if self.w[self.i_cr1] & self.UE_TE != self.UE_TE:
             return
         if not self.shifting:
             self._start(value & 0xFF)
@@ -100,7 +118,7 @@ class Usart(Model):
     def pull(self) -> None:
         """With DMAT, an empty data register asks the transmit channel for
         the next byte (RM0008 27.3.13, RM0360 23.5.15)."""
-        if self.tdr is None and self.get("CR3") & self.DMAT:
+        if self.tdr is None and self.w[self.i_cr3] & self.DMAT:
             byte = self.dma.take(self.tx_dma_channel)
             if byte is not None:
                 self._write_data(byte, 0, 1)
@@ -112,19 +130,19 @@ class Usart(Model):
         re = self.bit("CR1", "RE")
         if value & re and not old & re:
             self.re_since_s = self.core.now_s()
-        if self._interrupt_due(self.get(self.status), value):
+        if self._interrupt_due(self.w[self.i_sr], value):
             self.core.assert_irq(self.irq, self.line)
             self.core.defer(lambda: None)
 
     def line(self) -> bool:
         """The USART's interrupt line, as its flags and enables set it now."""
-        return self._interrupt_due(self.get(self.status), self.get("CR1"))
+        return self._interrupt_due(self.w[self.i_sr], self.w[self.i_cr1])
 
     def _interrupt_due(self, sr: int, cr1: int) -> bool:
-        return bool((cr1 & self.bit("CR1", "TXEIE") and sr & self.TXE) or
-                    (cr1 & self.bit("CR1", "TCIE") and sr & self.TC) or
-                    (cr1 & self.bit("CR1", "RXNEIE") and sr & (self.RXNE | self.ORE)) or
-                    (cr1 & self.bit("CR1", "IDLEIE") and sr & self.IDLE))
+        return bool((cr1 & self.TXEIE and sr & self.TXE) or
+                    (cr1 & self.TCIE and sr & self.TC) or
+                    (cr1 & self.RXNEIE and sr & (self.RXNE | self.ORE)) or
+                    (cr1 & self.IDLEIE and sr & self.IDLE))
 
     def _clear_flags(self, value, old, size):
         sr = self.get(self.status)
@@ -142,9 +160,10 @@ class Usart(Model):
         """A byte off the wire, at the time it ends; heard only by a
         receiver that was on when it began (the line turned around at the
         last stop bit of the USART's own answer does not hear that byte)."""
-        if not (self.cr1("UE") and self.cr1("RE")):
+        w = self.w
+        if w[self.i_cr1] & self.UE_RE != self.UE_RE:
             return
-        if self.re_since_s > self.core.now_s() - FRAME_BITS / baud:
+        if self.re_since_s > self.core.time_s - FRAME_BITS / baud:
             self.begun_deaf += 1
             return
         own = self.baud()
@@ -155,13 +174,11 @@ class Usart(Model):
         self.rx_bytes += 1
         # A whole idle frame after this stop bit: a byte that starts right
         # at its end (back to back) is no idle line, so half a bit more.
-        self.idle_at_s = self.core.now_s() + (FRAME_BITS + 0.5) / own
-        cr3 = self.get("CR3")
-        if cr3 & self.bit("CR3", "DMAR") and self.dma.enabled(self.dma_channel):
+        self.idle_at_s = self.core.time_s + (FRAME_BITS + 0.5) / own
+        if w[self.i_cr3] & self.DMAR and self.dma.enabled(self.dma_channel):
             self.dma.transfer(self.dma_channel, byte)
             return
-        sr = self.get(self.status)
-        if sr & self.RXNE:
+        if w[self.i_sr] & self.RXNE:
             self.overruns += 1
             self._set(self.ORE, True)
             return
@@ -179,8 +196,6 @@ class Usart(Model):
                 self._start(byte)
             else:
                 self._set(self.TC, True)
-        if self._interrupt_due(self.get(self.status), self.get("CR1")):
-            self.core.assert_irq(self.irq, self.line)
 
     def next_event_s(self, now_s: float) -> float:
         idle = float("inf") if self.idle_at_s is None else self.idle_at_s
