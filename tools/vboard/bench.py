@@ -24,6 +24,7 @@ from .run import MAX_SLICE_S, Runner
 
 PING_PERIOD_S = 1.5e-3   # request 0.52 ms, answer 0.52 ms, and the turnarounds
 ANSWER = 6               # a Ping's answer, bytes
+DRAIN_S = 5e-3           # the last request and its answer, and the servo's turnaround
 
 
 def runner_for(board: str, ids, state_dir: str) -> Runner:
@@ -36,7 +37,8 @@ def runner_for(board: str, ids, state_dir: str) -> Runner:
 
 def measure(runner: Runner, seconds: float, ping_ids=()) -> tuple:
     """Runs seconds of simulated time as fast as it goes; returns (speed,
-    pings sent, answers heard)."""
+    pings sent, answers heard). The answers still on the wire at the end
+    are waited for, untimed, before they are counted."""
     start_sim, start_wall = runner.now_s, time.perf_counter()
     next_ping, sent, k = runner.now_s, 0, 0
     runner.bus.to_host.clear()
@@ -47,7 +49,11 @@ def measure(runner: Runner, seconds: float, ping_ids=()) -> tuple:
             k, sent, next_ping = k + 1, sent + 1, next_ping + PING_PERIOD_S
         runner.step()
     wall = time.perf_counter() - start_wall
-    return (runner.now_s - start_sim) / wall, sent, len(runner.bus.to_host) // ANSWER
+    speed = (runner.now_s - start_sim) / wall
+    drained = max(runner.now_s, next_ping) + DRAIN_S
+    while runner.now_s < drained:
+        runner.step()
+    return speed, sent, len(runner.bus.to_host) // ANSWER
 
 
 def main(argv=None) -> int:
@@ -69,7 +75,7 @@ def main(argv=None) -> int:
             answered = f"{heard}/{sent}" if sent else "-"
             print(f"{board:<12} {name:<8} {speed:>22.2f}x {answered:>10}", flush=True)
             worst = min(worst, speed)
-            if sent and heard < sent - 1:
+            if sent and heard < sent:
                 print(f"vboard.bench: {board} answered {heard} of {sent} pings", file=sys.stderr)
                 return 1
     return 0

@@ -106,6 +106,7 @@ class Board:
         h, part = self.h, self.part
         self.core = Core(part.cpu, 8_000_000, part.cpi, part.has_vtor, part.irq_words)
         self.clock_setting = 0  # counts the firmware's clock switches
+        self._pins_for, self._roles = None, None  # _pin_roles's cache
         uc = self.core.uc
         self.flash_base = h["BOARD_FLASH_BASE"]
         self.flash_size = h["BOARD_CONFIG_PAGE1"] + h["BOARD_FLASH_PAGE"] - self.flash_base
@@ -220,15 +221,32 @@ class Board:
         afr = self.gpio.get("AFRL" if pin < 8 else "AFRH") >> (4 * (pin % 8)) & 0xF
         return mode == 2 and afr == af
 
+    def _pins(self) -> tuple:
+        """The port's configuration words that say what PA6, PA7 and PA9 are."""
+        g = self.gpio
+        if "syscfg" in self.part.names:
+            return g.w[g.i["MODER"]], g.w[g.i["AFRL"]], g.w[g.i["AFRH"]]
+        return g.w[g.i["CRL"]], g.w[g.i["CRH"]]
+
+    def _pin_roles(self) -> tuple:
+        """(PA9 is USART1_TX, PA6 and PA7 are TIM3_CH1/CH2), worked out
+        again only when the port's configuration changed."""
+        key = self._pins()
+        if key != self._pins_for:
+            if "syscfg" in self.part.names:  # F0: AF1
+                roles = (self._f0_pin_af(9, 1), self._f0_pin_af(6, 1) and self._f0_pin_af(7, 1))
+            else:  # F1: alternate-function outputs
+                roles = (self._f1_pin_af_output(9), self._f1_pin_af_output(6) and self._f1_pin_af_output(7))
+            self._pins_for, self._roles = key, roles
+        return self._roles
+
     def bus_pin_ok(self) -> bool:
         """PA9 is USART1_TX (F1: alternate-function output; F0: AF1)."""
-        return self._f0_pin_af(9, 1) if "syscfg" in self.part.names else self._f1_pin_af_output(9)
+        return self._pin_roles()[0]
 
     def bridge_pins_ok(self) -> bool:
         """PA6/PA7 are TIM3_CH1/CH2."""
-        if "syscfg" in self.part.names:
-            return self._f0_pin_af(6, 1) and self._f0_pin_af(7, 1)
-        return self._f1_pin_af_output(6) and self._f1_pin_af_output(7)
+        return self._pin_roles()[1]
 
     def adc_input(self, channel: int) -> int:
         """The front end's reading of the models (board.h's scaling; no noise)."""
@@ -258,6 +276,7 @@ class Board:
             self.alias_zero(self.flash_mem, self.flash_size)
         self.core.reset(self.flash_base)
         self.motor.coast()
+        self.duty = None  # the bridge's, as the motor was last told
 
     def power_cycle(self, off_s: float = 0.1) -> None:
         """Power off (the motor coasts, RAM is lost), then on."""
@@ -271,9 +290,9 @@ class Board:
         ending where a model or SysTick next has something to do, and no
         further than the end of a byte it starts sending: the runner
         delivers it then, to the host and to the other boards."""
-        core = self.core
-        while (now := core.now_s()) < t_s:
-            t_s = min(t_s, self.bus.next_event_s())
+        core, motor, bus = self.core, self.motor, self.bus
+        while (now := core.time_s) < t_s:
+            t_s = min(t_s, bus.next_event_s())
             soon = min(t_s, now + max_step_s, now + core.cycles_to_systick() / core.hz)
             for m in self.timed:
                 soon = min(soon, m.next_event_s(now))
@@ -286,19 +305,21 @@ class Board:
                 else:
                     self.reset(stop.args[0])
                 continue
-            self.motor.step(passed)
-            now = core.now_s()
+            motor.step(passed)
+            now = core.time_s
             if core.ran and not self.flash.check_wait_states(core.hz):
                 core.pending.add(3)  # reads at this clock return garbage: a fault
             for m in self.stepped:
                 m.step(now)
             if core.ran:  # the clock, the bridge and its pins change only by the code's stores
                 duty = self.tim.duty()
-                if duty is None:
-                    self.motor.coast()
-                else:
-                    self.motor.drive(duty)
-            if self.iwdg.expired(now):
+                if duty != self.duty:
+                    self.duty = duty
+                    if duty is None:
+                        motor.coast()
+                    else:
+                        motor.drive(duty)
+            if now >= self.iwdg.bites_s:
                 self.reset("watchdog")
 
     def bus_id(self) -> int:

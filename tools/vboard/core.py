@@ -219,7 +219,9 @@ class Core(SystemControlSpace):
                 self._pages[page] = hit
         return hit
 
-    def _view(self, address: int):
+    def view(self, address: int):
+        """(the host-mapped region holding address, as bytes, address's
+        offset in it)."""
         hit = self._region(address)
         if hit is None:
             raise KeyError(f"{address:#010x} is not host-mapped")
@@ -271,11 +273,11 @@ class Core(SystemControlSpace):
         return self._read(address, {1: "<B", 2: "<H", 4: "<I"}[size])
 
     def wr32(self, address: int, value: int) -> None:
-        view, at = self._view(address)
+        view, at = self.view(address)
         struct.pack_into("<I", view, at, value & 0xFFFFFFFF)
 
     def write(self, address: int, data: bytes) -> None:
-        view, at = self._view(address)
+        view, at = self.view(address)
         view[at:at + len(data)] = data
 
     def fix(self, address: int, value, size: int = 4) -> None:
@@ -515,7 +517,7 @@ class Core(SystemControlSpace):
             self._fault(f"CPU exception {intno}")
             return
         sp = self.reg(arm.UC_ARM_REG_SP)
-        view, at = self._view(sp)
+        view, at = self.view(sp)
         frame = struct.unpack_from("<8I", view, at)
         xpsr = frame[7]
         # the interrupted handler's IPSR, or 0

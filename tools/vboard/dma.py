@@ -55,12 +55,13 @@ class Dma(Model):
         msize = 1 << ((ccr >> 10) & 3)
         base, minc, circular = w[i_cmar], ccr & (1 << 7), ccr & (1 << 5)
         mask = (1 << 8 * msize) - 1
+        view, at = self.core.view(base)  # the memory the channel writes (one region: CMAR's)
         flags = moved = 0
         for value in values:
             if left == 0:
                 break
-            position = (total - left) if minc else 0
-            self.core.write(base + position * msize, (value & mask).to_bytes(msize, "little"))
+            position = at + ((total - left) * msize if minc else 0)
+            view[position:position + msize] = (value & mask).to_bytes(msize, "little")
             left, flags = self._counted(left - 1, total, circular, flags)
             moved += 1
         self._done(n, ccr, left, flags)

@@ -38,6 +38,7 @@ class Flash(Model):
         self.blank = True
         if path is not None:
             self._open(path)
+        self.i_acr, self.LATENCY = self.i["ACR"], self.bit("ACR", "LATENCY")
         self.watch("KEYR", self._keyr)
         self.watch("CR", self._cr)
         self.watch("SR", self._sr)
@@ -63,7 +64,7 @@ class Flash(Model):
         self.keys_seen = 0
 
     def check_wait_states(self, hz: int) -> bool:
-        latency = self.get("ACR") & self.bit("ACR", "LATENCY")
+        latency = self.w[self.i_acr] & self.LATENCY
         return hz <= 24_000_000 * (latency + 1)
 
     def _flag(self, name: str) -> int:

@@ -22,12 +22,13 @@ class BridgeTimer(Model):
 
     def duty(self) -> float:
         """-1..1, or None when the bridge is off (coasting)."""
-        if not self.get("CR1") & 1 or not self.pins_ok():
+        w, i = self.w, self.i
+        if not w[i["CR1"]] & 1 or not self.pins_ok():
             return None
-        top = (self.get("ARR") & 0xFFFF) + 1
-        ccer = self.get("CCER")
-        a = (self.get("CCR1") & 0xFFFF) if ccer & 1 else 0
-        b = (self.get("CCR2") & 0xFFFF) if ccer & (1 << 4) else 0
+        top = (w[i["ARR"]] & 0xFFFF) + 1
+        ccer = w[i["CCER"]]
+        a = (w[i["CCR1"]] & 0xFFFF) if ccer & 1 else 0
+        b = (w[i["CCR2"]] & 0xFFFF) if ccer & (1 << 4) else 0
         if a == 0 and b == 0:
             return None
         return (min(a, top) - min(b, top)) / top
