@@ -1,8 +1,6 @@
 #ifndef CORTEX_SLEEP_H
 #define CORTEX_SLEEP_H
 
-#include <stdbool.h>
-
 /* Sleep until an interrupt, without the race of checking for work and then
  * sleeping: interrupts are masked around both, and a pending interrupt ends
  * WFI whatever PRIMASK says (ARMv6-M and ARMv7-M ARM B1.5.19); its handler

@@ -42,7 +42,6 @@
 #define USART_CR1_TE (1u << 3)
 #define USART_CR1_IDLEIE (1u << 4)
 #define USART_CR1_TCIE (1u << 6)
-#define USART_CR1_TXEIE (1u << 7)
 #define USART_CR3_HDSEL (1u << 3)
 #define USART_CR3_DMAR (1u << 6)
 #define USART_CR3_DMAT (1u << 7)
