@@ -8,50 +8,19 @@
 #define USER(id_, field_, size_, access_, min_, max_, factory_)                    \
     {(id_), (size_), (uint8_t)((access_) | DATA_USER),                             \
      (uint8_t)offsetof(struct user_config, field_), (min_), (max_), (factory_)}
+#define RO DATA_READ
+#define RO_SIGNED (DATA_READ | DATA_SIGNED)
 #define RW (DATA_READ | DATA_WRITE)
 #define RW_SIGNED (DATA_READ | DATA_WRITE | DATA_SIGNED)
 #define RESERVED 0u /* kept in the batch block, hidden from ReadData/WriteData */
+#define RESERVED_SIGNED DATA_SIGNED
 
-/* Rows in ID order; status area first, then the user area in wire order. */
-static const struct data_item items[] = {
-    RO_STATUS(1, voltage_mv, 2),
-    RO_STATUS(2, current_ma, 2),
-    RO_STATUS(3, power_mw, 2),
-    RO_STATUS(4, temperature_adc, 2),
-    RO_STATUS(5, status, 1),
-    RO_STATUS(6, model, 2),
-    RO_STATUS(7, firmware_version, 2),
-    RO_STATUS(8, serial_number, 4),
-    USER(32, check_flag, 1, RW, 1, 1, 1),
-    USER(33, control_response, 1, RW, 0, 1, 0),
-    USER(34, servo_id, 1, RW, 0, SERVO_ID_MAX, 0),
-    USER(35, reserved_35, 1, RESERVED, 0, 255, 0),
-    USER(36, baud_index, 1, RW, BAUD_INDEX_MIN, BAUD_INDEX_MAX, BAUD_INDEX_FACTORY),
-    USER(37, stall_release, 1, RW, 0, 1, 0),
-    USER(38, stall_power_mw, 2, RW, 0, 65535, 10000),
-    USER(39, low_voltage_mv, 2, RW, 0, 65535, 4000),
-    USER(40, high_voltage_mv, 2, RW, 0, 65535, 8400),
-    USER(41, temperature_limit_adc, 2, RW, 0, 65535, 651),
-    USER(42, power_limit_mw, 2, RW, 0, 65535, 10000),
-    USER(43, current_limit_ma, 2, RW, 0, 65535, 4000),
-    USER(44, start_force, 1, RW, 0, 255, 0),
-    USER(45, reserved_45, 1, RESERVED, 0, 255, 0),
-    USER(46, power_on_lock, 1, RW, 0, 1, 0),
-    USER(47, wheel_brake, 1, RW, 0, 1, 0),
-    USER(48, angle_limit_on, 1, RW, 0, 1, 1),
-    USER(49, soft_start_on, 1, RW, 0, 1, 1),
-    USER(50, soft_start_ms, 2, RW, 0, 65535, 3000),
-    USER(51, angle_max_decideg, 2, RW_SIGNED, -1800, 1800, 1350),
-    USER(52, angle_min_decideg, 2, RW_SIGNED, -1800, 1800, -1350),
-    USER(53, center_offset_decideg, 2, RW_SIGNED, -1800, 1800, 0),
-};
+/* Rows in ID order; status area first, then the user area in wire order
+ * (protocol/schema.toml). */
+static const struct data_item items[] = {DATA_ITEM_ROWS};
 
 enum {
     ITEM_COUNT = sizeof items / sizeof items[0],
-    STATUS_FIRST = 1,
-    STATUS_LAST = 8,
-    USER_FIRST = 32,
-    USER_LAST = 53,
     USER_ROW = STATUS_LAST - STATUS_FIRST + 1,
 };
 

@@ -12,7 +12,11 @@
 
 #include "registers/registers.h"
 
-#define CONFIG_RECORD_SIZE 48u
+/* The header, the user area and its CRC, in whole 8-byte write blocks (the
+ * largest a part programs at once); padding after the CRC is written
+ * erased (0xFF). 48 bytes for the maker's 32-byte user area. */
+#define CONFIG_RECORD_UNPADDED (12u + USER_AREA_SIZE + 4u)
+#define CONFIG_RECORD_SIZE ((CONFIG_RECORD_UNPADDED + 7u) / 8u * 8u)
 
 enum {
     REC_MAGIC = 0,      /* u16 */
@@ -37,7 +41,7 @@ enum {
 #define RECORD_HEADER_WORD                                                                   \
     ((uint32_t)RECORD_MAGIC | (uint32_t)RECORD_FORMAT << 16 | (uint32_t)USER_AREA_SIZE << 24)
 
-_Static_assert(REC_CRC + 4 == CONFIG_RECORD_SIZE, "record layout");
+_Static_assert(REC_CRC + 4 == CONFIG_RECORD_UNPADDED, "record layout");
 _Static_assert(CONFIG_RECORD_SIZE % 8 == 0, "a record is whole write blocks of 2, 4 or 8 bytes");
 
 #endif

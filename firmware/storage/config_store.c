@@ -169,6 +169,9 @@ enum config_save_result config_store_begin(struct config_store *s, const struct 
     le_put_u32(&rec[REC_SEQUENCE], s->sequence + 1u);
     le_put_u32(&rec[REC_OP_SECONDS], op_seconds);
     le_put_u32(&rec[REC_CRC], crc32(rec, REC_CRC));
+#if CONFIG_RECORD_SIZE > CONFIG_RECORD_UNPADDED
+    memset(&rec[CONFIG_RECORD_UNPADDED], 0xFF, CONFIG_RECORD_SIZE - CONFIG_RECORD_UNPADDED);
+#endif
     s->job_active = 1;
     s->job_page = page;
     s->job_slot = slot;

@@ -1,43 +1,23 @@
-"""Frames of the servo protocol (servo-protocol.md, extensions.md) and a bus
-that sends requests and waits for the matching response."""
+"""Frames of the servo protocol (docs/protocol.md, from protocol/schema.toml)
+and a bus that sends requests and waits for the matching response."""
 import struct
 import time
+
+from . import schema as _schema
 
 # The errors are errors.py's; named here too, as p.NoReply and the like.
 from .errors import (BadAnswer, BadChecksum, LinkError, NoReply, Refused,  # noqa: F401
                      ServoError, UsageError, ValueOutOfRange)
 
-REQUEST_HEADER = b"\x12\x4c"
-RESPONSE_HEADER = b"\x05\x1c"
-BROADCAST = 0xFF
-MAX_ID = 254  # behaviour.md: servo IDs are 0..254; 0xFF is broadcast
-
-PING = 1
-RESET_USER_DATA = 2
-READ_DATA = 3
-WRITE_DATA = 4
-READ_BATCH = 5
-WRITE_BATCH = 6
-WHEEL = 7
-ANGLE = 8
-DAMPING = 9
-READ_ANGLE = 10
-ANGLE_BY_INTERVAL = 11
-ANGLE_BY_VELOCITY = 12
-MULTI_TURN = 13
-MULTI_TURN_BY_INTERVAL = 14
-MULTI_TURN_BY_VELOCITY = 15
-READ_MULTI_TURN = 16
-RESET_MULTI_TURN = 17
-BEGIN_ASYNC = 18
-END_ASYNC = 19
-MONITOR = 22
-SET_ORIGIN = 23
-STOP_ON_CONTROL = 24
-SYNC = 25
-READ_MOTION = 0x40  # this firmware's own (docs/packets.md)
-READ_STORE = 0x41
-ASSIGN_ID = 0x42
+_SCHEMA = _schema.load()
+REQUEST_HEADER = bytes(_SCHEMA.frame["request_header"])
+RESPONSE_HEADER = bytes(_SCHEMA.frame["response_header"])
+BROADCAST = _SCHEMA.frame["broadcast_id"]
+MAX_ID = _SCHEMA.frame["max_id"]  # servo IDs are 0..254; 0xFF is broadcast
+# Every packet's code by servoctl's name for it, as module constants:
+# protocol.PING, protocol.WRITE_DATA, protocol.UPDATE_STATUS, ...
+CODES = {pkt.py: pkt.code for pkt in _SCHEMA.packets}
+globals().update(CODES)
 
 
 # What servo_sim and the virtual boards tell a second TCP client while

@@ -1,8 +1,9 @@
-"""The servo's data table (servo-protocol.md 4.2, extensions.md, behaviour.md):
+"""The servo's data table, from protocol/schema.toml (docs/protocol.md):
 names, sizes, units and ranges, so values are checked before they are sent."""
 from dataclasses import dataclass
 import struct
 
+from . import schema
 from .protocol import ValueOutOfRange
 
 
@@ -38,47 +39,20 @@ class Item:
                 f"not {value}")
 
 
-U16 = 65535
-STATUS = [
-    Item(1, "voltage", 2, unit="mV", writable=False),
-    Item(2, "current", 2, unit="mA", writable=False),
-    Item(3, "power", 2, unit="mW", writable=False),
-    Item(4, "temperature", 2, unit="ADC", writable=False, help="NTC ADC value; falls as it heats"),
-    Item(5, "status", 1, writable=False),
-    Item(6, "model", 2, writable=False),
-    Item(7, "firmware", 2, writable=False),
-    Item(8, "serial", 4, writable=False),
-]
-USER = [
-    Item(32, "check_flag", 1, low=1, high=1, default=1),
-    Item(33, "control_response", 1, low=0, high=1, default=0, help="answer motion when finished"),
-    Item(34, "servo_id", 1, low=0, high=254, default=0),
-    Item(35, "reserved_35", 1, writable=False, public=False, high=255),
-    Item(36, "baud", 1, low=1, high=8, default=5, help="1=9600 ... 5=115200 ... 8=1000000", quantity="baud"),
-    Item(37, "stall_release", 1, low=0, high=1, default=0, help="0 limit to stall power, 1 release"),
-    Item(38, "stall_power", 2, unit="mW", high=U16, default=10000, quantity="power"),
-    Item(39, "low_voltage", 2, unit="mV", high=U16, default=4000, quantity="voltage"),
-    Item(40, "high_voltage", 2, unit="mV", high=U16, default=8400, quantity="voltage"),
-    Item(41, "temperature_limit", 2, unit="ADC", high=U16, default=651, help="trips at or below", quantity="temperature"),
-    Item(42, "power_limit", 2, unit="mW", high=U16, default=10000, quantity="power"),
-    Item(43, "current_limit", 2, unit="mA", high=U16, default=4000, quantity="current"),
-    Item(44, "start_force", 1, high=255, default=0),
-    Item(45, "reserved_45", 1, writable=False, public=False, high=255),
-    Item(46, "power_on_lock", 1, low=0, high=1, default=0),
-    Item(47, "wheel_brake", 1, low=0, high=1, default=0),
-    Item(48, "angle_limit_on", 1, low=0, high=1, default=1),
-    Item(49, "soft_start_on", 1, low=0, high=1, default=1),
-    Item(50, "soft_start_time", 2, unit="ms", high=U16, default=3000, quantity="time"),
-    Item(51, "angle_max", 2, signed=True, unit="0.1deg", low=-1800, high=1800, default=1350, quantity="angle"),
-    Item(52, "angle_min", 2, signed=True, unit="0.1deg", low=-1800, high=1800, default=-1350, quantity="angle"),
-    Item(53, "center_offset", 2, signed=True, unit="0.1deg", low=-1800, high=1800, default=0, quantity="angle"),
-]
-USER_AREA_SIZE = sum(item.size for item in USER)  # 32: the WriteBatchData block
+def _item(i: schema.Item) -> Item:
+    return Item(i.id, i.name, i.size, signed=i.signed, unit=i.unit, writable=i.access == "read-write",
+                public=i.access != "reserved", low=i.min, high=i.max, default=i.factory,
+                help=i.help, quantity=i.quantity)
+
+
+_SCHEMA = schema.load()
+STATUS = [_item(i) for i in _SCHEMA.area("status")]
+USER = [_item(i) for i in _SCHEMA.area("user")]
+USER_AREA_SIZE = sum(item.size for item in USER)  # the WriteBatchData block
 ITEMS = STATUS + USER
 BY_ID = {i.id: i for i in ITEMS}
 BY_NAME = {i.name: i for i in ITEMS}
-STATUS_BITS = ["executing", "command_error", "stall", "high_voltage", "low_voltage",
-               "over_current", "over_power", "over_temperature"]
+STATUS_BITS = [b.name for b in _SCHEMA.status_bits]
 BAUD_RATES = {1: 9600, 2: 19200, 3: 38400, 4: 57600, 5: 115200, 6: 250000, 7: 500000, 8: 1000000}
 
 

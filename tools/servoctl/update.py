@@ -9,10 +9,12 @@ import struct
 import zlib
 from dataclasses import dataclass
 
+from . import protocol as _p
 from .image import CHECKED, Image, board_named
 from .protocol import BadAnswer, NoReply, Refused
 
-UPDATE_ENTER, UPDATE_ERASE, UPDATE_WRITE, UPDATE_VERIFY, UPDATE_BOOT, UPDATE_STATUS = range(0x50, 0x56)
+UPDATE_ENTER, UPDATE_ERASE, UPDATE_WRITE = _p.UPDATE_ENTER, _p.UPDATE_ERASE, _p.UPDATE_WRITE
+UPDATE_VERIFY, UPDATE_BOOT, UPDATE_STATUS = _p.UPDATE_VERIFY, _p.UPDATE_BOOT, _p.UPDATE_STATUS
 MODE_APP, MODE_BOOTLOADER = 0, 1
 VERDICTS = {0: "valid", 1: "no image", 2: "header damaged", 3: "another board's image",
             4: "image does not match its CRC"}

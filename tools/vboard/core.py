@@ -191,8 +191,7 @@ class Core(SystemControlSpace):
         return buf
 
     def words(self, address: int):
-        """(the host-mapped region holding the word at address, as 32-bit
-        words, that word's index in it)."""
+        """(address's host-mapped region as 32-bit words, its word's index)."""
         base, _ = self._region(address)
         return self._words[base], (address - base) // 4
 
@@ -220,8 +219,7 @@ class Core(SystemControlSpace):
         return hit
 
     def view(self, address: int):
-        """(the host-mapped region holding address, as bytes, address's
-        offset in it)."""
+        """(address's host-mapped region as bytes, address's offset in it)."""
         hit = self._region(address)
         if hit is None:
             raise KeyError(f"{address:#010x} is not host-mapped")
@@ -294,9 +292,8 @@ class Core(SystemControlSpace):
         self.uc.emu_stop()
 
     def new_event(self) -> None:
-        """From a handler: the peripheral has something to do sooner than
-        this run was planned to last (a byte now shifting out): the CPU
-        stops after this store, so the next run ends in time for it."""
+        """From a handler: the peripheral acts sooner than this run would end
+        (a byte shifting out): the CPU stops after this store."""
         if self.running:
             self.defer(lambda: None)
 

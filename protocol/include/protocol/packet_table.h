@@ -8,6 +8,7 @@
 
 #include "protocol/dispatcher.h"
 #include "protocol/packet_codes.h"
+#include "protocol/packet_rows.h"
 
 enum packet_flags {
     PF_ADDRESSED = 1u << 0,   /* content starts with the servo ID */
@@ -64,33 +65,8 @@ struct packet_desc {
 };
 
 const struct packet_desc *packet_find(uint8_t code);
-/* Handlers, grouped by what they touch. */
-enum packet_outcome handle_ping(const struct packet_call *c, struct response *r);
-enum packet_outcome handle_reset_user_data(const struct packet_call *c, struct response *r);
-enum packet_outcome handle_read_data(const struct packet_call *c, struct response *r);
-enum packet_outcome handle_write_data(const struct packet_call *c, struct response *r);
-enum packet_outcome handle_read_batch(const struct packet_call *c, struct response *r);
-enum packet_outcome handle_write_batch(const struct packet_call *c, struct response *r);
-enum packet_outcome handle_monitor(const struct packet_call *c, struct response *r);
-enum packet_outcome handle_read_motion(const struct packet_call *c, struct response *r);
-enum packet_outcome handle_read_store(const struct packet_call *c, struct response *r);
-enum packet_outcome handle_assign_id(const struct packet_call *c, struct response *r);
-enum packet_outcome handle_update_enter(const struct packet_call *c, struct response *r);
-enum packet_outcome handle_update_status(const struct packet_call *c, struct response *r);
-
-enum packet_outcome handle_move_wheel(const struct packet_call *c, struct response *r);
-enum packet_outcome handle_move_angle(const struct packet_call *c, struct response *r);
-enum packet_outcome handle_move_damping(const struct packet_call *c, struct response *r);
-enum packet_outcome handle_read_angle(const struct packet_call *c, struct response *r);
-enum packet_outcome handle_read_multi_turn(const struct packet_call *c, struct response *r);
-enum packet_outcome handle_reset_multi_turn(const struct packet_call *c, struct response *r);
-enum packet_outcome handle_begin_async(const struct packet_call *c, struct response *r);
-enum packet_outcome handle_end_async(const struct packet_call *c, struct response *r);
-enum packet_outcome handle_set_origin(const struct packet_call *c, struct response *r);
-enum packet_outcome handle_stop(const struct packet_call *c, struct response *r);
-
-enum packet_outcome handle_sync(const struct packet_call *c, struct response *r);
-enum packet_outcome handle_ignored(const struct packet_call *c, struct response *r);
+/* Every handler a packet table names (protocol/schema.toml). */
+PACKET_HANDLERS_DECLARED
 
 /* Runs one packet for this servo, as dispatch() does for a whole frame;
  * SyncCommand runs its record through it. The caller fills in call's

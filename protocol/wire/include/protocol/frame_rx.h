@@ -13,11 +13,12 @@
 #include <stdint.h>
 
 #include "hal/hal_rx_ring.h"
+#include "protocol/packet_codes.h"
 
-/* Largest request content kept: WriteBatchData is 1 + 32 bytes. A longer
- * request is consumed by its length and delivered with FRAME_TRUNCATED so the
+/* Largest request content kept (protocol/schema.toml). A longer request is
+ * consumed by its length and delivered with FRAME_TRUNCATED so the
  * dispatcher can reject it as a length error. */
-#define FRAME_CONTENT_MAX 34u
+#define FRAME_CONTENT_MAX REQUEST_CONTENT_MAX
 /* Largest SyncCommand record kept (packet 14: 15 bytes). */
 #define FRAME_SYNC_RECORD_MAX 15u
 /* Slots in the frame queue; one is always the framer's work slot. */

@@ -5,9 +5,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
-/* Largest response content: ReadStore (0x41), 34 bytes (ReadBatchData's
- * is 1 + 32). */
-#define RESPONSE_CONTENT_MAX 34u
+#include "protocol/packet_codes.h" /* RESPONSE_CONTENT_MAX: the largest answer's content */
+
 #define RESPONSE_FRAME_MAX (RESPONSE_CONTENT_MAX + 5u)
 #define RESPONSE_FRAME_WORDS ((RESPONSE_FRAME_MAX + 5u) / 4u) /* + 2 zeros */
 

@@ -1,0 +1,243 @@
+"""The protocol's one declaration, protocol/schema.toml, read and checked:
+the packets, the data items and the status bits that the firmware's tables
+(scripts/gen_protocol.py), servoctl and docs/protocol.md all come from.
+Standard library only: the build runs it with the system's Python."""
+import dataclasses
+import functools
+import re
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+
+SCHEMA = Path(__file__).resolve().parents[2] / "protocol" / "schema.toml"
+FLAGS = ("addressed", "answers", "answers_if_control_response", "broadcast", "query", "syncable",
+         "one_answers")
+FIELD_TYPES = {"u8": 1, "u16": 2, "u32": 4, "i16": 2, "i32": 4, "item": None, "user_area": None, "bytes": None}
+ITEM_SIZES = (1, 4)  # an item's value: 1 to 4 bytes
+ACCESS = ("read", "read-write", "reserved")
+FRAME_KEYS = {"request_header", "response_header", "broadcast_id", "max_id", "extended_length",
+              "request_content_max", "answer_content_max"}
+AREAS = {"status": 1, "user": 32}  # each area's first ID (the maker's data table)
+
+
+class SchemaError(ValueError):
+    """schema.toml says something that cannot be: the sentence says what."""
+
+
+@dataclass(frozen=True)
+class Field:
+    name: str
+    type: str
+    unit: str
+    what: str
+
+
+@dataclass(frozen=True)
+class Packet:
+    code: int
+    name: str       # the protocol's (Ping)
+    c: str          # PKT_<c> in C
+    py: str         # servoctl's protocol.<py>
+    source: str     # maker, extension or firmware
+    table: str      # the firmware's packet table its row is in
+    flags: tuple
+    length: tuple   # (least, most) content bytes
+    handler: str    # handle_<handler>()
+    what: str
+    request: tuple
+    answer: tuple
+
+    def has(self, flag: str) -> bool:
+        return flag in self.flags
+
+
+@dataclass(frozen=True)
+class Item:
+    id: int
+    area: str
+    name: str       # servoctl's and the docs'
+    field: str      # the register struct's member
+    size: int
+    signed: bool
+    access: str
+    unit: str
+    quantity: str
+    min: int
+    max: int
+    factory: int
+    what: str
+    help: str
+
+
+@dataclass(frozen=True)
+class StatusBit:
+    bit: int
+    name: str
+    what: str
+
+
+@dataclass(frozen=True)
+class Schema:
+    frame: dict
+    status_bits: tuple
+    items: tuple
+    packets: tuple
+
+    def area(self, name: str) -> tuple:
+        return tuple(i for i in self.items if i.area == name)
+
+    def tables(self) -> dict:
+        """{table: its packets, in code order}, tables in the order they first appear."""
+        out = {}
+        for pkt in self.packets:
+            out.setdefault(pkt.table, []).append(pkt)
+        return {name: tuple(rows) for name, rows in out.items()}
+
+
+def _fields(where: str, rows) -> tuple:
+    out = []
+    for row in rows:
+        if len(row) != 4 or row[1] not in FIELD_TYPES:
+            raise SchemaError(f"{where}: a field is [name, type, unit, meaning] with a type of "
+                              f"{', '.join(FIELD_TYPES)}, not {row!r}")
+        out.append(Field(*row))
+    return tuple(out)
+
+
+def _length(where: str, value) -> tuple:
+    if value == "any":
+        return (0, 0xFFFF)
+    if value is None:
+        return None  # the fields' sizes: parse() adds them up once the items are known
+    if isinstance(value, int):
+        value = [value, value]
+    if (not isinstance(value, list) or len(value) != 2 or not all(isinstance(v, int) for v in value)
+            or not 0 <= value[0] <= value[1] <= 0xFFFF):
+        raise SchemaError(f"{where}: length is a number, [least, most] (0..65535) or \"any\", not {value!r}")
+    return tuple(value)
+
+
+def _type_range(size: int, signed: bool) -> tuple:
+    bits = 8 * size
+    return (-(1 << (bits - 1)), (1 << (bits - 1)) - 1) if signed else (0, (1 << bits) - 1)
+
+
+def _item(raw: dict) -> Item:
+    where = f"item {raw.get('id')}"
+    try:
+        item = Item(id=raw["id"], area=raw["area"], name=raw["name"], field=raw["field"], size=raw["size"],
+                    signed=raw.get("signed", False), access=raw["access"], unit=raw.get("unit", ""),
+                    quantity=raw.get("quantity", ""), min=raw.get("min", 0), max=raw.get("max", 0),
+                    factory=raw.get("factory", 0), what=raw["what"], help=raw.get("help", ""))
+    except KeyError as e:
+        raise SchemaError(f"{where}: no {e.args[0]}") from None
+    if item.area not in AREAS:
+        raise SchemaError(f"{where}: area is one of {', '.join(AREAS)}, not {item.area!r}")
+    if item.size not in (1, 2, 4) or item.access not in ACCESS:
+        raise SchemaError(f"{where}: size 1, 2 or 4 and access one of {', '.join(ACCESS)}")
+    if item.area == "user":
+        low, high = _type_range(item.size, item.signed)
+        if not low <= item.min <= item.factory <= item.max <= high:
+            raise SchemaError(f"{where} ({item.name}): needs {low} <= min <= factory <= max <= {high}")
+    elif item.access != "read":
+        raise SchemaError(f"{where}: a status item is read-only")
+    return item
+
+
+def _packet(raw: dict) -> Packet:
+    where = f"packet {raw.get('code')}"
+    try:
+        c = raw.get("c", re.sub(r"(?<!^)(?=[A-Z])", "_", raw["name"]).upper())  # ResetUserData: RESET_USER_DATA
+        pkt = Packet(code=raw["code"], name=raw["name"], c=c, py=raw.get("py", c), source=raw["source"],
+                     table=raw["table"], flags=tuple(raw.get("flags", ())),
+                     length=_length(where, raw.get("length")), handler=raw["handler"], what=raw["what"],
+                     request=_fields(where, raw.get("request", ())), answer=_fields(where, raw.get("answer", ())))
+    except KeyError as e:
+        raise SchemaError(f"{where}: no {e.args[0]}") from None
+    unknown = [f for f in pkt.flags if f not in FLAGS]
+    if unknown or not 1 <= pkt.code <= 0xFE:
+        raise SchemaError(f"{where}: codes are 1..254 and flags {', '.join(FLAGS)} (not {unknown})")
+    if pkt.source not in ("maker", "extension", "firmware"):
+        raise SchemaError(f"{where}: source is maker, extension or firmware")
+    return pkt
+
+
+def content_size(fields, user_area: int):
+    """(least, most) bytes of a request's or an answer's fields, or None
+    when a block of bytes makes it unknown."""
+    least = most = 0
+    for f in fields:
+        if f.type == "bytes":
+            return None
+        low, high = ITEM_SIZES if f.type == "item" else (user_area, user_area) if f.type == "user_area" else \
+            (FIELD_TYPES[f.type], FIELD_TYPES[f.type])
+        least, most = least + low, most + high
+    return least, most
+
+
+def _sized(p: Packet, user_area: int, frame: dict) -> Packet:
+    """The packet with its length worked out where the schema leaves it to
+    the fields; refused when a request or an answer outgrows the firmware's
+    frame buffers."""
+    where = f"packet {p.code:#04x} ({p.name})"
+    if p.length is None:
+        size = content_size(p.request, user_area)
+        if size is None or size[0] != size[1]:
+            raise SchemaError(f"{where}: give its length: its fields' sizes vary")
+        p = dataclasses.replace(p, length=size)
+    if p.length[1] != 0xFFFF and p.length[1] > frame.get("request_content_max", 0xFFFF):
+        raise SchemaError(f"{where}: a request of {p.length[1]} bytes does not fit the frame's "
+                          f"request_content_max ({frame['request_content_max']})")
+    answer = content_size(p.answer, user_area)
+    if answer is not None and answer[1] > frame.get("answer_content_max", 0xFFFF):
+        raise SchemaError(f"{where}: an answer of {answer[1]} bytes does not fit the frame's "
+                          f"answer_content_max ({frame['answer_content_max']})")
+    return p
+
+
+def _unique(kind: str, values) -> None:
+    seen = set()
+    for v in values:
+        if v in seen:
+            raise SchemaError(f"two {kind} {v!r}")
+        seen.add(v)
+
+
+def parse(text: str) -> Schema:
+    try:
+        raw = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:
+        raise SchemaError(f"not TOML: {e}") from None
+    unknown = set(raw) - {"frame", "status_bit", "item", "packet"}
+    missing = FRAME_KEYS - set(raw.get("frame", {}))
+    if unknown or missing or not raw.get("item") or not raw.get("packet"):
+        raise SchemaError(f"the schema has frame (with {', '.join(sorted(FRAME_KEYS))}), status_bit, item and "
+                          f"packet, and nothing else (unknown: {sorted(unknown)}, missing from frame: "
+                          f"{sorted(missing)})")
+    bits = tuple(StatusBit(b["bit"], b["name"], b["what"]) for b in raw.get("status_bit", []))
+    items = tuple(sorted((_item(i) for i in raw.get("item", [])), key=lambda i: i.id))
+    packets = tuple(sorted((_packet(p) for p in raw.get("packet", [])), key=lambda p: p.code))
+    if sorted(b.bit for b in bits) != list(range(len(bits))) or len(bits) > 8:
+        raise SchemaError("status bits are 0..7, each once")
+    for kind, values in (("item IDs", [i.id for i in items]), ("item names", [i.name for i in items]),
+                         ("item fields", [i.field for i in items]), ("packet codes", [p.code for p in packets]),
+                         ("packet C names", [p.c for p in packets]), ("packet names", [p.name for p in packets])):
+        _unique(kind, values)
+    for area, first in AREAS.items():
+        ids = [i.id for i in items if i.area == area]
+        if ids != list(range(first, first + len(ids))) or (ids and ids[0] != first):
+            raise SchemaError(f"the {area} area's items are consecutive IDs from {first}, not {ids}")
+    frame = raw.get("frame", {})
+    user_area = sum(i.size for i in items if i.area == "user")
+    packets = tuple(_sized(p, user_area, frame) for p in packets)
+    schema = Schema(frame, bits, items, packets)
+    for table, rows in schema.tables().items():
+        codes = [p.code for p in rows]
+        if codes != list(range(codes[0], codes[0] + len(codes))):
+            raise SchemaError(f"packet table {table!r} is a run of consecutive codes, not {codes}")
+    return schema
+
+
+@functools.lru_cache(maxsize=None)
+def load(path: str = str(SCHEMA)) -> Schema:
+    return parse(Path(path).read_text(encoding="utf-8"))

@@ -1,0 +1,143 @@
+"""protocol/schema.toml declares the protocol once: the firmware's tables,
+servoctl's and the reference (docs/protocol.md, protocol-packets.md) are
+made from it. The reference is committed and must be what the schema makes
+now; a schema that cannot be
+is refused with a sentence that says why; and a new data item and a new
+packet need the schema and the packet's handler, nothing else."""
+import os
+import shutil
+import subprocess
+import sys
+import tarfile
+from pathlib import Path
+
+import pytest
+
+from servoctl import schema
+
+ROOT = Path(__file__).resolve().parents[2]
+GEN = ROOT / "scripts" / "gen_protocol.py"
+
+
+def test_the_protocol_reference_is_what_the_schema_makes():
+    done = subprocess.run([sys.executable, str(GEN), "docs", str(ROOT / "docs"), "--check"],
+                          capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+
+
+def _with(text: str, old: str, new: str) -> str:
+    assert old in text
+    return text.replace(old, new, 1)
+
+
+SCHEMA = schema.SCHEMA.read_text(encoding="utf-8")
+
+
+NEW_ITEM = ('  {id = 54, area = "user", name = "test_hold_ms", field = "test_hold_ms", size = 2, '
+            'access = "read-write", min = 0, max = 1000, factory = 250, unit = "ms", '
+            'what = "an item added by test_schema"},\n')
+LAST_ITEM = "what = \"shifts the zero every angle read and written refers to\"},\n"
+
+@pytest.mark.parametrize("broken, said", [
+    (_with(SCHEMA, "code = 2\n", "code = 1\n"), "two packet codes 1"),
+    (_with(SCHEMA, 'flags = ["addressed", "answers", "query"]', 'flags = ["adressed"]'), "flags"),
+    (_with(SCHEMA, "code = 0x41\n", "code = 0x44\n"), "consecutive codes"),
+    (_with(SCHEMA, "factory = 3000,", "factory = 70000,"), "soft_start_time"),
+    (_with(SCHEMA, "{id = 33,", "{id = 60,"), "consecutive IDs from 32"),
+    (_with(SCHEMA, 'access = "reserved"', 'access = "hidden"'), "access one of"),
+    (_with(SCHEMA, "length = 6\n", "length = [6, 3]\n"), "length is a number"),
+    (_with(SCHEMA, 'request = [["id", "u8", "", "servo ID"]]', 'request = [["id", "u9", "", "x"]]'), "type"),
+    (_with(SCHEMA, LAST_ITEM, LAST_ITEM + "  {id = 54},\n"), "no area"),
+    (_with(SCHEMA, LAST_ITEM, LAST_ITEM + NEW_ITEM),
+     "ReadBatchData.*an answer of 35 bytes does not fit the frame's answer_content_max"),
+    ("[frame\n", "not TOML"),
+])
+def test_a_schema_that_cannot_be_is_refused_with_its_reason(broken, said):
+    with pytest.raises(schema.SchemaError, match=said):
+        schema.parse(broken)
+
+
+NEW_PACKET = '''
+[[packet]]
+code = 0x43
+name = "Echo"
+c = "ECHO"
+source = "firmware"
+table = "firmware"
+flags = ["addressed", "answers", "query"]
+length = 2
+handler = "echo"
+what = "answers its byte back (added by test_schema)"
+request = [["id", "u8", "", "servo ID"], ["value", "u8", "", "any"]]
+answer = [["id", "u8", "", "servo ID"], ["value", "u8", "", "the request's"]]
+'''
+
+NEW_HANDLER = '''
+enum packet_outcome handle_echo(const struct packet_call *c, struct response *r)
+{
+    r->content[1] = c->content[1];
+    r->length = 2;
+    return OUTCOME_OK;
+}
+'''
+
+# In the copy of the tree, with its own servo_sim: the item answers its
+# factory value through ReadData and config dump, the packet its byte.
+CLIENT = '''
+import sys
+from servoctl import protocol as p, registers
+from servoctl.cli import main
+from servoctl.sim import Simulator
+with Simulator(ids=[1]) as sim:
+    with sim.bus() as bus:
+        assert bus.request(p.ECHO, bytes([1, 0x5A])) == bytes([1, 0x5A]), "Echo"
+        assert bus.request(p.READ_DATA, bytes([1, 54])) == bytes([1, 54, 250, 0]), "item 54"
+        assert len(bus.request(p.READ_BATCH, bytes([1]))) == 1 + registers.USER_AREA_SIZE == 35
+    sys.exit(main(["--port", sim.url, "config", "dump", "1"], clock=sim.clock_s))
+'''
+
+
+def test_a_new_item_and_a_new_packet_need_the_schema_and_the_handler_only(tmp_path):
+    """A copy of the tree, changed in two files: schema.toml gains user item
+    54 and packet 0x43 (and room for the batch packets, which grow with the
+    user area), and handlers_data.c gains handle_echo(). Its
+    servo_sim builds and answers both, its servoctl knows both (config dump
+    lists the item), and its docs/protocol.md describes both."""
+    tree = tmp_path / "tree"
+    with tarfile.open(tmp_path / "tree.tar", "w") as tar:
+        for name in ("CMakeLists.txt", "CMakePresets.json", "cmake", "firmware", "hal", "motion", "protocol",
+                     "registers", "scripts", "tests", "tools"):
+            tar.add(ROOT / name, arcname=name,
+                    filter=lambda t: None if "__pycache__" in t.name or t.name.endswith(".egg-info") else t)
+    with tarfile.open(tmp_path / "tree.tar") as tar:
+        tar.extractall(tree, filter="data")
+    schema_file = tree / "protocol/schema.toml"
+    text = _with(schema_file.read_text(encoding="utf-8"), LAST_ITEM, LAST_ITEM + NEW_ITEM) + NEW_PACKET
+    # The batch packets grow with the user area: the frame buffers with them.
+    text = _with(_with(text, "request_content_max = 34", "request_content_max = 35"),
+                 "answer_content_max = 34", "answer_content_max = 35")
+    schema_file.write_text(text, encoding="utf-8")
+    handlers = tree / "protocol/handlers_data.c"
+    handlers.write_text(handlers.read_text(encoding="utf-8") + NEW_HANDLER, encoding="utf-8")
+
+    build = tree / "build/sim"
+    for argv in (["cmake", "-S", str(tree), "-B", str(build), "-G", "Ninja", "-DCMAKE_BUILD_TYPE=Release"],
+                 ["cmake", "--build", str(build), "--target", "servo_sim"]):
+        done = subprocess.run(argv, capture_output=True, text=True)
+        assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
+    sim = next(build.rglob("servo_sim"))
+
+    env = dict(os.environ, SERVO_SIM=str(sim), PYTHONPATH=str(tree / "tools"))
+    done = subprocess.run([sys.executable, "-c", CLIENT], cwd=tree / "tools", env=env, capture_output=True,
+                          text=True, timeout=120)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "test_hold_ms" in done.stdout and "250" in done.stdout, done.stdout
+
+    docs = tree / "docs"
+    docs.mkdir(exist_ok=True)
+    subprocess.run([sys.executable, str(tree / "scripts/gen_protocol.py"), "docs", str(docs)], check=True)
+    text = (docs / "protocol.md").read_text(encoding="utf-8")
+    assert "| 0x43 (67) | [Echo](protocol-packets.md#0x43-echo) |" in text
+    assert "| 54 | test_hold_ms | 2 | u16 | read-write | 0..1000 | 250 | ms |" in text
+    assert "## 0x43 Echo" in (docs / "protocol-packets.md").read_text(encoding="utf-8")
+    shutil.rmtree(build)
