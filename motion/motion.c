@@ -9,7 +9,7 @@
 #include "motion/gains.h"
 #include "motion_internal.h"
 
-/* Limits of behaviour.md, "Motion". */
+/* Limits of docs/protocol.md, "Moves". */
 enum {
     SINGLE_TURN_LIMIT = 1800,
     MIN_RAMP_MS = 20,

@@ -11,7 +11,7 @@
 #include "saturate.h"
 
 enum {
-    MULTI_TURN_LIMIT = 3686400, /* behaviour.md, "Motion" */
+    MULTI_TURN_LIMIT = 3686400, /* docs/protocol.md, "Moves" */
     DECIDEG_PER_TURN = 3600,
     SUPPLY_HYSTERESIS_MV = 128, /* the limits follow the supply past this */
     CLOCK_REAL_TIME = 256,      /* clock_rate, Q8 */

@@ -7,7 +7,7 @@
 #include "protocol/packet_table.h"
 #include "protocol/wire.h"
 
-/* Ramps of the packets that carry none (8, 13): behaviour.md, "Motion". */
+/* Ramps of the packets that carry none (8, 13): docs/protocol.md, "Moves". */
 enum { DEFAULT_RAMP_MS = 20 };
 
 enum time_field { TIME_INTERVAL_U16, TIME_INTERVAL_U32, TIME_VELOCITY };

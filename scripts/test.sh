@@ -73,7 +73,7 @@ target_arith() {
 
 fuzz_run() {
   cmake --preset fuzz >/dev/null
-  # The whole preset, as the README builds it: a flag clang does not take
+  # The whole preset, as docs/building.md builds it: a flag clang does not take
   # fails here, not for the next reader.
   cmake --build --preset fuzz
   local work

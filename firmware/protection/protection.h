@@ -1,7 +1,7 @@
 /* Protection monitors: supply voltage (39/40), current (43), power (42),
  * temperature (41) and stall (37/38). Fed once per control tick, they set
  * status bits 2-7 while a condition lasts and say what the output must do
- * (behaviour.md, "Protection"):
+ * (docs/protocol.md, "Protection"):
  *   voltage out of range, over-temperature: release, refuse motion
  *   over-current, over-power: halve the current the output may draw
  *   stall: limit the power to 38 (37 = 0), or release once (37 = 1)

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Generates ntc_table.c: the NTC relation of servo-protocol.md appendix 5.1
+"""Generates ntc_table.c: the NTC relation of docs/protocol.md, "The temperature reading"
 as a table of ADC values at whole temperatures, so the firmware converts
 without log/exp. Run by the build; the divider constants are the protocol's
 (R1 = 10 kohm to the supply, NTC 10 kohm at 25 degC to ground, B = 3435,

@@ -1,4 +1,4 @@
-/* The NTC relation of servo-protocol.md appendix 5.1, both ways, from a
+/* The NTC relation of docs/protocol.md, "The temperature reading", both ways, from a
  * table generated at build time (gen_ntc_table.py): the ADC value falls as
  * the servo heats. Between table points the conversion is linear; within
  * 0.2 degC of the exact formula from -20 to 120 degC. */

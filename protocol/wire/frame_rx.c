@@ -227,7 +227,7 @@ INLINE_IN_FAST_BUILD void step(struct frame_rx *rx, uint8_t byte)
         rx->state = RX_LENGTH;
         return;
     case RX_LENGTH:
-        /* Only requests use the extended length (extensions.md). */
+        /* Only requests use the extended length (docs/protocol.md). */
         if (rx->is_request && byte == WIRE_EXTENDED_LENGTH) {
             rx->state = RX_LENGTH_LO;
         } else {

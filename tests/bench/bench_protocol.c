@@ -247,7 +247,7 @@ static void latency(const char *name, uint8_t code, const uint8_t *content, size
 #define ANSWER(name, code, ...) latency("answer_" name, code, BYTES(__VA_ARGS__), true)
 #define QUIET(name, code, ...) latency("request_" name, code, BYTES(__VA_ARGS__), false)
 
-/* Every packet of servo-protocol.md, extensions.md and docs/packets.md, in
+/* Every packet of docs/protocol.md, in
  * the order a session might send them. */
 static void every_packet(void)
 {

@@ -1,5 +1,5 @@
-/* The data table against servo-protocol.md 4.2, extensions.md (factory
- * values) and behaviour.md, "The data table": every item. */
+/* The data table against docs/protocol.md (the items, their factory values
+ * and "Reading and writing items"): every item. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -20,7 +20,7 @@ static int setup(void **state)
     return 0;
 }
 
-/* Factory values as extensions.md lists them, on the wire (ReadBatchData). */
+/* Factory values as docs/protocol.md lists them, on the wire (ReadBatchData). */
 static const uint8_t factory_block[USER_AREA_SIZE] = {
     1,    /* 32 check flag */
     0,    /* 33 control response */

@@ -1,5 +1,5 @@
 /* The dispatcher: addressing, broadcast, length and command-error rules of
- * behaviour.md, and how every motion packet reaches the motion layer
+ * docs/protocol.md, and how every motion packet reaches the motion layer
  * (mocked with cmocka). */
 #include <setjmp.h>
 #include <stdarg.h>

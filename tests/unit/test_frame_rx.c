@@ -1,4 +1,4 @@
-/* The framer against every rule of behaviour.md, "The wire". */
+/* The framer against every rule of docs/protocol.md, "The shared wire". */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>

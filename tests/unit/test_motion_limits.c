@@ -139,7 +139,7 @@ struct results {
     unsigned over_goal;
 };
 
-/* The worst overshoot allowed past the target (issue 9). */
+/* The worst overshoot allowed past the target (docs/motion-at-the-limits.md). */
 #define OVERSHOOT_BOUND_DEG 1.0
 
 static struct results results;

@@ -1,4 +1,4 @@
-/* Every motion packet and every rule of behaviour.md, "Motion": request
+/* Every motion packet and every rule of docs/protocol.md, "Moves": request
  * bytes in, response bytes and behaviour out, on an ideal servo (the encoder
  * follows the setpoint while under control). Its power and current
  * protections are at their most, so that the motor's own limits (the

@@ -238,7 +238,7 @@ static int64_t random_position(bool multi_turn)
     return from_decideg(frac * range) + (rand() % 65536);
 }
 
-/* A move as the protocol can ask for it, clamped as behaviour.md says. */
+/* A move as the protocol can ask for it, clamped as docs/protocol.md says. */
 static void random_move(struct profile *p, int64_t start, int64_t v0, bool *velocity_based,
                         double *analytic_ticks)
 {

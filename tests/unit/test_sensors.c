@@ -51,7 +51,7 @@ static void test_protocol_reference_points(void **state)
 {
     (void)state;
     assert_int_equal(ntc_adc(250), 2048);           /* 25 degC: R_t = R_1 */
-    /* extensions.md: 651 is "about 75 degC". */
+    /* docs/protocol.md: 651 is "about 75 degC". */
     assert_true(fabs(ntc_decicelsius(651) / 10.0 - exact_celsius(651)) <= 0.2);
     assert_in_range(ntc_decicelsius(2048), 249, 251);
     /* Beyond the table's ends: clamped. */

@@ -11,7 +11,7 @@ from . import update as upd
 
 BITS_PER_BYTE = 10  # start, 8 data, stop
 FRAME_OVERHEAD = 5  # header 2, packet number, content length, checksum
-MONITOR_ANSWER = 16  # content bytes of a Monitor answer (servo-protocol.md 3.22)
+MONITOR_ANSWER = 16  # content bytes of a Monitor answer (docs/protocol-packets.md)
 # The STM32F1 flash's slowest page erase and half-word program (datasheet
 # DS5319, tERASE and tPROG maximum), which the simulator models too
 # (hal/ports/host/sim_flash.h).

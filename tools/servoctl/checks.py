@@ -20,11 +20,11 @@ def check_range(name: str, value: int, low: int, high: int, unit: str = "", per_
     return value
 
 
-MIN_RAMP_MS = 20  # behaviour.md: acc >= 20, dec >= 20, interval >= acc + dec
+MIN_RAMP_MS = 20  # docs/protocol.md: acc >= 20, dec >= 20, interval >= acc + dec
 
 
 def check_profile(acc_ms: int, dec_ms: int, interval_ms: int = None, velocity: int = None) -> None:
-    """Refuses a profile the firmware would clamp (behaviour.md, Motion):
+    """Refuses a profile the firmware would clamp (docs/protocol.md, "Moves"):
     the move would run, but not as asked."""
     for name, ramp in (("acceleration time", acc_ms), ("deceleration time", dec_ms)):
         if ramp < MIN_RAMP_MS:

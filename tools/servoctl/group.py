@@ -10,7 +10,7 @@ from .errors import NoReply, Refused, UsageError
 from .checks import MIN_RAMP_MS, check_profile, check_range, scaled, to_ms
 from .servo import Monitor, Servo
 
-# SyncCommand records (servo-protocol.md 3.25): the packet's own content.
+# SyncCommand records (docs/protocol-packets.md): the packet's own content.
 _ANGLE_RECORD = "<BhHH"       # packet 8: id, angle, interval, power
 _MULTI_TURN_RECORD = "<BiIH"  # packet 13
 MAX_SYNC_RECORDS = 255
@@ -22,7 +22,7 @@ def sync_move(bus: p.Bus, targets: dict, duration_s: float, power_w: float = 0.0
     frame: single-turn records, or multi-turn ones if multi_turn. Each
     target is checked against its servo first (frame.check_target: one
     frame of reference, the angle limits), and nothing is sent unless all
-    pass. No servo answers a sync move (behaviour.md)."""
+    pass. No servo answers a sync move (docs/protocol.md)."""
     if not targets or len(targets) > MAX_SYNC_RECORDS:
         raise UsageError(f"a sync move takes 1..{MAX_SYNC_RECORDS} servos, not {len(targets)}")
     multi = multi_turn

@@ -1,4 +1,4 @@
-"""The NTC relation of servo-protocol.md appendix 5.1, both ways, for tools.
+"""The NTC relation of docs/protocol.md, "The temperature reading", both ways, for tools.
 
 The status area reports temperature as the ADC value of an NTC divider
 (10 kohm to the rail, 10 kohm NTC with B = 3435 to ground, 12-bit ADC), so the

@@ -9,7 +9,7 @@ from .errors import BadAnswer, NoReply, Refused
 from .move_request import MoveRequest
 
 TOLERANCE_DEG = 0.5
-# Status bits under which the servo refuses motion (behaviour.md,
+# Status bits under which the servo refuses motion (docs/protocol.md,
 # "Protection"): high and low voltage, over-temperature.
 INHIBITING = (1 << 3) | (1 << 4) | (1 << 7)
 STALL = 1 << 2

@@ -249,7 +249,7 @@ class Servo:
     def reset_multi_turn(self) -> None:
         self.bus.send(p.RESET_MULTI_TURN, bytes([self.id]))
 
-    # ---- engineering units: the documented Python API (README) -------------
+    # ---- engineering units: the documented Python API (docs/servoctl.md) ---
     def move_to(self, degrees: float, duration_s: float = None, speed_dps: float = None,
                 accel_s: float = 0.02, decel_s: float = 0.02, power_w: float = 0.0,
                 multi_turn: bool = False, wait: bool = False, tolerance_deg: float = 0.5):

@@ -1,8 +1,7 @@
 """Every failure is one line and an exit code, never a traceback: a servo
 whose answers are short (with a good checksum: garbled, another firmware,
 two servos on one ID), and a link that drops in a way pyserial reports as
-termios.error, which is not an OSError (issue 23, "It says the wrong
-thing")."""
+termios.error, which is not an OSError."""
 import socket
 import termios
 import threading

@@ -6,7 +6,7 @@ from servoctl import ntc
 def test_reference_points():
     assert ntc.celsius_to_adc(25.0) == 2048
     assert ntc.adc_to_celsius(2048) == pytest.approx(25.0, abs=0.05)
-    # extensions.md: 651 is about 75 degC.
+    # docs/protocol.md: 651 is about 75 degC.
     assert 74.0 < ntc.adc_to_celsius(651) < 77.0
 
 

@@ -32,7 +32,7 @@
 
 /* The analogue front end: 3.3 V ADC reference; supply through a 100k/10k
  * divider (11:1); 25 mOhm shunt into a gain-of-20 amplifier (0.5 V/A); the
- * NTC divider of servo-protocol.md appendix 5.1. */
+ * NTC divider of docs/protocol.md, "The temperature reading". */
 #define BOARD_SUPPLY_UV_PER_COUNT 8862  /* 3.3 V x 11 / 4096 */
 #define BOARD_CURRENT_UA_PER_COUNT 1611 /* 3.3 V / 0.5 V/A / 4096 */
 #define BOARD_CURRENT_ZERO_COUNTS 0

@@ -1,6 +1,6 @@
 /* The motion layer: turns decoded motion commands into profiles, runs the
  * control loop every tick and answers for position and state. Units at this
- * interface are the protocol's (0.1 degree, ms, mW); behaviour.md, "Motion",
+ * interface are the protocol's (0.1 degree, ms, mW); docs/protocol.md, "Moves",
  * says what each command does. */
 #ifndef MOTION_MOTION_H
 #define MOTION_MOTION_H

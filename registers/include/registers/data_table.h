@@ -24,7 +24,7 @@ struct data_item {
     uint8_t offset;   /* offsetof() in its area's struct */
     int32_t min;      /* accepted range for writes, inclusive */
     int32_t max;
-    int32_t factory;  /* user area: factory value (extensions.md) */
+    int32_t factory;  /* user area: factory value (docs/protocol.md) */
 };
 
 /* Largest item: the serial number, 4 bytes. */

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Runs the ARM builds of the benchmarks under qemu-system-arm with the
 instruction-counting plugin and prints Thumb-2 instruction counts per region
-for the Cortex-M3 and the Cortex-M0, beside issue 10's budgets.
+for the Cortex-M3 and the Cortex-M0, beside their budgets.
 
     python3 tests/bench/target/run_target_bench.py [--check] [--json FILE] [--profile REGION]
 
@@ -38,7 +38,7 @@ CPUS = {"cortex-m3": ROOT / "build/target-bench-m3/bench", "cortex-m0": ROOT / "
 MODEL = {"cortex-m3": "core=m3,ws=2,line=8", "cortex-m0": "core=m0,ws=1,line=4"}
 CLOCK_MHZ = {"cortex-m3": 72, "cortex-m0": 48}
 KNOWN_LOOP = 200  # 100 more iterations of a 2-instruction loop
-# Budgets (issues 10 and 26), in instructions or modelled us, per CPU.
+# Budgets, in instructions or modelled us, per CPU (docs/benchmark.md).
 # Each fails the run (--check) when exceeded.
 BUDGETS = {
     "cortex-m3": {"rx_per_byte": 40, "tick": 300, "servo_tick": 450, "plan": 1000},
@@ -46,7 +46,7 @@ BUDGETS = {
 }
 RESPONSE_BUDGET_US = {"cortex-m3": 20, "cortex-m0": 30}
 # A write that changes the user area is answered once its record is
-# programmed (issue 22): this budget is the CPU's part; the flash's own
+# programmed: this budget is the CPU's part; the flash's own
 # 24 half-words x 40-70 us (DS5319) come on top (docs/decisions.md).
 DURABLE_WRITE_BUDGET_US = {"cortex-m3": 200, "cortex-m0": 600}
 DURABLE_WRITES = ("answer_write_data", "answer_write_batch", "answer_reset_user_data")

@@ -1,4 +1,4 @@
-"""Config and backup files say what they mean (issue 23): units on every
+"""Config and backup files say what they mean: units on every
 value, the servo they came from; raw files load only when marked as raw;
 config diff compares servos, files and factory values, by serial number
 where known."""

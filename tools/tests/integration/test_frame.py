@@ -2,7 +2,7 @@
 its origin in every command and in the Python API, single-turn unless asked
 otherwise, never changed by what else is in the command; the angle limits
 hold for every move servoctl makes. Each case below drove a horn somewhere
-it was not asked to go (issue 23, "Why")."""
+it was not asked to go."""
 import re
 
 import pytest

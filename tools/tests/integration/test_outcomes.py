@@ -1,6 +1,6 @@
 """servoctl says what really happened, in one line, with an exit code
 (0 done, 1 refused or not arrived, 2 usage, 3 no reply, 4 link, 130
-interrupted): every case a new user met (issue 11, "Why")."""
+interrupted): every case a new user met."""
 import json
 import os
 import signal
@@ -355,7 +355,7 @@ def test_a_new_id_already_on_the_bus_is_refused(sim3, capsys):
 
 def test_id_254_is_a_servo_id(tmp_path, capsys):
     """254 was skipped by scan and backup, refused by sync-move, monitor
-    and update (behaviour.md: IDs are 0..254)."""
+    and update (IDs are 0..254)."""
     from servoctl.sim import Simulator
 
     sim = Simulator(ids=[254], tcp=True, state_dir=str(tmp_path / "state"))

@@ -1,4 +1,4 @@
-"""scan and the servos it finds (issue 23): two servos on one ID are
+"""scan and the servos it finds: two servos on one ID are
 noticed (their answers arrive twice, or garbled), a servo waiting in its
 bootloader is named as such with the command that recovers it, and a
 socket:// link, which carries no baud rate, is scanned once."""

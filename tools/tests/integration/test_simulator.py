@@ -36,7 +36,7 @@ def test_a_servo_at_another_baud_rate_is_not_heard(pty_sim):
 
 
 def test_a_second_program_on_the_port_is_refused_not_let_in(pty_sim, capsys):
-    """Issue 23: servoctl opens the port exclusively. A second servoctl gets
+    """servoctl opens the port exclusively. A second servoctl gets
     a one-line 'in use' and exit 4, and the first keeps its answers."""
     from servoctl.cli import main
 

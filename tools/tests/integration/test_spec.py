@@ -73,7 +73,7 @@ def test_a_move_faster_than_the_motor_arrives_late_without_overshoot(servo, sim)
 
 
 def test_protocol_worked_example_timing(servo, sim):
-    """100 deg at 300 deg/s, ramps 100/200 ms: 483 ms (servo-protocol.md 3.12.3)."""
+    """100 deg at 300 deg/s, ramps 100/200 ms: 483 ms (docs/protocol.md, "Moves")."""
     took, angle = timed_move(servo, sim, angle_decideg=1000, velocity=3000, acc_ms=100, dec_ms=200)
     assert abs(took * 1000 - 483) <= 20
     assert abs(angle - 100.0) <= 0.5

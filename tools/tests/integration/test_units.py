@@ -102,7 +102,7 @@ def test_the_firmware_answers_every_item_as_the_schema_declares_it(sim):
     (["sync-move", "1:10", "--interval", "10"], "give 40 ms or more"),
 ])
 def test_a_value_the_servo_would_clamp_is_refused_in_the_users_units(sim, capsys, argv, said):
-    """Issue 23: --acc 5 was accepted (the servo takes 20), and a range was
+    """--acc 5 was accepted (the servo takes 20), and a range was
     said in protocol units (-1800..1800 x0.1 deg) after the user typed
     degrees. Nothing is sent."""
     rc, _, err = run(sim, capsys, *argv)

@@ -1,4 +1,4 @@
-"""Issue 12: firmware update over the bus, on a simulated three-servo bus.
+"""Firmware update over the bus, on a simulated three-servo bus.
 
 The simulator runs the bootloader core on each servo (firmware/boards/
 host_sim/sim_boot.c): its answers, its boot decision and the slot in a
@@ -217,7 +217,7 @@ def test_update_enter_is_refused_while_a_load_is_held(sim, capsys, tmp_path):
         sim.wait_until(lambda: not s.status() & 1, 3)
         sim.control("load 1.2")
         sim.sleep(0.5)
-        held = sim.state(1)["angle"]  # within a degree of 44 (issue 26: the hold sags)
+        held = sim.state(1)["angle"]  # within a degree of 44 (the hold sags)
         assert abs(held - 44.0) < 1.5
         assert bus.request(upd.UPDATE_ENTER, bytes([1]))[1:] == bytes([0, upd.ENTER_OUTPUT_DRIVEN])
     path = tmp_path / "app.img"
@@ -290,7 +290,7 @@ def test_flash_faults_are_reported_not_hidden(sim):
 @pytest.mark.parametrize("lost", [upd.UPDATE_ENTER, upd.UPDATE_ERASE, upd.UPDATE_WRITE,
                                   upd.UPDATE_VERIFY, upd.UPDATE_BOOT])
 def test_every_step_survives_a_lost_answer(sim, lost):
-    """Issue 23: the servo carries out a request whose answer the host
+    """The servo carries out a request whose answer the host
     never sees (the answer is read off the wire and thrown away). The update
     still ends with the new version running and exit 0: a repeated write
     finds its bytes in place, and after UpdateEnter or UpdateBoot the mode
