@@ -9,8 +9,9 @@ reference's rules in prose, protocol/rules.md:
 
 The C headers: protocol/packet_codes.h (every packet's code, which carry a
 servo ID), protocol/packet_rows.h (each packet table's rows and the
-handlers' prototypes) and registers/schema_items.h (the register structs,
-the status bits, each item's row and range)."""
+handlers' prototypes), registers/schema_items.h (the register structs,
+the status bits, each item's row and range) and sim/control_commands.h
+(servo_sim's control port)."""
 import sys
 from pathlib import Path
 
@@ -116,6 +117,19 @@ def schema_items_h(s: sch.Schema) -> str:
             + _macro("DATA_ITEM_ROWS", rows) + "\n#endif\n")
 
 
+def control_commands_h(s: sch.Schema) -> str:
+    """servo_sim's control commands: each one's name and the value it takes."""
+    def row(c: sch.Control) -> str:
+        lo, hi, unit = c.value if c.value else (0, 0, "")
+        return (f'{{"{c.name}", {"true" if c.value else "false"}, {"true" if c.off else "false"}, '
+                f'{float(lo)!r}, {float(hi)!r}, "{unit}"}},')
+    return (NOTICE + "#ifndef SIM_CONTROL_COMMANDS_H\n#define SIM_CONTROL_COMMANDS_H\n\n"
+            "/* servo_sim's control port: what help answers, and each command's row:\n"
+            " * {name, takes a number, takes \"off\", least, most, unit}. */\n"
+            f'#define SIM_CONTROL_HELP "{s.help_line("servo_sim")}\\n"\n'
+            + _macro("SIM_CONTROL_COMMANDS", [row(c) for c in s.controls_of("servo_sim")]) + "\n#endif\n")
+
+
 def write(path: Path, text: str) -> None:
     """Only a changed text is written: a schema change that leaves the C
     headers as they were (a rule's words) recompiles nothing."""
@@ -128,6 +142,10 @@ def write(path: Path, text: str) -> None:
 # ---- docs/protocol.md -----------------------------------------------------
 def _cell(text: str) -> str:
     return str(text).replace("|", "\\|")
+
+
+def _number(value) -> str:
+    return f"{int(value)}" if float(value).is_integer() else f"{value}"
 
 
 def _sentence(text: str) -> str:
@@ -228,6 +246,17 @@ def protocol_md(s: sch.Schema) -> str:
                    f"{_cell(i.what)} |")
     out += ["", "## Status bits (item 5)", "", "| bit | name | meaning |", "|---|---|---|"]
     out += [f"| {b.bit} | {b.name} | {_cell(b.what)} |" for b in s.status_bits]
+    out += ["", "## The simulators' control port", "",
+            "servo_sim and the virtual boards (`servoctl sim`, `--board`) take these commands on their",
+            "control port, a text line each, answered with a line: `ok`, `error: ...` (what is wrong), or",
+            "the state. A command with a value may end with a servo's bus ID; without one it applies to",
+            "every servo. `help` lists them.", "",
+            "| command | value | servo_sim | virtual boards | what |", "|---|---|---|---|---|"]
+    for c in s.controls:
+        value = f"{_number(c.value[0])} to {_number(c.value[1])} {c.value[2]}" + \
+            (", or off" if c.off else "") if c.value else ""
+        out.append(f"| `{_cell(c.usage)}` | {value} | {'yes' if 'servo_sim' in c.on else 'no'} | "
+                   f"{'yes' if 'vboard' in c.on else 'no'} | {_cell(c.what)} |")
     rules = RULES.read_text(encoding="utf-8")
     out += ["", "## Rules", "", rules[rules.index("\n") + 1:].strip(), ""]
     return "\n".join(out).rstrip("\n") + "\n"
@@ -260,6 +289,7 @@ def main(argv=None) -> int:
         write(out / "protocol" / "packet_codes.h", packet_codes_h(s))
         write(out / "protocol" / "packet_rows.h", packet_rows_h(s))
         write(out / "registers" / "schema_items.h", schema_items_h(s))
+        write(out / "sim" / "control_commands.h", control_commands_h(s))
         return 0
     folder = Path(args[1])
     pages = {folder / "protocol.md": protocol_md(s), folder / "protocol-packets.md": packets_md(s)}

@@ -70,6 +70,17 @@ class Item:
 
 
 @dataclass(frozen=True)
+class Control:
+    """A command of the simulators' control port."""
+    name: str       # its first word
+    usage: str      # as help shows it
+    value: tuple    # (least, most, unit) of the number it takes, or None
+    off: bool       # it also takes the word off
+    on: tuple       # the simulators that take it: servo_sim, vboard
+    what: str
+
+
+@dataclass(frozen=True)
 class StatusBit:
     bit: int
     name: str
@@ -82,6 +93,14 @@ class Schema:
     status_bits: tuple
     items: tuple
     packets: tuple
+    controls: tuple
+
+    def controls_of(self, simulator: str) -> tuple:
+        return tuple(c for c in self.controls if simulator in c.on)
+
+    def help_line(self, simulator: str) -> str:
+        """What help answers on that simulator's control port."""
+        return "ok " + " | ".join(c.usage for c in self.controls_of(simulator))
 
     def area(self, name: str) -> tuple:
         return tuple(i for i in self.items if i.area == name)
@@ -195,6 +214,20 @@ def _sized(p: Packet, user_area: int, frame: dict) -> Packet:
     return p
 
 
+def _control(raw: dict) -> Control:
+    try:
+        value = raw.get("value")
+        if value is not None and (len(value) != 3 or not value[0] <= value[1] or not isinstance(value[2], str)):
+            raise SchemaError(f"control {raw['usage']!r}: value is [least, most, unit]")
+        on = tuple(raw["on"])
+        if not on or set(on) - {"servo_sim", "vboard"}:
+            raise SchemaError(f"control {raw['usage']!r}: on names servo_sim and/or vboard")
+        return Control(raw["usage"].split()[0], raw["usage"], tuple(value) if value else None,
+                       raw.get("off", False), on, raw["what"])
+    except KeyError as e:
+        raise SchemaError(f"a control command has no {e.args[0]}") from None
+
+
 def _unique(kind: str, values) -> None:
     seen = set()
     for v in values:
@@ -208,7 +241,7 @@ def parse(text: str) -> Schema:
         raw = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
         raise SchemaError(f"not TOML: {e}") from None
-    unknown = set(raw) - {"frame", "status_bit", "item", "packet"}
+    unknown = set(raw) - {"frame", "status_bit", "item", "packet", "control"}
     missing = FRAME_KEYS - set(raw.get("frame", {}))
     if unknown or missing or not raw.get("item") or not raw.get("packet"):
         raise SchemaError(f"the schema has frame (with {', '.join(sorted(FRAME_KEYS))}), status_bit, item and "
@@ -230,7 +263,8 @@ def parse(text: str) -> Schema:
     frame = raw.get("frame", {})
     user_area = sum(i.size for i in items if i.area == "user")
     packets = tuple(_sized(p, user_area, frame) for p in packets)
-    schema = Schema(frame, bits, items, packets)
+    schema = Schema(frame, bits, items, packets, tuple(_control(c) for c in raw.get("control", [])))
+    _unique("control commands", [c.name for c in schema.controls])
     for table, rows in schema.tables().items():
         codes = [p.code for p in rows]
         if codes != list(range(codes[0], codes[0] + len(codes))):

@@ -18,17 +18,16 @@ import sys
 import tempfile
 import time
 
+from servoctl import schema
+
 from .board import PARTS, Board, images
 from .bus import Bus
 
 MAX_SLICE_S = 1e-3  # longest the CPUs run between two looks at the host and the models
-RANGES = {"supply": (0, 30000, "mV"), "load": (-50, 50, "N m"), "ambient": (-40, 150, "degC"),
-          "soak": (-40, 150, "degC"), "stop": (-1e6, 1e6, "deg"), "hostbaud": (1200, 4000000, "baud"),
-          "failerase": (0, 1e6, "erases"), "failprogram": (0, 1e6, "programs"),
-          "cutprogram": (1, 1e6, "programs")}
-HELP = ("ok supply MV | load NM | stop DEG | stop off | ambient DEGC | soak DEGC | hostbaud BAUD | "
-        "failerase N | failprogram N | cutprogram N | powercycle [ID] | state [ID] | clock | "
-        "hostsend MS HEX | peek ADDR N ID")
+# The control port's commands (protocol/schema.toml, as servo_sim's): what
+# help answers, and the range of each one's number.
+CONTROLS = {c.name: c for c in schema.load().controls_of("vboard")}
+HELP = schema.load().help_line("vboard")
 
 
 class Runner:
@@ -69,7 +68,10 @@ class Runner:
                 return bytes(board.core.uc.mem_read(address, min(n, 256))).hex()
             except (IndexError, ValueError, StopIteration) as e:
                 return f"error: peek takes ADDR N ID ({e})"
-        takes_value = cmd not in ("state", "powercycle")
+        control = CONTROLS.get(cmd)
+        if control is None:
+            return "error: unknown command (try help)"
+        takes_value = control.value is not None
         id_word = 2 if takes_value else 1
         boards = self.boards
         if len(words) > id_word:  # the ID a board holds now, not the one it started with
@@ -82,16 +84,16 @@ class Runner:
                 return "error: no servo holds that ID"
         value = 0.0
         if takes_value:
-            if cmd not in RANGES:
-                return "error: unknown command (try help)"
             if len(words) < 2:
                 return "error: missing value"
-            if not (cmd == "stop" and words[1] == "off"):
+            if words[1] == "off" and not control.off:
+                return "error: only stop takes off"
+            if words[1] != "off":
                 try:
                     value = float(words[1])
                 except ValueError:
                     return "error: the value must be a number"
-                lo, hi, unit = RANGES[cmd]
+                lo, hi, unit = control.value
                 if not lo <= value <= hi:
                     return f"error: {cmd} takes {lo:g} to {hi:g} {unit}, not {words[1]}"
         if cmd == "hostbaud":

@@ -9,7 +9,29 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include "sim/control_commands.h"
 #include "sim_link.h"
+
+/* The control port's commands (protocol/schema.toml): what each takes. */
+struct control_command {
+    const char *name;
+    bool takes_value; /* a number, checked against lo..hi */
+    bool takes_off;   /* the word off instead */
+    double lo, hi;    /* what each model can take: a NaN or an infinity would stay in it for good */
+    const char *unit;
+};
+
+static const struct control_command commands[] = {SIM_CONTROL_COMMANDS};
+
+static const struct control_command *command_named(const char *name)
+{
+    for (size_t k = 0; k < sizeof commands / sizeof commands[0]; k++) {
+        if (strcmp(name, commands[k].name) == 0) {
+            return &commands[k];
+        }
+    }
+    return NULL;
+}
 
 /* A command's servo: its bus ID as it is now (0..254: every servo that
  * holds it), or its serial number; -1 when the word is neither. */
@@ -116,8 +138,16 @@ static void control_command(const struct sim_control *c, int fd, char *line)
         host_send(c, fd, n, words);
         return;
     }
-    bool takes_value = strcmp(cmd, "state") != 0 && strcmp(cmd, "help") != 0 &&
-                       strcmp(cmd, "powercycle") != 0;
+    if (strcmp(cmd, "help") == 0) {
+        reply(fd, SIM_CONTROL_HELP);
+        return;
+    }
+    const struct control_command *command = command_named(cmd);
+    if (command == NULL) {
+        reply(fd, "error: unknown command (try help)\n");
+        return;
+    }
+    bool takes_value = command->takes_value;
     int id_word = takes_value ? 2 : 1;
     long only = -1; /* every servo */
     if (n > id_word) {
@@ -131,12 +161,6 @@ static void control_command(const struct sim_control *c, int fd, char *line)
             return;
         }
     }
-    if (strcmp(cmd, "help") == 0) {
-        reply(fd, "ok supply MV | load NM | stop DEG | stop off | ambient DEGC | soak DEGC | "
-                  "hostbaud BAUD | failerase N | failprogram N | powercycle [ID] | state [ID] | "
-                  "clock | hostsend MS HEX\n");
-        return;
-    }
     if (takes_value && n < 2) {
         reply(fd, "error: missing value\n");
         return;
@@ -144,48 +168,24 @@ static void control_command(const struct sim_control *c, int fd, char *line)
     char *end = NULL;
     double value = takes_value ? strtod(words[1], &end) : 0.0;
     bool off = takes_value && strcmp(words[1], "off") == 0;
+    if (off && !command->takes_off) {
+        reply(fd, "error: only stop takes off\n");
+        return;
+    }
     if (takes_value && !off && (end == words[1] || *end != '\0')) {
         reply(fd, "error: the value must be a number\n");
         return;
     }
-    /* What each model can take: a NaN or an infinity would stay in the
-     * plant for good. */
-    static const struct {
-        const char *cmd;
-        double lo, hi;
-        const char *unit;
-    } ranges[] = {
-        {"supply", 0, 30000, "mV"},   {"load", -50, 50, "N m"},
-        {"ambient", -40, 150, "degC"}, {"soak", -40, 150, "degC"},
-        {"stop", -1e6, 1e6, "deg"},    {"hostbaud", 1200, 4000000, "baud"},
-        {"failerase", 0, 1000000, "erases"}, {"failprogram", 0, 1000000, "programs"},
-    };
-    for (size_t r = 0; takes_value && !off && r < sizeof ranges / sizeof ranges[0]; r++) {
-        if (strcmp(cmd, ranges[r].cmd) == 0 && !(value >= ranges[r].lo && value <= ranges[r].hi)) {
-            char msg[128];
-            snprintf(msg, sizeof msg, "error: %s takes %g to %g %s, not %s\n", cmd, ranges[r].lo,
-                     ranges[r].hi, ranges[r].unit, words[1]);
-            reply(fd, msg);
-            return;
-        }
-    }
-    if (off && strcmp(cmd, "stop") != 0) {
-        reply(fd, "error: only stop takes off\n");
+    if (takes_value && !off && !(value >= command->lo && value <= command->hi)) {
+        char msg[128];
+        snprintf(msg, sizeof msg, "error: %s takes %g to %g %s, not %s\n", cmd, command->lo,
+                 command->hi, command->unit, words[1]);
+        reply(fd, msg);
         return;
     }
     if (strcmp(cmd, "hostbaud") == 0) {
         c->bus->host_baud = (uint32_t)value;
         reply(fd, "ok\n");
-        return;
-    }
-    static const char *const known[] = {"supply", "load", "ambient", "soak", "stop", "failerase",
-                                        "failprogram", "powercycle", "state"};
-    bool is_known = false;
-    for (size_t k = 0; k < sizeof known / sizeof known[0]; k++) {
-        is_known = is_known || strcmp(cmd, known[k]) == 0;
-    }
-    if (!is_known) {
-        reply(fd, "error: unknown command (try help)\n");
         return;
     }
     /* Who is addressed is decided before any servo is touched: a power
