@@ -2,7 +2,7 @@
  * in integers, low-pass filtered at the rate each reading changes: the
  * current every control tick (a stall or a short moves it within one), the
  * supply, the power and the temperature one per tick in turn, each every
- * SENSE_ROUND_TICKS (docs/decisions.md, "Monitors at the rate of their
+ * SENSE_ROUND_TICKS (docs/benchmark.md, "Monitors at the rate of their
  * physics"). */
 #ifndef SENSORS_SCALING_H
 #define SENSORS_SCALING_H

@@ -1,4 +1,4 @@
-/* The ends of the position range (docs/decisions.md, "The ends of every
+/* The ends of the position range (docs/decisions-motion.md, "The ends of every
  * range"): whatever turns the horn, the multi-turn reading stays within
  * +-3 686 400, its turn count agrees with it, a move in flight goes on
  * across a shift of the origin, and the controller's error saturates
