@@ -39,7 +39,7 @@ static void rebase_endless(struct motion *m)
 /* The multi-turn reading stays within +-MULTI_TURN_LIMIT whatever turns the
  * horn (wheel mode, many turns, a load back-driving it): past either end
  * the origin moves FRAME_SHIFT (1024 turns) the same way and the reading
- * goes on from about 0 (docs/decisions.md, "The ends of every range"). A
+ * goes on from about 0 (docs/decisions-motion.md, "The ends of every range"). A
  * whole range lies between two shifts, so a horn held at an end does not
  * shift back and forth. */
 #define FRAME_SHIFT_COUNTS ((int32_t)(MULTI_TURN_LIMIT / DECIDEG_PER_TURN) * ENCODER_COUNTS)
