@@ -59,9 +59,7 @@ def packet_codes_h(s: sch.Schema) -> str:
 
 def _length_rule(p: sch.Packet) -> str:
     least, most = p.length
-    if (least, most) == (0, 0xFFFF):
-        return "{0, 0xFFFFu}"
-    return f"{{{least}, {most}}}" if least == most else f"{{{least}, {'0xFFFFu' if most == 0xFFFF else most}}}"
+    return f"{{{least}, {'0xFFFFu' if most == 0xFFFF else most}}}"
 
 
 def packet_rows_h(s: sch.Schema) -> str:
