@@ -74,9 +74,6 @@ class Usart(Model):
         self.shifting, self.tdr = False, None
         self.idle_at_s = None
 
-    def cr1(self, field: str) -> bool:
-        return bool(self.w[self.i_cr1] & self.bit("CR1", field))
-
     def baud(self) -> int:
         """PCLK / BRR: worked out again only when BRR or the clocks change."""
         key = (self.w[self.i_brr] & 0xFFFF, self.board.clock_setting)
