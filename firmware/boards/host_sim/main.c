@@ -32,6 +32,9 @@ static volatile sig_atomic_t stop_requested;
  * servoctl recognises (protocol.py, BUS_IN_USE). */
 #define BUS_IN_USE "servo_sim: the bus is in use by another client\n"
 enum { REFUSED_MAX = 4 };
+/* How long the servos run before the simulator says it is ready: their
+ * first control ticks (1 ms apart) have run by then. */
+enum { READY_AFTER_US = 5000 };
 static int refused[REFUSED_MAX] = {-1, -1, -1, -1};
 
 static void tell_in_use(int fd)
@@ -53,6 +56,21 @@ static void refuse(int fd)
         }
     }
     close(fd);
+}
+
+/* The servos and the wire up to target on the bus clock, a byte time at a
+ * time, the servos' main loops running at each (as on silicon, between one
+ * byte's interrupt and the next): when the loop was late, the bytes it
+ * catches up on do not all land before a servo has seen the first. */
+static void run_to(uint64_t target)
+{
+    do {
+        uint64_t next = sim_bus_next_at(&bus, target);
+        sim_bus_deliver(&bus, next);
+        for (unsigned i = 0; i < bus.station_count; i++) {
+            sim_servo_poll(&servos[i], bus.now_us);
+        }
+    } while (bus.now_us < target);
 }
 
 static void on_signal(int sig)
@@ -92,6 +110,15 @@ int main(int argc, char **argv)
     }
     struct sim_control control;
     sim_control_open(&control, o.control_port, &bus, servos, &most_behind_us);
+    /* The servos run the first READY_AFTER_US of their power-up before
+     * "ready": the first requests find their first control ticks run and
+     * their readings (IDs 1-4) taken, as a host finds a servo after its
+     * power-up, however long the PC then keeps this process waiting. */
+    uint64_t ready_at = bus.now_us + READY_AFTER_US;
+    while (bus.now_us < ready_at) {
+        uint64_t to = sim_bus_step_to(&bus, sim_now_us());
+        run_to(to < ready_at ? to : ready_at);
+    }
 
     printf("servo_sim: bus %s\n", where);
     if (o.link) {
@@ -186,17 +213,7 @@ int main(int argc, char **argv)
         if (wall_now - target > most_behind_us) {
             most_behind_us = wall_now - target;
         }
-        /* Up to the target a byte time at a time, the servos' main loops
-         * running at each (as on silicon, between one byte's interrupt and
-         * the next): when the loop was late, the bytes it catches up on do
-         * not all land before a servo has seen the first. */
-        do {
-            uint64_t next = sim_bus_next_at(&bus, target);
-            sim_bus_deliver(&bus, next);
-            for (unsigned i = 0; i < bus.station_count; i++) {
-                sim_servo_poll(&servos[i], bus.now_us);
-            }
-        } while (bus.now_us < target);
+        run_to(target);
     }
     if (o.link) {
         unlink(o.link);

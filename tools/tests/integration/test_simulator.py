@@ -107,3 +107,31 @@ def test_the_fault_channel_refuses_what_no_model_can_take(sim, value):
         assert math.isfinite(state[key]), key
     with sim.bus() as bus:
         assert Servo(bus, 1).ping()
+
+
+def test_a_request_the_moment_the_simulator_is_ready_finds_the_readings_taken(tmp_path):
+    """servo_sim says ready once its servos have run their first control
+    ticks, as a host meets a servo after its power-up. The request here
+    reaches the simulator while it is stopped at that moment (a busy PC), so
+    it lands on the bus at the simulated instant of ready: the supply (ID 1)
+    has been read by then, not 0 mV."""
+    import os
+    import signal
+    import socket
+
+    with Simulator(ids=[1], state_dir=str(tmp_path / "state")) as sim:
+        host, port = sim.url.removeprefix("socket://").split(":")
+        with socket.create_connection((host, int(port))) as link:
+            os.kill(sim.process.pid, signal.SIGSTOP)
+            try:
+                link.sendall(p.request_frame(p.READ_DATA, bytes([1, 1])))
+                time.sleep(0.05)
+            finally:
+                os.kill(sim.process.pid, signal.SIGCONT)
+            link.settimeout(5.0)  # a bound on a hung simulator, not a judgement of time
+            answer = b""
+            while len(answer) < 8:
+                answer += link.recv(64)
+    assert answer[:6] == p.response_frame(p.READ_DATA, bytes([1, 1, 0, 0]))[:6]
+    voltage_mv = int.from_bytes(answer[6:8], "little")
+    assert 7300 <= voltage_mv <= 7500, f"the supply read {voltage_mv} mV"
