@@ -6,14 +6,11 @@ Roots: main and every interrupt handler defined in the image. Functions
 nothing calls directly are what a function only reached through a pointer
 looks like; the firmware has three kinds of function pointer, and an
 indirect call is bounded by the worst target of its kind:
-  in dispatch_packet   the packet handlers (handle_*)
+  in dispatch(_packet) the packet handlers (handle_*)
   in usart_hd_irq      the clock that stamps received bytes (systick_now_us)
   in a packet handler  the store's persist hook (persist_user), or a HAL op
   anywhere else        the port's HAL operations (everything else)
-Recursion is an error, but for one bounded case: handle_sync runs its
-record through dispatch_packet, and a record is never itself a sync
-(PF_SYNCABLE), so dispatch_packet may appear twice on a path. A
-library function without a call graph (memcpy, libgcc) is charged
+Recursion is an error. A library function without a call graph (memcpy, libgcc) is charged
 LIBRARY_BYTES. All interrupts share one priority, so they do not nest: the
 worst case is main's deepest path plus the deepest handler plus the
 Cortex-M3's 32-byte exception frame. Fails when that exceeds the stack the
@@ -103,8 +100,11 @@ def main() -> int:
     def short(t):
         return t.split(":")[-1]
 
+    handlers = [t for t in pointer_targets if short(t).startswith("handle_")]
     kinds = {
-        "dispatch_packet": [t for t in pointer_targets if short(t).startswith("handle_")],
+        # dispatch_packet is dispatch's, inlined or not.
+        "dispatch": handlers,
+        "dispatch_packet": handlers,
         # systick_now_us is also called directly, so it is no pointer target.
         "usart_hd_irq": [t for t in stack if short(t) == "systick_now_us"],
     }
@@ -126,14 +126,12 @@ def main() -> int:
                 has_indirect(c, seen | {title}) for c in cs)
         return indirect_below[title]
 
-    reentry = {"dispatch_packet": 2}  # times it may stand on one path
-
     def worst(title, path):
-        if path.count(title) >= reentry.get(title.split(":")[-1], 1):
+        if title in path:
             raise Recursion(title)
         if title not in stack:
             return LIBRARY_BYTES, [title.split(":")[-1] + " (library)"]
-        if title in memo and title not in path:
+        if title in memo:
             return memo[title]
         best, chain = 0, []
         for callee in calls[title]:
@@ -141,8 +139,6 @@ def main() -> int:
                 targets = kinds.get(short(title), hal_ops)
                 if short(title).startswith(("handle_", "commit_user")):
                     targets = hal_ops + persist  # WriteData, WriteBatchData, ResetUserData
-                if short(title) == "dispatch_packet" and title in path:
-                    targets = [t for t in targets if short(t) != "handle_sync"]  # a record is no sync
                 for c in targets:
                     d, ch = worst(c, path + (title,))
                     if d > best:
@@ -152,7 +148,7 @@ def main() -> int:
                 if d > best:
                     best, chain = d, ch
         result = (stack[title] + best, [title.split(":")[-1]] + chain)
-        if not has_indirect(title) and title not in path:
+        if not has_indirect(title):
             memo[title] = result  # path-independent
         return result
 

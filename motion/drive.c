@@ -1,6 +1,6 @@
-/* The output's limits: the current the bridge may draw (the move's power, a
- * stall's cap, the current protection, a derate), as a duty for the supply
- * now, and the braking a load leaves. Divides only when what it depends on
+/* The output: the current the bridge may draw (the move's power, a stall's
+ * cap, the current protection, a derate), as a duty for the supply now; the
+ * braking a load leaves; letting it go. Divides only when what it depends on
  * has changed. */
 #include <stddef.h>
 
@@ -67,4 +67,12 @@ int32_t motion_brake_duty(const struct motion *m, int32_t dir)
     int32_t assisting = dir > 0 ? -m->controller.integral_q15 : m->controller.integral_q15;
     assisting = assisting < 0 ? 0 : assisting > limit / 2 ? limit / 2 : assisting;
     return brake_duty(limit, assisting);
+}
+
+void motion_coast(struct motion *m)
+{
+    m->mode = MODE_RELEASED;
+    m->running = 0;
+    m->controller.at_limit = 0;
+    m->hal->motor.coast(m->hal->ctx);
 }

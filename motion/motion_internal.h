@@ -1,5 +1,5 @@
-/* What motion.c (commands, state) and control_tick.c (the tick) share;
- * private to the motion layer. The tick's positions are Q8 decidegrees in
+/* What the motion layer's parts share (motion.c lists them); private to
+ * the layer. The tick's positions are Q8 decidegrees in
  * int32, the profile's Q32 in int64; speeds are decidegrees per tick in the
  * same formats (motion.h). */
 #ifndef MOTION_INTERNAL_H
@@ -62,23 +62,41 @@ static inline int32_t motion_center_offset_q8(const struct motion *m)
     return (int32_t)m->regs->user.center_offset_decideg * 256;
 }
 
-/* Moves the origin by counts the way the angle grows: every position the
- * motion layer holds (horn, setpoint, profile) moves with it, so a move in
- * flight goes on unchanged. The encoder's count and the origin are kept
- * within a turn of each other's whole turns, so neither outgrows int32. */
-void motion_move_origin(struct motion *m, int32_t counts);
-/* The supply the limits are worked out for: the measured one, 7.4 V until
- * there is one. */
-uint16_t motion_supply_mv(const struct motion *m);
-/* The current limit and the supply-scaled gains (divides: on changes only). */
-void motion_update_limits(struct motion *m);
+/* ---- setpoint.c ---- */
+/* The tick's copies of the profile (Q8, saturated): at tick (at_tick, Q32),
+ * at tick + 1 (where the walk is), the target, and the setpoint between
+ * them at the clock's fraction. */
+void motion_take_profile_q8(struct motion *m, int64_t at_tick);
 /* Starts the profile's clock at its tick 0, in real time. */
 void motion_clock_restart(struct motion *m);
 /* The acceleration feed-forward of the walk's phase at the present ka,
  * from tick on. */
 void motion_take_accel_duty(struct motion *m, uint32_t tick);
+
+/* ---- position.c ---- */
+/* Moves the origin by counts the way the angle grows: every position the
+ * motion layer holds (horn, setpoint, profile) moves with it, so a move in
+ * flight goes on unchanged. The encoder's count and the origin are kept
+ * within a turn of each other's whole turns, so neither outgrows int32. */
+void motion_move_origin(struct motion *m, int32_t counts);
+
+/* ---- drive.c ---- */
+/* The supply the limits are worked out for: the measured one, 7.4 V until
+ * there is one. */
+uint16_t motion_supply_mv(const struct motion *m);
+/* The current limit and the supply-scaled gains for the running command's
+ * power (power_mw) (divides: on changes only). */
+void motion_update_limits(struct motion *m);
 /* The braking duty the output can count on moving in direction dir. */
 int32_t motion_brake_duty(const struct motion *m, int32_t dir);
+/* Lets the output go (released, turning freely); the command ends. */
+void motion_coast(struct motion *m);
+
+/* ---- planning.c ---- */
+/* Runs a command now: its profile, or the mode it sets. */
+void motion_run(struct motion *m, const struct motion_command *cmd);
+
+/* ---- command_queue.c ---- */
 /* The running command has finished: answer, release or hold, next one. */
 void motion_finish(struct motion *m);
 

@@ -27,8 +27,10 @@ static bool answers(const struct dispatcher *d, uint8_t flags)
            ((flags & PF_ANSWERS_IF_CONTROL_RESPONSE) && d->regs->user.control_response);
 }
 
-void dispatch_packet(const struct packet_desc *desc, struct packet_call *call,
-                     struct response *response)
+/* Runs one packet for this servo: a frame's, or the record a SyncCommand
+ * carries for it. */
+static void dispatch_packet(const struct packet_desc *desc, struct packet_call *call,
+                            struct response *response)
 {
     struct dispatcher *d = call->d;
     struct packet_origin origin = call->origin;
@@ -104,38 +106,20 @@ void dispatch(struct dispatcher *d, const struct rx_frame *frame, struct respons
     call.length = frame->length;
     call.origin = origin;
     call.result = result;
+    if (desc->flags & PF_CARRIES_RECORDS) {
+        /* SyncCommand: this servo's record is the packet. It carries no ID,
+         * so its origin is never a broadcast: the record's is a sync. */
+        if (frame->sync_index == FRAME_SYNC_NO_RECORD) {
+            return; /* no record for this servo */
+        }
+        desc = packet_find(frame->content[0]);
+        if (desc == NULL || !(desc->flags & PF_SYNCABLE) || frame->content[1] != desc->length.min) {
+            set_command_error(d, true);
+            return;
+        }
+        call.content = &frame->content[3];
+        call.length = frame->content[1];
+        call.origin.from_sync = true;
+    }
     dispatch_packet(desc, &call, response);
-}
-
-enum packet_outcome answer_result(struct response *r, bool ok)
-{
-    r->content[1] = ok ? 1u : 0u;
-    r->length = 2;
-    return ok ? OUTCOME_OK : OUTCOME_FAILED;
-}
-
-enum packet_outcome handle_ignored(const struct packet_call *c, struct response *r)
-{
-    (void)c;
-    (void)r;
-    return OUTCOME_NONE;
-}
-
-enum packet_outcome handle_sync(const struct packet_call *c, struct response *r)
-{
-    if (c->origin.sync_index == FRAME_SYNC_NO_RECORD) {
-        return OUTCOME_NONE; /* no record for this servo */
-    }
-    const struct packet_desc *inner = packet_find(c->content[0]);
-    if (inner == NULL || !(inner->flags & PF_SYNCABLE) || c->content[1] != inner->length.min) {
-        return OUTCOME_ERROR;
-    }
-    /* SyncCommand carries no ID (packet_table.c), so c's origin is never a
-     * broadcast: the record's is c's, from a sync. */
-    struct packet_call record = *c;
-    record.content = &c->content[3];
-    record.length = c->content[1];
-    record.origin.from_sync = true;
-    dispatch_packet(inner, &record, r);
-    return OUTCOME_NONE;
 }

@@ -10,7 +10,9 @@
  *          passes (1, 2, 4, 8), bit 4 a UART slow to finish
  *   op     low 3 bits what, high 5 bits n:
  *          0, 7  n+1 bytes on the wire follow
- *          1     (n & 15) + 1 ms pass, a main-loop pass (and tick) each
+ *          1     (n & 15) + 1 ms pass, a main-loop pass (and tick) each, or
+ *                with n bit 4 a pass each 100 us (a finished move's answer
+ *                waits for a 300 us window of its own)
  *          2     the horn: next byte, as int8 counts per tick; n bit 0: the
  *                encoder follows the setpoint instead; n bit 1: it is held
  *          3     sensors: next 3 bytes are supply (x 40 mV), current
@@ -215,8 +217,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
              * the wire bytes' passes. */
             if (sim_ms + (n & 15u) + 1u <= MAX_SIM_MS) {
                 sim_ms += (n & 15u) + 1u;
-                for (unsigned k = 0; k < (n & 15u) + 1u; k++) {
-                    live.hal.now_us += 1000u;
+                unsigned per_ms = (n & 16u) ? 10u : 1u;
+                for (unsigned k = 0; k < ((n & 15u) + 1u) * per_ms; k++) {
+                    live.hal.now_us += 1000u / per_ms;
                     live.hal.tx_busy = slow_uart && (k & 1u);
                     servo_poll(&live.servo);
                     if (live.hal.sent_length != 0u) {

@@ -89,6 +89,16 @@ def ms(t: int) -> bytes:
     return out
 
 
+def ms_fine(t: int) -> bytes:
+    """t ms with a pass each 100 us."""
+    out = b""
+    while t > 0:
+        step = min(t, 16)
+        out += bytes([(16 | step - 1) << 3 | 1])
+        t -= step
+    return out
+
+
 FOLLOW, SPIN, HELD = 1, 0, 2
 
 
@@ -127,6 +137,9 @@ SERVO_SEEDS = {
     "move_to_completion": (USED, wire(move(900, 200)) + ms(400) + wire(req(0x40, b"\x00"))),
     "move_answered": (ANSWERING, wire(move(-450, 100)) + ms(300) + wire(req(3, b"\x00\x05"))),
     "queued_moves_answered": (ANSWERING, wire(move(300, 60) + move(0, 60) + move(600, 60)) + ms(400)),
+    # Each answer in its window: the quiet before it, then the servo's slot.
+    "finished_moves_answer_in_their_slot": (ANSWERING, wire(move(300, 40) + move(0, 40)) + ms_fine(400)),
+    "queue_full": (ANSWERING, wire(b"".join(move(100 * k, 50) for k in range(10))) + ms(100)),
     "velocity_moves": (USED, wire(req(12, struct.pack("<BhHHHH", 0, 200, 3000, 100, 200, 0))) + ms(200)
                        + wire(req(15, struct.pack("<BiHHHH", 0, -7200, 7500, 50, 60, 0))) + ms(600)),
     "interval_moves": (USED, wire(req(11, struct.pack("<BhHHHH", 0, 1000, 300, 100, 100, 0))) + ms(150)

@@ -11,7 +11,7 @@ from pathlib import Path
 
 SCHEMA = Path(__file__).resolve().parents[2] / "protocol" / "schema.toml"
 FLAGS = ("addressed", "answers", "answers_if_control_response", "broadcast", "query", "syncable",
-         "one_answers")
+         "one_answers", "carries_records")
 FIELD_TYPES = {"u8": 1, "u16": 2, "u32": 4, "i16": 2, "i32": 4, "item": None, "user_area": None, "bytes": None}
 ITEM_SIZES = (1, 4)  # an item's value: 1 to 4 bytes
 ACCESS = ("read", "read-write", "reserved")
@@ -42,7 +42,7 @@ class Packet:
     table: str      # the firmware's packet table its row is in
     flags: tuple
     length: tuple   # (least, most) content bytes
-    handler: str    # handle_<handler>()
+    handler: str    # handle_<handler>(); "" for a packet that carries records
     what: str
     request: tuple
     answer: tuple
@@ -169,7 +169,7 @@ def _packet(raw: dict) -> Packet:
         c = raw.get("c", re.sub(r"(?<!^)(?=[A-Z])", "_", raw["name"]).upper())  # ResetUserData: RESET_USER_DATA
         pkt = Packet(code=raw["code"], name=raw["name"], c=c, py=raw.get("py", c), source=raw["source"],
                      table=raw["table"], flags=tuple(raw.get("flags", ())),
-                     length=_length(where, raw.get("length")), handler=raw["handler"], what=raw["what"],
+                     length=_length(where, raw.get("length")), handler=raw.get("handler", ""), what=raw["what"],
                      request=_fields(where, raw.get("request", ())), answer=_fields(where, raw.get("answer", ())))
     except KeyError as e:
         raise SchemaError(f"{where}: no {e.args[0]}") from None
@@ -178,6 +178,9 @@ def _packet(raw: dict) -> Packet:
         raise SchemaError(f"{where}: codes are 1..254 and flags {', '.join(FLAGS)} (not {unknown})")
     if pkt.source not in ("maker", "extension", "firmware"):
         raise SchemaError(f"{where}: source is maker, extension or firmware")
+    if bool(pkt.handler) == pkt.has("carries_records"):
+        raise SchemaError(f"{where}: a handler, or the flag carries_records (the dispatcher runs "
+                          f"the records), one of the two")
     return pkt
 
 

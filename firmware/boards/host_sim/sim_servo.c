@@ -26,7 +26,7 @@ uint64_t sim_now_us(void)
 
 /* Runs motor and winding up to now with the drive last set; the bus clock
  * moves in small steps, so dt stays near one control tick. */
-void sim_servo_run_models(struct sim_servo *s)
+static void run_models(struct sim_servo *s)
 {
     uint64_t now = s->bus->now_us;
     double dt = (double)(now - s->stepped_us) * 1e-6;
@@ -71,21 +71,21 @@ static void uart_set_baud(void *ctx, uint32_t baud)
 static void motor_drive(void *ctx, int16_t duty)
 {
     struct sim_servo *s = ctx;
-    sim_servo_run_models(s);
+    run_models(s);
     plant_drive(&s->plant, duty);
 }
 
 static void motor_coast(void *ctx)
 {
     struct sim_servo *s = ctx;
-    sim_servo_run_models(s);
+    run_models(s);
     plant_coast(&s->plant);
 }
 
 static uint16_t encoder_read(void *ctx)
 {
     struct sim_servo *s = ctx;
-    sim_servo_run_models(s);
+    run_models(s);
     return plant_encoder(&s->plant);
 }
 
@@ -162,21 +162,49 @@ static uint16_t image_version(void *ctx)
     return app_image_check(&s->slot, SIM_BOARD, &info) == APP_IMAGE_VALID ? info.version : 0u;
 }
 
-static void enter_bootloader(void *ctx)
-{
-    sim_boot_reset(ctx, true);
-}
-
-void sim_servo_start_app(struct sim_servo *s)
+/* The application starts: the servo core, reporting the slot image's
+ * version. */
+static void start_app(struct sim_servo *s)
 {
     s->in_bootloader = false;
     servo_init(&s->core, &s->port);
 }
 
+/* The bootloader, the boards' loop (firmware/bootloader/bootloader.c) on the
+ * servo's port: its receive ring and UART, the config store's flash file,
+ * the slot's. A reset into it (stay: UpdateEnter asked), and its main-loop
+ * pass: false once it has started the application. */
+static void boot_reset(struct sim_servo *s, bool stay)
+{
+    struct sim_boot *b = &s->boot;
+    b->board = (struct boot_board){.port = &s->port, .slot = &s->slot, .board = SIM_BOARD,
+                                   .stay_word = stay ? BOOT_STAY_MAGIC : 0u};
+    s->rx.read = s->rx.written; /* what the application had not read is gone */
+    boot_loop_start(&b->loop, &b->board);
+    run_models(s);
+    plant_coast(&s->plant); /* a reset lets go of the output */
+    s->in_bootloader = true;
+}
+
+static bool boot_poll(struct sim_servo *s)
+{
+    run_models(s);
+    if (boot_loop_step(&s->boot.loop)) {
+        return true;
+    }
+    start_app(s);
+    return false;
+}
+
+static void enter_bootloader(void *ctx)
+{
+    boot_reset(ctx, true);
+}
+
 void sim_servo_power_cycle(struct sim_servo *s)
 {
     s->power_ups++;
-    sim_boot_reset(s, false);
+    boot_reset(s, false);
 }
 
 bool sim_servo_start(struct sim_servo *s, struct sim_bus *bus, unsigned index, uint8_t id,
@@ -241,9 +269,9 @@ bool sim_servo_start(struct sim_servo *s, struct sim_bus *bus, unsigned index, u
     }
     struct app_image_info info;
     if (app_image_check(&s->slot, SIM_BOARD, &info) == APP_IMAGE_VALID) {
-        sim_servo_start_app(s);
+        start_app(s);
     } else {
-        sim_boot_reset(s, false);
+        boot_reset(s, false);
     }
     s->flash.stall_us = 0; /* power-up, before the servo joins the bus */
     s->slot_flash.stall_us = 0;
@@ -292,7 +320,7 @@ void sim_servo_poll(struct sim_servo *s, uint64_t now_us)
         s->uart_full = false;
         hal_rx_ring_put(&s->rx, s->uart_held, s->uart_held_at_us);
     }
-    if (!s->in_bootloader || !sim_boot_poll(s)) {
+    if (!s->in_bootloader || !boot_poll(s)) {
         servo_poll(&s->core);
     }
     bool executing = !s->in_bootloader && (s->core.regs.status.status & STATUS_EXECUTING) != 0u;

@@ -19,7 +19,7 @@
 #define SIM_SLOT_PAGES ((uint32_t)BOARD_SLOT_PAGES)
 #define SIM_CONFIG_BASE ((uint32_t)BOARD_CONFIG_PAGE0)
 #define SIM_BOARD ((uint16_t)BOARD_ID)
-/* The bootloader, as the simulator runs it (sim_boot.c): the boards' loop
+/* The bootloader, as the simulator runs it (sim_servo.c): the boards' loop
  * (bootloader.c) on the servo's port; the image in the slot is not
  * executed, its version is what the "application" then reports (data
  * item 7). */
@@ -89,9 +89,6 @@ uint32_t sim_servo_serial(const struct sim_servo *s);
  * bootloader's (the stored one). */
 uint8_t sim_servo_bus_id(const struct sim_servo *s);
 
-/* The motor and winding models up to the bus's now. */
-void sim_servo_run_models(struct sim_servo *s);
-
 /* A byte off the wire at at_us, as the port takes it. */
 /* The servo as a station of the bus: its UART. */
 struct sim_station sim_servo_station(struct sim_servo *s);
@@ -103,13 +100,5 @@ void sim_servo_poll(struct sim_servo *s, uint64_t now_us);
 /* The power goes and comes back: the servo restarts through its
  * bootloader (200 ms listening, or for good without a valid image). */
 void sim_servo_power_cycle(struct sim_servo *s);
-
-/* sim_boot.c: reset into the bootloader (stay: UpdateEnter asked), and its
- * main-loop pass; false once it has started the application. */
-void sim_boot_reset(struct sim_servo *s, bool stay);
-bool sim_boot_poll(struct sim_servo *s);
-/* The application starts: the servo core, reporting the slot image's
- * version. */
-void sim_servo_start_app(struct sim_servo *s);
 
 #endif

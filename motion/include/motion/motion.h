@@ -173,7 +173,11 @@ void motion_init(struct motion *m, const struct registers *regs, const struct ha
 void motion_tick(struct motion *m);
 
 MUST_CHECK enum motion_submit_result motion_submit(struct motion *m, const struct motion_command *cmd);
-bool motion_is_released(const struct motion *m);
+/* Not under position control (released or damping). */
+static inline bool motion_is_released(const struct motion *m)
+{
+    return m->mode != MODE_POSITION;
+}
 void motion_read_angle(const struct motion *m, struct motion_angle *out);
 /* ResetMultiTurnAngle (17), SetOriginPoint (23): false unless released. */
 bool motion_reset_multi_turn(struct motion *m);

@@ -20,6 +20,9 @@ enum packet_flags {
     /* Broadcast, and answered by the one servo it selects (AssignId, by
      * serial number): one answer at most. */
     PF_ONE_ANSWERS = 1u << 6,
+    /* Carries records, each a syncable packet for one servo (SyncCommand):
+     * the dispatcher runs this servo's record; no handler. */
+    PF_CARRIES_RECORDS = 1u << 7,
 };
 
 enum packet_outcome {
@@ -43,7 +46,7 @@ struct packet_call {
     const uint8_t *content;
     uint16_t length;
     struct packet_origin origin;
-    /* Set by dispatch_packet(): */
+    /* Set by the dispatcher: */
     uint8_t code;
     bool answer_when_done; /* control response on and addressed to us alone */
     struct dispatch_result *result;
@@ -68,13 +71,7 @@ const struct packet_desc *packet_find(uint8_t code);
 /* Every handler a packet table names (protocol/schema.toml). */
 PACKET_HANDLERS_DECLARED
 
-/* Runs one packet for this servo, as dispatch() does for a whole frame;
- * SyncCommand runs its record through it. The caller fills in call's
- * request (d, content, length, origin, result). */
-void dispatch_packet(const struct packet_desc *desc, struct packet_call *call,
-                     struct response *response);
-
-/* The "id, result" answer most packets give (dispatch_packet has put the
+/* The "id, result" answer most packets give (the dispatcher has put the
  * ID in already). */
 enum packet_outcome answer_result(struct response *r, bool ok);
 

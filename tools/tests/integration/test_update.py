@@ -1,7 +1,7 @@
 """Firmware update over the bus, on a simulated three-servo bus.
 
 The simulator runs the bootloader core on each servo (firmware/boards/
-host_sim/sim_boot.c): its answers, its boot decision and the slot in a
+host_sim/sim_servo.c): its answers, its boot decision and the slot in a
 flash file are the real ones; the image itself is not executed, its version
 is what the application then reports (data item 7). A power cut inside a
 flash step is the unit test's (test_bootloader.c, every erase and program

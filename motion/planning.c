@@ -1,0 +1,217 @@
+/* A profile for each motion command: where it starts (the setpoint it
+ * takes over, or the horn), where it ends and how long each phase takes,
+ * clamped to the limits of docs/protocol.md, "Moves". Plans: divides. */
+#include "motion/div64.h"
+#include "motion/gains.h"
+#include "motion_internal.h"
+
+/* Limits of docs/protocol.md, "Moves". */
+enum {
+    SINGLE_TURN_LIMIT = 1800,
+    MIN_RAMP_MS = 20,
+    MAX_INTERVAL_MS = 4096000,
+    MIN_VELOCITY = 10,     /* 0.1 deg/s */
+    MAX_VELOCITY = 7500,
+    MAX_WHEEL_SPEED = 750, /* deg/s, the angle modes' top speed */
+    WHEEL_RAMP_MS = 20,
+};
+
+static int32_t clamp_i32(int32_t v, int32_t lo, int32_t hi)
+{
+    return v < lo ? lo : v > hi ? hi : v;
+}
+
+static uint32_t clamp_u32(uint32_t v, uint32_t lo, uint32_t hi)
+{
+    return v < lo ? lo : v > hi ? hi : v;
+}
+
+/* The horn is within FOLLOW_GAP of the setpoint and within FOLLOW_SPEED
+ * of its speed. */
+static bool horn_follows(const struct motion *m)
+{
+    int32_t gap = m->setpoint_q8 - m->measured_q8;
+    int32_t speed = (m->setpoint_q8 - m->last_setpoint_q8) - m->measured_velocity_q8;
+    return gap < FOLLOW_GAP_Q8 && gap > -FOLLOW_GAP_Q8 && speed < FOLLOW_SPEED_Q8 &&
+           speed > -FOLLOW_SPEED_Q8;
+}
+
+/* Where a new profile starts: the current setpoint and its velocity when
+ * following one (no jerk to a stop; the velocity the slowed clock gives
+ * it), else the measured position at rest. */
+static void start_state(const struct motion *m, int64_t *start, int64_t *v0)
+{
+    if (m->mode == MODE_POSITION && !horn_follows(m)) {
+        /* The horn is elsewhere or moves otherwise than the setpoint (a
+         * slowed clock, a load): take over from where it really is. */
+        *start = q8_to_q32(m->measured_q8);
+        *v0 = q8_to_q32(m->measured_velocity_q8);
+    } else if (m->mode == MODE_POSITION) {
+        *start = q8_to_q32(m->setpoint_q8);
+        *v0 = q8_to_q32(m->setpoint_q8 - m->last_setpoint_q8);
+    } else {
+        *start = q8_to_q32(m->measured_q8);
+        *v0 = 0;
+    }
+}
+
+static void begin_profile(struct motion *m, uint8_t end)
+{
+    if (m->mode != MODE_POSITION) {
+        controller_reset(&m->controller);
+    }
+    m->mode = MODE_POSITION;
+    motion_clock_restart(m);
+    m->last_setpoint_q8 = m->setpoint_q8 - q32_to_q8_sat(m->profile.v0, TARGET_LIMIT_Q8); /* moving at v0 */
+    m->end = end;
+    m->running = 1;
+}
+
+/* Q32 decideg per tick for a velocity in 0.1 deg/s. */
+static int64_t velocity_q32(uint32_t decideg_per_s)
+{
+    _Static_assert(MOTION_TICK_HZ == 1000u && MAX_VELOCITY < 59074, "thousandth_q32's range");
+    return (int64_t)thousandth_q32(decideg_per_s);
+}
+
+/* From start moving at v0, come to rest at the output's braking (in at
+ * least min_ticks): the target is where that ends. Plans: it divides. */
+static void plan_stop(struct motion *m, int64_t start, int64_t v0, uint32_t min_ticks)
+{
+    int32_t v = q32_to_q8_sat(v0, INT32_MAX);
+    uint64_t speed = (uint64_t)(v < 0 ? -(int64_t)v : v);
+    uint64_t per_tick = (uint64_t)motion_brake_duty(m, v) << 8; /* x ka: decideg Q8 per tick^2 */
+    uint64_t n = div64_u(speed * (uint64_t)m->drive.ka + per_tick - 1u, per_tick);
+    n = n > min_ticks ? n : min_ticks;
+    n = n < PROFILE_MAX_RAMP ? n : PROFILE_MAX_RAMP;
+    int64_t target = start + v0 * (int64_t)n / 2;
+    profile_plan(&m->profile, start, v0, target, (struct profile_timing){0, 0, (uint32_t)n});
+}
+
+/* ---- commands ----------------------------------------------------------- */
+
+static int64_t angle_target(const struct motion *m, const struct motion_command *cmd)
+{
+    const struct user_config *cfg = &m->regs->user;
+    if (cmd->multi_turn) {
+        int32_t angle = clamp_i32(cmd->angle_decideg, -MULTI_TURN_LIMIT, MULTI_TURN_LIMIT);
+        return (int64_t)angle * DECIDEG_Q32 + q8_to_q32(motion_center_offset_q8(m));
+    }
+    int32_t angle = clamp_i32(cmd->angle_decideg, -SINGLE_TURN_LIMIT, SINGLE_TURN_LIMIT);
+    if (cfg->angle_limit_on) {
+        angle = clamp_i32(angle, cfg->angle_min_decideg, cfg->angle_max_decideg);
+    }
+    /* A single-turn angle is within the turn the servo is in now. */
+    struct motion_angle now;
+    motion_read_angle(m, &now);
+    int32_t turn_base = now.multi_turn_decideg - now.single_turn_decideg;
+    return ((int64_t)turn_base + angle) * DECIDEG_Q32 + q8_to_q32(motion_center_offset_q8(m));
+}
+
+static void run_angle(struct motion *m, const struct motion_command *cmd)
+{
+    const struct user_config *cfg = &m->regs->user;
+    uint32_t acc = clamp_u32(cmd->acc_ms, MIN_RAMP_MS, PROFILE_MAX_RAMP);
+    uint32_t dec = clamp_u32(cmd->dec_ms, MIN_RAMP_MS, PROFILE_MAX_RAMP);
+    int64_t start, v0;
+    start_state(m, &start, &v0);
+    int64_t target = angle_target(m, cmd);
+    struct profile_timing timing;
+    bool soft_start = m->soft_start_pending && cfg->soft_start_on;
+    m->soft_start_pending = 0;
+    if (cmd->profile == PROFILE_INTERVAL || soft_start) {
+        uint32_t interval = soft_start ? cfg->soft_start_ms : cmd->interval_ms;
+        interval = clamp_u32(interval, acc + dec, MAX_INTERVAL_MS);
+        timing = (struct profile_timing){acc, interval - acc - dec, dec};
+    } else {
+        uint32_t v = clamp_u32(cmd->velocity_decideg_s, MIN_VELOCITY, MAX_VELOCITY);
+        timing = profile_velocity_timing(target - start, v0, velocity_q32(v), acc, dec);
+    }
+    profile_plan(&m->profile, start, v0, target, timing);
+    begin_profile(m, END_HOLD);
+}
+
+static void run_wheel(struct motion *m, const struct motion_command *cmd)
+{
+    uint8_t action = cmd->method & (uint8_t)~WHEEL_CLOCKWISE;
+    uint32_t speed = clamp_u32(cmd->wheel_speed_deg_s, 0, MAX_WHEEL_SPEED);
+    int64_t v = velocity_q32(speed * 10u);
+    if (cmd->method & WHEEL_CLOCKWISE) {
+        v = -v;
+    }
+    uint8_t end = m->regs->user.wheel_brake ? END_HOLD : END_RELEASE;
+    int64_t start, v0;
+    start_state(m, &start, &v0);
+    if (action == WHEEL_RUN && speed != 0u) {
+        profile_plan_endless(&m->profile, start, v0, v, WHEEL_RAMP_MS);
+        begin_profile(m, END_HOLD);
+        m->endless = 1;
+        return;
+    }
+    struct profile_timing timing = {WHEEL_RAMP_MS, 0, WHEEL_RAMP_MS};
+    int64_t target;
+    if (action == WHEEL_TURNS && speed != 0u) {
+        int64_t distance = (int64_t)cmd->wheel_value * DECIDEG_PER_TURN * DECIDEG_Q32;
+        target = start + (v < 0 ? -distance : distance);
+        timing = profile_velocity_timing(target - start, v0, v < 0 ? -v : v, WHEEL_RAMP_MS,
+                                         WHEEL_RAMP_MS);
+    } else if (action == WHEEL_TIME && speed != 0u) {
+        /* Run for value ms at speed: the cruise fills what the ramps leave. */
+        uint32_t t = clamp_u32(cmd->wheel_value, 2u * WHEEL_RAMP_MS, UINT16_MAX);
+        timing.cruise = t - 2u * WHEEL_RAMP_MS;
+        target = start + v * (int64_t)(t - WHEEL_RAMP_MS);
+    } else {
+        /* Stop: come to rest within one ramp, or as fast as the motor can. */
+        plan_stop(m, start, v0, WHEEL_RAMP_MS);
+        begin_profile(m, end);
+        return;
+    }
+    profile_plan(&m->profile, start, v0, target, timing);
+    begin_profile(m, end);
+}
+
+static void run_stop(struct motion *m, const struct motion_command *cmd)
+{
+    switch (cmd->method) {
+    case STOP_HOLD:
+        /* Hold where the servo comes to rest, braking as hard as the motor
+         * can from where it is, not where it aimed. */
+        if (m->mode == MODE_POSITION) {
+            plan_stop(m, q8_to_q32(m->setpoint_q8), q8_to_q32(m->setpoint_q8 - m->last_setpoint_q8), 0);
+        } else {
+            plan_stop(m, q8_to_q32(m->measured_q8), q8_to_q32(m->measured_velocity_q8), 0);
+        }
+        begin_profile(m, END_HOLD);
+        break;
+    case STOP_DAMPING:
+        m->mode = MODE_DAMPING;
+        break;
+    default:
+        motion_coast(m);
+        break;
+    }
+    m->running = 0;
+}
+
+void motion_run(struct motion *m, const struct motion_command *cmd)
+{
+    m->endless = 0;
+    m->answer_packet = cmd->answer_when_done ? cmd->packet : 0u;
+    m->power_mw = cmd->power_mw;
+    motion_update_limits(m);
+    switch (cmd->kind) {
+    case MOTION_ANGLE:
+        run_angle(m, cmd);
+        break;
+    case MOTION_WHEEL:
+        run_wheel(m, cmd);
+        break;
+    case MOTION_DAMPING:
+        m->mode = MODE_DAMPING;
+        m->running = 0;
+        break;
+    default:
+        run_stop(m, cmd);
+        break;
+    }
+}

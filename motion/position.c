@@ -1,0 +1,114 @@
+/* Positions and the frames they are given in: measured_q8 is Q8 decideg
+ * from the origin (SetOriginPoint, ResetMultiTurnAngle); protocol angles are
+ * that minus the center offset (53). Moving the origin, and the readings. */
+#include "motion/div64.h"
+#include "motion_internal.h"
+
+static int32_t q8_to_decideg(int32_t q8)
+{
+    return (q8 + 128) >> 8; /* nearest */
+}
+
+void motion_move_origin(struct motion *m, int32_t counts)
+{
+    int32_t shift_q8 = counts_to_q8(counts);
+    int64_t shift = q8_to_q32(shift_q8);
+    m->origin_counts += counts;
+    m->measured_q8 -= shift_q8;
+    m->profile.start -= shift;
+    m->profile.target -= shift;
+    m->profile.cruise_start -= shift;
+    m->walk.at -= shift;
+    /* The setpoint may be further from the horn than Q8 holds (a load has
+     * turned the horn back thousands of turns): it is taken from the
+     * profile again, which holds it exactly. */
+    int32_t step = m->setpoint_q8 - m->last_setpoint_q8;
+    motion_take_profile_q8(m, profile_position(&m->profile, m->tick));
+    m->last_setpoint_q8 = m->setpoint_q8 - step;
+    /* Whole turns of the origin come off the encoder's count too: the raw
+     * reading's place in the turn, and the difference, stay as they were
+     * (the tracker follows the count's changes, not the count). */
+    int32_t within = m->origin_counts % ENCODER_COUNTS;
+    within = within < 0 ? within + ENCODER_COUNTS : within;
+    int32_t whole = m->origin_counts - within;
+    m->origin_counts = within;
+    m->encoder.counts -= whole;
+}
+
+/* The angle within its turn, [-180, 180) degrees. */
+static int32_t wrap_single_turn(int32_t decideg, int32_t turns)
+{
+    int32_t r = decideg - turns * DECIDEG_PER_TURN;
+    if (r >= DECIDEG_PER_TURN / 2) {
+        r -= DECIDEG_PER_TURN;
+    } else if (r < -DECIDEG_PER_TURN / 2) {
+        r += DECIDEG_PER_TURN;
+    }
+    return r;
+}
+
+void motion_read_angle(const struct motion *m, struct motion_angle *out)
+{
+    int32_t angle = q8_to_decideg(m->measured_q8 - motion_center_offset_q8(m));
+    out->multi_turn_decideg = angle;
+    int32_t turns = decideg_whole_turns(angle);
+    out->turns = (int16_t)turns;
+    out->single_turn_decideg = (int16_t)wrap_single_turn(angle, turns);
+}
+
+static int16_t saturate_i16(int32_t v)
+{
+    return (int16_t)(v > INT16_MAX ? INT16_MAX : v < -INT16_MAX ? -INT16_MAX : v);
+}
+
+/* Errors this large (1638 deg) already saturate the answer's centidegrees;
+ * clamped to it, x 10 stays in 32 bits (no 64-bit multiply on the M0). */
+#define TRACKING_ERROR_SPAN_Q8 (INT32_C(1) << 22)
+
+void motion_read_diagnostics(const struct motion *m, struct motion_diagnostics *out)
+{
+    bool controlled = m->mode == MODE_POSITION;
+    int32_t offset = motion_center_offset_q8(m);
+    int32_t setpoint = controlled ? m->setpoint_q8 : m->measured_q8;
+    /* decideg per tick Q8 to decideg per s: x 1000 / 256 = x 125 / 32. */
+    int32_t error_q8 = setpoint - m->measured_q8;
+    int64_t target = controlled ? m->profile.target : q8_to_q32(m->measured_q8);
+    *out = (struct motion_diagnostics){
+        .angle_decideg = q8_to_decideg(m->measured_q8 - offset),
+        .setpoint_decideg = q8_to_decideg(setpoint - offset),
+        .target_decideg = (int32_t)((target - q8_to_q32(offset) + (DECIDEG_Q32 / 2)) >> 32),
+        .velocity_decideg_s = saturate_i16(m->measured_velocity_q8 * 125 / 32),
+        .tracking_error_centideg = saturate_i16(sat_q(error_q8, TRACKING_ERROR_SPAN_Q8) * 10 / 256),
+        .flags = (uint8_t)((controlled && m->tick >= m->profile.total_ticks ? DIAG_PROFILE_ENDED : 0u) |
+                           (controlled && m->clock_rate != CLOCK_REAL_TIME ? DIAG_CLOCK_SLOWED : 0u) |
+                           (controlled && m->braking ? DIAG_BRAKING : 0u) |
+                           (motion_output_at_limit(m) != 0 ? DIAG_AT_LIMIT : 0u) |
+                           (controlled ? 0u : DIAG_RELEASED)),
+    };
+}
+
+bool motion_reset_multi_turn(struct motion *m)
+{
+    if (!motion_is_released(m)) {
+        return false;
+    }
+    /* Keep the angle within the turn; drop the whole turns. */
+    int32_t rel = m->encoder.counts - m->origin_counts;
+    int32_t within = rel % ENCODER_COUNTS;
+    if (within >= ENCODER_COUNTS / 2) {
+        within -= ENCODER_COUNTS;
+    } else if (within < -ENCODER_COUNTS / 2) {
+        within += ENCODER_COUNTS;
+    }
+    motion_move_origin(m, rel - within);
+    return true;
+}
+
+bool motion_set_origin(struct motion *m)
+{
+    if (!motion_is_released(m)) {
+        return false;
+    }
+    motion_move_origin(m, m->encoder.counts - m->origin_counts);
+    return true;
+}
