@@ -14,6 +14,8 @@ REQUEST_HEADER = bytes(_SCHEMA.frame["request_header"])
 RESPONSE_HEADER = bytes(_SCHEMA.frame["response_header"])
 BROADCAST = _SCHEMA.frame["broadcast_id"]
 MAX_ID = _SCHEMA.frame["max_id"]  # servo IDs are 0..254; 0xFF is broadcast
+# The longest answer frame: header, code, length, content, checksum.
+ANSWER_FRAME_MAX = len(RESPONSE_HEADER) + 3 + _SCHEMA.frame["answer_content_max"]
 # Every packet's code by servoctl's name for it, as module constants:
 # protocol.PING, protocol.WRITE_DATA, protocol.UPDATE_STATUS, ...
 CODES = {pkt.py: pkt.code for pkt in _SCHEMA.packets}
@@ -204,7 +206,7 @@ class Bus:
         self.stray_bytes = 0
         good, bad = [], 0
         deadline = self.clock() + window_s
-        last_look = False
+        last_look = finishing = False
         while True:
             while (frame := self._take_frame()) is not None:
                 fcode, answer, ok = frame
@@ -215,6 +217,11 @@ class Bus:
             if last_look:
                 return good, bad, self.stray_bytes + len(self._buffer)
             last_look = self.clock() > deadline
+            if last_look and self._buffer and not finishing:
+                # A frame begun in the window is read whole, not counted as
+                # garbage: the longest answer's time more, and 5 ms.
+                finishing, last_look = True, False
+                deadline = self.clock() + ANSWER_FRAME_MAX * 10 / self.serial.baudrate + 0.005
             self._fill(wait=not last_look)
 
     def _take_frame(self):

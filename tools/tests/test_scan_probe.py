@@ -53,3 +53,36 @@ def test_every_servo_at_one_id_is_heard_whole(servos):
     assert found.garbled == 0, wire.windows
     assert found.serials == serials and found.serials_complete
     assert found.servos == servos
+
+
+class SplitAnswer:
+    """A port whose one answer arrives in two parts: the first inside the
+    window, the rest once the bus clock has passed its end (a busy host
+    reads a socket late; a real wire's answer may straddle the end)."""
+
+    def __init__(self, frame: bytes, window_s: float):
+        self.baudrate = BAUD
+        self.now = 0.0
+        self.parts = [(0.001, frame[:4]), (window_s + 0.0005, frame[4:])]
+
+    def clock(self):
+        self.now += 0.0002  # each look at the clock, the bus moves on
+        return self.now
+
+    def write(self, data):
+        return len(data)
+
+    def read(self, _n):
+        ready = [d for t, d in self.parts if t <= self.now]
+        self.parts = [(t, d) for t, d in self.parts if t > self.now]
+        return b"".join(ready)
+
+
+def test_an_answer_that_straddles_the_window_s_end_is_read_whole():
+    window_s = 0.004
+    frame = p.response_frame(p.PING, bytes([3]))
+    bus = p.Bus("loop://", BAUD)
+    port = SplitAnswer(frame, window_s)
+    bus.serial, bus._fd, bus.clock = port, None, port.clock
+    good, bad, stray = bus.gather(p.PING, bytes([3]), window_s)
+    assert (good, bad, stray) == ([bytes([3])], 0, 0)
