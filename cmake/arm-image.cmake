@@ -2,14 +2,16 @@
 # from firmware/linker/TEMPLATE.ld.in and the board's board.h by the C
 # preprocessor (the board is the folder whose CMakeLists.txt calls this).
 function(servo_board_linker_script out template)
+  get_filename_component(board ${CMAKE_CURRENT_SOURCE_DIR} NAME)
   set(in ${PROJECT_SOURCE_DIR}/firmware/linker/${template}.ld.in)
   set(ld ${CMAKE_CURRENT_BINARY_DIR}/${template}.ld)
   add_custom_command(
     OUTPUT ${ld}
-    COMMAND ${CMAKE_C_COMPILER} -E -P -x c -I${CMAKE_CURRENT_SOURCE_DIR} ${in} -o ${ld}
+    COMMAND ${CMAKE_C_COMPILER} -E -P -x c -I${PROJECT_SOURCE_DIR}/firmware
+            "-DSERVO_BOARD_H=\"boards/${board}/board.h\"" ${in} -o ${ld}
     DEPENDS ${in} ${CMAKE_CURRENT_SOURCE_DIR}/board.h ${PROJECT_SOURCE_DIR}/firmware/boards/board_derived.h
-    COMMENT "Linker script ${template}.ld from ${CMAKE_CURRENT_SOURCE_DIR}/board.h")
-  get_filename_component(board ${CMAKE_CURRENT_SOURCE_DIR} NAME)
+    COMMENT "Linker script ${template}.ld from ${CMAKE_CURRENT_SOURCE_DIR}/board.h"
+    VERBATIM)
   if(NOT TARGET ${board}_${template}_ld)
     add_custom_target(${board}_${template}_ld DEPENDS ${ld})
   endif()
@@ -38,8 +40,7 @@ function(servo_arm_image name)
     target_sources(${name}.elf PRIVATE $<TARGET_OBJECTS:servo_small_runtime>
                    $<TARGET_OBJECTS:servo_small_div>)
   endif()
-  target_include_directories(${name}.elf PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}
-                             ${PROJECT_SOURCE_DIR}/firmware/bootloader)
+  target_include_directories(${name}.elf PRIVATE ${PROJECT_SOURCE_DIR}/firmware)
   add_dependencies(${name}.elf ${board}_app_ld)
   servo_firmware_target(${name}.elf)
   target_link_options(${name}.elf PRIVATE -L${PROJECT_SOURCE_DIR}/firmware/linker -T${I_LINKER}
@@ -90,7 +91,7 @@ function(servo_arm_bootloader name)
   target_compile_options(${name}.elf PRIVATE -Oz -flto -fno-tree-loop-distribute-patterns)
   target_link_options(${name}.elf PRIVATE -Oz -flto)
   target_link_libraries(${name}.elf PRIVATE ${SERVO_BOARD_PORT} servo_bootloader_core)
-  target_include_directories(${name}.elf PRIVATE ${CMAKE_CURRENT_SOURCE_DIR})
+  target_include_directories(${name}.elf PRIVATE ${PROJECT_SOURCE_DIR}/firmware)
   servo_firmware_target(${name}.elf)
   servo_board_linker_script(boot_ld boot)
   get_filename_component(board ${CMAKE_CURRENT_SOURCE_DIR} NAME)

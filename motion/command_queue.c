@@ -3,7 +3,7 @@
  * the answers owed when a queued command finishes. */
 #include <stddef.h>
 
-#include "motion_internal.h"
+#include "motion/motion_internal.h"
 
 static bool queue_push(struct motion_queue *q, const struct motion_command *cmd)
 {

@@ -8,7 +8,7 @@
 
 #include "motion/div64.h"
 #include "motion/gains.h"
-#include "motion_internal.h"
+#include "motion/motion_internal.h"
 
 /* A move has finished when its setpoint has reached the target and the
  * horn has arrived there, within ARRIVE_DECIDEG, and nearly stopped (not

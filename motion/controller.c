@@ -4,7 +4,7 @@
 
 #include "motion/div64.h"
 #include "motion/gains.h"
-#include "saturate.h"
+#include "motion/saturate.h"
 
 /* Input ranges that keep every product within int32 (the gains: kv +
  * viscous < 2^15.3 down to GAIN_MIN_SUPPLY_MV, KP < 2^10, KD and DAMPING

@@ -5,7 +5,7 @@
 #include <stddef.h>
 
 #include "motion/gains.h"
-#include "motion_internal.h"
+#include "motion/motion_internal.h"
 
 /* The braking duty of a current window limit when a load takes assisting
  * of it, less the quarter kept for the controller (motion_brake_duty). */

@@ -3,7 +3,7 @@
  * position.c, drive.c, planning.c, command_queue.c and control_tick.c. */
 #include "motion/motion.h"
 
-#include "motion_internal.h"
+#include "motion/motion_internal.h"
 
 /* Hold still where the setpoint is now (or where the servo is, if it was
  * released): a zero-length profile. */

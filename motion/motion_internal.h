@@ -8,7 +8,7 @@
 #include <stdint.h>
 
 #include "motion/motion.h"
-#include "saturate.h"
+#include "motion/saturate.h"
 
 enum {
     MULTI_TURN_LIMIT = 3686400, /* docs/protocol.md, "Moves" */

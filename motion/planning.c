@@ -3,7 +3,7 @@
  * clamped to the limits of docs/protocol.md, "Moves". Plans: divides. */
 #include "motion/div64.h"
 #include "motion/gains.h"
-#include "motion_internal.h"
+#include "motion/motion_internal.h"
 
 /* Limits of docs/protocol.md, "Moves". */
 enum {

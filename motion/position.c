@@ -2,7 +2,7 @@
  * from the origin (SetOriginPoint, ResetMultiTurnAngle); protocol angles are
  * that minus the center offset (53). Moving the origin, and the readings. */
 #include "motion/div64.h"
-#include "motion_internal.h"
+#include "motion/motion_internal.h"
 
 static int32_t q8_to_decideg(int32_t q8)
 {

@@ -1,7 +1,7 @@
 /* The setpoint the tick follows: the profile's clock at its start, the
  * tick's Q8 copies of the profile, and the acceleration feed-forward of the
  * profile's phase. */
-#include "motion_internal.h"
+#include "motion/motion_internal.h"
 
 void motion_take_profile_q8(struct motion *m, int64_t at_tick)
 {

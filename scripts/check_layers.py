@@ -78,32 +78,54 @@ def sources(root):
         yield rel
 
 
-def resolve(root, including, name, by_suffix):
-    """The file an #include names: beside the including file, else the one
-    file whose path ends in the name (include/<lib>/x.h or a folder's x.h)."""
-    beside = (Path(including).parent / name).as_posix()
-    if (root / beside).is_file():
-        return beside
-    found = by_suffix.get(name, [])
-    if len(found) == 1:
-        return found[0]
-    # Two ports' headers of one name: the one in the including file's folder tree.
-    top = including.split("/")[0]
-    near = [f for f in found if f.split("/")[0] == top]
-    return near[0] if len(near) == 1 else None
+# Where an include's name is looked up: each layer's headers are named
+# from one of these (firmware/storage/crc32.h is "storage/crc32.h").
+INCLUDE_ROOTS = ("hal/include", "motion/include", "protocol/wire/include", "protocol/include",
+                 "registers/include", "firmware", "hal", "tests", "")
+BOARD_FOLDER = re.compile(r"^firmware/boards/[^/]+/")
+
+
+def resolve(root, including, name):
+    """The files an #include names: in a board's folder, its own files by
+    bare name beside it (a copied folder is a new board); elsewhere the
+    name from one of INCLUDE_ROOTS."""
+    board = BOARD_FOLDER.match(including)
+    if board and "/" not in name and (root / board.group(0) / name).is_file():
+        return [board.group(0) + name]
+    if "/" not in name:
+        return []
+    return [f"{r}/{name}" if r else name for r in INCLUDE_ROOTS if (root / r / name).is_file()]
+
+
+def include_breaches(root):
+    """Every include names its layer ("storage/crc32.h") and one file; no
+    two headers share a name, but for a board's own (board.h in each)."""
+    out = []
+    files = [p for p in sorted(root.rglob("*")) if p.suffix in (".c", ".h", ".in") and p.is_file()]
+    headers = {}
+    for path in files:
+        rel = path.relative_to(root).as_posix()
+        if rel.startswith(("build/", ".")) or "/." in rel:
+            continue
+        if path.suffix == ".h" and not BOARD_FOLDER.match(rel):
+            headers.setdefault(path.name, []).append(rel)
+        for name in INCLUDE.findall(path.read_text(errors="replace")):
+            found = resolve(root, rel, name)
+            if "/" not in name and not found:
+                out.append(f'include: {rel} includes "{name}", which names no layer')
+            elif len(found) > 1:
+                out.append(f'include: {rel} includes "{name}", which names {len(found)} files')
+    for name, where in sorted(headers.items()):
+        if len(where) > 1:
+            out.append(f"header name: {name} is {', '.join(where)}")
+    return out
 
 
 def include_graph(root):
-    files = list(sources(root))
-    by_suffix = {}
-    for rel in files:
-        parts = rel.split("/")
-        for i in range(len(parts)):
-            by_suffix.setdefault("/".join(parts[i:]), []).append(rel)
     graph = {}
-    for rel in files:
+    for rel in sources(root):
         text = (root / rel).read_text(errors="replace")
-        graph[rel] = [t for t in (resolve(root, rel, n, by_suffix) for n in INCLUDE.findall(text)) if t]
+        graph[rel] = [t for n in INCLUDE.findall(text) for t in resolve(root, rel, n)[:1]]
     return graph
 
 
@@ -212,7 +234,7 @@ def long_files(root):
 
 
 def check(root, build=None):
-    breaches = []
+    breaches = include_breaches(root)
     graph = include_graph(root)
     for rel, targets in graph.items():
         mine = layer_of(rel)

@@ -1,9 +1,9 @@
-#include "servo.h"
+#include "app/servo.h"
 
 #include <stddef.h>
 #include <string.h>
 
-#include "identity.h"
+#include "app/identity.h"
 #include "registers/data_table.h"
 
 static uint32_t idle_timeout_us(const struct servo *s, uint32_t baud)

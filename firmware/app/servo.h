@@ -7,11 +7,11 @@
 #include <stdbool.h>
 #include <stdint.h>
 
-#include "config_store.h"
-#include "save_policy.h"
+#include "storage/config_store.h"
+#include "storage/save_policy.h"
 #include "hal/hal_port.h"
-#include "protection.h"
-#include "scaling.h"
+#include "protection/protection.h"
+#include "sensors/scaling.h"
 #include "motion/motion.h"
 #include "protocol/dispatcher.h"
 #include "protocol/frame_rx.h"

@@ -6,7 +6,7 @@
 #ifndef BOARDS_TEST_BUILD_H
 #define BOARDS_TEST_BUILD_H
 
-#include "systick_clock.h"
+#include "ports/stm32_common/systick_clock.h"
 
 static inline void test_build_main_loop(void)
 {

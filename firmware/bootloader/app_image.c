@@ -1,8 +1,8 @@
-#include "app_image.h"
+#include "bootloader/app_image.h"
 
 #include <string.h>
 
-#include "crc32.h"
+#include "storage/crc32.h"
 #include "protocol/wire.h"
 
 void app_image_make_header(uint8_t header[APP_HEADER_SIZE], const uint8_t *code, uint32_t size,

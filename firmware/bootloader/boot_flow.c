@@ -1,4 +1,4 @@
-#include "boot_flow.h"
+#include "bootloader/boot_flow.h"
 
 void boot_flow_start(struct boot_flow *f, bool app_valid, uint32_t stay_word)
 {

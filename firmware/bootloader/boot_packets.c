@@ -1,11 +1,11 @@
-#include "boot_packets.h"
+#include "bootloader/boot_packets.h"
 
 #include <stddef.h>
 
 #include "protocol/packet_codes.h"
 #include "protocol/update_status.h"
 #include "protocol/wire.h"
-#include "slot_write.h"
+#include "bootloader/slot_write.h"
 
 struct call {
     struct bootloader *b;

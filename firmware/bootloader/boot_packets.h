@@ -9,7 +9,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
-#include "app_image.h"
+#include "bootloader/app_image.h"
 #include "protocol/frame_tx.h"
 #include "hal/must_check.h"
 

@@ -1,8 +1,8 @@
-#include "bootloader.h"
+#include "bootloader/bootloader.h"
 
 #include <stddef.h>
 
-#include "config_peek.h"
+#include "storage/config_peek.h"
 #include "registers/data_table.h"
 #include "protocol/packet_codes.h"
 

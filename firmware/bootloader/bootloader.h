@@ -9,9 +9,9 @@
 #include <stdbool.h>
 #include <stdint.h>
 
-#include "app_image.h"
-#include "boot_flow.h"
-#include "boot_packets.h"
+#include "bootloader/app_image.h"
+#include "bootloader/boot_flow.h"
+#include "bootloader/boot_packets.h"
 #include "hal/hal_port.h"
 #include "protocol/frame_rx.h"
 #include "protocol/frame_tx.h"

@@ -1,8 +1,8 @@
-#include "slot_write.h"
+#include "bootloader/slot_write.h"
 
 #include <string.h>
 
-#include "crc32.h"
+#include "storage/crc32.h"
 
 enum slot_write_result slot_erase_page(const struct app_slot *slot, uint32_t page)
 {

@@ -8,7 +8,7 @@
 
 #include <stdint.h>
 
-#include "app_image.h"
+#include "bootloader/app_image.h"
 #include "hal/must_check.h"
 
 enum slot_write_result {

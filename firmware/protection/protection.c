@@ -1,8 +1,8 @@
-#include "protection.h"
+#include "protection/protection.h"
 
 #include <stddef.h>
 
-#include "ntc.h"
+#include "sensors/ntc.h"
 
 void protection_init(struct protection *p)
 {

@@ -19,7 +19,7 @@
 #include <stdint.h>
 
 #include "registers/registers.h"
-#include "scaling.h"
+#include "sensors/scaling.h"
 
 #define PROTECT_TRIP_TICKS 10u    /* 10 ms */
 #define PROTECT_CLEAR_TICKS 100u  /* 100 ms */

@@ -9,7 +9,7 @@
  * divide-by-zero trap). */
 #include <stdint.h>
 
-#include "small_div.h"
+#include "runtime/small_div.h"
 
 uint64_t small_udivmod(uint32_t n, uint32_t d)
 {

@@ -5,7 +5,7 @@
  * planner calls it a dozen times a move: 138 bytes against libgcc's
  * __aeabi_lmul's 90, and about 25 instructions a call where that takes 41
  * (docs/benchmark.md). */
-#include "small_mul.h"
+#include "runtime/small_mul.h"
 
 /* a x s for s below 2^16 (the planner's tick counts): three products. */
 static uint64_t times_short(uint64_t a, uint32_t s)

@@ -1,4 +1,4 @@
-#include "ntc.h"
+#include "sensors/ntc.h"
 
 enum { LAST = NTC_TABLE_SIZE - 1 };
 

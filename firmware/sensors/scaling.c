@@ -1,4 +1,4 @@
-#include "scaling.h"
+#include "sensors/scaling.h"
 
 /* The per-tick helpers inline where speed comes first; one copy of each
  * where size does (SERVO_SIZE_FIRST: the Cortex-M0). */

@@ -8,9 +8,9 @@
  * USART's interrupt (84 bytes of its 4 KB shorter). */
 #include <stdint.h>
 
-#include "board_mark.h"
-#include "startup_memory.h"
-#include "stm32f0_regs.h"
+#include "startup/board_mark.h"
+#include "startup/startup_memory.h"
+#include "ports/stm32f0/stm32f0_regs.h"
 
 int main(void);
 void Reset_Handler(void);

@@ -1,8 +1,8 @@
 /* Reset handler and vector table for the STM32F103 (Cortex-M3). */
 #include <stdint.h>
 
-#include "board_mark.h"
-#include "startup_memory.h"
+#include "startup/board_mark.h"
+#include "startup/startup_memory.h"
 
 int main(void);
 void Reset_Handler(void);

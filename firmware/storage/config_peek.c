@@ -1,7 +1,7 @@
-#include "config_peek.h"
+#include "storage/config_peek.h"
 
-#include "config_record.h"
-#include "crc32.h"
+#include "storage/config_record.h"
+#include "storage/crc32.h"
 #include "registers/byte_order.h"
 
 /* The newest format-2 record whose CRC checks (config_record.h). The

@@ -1,9 +1,9 @@
-#include "config_store.h"
+#include "storage/config_store.h"
 
 #include <string.h>
 
-#include "config_record.h"
-#include "crc32.h"
+#include "storage/config_record.h"
+#include "storage/crc32.h"
 #include "registers/byte_order.h"
 #include "registers/data_table.h"
 

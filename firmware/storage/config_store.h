@@ -21,7 +21,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
-#include "config_record.h"
+#include "storage/config_record.h"
 #include "hal/hal_flash.h"
 #include "hal/must_check.h"
 #include "registers/registers.h"

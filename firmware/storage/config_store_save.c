@@ -2,7 +2,7 @@
  * yet or any more (the servo's boot, its restart into the bootloader),
  * the simulator's factory ID, and tests. The running servo saves in steps
  * (servo.c). */
-#include "config_store.h"
+#include "storage/config_store.h"
 
 enum config_save_result config_store_save(struct config_store *s, const struct user_config *cfg,
                                           uint32_t op_seconds)

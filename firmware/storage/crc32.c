@@ -1,4 +1,4 @@
-#include "crc32.h"
+#include "storage/crc32.h"
 
 #ifdef CRC32_BITWISE
 /* The bootloader's: no table, 4 KB is all it has. */

@@ -1,4 +1,4 @@
-#include "save_policy.h"
+#include "storage/save_policy.h"
 
 void save_policy_init(struct save_policy *p, const struct config_store *store, uint32_t now_us)
 {

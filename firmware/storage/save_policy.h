@@ -14,7 +14,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
-#include "config_store.h"
+#include "storage/config_store.h"
 
 /* STM32F103 datasheet (DS5319), "Flash memory endurance and data
  * retention": NEND 10 kcycles minimum over the temperature range. */

@@ -21,11 +21,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "bench_region.h"
-#include "hal_double.h"
-#include "ideal_encoder.h"
+#include "bench/bench_region.h"
+#include "doubles/hal_double.h"
+#include "doubles/ideal_encoder.h"
 #include "motion/motion.h"
-#include "servo.h"
+#include "app/servo.h"
 
 #define MOTION_BENCH_TICKS 2000u
 

@@ -26,15 +26,15 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "bench_region.h"
+#include "bench/bench_region.h"
 #include "registers/data_table.h"
-#include "dma_rx.h"
-#include "frames.h"
-#include "hal_double.h"
-#include "servo.h"
-#include "stm32f1_regs.h"
-#include "systick_clock.h"
-#include "usart_hd.h"
+#include "ports/stm32_common/dma_rx.h"
+#include "support/frames.h"
+#include "doubles/hal_double.h"
+#include "app/servo.h"
+#include "ports/stm32f1/stm32f1_regs.h"
+#include "ports/stm32_common/systick_clock.h"
+#include "ports/stm32f1/usart_hd.h"
 
 #define OWN_ID 1u
 #ifndef BENCH_MESSAGES

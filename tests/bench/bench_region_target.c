@@ -1,7 +1,7 @@
 /* The plugin (qemu_insn_count.c) is told the addresses of the two marker
  * functions; it snapshots its instruction counter when each runs. The
  * region's name goes out over semihosting after the count has stopped. */
-#include "bench_region.h"
+#include "bench/bench_region.h"
 
 #include <stdint.h>
 #include <stdio.h>

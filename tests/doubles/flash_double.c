@@ -1,4 +1,4 @@
-#include "flash_double.h"
+#include "doubles/flash_double.h"
 
 #include <string.h>
 

@@ -1,4 +1,4 @@
-#include "hal_double.h"
+#include "doubles/hal_double.h"
 
 #include <string.h>
 

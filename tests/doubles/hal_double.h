@@ -7,7 +7,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "flash_double.h"
+#include "doubles/flash_double.h"
 #include "hal/hal_port.h"
 
 #define HAL_DOUBLE_SENT_MAX 4096u

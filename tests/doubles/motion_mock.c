@@ -5,7 +5,7 @@
 
 #include <cmocka.h>
 
-#include "motion_mock.h"
+#include "doubles/motion_mock.h"
 
 struct motion_command motion_mock_last;
 

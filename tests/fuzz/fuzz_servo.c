@@ -29,10 +29,10 @@
 #include <stdint.h>
 #include <string.h>
 
-#include "hal_double.h"
-#include "ideal_encoder.h"
+#include "doubles/hal_double.h"
+#include "doubles/ideal_encoder.h"
 #include "registers/data_table.h"
-#include "servo.h"
+#include "app/servo.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 

@@ -7,7 +7,7 @@ root=$(cd "$(dirname "$0")/../.." && pwd)
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 # The reference board's application memory map, as the build makes it.
-arm-none-eabi-gcc -E -P -x c -I "$root/firmware/boards/stm32f103" "$root/firmware/linker/app.ld.in" \
+arm-none-eabi-gcc -E -P -x c -I "$root/firmware" -DSERVO_BOARD_H='"boards/stm32f103/board.h"' "$root/firmware/linker/app.ld.in" \
   -o "$tmp/app.ld" || exit 1
 build() {
   arm-none-eabi-gcc -mcpu=cortex-m3 -mthumb -Os -nostartfiles --specs=nano.specs \

@@ -1,4 +1,4 @@
-#include "frames.h"
+#include "support/frames.h"
 
 static size_t finish(uint8_t *out, size_t n)
 {

@@ -1,4 +1,4 @@
-#include "plant_harness.h"
+#include "support/plant_harness.h"
 
 #include <math.h>
 

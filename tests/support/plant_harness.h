@@ -4,8 +4,8 @@
 #ifndef TEST_PLANT_HARNESS_H
 #define TEST_PLANT_HARNESS_H
 
-#include "plant.h"
-#include "servo_harness.h"
+#include "ports/host/plant.h"
+#include "support/servo_harness.h"
 
 extern struct plant plant;
 

@@ -1,6 +1,6 @@
-#include "servo_harness.h"
+#include "support/servo_harness.h"
 
-#include "ideal_encoder.h"
+#include "doubles/ideal_encoder.h"
 
 #include <setjmp.h>
 #include <stdarg.h>

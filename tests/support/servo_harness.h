@@ -7,9 +7,9 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "frames.h"
-#include "hal_double.h"
-#include "servo.h"
+#include "support/frames.h"
+#include "doubles/hal_double.h"
+#include "app/servo.h"
 
 #define HARNESS_BYTE_US 87u
 

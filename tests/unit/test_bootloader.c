@@ -8,12 +8,12 @@
 
 #include <cmocka.h>
 
-#include "app_image.h"
-#include "boot_flow.h"
-#include "boot_packets.h"
-#include "crc32.h"
+#include "bootloader/app_image.h"
+#include "bootloader/boot_flow.h"
+#include "bootloader/boot_packets.h"
+#include "storage/crc32.h"
 #include "protocol/packet_codes.h"
-#include "slot_write.h"
+#include "bootloader/slot_write.h"
 #include "protocol/wire.h"
 
 #define PAGE 1024u

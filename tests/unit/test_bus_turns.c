@@ -14,10 +14,10 @@
 
 #include <cmocka.h>
 
-#include "frames.h"
-#include "hal_double.h"
-#include "ideal_encoder.h"
-#include "servo.h"
+#include "support/frames.h"
+#include "doubles/hal_double.h"
+#include "doubles/ideal_encoder.h"
+#include "app/servo.h"
 
 enum {
     NODES = 3,

@@ -9,10 +9,10 @@
 
 #include <cmocka.h>
 
-#include "config_peek.h"
-#include "config_store.h"
-#include "crc32.h"
-#include "flash_double.h"
+#include "storage/config_peek.h"
+#include "storage/config_store.h"
+#include "storage/crc32.h"
+#include "doubles/flash_double.h"
 #include "registers/data_table.h"
 
 static struct flash_double flash;

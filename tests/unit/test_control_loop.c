@@ -14,7 +14,7 @@
 #define M_PI 3.14159265358979323846
 #endif
 
-#include "plant_harness.h"
+#include "support/plant_harness.h"
 
 static int setup(void **state)
 {

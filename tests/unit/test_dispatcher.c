@@ -9,7 +9,7 @@
 
 #include <cmocka.h>
 
-#include "motion_mock.h"
+#include "doubles/motion_mock.h"
 #include "registers/data_table.h"
 #include "protocol/dispatcher.h"
 #include "protocol/packet_table.h"

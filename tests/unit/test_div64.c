@@ -9,7 +9,7 @@
 #include <cmocka.h>
 
 #include "motion/div64.h"
-#include "xorshift.h"
+#include "support/xorshift.h"
 
 static uint64_t state = 0x9E3779B97F4A7C15u;
 static uint64_t rnd(void)

@@ -7,7 +7,7 @@
 
 #include <cmocka.h>
 
-#include "frames.h"
+#include "support/frames.h"
 #include "protocol/frame_rx.h"
 #include "protocol/packet_codes.h"
 

@@ -20,7 +20,7 @@
 
 #include <cmocka.h>
 
-#include "plant_harness.h"
+#include "support/plant_harness.h"
 
 static uint64_t rng_state;
 static int trace_trial = -1; /* MOTION_TRACE: print one trial's move */

@@ -14,7 +14,7 @@
 
 #include "motion/controller.h"
 #include "motion/gains.h"
-#include "servo_harness.h"
+#include "support/servo_harness.h"
 
 static void full_power(void)
 {

@@ -13,7 +13,7 @@
 
 #include <cmocka.h>
 
-#include "servo_harness.h"
+#include "support/servo_harness.h"
 
 enum { LIMIT = 3686400, SHIFT = 3686400, TURN = 3600 };
 

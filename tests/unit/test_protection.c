@@ -9,8 +9,8 @@
 
 #include <cmocka.h>
 
-#include "ntc.h"
-#include "protection.h"
+#include "sensors/ntc.h"
+#include "protection/protection.h"
 #include "registers/data_table.h"
 
 static struct protection prot;

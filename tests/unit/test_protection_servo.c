@@ -9,7 +9,7 @@
 #include <cmocka.h>
 
 #include "motion/controller.h"
-#include "servo_harness.h"
+#include "support/servo_harness.h"
 
 static int setup(void **state)
 {

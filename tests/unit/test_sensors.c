@@ -9,8 +9,8 @@
 
 #include <cmocka.h>
 
-#include "ntc.h"
-#include "scaling.h"
+#include "sensors/ntc.h"
+#include "sensors/scaling.h"
 
 static double exact_adc(double celsius)
 {

@@ -12,7 +12,7 @@
 #include <cmocka.h>
 
 #include "registers/data_table.h"
-#include "servo_harness.h"
+#include "support/servo_harness.h"
 
 static int setup(void **state)
 {

@@ -11,7 +11,7 @@
 
 #include <cmocka.h>
 
-#include "servo_harness.h"
+#include "support/servo_harness.h"
 
 static int setup(void **state)
 {

@@ -7,8 +7,8 @@
 
 #include <cmocka.h>
 
-#include "small_div.h"
-#include "xorshift.h"
+#include "runtime/small_div.h"
+#include "support/xorshift.h"
 
 static uint64_t state = 0x2545F4914F6CDD1Du;
 static uint32_t rnd(void)

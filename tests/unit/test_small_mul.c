@@ -7,8 +7,8 @@
 
 #include <cmocka.h>
 
-#include "small_mul.h"
-#include "xorshift.h"
+#include "runtime/small_mul.h"
+#include "support/xorshift.h"
 
 static uint64_t state = 0x9E3779B97F4A7C15u;
 static uint64_t rnd(void)

@@ -97,3 +97,32 @@ def test_a_long_file_is_found(tmp_path):
     write(root, "motion/motion.c", "\n" * 550)
     breaches, _ = check_layers.check(root)
     assert breaches == ["long file: tools/servoctl/cli.py has 551 lines (limit 550)"]
+
+
+def test_an_include_that_names_no_layer_is_found(tmp_path):
+    root = tree(tmp_path)
+    write(root, "firmware/storage/crc32.h", "int crc32(void);\n")
+    write(root, "firmware/storage/crc32.c", '#include "crc32.h"\n')  # beside it, but bare
+    write(root, "firmware/storage/save.c", '#include "storage/crc32.h"\n')
+    breaches, _ = check_layers.check(root)
+    assert breaches == ['include: firmware/storage/crc32.c includes "crc32.h", which names no layer']
+
+
+def test_a_board_includes_its_own_files_by_name(tmp_path):
+    """A copied board folder is a new board: its board.h is its own."""
+    root = tree(tmp_path)
+    for board in ("stm32f103", "my_servo"):
+        write(root, f"firmware/boards/{board}/board.h", "#define BOARD_ID 1\n")
+        write(root, f"firmware/boards/{board}/main.c", '#include "board.h"\n')
+    breaches, graph = check_layers.check(root)
+    assert breaches == []
+    assert graph["firmware/boards/my_servo/main.c"] == ["firmware/boards/my_servo/board.h"]
+
+
+def test_two_headers_of_one_name_are_found(tmp_path):
+    root = tree(tmp_path)
+    write(root, "hal/ports/stm32f1/port_uart.h", "void f1(void);\n")
+    write(root, "hal/ports/stm32f0/port_uart.h", "void f0(void);\n")
+    breaches, _ = check_layers.check(root)
+    assert breaches == ["header name: port_uart.h is hal/ports/stm32f0/port_uart.h, "
+                        "hal/ports/stm32f1/port_uart.h"]

@@ -4,7 +4,7 @@
 #ifndef SIM_BOARD_H
 #define SIM_BOARD_H
 
-#include "../stm32f103/board.h"
+#include "boards/stm32f103/board.h"
 
 #undef BOARD_ID
 #define BOARD_ID 0x5100 /* the update image header's board field */

@@ -6,11 +6,11 @@
 #include <string.h>
 #include <time.h>
 
-#include "config_store.h"
-#include "crc32.h"
+#include "storage/config_store.h"
+#include "storage/crc32.h"
 #include "registers/data_table.h"
 #include "sim_bus.h"
-#include "slot_write.h"
+#include "bootloader/slot_write.h"
 
 uint64_t sim_now_us(void)
 {

@@ -5,14 +5,14 @@
 
 #include <stdint.h>
 
-#include "app_image.h"
+#include "bootloader/app_image.h"
 #include "board.h"
-#include "bootloader.h"
-#include "plant.h"
-#include "servo.h"
+#include "bootloader/bootloader.h"
+#include "ports/host/plant.h"
+#include "app/servo.h"
 #include "sim_bus.h"
-#include "sim_flash.h"
-#include "thermal.h"
+#include "ports/host/sim_flash.h"
+#include "ports/host/thermal.h"
 
 /* The simulated servo's flash map and board ID (board.h), in C's types. */
 #define SIM_SLOT_BASE ((uint32_t)BOARD_SLOT_BASE)

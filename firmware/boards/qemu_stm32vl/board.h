@@ -30,6 +30,6 @@
 #define BOARD_RX_RING_BYTES 256
 #define BOARD_BOOT_RX_RING_BYTES 256
 
-#include "../board_derived.h"
+#include "boards/board_derived.h"
 
 #endif

@@ -5,13 +5,13 @@
  * store in RAM on this board, so the bootloader finds none there (QEMU's
  * unwritten flash reads 0) and answers at the factory ID and baud rate. */
 #include "board.h"
-#include "boot_flow.h"
-#include "boot_jump.h"
-#include "bootloader.h"
-#include "port_uart.h"
+#include "bootloader/boot_flow.h"
+#include "ports/stm32_common/boot_jump.h"
+#include "bootloader/bootloader.h"
+#include "ports/stm32f1/stm32f1_uart.h"
 #include "qemu_board.h"
-#include "stm32f1_regs.h"
-#include "systick_clock.h"
+#include "ports/stm32f1/stm32f1_regs.h"
+#include "ports/stm32_common/systick_clock.h"
 
 static struct usart_hd usart;
 static uint8_t rx_bytes[BOARD_BOOT_RX_RING_BYTES];

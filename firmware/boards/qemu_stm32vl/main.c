@@ -4,14 +4,14 @@
 #include "board.h"
 #include "plant_fixed.h"
 #include "qemu_board.h"
-#include "app_image.h"
-#include "boot_flow.h"
-#include "boot_jump.h"
-#include "servo.h"
-#include "stm32f1_regs.h"
-#include "systick_clock.h"
-#include "port_uart.h"
-#include "usart_hd.h"
+#include "bootloader/app_image.h"
+#include "bootloader/boot_flow.h"
+#include "ports/stm32_common/boot_jump.h"
+#include "app/servo.h"
+#include "ports/stm32f1/stm32f1_regs.h"
+#include "ports/stm32_common/systick_clock.h"
+#include "ports/stm32f1/stm32f1_uart.h"
+#include "ports/stm32f1/usart_hd.h"
 
 /* The config store's pages, kept in RAM at the addresses they would have. */
 #define FLASH_PAGE ((uint32_t)BOARD_FLASH_PAGE)

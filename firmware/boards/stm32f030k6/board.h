@@ -41,6 +41,6 @@
 
 /* Pins: this folder's README.md; the port (hal/ports/stm32f0) drives them. */
 
-#include "../board_derived.h"
+#include "boards/board_derived.h"
 
 #endif

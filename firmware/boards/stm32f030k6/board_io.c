@@ -1,6 +1,6 @@
 #include "board_io.h"
 
-#include "stm32f0_regs.h"
+#include "ports/stm32f0/stm32f0_regs.h"
 
 enum { HSE_STARTUP_TRIES = 100000 };
 

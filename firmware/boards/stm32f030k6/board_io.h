@@ -7,7 +7,7 @@
 
 #include <stdint.h>
 
-#include "board_common.h" /* the bridge PWM, the ADC scan, the watchdog */
+#include "ports/stm32_common/board_common.h" /* the bridge PWM, the ADC scan, the watchdog */
 
 #define F030_CORE_HZ 48000000u
 #define F030_PCLK_HZ 48000000u /* USART1, TIM3, the ADC (through /2) */

@@ -1,16 +1,16 @@
 /* The Cortex-M0 board: STM32F030K6 servo controller (pin map: README.md). */
 #include "board.h"
 #include "board_io.h"
-#include "app_image.h"
-#include "boot_flow.h"
-#include "boot_jump.h"
-#include "cortex_sleep.h"
-#include "flash_f0f1.h"
-#include "port_uart.h"
-#include "servo.h"
-#include "stm32f0_regs.h"
-#include "systick_clock.h"
-#include "../test_build.h"
+#include "bootloader/app_image.h"
+#include "bootloader/boot_flow.h"
+#include "ports/stm32_common/boot_jump.h"
+#include "ports/stm32_common/cortex_sleep.h"
+#include "ports/stm32_common/flash_f0f1.h"
+#include "ports/stm32f0/stm32f0_uart.h"
+#include "app/servo.h"
+#include "ports/stm32f0/stm32f0_regs.h"
+#include "ports/stm32_common/systick_clock.h"
+#include "boards/test_build.h"
 
 static struct servo servo;
 static struct usart_v2_hd usart;

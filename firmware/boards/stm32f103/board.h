@@ -41,6 +41,6 @@
  * TIM3 CH1/CH2, the bridge; PA0-PA3 ADC1 IN0-IN3: supply, current, NTC and
  * the encoder's analogue output. The port (hal/ports/stm32f1) drives them. */
 
-#include "../board_derived.h"
+#include "boards/board_derived.h"
 
 #endif

@@ -1,6 +1,6 @@
 #include "board_io.h"
 
-#include "stm32f1_regs.h"
+#include "ports/stm32f1/stm32f1_regs.h"
 
 enum { HSE_STARTUP_TRIES = 100000 };
 

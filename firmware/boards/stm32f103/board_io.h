@@ -6,7 +6,7 @@
 
 #include <stdint.h>
 
-#include "board_common.h" /* the bridge PWM, the ADC scan, the watchdog */
+#include "ports/stm32_common/board_common.h" /* the bridge PWM, the ADC scan, the watchdog */
 
 #define F103_CORE_HZ 72000000u
 #define F103_PCLK2_HZ 72000000u /* USART1, ADC (through /6), TIM on APB2 */

@@ -3,13 +3,13 @@
  * (firmware/bootloader/bootloader.c). */
 #include "board.h"
 #include "board_io.h"
-#include "boot_flow.h"
-#include "boot_jump.h"
-#include "bootloader.h"
-#include "flash_f0f1.h"
-#include "port_uart.h"
-#include "stm32f1_regs.h"
-#include "systick_clock.h"
+#include "bootloader/boot_flow.h"
+#include "ports/stm32_common/boot_jump.h"
+#include "bootloader/bootloader.h"
+#include "ports/stm32_common/flash_f0f1.h"
+#include "ports/stm32f1/stm32f1_uart.h"
+#include "ports/stm32f1/stm32f1_regs.h"
+#include "ports/stm32_common/systick_clock.h"
 
 static struct usart_hd usart;
 static uint8_t rx_bytes[BOARD_BOOT_RX_RING_BYTES];

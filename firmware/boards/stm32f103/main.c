@@ -1,17 +1,17 @@
 /* The reference board: STM32F103 servo controller (pin map: README.md). */
 #include "board.h"
 #include "board_io.h"
-#include "flash_f0f1.h"
-#include "app_image.h"
-#include "boot_flow.h"
-#include "boot_jump.h"
-#include "cortex_sleep.h"
-#include "servo.h"
-#include "stm32f1_regs.h"
-#include "systick_clock.h"
-#include "../test_build.h"
-#include "port_uart.h"
-#include "usart_hd.h"
+#include "ports/stm32_common/flash_f0f1.h"
+#include "bootloader/app_image.h"
+#include "bootloader/boot_flow.h"
+#include "ports/stm32_common/boot_jump.h"
+#include "ports/stm32_common/cortex_sleep.h"
+#include "app/servo.h"
+#include "ports/stm32f1/stm32f1_regs.h"
+#include "ports/stm32_common/systick_clock.h"
+#include "boards/test_build.h"
+#include "ports/stm32f1/stm32f1_uart.h"
+#include "ports/stm32f1/usart_hd.h"
 
 static struct servo servo;
 static struct usart_hd usart;

@@ -16,8 +16,8 @@
 #include "hal/hal_sensors.h"
 
 /* The servo's bus: the half-duplex UART and the clock its bytes are
- * stamped by. One port provides all of it (its port_uart.h names it as one
- * initialiser); ctx is the hal_port's. */
+ * stamped by. One port provides all of it (stm32f1_uart.h, stm32f0_uart.h:
+ * one initialiser); ctx is the hal_port's. */
 struct hal_bus {
     /* Free-running microsecond clock; wraps at 2^32. */
     uint32_t (*now_us)(void *ctx);

@@ -1,4 +1,4 @@
-#include "plant.h"
+#include "ports/host/plant.h"
 
 #include <math.h>
 

@@ -1,5 +1,5 @@
 #define _POSIX_C_SOURCE 200809L
-#include "sim_flash.h"
+#include "ports/host/sim_flash.h"
 
 #include <fcntl.h>
 #include <string.h>

@@ -1,4 +1,4 @@
-#include "thermal.h"
+#include "ports/host/thermal.h"
 
 #include <math.h>
 

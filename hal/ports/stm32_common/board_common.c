@@ -1,6 +1,6 @@
-#include "board_common.h"
+#include "ports/stm32_common/board_common.h"
 
-#include "stm32_core_regs.h"
+#include "ports/stm32_common/stm32_core_regs.h"
 
 enum { PWM_HZ = 20000 };
 

@@ -1,6 +1,6 @@
-#include "boot_jump.h"
+#include "ports/stm32_common/boot_jump.h"
 
-#include "stm32_core_regs.h"
+#include "ports/stm32_common/stm32_core_regs.h"
 
 #define SCB_VTOR REG32(0xE000ED08u)
 

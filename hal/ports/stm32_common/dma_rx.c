@@ -1,6 +1,6 @@
-#include "dma_rx.h"
+#include "ports/stm32_common/dma_rx.h"
 
-#include "stm32_core_regs.h"
+#include "ports/stm32_common/stm32_core_regs.h"
 
 /* MINC | CIRC | TCIE | EN; bytes both sides; priority very high (PL = 3). */
 #define DMA_CCR_RX_CIRCULAR ((1u << 7) | (1u << 5) | (1u << 1) | (1u << 0) | (3u << 12))

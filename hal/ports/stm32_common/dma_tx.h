@@ -3,7 +3,7 @@
 
 #include <stdint.h>
 
-#include "stm32_core_regs.h"
+#include "ports/stm32_common/stm32_core_regs.h"
 
 /* MINC | DIR (memory to peripheral) | EN; bytes both sides; priority high
  * (PL = 2), below the receiving channel's very high. No interrupt: the

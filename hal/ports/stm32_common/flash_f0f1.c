@@ -1,6 +1,6 @@
-#include "flash_f0f1.h"
+#include "ports/stm32_common/flash_f0f1.h"
 
-#include "stm32_core_regs.h"
+#include "ports/stm32_common/stm32_core_regs.h"
 
 static void unlock(void)
 {

@@ -1,6 +1,6 @@
-#include "systick_clock.h"
+#include "ports/stm32_common/systick_clock.h"
 
-#include "stm32_core_regs.h"
+#include "ports/stm32_common/stm32_core_regs.h"
 
 static volatile uint32_t uptime_ms;
 static uint32_t reload;

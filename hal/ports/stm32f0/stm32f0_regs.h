@@ -3,7 +3,7 @@
 #ifndef STM32F0_REGS_H
 #define STM32F0_REGS_H
 
-#include "stm32_core_regs.h"
+#include "ports/stm32_common/stm32_core_regs.h"
 
 /* RCC (RM0360 6.4) */
 #define RCC_CFGR_PLLMUL6 (4u << 18)

@@ -1,7 +1,7 @@
-#include "usart_v2_hd.h"
+#include "ports/stm32f0/usart_v2_hd.h"
 
-#include "dma_tx.h"
-#include "stm32f0_regs.h"
+#include "ports/stm32_common/dma_tx.h"
+#include "ports/stm32f0/stm32f0_regs.h"
 
 /* Receiving: the DMA takes the bytes, the line going idle after them
  * wakes a sleeping main loop to frame them. */

@@ -3,7 +3,7 @@
 #ifndef STM32F1_REGS_H
 #define STM32F1_REGS_H
 
-#include "stm32_core_regs.h"
+#include "ports/stm32_common/stm32_core_regs.h"
 
 /* RCC */
 #define RCC_CSR REG32(RCC_BASE + 0x24u)

@@ -1,7 +1,7 @@
-#include "usart_hd.h"
+#include "ports/stm32f1/usart_hd.h"
 
-#include "dma_tx.h"
-#include "stm32f1_regs.h"
+#include "ports/stm32_common/dma_tx.h"
+#include "ports/stm32f1/stm32f1_regs.h"
 
 void usart_hd_set_baud(struct usart_hd *u, uint32_t baud)
 {

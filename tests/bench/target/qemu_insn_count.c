@@ -30,8 +30,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "qemu_plugin_api.h"
-#include "thumb_cycles.h"
+#include "bench/target/qemu_plugin_api.h"
+#include "bench/target/thumb_cycles.h"
 
 PLUGIN_EXPORT int qemu_plugin_version = 1;
 

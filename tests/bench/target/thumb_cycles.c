@@ -1,4 +1,4 @@
-#include "thumb_cycles.h"
+#include "bench/target/thumb_cycles.h"
 
 static unsigned bits_set(uint32_t v)
 {

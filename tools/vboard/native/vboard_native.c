@@ -8,11 +8,11 @@
 #include <stdint.h>
 #include <string.h>
 
-#include "config_peek.h"
-#include "config_store.h"
-#include "plant.h"
+#include "storage/config_peek.h"
+#include "storage/config_store.h"
+#include "ports/host/plant.h"
 #include "registers/data_table.h"
-#include "thermal.h"
+#include "ports/host/thermal.h"
 
 struct vboard_motor {
     struct plant plant;

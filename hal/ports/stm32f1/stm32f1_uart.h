@@ -5,9 +5,9 @@
 #ifndef STM32F1_PORT_UART_H
 #define STM32F1_PORT_UART_H
 
-#include "dma_rx.h"
+#include "ports/stm32_common/dma_rx.h"
 #include "hal/hal_port.h"
-#include "usart_hd.h"
+#include "ports/stm32f1/usart_hd.h"
 
 uint32_t port_now_us(void *ctx);
 void port_uart_send(void *ctx, const uint8_t *data, uint16_t len);

@@ -1,9 +1,9 @@
-#include "port_uart.h"
+#include "ports/stm32f1/stm32f1_uart.h"
 
 #include <stddef.h>
 
-#include "stm32f1_regs.h"
-#include "systick_clock.h"
+#include "ports/stm32f1/stm32f1_regs.h"
+#include "ports/stm32_common/systick_clock.h"
 
 static struct usart_hd *bus_usart;
 static struct dma_rx *bus_dma;

@@ -5,9 +5,9 @@
 #ifndef STM32F0_PORT_UART_H
 #define STM32F0_PORT_UART_H
 
-#include "dma_rx.h"
+#include "ports/stm32_common/dma_rx.h"
 #include "hal/hal_port.h"
-#include "usart_v2_hd.h"
+#include "ports/stm32f0/usart_v2_hd.h"
 
 enum port_uart_send {
     PORT_UART_SEND_DMA, /* port_uart_send: by DMA1 channel 2, the USART's interrupt at the end */

@@ -1,7 +1,7 @@
-#include "port_uart.h"
+#include "ports/stm32f0/stm32f0_uart.h"
 
-#include "stm32f0_regs.h"
-#include "systick_clock.h"
+#include "ports/stm32f0/stm32f0_regs.h"
+#include "ports/stm32_common/systick_clock.h"
 
 static struct usart_v2_hd *bus_usart;
 static struct dma_rx *bus_dma;
