@@ -114,8 +114,6 @@ enum packet_outcome handle_monitor(const struct packet_call *c, struct response 
     return OUTCOME_OK;
 }
 
-enum { ITEM_SERVO_ID = 34 };
-
 /* AssignId (docs/packets.md): sent to every servo (ID 0xFF) and taken by
  * the one with the serial number, so it reaches one servo among several
  * that share an ID; the others stay silent. The ID is written as WriteData

@@ -10,8 +10,9 @@ reference's rules in prose, protocol/rules.md:
 The C headers: protocol/packet_codes.h (every packet's code, which carry a
 servo ID), protocol/packet_rows.h (each packet table's rows and the
 handlers' prototypes), registers/schema_items.h (the register structs,
-the status bits, each item's row and range) and sim/control_commands.h
-(servo_sim's control port)."""
+the status bits, each item's ID, row and range), protocol/packet_fields.h
+(where each fixed field of an answer lies: for the unit tests) and
+sim/control_commands.h (servo_sim's control port)."""
 import sys
 from pathlib import Path
 
@@ -98,12 +99,14 @@ def schema_items_h(s: sch.Schema) -> str:
     def number(value: int, item: sch.Item) -> str:  # unsigned items' limits compare as unsigned
         return f"{value}" if item.signed else f"{value}u"
 
+    ids = "".join(f"    ITEM_{i.field.upper()} = {i.id},\n" for i in s.items)
     limits = "".join(f"#define ITEM_{i.field.upper()}_MIN {number(i.min, i)}\n"
                      f"#define ITEM_{i.field.upper()}_MAX {number(i.max, i)}\n"
                      f"#define ITEM_{i.field.upper()}_FACTORY {number(i.factory, i)}\n" for i in user)
     return (NOTICE + "#ifndef REGISTERS_SCHEMA_ITEMS_H\n#define REGISTERS_SCHEMA_ITEMS_H\n\n#include <stdint.h>\n\n"
             "/* Status area: live readings and identity, read-only. */\n" + struct("status_area", status) +
             "\n/* Bits of status (data item 5). */\nenum status_bit {\n" + bits + "};\n\n"
+            "/* Each data item's ID, by its register's name. */\nenum data_item_id {\n" + ids + "};\n\n"
             "/* User area: configuration that persists, laid out as its wire image (the\n"
             " * ReadBatchData block: every item at its own size, in ID order). */\n"
             + struct("user_config", user) +
@@ -114,6 +117,25 @@ def schema_items_h(s: sch.Schema) -> str:
             "/* Each user item's range and factory value. */\n" + limits + "\n"
             "/* The data table's rows, in ID order (data_table.c's RO_STATUS and USER). */\n"
             + _macro("DATA_ITEM_ROWS", rows) + "\n#endif\n")
+
+
+def packet_fields_h(s: sch.Schema) -> str:
+    """ANSWER_<packet>_<field>: offset, size, signed, of each answer field
+    whose place is fixed (before any field of varying size)."""
+    sizes = {"u8": (1, 0), "u16": (2, 0), "u32": (4, 0), "i16": (2, 1), "i32": (4, 1)}
+    rows = []
+    for p in s.packets:
+        at = 0
+        for f in p.answer:
+            if f.type not in sizes:
+                break
+            size, signed = sizes[f.type]
+            rows.append(f"#define ANSWER_{p.c}_{f.name.upper()} {at}, {size}, {signed}\n")
+            at += size
+    return (NOTICE + "#ifndef PROTOCOL_PACKET_FIELDS_H\n#define PROTOCOL_PACKET_FIELDS_H\n\n"
+            "/* Each answer field's place in the answer's content: offset, size in\n"
+            " * bytes, signed (little-endian). For the unit tests' answer_field(). */\n"
+            + "".join(rows) + "\n#endif\n")
 
 
 def control_commands_h(s: sch.Schema) -> str:
@@ -288,6 +310,7 @@ def main(argv=None) -> int:
         write(out / "protocol" / "packet_codes.h", packet_codes_h(s))
         write(out / "protocol" / "packet_rows.h", packet_rows_h(s))
         write(out / "registers" / "schema_items.h", schema_items_h(s))
+        write(out / "protocol" / "packet_fields.h", packet_fields_h(s))
         write(out / "sim" / "control_commands.h", control_commands_h(s))
         return 0
     folder = Path(args[1])

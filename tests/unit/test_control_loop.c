@@ -14,6 +14,7 @@
 #define M_PI 3.14159265358979323846
 #endif
 
+#include "support/by_name.h"
 #include "support/plant_harness.h"
 
 static int setup(void **state)
@@ -22,7 +23,7 @@ static int setup(void **state)
     plant_init(&plant);
     harness_init();
     plant_harness_attach();
-    REQUEST(4, 0, 49, 0); /* no soft start */
+    WRITE_ITEM(0, ITEM_SOFT_START_ON, 0); /* no soft start */
     return 0;
 }
 
@@ -46,7 +47,7 @@ static double run_tracking(uint32_t ms)
 static void test_interval_move_tracks_and_settles(void **state)
 {
     (void)state;
-    REQUEST(11, 0, 0x84, 0x03, 0xF4, 0x01, 0x64, 0x00, 0x64, 0x00, 0x00, 0x00); /* 90 deg, 500 ms */
+    REQUEST(PKT_MOVE_ANGLE_BY_INTERVAL, 0, 0x84, 0x03, 0xF4, 0x01, 0x64, 0x00, 0x64, 0x00, 0x00, 0x00); /* 90 deg, 500 ms */
     double tracking = run_tracking(500);
     double peak = 0;
     for (int i = 0; i < 300; i++) {
@@ -60,18 +61,18 @@ static void test_interval_move_tracks_and_settles(void **state)
     assert_true(peak - 90.0 < 0.2);
     assert_true(final_error < 0.14); /* within one count of the target's count */
     /* ReadAngle: 90.0, or 90.1 where the horn rests on the next count. */
-    REQUEST(10, 0);
-    assert_true(hal.sent_length == 8 && hal.sent[6] == 0x03 &&
-                (hal.sent[5] == 0x84 || hal.sent[5] == 0x85));
+    REQUEST(PKT_READ_ANGLE, 0);
+    int32_t angle = ANSWER_FIELD(PKT_READ_ANGLE, ANSWER_READ_ANGLE_ANGLE);
+    assert_true(angle == 900 || angle == 901);
 }
 
 static void test_velocity_move_and_return(void **state)
 {
     (void)state;
     /* 180 deg at 300 deg/s, ramps 100/100 ms; then back to 0. */
-    REQUEST(12, 0, 0x08, 0x07, 0xB8, 0x0B, 0x64, 0x00, 0x64, 0x00, 0x00, 0x00);
+    REQUEST(PKT_MOVE_ANGLE_BY_VELOCITY, 0, 0x08, 0x07, 0xB8, 0x0B, 0x64, 0x00, 0x64, 0x00, 0x00, 0x00);
     double out = run_tracking(800);
-    REQUEST(12, 0, 0x00, 0x00, 0xB8, 0x0B, 0x64, 0x00, 0x64, 0x00, 0x00, 0x00);
+    REQUEST(PKT_MOVE_ANGLE_BY_VELOCITY, 0, 0x00, 0x00, 0xB8, 0x0B, 0x64, 0x00, 0x64, 0x00, 0x00, 0x00);
     double back = run_tracking(800);
     printf("# 180 deg at 300 deg/s: tracking error %.2f / %.2f deg, final %.3f deg\n", out, back,
            plant_angle_deg(&plant));
@@ -84,7 +85,7 @@ static void test_velocity_move_and_return(void **state)
 static void test_load_is_held(void **state)
 {
     (void)state;
-    REQUEST(8, 0, 0x00, 0x00, 0xC8, 0x00, 0x00, 0x00); /* hold at 0 */
+    REQUEST(PKT_MOVE_ANGLE, 0, 0x00, 0x00, 0xC8, 0x00, 0x00, 0x00); /* hold at 0 */
     plant.load_torque = 0.5; /* N m, a quarter of the 1.9 N m stall torque */
     harness_run_ms(1000);
     printf("# 0.5 N m load: held at %.3f deg\n", plant_angle_deg(&plant));
@@ -126,8 +127,8 @@ static void hold_30_under(double load_nm, const struct load_arrival *a, double *
     plant_init(&plant);
     harness_init();
     plant_harness_attach();
-    REQUEST(4, 0, 49, 0); /* no soft start */
-    REQUEST(8, 0, 0x2C, 0x01, 0xF4, 0x01, 0x00, 0x00);
+    WRITE_ITEM(0, ITEM_SOFT_START_ON, 0); /* no soft start */
+    REQUEST(PKT_MOVE_ANGLE, 0, 0x2C, 0x01, 0xF4, 0x01, 0x00, 0x00);
     harness_run_ms(800);
     for (int i = 0; i < a->steps; i++) {
         plant.load_torque = a->fractions[i] * load_nm;
@@ -135,8 +136,8 @@ static void hold_30_under(double load_nm, const struct load_arrival *a, double *
     }
     harness_run_ms(2000);
     *at_deg = plant_angle_deg(&plant);
-    REQUEST(3, 0, 5);
-    *status = hal.sent[6];
+    REQUEST(PKT_READ_DATA, 0, ITEM_STATUS);
+    *status = (uint8_t)ANSWER_FIELD(PKT_READ_DATA, 2, 1, 0); /* the item's byte after id, item */
 }
 
 static void test_a_hold_does_not_sag(void **state)
@@ -175,7 +176,7 @@ static void test_power_bounds_the_current(void **state)
     (void)state;
     /* 90 deg at 750 deg/s with 20 ms ramps at 2000 mW: far more than that
      * power can do, so the current limit governs the whole move. */
-    REQUEST(12, 0, 0x84, 0x03, 0x4C, 0x1D, 0x14, 0x00, 0x14, 0x00, 0xD0, 0x07);
+    REQUEST(PKT_MOVE_ANGLE_BY_VELOCITY, 0, 0x84, 0x03, 0x4C, 0x1D, 0x14, 0x00, 0x14, 0x00, 0xD0, 0x07);
     double peak = 0;
     double furthest = 0;
     for (int i = 0; i < 3000; i++) {
@@ -200,7 +201,7 @@ static void test_power_bounds_the_current(void **state)
 static void hold_and_watch(double load, const char *what)
 {
     plant.load_torque = load;
-    REQUEST(11, 0, 0x84, 0x03, 0xF4, 0x01, 0x64, 0x00, 0x64, 0x00, 0x00, 0x00); /* 90 deg */
+    REQUEST(PKT_MOVE_ANGLE_BY_INTERVAL, 0, 0x84, 0x03, 0xF4, 0x01, 0x64, 0x00, 0x64, 0x00, 0x00, 0x00); /* 90 deg */
     harness_run_ms(1500); /* the move, then settling */
     uint16_t lo = 4096, hi = 0;
     double i_lo = 1e9, i_hi = -1e9;
@@ -230,14 +231,14 @@ static void test_holding_has_no_limit_cycle(void **state)
  * does not swing back to a point it had already passed. */
 static void stop_from_wheel_run(uint8_t packet)
 {
-    REQUEST(7, 0, 0x01, 0xEE, 0x02, 0x00, 0x00); /* run counter-clockwise at 750 deg/s */
+    REQUEST(PKT_MOVE_WHEEL, 0, 0x01, 0xEE, 0x02, 0x00, 0x00); /* run counter-clockwise at 750 deg/s */
     harness_run_ms(1500);
     double speed = plant.velocity * 180.0 / M_PI;
     if (packet == 7) {
-        REQUEST(4, 0, 47, 1); /* wheel brake: hold where it stops */
-        REQUEST(7, 0, 0x00, 0x00, 0x00, 0x00, 0x00);
+        WRITE_ITEM(0, ITEM_WHEEL_BRAKE, 1); /* wheel brake: hold where it stops */
+        REQUEST(PKT_MOVE_WHEEL, 0, 0x00, 0x00, 0x00, 0x00, 0x00);
     } else {
-        REQUEST(24, 0, 0x11, 0x00, 0x00);
+        REQUEST(PKT_STOP_ON_CONTROL_MODE, 0, 0x11, 0x00, 0x00);
     }
     double furthest = plant_angle_deg(&plant);
     for (int i = 0; i < 1000; i++) {
@@ -257,14 +258,14 @@ static void stop_from_wheel_run(uint8_t packet)
 static void test_wheel_stop_brakes_within_the_motor(void **state)
 {
     (void)state;
-    REQUEST(4, 0, 42, 0xD0, 0x07); /* power protection 2000 mW */
+    WRITE_ITEM(0, ITEM_POWER_LIMIT_MW, 2000); /* power protection 2000 mW */
     stop_from_wheel_run(7);
 }
 
 static void test_stop_and_hold_brakes_within_the_motor(void **state)
 {
     (void)state;
-    REQUEST(4, 0, 42, 0xD0, 0x07);
+    WRITE_ITEM(0, ITEM_POWER_LIMIT_MW, 2000);
     stop_from_wheel_run(24);
 }
 
@@ -275,7 +276,7 @@ static void test_stop_and_hold_brakes_within_the_motor(void **state)
 static void test_back_driving_is_bounded(void **state)
 {
     (void)state;
-    REQUEST(24, 0, 0x10, 0x00, 0x00); /* stop and release */
+    REQUEST(PKT_STOP_ON_CONTROL_MODE, 0, 0x10, 0x00, 0x00); /* stop and release */
     plant.load_torque = 3.0;          /* N m, 1.6 x the stall torque */
     double fastest = 0;
     for (int i = 0; i < 2000; i++) {
@@ -299,10 +300,10 @@ static void test_back_driving_is_bounded(void **state)
 static void test_pushed_backwards_is_a_stall(void **state)
 {
     (void)state;
-    REQUEST(8, 0, 0x2C, 0x01, 0x2C, 0x01, 0x00, 0x00); /* 30.0 deg in 300 ms */
+    REQUEST(PKT_MOVE_ANGLE, 0, 0x2C, 0x01, 0x2C, 0x01, 0x00, 0x00); /* 30.0 deg in 300 ms */
     harness_run_ms(600);
-    REQUEST(3, 0, 5);
-    EXPECT_RESPONSE(3, 0, 5, 0x00);
+    REQUEST(PKT_READ_DATA, 0, ITEM_STATUS);
+    EXPECT_ITEM(0, ITEM_STATUS, 0);
     plant.load_torque = 5.0; /* through the gears' losses: 1.5 x stall at the motor */
     harness_run_ms(300);
     double speed = plant.velocity * 180.0 / M_PI;
@@ -321,7 +322,7 @@ static void test_damping_brakes_a_spinning_horn(void **state)
     harness_run_ms(100);
     double coasting = plant.velocity;
     plant.velocity = 3.0;
-    REQUEST(9, 0, 0x10, 0x27);
+    REQUEST(PKT_MOVE_DAMPING, 0, 0x10, 0x27);
     harness_run_ms(100);
     printf("# after 100 ms: coasting %.2f rad/s, damped %.2f rad/s\n", coasting, plant.velocity);
     assert_true(plant.velocity < coasting / 2.0);
@@ -333,7 +334,7 @@ static void stall_against_a_stop(void)
 {
     plant.has_stop = true;
     plant.stop_angle = 45.0 * 3.14159265358979 / 180.0;
-    REQUEST(8, 0, 0x84, 0x03, 0xF4, 0x01, 0x00, 0x00);
+    REQUEST(PKT_MOVE_ANGLE, 0, 0x84, 0x03, 0xF4, 0x01, 0x00, 0x00);
     /* The horn meets the stop half-way through the 500 ms move, at about
      * 0.26 s. Its back-EMF gone at once, the current jumps past the power
      * protection for a while (bit 6 derates the output), so the stall time
@@ -346,10 +347,10 @@ static void stall_against_a_stop(void)
 static void test_stall_limits_to_the_stall_power(void **state)
 {
     (void)state;
-    REQUEST(4, 0, 38, 0xD0, 0x07); /* stall power limit 2000 mW */
+    WRITE_ITEM(0, ITEM_STALL_POWER_MW, 2000); /* stall power limit 2000 mW */
     stall_against_a_stop();
-    REQUEST(3, 0, 5);
-    EXPECT_RESPONSE(3, 0, 5, STATUS_STALL | STATUS_EXECUTING); /* the move waits */
+    REQUEST(PKT_READ_DATA, 0, ITEM_STATUS);
+    EXPECT_RESPONSE(PKT_READ_DATA, 0, ITEM_STATUS, STATUS_STALL | STATUS_EXECUTING); /* the move waits */
     harness_run_ms(100);
     double limit = 2.0 / 7.4;
     printf("# stalled at %.1f deg: current %.3f A, stall-power limit %.3f A\n",
@@ -359,27 +360,27 @@ static void test_stall_limits_to_the_stall_power(void **state)
     /* The stop goes away: it moves on to 90 and the bit clears. */
     plant.has_stop = false;
     harness_run_ms(2000);
-    REQUEST(3, 0, 5);
-    EXPECT_RESPONSE(3, 0, 5, 0x00);
+    REQUEST(PKT_READ_DATA, 0, ITEM_STATUS);
+    EXPECT_ITEM(0, ITEM_STATUS, 0);
     assert_true(fabs(plant_angle_deg(&plant) - 90.0) < 0.3);
 }
 
 static void test_stall_releases_when_37_says_so(void **state)
 {
     (void)state;
-    REQUEST(4, 0, 37, 1);
+    WRITE_ITEM(0, ITEM_STALL_RELEASE, 1);
     stall_against_a_stop();
-    REQUEST(3, 0, 5);
-    EXPECT_RESPONSE(3, 0, 5, STATUS_STALL);
+    REQUEST(PKT_READ_DATA, 0, ITEM_STATUS);
+    EXPECT_RESPONSE(PKT_READ_DATA, 0, ITEM_STATUS, STATUS_STALL);
     assert_true(hal.coasting);
     harness_run_ms(1000);
-    REQUEST(3, 0, 5);
-    EXPECT_RESPONSE(3, 0, 5, STATUS_STALL); /* until the next command */
+    REQUEST(PKT_READ_DATA, 0, ITEM_STATUS);
+    EXPECT_RESPONSE(PKT_READ_DATA, 0, ITEM_STATUS, STATUS_STALL); /* until the next command */
     plant.has_stop = false;
-    REQUEST(8, 0, 0x00, 0x00, 0xF4, 0x01, 0x00, 0x00);
+    REQUEST(PKT_MOVE_ANGLE, 0, 0x00, 0x00, 0xF4, 0x01, 0x00, 0x00);
     harness_run_ms(700);
-    REQUEST(3, 0, 5);
-    EXPECT_RESPONSE(3, 0, 5, 0x00);
+    REQUEST(PKT_READ_DATA, 0, ITEM_STATUS);
+    EXPECT_ITEM(0, ITEM_STATUS, 0);
 }
 
 int main(void)

@@ -20,6 +20,7 @@
 
 #include <cmocka.h>
 
+#include "support/by_name.h"
 #include "support/plant_harness.h"
 
 static uint64_t rng_state;
@@ -166,11 +167,11 @@ static void run_trial(unsigned trial, double inertia_scale)
     harness_init();
     hal.sensors.supply = (uint16_t)lround(plant.p.supply_v * 1000.0);
     plant_harness_attach();
-    REQUEST(4, 0, 49, 0);        /* no soft start */
-    REQUEST(4, 0, 40, 0x28, 0x23); /* high-voltage protection 9000 mV */
+    WRITE_ITEM(0, ITEM_SOFT_START_ON, 0);        /* no soft start */
+    WRITE_ITEM(0, ITEM_HIGH_VOLTAGE_MV, 9000); /* high-voltage protection 9000 mV */
     bool queued = rng() % 4u == 0u;
     if (queued) {
-        REQUEST(4, 0, 33, 1); /* control response: the second move waits */
+        WRITE_ITEM(0, ITEM_CONTROL_RESPONSE, 1); /* control response: the second move waits */
     }
     harness_run_ms(20);
     uint16_t power = (uint16_t)rng_range(1000, 10000);

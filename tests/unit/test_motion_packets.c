@@ -14,12 +14,13 @@
 
 #include "motion/controller.h"
 #include "motion/gains.h"
+#include "support/by_name.h"
 #include "support/servo_harness.h"
 
 static void full_power(void)
 {
-    REQUEST(4, 0, 42, 0xFF, 0xFF);
-    REQUEST(4, 0, 43, 0xFF, 0xFF);
+    WRITE_ITEM(0, ITEM_POWER_LIMIT_MW, 65535);
+    WRITE_ITEM(0, ITEM_CURRENT_LIMIT_MA, 65535);
 }
 
 static int setup(void **state)
@@ -28,7 +29,7 @@ static int setup(void **state)
     harness_init();
     harness_ideal_tracking();
     full_power();
-    REQUEST(4, 0, 49, 0); /* soft start off, except where a test turns it on */
+    WRITE_ITEM(0, ITEM_SOFT_START_ON, 0); /* soft start off, except where a test turns it on */
     return 0;
 }
 
@@ -70,17 +71,17 @@ static uint32_t run_until_done(uint32_t limit_ms)
 static void test_angle_move_reaches_target(void **state)
 {
     (void)state;
-    REQUEST(8, 0, 0x84, 0x03, 0xF4, 0x01, 0x00, 0x00); /* 90.0 deg in 500 ms */
+    REQUEST(PKT_MOVE_ANGLE, 0, 0x84, 0x03, 0xF4, 0x01, 0x00, 0x00); /* 90.0 deg in 500 ms */
     EXPECT_SILENCE();
-    REQUEST(3, 0, 5);
-    EXPECT_RESPONSE(3, 0, 5, STATUS_EXECUTING);
+    REQUEST(PKT_READ_DATA, 0, ITEM_STATUS);
+    EXPECT_RESPONSE(PKT_READ_DATA, 0, ITEM_STATUS, STATUS_EXECUTING);
     assert_in_range(run_until_done(1000), 495, 505);
-    REQUEST(3, 0, 5);
-    EXPECT_RESPONSE(3, 0, 5, 0x00);
-    REQUEST(10, 0);
-    EXPECT_RESPONSE(10, 0, 0x84, 0x03);
-    REQUEST(16, 0);
-    EXPECT_RESPONSE(16, 0, 0x84, 0x03, 0x00, 0x00, 0x00, 0x00);
+    REQUEST(PKT_READ_DATA, 0, ITEM_STATUS);
+    EXPECT_ITEM(0, ITEM_STATUS, 0);
+    REQUEST(PKT_READ_ANGLE, 0);
+    EXPECT_RESPONSE(PKT_READ_ANGLE, 0, 0x84, 0x03);
+    REQUEST(PKT_READ_MULTI_TURN_ANGLE, 0);
+    EXPECT_RESPONSE(PKT_READ_MULTI_TURN_ANGLE, 0, 0x84, 0x03, 0x00, 0x00, 0x00, 0x00);
     /* Then it holds there, under control. */
     assert_false(motion_is_released(&servo.motion));
     assert_false(hal.coasting);
@@ -89,36 +90,36 @@ static void test_angle_move_reaches_target(void **state)
 static void test_soft_start_times_the_first_move(void **state)
 {
     (void)state;
-    REQUEST(8, 0, 0x84, 0x03, 0xF4, 0x01, 0x00, 0x00);
+    REQUEST(PKT_MOVE_ANGLE, 0, 0x84, 0x03, 0xF4, 0x01, 0x00, 0x00);
     assert_in_range(run_until_done(5000), 2995, 3005); /* 3000 ms (data 50) */
-    REQUEST(8, 0, 0x00, 0x00, 0xF4, 0x01, 0x00, 0x00);
+    REQUEST(PKT_MOVE_ANGLE, 0, 0x00, 0x00, 0xF4, 0x01, 0x00, 0x00);
     assert_in_range(run_until_done(5000), 495, 505); /* only the first */
-    REQUEST(10, 0);
-    EXPECT_RESPONSE(10, 0, 0x00, 0x00);
+    REQUEST(PKT_READ_ANGLE, 0);
+    EXPECT_RESPONSE(PKT_READ_ANGLE, 0, 0x00, 0x00);
 }
 
 static void test_single_turn_targets_are_clamped_to_the_limits(void **state)
 {
     (void)state;
-    REQUEST(8, 0, 0xDC, 0x05, 0xC8, 0x00, 0x00, 0x00); /* 150.0 > 135.0 limit */
+    REQUEST(PKT_MOVE_ANGLE, 0, 0xDC, 0x05, 0xC8, 0x00, 0x00, 0x00); /* 150.0 > 135.0 limit */
     run_until_done(1000);
-    REQUEST(10, 0);
-    EXPECT_RESPONSE(10, 0, 0x46, 0x05); /* 1350 */
-    REQUEST(8, 0, 0x24, 0xFA, 0xC8, 0x00, 0x00, 0x00); /* -150.0 */
+    REQUEST(PKT_READ_ANGLE, 0);
+    EXPECT_RESPONSE(PKT_READ_ANGLE, 0, 0x46, 0x05); /* 1350 */
+    REQUEST(PKT_MOVE_ANGLE, 0, 0x24, 0xFA, 0xC8, 0x00, 0x00, 0x00); /* -150.0 */
     run_until_done(1000);
-    REQUEST(10, 0);
-    EXPECT_RESPONSE(10, 0, 0xBA, 0xFA); /* -1350 */
-    REQUEST(4, 0, 51, 0x84, 0x03);                      /* upper limit 90.0 */
-    REQUEST(8, 0, 0xE8, 0x03, 0xC8, 0x00, 0x00, 0x00); /* 100.0 */
+    REQUEST(PKT_READ_ANGLE, 0);
+    EXPECT_RESPONSE(PKT_READ_ANGLE, 0, 0xBA, 0xFA); /* -1350 */
+    WRITE_ITEM(0, ITEM_ANGLE_MAX_DECIDEG, 900);                      /* upper limit 90.0 */
+    REQUEST(PKT_MOVE_ANGLE, 0, 0xE8, 0x03, 0xC8, 0x00, 0x00, 0x00); /* 100.0 */
     run_until_done(1000);
-    REQUEST(10, 0);
-    EXPECT_RESPONSE(10, 0, 0x84, 0x03);
-    REQUEST(4, 0, 48, 0);                               /* limits off */
-    REQUEST(8, 0, 0xA4, 0x06, 0xC8, 0x00, 0x00, 0x00); /* 170.0 */
+    REQUEST(PKT_READ_ANGLE, 0);
+    EXPECT_RESPONSE(PKT_READ_ANGLE, 0, 0x84, 0x03);
+    WRITE_ITEM(0, ITEM_ANGLE_LIMIT_ON, 0);                               /* limits off */
+    REQUEST(PKT_MOVE_ANGLE, 0, 0xA4, 0x06, 0xC8, 0x00, 0x00, 0x00); /* 170.0 */
     run_until_done(1000);
-    REQUEST(10, 0);
-    EXPECT_RESPONSE(10, 0, 0xA4, 0x06);
-    REQUEST(8, 0, 0x10, 0x27, 0xC8, 0x00, 0x00, 0x00); /* 1000.0: clamped to 180.0 */
+    REQUEST(PKT_READ_ANGLE, 0);
+    EXPECT_RESPONSE(PKT_READ_ANGLE, 0, 0xA4, 0x06);
+    REQUEST(PKT_MOVE_ANGLE, 0, 0x10, 0x27, 0xC8, 0x00, 0x00, 0x00); /* 1000.0: clamped to 180.0 */
     run_until_done(1000);
     assert_int_equal(angle_now(), 1800);
 }
@@ -126,39 +127,38 @@ static void test_single_turn_targets_are_clamped_to_the_limits(void **state)
 static void test_single_turn_angle_is_within_the_current_turn(void **state)
 {
     (void)state;
-    REQUEST(13, 0, 0x10, 0x0E, 0, 0, 0xB8, 0x0B, 0, 0, 0, 0); /* 360.0 deg, 3 s */
+    REQUEST(PKT_MOVE_MULTI_TURN, 0, 0x10, 0x0E, 0, 0, 0xB8, 0x0B, 0, 0, 0, 0); /* 360.0 deg, 3 s */
     run_until_done(4000);
-    REQUEST(8, 0, 0x84, 0x03, 0xF4, 0x01, 0x00, 0x00); /* 90.0 */
+    REQUEST(PKT_MOVE_ANGLE, 0, 0x84, 0x03, 0xF4, 0x01, 0x00, 0x00); /* 90.0 */
     run_until_done(1000);
-    REQUEST(16, 0);
-    EXPECT_RESPONSE(16, 0, 0x94, 0x11, 0x00, 0x00, 0x01, 0x00); /* 450.0, 1 turn */
-    REQUEST(10, 0);
-    EXPECT_RESPONSE(10, 0, 0x84, 0x03);
+    REQUEST(PKT_READ_MULTI_TURN_ANGLE, 0);
+    EXPECT_RESPONSE(PKT_READ_MULTI_TURN_ANGLE, 0, 0x94, 0x11, 0x00, 0x00, 0x01, 0x00); /* 450.0, 1 turn */
+    REQUEST(PKT_READ_ANGLE, 0);
+    EXPECT_RESPONSE(PKT_READ_ANGLE, 0, 0x84, 0x03);
 }
 
 static void test_multi_turn_target_is_clamped(void **state)
 {
     (void)state;
     /* 400 000.0 deg asked, 368 640.0 deg (1024 turns) allowed; 10 s. */
-    REQUEST(13, 0, 0x00, 0x09, 0x3D, 0x00, 0x10, 0x27, 0x00, 0x00, 0x00, 0x00);
+    REQUEST(PKT_MOVE_MULTI_TURN, 0, 0x00, 0x09, 0x3D, 0x00, 0x10, 0x27, 0x00, 0x00, 0x00, 0x00);
     run_until_done(11000);
-    REQUEST(16, 0);
-    EXPECT_RESPONSE(16, 0, 0x00, 0x40, 0x38, 0x00, 0x00, 0x04);
+    REQUEST(PKT_READ_MULTI_TURN_ANGLE, 0);
+    EXPECT_RESPONSE(PKT_READ_MULTI_TURN_ANGLE, 0, 0x00, 0x40, 0x38, 0x00, 0x00, 0x04);
 }
 
 static void test_interval_shorter_than_ramps_is_clamped(void **state)
 {
     (void)state;
     /* 11: 90.0 deg, interval 100 ms, ramps 100 + 200 ms: runs 300 ms. */
-    REQUEST(11, 0, 0x84, 0x03, 0x64, 0x00, 0x64, 0x00, 0xC8, 0x00, 0x00, 0x00);
+    REQUEST(PKT_MOVE_ANGLE_BY_INTERVAL, 0, 0x84, 0x03, 0x64, 0x00, 0x64, 0x00, 0xC8, 0x00, 0x00, 0x00);
     assert_in_range(run_until_done(1000), 297, 303);
     /* 14: ramps below 20 ms count as 20; 1 ms interval becomes 40 ms (to
      * 88.0 deg: a stroke the motor can brake in 20 ms). */
-    REQUEST(14, 0, 0x70, 0x03, 0x00, 0x00, 0x01, 0x00, 0x00, 0x00, 0x05, 0x00, 0x05, 0x00,
-            0x00, 0x00);
+    REQUEST(PKT_MOVE_MULTI_TURN_BY_INTERVAL, 0, 0x70, 0x03, 0x00, 0x00, 0x01, 0x00, 0x00, 0x00, 0x05, 0x00, 0x05, 0x00, 0x00, 0x00);
     assert_in_range(run_until_done(1000), 37, 43);
-    REQUEST(16, 0);
-    EXPECT_RESPONSE(16, 0, 0x70, 0x03, 0x00, 0x00, 0x00, 0x00);
+    REQUEST(PKT_READ_MULTI_TURN_ANGLE, 0);
+    EXPECT_RESPONSE(PKT_READ_MULTI_TURN_ANGLE, 0, 0x70, 0x03, 0x00, 0x00, 0x00, 0x00);
 }
 
 static void test_velocity_is_clamped(void **state)
@@ -166,10 +166,10 @@ static void test_velocity_is_clamped(void **state)
     (void)state;
     /* 90.0 deg at 900 deg/s asked, 750 deg/s allowed, 100/100 ms ramps:
      * 75 deg on the ramps, 20 ms of cruise, 220 ms (900 would take 200). */
-    REQUEST(12, 0, 0x84, 0x03, 0x28, 0x23, 0x64, 0x00, 0x64, 0x00, 0x00, 0x00);
+    REQUEST(PKT_MOVE_ANGLE_BY_VELOCITY, 0, 0x84, 0x03, 0x28, 0x23, 0x64, 0x00, 0x64, 0x00, 0x00, 0x00);
     assert_in_range(run_until_done(1000), 217, 223);
     /* 1.0 deg at 0.5 deg/s asked, 1 deg/s the least: 1020 ms. */
-    REQUEST(12, 0, 0x8E, 0x03, 0x05, 0x00, 0x14, 0x00, 0x14, 0x00, 0x00, 0x00);
+    REQUEST(PKT_MOVE_ANGLE_BY_VELOCITY, 0, 0x8E, 0x03, 0x05, 0x00, 0x14, 0x00, 0x14, 0x00, 0x00, 0x00);
     assert_in_range(run_until_done(3000), 1017, 1023);
 }
 
@@ -177,15 +177,15 @@ static void test_velocity_profile_worked_examples(void **state)
 {
     (void)state;
     /* 100 deg at 300 deg/s, ramps 100/200 ms: 483 ms. */
-    REQUEST(12, 0, 0xE8, 0x03, 0xB8, 0x0B, 0x64, 0x00, 0xC8, 0x00, 0x00, 0x00);
+    REQUEST(PKT_MOVE_ANGLE_BY_VELOCITY, 0, 0xE8, 0x03, 0xB8, 0x0B, 0x64, 0x00, 0xC8, 0x00, 0x00, 0x00);
     assert_in_range(run_until_done(1000), 481, 485);
     /* 20 deg more at 300 deg/s: ramps shrink to 44/88 ms, 133 ms in all. */
-    REQUEST(12, 0, 0xB0, 0x04, 0xB8, 0x0B, 0x64, 0x00, 0xC8, 0x00, 0x00, 0x00);
+    REQUEST(PKT_MOVE_ANGLE_BY_VELOCITY, 0, 0xB0, 0x04, 0xB8, 0x0B, 0x64, 0x00, 0xC8, 0x00, 0x00, 0x00);
     assert_int_equal(servo.motion.profile.accel_ticks, 44);
     assert_int_equal(servo.motion.profile.total_ticks - servo.motion.profile.cruise_end, 88);
     assert_in_range(run_until_done(1000), 131, 135);
-    REQUEST(10, 0);
-    EXPECT_RESPONSE(10, 0, 0xB0, 0x04); /* 120.0 */
+    REQUEST(PKT_READ_ANGLE, 0);
+    EXPECT_RESPONSE(PKT_READ_ANGLE, 0, 0xB0, 0x04); /* 120.0 */
 }
 
 /* ReadMotion (0x40) as decoded from its answer. */
@@ -196,24 +196,19 @@ struct motion_snapshot {
     uint32_t tick_us; /* the servo's clock at the tick the values are from */
 };
 
-static int32_t le(const uint8_t *p, unsigned size)
-{
-    uint32_t v = 0;
-    for (unsigned i = 0; i < size; i++) {
-        v |= (uint32_t)p[i] << (8u * i);
-    }
-    return size == 2 ? (int16_t)v : (int32_t)v;
-}
 
 static struct motion_snapshot read_motion(void)
 {
-    REQUEST(0x40, 0);
-    assert_int_equal(hal.sent_length, 4u + 25u + 1u);
-    assert_int_equal(hal.sent[2], 0x40);
-    const uint8_t *c = &hal.sent[4];
-    return (struct motion_snapshot){le(&c[1], 4), le(&c[5], 4), le(&c[9], 4),
-                                    (int16_t)le(&c[13], 2), (int16_t)le(&c[15], 2), c[19],
-                                    c[20], (uint32_t)le(&c[21], 4)};
+    REQUEST(PKT_READ_MOTION, 0);
+    return (struct motion_snapshot){
+        ANSWER_FIELD(PKT_READ_MOTION, ANSWER_READ_MOTION_ANGLE),
+        ANSWER_FIELD(PKT_READ_MOTION, ANSWER_READ_MOTION_SETPOINT),
+        ANSWER_FIELD(PKT_READ_MOTION, ANSWER_READ_MOTION_TARGET),
+        (int16_t)ANSWER_FIELD(PKT_READ_MOTION, ANSWER_READ_MOTION_VELOCITY),
+        (int16_t)ANSWER_FIELD(PKT_READ_MOTION, ANSWER_READ_MOTION_TRACKING_ERROR),
+        (uint8_t)ANSWER_FIELD(PKT_READ_MOTION, ANSWER_READ_MOTION_STATUS),
+        (uint8_t)ANSWER_FIELD(PKT_READ_MOTION, ANSWER_READ_MOTION_MOTION_FLAGS),
+        (uint32_t)ANSWER_FIELD(PKT_READ_MOTION, ANSWER_READ_MOTION_TIME)};
 }
 
 /* ReadMotion: angle, setpoint, target, the servo's own speed and tracking
@@ -223,7 +218,7 @@ static void test_read_motion_snapshot(void **state)
     (void)state;
     struct motion_snapshot at_rest = read_motion();
     assert_true(at_rest.flags & DIAG_RELEASED);
-    REQUEST(12, 0, 0x84, 0x03, 0xE8, 0x03, 0x14, 0x00, 0x14, 0x00, 0x00, 0x00); /* 100 deg/s */
+    REQUEST(PKT_MOVE_ANGLE_BY_VELOCITY, 0, 0x84, 0x03, 0xE8, 0x03, 0x14, 0x00, 0x14, 0x00, 0x00, 0x00); /* 100 deg/s */
     harness_run_ms(400);
     struct motion_snapshot moving = read_motion();
     /* Stamped with the servo's clock: the last tick ran within a period of
@@ -247,7 +242,7 @@ static void test_read_motion_snapshot(void **state)
     assert_true(done.flags & DIAG_PROFILE_ENDED);
     assert_true(abs(done.speed) <= 10); /* settling: under 1 deg/s */
     /* A wrong length is a command error, as for the maker's packets. */
-    REQUEST(0x40, 0, 0);
+    REQUEST(PKT_READ_MOTION, 0, 0);
     EXPECT_SILENCE();
     assert_true(servo.regs.status.status & STATUS_COMMAND_ERROR);
 }
@@ -255,13 +250,13 @@ static void test_read_motion_snapshot(void **state)
 static void test_center_offset_shifts_the_zero(void **state)
 {
     (void)state;
-    REQUEST(4, 0, 53, 0x64, 0x00); /* +10.0 deg */
-    REQUEST(10, 0);
-    EXPECT_RESPONSE(10, 0, 0x9C, 0xFF); /* the servo at raw 0 reads -10.0 */
-    REQUEST(8, 0, 0x00, 0x00, 0xC8, 0x00, 0x00, 0x00);
+    WRITE_ITEM(0, ITEM_CENTER_OFFSET_DECIDEG, 100); /* +10.0 deg */
+    REQUEST(PKT_READ_ANGLE, 0);
+    EXPECT_RESPONSE(PKT_READ_ANGLE, 0, 0x9C, 0xFF); /* the servo at raw 0 reads -10.0 */
+    REQUEST(PKT_MOVE_ANGLE, 0, 0x00, 0x00, 0xC8, 0x00, 0x00, 0x00);
     run_until_done(1000);
-    REQUEST(10, 0);
-    EXPECT_RESPONSE(10, 0, 0x00, 0x00);
+    REQUEST(PKT_READ_ANGLE, 0);
+    EXPECT_RESPONSE(PKT_READ_ANGLE, 0, 0x00, 0x00);
     /* Raw: 10.0 deg = 113.8 counts. */
     assert_int_equal(servo.motion.encoder.counts, 114);
 }
@@ -272,24 +267,24 @@ static void test_power_bounds_the_output(void **state)
     /* P R / V^2 in Q15 with R = 2.741 ohm, V = 7.4 V. */
     assert_int_equal(duty_limit_for_power(500, 7400), 820);
     assert_int_equal(duty_limit_for_power(10000, 7400), 16401);
-    REQUEST(4, 0, 42, 0x10, 0x27); /* power protection back at 10 000 mW */
+    WRITE_ITEM(0, ITEM_POWER_LIMIT_MW, 10000); /* power protection back at 10 000 mW */
     /* Hold at 0 with 500 mW while a hand holds the horn 20 degrees away: the
      * output stands at 500 mW's duty. */
-    REQUEST(8, 0, 0x00, 0x00, 0x14, 0x00, 0xF4, 0x01);
+    REQUEST(PKT_MOVE_ANGLE, 0, 0x00, 0x00, 0x14, 0x00, 0xF4, 0x01);
     run_until_done(100);
     hal.encoder_model = NULL;
     hal.encoder_raw = 228; /* 20.04 degrees */
     harness_run_ms(200);   /* the jump's filtered velocity dies away */
     assert_int_equal(hal.duty, -820);
     /* 0, and anything above the power protection (42), mean 42. */
-    REQUEST(8, 0, 0x00, 0x00, 0x14, 0x00, 0x00, 0x00);
+    REQUEST(PKT_MOVE_ANGLE, 0, 0x00, 0x00, 0x14, 0x00, 0x00, 0x00);
     harness_run_ms(50);
     assert_int_equal(hal.duty, -16401);
-    REQUEST(8, 0, 0x00, 0x00, 0x14, 0x00, 0x60, 0xEA);
+    REQUEST(PKT_MOVE_ANGLE, 0, 0x00, 0x00, 0x14, 0x00, 0x60, 0xEA);
     harness_run_ms(50);
     assert_int_equal(hal.duty, -16401);
-    REQUEST(4, 0, 42, 0xE8, 0x03); /* power protection 1000 mW */
-    REQUEST(8, 0, 0x00, 0x00, 0x14, 0x00, 0x00, 0x00);
+    WRITE_ITEM(0, ITEM_POWER_LIMIT_MW, 1000); /* power protection 1000 mW */
+    REQUEST(PKT_MOVE_ANGLE, 0, 0x00, 0x00, 0x14, 0x00, 0x00, 0x00);
     harness_run_ms(50);
     assert_int_equal(hal.duty, -duty_limit_for_power(1000, 7400));
 }
@@ -311,14 +306,14 @@ static uint32_t wait_for_answer(uint32_t limit_ms)
 static void test_control_response_queues_and_answers_each(void **state)
 {
     (void)state;
-    REQUEST(4, 0, 33, 1);
-    REQUEST(8, 0, 0x64, 0x00, 0x64, 0x00, 0x00, 0x00); /* 10.0, 100 ms */
-    REQUEST(8, 0, 0xC8, 0x00, 0x64, 0x00, 0x00, 0x00); /* 20.0 */
-    REQUEST(8, 0, 0x2C, 0x01, 0x64, 0x00, 0x00, 0x00); /* 30.0 */
+    WRITE_ITEM(0, ITEM_CONTROL_RESPONSE, 1);
+    REQUEST(PKT_MOVE_ANGLE, 0, 0x64, 0x00, 0x64, 0x00, 0x00, 0x00); /* 10.0, 100 ms */
+    REQUEST(PKT_MOVE_ANGLE, 0, 0xC8, 0x00, 0x64, 0x00, 0x00, 0x00); /* 20.0 */
+    REQUEST(PKT_MOVE_ANGLE, 0, 0x2C, 0x01, 0x64, 0x00, 0x00, 0x00); /* 30.0 */
     EXPECT_SILENCE();
     for (int i = 1; i <= 3; i++) {
         wait_for_answer(300);
-        EXPECT_RESPONSE(8, 0, 1);
+        EXPECT_RESPONSE(PKT_MOVE_ANGLE, 0, 1);
         assert_true(angle_now() >= 100 * i); /* after its move, in order */
     }
     harness_run_ms(5);
@@ -326,13 +321,13 @@ static void test_control_response_queues_and_answers_each(void **state)
     assert_false(executing());
     /* One running and MOTION_QUEUE_DEPTH waiting; the next is dropped. */
     for (unsigned i = 0; i < 1 + MOTION_QUEUE_DEPTH; i++) {
-        REQUEST(8, 0, 0x00, 0x00, 0xE8, 0x03, 0x00, 0x00);
+        REQUEST(PKT_MOVE_ANGLE, 0, 0x00, 0x00, 0xE8, 0x03, 0x00, 0x00);
     }
-    REQUEST(3, 0, 5);
-    EXPECT_RESPONSE(3, 0, 5, STATUS_EXECUTING);
-    REQUEST(8, 0, 0x00, 0x00, 0xE8, 0x03, 0x00, 0x00);
-    REQUEST(3, 0, 5);
-    EXPECT_RESPONSE(3, 0, 5, STATUS_EXECUTING | STATUS_COMMAND_ERROR);
+    REQUEST(PKT_READ_DATA, 0, ITEM_STATUS);
+    EXPECT_RESPONSE(PKT_READ_DATA, 0, ITEM_STATUS, STATUS_EXECUTING);
+    REQUEST(PKT_MOVE_ANGLE, 0, 0x00, 0x00, 0xE8, 0x03, 0x00, 0x00);
+    REQUEST(PKT_READ_DATA, 0, ITEM_STATUS);
+    EXPECT_RESPONSE(PKT_READ_DATA, 0, ITEM_STATUS, STATUS_EXECUTING | STATUS_COMMAND_ERROR);
     assert_int_equal(servo.motion.queue.count, MOTION_QUEUE_DEPTH);
 }
 
@@ -340,13 +335,11 @@ static void test_new_move_replaces_the_running_one_smoothly(void **state)
 {
     (void)state;
     /* 10 turns in 10 s with 1 s ramps; 0.5 s in, mid-ramp, turn back. */
-    REQUEST(14, 0, 0xA0, 0x8C, 0x00, 0x00, 0x10, 0x27, 0x00, 0x00, 0xE8, 0x03, 0xE8, 0x03,
-            0x00, 0x00);
+    REQUEST(PKT_MOVE_MULTI_TURN_BY_INTERVAL, 0, 0xA0, 0x8C, 0x00, 0x00, 0x10, 0x27, 0x00, 0x00, 0xE8, 0x03, 0xE8, 0x03, 0x00, 0x00);
     harness_run_ms(500);
     int32_t before = servo.motion.setpoint_q8 - servo.motion.last_setpoint_q8;
     assert_true(before > 0);
-    REQUEST(14, 0, 0x00, 0x00, 0x00, 0x00, 0x88, 0x13, 0x00, 0x00, 0xE8, 0x03, 0xE8, 0x03,
-            0x00, 0x00);
+    REQUEST(PKT_MOVE_MULTI_TURN_BY_INTERVAL, 0, 0x00, 0x00, 0x00, 0x00, 0x88, 0x13, 0x00, 0x00, 0xE8, 0x03, 0xE8, 0x03, 0x00, 0x00);
     harness_run_ms(1);
     int32_t after = servo.motion.setpoint_q8 - servo.motion.last_setpoint_q8;
     /* The velocity carries over: no jerk to a stop (the change within two
@@ -359,50 +352,50 @@ static void test_new_move_replaces_the_running_one_smoothly(void **state)
 static void test_reset_turns_and_origin_only_when_released(void **state)
 {
     (void)state;
-    REQUEST(4, 0, 33, 1);
-    REQUEST(13, 0, 0x10, 0x1F, 0, 0, 0xB8, 0x0B, 0, 0, 0, 0); /* 795.2 deg */
+    WRITE_ITEM(0, ITEM_CONTROL_RESPONSE, 1);
+    REQUEST(PKT_MOVE_MULTI_TURN, 0, 0x10, 0x1F, 0, 0, 0xB8, 0x0B, 0, 0, 0, 0); /* 795.2 deg */
     run_until_done(4000);
-    REQUEST(17, 0);
-    EXPECT_RESPONSE(17, 0, 0); /* under angle control */
-    REQUEST(23, 0, 0);
+    REQUEST(PKT_RESET_MULTI_TURN_ANGLE, 0);
+    EXPECT_RESPONSE(PKT_RESET_MULTI_TURN_ANGLE, 0, 0); /* under angle control */
+    REQUEST(PKT_SET_ORIGIN_POINT, 0, 0);
     EXPECT_SILENCE();
-    REQUEST(16, 0);
-    EXPECT_RESPONSE(16, 0, 0x10, 0x1F, 0, 0, 0x02, 0x00);
-    REQUEST(24, 0, 0x10, 0, 0); /* stop and release */
+    REQUEST(PKT_READ_MULTI_TURN_ANGLE, 0);
+    EXPECT_RESPONSE(PKT_READ_MULTI_TURN_ANGLE, 0, 0x10, 0x1F, 0, 0, 0x02, 0x00);
+    REQUEST(PKT_STOP_ON_CONTROL_MODE, 0, 0x10, 0, 0); /* stop and release */
     EXPECT_SILENCE();
     assert_true(hal.coasting);
-    REQUEST(17, 0);
-    EXPECT_RESPONSE(17, 0, 1);
-    REQUEST(16, 0);
-    EXPECT_RESPONSE(16, 0, 0xF0, 0x02, 0, 0, 0, 0); /* 75.2 deg, 0 turns */
-    REQUEST(23, 0, 0);
-    REQUEST(10, 0);
-    EXPECT_RESPONSE(10, 0, 0, 0);
+    REQUEST(PKT_RESET_MULTI_TURN_ANGLE, 0);
+    EXPECT_RESPONSE(PKT_RESET_MULTI_TURN_ANGLE, 0, 1);
+    REQUEST(PKT_READ_MULTI_TURN_ANGLE, 0);
+    EXPECT_RESPONSE(PKT_READ_MULTI_TURN_ANGLE, 0, 0xF0, 0x02, 0, 0, 0, 0); /* 75.2 deg, 0 turns */
+    REQUEST(PKT_SET_ORIGIN_POINT, 0, 0);
+    REQUEST(PKT_READ_ANGLE, 0);
+    EXPECT_RESPONSE(PKT_READ_ANGLE, 0, 0, 0);
 }
 
 static void test_wheel_run_and_stop(void **state)
 {
     (void)state;
-    REQUEST(4, 0, 33, 1);
-    REQUEST(7, 0, 0x01, 0x5A, 0x00, 0x00, 0x00); /* counter-clockwise, 90 deg/s */
+    WRITE_ITEM(0, ITEM_CONTROL_RESPONSE, 1);
+    REQUEST(PKT_MOVE_WHEEL, 0, 0x01, 0x5A, 0x00, 0x00, 0x00); /* counter-clockwise, 90 deg/s */
     EXPECT_SILENCE();
     harness_run_ms(25);
     wait_for_answer(300);
-    EXPECT_RESPONSE(7, 0, 1); /* answered once at speed */
+    EXPECT_RESPONSE(PKT_MOVE_WHEEL, 0, 1); /* answered once at speed */
     int32_t a0 = angle_now();
     harness_run_ms(1000);
     assert_in_range(angle_now() - a0, 898, 902); /* 90.0 deg in a second */
-    REQUEST(7, 0, 0x00, 0x00, 0x00, 0x00, 0x00);  /* stop */
+    REQUEST(PKT_MOVE_WHEEL, 0, 0x00, 0x00, 0x00, 0x00, 0x00);  /* stop */
     harness_run_ms(25);
     wait_for_answer(300);
-    EXPECT_RESPONSE(7, 0, 1);
+    EXPECT_RESPONSE(PKT_MOVE_WHEEL, 0, 1);
     assert_true(hal.coasting); /* 47 = 0: released when stopped */
     assert_true(motion_is_released(&servo.motion));
-    REQUEST(4, 0, 47, 1);
-    REQUEST(7, 0, 0x81, 0x5A, 0x00, 0x00, 0x00); /* clockwise */
+    WRITE_ITEM(0, ITEM_WHEEL_BRAKE, 1);
+    REQUEST(PKT_MOVE_WHEEL, 0, 0x81, 0x5A, 0x00, 0x00, 0x00); /* clockwise */
     harness_run_ms(500);
     assert_true(angle_now() < a0 + 900 - 400);
-    REQUEST(7, 0, 0x80, 0x00, 0x00, 0x00, 0x00);
+    REQUEST(PKT_MOVE_WHEEL, 0, 0x80, 0x00, 0x00, 0x00, 0x00);
     harness_run_ms(25);
     assert_false(hal.coasting); /* 47 = 1: holds when stopped */
     assert_false(motion_is_released(&servo.motion));
@@ -412,14 +405,14 @@ static void test_wheel_turns_and_time(void **state)
 {
     (void)state;
     int32_t a0 = angle_now();
-    REQUEST(7, 0, 0x82, 0xB4, 0x00, 0x02, 0x00); /* clockwise, 180 deg/s, 2 turns */
+    REQUEST(PKT_MOVE_WHEEL, 0, 0x82, 0xB4, 0x00, 0x02, 0x00); /* clockwise, 180 deg/s, 2 turns */
     uint32_t ms = run_until_done(6000);
     /* 4 s at speed plus half of each ramp (4020 ms), then it holds until the
      * horn is still (filtered speed under 25 deg/s) before releasing. */
     assert_in_range(ms, 4020, 4040);
     assert_int_equal(angle_now(), a0 - 7200);
     assert_true(hal.coasting);
-    REQUEST(7, 0, 0x03, 0x5A, 0x00, 0xF4, 0x01); /* ccw, 90 deg/s, 500 ms */
+    REQUEST(PKT_MOVE_WHEEL, 0, 0x03, 0x5A, 0x00, 0xF4, 0x01); /* ccw, 90 deg/s, 500 ms */
     assert_in_range(run_until_done(1000), 497, 510); /* and its settle */
     assert_int_equal(angle_now(), a0 - 7200 + 432); /* 0.9 x (500 - 20) */
 }
@@ -435,7 +428,7 @@ static int32_t braking_effort(void)
 static void test_damping_brakes_in_proportion_to_speed(void **state)
 {
     (void)state;
-    REQUEST(9, 0, 0x10, 0x27); /* 10 000 mW */
+    REQUEST(PKT_MOVE_DAMPING, 0, 0x10, 0x27); /* 10 000 mW */
     EXPECT_SILENCE();
     hal.encoder_model = NULL; /* an outside hand turns the horn */
     for (int i = 0; i < 40; i++) {
@@ -461,18 +454,18 @@ static void test_damping_brakes_in_proportion_to_speed(void **state)
 static void test_stop_on_control_mode(void **state)
 {
     (void)state;
-    REQUEST(8, 0, 0x84, 0x03, 0xE8, 0x03, 0x00, 0x00);
+    REQUEST(PKT_MOVE_ANGLE, 0, 0x84, 0x03, 0xE8, 0x03, 0x00, 0x00);
     harness_run_ms(500);
     int32_t mid = angle_now();
-    REQUEST(24, 0, 0x11, 0x00, 0x00); /* stop and hold */
+    REQUEST(PKT_STOP_ON_CONTROL_MODE, 0, 0x11, 0x00, 0x00); /* stop and hold */
     EXPECT_SILENCE();
     harness_run_ms(200);
     assert_false(executing());
     assert_false(hal.coasting);
     assert_in_range(angle_now(), mid - 10, mid + 10);
-    REQUEST(24, 0, 0x12, 0xE8, 0x03); /* stop into damping */
+    REQUEST(PKT_STOP_ON_CONTROL_MODE, 0, 0x12, 0xE8, 0x03); /* stop into damping */
     assert_int_equal(servo.motion.mode, MODE_DAMPING);
-    REQUEST(24, 0, 0x10, 0x00, 0x00); /* stop and release */
+    REQUEST(PKT_STOP_ON_CONTROL_MODE, 0, 0x10, 0x00, 0x00); /* stop and release */
     assert_true(hal.coasting);
     assert_int_equal(servo.motion.mode, MODE_RELEASED);
 }
@@ -480,16 +473,16 @@ static void test_stop_on_control_mode(void **state)
 static void test_async_moves_start_together(void **state)
 {
     (void)state;
-    harness_request(18, NULL, 0);
-    REQUEST(8, 0, 0x84, 0x03, 0xC8, 0x00, 0x00, 0x00);
+    harness_request(PKT_BEGIN_ASYNC, NULL, 0);
+    REQUEST(PKT_MOVE_ANGLE, 0, 0x84, 0x03, 0xC8, 0x00, 0x00, 0x00);
     harness_run_ms(300);
     assert_int_equal(angle_now(), 0); /* buffered, not started */
-    REQUEST(19, 0);
+    REQUEST(PKT_END_ASYNC, 0);
     run_until_done(1000);
     assert_int_equal(angle_now(), 900);
-    harness_request(18, NULL, 0);
-    REQUEST(8, 0, 0x10, 0x00, 0xC8, 0x00, 0x00, 0x00);
-    REQUEST(19, 1); /* discarded */
+    harness_request(PKT_BEGIN_ASYNC, NULL, 0);
+    REQUEST(PKT_MOVE_ANGLE, 0, 0x10, 0x00, 0xC8, 0x00, 0x00, 0x00);
+    REQUEST(PKT_END_ASYNC, 1); /* discarded */
     harness_run_ms(300);
     assert_int_equal(angle_now(), 900);
 }
@@ -497,13 +490,13 @@ static void test_async_moves_start_together(void **state)
 static void test_sync_and_broadcast_moves(void **state)
 {
     (void)state;
-    REQUEST(4, 0, 33, 1); /* even with control response on: no answers */
+    WRITE_ITEM(0, ITEM_CONTROL_RESPONSE, 1); /* even with control response on: no answers */
     const uint8_t sync[] = {8, 7, 2, 4, 0x10, 0, 0, 0, 0, 0, 0, 0x84, 0x03, 0xC8, 0x00, 0, 0};
-    harness_request(25, sync, sizeof sync);
+    harness_request(PKT_SYNC_COMMAND, sync, sizeof sync);
     run_until_done(1000);
     EXPECT_SILENCE();
     assert_int_equal(angle_now(), 900);
-    REQUEST(8, 0xFF, 0x00, 0x00, 0xC8, 0x00, 0x00, 0x00);
+    REQUEST(PKT_MOVE_ANGLE, 0xFF, 0x00, 0x00, 0xC8, 0x00, 0x00, 0x00);
     run_until_done(1000);
     EXPECT_SILENCE();
     assert_int_equal(angle_now(), 0);
@@ -513,7 +506,7 @@ static void test_power_on_lock(void **state)
 {
     (void)state;
     assert_true(hal.coasting); /* 46 = 0: released at power-up */
-    REQUEST(4, 0, 46, 1);
+    WRITE_ITEM(0, ITEM_POWER_ON_LOCK, 1);
     harness_run_ms(60); /* saved */
     harness_restart();
     harness_run_ms(5);
@@ -524,11 +517,11 @@ static void test_power_on_lock(void **state)
 static void test_monitor_after_move(void **state)
 {
     (void)state;
-    REQUEST(12, 0, 0x2C, 0x01, 0xB8, 0x0B, 0x64, 0x00, 0xC8, 0x00, 0x00, 0x00); /* 30.0 */
+    REQUEST(PKT_MOVE_ANGLE_BY_VELOCITY, 0, 0x2C, 0x01, 0xB8, 0x0B, 0x64, 0x00, 0xC8, 0x00, 0x00, 0x00); /* 30.0 */
     run_until_done(1000);
-    REQUEST(22, 0);
+    REQUEST(PKT_MONITOR, 0);
     /* Live readings from the double's sensors: 7400 mV, 0 mA, 0 mW, NTC 2048. */
-    EXPECT_RESPONSE(22, 0, 0xE8, 0x1C, 0, 0, 0, 0, 0x00, 0x08, 0x00, 0x2C, 0x01, 0, 0, 0, 0);
+    EXPECT_RESPONSE(PKT_MONITOR, 0, 0xE8, 0x1C, 0, 0, 0, 0, 0x00, 0x08, 0x00, 0x2C, 0x01, 0, 0, 0, 0);
 }
 
 int main(void)

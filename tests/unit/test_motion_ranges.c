@@ -13,6 +13,7 @@
 
 #include <cmocka.h>
 
+#include "support/by_name.h"
 #include "support/servo_harness.h"
 
 enum { LIMIT = 3686400, SHIFT = 3686400, TURN = 3600 };
@@ -44,20 +45,17 @@ static int setup(void **state)
 {
     (void)state;
     harness_init();
-    REQUEST(4, 0, 49, 0); /* no soft start */
-    REQUEST(4, 0, 37, 0); /* a stall limits the power, keeps control */
+    WRITE_ITEM(0, ITEM_SOFT_START_ON, 0); /* no soft start */
+    WRITE_ITEM(0, ITEM_STALL_RELEASE, 0); /* a stall limits the power, keeps control */
     return 0;
 }
 
 /* ReadMultiTurnAngle (16), decoded. */
 static void read_multi_turn(int32_t *angle, int16_t *turns)
 {
-    REQUEST(16, 0);
-    assert_int_equal(hal.sent_length, 4 + 7 + 1);
-    const uint8_t *c = &hal.sent[4];
-    *angle = (int32_t)((uint32_t)c[1] | (uint32_t)c[2] << 8 | (uint32_t)c[3] << 16 |
-                       (uint32_t)c[4] << 24);
-    *turns = (int16_t)((uint16_t)c[5] | (uint16_t)(c[6] << 8));
+    REQUEST(PKT_READ_MULTI_TURN_ANGLE, 0);
+    *angle = ANSWER_FIELD(PKT_READ_MULTI_TURN_ANGLE, ANSWER_READ_MULTI_TURN_ANGLE_ANGLE);
+    *turns = (int16_t)ANSWER_FIELD(PKT_READ_MULTI_TURN_ANGLE, ANSWER_READ_MULTI_TURN_ANGLE_TURNS);
 }
 
 /* Until the horn has spun for ms milliseconds: the reading within the range, its turns the whole
@@ -94,7 +92,7 @@ static unsigned watch_reading(uint32_t ms, int32_t counts_per_ms)
 static void test_a_back_driven_reading_stays_in_range(void **state)
 {
     (void)state;
-    REQUEST(24, 0, 0x10, 0, 0); /* released */
+    REQUEST(PKT_STOP_ON_CONTROL_MODE, 0, 0x10, 0, 0); /* released */
     spin_at(1000);              /* 0.24 turn per ms */
     assert_int_equal(watch_reading(6150, 1000), 1); /* 1500 turns */
     spin_at(-1000);
@@ -106,7 +104,7 @@ static void test_a_back_driven_reading_stays_in_range(void **state)
 static void test_a_wheel_move_across_the_end_keeps_its_length(void **state)
 {
     (void)state;
-    REQUEST(24, 0, 0x10, 0, 0);
+    REQUEST(PKT_STOP_ON_CONTROL_MODE, 0, 0x10, 0, 0);
     spin_at(1000);
     harness_run_ms(4180); /* 1020.5 turns */
     harness_ideal_tracking();
@@ -114,7 +112,7 @@ static void test_a_wheel_move_across_the_end_keeps_its_length(void **state)
     int16_t turns;
     read_multi_turn(&start, &turns);
     assert_true(start > LIMIT - 5 * TURN && start < LIMIT - 3 * TURN);
-    REQUEST(7, 0, 0x02, 0xEE, 0x02, 0x08, 0x00); /* ccw (growing), 750 deg/s, 8 turns */
+    REQUEST(PKT_MOVE_WHEEL, 0, 0x02, 0xEE, 0x02, 0x08, 0x00); /* ccw (growing), 750 deg/s, 8 turns */
     harness_run_ms(5000);
     assert_false(servo.regs.status.status & STATUS_EXECUTING);
     int32_t end;
@@ -131,11 +129,11 @@ static void test_a_wheel_move_across_the_end_keeps_its_length(void **state)
 static void test_the_error_saturates_instead_of_changing_sign(void **state)
 {
     (void)state;
-    REQUEST(24, 0, 0x10, 0, 0);
+    REQUEST(PKT_STOP_ON_CONTROL_MODE, 0, 0x10, 0, 0);
     spin_at(1000);
     harness_run_ms(4180);
     harness_ideal_tracking();
-    REQUEST(13, 0, 0x00, 0x40, 0x38, 0x00, 0x64, 0x00, 0x00, 0x00, 0, 0); /* 3 686 400, 100 ms */
+    REQUEST(PKT_MOVE_MULTI_TURN, 0, 0x00, 0x40, 0x38, 0x00, 0x64, 0x00, 0x00, 0x00, 0, 0); /* 3 686 400, 100 ms */
     harness_run_ms(5000);
     int32_t angle;
     int16_t turns;

@@ -9,6 +9,7 @@
 #include <cmocka.h>
 
 #include "motion/controller.h"
+#include "support/by_name.h"
 #include "support/servo_harness.h"
 
 static int setup(void **state)
@@ -16,7 +17,7 @@ static int setup(void **state)
     (void)state;
     harness_init();
     harness_ideal_tracking();
-    REQUEST(4, 0, 49, 0); /* no soft start */
+    WRITE_ITEM(0, ITEM_SOFT_START_ON, 0); /* no soft start */
     harness_run_ms(20);
     return 0;
 }
@@ -26,46 +27,46 @@ static void test_status_area_is_live(void **state)
     (void)state;
     hal.sensors = (struct sensor_raw){.supply = 7800, .current = 650, .ntc = 1700};
     harness_run_ms(200); /* the low-passes settle (the supply's in 115 ms) */
-    REQUEST(3, 0, 1);
-    EXPECT_RESPONSE(3, 0, 1, 0x78, 0x1E); /* 7800 mV */
-    REQUEST(3, 0, 2);
-    EXPECT_RESPONSE(3, 0, 2, 0x8A, 0x02); /* 650 mA */
-    REQUEST(3, 0, 3);
-    EXPECT_RESPONSE(3, 0, 3, 0xCE, 0x13); /* 5070 mW */
-    REQUEST(3, 0, 4);
-    EXPECT_RESPONSE(3, 0, 4, 0xA4, 0x06); /* NTC 1700 */
-    REQUEST(3, 0, 5);
-    EXPECT_RESPONSE(3, 0, 5, 0x00);
+    REQUEST(PKT_READ_DATA, 0, ITEM_VOLTAGE_MV);
+    EXPECT_ITEM(0, ITEM_VOLTAGE_MV, 7800); /* 7800 mV */
+    REQUEST(PKT_READ_DATA, 0, ITEM_CURRENT_MA);
+    EXPECT_ITEM(0, ITEM_CURRENT_MA, 650); /* 650 mA */
+    REQUEST(PKT_READ_DATA, 0, ITEM_POWER_MW);
+    EXPECT_ITEM(0, ITEM_POWER_MW, 5070); /* 5070 mW */
+    REQUEST(PKT_READ_DATA, 0, ITEM_TEMPERATURE_ADC);
+    EXPECT_ITEM(0, ITEM_TEMPERATURE_ADC, 1700); /* NTC 1700 */
+    REQUEST(PKT_READ_DATA, 0, ITEM_STATUS);
+    EXPECT_ITEM(0, ITEM_STATUS, 0);
 }
 
 static void test_low_voltage_releases_and_refuses_motion(void **state)
 {
     (void)state;
-    REQUEST(8, 0, 0x84, 0x03, 0xC8, 0x00, 0x00, 0x00); /* 90.0 */
+    REQUEST(PKT_MOVE_ANGLE, 0, 0x84, 0x03, 0xC8, 0x00, 0x00, 0x00); /* 90.0 */
     harness_run_ms(300);
     assert_false(hal.coasting);
     hal.sensors.supply = 3500; /* below 39 = 4000 mV */
     harness_run_ms(60);
-    REQUEST(3, 0, 5);
-    EXPECT_RESPONSE(3, 0, 5, STATUS_LOW_VOLTAGE);
+    REQUEST(PKT_READ_DATA, 0, ITEM_STATUS);
+    EXPECT_RESPONSE(PKT_READ_DATA, 0, ITEM_STATUS, STATUS_LOW_VOLTAGE);
     assert_true(hal.coasting);
-    REQUEST(8, 0, 0x00, 0x00, 0xC8, 0x00, 0x00, 0x00); /* refused */
+    REQUEST(PKT_MOVE_ANGLE, 0, 0x00, 0x00, 0xC8, 0x00, 0x00, 0x00); /* refused */
     harness_run_ms(300);
-    REQUEST(3, 0, 5);
-    EXPECT_RESPONSE(3, 0, 5, STATUS_LOW_VOLTAGE | STATUS_COMMAND_ERROR);
-    REQUEST(10, 0);
-    EXPECT_RESPONSE(10, 0, 0x84, 0x03); /* it did not move */
+    REQUEST(PKT_READ_DATA, 0, ITEM_STATUS);
+    EXPECT_RESPONSE(PKT_READ_DATA, 0, ITEM_STATUS, STATUS_LOW_VOLTAGE | STATUS_COMMAND_ERROR);
+    REQUEST(PKT_READ_ANGLE, 0);
+    EXPECT_RESPONSE(PKT_READ_ANGLE, 0, 0x84, 0x03); /* it did not move */
     hal.sensors.supply = 7400;          /* recovered */
     harness_run_ms(200);
-    REQUEST(3, 0, 5);
-    EXPECT_RESPONSE(3, 0, 5, STATUS_COMMAND_ERROR); /* until a command succeeds */
+    REQUEST(PKT_READ_DATA, 0, ITEM_STATUS);
+    EXPECT_RESPONSE(PKT_READ_DATA, 0, ITEM_STATUS, STATUS_COMMAND_ERROR); /* until a command succeeds */
     assert_true(hal.coasting);                      /* and released until commanded */
-    REQUEST(8, 0, 0x00, 0x00, 0xC8, 0x00, 0x00, 0x00);
+    REQUEST(PKT_MOVE_ANGLE, 0, 0x00, 0x00, 0xC8, 0x00, 0x00, 0x00);
     harness_run_ms(300);
-    REQUEST(3, 0, 5);
-    EXPECT_RESPONSE(3, 0, 5, 0x00);
-    REQUEST(10, 0);
-    EXPECT_RESPONSE(10, 0, 0x00, 0x00);
+    REQUEST(PKT_READ_DATA, 0, ITEM_STATUS);
+    EXPECT_ITEM(0, ITEM_STATUS, 0);
+    REQUEST(PKT_READ_ANGLE, 0);
+    EXPECT_RESPONSE(PKT_READ_ANGLE, 0, 0x00, 0x00);
 }
 
 static void test_high_voltage_and_heat_release(void **state)
@@ -73,37 +74,37 @@ static void test_high_voltage_and_heat_release(void **state)
     (void)state;
     hal.sensors.supply = 9000;
     harness_run_ms(60);
-    REQUEST(3, 0, 5);
-    EXPECT_RESPONSE(3, 0, 5, STATUS_HIGH_VOLTAGE);
+    REQUEST(PKT_READ_DATA, 0, ITEM_STATUS);
+    EXPECT_RESPONSE(PKT_READ_DATA, 0, ITEM_STATUS, STATUS_HIGH_VOLTAGE);
     hal.sensors.supply = 7400;
     hal.sensors.ntc = 600; /* hotter than 41 = 651 */
     harness_run_ms(200);
-    REQUEST(3, 0, 5);
-    EXPECT_RESPONSE(3, 0, 5, STATUS_OVER_TEMPERATURE);
-    REQUEST(8, 0, 0x84, 0x03, 0xC8, 0x00, 0x00, 0x00);
+    REQUEST(PKT_READ_DATA, 0, ITEM_STATUS);
+    EXPECT_RESPONSE(PKT_READ_DATA, 0, ITEM_STATUS, STATUS_OVER_TEMPERATURE);
+    REQUEST(PKT_MOVE_ANGLE, 0, 0x84, 0x03, 0xC8, 0x00, 0x00, 0x00);
     assert_true(hal.coasting);
     hal.sensors.ntc = 2048;
     harness_run_ms(300);
-    REQUEST(3, 0, 5);
-    EXPECT_RESPONSE(3, 0, 5, STATUS_COMMAND_ERROR);
+    REQUEST(PKT_READ_DATA, 0, ITEM_STATUS);
+    EXPECT_RESPONSE(PKT_READ_DATA, 0, ITEM_STATUS, STATUS_COMMAND_ERROR);
 }
 
 static void test_over_current_halves_the_output_while_moving(void **state)
 {
     (void)state;
-    REQUEST(8, 0, 0x10, 0x27, 0xE8, 0x03, 0x00, 0x00); /* a long move */
+    REQUEST(PKT_MOVE_ANGLE, 0, 0x10, 0x27, 0xE8, 0x03, 0x00, 0x00); /* a long move */
     harness_run_ms(50);
     /* Factory: 42's 10 W binds before 43's 4 A (4 A x 2 ohm > the supply). */
     assert_int_equal(servo.motion.drive.duty_limit, duty_limit_for_power(10000, 7400));
-    REQUEST(4, 0, 43, 0xE8, 0x03); /* 43 = 1000 mA: now it binds */
-    REQUEST(8, 0, 0x10, 0x27, 0xE8, 0x03, 0x00, 0x00);
+    WRITE_ITEM(0, ITEM_CURRENT_LIMIT_MA, 1000); /* 43 = 1000 mA: now it binds */
+    REQUEST(PKT_MOVE_ANGLE, 0, 0x10, 0x27, 0xE8, 0x03, 0x00, 0x00);
     int16_t normal = servo.motion.drive.duty_limit;
     assert_int_equal(normal, duty_limit_for_current(1000, 7400));
     assert_true(normal < duty_limit_for_power(10000, 7400));
     hal.sensors.current = 1200;
     harness_run_ms(60);
-    REQUEST(3, 0, 5);
-    EXPECT_RESPONSE(3, 0, 5, STATUS_EXECUTING | STATUS_OVER_CURRENT);
+    REQUEST(PKT_READ_DATA, 0, ITEM_STATUS);
+    EXPECT_RESPONSE(PKT_READ_DATA, 0, ITEM_STATUS, STATUS_EXECUTING | STATUS_OVER_CURRENT);
     assert_int_equal(servo.motion.drive.duty_limit, normal / 2);
     assert_false(hal.coasting); /* limited, not released */
     hal.sensors.current = 300;

@@ -12,6 +12,7 @@
 #include <cmocka.h>
 
 #include "registers/data_table.h"
+#include "support/by_name.h"
 #include "support/servo_harness.h"
 
 static int setup(void **state)
@@ -35,9 +36,9 @@ static void test_ping_exact_bytes(void **state)
 static void test_silence_for_others_broadcast_and_bad_checksum(void **state)
 {
     (void)state;
-    REQUEST(1, 5);
+    REQUEST(PKT_PING, 5);
     EXPECT_SILENCE();
-    REQUEST(1, 0xFF);
+    REQUEST(PKT_PING, 0xFF);
     EXPECT_SILENCE();
     const uint8_t bad[] = {0x12, 0x4C, 0x01, 0x01, 0x00, 0x61};
     hal_double_clear_sent(&hal);
@@ -56,7 +57,7 @@ static void test_read_data_every_item(void **state)
     unsigned pos = 0;
     for (uint8_t id = 32; id <= 53; id++) {
         const struct data_item *it = data_table_find(id);
-        REQUEST(3, 0, id);
+        REQUEST(PKT_READ_DATA, 0, id);
         uint8_t content[8] = {0, id};
         uint8_t n = 2;
         if (id != 35 && id != 45) {
@@ -69,32 +70,32 @@ static void test_read_data_every_item(void **state)
         pos += it->size;
     }
     /* Status area: model, version, serial from the port. */
-    REQUEST(3, 0, 6);
-    EXPECT_RESPONSE(3, 0, 6, 0x00, 0x0F);
-    REQUEST(3, 0, 7);
-    EXPECT_RESPONSE(3, 0, 7, 0x10, 0x00);
-    REQUEST(3, 0, 8);
-    EXPECT_RESPONSE(3, 0, 8, 0x78, 0x56, 0x34, 0x12);
-    REQUEST(3, 0, 200);
-    EXPECT_RESPONSE(3, 0, 200);
+    REQUEST(PKT_READ_DATA, 0, ITEM_MODEL);
+    EXPECT_ITEM(0, ITEM_MODEL, 0xf00);
+    REQUEST(PKT_READ_DATA, 0, ITEM_FIRMWARE_VERSION);
+    EXPECT_ITEM(0, ITEM_FIRMWARE_VERSION, 0x10);
+    REQUEST(PKT_READ_DATA, 0, ITEM_SERIAL_NUMBER);
+    EXPECT_ITEM(0, ITEM_SERIAL_NUMBER, 0x12345678);
+    REQUEST(PKT_READ_DATA, 0, 200);
+    EXPECT_RESPONSE(PKT_READ_DATA, 0, 200);
 }
 
 static void test_write_data_and_failures(void **state)
 {
     (void)state;
-    REQUEST(4, 0, 50, 0xE8, 0x03);
-    EXPECT_RESPONSE(4, 0, 50, 1);
-    REQUEST(3, 0, 50);
-    EXPECT_RESPONSE(3, 0, 50, 0xE8, 0x03);
-    REQUEST(4, 0, 1, 0, 0); /* read-only */
-    EXPECT_RESPONSE(4, 0, 1, 0);
-    REQUEST(4, 0, 50, 0xE8); /* wrong size */
-    EXPECT_RESPONSE(4, 0, 50, 0);
-    REQUEST(4, 0, 53, 0x09, 0x07); /* 1801: out of range */
-    EXPECT_RESPONSE(4, 0, 53, 0);
+    WRITE_ITEM(0, ITEM_SOFT_START_MS, 1000);
+    EXPECT_RESPONSE(PKT_WRITE_DATA, 0, ITEM_SOFT_START_MS, 1);
+    REQUEST(PKT_READ_DATA, 0, ITEM_SOFT_START_MS);
+    EXPECT_ITEM(0, ITEM_SOFT_START_MS, 1000);
+    WRITE_ITEM(0, ITEM_VOLTAGE_MV, 0); /* read-only */
+    EXPECT_RESPONSE(PKT_WRITE_DATA, 0, ITEM_VOLTAGE_MV, 0);
+    REQUEST(PKT_WRITE_DATA, 0, ITEM_SOFT_START_MS, 0xE8); /* wrong size */
+    EXPECT_RESPONSE(PKT_WRITE_DATA, 0, ITEM_SOFT_START_MS, 0);
+    WRITE_ITEM(0, ITEM_CENTER_OFFSET_DECIDEG, 1801); /* 1801: out of range */
+    EXPECT_RESPONSE(PKT_WRITE_DATA, 0, ITEM_CENTER_OFFSET_DECIDEG, 0);
     assert_true(servo.regs.status.status & STATUS_COMMAND_ERROR);
-    REQUEST(3, 0, 5);
-    EXPECT_RESPONSE(3, 0, 5, STATUS_COMMAND_ERROR);
+    REQUEST(PKT_READ_DATA, 0, ITEM_STATUS);
+    EXPECT_RESPONSE(PKT_READ_DATA, 0, ITEM_STATUS, STATUS_COMMAND_ERROR);
 }
 
 static void test_batch_read_write_and_reset(void **state)
@@ -102,7 +103,7 @@ static void test_batch_read_write_and_reset(void **state)
     (void)state;
     uint8_t block[1 + USER_AREA_SIZE] = {0};
     user_config_encode(&servo.regs.user, &block[1]);
-    REQUEST(5, 0);
+    REQUEST(PKT_READ_BATCH_DATA, 0);
     uint8_t frame[64];
     size_t n = make_response(frame, 5, block, sizeof block);
     harness_assert_sent(frame, n);
@@ -110,20 +111,20 @@ static void test_batch_read_write_and_reset(void **state)
     block[1 + 1] = 1;    /* control response */
     block[1 + 3] = 0x42; /* reserved 35 kept as given */
     block[1 + 28] = 0x10; /* 52 = -1520 (0xFA10) */
-    harness_request(6, block, sizeof block);
-    EXPECT_RESPONSE(6, 0, 1);
-    REQUEST(5, 0);
+    harness_request(PKT_WRITE_BATCH_DATA, block, sizeof block);
+    EXPECT_RESPONSE(PKT_WRITE_BATCH_DATA, 0, 1);
+    REQUEST(PKT_READ_BATCH_DATA, 0);
     n = make_response(frame, 5, block, sizeof block);
     harness_assert_sent(frame, n);
 
     block[1 + 4] = 0; /* invalid baud index: all or nothing */
     block[1 + 1] = 0;
-    harness_request(6, block, sizeof block);
-    EXPECT_RESPONSE(6, 0, 0);
+    harness_request(PKT_WRITE_BATCH_DATA, block, sizeof block);
+    EXPECT_RESPONSE(PKT_WRITE_BATCH_DATA, 0, 0);
     assert_int_equal(servo.regs.user.control_response, 1);
 
-    REQUEST(2, 0);
-    EXPECT_RESPONSE(2, 0, 1);
+    REQUEST(PKT_RESET_USER_DATA, 0);
+    EXPECT_RESPONSE(PKT_RESET_USER_DATA, 0, 1);
     assert_int_equal(servo.regs.user.control_response, 0);
     assert_int_equal(servo.regs.user.reserved_35, 0);
 }
@@ -132,8 +133,8 @@ static void test_new_id_takes_effect_after_the_response(void **state)
 {
     (void)state;
     hal.tx_busy = true; /* the response is still on the wire */
-    REQUEST(4, 0, 34, 7);
-    EXPECT_RESPONSE(4, 0, 34, 1); /* answered with the old ID */
+    WRITE_ITEM(0, ITEM_SERVO_ID, 7);
+    EXPECT_RESPONSE(PKT_WRITE_DATA, 0, ITEM_SERVO_ID, 1); /* answered with the old ID */
     harness_poll(2);
     assert_int_equal(servo.active_id, 0); /* not while the response is on the wire */
     /* The host's next request, to the new ID, follows the last stop bit at
@@ -146,10 +147,10 @@ static void test_new_id_takes_effect_after_the_response(void **state)
     harness_feed(wire, n);
     harness_poll(2);
     assert_int_equal(servo.active_id, 7);
-    EXPECT_RESPONSE(1, 7);
-    REQUEST(1, 7);
-    EXPECT_RESPONSE(1, 7);
-    REQUEST(1, 0);
+    EXPECT_RESPONSE(PKT_PING, 7);
+    REQUEST(PKT_PING, 7);
+    EXPECT_RESPONSE(PKT_PING, 7);
+    REQUEST(PKT_PING, 0);
     EXPECT_SILENCE();
 }
 
@@ -158,8 +159,8 @@ static void test_new_baud_takes_effect_after_the_response(void **state)
     (void)state;
     assert_int_equal(hal.baud, 115200);
     hal.tx_busy = true;
-    REQUEST(4, 0, 36, 8);
-    EXPECT_RESPONSE(4, 0, 36, 1);
+    WRITE_ITEM(0, ITEM_BAUD_INDEX, 8);
+    EXPECT_RESPONSE(PKT_WRITE_DATA, 0, ITEM_BAUD_INDEX, 1);
     assert_int_equal(hal.baud, 115200);
     hal.tx_busy = false;
     harness_poll(2);
@@ -188,15 +189,15 @@ static void test_an_idle_line_drops_a_partial_frame(void **state)
     feed_ping_in_two(servo.rx_idle_us);
     EXPECT_SILENCE();
     assert_int_equal(servo.rx.stats.idle_timeouts, 1);
-    REQUEST(1, 0); /* the next frame is whole */
-    EXPECT_RESPONSE(1, 0);
+    REQUEST(PKT_PING, 0); /* the next frame is whole */
+    EXPECT_RESPONSE(PKT_PING, 0);
 }
 
 static void test_a_pause_within_the_idle_time_keeps_the_frame(void **state)
 {
     (void)state;
     feed_ping_in_two(servo.rx_idle_us - 1u - HARNESS_BYTE_US);
-    EXPECT_RESPONSE(1, 0);
+    EXPECT_RESPONSE(PKT_PING, 0);
     assert_int_equal(servo.rx.stats.idle_timeouts, 0);
 }
 
@@ -206,7 +207,7 @@ static void test_the_idle_time_survives_the_clock_wrap(void **state)
     hal.now_us = 0xFFFFFFFFu - 3u * HARNESS_BYTE_US;
     servo.next_tick_us = hal.now_us;
     feed_ping_in_two(100);
-    EXPECT_RESPONSE(1, 0);
+    EXPECT_RESPONSE(PKT_PING, 0);
     assert_int_equal(servo.rx.stats.idle_timeouts, 0);
 }
 
@@ -222,24 +223,24 @@ static void test_a_clock_stepping_back_is_no_idle_line(void **state)
     harness_poll(1);
     harness_feed(wire + 3, n - 3);
     harness_poll(2);
-    EXPECT_RESPONSE(1, 0);
+    EXPECT_RESPONSE(PKT_PING, 0);
     assert_int_equal(servo.rx.stats.idle_timeouts, 0);
 }
 
 static void test_config_survives_restart(void **state)
 {
     (void)state;
-    REQUEST(4, 0, 34, 9);
-    REQUEST(4, 9, 43, 0xD0, 0x07);
-    EXPECT_RESPONSE(4, 9, 43, 1);
+    WRITE_ITEM(0, ITEM_SERVO_ID, 9);
+    WRITE_ITEM(9, ITEM_CURRENT_LIMIT_MA, 2000);
+    EXPECT_RESPONSE(PKT_WRITE_DATA, 9, ITEM_CURRENT_LIMIT_MA, 1);
     /* In flash before the answer: a power cut right after it keeps it. */
     harness_restart();
-    REQUEST(3, 9, 43);
-    EXPECT_RESPONSE(3, 9, 43, 0xD0, 0x07);
+    REQUEST(PKT_READ_DATA, 9, ITEM_CURRENT_LIMIT_MA);
+    EXPECT_ITEM(9, ITEM_CURRENT_LIMIT_MA, 2000);
     /* Writing the same value again writes no flash. */
     long steps = hal.flash.steps;
-    REQUEST(4, 9, 43, 0xD0, 0x07);
-    EXPECT_RESPONSE(4, 9, 43, 1);
+    WRITE_ITEM(9, ITEM_CURRENT_LIMIT_MA, 2000);
+    EXPECT_RESPONSE(PKT_WRITE_DATA, 9, ITEM_CURRENT_LIMIT_MA, 1);
     harness_run_ms(100);
     assert_int_equal(hal.flash.steps, steps);
 }
@@ -250,34 +251,29 @@ static void test_config_survives_restart(void **state)
 static void test_assign_id_by_serial_number(void **state)
 {
     (void)state;
-    REQUEST(0x42, 0xFF, 0x79, 0x56, 0x34, 0x12, 7); /* another servo's serial number */
+    REQUEST(PKT_ASSIGN_ID, 0xFF, 0x79, 0x56, 0x34, 0x12, 7); /* another servo's serial number */
     EXPECT_SILENCE();
     assert_int_equal(servo.regs.user.servo_id, 0);
     assert_int_equal(servo.regs.status.status & STATUS_COMMAND_ERROR, 0);
-    REQUEST(0x42, 0xFF, 0x78, 0x56, 0x34, 0x12, 255);
-    EXPECT_RESPONSE(0x42, 0, 0);
-    REQUEST(0x42, 0xFF, 0x78, 0x56, 0x34, 0x12, 7);
-    EXPECT_RESPONSE(0x42, 7, 1);
+    REQUEST(PKT_ASSIGN_ID, 0xFF, 0x78, 0x56, 0x34, 0x12, 255);
+    EXPECT_RESPONSE(PKT_ASSIGN_ID, 0, 0);
+    REQUEST(PKT_ASSIGN_ID, 0xFF, 0x78, 0x56, 0x34, 0x12, 7);
+    EXPECT_RESPONSE(PKT_ASSIGN_ID, 7, 1);
     harness_restart();
-    REQUEST(1, 7);
-    EXPECT_RESPONSE(1, 7);
-    REQUEST(0x42, 0x07, 0x78, 0x56, 0x34, 0x12, 9); /* to its own ID: taken too */
-    EXPECT_RESPONSE(0x42, 9, 1);
-    REQUEST(0x42, 0xFF, 0x78, 0x56, 0x34, 0x12); /* short: a malformed frame, no answer */
+    REQUEST(PKT_PING, 7);
+    EXPECT_RESPONSE(PKT_PING, 7);
+    REQUEST(PKT_ASSIGN_ID, 0x07, 0x78, 0x56, 0x34, 0x12, 9); /* to its own ID: taken too */
+    EXPECT_RESPONSE(PKT_ASSIGN_ID, 9, 1);
+    REQUEST(PKT_ASSIGN_ID, 0xFF, 0x78, 0x56, 0x34, 0x12); /* short: a malformed frame, no answer */
     EXPECT_SILENCE();
 }
 
-/* ReadStore (0x41): field at offset `at` of the answer's content. */
-static uint32_t store_field(size_t at)
+/* A field of ReadStore's answer, by a request of its own:
+ * store_field(ANSWER_READ_STORE_FLAGS). */
+static uint32_t store_field(size_t at, size_t size, int is_signed)
 {
-    REQUEST(0x41, 0);
-    assert_int_equal(hal.sent_length, 4 + 34 + 1);
-    const uint8_t *c = &hal.sent[4];
-    if (at == 1) {
-        return c[1];
-    }
-    return (uint32_t)c[at] | (uint32_t)c[at + 1] << 8 | (uint32_t)c[at + 2] << 16 |
-           (uint32_t)c[at + 3] << 24;
+    REQUEST(PKT_READ_STORE, 0);
+    return (uint32_t)harness_answer_field(PKT_READ_STORE, at, size, is_signed);
 }
 
 /* Every flash write fails (a dead or worn page): a change is answered 0
@@ -288,26 +284,26 @@ static void test_a_write_the_flash_refuses_is_not_made(void **state)
     (void)state;
     const uint16_t kept = servo.regs.user.current_limit_ma;
     hal.flash.dead = true;
-    REQUEST(4, 0, 43, 0xD0, 0x07);
-    EXPECT_RESPONSE(4, 0, 43, 0);
+    WRITE_ITEM(0, ITEM_CURRENT_LIMIT_MA, 2000);
+    EXPECT_RESPONSE(PKT_WRITE_DATA, 0, ITEM_CURRENT_LIMIT_MA, 0);
     assert_int_equal(servo.store.write_failures, 1);
-    REQUEST(3, 0, 43);
-    EXPECT_RESPONSE(3, 0, 43, (uint8_t)kept, (uint8_t)(kept >> 8));
-    assert_int_equal(store_field(1), STORE_FAILED);
-    assert_int_equal(store_field(22), 1); /* failures */
+    REQUEST(PKT_READ_DATA, 0, ITEM_CURRENT_LIMIT_MA);
+    EXPECT_RESPONSE(PKT_READ_DATA, 0, ITEM_CURRENT_LIMIT_MA, (uint8_t)kept, (uint8_t)(kept >> 8));
+    assert_int_equal(store_field(ANSWER_READ_STORE_FLAGS), STORE_FAILED);
+    assert_int_equal(store_field(ANSWER_READ_STORE_FAILURES), 1); /* failures */
     uint8_t batch[1 + USER_AREA_SIZE] = {0};
     user_config_encode(&servo.regs.user, &batch[1]);
     batch[1 + 43 - 32] = 0xB8; /* a real change: stored or refused */
     batch[1 + 44 - 32] = 0x0B;
-    harness_request(6, batch, sizeof batch);
-    EXPECT_RESPONSE(6, 0, 0);
+    harness_request(PKT_WRITE_BATCH_DATA, batch, sizeof batch);
+    EXPECT_RESPONSE(PKT_WRITE_BATCH_DATA, 0, 0);
     hal.flash.dead = false;
-    REQUEST(4, 0, 43, 0xB8, 0x0B);
-    EXPECT_RESPONSE(4, 0, 43, 1);
-    assert_int_equal(store_field(1), 0);
+    WRITE_ITEM(0, ITEM_CURRENT_LIMIT_MA, 3000);
+    EXPECT_RESPONSE(PKT_WRITE_DATA, 0, ITEM_CURRENT_LIMIT_MA, 1);
+    assert_int_equal(store_field(ANSWER_READ_STORE_FLAGS), 0);
     harness_restart();
-    REQUEST(3, 0, 43);
-    EXPECT_RESPONSE(3, 0, 43, 0xB8, 0x0B);
+    REQUEST(PKT_READ_DATA, 0, ITEM_CURRENT_LIMIT_MA);
+    EXPECT_ITEM(0, ITEM_CURRENT_LIMIT_MA, 3000);
 }
 
 /* Every accepted change is a record of its own, written before its
@@ -317,13 +313,13 @@ static void test_every_change_is_in_flash_before_its_answer(void **state)
     (void)state;
     const uint32_t first = servo.store.sequence;
     for (unsigned i = 0; i < 10u; i++) {
-        REQUEST(4, 0, 44, (uint8_t)(100u + i));
-        EXPECT_RESPONSE(4, 0, 44, 1);
+        REQUEST(PKT_WRITE_DATA, 0, ITEM_START_FORCE, (uint8_t)(100u + i));
+        EXPECT_RESPONSE(PKT_WRITE_DATA, 0, ITEM_START_FORCE, 1);
         assert_int_equal(servo.store.sequence, first + i + 1u);
     }
     long steps = hal.flash.steps;
-    REQUEST(4, 0, 44, 109);
-    EXPECT_RESPONSE(4, 0, 44, 1);
+    WRITE_ITEM(0, ITEM_START_FORCE, 109);
+    EXPECT_RESPONSE(PKT_WRITE_DATA, 0, ITEM_START_FORCE, 1);
     assert_int_equal(hal.flash.steps, steps);
 }
 
@@ -344,8 +340,8 @@ static void test_writes_in_a_loop_stay_within_the_wear_budget(void **state)
     uint32_t refused = 0;
     for (uint32_t i = 0; ms < 2u * 3600u * 1000u; i++) {
         uint8_t flip = (uint8_t)(servo.regs.user.start_force ^ 1u);
-        REQUEST(4, 0, 44, flip);
-        refused += hal.sent[6] == 0u;
+        REQUEST(PKT_WRITE_DATA, 0, ITEM_START_FORCE, flip);
+        refused += ANSWER_FIELD(PKT_WRITE_DATA, ANSWER_WRITE_DATA_RESULT) == 0;
         hal.now_us += 149000u; /* no motion: ticks beyond the catch-up drop */
         harness_poll(2);
         ms += 150;
@@ -363,16 +359,16 @@ static void test_writes_in_a_loop_stay_within_the_wear_budget(void **state)
     assert_true(refused > 40000u);
     assert_int_equal(servo.store.sequence, save_policy_budget(&servo.saver));
     uint8_t held = servo.regs.user.start_force;
-    REQUEST(4, 0, 44, (uint8_t)(held ^ 1u));
-    EXPECT_RESPONSE(4, 0, 44, 0);
+    REQUEST(PKT_WRITE_DATA, 0, ITEM_START_FORCE, (uint8_t)(held ^ 1u));
+    EXPECT_RESPONSE(PKT_WRITE_DATA, 0, ITEM_START_FORCE, 0);
     assert_int_equal(servo.regs.user.start_force, held);
-    assert_int_equal(store_field(1), STORE_OVER_BUDGET);
-    assert_int_equal(store_field(2), servo.store.sequence);
+    assert_int_equal(store_field(ANSWER_READ_STORE_FLAGS), STORE_OVER_BUDGET);
+    assert_int_equal(store_field(ANSWER_READ_STORE_RECORDS), servo.store.sequence);
     uint32_t pages_started = (servo.store.sequence + 20u) / 21u; /* 21 records a page */
-    assert_int_equal(store_field(6), (pages_started + 1u) / 2u);
-    assert_int_equal(store_field(10), FLASH_RATED_CYCLES);
-    assert_int_equal(store_field(14), save_policy_budget(&servo.saver));
-    assert_int_equal(store_field(18), op);
+    assert_int_equal(store_field(ANSWER_READ_STORE_PAGE_ERASES), (pages_started + 1u) / 2u);
+    assert_int_equal(store_field(ANSWER_READ_STORE_RATED_CYCLES), FLASH_RATED_CYCLES);
+    assert_int_equal(store_field(ANSWER_READ_STORE_BUDGET), save_policy_budget(&servo.saver));
+    assert_int_equal(store_field(ANSWER_READ_STORE_OPERATING_TIME), op);
     assert_true(servo.store.sequence > SAVE_ALLOWANCE);
     assert_true(servo.store.sequence >= SAVE_ALLOWANCE + op / per_save - 1u);
 }
@@ -380,12 +376,12 @@ static void test_writes_in_a_loop_stay_within_the_wear_budget(void **state)
 static void test_reset_keeps_link(void **state)
 {
     (void)state;
-    REQUEST(4, 0, 34, 4);
+    WRITE_ITEM(0, ITEM_SERVO_ID, 4);
     harness_poll(2);
-    REQUEST(2, 4);
-    EXPECT_RESPONSE(2, 4, 1);
-    REQUEST(1, 4);
-    EXPECT_RESPONSE(1, 4);
+    REQUEST(PKT_RESET_USER_DATA, 4);
+    EXPECT_RESPONSE(PKT_RESET_USER_DATA, 4, 1);
+    REQUEST(PKT_PING, 4);
+    EXPECT_RESPONSE(PKT_PING, 4);
 }
 
 
@@ -408,21 +404,19 @@ static void test_sync_monitor_waits_its_turn(void **state)
 {
     (void)state;
     const uint8_t sync[] = {22, 1, 4, 5, 6, 0, 9};
-    harness_request(25, sync, sizeof sync);
+    harness_request(PKT_SYNC_COMMAND, sync, sizeof sync);
     EXPECT_SILENCE();
     other_servo_answers(5);
     EXPECT_SILENCE();
     other_servo_answers(6);
-    assert_int_equal(hal.sent_length, 21);
-    assert_int_equal(hal.sent[2], 22);
-    assert_int_equal(hal.sent[4], 0);
+    assert_int_equal(ANSWER_FIELD(PKT_MONITOR, ANSWER_MONITOR_ID), 0);
 }
 
 static void test_sync_monitor_passes_a_silent_servo(void **state)
 {
     (void)state;
     const uint8_t sync[] = {22, 1, 3, 5, 6, 0};
-    harness_request(25, sync, sizeof sync);
+    harness_request(PKT_SYNC_COMMAND, sync, sizeof sync);
     other_servo_answers(5);
     EXPECT_SILENCE();
     /* Servo 6 never answers: after the documented silence, servo 0 goes. */
@@ -446,7 +440,7 @@ static void test_a_new_request_ends_the_wait_for_a_sync_turn(void **state)
         sync[3 + i] = (uint8_t)(1 + i);
     }
     sync[3 + 251] = 0;
-    harness_request(25, sync, sizeof sync);
+    harness_request(PKT_SYNC_COMMAND, sync, sizeof sync);
     hal.now_us += 10000;
     harness_poll(3);
     EXPECT_SILENCE(); /* still waiting: 3 of 251 turns gone */
@@ -485,36 +479,36 @@ static void test_the_flash_is_erased_only_while_released(void **state)
 {
     (void)state;
     harness_ideal_tracking();
-    REQUEST(4, 0, 49, 0); /* soft start off: the move starts at once */
+    WRITE_ITEM(0, ITEM_SOFT_START_ON, 0); /* soft start off: the move starts at once */
     const unsigned slots = config_store_slots_per_page(&servo.store);
     const uint32_t first = servo.store.sequence;
     for (unsigned i = 0; servo.store.sequence < first + 2u * slots - 1u; i++) {
-        REQUEST(4, 0, 43, (uint8_t)(100u + i), 0x07); /* a new value each time */
-        EXPECT_RESPONSE(4, 0, 43, 1);
+        REQUEST(PKT_WRITE_DATA, 0, ITEM_CURRENT_LIMIT_MA, (uint8_t)(100u + i), 0x07); /* a new value each time */
+        EXPECT_RESPONSE(PKT_WRITE_DATA, 0, ITEM_CURRENT_LIMIT_MA, 1);
         harness_run_ms(70); /* too short a pause for an erase */
     }
     uint32_t erases = hal.flash.erases[0] + hal.flash.erases[1];
     /* A 1 s move to 100 degrees; a change during it, and while it holds. */
-    REQUEST(11, 0, 0xE8, 0x03, 0xE8, 0x03, 0x64, 0, 0xC8, 0, 0, 0);
+    REQUEST(PKT_MOVE_ANGLE_BY_INTERVAL, 0, 0xE8, 0x03, 0xE8, 0x03, 0x64, 0, 0xC8, 0, 0, 0);
     const uint16_t kept = servo.regs.user.current_limit_ma;
-    REQUEST(4, 0, 43, 0x55, 0x06);
-    EXPECT_RESPONSE(4, 0, 43, 0);
+    WRITE_ITEM(0, ITEM_CURRENT_LIMIT_MA, 1621);
+    EXPECT_RESPONSE(PKT_WRITE_DATA, 0, ITEM_CURRENT_LIMIT_MA, 0);
     assert_int_equal(servo.regs.user.current_limit_ma, kept);
-    assert_int_equal(store_field(1), STORE_AWAITS_ERASE);
+    assert_int_equal(store_field(ANSWER_READ_STORE_FLAGS), STORE_AWAITS_ERASE);
     harness_run_ms(2000); /* the move ends and holds; the line is quiet */
     assert_int_equal(hal.flash.erases[0] + hal.flash.erases[1], erases);
-    REQUEST(4, 0, 43, 0x55, 0x06);
-    EXPECT_RESPONSE(4, 0, 43, 0);
-    REQUEST(24, 0, 0x10, 0, 0); /* released */
+    WRITE_ITEM(0, ITEM_CURRENT_LIMIT_MA, 1621);
+    EXPECT_RESPONSE(PKT_WRITE_DATA, 0, ITEM_CURRENT_LIMIT_MA, 0);
+    REQUEST(PKT_STOP_ON_CONTROL_MODE, 0, 0x10, 0, 0); /* released */
     harness_run_ms(150);
     assert_int_equal(hal.flash.erases[0] + hal.flash.erases[1], erases + 1u);
     assert_false(config_store_spare_dirty(&servo.store));
-    assert_int_equal(store_field(1), 0);
-    REQUEST(4, 0, 43, 0x55, 0x06);
-    EXPECT_RESPONSE(4, 0, 43, 1);
+    assert_int_equal(store_field(ANSWER_READ_STORE_FLAGS), 0);
+    WRITE_ITEM(0, ITEM_CURRENT_LIMIT_MA, 1621);
+    EXPECT_RESPONSE(PKT_WRITE_DATA, 0, ITEM_CURRENT_LIMIT_MA, 1);
     harness_restart();
-    REQUEST(3, 0, 43);
-    EXPECT_RESPONSE(3, 0, 43, 0x55, 0x06);
+    REQUEST(PKT_READ_DATA, 0, ITEM_CURRENT_LIMIT_MA);
+    EXPECT_ITEM(0, ITEM_CURRENT_LIMIT_MA, 1621);
 }
 
 /* A WriteData that arrives in the ring while an erase stalls the CPU. */
@@ -536,7 +530,7 @@ static void erase_with_bytes_arriving(void (*arrive)(void *ctx))
 {
     const unsigned slots = config_store_slots_per_page(&servo.store);
     for (unsigned i = 0; i < 2u * slots; i++) {
-        REQUEST(4, 0, 43, (uint8_t)(100u + i), 0x07);
+        REQUEST(PKT_WRITE_DATA, 0, ITEM_CURRENT_LIMIT_MA, (uint8_t)(100u + i), 0x07);
         harness_run_ms(70);
     }
     uint32_t erases = hal.flash.erases[0] + hal.flash.erases[1];
@@ -565,10 +559,10 @@ static void test_an_answer_that_would_leave_late_is_dropped(void **state)
     assert_int_equal(servo.answers_dropped, 1u);
     assert_int_equal(servo.ticks_dropped, dropped_ticks);
     harness_run_ms(2);
-    assert_int_equal(store_field(26), 1u);       /* ReadStore: answers dropped */
-    assert_int_equal(store_field(30), 0u);       /* bytes lost */
-    REQUEST(1, 0);
-    EXPECT_RESPONSE(1, 0);
+    assert_int_equal(store_field(ANSWER_READ_STORE_ANSWERS_DROPPED), 1u);       /* ReadStore: answers dropped */
+    assert_int_equal(store_field(ANSWER_READ_STORE_BYTES_LOST), 0u);       /* bytes lost */
+    REQUEST(PKT_PING, 0);
+    EXPECT_RESPONSE(PKT_PING, 0);
 }
 
 /* 90 ReadData (540 bytes) and a WriteData in the ring while an erase
@@ -600,7 +594,7 @@ static void test_a_ring_that_wrapped_during_an_erase_is_dropped_and_counted(void
 {
     (void)state;
     assert_int_equal(hal_rx_ring_size(&hal.rx), 512u);
-    REQUEST(4, 0, 36, 8); /* 1 Mbaud */
+    WRITE_ITEM(0, ITEM_BAUD_INDEX, 8); /* 1 Mbaud */
     harness_poll(2);
     assert_int_equal(hal.baud, 1000000);
     const uint16_t stall_power = servo.regs.user.stall_power_mw;
@@ -610,8 +604,8 @@ static void test_a_ring_that_wrapped_during_an_erase_is_dropped_and_counted(void
     assert_int_equal(servo.regs.user.stall_power_mw, stall_power); /* not carried out */
     assert_true(servo.rx_lost >= 512u);
     assert_int_equal(servo.answers_dropped, 0u);
-    REQUEST(1, 0);
-    EXPECT_RESPONSE(1, 0);
+    REQUEST(PKT_PING, 0);
+    EXPECT_RESPONSE(PKT_PING, 0);
 }
 
 /* Six ReadData and a WriteData arrive in the ring while an erase stalls
@@ -644,8 +638,8 @@ static void test_a_burst_during_an_erase_is_carried_out_and_never_answered_late(
     assert_int_equal(servo.answers_dropped, 7u);
     assert_int_equal(servo.rx.stats.queue_overflows, 0u);
     assert_int_equal(servo.rx_lost, 0u);
-    REQUEST(1, 0);
-    EXPECT_RESPONSE(1, 0);
+    REQUEST(PKT_PING, 0);
+    EXPECT_RESPONSE(PKT_PING, 0);
 }
 
 /* UpdateEnter (0x50): refused without a bootloader, and while the output
@@ -656,44 +650,43 @@ static void test_a_burst_during_an_erase_is_carried_out_and_never_answered_late(
 static void test_update_enter_restarts_into_the_bootloader(void **state)
 {
     (void)state;
-    REQUEST(0x50, 0);
-    EXPECT_RESPONSE(0x50, 0, 0, 2); /* no bootloader on this port */
+    REQUEST(PKT_UPDATE_ENTER, 0);
+    EXPECT_RESPONSE(PKT_UPDATE_ENTER, 0, 0, 2); /* no bootloader on this port */
     hal.port.enter_bootloader = hal_double_enter_bootloader;
     hal.port.board = 0x0103;
     servo_init(&servo, &hal.port);
     harness_ideal_tracking();
-    REQUEST(0x55, 0);
+    REQUEST(PKT_UPDATE_STATUS, 0);
     uint16_t version = servo.regs.status.firmware_version;
-    EXPECT_RESPONSE(0x55, 0, 0, 0, 0, 0, (uint8_t)version, (uint8_t)(version >> 8), 0x03, 0x01,
-                    0, 0, 0, 0, 0, 0, 0);
-    REQUEST(4, 0, 49, 0); /* soft start off: the move starts at once */
-    REQUEST(11, 0, 0xE8, 0x03, 0xE8, 0x03, 0x64, 0, 0xC8, 0, 0, 0);
-    REQUEST(0x50, 0);
-    EXPECT_RESPONSE(0x50, 0, 0, 1); /* a move runs */
+    EXPECT_RESPONSE(PKT_UPDATE_STATUS, 0, 0, 0, 0, 0, (uint8_t)version, (uint8_t)(version >> 8), 0x03, 0x01, 0, 0, 0, 0, 0, 0, 0);
+    WRITE_ITEM(0, ITEM_SOFT_START_ON, 0); /* soft start off: the move starts at once */
+    REQUEST(PKT_MOVE_ANGLE_BY_INTERVAL, 0, 0xE8, 0x03, 0xE8, 0x03, 0x64, 0, 0xC8, 0, 0, 0);
+    REQUEST(PKT_UPDATE_ENTER, 0);
+    EXPECT_RESPONSE(PKT_UPDATE_ENTER, 0, 0, 1); /* a move runs */
     harness_run_ms(1200);
-    REQUEST(0x50, 0);
-    EXPECT_RESPONSE(0x50, 0, 0, 1); /* it holds the end: a load would fall */
-    REQUEST(9, 0, 0xF4, 0x01);
-    REQUEST(0x50, 0);
-    EXPECT_RESPONSE(0x50, 0, 0, 1); /* damping */
-    REQUEST(24, 0, 0x10, 0, 0); /* released */
-    harness_request(18, NULL, 0); /* a move buffered for EndAsync */
-    REQUEST(11, 0, 0xE8, 0x03, 0xE8, 0x03, 0x64, 0, 0xC8, 0, 0, 0);
-    REQUEST(0x50, 0);
-    EXPECT_RESPONSE(0x50, 0, 0, 1);
-    REQUEST(19, 1); /* the buffer dropped */
-    REQUEST(4, 0, 43, 0x55, 0x06); /* in flash before its answer */
+    REQUEST(PKT_UPDATE_ENTER, 0);
+    EXPECT_RESPONSE(PKT_UPDATE_ENTER, 0, 0, 1); /* it holds the end: a load would fall */
+    REQUEST(PKT_MOVE_DAMPING, 0, 0xF4, 0x01);
+    REQUEST(PKT_UPDATE_ENTER, 0);
+    EXPECT_RESPONSE(PKT_UPDATE_ENTER, 0, 0, 1); /* damping */
+    REQUEST(PKT_STOP_ON_CONTROL_MODE, 0, 0x10, 0, 0); /* released */
+    harness_request(PKT_BEGIN_ASYNC, NULL, 0); /* a move buffered for EndAsync */
+    REQUEST(PKT_MOVE_ANGLE_BY_INTERVAL, 0, 0xE8, 0x03, 0xE8, 0x03, 0x64, 0, 0xC8, 0, 0, 0);
+    REQUEST(PKT_UPDATE_ENTER, 0);
+    EXPECT_RESPONSE(PKT_UPDATE_ENTER, 0, 0, 1);
+    REQUEST(PKT_END_ASYNC, 1); /* the buffer dropped */
+    WRITE_ITEM(0, ITEM_CURRENT_LIMIT_MA, 1621); /* in flash before its answer */
     hal.tx_busy = true;
-    REQUEST(0x50, 0);
-    EXPECT_RESPONSE(0x50, 0, 1, 0);
+    REQUEST(PKT_UPDATE_ENTER, 0);
+    EXPECT_RESPONSE(PKT_UPDATE_ENTER, 0, 1, 0);
     harness_poll(4);
     assert_int_equal(hal.bootloader_entries, 0); /* the answer is still on the wire */
     hal.tx_busy = false;
     harness_poll(2);
     assert_int_equal(hal.bootloader_entries, 1);
     harness_restart();
-    REQUEST(3, 0, 43);
-    EXPECT_RESPONSE(3, 0, 43, 0x55, 0x06);
+    REQUEST(PKT_READ_DATA, 0, ITEM_CURRENT_LIMIT_MA);
+    EXPECT_ITEM(0, ITEM_CURRENT_LIMIT_MA, 1621);
 }
 
 static void test_garbage_between_frames_and_responses_of_others(void **state)
@@ -711,7 +704,7 @@ static void test_garbage_between_frames_and_responses_of_others(void **state)
     hal_double_clear_sent(&hal);
     harness_feed(wire, n);
     harness_poll(4);
-    EXPECT_RESPONSE(1, 0); /* exactly one answer: the inner ping was skipped */
+    EXPECT_RESPONSE(PKT_PING, 0); /* exactly one answer: the inner ping was skipped */
 }
 
 int main(void)

@@ -11,6 +11,7 @@
 
 #include <cmocka.h>
 
+#include "support/by_name.h"
 #include "support/servo_harness.h"
 
 static int setup(void **state)
@@ -63,7 +64,7 @@ static void test_an_answer_that_has_left_unnoticed_keeps_it_awake(void **state)
     (void)state;
     settle();
     hal.tx_busy = true;
-    REQUEST(1, 0); /* Ping (the harness servo holds the factory ID 0) */
+    REQUEST(PKT_PING, 0); /* Ping (the harness servo holds the factory ID 0) */
     assert_true(servo.tx.sending);
     assert_true(servo_may_sleep(&servo)); /* the end of the answer is an interrupt */
     hal.tx_busy = false;
@@ -77,7 +78,7 @@ static void test_a_sync_monitor_turn_keeps_it_awake(void **state)
     (void)state;
     settle();
     const uint8_t sync[] = {22, 1, 2, 5, 0}; /* after servo 5 */
-    harness_request(25, sync, sizeof sync);
+    harness_request(PKT_SYNC_COMMAND, sync, sizeof sync);
     assert_true(servo.tx.waiting);
     assert_false(servo_may_sleep(&servo));
 }
@@ -87,7 +88,7 @@ static void test_a_new_link_setting_keeps_it_awake_until_applied(void **state)
     (void)state;
     settle();
     hal.tx_busy = true;
-    REQUEST(4, 0, 36, 4); /* WriteData: baud index 4, applied once the answer has left */
+    WRITE_ITEM(0, ITEM_BAUD_INDEX, 4); /* WriteData: baud index 4, applied once the answer has left */
     assert_true(servo.link_settings_pending);
     assert_false(servo_may_sleep(&servo));
 }
