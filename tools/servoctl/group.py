@@ -1,7 +1,6 @@
 """Several servos at once: a sync move (SyncCommand, one frame for every
 listed servo), a broadcast move, async begin and end, Sync Monitor, and the
 backup and restore of a whole bus. Angles in degrees, times in seconds."""
-import struct
 
 from . import protocol as p
 from . import config_file
@@ -10,9 +9,7 @@ from .errors import NoReply, Refused, UsageError
 from .checks import MIN_RAMP_MS, check_profile, check_range, scaled, to_ms
 from .servo import Monitor, Servo
 
-# SyncCommand records (docs/protocol-packets.md): the packet's own content.
-_ANGLE_RECORD = "<BhHH"       # packet 8: id, angle, interval, power
-_MULTI_TURN_RECORD = "<BiIH"  # packet 13
+# A SyncCommand record is its packet's own request (p.encode_request).
 MAX_SYNC_RECORDS = 255
 
 
@@ -30,10 +27,10 @@ def sync_move(bus: p.Bus, targets: dict, duration_s: float, power_w: float = 0.0
     check_profile(MIN_RAMP_MS, MIN_RAMP_MS, interval)  # packets 8 and 13 ramp 20 ms
     power = check_range("power", scaled(power_w, 1000, "power_w"), 0, 65535, "mW")
     if multi:
-        fmt, code = _MULTI_TURN_RECORD, p.MULTI_TURN
+        code = p.MULTI_TURN
         check_range("interval", interval, 0, 4096000, "ms")
     else:
-        fmt, code = _ANGLE_RECORD, p.ANGLE
+        code = p.ANGLE
         check_range("interval", interval, 0, 65535, "ms")
     records = b""
     for servo_id, degrees in targets.items():
@@ -41,8 +38,8 @@ def sync_move(bus: p.Bus, targets: dict, duration_s: float, power_w: float = 0.0
         angle = scaled(degrees, 10, "degrees")
         check_range("angle", angle, -3686400, 3686400, "deg", 10)
         check_target(Servo(bus, servo_id), angle, multi)
-        records += struct.pack(fmt, servo_id, angle, interval, power)
-    bus.send(p.SYNC, bytes([code, struct.calcsize(fmt), len(targets)]) + records)
+        records += p.encode_request(code, servo_id, angle, interval, power)
+    bus.send(p.SYNC, bytes([code, len(records) // len(targets), len(targets)]) + records)
 
 
 def broadcast_move(bus: p.Bus, degrees: float, duration_s: float, power_w: float = 0.0,
@@ -59,7 +56,7 @@ def broadcast_move(bus: p.Bus, degrees: float, duration_s: float, power_w: float
         raise NoReply("no servo on the bus answered: nothing to move")
     for servo_id in ids:
         check_target(Servo(bus, servo_id), angle, False)
-    bus.send(p.ANGLE, struct.pack(_ANGLE_RECORD, p.BROADCAST, angle, interval, power))
+    bus.send(p.ANGLE, p.encode_request(p.ANGLE, p.BROADCAST, angle, interval, power))
 
 
 def begin_async(bus: p.Bus) -> None:

@@ -2,7 +2,6 @@
 servo with a serial number whatever its ID, so two servos on one ID can be
 told apart, and a bus of new servos (all at the factory ID) can be numbered
 one servo at a time."""
-import struct
 
 from . import protocol as p
 from . import scan
@@ -30,7 +29,7 @@ def assign(bus: p.Bus, serial: int, new_id: int) -> None:
     holder = scan.probe(bus, new_id, scan.reply_window_s(bus.serial.baudrate))
     if holder is not None and serial not in holder.serials:
         raise Refused(f"ID {new_id} already answers on this bus ({holder.describe()}): pick a free one")
-    bus.send(p.ASSIGN_ID, struct.pack("<BIB", p.BROADCAST, serial, new_id))
+    bus.send(p.ASSIGN_ID, p.encode_request(p.ASSIGN_ID, p.BROADCAST, serial, new_id))
     try:
         answer = bus.read_response(p.ASSIGN_ID, None)
     except NoReply:

@@ -31,6 +31,24 @@ def checksum(data: bytes) -> int:
     return sum(data) % 256
 
 
+def decode_answer(code: int, content: bytes) -> tuple:
+    """An answer's fields, as protocol/schema.toml lays them out, once its
+    length is the packet's: any other length is an error that says so,
+    never a traceback."""
+    fmt = _SCHEMA.answer_format(code)
+    if len(content) != struct.calcsize(fmt):
+        who = content[0] if content else "?"
+        raise BadAnswer(f"servo {who}: a {_SCHEMA.packet(code).name} answer of {len(content)} bytes, "
+                        f"not {struct.calcsize(fmt)} (garbled, another firmware, or two servos on one ID)")
+    return struct.unpack(fmt, content)
+
+
+def encode_request(code: int, *values) -> bytes:
+    """A request's content from its fields' values, as protocol/schema.toml
+    lays them out."""
+    return struct.pack(_SCHEMA.request_format(code), *values)
+
+
 def request_frame(code: int, content: bytes) -> bytes:
     """A request frame; content of 255 bytes or more uses the extended length."""
     if len(content) >= 255:

@@ -93,7 +93,7 @@ def probe(bus: p.Bus, servo_id: int, window_s: float):
     statuses, bad, stray = bus.gather(update.UPDATE_STATUS, bytes([servo_id]), window_s)
     found.garbled += bad + (stray > 0)
     try:
-        st = update.decode_status(servo_id, statuses[0]) if statuses else None
+        st = update.decode_status(statuses[0]) if statuses else None
     except BadAnswer:
         st = None  # another firmware's
     if st is not None and st.mode == update.MODE_BOOTLOADER:

@@ -105,6 +105,30 @@ class Schema:
     def area(self, name: str) -> tuple:
         return tuple(i for i in self.items if i.area == name)
 
+    def packet(self, code: int) -> Packet:
+        return next(p for p in self.packets if p.code == code)
+
+    def answer_format(self, code: int):
+        """The struct format of a packet's answer (little-endian), or None
+        when a field's size varies (an item's value, a block of bytes)."""
+        return self._format(self.packet(code).answer)
+
+    def request_format(self, code: int):
+        """The same for its request."""
+        return self._format(self.packet(code).request)
+
+    def _format(self, fields):
+        codes = {"u8": "B", "u16": "H", "u32": "I", "i16": "h", "i32": "i"}
+        out = "<"
+        for f in fields:
+            if f.type == "user_area":
+                out += f"{sum(i.size for i in self.area('user'))}s"
+            elif f.type in codes:
+                out += codes[f.type]
+            else:
+                return None
+        return out
+
     def tables(self) -> dict:
         """{table: its packets, in code order}, tables in the order they first appear."""
         out = {}

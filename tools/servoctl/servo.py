@@ -1,7 +1,6 @@
 """One servo on a bus: every packet of the protocol as a method, values in
 protocol units (0.1 degree, ms, mW) unless the name says otherwise."""
 from dataclasses import dataclass
-import struct
 
 from . import frame, outcome
 from . import protocol as p
@@ -24,17 +23,7 @@ class Monitor:
 
     @classmethod
     def decode(cls, content: bytes) -> "Monitor":
-        return cls(*_unpack("<BHHHHBih", content, "Monitor"))
-
-
-def _unpack(fmt: str, content: bytes, packet: str) -> tuple:
-    """An answer's fields, once its length is the packet's: any other
-    length is an error that says so, never a traceback."""
-    if len(content) != struct.calcsize(fmt):
-        who = content[0] if content else "?"
-        raise BadAnswer(f"servo {who}: a {packet} answer of {len(content)} bytes, not "
-                        f"{struct.calcsize(fmt)} (garbled, another firmware, or two servos on one ID)")
-    return struct.unpack(fmt, content)
+        return cls(*p.decode_answer(p.MONITOR, content))
 
 
 @dataclass
@@ -55,7 +44,7 @@ class MotionSnapshot:
 
     @classmethod
     def decode(cls, content: bytes) -> "MotionSnapshot":
-        return cls(*_unpack("<BiiihhHBBI", content, "ReadMotion"))
+        return cls(*p.decode_answer(p.READ_MOTION, content))
 
     def seconds_since(self, earlier: "MotionSnapshot") -> float:
         """Servo time from an earlier snapshot to this one (less than 71
@@ -92,7 +81,7 @@ class StoreHealth:
 
     @classmethod
     def decode(cls, content: bytes) -> "StoreHealth":
-        return cls(*_unpack("<BB8I", content, "ReadStore"))
+        return cls(*p.decode_answer(p.READ_STORE, content))
 
     def flag_names(self) -> list:
         return [name for bit, name in enumerate(self.FLAGS) if name and self.flags >> bit & 1]
@@ -126,22 +115,21 @@ class Servo:
         item = registers.find(key)
         item.check(value)
         content = self.bus.request(p.WRITE_DATA, bytes([self.id, item.id]) + item.pack(value))
-        if _unpack("<BBB", content, "WriteData")[2] != 1:
+        if p.decode_answer(p.WRITE_DATA, content)[2] != 1:
             raise Refused(f"servo {self.id} refused {item.name} = {value}{self._why_refused()}")
 
     def read_all(self) -> dict:
         content = self.bus.request(p.READ_BATCH, bytes([self.id]))
-        return registers.decode_user_area(_unpack(f"<B{registers.USER_AREA_SIZE}s", content,
-                                                  "ReadBatchData")[1])
+        return registers.decode_user_area(p.decode_answer(p.READ_BATCH, content)[1])
 
     def write_all(self, values: dict) -> None:
         block = registers.encode_user_area(values)
         content = self.bus.request(p.WRITE_BATCH, bytes([self.id]) + block)
-        if _unpack("<BB", content, "WriteBatchData")[1] != 1:
+        if p.decode_answer(p.WRITE_BATCH, content)[1] != 1:
             raise Refused(f"servo {self.id} refused the user area block{self._why_refused()}")
 
     def reset_user_data(self) -> None:
-        if _unpack("<BB", self.bus.request(p.RESET_USER_DATA, bytes([self.id])), "ResetUserData")[1] != 1:
+        if p.decode_answer(p.RESET_USER_DATA, self.bus.request(p.RESET_USER_DATA, bytes([self.id])))[1] != 1:
             raise Refused(f"servo {self.id} refused the reset{self._why_refused()}")
 
     def _why_refused(self) -> str:
@@ -158,11 +146,11 @@ class Servo:
         return ": " + "; ".join(reasons) if reasons else ""
 
     def angle(self) -> int:
-        return _unpack("<Bh", self.bus.request(p.READ_ANGLE, bytes([self.id])), "ReadAngle")[1]
+        return p.decode_answer(p.READ_ANGLE, self.bus.request(p.READ_ANGLE, bytes([self.id])))[1]
 
     def multi_turn_angle(self):
         """(angle in 0.1 degree, turns)."""
-        return _unpack("<Bih", self.bus.request(p.READ_MULTI_TURN, bytes([self.id])), "ReadMultiTurn")[1:]
+        return p.decode_answer(p.READ_MULTI_TURN, self.bus.request(p.READ_MULTI_TURN, bytes([self.id])))[1:]
 
     def monitor(self) -> Monitor:
         return Monitor.decode(self.bus.request(p.MONITOR, bytes([self.id])))
@@ -205,16 +193,16 @@ class Servo:
             raise ValueOutOfRange("give either an interval or a velocity")
         if velocity is not None:
             check_range("speed", velocity, 10, 7500, "deg/s", 10)
-            fmt, code = ("<BiHHHH", p.MULTI_TURN_BY_VELOCITY) if multi_turn else ("<BhHHHH", p.ANGLE_BY_VELOCITY)
-            content = struct.pack(fmt, self.id, angle_decideg, velocity, acc_ms, dec_ms, power_mw)
+            code = p.MULTI_TURN_BY_VELOCITY if multi_turn else p.ANGLE_BY_VELOCITY
+            content = p.encode_request(code, self.id, angle_decideg, velocity, acc_ms, dec_ms, power_mw)
         elif not ramps:
             check_range("interval", interval_ms, 0, 4096000 if multi_turn else 65535, "ms")
-            fmt, code = ("<BiIH", p.MULTI_TURN) if multi_turn else ("<BhHH", p.ANGLE)
-            content = struct.pack(fmt, self.id, angle_decideg, interval_ms, power_mw)
+            code = p.MULTI_TURN if multi_turn else p.ANGLE
+            content = p.encode_request(code, self.id, angle_decideg, interval_ms, power_mw)
         else:
             check_range("interval", interval_ms, 0, 4096000 if multi_turn else 65535, "ms")
-            fmt, code = ("<BiIHHH", p.MULTI_TURN_BY_INTERVAL) if multi_turn else ("<BhHHHH", p.ANGLE_BY_INTERVAL)
-            content = struct.pack(fmt, self.id, angle_decideg, interval_ms, acc_ms, dec_ms, power_mw)
+            code = p.MULTI_TURN_BY_INTERVAL if multi_turn else p.ANGLE_BY_INTERVAL
+            content = p.encode_request(code, self.id, angle_decideg, interval_ms, acc_ms, dec_ms, power_mw)
         return self._move(code, content, wait)
 
     def send_move(self, angle_decideg: int, request: MoveRequest, wait=False):
@@ -231,17 +219,17 @@ class Servo:
         check_range("wheel speed", speed_dps, 0, 65535, "deg/s")
         check_range("wheel value", value, 0, 65535)
         method = actions[action] | (0x80 if clockwise else 0)
-        return self._move(p.WHEEL, struct.pack("<BBHH", self.id, method, speed_dps, value), wait)
+        return self._move(p.WHEEL, p.encode_request(p.WHEEL, self.id, method, speed_dps, value), wait)
 
     def damping(self, power_mw: int = 0) -> None:
         check_range("power", power_mw, 0, 65535, "mW")
-        self.bus.send(p.DAMPING, struct.pack("<BH", self.id, power_mw))
+        self.bus.send(p.DAMPING, p.encode_request(p.DAMPING, self.id, power_mw))
 
     def stop(self, mode: str = "release", power_mw: int = 0) -> None:
         modes = {"release": 0x10, "hold": 0x11, "damping": 0x12}
         if mode not in modes:
             raise ValueOutOfRange(f"stop mode must be one of {', '.join(modes)}, not {mode!r}")
-        self.bus.send(p.STOP_ON_CONTROL, struct.pack("<BBH", self.id, modes[mode], power_mw))
+        self.bus.send(p.STOP_ON_CONTROL, p.encode_request(p.STOP_ON_CONTROL, self.id, modes[mode], power_mw))
 
     def set_origin(self) -> None:
         self.bus.send(p.SET_ORIGIN, bytes([self.id, 0]))

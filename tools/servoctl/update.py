@@ -39,13 +39,11 @@ class Status:
 
 
 def status(bus, servo_id: int, timeout=None) -> Status:
-    return decode_status(servo_id, bus.request(UPDATE_STATUS, bytes([servo_id]), timeout=timeout))
+    return decode_status(bus.request(UPDATE_STATUS, bytes([servo_id]), timeout=timeout))
 
 
-def decode_status(servo_id: int, c: bytes) -> Status:
-    if len(c) != 16:
-        raise BadAnswer(f"servo {servo_id}: an UpdateStatus answer of {len(c)} bytes, not 16: not this firmware")
-    return Status(c[1], *struct.unpack_from("<HBHHHHBH", c, 2))
+def decode_status(c: bytes) -> Status:
+    return Status(*_p.decode_answer(UPDATE_STATUS, c)[1:])
 
 
 def enter_refusal(servo_id: int, reason) -> str:
@@ -182,8 +180,8 @@ def write_image(bus, servo_id: int, image: Image, st: Status, progress=lambda do
     for offset in range(0, head, step):
         _write(bus, servo_id, offset, data[offset:offset + step])
     progress(total, total)
-    c = _answer(_retry(lambda: bus.request(UPDATE_VERIFY, bytes([servo_id]))), 14, servo_id, "UpdateVerify")
-    verdict, size, crc, version, _board = struct.unpack_from("<BIIHH", c, 1)
+    c = _retry(lambda: bus.request(UPDATE_VERIFY, bytes([servo_id])))
+    verdict, size, crc, version, _board = _p.decode_answer(UPDATE_VERIFY, c)[1:]
     if verdict != 0 or (size, crc, version) != (image.size, image.crc, image.version):
         raise Refused(f"servo {servo_id}: the written image does not check: {VERDICTS.get(verdict, verdict)}")
 

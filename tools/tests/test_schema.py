@@ -90,7 +90,8 @@ from servoctl.cli import main
 from servoctl.sim import Simulator
 with Simulator(ids=[1]) as sim:
     with sim.bus() as bus:
-        assert bus.request(p.ECHO, bytes([1, 0x5A])) == bytes([1, 0x5A]), "Echo"
+        answer = bus.request(p.ECHO, p.encode_request(p.ECHO, 1, 0x5A))
+        assert p.decode_answer(p.ECHO, answer) == (1, 0x5A), "Echo"
         assert bus.request(p.READ_DATA, bytes([1, 54])) == bytes([1, 54, 250, 0]), "item 54"
         assert len(bus.request(p.READ_BATCH, bytes([1]))) == 1 + registers.USER_AREA_SIZE == 35
     sys.exit(main(["--port", sim.url, "config", "dump", "1"], clock=sim.clock_s))
