@@ -98,7 +98,9 @@ class Simulator(_Child):
         for i in self.ids:
             cmd += ["--id", str(i)]
         if self.tcp:
-            cmd += ["--tcp", str(self.tcp_port or _free_port())]
+            # 0: the simulator takes a free port itself and prints it (no
+            # other process can take it between a look and the bind).
+            cmd += ["--tcp", str(self.tcp_port or 0)]
         if self.link:
             cmd += ["--link", str(self.link)]
         if self.supply_mv is not None:

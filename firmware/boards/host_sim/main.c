@@ -102,7 +102,7 @@ int main(int argc, char **argv)
     int slave_fd = -1;
     int bound = 0;
     char where[128];
-    if (o.tcp_port) {
+    if (o.tcp_port >= 0) {
         listen_fd = sim_listen_on(o.tcp_port, &bound);
         snprintf(where, sizeof where, "socket://127.0.0.1:%d", bound);
     } else {

@@ -12,7 +12,8 @@ static void usage(FILE *out)
           "  --id N         a servo with ID N (repeat for more; default 1). An ID given\n"
           "                 again is one more servo at it, as new servos all hold ID 0\n"
           "                 (serial 0x51a0UUNN: NN the ID given, UU the servos given it before)\n"
-          "  --tcp PORT     the bus on 127.0.0.1:PORT (pyserial socket://) instead of a pty\n"
+          "  --tcp PORT     the bus on 127.0.0.1:PORT (pyserial socket://; 0: any free port,\n"
+          "                 printed) instead of a pty\n"
           "  --link PATH    also make PATH a symlink to the pty\n"
           "  --control PORT fault injection on 127.0.0.1:PORT (default: any free port)\n"
           "  --state DIR    where each servo's flash file lives (default ./sim-state)\n"
@@ -51,7 +52,7 @@ static int parse_int(const char *s, const char *what, long lo, long hi)
 
 void sim_options_parse(int argc, char **argv, struct sim_options *o)
 {
-    *o = (struct sim_options){.state_dir = "sim-state", .supply_v = 7.4, .ambient_c = 25.0};
+    *o = (struct sim_options){.tcp_port = -1, .state_dir = "sim-state", .supply_v = 7.4, .ambient_c = 25.0};
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
@@ -79,7 +80,7 @@ void sim_options_parse(int argc, char **argv, struct sim_options *o)
             o->units[o->id_count] = unit;
             o->ids[o->id_count++] = id;
         } else if (strcmp(a, "--tcp") == 0) {
-            o->tcp_port = parse_int(v, "--tcp", 1, 65535);
+            o->tcp_port = parse_int(v, "--tcp", 0, 65535);
         } else if (strcmp(a, "--control") == 0) {
             o->control_port = parse_int(v, "--control", 1, 65535);
         } else if (strcmp(a, "--link") == 0) {

@@ -12,7 +12,7 @@ struct sim_options {
     uint8_t ids[SIM_MAX_SERVOS];
     uint8_t units[SIM_MAX_SERVOS]; /* earlier servos given the same ID */
     unsigned id_count;
-    int tcp_port;          /* 0: a pseudo-terminal */
+    int tcp_port;          /* -1: a pseudo-terminal; 0: any free port */
     int control_port;      /* 0: any free port */
     const char *link;      /* symlink to the pty */
     const char *state_dir;
