@@ -13,6 +13,7 @@ handlers' prototypes), registers/schema_items.h (the register structs,
 the status bits, each item's ID, row and range), protocol/packet_fields.h
 (where each fixed field of an answer lies: for the unit tests) and
 sim/control_commands.h (servo_sim's control port)."""
+import struct
 import sys
 from pathlib import Path
 
@@ -122,15 +123,15 @@ def schema_items_h(s: sch.Schema) -> str:
 def packet_fields_h(s: sch.Schema) -> str:
     """ANSWER_<packet>_<field>: offset, size, signed, of each answer field
     whose place is fixed (before any field of varying size)."""
-    sizes = {"u8": (1, 0), "u16": (2, 0), "u32": (4, 0), "i16": (2, 1), "i32": (4, 1)}
     rows = []
     for p in s.packets:
         at = 0
         for f in p.answer:
-            if f.type not in sizes:
+            code = sch.STRUCT_CODES.get(f.type)
+            if code is None:
                 break
-            size, signed = sizes[f.type]
-            rows.append(f"#define ANSWER_{p.c}_{f.name.upper()} {at}, {size}, {signed}\n")
+            size = struct.calcsize("<" + code)
+            rows.append(f"#define ANSWER_{p.c}_{f.name.upper()} {at}, {size}, {int(code.islower())}\n")
             at += size
     return (NOTICE + "#ifndef PROTOCOL_PACKET_FIELDS_H\n#define PROTOCOL_PACKET_FIELDS_H\n\n"
             "/* Each answer field's place in the answer's content: offset, size in\n"

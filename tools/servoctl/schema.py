@@ -12,6 +12,8 @@ from pathlib import Path
 SCHEMA = Path(__file__).resolve().parents[2] / "protocol" / "schema.toml"
 FLAGS = ("addressed", "answers", "answers_if_control_response", "broadcast", "query", "syncable",
          "one_answers", "carries_records")
+# The fields of fixed size, by their struct code (lower case: signed).
+STRUCT_CODES = {"u8": "B", "u16": "H", "u32": "I", "i16": "h", "i32": "i"}
 FIELD_TYPES = {"u8": 1, "u16": 2, "u32": 4, "i16": 2, "i32": 4, "item": None, "user_area": None, "bytes": None}
 ITEM_SIZES = (1, 4)  # an item's value: 1 to 4 bytes
 ACCESS = ("read", "read-write", "reserved")
@@ -118,13 +120,12 @@ class Schema:
         return self._format(self.packet(code).request)
 
     def _format(self, fields):
-        codes = {"u8": "B", "u16": "H", "u32": "I", "i16": "h", "i32": "i"}
         out = "<"
         for f in fields:
             if f.type == "user_area":
                 out += f"{sum(i.size for i in self.area('user'))}s"
-            elif f.type in codes:
-                out += codes[f.type]
+            elif f.type in STRUCT_CODES:
+                out += STRUCT_CODES[f.type]
             else:
                 return None
         return out
