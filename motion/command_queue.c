@@ -52,6 +52,15 @@ enum motion_submit_result motion_submit(struct motion *m, const struct motion_co
     return dispatch_command(m, cmd);
 }
 
+void motion_stop(struct motion *m, uint8_t method)
+{
+    const struct motion_command stop = {.kind = MOTION_STOP, .method = method};
+    m->queue.count = 0;
+    m->async_open = 0;
+    m->async.count = 0;
+    motion_run(m, &stop);
+}
+
 void motion_begin_async(struct motion *m)
 {
     m->async_open = 1;

@@ -46,6 +46,11 @@ void motion_update_limits(struct motion *m)
     int16_t by_power = duty_limit_for_power(power, now.supply_mv);
     int16_t by_current = duty_limit_for_current(cfg->current_limit_ma, now.supply_mv);
     int16_t limit = (int16_t)(by_power < by_current ? by_power : by_current);
+    bool capped = m->power_cap_mw != 0u && power == m->power_cap_mw;
+    m->drive_limiter = limit == INT16_MAX       ? LIMITER_SUPPLY
+                       : by_power >= by_current ? LIMITER_CURRENT
+                       : capped                 ? m->cap_limiter
+                                                : LIMITER_POWER;
     m->drive.duty_limit = (int16_t)(m->derate ? limit / 2 : limit);
     drive_limits_for_supply(&m->drive, now.supply_mv);
     motion_take_accel_duty(m, m->tick);

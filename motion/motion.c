@@ -36,8 +36,10 @@ void motion_init(struct motion *m, const struct registers *regs, const struct ha
 
 /* ---- what the protection monitors ask of the output --------------------- */
 
-void motion_guard(struct motion *m, bool inhibit, bool derate, uint16_t power_cap_mw)
+void motion_guard(struct motion *m, bool inhibit, bool derate, uint16_t power_cap_mw,
+                  uint8_t cap_limiter)
 {
+    m->cap_limiter = cap_limiter;
     if (inhibit && !m->inhibit) {
         m->queue.count = 0;
         m->answer_packet = 0;

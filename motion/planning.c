@@ -90,7 +90,7 @@ static void plan_stop(struct motion *m, int64_t start, int64_t v0, uint32_t min_
 
 /* ---- commands ----------------------------------------------------------- */
 
-static int64_t angle_target(const struct motion *m, const struct motion_command *cmd)
+static int64_t angle_target(struct motion *m, const struct motion_command *cmd)
 {
     const struct user_config *cfg = &m->regs->user;
     if (cmd->multi_turn) {
@@ -101,6 +101,7 @@ static int64_t angle_target(const struct motion *m, const struct motion_command 
     if (cfg->angle_limit_on) {
         angle = clamp_i32(angle, cfg->angle_min_decideg, cfg->angle_max_decideg);
     }
+    m->angle_clamped = angle != cmd->angle_decideg;
     /* A single-turn angle is within the turn the servo is in now. */
     struct motion_angle now;
     motion_read_angle(m, &now);
@@ -196,6 +197,7 @@ static void run_stop(struct motion *m, const struct motion_command *cmd)
 void motion_run(struct motion *m, const struct motion_command *cmd)
 {
     m->endless = 0;
+    m->angle_clamped = 0;
     m->answer_packet = cmd->answer_when_done ? cmd->packet : 0u;
     m->power_mw = cmd->power_mw;
     motion_update_limits(m);

@@ -83,7 +83,8 @@ void motion_read_diagnostics(const struct motion *m, struct motion_diagnostics *
                            (controlled && m->clock_rate != CLOCK_REAL_TIME ? DIAG_CLOCK_SLOWED : 0u) |
                            (controlled && m->braking ? DIAG_BRAKING : 0u) |
                            (motion_output_at_limit(m) != 0 ? DIAG_AT_LIMIT : 0u) |
-                           (controlled ? 0u : DIAG_RELEASED)),
+                           (controlled ? 0u : DIAG_RELEASED) |
+                           (uint32_t)motion_limiter(m) << LIMITER_SHIFT),
     };
 }
 

@@ -34,6 +34,7 @@ static void dispatch_packet(const struct packet_desc *desc, struct packet_call *
 {
     struct dispatcher *d = call->d;
     struct packet_origin origin = call->origin;
+    d->heard++;
     /* Answering packets would make every servo talk at once. */
     if (origin.broadcast && !(desc->flags & PF_BROADCAST)) {
         return;

@@ -8,6 +8,9 @@
 #define USER(id_, field_, size_, access_, min_, max_, factory_)                    \
     {(id_), (size_), (uint8_t)((access_) | DATA_USER),                             \
      (uint8_t)offsetof(struct user_config, field_), (min_), (max_), (factory_)}
+#define FIRMWARE(id_, field_, size_, access_, min_, max_, factory_)                \
+    {(id_), (size_), (uint8_t)((access_) | DATA_FIRMWARE),                         \
+     (uint8_t)offsetof(struct firmware_area, field_), (min_), (max_), (factory_)}
 #define RO DATA_READ
 #define RO_SIGNED (DATA_READ | DATA_SIGNED)
 #define RW (DATA_READ | DATA_WRITE)
@@ -15,16 +18,17 @@
 #define RESERVED 0u /* kept in the batch block, hidden from ReadData/WriteData */
 #define RESERVED_SIGNED DATA_SIGNED
 
-/* Rows in ID order; status area first, then the user area in wire order
- * (protocol/schema.toml). */
+/* Rows in ID order; status area first, then the user area in wire order,
+ * then the firmware area (protocol/schema.toml). */
 static const struct data_item items[] = {DATA_ITEM_ROWS};
 
 enum {
     ITEM_COUNT = sizeof items / sizeof items[0],
     USER_ROW = STATUS_LAST - STATUS_FIRST + 1,
+    FIRMWARE_ROW = USER_ROW + (USER_LAST - USER_FIRST + 1),
 };
 
-_Static_assert(ITEM_COUNT == USER_ROW + (USER_LAST - USER_FIRST + 1), "table rows");
+_Static_assert(ITEM_COUNT == FIRMWARE_ROW + (FIRMWARE_LAST - FIRMWARE_FIRST + 1), "table rows");
 /* struct user_config is laid out as its wire image: every item at its own
  * size, in ID order, no padding (test_data_table checks each row's offset
  * against its wire position). On a little-endian CPU the wire bytes are
@@ -40,13 +44,17 @@ const struct data_item *data_table_find(uint8_t id)
     if (id >= USER_FIRST && id <= USER_LAST) {
         return &items[USER_ROW + (id - USER_FIRST)];
     }
+    if (id >= FIRMWARE_FIRST && id <= FIRMWARE_LAST) {
+        return &items[FIRMWARE_ROW + (id - FIRMWARE_FIRST)];
+    }
     return NULL;
 }
 
 static const uint8_t *field_of(const struct registers *regs, const struct data_item *it)
 {
-    const uint8_t *base = (it->access & DATA_USER) ? (const uint8_t *)&regs->user
-                                                   : (const uint8_t *)&regs->status;
+    const uint8_t *base = (it->access & DATA_USER)       ? (const uint8_t *)&regs->user
+                          : (it->access & DATA_FIRMWARE) ? (const uint8_t *)&regs->firmware
+                                                         : (const uint8_t *)&regs->status;
     return base + it->offset;
 }
 
@@ -69,10 +77,11 @@ static int32_t field_get(const uint8_t *field, const struct data_item *it)
     }
 }
 
-/* Only user-area items are ever written. */
-static void field_set(struct user_config *cfg, const struct data_item *it, int32_t value)
+/* Only user-area and firmware-area items are ever written: area is the
+ * item's struct. */
+static void field_set(void *area, const struct data_item *it, int32_t value)
 {
-    void *field = (uint8_t *)cfg + it->offset;
+    void *field = (uint8_t *)area + it->offset;
     if (it->size == 1) {
         *(uint8_t *)field = (uint8_t)value;
     } else if (it->size == 2) {
@@ -131,8 +140,7 @@ enum data_write_result data_table_write(struct registers *regs, uint8_t id, cons
                                         uint8_t len)
 {
     const struct data_item *it = data_table_find(id);
-    if (it == NULL || !(it->access & DATA_WRITE) || !(it->access & DATA_USER) ||
-        len != it->size) {
+    if (it == NULL || !(it->access & DATA_WRITE) || len != it->size) {
         return DATA_WRITE_REFUSED;
     }
     int32_t value = wire_value(data, it);
@@ -140,6 +148,10 @@ enum data_write_result data_table_write(struct registers *regs, uint8_t id, cons
         return DATA_WRITE_REFUSED;
     }
     if (value == field_get(field_of(regs, it), it)) {
+        return DATA_WRITE_SAME;
+    }
+    if (it->access & DATA_FIRMWARE) { /* RAM only, no rule across items */
+        field_set(&regs->firmware, it, value);
         return DATA_WRITE_SAME;
     }
     /* The user area is valid before (every write comes through here or
@@ -162,6 +174,15 @@ void user_config_factory(struct user_config *cfg)
         field_set(&factory, it, it->factory);
     }
     *cfg = factory;
+}
+
+void firmware_area_factory(struct firmware_area *area)
+{
+    *area = (struct firmware_area){0};
+    for (uint8_t id = FIRMWARE_FIRST; id <= FIRMWARE_LAST; id++) {
+        const struct data_item *it = data_table_find(id);
+        field_set(area, it, it->factory);
+    }
 }
 
 void user_config_reset(struct user_config *cfg)

@@ -85,7 +85,7 @@ def packet_rows_h(s: sch.Schema) -> str:
 
 
 def schema_items_h(s: sch.Schema) -> str:
-    status, user = s.area("status"), s.area("user")
+    status, user, firmware = s.area("status"), s.area("user"), s.area("firmware")
 
     def struct(name: str, items) -> str:
         members = "".join(f"    {C_TYPES[(i.size, i.signed)]} {i.field}; /* {i.id}"
@@ -97,13 +97,16 @@ def schema_items_h(s: sch.Schema) -> str:
     rows = [f"RO_STATUS({i.id}, {i.field}, {i.size})," for i in status]
     rows += [f"USER({i.id}, {i.field}, {i.size}, {access[i.access] + ('_SIGNED' if i.signed else '')}, "
              f"{i.min}, {i.max}, {i.factory})," for i in user]
+    rows += [f"FIRMWARE({i.id}, {i.field}, {i.size}, {access[i.access] + ('_SIGNED' if i.signed else '')}, "
+             f"{i.min}, {i.max}, {i.factory})," for i in firmware]
     def number(value: int, item: sch.Item) -> str:  # unsigned items' limits compare as unsigned
         return f"{value}" if item.signed else f"{value}u"
 
     ids = "".join(f"    ITEM_{i.field.upper()} = {i.id},\n" for i in s.items)
     limits = "".join(f"#define ITEM_{i.field.upper()}_MIN {number(i.min, i)}\n"
                      f"#define ITEM_{i.field.upper()}_MAX {number(i.max, i)}\n"
-                     f"#define ITEM_{i.field.upper()}_FACTORY {number(i.factory, i)}\n" for i in user)
+                     f"#define ITEM_{i.field.upper()}_FACTORY {number(i.factory, i)}\n"
+                     for i in user + tuple(f for f in firmware if f.access == "read-write"))
     return (NOTICE + "#ifndef REGISTERS_SCHEMA_ITEMS_H\n#define REGISTERS_SCHEMA_ITEMS_H\n\n#include <stdint.h>\n\n"
             "/* Status area: live readings and identity, read-only. */\n" + struct("status_area", status) +
             "\n/* Bits of status (data item 5). */\nenum status_bit {\n" + bits + "};\n\n"
@@ -111,12 +114,15 @@ def schema_items_h(s: sch.Schema) -> str:
             "/* User area: configuration that persists, laid out as its wire image (the\n"
             " * ReadBatchData block: every item at its own size, in ID order). */\n"
             + struct("user_config", user) +
+            "\n/* Firmware area: this firmware's own items, in RAM (factory values at\n"
+            " * power-up), read and written one at a time. */\n" + struct("firmware_area", firmware) +
             f"\n#define STATUS_FIRST {status[0].id}\n#define STATUS_LAST {status[-1].id}\n"
             f"#define USER_FIRST {user[0].id}\n#define USER_LAST {user[-1].id}\n"
+            f"#define FIRMWARE_FIRST {firmware[0].id}\n#define FIRMWARE_LAST {firmware[-1].id}\n"
             f"/* The user area's bytes on the wire and in the config store. */\n"
             f"#define USER_AREA_SIZE {sum(i.size for i in user)}u\n\n"
-            "/* Each user item's range and factory value. */\n" + limits + "\n"
-            "/* The data table's rows, in ID order (data_table.c's RO_STATUS and USER). */\n"
+            "/* Each writable item's range and factory value. */\n" + limits + "\n"
+            "/* The data table's rows, in ID order (data_table.c's RO_STATUS, USER and FIRMWARE). */\n"
             + _macro("DATA_ITEM_ROWS", rows) + "\n#endif\n")
 
 
@@ -257,12 +263,14 @@ def protocol_md(s: sch.Schema) -> str:
             "ReadData (3) reads an item; WriteData (4) writes a user item, which is checked against its",
             "range and the rules across items (low voltage below high voltage, angle max above angle",
             "min) and kept in flash before the answer. An unknown or hidden item reads as no data.",
-            "ReadBatchData (5) and WriteBatchData (6) carry the user area whole.", "",
+            "ReadBatchData (5) and WriteBatchData (6) carry the user area whole. The firmware area",
+            "(from 64) is this firmware's own: kept in RAM, back to its factory values at every power-up,",
+            "read and written by ReadData and WriteData only (the maker's batch block is unchanged).", "",
             "| id | name | bytes | type | access | range | factory | unit | meaning |",
             "|---|---|---|---|---|---|---|---|---|"]
     for i in s.items:
         kind = ("i" if i.signed else "u") + str(8 * i.size)
-        user = i.area == "user"
+        user = i.area == "user" or i.access == "read-write"
         out.append(f"| {i.id} | {i.name} | {i.size} | {kind} | {i.access} | "
                    f"{f'{i.min}..{i.max}' if user else ''} | {i.factory if user else ''} | {i.unit} | "
                    f"{_cell(i.what)} |")

@@ -12,6 +12,8 @@ static uint32_t idle_timeout_us(const struct servo *s, uint32_t baud)
 }
 
 static bool persist_user(void *ctx, const struct user_config *cfg);
+static void watch_bus(struct servo *s);
+static void heat_step(struct servo *s);
 
 static void apply_link_settings(struct servo *s)
 {
@@ -33,6 +35,7 @@ void servo_init(struct servo *s, const struct hal_port *hal)
 {
     *s = (struct servo){.hal = hal};
     config_store_load(&s->store, hal->flash, &s->regs.user);
+    firmware_area_factory(&s->regs.firmware);
     /* A store older firmware wrote (format 1) is rewritten in format 2, the
      * one the bootloader reads the ID and baud rate from. Then the spare
      * page is erased ahead, before the control loop runs: saves need no
@@ -51,6 +54,7 @@ void servo_init(struct servo *s, const struct hal_port *hal)
     s->regs.status.firmware_version = image_version != 0u ? image_version : FIRMWARE_VERSION;
     s->regs.status.serial_number = hal->serial_number(hal->ctx);
     protection_init(&s->protection);
+    winding_init(&s->winding);
     motion_init(&s->motion, &s->regs, hal);
     s->next_tick_us = hal->bus.now_us(hal->ctx) + CONTROL_TICK_US;
     frame_rx_init(&s->rx, &s->active_id);
@@ -256,6 +260,23 @@ static void erase_spare(struct servo *s, uint32_t now)
     s->erase_passed = 1;
 }
 
+/* In the pass of each control tick, after it: the bus watchdog (it acts
+ * within a tick of its time) and, every SENSE_ROUND_TICKS, a sample of
+ * the winding's heat. Neither is part of the control law, so neither
+ * lengthens the control tick. */
+static void tend_safety(struct servo *s)
+{
+    if (s->regs.firmware.watchdog_ms != 0u || s->watchdog.fired) {
+        watch_bus(s);
+    }
+    if (++s->heat_ticks == SENSE_ROUND_TICKS) {
+        s->heat_ticks = 0;
+        if (winding_sample(&s->winding, s->regs.status.current_ma)) {
+            heat_step(s);
+        }
+    }
+}
+
 /* Once a control tick: counts operating time and erases the spare page
  * when that costs nothing. */
 static void tend_store(struct servo *s, uint32_t now, bool ticked)
@@ -263,6 +284,7 @@ static void tend_store(struct servo *s, uint32_t now, bool ticked)
     if (!ticked) {
         return;
     }
+    tend_safety(s);
     save_policy_count_time(&s->saver, now);
     if (config_store_spare_dirty(&s->store) && erase_may_stall(s, now)) {
         erase_spare(s, now);
@@ -279,6 +301,45 @@ _Static_assert(offsetof(struct status_area, current_ma) - offsetof(struct status
                offsetof(struct sensor_readings, voltage_mv) == 0 &&
                sizeof(struct sensor_readings) == 8,
                "the status area's IDs 1-4 lie as struct sensor_readings");
+
+/* What a protection or the watchdog holds the output back by (enum
+ * limiter), from the status bits: on their changes only (the motion's
+ * own limit is added as item 66 or ReadMotion is read). */
+static void note_held_by(struct servo *s, uint8_t bits)
+{
+    s->regs.held_by = s->watchdog.fired                                          ? LIMITER_WATCHDOG
+                      : (bits & (STATUS_LOW_VOLTAGE | STATUS_HIGH_VOLTAGE)) != 0u ? LIMITER_SUPPLY
+                      : (bits & STATUS_OVER_TEMPERATURE) != 0u                    ? LIMITER_HEAT
+                      : (bits & STATUS_STALL) != 0u && s->regs.user.stall_release ? LIMITER_STALL
+                                                                                  : LIMITER_NONE;
+}
+
+/* A step of the winding's model (every WINDING_SAMPLES rounds): its
+ * estimate to item 67, its derating to the output. */
+__attribute__((noinline)) static void heat_step(struct servo *s)
+{
+    const struct user_config *cfg = &s->regs.user;
+    winding_step(&s->winding, s->hal->calibration, s->regs.status.temperature_adc,
+                 cfg->temperature_limit_adc);
+    s->regs.firmware.winding_decic = s->winding.winding_decic;
+    uint16_t cap = winding_power_cap(&s->winding, cfg->power_limit_mw);
+    if (cap != s->heat_cap_mw) {
+        s->heat_cap_mw = cap;
+        s->protection.act_changes++;
+    }
+}
+
+/* The tighter of the stall's cap and the derating's, and whose it is. */
+static void guard_motion(struct servo *s)
+{
+    const struct protection *p = &s->protection;
+    uint16_t stall_cap = p->act.power_cap_mw;
+    uint16_t heat_cap = s->heat_cap_mw;
+    bool heat_binds = heat_cap != 0u && (stall_cap == 0u || heat_cap < stall_cap);
+    motion_guard(&s->motion, protection_inhibits(p->threshold_bits),
+                 protection_derates(p->threshold_bits), heat_binds ? heat_cap : stall_cap,
+                 heat_binds ? LIMITER_HEAT : LIMITER_STALL);
+}
 
 /* Sensors to the status area (IDs 1-4), monitors to what the output may
  * do; returns status bits 2-7. */
@@ -299,10 +360,26 @@ static uint8_t sense_and_protect(struct servo *s)
     }
     if (p->act_changes != s->guard_seen) {
         s->guard_seen = p->act_changes;
-        motion_guard(&s->motion, protection_inhibits(p->threshold_bits),
-                     protection_derates(p->threshold_bits), p->act.power_cap_mw);
+        guard_motion(s);
+        note_held_by(s, bits);
     }
     return bits;
+}
+
+/* The bus watchdog, where it is on (item 64): item 65's stop, once. */
+__attribute__((noinline)) static void watch_bus(struct servo *s)
+{
+    const struct firmware_area *fw = &s->regs.firmware;
+    bool fired = s->watchdog.fired;
+    if (bus_watchdog_tick(&s->watchdog, fw->watchdog_ms, !motion_is_released(&s->motion),
+                          s->dispatcher.heard, s->motion.commands)) {
+        static const uint8_t method[] = {
+            [WATCHDOG_HOLD] = STOP_HOLD, [WATCHDOG_DAMP] = STOP_DAMPING, [WATCHDOG_RELEASE] = STOP_RELEASE};
+        motion_stop(&s->motion, method[fw->watchdog_action < 3u ? fw->watchdog_action : WATCHDOG_RELEASE]);
+    }
+    if (fired != s->watchdog.fired) {
+        note_held_by(s, s->regs.status.status);
+    }
 }
 
 /* The status byte once a tick: the monitors' bits, the motion's (bit 0),

@@ -10,7 +10,9 @@
 #include "storage/config_store.h"
 #include "storage/save_policy.h"
 #include "hal/hal_port.h"
+#include "protection/bus_watchdog.h"
 #include "protection/protection.h"
+#include "protection/winding.h"
 #include "sensors/scaling.h"
 #include "motion/motion.h"
 #include "protocol/dispatcher.h"
@@ -72,6 +74,10 @@ struct servo {
     struct servo_tx tx;
     struct sensor_filter sensors;
     struct protection protection;
+    struct winding_model winding;
+    uint16_t heat_cap_mw;        /* the derating's power cap; 0 = none */
+    uint8_t heat_ticks;          /* ticks towards the winding's next sample */
+    struct bus_watchdog watchdog;
     uint8_t guard_seen;          /* protection.act_changes the motion has */
     uint32_t next_tick_us;       /* when the next control tick is due */
     uint32_t ticks_dropped;      /* control ticks skipped by a late main loop */

@@ -17,7 +17,18 @@
         .supply_mv_q12 = SENSOR_Q12_FROM_MICRO(BOARD_SUPPLY_UV_PER_COUNT),  \
         .current_ma_q12 = SENSOR_Q12_FROM_MICRO(BOARD_CURRENT_UA_PER_COUNT), \
         .current_zero_counts = BOARD_CURRENT_ZERO_COUNTS,                  \
+        .winding_heat_k = BOARD_WINDING_HEAT_K,                            \
+        .winding_step_k = BOARD_WINDING_STEP_K,                            \
+        .winding_limit_decic = BOARD_WINDING_LIMIT_DECIC,                  \
     }
+/* The winding model's constants (protection/winding.h): R (mOhm) x R_wc
+ * (mK/W) x 16 x 65536 x 256 / 10^12, and 65536 x 80 ms / tau. */
+#define BOARD_WINDING_HEAT_K                                                                 \
+    ((uint16_t)(((uint64_t)BOARD_MOTOR_MOHM * BOARD_WINDING_CASE_MK_PER_W * (1ull << 28) +   \
+                 500000000000ull) / 1000000000000ull))
+#define BOARD_WINDING_STEP_K ((uint16_t)((65536u * 80u + BOARD_WINDING_TAU_MS / 2u) / BOARD_WINDING_TAU_MS))
+_Static_assert(BOARD_WINDING_HEAT_K < 4096 && BOARD_WINDING_TAU_MS >= 1300u,
+               "board.h: the winding model's products fit 32 bits (winding.c)");
 _Static_assert(BOARD_SUPPLY_UV_PER_COUNT < 16000 && BOARD_CURRENT_UA_PER_COUNT < 16000,
                "board.h: a count is worth less than 16 mV (16 mA), the Q12 scale's range");
 

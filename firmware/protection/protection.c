@@ -184,7 +184,11 @@ uint8_t protection_watch_stall(struct protection *p, const struct user_config *c
         p->act_changes++;
     }
     p->stall_busy = (stall->count | stall->active | p->stall_latched) != 0u;
-    bool shown = cfg->stall_release ? p->stall_latched : stall->active;
+    uint8_t shown = cfg->stall_release ? p->stall_latched : stall->active;
+    if (shown != p->stall_shown) {
+        p->stall_shown = shown;
+        p->act_changes++; /* what holds the output back may have changed */
+    }
     return shown ? STATUS_STALL : 0u;
 }
 

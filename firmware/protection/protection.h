@@ -82,6 +82,7 @@ struct protection {
                                  * the power cap; wraps: compare for inequality */
     uint8_t stall_busy;         /* a stall counted, set or latched */
     uint8_t stall_latched;      /* release mode: held until the next command */
+    uint8_t stall_shown;        /* status bit 2 as last returned */
     struct protection_action act;
     uint32_t commands_at_stall;
     struct monitor stall;

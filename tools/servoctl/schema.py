@@ -19,7 +19,8 @@ ITEM_SIZES = (1, 4)  # an item's value: 1 to 4 bytes
 ACCESS = ("read", "read-write", "reserved")
 FRAME_KEYS = {"request_header", "response_header", "broadcast_id", "max_id", "extended_length",
               "request_content_max", "answer_content_max"}
-AREAS = {"status": 1, "user": 32}  # each area's first ID (the maker's data table)
+# Each area's first ID: the maker's data table's two, and this firmware's own.
+AREAS = {"status": 1, "user": 32, "firmware": 64}
 
 
 class SchemaError(ValueError):
@@ -179,12 +180,12 @@ def _item(raw: dict) -> Item:
         raise SchemaError(f"{where}: area is one of {', '.join(AREAS)}, not {item.area!r}")
     if item.size not in (1, 2, 4) or item.access not in ACCESS:
         raise SchemaError(f"{where}: size 1, 2 or 4 and access one of {', '.join(ACCESS)}")
-    if item.area == "user":
+    if item.area == "user" or (item.area == "firmware" and item.access == "read-write"):
         low, high = _type_range(item.size, item.signed)
         if not low <= item.min <= item.factory <= item.max <= high:
             raise SchemaError(f"{where} ({item.name}): needs {low} <= min <= factory <= max <= {high}")
     elif item.access != "read":
-        raise SchemaError(f"{where}: a status item is read-only")
+        raise SchemaError(f"{where}: a status item is read-only, a firmware item read or read-write")
     return item
 
 

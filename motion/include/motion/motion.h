@@ -146,6 +146,9 @@ struct motion {
     struct drive_limits drive; /* current margin (power, 43, protection), kv, ka */
     int32_t brake_floor_duty;  /* the least braking duty a load leaves (motion_brake_duty) */
     struct drive_inputs drive_inputs;
+    uint8_t drive_limiter;     /* enum limiter: what sets the duty limit */
+    uint8_t cap_limiter;       /* enum limiter: whose power_cap_mw it is */
+    uint8_t angle_clamped;     /* the running move's target was clamped (51, 52) */
     uint16_t power_mw;         /* the running command's power, 0 = 42's value */
     uint8_t supply_check;      /* ticks since the supply was last looked at */
     uint8_t mode;              /* enum motion_mode */
@@ -199,6 +202,7 @@ enum motion_diagnostic_flag {
     DIAG_BRAKING = 1u << 2,       /* braking within the output's limit */
     DIAG_AT_LIMIT = 1u << 3,      /* the output is at its current or supply limit */
     DIAG_RELEASED = 1u << 4,      /* not under position control */
+    /* bits 5-7: motion_limiter() (LIMITER_SHIFT) */
 };
 
 void motion_read_diagnostics(const struct motion *m, struct motion_diagnostics *out);
@@ -230,8 +234,26 @@ bool motion_is_idle(const struct motion *m);
 
 /* What the protection monitors require of the output: inhibit releases it
  * and refuses motion until lifted; derate halves the current it may draw;
- * power_cap_mw (0 = none) bounds every move's power. */
-void motion_guard(struct motion *m, bool inhibit, bool derate, uint16_t power_cap_mw);
+ * power_cap_mw (0 = none) bounds every move's power, and cap_limiter (enum
+ * limiter) says whose cap it is. */
+void motion_guard(struct motion *m, bool inhibit, bool derate, uint16_t power_cap_mw,
+                  uint8_t cap_limiter);
+/* Stops now as StopOnControlMode's method does (enum stop_method), dropping
+ * what is queued or buffered; no answer is owed and no command counted
+ * (the bus watchdog). */
+void motion_stop(struct motion *m, uint8_t method);
+/* What holds the output back at this tick (enum limiter, item 66): a
+ * protection or the watchdog (the registers' held_by), else the limit the
+ * controller is at, else a clamped target, else none. */
+static inline uint8_t motion_limiter(const struct motion *m)
+{
+    uint8_t held = m->regs->held_by;
+    if (held != 0u || m->mode != MODE_POSITION) {
+        return held;
+    }
+    return m->controller.at_limit != 0 ? m->drive_limiter
+                                       : (uint8_t)(m->angle_clamped ? LIMITER_ANGLE : LIMITER_NONE);
+}
 /* Releases the output now (a stall in release mode). */
 void motion_release(struct motion *m);
 /* The controller's output was held back by its limit on the last tick:

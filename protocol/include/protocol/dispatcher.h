@@ -30,6 +30,9 @@ struct dispatcher {
      * stamps its snapshot with the time of the tick that computed it.
      * NULL where no control loop runs (time 0). */
     const uint32_t *next_tick_us;
+    /* Frames for this servo so far (its ID, a broadcast, its SyncCommand
+     * record): the bus watchdog's food. */
+    uint32_t heard;
 };
 
 struct dispatch_result {

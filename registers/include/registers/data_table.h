@@ -14,7 +14,8 @@ enum data_access {
     DATA_READ = 1u << 0,   /* ReadData answers the value */
     DATA_WRITE = 1u << 1,  /* WriteData may change it */
     DATA_SIGNED = 1u << 2,
-    DATA_USER = 1u << 3,   /* lives in struct user_config, else status_area */
+    DATA_USER = 1u << 3,   /* lives in struct user_config */
+    DATA_FIRMWARE = 1u << 4, /* lives in struct firmware_area; else status_area */
 };
 
 struct data_item {
@@ -38,7 +39,8 @@ uint8_t data_table_read(const struct registers *regs, uint8_t id, uint8_t *out);
 
 enum data_write_result {
     DATA_WRITE_REFUSED,   /* not writable, wrong size or invalid: unchanged */
-    DATA_WRITE_SAME,      /* accepted; the item already held that value */
+    DATA_WRITE_SAME,      /* accepted; nothing to store (the item already held
+                           * that value, or it is a firmware item: RAM only) */
     DATA_WRITE_CHANGED,   /* accepted and changed: the store must save it */
 };
 
@@ -48,6 +50,8 @@ enum data_write_result data_table_write(struct registers *regs, uint8_t id, cons
                                         uint8_t len);
 
 void user_config_factory(struct user_config *cfg);
+/* The firmware area's writable items at their factory values, the rest 0. */
+void firmware_area_factory(struct firmware_area *area);
 /* ResetUserData: factory values except the servo ID and the baud rate. */
 void user_config_reset(struct user_config *cfg);
 bool user_config_valid(const struct user_config *cfg);
