@@ -8,7 +8,8 @@ looks like; the firmware has three kinds of function pointer, and an
 indirect call is bounded by the worst target of its kind:
   in dispatch(_packet) the packet handlers (handle_*)
   in usart_hd_irq      the clock that stamps received bytes (systick_now_us)
-  in a packet handler  the store's persist hook (persist_user), or a HAL op
+  in a packet handler  the application's hooks (persist_user, the fault
+                       history's read_fault and clear_faults), or a HAL op
   anywhere else        the port's HAL operations (everything else)
 Recursion is an error. A library function without a call graph (memcpy, libgcc) is charged
 LIBRARY_BYTES. All interrupts share one priority, so they do not nest: the
@@ -108,9 +109,10 @@ def main() -> int:
         # systick_now_us is also called directly, so it is no pointer target.
         "usart_hd_irq": [t for t in stack if short(t) == "systick_now_us"],
     }
-    persist = [t for t in pointer_targets if short(t) == "persist_user"]
+    app_hooks = ("persist_user", "read_fault", "clear_faults")
+    persist = [t for t in pointer_targets if short(t) in app_hooks]
     hal_ops = [t for t in pointer_targets
-               if not short(t).startswith("handle_") and short(t) != "persist_user"]
+               if not short(t).startswith("handle_") and short(t) not in app_hooks]
     memo = {}
     indirect_below = {}
 
@@ -138,7 +140,7 @@ def main() -> int:
             if callee == "__indirect_call":
                 targets = kinds.get(short(title), hal_ops)
                 if short(title).startswith(("handle_", "commit_user")):
-                    targets = hal_ops + persist  # WriteData, WriteBatchData, ResetUserData
+                    targets = hal_ops + persist  # the writes, ReadFaults, ClearFaults
                 for c in targets:
                     d, ch = worst(c, path + (title,))
                     if d > best:

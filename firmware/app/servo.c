@@ -5,6 +5,7 @@
 
 #include "app/identity.h"
 #include "registers/data_table.h"
+#include "sensors/ntc.h"
 
 static uint32_t idle_timeout_us(const struct servo *s, uint32_t baud)
 {
@@ -14,6 +15,8 @@ static uint32_t idle_timeout_us(const struct servo *s, uint32_t baud)
 static bool persist_user(void *ctx, const struct user_config *cfg);
 static void watch_bus(struct servo *s);
 static void heat_step(struct servo *s);
+static bool read_fault(void *ctx, uint8_t index, uint8_t *out);
+static bool clear_faults(void *ctx);
 
 static void apply_link_settings(struct servo *s)
 {
@@ -65,6 +68,13 @@ void servo_init(struct servo *s, const struct hal_port *hal)
     s->dispatcher.next_tick_us = &s->next_tick_us;
     s->dispatcher.persist = persist_user;
     s->dispatcher.persist_ctx = s;
+    fault_log_load(&s->faults, hal->fault_flash);
+    if (fault_log_spare_dirty(&s->faults) && !fault_log_erase_spare(&s->faults)) {
+        s->regs.status.status |= STATUS_COMMAND_ERROR; /* nobody waits at power-up */
+    }
+    s->dispatcher.read_fault = read_fault;
+    s->dispatcher.clear_faults = clear_faults;
+    s->dispatcher.faults_ctx = s;
     s->active_baud_index = 0; /* forces the first apply to set the UART */
     apply_link_settings(s);
 }
@@ -189,6 +199,8 @@ static void report_store(struct servo *s)
     uint32_t op_seconds = save_policy_op_seconds(&s->saver);
     h->answers_dropped = s->answers_dropped;
     h->bytes_lost = s->rx_lost;
+    h->fault_count = s->faults.shown_count;
+    h->faults_not_logged = s->faults.not_logged;
     if (flags == h->flags && op_seconds == h->op_seconds && h->rated_cycles != 0u &&
         s->store.sequence == h->records && s->store.write_failures == h->failures) {
         return;
@@ -250,14 +262,73 @@ static bool erase_may_stall(const struct servo *s, uint32_t now)
 static void erase_spare(struct servo *s, uint32_t now)
 {
     s->erase_from = s->hal->rx->written;
-    bool ok = config_store_erase_spare(&s->store);
-    save_policy_outcome(&s->saver, ok, now);
-    if (ok) {
-        s->saver.awaits_erase = 0;
+    bool ok;
+    if (config_store_spare_dirty(&s->store)) {
+        ok = config_store_erase_spare(&s->store);
+        save_policy_outcome(&s->saver, ok, now);
+        s->saver.awaits_erase = (uint8_t)(s->saver.awaits_erase && !ok);
     } else {
+        ok = fault_log_erase_spare(&s->faults);
+        save_policy_outcome(&s->saver, ok, now); /* its retry wait, shared */
+    }
+    if (!ok) {
         s->regs.status.status |= STATUS_COMMAND_ERROR;
     }
     s->erase_passed = 1;
+}
+
+/* Status bits 2-7: each one that sets is a fault for the history. */
+#define FAULT_STATUS_BITS                                                                        \
+    (STATUS_STALL | STATUS_HIGH_VOLTAGE | STATUS_LOW_VOLTAGE | STATUS_OVER_CURRENT |            \
+     STATUS_OVER_POWER | STATUS_OVER_TEMPERATURE)
+
+/* One fault into the history's queue, with the readings of this moment. */
+static void log_fault(struct servo *s, uint8_t what)
+{
+    const struct status_area *st = &s->regs.status;
+    struct motion_angle angle;
+    motion_read_angle(&s->motion, &angle);
+    const struct fault_entry e = {
+        .op_seconds = save_policy_op_seconds(&s->saver),
+        .angle_decideg = angle.multi_turn_decideg,
+        .voltage_mv = st->voltage_mv,
+        .current_ma = st->current_ma,
+        .power_mw = st->power_mw,
+        .winding_decic = s->regs.firmware.winding_decic,
+        .case_decic = ntc_decicelsius(st->temperature_adc),
+        .what = what,
+    };
+    (void)fault_log_add(&s->faults, &e); /* one not logged is counted */
+}
+
+__attribute__((noinline)) static void note_faults(struct servo *s, uint8_t trips)
+{
+    uint8_t rose = (uint8_t)(trips & ~s->fault_bits_seen);
+    s->fault_bits_seen = trips;
+    for (uint8_t bit = 2; bit < 8u; bit++) {
+        if (rose & (1u << bit)) {
+            log_fault(s, bit);
+        }
+    }
+}
+
+static bool read_fault(void *ctx, uint8_t index, uint8_t *out)
+{
+    const struct servo *s = ctx;
+    return fault_log_read(&s->faults, index, out);
+}
+
+static bool clear_faults(void *ctx)
+{
+    struct servo *s = ctx;
+    struct fault_entry marker; /* field by field: an initialiser is a memset call on the M0 */
+    marker.number = 0;
+    marker.op_seconds = save_policy_op_seconds(&s->saver);
+    marker.angle_decideg = 0;
+    marker.voltage_mv = marker.current_ma = marker.power_mw = 0;
+    marker.winding_decic = marker.case_decic = 0;
+    marker.what = FAULT_CLEARED;
+    return fault_log_add(&s->faults, &marker);
 }
 
 /* In the pass of each control tick, after it: the bus watchdog (it acts
@@ -268,6 +339,10 @@ static void tend_safety(struct servo *s)
 {
     if (s->regs.firmware.watchdog_ms != 0u || s->watchdog.fired) {
         watch_bus(s);
+    }
+    uint8_t trips = (uint8_t)(s->regs.status.status & FAULT_STATUS_BITS);
+    if (trips != s->fault_bits_seen) {
+        note_faults(s, trips);
     }
     if (++s->heat_ticks == SENSE_ROUND_TICKS) {
         s->heat_ticks = 0;
@@ -286,8 +361,11 @@ static void tend_store(struct servo *s, uint32_t now, bool ticked)
     }
     tend_safety(s);
     save_policy_count_time(&s->saver, now);
-    if (config_store_spare_dirty(&s->store) && erase_may_stall(s, now)) {
+    if ((config_store_spare_dirty(&s->store) || fault_log_spare_dirty(&s->faults)) &&
+        erase_may_stall(s, now)) {
         erase_spare(s, now);
+    } else {
+        fault_log_step(&s->faults); /* a write block a tick: 70 us at most */
     }
     report_store(s);
 }
@@ -379,6 +457,9 @@ __attribute__((noinline)) static void watch_bus(struct servo *s)
     }
     if (fired != s->watchdog.fired) {
         note_held_by(s, s->regs.status.status);
+        if (s->watchdog.fired) {
+            log_fault(s, FAULT_WATCHDOG);
+        }
     }
 }
 

@@ -8,6 +8,7 @@
 #include <stdint.h>
 
 #include "storage/config_store.h"
+#include "storage/fault_log.h"
 #include "storage/save_policy.h"
 #include "hal/hal_port.h"
 #include "protection/bus_watchdog.h"
@@ -78,6 +79,8 @@ struct servo {
     uint16_t heat_cap_mw;        /* the derating's power cap; 0 = none */
     uint8_t heat_ticks;          /* ticks towards the winding's next sample */
     struct bus_watchdog watchdog;
+    struct fault_log faults;
+    uint8_t fault_bits_seen;     /* status bits 2-7 as the fault history last saw them */
     uint8_t guard_seen;          /* protection.act_changes the motion has */
     uint32_t next_tick_us;       /* when the next control tick is due */
     uint32_t ticks_dropped;      /* control ticks skipped by a late main loop */

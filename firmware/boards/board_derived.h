@@ -38,6 +38,12 @@ _Static_assert(BOARD_RX_RING_BYTES >= 256 && (BOARD_RX_RING_BYTES & (BOARD_RX_RI
                    BOARD_BOOT_RX_RING_BYTES >= 256 &&
                    (BOARD_BOOT_RX_RING_BYTES & (BOARD_BOOT_RX_RING_BYTES - 1)) == 0,
                "board.h: the receive rings are powers of two, 256 bytes or more");
+#ifdef BOARD_FAULT_PAGE0
+_Static_assert(BOARD_SLOT_BASE + BOARD_SLOT_PAGES * BOARD_FLASH_PAGE <= BOARD_FAULT_PAGE0 &&
+                   BOARD_FAULT_PAGE1 == BOARD_FAULT_PAGE0 + BOARD_FLASH_PAGE &&
+                   BOARD_FAULT_PAGE1 + BOARD_FLASH_PAGE <= BOARD_CONFIG_PAGE0,
+               "board.h: the slot, then the fault history's two adjacent pages, then the store");
+#endif
 #ifdef BOARD_CONFIG_PAGE0
 _Static_assert(BOARD_SLOT_BASE + BOARD_SLOT_PAGES * BOARD_FLASH_PAGE <= BOARD_CONFIG_PAGE0,
                "board.h: the slot ends before the config store");

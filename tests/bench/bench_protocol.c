@@ -259,6 +259,13 @@ static void every_packet(void)
     ANSWER("read_multi_turn", 16, ID);
     ANSWER("read_motion", 0x40, ID);
     ANSWER("read_store", 0x41, ID);
+    /* A fault in the history to read (it is written before the stream). */
+    const struct fault_entry stall = {.what = FAULT_STALL, .op_seconds = 60, .voltage_mv = 7400};
+    if (fault_log_add(&servo.faults, &stall)) {
+        while (fault_log_step(&servo.faults)) {
+        }
+    }
+    ANSWER("read_faults", 0x43, ID, 0);
     ANSWER("update_status", 0x55, ID);
     /* A change is programmed before its answer (docs/decisions.md); the
      * same value again writes nothing. */
@@ -299,6 +306,7 @@ static void every_packet(void)
     uint32_t serial = servo.regs.status.serial_number;
     ANSWER("assign_id", 0x42, 0xFF, (uint8_t)serial, (uint8_t)(serial >> 8), (uint8_t)(serial >> 16),
         (uint8_t)(serial >> 24), ID);
+    ANSWER("clear_faults", 0x44, ID);
     /* Refused while the servo holds, but answered. */
     ANSWER("update_enter", 0x50, ID);
 }

@@ -78,6 +78,7 @@ void hal_double_init(struct hal_double *h)
     memset(h, 0, sizeof *h);
     h->rx = (struct hal_rx_ring)HAL_RX_RING_OVER(h->rx_bytes);
     flash_double_init(&h->flash, 1024);
+    flash_double_init(&h->fault_flash, 1024);
     h->sensors = (struct sensor_raw){.supply = 7400, .current = 0, .ntc = 2048};
     h->calibration = (struct sensor_calibration){.supply_mv_q12 = SENSOR_Q12_FROM_MICRO(1000u),
                                                  .current_ma_q12 = SENSOR_Q12_FROM_MICRO(1000u)};
@@ -90,6 +91,7 @@ void hal_double_init(struct hal_double *h)
                   .read_sensors = sensors_read},
         .calibration = &h->calibration,
         .flash = &h->flash.hal,
+        .fault_flash = &h->fault_flash.hal,
         .serial_number = serial_number,
     };
 }

@@ -15,6 +15,7 @@
 struct hal_double {
     struct hal_port port;
     struct flash_double flash;
+    struct flash_double fault_flash; /* the fault history's pages */
     struct hal_rx_ring rx; /* servo_on_rx_byte puts received bytes here */
     uint8_t rx_bytes[512];  /* the smallest an application has (the Cortex-M0 board) */
     uint32_t now_us;

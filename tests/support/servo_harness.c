@@ -23,6 +23,7 @@ void harness_init(void)
 void harness_restart(void)
 {
     flash_double_power_on(&hal.flash);
+    flash_double_power_on(&hal.fault_flash);
     servo_init(&servo, &hal.port);
 }
 

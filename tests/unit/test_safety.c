@@ -9,6 +9,7 @@
 
 #include <cmocka.h>
 
+#include "registers/faults.h"
 #include "support/by_name.h"
 #include "support/servo_harness.h"
 
@@ -179,6 +180,44 @@ static void test_a_hot_case_derates_the_power_limit(void **state)
     assert_int_equal(servo.motion.power_cap_mw, 0);
 }
 
+/* The fault history through the servo: a trip is logged with its
+ * readings, kept across a power cycle, and cleared. */
+static void test_faults_are_logged_kept_and_cleared(void **state)
+{
+    (void)state;
+    move_to_90();
+    harness_run_ms(200);
+    hal.sensors.supply = 3500; /* below 39 */
+    harness_run_ms(100);
+    hal.sensors.supply = 7400;
+    harness_run_ms(400);
+    WRITE_ITEM(0, ITEM_WATCHDOG_MS, 20);
+    WRITE_ITEM(0, ITEM_WATCHDOG_ACTION, 2);
+    move_to_90();
+    harness_run_ms(200); /* the watchdog */
+    REQUEST(PKT_READ_FAULTS, 0, 0);
+    assert_int_equal(ANSWER_FIELD(PKT_READ_FAULTS, ANSWER_READ_FAULTS_COUNT), 2);
+    assert_int_equal(ANSWER_FIELD(PKT_READ_FAULTS, ANSWER_READ_FAULTS_WHAT), FAULT_WATCHDOG);
+    harness_restart();
+    harness_run_ms(5);
+    REQUEST(PKT_READ_FAULTS, 0, 1);
+    assert_int_equal(ANSWER_FIELD(PKT_READ_FAULTS, ANSWER_READ_FAULTS_COUNT), 2);
+    assert_int_equal(ANSWER_FIELD(PKT_READ_FAULTS, ANSWER_READ_FAULTS_WHAT), FAULT_LOW_VOLTAGE);
+    assert_int_equal(ANSWER_FIELD(PKT_READ_FAULTS, ANSWER_READ_FAULTS_NUMBER), 1);
+    int32_t mv = ANSWER_FIELD(PKT_READ_FAULTS, ANSWER_READ_FAULTS_VOLTAGE);
+    assert_true(mv < 4000);
+    assert_int_equal(ANSWER_FIELD(PKT_READ_FAULTS, ANSWER_READ_FAULTS_ANGLE), 900);
+    REQUEST(PKT_READ_FAULTS, 0, 2); /* beyond the count */
+    assert_int_equal(ANSWER_FIELD(PKT_READ_FAULTS, ANSWER_READ_FAULTS_WHAT), 0);
+    REQUEST(PKT_CLEAR_FAULTS, 0);
+    EXPECT_RESPONSE(PKT_CLEAR_FAULTS, 0, 1);
+    harness_run_ms(50);
+    harness_restart();
+    harness_run_ms(5);
+    REQUEST(PKT_READ_FAULTS, 0, 0);
+    assert_int_equal(ANSWER_FIELD(PKT_READ_FAULTS, ANSWER_READ_FAULTS_COUNT), 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -189,6 +228,7 @@ int main(void)
         cmocka_unit_test_setup(test_the_watchdog_items_live_in_ram, setup),
         cmocka_unit_test_setup(test_the_limiter_names_a_clamped_angle_the_supply_and_heat, setup),
         cmocka_unit_test_setup(test_a_hot_case_derates_the_power_limit, setup),
+        cmocka_unit_test_setup(test_faults_are_logged_kept_and_cleared, setup),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

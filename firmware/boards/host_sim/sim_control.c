@@ -211,9 +211,10 @@ static void control_command(const struct sim_control *c, int fd, char *line)
             s->plant.has_stop = !off;
             s->plant.stop_angle = value * M_PI / 180.0;
         } else if (strcmp(cmd, "failerase") == 0) {
-            s->flash.fail_erases = s->slot_flash.fail_erases = (uint32_t)value;
+            s->flash.fail_erases = s->slot_flash.fail_erases = s->fault_flash.fail_erases = (uint32_t)value;
         } else if (strcmp(cmd, "failprogram") == 0) {
-            s->flash.fail_programs = s->slot_flash.fail_programs = (uint32_t)value;
+            s->flash.fail_programs = s->slot_flash.fail_programs = s->fault_flash.fail_programs =
+                (uint32_t)value;
         } else if (strcmp(cmd, "powercycle") == 0) {
             sim_servo_power_cycle(s);
         } else { /* state: a line a servo, however many (no buffer to outgrow) */

@@ -52,7 +52,7 @@ static uint32_t now_us(void *ctx)
 static void uart_send(void *ctx, const uint8_t *data, uint16_t len)
 {
     struct sim_servo *s = ctx;
-    uint64_t at = s->bus->now_us + s->flash.stall_us + s->slot_flash.stall_us;
+    uint64_t at = s->bus->now_us + s->flash.stall_us + s->slot_flash.stall_us + s->fault_flash.stall_us;
     s->last_sent_us = at;
     s->tx_done_us = sim_bus_send(s->bus, s->index, data, len, s->baud, at);
 }
@@ -221,9 +221,13 @@ bool sim_servo_start(struct sim_servo *s, struct sim_bus *bus, unsigned index, u
     snprintf(path, sizeof path, "%s/%s.flash", state_dir, name);
     char slot_path[300];
     snprintf(slot_path, sizeof slot_path, "%s/%s.slot", state_dir, name);
+    char fault_path[300];
+    snprintf(fault_path, sizeof fault_path, "%s/%s.faults", state_dir, name);
     if (!sim_flash_open(&s->flash, path, SIM_CONFIG_BASE, 2, s->config_mem) ||
-        !sim_flash_open(&s->slot_flash, slot_path, SIM_SLOT_BASE, SIM_SLOT_PAGES, s->slot_mem)) {
-        fprintf(stderr, "servo_sim: cannot open the flash files %s, %s: ", path, slot_path);
+        !sim_flash_open(&s->slot_flash, slot_path, SIM_SLOT_BASE, SIM_SLOT_PAGES, s->slot_mem) ||
+        !sim_flash_open(&s->fault_flash, fault_path, BOARD_FAULT_PAGE0, 2, s->fault_mem)) {
+        fprintf(stderr, "servo_sim: cannot open the flash files %s, %s, %s: ", path, slot_path,
+                fault_path);
         perror(NULL);
         return false;
     }
@@ -252,6 +256,7 @@ bool sim_servo_start(struct sim_servo *s, struct sim_bus *bus, unsigned index, u
                   .read_sensors = sensors_read},
         .calibration = &calibration,
         .flash = &s->flash.hal,
+        .fault_flash = &s->fault_flash.hal,
         .serial_number = serial_number,
         .image_version = image_version,
         .enter_bootloader = enter_bootloader,
@@ -275,6 +280,7 @@ bool sim_servo_start(struct sim_servo *s, struct sim_bus *bus, unsigned index, u
     }
     s->flash.stall_us = 0; /* power-up, before the servo joins the bus */
     s->slot_flash.stall_us = 0;
+    s->fault_flash.stall_us = 0;
     return true;
 }
 
@@ -330,12 +336,13 @@ void sim_servo_poll(struct sim_servo *s, uint64_t now_us)
         s->last_execution_us = now_us - s->executing_from_us;
     }
     s->executing = executing;
-    uint32_t stall = s->flash.stall_us + s->slot_flash.stall_us;
+    uint32_t stall = s->flash.stall_us + s->slot_flash.stall_us + s->fault_flash.stall_us;
     if (stall != 0u) {
         s->cpu_free_us = now_us + stall;
         s->flash_stall_us += stall;
         s->flash.stall_us = 0;
         s->slot_flash.stall_us = 0;
+        s->fault_flash.stall_us = 0;
     }
 }
 

@@ -36,8 +36,10 @@ struct sim_servo {
     struct thermal thermal;
     struct sim_flash flash;      /* the config store's pages */
     struct sim_flash slot_flash; /* the application slot */
+    struct sim_flash fault_flash; /* the fault history's pages */
     struct app_slot slot;
     uint8_t config_mem[2u * SIM_FLASH_PAGE];
+    uint8_t fault_mem[2u * SIM_FLASH_PAGE];
     uint8_t slot_mem[SIM_SLOT_PAGES * SIM_FLASH_PAGE];
     bool in_bootloader;
     struct sim_boot boot;

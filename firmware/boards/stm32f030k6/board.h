@@ -7,13 +7,16 @@
 
 #define BOARD_ID 0x0030 /* the update image header's board field */
 
-/* Flash (RM0360 3.2: 1 KB pages): the 4 KB bootloader, the application
- * slot up to the config store's two pages at the end. */
+/* Flash (RM0360 3.2: 1 KB pages): the 4 KB bootloader, the 24 KB
+ * application slot, the fault history's two pages, the config store's two
+ * at the end. */
 #define BOARD_FLASH_BASE 0x08000000
 #define BOARD_FLASH_PAGE 1024
 #define BOARD_BOOT_SIZE 4096
 #define BOARD_SLOT_BASE 0x08001000
-#define BOARD_SLOT_PAGES 26
+#define BOARD_SLOT_PAGES 24
+#define BOARD_FAULT_PAGE0 0x08007000
+#define BOARD_FAULT_PAGE1 0x08007400
 #define BOARD_CONFIG_PAGE0 0x08007800
 #define BOARD_CONFIG_PAGE1 0x08007C00
 

@@ -8,12 +8,14 @@
 #define BOARD_ID 0x0103 /* the update image header's board field */
 
 /* Flash (RM0008 3.3.3: 1 KB pages): the 4 KB bootloader, the application
- * slot, the config store's two pages at the end. */
+ * slot, the fault history's two pages, the config store's two at the end. */
 #define BOARD_FLASH_BASE 0x08000000
 #define BOARD_FLASH_PAGE 1024
 #define BOARD_BOOT_SIZE 4096
 #define BOARD_SLOT_BASE 0x08001000
-#define BOARD_SLOT_PAGES 58
+#define BOARD_SLOT_PAGES 56
+#define BOARD_FAULT_PAGE0 0x0800F000
+#define BOARD_FAULT_PAGE1 0x0800F400
 #define BOARD_CONFIG_PAGE0 0x0800F800
 #define BOARD_CONFIG_PAGE1 0x0800FC00
 

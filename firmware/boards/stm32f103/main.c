@@ -19,6 +19,7 @@ static uint8_t rx_bytes[BOARD_RX_RING_BYTES];
 static struct hal_rx_ring rx_ring = HAL_RX_RING_OVER(rx_bytes);
 static struct dma_rx rx_dma;
 static struct hal_flash flash;
+static struct hal_flash fault_flash;
 
 static const struct sensor_calibration calibration = BOARD_SENSOR_CALIBRATION;
 
@@ -54,6 +55,7 @@ static const struct hal_port port = {
     .motor = BOARD_MOTOR,
     .calibration = &calibration,
     .flash = &flash,
+    .fault_flash = &fault_flash,
     .serial_number = unique_id_serial,
     .image_version = image_version,
     .enter_bootloader = enter_bootloader,
@@ -68,6 +70,7 @@ int main(void)
     adc_scan_init();
     pwm_bridge_init();
     flash_f0f1_init(&flash, BOARD_FLASH_PAGE, BOARD_CONFIG_PAGE0, BOARD_CONFIG_PAGE1);
+    flash_f0f1_init(&fault_flash, BOARD_FLASH_PAGE, BOARD_FAULT_PAGE0, BOARD_FAULT_PAGE1);
     port_uart_init(&usart, &rx_ring, &rx_dma, F103_PCLK2_HZ);
     port_uart_send_by_dma(&usart);
     servo_init(&servo, &port);

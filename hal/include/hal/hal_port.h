@@ -56,6 +56,8 @@ struct hal_port {
     struct hal_motor motor;
     const struct sensor_calibration *calibration;
     const struct hal_flash *flash;
+    /* The fault history's two pages (storage/fault_log.h); NULL: none kept. */
+    const struct hal_flash *fault_flash;
     /* Data ID 8: derived by the port from the MCU's unique ID; read once,
      * at start. An operation, so a board's hal_port can be all constant. */
     uint32_t (*serial_number)(void *ctx);

@@ -10,6 +10,7 @@
 #include "motion/motion.h"
 #include "protocol/frame_rx.h"
 #include "protocol/frame_tx.h"
+#include "registers/faults.h"
 #include "registers/registers.h"
 
 struct dispatcher {
@@ -33,6 +34,13 @@ struct dispatcher {
     /* Frames for this servo so far (its ID, a broadcast, its SyncCommand
      * record): the bus watchdog's food. */
     uint32_t heard;
+    /* The fault history (ReadFaults, ClearFaults): the index-th newest
+     * fault's bytes (struct fault_entry's image) into out, false beyond
+     * the count (store_health has the count); and a clear. NULL where none
+     * is kept. */
+    bool (*read_fault)(void *ctx, uint8_t index, uint8_t *out);
+    bool (*clear_faults)(void *ctx);
+    void *faults_ctx;
 };
 
 struct dispatch_result {

@@ -49,6 +49,10 @@ struct store_health {
      * port's ring overwrote before the main loop took them. */
     uint32_t answers_dropped;
     uint32_t bytes_lost;
+    /* The fault history (ReadFaults): faults shown, and faults not written
+     * since power-up (storage/fault_log.h). */
+    uint8_t fault_count;
+    uint16_t faults_not_logged;
 };
 
 struct registers {
