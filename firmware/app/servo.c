@@ -4,8 +4,8 @@
 #include <string.h>
 
 #include "app/identity.h"
+#include "app/servo_safety.h"
 #include "registers/data_table.h"
-#include "sensors/ntc.h"
 
 static uint32_t idle_timeout_us(const struct servo *s, uint32_t baud)
 {
@@ -13,10 +13,6 @@ static uint32_t idle_timeout_us(const struct servo *s, uint32_t baud)
 }
 
 static bool persist_user(void *ctx, const struct user_config *cfg);
-static void watch_bus(struct servo *s);
-static void heat_step(struct servo *s);
-static bool read_fault(void *ctx, uint8_t index, uint8_t *out);
-static bool clear_faults(void *ctx);
 
 static void apply_link_settings(struct servo *s)
 {
@@ -57,7 +53,6 @@ void servo_init(struct servo *s, const struct hal_port *hal)
     s->regs.status.firmware_version = image_version != 0u ? image_version : FIRMWARE_VERSION;
     s->regs.status.serial_number = hal->serial_number(hal->ctx);
     protection_init(&s->protection);
-    winding_init(&s->winding);
     motion_init(&s->motion, &s->regs, hal);
     s->next_tick_us = hal->bus.now_us(hal->ctx) + CONTROL_TICK_US;
     frame_rx_init(&s->rx, &s->active_id);
@@ -68,13 +63,7 @@ void servo_init(struct servo *s, const struct hal_port *hal)
     s->dispatcher.next_tick_us = &s->next_tick_us;
     s->dispatcher.persist = persist_user;
     s->dispatcher.persist_ctx = s;
-    fault_log_load(&s->faults, hal->fault_flash);
-    if (fault_log_spare_dirty(&s->faults) && !fault_log_erase_spare(&s->faults)) {
-        s->regs.status.status |= STATUS_COMMAND_ERROR; /* nobody waits at power-up */
-    }
-    s->dispatcher.read_fault = read_fault;
-    s->dispatcher.clear_faults = clear_faults;
-    s->dispatcher.faults_ctx = s;
+    safety_init(s);
     s->active_baud_index = 0; /* forces the first apply to set the UART */
     apply_link_settings(s);
 }
@@ -277,81 +266,6 @@ static void erase_spare(struct servo *s, uint32_t now)
     s->erase_passed = 1;
 }
 
-/* Status bits 2-7: each one that sets is a fault for the history. */
-#define FAULT_STATUS_BITS                                                                        \
-    (STATUS_STALL | STATUS_HIGH_VOLTAGE | STATUS_LOW_VOLTAGE | STATUS_OVER_CURRENT |            \
-     STATUS_OVER_POWER | STATUS_OVER_TEMPERATURE)
-
-/* One fault into the history's queue, with the readings of this moment. */
-static void log_fault(struct servo *s, uint8_t what)
-{
-    const struct status_area *st = &s->regs.status;
-    struct motion_angle angle;
-    motion_read_angle(&s->motion, &angle);
-    const struct fault_entry e = {
-        .op_seconds = save_policy_op_seconds(&s->saver),
-        .angle_decideg = angle.multi_turn_decideg,
-        .voltage_mv = st->voltage_mv,
-        .current_ma = st->current_ma,
-        .power_mw = st->power_mw,
-        .winding_decic = s->regs.firmware.winding_decic,
-        .case_decic = ntc_decicelsius(st->temperature_adc),
-        .what = what,
-    };
-    (void)fault_log_add(&s->faults, &e); /* one not logged is counted */
-}
-
-__attribute__((noinline)) static void note_faults(struct servo *s, uint8_t trips)
-{
-    uint8_t rose = (uint8_t)(trips & ~s->fault_bits_seen);
-    s->fault_bits_seen = trips;
-    for (uint8_t bit = 2; bit < 8u; bit++) {
-        if (rose & (1u << bit)) {
-            log_fault(s, bit);
-        }
-    }
-}
-
-static bool read_fault(void *ctx, uint8_t index, uint8_t *out)
-{
-    const struct servo *s = ctx;
-    return fault_log_read(&s->faults, index, out);
-}
-
-static bool clear_faults(void *ctx)
-{
-    struct servo *s = ctx;
-    struct fault_entry marker; /* field by field: an initialiser is a memset call on the M0 */
-    marker.number = 0;
-    marker.op_seconds = save_policy_op_seconds(&s->saver);
-    marker.angle_decideg = 0;
-    marker.voltage_mv = marker.current_ma = marker.power_mw = 0;
-    marker.winding_decic = marker.case_decic = 0;
-    marker.what = FAULT_CLEARED;
-    return fault_log_add(&s->faults, &marker);
-}
-
-/* In the pass of each control tick, after it: the bus watchdog (it acts
- * within a tick of its time) and, every SENSE_ROUND_TICKS, a sample of
- * the winding's heat. Neither is part of the control law, so neither
- * lengthens the control tick. */
-static void tend_safety(struct servo *s)
-{
-    if (s->regs.firmware.watchdog_ms != 0u || s->watchdog.fired) {
-        watch_bus(s);
-    }
-    uint8_t trips = (uint8_t)(s->regs.status.status & FAULT_STATUS_BITS);
-    if (trips != s->fault_bits_seen) {
-        note_faults(s, trips);
-    }
-    if (++s->heat_ticks == SENSE_ROUND_TICKS) {
-        s->heat_ticks = 0;
-        if (winding_sample(&s->winding, s->regs.status.current_ma)) {
-            heat_step(s);
-        }
-    }
-}
-
 /* Once a control tick: counts operating time and erases the spare page
  * when that costs nothing. */
 static void tend_store(struct servo *s, uint32_t now, bool ticked)
@@ -359,7 +273,7 @@ static void tend_store(struct servo *s, uint32_t now, bool ticked)
     if (!ticked) {
         return;
     }
-    tend_safety(s);
+    safety_tend(s);
     save_policy_count_time(&s->saver, now);
     if ((config_store_spare_dirty(&s->store) || fault_log_spare_dirty(&s->faults)) &&
         erase_may_stall(s, now)) {
@@ -380,45 +294,6 @@ _Static_assert(offsetof(struct status_area, current_ma) - offsetof(struct status
                sizeof(struct sensor_readings) == 8,
                "the status area's IDs 1-4 lie as struct sensor_readings");
 
-/* What a protection or the watchdog holds the output back by (enum
- * limiter), from the status bits: on their changes only (the motion's
- * own limit is added as item 66 or ReadMotion is read). */
-static void note_held_by(struct servo *s, uint8_t bits)
-{
-    s->regs.held_by = s->watchdog.fired                                          ? LIMITER_WATCHDOG
-                      : (bits & (STATUS_LOW_VOLTAGE | STATUS_HIGH_VOLTAGE)) != 0u ? LIMITER_SUPPLY
-                      : (bits & STATUS_OVER_TEMPERATURE) != 0u                    ? LIMITER_HEAT
-                      : (bits & STATUS_STALL) != 0u && s->regs.user.stall_release ? LIMITER_STALL
-                                                                                  : LIMITER_NONE;
-}
-
-/* A step of the winding's model (every WINDING_SAMPLES rounds): its
- * estimate to item 67, its derating to the output. */
-__attribute__((noinline)) static void heat_step(struct servo *s)
-{
-    const struct user_config *cfg = &s->regs.user;
-    winding_step(&s->winding, s->hal->calibration, s->regs.status.temperature_adc,
-                 cfg->temperature_limit_adc);
-    s->regs.firmware.winding_decic = s->winding.winding_decic;
-    uint16_t cap = winding_power_cap(&s->winding, cfg->power_limit_mw);
-    if (cap != s->heat_cap_mw) {
-        s->heat_cap_mw = cap;
-        s->protection.act_changes++;
-    }
-}
-
-/* The tighter of the stall's cap and the derating's, and whose it is. */
-static void guard_motion(struct servo *s)
-{
-    const struct protection *p = &s->protection;
-    uint16_t stall_cap = p->act.power_cap_mw;
-    uint16_t heat_cap = s->heat_cap_mw;
-    bool heat_binds = heat_cap != 0u && (stall_cap == 0u || heat_cap < stall_cap);
-    motion_guard(&s->motion, protection_inhibits(p->threshold_bits),
-                 protection_derates(p->threshold_bits), heat_binds ? heat_cap : stall_cap,
-                 heat_binds ? LIMITER_HEAT : LIMITER_STALL);
-}
-
 /* Sensors to the status area (IDs 1-4), monitors to what the output may
  * do; returns status bits 2-7. */
 static uint8_t sense_and_protect(struct servo *s)
@@ -438,29 +313,9 @@ static uint8_t sense_and_protect(struct servo *s)
     }
     if (p->act_changes != s->guard_seen) {
         s->guard_seen = p->act_changes;
-        guard_motion(s);
-        note_held_by(s, bits);
+        safety_guard(s, bits);
     }
     return bits;
-}
-
-/* The bus watchdog, where it is on (item 64): item 65's stop, once. */
-__attribute__((noinline)) static void watch_bus(struct servo *s)
-{
-    const struct firmware_area *fw = &s->regs.firmware;
-    bool fired = s->watchdog.fired;
-    if (bus_watchdog_tick(&s->watchdog, fw->watchdog_ms, !motion_is_released(&s->motion),
-                          s->dispatcher.heard, s->motion.commands)) {
-        static const uint8_t method[] = {
-            [WATCHDOG_HOLD] = STOP_HOLD, [WATCHDOG_DAMP] = STOP_DAMPING, [WATCHDOG_RELEASE] = STOP_RELEASE};
-        motion_stop(&s->motion, method[fw->watchdog_action < 3u ? fw->watchdog_action : WATCHDOG_RELEASE]);
-    }
-    if (fired != s->watchdog.fired) {
-        note_held_by(s, s->regs.status.status);
-        if (s->watchdog.fired) {
-            log_fault(s, FAULT_WATCHDOG);
-        }
-    }
 }
 
 /* The status byte once a tick: the monitors' bits, the motion's (bit 0),

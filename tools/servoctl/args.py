@@ -127,9 +127,15 @@ def build_parser():
     c.add_argument("id", type=int)
     c.add_argument("--json", action="store_true")
 
-    c = sub.add_parser("info", help="status area decoded: V, A, W, degC, status bits")
+    c = sub.add_parser("info", help="status area decoded: V, A, W, degC, status bits; the winding's "
+                       "temperature, what limits the output, the watchdog")
     c.add_argument("id", type=int)
     c.add_argument("--json", action="store_true", help="as one JSON object, SI units")
+
+    c = sub.add_parser("faults", help="the fault history, newest first (kept across power cycles)")
+    c.add_argument("id", type=int)
+    c.add_argument("--clear", action="store_true", help="clear the history")
+    c.add_argument("--json", action="store_true", help="as one JSON object")
 
     c = sub.add_parser("id", help="IDs by serial number: assign SERIAL ID; bringup numbers new "
                                   "servos connected one at a time")

@@ -14,6 +14,8 @@ from .args import build_parser
 from .errors import BadAnswer, NoReply, Refused, ServoError, UsageError
 from .protocol import Bus
 from .record import check_writable, cmd_record
+from .faults import cmd_faults
+from .info import cmd_info
 from .servo import Servo
 
 EXIT_INTERRUPTED = 130
@@ -76,30 +78,6 @@ def cmd_ping(bus, args):
         return 0
     print(f"servo {args.id}: no reply")
     return NoReply.exit_code
-
-
-def cmd_info(bus, args):
-    s = Servo(bus, args.id)
-    m = s.monitor()
-    if args.json:
-        print(json.dumps({
-            "id": args.id, "voltage_v": m.voltage_mv / 1000, "current_a": m.current_ma / 1000,
-            "power_w": m.power_mw / 1000, "temperature_adc": m.temperature_adc,
-            "temperature_c": ntc.celsius_or_none(m.temperature_adc, 2), "status": registers.status_names(m.status),
-            "angle_deg": m.angle_decideg / 10, "turns": m.turns, "model": s.read("model"),
-            "firmware": s.read("firmware"), "serial": s.read("serial")}))
-        return 0
-    print(f"servo {args.id}")
-    print(f"  voltage      {m.voltage_mv / 1000:.2f} V")
-    print(f"  current      {m.current_ma / 1000:.3f} A")
-    print(f"  power        {m.power_mw / 1000:.2f} W")
-    print(f"  temperature  {ntc.describe(m.temperature_adc)}")
-    print(f"  status       0x{m.status:02x}: {fmt_status(m.status)}")
-    print(f"  angle        {m.angle_decideg / 10:.1f} deg ({m.turns} turns)")
-    print(f"  model        0x{s.read('model'):04x}")
-    print(f"  firmware     0x{s.read('firmware'):04x}")
-    print(f"  serial       0x{s.read('serial'):08x}")
-    return 0
 
 
 def cmd_id(bus, args):
@@ -456,6 +434,7 @@ COMMANDS = {
     "scan": cmd_scan,
     "ping": cmd_ping,
     "info": cmd_info,
+    "faults": cmd_faults,
     "id": cmd_id,
     "bench": cmd_bench,
     "store": cmd_store,

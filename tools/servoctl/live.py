@@ -9,7 +9,8 @@ import sys
 
 from . import group, ntc, registers
 from .protocol import NoReply
-from .servo import Servo
+from .errors import ServoError
+from .servo import MotionSnapshot, Servo
 
 
 @dataclass
@@ -23,7 +24,7 @@ class Sample:
     power_w: float
     temperature_c: float  # NaN without a sensor reading
     status: list
-
+    limiter: str = ""     # what holds the output back (item 66); "" where not read
 
 def _celsius(adc: int) -> float:
     celsius = ntc.celsius_or_none(adc)
@@ -36,12 +37,20 @@ class Sampler:
         self.last = {}
         self.t0 = bus.clock()
 
+    def _limiter(self, servo_id: int) -> str:
+        """Item 66 by name; "" from a servo without it (the maker's). One
+        request more a servo: only where each is asked alone (not --sync)."""
+        try:
+            return MotionSnapshot.LIMITERS[Servo(self.bus, servo_id).read("limiter")]
+        except (NoReply, ServoError):
+            return ""
+
     def take(self) -> tuple:
         """One sample of every servo that answered, and {id: why} of those
         that did not (silent). Each sample is stamped with the time its
         answer arrived, so a host that falls behind bends neither the time
         axis nor the speed."""
-        arrivals, silent = {}, {}
+        arrivals, silent, limiters = {}, {}, {}
         if self.sync:
             monitors = group.sync_monitor(self.bus, self.ids, arrivals=arrivals)
             silent = {i: f"servo {i}: no answer in its Sync Monitor slot" for i in self.ids if i not in monitors}
@@ -54,6 +63,7 @@ class Sampler:
                     silent[servo_id] = str(e)
                     continue
                 arrivals[servo_id] = self.bus.arrived_at
+                limiters[servo_id] = self._limiter(servo_id)
         out = []
         for servo_id, m in monitors.items():
             now = arrivals[servo_id] - self.t0
@@ -64,7 +74,7 @@ class Sampler:
             self.last[servo_id] = (now, angle)
             out.append(Sample(round(now, 3), servo_id, angle, round(speed, 1), m.voltage_mv / 1000.0,
                               m.current_ma / 1000.0, m.power_mw / 1000.0, _celsius(m.temperature_adc),
-                              registers.status_names(m.status)))
+                              registers.status_names(m.status), limiters.get(servo_id, "")))
         for servo_id in silent:
             self.last.pop(servo_id, None)
         return out, silent
@@ -74,16 +84,16 @@ def _table(samples: dict):
     from rich.table import Table
 
     t = Table(title="servoctl monitor (Ctrl-C stops)")
-    for name in ("id", "angle deg", "deg/s", "V", "A", "W", "degC", "status"):
-        t.add_column(name, justify="right" if name != "status" else "left")
+    for name in ("id", "angle deg", "deg/s", "V", "A", "W", "degC", "limit", "status"):
+        t.add_column(name, justify="right" if name not in ("status", "limit") else "left")
     for servo_id in sorted(samples):
         s = samples[servo_id]
         if isinstance(s, str):  # silent: why, and no stale values
-            t.add_row(str(servo_id), *[""] * 6, f"silent: {s}")
+            t.add_row(str(servo_id), *[""] * 7, f"silent: {s}")
             continue
         t.add_row(str(s.id), f"{s.angle_deg:.1f}", _num(s.velocity_dps, ".0f"), f"{s.voltage_v:.2f}",
                   f"{s.current_a:.3f}", f"{s.power_w:.2f}", _num(s.temperature_c, ".1f"),
-                  ", ".join(s.status) or "ok")
+                  s.limiter or "-", ", ".join(s.status) or "ok")
     return t
 
 
@@ -100,8 +110,8 @@ def sample_json(s: Sample) -> str:
 
 def _row(s: Sample) -> str:
     return (f"{s.id:>3} {s.angle_deg:>10.1f} {_num(s.velocity_dps, '.0f'):>7} {s.voltage_v:>6.2f} "
-            f"{s.current_a:>6.3f} {s.power_w:>6.2f} {_num(s.temperature_c, '.1f'):>6}  "
-            f"{', '.join(s.status) or 'ok'}")
+            f"{s.current_a:>6.3f} {s.power_w:>6.2f} {_num(s.temperature_c, '.1f'):>6} "
+            f"{s.limiter or '-':>8}  {', '.join(s.status) or 'ok'}")
 
 
 class Plot:
@@ -184,7 +194,7 @@ def monitor(bus, ids, every_s: float, count: int, sync: bool, as_json: bool,
         live = Live(_table(latest), refresh_per_second=10)
         live.start()
     elif not as_json:
-        print(f"{'id':>3} {'angle deg':>10} {'deg/s':>7} {'V':>6} {'A':>6} {'W':>6} {'degC':>6}  status")
+        print(f"{'id':>3} {'angle deg':>10} {'deg/s':>7} {'V':>6} {'A':>6} {'W':>6} {'degC':>6} {'limit':>8}  status")
     try:
         while count == 0 or n < count:
             samples, silent = sampler.take()

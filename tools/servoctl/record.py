@@ -1,5 +1,6 @@
 """servoctl record: a move sampled as the servo sees it, against its plan, as
 CSV and a plot."""
+import collections
 import csv
 import math
 import os
@@ -62,13 +63,13 @@ def cmd_record(bus, args):
         rows.append((round(t * 1000, 1), m.angle_decideg / 10.0, m.velocity_decideg_s / 10.0,
                      m.current_ma / 1000.0, round(planned, 2), m.setpoint_decideg / 10.0,
                      m.tracking_error_centideg / 100.0, round(planned_speed, 1), m.status,
-                     m.flags))
+                     m.flags, m.limiter))
     csv_path = args.out + ".csv"
     with open(csv_path, "w", newline="") as f:
         w = csv.writer(f)
         w.writerow(["time_ms", "angle_deg", "velocity_dps", "current_a", "planned_deg",
                     "setpoint_deg", "tracking_error_deg", "planned_velocity_dps", "status",
-                    "motion_flags"])
+                    "motion_flags", "limiter"])
         w.writerows(rows)
     png_path = args.out + ".png"
     _plot(rows, plan, png_path, f"servo {args.id}: {start / 10:.1f} -> {target / 10:.1f} deg",
@@ -78,6 +79,9 @@ def cmd_record(bus, args):
     print(f"{len(rows)} samples over {rows[-1][0]:.0f} ms; {ends}finished after "
           f"{done_at * 1000:.0f} ms (planned {len(plan) - 1} ms); worst tracking error "
           f"{worst:.2f} deg; final {rows[-1][1]:.1f} deg")
+    limited = collections.Counter(r[10] for r in rows if r[10] != "none")
+    if limited:
+        print("held back by " + ", ".join(f"{k} in {n} of {len(rows)} samples" for k, n in limited.most_common()))
     print(f"csv  {os.path.abspath(csv_path)}")
     print(f"plot {os.path.abspath(png_path)}")
     off = abs(rows[-1][1] - target / 10.0)

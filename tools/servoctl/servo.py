@@ -41,15 +41,50 @@ class MotionSnapshot:
     time_us: int  # the servo's clock at the tick the values are from; wraps at 2**32
 
     PROFILE_ENDED, CLOCK_SLOWED, BRAKING, AT_LIMIT, RELEASED = 1, 2, 4, 8, 16
+    # What holds the output back (flags bits 5-7, item 66; docs/safety.md).
+    LIMITERS = ("none", "power", "current", "stall", "supply", "heat", "angle", "watchdog")
 
     @classmethod
     def decode(cls, content: bytes) -> "MotionSnapshot":
         return cls(*p.decode_answer(p.READ_MOTION, content))
 
+    @property
+    def limiter(self) -> str:
+        return self.LIMITERS[self.flags >> 5]
+
     def seconds_since(self, earlier: "MotionSnapshot") -> float:
         """Servo time from an earlier snapshot to this one (less than 71
         minutes apart: the clock wraps)."""
         return ((self.time_us - earlier.time_us) % 2**32) / 1e6
+
+
+@dataclass
+class Fault:
+    """ReadFaults (0x43): one fault of the history, kept across power
+    cycles (docs/safety.md)."""
+    id: int
+    count: int         # faults in the history
+    not_logged: int    # faults not written since power-up
+    number: int
+    op_seconds: int
+    angle_decideg: int
+    voltage_mv: int
+    current_ma: int
+    power_mw: int
+    winding_decic: int
+    case_decic: int
+    what: int
+
+    KINDS = {0: "none", 2: "stall", 3: "high_voltage", 4: "low_voltage", 5: "over_current",
+             6: "over_power", 7: "over_temperature", 8: "watchdog"}
+
+    @classmethod
+    def decode(cls, content: bytes) -> "Fault":
+        return cls(*p.decode_answer(p.READ_FAULTS, content))
+
+    @property
+    def kind(self) -> str:
+        return self.KINDS.get(self.what, f"kind {self.what}")
 
 
 @dataclass
@@ -162,6 +197,23 @@ class Servo:
     def read_store(self) -> StoreHealth:
         """Needs this firmware: the maker's servos do not know packet 0x41."""
         return StoreHealth.decode(self.bus.request(p.READ_STORE, bytes([self.id])))
+
+    def read_fault(self, index: int) -> Fault:
+        """Needs this firmware: index 0 is the newest."""
+        check_range("fault index", index, 0, 255)
+        return Fault.decode(self.bus.request(p.READ_FAULTS, bytes([self.id, index])))
+
+    def faults(self) -> list:
+        """The whole history, newest first."""
+        first = self.read_fault(0)
+        if first.what == 0:
+            return []
+        return [first] + [self.read_fault(i) for i in range(1, first.count)]
+
+    def clear_faults(self) -> None:
+        if p.decode_answer(p.CLEAR_FAULTS, self.bus.request(p.CLEAR_FAULTS, bytes([self.id])))[1] != 1:
+            raise Refused(f"servo {self.id} refused to clear its fault history (none kept, "
+                          f"or its wear budget allows no record now)")
 
     def status(self) -> int:
         return self.read("status")

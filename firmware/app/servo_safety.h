@@ -1,0 +1,21 @@
+/* The servo core's safety parts (servo_safety.c, docs/safety.md): the bus
+ * watchdog, the winding's model and its derating, what holds the output
+ * back (item 66) and the fault history. */
+#ifndef APP_SERVO_SAFETY_H
+#define APP_SERVO_SAFETY_H
+
+#include <stdint.h>
+
+#include "app/servo_state.h"
+
+/* After the store's load and the dispatcher's init: the fault history and
+ * its packets' hooks. */
+void safety_init(struct servo *s);
+/* In the pass of each control tick, after it. */
+void safety_tend(struct servo *s);
+/* The protection's action changed: the output's guard (the tighter of the
+ * stall's and the derating's caps) and what holds it back, from bits
+ * (status bits 2-7). */
+void safety_guard(struct servo *s, uint8_t bits);
+
+#endif

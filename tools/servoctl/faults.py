@@ -1,0 +1,52 @@
+"""servoctl faults: a servo's fault history, newest first, and clearing it
+(ReadFaults, ClearFaults; docs/safety.md says what a host should do about
+each kind)."""
+import json
+from dataclasses import asdict
+
+from .servo import Servo
+
+# What a host can do about each kind (docs/safety.md, "Faults").
+ADVICE = {
+    "stall": "the horn was blocked at its power limit: check the load and the range of motion",
+    "high_voltage": "the supply rose above item 40: check the supply (and regenerated power)",
+    "low_voltage": "the supply fell below item 39: check the supply and its wiring under load",
+    "over_current": "the current passed item 43: check for a short or a jammed gear",
+    "over_power": "the power passed item 42: lighten the load or slow the moves",
+    "over_temperature": "the case reached item 41: let it cool; lower the duty or the load",
+    "watchdog": "the host fell silent for longer than item 64: check the host and the bus",
+}
+
+
+def _hms(seconds: int) -> str:
+    return f"{seconds // 3600}:{seconds // 60 % 60:02d}:{seconds % 60:02d}"
+
+
+def cmd_faults(bus, args):
+    s = Servo(bus, args.id)
+    if args.clear:
+        s.clear_faults()
+        print(f"servo {args.id}: fault history cleared")
+        return 0
+    faults = s.faults()
+    first = faults[0] if faults else s.read_fault(0)
+    if args.json:
+        print(json.dumps({"id": args.id, "not_logged": first.not_logged,
+                          "faults": [dict(asdict(f), kind=f.kind) for f in faults]}))
+        return 0
+    if not faults:
+        print(f"servo {args.id}: no faults{_not_logged(first.not_logged)}")
+        return 0
+    print(f"servo {args.id}: {len(faults)} fault(s), newest first{_not_logged(first.not_logged)}")
+    print("   #   op time  fault               supply  current   power  winding     case    angle")
+    for f in faults:
+        print(f"{f.number:>4} {_hms(f.op_seconds):>9}  {f.kind:<17} {f.voltage_mv / 1000:>6.2f} V "
+              f"{f.current_ma / 1000:>6.3f} A {f.power_mw / 1000:>5.2f} W {f.winding_decic / 10:>6.1f} C "
+              f"{f.case_decic / 10:>6.1f} C {f.angle_decideg / 10:>7.1f}")
+    for kind in dict.fromkeys(f.kind for f in faults):
+        print(f"  {kind}: {ADVICE.get(kind, '')}")
+    return 0
+
+
+def _not_logged(n: int) -> str:
+    return f" ({n} more since power-up not logged: repeats within 10 s, or the wear budget)" if n else ""

@@ -1,0 +1,45 @@
+"""servoctl info: one servo's status area decoded, and this firmware's
+safety items (the winding's temperature, what holds the output back, the
+bus watchdog)."""
+import json
+
+from . import ntc, registers
+from .errors import ServoError
+from .servo import MotionSnapshot, Servo
+
+
+def cmd_info(bus, args):
+    s = Servo(bus, args.id)
+    m = s.monitor()
+    if args.json:
+        print(json.dumps({
+            "id": args.id, "voltage_v": m.voltage_mv / 1000, "current_a": m.current_ma / 1000,
+            "power_w": m.power_mw / 1000, "temperature_adc": m.temperature_adc,
+            "temperature_c": ntc.celsius_or_none(m.temperature_adc, 2), "status": registers.status_names(m.status),
+            "angle_deg": m.angle_decideg / 10, "turns": m.turns, "model": s.read("model"),
+            "firmware": s.read("firmware"), "serial": s.read("serial"), **_safety(s)}))
+        return 0
+    print(f"servo {args.id}")
+    print(f"  voltage      {m.voltage_mv / 1000:.2f} V")
+    print(f"  current      {m.current_ma / 1000:.3f} A")
+    print(f"  power        {m.power_mw / 1000:.2f} W")
+    print(f"  temperature  {ntc.describe(m.temperature_adc)}")
+    status = ", ".join(registers.status_names(m.status)) or "ok"
+    print(f"  status       0x{m.status:02x}: {status}")
+    print(f"  angle        {m.angle_decideg / 10:.1f} deg ({m.turns} turns)")
+    print(f"  model        0x{s.read('model'):04x}")
+    print(f"  firmware     0x{s.read('firmware'):04x}")
+    print(f"  serial       0x{s.read('serial'):08x}")
+    for name, value in _safety(s).items():
+        print(f"  {name:<12} {value}")
+    return 0
+
+
+def _safety(s: Servo) -> dict:
+    """This firmware's items 64-67; none from a servo without them."""
+    try:
+        watchdog, action = s.read("watchdog_ms"), s.read("watchdog_action")
+        return {"winding_c": s.read("winding_temperature") / 10, "limiter": MotionSnapshot.LIMITERS[s.read("limiter")],
+                "watchdog": f"{watchdog} ms, then {('hold', 'damp', 'release')[action]}" if watchdog else "off"}
+    except ServoError:
+        return {}
