@@ -166,6 +166,9 @@ static inline __attribute__((always_inline)) void handle_next_frame(struct servo
     uint32_t responses_base = frame->responses_seen;
     frame_rx_release(&s->rx);
     show_executing(s);
+    if (s->watchdog.fired) {
+        safety_after_frame(s); /* a motion command clears what the watchdog did */
+    }
     if (result.config_changed) {
         s->link_settings_pending = 1;
     }

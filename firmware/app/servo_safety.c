@@ -7,7 +7,7 @@
 
 /* What a protection or the watchdog holds the output back by (enum
  * limiter), from the status bits: on their changes only (the motion's
- * own limit is added as item 66 or ReadMotion is read). */
+ * own limit is added as item 67 or ReadMotion is read). */
 static void note_held_by(struct servo *s, uint8_t bits)
 {
     s->regs.held_by = s->watchdog.fired                                          ? LIMITER_WATCHDOG
@@ -18,14 +18,14 @@ static void note_held_by(struct servo *s, uint8_t bits)
 }
 
 /* A step of the winding's model (every WINDING_SAMPLES rounds): its
- * estimate to item 67, its derating to the output. */
+ * estimate to item 68, its derating to the output. */
 __attribute__((noinline)) static void heat_step(struct servo *s)
 {
     const struct user_config *cfg = &s->regs.user;
     winding_step(&s->winding, s->hal->calibration, s->regs.status.temperature_adc,
                  cfg->temperature_limit_adc);
     s->regs.firmware.winding_decic = s->winding.winding_decic;
-    uint16_t cap = winding_power_cap(&s->winding, cfg->power_limit_mw);
+    uint16_t cap = s->regs.firmware.derating_on ? winding_power_cap(&s->winding, cfg->power_limit_mw) : 0u;
     if (cap != s->heat_cap_mw) {
         s->heat_cap_mw = cap;
         s->protection.act_changes++;
@@ -115,6 +115,14 @@ __attribute__((noinline)) static void watch_bus(struct servo *s)
         if (s->watchdog.fired) {
             log_fault(s, FAULT_WATCHDOG);
         }
+    }
+}
+
+__attribute__((noinline)) void safety_after_frame(struct servo *s)
+{
+    if (s->motion.commands != s->watchdog.commands_at_fire) {
+        s->watchdog.fired = 0;
+        note_held_by(s, s->regs.status.status);
     }
 }
 

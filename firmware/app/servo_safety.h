@@ -1,6 +1,6 @@
 /* The servo core's safety parts (servo_safety.c, docs/safety.md): the bus
  * watchdog, the winding's model and its derating, what holds the output
- * back (item 66) and the fault history. */
+ * back (item 67) and the fault history. */
 #ifndef APP_SERVO_SAFETY_H
 #define APP_SERVO_SAFETY_H
 
@@ -11,6 +11,9 @@
 /* After the store's load and the dispatcher's init: the fault history and
  * its packets' hooks. */
 void safety_init(struct servo *s);
+/* After a frame, while the watchdog has acted: a motion command clears it
+ * at once (what item 67 and ReadMotion say with it). */
+void safety_after_frame(struct servo *s);
 /* In the pass of each control tick, after it. */
 void safety_tend(struct servo *s);
 /* The protection's action changed: the output's guard (the tighter of the

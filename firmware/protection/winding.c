@@ -12,7 +12,9 @@ _Static_assert(WINDING_SAMPLES * SENSE_ROUND_TICKS == 80u,
 
 void winding_init(struct winding_model *w)
 {
-    *w = (struct winding_model){.level = DERATE_LEVELS};
+    /* The first sample completes a step: an estimate (the case's reading,
+     * nothing risen yet) from the first sensor round on. */
+    *w = (struct winding_model){.level = DERATE_LEVELS, .samples = WINDING_SAMPLES - 1u};
 }
 
 /* Sixteenths of the power limit left at temperature t (decideg) below

@@ -178,8 +178,9 @@ void fault_log_load(struct fault_log *l, const struct hal_flash *flash)
 bool fault_log_add(struct fault_log *l, const struct fault_entry *e)
 {
     uint8_t what = e->what <= FAULT_WATCHDOG ? e->what : FAULT_WATCHDOG;
-    uint32_t since = e->op_seconds - l->last_op_seconds[what];
-    bool repeat = what != FAULT_CLEARED && l->last_op_seconds[what] != 0u && since < FAULT_REPEAT_S;
+    /* last_seen: each kind's last record's operating second + 1; 0 none. */
+    uint32_t since = e->op_seconds + 1u - l->last_seen[what];
+    bool repeat = what != FAULT_CLEARED && l->last_seen[what] != 0u && since < FAULT_REPEAT_S;
     uint32_t records = l->newest + l->pending_count;
     bool over_budget = records >= FAULT_ALLOWANCE &&
                        records >= FAULT_ALLOWANCE + e->op_seconds / FAULT_SECONDS_PER_RECORD;
@@ -187,7 +188,7 @@ bool fault_log_add(struct fault_log *l, const struct fault_entry *e)
         l->not_logged = (uint16_t)(l->not_logged + (l->not_logged != UINT16_MAX));
         return false;
     }
-    l->last_op_seconds[what] = e->op_seconds != 0u ? e->op_seconds : 1u;
+    l->last_seen[what] = e->op_seconds + 1u;
     l->pending[l->pending_count++] = *e;
     return true;
 }

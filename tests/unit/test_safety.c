@@ -1,6 +1,6 @@
 /* The servo when its host is not there: the bus watchdog (items 64, 65),
- * what holds the output back (item 66, ReadMotion bits 5-7) and the
- * winding's estimate and derating (item 67), through the whole servo core,
+ * what holds the output back (item 67, ReadMotion bits 5-7) and the
+ * winding's estimate and derating (item 68), through the whole servo core,
  * request bytes in. */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -174,6 +174,12 @@ static void test_a_hot_case_derates_the_power_limit(void **state)
     int32_t winding = read_item(ITEM_WINDING_DECIC);
     print_message("# case at NTC 720: cap %u mW, winding %.1f degC\n", servo.heat_cap_mw, winding / 10.0);
     assert_true(winding > 690 && winding < 730);
+    WRITE_ITEM(0, ITEM_DERATING_ON, 0); /* the maker's behaviour: full power until 41 trips */
+    harness_run_ms(200);
+    assert_int_equal(servo.motion.power_cap_mw, 0);
+    WRITE_ITEM(0, ITEM_DERATING_ON, 1);
+    harness_run_ms(200);
+    assert_int_equal(servo.motion.power_cap_mw, servo.heat_cap_mw);
     hal.sensors.ntc = 2048;
     harness_run_ms(300);
     assert_int_equal(servo.heat_cap_mw, 0);

@@ -24,7 +24,7 @@ class Sample:
     power_w: float
     temperature_c: float  # NaN without a sensor reading
     status: list
-    limiter: str = ""     # what holds the output back (item 66); "" where not read
+    limiter: str = ""     # what holds the output back (item 67); "" where not read
 
 def _celsius(adc: int) -> float:
     celsius = ntc.celsius_or_none(adc)

@@ -41,7 +41,7 @@ class MotionSnapshot:
     time_us: int  # the servo's clock at the tick the values are from; wraps at 2**32
 
     PROFILE_ENDED, CLOCK_SLOWED, BRAKING, AT_LIMIT, RELEASED = 1, 2, 4, 8, 16
-    # What holds the output back (flags bits 5-7, item 66; docs/safety.md).
+    # What holds the output back (flags bits 5-7, item 67; docs/safety.md).
     LIMITERS = ("none", "power", "current", "stall", "supply", "heat", "angle", "watchdog")
 
     @classmethod

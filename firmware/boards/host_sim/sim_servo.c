@@ -73,6 +73,7 @@ static void motor_drive(void *ctx, int16_t duty)
     struct sim_servo *s = ctx;
     run_models(s);
     plant_drive(&s->plant, duty);
+    s->driven = true;
 }
 
 static void motor_coast(void *ctx)
@@ -80,6 +81,10 @@ static void motor_coast(void *ctx)
     struct sim_servo *s = ctx;
     run_models(s);
     plant_coast(&s->plant);
+    if (s->driven) {
+        s->driven = false;
+        s->coasted_us = s->bus->now_us;
+    }
 }
 
 static uint16_t encoder_read(void *ctx)
@@ -328,6 +333,10 @@ void sim_servo_poll(struct sim_servo *s, uint64_t now_us)
     }
     if (!s->in_bootloader || !boot_poll(s)) {
         servo_poll(&s->core);
+    }
+    if (s->core.dispatcher.heard != s->heard_seen) {
+        s->heard_seen = s->core.dispatcher.heard;
+        s->heard_us = now_us;
     }
     bool executing = !s->in_bootloader && (s->core.regs.status.status & STATUS_EXECUTING) != 0u;
     if (executing && !s->executing) {

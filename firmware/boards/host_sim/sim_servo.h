@@ -71,6 +71,12 @@ struct sim_servo {
     uint64_t executing_from_us;
     uint64_t last_execution_us;
     uint64_t last_sent_us;   /* its last frame started onto the wire */
+    /* For the bus watchdog's tests: when a frame for this servo was last
+     * carried out, and when a driven output was last let go. */
+    uint64_t heard_us;
+    uint32_t heard_seen;
+    uint64_t coasted_us;
+    bool driven;
 };
 
 /* Monotonic microseconds since the simulator started. */

@@ -242,7 +242,7 @@ void motion_guard(struct motion *m, bool inhibit, bool derate, uint16_t power_ca
  * what is queued or buffered; no answer is owed and no command counted
  * (the bus watchdog). */
 void motion_stop(struct motion *m, uint8_t method);
-/* What holds the output back at this tick (enum limiter, item 66): a
+/* What holds the output back at this tick (enum limiter, item 67): a
  * protection or the watchdog (the registers' held_by), else the limit the
  * controller is at, else a clamped target, else none. */
 static inline uint8_t motion_limiter(const struct motion *m)

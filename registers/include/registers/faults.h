@@ -29,7 +29,7 @@ struct fault_entry {
     uint16_t voltage_mv;
     uint16_t current_ma;
     uint16_t power_mw;
-    int16_t winding_decic;  /* item 67 */
+    int16_t winding_decic;  /* item 68 */
     int16_t case_decic;     /* the NTC's reading in 0.1 degC */
     uint8_t what;           /* enum fault_kind */
 };

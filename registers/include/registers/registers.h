@@ -18,7 +18,7 @@ enum store_flag {
     STORE_AWAITS_ERASE = 1u << 3, /* the last change was refused: no erased slot */
 };
 
-/* What holds the output back at this instant (item 66, ReadMotion's
+/* What holds the output back at this instant (item 67, ReadMotion's
  * motion_flags bits 5-7), the first that applies in this order: the
  * watchdog has acted; a protection releases it (the supply, heat); the
  * controller is at its limit, and which limit that is; a target was
@@ -61,7 +61,7 @@ struct registers {
     struct firmware_area firmware;
     struct store_health store;
     /* What a protection or the watchdog holds the output back by (enum
-     * limiter; 0 none): item 66 is this, else the motion's own limit. */
+     * limiter; 0 none): item 67 is this, else the motion's own limit. */
     uint8_t held_by;
 };
 

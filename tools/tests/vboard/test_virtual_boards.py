@@ -128,6 +128,34 @@ def test_protections_under_injected_faults(one):
     assert servo.read("status") & (1 << 7)
 
 
+def test_the_safety_features_on_the_real_images(one):
+    """The bus watchdog, what holds the output back, the winding's estimate
+    and the fault history in the board's own flash pages, across a power
+    cycle (docs/safety.md)."""
+    sim, bus, servo = one
+    state = sim.state(1)
+    assert abs(servo.read("winding_temperature") / 10 - state["winding"]) < 2.0  # at rest: the case's
+    servo.write("watchdog_action", 2)
+    servo.write("watchdog_ms", 50)
+    servo.move(300, interval_ms=100)
+    sim.sleep(0.3)  # silent: the watchdog lets go
+    m = servo.read_motion()
+    assert m.limiter == "watchdog" and m.flags & m.RELEASED
+    sim.control("supply 3500")
+    sim.sleep(0.2)
+    sim.control("supply 7400")
+    sim.sleep(0.3)
+    sim.control("powercycle 1")
+    sim.sleep(0.5)  # the bootloader's window, then the application
+    faults = servo.faults()
+    assert [f.kind for f in faults] == ["low_voltage", "watchdog"]
+    assert faults[1].angle_decideg > 0 and faults[0].voltage_mv < 4000
+    assert servo.read("watchdog_ms") == 0  # in RAM: off again after the power cycle
+    servo.clear_faults()
+    sim.sleep(0.1)
+    assert servo.faults() == []
+
+
 def test_sync_monitor_and_sync_moves_on_a_bus(tmp_path, board):
     sim = start(tmp_path, board, ids=(1, 2, 3))
     with sim.bus(timeout=0.3) as bus:
