@@ -14,6 +14,9 @@
  *          firmware runs them (sensors, protection monitors, motion,
  *          status) on the same followed move, sensors at their healthy
  *          readings: one region per tick, for the worst tick
+ *   safety_pass  what the main loop's pass runs after each of those ticks
+ *          (safety_tend): the bus watchdog (on, never firing), the winding's
+ *          sample and its model's step every 80 ms
  * The runner takes the HAL double's own instructions (hal_double.c, found
  * by the plugin's per-block profile) off every tick region; the firmware's
  * calls to it stay in. */
@@ -26,6 +29,7 @@
 #include "doubles/ideal_encoder.h"
 #include "motion/motion.h"
 #include "app/servo.h"
+#include "app/servo_safety.h"
 
 #define MOTION_BENCH_TICKS 2000u
 
@@ -101,12 +105,16 @@ int main(void)
     hal.sensors.current = 300;
     servo_init(&servo, &hal.port);
     servo.motion.soft_start_pending = 0;
+    servo.regs.firmware.watchdog_ms = 60000; /* on, counting; it never fires here */
     must_accept(motion_submit(&servo.motion, &follow), "the servo's followed move");
     for (unsigned i = 0; i < MOTION_BENCH_TICKS; i++) {
         hal.encoder_raw = follow_raw[i];
         bench_begin();
         servo_control_tick(&servo);
         bench_end("servo_tick");
+        bench_begin();
+        safety_tend(&servo);
+        bench_end("safety_pass");
     }
     if (servo.regs.status.status & ~STATUS_EXECUTING) {
         printf("bench: the servo's monitors tripped (status %#x)\n", servo.regs.status.status);

@@ -30,8 +30,12 @@ def cmd_info(bus, args):
     print(f"  model        0x{s.read('model'):04x}")
     print(f"  firmware     0x{s.read('firmware'):04x}")
     print(f"  serial       0x{s.read('serial'):08x}")
-    for name, value in _safety(s).items():
-        print(f"  {name:<12} {value}")
+    safety = _safety(s)
+    if safety:
+        print(f"  winding      {safety['winding_c']:.1f} degC (estimated; derating "
+              f"{'on' if safety['derating'] else 'off'})")
+        print(f"  limiter      {safety['limiter']}")
+        print(f"  watchdog     {safety['watchdog']}")
     return 0
 
 
@@ -39,7 +43,8 @@ def _safety(s: Servo) -> dict:
     """This firmware's items 64-67; none from a servo without them."""
     try:
         watchdog, action = s.read("watchdog_ms"), s.read("watchdog_action")
-        return {"winding_c": s.read("winding_temperature") / 10, "limiter": MotionSnapshot.LIMITERS[s.read("limiter")],
+        return {"winding_c": s.read("winding_temperature") / 10, "derating": s.read("derating"),
+                "limiter": MotionSnapshot.LIMITERS[s.read("limiter")],
                 "watchdog": f"{watchdog} ms, then {('hold', 'damp', 'release')[action]}" if watchdog else "off"}
     except ServoError:
         return {}

@@ -40,7 +40,7 @@ def test_the_boards_are_the_builds():
     boards = img.boards()
     assert set(boards) == folders >= {"stm32f103", "stm32f030k6", "qemu_stm32vl", "host_sim"}
     assert boards["stm32f030k6"].id == 0x0030 and boards["stm32f103"].id == 0x0103
-    assert boards["stm32f030k6"].flash == (0x08001100, 0x08007800)  # 26 KB less the header
+    assert boards["stm32f030k6"].flash == (0x08001100, 0x08007000)  # 24 KB less the header
     assert boards["stm32f103"].ram == (0x20000000, 0x20005000 - 16)
     assert boards["host_sim"].id == 0x5100 and boards["host_sim"].flash is None  # never executed
 

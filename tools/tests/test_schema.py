@@ -45,7 +45,7 @@ LAST_ITEM = "what = \"shifts the zero every angle read and written refers to\"},
     (_with(SCHEMA, "factory = 3000,", "factory = 70000,"), "soft_start_time"),
     (_with(SCHEMA, "{id = 33,", "{id = 60,"), "consecutive IDs from 32"),
     (_with(SCHEMA, 'access = "reserved"', 'access = "hidden"'), "access one of"),
-    (_with(SCHEMA, "length = 6\n", "length = [6, 3]\n"), "length is a number"),
+    (_with(SCHEMA, "length = [3, 6]\n", "length = [6, 3]\n"), "length is a number"),
     (_with(SCHEMA, 'request = [["id", "u8", "", "servo ID"]]', 'request = [["id", "u9", "", "x"]]'), "type"),
     (_with(SCHEMA, LAST_ITEM, LAST_ITEM + "  {id = 54},\n"), "no area"),
     (_with(SCHEMA, LAST_ITEM, LAST_ITEM + NEW_ITEM),
@@ -100,7 +100,7 @@ with Simulator(ids=[1]) as sim:
 
 def test_a_new_item_and_a_new_packet_need_the_schema_and_the_handler_only(tmp_path):
     """A copy of the tree, changed in two files: schema.toml gains user item
-    54 and packet 0x43 (and room for the batch packets, which grow with the
+    54 and packet 0x45 (and room for the batch packets, which grow with the
     user area), and handlers_data.c gains handle_echo(). Its
     servo_sim builds and answers both, its servoctl knows both (config dump
     lists the item), and its docs/protocol.md describes both."""
@@ -140,5 +140,5 @@ def test_a_new_item_and_a_new_packet_need_the_schema_and_the_handler_only(tmp_pa
     text = (docs / "protocol.md").read_text(encoding="utf-8")
     assert "| 0x45 (69) | [Echo](protocol-packets.md#0x45-echo) |" in text
     assert "| 54 | test_hold_ms | 2 | u16 | read-write | 0..1000 | 250 | ms |" in text
-    assert "## 0x43 Echo" in (docs / "protocol-packets.md").read_text(encoding="utf-8")
+    assert "## 0x45 Echo" in (docs / "protocol-packets.md").read_text(encoding="utf-8")
     shutil.rmtree(build)

@@ -72,8 +72,8 @@ static void state_of(const struct sim_control *c, const struct sim_servo *s, cha
              "supply=%.3f "
              "load=%.3f stop=%s status=0x%02x reported=%d collisions=%lu dropped_ticks=%u "
              "most_behind_ms=%.1f baud=%u host_baud=%u baud_mismatches=%lu rx_overruns=%u "
-             "rx_lost=%u flash_stall_ms=%.2f saves=%u mode=%s version=0x%04x resets_power=%u serial=0x%08x "
-             "heard_ms=%.3f coasted_ms=%.3f winding_estimate=%.1f\n",
+             "rx_lost=%u flash_stall_ms=%.2f saves=%u mode=%s version=0x%04x resets_power=%u "
+             "heard_ms=%.3f coasted_ms=%.3f winding_estimate=%.1f serial=0x%08x\n",
              sim_servo_bus_id(s), (double)c->bus->now_us / 1000.0, (double)s->last_execution_us / 1000.0,
              (double)s->last_sent_us / 1000.0, plant_angle_deg(&s->plant),
              s->plant.velocity * 180.0 / M_PI,
@@ -85,8 +85,8 @@ static void state_of(const struct sim_control *c, const struct sim_servo *s, cha
              c->bus->baud_mismatches, (unsigned)s->rx.overruns, (unsigned)s->core.rx_lost,
              (double)s->flash_stall_us / 1000.0, (unsigned)s->core.store.sequence,
              s->in_bootloader ? "bootloader" : "app", (unsigned)s->core.regs.status.firmware_version,
-             s->power_ups, (unsigned)sim_servo_serial(s), (double)s->heard_us / 1000.0,
-             (double)s->coasted_us / 1000.0, (double)s->core.regs.firmware.winding_decic / 10.0);
+             s->power_ups, (double)s->heard_us / 1000.0, (double)s->coasted_us / 1000.0,
+             (double)s->core.regs.firmware.winding_decic / 10.0, (unsigned)sim_servo_serial(s));
 }
 
 /* "hostsend MS HEX": the host's bytes on the wire from simulated time MS

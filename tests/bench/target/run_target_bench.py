@@ -249,6 +249,10 @@ def figures(cpu: str, profile_region: str = "", by_line: bool = False) -> dict:
         # (each tick is a region): a slow reading's turn, a profile segment.
         "servo_tick": per_tick(motion, "servo_tick", nticks),
         "servo_tick_worst": motion["servo_tick.worst"],
+        # The pass after each of those ticks (safety_tend): the watchdog,
+        # the winding's sample and model; outside the control tick.
+        "safety_pass": per_tick(motion, "safety_pass", nticks),
+        "safety_pass_worst": motion["safety_pass.worst"],
         "plan": max(plans.values()),
     }
     out.update({k: v for k, v in proto.items() if k.startswith(("answer_", "request_"))})
