@@ -56,9 +56,13 @@ void motion_read_angle(const struct motion *m, struct motion_angle *out)
     out->single_turn_decideg = (int16_t)wrap_single_turn(angle, turns);
 }
 
+/* One unsigned comparison for the common case (within range). */
 static int16_t saturate_i16(int32_t v)
 {
-    return (int16_t)(v > INT16_MAX ? INT16_MAX : v < -INT16_MAX ? -INT16_MAX : v);
+    if ((uint32_t)(v + INT16_MAX) > 2u * INT16_MAX) {
+        v = v < 0 ? -INT16_MAX : INT16_MAX;
+    }
+    return (int16_t)v;
 }
 
 /* Errors this large (1638 deg) already saturate the answer's centidegrees;
@@ -73,18 +77,29 @@ void motion_read_diagnostics(const struct motion *m, struct motion_diagnostics *
     /* decideg per tick Q8 to decideg per s: x 1000 / 256 = x 125 / 32. */
     int32_t error_q8 = setpoint - m->measured_q8;
     int64_t target = controlled ? m->profile.target : q8_to_q32(m->measured_q8);
+    /* The flags and motion_limiter()'s value, each test made once. */
+    uint32_t flags = DIAG_RELEASED;
+    uint32_t limiter = LIMITER_NONE;
+    if (controlled) {
+        int8_t at_limit = m->controller.at_limit;
+        flags = (m->tick >= m->profile.total_ticks ? DIAG_PROFILE_ENDED : 0u) |
+                (m->clock_rate != CLOCK_REAL_TIME ? DIAG_CLOCK_SLOWED : 0u) |
+                (m->braking ? DIAG_BRAKING : 0u) | (at_limit != 0 ? DIAG_AT_LIMIT : 0u);
+        limiter = at_limit != 0 ? m->drive_limiter : m->angle_clamped ? LIMITER_ANGLE : LIMITER_NONE;
+    }
+    if (m->regs->held_by != 0u) {
+        limiter = m->regs->held_by;
+    }
     *out = (struct motion_diagnostics){
         .angle_decideg = q8_to_decideg(m->measured_q8 - offset),
         .setpoint_decideg = q8_to_decideg(setpoint - offset),
         .target_decideg = (int32_t)((target - q8_to_q32(offset) + (DECIDEG_Q32 / 2)) >> 32),
-        .velocity_decideg_s = saturate_i16(m->measured_velocity_q8 * 125 / 32),
-        .tracking_error_centideg = saturate_i16(sat_q(error_q8, TRACKING_ERROR_SPAN_Q8) * 10 / 256),
-        .flags = (uint8_t)((controlled && m->tick >= m->profile.total_ticks ? DIAG_PROFILE_ENDED : 0u) |
-                           (controlled && m->clock_rate != CLOCK_REAL_TIME ? DIAG_CLOCK_SLOWED : 0u) |
-                           (controlled && m->braking ? DIAG_BRAKING : 0u) |
-                           (motion_output_at_limit(m) != 0 ? DIAG_AT_LIMIT : 0u) |
-                           (controlled ? 0u : DIAG_RELEASED) |
-                           (uint32_t)motion_limiter(m) << LIMITER_SHIFT),
+        /* Shifts, not divisions: they round down (by less than the last
+         * digit), where a division by a power of two rounds to zero at some
+         * instructions' cost on the M0. */
+        .velocity_decideg_s = saturate_i16((m->measured_velocity_q8 * 125) >> 5),
+        .tracking_error_centideg = saturate_i16((sat_q(error_q8, TRACKING_ERROR_SPAN_Q8) * 5) >> 7),
+        .flags = (uint8_t)(flags | limiter << LIMITER_SHIFT),
     };
 }
 

@@ -138,7 +138,7 @@ enum packet_outcome handle_read_angle(const struct packet_call *c, struct respon
 }
 
 /* ReadMotion (0x40): one instant of the motion state, docs/packets.md. */
-enum { READ_MOTION_ANSWER_LENGTH = 25 };
+enum { READ_MOTION_ANSWER_LENGTH = 27 };
 
 enum packet_outcome handle_read_motion(const struct packet_call *c, struct response *r)
 {
@@ -156,6 +156,7 @@ enum packet_outcome handle_read_motion(const struct packet_call *c, struct respo
     /* The snapshot is the last tick's: it ran one period before the next. */
     const uint32_t *next_tick = c->d->next_tick_us;
     le_put_u32(&p[21], next_tick != NULL ? *next_tick - 1000000u / MOTION_TICK_HZ : 0u);
+    le_put_u16(&p[25], (uint16_t)c->d->regs->firmware.winding_decic);
     r->length = READ_MOTION_ANSWER_LENGTH;
     return OUTCOME_OK;
 }

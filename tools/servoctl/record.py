@@ -63,13 +63,13 @@ def cmd_record(bus, args):
         rows.append((round(t * 1000, 1), m.angle_decideg / 10.0, m.velocity_decideg_s / 10.0,
                      m.current_ma / 1000.0, round(planned, 2), m.setpoint_decideg / 10.0,
                      m.tracking_error_centideg / 100.0, round(planned_speed, 1), m.status,
-                     m.flags, m.limiter))
+                     m.flags, m.limiter, m.winding_decic / 10.0))
     csv_path = args.out + ".csv"
     with open(csv_path, "w", newline="") as f:
         w = csv.writer(f)
         w.writerow(["time_ms", "angle_deg", "velocity_dps", "current_a", "planned_deg",
                     "setpoint_deg", "tracking_error_deg", "planned_velocity_dps", "status",
-                    "motion_flags", "limiter"])
+                    "motion_flags", "limiter", "winding_c"])
         w.writerows(rows)
     png_path = args.out + ".png"
     _plot(rows, plan, png_path, f"servo {args.id}: {start / 10:.1f} -> {target / 10:.1f} deg",

@@ -39,6 +39,7 @@ class MotionSnapshot:
     status: int
     flags: int
     time_us: int  # the servo's clock at the tick the values are from; wraps at 2**32
+    winding_decic: int  # the winding's temperature, estimated (item 68)
 
     PROFILE_ENDED, CLOCK_SLOWED, BRAKING, AT_LIMIT, RELEASED = 1, 2, 4, 8, 16
     # What holds the output back (flags bits 5-7, item 67; docs/safety.md).

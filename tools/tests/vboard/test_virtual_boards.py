@@ -135,6 +135,7 @@ def test_the_safety_features_on_the_real_images(one):
     sim, bus, servo = one
     state = sim.state(1)
     assert abs(servo.read("winding_temperature") / 10 - state["winding"]) < 2.0  # at rest: the case's
+    assert abs(servo.read_motion().winding_decic / 10 - state["winding"]) < 2.0
     servo.write("watchdog_action", 2)
     servo.write("watchdog_ms", 50)
     servo.move(300, interval_ms=100)
