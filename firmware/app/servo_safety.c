@@ -103,18 +103,13 @@ static bool clear_faults(void *ctx)
 __attribute__((noinline)) static void watch_bus(struct servo *s)
 {
     const struct firmware_area *fw = &s->regs.firmware;
-    bool fired = s->watchdog.fired;
     if (bus_watchdog_tick(&s->watchdog, fw->watchdog_ms, !motion_is_released(&s->motion),
                           s->dispatcher.heard, s->motion.commands)) {
         static const uint8_t method[] = {
             [WATCHDOG_HOLD] = STOP_HOLD, [WATCHDOG_DAMP] = STOP_DAMPING, [WATCHDOG_RELEASE] = STOP_RELEASE};
         motion_stop(&s->motion, method[fw->watchdog_action < 3u ? fw->watchdog_action : WATCHDOG_RELEASE]);
-    }
-    if (fired != s->watchdog.fired) {
         note_held_by(s, s->regs.status.status);
-        if (s->watchdog.fired) {
-            log_fault(s, FAULT_WATCHDOG);
-        }
+        log_fault(s, FAULT_WATCHDOG);
     }
 }
 
@@ -132,7 +127,7 @@ __attribute__((noinline)) void safety_after_frame(struct servo *s)
  * lengthens the control tick. */
 void safety_tend(struct servo *s)
 {
-    if (s->regs.firmware.watchdog_ms != 0u || s->watchdog.fired) {
+    if (s->regs.firmware.watchdog_ms != 0u) {
         watch_bus(s);
     }
     uint8_t trips = (uint8_t)(s->regs.status.status & FAULT_STATUS_BITS);

@@ -12,9 +12,6 @@ bool bus_watchdog_tick(struct bus_watchdog *w, uint16_t timeout_ms, bool driven,
     } else if (w->silent_ticks != UINT16_MAX) {
         w->silent_ticks++;
     }
-    if (w->fired && commands != w->commands_at_fire) {
-        w->fired = 0; /* a motion command since: the host is back */
-    }
     if (timeout_ms == 0u || !driven || w->fired || w->silent_ticks < timeout_ms) {
         return false;
     }

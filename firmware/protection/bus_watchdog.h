@@ -18,14 +18,15 @@ struct bus_watchdog {
     uint32_t heard;        /* frames for this servo so far (the dispatcher's count) */
     uint32_t heard_seen;   /* the count at the last tick */
     uint16_t silent_ticks; /* ticks since the count last moved */
-    uint8_t fired;         /* acted; until the next motion command */
-    uint32_t commands_at_fire;
+    uint8_t fired;         /* acted; the caller clears it at the next motion command */
+    uint32_t commands_at_fire; /* motion commands when it acted */
 };
 
 /* One control tick. timeout_ms: item 64 (0 off); driven: the output is
  * under position control; heard: frames for this servo so far; commands:
- * motion commands so far. True once, on the tick the watchdog acts: the
- * caller then stops the motion as item 65 says. */
+ * motion commands so far (kept with the act, so that the caller can tell
+ * a new one). True once, on the tick the watchdog acts: the caller then
+ * stops the motion as item 65 says. */
 bool bus_watchdog_tick(struct bus_watchdog *w, uint16_t timeout_ms, bool driven, uint32_t heard,
                        uint32_t commands);
 

@@ -17,7 +17,8 @@
  *                encoder follows the setpoint instead; n bit 1: it is held
  *          3     sensors: next 3 bytes are supply (x 40 mV), current
  *                (x 20 mA) and NTC (x 16 counts)
- *          4     flash: n bit 0 every write fails; n bit 1 the power is cut
+ *          4     flash: n bit 0 every write fails (the config store's and the
+ *                fault history's); n bit 1 the power is cut
  *                at the write step the next byte names
  *          5     power cycle: the servo boots again from its flash (3 at most)
  *          6     (n+1) x 50 ms pass at once (the main loop was stalled)
@@ -245,6 +246,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             break;
         case 4:
             live.hal.flash.dead = n & 1u;
+            live.hal.fault_flash.dead = n & 1u; /* the fault history's pages too */
             if ((n & 2u) && i < size) {
                 live.hal.flash.cut_at = live.hal.flash.steps + data[i++];
                 live.hal.flash.cut_mode = (enum cut_mode)(n >> 2 & 3u);

@@ -38,7 +38,8 @@ assert len(FACTORY) == 32
 SEEDS = {
     "ping": req(1, b"\x00"),
     "reset": req(2, b"\x00"),
-    "read_every_item": b"".join(req(3, bytes([0, i])) for i in list(range(1, 9)) + list(range(32, 54))),
+    "read_every_item": b"".join(req(3, bytes([0, i])) for i in list(range(1, 9)) + list(range(32, 54))
+                               + list(range(64, 69))),
     "write_items": req(4, b"\x00\x21\x01") + req(4, b"\x00\x32\xe8\x03") + req(4, b"\x00\x35\x10\x00"),
     "write_id_and_baud": req(4, b"\x00\x22\x07") + req(1, b"\x07") + req(4, b"\x07\x24\x08"),
     "batch": req(5, b"\x00") + req(6, b"\x00" + FACTORY),
@@ -200,6 +201,29 @@ SERVO_SEEDS = {
                               + ms(50)),
     "slow_uart_sync": (USED | SLOW_UART | 1 << 2, wire(req(25, bytes([22, 1, 3, 5, 0, 9]))) + ms(10)
                        + wire(resp(22, bytes(16))) + ms(10)),
+    # The bus watchdog (64, 65): each action, what item 67 and ReadMotion say, a
+    # move that clears it; a move past the angle limit (67 = angle).
+    "watchdog_release": (USED, wire(write(64, 30, 2) + write(65, 2) + move(900, 200)) + ms(60)
+                         + wire(req(3, b"\x00\x43") + req(0x40, b"\x00") + move(1800, 100)) + ms(150)
+                         + wire(req(0x40, b"\x00") + req(3, b"\x00\x43"))),
+    "watchdog_hold_then_damp": (USED, wire(write(64, 20, 2) + write(65, 0) + move(900, 100)) + ms(40)
+                                + wire(write(65, 1) + move(0, 100)) + ms(40) + wire(write(64, 0, 2))
+                                + ms(5)),
+    # The fault history (0x43, 0x44): faults with their readings, read back
+    # across a power cycle, cleared; the supply and heat held back (67).
+    "faults_read_and_cleared": (USED, wire(move(900, 300)) + sensors(3000, 100, 2048) + ms(150)
+                                + wire(req(0x40, b"\x00") + req(3, b"\x00\x43")) + HEALTHY + ms(250)
+                                + sensors(7400, 200, 500) + ms(100) + wire(req(3, b"\x00\x43")) + HEALTHY
+                                + ms(250) + POWER_CYCLE + ms(5)
+                                + wire(req(0x43, b"\x00\x00") + req(0x43, b"\x00\x01")
+                                       + req(0x43, b"\x00\x09") + req(0x44, b"\x00")) + ms(40)
+                                + POWER_CYCLE + ms(5)),
+    "fault_with_a_dead_flash": (USED, flash(dead=True) + sensors(3000, 100, 2048) + ms(150) + HEALTHY
+                                + ms(250) + flash(dead=False) + sensors(9600, 100, 2048) + ms(150)
+                                + HEALTHY + ms(100) + wire(req(0x43, b"\x00\x00"))),
+    "hot_case_derates": (USED, wire(move(900, 400)) + sensors(7400, 3000, 720) + ms(300)
+                         + wire(write(66, 0) + req(3, b"\x00\x44")) + ms(100) + wire(write(66, 1))
+                         + ms(100) + HEALTHY + ms(100)),
 }
 
 
