@@ -85,7 +85,7 @@ void motion_read_diagnostics(const struct motion *m, struct motion_diagnostics *
         flags = (m->tick >= m->profile.total_ticks ? DIAG_PROFILE_ENDED : 0u) |
                 (m->clock_rate != CLOCK_REAL_TIME ? DIAG_CLOCK_SLOWED : 0u) |
                 (m->braking ? DIAG_BRAKING : 0u) | (at_limit != 0 ? DIAG_AT_LIMIT : 0u);
-        limiter = at_limit != 0 ? m->drive_limiter : m->angle_clamped ? LIMITER_ANGLE : LIMITER_NONE;
+        limiter = motion_own_limiter(m);
     }
     if (m->regs->held_by != 0u) {
         limiter = m->regs->held_by;

@@ -245,14 +245,21 @@ void motion_stop(struct motion *m, uint8_t method);
 /* What holds the output back at this tick (enum limiter, item 67): a
  * protection or the watchdog (the registers' held_by), else the limit the
  * controller is at, else a clamped target, else none. */
+/* The motion's own part, under position control: the limit the controller
+ * is at, else a clamped target, else none. */
+static inline uint8_t motion_own_limiter(const struct motion *m)
+{
+    return m->controller.at_limit != 0 ? m->drive_limiter
+                                       : (uint8_t)(m->angle_clamped ? LIMITER_ANGLE : LIMITER_NONE);
+}
+
 static inline uint8_t motion_limiter(const struct motion *m)
 {
     uint8_t held = m->regs->held_by;
     if (held != 0u || m->mode != MODE_POSITION) {
         return held;
     }
-    return m->controller.at_limit != 0 ? m->drive_limiter
-                                       : (uint8_t)(m->angle_clamped ? LIMITER_ANGLE : LIMITER_NONE);
+    return motion_own_limiter(m);
 }
 /* Releases the output now (a stall in release mode). */
 void motion_release(struct motion *m);
