@@ -7,10 +7,12 @@
     {(id_), (size_), DATA_READ, (uint8_t)offsetof(struct status_area, field_), 0, 0, 0}
 #define USER(id_, field_, size_, access_, min_, max_, factory_)                    \
     {(id_), (size_), (uint8_t)((access_) | DATA_USER),                             \
-     (uint8_t)offsetof(struct user_config, field_), (min_), (max_), (factory_)}
+     (uint8_t)offsetof(struct user_config, field_), (uint16_t)(min_), (uint16_t)(max_), \
+     (uint16_t)(factory_)}
 #define FIRMWARE(id_, field_, size_, access_, min_, max_, factory_)                \
     {(id_), (size_), (uint8_t)((access_) | DATA_FIRMWARE),                         \
-     (uint8_t)offsetof(struct firmware_area, field_), (min_), (max_), (factory_)}
+     (uint8_t)offsetof(struct firmware_area, field_), (uint16_t)(min_), (uint16_t)(max_), \
+     (uint16_t)(factory_)}
 #define RO DATA_READ
 #define RO_SIGNED (DATA_READ | DATA_SIGNED)
 #define RW (DATA_READ | DATA_WRITE)
@@ -89,6 +91,15 @@ static void field_set(void *area, const struct data_item *it, int32_t value)
     }
 }
 
+/* v is within the item's range (its bounds read as its field is). */
+static bool in_range(int32_t v, const struct data_item *it)
+{
+    bool sign = (it->access & DATA_SIGNED) != 0u;
+    int32_t min = sign ? (int16_t)it->min : it->min;
+    int32_t max = sign ? (int16_t)it->max : it->max;
+    return v >= min && v <= max;
+}
+
 /* Little-endian wire bytes of an item, sign-extended for signed items. */
 static int32_t wire_value(const uint8_t *data, const struct data_item *it)
 {
@@ -129,7 +140,7 @@ bool user_config_valid(const struct user_config *cfg)
     for (uint8_t id = USER_FIRST; id <= USER_LAST; id++) {
         const struct data_item *it = data_table_find(id);
         int32_t v = field_get(field_of(&view, it), it);
-        if (v < it->min || v > it->max) {
+        if (!in_range(v, it)) {
             return false;
         }
     }
@@ -144,7 +155,7 @@ enum data_write_result data_table_write(struct registers *regs, uint8_t id, cons
         return DATA_WRITE_REFUSED;
     }
     int32_t value = wire_value(data, it);
-    if (value < it->min || value > it->max) {
+    if (!in_range(value, it)) {
         return DATA_WRITE_REFUSED;
     }
     if (value == field_get(field_of(regs, it), it)) {
@@ -166,23 +177,25 @@ enum data_write_result data_table_write(struct registers *regs, uint8_t id, cons
     return DATA_WRITE_CHANGED;
 }
 
+/* Each item of IDs first..last to its factory value, in area (its struct,
+ * cleared first). */
+static void area_factory(void *area, size_t size, uint8_t first, uint8_t last)
+{
+    memset(area, 0, size);
+    for (uint8_t id = first; id <= last; id++) {
+        const struct data_item *it = data_table_find(id);
+        field_set(area, it, it->factory);
+    }
+}
+
 void user_config_factory(struct user_config *cfg)
 {
-    struct user_config factory = {0};
-    for (uint8_t id = USER_FIRST; id <= USER_LAST; id++) {
-        const struct data_item *it = data_table_find(id);
-        field_set(&factory, it, it->factory);
-    }
-    *cfg = factory;
+    area_factory(cfg, sizeof *cfg, USER_FIRST, USER_LAST);
 }
 
 void firmware_area_factory(struct firmware_area *area)
 {
-    *area = (struct firmware_area){0};
-    for (uint8_t id = FIRMWARE_FIRST; id <= FIRMWARE_LAST; id++) {
-        const struct data_item *it = data_table_find(id);
-        field_set(area, it, it->factory);
-    }
+    area_factory(area, sizeof *area, FIRMWARE_FIRST, FIRMWARE_LAST);
 }
 
 void user_config_reset(struct user_config *cfg)

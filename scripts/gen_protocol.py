@@ -94,6 +94,9 @@ def schema_items_h(s: sch.Schema) -> str:
 
     bits = "".join(f"    STATUS_{b.name.upper()} = 1u << {b.bit},\n" for b in s.status_bits)
     access = {"read": "RO", "read-write": "RW", "reserved": "RESERVED"}
+    for i in user + firmware:  # data_table.h keeps their bounds in 16 bits
+        if i.size > 2 and i.access != "read":
+            raise SystemExit(f"item {i.id}: a writable item of {i.size} bytes (data_table.h takes 1 or 2)")
     rows = [f"RO_STATUS({i.id}, {i.field}, {i.size})," for i in status]
     rows += [f"USER({i.id}, {i.field}, {i.size}, {access[i.access] + ('_SIGNED' if i.signed else '')}, "
              f"{i.min}, {i.max}, {i.factory})," for i in user]

@@ -23,9 +23,11 @@ struct data_item {
     uint8_t size;     /* bytes on the wire: 1, 2 or 4 */
     uint8_t access;   /* enum data_access */
     uint8_t offset;   /* offsetof() in its area's struct */
-    int32_t min;      /* accepted range for writes, inclusive */
-    int32_t max;
-    int32_t factory;  /* user area: factory value (docs/protocol.md) */
+    /* The writable items are 1 or 2 bytes: these are the field's own bits
+     * (signed where the access says DATA_SIGNED; data_item_limit()). */
+    uint16_t min;     /* accepted range for writes, inclusive */
+    uint16_t max;
+    uint16_t factory; /* factory value (docs/protocol.md) */
 };
 
 /* Largest item: the serial number, 4 bytes. */
