@@ -24,16 +24,21 @@ static bool arrived(const struct motion *m)
 }
 
 /* Turning without end (wheel run) must not outgrow the tick count: the
- * profile restarts its clock before it gets large. */
-enum { REBASE_TICKS = 1u << 24 };
-
+ * profile restarts its clock before it gets large (endless_until is
+ * REBASE_TICKS). A stream whose next setpoint is late stops there instead,
+ * from where its setpoint is, within the output's braking, and holds. */
 static void rebase_endless(struct motion *m)
 {
-    if (m->tick >= REBASE_TICKS) {
-        int64_t v = m->profile.cruise;
-        profile_plan_endless(&m->profile, q8_to_q32(m->setpoint_q8), v, v, 0);
-        motion_clock_restart(m);
+    if (m->tick < m->endless_until) {
+        return;
     }
+    if (m->streaming) {
+        motion_stop(m, STOP_HOLD);
+        return;
+    }
+    int64_t v = m->profile.cruise;
+    profile_plan_endless(&m->profile, q8_to_q32(m->setpoint_q8), v, v, 0);
+    motion_clock_restart(m);
 }
 
 /* The multi-turn reading stays within +-MULTI_TURN_LIMIT whatever turns the
@@ -148,7 +153,7 @@ static void advance_clock(struct motion *m)
         if (profile_walk_next(&m->walk, &m->profile)) {
             motion_take_accel_duty(m, m->walk.tick + 1u);
         }
-        m->profile_at_next_tick_q8 = q32_to_q8_sat(m->walk.at, TARGET_LIMIT_Q8);
+        m->profile_at_next_tick_q8 = q32_to_q8_sat(m->walk.at);
         if (m->tick == m->accel_from) {
             m->accel_duty = m->accel_duty_next;
         } else if (m->tick == 1u) {

@@ -6,6 +6,13 @@
 #include "motion/gains.h"
 #include "motion/saturate.h"
 
+#if !defined(__ARM_FEATURE_SAT) && defined(SERVO_SIZE_FIRST)
+__attribute__((noinline)) int32_t sat_q(int32_t v, int32_t limit)
+{
+    return v > limit - 1 ? limit - 1 : v < -limit ? -limit : v;
+}
+#endif
+
 /* Input ranges that keep every product within int32 (the gains: kv +
  * viscous < 2^15.3 down to GAIN_MIN_SUPPLY_MV, KP < 2^10, KD and DAMPING
  * < 2^13); the output saturates far inside each. */

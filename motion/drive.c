@@ -78,6 +78,7 @@ void motion_coast(struct motion *m)
 {
     m->mode = MODE_RELEASED;
     m->running = 0;
+    m->streaming = 0;
     m->controller.at_limit = 0;
     m->hal->motor.coast(m->hal->ctx);
 }

@@ -1,5 +1,5 @@
 /* The motion layer's start (the power-on state, 46) and what the
- * protection monitors ask of the output. The layer's parts: setpoint.c,
+ * protection monitors ask of the output. The layer's parts: setpoint.c, stream.c,
  * position.c, drive.c, planning.c, command_queue.c and control_tick.c. */
 #include "motion/motion.h"
 
@@ -23,7 +23,8 @@ static void hold_here(struct motion *m)
 
 void motion_init(struct motion *m, const struct registers *regs, const struct hal_port *hal)
 {
-    *m = (struct motion){.regs = regs, .hal = hal, .soft_start_pending = 1};
+    *m = (struct motion){.regs = regs, .hal = hal, .soft_start_pending = 1,
+                        .stream_period_ms = STREAM_DEFAULT_PERIOD_MS};
     encoder_start(&m->encoder, hal->motor.read_encoder(hal->ctx));
     m->measured_q8 = counts_to_q8(m->encoder.counts);
     motion_update_limits(m);

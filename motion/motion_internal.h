@@ -30,6 +30,12 @@ enum { FOLLOW_GAP_Q8 = 5 << 8, FOLLOW_SPEED_Q8 = 64 };
  * int32, with the right sign. */
 #define TARGET_LIMIT_Q8 (1 << 30)
 
+/* A wheel's endless_until: its clock restarts there (control_tick.c). */
+enum { REBASE_TICKS = 1u << 24 };
+
+/* A stream's period until the host's stamps tell: 50 Hz (stream.c). */
+enum { STREAM_DEFAULT_PERIOD_MS = 20 };
+
 /* The profile's clock (control_tick.c, "the profile's clock"). */
 enum {
     LEAD_FREE_Q8 = 5 << 8, /* 0.5 degree */
@@ -49,12 +55,19 @@ static inline int64_t q8_to_q32(int32_t v)
     return (int64_t)v * ((int64_t)1 << 24);
 }
 
-/* Q32 to Q8 (decideg, or decideg per tick), saturated to +-limit. */
-static inline int32_t q32_to_q8_sat(int64_t v, int32_t limit)
+/* Q32 to Q8 (decideg, or decideg per tick), saturated to +-TARGET_LIMIT. */
+static inline int32_t q32_to_q8_sat_inline(int64_t v)
 {
     int64_t q8 = v >> 24;
-    return q8 > limit ? limit : q8 < -limit ? -limit : (int32_t)q8;
+    return q8 > TARGET_LIMIT_Q8 ? TARGET_LIMIT_Q8 : q8 < -TARGET_LIMIT_Q8 ? -TARGET_LIMIT_Q8 : (int32_t)q8;
 }
+/* A call where size comes first (SERVO_SIZE_FIRST: the Cortex-M0):
+ * setpoint.c. */
+#ifdef SERVO_SIZE_FIRST
+int32_t q32_to_q8_sat(int64_t v);
+#else
+#define q32_to_q8_sat q32_to_q8_sat_inline
+#endif
 
 /* The center offset (53), decideg Q8: protocol angles are measured minus this. */
 static inline int32_t motion_center_offset_q8(const struct motion *m)
@@ -95,6 +108,10 @@ void motion_coast(struct motion *m);
 /* ---- planning.c ---- */
 /* Runs a command now: its profile, or the mode it sets. */
 void motion_run(struct motion *m, const struct motion_command *cmd);
+/* The angle modes' top speed, 0.1 deg/s (docs/protocol.md, "Moves"). */
+enum { MAX_VELOCITY = 7500 };
+/* Starts following the profile just planned; then end (enum motion_end). */
+void motion_begin_profile(struct motion *m, uint8_t end);
 
 /* ---- command_queue.c ---- */
 /* The running command has finished: answer, release or hold, next one. */

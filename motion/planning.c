@@ -11,7 +11,6 @@ enum {
     MIN_RAMP_MS = 20,
     MAX_INTERVAL_MS = 4096000,
     MIN_VELOCITY = 10,     /* 0.1 deg/s */
-    MAX_VELOCITY = 7500,
     MAX_WHEEL_SPEED = 750, /* deg/s, the angle modes' top speed */
     WHEEL_RAMP_MS = 20,
 };
@@ -55,14 +54,14 @@ static void start_state(const struct motion *m, int64_t *start, int64_t *v0)
     }
 }
 
-static void begin_profile(struct motion *m, uint8_t end)
+void motion_begin_profile(struct motion *m, uint8_t end)
 {
     if (m->mode != MODE_POSITION) {
         controller_reset(&m->controller);
     }
     m->mode = MODE_POSITION;
     motion_clock_restart(m);
-    m->last_setpoint_q8 = m->setpoint_q8 - q32_to_q8_sat(m->profile.v0, TARGET_LIMIT_Q8); /* moving at v0 */
+    m->last_setpoint_q8 = m->setpoint_q8 - q32_to_q8_sat(m->profile.v0); /* moving at v0 */
     m->end = end;
     m->running = 1;
 }
@@ -78,7 +77,7 @@ static int64_t velocity_q32(uint32_t decideg_per_s)
  * least min_ticks): the target is where that ends. Plans: it divides. */
 static void plan_stop(struct motion *m, int64_t start, int64_t v0, uint32_t min_ticks)
 {
-    int32_t v = q32_to_q8_sat(v0, INT32_MAX);
+    int32_t v = q32_to_q8_sat(v0);
     uint64_t speed = (uint64_t)(v < 0 ? -(int64_t)v : v);
     uint64_t per_tick = (uint64_t)motion_brake_duty(m, v) << 8; /* x ka: decideg Q8 per tick^2 */
     uint64_t n = div64_u(speed * (uint64_t)m->drive.ka + per_tick - 1u, per_tick);
@@ -129,7 +128,7 @@ static void run_angle(struct motion *m, const struct motion_command *cmd)
         timing = profile_velocity_timing(target - start, v0, velocity_q32(v), acc, dec);
     }
     profile_plan(&m->profile, start, v0, target, timing);
-    begin_profile(m, END_HOLD);
+    motion_begin_profile(m, END_HOLD);
 }
 
 static void run_wheel(struct motion *m, const struct motion_command *cmd)
@@ -145,8 +144,9 @@ static void run_wheel(struct motion *m, const struct motion_command *cmd)
     start_state(m, &start, &v0);
     if (action == WHEEL_RUN && speed != 0u) {
         profile_plan_endless(&m->profile, start, v0, v, WHEEL_RAMP_MS);
-        begin_profile(m, END_HOLD);
+        motion_begin_profile(m, END_HOLD);
         m->endless = 1;
+        m->endless_until = REBASE_TICKS;
         return;
     }
     struct profile_timing timing = {WHEEL_RAMP_MS, 0, WHEEL_RAMP_MS};
@@ -164,11 +164,11 @@ static void run_wheel(struct motion *m, const struct motion_command *cmd)
     } else {
         /* Stop: come to rest within one ramp, or as fast as the motor can. */
         plan_stop(m, start, v0, WHEEL_RAMP_MS);
-        begin_profile(m, end);
+        motion_begin_profile(m, end);
         return;
     }
     profile_plan(&m->profile, start, v0, target, timing);
-    begin_profile(m, end);
+    motion_begin_profile(m, end);
 }
 
 static void run_stop(struct motion *m, const struct motion_command *cmd)
@@ -182,7 +182,7 @@ static void run_stop(struct motion *m, const struct motion_command *cmd)
         } else {
             plan_stop(m, q8_to_q32(m->measured_q8), q8_to_q32(m->measured_velocity_q8), 0);
         }
-        begin_profile(m, END_HOLD);
+        motion_begin_profile(m, END_HOLD);
         break;
     case STOP_DAMPING:
         m->mode = MODE_DAMPING;
@@ -197,6 +197,7 @@ static void run_stop(struct motion *m, const struct motion_command *cmd)
 void motion_run(struct motion *m, const struct motion_command *cmd)
 {
     m->endless = 0;
+    m->streaming = 0;
     m->angle_clamped = 0;
     m->answer_packet = cmd->answer_when_done ? cmd->packet : 0u;
     m->power_mw = cmd->power_mw;

@@ -53,6 +53,7 @@ void profile_plan(struct profile *p, int64_t start, int64_t v0, int64_t target,
     p->v0 = v0;
     p->cruise = v;
     p->accel_k = n1 ? div_round((v - v0) * 256, 2 * n1) : 0;
+    p->accel_j = 0;
     p->decel_k = n3 ? div_round(v * 256, 2 * n3) : 0;
     p->accel_ticks = (uint32_t)n1;
     p->cruise_end = (uint32_t)(n1 + nc);
@@ -68,11 +69,40 @@ void profile_plan_endless(struct profile *p, int64_t start, int64_t v0, int64_t 
     p->v0 = v0;
     p->cruise = velocity;
     p->accel_k = accel ? div_round((velocity - v0) * 256, 2 * (int64_t)accel) : 0;
+    p->accel_j = 0;
     p->decel_k = 0;
     p->accel_ticks = accel;
     p->cruise_end = UINT32_MAX;
     p->total_ticks = UINT32_MAX;
     p->cruise_start = start + v0 * (int64_t)accel + quadratic(p->accel_k, accel);
+}
+
+/* p(t) = start + v0 t + c t^2 + d t^3 with p(T) = target, p'(T) = v1:
+ *     c = (3 D - (2 v0 + v1) T) / T^2,  d = ((v0 + v1) T - 2 D) / T^3.
+ * Within the segment's limits (profile.h) both numerators fit int32 in Q8
+ * (|3D| <= 2^23.6, |(2 v0 + v1) T| <= 2^27.6), so each coefficient is one
+ * division of a Q40 numerator within 2^60; the coefficients then keep
+ * every product here, in profile_position and in the walk within 2^61. */
+void profile_plan_segment(struct profile *p, int32_t start_q8, int32_t v0_q8, int32_t target_q8,
+                          int32_t v1_q8, uint32_t ticks)
+{
+    const int64_t q24 = (int64_t)1 << 24, q32 = (int64_t)1 << 32;
+    int32_t t = (int32_t)ticks;
+    int32_t d = target_q8 - start_q8;
+    int64_t tt = (int64_t)t * t;
+    p->start = start_q8 * q24;
+    p->target = target_q8 * q24;
+    p->v0 = v0_q8 * q24;
+    p->cruise = v1_q8 * q24;
+    p->cruise_start = p->target;
+    p->accel_k = div_round((3 * d - (2 * v0_q8 + v1_q8) * t) * q32, tt);
+    p->accel_j = div_round(((v0_q8 + v1_q8) * t - 2 * d) * q32, tt * t);
+    p->decel_k = 0;
+    p->accel_ticks = ticks;
+    /* At rest at the end: a move that ends there, which the braking guard
+     * watches. Else on at v1 for ever. */
+    p->cruise_end = v1_q8 != 0 ? UINT32_MAX : ticks;
+    p->total_ticks = p->cruise_end;
 }
 
 struct profile_timing profile_velocity_timing(int64_t distance, int64_t v0, int64_t vmax,
@@ -117,7 +147,11 @@ struct profile_timing profile_velocity_timing(int64_t distance, int64_t v0, int6
 int64_t profile_position(const struct profile *p, uint32_t tick)
 {
     if (tick < p->accel_ticks) {
-        return p->start + p->v0 * (int64_t)tick + quadratic(p->accel_k, tick);
+        int64_t at = p->start + p->v0 * (int64_t)tick + quadratic(p->accel_k, tick);
+        /* A segment's cubic alone: the trapezoid's planning pays nothing for
+         * it. t^3 < 2^30 (PROFILE_MAX_SEGMENT), j t^3 within 2^60
+         * (profile_plan_segment), rounded once. */
+        return p->accel_j != 0 ? at + ((p->accel_j * (int64_t)(tick * tick * tick)) >> 8) : at;
     }
     if (tick < p->cruise_end) {
         return p->cruise_start + p->cruise * (int64_t)(tick - p->accel_ticks);
@@ -131,13 +165,20 @@ int64_t profile_position(const struct profile *p, uint32_t tick)
 void profile_walk_start(struct profile_walk *w, const struct profile *p, uint32_t tick)
 {
     /* p(t + 1) - p(t) of each phase's closed form, in Q40: v0 + k (2t + 1)
-     * ramping up, V cruising, dk (2r - 1) ramping down (r = T - t). The
-     * products are those profile_position bounds. */
+     * + j (3t^2 + 3t + 1) ramping up (j: a segment's cubic), V cruising,
+     * dk (2r - 1) ramping down (r = T - t). The products are those
+     * profile_position bounds. */
     w->at = profile_position(p, tick);
     w->tick = tick;
+    w->jerk_q40 = 0;
     if (tick < p->accel_ticks) {
         w->step_q40 = p->v0 * 256 + p->accel_k * (2 * (int64_t)tick + 1);
         w->change_q40 = 2 * p->accel_k;
+        if (p->accel_j != 0) { /* a segment: tick < PROFILE_MAX_SEGMENT, 32 bits */
+            w->step_q40 += p->accel_j * (int64_t)(3u * tick * (tick + 1u) + 1u);
+            w->change_q40 += p->accel_j * (int64_t)(6u * tick + 6u);
+            w->jerk_q40 = 6 * p->accel_j;
+        }
         w->phase_end = p->accel_ticks;
     } else if (tick < p->cruise_end) {
         w->step_q40 = p->cruise * 256;

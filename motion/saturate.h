@@ -10,6 +10,9 @@
  * tracker). */
 #if defined(__ARM_FEATURE_SAT)
 #define sat_q(v, limit) ((int32_t)__builtin_arm_ssat((int)(v), (unsigned)__builtin_ctz((unsigned)(limit)) + 1u))
+#elif defined(SERVO_SIZE_FIRST)
+/* A call where size comes first (the Cortex-M0): controller.c. */
+int32_t sat_q(int32_t v, int32_t limit);
 #else
 static inline int32_t sat_q(int32_t v, int32_t limit)
 {

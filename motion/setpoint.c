@@ -3,11 +3,18 @@
  * profile's phase. */
 #include "motion/motion_internal.h"
 
+#ifdef SERVO_SIZE_FIRST
+__attribute__((noinline)) int32_t q32_to_q8_sat(int64_t v)
+{
+    return q32_to_q8_sat_inline(v);
+}
+#endif
+
 void motion_take_profile_q8(struct motion *m, int64_t at_tick)
 {
-    m->profile_at_tick_q8 = q32_to_q8_sat(at_tick, TARGET_LIMIT_Q8);
-    m->profile_at_next_tick_q8 = q32_to_q8_sat(m->walk.at, TARGET_LIMIT_Q8);
-    m->target_q8 = q32_to_q8_sat(m->profile.target, TARGET_LIMIT_Q8);
+    m->profile_at_tick_q8 = q32_to_q8_sat(at_tick);
+    m->profile_at_next_tick_q8 = q32_to_q8_sat(m->walk.at);
+    m->target_q8 = q32_to_q8_sat(m->profile.target);
     m->setpoint_q8 = m->profile_at_tick_q8 + (((m->profile_at_next_tick_q8 - m->profile_at_tick_q8) * m->tick_frac) >> 8);
 }
 

@@ -1,4 +1,4 @@
-/* Packets that command or read the motion layer: 7-19, 23, 24. They decode
+/* Packets that command or read the motion layer: 7-19, 23, 24, 0x40, 0x45. They decode
  * the request into a struct motion_command and leave clamping, limits and
  * timing to the motion layer. */
 #include <stddef.h>
@@ -126,6 +126,17 @@ enum packet_outcome handle_stop(const struct packet_call *c, struct response *r)
         return OUTCOME_ERROR;
     }
     return motion_submit(c->d->motion, &cmd) == MOTION_ACCEPTED ? OUTCOME_OK : OUTCOME_ERROR;
+}
+
+enum packet_outcome handle_stream_setpoint(const struct packet_call *c, struct response *r)
+{
+    (void)r;
+    const struct motion_setpoint sp = {
+        .angle_decideg = le_get_i32(&c->content[1]),
+        .velocity_decideg_s = le_get_i16(&c->content[5]),
+        .host_ms = le_get_u16(&c->content[7]),
+    };
+    return motion_stream(c->d->motion, &sp) == MOTION_ACCEPTED ? OUTCOME_OK : OUTCOME_ERROR;
 }
 
 enum packet_outcome handle_read_angle(const struct packet_call *c, struct response *r)

@@ -17,6 +17,16 @@ enum motion_submit_result motion_submit(struct motion *m, const struct motion_co
     return (enum motion_submit_result)mock();
 }
 
+struct motion_setpoint motion_mock_last_setpoint;
+
+enum motion_submit_result motion_stream(struct motion *m, const struct motion_setpoint *sp)
+{
+    (void)m;
+    function_called();
+    motion_mock_last_setpoint = *sp;
+    return (enum motion_submit_result)mock();
+}
+
 void motion_read_angle(const struct motion *m, struct motion_angle *out)
 {
     (void)m;

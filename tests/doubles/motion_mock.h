@@ -6,5 +6,7 @@
 #include "motion/motion.h"
 
 extern struct motion_command motion_mock_last;
+/* The last setpoint motion_stream was given. */
+extern struct motion_setpoint motion_mock_last_setpoint;
 
 #endif

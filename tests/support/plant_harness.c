@@ -2,6 +2,8 @@
 
 #include <math.h>
 
+#include "support/by_name.h"
+
 struct plant plant;
 static uint32_t plant_time_us;
 
@@ -23,4 +25,12 @@ void plant_harness_attach(void)
 {
     plant_time_us = hal.now_us;
     hal.encoder_model = plant_encoder_model;
+}
+
+void plant_harness_start(void)
+{
+    plant_init(&plant);
+    harness_init();
+    plant_harness_attach();
+    harness_write_item(0, ITEM_SOFT_START_ON, 0); /* no soft start */
 }

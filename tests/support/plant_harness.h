@@ -11,5 +11,7 @@ extern struct plant plant;
 
 /* After plant_init and harness_init: the plant drives the encoder from now. */
 void plant_harness_attach(void);
+/* A fresh plant and servo (servo ID 0, soft start off), attached. */
+void plant_harness_start(void);
 
 #endif

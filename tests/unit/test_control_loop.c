@@ -20,10 +20,7 @@
 static int setup(void **state)
 {
     (void)state;
-    plant_init(&plant);
-    harness_init();
-    plant_harness_attach();
-    WRITE_ITEM(0, ITEM_SOFT_START_ON, 0); /* no soft start */
+    plant_harness_start();
     return 0;
 }
 
@@ -124,10 +121,7 @@ static double lift_limit_nm(void)
 
 static void hold_30_under(double load_nm, const struct load_arrival *a, double *at_deg, uint8_t *status)
 {
-    plant_init(&plant);
-    harness_init();
-    plant_harness_attach();
-    WRITE_ITEM(0, ITEM_SOFT_START_ON, 0); /* no soft start */
+    plant_harness_start();
     REQUEST(PKT_MOVE_ANGLE, 0, 0x2C, 0x01, 0xF4, 0x01, 0x00, 0x00);
     harness_run_ms(800);
     for (int i = 0; i < a->steps; i++) {

@@ -280,6 +280,33 @@ static void test_motion_answers_when_done_with_control_response(void **state)
     assert_false(result.answer);
 }
 
+/* StreamSetpoint (0x45): angle, velocity and host time as sent, signs
+ * kept; never answered, addressed or broadcast; a refusal (the output
+ * inhibited) flags the command error. */
+static void test_stream_setpoint_decodes(void **state)
+{
+    (void)state;
+    regs.user.control_response = 1;
+    expect_function_call(motion_stream);
+    will_return(motion_stream, MOTION_ACCEPTED);
+    RUN(0x45, OWN_ID, 0x18, 0xFC, 0xFF, 0xFF, 0x0C, 0xFE, 0xFE, 0xFF); /* -1000, -500, 65534 */
+    assert_int_equal(motion_mock_last_setpoint.angle_decideg, -1000);
+    assert_int_equal(motion_mock_last_setpoint.velocity_decideg_s, -500);
+    assert_int_equal(motion_mock_last_setpoint.host_ms, 65534);
+    assert_false(result.answer);
+    expect_function_call(motion_stream);
+    will_return(motion_stream, MOTION_ACCEPTED);
+    RUN(0x45, 0xFF, 0x40, 0x42, 0x0F, 0x00, 0x10, 0x27, 0x01, 0x00); /* 1 000 000, 10 000, 1 */
+    assert_int_equal(motion_mock_last_setpoint.angle_decideg, 1000000);
+    assert_int_equal(motion_mock_last_setpoint.velocity_decideg_s, 10000);
+    assert_false(result.answer);
+    expect_function_call(motion_stream);
+    will_return(motion_stream, MOTION_REFUSED);
+    RUN(0x45, OWN_ID, 0, 0, 0, 0, 0, 0, 0, 0);
+    assert_false(result.answer);
+    assert_true(command_error());
+}
+
 static void test_full_queue_drops_and_flags(void **state)
 {
     (void)state;
@@ -491,6 +518,7 @@ int main(void)
         cmocka_unit_test_setup(test_angle_packets_decode, setup),
         cmocka_unit_test_setup(test_wheel_packet_decodes, setup),
         cmocka_unit_test_setup(test_motion_answers_when_done_with_control_response, setup),
+        cmocka_unit_test_setup(test_stream_setpoint_decodes, setup),
         cmocka_unit_test_setup(test_full_queue_drops_and_flags, setup),
         cmocka_unit_test_setup(test_damping_answers_at_once_with_control_response, setup),
         cmocka_unit_test_setup(test_stop_on_control_mode, setup),

@@ -12,6 +12,7 @@
 #include <cmocka.h>
 
 #include "motion/profile.h"
+#include "support/xorshift.h"
 
 #define TOLERANCE_DECIDEG 0.5 /* 0.05 degree */
 
@@ -402,6 +403,61 @@ static void test_the_walk_follows_the_closed_form(void **state)
     assert_true(walked > 1000u);
 }
 
+/* A streamed segment (profile_plan_segment): the Hermite cubic from
+ * (start, v0) to (target, v1) in T ticks, then on at v1. Against the same
+ * cubic in doubles at every tick, within the two coefficients' rounding
+ * (half a Q40 unit each: (T^2 + T^3) / 2 Q40 at the end, under 0.001
+ * decideg) and the closed form's own (t + 1 Q32 units at tick t), and the walk against the closed form as for the moves. Random
+ * segments over the whole of profile.h's limits. */
+static void test_segments_meet_their_ends(void **state)
+{
+    (void)state;
+    uint64_t seed = 20261126;
+    double worst = 0, worst_end = 0;
+    for (unsigned i = 0; i < 2000; i++) {
+        uint32_t ticks = 1u + (uint32_t)(xorshift64(&seed) % PROFILE_MAX_SEGMENT);
+        int32_t start = (int32_t)(xorshift64(&seed) % (1u << 30)) - (1 << 29);
+        int32_t distance = (int32_t)(xorshift64(&seed) % (2u * PROFILE_MAX_SEGMENT_DISTANCE + 1u)) - PROFILE_MAX_SEGMENT_DISTANCE;
+        int32_t v0 = (int32_t)(xorshift64(&seed) % (2u * PROFILE_MAX_SEGMENT_SPEED + 1u)) - PROFILE_MAX_SEGMENT_SPEED;
+        int32_t v1 = (int32_t)(xorshift64(&seed) % (2u * PROFILE_MAX_SEGMENT_SPEED + 1u)) - PROFILE_MAX_SEGMENT_SPEED;
+        if (i % 4 == 0) { /* the common case: small steps of a smooth path */
+            distance /= 256;
+            v0 /= 256;
+            v1 = v0 + (v1 / 4096);
+        }
+        struct profile p;
+        profile_plan_segment(&p, start, v0, start + distance, v1, ticks);
+        double T = ticks, d = distance / 256.0, a = v0 / 256.0, b = v1 / 256.0;
+        double c2 = (3 * d - (2 * a + b) * T) / (T * T), c3 = ((a + b) * T - 2 * d) / (T * T * T);
+        assert_true(profile_position(&p, 0) == start * ((int64_t)1 << 24));
+        struct profile_walk w;
+        profile_walk_start(&w, &p, 0);
+        for (uint32_t t = 1; t <= ticks + 3u; t++) {
+            bool started = profile_walk_next(&w, &p);
+            double x = t <= ticks ? ((c3 * t + c2) * t + a) * t : d + b * (t - T);
+            double off = fabs(to_decideg(profile_position(&p, t)) - start / 256.0 - x);
+            double bound = (T * T + T * T * T) / 2.0 / 1099511627776.0 + (t + 2.0) / 4294967296.0;
+            if (off > bound) {
+                fail_msg("segment %u (T %u, d %d, v0 %d, v1 %d) tick %u: %.3g decideg off the cubic", i,
+                         ticks, distance, v0, v1, t, off);
+            }
+            worst = off > worst ? off : worst;
+            if (t == ticks) {
+                worst_end = off > worst_end ? off : worst_end;
+                assert_true(started); /* the cubic ends: the walk starts again there */
+            }
+            int64_t walked_off = w.at - profile_position(&p, t);
+            if (walked_off > 2 * (int64_t)ticks + 1 || walked_off < -2 * (int64_t)ticks - 1) {
+                fail_msg("segment %u tick %u: the walk is %lld Q32 off the closed form", i, t,
+                         (long long)walked_off);
+            }
+        }
+        /* After the cubic, on at v1 exactly. */
+        assert_true(profile_position(&p, ticks + 2u) - profile_position(&p, ticks + 1u) == v1 * ((int64_t)1 << 24));
+    }
+    printf("# 2000 segments: at most %.2g decideg off the cubic, %.2g at its end\n", worst, worst_end);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -414,6 +470,7 @@ int main(void)
         cmocka_unit_test(test_too_fast_moves_take_longer),
         cmocka_unit_test(test_randomized_moves),
         cmocka_unit_test(test_the_walk_follows_the_closed_form),
+        cmocka_unit_test(test_segments_meet_their_ends),
     };
     return cmocka_run_group_tests_name("profile", tests, NULL, NULL);
 }

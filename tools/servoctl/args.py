@@ -232,6 +232,10 @@ def build_parser():
     c.add_argument("--settle", type=int, default=300, help="ms to keep sampling after the plan")
     tolerance_option(c)
 
+    c = sub.add_parser("stream", help="stream a trajectory (CSV: time s, one column of degrees per servo ID)")
+    c.add_argument("file", help="CSV: a header 'time,ID,ID...', then evenly spaced rows")
+    c.add_argument("--lead-in", type=float, default=1.0, help="s to move to the first row first (default 1)")
+
     c = sub.add_parser("sync-move", help="several servos start their moves in one frame")
     c.add_argument("targets", type=_target, nargs="+", metavar="ID:DEGREES")
     c.add_argument("--interval", type=int, default=1000, help="ms to get there (default 1000)")

@@ -14,6 +14,7 @@ from .args import build_parser
 from .errors import BadAnswer, NoReply, Refused, ServoError, UsageError
 from .protocol import Bus
 from .record import check_writable, cmd_record
+from .stream import cmd_stream
 from .faults import cmd_faults
 from .info import cmd_info
 from .servo import Servo
@@ -446,6 +447,7 @@ COMMANDS = {
     "origin": cmd_origin,
     "monitor": cmd_monitor,
     "record": cmd_record,
+    "stream": cmd_stream,
     "sync-move": cmd_sync_move,
     "broadcast-move": cmd_broadcast_move,
     "async": cmd_async,

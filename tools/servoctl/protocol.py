@@ -43,6 +43,11 @@ def decode_answer(code: int, content: bytes) -> tuple:
     return struct.unpack(fmt, content)
 
 
+def answer_frame_size(code: int) -> int:
+    """The bytes of a packet's answer frame on the wire (its fields fixed)."""
+    return len(RESPONSE_HEADER) + 3 + struct.calcsize(_SCHEMA.answer_format(code))
+
+
 def encode_request(code: int, *values) -> bytes:
     """A request's content from its fields' values, as protocol/schema.toml
     lays them out."""

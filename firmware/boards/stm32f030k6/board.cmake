@@ -7,5 +7,5 @@ set(SERVO_BOARD_CPU cortex-m0)
 set(SERVO_BOARD_PORT servo_stm32f0)                      # hal/ports/stm32f0
 set(SERVO_BOARD_STARTUP ${PROJECT_SOURCE_DIR}/firmware/startup/startup_stm32f030.c)
 set(SERVO_BOARD_RAM_LIMIT 4096)
-set(SERVO_BOARD_FLASH_LIMIT 24576) # the application: README, "Footprint"
+set(SERVO_BOARD_FLASH_LIMIT 24320) # the application: its 24 KB slot less the update image's 256-byte header (board.h)
 set(SERVO_BOARD_SOURCES ${CMAKE_CURRENT_LIST_DIR}/board_io.c)         # pins, clocks, ADC, PWM: this board's

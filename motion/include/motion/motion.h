@@ -154,7 +154,13 @@ struct motion {
     uint8_t mode;              /* enum motion_mode */
     uint8_t end;               /* enum motion_end */
     uint8_t running;           /* a command runs: status bit 0 */
-    uint8_t endless;           /* wheel run: finished once at speed */
+    uint8_t endless;           /* wheel run, stream: finished once at speed */
+    uint8_t streaming;         /* a stream's segment runs, or its end speed goes on */
+    /* An endless profile is looked at again at this tick: a wheel's clock
+     * restarts, a stream whose next setpoint has not come brakes. */
+    uint32_t endless_until;
+    uint16_t stream_host_ms;   /* the host's stamp of the last setpoint */
+    uint16_t stream_period_ms; /* learned from the stamps */
     uint8_t answer_packet;     /* owed when the running command finishes */
     uint8_t soft_start_pending;
     uint8_t async_open;
@@ -176,6 +182,20 @@ void motion_init(struct motion *m, const struct registers *regs, const struct ha
 void motion_tick(struct motion *m);
 
 MUST_CHECK enum motion_submit_result motion_submit(struct motion *m, const struct motion_command *cmd);
+
+/* A streamed setpoint (StreamSetpoint, 0x45): where the horn should be, how
+ * fast it should move there, and the host's time it is for. */
+struct motion_setpoint {
+    int32_t angle_decideg;      /* multi-turn, as ReadMultiTurnAngle */
+    int16_t velocity_decideg_s;
+    uint16_t host_ms;           /* wraps; its steps are the host's period */
+};
+
+/* Interpolates from where the setpoint is to sp in one period (item 69, or
+ * learned from the stamps): a cubic at the tick rate, then on at sp's
+ * speed; a period late, it brakes to a hold. It takes over from any
+ * command, and drops what is queued (docs/streaming.md). */
+MUST_CHECK enum motion_submit_result motion_stream(struct motion *m, const struct motion_setpoint *sp);
 /* Not under position control (released or damping). */
 static inline bool motion_is_released(const struct motion *m)
 {

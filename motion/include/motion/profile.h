@@ -2,7 +2,8 @@
  *
  * Units: time in control ticks (MOTION_TICK_HZ); positions in Q32
  * decidegrees (int64, 1 decideg = 2^32); velocities in Q32 decidegrees per
- * tick; the two ramp coefficients in Q40 decidegrees per tick squared.
+ * tick; the two ramp coefficients in Q40 decidegrees per tick squared; a
+ * streamed segment's cubic coefficient in Q40 decidegrees per tick cubed.
  *
  * A profile has three phases of whole ticks: acceleration (N1 ticks, from the
  * start velocity v0 to the cruise velocity V), cruise (Nc) and deceleration
@@ -36,6 +37,7 @@ struct profile {
     int64_t cruise;       /* V */
     int64_t cruise_start; /* position at tick accel_ticks */
     int64_t accel_k;      /* (V - v0) / (2 N1), Q40 */
+    int64_t accel_j;      /* the first phase's cubic term, Q40: a streamed segment's (else 0) */
     int64_t decel_k;      /* V / (2 N3), Q40 */
     uint32_t accel_ticks; /* N1 */
     uint32_t cruise_end;  /* N1 + Nc */
@@ -60,6 +62,18 @@ void profile_plan(struct profile *p, int64_t start, int64_t v0, int64_t target,
 void profile_plan_endless(struct profile *p, int64_t start, int64_t v0, int64_t velocity,
                           uint32_t accel);
 
+/* A streamed segment: the cubic (Hermite) from start moving at v0 to
+ * target moving at v1 in ticks ticks, then on at v1 for ever (v1 = 0: the
+ * profile ends there, as a move's does). Positions
+ * and speeds in the control tick's Q8 (decideg, decideg per tick), within
+ * PROFILE_MAX_SEGMENT_DISTANCE of each other and PROFILE_MAX_SEGMENT_SPEED;
+ * 1 <= ticks <= PROFILE_MAX_SEGMENT. */
+#define PROFILE_MAX_SEGMENT 1000u
+#define PROFILE_MAX_SEGMENT_DISTANCE (1 << 22) /* 16384 decideg */
+#define PROFILE_MAX_SEGMENT_SPEED (1 << 16)    /* 256 decideg per tick */
+void profile_plan_segment(struct profile *p, int32_t start_q8, int32_t v0_q8, int32_t target_q8,
+                          int32_t v1_q8, uint32_t ticks);
+
 /* Phase lengths of a velocity-based move (packets 12, 15): peak |velocity|
  * vmax, ramps of accel and decel ticks. The cruise time is rounded to whole
  * ticks; a stroke too short for a cruise shrinks both ramps in their ratio
@@ -70,7 +84,8 @@ struct profile_timing profile_velocity_timing(int64_t distance, int64_t v0, int6
 int64_t profile_position(const struct profile *p, uint32_t tick);
 
 /* A profile walked tick by tick with additions only, for the control tick:
- * within a phase the step between two ticks changes by a constant (Q40, so
+ * within a phase the step between two ticks changes by a constant (a
+ * segment's cubic: the change changes by a constant) (Q40, so
  * exact), and each phase starts from the closed form's position: the walk
  * meets profile_position exactly at every phase's start and at the target,
  * and between stays within two Q32 units per tick of the phase's length
@@ -79,6 +94,7 @@ struct profile_walk {
     int64_t at;         /* position at tick, Q32 */
     int64_t step_q40;   /* to the position at tick + 1 (less rounding), Q40 */
     int64_t change_q40; /* of step_q40 a tick: the phase's second difference */
+    int64_t jerk_q40;   /* of change_q40 a tick: a cubic phase's third difference */
     uint32_t tick;
     uint32_t phase_end; /* the tick the next phase starts */
 };
@@ -91,6 +107,7 @@ static inline bool profile_walk_next(struct profile_walk *w, const struct profil
 {
     w->at += w->step_q40 >> 8;
     w->step_q40 += w->change_q40;
+    w->change_q40 += w->jerk_q40;
     if (++w->tick < w->phase_end) {
         return false;
     }

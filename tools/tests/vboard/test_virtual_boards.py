@@ -176,6 +176,23 @@ def test_sync_monitor_and_sync_moves_on_a_bus(tmp_path, board):
     finish(sim, [1, 2, 3])
 
 
+def test_a_streamed_trajectory_is_followed(one):
+    """StreamSetpoint on the image as flashed: a 0.5 Hz +-60 deg cosine at
+    50 Hz for 1.5 s, from rest at its peak, followed as on servo_sim."""
+    import math
+
+    from servoctl.stream import stream_file
+
+    sim, bus, servo = one
+    times = [k * 0.02 for k in range(76)]
+    angles = {1: [60.0 * math.cos(math.pi * t) for t in times]}
+    group.sync_move(bus, {1: 60.0}, duration_s=0.5, multi_turn=True)
+    sim.sleep(0.7)
+    report = stream_file(bus, times, angles)
+    assert report.missed == 0
+    assert report.rms_deg[1] < 0.8 and report.peak_deg[1] < 2.0, report
+
+
 def test_the_makers_sdk(tmp_path, board):
     # The SDK waits on the wall clock (100 ms an answer): the board gets the
     # priority of a real-time twin, so it keeps up on a loaded PC (root only).
