@@ -67,9 +67,9 @@ def test_the_robot_loop_returns_every_state_within_the_wire_limit(sim3):
         rate = loop.rate()
     assert loop.missed == 0
     assert rate.cycles == 60
-    # A cycle cannot beat its own bytes on the wire; a simulator on a busy
-    # machine may fall behind, never ahead.
-    assert 0 < rate.ratio <= 1.0
+    # A cycle cannot beat its own bytes on the wire; at 115 200 baud the
+    # wire, not the host, sets the pace (scripts/stream_bench.sh: 0.98).
+    assert 0.9 <= rate.ratio <= 1.0
     print(f"robot loop, 3 servos at 115200: {rate.rate_hz:.0f} Hz of {rate.wire_limit_hz:.0f} "
           f"({rate.ratio:.2f} of the wire limit)")
 

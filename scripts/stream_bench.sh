@@ -1,0 +1,105 @@
+#!/usr/bin/env bash
+# Streamed setpoints against plain angle moves, and the robot loop at the
+# wire's speed (docs/streaming.md, "Figures"):
+#  1. one servo on the plant model (tests/unit/test_stream.c): a 0.5 Hz
+#     +-60 deg sine sent at 50 Hz, streamed and as 20 ms angle moves: the RMS
+#     error to the sine and the setpoint's peak acceleration;
+#  2. the same path on 6 simulated servos (servo_sim) at 1 Mbaud, through
+#     servoctl: the RMS error of each servo's Sync Monitor state;
+#  3. the robot loop (one SyncCommand of setpoints and one Sync Monitor a
+#     cycle, servoctl.stream.RobotLoop) for 6 and 16 servos at 1 000 000 and
+#     115 200 baud: its rate against the wire limit.
+# Times are the simulator's clock. Not part of the test command (a minute).
+#   bash scripts/stream_bench.sh
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/setup.sh >/dev/null
+cmake --preset host >/dev/null
+cmake --build --preset host --target servo_sim test_stream >/dev/null
+echo "1. one servo on the plant model (tests/unit/test_stream.c):"
+build/host/tests/test_stream 2>/dev/null | sed -n 's/^# /   /p' | head -1
+exec .venv/bin/python - <<'PY'
+import contextlib
+import math
+import tempfile
+
+from servoctl import protocol as p
+from servoctl import registers
+from servoctl.group import sync_move, sync_monitor
+from servoctl.servo import Servo
+from servoctl.sim import Simulator
+from servoctl.stream import RobotLoop, stream_file
+
+PERIOD, SECONDS = 0.02, 4.0
+
+
+@contextlib.contextmanager
+def at_baud(ids, baud):
+    """Simulated servos at baud, soft start off; stopped whatever happens."""
+    with Simulator(ids=ids, state_dir=tempfile.mkdtemp(prefix="stream-bench-")) as sim:
+        set_up(sim, ids, baud)
+        yield sim
+
+
+def set_up(sim, ids, baud):
+    code = {rate: c for c, rate in registers.BAUD_RATES.items()}[baud]
+    with sim.bus() as bus:
+        for i in ids:
+            Servo(bus, i).write("soft_start_on", 0)
+            if baud != 115200:
+                Servo(bus, i).write("baud", code)  # answered at 115200, then it switches
+    if baud != 115200:
+        sim.control(f"hostbaud {baud}")
+        sim.sleep(0.05)
+
+
+def path(t):
+    return 60.0 * math.cos(math.pi * t)  # 0.5 Hz, +-60 deg, from rest at its peak
+
+
+def plain_moves(bus, ids, times):
+    """The path as 20 ms MoveAngle records, one SyncCommand a period; each
+    cycle's Sync Monitor against the path when it was taken."""
+    answer_s = p.answer_frame_size(p.MONITOR) * 10 / bus.serial.baudrate
+    start = bus.clock() + PERIOD
+    errors = []
+    for k, t in enumerate(times):
+        bus.sleep(max(0.0, start + (k - 1) * PERIOD - bus.clock()))
+        body = b"".join(p.encode_request(p.ANGLE, i, round(path(t) * 10), 20, 0) for i in ids)
+        bus.send(p.SYNC, bytes([p.ANGLE, len(body) // len(ids), len(ids)]) + body)
+        arrivals = {}
+        states = sync_monitor(bus, ids, arrivals=arrivals)
+        for n, i in enumerate(ids):
+            if k and i in states:
+                at = arrivals[i] - (n + 1) * answer_s - start
+                errors.append(states[i].angle_decideg / 10 - path(at))
+    return math.sqrt(sum(e * e for e in errors) / len(errors)), max(map(abs, errors))
+
+
+ids = list(range(1, 7))
+times = [k * PERIOD for k in range(int(SECONDS / PERIOD) + 1)]
+print("2. 6 servos at 1 Mbaud, the same path through servoctl (Sync Monitor each period):")
+for streamed in (True, False):
+    with at_baud(ids, 1000000) as sim, sim.bus(baud=1000000, timeout=0.1) as bus:
+        sync_move(bus, {i: path(0) for i in ids}, 0.5, multi_turn=True)
+        bus.sleep(0.7)
+        if streamed:
+            r = stream_file(bus, times, {i: [path(t) for t in times] for i in ids})
+            rms, peak = max(r.rms_deg.values()), max(r.peak_deg.values())
+        else:
+            rms, peak = plain_moves(bus, ids, times)
+    how = "streamed     " if streamed else "angle moves  "
+    print(f"   {how} RMS error {rms:.2f} deg, peak {peak:.2f} deg (the worst servo)")
+
+print("3. the robot loop through servoctl's Python API (RobotLoop.cycle, 200 cycles):")
+for count in (6, 16):
+    for baud in (1000000, 115200):
+        ids = list(range(1, count + 1))
+        with at_baud(ids, baud) as sim, sim.bus(baud=baud, timeout=0.1) as bus:
+            loop = RobotLoop(bus, ids, PERIOD)
+            for k in range(200):
+                loop.cycle({i: 10.0 * math.sin(k / 20) for i in ids})
+            r = loop.rate()
+        print(f"   {count:2} servos at {baud:7} baud: {r.rate_hz:6.0f} Hz of the wire's {r.wire_limit_hz:6.0f} "
+              f"({r.ratio:.2f}), {loop.missed} state(s) missed")
+PY
