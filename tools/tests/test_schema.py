@@ -59,7 +59,7 @@ def test_a_schema_that_cannot_be_is_refused_with_its_reason(broken, said):
 
 NEW_PACKET = '''
 [[packet]]
-code = 0x45
+code = 0x46
 name = "Echo"
 c = "ECHO"
 source = "firmware"
@@ -100,7 +100,7 @@ with Simulator(ids=[1]) as sim:
 
 def test_a_new_item_and_a_new_packet_need_the_schema_and_the_handler_only(tmp_path):
     """A copy of the tree, changed in two files: schema.toml gains user item
-    54 and packet 0x45 (and room for the batch packets, which grow with the
+    54 and packet 0x46 (and room for the batch packets, which grow with the
     user area), and handlers_data.c gains handle_echo(). Its
     servo_sim builds and answers both, its servoctl knows both (config dump
     lists the item), and its docs/protocol.md describes both."""
@@ -138,7 +138,7 @@ def test_a_new_item_and_a_new_packet_need_the_schema_and_the_handler_only(tmp_pa
     docs.mkdir(exist_ok=True)
     subprocess.run([sys.executable, str(tree / "scripts/gen_protocol.py"), "docs", str(docs)], check=True)
     text = (docs / "protocol.md").read_text(encoding="utf-8")
-    assert "| 0x45 (69) | [Echo](protocol-packets.md#0x45-echo) |" in text
+    assert "| 0x46 (70) | [Echo](protocol-packets.md#0x46-echo) |" in text
     assert "| 54 | test_hold_ms | 2 | u16 | read-write | 0..1000 | 250 | ms |" in text
-    assert "## 0x45 Echo" in (docs / "protocol-packets.md").read_text(encoding="utf-8")
+    assert "## 0x46 Echo" in (docs / "protocol-packets.md").read_text(encoding="utf-8")
     shutil.rmtree(build)
