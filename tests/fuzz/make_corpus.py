@@ -39,7 +39,7 @@ SEEDS = {
     "ping": req(1, b"\x00"),
     "reset": req(2, b"\x00"),
     "read_every_item": b"".join(req(3, bytes([0, i])) for i in list(range(1, 9)) + list(range(32, 54))
-                               + list(range(64, 69))),
+                               + list(range(64, 70))),
     "write_items": req(4, b"\x00\x21\x01") + req(4, b"\x00\x32\xe8\x03") + req(4, b"\x00\x35\x10\x00"),
     "write_id_and_baud": req(4, b"\x00\x22\x07") + req(1, b"\x07") + req(4, b"\x07\x24\x08"),
     "batch": req(5, b"\x00") + req(6, b"\x00" + FACTORY),
@@ -61,6 +61,10 @@ SEEDS = {
     "sync_move": req(25, bytes([8, 7, 2]) + struct.pack("<BhHH", 4, 0, 0, 0) + struct.pack("<BhHH", 0, 900, 500, 0)),
     "sync_long": req(25, bytes([14, 15, 200]) + b"".join(
         struct.pack("<BiIHHH", (k + 1) % 255, k * 10, 1000, 20, 20, 0) for k in range(200))),
+    "stream_setpoints": req(0x45, struct.pack("<BihH", 0, 900, 500, 0)) + req(4, b"\x00\x45\x0a\x00")
+                        + req(0x45, struct.pack("<BihH", 0xFF, -3686400, -7500, 65535))
+                        + req(25, bytes([0x45, 9, 2]) + struct.pack("<BihH", 0, 100, 0, 20)
+                              + struct.pack("<BihH", 4, 100, 0, 20)),
     "others_responses": resp(3, req(1, b"\x00")) + req(1, b"\x00"),
     "bad_checksum": req(1, b"\x00")[:-1] + b"\x00" + req(1, b"\x00"),
 }
@@ -130,6 +134,10 @@ def move(angle: int, interval: int, power: int = 0) -> bytes:
     return req(8, struct.pack("<BhHH", 0, angle, interval, power))
 
 
+def stream(angle: int, velocity: int, host_ms: int) -> bytes:
+    return req(0x45, struct.pack("<BihH", 0, angle, velocity, host_ms & 0xFFFF))
+
+
 def write(item: int, value: int, size: int = 1) -> bytes:
     return req(4, bytes([0, item]) + value.to_bytes(size, "little", signed=value < 0))
 
@@ -147,6 +155,10 @@ SERVO_SEEDS = {
                        + wire(req(14, struct.pack("<BiIHHH", 0, 3600, 200, 20, 30, 0))) + ms(400)),
     "preempted": (USED, wire(move(1800, 500)) + ms(100) + wire(move(-1800, 300)) + ms(100)
                   + wire(req(13, struct.pack("<BiIH", 0, 36000, 400, 0))) + ms(500)),
+    # A 50 Hz stream at 250 deg/s, then silence (it brakes to a hold), then
+    # the period told (item 69) and a setpoint at rest far away.
+    "stream_then_late": (USED, b"".join(wire(stream(50 * k, 2500, 20 * k)) + ms(20) for k in range(12))
+                         + ms(120) + wire(write(69, 30, 2) + stream(-900, 0, 400)) + ms(300)),
     "wheel_run_stop": (USED, wire(req(7, struct.pack("<BBHH", 0, 0x01, 300, 0))) + ms(100)
                        + wire(req(7, struct.pack("<BBHH", 0, 0x00, 0, 0))) + ms(60)
                        + wire(write(47, 1) + req(7, struct.pack("<BBHH", 0, 0x81, 90, 0))) + ms(60)
