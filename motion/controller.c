@@ -9,7 +9,7 @@
 #if !defined(__ARM_FEATURE_SAT) && defined(SERVO_SIZE_FIRST)
 __attribute__((noinline)) int32_t sat_q(int32_t v, int32_t limit)
 {
-    return v > limit - 1 ? limit - 1 : v < -limit ? -limit : v;
+    return sat_q_inline(v, limit);
 }
 #endif
 

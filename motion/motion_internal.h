@@ -69,6 +69,11 @@ int32_t q32_to_q8_sat(int64_t v);
 #define q32_to_q8_sat q32_to_q8_sat_inline
 #endif
 
+static inline int32_t clamp_i32(int32_t v, int32_t lo, int32_t hi)
+{
+    return v < lo ? lo : v > hi ? hi : v;
+}
+
 /* The center offset (53), decideg Q8: protocol angles are measured minus this. */
 static inline int32_t motion_center_offset_q8(const struct motion *m)
 {

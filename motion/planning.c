@@ -15,11 +15,6 @@ enum {
     WHEEL_RAMP_MS = 20,
 };
 
-static int32_t clamp_i32(int32_t v, int32_t lo, int32_t hi)
-{
-    return v < lo ? lo : v > hi ? hi : v;
-}
-
 static uint32_t clamp_u32(uint32_t v, uint32_t lo, uint32_t hi)
 {
     return v < lo ? lo : v > hi ? hi : v;

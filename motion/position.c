@@ -66,17 +66,9 @@ static int16_t saturate_i16(int32_t v)
 }
 
 /* Errors this large (1638 deg) already saturate the answer's centidegrees;
- * clamped to it, x 10 stays in 32 bits (no 64-bit multiply on the M0). */
+ * clamped to it, x 10 stays in 32 bits (no 64-bit multiply on the M0).
+ * Inline: ReadMotion's answer has no time for a call on the M0. */
 #define TRACKING_ERROR_SPAN_Q8 (INT32_C(1) << 22)
-
-/* sat_q to the span, inline: ReadMotion's answer has no time for a call on
- * the M0 (sat_q is one there). */
-static inline int32_t sat_span(int32_t v)
-{
-    return v > TRACKING_ERROR_SPAN_Q8 - 1 ? TRACKING_ERROR_SPAN_Q8 - 1
-           : v < -TRACKING_ERROR_SPAN_Q8  ? -TRACKING_ERROR_SPAN_Q8
-                                          : v;
-}
 
 void motion_read_diagnostics(const struct motion *m, struct motion_diagnostics *out)
 {
@@ -107,7 +99,7 @@ void motion_read_diagnostics(const struct motion *m, struct motion_diagnostics *
          * digit), where a division by a power of two rounds to zero at some
          * instructions' cost on the M0. */
         .velocity_decideg_s = saturate_i16((m->measured_velocity_q8 * 125) >> 5),
-        .tracking_error_centideg = saturate_i16((sat_span(error_q8) * 5) >> 7),
+        .tracking_error_centideg = saturate_i16((sat_q_inline(error_q8, TRACKING_ERROR_SPAN_Q8) * 5) >> 7),
         .flags = (uint8_t)(flags | limiter << LIMITER_SHIFT),
     };
 }

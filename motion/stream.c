@@ -6,11 +6,6 @@
 #include "motion/motion_internal.h"
 #include "motion/saturate.h"
 
-static int32_t clamp_i32(int32_t v, int32_t limit)
-{
-    return v > limit ? limit : v < -limit ? -limit : v;
-}
-
 /* The period: item 69 if set, else the step between the host's stamps
  * (learned while a stream runs; 20 ms, 50 Hz, until then: motion_init). */
 static uint32_t stream_period(struct motion *m, uint16_t host_ms)
@@ -41,12 +36,12 @@ enum motion_submit_result motion_stream(struct motion *m, const struct motion_se
         start = m->setpoint_q8;
         v0 = sat_q(start - m->last_setpoint_q8, PROFILE_MAX_SEGMENT_SPEED);
     }
-    int32_t angle = clamp_i32(sp->angle_decideg, MULTI_TURN_LIMIT);
+    int32_t angle = clamp_i32(sp->angle_decideg, -MULTI_TURN_LIMIT, MULTI_TURN_LIMIT);
     int32_t distance = sat_q(angle * 256 + motion_center_offset_q8(m) - start,
                              PROFILE_MAX_SEGMENT_DISTANCE);
     /* 0.1 deg/s to Q8 decideg per tick: x 256 / 1000, as 16777 / 2^16
      * (an arithmetic shift: toward minus infinity, under 2^-8 decideg). */
-    int32_t v1 = (clamp_i32(sp->velocity_decideg_s, MAX_VELOCITY) * 16777) >> 16;
+    int32_t v1 = (clamp_i32(sp->velocity_decideg_s, -MAX_VELOCITY, MAX_VELOCITY) * 16777) >> 16;
 
     m->queue.count = 0;
     m->angle_clamped = 0;

@@ -4,7 +4,6 @@
 #if defined(SERVO_SIZE_FIRST) && !defined(STARTUP_BOOTLOADER)
 uint32_t le_get_u32(const uint8_t *p)
 {
-    return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) |
-           ((uint32_t)p[3] << 24);
+    return le_get_u32_inline(p);
 }
 #endif

@@ -39,6 +39,16 @@ static bool settle(void)
     return false;
 }
 
+/* n faults of one kind, 20 s apart, each logged and settled. */
+static void log_faults(uint8_t what, uint32_t count)
+{
+    for (uint32_t n = 1; n <= count; n++) {
+        struct fault_entry e = fault(what, 20u * n);
+        assert_true(fault_log_add(&log_, &e));
+        assert_true(settle());
+    }
+}
+
 static int setup(void **state)
 {
     (void)state;
@@ -116,11 +126,7 @@ static void test_the_history_keeps_the_newest_16_across_pages(void **state)
 static void test_a_clear_hides_the_older_faults(void **state)
 {
     (void)state;
-    for (uint32_t n = 1; n <= 5; n++) {
-        struct fault_entry e = fault(FAULT_OVER_POWER, 20u * n);
-        assert_true(fault_log_add(&log_, &e));
-        assert_true(settle());
-    }
+    log_faults(FAULT_OVER_POWER, 5);
     struct fault_entry clear = {.what = FAULT_CLEARED, .op_seconds = 200};
     assert_true(fault_log_add(&log_, &clear));
     assert_true(settle());
@@ -160,11 +166,7 @@ static void test_repeats_and_the_wear_budget_are_counted_not_written(void **stat
 static void test_a_refused_program_spends_a_slot_not_the_history(void **state)
 {
     (void)state;
-    for (uint32_t n = 1; n <= 3; n++) {
-        struct fault_entry e = fault(FAULT_STALL, 20u * n);
-        assert_true(fault_log_add(&log_, &e));
-        assert_true(settle());
-    }
+    log_faults(FAULT_STALL, 3);
     flash.mem[0][3 * FAULT_RECORD_SIZE] = 0x00; /* the next slot is not erased: the program fails */
     struct fault_entry e = fault(FAULT_STALL, 100);
     assert_true(fault_log_add(&log_, &e));

@@ -17,14 +17,15 @@ static inline int16_t le_get_i16(const uint8_t *p)
 
 /* A call in the Cortex-M0's application, where size comes first and no
  * answer's time hangs on it (byte_order.c); inline elsewhere. */
-#if defined(SERVO_SIZE_FIRST) && !defined(STARTUP_BOOTLOADER)
-uint32_t le_get_u32(const uint8_t *p);
-#else
-static inline uint32_t le_get_u32(const uint8_t *p)
+static inline uint32_t le_get_u32_inline(const uint8_t *p)
 {
     return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) |
            ((uint32_t)p[3] << 24);
 }
+#if defined(SERVO_SIZE_FIRST) && !defined(STARTUP_BOOTLOADER)
+uint32_t le_get_u32(const uint8_t *p);
+#else
+#define le_get_u32 le_get_u32_inline
 #endif
 
 static inline int32_t le_get_i32(const uint8_t *p)
