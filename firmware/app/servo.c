@@ -28,6 +28,7 @@ static void apply_link_settings(struct servo *s)
     s->ring_covers_erase = hal_rx_ring_size(s->hal->rx) * byte_us >= STORE_ERASE_MAX_US;
     s->unsolicited_slot_us = UNSOLICITED_WINDOW_US + 2u * byte_us + UNSOLICITED_DRIFT_GUARD_US;
     s->unsolicited_first_us = UNSOLICITED_QUIET_US + (uint32_t)s->active_id * s->unsolicited_slot_us;
+    s->turn_guard_bytes = (uint8_t)(byte_us != 0u ? s->hal->tick_and_pass_us / byte_us : 0u);
 }
 
 void servo_init(struct servo *s, const struct hal_port *hal)
@@ -55,6 +56,7 @@ void servo_init(struct servo *s, const struct hal_port *hal)
     protection_init(&s->protection);
     motion_init(&s->motion, &s->regs, hal);
     s->next_tick_us = hal->bus.now_us(hal->ctx) + CONTROL_TICK_US;
+    s->tick_due_us = s->next_tick_us;
     frame_rx_init(&s->rx, &s->active_id);
     s->rx_idle_us = idle_timeout_us(s, 0);
     dispatcher_init(&s->dispatcher, &s->regs, &s->motion, &s->active_id);
@@ -85,6 +87,14 @@ static void wait_for_turn(struct servo *s, uint32_t now)
     if (now - last_byte < now - s->tx.silence_from_us) {
         s->tx.silence_from_us = last_byte; /* the line was busy since */
     }
+    /* The answer on the line is the last before this turn and ends sooner
+     * than a tick and a pass take: a tick started now would hold the turn
+     * back (on the M0 a tick is 4 byte times at 1 Mbaud), so a tick due
+     * waits for this servo's answer to start, a tick and a pass at most
+     * (the schedule stays: the tick after is due on time). */
+    bool imminent = seen + 1u >= s->tx.turns_left &&
+                    frame_rx_skip_ends_within(&s->rx, s->turn_guard_bytes);
+    s->tick_due_us = s->next_tick_us + (imminent ? s->hal->tick_and_pass_us : 0u);
     if (seen >= s->tx.turns_left) {
         start_send(s);
     } else if (now - s->tx.silence_from_us >= SYNC_SLOT_SILENCE_US) {
@@ -338,7 +348,7 @@ void servo_control_tick(struct servo *s)
  * racing through them. */
 static bool run_control_tick(struct servo *s, uint32_t now)
 {
-    if ((int32_t)(now - s->next_tick_us) < 0) {
+    if ((int32_t)(now - s->tick_due_us) < 0) {
         return false; /* most passes */
     }
     unsigned n = 0;
@@ -346,11 +356,13 @@ static bool run_control_tick(struct servo *s, uint32_t now)
         if (n == SERVO_MAX_CATCH_UP) {
             s->ticks_dropped += (uint32_t)(now - s->next_tick_us) / CONTROL_TICK_US + 1u;
             s->next_tick_us = now + CONTROL_TICK_US;
+            s->tick_due_us = s->next_tick_us;
             return true;
         }
         servo_control_tick(s);
         s->next_tick_us += CONTROL_TICK_US;
     }
+    s->tick_due_us = s->next_tick_us;
     return true;
 }
 
@@ -373,6 +385,7 @@ __attribute__((noinline, cold)) static void after_erase(struct servo *s, uint32_
 {
     s->erase_passed = 0;
     s->next_tick_us = now + CONTROL_TICK_US;
+    s->tick_due_us = s->next_tick_us;
     struct hal_rx_ring *ring = s->hal->rx;
     hal_rx_sync(s->hal, now);
     uint32_t came = ring->written - s->erase_from;

@@ -53,7 +53,6 @@
 #define CONTROL_TICK_US (1000000u / MOTION_TICK_HZ)
 
 struct servo_tx {
-    struct response frame;     /* built in place, sent from here */
     uint8_t size;
     uint8_t sending;           /* handed to the UART, not yet off the wire */
     uint8_t waiting;           /* ready, waiting for its turn (sync Monitor) */
@@ -62,29 +61,17 @@ struct servo_tx {
     uint32_t requests_base;    /* framer's request count when it began to wait */
     uint32_t silence_from_us;  /* start of the current wait for a turn */
     uint32_t ended_us;         /* when the last response left the wire */
+    struct response frame;     /* built in place, sent from here */
 };
 
+/* The scalars first, then the small structs, then the large ones: on the
+ * Cortex-M0 a field is reached by an immediate offset only within the
+ * first 32 bytes (a byte), 64 (a half-word) or 128 (a word) of the struct;
+ * one further away costs a literal and a register at each use. */
 struct servo {
     const struct hal_port *hal;
-    struct frame_rx rx;
-    struct registers regs;
-    struct motion motion;
-    struct dispatcher dispatcher;
-    struct config_store store;
-    struct servo_tx tx;
-    struct sensor_filter sensors;
-    struct protection protection;
-    struct winding_model winding;
-    uint16_t heat_cap_mw;        /* the derating's power cap; 0 = none */
-    uint8_t heat_ticks;          /* ticks towards the winding's next sample */
-    struct bus_watchdog watchdog;
-    struct fault_log faults;
-    uint8_t fault_bits_seen;     /* status bits 2-7 as the fault history last saw them */
-    uint8_t guard_seen;          /* protection.act_changes the motion has */
-    uint32_t next_tick_us;       /* when the next control tick is due */
-    uint32_t ticks_dropped;      /* control ticks skipped by a late main loop */
-    uint32_t sync_turns_abandoned; /* Sync Monitor answers dropped for a new request */
-    uint32_t rx_lost;            /* bytes the DMA wrote over before the main loop took them */
+    uint32_t next_tick_us;       /* the control tick's schedule */
+    uint32_t tick_due_us;        /* when it runs: later while a Sync Monitor turn is near */
     uint32_t rx_idle_us;         /* line idle this long drops a partial frame */
     volatile uint8_t active_id;  /* the ID answered to now */
     uint8_t active_baud_index;
@@ -92,12 +79,31 @@ struct servo {
     uint8_t enter_bootloader;    /* UpdateEnter taken: restart once the answer is out */
     uint8_t erase_passed;        /* a page erase stalled the CPU in the last pass */
     uint8_t ring_covers_erase;   /* the ring holds an erase's bytes at this baud */
+    uint8_t turn_guard_bytes;    /* a tick and a pass, in byte times at this baud */
+    uint8_t stale_frames;        /* frames that arrived during an erase: not answered */
+    uint8_t heat_ticks;          /* ticks towards the winding's next sample */
+    uint8_t fault_bits_seen;     /* status bits 2-7 as the fault history last saw them */
+    uint8_t guard_seen;          /* protection.act_changes the motion has */
+    uint16_t heat_cap_mw;        /* the derating's power cap; 0 = none */
     uint32_t erase_from;         /* the ring's written count as the erase began */
-    uint8_t stale_frames;        /* frames that arrived during it: not answered */
+    uint32_t ticks_dropped;      /* control ticks skipped by a late main loop */
+    uint32_t sync_turns_abandoned; /* Sync Monitor answers dropped for a new request */
+    uint32_t rx_lost;            /* bytes the DMA wrote over before the main loop took them */
     uint32_t answers_dropped;    /* answers not sent: they would have left late */
     uint32_t unsolicited_slot_us;  /* slot length at this baud */
     uint32_t unsolicited_first_us; /* quiet ahead of this ID's first slot */
+    struct bus_watchdog watchdog;
     struct save_policy saver;
+    struct servo_tx tx;
+    struct frame_rx rx;
+    struct registers regs;
+    struct motion motion;
+    struct dispatcher dispatcher;
+    struct config_store store;
+    struct sensor_filter sensors;
+    struct protection protection;
+    struct winding_model winding;
+    struct fault_log faults;
 };
 
 #endif

@@ -16,6 +16,7 @@ enum rx_state {
     RX_CHECKSUM,
     RX_SKIP,      /* a frame not kept: remaining counts its checksum too */
 };
+_Static_assert(RX_SKIP == FRAME_RX_SKIPPING, "frame_rx.h names the skipping state");
 
 /* The bursts' fast paths (a header, a run of content or garbage at once,
  * the hot helpers inlined) buy the receive path its budget. FRAME_RX_SMALL

@@ -205,7 +205,7 @@ static void test_the_idle_time_survives_the_clock_wrap(void **state)
 {
     (void)state;
     hal.now_us = 0xFFFFFFFFu - 3u * HARNESS_BYTE_US;
-    servo.next_tick_us = hal.now_us;
+    servo.next_tick_us = servo.tick_due_us = hal.now_us;
     feed_ping_in_two(100);
     EXPECT_RESPONSE(PKT_PING, 0);
     assert_int_equal(servo.rx.stats.idle_timeouts, 0);
@@ -426,6 +426,88 @@ static void test_sync_monitor_passes_a_silent_servo(void **state)
     hal.now_us += 2;
     harness_poll(3);
     assert_int_equal(hal.sent_length, 21);
+}
+
+/* At 1 Mbaud, bytes 10 us apart, as a port stamps them. */
+static void feed_at_1mbaud(const uint8_t *bytes, size_t n)
+{
+    for (size_t i = 0; i < n; i++) {
+        hal.now_us += 10u;
+        servo_on_rx_byte(&servo, bytes[i], hal.now_us);
+    }
+}
+
+/* Servo 0 second in a Sync Monitor at 1 Mbaud on a CPU whose tick and
+ * pass take 46 us (the M0's): servo 5's answer is on the line, all but its
+ * last `left` bytes received, and the control tick falls due. Returns
+ * the tick's schedule as it was. */
+static uint32_t tick_due_near_the_turn(uint8_t tick_and_pass_us, size_t left, uint8_t frame[32],
+                                       size_t *n)
+{
+    hal.port.tick_and_pass_us = tick_and_pass_us;
+    servo.regs.user.baud_index = 8; /* 1 Mbaud */
+    servo.link_settings_pending = 1;
+    harness_poll(1);
+    const uint8_t sync[] = {22, 1, 2, 5, 0};
+    harness_request(PKT_SYNC_COMMAND, sync, sizeof sync);
+    uint8_t content[16] = {5};
+    *n = make_response(frame, 22, content, sizeof content);
+    while (servo.next_tick_us - hal.now_us <= 10u * (*n - left)) { /* time only goes on */
+        hal.now_us = servo.next_tick_us;
+        harness_poll(1);
+    }
+    hal.now_us = servo.next_tick_us - 10u * (*n - left) - 1u;
+    feed_at_1mbaud(frame, *n - left);
+    harness_poll(1); /* the framer sees `left` bytes to come */
+    uint32_t due = servo.next_tick_us;
+    hal.now_us = due;
+    harness_poll(1);
+    return due;
+}
+
+/* The tick that falls due 3 byte times before this servo's turn waits: the
+ * answer starts in the pass after the line frees, the tick in the next, on
+ * its schedule. */
+static void test_a_tick_waits_for_a_sync_turn_a_tick_away(void **state)
+{
+    (void)state;
+    uint8_t frame[32];
+    size_t n;
+    uint32_t due = tick_due_near_the_turn(46, 3, frame, &n);
+    assert_int_equal(servo.turn_guard_bytes, 4);
+    assert_int_equal(servo.next_tick_us, due); /* held */
+    EXPECT_SILENCE();
+    feed_at_1mbaud(&frame[n - 3], 3);
+    harness_poll(1);
+    assert_int_equal(hal.sent_length, 21); /* 30 us after the tick was due */
+    assert_int_equal(servo.next_tick_us, due);
+    harness_poll(1);
+    assert_int_equal(servo.next_tick_us, due + CONTROL_TICK_US);
+}
+
+/* Further from the turn, or on a CPU whose tick is shorter than a byte
+ * time, the tick runs when due; and a turn that does not come holds it
+ * back by a tick and a pass at most. */
+static void test_a_tick_waits_only_for_a_turn_it_would_delay(void **state)
+{
+    (void)state;
+    uint8_t frame[32];
+    size_t n;
+    uint32_t due = tick_due_near_the_turn(46, 5, frame, &n);
+    assert_int_equal(servo.next_tick_us, due + CONTROL_TICK_US);
+    harness_init();
+    due = tick_due_near_the_turn(9, 3, frame, &n);
+    assert_int_equal(servo.turn_guard_bytes, 0);
+    assert_int_equal(servo.next_tick_us, due + CONTROL_TICK_US);
+    harness_init();
+    due = tick_due_near_the_turn(46, 3, frame, &n);
+    hal.now_us = due + 45u;
+    harness_poll(1);
+    assert_int_equal(servo.next_tick_us, due);
+    hal.now_us = due + 46u;
+    harness_poll(1);
+    assert_int_equal(servo.next_tick_us, due + CONTROL_TICK_US);
+    EXPECT_SILENCE();
 }
 
 /* Listed after 251 absent servos, this one would wait 251 x 3 ms for its
@@ -725,6 +807,8 @@ int main(void)
         cmocka_unit_test_setup(test_reset_keeps_link, setup),
         cmocka_unit_test_setup(test_sync_monitor_waits_its_turn, setup),
         cmocka_unit_test_setup(test_sync_monitor_passes_a_silent_servo, setup),
+        cmocka_unit_test_setup(test_a_tick_waits_for_a_sync_turn_a_tick_away, setup),
+        cmocka_unit_test_setup(test_a_tick_waits_only_for_a_turn_it_would_delay, setup),
         cmocka_unit_test_setup(test_a_new_request_ends_the_wait_for_a_sync_turn, setup),
         cmocka_unit_test_setup(test_a_write_the_flash_refuses_is_not_made, setup),
         cmocka_unit_test_setup(test_every_change_is_in_flash_before_its_answer, setup),

@@ -34,6 +34,9 @@
  * controller, so nothing stalls the CPU for longer than a main-loop pass. */
 #define BOARD_RX_RING_BYTES 256
 #define BOARD_BOOT_RX_RING_BYTES 256
+/* The longest control tick and a main-loop pass of the Cortex-M3 bench
+ * figures (docs/benchmark.md) at the STM32F100's 24 MHz: 41.2 + 10.7 us. */
+#define BOARD_TICK_AND_PASS_US 52
 
 #include "boards/board_derived.h"
 

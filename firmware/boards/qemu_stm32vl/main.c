@@ -116,6 +116,7 @@ static const struct hal_port port = {
     .image_version = image_version,
     .enter_bootloader = enter_bootloader,
     .board = BOARD_ID,
+    .tick_and_pass_us = BOARD_TICK_AND_PASS_US,
     .serial_number = serial_number,
     .rx_gap_tolerance_us = QEMU_RX_GAP_TOLERANCE_US,
 };

@@ -31,6 +31,9 @@
  * waits: 256 bytes. */
 #define BOARD_RX_RING_BYTES 4096
 #define BOARD_BOOT_RX_RING_BYTES 256
+/* The longest control tick and a main-loop pass at 72 MHz (the target
+ * bench's servo_tick_worst and idle_poll, docs/benchmark.md): 13.7 + 3.6 us. */
+#define BOARD_TICK_AND_PASS_US 18
 
 /* The analogue front end: 3.3 V ADC reference; supply through a 100k/10k
  * divider (11:1); 25 mOhm shunt into a gain-of-20 amplifier (0.5 V/A); the

@@ -74,6 +74,11 @@ struct hal_port {
      * us; 0 for a real UART (the framer's own rule, frame_rx_idle_us). An
      * emulated UART delivers bytes with the host's scheduling jitter. */
     uint32_t rx_gap_tolerance_us;
+    /* This CPU's longest control tick and main-loop pass together, in us
+     * (the target bench's worst figures, docs/benchmark.md): a tick that
+     * starts less than this before a Sync Monitor turn would delay the
+     * answer, so it waits for the answer to start (servo.c). 0: never. */
+    uint8_t tick_and_pass_us;
 };
 
 /* Brings the receive ring up to date (a port whose DMA fills it). */

@@ -96,6 +96,14 @@ uint32_t frame_rx_feed_until_full(struct frame_rx *rx, const uint8_t *data, uint
 /* The line has been idle for the idle timeout (frame_rx_idle_us): a partial
  * frame is dropped. */
 void frame_rx_line_idle(struct frame_rx *rx);
+/* The framer's state while it passes over a frame it does not keep
+ * (another servo's response): skip_left bytes are still to come. */
+#define FRAME_RX_SKIPPING 8u
+/* A frame passed over ends within `bytes` more bytes. */
+static inline bool frame_rx_skip_ends_within(const struct frame_rx *rx, uint32_t bytes)
+{
+    return rx->state == FRAME_RX_SKIPPING && rx->skip_left <= bytes;
+}
 /* A frame has begun and not ended. */
 static inline bool frame_rx_in_frame(const struct frame_rx *rx)
 {
