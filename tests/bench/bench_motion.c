@@ -14,6 +14,8 @@
  *          firmware runs them (sensors, protection monitors, motion,
  *          status) on the same followed move, sensors at their healthy
  *          readings: one region per tick, for the worst tick
+ *   ticks_stream  MOTION_BENCH_TICKS ticks of a 50 Hz stream the horn
+ *          follows: the cubic's walk, a segment begun every 20 ticks
  *   safety_pass  what the main loop's pass runs after each of those ticks
  *          (safety_tend): the bus watchdog (on, never firing), the winding's
  *          sample and its model's step every 80 ms
@@ -32,6 +34,7 @@
 #include "app/servo_safety.h"
 
 #define MOTION_BENCH_TICKS 2000u
+#define STREAM_PERIOD_TICKS 20u /* 50 Hz */
 
 static struct hal_double hal;
 static struct registers regs;
@@ -151,6 +154,36 @@ int main(void)
                                                 .velocity_decideg_s = 3000, .acc_ms = 100,
                                                 .dec_ms = 200};
     plan("plan_short_stroke", &short_stroke);
+
+    /* A host's stream at 50 Hz (StreamSetpoint): setpoints on arches of
+     * 0..60 deg, 2 s each, with their speeds; the horn follows (the
+     * readings of a first run replayed). The setpoints' arrivals are
+     * outside the region, each period's 20 ticks in it. */
+    for (int replay = 0; replay < 2; replay++) {
+        fresh();
+        for (unsigned k = 0; k < MOTION_BENCH_TICKS / STREAM_PERIOD_TICKS; k++) {
+            int32_t p = (int32_t)(k % 100u);
+            const struct motion_setpoint sp = {
+                .angle_decideg = 600 - 24 * p * (100 - p) / 100,
+                .velocity_decideg_s = (int16_t)(-12 * (100 - 2 * p)),
+                .host_ms = (uint16_t)(k * STREAM_PERIOD_TICKS)};
+            must_accept(motion_stream(&motion, &sp), "a streamed setpoint");
+            unsigned at = k * STREAM_PERIOD_TICKS;
+            if (!replay) {
+                for (unsigned i = at; i < at + STREAM_PERIOD_TICKS; i++) {
+                    hal.encoder_raw = follow_raw[i] = ideal_encoder_raw(&motion);
+                    motion_tick(&motion);
+                }
+                continue;
+            }
+            bench_begin();
+            for (unsigned i = at; i < at + STREAM_PERIOD_TICKS; i++) {
+                hal.encoder_raw = follow_raw[i];
+                motion_tick(&motion);
+            }
+            bench_end("ticks_stream");
+        }
+    }
     printf("ticks %u\n", MOTION_BENCH_TICKS);
     return 0;
 }

@@ -35,7 +35,7 @@
 
 PLUGIN_EXPORT int qemu_plugin_version = 1;
 
-enum { MAX_REGIONS = 4096, MAX_BLOCKS = 65536 };
+enum { MAX_REGIONS = 8192, MAX_BLOCKS = 65536 };
 
 static uint64_t executed, cycles;
 static uint64_t begun_at, begun_cycles;

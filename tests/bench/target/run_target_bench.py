@@ -241,9 +241,12 @@ def figures(cpu: str, profile_region: str = "", by_line: bool = False) -> dict:
         # One motion tick less the HAL double: the worse of a move the horn
         # follows and one it cannot; each also on its own.
         "tick": max(per_tick(motion, "ticks_follow", nticks),
-                    per_tick(motion, "ticks_at_limit", nticks)),
+                    per_tick(motion, "ticks_at_limit", nticks),
+                    per_tick(motion, "ticks_stream", nticks)),
         "tick_follow": per_tick(motion, "ticks_follow", nticks),
         "tick_at_limit": per_tick(motion, "ticks_at_limit", nticks),
+        # A 50 Hz stream's ticks (StreamSetpoint), the horn following.
+        "tick_stream": per_tick(motion, "ticks_stream", nticks),
         # The whole control tick (servo_control_tick) on the followed move:
         # the mean of its ticks, as the motion tick's, and the worst one
         # (each tick is a region): a slow reading's turn, a profile segment.
