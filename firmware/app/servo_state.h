@@ -29,8 +29,8 @@
  *   slot of ID i, cycle k:  last activity + QUIET + (k x 254 + i) x SLOT
  * QUIET is longer than a Sync Monitor slot, so a round in progress is never
  * cut into. A servo starts only within the first UNSOLICITED_WINDOW_US of
- * its slot (the main loop's longest pass, the simulator's 250 us step
- * included); SLOT adds two byte times, by which the next ID has heard the
+ * its slot (longer than the main loop's longest pass, a tick and an
+ * answer); SLOT adds two byte times, by which the next ID has heard the
  * first byte, and a guard for the drift of two crystals. */
 #define UNSOLICITED_QUIET_US (SYNC_SLOT_SILENCE_US + 1000u)
 #define UNSOLICITED_WINDOW_US 300u

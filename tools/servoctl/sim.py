@@ -63,7 +63,8 @@ class Simulator(_Child):
     socket://) unless tcp=False, then a pseudo-terminal (optionally linked)."""
 
     def __init__(self, ids=(1,), tcp=True, link=None, state_dir=None, supply_mv=None,
-                 ambient_c=None, tcp_port=None, rx=None, board=None, app_image=None, nice=None):
+                 ambient_c=None, tcp_port=None, rx=None, board=None, app_image=None, nice=None,
+                 cpu=None):
         self.ids = list(ids)
         self.tcp = tcp or tcp_port is not None
         self.tcp_port = tcp_port
@@ -73,6 +74,7 @@ class Simulator(_Child):
         self.supply_mv = supply_mv
         self.ambient_c = ambient_c
         self.rx = rx  # "dma" (default) or "interrupt": how the servos' port receives
+        self.cpu = cpu  # "m3" (default) or "m0": whose time a pass, a tick, an answer take
         self.board = board  # None: servo_sim; else a virtual board (tools/vboard)
         self.app_image = app_image  # a virtual board's slot, if not the build's image
         # A niceness for the simulator (below 0 needs root): a client that
@@ -88,8 +90,8 @@ class Simulator(_Child):
 
     def start(self) -> "Simulator":
         if self.board is not None:
-            if self.rx is not None:
-                raise ServoError("a virtual board receives as its port does: --rx is servo_sim's")
+            if self.rx is not None or self.cpu is not None:
+                raise ServoError("a virtual board runs as its MCU does: --rx and --cpu are servo_sim's")
             cmd = [sys.executable, "-m", "vboard", "--board", self.board, "--state", self.state_dir]
             if self.app_image is not None:
                 cmd += ["--app", str(self.app_image)]
@@ -109,6 +111,8 @@ class Simulator(_Child):
             cmd += ["--ambient", str(self.ambient_c)]
         if self.rx is not None:
             cmd += ["--rx", self.rx]
+        if self.cpu is not None:
+            cmd += ["--cpu", self.cpu]
         env = dict(os.environ, PYTHONPATH=os.pathsep.join(
             [str(REPO / "tools")] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]))
         self.process = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,

@@ -58,15 +58,20 @@ static void refuse(int fd)
     close(fd);
 }
 
-/* The servos and the wire up to target on the bus clock, a byte time at a
- * time, the servos' main loops running at each (as on silicon, between one
- * byte's interrupt and the next): when the loop was late, the bytes it
- * catches up on do not all land before a servo has seen the first. */
+/* The servos and the wire up to target on the bus clock, event by event:
+ * each byte as it ends on the wire, and each servo's main-loop pass when
+ * its CPU would run it (sim_servo_wake_at): when the loop was late, the
+ * bytes it catches up on do not all land before a servo has seen the
+ * first, and an answer leaves when the target's CPU would have sent it. */
 static void run_to(uint64_t target)
 {
     do {
         uint64_t next = sim_bus_next_at(&bus, target);
-        sim_bus_deliver(&bus, next);
+        for (unsigned i = 0; i < bus.station_count; i++) {
+            uint64_t wake = sim_servo_wake_at(&servos[i]);
+            next = wake < next ? wake : next;
+        }
+        sim_bus_deliver(&bus, next > bus.now_us ? next : bus.now_us);
         for (unsigned i = 0; i < bus.station_count; i++) {
             sim_servo_poll(&servos[i], bus.now_us);
         }
@@ -90,6 +95,7 @@ int main(int argc, char **argv)
 
     sim_bus_init(&bus, sim_now_us());
     for (unsigned i = 0; i < o.id_count; i++) {
+        servos[i].cpu = o.cpu;
         if (!sim_servo_start(&servos[i], &bus, i, o.ids[i], o.units[i], o.state_dir, o.supply_v,
                              o.ambient_c)) {
             return 1;

@@ -23,6 +23,11 @@ static uint64_t enqueue(struct sim_bus *b, uint8_t sender, const uint8_t *data, 
 {
     uint64_t byte_us = baud ? (10000000u + baud - 1u) / baud : 87u;
     uint64_t t = now_us > b->wire_until_us ? now_us : b->wire_until_us;
+    struct sim_bus_span *last = &b->spans[(b->span_count - 1u) % SIM_BUS_SPANS];
+    if (b->span_count == 0u || last->sender != sender || last->end_us != t) {
+        last = &b->spans[b->span_count++ % SIM_BUS_SPANS];
+        *last = (struct sim_bus_span){.start_us = t, .end_us = t, .sender = sender};
+    }
     for (unsigned i = 0; i < len; i++) {
         if (b->count == SIM_BUS_QUEUE) {
             b->dropped++; /* never on the wire: it takes no wire time */
@@ -34,6 +39,8 @@ static uint64_t enqueue(struct sim_bus *b, uint8_t sender, const uint8_t *data, 
         b->count++;
     }
     b->wire_until_us = t;
+    last->end_us = t;
+    last->bytes = (uint16_t)(last->bytes + len);
     return t;
 }
 

@@ -42,6 +42,16 @@ struct sim_station {
     uint8_t log_id;
 };
 
+/* One sender's bytes back to back on the wire: from the first start bit
+ * to the last stop bit, on the bus clock. */
+struct sim_bus_span {
+    uint64_t start_us;
+    uint64_t end_us;
+    uint16_t bytes;
+    uint8_t sender; /* a station's index, or SIM_HOST */
+};
+#define SIM_BUS_SPANS 1024u /* the wire's log keeps the latest */
+
 struct sim_bus_byte {
     uint64_t at_us;
     uint32_t baud;
@@ -64,6 +74,8 @@ struct sim_bus {
     unsigned long collisions;
     unsigned long dropped;    /* queue overflow (servo bytes; the host is held back) */
     unsigned long baud_mismatches; /* bytes no station at that rate received */
+    struct sim_bus_span spans[SIM_BUS_SPANS];
+    unsigned long span_count; /* in all: the latest SIM_BUS_SPANS are kept */
 };
 
 /* Room for this many more bytes: the host is read no faster. */

@@ -117,6 +117,29 @@ static void host_send(const struct sim_control *c, int fd, int n, char **words)
     reply(fd, "ok\n");
 }
 
+/* The wire's latest spans, oldest first (sim_bus.h). */
+static void wire_log(const struct sim_control *c, int fd, const char *count)
+{
+    const struct sim_bus *b = c->bus;
+    unsigned long want = count != NULL ? strtoul(count, NULL, 10) : 64u;
+    unsigned long kept = b->span_count < SIM_BUS_SPANS ? b->span_count : SIM_BUS_SPANS;
+    want = want < kept ? want : kept;
+    for (unsigned long i = b->span_count - want; i < b->span_count; i++) {
+        const struct sim_bus_span *s = &b->spans[i % SIM_BUS_SPANS];
+        char line[96];
+        if (s->sender == SIM_HOST) {
+            snprintf(line, sizeof line, "%llu %llu %u host\n", (unsigned long long)s->start_us,
+                     (unsigned long long)s->end_us, (unsigned)s->bytes);
+        } else {
+            snprintf(line, sizeof line, "%llu %llu %u %u\n", (unsigned long long)s->start_us,
+                     (unsigned long long)s->end_us, (unsigned)s->bytes,
+                     (unsigned)sim_servo_bus_id(&c->servos[s->sender]));
+        }
+        reply(fd, line);
+    }
+    reply(fd, "end\n");
+}
+
 /* One control line: "command [value] [servo id]". */
 static void control_command(const struct sim_control *c, int fd, char *line)
 {
@@ -134,6 +157,10 @@ static void control_command(const struct sim_control *c, int fd, char *line)
         snprintf(out, sizeof out, "sim_ms=%.3f behind_ms=%.1f\n", (double)c->bus->now_us / 1000.0,
                  (double)(sim_now_us() - c->bus->now_us) / 1000.0);
         reply(fd, out);
+        return;
+    }
+    if (strcmp(cmd, "wire") == 0) {
+        wire_log(c, fd, n > 1 ? words[1] : NULL);
         return;
     }
     if (strcmp(cmd, "hostsend") == 0) {

@@ -7,7 +7,8 @@
 static void usage(FILE *out)
 {
     fputs("usage: servo_sim [--id N]... [--tcp PORT | --link PATH] [--control PORT]\n"
-          "                 [--state DIR] [--supply MV] [--ambient DEGC]\n"
+          "                 [--state DIR] [--supply MV] [--ambient DEGC] [--rx dma|interrupt]\n"
+          "                 [--cpu m3|m0]\n"
           "Runs the servo firmware on simulated servos sharing one bus.\n"
           "  --id N         a servo with ID N (repeat for more; default 1). An ID given\n"
           "                 again is one more servo at it, as new servos all hold ID 0\n"
@@ -22,6 +23,8 @@ static void usage(FILE *out)
           "  --rx dma|interrupt  how the port receives: DMA into a ring (the reference\n"
           "                 board, default) or a byte per interrupt, which overruns\n"
           "                 while the flash stalls the CPU\n"
+          "  --cpu m3|m0    whose time a main-loop pass, a tick and an answer take:\n"
+          "                 the reference board's STM32F103 (default) or the STM32F030's\n"
           "Control commands, one per line, optional servo last: its bus ID as it is now\n"
           "(every servo that holds it), or its serial number (0x51a0UUNN):\n"
           "  supply MV | load NM | stop DEG | stop off | ambient DEGC | soak DEGC |\n"
@@ -52,7 +55,8 @@ static int parse_int(const char *s, const char *what, long lo, long hi)
 
 void sim_options_parse(int argc, char **argv, struct sim_options *o)
 {
-    *o = (struct sim_options){.tcp_port = -1, .state_dir = "sim-state", .supply_v = 7.4, .ambient_c = 25.0};
+    *o = (struct sim_options){.tcp_port = -1, .state_dir = "sim-state", .supply_v = 7.4, .ambient_c = 25.0,
+                              .cpu = sim_cpu_named("m3")};
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
@@ -91,6 +95,12 @@ void sim_options_parse(int argc, char **argv, struct sim_options *o)
             o->supply_v = parse_int(v, "--supply", 0, 30000) / 1000.0;
         } else if (strcmp(a, "--ambient") == 0) {
             o->ambient_c = parse_int(v, "--ambient", -40, 150);
+        } else if (strcmp(a, "--cpu") == 0) {
+            o->cpu = sim_cpu_named(v);
+            if (o->cpu == NULL) {
+                fprintf(stderr, "servo_sim: --cpu is m3 or m0, not '%s'\n", v);
+                exit(2);
+            }
         } else if (strcmp(a, "--rx") == 0) {
             if (strcmp(v, "dma") != 0 && strcmp(v, "interrupt") != 0) {
                 fprintf(stderr, "servo_sim: --rx is dma or interrupt, not '%s'\n", v);

@@ -7,6 +7,7 @@
 #include <stdint.h>
 
 #include "sim_bus.h"
+#include "sim_cpu.h"
 
 struct sim_options {
     uint8_t ids[SIM_MAX_SERVOS];
@@ -19,6 +20,7 @@ struct sim_options {
     double supply_v;
     double ambient_c;
     bool rx_interrupt;
+    const struct sim_cpu *cpu;
 };
 
 /* Parses argv; prints the usage and exits on --help or a bad option. */

@@ -46,15 +46,14 @@ static uint32_t now_us(void *ctx)
     return (uint32_t)s->bus->now_us;
 }
 
-/* The CPU sends after the flash work it did earlier in this pass: a flash
- * step stalls it (RM0008 3.3.3), so an answer to a write that programmed
- * flash leaves once the programming is done, not before. */
+/* The UART starts once the pass that handed it the bytes has run on the
+ * target's CPU (sim_servo_poll): until then it is not done. */
 static void uart_send(void *ctx, const uint8_t *data, uint16_t len)
 {
     struct sim_servo *s = ctx;
-    uint64_t at = s->bus->now_us + s->flash.stall_us + s->slot_flash.stall_us + s->fault_flash.stall_us;
-    s->last_sent_us = at;
-    s->tx_done_us = sim_bus_send(s->bus, s->index, data, len, s->baud, at);
+    s->tx_data = data;
+    s->tx_len = len;
+    s->tx_done_us = UINT64_MAX;
 }
 
 static bool uart_tx_done(void *ctx)
@@ -266,6 +265,7 @@ bool sim_servo_start(struct sim_servo *s, struct sim_bus *bus, unsigned index, u
         .image_version = image_version,
         .enter_bootloader = enter_bootloader,
         .board = SIM_BOARD,
+        .tick_and_pass_us = s->cpu->tick_and_pass_us,
     };
     /* Powered long before the host connects: the application runs (the
      * bootloader's listening window is modelled after a restart), if its
@@ -292,6 +292,10 @@ bool sim_servo_start(struct sim_servo *s, struct sim_bus *bus, unsigned index, u
 static void receive(void *ctx, uint8_t byte, uint64_t at_us)
 {
     struct sim_servo *s = ctx;
+    /* A byte's interrupt ends a sleep; by DMA, the USART's IDLE does, a
+     * byte time after the last byte (RM0008 27.3.3). */
+    s->asleep = s->asleep && !s->rx_interrupt;
+    s->idle_at_us = at_us + (10000000u + s->baud - 1u) / s->baud;
     if (s->rx_interrupt) {
         if (at_us < s->cpu_free_us) {
             if (s->uart_full) {
@@ -322,18 +326,76 @@ static void receive(void *ctx, uint8_t byte, uint64_t at_us)
     s->rx.heard_us = (uint32_t)at_us;
 }
 
+/* The bus time a 32-bit firmware time falls at, not before now. */
+static uint64_t bus_time_of(uint64_t now_us, uint32_t at_us)
+{
+    int32_t ahead = (int32_t)(at_us - (uint32_t)now_us);
+    return ahead > 0 ? now_us + (uint64_t)ahead : now_us;
+}
+
+uint64_t sim_servo_wake_at(const struct sim_servo *s)
+{
+    uint64_t now = s->bus->now_us;
+    uint64_t free = s->cpu_free_us > s->next_pass_us ? s->cpu_free_us : s->next_pass_us;
+    if (!s->asleep) {
+        return free > now ? free : now;
+    }
+    uint64_t wake = bus_time_of(now, s->core.tick_due_us);
+    if (s->idle_at_us != 0u && s->idle_at_us < wake) {
+        wake = s->idle_at_us;
+    }
+    if (s->core.tx.sending && s->tx_done_us < wake) {
+        wake = s->tx_done_us; /* the transmission's end */
+    }
+    return wake > free ? wake : free;
+}
+
+/* One main-loop pass at now_us, then what it cost on the target's CPU:
+ * the answer it started leaves at its end, and the next pass starts
+ * there. */
+static void run_pass(struct sim_servo *s, uint64_t now_us)
+{
+    uint32_t ticks_before = s->core.next_tick_us;
+    uint32_t heard_before = s->core.dispatcher.heard;
+    uint32_t frames_before = s->core.rx.stats.frames;
+    bool in_app = !s->in_bootloader; /* the core's counters are this pass's */
+    if (!s->in_bootloader || !boot_poll(s)) {
+        servo_poll(&s->core);
+    }
+    uint64_t cost_ns = s->cpu->pass_ns;
+    if (in_app && !s->in_bootloader) {
+        cost_ns += (uint64_t)((s->core.next_tick_us - ticks_before) / CONTROL_TICK_US) * s->cpu->tick_ns;
+        cost_ns += (s->core.dispatcher.heard != heard_before ||
+                    s->core.rx.stats.frames != frames_before) * (uint64_t)s->cpu->answer_ns;
+    }
+    uint64_t cost_us = (cost_ns + 500u) / 1000u;
+    s->next_pass_us = now_us + (cost_us != 0u ? cost_us : 1u);
+    if (s->tx_data != NULL) {
+        /* After the flash work of this pass too: a flash step stalls the
+         * CPU (RM0008 3.3.3), so an answer to a write that programmed
+         * flash leaves once the programming is done. */
+        uint64_t at = now_us + cost_us + s->flash.stall_us + s->slot_flash.stall_us +
+                      s->fault_flash.stall_us;
+        s->last_sent_us = at;
+        s->tx_done_us = sim_bus_send(s->bus, s->index, s->tx_data, s->tx_len, s->baud, at);
+        s->tx_data = NULL;
+    }
+    s->asleep = !s->in_bootloader && servo_may_sleep(&s->core);
+    if (s->idle_at_us <= now_us) {
+        s->idle_at_us = 0;
+    }
+}
+
 void sim_servo_poll(struct sim_servo *s, uint64_t now_us)
 {
-    if (now_us < s->cpu_free_us) {
+    if (now_us < sim_servo_wake_at(s)) {
         return;
     }
     if (s->uart_full) { /* the interrupt runs as soon as the CPU does */
         s->uart_full = false;
         hal_rx_ring_put(&s->rx, s->uart_held, s->uart_held_at_us);
     }
-    if (!s->in_bootloader || !boot_poll(s)) {
-        servo_poll(&s->core);
-    }
+    run_pass(s, now_us);
     if (s->core.dispatcher.heard != s->heard_seen) {
         s->heard_seen = s->core.dispatcher.heard;
         s->heard_us = now_us;

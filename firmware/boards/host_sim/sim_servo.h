@@ -11,6 +11,7 @@
 #include "ports/host/plant.h"
 #include "app/servo.h"
 #include "sim_bus.h"
+#include "sim_cpu.h"
 #include "ports/host/sim_flash.h"
 #include "ports/host/thermal.h"
 
@@ -59,6 +60,17 @@ struct sim_servo {
      * (uart_held) and loses the next ones; by DMA (the reference board)
      * bytes go on into the ring. */
     uint64_t cpu_free_us;
+    /* The main loop as the target's CPU runs it (sim_cpu.h): the next pass
+     * starts when this one would have ended, or, asleep, at the interrupt
+     * that wakes it (the tick, the USART's IDLE, a byte's interrupt, a
+     * transmission's end). The bytes of an answer wait in tx_data for the
+     * end of the pass that sent them. */
+    const struct sim_cpu *cpu;
+    uint64_t next_pass_us;
+    uint64_t idle_at_us; /* the line's IDLE after the last byte; 0: none due */
+    bool asleep;
+    const uint8_t *tx_data;
+    uint16_t tx_len;
     bool rx_interrupt;
     bool uart_full;
     uint8_t uart_held;
@@ -101,7 +113,12 @@ uint8_t sim_servo_bus_id(const struct sim_servo *s);
 /* The servo as a station of the bus: its UART. */
 struct sim_station sim_servo_station(struct sim_servo *s);
 
-/* A main-loop pass, unless the flash stalls the CPU at now_us; the stall
+/* When the servo's CPU next runs a main-loop pass (sim_servo_poll does
+ * nothing before): the end of its last pass or of a flash stall, or, when
+ * it sleeps, the interrupt that wakes it. */
+uint64_t sim_servo_wake_at(const struct sim_servo *s);
+
+/* A main-loop pass, if one is due at now_us (sim_servo_wake_at); the stall
  * of what it did to the flash starts at now_us. */
 void sim_servo_poll(struct sim_servo *s, uint64_t now_us);
 
