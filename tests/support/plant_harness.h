@@ -13,5 +13,7 @@ extern struct plant plant;
 void plant_harness_attach(void);
 /* A fresh plant and servo (servo ID 0, soft start off), attached. */
 void plant_harness_start(void);
+/* plant_harness_start as a cmocka setup. */
+int plant_harness_setup(void **state);
 
 #endif

@@ -17,13 +17,6 @@
 #include "support/by_name.h"
 #include "support/plant_harness.h"
 
-static int setup(void **state)
-{
-    (void)state;
-    plant_harness_start();
-    return 0;
-}
-
 static double setpoint_deg(void)
 {
     return (double)servo.motion.setpoint_q8 / 256.0 / 10.0;
@@ -380,19 +373,19 @@ static void test_stall_releases_when_37_says_so(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test_setup(test_interval_move_tracks_and_settles, setup),
-        cmocka_unit_test_setup(test_velocity_move_and_return, setup),
-        cmocka_unit_test_setup(test_load_is_held, setup),
-        cmocka_unit_test_setup(test_a_hold_does_not_sag, setup),
-        cmocka_unit_test_setup(test_power_bounds_the_current, setup),
-        cmocka_unit_test_setup(test_holding_has_no_limit_cycle, setup),
-        cmocka_unit_test_setup(test_wheel_stop_brakes_within_the_motor, setup),
-        cmocka_unit_test_setup(test_stop_and_hold_brakes_within_the_motor, setup),
-        cmocka_unit_test_setup(test_back_driving_is_bounded, setup),
-        cmocka_unit_test_setup(test_pushed_backwards_is_a_stall, setup),
-        cmocka_unit_test_setup(test_damping_brakes_a_spinning_horn, setup),
-        cmocka_unit_test_setup(test_stall_limits_to_the_stall_power, setup),
-        cmocka_unit_test_setup(test_stall_releases_when_37_says_so, setup),
+        cmocka_unit_test_setup(test_interval_move_tracks_and_settles, plant_harness_setup),
+        cmocka_unit_test_setup(test_velocity_move_and_return, plant_harness_setup),
+        cmocka_unit_test_setup(test_load_is_held, plant_harness_setup),
+        cmocka_unit_test_setup(test_a_hold_does_not_sag, plant_harness_setup),
+        cmocka_unit_test_setup(test_power_bounds_the_current, plant_harness_setup),
+        cmocka_unit_test_setup(test_holding_has_no_limit_cycle, plant_harness_setup),
+        cmocka_unit_test_setup(test_wheel_stop_brakes_within_the_motor, plant_harness_setup),
+        cmocka_unit_test_setup(test_stop_and_hold_brakes_within_the_motor, plant_harness_setup),
+        cmocka_unit_test_setup(test_back_driving_is_bounded, plant_harness_setup),
+        cmocka_unit_test_setup(test_pushed_backwards_is_a_stall, plant_harness_setup),
+        cmocka_unit_test_setup(test_damping_brakes_a_spinning_horn, plant_harness_setup),
+        cmocka_unit_test_setup(test_stall_limits_to_the_stall_power, plant_harness_setup),
+        cmocka_unit_test_setup(test_stall_releases_when_37_says_so, plant_harness_setup),
     };
     return cmocka_run_group_tests_name("control_loop", tests, NULL, NULL);
 }

@@ -20,13 +20,6 @@
 #include "support/by_name.h"
 #include "support/plant_harness.h"
 
-static int setup(void **state)
-{
-    (void)state;
-    plant_harness_start();
-    return 0;
-}
-
 static void stream(uint8_t id, int32_t angle_decideg, int16_t velocity_decideg_s, uint16_t host_ms)
 {
     uint32_t a = (uint32_t)angle_decideg;
@@ -109,7 +102,7 @@ static void test_a_stream_tracks_the_path_smoothly(void **state)
     stream(0, 0, 0, 0); /* start from rest at 0 */
     harness_run_ms(200);
     struct tracking streamed = follow_path(true);
-    setup(state);
+    plant_harness_setup(state);
     move_angle(0, 100);
     harness_run_ms(200);
     struct tracking moves = follow_path(false);
@@ -225,12 +218,12 @@ static void test_a_broadcast_setpoint_is_taken_silently(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test_setup(test_a_stream_tracks_the_path_smoothly, setup),
-        cmocka_unit_test_setup(test_a_late_stream_brakes_to_a_hold, setup),
-        cmocka_unit_test_setup(test_the_period_is_learned_or_told, setup),
-        cmocka_unit_test_setup(test_the_host_clock_wraps, setup),
-        cmocka_unit_test_setup(test_a_stream_takes_over_a_move, setup),
-        cmocka_unit_test_setup(test_a_broadcast_setpoint_is_taken_silently, setup),
+        cmocka_unit_test_setup(test_a_stream_tracks_the_path_smoothly, plant_harness_setup),
+        cmocka_unit_test_setup(test_a_late_stream_brakes_to_a_hold, plant_harness_setup),
+        cmocka_unit_test_setup(test_the_period_is_learned_or_told, plant_harness_setup),
+        cmocka_unit_test_setup(test_the_host_clock_wraps, plant_harness_setup),
+        cmocka_unit_test_setup(test_a_stream_takes_over_a_move, plant_harness_setup),
+        cmocka_unit_test_setup(test_a_broadcast_setpoint_is_taken_silently, plant_harness_setup),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

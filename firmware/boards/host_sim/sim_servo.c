@@ -326,6 +326,12 @@ static void receive(void *ctx, uint8_t byte, uint64_t at_us)
     s->rx.heard_us = (uint32_t)at_us;
 }
 
+/* What this pass's flash work stalls the CPU for (sim_flash.h). */
+static uint32_t flash_stall_us(const struct sim_servo *s)
+{
+    return s->flash.stall_us + s->slot_flash.stall_us + s->fault_flash.stall_us;
+}
+
 /* The bus time a 32-bit firmware time falls at, not before now. */
 static uint64_t bus_time_of(uint64_t now_us, uint32_t at_us)
 {
@@ -374,8 +380,7 @@ static void run_pass(struct sim_servo *s, uint64_t now_us)
         /* After the flash work of this pass too: a flash step stalls the
          * CPU (RM0008 3.3.3), so an answer to a write that programmed
          * flash leaves once the programming is done. */
-        uint64_t at = now_us + cost_us + s->flash.stall_us + s->slot_flash.stall_us +
-                      s->fault_flash.stall_us;
+        uint64_t at = now_us + cost_us + flash_stall_us(s);
         s->last_sent_us = at;
         s->tx_done_us = sim_bus_send(s->bus, s->index, s->tx_data, s->tx_len, s->baud, at);
         s->tx_data = NULL;
@@ -407,7 +412,7 @@ void sim_servo_poll(struct sim_servo *s, uint64_t now_us)
         s->last_execution_us = now_us - s->executing_from_us;
     }
     s->executing = executing;
-    uint32_t stall = s->flash.stall_us + s->slot_flash.stall_us + s->fault_flash.stall_us;
+    uint32_t stall = flash_stall_us(s);
     if (stall != 0u) {
         s->cpu_free_us = now_us + stall;
         s->flash_stall_us += stall;
