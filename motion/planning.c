@@ -122,7 +122,23 @@ static void run_angle(struct motion *m, const struct motion_command *cmd)
         uint32_t v = clamp_u32(cmd->velocity_decideg_s, MIN_VELOCITY, MAX_VELOCITY);
         timing = profile_velocity_timing(target - start, v0, velocity_q32(v), acc, dec);
     }
+    uint32_t jerk = PROFILE_SMOOTHING ? m->regs->firmware.jerk_limit : 0u;
+    if (jerk != 0u) {
+        /* The average of a trapezoid is C2 only if the trapezoid's
+         * velocity is continuous: a ramp of at least a tick. */
+        timing.accel += timing.accel == 0u;
+        timing.decel += timing.decel == 0u;
+    }
     profile_plan(&m->profile, start, v0, target, timing);
+    if (jerk != 0u) {
+        /* (deg/s^2)/ms is 1e-5 decideg per tick^3, 167.77 in Q24: 167 is
+         * 0.5 % less (a longer window, never a higher jerk). */
+        uint32_t window = profile_smooth_ticks(&m->profile, jerk * 167u);
+        if (v0 != 0 && window != 0u) {
+            profile_plan(&m->profile, start + profile_smooth_shift(v0, window), v0, target, timing);
+        }
+        profile_smooth(&m->profile, window);
+    }
     motion_begin_profile(m, END_HOLD);
 }
 

@@ -17,13 +17,12 @@ void motion_move_origin(struct motion *m, int32_t counts)
     m->measured_q8 -= shift_q8;
     m->profile.start -= shift;
     m->profile.target -= shift;
-    m->profile.cruise_start -= shift;
     m->walk.at -= shift;
     /* The setpoint may be further from the horn than Q8 holds (a load has
      * turned the horn back thousands of turns): it is taken from the
-     * profile again, which holds it exactly. */
+     * walk again (one step back), which holds it exactly. */
     int32_t step = m->setpoint_q8 - m->last_setpoint_q8;
-    motion_take_profile_q8(m, profile_position(&m->profile, m->tick));
+    motion_take_profile_q8(m, m->walk.at - ((m->walk.step_q40 - m->walk.change_q40 + m->walk.jerk_q40) >> 8));
     m->last_setpoint_q8 = m->setpoint_q8 - step;
     /* Whole turns of the origin come off the encoder's count too: the raw
      * reading's place in the turn, and the difference, stay as they were
@@ -83,7 +82,7 @@ void motion_read_diagnostics(const struct motion *m, struct motion_diagnostics *
     uint32_t limiter = LIMITER_NONE;
     if (controlled) {
         int8_t at_limit = m->controller.at_limit;
-        flags = (m->tick >= m->profile.total_ticks ? DIAG_PROFILE_ENDED : 0u) |
+        flags = (profile_done(&m->profile, m->tick) ? DIAG_PROFILE_ENDED : 0u) |
                 (m->clock_rate != CLOCK_REAL_TIME ? DIAG_CLOCK_SLOWED : 0u) |
                 (m->braking ? DIAG_BRAKING : 0u) | (at_limit != 0 ? DIAG_AT_LIMIT : 0u);
         limiter = motion_own_limiter(m);

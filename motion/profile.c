@@ -56,9 +56,9 @@ void profile_plan(struct profile *p, int64_t start, int64_t v0, int64_t target,
     p->accel_j = 0;
     p->decel_k = n3 ? div_round(v * 256, 2 * n3) : 0;
     p->accel_ticks = (uint32_t)n1;
+    p->smooth_ticks = 0;
     p->cruise_end = (uint32_t)(n1 + nc);
     p->total_ticks = (uint32_t)(n1 + nc + n3);
-    p->cruise_start = start + v0 * n1 + quadratic(p->accel_k, (uint32_t)n1);
 }
 
 void profile_plan_endless(struct profile *p, int64_t start, int64_t v0, int64_t velocity,
@@ -72,9 +72,9 @@ void profile_plan_endless(struct profile *p, int64_t start, int64_t v0, int64_t 
     p->accel_j = 0;
     p->decel_k = 0;
     p->accel_ticks = accel;
+    p->smooth_ticks = 0;
     p->cruise_end = UINT32_MAX;
     p->total_ticks = UINT32_MAX;
-    p->cruise_start = start + v0 * (int64_t)accel + quadratic(p->accel_k, accel);
 }
 
 /* p(t) = start + v0 t + c t^2 + d t^3 with p(T) = target, p'(T) = v1:
@@ -94,11 +94,11 @@ void profile_plan_segment(struct profile *p, int32_t start_q8, int32_t v0_q8, in
     p->target = target_q8 * q24;
     p->v0 = v0_q8 * q24;
     p->cruise = v1_q8 * q24;
-    p->cruise_start = p->target;
     p->accel_k = div_round((3 * d - (2 * v0_q8 + v1_q8) * t) * q32, tt);
     p->accel_j = div_round(((v0_q8 + v1_q8) * t - 2 * d) * q32, tt * t);
     p->decel_k = 0;
     p->accel_ticks = ticks;
+    p->smooth_ticks = 0;
     /* At rest at the end: a move that ends there, which the braking guard
      * watches. Else on at v1 for ever. */
     p->cruise_end = v1_q8 != 0 ? UINT32_MAX : ticks;
@@ -144,17 +144,23 @@ struct profile_timing profile_velocity_timing(int64_t distance, int64_t v0, int6
     return t;
 }
 
+/* The first phase's closed form. */
+static int64_t ramp_position(const struct profile *p, uint32_t tick)
+{
+    int64_t at = p->start + p->v0 * (int64_t)tick + quadratic(p->accel_k, tick);
+    /* A segment's cubic alone: the trapezoid's planning pays nothing for
+     * it. t^3 < 2^30 (PROFILE_MAX_SEGMENT), j t^3 within 2^60
+     * (profile_plan_segment), rounded once. */
+    return p->accel_j != 0 ? at + ((p->accel_j * (int64_t)(tick * tick * tick)) >> 8) : at;
+}
+
 int64_t profile_position(const struct profile *p, uint32_t tick)
 {
     if (tick < p->accel_ticks) {
-        int64_t at = p->start + p->v0 * (int64_t)tick + quadratic(p->accel_k, tick);
-        /* A segment's cubic alone: the trapezoid's planning pays nothing for
-         * it. t^3 < 2^30 (PROFILE_MAX_SEGMENT), j t^3 within 2^60
-         * (profile_plan_segment), rounded once. */
-        return p->accel_j != 0 ? at + ((p->accel_j * (int64_t)(tick * tick * tick)) >> 8) : at;
+        return ramp_position(p, tick);
     }
     if (tick < p->cruise_end) {
-        return p->cruise_start + p->cruise * (int64_t)(tick - p->accel_ticks);
+        return ramp_position(p, p->accel_ticks) + p->cruise * (int64_t)(tick - p->accel_ticks);
     }
     if (tick >= p->total_ticks) {
         return p->target;
@@ -162,35 +168,140 @@ int64_t profile_position(const struct profile *p, uint32_t tick)
     return p->target - quadratic(p->decel_k, p->total_ticks - tick);
 }
 
+/* The trapezoid's phase at tick: 1 accelerating, 2 cruising, 3
+ * decelerating, 4 after it (0: before it, which a window's far end sees). */
+static unsigned phase_at(const struct profile *p, uint32_t tick)
+{
+    return 1u + (tick >= p->accel_ticks) + (tick >= p->cruise_end) + (tick >= p->total_ticks);
+}
+
+static uint32_t phase_end(const struct profile *p, unsigned phase)
+{
+    return phase == 0u   ? 0u
+           : phase == 1u ? p->accel_ticks
+           : phase == 2u ? p->cruise_end
+           : phase == 3u ? p->total_ticks
+                         : UINT32_MAX;
+}
+
+/* A smoothed phase's jerk ([0]) or its sixth ([1]): the ramps' only. */
+static int64_t phase_jerk(const struct profile *p, unsigned phase, unsigned sixth)
+{
+    return phase & 1u ? p->smooth_jerk[phase >> 1][sixth] : 0;
+}
+
 void profile_walk_start(struct profile_walk *w, const struct profile *p, uint32_t tick)
 {
+    uint32_t window = profile_window(p);
+    unsigned lead = phase_at(p, tick);
+    unsigned lag = lead;
+    uint32_t end = phase_end(p, lead);
+    if (window != 0u) {
+        lag = tick < window ? 0u : phase_at(p, tick - window);
+        uint32_t lag_end = phase_end(p, lag); /* finite unless lead's is too */
+        if (lag < 4u && lag_end + window < end) {
+            end = lag_end + window;
+        }
+    }
+    w->phase_end = end;
+    w->tick = tick;
+    if (lead != lag) {
+        /* The window spans a change of acceleration: the average's third
+         * derivative changes by delta there, and (t - tick)^3 delta / 6
+         * adds delta / 6, delta and delta to the walk's three differences. */
+        int64_t jerk = phase_jerk(p, lead, 0) - phase_jerk(p, lag, 0);
+        int64_t jerk6 = phase_jerk(p, lead, 1) - phase_jerk(p, lag, 1);
+        w->step_q40 += jerk6 - w->jerk6_q40;
+        w->change_q40 += jerk - w->jerk_q40;
+        w->jerk_q40 = jerk;
+        w->jerk6_q40 = jerk6;
+        return;
+    }
     /* p(t + 1) - p(t) of each phase's closed form, in Q40: v0 + k (2t + 1)
      * + j (3t^2 + 3t + 1) ramping up (j: a segment's cubic), V cruising,
      * dk (2r - 1) ramping down (r = T - t). The products are those
-     * profile_position bounds. */
-    w->at = profile_position(p, tick);
-    w->tick = tick;
-    w->jerk_q40 = 0;
-    if (tick < p->accel_ticks) {
-        w->step_q40 = p->v0 * 256 + p->accel_k * (2 * (int64_t)tick + 1);
-        w->change_q40 = 2 * p->accel_k;
+     * profile_position bounds. A smoothed move's window lies in one phase:
+     * the phase's average over it is the phase half a window late (a
+     * quadratic's average is its middle's value plus a constant), so t is
+     * tick - window / 2 (2t is whole). */
+    int64_t step = 0, change = 0, jerk = 0;
+    if (lead == 1u) {
+        step = p->v0 * 256 + p->accel_k * (int64_t)(2u * tick + 1u - window);
+        change = 2 * p->accel_k;
         if (p->accel_j != 0) { /* a segment: tick < PROFILE_MAX_SEGMENT, 32 bits */
-            w->step_q40 += p->accel_j * (int64_t)(3u * tick * (tick + 1u) + 1u);
-            w->change_q40 += p->accel_j * (int64_t)(6u * tick + 6u);
-            w->jerk_q40 = 6 * p->accel_j;
+            step += p->accel_j * (int64_t)(3u * tick * (tick + 1u) + 1u);
+            change += p->accel_j * (int64_t)(6u * tick + 6u);
+            jerk = 6 * p->accel_j;
         }
-        w->phase_end = p->accel_ticks;
-    } else if (tick < p->cruise_end) {
-        w->step_q40 = p->cruise * 256;
-        w->change_q40 = 0;
-        w->phase_end = p->cruise_end;
-    } else if (tick < p->total_ticks) {
-        w->step_q40 = p->decel_k * (2 * (int64_t)(p->total_ticks - tick) - 1);
-        w->change_q40 = -2 * p->decel_k;
-        w->phase_end = p->total_ticks;
+    } else if (lead == 2u) {
+        step = p->cruise * 256;
+    } else if (lead == 3u) {
+        step = p->decel_k * (int64_t)(2u * (p->total_ticks - tick) + window - 1u);
+        change = -2 * p->decel_k;
     } else {
-        w->step_q40 = 0;
+        w->at = p->target; /* exactly, whatever the steps' rounding left */
+    }
+    w->step_q40 = step;
+    w->change_q40 = change;
+    w->jerk_q40 = jerk;
+    w->jerk6_q40 = 0;
+}
+
+#ifdef SERVO_SIZE_FIRST
+bool profile_walk_next(struct profile_walk *w, const struct profile *p)
+{
+    return profile_walk_next_inline(w, p);
+}
+#endif
+
+void profile_walk_begin(struct profile_walk *w, const struct profile *p)
+{
+    w->at = profile_origin(p);
+    if (profile_window(p) != 0u) {
+        /* Before tick 0 the window holds the start moving at v0. */
+        w->step_q40 = p->v0 * 256;
         w->change_q40 = 0;
-        w->phase_end = UINT32_MAX;
+        w->jerk_q40 = 0;
+        w->jerk6_q40 = 0;
+    }
+    profile_walk_start(w, p, 0);
+    profile_walk_next(w, p);
+}
+
+uint32_t profile_smooth_ticks(const struct profile *p, uint32_t jerk_q24)
+{
+    /* The ramps' accelerations (2k) in Q24 per tick^2, rounded up (never a
+     * shorter window): within 32 bits for any a ramp of the angle moves
+     * reaches (k < 2^45, 32 decideg per tick^2). */
+    int32_t a1 = (int32_t)((2 * p->accel_k + 0xFFFF) >> 16);
+    int32_t a3 = (int32_t)((-2 * p->decel_k + 0xFFFF) >> 16);
+    uint32_t most = (uint32_t)(a1 < 0 ? -a1 : a1);
+    uint32_t other = (uint32_t)(a3 < 0 ? -a3 : a3);
+    uint32_t both = (uint32_t)(a3 > a1 ? a3 - a1 : a1 - a3);
+    most = most > other ? most : other;
+    uint32_t t = 0;
+    for (unsigned pass = 0; pass < 2u; pass++) {
+        /* A window longer than the cruise spans the end of the one ramp and
+         * the start of the other: their jumps add. */
+        uint32_t jump = t > p->cruise_end - p->accel_ticks && both > most ? both : most;
+        uint32_t need = (jump + jerk_q24 - 1u) / jerk_q24;
+        t = need < PROFILE_MAX_SMOOTH ? need : PROFILE_MAX_SMOOTH;
+    }
+    return t;
+}
+
+void profile_smooth(struct profile *p, uint32_t smooth_ticks)
+{
+    p->smooth_ticks = smooth_ticks;
+    if (smooth_ticks == 0u) {
+        return;
+    }
+    /* jerk / 6 by 10923 / 2^16: off by 3.4e-5 of it, for at most a window:
+     * 3.4e-5 of the acceleration in position, far below a Q8 unit. */
+    int64_t k[2] = {p->accel_k, -p->decel_k};
+    for (unsigned i = 0; i < 2u; i++) {
+        int64_t jerk = div_round(2 * k[i], smooth_ticks);
+        p->smooth_jerk[i][0] = jerk;
+        p->smooth_jerk[i][1] = (jerk * 10923) >> 16;
     }
 }

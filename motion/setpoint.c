@@ -25,13 +25,13 @@ void motion_clock_restart(struct motion *m)
     m->clock_rate = CLOCK_REAL_TIME;
     m->lead_q8 = 0;
     m->braking = 0;
-    profile_walk_start(&m->walk, &m->profile, 1);
+    profile_walk_begin(&m->walk, &m->profile);
     /* The feed-forward is the second difference of the last three
      * setpoints, and the setpoint moved at v0 until tick 0: 0 there, half
      * the first phase's at tick 1 (control_tick.c), the phase's from 2. */
     m->accel_duty = 0;
     motion_take_accel_duty(m, 2);
-    motion_take_profile_q8(m, m->profile.start);
+    motion_take_profile_q8(m, profile_origin(&m->profile));
 }
 
 /* The second difference of the walk's phase is change_q40; in Q16 decideg

@@ -100,17 +100,23 @@ def schema_items_h(s: sch.Schema) -> str:
     rows = [f"RO_STATUS({i.id}, {i.field}, {i.size})," for i in status]
     rows += [f"USER({i.id}, {i.field}, {i.size}, {access[i.access] + ('_SIGNED' if i.signed else '')}, "
              f"{i.min}, {i.max}, {i.factory})," for i in user]
+    def most(i: sch.Item, suffix: str = "") -> str:  # a feature a size-first build leaves out takes less
+        full = f"{i.max}{suffix}"
+        return full if i.size_first_max < 0 else f"SIZE_FIRST_OR({i.size_first_max}{suffix}, {full})"
     rows += [f"FIRMWARE({i.id}, {i.field}, {i.size}, {access[i.access] + ('_SIGNED' if i.signed else '')}, "
-             f"{i.min}, {i.max}, {i.factory})," for i in firmware]
+             f"{i.min}, {most(i)}, {i.factory})," for i in firmware]
     def number(value: int, item: sch.Item) -> str:  # unsigned items' limits compare as unsigned
         return f"{value}" if item.signed else f"{value}u"
 
     ids = "".join(f"    ITEM_{i.field.upper()} = {i.id},\n" for i in s.items)
     limits = "".join(f"#define ITEM_{i.field.upper()}_MIN {number(i.min, i)}\n"
-                     f"#define ITEM_{i.field.upper()}_MAX {number(i.max, i)}\n"
+                     f"#define ITEM_{i.field.upper()}_MAX {most(i, '' if i.signed else 'u')}\n"
                      f"#define ITEM_{i.field.upper()}_FACTORY {number(i.factory, i)}\n"
                      for i in user + tuple(f for f in firmware if f.access == "read-write"))
     return (NOTICE + "#ifndef REGISTERS_SCHEMA_ITEMS_H\n#define REGISTERS_SCHEMA_ITEMS_H\n\n#include <stdint.h>\n\n"
+            "/* An item's most where a size-first build (SERVO_SIZE_FIRST: the Cortex-M0) leaves its\n"
+            " * feature out (the schema's size_first_max). */\n#ifdef SERVO_SIZE_FIRST\n"
+            "#define SIZE_FIRST_OR(small, full) (small)\n#else\n#define SIZE_FIRST_OR(small, full) (full)\n#endif\n\n"
             "/* Status area: live readings and identity, read-only. */\n" + struct("status_area", status) +
             "\n/* Bits of status (data item 5). */\nenum status_bit {\n" + bits + "};\n\n"
             "/* Each data item's ID, by its register's name. */\nenum data_item_id {\n" + ids + "};\n\n"

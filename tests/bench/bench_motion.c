@@ -4,6 +4,8 @@
  * Regions (bench_region.h):
  *   plan_interval, plan_velocity, plan_short_stroke, plan_preempt
  *       motion_submit() of one move: clamping, timing, profile planning
+ *   plan_jerk_rest, plan_jerk_preempt  the same for a jerk-limited move
+ *       (item 70), from rest and over a moving setpoint (the M3 only)
  *   ticks_follow  MOTION_BENCH_TICKS control ticks of a move the horn
  *          follows (the encoder replays the setpoint of a first run): real
  *          time, the braking guard's full check, the whole controller
@@ -154,6 +156,18 @@ int main(void)
                                                 .velocity_decideg_s = 3000, .acc_ms = 100,
                                                 .dec_ms = 200};
     plan("plan_short_stroke", &short_stroke);
+
+    /* Jerk-limited moves (item 70, 20 (deg/s^2)/ms; not in the Cortex-M0
+     * image): from rest, then over the moving setpoint 300 ticks on. */
+    if (PROFILE_SMOOTHING) {
+        fresh();
+        regs.firmware.jerk_limit = 20;
+        plan("plan_jerk_rest", &velocity);
+        for (unsigned i = 0; i < 300u; i++) {
+            motion_tick(&motion);
+        }
+        plan("plan_jerk_preempt", &preempt);
+    }
 
     /* A host's stream at 50 Hz (StreamSetpoint): setpoints on arches of
      * 0..60 deg, 2 s each, with their speeds; the horn follows (the

@@ -70,6 +70,7 @@ class Item:
     factory: int
     what: str
     help: str
+    size_first_max: int = -1  # the most a size-first build (the Cortex-M0's) takes; -1: max
 
 
 @dataclass(frozen=True)
@@ -173,7 +174,8 @@ def _item(raw: dict) -> Item:
         item = Item(id=raw["id"], area=raw["area"], name=raw["name"], field=raw["field"], size=raw["size"],
                     signed=raw.get("signed", False), access=raw["access"], unit=raw.get("unit", ""),
                     quantity=raw.get("quantity", ""), min=raw.get("min", 0), max=raw.get("max", 0),
-                    factory=raw.get("factory", 0), what=raw["what"], help=raw.get("help", ""))
+                    factory=raw.get("factory", 0), what=raw["what"], help=raw.get("help", ""),
+                    size_first_max=raw.get("size_first_max", -1))
     except KeyError as e:
         raise SchemaError(f"{where}: no {e.args[0]}") from None
     if item.area not in AREAS:

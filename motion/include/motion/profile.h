@@ -35,13 +35,17 @@ struct profile {
     int64_t target;       /* position from total_ticks on */
     int64_t v0;           /* velocity at tick 0 */
     int64_t cruise;       /* V */
-    int64_t cruise_start; /* position at tick accel_ticks */
     int64_t accel_k;      /* (V - v0) / (2 N1), Q40 */
     int64_t accel_j;      /* the first phase's cubic term, Q40: a streamed segment's (else 0) */
     int64_t decel_k;      /* V / (2 N3), Q40 */
+    /* A jerk-limited move (profile_smooth): each phase's second
+     * difference / T and its sixth, Q40 per tick cubed; 0 before the
+     * start, in the cruise and after the end. */
+    int64_t smooth_jerk[2][2]; /* [accel, decel][jerk, jerk / 6] */
     uint32_t accel_ticks; /* N1 */
     uint32_t cruise_end;  /* N1 + Nc */
     uint32_t total_ticks; /* N1 + Nc + N3; UINT32_MAX cruises for ever */
+    uint32_t smooth_ticks; /* T: the window the trapezoid is averaged over; 0: none */
 };
 
 /* Phase lengths in ticks. */
@@ -83,6 +87,52 @@ struct profile_timing profile_velocity_timing(int64_t distance, int64_t v0, int6
 
 int64_t profile_position(const struct profile *p, uint32_t tick);
 
+/* Jerk-limited (S-curve) moves: the trapezoid averaged over a window of T
+ * ticks. The average of a trapezoid is C2 and piecewise cubic: each ramp
+ * gains jerk phases of T ticks on either side and the move takes T ticks
+ * longer; the acceleration never exceeds the trapezoid's, and the
+ * trapezoid's phases (its short-stroke rescaling) are unchanged. The
+ * window's jerk is the change of the trapezoid's acceleration across it,
+ * / T. A trapezoid moving at v0 from start is planned from
+ * start + v0 T / 2 (profile_smooth_shift) so that its average starts at
+ * start, moving at v0. */
+#define PROFILE_MAX_SMOOTH 4096u /* T's ceiling: 4.1 s */
+
+/* The Cortex-M0 image (SERVO_SIZE_FIRST) has no room for smoothing: its
+ * profiles are trapezoids, and the code that walks a window folds away. */
+#ifdef SERVO_SIZE_FIRST
+#define PROFILE_SMOOTHING 0
+#else
+#define PROFILE_SMOOTHING 1
+#endif
+
+/* T of p (0 where there is no smoothing). */
+static inline uint32_t profile_window(const struct profile *p)
+{
+    return PROFILE_SMOOTHING ? p->smooth_ticks : 0u;
+}
+
+/* T for a jerk limit in Q24 decideg per tick cubed (> 0): the least that
+ * keeps every jump of the trapezoid's acceleration across a window within
+ * it, or PROFILE_MAX_SMOOTH; 0 for a move without acceleration. */
+uint32_t profile_smooth_ticks(const struct profile *p, uint32_t jerk_q24);
+
+/* Averages p over smooth_ticks ticks (0: leaves the trapezoid). */
+void profile_smooth(struct profile *p, uint32_t smooth_ticks);
+
+/* What planning adds to a start moving at v0 for a window of T ticks. */
+static inline int64_t profile_smooth_shift(int64_t v0, uint32_t smooth_ticks)
+{
+    return (v0 * (int64_t)smooth_ticks) >> 1;
+}
+
+/* Where the move starts (tick 0). */
+static inline int64_t profile_origin(const struct profile *p)
+{
+    uint32_t window = profile_window(p);
+    return window != 0u ? p->start - profile_smooth_shift(p->v0, window) : p->start;
+}
+
 /* A profile walked tick by tick with additions only, for the control tick:
  * within a phase the step between two ticks changes by a constant (a
  * segment's cubic: the change changes by a constant) (Q40, so
@@ -95,15 +145,28 @@ struct profile_walk {
     int64_t step_q40;   /* to the position at tick + 1 (less rounding), Q40 */
     int64_t change_q40; /* of step_q40 a tick: the phase's second difference */
     int64_t jerk_q40;   /* of change_q40 a tick: a cubic phase's third difference */
+    int64_t jerk6_q40;  /* a smoothed move's jerk / 6, as profile_smooth rounds it */
     uint32_t tick;
     uint32_t phase_end; /* the tick the next phase starts */
 };
 
-/* Starts a walk at tick (also where a phase starts). */
+/* Starts a walk at tick (also where a phase starts). A smoothed move's
+ * phases are its window's: where both its ends lie in one phase of the
+ * trapezoid, the walk is that phase's, half a window late; where they lie
+ * in two, the walk goes on with the jerk changed (the average is C2). */
 void profile_walk_start(struct profile_walk *w, const struct profile *p, uint32_t tick);
 
-/* Moves the walk on a tick; true when a phase started. */
-static inline bool profile_walk_next(struct profile_walk *w, const struct profile *p)
+/* Starts a walk at tick 1, from tick 0 at profile_origin. */
+void profile_walk_begin(struct profile_walk *w, const struct profile *p);
+
+/* Moves the walk on a tick; true when a phase started. Where size comes
+ * first (SERVO_SIZE_FIRST: the Cortex-M0) a call, profile.c. */
+#ifdef SERVO_SIZE_FIRST
+bool profile_walk_next(struct profile_walk *w, const struct profile *p);
+#else
+#define profile_walk_next profile_walk_next_inline
+#endif
+static inline bool profile_walk_next_inline(struct profile_walk *w, const struct profile *p)
 {
     w->at += w->step_q40 >> 8;
     w->step_q40 += w->change_q40;
@@ -117,7 +180,8 @@ static inline bool profile_walk_next(struct profile_walk *w, const struct profil
 
 static inline bool profile_done(const struct profile *p, uint32_t tick)
 {
-    return tick >= p->total_ticks;
+    /* A smoothed move is finite: no wrap. */
+    return tick >= p->total_ticks + profile_window(p);
 }
 
 #endif
