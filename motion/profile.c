@@ -15,14 +15,6 @@ static int64_t abs64(int64_t v)
     return v < 0 ? -v : v;
 }
 
-/* k t^2 with k in Q40 and t <= PROFILE_MAX_RAMP: the result in Q32.
- * With |V|, |v0| <= PROFILE_MAX_VELOCITY (2^46), |k t| <= 2^54 for t within
- * the ramp, so |(k t) >> 8| t <= 2^62. */
-static int64_t quadratic(int64_t k, uint32_t t)
-{
-    return ((k * (int64_t)t) >> 8) * (int64_t)t;
-}
-
 void profile_plan(struct profile *p, int64_t start, int64_t v0, int64_t target,
                   struct profile_timing timing)
 {
@@ -82,7 +74,7 @@ void profile_plan_endless(struct profile *p, int64_t start, int64_t v0, int64_t 
  * Within the segment's limits (profile.h) both numerators fit int32 in Q8
  * (|3D| <= 2^23.6, |(2 v0 + v1) T| <= 2^27.6), so each coefficient is one
  * division of a Q40 numerator within 2^60; the coefficients then keep
- * every product here, in profile_position and in the walk within 2^61. */
+ * every product here, in the closed form and in the walk within 2^61. */
 void profile_plan_segment(struct profile *p, int32_t start_q8, int32_t v0_q8, int32_t target_q8,
                           int32_t v1_q8, uint32_t ticks)
 {
@@ -144,30 +136,6 @@ struct profile_timing profile_velocity_timing(int64_t distance, int64_t v0, int6
     return t;
 }
 
-/* The first phase's closed form. */
-static int64_t ramp_position(const struct profile *p, uint32_t tick)
-{
-    int64_t at = p->start + p->v0 * (int64_t)tick + quadratic(p->accel_k, tick);
-    /* A segment's cubic alone: the trapezoid's planning pays nothing for
-     * it. t^3 < 2^30 (PROFILE_MAX_SEGMENT), j t^3 within 2^60
-     * (profile_plan_segment), rounded once. */
-    return p->accel_j != 0 ? at + ((p->accel_j * (int64_t)(tick * tick * tick)) >> 8) : at;
-}
-
-int64_t profile_position(const struct profile *p, uint32_t tick)
-{
-    if (tick < p->accel_ticks) {
-        return ramp_position(p, tick);
-    }
-    if (tick < p->cruise_end) {
-        return ramp_position(p, p->accel_ticks) + p->cruise * (int64_t)(tick - p->accel_ticks);
-    }
-    if (tick >= p->total_ticks) {
-        return p->target;
-    }
-    return p->target - quadratic(p->decel_k, p->total_ticks - tick);
-}
-
 /* The trapezoid's phase at tick: 1 accelerating, 2 cruising, 3
  * decelerating, 4 after it (0: before it, which a window's far end sees). */
 static unsigned phase_at(const struct profile *p, uint32_t tick)
@@ -219,8 +187,8 @@ void profile_walk_start(struct profile_walk *w, const struct profile *p, uint32_
     }
     /* p(t + 1) - p(t) of each phase's closed form, in Q40: v0 + k (2t + 1)
      * + j (3t^2 + 3t + 1) ramping up (j: a segment's cubic), V cruising,
-     * dk (2r - 1) ramping down (r = T - t). The products are those
-     * profile_position bounds. A smoothed move's window lies in one phase:
+     * dk (2r - 1) ramping down (r = T - t). The products are within
+     * the closed form's bounds. A smoothed move's window lies in one phase:
      * the phase's average over it is the phase half a window late (a
      * quadratic's average is its middle's value plus a constant), so t is
      * tick - window / 2 (2t is whole). */

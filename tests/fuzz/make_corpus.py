@@ -159,6 +159,12 @@ SERVO_SEEDS = {
     # the period told (item 69) and a setpoint at rest far away.
     "stream_then_late": (USED, b"".join(wire(stream(50 * k, 2500, 20 * k)) + ms(20) for k in range(12))
                          + ms(120) + wire(write(69, 30, 2) + stream(-900, 0, 400)) + ms(300)),
+    # Jerk-limited moves (item 70): from rest, over the moving setpoint (a
+    # velocity move 200 ms in), a short stroke, to their ends.
+    "jerk_limited_moves": (USED, wire(write(70, 20, 2) + req(11, struct.pack("<BhHHHH", 0, 900, 400, 100, 100, 0)))
+                           + ms(200) + wire(req(12, struct.pack("<BhHHHH", 0, -300, 3000, 50, 80, 0))) + ms(700)
+                           + wire(req(12, struct.pack("<BhHHHH", 0, -200, 3000, 100, 200, 0))) + ms(900)
+                           + wire(req(0x40, b"\x00"))),
     "wheel_run_stop": (USED, wire(req(7, struct.pack("<BBHH", 0, 0x01, 300, 0))) + ms(100)
                        + wire(req(7, struct.pack("<BBHH", 0, 0x00, 0, 0))) + ms(60)
                        + wire(write(47, 1) + req(7, struct.pack("<BBHH", 0, 0x81, 90, 0))) + ms(60)

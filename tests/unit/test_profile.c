@@ -12,6 +12,7 @@
 #include <cmocka.h>
 
 #include "motion/profile.h"
+#include "support/profile_closed_form.h"
 #include "support/xorshift.h"
 
 #define TOLERANCE_DECIDEG 0.5 /* 0.05 degree */

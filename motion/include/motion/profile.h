@@ -85,8 +85,6 @@ void profile_plan_segment(struct profile *p, int32_t start_q8, int32_t v0_q8, in
 struct profile_timing profile_velocity_timing(int64_t distance, int64_t v0, int64_t vmax,
                                               uint32_t accel, uint32_t decel);
 
-int64_t profile_position(const struct profile *p, uint32_t tick);
-
 /* Jerk-limited (S-curve) moves: the trapezoid averaged over a window of T
  * ticks. The average of a trapezoid is C2 and piecewise cubic: each ramp
  * gains jerk phases of T ticks on either side and the move takes T ticks
@@ -135,11 +133,11 @@ static inline int64_t profile_origin(const struct profile *p)
 
 /* A profile walked tick by tick with additions only, for the control tick:
  * within a phase the step between two ticks changes by a constant (a
- * segment's cubic: the change changes by a constant) (Q40, so
- * exact), and each phase starts from the closed form's position: the walk
- * meets profile_position exactly at every phase's start and at the target,
- * and between stays within two Q32 units per tick of the phase's length
- * (both round; test_profile.c). */
+ * segment's cubic: the change changes by a constant) (Q40, so exact); each
+ * phase starts from the position the last one reached, and the end is the
+ * target exactly. The walk stays within two Q32 units a tick of the closed
+ * form (tests/support/profile_closed_form.c) and that form's own rounding
+ * where its phases meet (test_profile.c). */
 struct profile_walk {
     int64_t at;         /* position at tick, Q32 */
     int64_t step_q40;   /* to the position at tick + 1 (less rounding), Q40 */
