@@ -20,7 +20,9 @@ void motion_move_origin(struct motion *m, int32_t counts)
     m->walk.at -= shift;
     /* The setpoint may be further from the horn than Q8 holds (a load has
      * turned the horn back thousands of turns): it is taken from the
-     * walk again (one step back), which holds it exactly. */
+     * walk again, one step back (on the tick a phase starts, along the new
+     * phase: off by about half that tick's change of acceleration, 0.005
+     * decideg for 1000 deg/s^2). */
     int32_t step = m->setpoint_q8 - m->last_setpoint_q8;
     motion_take_profile_q8(m, m->walk.at - ((m->walk.step_q40 - m->walk.change_q40 + m->walk.jerk_q40) >> 8));
     m->last_setpoint_q8 = m->setpoint_q8 - step;

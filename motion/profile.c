@@ -236,21 +236,24 @@ void profile_walk_begin(struct profile_walk *w, const struct profile *p)
     profile_walk_next(w, p);
 }
 
+/* |a| in Q24 from Q40, rounded up: within 32 bits for any acceleration a
+ * ramp of the angle moves reaches (|a| < 2^46, 64 decideg per tick^2). */
+static uint32_t q24_up(int64_t a_q40)
+{
+    return (uint32_t)((abs64(a_q40) + 0xFFFF) >> 16);
+}
+
 uint32_t profile_smooth_ticks(const struct profile *p, uint32_t jerk_q24)
 {
-    /* The ramps' accelerations (2k) in Q24 per tick^2, rounded up (never a
-     * shorter window): within 32 bits for any a ramp of the angle moves
-     * reaches (k < 2^45, 32 decideg per tick^2). */
-    int32_t a1 = (int32_t)((2 * p->accel_k + 0xFFFF) >> 16);
-    int32_t a3 = (int32_t)((-2 * p->decel_k + 0xFFFF) >> 16);
-    uint32_t most = (uint32_t)(a1 < 0 ? -a1 : a1);
-    uint32_t other = (uint32_t)(a3 < 0 ? -a3 : a3);
-    uint32_t both = (uint32_t)(a3 > a1 ? a3 - a1 : a1 - a3);
-    most = most > other ? most : other;
+    /* The ramps' accelerations (2k), and the jump where the end of the one
+     * meets the start of the other (decelerating after accelerating adds),
+     * each rounded up: never a shorter window. */
+    uint32_t a1 = q24_up(2 * p->accel_k), a3 = q24_up(2 * p->decel_k);
+    uint32_t both = q24_up(2 * (p->accel_k + p->decel_k));
+    uint32_t most = a1 > a3 ? a1 : a3;
     uint32_t t = 0;
     for (unsigned pass = 0; pass < 2u; pass++) {
-        /* A window longer than the cruise spans the end of the one ramp and
-         * the start of the other: their jumps add. */
+        /* A window longer than the cruise spans both ramps' edges. */
         uint32_t jump = t > p->cruise_end - p->accel_ticks && both > most ? both : most;
         uint32_t need = (jump + jerk_q24 - 1u) / jerk_q24;
         t = need < PROFILE_MAX_SMOOTH ? need : PROFILE_MAX_SMOOTH;
