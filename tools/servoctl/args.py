@@ -284,4 +284,6 @@ def build_parser():
                    help="a TCP port instead of a pty (any free port if none given)")
     c.add_argument("--link", help="symlink to the pty")
     c.add_argument("--state", help="folder for the flash files")
+    c.add_argument("--plant", help="the servo's motor, gears and heat from a plant file "
+                                   "(hal/ports/host/plants/*.toml; default: the reference servo)")
     return ap

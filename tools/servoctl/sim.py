@@ -64,7 +64,7 @@ class Simulator(_Child):
 
     def __init__(self, ids=(1,), tcp=True, link=None, state_dir=None, supply_mv=None,
                  ambient_c=None, tcp_port=None, rx=None, board=None, app_image=None, nice=None,
-                 cpu=None):
+                 cpu=None, plant=None):
         self.ids = list(ids)
         self.tcp = tcp or tcp_port is not None
         self.tcp_port = tcp_port
@@ -77,6 +77,8 @@ class Simulator(_Child):
         self.cpu = cpu  # "m3" (default) or "m0": whose time a pass, a tick, an answer take
         self.board = board  # None: servo_sim; else a virtual board (tools/vboard)
         self.app_image = app_image  # a virtual board's slot, if not the build's image
+        self.plant = plant  # a plant file (hal/ports/host/plants); None: the reference servo
+        self.plant_name = None  # the plant's name, as servo_sim prints it
         # A niceness for the simulator (below 0 needs root): a client that
         # times its answers on the wall clock (the maker's SDK) then meets
         # a servo that keeps up on a loaded PC. None: as started.
@@ -109,6 +111,8 @@ class Simulator(_Child):
             cmd += ["--supply", str(self.supply_mv)]
         if self.ambient_c is not None:
             cmd += ["--ambient", str(self.ambient_c)]
+        if self.plant is not None:
+            cmd += ["--plant", str(self.plant)]
         if self.rx is not None:
             cmd += ["--rx", self.rx]
         if self.cpu is not None:
@@ -138,6 +142,8 @@ class Simulator(_Child):
             words = line.split()
             if words[1:2] == ["bus"]:
                 self.url = words[2]
+            elif words[1:2] == ["plant"]:
+                self.plant_name = " ".join(words[2:])
             elif words[1:2] == ["control"]:
                 self.control_port = int(words[2].rsplit(":", 1)[1])
             elif words[1:2] == ["ready"]:

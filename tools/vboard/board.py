@@ -96,7 +96,7 @@ class Memory:
 
 class Board:
     def __init__(self, board: str, servo_id: int, bus, state_dir=None, supply_v=7.4, ambient_c=25.0,
-                 boot_image=None, app_image=None, unit=0):
+                 boot_image=None, app_image=None, unit=0, plant=None):
         # unit: boards started before this one with the same ID (a bus of
         # new servos all at ID 0): it names the flash file and the chip's
         # unique ID apart from theirs.
@@ -124,7 +124,7 @@ class Board:
         dev = svd.device(part.svd)
         irqs = svd.interrupts(part.svd)
         n = part.names
-        self.motor = Motor(supply_v, ambient_c)
+        self.motor = Motor(supply_v, ambient_c, plant)
         self.rcc = Rcc(self, dev[n["rcc"]], HSE_HZ, 1)
         file = f"{board}-{servo_id}" + (f"-{unit + 1}" if unit else "") + ".flash"
         path = None if state_dir is None else Path(state_dir) / file
@@ -341,6 +341,7 @@ class Board:
                 "current": round(m.get("current_a"), 3), "winding": round(m.get("winding_c"), 2),
                 "case": round(m.get("case_c"), 2), "ambient": round(m.get("ambient_c"), 1),
                 "supply": round(m.get("supply_v"), 3), "load": round(m.get("load_nm"), 3),
+                "payload": round(m.get("payload_gcm2"), 1),
                 "core_mhz": round(self.core.hz / 1e6, 3), "resets_power": self.resets["power"],
                 "resets_software": self.resets["software"], "resets_watchdog": self.resets["watchdog"],
                 "last_reset": self.last_reset, "mode": "app" if self.in_application() else "bootloader",

@@ -7,7 +7,7 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[2]
 DEFAULT = REPO / "build/host/tools/vboard/native/libvboard_native.so"
 QUANTITIES = {"angle_deg": 0, "velocity_dps": 1, "current_a": 2, "supply_v": 3, "load_nm": 4,
-              "winding_c": 5, "case_c": 6, "ambient_c": 7, "stop_deg": 8, "soak_c": 9}
+              "winding_c": 5, "case_c": 6, "ambient_c": 7, "stop_deg": 8, "soak_c": 9, "payload_gcm2": 10}
 
 
 def _library():
@@ -17,6 +17,8 @@ def _library():
     lib = ctypes.CDLL(str(path))
     lib.vboard_motor_size.restype = ctypes.c_uint32
     lib.vboard_motor_init.argtypes = [ctypes.c_void_p, ctypes.c_double, ctypes.c_double]
+    lib.vboard_motor_load_plant.argtypes = [ctypes.c_void_p, ctypes.c_char_p, ctypes.c_double, ctypes.c_char_p,
+                                            ctypes.c_uint32]
     lib.vboard_motor_step.argtypes = [ctypes.c_void_p, ctypes.c_double]
     lib.vboard_motor_drive.argtypes = [ctypes.c_void_p, ctypes.c_double]
     lib.vboard_motor_coast.argtypes = [ctypes.c_void_p]
@@ -43,11 +45,18 @@ def lib():
 
 
 class Motor:
-    """plant.c and thermal.c: the motor, gears, horn and winding."""
+    """plant.c and thermal.c: the motor, gears, horn and winding; the reference
+    servo's, or a plant file's (hal/ports/host/plants). supply_v None: the plant's."""
 
-    def __init__(self, supply_v: float, ambient_c: float):
+    def __init__(self, supply_v: float | None, ambient_c: float, plant: str | None = None):
         self.buf = ctypes.create_string_buffer(lib().vboard_motor_size())
-        lib().vboard_motor_init(self.buf, supply_v, ambient_c)
+        lib().vboard_motor_init(self.buf, 7.4 if supply_v is None else supply_v, ambient_c)
+        if plant is not None:
+            err = ctypes.create_string_buffer(256)
+            if not lib().vboard_motor_load_plant(self.buf, str(plant).encode(), ambient_c, err, len(err)):
+                raise ValueError(err.value.decode())
+            if supply_v is not None:
+                self.set("supply_v", supply_v)
 
     def step(self, dt: float) -> None:
         if dt > 0:

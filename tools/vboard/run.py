@@ -1,7 +1,7 @@
 """Runs virtual boards on one bus with a control port, as servo_sim does:
 
     python -m vboard --board stm32f103 [--id N ...] [--tcp PORT | --link PATH]
-                     [--state DIR] [--supply MV] [--ambient DEGC]
+                     [--state DIR] [--supply MV] [--ambient DEGC] [--plant FILE]
 
 prints `vboard: bus URL`, `vboard: control 127.0.0.1:PORT`, `vboard: servos
 ...` and `vboard: ready`, so servoctl and the tests drive it as they drive
@@ -35,8 +35,9 @@ class Runner:
         self.bus = Bus()
         self.state_dir = args.state or tempfile.mkdtemp(prefix="vboard-")
         os.makedirs(self.state_dir, exist_ok=True)
-        self.boards = [Board(args.board, i, self.bus, self.state_dir, args.supply / 1000.0, args.ambient,
-                             app_image=args.app, unit=args.id[:k].count(i))
+        supply_v = None if args.supply is None else args.supply / 1000.0
+        self.boards = [Board(args.board, i, self.bus, self.state_dir, supply_v, args.ambient,
+                             app_image=args.app, unit=args.id[:k].count(i), plant=args.plant)
                        for k, i in enumerate(args.id)]
         self.url = self.bus.serve_tcp(args.tcp) if args.tcp is not None else self.bus.serve_pty(args.link)
         self.control = socket.socket()
@@ -105,6 +106,8 @@ class Runner:
                 b.motor.set("supply_v", value / 1000.0)
             elif cmd == "load":
                 b.motor.set("load_nm", value)
+            elif cmd == "payload":
+                b.motor.set("payload_gcm2", value)
             elif cmd == "ambient":
                 b.motor.set("ambient_c", value)
             elif cmd == "soak":
@@ -227,7 +230,8 @@ def main(argv=None) -> int:
     ap.add_argument("--tcp", type=int, help="the bus on 127.0.0.1:PORT (0: any free port)")
     ap.add_argument("--link", help="the bus's pseudo-terminal, linked here")
     ap.add_argument("--state", help="the boards' flash files live here (kept across runs)")
-    ap.add_argument("--supply", type=float, default=7400.0, help="supply, mV")
+    ap.add_argument("--supply", type=float, help="supply, mV (default: the plant's, 7400 for the reference)")
+    ap.add_argument("--plant", help="the motor, gears and heat from a plant file (hal/ports/host/plants/*.toml)")
     ap.add_argument("--ambient", type=float, default=25.0, help="ambient temperature, degC")
     ap.add_argument("--app", help="the update image a blank board's slot gets (default: the build's)")
     args = ap.parse_args(argv)
@@ -239,7 +243,11 @@ def main(argv=None) -> int:
         print(f"vboard: no {' or '.join(missing)}: build the {args.board}'s images first "
               f"('cmake --preset {build} && cmake --build --preset {build}')", file=sys.stderr)
         return 2
-    runner = Runner(args)
+    try:
+        runner = Runner(args)
+    except ValueError as e:  # a plant file that is refused says why
+        print(f"vboard: {e}", file=sys.stderr)
+        return 2
     runner.power_up()
     stuck = [b for b in runner.boards if b.core.locked_up]
     if stuck:

@@ -96,8 +96,8 @@ int main(int argc, char **argv)
     sim_bus_init(&bus, sim_now_us());
     for (unsigned i = 0; i < o.id_count; i++) {
         servos[i].cpu = o.cpu;
-        if (!sim_servo_start(&servos[i], &bus, i, o.ids[i], o.units[i], o.state_dir, o.supply_v,
-                             o.ambient_c)) {
+        if (!sim_servo_start(&servos[i], &bus, i, o.ids[i], o.units[i], o.state_dir, &o.plant,
+                             o.supply_v, o.ambient_c)) {
             return 1;
         }
         servos[i].rx_interrupt = o.rx_interrupt;
@@ -126,6 +126,7 @@ int main(int argc, char **argv)
         run_to(to < ready_at ? to : ready_at);
     }
 
+    printf("servo_sim: plant %s\n", o.plant.name);
     printf("servo_sim: bus %s\n", where);
     if (o.link) {
         printf("servo_sim: link %s\n", o.link);

@@ -8,7 +8,7 @@ static void usage(FILE *out)
 {
     fputs("usage: servo_sim [--id N]... [--tcp PORT | --link PATH] [--control PORT]\n"
           "                 [--state DIR] [--supply MV] [--ambient DEGC] [--rx dma|interrupt]\n"
-          "                 [--cpu m3|m0]\n"
+          "                 [--cpu m3|m0] [--plant FILE]\n"
           "Runs the servo firmware on simulated servos sharing one bus.\n"
           "  --id N         a servo with ID N (repeat for more; default 1). An ID given\n"
           "                 again is one more servo at it, as new servos all hold ID 0\n"
@@ -18,16 +18,19 @@ static void usage(FILE *out)
           "  --link PATH    also make PATH a symlink to the pty\n"
           "  --control PORT fault injection on 127.0.0.1:PORT (default: any free port)\n"
           "  --state DIR    where each servo's flash file lives (default ./sim-state)\n"
-          "  --supply MV    supply voltage (default 7400)\n"
+          "  --supply MV    supply voltage (default: the plant's, 7400 for the reference)\n"
           "  --ambient DEGC ambient temperature (default 25)\n"
           "  --rx dma|interrupt  how the port receives: DMA into a ring (the reference\n"
           "                 board, default) or a byte per interrupt, which overruns\n"
           "                 while the flash stalls the CPU\n"
           "  --cpu m3|m0    whose time a main-loop pass, a tick and an answer take:\n"
           "                 the reference board's STM32F103 (default) or the STM32F030's\n"
+          "  --plant FILE   every servo's motor, gears and heat from a plant file\n"
+          "                 (hal/ports/host/plants/*.toml; default: the reference servo's)\n"
           "Control commands, one per line, optional servo last: its bus ID as it is now\n"
           "(every servo that holds it), or its serial number (0x51a0UUNN):\n"
-          "  supply MV | load NM | stop DEG | stop off | ambient DEGC | soak DEGC |\n"
+          "  supply MV | load NM | payload GCM2 | stop DEG | stop off | ambient DEGC |\n"
+          "  soak DEGC |\n"
           "  hostbaud BAUD (a TCP host's rate; a pty's is what the host set) |\n"
           "  failerase N | failprogram N (the next N flash erases, or half-word\n"
           "  programs, of the config store and the slot fail, as a worn page's do) |\n"
@@ -55,8 +58,9 @@ static int parse_int(const char *s, const char *what, long lo, long hi)
 
 void sim_options_parse(int argc, char **argv, struct sim_options *o)
 {
-    *o = (struct sim_options){.tcp_port = -1, .state_dir = "sim-state", .supply_v = 7.4, .ambient_c = 25.0,
+    *o = (struct sim_options){.tcp_port = -1, .state_dir = "sim-state", .supply_v = -1.0, .ambient_c = 25.0,
                               .cpu = sim_cpu_named("m3")};
+    plant_model_reference(&o->plant);
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
@@ -95,6 +99,12 @@ void sim_options_parse(int argc, char **argv, struct sim_options *o)
             o->supply_v = parse_int(v, "--supply", 0, 30000) / 1000.0;
         } else if (strcmp(a, "--ambient") == 0) {
             o->ambient_c = parse_int(v, "--ambient", -40, 150);
+        } else if (strcmp(a, "--plant") == 0) {
+            char err[256];
+            if (!plant_model_load(v, &o->plant, err, sizeof err)) {
+                fprintf(stderr, "servo_sim: %s\n", err);
+                exit(2);
+            }
         } else if (strcmp(a, "--cpu") == 0) {
             o->cpu = sim_cpu_named(v);
             if (o->cpu == NULL) {
@@ -112,6 +122,9 @@ void sim_options_parse(int argc, char **argv, struct sim_options *o)
             usage(stderr);
             exit(2);
         }
+    }
+    if (o->supply_v < 0.0) {
+        o->supply_v = o->plant.plant.supply_v;
     }
     if (o->id_count == 0) {
         o->ids[o->id_count++] = 1;

@@ -1,11 +1,12 @@
 /* servo_sim's command line: which servos, where the bus and the control port
- * are, where the flash files live, the supply and the ambient. */
+ * are, where the flash files live, the plant, the supply and the ambient. */
 #ifndef SIM_OPTIONS_H
 #define SIM_OPTIONS_H
 
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "ports/host/plant_model.h"
 #include "sim_bus.h"
 #include "sim_cpu.h"
 
@@ -17,7 +18,8 @@ struct sim_options {
     int control_port;      /* 0: any free port */
     const char *link;      /* symlink to the pty */
     const char *state_dir;
-    double supply_v;
+    struct plant_model plant; /* --plant's file, or the reference servo */
+    double supply_v;          /* --supply, else the plant's */
     double ambient_c;
     bool rx_interrupt;
     const struct sim_cpu *cpu;

@@ -212,7 +212,8 @@ void sim_servo_power_cycle(struct sim_servo *s)
 }
 
 bool sim_servo_start(struct sim_servo *s, struct sim_bus *bus, unsigned index, uint8_t id,
-                     uint8_t unit, const char *state_dir, double supply_v, double ambient_c)
+                     uint8_t unit, const char *state_dir, const struct plant_model *plant,
+                     double supply_v, double ambient_c)
 {
     /* servo-ID.flash; the second servo given that ID servo-ID-2.flash. */
     char name[32];
@@ -247,9 +248,8 @@ bool sim_servo_start(struct sim_servo *s, struct sim_bus *bus, unsigned index, u
     s->unit = unit;
     s->power_ups = 1;
     s->rx = (struct hal_rx_ring)HAL_RX_RING_OVER(s->rx_bytes);
-    plant_init(&s->plant);
+    plant_model_apply(plant, &s->plant, &s->thermal, ambient_c);
     s->plant.p.supply_v = supply_v;
-    thermal_init(&s->thermal, ambient_c);
     s->stepped_us = bus->now_us;
     s->port = (struct hal_port){
         .ctx = s,

@@ -8,7 +8,7 @@
 #include "bootloader/app_image.h"
 #include "board.h"
 #include "bootloader/bootloader.h"
-#include "ports/host/plant.h"
+#include "ports/host/plant_model.h"
 #include "app/servo.h"
 #include "sim_bus.h"
 #include "sim_cpu.h"
@@ -99,7 +99,8 @@ uint64_t sim_now_us(void);
  * the same ID: it names its files and its serial number apart from theirs.
  * False, with a message, on failure. */
 bool sim_servo_start(struct sim_servo *s, struct sim_bus *bus, unsigned index, uint8_t id,
-                     uint8_t unit, const char *state_dir, double supply_v, double ambient_c);
+                     uint8_t unit, const char *state_dir, const struct plant_model *plant,
+                     double supply_v, double ambient_c);
 
 /* Data item 8 of this servo: 0x51A0UUNN (UU its unit, NN the ID it was
  * started with), the same at every start. */

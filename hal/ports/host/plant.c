@@ -4,7 +4,8 @@
 
 #define PI 3.14159265358979323846
 
-/* The reference servo is a 20 kg cm class bus servo at 7.4 V. Its published
+/* The reference servo is a 20 kg cm class bus servo at 7.4 V (its plant
+ * file, plants/reference_st3215.toml, holds the same numbers). Its published
  * figures (DFRobot SER0069 / Feetech ST3215 product data, 7.4 V version):
  *   stall torque 19.5 kg cm (1.912 N m), no-load speed 0.192 s/60 deg
  *   (312.5 deg/s), no-load current 150 mA, gear train 1:345, and a stall
@@ -54,7 +55,7 @@ void plant_coast(struct plant *pl)
 
 double plant_output_inertia(const struct plant *pl)
 {
-    return pl->p.rotor_inertia * pl->p.gear_ratio * pl->p.gear_ratio;
+    return pl->p.rotor_inertia * pl->p.gear_ratio * pl->p.gear_ratio + pl->payload_inertia;
 }
 
 double plant_stall_torque(const struct plant *pl)

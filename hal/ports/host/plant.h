@@ -40,6 +40,7 @@ struct plant {
     double duty;         /* -1..1 */
     bool coast;          /* bridge off */
     double load_torque;  /* external, at the output, N m, opposing positive motion if positive */
+    double payload_inertia; /* on the horn, kg m^2 (added to the output's) */
     bool has_stop;       /* a hard stop at stop_angle, from below */
     double stop_angle;
 };
@@ -54,7 +55,8 @@ uint16_t plant_encoder(const struct plant *pl);
 double plant_angle_deg(const struct plant *pl);
 
 /* Figures of the parameters, at the output: stall torque (N m) at duty 1
- * and the present supply; no-load speed (rad/s); inertia (kg m^2). */
+ * and the present supply; no-load speed (rad/s); inertia (kg m^2, the
+ * payload's included). */
 double plant_stall_torque(const struct plant *pl);
 double plant_no_load_speed(const struct plant *pl);
 double plant_output_inertia(const struct plant *pl);

@@ -7,22 +7,29 @@
  *   thermal resistance winding-housing  3.1 K/W,  time constant winding  12.0 s
  *   thermal resistance housing-ambient   14 K/W,  time constant motor     612 s
  * Capacities follow as time constant / resistance: 3.87 J/K (winding) and
- * 43.7 J/K (case). The RE 25 is a little larger than a 20 kg cm servo's
+ * 43.7 J/K (case). A plant file (plant_model.h) may give other figures. The RE 25 is a little larger than a 20 kg cm servo's
  * motor; the servo's plastic case keeps its heat in at least as well. */
 #ifndef HOST_THERMAL_H
 #define HOST_THERMAL_H
 
-#define THERMAL_WINDING_CASE_K_PER_W 3.1
-#define THERMAL_CASE_AMBIENT_K_PER_W 14.0
-#define THERMAL_WINDING_J_PER_K (12.0 / THERMAL_WINDING_CASE_K_PER_W)
-#define THERMAL_CASE_J_PER_K (612.0 / THERMAL_CASE_AMBIENT_K_PER_W)
+struct thermal_params {
+    double winding_case_k_per_w;
+    double winding_tau_s;        /* the winding's time constant */
+    double case_ambient_k_per_w;
+    double case_tau_s;           /* the motor's (case) time constant */
+};
 
 struct thermal {
+    struct thermal_params p;
     double ambient_c;
     double winding_c;
     double case_c;
 };
 
+/* The reference servo's figures above. */
+extern const struct thermal_params thermal_reference;
+
+/* The reference servo's parameters, everything at ambient_c. */
 void thermal_init(struct thermal *t, double ambient_c);
 /* Everything at temp_c at once: the servo has soaked in that air. */
 void thermal_soak(struct thermal *t, double temp_c);

@@ -10,7 +10,7 @@
 
 #include "storage/config_peek.h"
 #include "storage/config_store.h"
-#include "ports/host/plant.h"
+#include "ports/host/plant_model.h"
 #include "registers/data_table.h"
 #include "ports/host/thermal.h"
 
@@ -21,6 +21,8 @@ struct vboard_motor {
 
 uint32_t vboard_motor_size(void);
 void vboard_motor_init(struct vboard_motor *m, double supply_v, double ambient_c);
+int vboard_motor_load_plant(struct vboard_motor *m, const char *path, double ambient_c, char *err,
+                            uint32_t err_size);
 void vboard_motor_step(struct vboard_motor *m, double dt);
 void vboard_motor_drive(struct vboard_motor *m, double duty);
 void vboard_motor_coast(struct vboard_motor *m);
@@ -32,7 +34,7 @@ int vboard_factory_config(uint8_t *pages, uint32_t page_size, uint32_t page0_add
 int vboard_stored_id(uint8_t *pages, uint32_t page_size, uint32_t page0_addr);
 
 enum { ANGLE_DEG, VELOCITY_DPS, CURRENT_A, SUPPLY_V, LOAD_NM, WINDING_C, CASE_C, AMBIENT_C, STOP_DEG,
-       SOAK_C };
+       SOAK_C, PAYLOAD_GCM2 };
 
 uint32_t vboard_motor_size(void)
 {
@@ -44,6 +46,19 @@ void vboard_motor_init(struct vboard_motor *m, double supply_v, double ambient_c
     plant_init(&m->plant);
     m->plant.p.supply_v = supply_v;
     thermal_init(&m->thermal, ambient_c);
+}
+
+/* A plant file's motor (plant_model.h), at the file's supply: 1, or 0 with
+ * the reason in err and the motor as it was. */
+int vboard_motor_load_plant(struct vboard_motor *m, const char *path, double ambient_c, char *err,
+                            uint32_t err_size)
+{
+    struct plant_model model;
+    if (!plant_model_load(path, &model, err, err_size)) {
+        return 0;
+    }
+    plant_model_apply(&model, &m->plant, &m->thermal, ambient_c);
+    return 1;
 }
 
 /* The winding heats by I^2 R, as in servo_sim. */
@@ -78,6 +93,7 @@ double vboard_motor_get(const struct vboard_motor *m, int what)
     case CURRENT_A: return m->plant.current;
     case SUPPLY_V: return m->plant.p.supply_v;
     case LOAD_NM: return m->plant.load_torque;
+    case PAYLOAD_GCM2: return m->plant.payload_inertia * 1e7;
     case WINDING_C: return m->thermal.winding_c;
     case CASE_C: return m->thermal.case_c;
     case AMBIENT_C: return m->thermal.ambient_c;
@@ -91,6 +107,7 @@ void vboard_motor_set(struct vboard_motor *m, int what, double value)
     switch (what) {
     case SUPPLY_V: m->plant.p.supply_v = value; break;
     case LOAD_NM: m->plant.load_torque = value; break;
+    case PAYLOAD_GCM2: m->plant.payload_inertia = value * 1e-7; break; /* g cm^2 to kg m^2 */
     case AMBIENT_C: m->thermal.ambient_c = value; break;
     case SOAK_C: thermal_soak(&m->thermal, value); break;
     case STOP_DEG:
