@@ -289,7 +289,7 @@ def protocol_md(s: sch.Schema) -> str:
             "servo_sim and the virtual boards (`servoctl sim`, `--board`) take these commands on their",
             "control port, a text line each, answered with a line: `ok`, `error: ...` (what is wrong), or",
             "the state. A command with a value may end with a servo's bus ID; without one it applies to",
-            "every servo. `help` lists them.", "",
+            "every servo. `help` lists them. `protocol/control_port.toml` declares them.", "",
             "| command | value | servo_sim | virtual boards | what |", "|---|---|---|---|---|"]
     for c in s.controls:
         value = f"{_number(c.value[0])} to {_number(c.value[1])} {c.value[2]}" + \

@@ -10,6 +10,9 @@ from dataclasses import dataclass
 from pathlib import Path
 
 SCHEMA = Path(__file__).resolve().parents[2] / "protocol" / "schema.toml"
+# The simulators' control port, beside it: not the servo's protocol, but
+# declared once for servo_sim and the virtual boards the same way.
+CONTROL_PORT = "control_port.toml"
 FLAGS = ("addressed", "answers", "answers_if_control_response", "broadcast", "query", "syncable",
          "one_answers", "carries_records")
 # The fields of fixed size, by their struct code (lower case: signed).
@@ -267,9 +270,13 @@ def _unique(kind: str, values) -> None:
         seen.add(v)
 
 
-def parse(text: str) -> Schema:
+def parse(text: str, control_text: str | None = None) -> Schema:
+    """The schema from its text, and the control port's commands from
+    control_text (else from the schema's own control key, if any)."""
     try:
         raw = tomllib.loads(text)
+        if control_text is not None:
+            raw["control"] = raw.get("control", []) + tomllib.loads(control_text).get("control", [])
     except tomllib.TOMLDecodeError as e:
         raise SchemaError(f"not TOML: {e}") from None
     unknown = set(raw) - {"frame", "status_bit", "item", "packet", "control"}
@@ -305,4 +312,6 @@ def parse(text: str) -> Schema:
 
 @functools.lru_cache(maxsize=None)
 def load(path: str = str(SCHEMA)) -> Schema:
-    return parse(Path(path).read_text(encoding="utf-8"))
+    control = Path(path).with_name(CONTROL_PORT)
+    return parse(Path(path).read_text(encoding="utf-8"),
+                 control.read_text(encoding="utf-8") if control.exists() else None)

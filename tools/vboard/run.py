@@ -24,7 +24,7 @@ from .board import PARTS, Board, images
 from .bus import Bus
 
 MAX_SLICE_S = 1e-3  # longest the CPUs run between two looks at the host and the models
-# The control port's commands (protocol/schema.toml, as servo_sim's): what
+# The control port's commands (protocol/control_port.toml, as servo_sim's): what
 # help answers, and the range of each one's number.
 CONTROLS = {c.name: c for c in schema.load().controls_of("vboard")}
 HELP = schema.load().help_line("vboard")

@@ -12,7 +12,7 @@
 #include "sim/control_commands.h"
 #include "sim_link.h"
 
-/* The control port's commands (protocol/schema.toml): what each takes. */
+/* The control port's commands (protocol/control_port.toml): what each takes. */
 struct control_command {
     const char *name;
     bool takes_value; /* a number, checked against lo..hi */

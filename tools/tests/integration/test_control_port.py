@@ -1,4 +1,4 @@
-"""The simulators' control port is declared once (protocol/schema.toml):
+"""The simulators' control port is declared once (protocol/control_port.toml):
 servo_sim and a virtual board list the commands the schema gives each, and
 answer the same line the same way: a value out of its declared range, off
 where only stop takes it, an unknown command."""
