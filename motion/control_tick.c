@@ -223,7 +223,11 @@ void motion_tick(struct motion *m)
     }
     switch (m->mode) {
     case MODE_DAMPING:
-        m->hal->motor.drive(m->hal->ctx, controller_damping(m->measured_velocity_q8, &m->drive));
+        m->damping_duty_q15 = controller_damping(m->measured_velocity_q8, m->open_duty_q15, &m->drive);
+        m->hal->motor.drive(m->hal->ctx, m->damping_duty_q15);
+        if (m->open_ticks != 0u && --m->open_ticks == 0u) {
+            motion_coast(m);
+        }
         return;
     case MODE_POSITION:
         break;

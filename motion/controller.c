@@ -82,10 +82,13 @@ int16_t controller_position(struct controller *c, const struct controller_input 
     return limited;
 }
 
-int16_t controller_damping(int32_t measured_velocity_q8, const struct drive_limits *lim)
+int16_t controller_damping(int32_t measured_velocity_q8, int16_t open_duty_q15, const struct drive_limits *lim)
 {
-    int32_t brake = -((sat_q(measured_velocity_q8, SPEED_LIMIT_Q8) * GAIN_DAMPING) >> 8);
-    return limit(brake, measured_velocity_q8, lim);
+    int32_t duty = open_duty_q15;
+    if (duty == 0) {
+        duty = -((sat_q(measured_velocity_q8, SPEED_LIMIT_Q8) * GAIN_DAMPING) >> 8);
+    }
+    return limit(duty, measured_velocity_q8, lim);
 }
 
 void drive_limits_for_supply(struct drive_limits *lim, uint16_t supply_mv)

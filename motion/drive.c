@@ -77,6 +77,7 @@ int32_t motion_brake_duty(const struct motion *m, int32_t dir)
 void motion_coast(struct motion *m)
 {
     m->mode = MODE_RELEASED;
+    m->damping_duty_q15 = 0;
     m->running = 0;
     m->streaming = 0;
     m->controller.at_limit = 0;

@@ -16,6 +16,7 @@ static void hold_here(struct motion *m)
     m->last_setpoint_q8 = m->setpoint_q8;
     if (m->mode != MODE_POSITION) {
         controller_reset(&m->controller);
+        m->damping_duty_q15 = 0;
     }
     m->mode = MODE_POSITION;
     m->end = END_HOLD;

@@ -53,6 +53,7 @@ void motion_begin_profile(struct motion *m, uint8_t end)
 {
     if (m->mode != MODE_POSITION) {
         controller_reset(&m->controller);
+        m->damping_duty_q15 = 0;
     }
     m->mode = MODE_POSITION;
     motion_clock_restart(m);
@@ -210,6 +211,8 @@ void motion_run(struct motion *m, const struct motion_command *cmd)
     m->endless = 0;
     m->streaming = 0;
     m->angle_clamped = 0;
+    m->open_duty_q15 = 0;
+    m->open_ticks = 0;
     m->answer_packet = cmd->answer_when_done ? cmd->packet : 0u;
     m->power_mw = cmd->power_mw;
     motion_update_limits(m);

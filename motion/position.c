@@ -100,6 +100,7 @@ void motion_read_diagnostics(const struct motion *m, struct motion_diagnostics *
          * digit), where a division by a power of two rounds to zero at some
          * instructions' cost on the M0. */
         .velocity_decideg_s = saturate_i16((m->measured_velocity_q8 * 125) >> 5),
+        .duty_q15 = m->damping_duty_q15, /* 0 outside damping and open loop */
         .tracking_error_centideg = saturate_i16((sat_q_inline(error_q8, TRACKING_ERROR_SPAN_Q8) * 5) >> 7),
         .flags = (uint8_t)(flags | limiter << LIMITER_SHIFT),
     };

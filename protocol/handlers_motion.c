@@ -139,6 +139,14 @@ enum packet_outcome handle_stream_setpoint(const struct packet_call *c, struct r
     return motion_stream(c->d->motion, &sp) == MOTION_ACCEPTED ? OUTCOME_OK : OUTCOME_ERROR;
 }
 
+enum packet_outcome handle_drive_duty(const struct packet_call *c, struct response *r)
+{
+    (void)r;
+    int16_t duty = le_get_i16(&c->content[1]);
+    uint16_t ms = le_get_u16(&c->content[3]);
+    return motion_drive_duty(c->d->motion, duty, ms) == MOTION_ACCEPTED ? OUTCOME_OK : OUTCOME_ERROR;
+}
+
 enum packet_outcome handle_read_angle(const struct packet_call *c, struct response *r)
 {
     struct motion_angle angle;
@@ -149,7 +157,7 @@ enum packet_outcome handle_read_angle(const struct packet_call *c, struct respon
 }
 
 /* ReadMotion (0x40): one instant of the motion state, docs/packets.md. */
-enum { READ_MOTION_ANSWER_LENGTH = 27 };
+enum { READ_MOTION_ANSWER_LENGTH = 29 };
 
 enum packet_outcome handle_read_motion(const struct packet_call *c, struct response *r)
 {
@@ -168,6 +176,7 @@ enum packet_outcome handle_read_motion(const struct packet_call *c, struct respo
     const uint32_t *next_tick = c->d->next_tick_us;
     le_put_u32(&p[21], next_tick != NULL ? *next_tick - 1000000u / MOTION_TICK_HZ : 0u);
     le_put_u16(&p[25], (uint16_t)c->d->regs->firmware.winding_decic);
+    le_put_u16(&p[27], (uint16_t)d.duty_q15);
     r->length = READ_MOTION_ANSWER_LENGTH;
     return OUTCOME_OK;
 }

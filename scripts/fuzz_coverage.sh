@@ -13,7 +13,8 @@ LLVM_PROFILE_FILE="$out/corpus.profraw" \
   ./build/coverage/tests/fuzz/fuzz_servo -runs=0 tests/fuzz/corpus >"$out/run.log" 2>&1
 llvm-profdata merge -o "$out/corpus.profdata" "$out/corpus.profraw"
 files=(motion/motion.c motion/setpoint.c motion/position.c motion/drive.c motion/planning.c
-       motion/command_queue.c motion/control_tick.c motion/profile.c motion/stream.c firmware/protection/protection.c
+       motion/command_queue.c motion/control_tick.c motion/profile.c motion/stream.c motion/open_loop.c
+       firmware/protection/protection.c
        firmware/storage/config_store.c firmware/storage/save_policy.c firmware/storage/fault_log.c
        firmware/protection/winding.c firmware/protection/bus_watchdog.c firmware/app/servo_safety.c)
 llvm-cov report ./build/coverage/tests/fuzz/fuzz_servo -instr-profile="$out/corpus.profdata" \

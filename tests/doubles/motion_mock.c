@@ -27,6 +27,14 @@ enum motion_submit_result motion_stream(struct motion *m, const struct motion_se
     return (enum motion_submit_result)mock();
 }
 
+enum motion_submit_result motion_drive_duty(struct motion *m, int16_t duty_q15, uint16_t ms)
+{
+    (void)m;
+    check_expected(duty_q15);
+    check_expected(ms);
+    return (enum motion_submit_result)mock();
+}
+
 void motion_read_angle(const struct motion *m, struct motion_angle *out)
 {
     (void)m;

@@ -165,6 +165,13 @@ SERVO_SEEDS = {
                            + ms(200) + wire(req(12, struct.pack("<BhHHHH", 0, -300, 3000, 50, 80, 0))) + ms(700)
                            + wire(req(12, struct.pack("<BhHHHH", 0, -200, 3000, 100, 200, 0))) + ms(900)
                            + wire(req(0x40, b"\x00"))),
+    # Open loop (DriveDuty): a step that ends by itself, one damping takes
+    # over, and the refused ones (no time, too long, no duty).
+    "open_loop": (USED, wire(req(0x46, struct.pack("<BhH", 0, 9830, 40)) + req(0x40, b"\x00")) + ms(60)
+                  + wire(req(0x46, struct.pack("<BhH", 0, -32768, 5000))) + ms(30)
+                  + wire(req(9, struct.pack("<BH", 0, 800))) + ms(30)
+                  + wire(req(0x46, struct.pack("<BhH", 0, 100, 0)) + req(0x46, struct.pack("<BhH", 0, 100, 10001))
+                         + req(0x46, struct.pack("<BhH", 0, 0, 100)))),
     "wheel_run_stop": (USED, wire(req(7, struct.pack("<BBHH", 0, 0x01, 300, 0))) + ms(100)
                        + wire(req(7, struct.pack("<BBHH", 0, 0x00, 0, 0))) + ms(60)
                        + wire(write(47, 1) + req(7, struct.pack("<BBHH", 0, 0x81, 90, 0))) + ms(60)

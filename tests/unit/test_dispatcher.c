@@ -307,6 +307,25 @@ static void test_stream_setpoint_decodes(void **state)
     assert_true(command_error());
 }
 
+/* DriveDuty (0x46): a signed duty and a time as sent; never answered; a
+ * refusal (inhibited, or a time out of range) flags the command error. */
+static void test_drive_duty_decodes(void **state)
+{
+    (void)state;
+    expect_value(motion_drive_duty, duty_q15, -16384);
+    expect_value(motion_drive_duty, ms, 10000);
+    will_return(motion_drive_duty, MOTION_ACCEPTED);
+    RUN(0x46, OWN_ID, 0x00, 0xC0, 0x10, 0x27); /* -16384, 10 000 ms */
+    assert_false(result.answer);
+    assert_false(command_error());
+    expect_value(motion_drive_duty, duty_q15, 32767);
+    expect_value(motion_drive_duty, ms, 0);
+    will_return(motion_drive_duty, MOTION_REFUSED);
+    RUN(0x46, OWN_ID, 0xFF, 0x7F, 0x00, 0x00);
+    assert_false(result.answer);
+    assert_true(command_error());
+}
+
 static void test_full_queue_drops_and_flags(void **state)
 {
     (void)state;
@@ -519,6 +538,7 @@ int main(void)
         cmocka_unit_test_setup(test_wheel_packet_decodes, setup),
         cmocka_unit_test_setup(test_motion_answers_when_done_with_control_response, setup),
         cmocka_unit_test_setup(test_stream_setpoint_decodes, setup),
+        cmocka_unit_test_setup(test_drive_duty_decodes, setup),
         cmocka_unit_test_setup(test_full_queue_drops_and_flags, setup),
         cmocka_unit_test_setup(test_damping_answers_at_once_with_control_response, setup),
         cmocka_unit_test_setup(test_stop_on_control_mode, setup),

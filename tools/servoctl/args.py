@@ -236,6 +236,13 @@ def build_parser():
     c.add_argument("file", help="CSV: a header 'time,ID,ID...', then evenly spaced rows")
     c.add_argument("--lead-in", type=float, default=1.0, help="s to move to the first row first (default 1)")
 
+    c = sub.add_parser("identify", help="the drive train's constants from open-loop duty steps (horn free)")
+    c.add_argument("id", type=int)
+    c.add_argument("--duty", type=float, default=0.45,
+                   help="the largest duty, of the supply (default 0.45); four steps up to it, each way")
+    c.add_argument("--step-ms", type=int, default=0,
+                   help="each step's length (default: 12 rise times of a first step, 0.7-10 s)")
+
     c = sub.add_parser("sync-move", help="several servos start their moves in one frame")
     c.add_argument("targets", type=_target, nargs="+", metavar="ID:DEGREES")
     c.add_argument("--interval", type=int, default=1000, help="ms to get there (default 1000)")

@@ -97,6 +97,12 @@ def cmd_id(bus, args):
     return 0
 
 
+def cmd_identify(bus, args):
+    from .identify import cmd_identify as identify  # scipy: loaded for this command alone
+
+    return identify(bus, args)
+
+
 def cmd_bench(bus, args):
     from . import bench, image as img
 
@@ -448,6 +454,7 @@ COMMANDS = {
     "monitor": cmd_monitor,
     "record": cmd_record,
     "stream": cmd_stream,
+    "identify": cmd_identify,
     "sync-move": cmd_sync_move,
     "broadcast-move": cmd_broadcast_move,
     "async": cmd_async,

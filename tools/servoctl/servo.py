@@ -40,6 +40,7 @@ class MotionSnapshot:
     flags: int
     time_us: int  # the servo's clock at the tick the values are from; wraps at 2**32
     winding_decic: int  # the winding's temperature, estimated (item 68)
+    duty_q15: int  # the bridge's duty in damping and open loop (DriveDuty), after the limits; else 0
 
     PROFILE_ENDED, CLOCK_SLOWED, BRAKING, AT_LIMIT, RELEASED = 1, 2, 4, 8, 16
     # What holds the output back (flags bits 5-7, item 67; docs/safety.md).
@@ -277,6 +278,18 @@ class Servo:
     def damping(self, power_mw: int = 0) -> None:
         check_range("power", power_mw, 0, 65535, "mW")
         self.bus.send(p.DAMPING, p.encode_request(p.DAMPING, self.id, power_mw))
+
+    def drive_duty(self, duty: float, ms: int) -> None:
+        """Open loop (DriveDuty, this firmware's 0x46): the bridge at duty (-1..1
+        of the supply) for ms (1-10000), then released. The current limit and
+        the protections hold it; the angle limits do not."""
+        if not -1.0 <= duty <= 1.0:
+            raise ValueOutOfRange(f"duty takes -1 to 1 (of the supply), not {duty!r}")
+        check_range("time", ms, 1, 10000, "ms")
+        q15 = round(duty * 32767)
+        if q15 == 0:
+            raise ValueOutOfRange(f"duty {duty} rounds to 0 (1/32767 of the supply is the least)")
+        self.bus.send(p.DRIVE_DUTY, p.encode_request(p.DRIVE_DUTY, self.id, q15, ms))
 
     def stop(self, mode: str = "release", power_mw: int = 0) -> None:
         modes = {"release": 0x10, "hold": 0x11, "damping": 0x12}

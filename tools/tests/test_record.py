@@ -6,7 +6,7 @@ from servoctl.servo import MotionSnapshot
 
 
 def snapshot(setpoint):
-    return MotionSnapshot(1, setpoint, setpoint, 600, 0, 0, 0, 1, 0, 0, 250)
+    return MotionSnapshot(1, setpoint, setpoint, 600, 0, 0, 0, 1, 0, 0, 250, 0)
 
 
 def test_the_profile_start_comes_from_the_setpoint_not_the_host():

@@ -41,7 +41,7 @@ LAST_ITEM = "what = \"shifts the zero every angle read and written refers to\"},
 @pytest.mark.parametrize("broken, said", [
     (_with(SCHEMA, "code = 2\n", "code = 1\n"), "two packet codes 1"),
     (_with(SCHEMA, 'flags = ["addressed", "answers", "query"]', 'flags = ["adressed"]'), "flags"),
-    (_with(SCHEMA, "code = 0x41\n", "code = 0x46\n"), "consecutive codes"),
+    (_with(SCHEMA, "code = 0x41\n", "code = 0x47\n"), "consecutive codes"),
     (_with(SCHEMA, "factory = 3000,", "factory = 70000,"), "soft_start_time"),
     (_with(SCHEMA, "{id = 33,", "{id = 60,"), "consecutive IDs from 32"),
     (_with(SCHEMA, 'access = "reserved"', 'access = "hidden"'), "access one of"),
@@ -59,7 +59,7 @@ def test_a_schema_that_cannot_be_is_refused_with_its_reason(broken, said):
 
 NEW_PACKET = '''
 [[packet]]
-code = 0x46
+code = 0x47
 name = "Echo"
 c = "ECHO"
 source = "firmware"
@@ -100,7 +100,7 @@ with Simulator(ids=[1]) as sim:
 
 def test_a_new_item_and_a_new_packet_need_the_schema_and_the_handler_only(tmp_path):
     """A copy of the tree, changed in two files: schema.toml gains user item
-    54 and packet 0x46 (and room for the batch packets, which grow with the
+    54 and packet 0x47 (and room for the batch packets, which grow with the
     user area), and handlers_data.c gains handle_echo(). Its
     servo_sim builds and answers both, its servoctl knows both (config dump
     lists the item), and its docs/protocol.md describes both."""
@@ -138,7 +138,7 @@ def test_a_new_item_and_a_new_packet_need_the_schema_and_the_handler_only(tmp_pa
     docs.mkdir(exist_ok=True)
     subprocess.run([sys.executable, str(tree / "scripts/gen_protocol.py"), "docs", str(docs)], check=True)
     text = (docs / "protocol.md").read_text(encoding="utf-8")
-    assert "| 0x46 (70) | [Echo](protocol-packets.md#0x46-echo) |" in text
+    assert "| 0x47 (71) | [Echo](protocol-packets.md#0x47-echo) |" in text
     assert "| 54 | test_hold_ms | 2 | u16 | read-write | 0..1000 | 250 | ms |" in text
-    assert "## 0x46 Echo" in (docs / "protocol-packets.md").read_text(encoding="utf-8")
+    assert "## 0x47 Echo" in (docs / "protocol-packets.md").read_text(encoding="utf-8")
     shutil.rmtree(build)

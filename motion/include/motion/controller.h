@@ -43,8 +43,9 @@ struct controller_input {
 void controller_reset(struct controller *c);
 int16_t controller_position(struct controller *c, const struct controller_input *in,
                             const struct drive_limits *lim);
-/* Damping mode: a braking duty proportional to the measured velocity. */
-int16_t controller_damping(int32_t measured_velocity_q8, const struct drive_limits *lim);
+/* Damping mode: a braking duty proportional to the measured velocity, or
+ * (open_duty_q15 not 0) that duty, open loop; within the limits either way. */
+int16_t controller_damping(int32_t measured_velocity_q8, int16_t open_duty_q15, const struct drive_limits *lim);
 /* Keeps duty within the duty limit of the back-EMF duty at this speed. */
 int16_t controller_limit(int32_t duty, int32_t measured_velocity_q8, const struct drive_limits *lim);
 /* kv, ka and the drag at supply_mv (0: the nominal supply; below

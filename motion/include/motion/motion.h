@@ -83,7 +83,7 @@ struct motion_angle {
 enum motion_mode {
     MODE_RELEASED, /* output off, turns freely */
     MODE_POSITION, /* following a profile, then holding its end */
-    MODE_DAMPING,  /* braking in proportion to speed */
+    MODE_DAMPING,  /* braking in proportion to speed, or open loop (open_duty) */
 };
 
 /* What the servo does once a profile has run out. */
@@ -173,6 +173,11 @@ struct motion {
     uint8_t derate;
     uint16_t power_cap_mw;
     uint32_t commands;         /* motion commands received */
+    /* Open loop (DriveDuty): MODE_DAMPING's duty instead of a brake, for
+     * open_ticks more ticks (0 with a brake: until another command). */
+    int16_t open_duty_q15;
+    uint16_t open_ticks;
+    int16_t damping_duty_q15;  /* what MODE_DAMPING gave the bridge last; 0 in other modes */
 };
 
 /* Reads the encoder and takes the power-on state (46). regs and hal must
@@ -196,6 +201,12 @@ struct motion_setpoint {
  * speed; a period late, it brakes to a hold. It takes over from any
  * command, and drops what is queued (docs/streaming.md). */
 MUST_CHECK enum motion_submit_result motion_stream(struct motion *m, const struct motion_setpoint *sp);
+/* Open loop (DriveDuty, 0x46): the bridge at duty_q15 (of the supply) for
+ * ms (1..MOTION_OPEN_LOOP_MAX_MS), then released. The output's current
+ * limit and the protections hold it; the angle limits do not. Refused
+ * while the protections hold the output. */
+#define MOTION_OPEN_LOOP_MAX_MS 10000u
+MUST_CHECK enum motion_submit_result motion_drive_duty(struct motion *m, int16_t duty_q15, uint16_t ms);
 /* Not under position control (released or damping). */
 static inline bool motion_is_released(const struct motion *m)
 {
@@ -214,6 +225,7 @@ struct motion_diagnostics {
     int16_t velocity_decideg_s;      /* the horn's speed, measured */
     int16_t tracking_error_centideg; /* setpoint - horn, 0.01 deg, saturated */
     uint8_t flags;                   /* enum motion_diagnostic_flag */
+    int16_t duty_q15;                /* damping or open loop's duty; 0 otherwise */
 };
 
 enum motion_diagnostic_flag {

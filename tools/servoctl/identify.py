@@ -1,0 +1,234 @@
+"""servoctl identify: the drive train's constants from open-loop duty steps.
+
+The servo is driven open loop (DriveDuty, 0x46) at a few duties each way,
+one step at a time from rest, and sampled through ReadMotion on the servo's
+own clock. A brushed DC motor behind a gearbox, seen at the output
+(K = kt x gear ratio, the drags at the output), obeys
+
+    V d = R i + K w                 (the winding; its inductance's
+                                     microseconds are below a sample)
+    J w' = K i - C sgn(w) - B w     (the output)
+
+so at each step's steady speed V d = R i + K w gives R and K, and
+K i = C + B w gives the Coulomb and viscous drags; from rest the speed
+rises as w_ss (1 - exp(-t / tau)) with tau = J / (K^2 / R + B), which gives
+the inertia. Every fit is least squares (scipy), and each value is given
+with its standard error. ReadMotion's duty is what the bridge was given
+(after the current limit), so a step the limit clips is known and not used
+for the inertia."""
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import optimize
+
+from .errors import ServoError
+
+DEFAULT_DUTIES = (0.15, 0.25, 0.35, 0.45)
+DEFAULT_STEP_MS = 700   # the least; longer where the rise is slower (step_length_ms)
+SETTLE_S = 0.4        # how often come_to_rest looks, x 8
+STEADY_FROM = 0.6     # the steady part of a step: its last 40 %
+CLIP_TOLERANCE = 0.02
+
+
+@dataclass
+class Sample:
+    t: float          # s, the servo's clock from the step's command
+    angle: float      # rad, output
+    current: float    # A, magnitude (item 2)
+    duty: float       # of the supply, as the bridge was given it
+
+
+@dataclass
+class Step:
+    duty: float       # commanded
+    samples: list
+
+
+@dataclass
+class Estimate:
+    value: float
+    sigma: float      # standard error
+
+    def percent(self) -> float:
+        return 100.0 * self.sigma / abs(self.value) if self.value else math.inf
+
+
+@dataclass
+class DriveTrain:
+    """At the output: K = kt x ratio (N m/A), R (ohm), J (kg m^2), C (N m),
+    B (N m s/rad); supply_v as measured."""
+    torque_constant: Estimate
+    resistance: Estimate
+    inertia: Estimate
+    coulomb: Estimate
+    viscous: Estimate
+    supply_v: float
+    steps_used: int
+
+    def rows(self):
+        return [("torque constant x ratio", self.torque_constant, "N m/A"),
+                ("resistance", self.resistance, "ohm"),
+                ("inertia at the output", self.inertia, "kg m^2"),
+                ("Coulomb drag at the output", self.coulomb, "N m"),
+                ("viscous drag at the output", self.viscous, "N m s/rad")]
+
+
+def record_step(servo, duty: float, step_ms: int, sleep) -> Step:
+    """One open-loop step from rest, sampled until the output is released
+    and has coasted a little; sleep(s) waits on the servo's (or the
+    simulator's) clock."""
+    first = servo.read_motion()
+    servo.drive_duty(duty, step_ms)
+    samples = []
+    end_s = step_ms / 1000.0 + 0.05
+    while True:
+        snap = servo.read_motion()
+        t = snap.seconds_since(first)
+        samples.append(Sample(t, math.radians(snap.angle_decideg / 10.0), snap.current_ma / 1000.0,
+                              snap.duty_q15 / 32767.0))
+        if t > end_s:
+            break
+        if len(samples) > 20000:
+            raise ServoError("the servo's clock did not advance during the step")
+    come_to_rest(servo, sleep)
+    return Step(duty, samples)
+
+
+def come_to_rest(servo, sleep, timeout_s: float = 10.0) -> None:
+    """Damping (packet 9) until the horn is still, then released: released
+    at once, a large inertia coasts for seconds, and the next step must
+    start from rest."""
+    servo.damping()
+    still = 0
+    waited = 0.0
+    while still < 3:
+        sleep(SETTLE_S / 8)
+        waited += SETTLE_S / 8
+        still = still + 1 if abs(servo.read_motion().velocity_decideg_s) < 5 else 0
+        if waited > timeout_s:
+            raise ServoError(f"the horn did not come to rest within {timeout_s:g} s of damping")
+    servo.stop("release")
+
+
+def _driven(step: Step):
+    return [s for s in step.samples if s.duty != 0.0]
+
+
+def _steady(step: Step):
+    """(applied duty, speed rad/s, signed current A) over the step's steady part."""
+    driven = _driven(step)
+    if len(driven) < 8:
+        raise ServoError(f"the step at duty {step.duty:+.2f} has {len(driven)} driven samples: too few "
+                         "(a faster bus, or longer steps)")
+    t0, t1 = driven[0].t, driven[-1].t
+    steady = [s for s in driven if s.t >= t0 + STEADY_FROM * (t1 - t0)]
+    ts = np.array([s.t for s in steady])
+    angles = np.array([s.angle for s in steady])
+    speed = np.polyfit(ts, angles, 1)[0]
+    sign = 1.0 if step.duty > 0 else -1.0
+    return (float(np.mean([s.duty for s in steady])), float(speed),
+            sign * float(np.mean([s.current for s in steady])))
+
+
+def _linear(rows, rhs):
+    """Least squares rows @ x = rhs: x and its standard errors."""
+    a, b = np.asarray(rows, float), np.asarray(rhs, float)
+    x, *_ = np.linalg.lstsq(a, b, rcond=None)
+    dof = max(len(b) - len(x), 1)
+    residual = float(np.sum((a @ x - b) ** 2)) / dof
+    cov = residual * np.linalg.pinv(a.T @ a)
+    return x, np.sqrt(np.maximum(np.diag(cov), 0.0))
+
+
+def _rise_tau(step: Step):
+    """tau (s) and its standard error from the angle's rise from rest, or
+    None where the current limit clipped the duty during the rise."""
+    driven = _driven(step)
+    t_on = driven[0].t
+    rise = [s for s in step.samples if s.t <= t_on + 0.5 * (driven[-1].t - t_on)]
+    if any(abs(s.duty - step.duty) > CLIP_TOLERANCE * abs(step.duty) for s in rise if s.duty != 0.0):
+        return None
+    t = np.array([s.t for s in rise])
+    angle = np.array([s.angle for s in rise])
+
+    def model(t, a0, t0, tau, w):
+        x = np.maximum(t - t0, 0.0)
+        return a0 + w * (x - tau * (1.0 - np.exp(-x / tau)))
+
+    w_guess = (angle[-1] - angle[0]) / max(t[-1] - t[0], 1e-3)
+    guess = (angle[0], t_on - 0.002, 0.02, w_guess)
+    bounds = ([-np.inf, t[0] - 0.05, 1e-4, -np.inf], [np.inf, t_on + 0.01, 5.0, np.inf])
+    params, cov = optimize.curve_fit(model, t, angle, p0=guess, bounds=bounds, maxfev=20000)
+    return float(params[2]), float(math.sqrt(max(cov[2, 2], 0.0)))
+
+
+def fit(steps, supply_v: float) -> DriveTrain:
+    """The drive train from recorded steps (at least two each way)."""
+    steady = [_steady(s) for s in steps]
+    # V d = R i + K w
+    (r, k), (sr, sk) = _linear([[i, w] for _, w, i in steady], [supply_v * d for d, _, _ in steady])
+    # K i = C sgn(w) + B w
+    (c, b), (sc, sb) = _linear([[math.copysign(1.0, w), w] for _, w, _ in steady], [k * i for _, _, i in steady])
+    taus = [tau for tau in (_rise_tau(s) for s in steps) if tau is not None]
+    if not taus:
+        raise ServoError("the current limit clipped every step's rise: lower the duties, or raise the "
+                         "power limit (item 42) for the identification")
+    damping = k * k / r + b
+    tau = float(np.mean([t for t, _ in taus]))
+    spread = float(np.std([t for t, _ in taus], ddof=1) / math.sqrt(len(taus))) if len(taus) > 1 else taus[0][1]
+    j = tau * damping
+    sj = j * math.hypot(spread / tau, math.hypot(2 * sk / k, sr / r) * (k * k / r) / damping)
+    return DriveTrain(Estimate(k, sk), Estimate(r, sr), Estimate(j, sj), Estimate(c, sc), Estimate(b, sb),
+                      supply_v, len(taus))
+
+
+def step_length_ms(servo, duty: float, sleep) -> int:
+    """A step long enough to be steady for its last 40 %: 12 rise times,
+    from a first step's rise (DEFAULT_STEP_MS at least, 10 s at most)."""
+    probe = _rise_tau(record_step(servo, duty, DEFAULT_STEP_MS, sleep))
+    if probe is None:
+        return DEFAULT_STEP_MS
+    return int(min(max(12.0 * probe[0] * 1000.0, DEFAULT_STEP_MS), 10000))
+
+
+def identify(servo, sleep, duties=DEFAULT_DUTIES, step_ms: int = 0, progress=None) -> DriveTrain:
+    """Steps at each duty, each way in turn (so the horn comes back), then
+    the fit; step_ms 0: as the drive train's rise time asks
+    (step_length_ms). progress(done, total) after each step."""
+    supply_v = servo.read("voltage") / 1000.0
+    if supply_v <= 0.5:
+        raise ServoError(f"the supply reads {supply_v:.2f} V: identify needs the motor powered")
+    if step_ms == 0:
+        step_ms = step_length_ms(servo, duties[0], sleep)
+        servo.drive_duty(-duties[0], DEFAULT_STEP_MS)  # back to about where it began
+        sleep(DEFAULT_STEP_MS / 1000.0)
+        come_to_rest(servo, sleep)
+    plan = [d * sign for d in duties for sign in (1.0, -1.0)]
+    steps = []
+    for n, duty in enumerate(plan):
+        steps.append(record_step(servo, duty, step_ms, sleep))
+        if progress is not None:
+            progress(n + 1, len(plan))
+    return fit(steps, supply_v)
+
+
+def cmd_identify(bus, args):
+    """servoctl identify ID: open-loop steps, the fit, a table with each
+    value's standard error."""
+    from .servo import Servo
+
+    servo = Servo(bus, args.id)
+    duties = tuple(args.duty * k / len(DEFAULT_DUTIES) for k in range(1, len(DEFAULT_DUTIES) + 1))
+    print(f"servo {args.id}: open-loop steps at duties {', '.join(f'±{d:.2f}' for d in duties)} "
+          "(the horn must turn freely: it goes round several times)", flush=True)
+
+    def progress(done, total):
+        print(f"  step {done}/{total}", flush=True)
+
+    drive = identify(servo, bus.sleep, duties, args.step_ms, progress)
+    print(f"drive train at the output, {drive.supply_v:.2f} V supply, inertia from {drive.steps_used} rises:")
+    for name, e, unit in drive.rows():
+        print(f"  {name:28s} {e.value:11.4g} {unit:10s} ± {e.percent():.2g} %")
+    print("  backlash                     not identified (no reversal under load in these steps)")
+    return 0
