@@ -242,6 +242,8 @@ def build_parser():
                    help="the largest duty, of the supply (default 0.45); four steps up to it, each way")
     c.add_argument("--step-ms", type=int, default=0,
                    help="each step's length (default: 12 rise times of a first step, 0.7-10 s)")
+    c.add_argument("--mujoco", metavar="FILE",
+                   help="also write a MuJoCo actuator model (MJCF) and say how closely it replays the steps")
 
     c = sub.add_parser("sync-move", help="several servos start their moves in one frame")
     c.add_argument("targets", type=_target, nargs="+", metavar="ID:DEGREES")

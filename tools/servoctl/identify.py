@@ -65,6 +65,7 @@ class DriveTrain:
     viscous: Estimate
     supply_v: float
     steps_used: int
+    steps: list = None  # the recorded steps the fit came from
 
     def rows(self):
         return [("torque constant x ratio", self.torque_constant, "N m/A"),
@@ -180,7 +181,7 @@ def fit(steps, supply_v: float) -> DriveTrain:
     j = tau * damping
     sj = j * math.hypot(spread / tau, math.hypot(2 * sk / k, sr / r) * (k * k / r) / damping)
     return DriveTrain(Estimate(k, sk), Estimate(r, sr), Estimate(j, sj), Estimate(c, sc), Estimate(b, sb),
-                      supply_v, len(taus))
+                      supply_v, len(taus), list(steps))
 
 
 def step_length_ms(servo, duty: float, sleep) -> int:
@@ -231,4 +232,11 @@ def cmd_identify(bus, args):
     for name, e, unit in drive.rows():
         print(f"  {name:28s} {e.value:11.4g} {unit:10s} ± {e.percent():.2g} %")
     print("  backlash                     not identified (no reversal under load in these steps)")
+    if args.mujoco:
+        from . import actuator_model
+
+        actuator_model.write(drive, args.mujoco)
+        rms_deg, percent = actuator_model.match(args.mujoco, drive)
+        print(f"mujoco model: {args.mujoco}; replaying the {len(drive.steps)} steps it follows the servo "
+              f"within {rms_deg:.2f} deg RMS ({percent:.2f} % of a step's travel)")
     return 0
