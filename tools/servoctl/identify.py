@@ -26,7 +26,7 @@ from .errors import ServoError
 
 DEFAULT_DUTIES = (0.15, 0.25, 0.35, 0.45)
 DEFAULT_STEP_MS = 700   # the least; longer where the rise is slower (step_length_ms)
-SETTLE_S = 0.4        # how often come_to_rest looks, x 8
+REST_POLL_S = 0.05    # how often come_to_rest looks at the horn
 STEADY_FROM = 0.6     # the steady part of a step: its last 40 %
 CLIP_TOLERANCE = 0.02
 
@@ -104,8 +104,8 @@ def come_to_rest(servo, sleep, timeout_s: float = 10.0) -> None:
     still = 0
     waited = 0.0
     while still < 3:
-        sleep(SETTLE_S / 8)
-        waited += SETTLE_S / 8
+        sleep(REST_POLL_S)
+        waited += REST_POLL_S
         still = still + 1 if abs(servo.read_motion().velocity_decideg_s) < 5 else 0
         if waited > timeout_s:
             raise ServoError(f"the horn did not come to rest within {timeout_s:g} s of damping")

@@ -14,6 +14,7 @@ from .protocol import Bus, LinkError, ServoError
 from .servo import Servo
 
 REPO = Path(__file__).resolve().parents[2]
+PLANTS = REPO / "hal" / "ports" / "host" / "plants"  # the shipped plant files (--plant)
 BOOT_TIMEOUT_S = 10
 # Host seconds a simulator's clock may stand still before a wait gives up
 # on it (a simulator falls behind on a busy PC; it does not stop).

@@ -14,7 +14,7 @@ static const struct sim_cpu cpus[] = {
     {.name = "m3", .pass_ns = 257 * 1000 / 72 + 1, .tick_ns = 989 * 1000 / 72 + 1,
      .answer_ns = 1153 * 1000 / 72 + 1, .tick_and_pass_us = 18},
     {.name = "m0", .pass_ns = 282 * 1000 / 48 + 1, .tick_ns = 1881 * 1000 / 48 + 1,
-     .answer_ns = 1404 * 1000 / 48 + 1, .tick_and_pass_us = 46},
+     .answer_ns = 1439 * 1000 / 48 + 1, .tick_and_pass_us = 46},
 };
 
 const struct sim_cpu *sim_cpu_named(const char *name)

@@ -69,10 +69,8 @@ struct reader {
 
 static bool fail(const struct reader *r, const char *fmt, ...)
 {
-    int n = snprintf(r->err, r->err_size, "plant file %s, line %u: ", r->path, r->line);
-    if (r->line == 0u) {
-        n = snprintf(r->err, r->err_size, "plant file %s: ", r->path);
-    }
+    int n = r->line != 0u ? snprintf(r->err, r->err_size, "plant file %s, line %u: ", r->path, r->line)
+                          : snprintf(r->err, r->err_size, "plant file %s: ", r->path);
     if (n >= 0 && (size_t)n < r->err_size) {
         va_list ap;
         va_start(ap, fmt);
@@ -179,14 +177,13 @@ static bool read_line(const struct reader *r, char *line, struct plant_model *m,
 }
 
 /* The parameters must give back the figures they were derived from. */
-static bool reproduces_published(struct reader *r, const struct plant_model *m)
+static bool reproduces_published(const struct reader *r, const struct plant_model *m)
 {
     struct plant pl;
     struct thermal t;
     plant_model_apply(m, &pl, &t, 25.0);
     double torque = plant_stall_torque(&pl);
     double speed = plant_no_load_speed(&pl) * 180.0 / PI;
-    r->line = 0u;
     if (fabs(torque / m->published_stall_torque_nm - 1.0) > PUBLISHED_TOLERANCE) {
         return fail(r, "the parameters give a stall torque of %.4g N m, not the published %.4g (within %.0f %%)",
                     torque, m->published_stall_torque_nm, PUBLISHED_TOLERANCE * 100.0);
@@ -219,19 +216,16 @@ bool plant_model_load(const char *path, struct plant_model *m, char *err, size_t
         }
     }
     fclose(f);
+    r.line = 0u; /* what follows is about the whole file */
     for (size_t k = 0; ok && k < KEY_COUNT; k++) {
-        r.line = 0u;
         if (!seen[k]) {
             ok = fail(&r, "%s is missing (every key is required)", keys[k].key);
         }
     }
     if (ok && !named) {
-        r.line = 0u;
         ok = fail(&r, "name is missing");
     }
-    if (ok && !reproduces_published(&r, &read)) {
-        ok = false;
-    }
+    ok = ok && reproduces_published(&r, &read);
     if (ok) {
         *m = read;
     }

@@ -5,7 +5,6 @@ reference servo's, wrong for the other two: identification runs open loop).
 Time is the simulator's (sim.sleep)."""
 import re
 import tomllib
-from pathlib import Path
 
 import pytest
 
@@ -13,11 +12,10 @@ from servoctl.cli import main
 from servoctl.errors import ServoError
 from servoctl.identify import identify
 from servoctl.servo import Servo
-from servoctl.sim import Simulator
+from servoctl.sim import PLANTS, Simulator
 
 from .conftest import finish
 
-PLANTS = Path(__file__).resolve().parents[3] / "hal/ports/host/plants"
 
 
 def at_the_output(plant: dict) -> dict:

@@ -3,17 +3,15 @@ servo runs on the file's motor, gears and supply, a refused file says why,
 and the control port's payload adds to the horn's inertia. Time is the
 simulator's (sim.sleep)."""
 import re
-from pathlib import Path
 
 import pytest
 
 from servoctl.errors import ServoError
 from servoctl.servo import Servo
-from servoctl.sim import Simulator
+from servoctl.sim import PLANTS, Simulator
 
 from .conftest import finish
 
-PLANTS = Path(__file__).resolve().parents[3] / "hal/ports/host/plants"
 # file: (name's start, supply in mV)
 SHIPPED = {"reference_st3215.toml": ("reference ST3215", 7400), "micro_9g.toml": ("9 g micro", 4800),
            "class_60kgcm.toml": ("60 kg cm", 12000)}

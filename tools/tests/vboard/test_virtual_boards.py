@@ -4,7 +4,6 @@ their peripherals laid out from ST's SVD files), driven through servoctl and
 the maker's SDK exactly as the simulator is. Time is the boards' simulated
 time (sim.sleep, sim.wait_until)."""
 import struct
-from pathlib import Path
 
 import pytest
 import serial
@@ -17,7 +16,7 @@ from servoctl import update as upd
 from servoctl.errors import ServoError
 from servoctl.registers import ITEMS
 from servoctl.servo import Servo
-from servoctl.sim import Simulator
+from servoctl.sim import PLANTS, Simulator
 from vboard.board import board_h, images
 
 from ..erase_rule import again_if_unanswered
@@ -441,9 +440,8 @@ def test_a_plant_file_gives_the_board_its_motor(tmp_path):
     """The virtual board's motor from a plant file, as servo_sim's: the 9 g
     micro-servo at its 4.8 V, read by the board's own ADC; a payload on its
     horn; a refused file stops the board with the reason."""
-    plants = Path(__file__).resolve().parents[3] / "hal/ports/host/plants"
     sim = Simulator(ids=[1], state_dir=str(tmp_path / "state"), board="stm32f103",
-                    plant=str(plants / "micro_9g.toml")).start()
+                    plant=str(PLANTS / "micro_9g.toml")).start()
     try:
         with sim.bus(timeout=0.3) as bus:
             s = Servo(bus, 1)
@@ -457,6 +455,6 @@ def test_a_plant_file_gives_the_board_its_motor(tmp_path):
     finally:
         finish(sim, [1])
     bad = tmp_path / "bad.toml"
-    bad.write_text((plants / "micro_9g.toml").read_text().replace("gear_ratio = 300", "gear_ratio = 0"))
+    bad.write_text((PLANTS / "micro_9g.toml").read_text().replace("gear_ratio = 300", "gear_ratio = 0"))
     with pytest.raises(ServoError, match="gear_ratio must be from 1 to 10000, not 0"):
         Simulator(ids=[1], state_dir=str(tmp_path / "state2"), board="stm32f103", plant=str(bad)).start()
