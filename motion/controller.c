@@ -1,6 +1,8 @@
 #include "motion/controller.h"
 
 #include <stdbool.h>
+#include <stddef.h>
+#include <string.h>
 
 #include "motion/div64.h"
 #include "motion/gains.h"
@@ -13,9 +15,10 @@ __attribute__((noinline)) int32_t sat_q(int32_t v, int32_t limit)
 }
 #endif
 
-/* Input ranges that keep every product within int32 (the gains: kv +
- * viscous < 2^15.3 down to GAIN_MIN_SUPPLY_MV, KP < 2^10, KD and DAMPING
- * < 2^13); the output saturates far inside each. */
+/* Input ranges that keep every product within int32 with the gains at
+ * their items' most (kp and ki < 2^10, kd < 2^15, damping < 2^16) and the
+ * derived kv and viscous each clamped below 2^16; the output saturates far
+ * inside each. */
 enum {
     ERROR_LIMIT_Q8 = 1 << 21,      /* 8192 decideg: KP x it is 4.4 x full duty */
     VELOCITY_LIMIT_Q8 = 1 << 13,   /* 32 decideg per tick, 3200 deg/s */
@@ -55,21 +58,19 @@ int16_t controller_position(struct controller *c, const struct controller_input 
         return limit(in->push > 0 ? OUTPUT_LIMIT : -OUTPUT_LIMIT, in->measured_velocity_q8, lim);
     }
     int32_t e = sat_q(in->error_q8, ERROR_LIMIT_Q8);
-    int32_t p = (e * GAIN_KP) >> 8;
+    int32_t p = (e * lim->kp) >> 8;
     /* Within one encoder count of the setpoint nothing is integrated: the
      * error there is the encoder's rounding, and integrating it would wind
      * the output up through static friction and back (a limit cycle). */
     bool in_count = e < INTEGRAL_DEADBAND_Q8 && e > -INTEGRAL_DEADBAND_Q8;
     int32_t integral = c->integral_q15;
     if (!in_count) {
-        integral += (e * GAIN_KI) >> 8;
-        integral = integral > INTEGRAL_LIMIT_Q15 ? INTEGRAL_LIMIT_Q15
-                   : integral < -INTEGRAL_LIMIT_Q15 ? -INTEGRAL_LIMIT_Q15 : integral;
+        integral = sat_q(integral + ((e * lim->ki) >> 8), INTEGRAL_LIMIT_Q15);
     }
     int32_t v = sat_q(in->velocity_q8, VELOCITY_LIMIT_Q8);
     int32_t drag = v > 0 ? lim->friction : v < 0 ? -lim->friction : 0;
     int32_t ff = ((v * (lim->kv + lim->viscous)) >> 8) + in->acceleration_duty + drag;
-    int32_t d = (sat_q(in->velocity_q8 - in->measured_velocity_q8, SLIP_LIMIT_Q8) * GAIN_KD) >> 8;
+    int32_t d = (sat_q(in->velocity_q8 - in->measured_velocity_q8, SLIP_LIMIT_Q8) * lim->kd) >> 8;
     int32_t out = sat_q(p + integral + ff + d, OUTPUT_LIMIT);
     int16_t limited = limit(out, in->measured_velocity_q8, lim);
     /* Anti-windup: no integrating while the limit holds the output back in
@@ -86,40 +87,70 @@ int16_t controller_damping(int32_t measured_velocity_q8, int16_t open_duty_q15, 
 {
     int32_t duty = open_duty_q15;
     if (duty == 0) {
-        duty = -((sat_q(measured_velocity_q8, SPEED_LIMIT_Q8) * GAIN_DAMPING) >> 8);
+        duty = -((sat_q(measured_velocity_q8, SPEED_LIMIT_Q8) * lim->damping) >> 8);
     }
     return limit(duty, measured_velocity_q8, lim);
 }
 
-void drive_limits_for_supply(struct drive_limits *lim, uint16_t supply_mv)
+/* The feed-forward from the drive train (items 80-85), each a duty in
+ * Q15. Motor torque T takes the current T / kt, and the duty T R / (kt V);
+ * so with kt in uN m/A, R in mOhm and V in mV, a torque in units u gives
+ * u x R / (kt V) x SCALE, SCALE = 32768 x u / 1e-6. One decideg per tick is
+ * 1.7453 rad/s at the output, ratio times that at the motor; one decideg
+ * per tick^2 is 1745.3 rad/s^2. Rounded scales: 0.01 % at most. */
+enum {
+    KV_SCALE_Q6 = 3660,    /* back-EMF: kt ratio x 1.7453e-6 x 32768e3 / V = 57.19 x 64 */
+    KA_SCALE = 5719,       /* inertia in 1e-10 kg m^2 x ratio x 1745.3 rad/s^2 */
+    FRICTION_SCALE = 3277, /* Coulomb drag in 1e-7 N m */
+    VISCOUS_SCALE_Q5 = 183, /* viscous drag in 1e-10 N m s/rad x ratio x 1.7453 rad/s: 5.719 x 32 */
+    DERIVED_MAX = 65535,   /* kv, friction and viscous: see the input ranges above */
+    KA_MAX = 1 << 30,
+};
+
+/* a x b / den, at most most: each factor within 32 bits (the items' 16-bit
+ * ranges see to it), the product within 64. */
+/* The gains' four items, kp to damping, side by side in both structs. */
+#define GAINS_SIZE (4u * sizeof(uint16_t))
+_Static_assert(offsetof(struct user_config, gain_damping) - offsetof(struct user_config, gain_kp) ==
+                       offsetof(struct drive_limits, damping) - offsetof(struct drive_limits, kp) &&
+                   offsetof(struct drive_limits, damping) - offsetof(struct drive_limits, kp) ==
+                       GAINS_SIZE - sizeof(uint16_t),
+               "gains: items 86-89 in order, as struct drive_limits has them");
+
+static int32_t derived(uint32_t a, uint32_t b, uint32_t den, int32_t most)
 {
-    if (supply_mv == 0u) {
-        supply_mv = NOMINAL_SUPPLY_MV;
-    } else if (supply_mv < GAIN_MIN_SUPPLY_MV) {
+    uint64_t q = div64_u((uint64_t)a * b, den);
+    return q > (uint64_t)most ? most : (int32_t)q;
+}
+
+void drive_limits_for_supply(struct drive_limits *lim, const struct user_config *dt, uint16_t supply_mv)
+{
+    if (supply_mv < GAIN_MIN_SUPPLY_MV) {
         supply_mv = GAIN_MIN_SUPPLY_MV;
     }
-    lim->kv = (int32_t)(((uint32_t)GAIN_KV * NOMINAL_SUPPLY_MV) / supply_mv);
-    lim->ka = (int32_t)div64_u((uint64_t)GAIN_KA * NOMINAL_SUPPLY_MV, supply_mv);
-    lim->friction = (int32_t)(((uint32_t)GAIN_FRICTION * NOMINAL_SUPPLY_MV) / supply_mv);
-    lim->viscous = (int32_t)(((uint32_t)GAIN_VISCOUS * NOMINAL_SUPPLY_MV) / supply_mv);
+    const uint32_t r = dt->resistance_mohm, ratio = dt->gear_ratio;
+    const uint32_t per_torque = (uint32_t)dt->kt_un_m_per_a * supply_mv; /* kt V */
+    lim->kv = derived(dt->kt_un_m_per_a * ratio, KV_SCALE_Q6, (uint32_t)supply_mv << 6, DERIVED_MAX);
+    int32_t ka = derived(dt->inertia_mg_cm2 * ratio, r * KA_SCALE, per_torque, KA_MAX);
+    lim->ka = ka | 1; /* never 0: planning divides by what it gives */
+    lim->friction = derived(dt->coulomb_dun_m * r, FRICTION_SCALE, per_torque, DERIVED_MAX);
+    lim->viscous = derived(dt->viscous_100pn_m_s * ratio, (r * VISCOUS_SCALE_Q5) >> 5, per_torque, DERIVED_MAX);
+    memcpy(&lim->kp, &dt->gain_kp, GAINS_SIZE);
 }
 
-int16_t duty_limit_for_power(uint16_t power_mw, uint16_t supply_mv)
+/* x R << 15 / den, at most full duty (32767). */
+static int16_t duty_of(uint32_t x, uint16_t r_mohm, uint32_t den)
 {
-    if (supply_mv == 0u) {
-        supply_mv = NOMINAL_SUPPLY_MV;
-    }
-    uint64_t num = (uint64_t)power_mw * MOTOR_RESISTANCE_MOHM << 15;
-    uint64_t duty = div64_u(num, (uint32_t)supply_mv * supply_mv);
+    uint64_t duty = div64_u((uint64_t)x * r_mohm << 15, den);
     return (int16_t)(duty > 32767u ? 32767u : duty);
 }
 
-int16_t duty_limit_for_current(uint16_t current_ma, uint16_t supply_mv)
+int16_t duty_limit_for_power(uint16_t power_mw, uint16_t supply_mv, uint16_t r_mohm)
 {
-    if (supply_mv == 0u) {
-        supply_mv = NOMINAL_SUPPLY_MV;
-    }
-    uint64_t num = div64_u((uint64_t)current_ma * MOTOR_RESISTANCE_MOHM << 15, 1000u);
-    uint64_t duty = div64_u(num, supply_mv);
-    return (int16_t)(duty > 32767u ? 32767u : duty);
+    return duty_of(power_mw, r_mohm, (uint32_t)supply_mv * supply_mv); /* P R / V^2 */
+}
+
+int16_t duty_limit_for_current(uint16_t current_ma, uint16_t supply_mv, uint16_t r_mohm)
+{
+    return duty_of(current_ma, r_mohm, (uint32_t)supply_mv * 1000u); /* I R / V, the current in mA */
 }

@@ -36,15 +36,17 @@ void motion_update_limits(struct motion *m)
         power = m->power_cap_mw;
     }
     /* Every command asks; the divisions run only when what they depend on
-     * has changed (a write to 42 or 43, a derate, a new supply). */
+     * has changed (a write to 42 or 43, a derate, a new supply, the drive
+     * train: motion_drive_train_changed). */
     struct drive_inputs now = {power, motion_supply_mv(m), cfg->current_limit_ma, m->derate};
     if (now.power_mw == m->drive_inputs.power_mw && now.supply_mv == m->drive_inputs.supply_mv &&
         now.current_limit_ma == m->drive_inputs.current_limit_ma && now.derate == m->drive_inputs.derate) {
         return;
     }
     m->drive_inputs = now;
-    int16_t by_power = duty_limit_for_power(power, now.supply_mv);
-    int16_t by_current = duty_limit_for_current(cfg->current_limit_ma, now.supply_mv);
+    const struct user_config *dt = &m->regs->user; /* its drive area */
+    int16_t by_power = duty_limit_for_power(power, now.supply_mv, dt->resistance_mohm);
+    int16_t by_current = duty_limit_for_current(cfg->current_limit_ma, now.supply_mv, dt->resistance_mohm);
     int16_t limit = (int16_t)(by_power < by_current ? by_power : by_current);
     bool capped = m->power_cap_mw != 0u && power == m->power_cap_mw;
     m->drive_limiter = limit == INT16_MAX       ? LIMITER_SUPPLY
@@ -52,10 +54,16 @@ void motion_update_limits(struct motion *m)
                        : capped                 ? m->cap_limiter
                                                 : LIMITER_POWER;
     m->drive.duty_limit = (int16_t)(m->derate ? limit / 2 : limit);
-    drive_limits_for_supply(&m->drive, now.supply_mv);
+    drive_limits_for_supply(&m->drive, dt, now.supply_mv);
     motion_take_accel_duty(m, m->tick);
     /* The least of motion_brake_duty: a load taking all it may. */
     m->brake_floor_duty = brake_duty(m->drive.duty_limit, m->drive.duty_limit / 2);
+}
+
+void motion_drive_train_changed(struct motion *m)
+{
+    m->drive_inputs.supply_mv = 0; /* never a supply motion_supply_mv gives */
+    motion_update_limits(m);
 }
 
 /* ---- braking within what the motor can do --------------------------------

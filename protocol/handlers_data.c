@@ -12,8 +12,8 @@ enum packet_outcome handle_ping(const struct packet_call *c, struct response *r)
     return OUTCOME_OK;
 }
 
-/* A change to the user area is kept only once it is durable (the store's
- * persist hook); otherwise the user area goes back to what it was. */
+/* A change to the user or drive area is kept only once it is durable (the
+ * store's persist hook); otherwise both go back to what they were. */
 static bool keep_change(const struct packet_call *c, const struct user_config *before)
 {
     struct dispatcher *d = c->d;
@@ -50,9 +50,13 @@ enum packet_outcome handle_read_data(const struct packet_call *c, struct respons
 /* One item written as WriteData does: true once it holds the value, durably. */
 static bool write_item(const struct packet_call *c, uint8_t id, const uint8_t *data, uint8_t length)
 {
-    const struct user_config before = c->d->regs->user;
-    enum data_write_result w = data_table_write(c->d->regs, id, data, length);
-    return w == DATA_WRITE_SAME || (w == DATA_WRITE_CHANGED && keep_change(c, &before));
+    struct user_config before;
+    enum data_write_result w = data_table_write(c->d->regs, id, data, length, &before);
+    bool ok = w == DATA_WRITE_SAME || (w == DATA_WRITE_CHANGED && keep_change(c, &before));
+    if (w == DATA_WRITE_CHANGED && id >= DRIVE_FIRST) { /* kept or put back: the feed-forward follows */
+        motion_drive_train_changed(c->d->motion);
+    }
+    return ok;
 }
 
 enum packet_outcome handle_write_data(const struct packet_call *c, struct response *r)
@@ -74,7 +78,7 @@ enum packet_outcome handle_read_batch(const struct packet_call *c, struct respon
 enum packet_outcome handle_write_batch(const struct packet_call *c, struct response *r)
 {
     const struct user_config before = c->d->regs->user;
-    bool ok = user_config_decode(&c->d->regs->user, &c->content[1]) && commit_user(c, &before);
+    bool ok = user_config_decode(&c->d->regs->user, &c->content[1], USER_AREA_SIZE) && commit_user(c, &before);
     return answer_result(r, ok);
 }
 

@@ -85,7 +85,7 @@ def packet_rows_h(s: sch.Schema) -> str:
 
 
 def schema_items_h(s: sch.Schema) -> str:
-    status, user, firmware = s.area("status"), s.area("user"), s.area("firmware")
+    status, user, firmware, drive = s.area("status"), s.area("user"), s.area("firmware"), s.area("drive")
 
     def struct(name: str, items) -> str:
         members = "".join(f"    {C_TYPES[(i.size, i.signed)]} {i.field}; /* {i.id}"
@@ -94,7 +94,7 @@ def schema_items_h(s: sch.Schema) -> str:
 
     bits = "".join(f"    STATUS_{b.name.upper()} = 1u << {b.bit},\n" for b in s.status_bits)
     access = {"read": "RO", "read-write": "RW", "reserved": "RESERVED"}
-    for i in user + firmware:  # data_table.h keeps their bounds in 16 bits
+    for i in user + firmware + drive:  # data_table.h keeps their bounds in 16 bits
         if i.size > 2 and i.access != "read":
             raise SystemExit(f"item {i.id}: a writable item of {i.size} bytes (data_table.h takes 1 or 2)")
     rows = [f"RO_STATUS({i.id}, {i.field}, {i.size})," for i in status]
@@ -105,6 +105,8 @@ def schema_items_h(s: sch.Schema) -> str:
         return full if i.size_first_max < 0 else f"SIZE_FIRST_OR({i.size_first_max}{suffix}, {full})"
     rows += [f"FIRMWARE({i.id}, {i.field}, {i.size}, {access[i.access] + ('_SIGNED' if i.signed else '')}, "
              f"{i.min}, {most(i)}, {i.factory})," for i in firmware]
+    rows += [f"USER({i.id}, {i.field}, {i.size}, {access[i.access] + ('_SIGNED' if i.signed else '')}, "
+             f"{i.min}, {i.max}, {i.factory})," for i in drive]  # kept after the batch block
     def number(value: int, item: sch.Item) -> str:  # unsigned items' limits compare as unsigned
         return f"{value}" if item.signed else f"{value}u"
 
@@ -112,7 +114,7 @@ def schema_items_h(s: sch.Schema) -> str:
     limits = "".join(f"#define ITEM_{i.field.upper()}_MIN {number(i.min, i)}\n"
                      f"#define ITEM_{i.field.upper()}_MAX {most(i, '' if i.signed else 'u')}\n"
                      f"#define ITEM_{i.field.upper()}_FACTORY {number(i.factory, i)}\n"
-                     for i in user + tuple(f for f in firmware if f.access == "read-write"))
+                     for i in user + tuple(f for f in firmware if f.access == "read-write") + drive)
     return (NOTICE + "#ifndef REGISTERS_SCHEMA_ITEMS_H\n#define REGISTERS_SCHEMA_ITEMS_H\n\n#include <stdint.h>\n\n"
             "/* An item's most where a size-first build (SERVO_SIZE_FIRST: the Cortex-M0) leaves its\n"
             " * feature out (the schema's size_first_max). */\n#ifdef SERVO_SIZE_FIRST\n"
@@ -120,16 +122,22 @@ def schema_items_h(s: sch.Schema) -> str:
             "/* Status area: live readings and identity, read-only. */\n" + struct("status_area", status) +
             "\n/* Bits of status (data item 5). */\nenum status_bit {\n" + bits + "};\n\n"
             "/* Each data item's ID, by its register's name. */\nenum data_item_id {\n" + ids + "};\n\n"
-            "/* User area: configuration that persists, laid out as its wire image (the\n"
-            " * ReadBatchData block: every item at its own size, in ID order). */\n"
-            + struct("user_config", user) +
+            "/* What the config store keeps, laid out as its wire image (every item at\n"
+            " * its own size, in ID order): the user area (its first USER_AREA_SIZE bytes,\n"
+            " * the ReadBatchData block), then the drive area (the drive train and the\n"
+            " * gains, read and written one at a time). */\n"
+            + struct("user_config", user + drive) +
             "\n/* Firmware area: this firmware's own items, in RAM (factory values at\n"
             " * power-up), read and written one at a time. */\n" + struct("firmware_area", firmware) +
+
             f"\n#define STATUS_FIRST {status[0].id}\n#define STATUS_LAST {status[-1].id}\n"
             f"#define USER_FIRST {user[0].id}\n#define USER_LAST {user[-1].id}\n"
             f"#define FIRMWARE_FIRST {firmware[0].id}\n#define FIRMWARE_LAST {firmware[-1].id}\n"
+            f"#define DRIVE_FIRST {drive[0].id}\n#define DRIVE_LAST {drive[-1].id}\n"
             f"/* The user area's bytes on the wire and in the config store. */\n"
-            f"#define USER_AREA_SIZE {sum(i.size for i in user)}u\n\n"
+            f"#define USER_AREA_SIZE {sum(i.size for i in user)}u\n"
+            f"/* The drive area's bytes, after the user area in struct user_config. */\n"
+            f"#define DRIVE_AREA_SIZE {sum(i.size for i in drive)}u\n\n"
             "/* Each writable item's range and factory value. */\n" + limits + "\n"
             "/* The data table's rows, in ID order (data_table.c's RO_STATUS, USER and FIRMWARE). */\n"
             + _macro("DATA_ITEM_ROWS", rows) + "\n#endif\n")
@@ -274,7 +282,10 @@ def protocol_md(s: sch.Schema) -> str:
             "min) and kept in flash before the answer. An unknown or hidden item reads as no data.",
             "ReadBatchData (5) and WriteBatchData (6) carry the user area whole. The firmware area",
             "(from 64) is this firmware's own: kept in RAM, back to its factory values at every power-up,",
-            "read and written by ReadData and WriteData only (the maker's batch block is unchanged).", "",
+            "read and written by ReadData and WriteData only (the maker's batch block is unchanged).",
+            "The drive area (from 80) is the drive train and the controller's gains: written one at a",
+            "time by WriteData and kept in flash like the user area, but left alone by ResetUserData;",
+            "the controller works out its feed-forward from them when one changes (docs/bring-up.md).", "",
             "| id | name | bytes | type | access | range | factory | unit | meaning |",
             "|---|---|---|---|---|---|---|---|---|"]
     for i in s.items:

@@ -12,7 +12,7 @@ static uint32_t idle_timeout_us(const struct servo *s, uint32_t baud)
     return frame_rx_port_idle_us(frame_rx_idle_us(baud), s->hal->rx_gap_tolerance_us);
 }
 
-static bool persist_user(void *ctx, const struct user_config *cfg);
+static bool persist_config(void *ctx, const struct user_config *cfg);
 
 static void apply_link_settings(struct servo *s)
 {
@@ -36,8 +36,8 @@ void servo_init(struct servo *s, const struct hal_port *hal)
     *s = (struct servo){.hal = hal};
     config_store_load(&s->store, hal->flash, &s->regs.user);
     firmware_area_factory(&s->regs.firmware);
-    /* A store older firmware wrote (format 1) is rewritten in format 2, the
-     * one the bootloader reads the ID and baud rate from. Then the spare
+    /* A store older firmware wrote (formats 1 and 2) is rewritten in format
+     * 3, the one the bootloader reads the ID and baud rate from. Then the spare
      * page is erased ahead, before the control loop runs: saves need no
      * erase until the page in use is full. A failure of either stays in the
      * store (ReadStore reports it, the next save tries again): at power-up
@@ -63,7 +63,7 @@ void servo_init(struct servo *s, const struct hal_port *hal)
     s->dispatcher.bootloader_present = hal->enter_bootloader != NULL;
     s->dispatcher.board = hal->board;
     s->dispatcher.next_tick_us = &s->next_tick_us;
-    s->dispatcher.persist = persist_user;
+    s->dispatcher.persist = persist_config;
     s->dispatcher.persist_ctx = s;
     safety_init(s);
     s->active_baud_index = 0; /* forces the first apply to set the UART */
@@ -192,12 +192,17 @@ static inline __attribute__((always_inline)) void handle_next_frame(struct servo
 
 /* ReadStore's register group, on a change or a new second only: it
  * divides. */
+static uint8_t store_flags(const struct servo *s)
+{
+    return (uint8_t)((s->store.failed ? STORE_FAILED : 0u) |
+                     (s->saver.over_budget ? STORE_OVER_BUDGET : 0u) |
+                     (s->saver.awaits_erase ? STORE_AWAITS_ERASE : 0u));
+}
+
 static void report_store(struct servo *s)
 {
     struct store_health *h = &s->regs.store;
-    uint8_t flags = (uint8_t)((s->store.failed ? STORE_FAILED : 0u) |
-                              (s->saver.over_budget ? STORE_OVER_BUDGET : 0u) |
-                              (s->saver.awaits_erase ? STORE_AWAITS_ERASE : 0u));
+    uint8_t flags = store_flags(s);
     uint32_t op_seconds = save_policy_op_seconds(&s->saver);
     h->answers_dropped = s->answers_dropped;
     h->bytes_lost = s->rx_lost;
@@ -216,15 +221,14 @@ static void report_store(struct servo *s)
     h->failures = s->store.write_failures;
 }
 
-/* The dispatcher's persist hook: a changed user area goes to flash before
- * the write is answered, all its write blocks at once (24 half-words,
- * 1.3-1.7 ms on the STM32F1; the ticks catch up after, the DMA ring holds
+/* The dispatcher's persist hook: a changed user or drive area goes to flash
+ * before the write is answered, all its write blocks at once (36
+ * half-words, 1.9-2.5 ms on the STM32F1; the ticks catch up after, the DMA ring holds
  * what arrives). A change that cannot be made durable now is refused, and
  * ReadStore says why: past the wear budget, no erased slot until the
  * output is released, or the flash refused. */
-static bool persist_user(void *ctx, const struct user_config *cfg)
+static bool save_now(struct servo *s, const struct user_config *cfg)
 {
-    struct servo *s = ctx;
     uint32_t now = s->hal->bus.now_us(s->hal->ctx);
     s->saver.over_budget = !save_policy_allows(&s->saver, &s->store);
     if (s->saver.over_budget) {
@@ -241,6 +245,16 @@ static bool persist_user(void *ctx, const struct user_config *cfg)
     }
     bool ok = r != CONFIG_WRITE_FAILED;
     save_policy_outcome(&s->saver, ok, now);
+    return ok;
+}
+
+static bool persist_config(void *ctx, const struct user_config *cfg)
+{
+    struct servo *s = ctx;
+    bool ok = save_now(s, cfg);
+    /* A ReadStore right after the answer says why; the rest of its group
+     * follows at the next tick (report_store). */
+    s->regs.store.flags = store_flags(s);
     return ok;
 }
 

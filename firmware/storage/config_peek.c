@@ -4,9 +4,9 @@
 #include "storage/crc32.h"
 #include "registers/byte_order.h"
 
-/* The newest format-2 record whose CRC checks (config_record.h). The
- * application rewrites a format-1 store in format 2 when it boots (servo.c),
- * so the bootloader reads format 2 only. */
+/* The newest format-3 record whose CRC checks (config_record.h). The
+ * application rewrites an older store in format 3 when it boots (servo.c),
+ * so the bootloader reads format 3 only. */
 void config_peek_link(const struct hal_flash *flash, uint8_t *id, uint8_t *baud_index)
 {
     uint32_t newest = 0;

@@ -18,26 +18,33 @@ static uint32_t slot_addr(const struct config_store *s, uint8_t page, uint16_t s
     return s->flash->page_addr[page] + (uint32_t)slot * size;
 }
 
-/* Where the fields of each record format are. */
+/* Where the fields of each record format are, newest format first. */
 struct record_layout {
     uint8_t format;
     uint8_t size;
     uint8_t payload;
     uint8_t crc;
+    uint8_t length; /* payload bytes: the user area, and the drive area from format 3 */
 };
-static const struct record_layout FORMAT_2 = {RECORD_FORMAT, CONFIG_RECORD_SIZE, REC_PAYLOAD, REC_CRC};
-static const struct record_layout FORMAT_1 = {V1_FORMAT, V1_RECORD_SIZE, V1_PAYLOAD, V1_CRC};
+static const struct record_layout FORMATS[] = {
+    {RECORD_FORMAT, CONFIG_RECORD_SIZE, REC_PAYLOAD, REC_CRC, STORED_SIZE},
+    {V2_FORMAT, V2_RECORD_SIZE, REC_PAYLOAD, V2_CRC, USER_AREA_SIZE},
+#ifndef SERVO_SIZE_FIRST /* the Cortex-M0 board came after format 2: none of its stores is older */
+    {V1_FORMAT, V1_RECORD_SIZE, V1_PAYLOAD, V1_CRC, USER_AREA_SIZE},
+#endif
+};
 
 /* A record whose every field checks out, including the item ranges: a
- * record from a firmware with other ranges is not loaded half-valid. */
+ * record from a firmware with other ranges is not loaded half-valid. A
+ * format without the drive area leaves out's as it was. */
 static bool record_valid(const uint8_t *rec, const struct record_layout *l, struct user_config *out)
 {
     if (le_get_u16(&rec[REC_MAGIC]) != RECORD_MAGIC || rec[REC_FORMAT] != l->format ||
-        rec[REC_LENGTH] != USER_AREA_SIZE || le_get_u32(&rec[REC_SEQUENCE]) == 0u ||
+        rec[REC_LENGTH] != l->length || le_get_u32(&rec[REC_SEQUENCE]) == 0u ||
         le_get_u32(&rec[l->crc]) != crc32(rec, l->crc)) {
         return false;
     }
-    return user_config_decode(out, &rec[l->payload]);
+    return user_config_decode(out, &rec[l->payload], l->length);
 }
 
 static bool slot_erased(const struct config_store *s, uint8_t page, uint16_t slot)
@@ -62,15 +69,15 @@ static bool scan(struct config_store *s, const struct record_layout *l, struct u
     for (uint8_t page = 0; page < 2u; page++) {
         for (uint16_t slot = 0; slot < slots; slot++) {
             uint8_t rec[CONFIG_RECORD_SIZE];
-            struct user_config candidate;
             s->flash->read(s->flash->ctx, slot_addr(s, page, slot, l->size), rec, l->size);
             uint32_t seq = le_get_u32(&rec[REC_SEQUENCE]);
-            if (seq > s->sequence && record_valid(rec, l, &candidate)) {
+            /* Decoded over newest (the factory drive area, before format 3),
+             * which it changes only when the record is valid. */
+            if (seq > s->sequence && record_valid(rec, l, newest)) {
                 s->sequence = seq;
                 s->page = page;
                 s->slot = slot;
-                s->op_seconds = l == &FORMAT_2 ? le_get_u32(&rec[REC_OP_SECONDS]) : 0u;
-                *newest = candidate;
+                s->op_seconds = l->payload == REC_PAYLOAD ? le_get_u32(&rec[REC_OP_SECONDS]) : 0u;
                 found = true;
             }
         }
@@ -102,13 +109,16 @@ bool config_store_load(struct config_store *s, const struct hal_flash *flash,
     *s = (struct config_store){.flash = flash};
     struct user_config newest;
     user_config_factory(&newest);
-    /* A store written by older firmware holds format 1 only; the next save
-     * starts a page in format 2. */
-    if (!scan(s, &FORMAT_2, &newest)) {
-        s->legacy = scan(s, &FORMAT_1, &newest);
+    /* A store written by older firmware holds an older format only; the
+     * next save starts a page in format 3. */
+    for (uint8_t f = 0; f < sizeof FORMATS / sizeof FORMATS[0]; f++) {
+        if (scan(s, &FORMATS[f], &newest)) {
+            s->legacy = f != 0u;
+            break;
+        }
     }
     *cfg = newest;
-    user_config_encode(&newest, s->saved);
+    memcpy(s->saved, &newest, STORED_SIZE); /* its wire image (data_table.c) */
     s->spare_erased = page_erased(s, spare_page(s));
     /* A blank store's first record goes to page 0 and makes page 1 the
      * spare: look at it now, not while a write waits for its answer. */
@@ -152,10 +162,10 @@ enum config_save_result config_store_begin(struct config_store *s, const struct 
                                            uint32_t op_seconds)
 {
     uint8_t *rec = s->job;
-    user_config_encode(cfg, &rec[REC_PAYLOAD]);
-    /* A format-1 store is written again in format 2 even unchanged: the
-     * bootloader reads format 2 only (config_peek.c). */
-    if (!s->legacy && memcmp(&rec[REC_PAYLOAD], s->saved, USER_AREA_SIZE) == 0) {
+    memcpy(&rec[REC_PAYLOAD], cfg, STORED_SIZE); /* its wire image (data_table.c) */
+    /* An older format is written again in format 3 even unchanged: the
+     * bootloader reads format 3 only (config_peek.c). */
+    if (!s->legacy && memcmp(&rec[REC_PAYLOAD], s->saved, STORED_SIZE) == 0) {
         return CONFIG_UNCHANGED;
     }
     uint8_t page;
@@ -165,13 +175,11 @@ enum config_save_result config_store_begin(struct config_store *s, const struct 
     }
     le_put_u16(&rec[REC_MAGIC], RECORD_MAGIC);
     rec[REC_FORMAT] = RECORD_FORMAT;
-    rec[REC_LENGTH] = USER_AREA_SIZE;
+    rec[REC_LENGTH] = STORED_SIZE;
     le_put_u32(&rec[REC_SEQUENCE], s->sequence + 1u);
     le_put_u32(&rec[REC_OP_SECONDS], op_seconds);
+    memset(&rec[REC_PADDING], 0xFF, REC_CRC - REC_PADDING); /* erased, as flash is */
     le_put_u32(&rec[REC_CRC], crc32(rec, REC_CRC));
-#if CONFIG_RECORD_SIZE > CONFIG_RECORD_UNPADDED
-    memset(&rec[CONFIG_RECORD_UNPADDED], 0xFF, CONFIG_RECORD_SIZE - CONFIG_RECORD_UNPADDED);
-#endif
     s->job_active = 1;
     s->job_page = page;
     s->job_slot = slot;
@@ -221,7 +229,7 @@ enum config_save_result config_store_step(struct config_store *s)
     s->legacy = 0;
     s->failed = 0;
     s->op_seconds = s->job_op_seconds;
-    memcpy(s->saved, &s->job[REC_PAYLOAD], USER_AREA_SIZE);
+    memcpy(s->saved, &s->job[REC_PAYLOAD], STORED_SIZE);
     return CONFIG_SAVED;
 }
 

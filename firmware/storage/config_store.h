@@ -1,8 +1,8 @@
-/* Power-safe store of the user area in two flash pages.
+/* Power-safe store of the user and drive areas in two flash pages.
  *
  * Each page is a log of fixed-size records: magic, format, length, sequence
- * number, the operating time so far, the 32-byte user area and a CRC-32
- * over all of it. A save appends a record with the next sequence number to
+ * number, the operating time so far, the 32-byte user area, the drive area
+ * and a CRC-32 over all of it. A save appends a record with the next sequence number to
  * the first erased slot after the newest record; when that page is full it
  * starts on the other page. The page holding the newest record is never
  * erased, and a record is only valid once its CRC (programmed last)
@@ -40,11 +40,11 @@ struct config_store {
     uint32_t sequence;   /* of the newest valid record; 0 when none */
     uint8_t page;        /* where the newest record is */
     uint16_t slot;
-    uint8_t saved[USER_AREA_SIZE]; /* what a boot would load now */
+    uint8_t saved[STORED_SIZE]; /* what a boot would load now */
     uint32_t op_seconds; /* operating time recorded with the newest record */
     uint32_t write_failures;
     uint8_t failed;      /* the last save failed (and nothing saved since) */
-    uint8_t legacy;      /* the newest record is format 1: the next starts a page */
+    uint8_t legacy;      /* the newest record is an older format: the next starts a page */
     uint8_t spare_erased; /* the page without the newest record is all 0xFF */
     uint8_t blank_page1_erased; /* a blank store's page 1 was all 0xFF on load */
     /* The save in progress: its record, where it goes, the next block. */
@@ -57,13 +57,14 @@ struct config_store {
 };
 
 /* Loads the newest valid record into cfg; factory values when the store is
- * blank or corrupt. Returns true when a record was found. */
+ * blank or corrupt (and the drive area's when the record is older than
+ * format 3). Returns true when a record was found. */
 bool config_store_load(struct config_store *s, const struct hal_flash *flash,
                        struct user_config *cfg);
 
 /* Starts appending cfg, with the operating time so far: CONFIG_STARTED,
  * CONFIG_UNCHANGED when cfg equals what is stored (and the store is in
- * format 2), CONFIG_NEEDS_ERASE when
+ * format 3), CONFIG_NEEDS_ERASE when
  * the record must start the other page and that is not erased yet. */
 MUST_CHECK enum config_save_result config_store_begin(struct config_store *s, const struct user_config *cfg,
                                            uint32_t op_seconds);

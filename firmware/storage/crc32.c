@@ -1,7 +1,8 @@
 #include "storage/crc32.h"
 
 #ifdef CRC32_BITWISE
-/* The bootloader's: no table, 4 KB is all it has. */
+/* The bootloaders' and the Cortex-M0 application's: no table, where flash
+ * is tightest. */
 static uint32_t crc32_byte(uint32_t crc)
 {
     for (int bit = 0; bit < 8; bit++) {

@@ -79,3 +79,11 @@ bool motion_is_idle(const struct motion *m)
     function_called();
     return (bool)mock();
 }
+
+unsigned motion_mock_drive_changes;
+
+void motion_drive_train_changed(struct motion *m)
+{
+    (void)m;
+    motion_mock_drive_changes++;
+}

@@ -9,4 +9,7 @@ extern struct motion_command motion_mock_last;
 /* The last setpoint motion_stream was given. */
 extern struct motion_setpoint motion_mock_last_setpoint;
 
+/* Calls of motion_drive_train_changed (a stored item changed) so far. */
+extern unsigned motion_mock_drive_changes;
+
 #endif

@@ -17,27 +17,28 @@ static const struct data_item *item_row(enum data_item_id item)
 }
 
 /* value's size low bytes, little-endian, after two bytes (servo ID, item). */
-static size_t put_item(uint8_t *out, uint8_t servo_id, const struct data_item *row, int32_t value)
+static size_t put_item(uint8_t *out, uint8_t servo_id, enum data_item_id item, int32_t value)
 {
+    const struct data_item *row = item_row(item);
     out[0] = servo_id;
-    out[1] = row->id;
-    for (size_t k = 0; k < row->size; k++) {
+    out[1] = (uint8_t)item;
+    for (size_t k = 0; k < data_item_size(row); k++) {
         out[2 + k] = (uint8_t)((uint32_t)value >> (8u * k));
     }
-    return 2u + row->size;
+    return 2u + data_item_size(row);
 }
 
 void harness_write_item(uint8_t servo_id, enum data_item_id item, int32_t value)
 {
     uint8_t content[2 + DATA_ITEM_MAX_SIZE];
-    harness_request(PKT_WRITE_DATA, content, put_item(content, servo_id, item_row(item), value));
+    harness_request(PKT_WRITE_DATA, content, put_item(content, servo_id, item, value));
 }
 
 void harness_expect_item(uint8_t servo_id, enum data_item_id item, int32_t value)
 {
     uint8_t content[2 + DATA_ITEM_MAX_SIZE];
     uint8_t frame[64];
-    size_t n = make_response(frame, PKT_READ_DATA, content, put_item(content, servo_id, item_row(item), value));
+    size_t n = make_response(frame, PKT_READ_DATA, content, put_item(content, servo_id, item, value));
     harness_assert_sent(frame, n);
 }
 

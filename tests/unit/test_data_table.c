@@ -11,6 +11,7 @@
 #include "registers/data_table.h"
 
 static struct registers regs;
+static struct user_config before; /* what a write changed */
 
 static int setup(void **state)
 {
@@ -66,10 +67,10 @@ static void test_every_user_item_reads_its_factory_bytes(void **state)
         if (id == 35 || id == 45) {
             assert_int_equal(n, 0); /* reserved: not public */
         } else {
-            assert_int_equal(n, it->size);
+            assert_int_equal(n, data_item_size(it));
             assert_memory_equal(out, &factory_block[pos], n);
         }
-        pos += it->size;
+        pos += data_item_size(it);
     }
     assert_int_equal(pos, USER_AREA_SIZE);
 }
@@ -120,11 +121,11 @@ static void test_status_and_reserved_items_refuse_writes(void **state)
     const uint8_t four[4] = {1, 2, 3, 4};
     for (uint8_t id = 1; id <= 8; id++) {
         const struct data_item *it = data_table_find(id);
-        assert_int_equal(data_table_write(&regs, id, four, it->size), DATA_WRITE_REFUSED);
+        assert_int_equal(data_table_write(&regs, id, four, data_item_size(it), &before), DATA_WRITE_REFUSED);
     }
-    assert_int_equal(data_table_write(&regs, 35, four, 1), DATA_WRITE_REFUSED);
-    assert_int_equal(data_table_write(&regs, 45, four, 1), DATA_WRITE_REFUSED);
-    assert_int_equal(data_table_write(&regs, 54, four, 1), DATA_WRITE_REFUSED);
+    assert_int_equal(data_table_write(&regs, 35, four, 1, &before), DATA_WRITE_REFUSED);
+    assert_int_equal(data_table_write(&regs, 45, four, 1, &before), DATA_WRITE_REFUSED);
+    assert_int_equal(data_table_write(&regs, 54, four, 1, &before), DATA_WRITE_REFUSED);
     test_factory_block_is_the_documented_one(state);
 }
 
@@ -148,7 +149,7 @@ static void test_every_item_range(void **state)
         int32_t probes[] = {ranges[i].min - 1, ranges[i].min, ranges[i].max, ranges[i].max + 1};
         for (size_t p = 0; p < 4; p++) {
             int32_t v = probes[p];
-            bool representable = it->size == 1 ? (v >= 0 && v <= 255)
+            bool representable = data_item_size(it) == 1 ? (v >= 0 && v <= 255)
                                  : (it->access & DATA_SIGNED) ? (v >= -32768 && v <= 32767)
                                                               : (v >= 0 && v <= 65535);
             if (!representable) {
@@ -156,13 +157,13 @@ static void test_every_item_range(void **state)
             }
             setup(NULL);
             uint8_t bytes[2] = {(uint8_t)((uint32_t)v & 0xFF), (uint8_t)(((uint32_t)v >> 8) & 0xFF)};
-            bool ok = data_table_write(&regs, ranges[i].id, bytes, it->size) != DATA_WRITE_REFUSED;
+            bool ok = data_table_write(&regs, ranges[i].id, bytes, data_item_size(it), &before) != DATA_WRITE_REFUSED;
             bool in_range = v >= ranges[i].min && v <= ranges[i].max;
             assert_int_equal(ok, in_range);
             uint8_t out[DATA_ITEM_MAX_SIZE];
-            assert_int_equal(data_table_read(&regs, ranges[i].id, out), it->size);
+            assert_int_equal(data_table_read(&regs, ranges[i].id, out), data_item_size(it));
             if (ok) {
-                assert_memory_equal(out, bytes, it->size);
+                assert_memory_equal(out, bytes, data_item_size(it));
             }
         }
     }
@@ -172,21 +173,21 @@ static void test_wrong_data_length_is_refused(void **state)
 {
     (void)state;
     const uint8_t bytes[4] = {1, 0, 0, 0};
-    assert_int_equal(data_table_write(&regs, 33, bytes, 2), DATA_WRITE_REFUSED); /* 1-byte item */
-    assert_int_equal(data_table_write(&regs, 38, bytes, 1), DATA_WRITE_REFUSED); /* 2-byte item */
-    assert_int_equal(data_table_write(&regs, 38, bytes, 3), DATA_WRITE_REFUSED);
-    assert_int_equal(data_table_write(&regs, 33, bytes, 1), DATA_WRITE_CHANGED);
+    assert_int_equal(data_table_write(&regs, 33, bytes, 2, &before), DATA_WRITE_REFUSED); /* 1-byte item */
+    assert_int_equal(data_table_write(&regs, 38, bytes, 1, &before), DATA_WRITE_REFUSED); /* 2-byte item */
+    assert_int_equal(data_table_write(&regs, 38, bytes, 3, &before), DATA_WRITE_REFUSED);
+    assert_int_equal(data_table_write(&regs, 33, bytes, 1, &before), DATA_WRITE_CHANGED);
 }
 
 static void test_unchanged_value_is_reported_as_same(void **state)
 {
     (void)state;
     const uint8_t v3000[] = {0xB8, 0x0B};
-    assert_int_equal(data_table_write(&regs, 50, v3000, 2), DATA_WRITE_SAME);
+    assert_int_equal(data_table_write(&regs, 50, v3000, 2, &before), DATA_WRITE_SAME);
     const uint8_t one[] = {1};
-    assert_int_equal(data_table_write(&regs, 32, one, 1), DATA_WRITE_SAME);
+    assert_int_equal(data_table_write(&regs, 32, one, 1, &before), DATA_WRITE_SAME);
     const uint8_t v3001[] = {0xB9, 0x0B};
-    assert_int_equal(data_table_write(&regs, 50, v3001, 2), DATA_WRITE_CHANGED);
+    assert_int_equal(data_table_write(&regs, 50, v3001, 2, &before), DATA_WRITE_CHANGED);
     assert_int_equal(regs.user.soft_start_ms, 3001);
 }
 
@@ -195,14 +196,14 @@ static void test_cross_item_rules(void **state)
     (void)state;
     /* 39 < 40: raising the low limit to the high one is refused. */
     const uint8_t v8400[] = {0xD0, 0x20};
-    assert_int_equal(data_table_write(&regs, 39, v8400, 2), DATA_WRITE_REFUSED);
+    assert_int_equal(data_table_write(&regs, 39, v8400, 2, &before), DATA_WRITE_REFUSED);
     const uint8_t v8399[] = {0xCF, 0x20};
-    assert_int_equal(data_table_write(&regs, 39, v8399, 2), DATA_WRITE_CHANGED);
+    assert_int_equal(data_table_write(&regs, 39, v8399, 2, &before), DATA_WRITE_CHANGED);
     /* 51 > 52 */
     const uint8_t minus1350[] = {0xBA, 0xFA};
-    assert_int_equal(data_table_write(&regs, 51, minus1350, 2), DATA_WRITE_REFUSED);
+    assert_int_equal(data_table_write(&regs, 51, minus1350, 2, &before), DATA_WRITE_REFUSED);
     const uint8_t v1350[] = {0x46, 0x05};
-    assert_int_equal(data_table_write(&regs, 52, v1350, 2), DATA_WRITE_REFUSED);
+    assert_int_equal(data_table_write(&regs, 52, v1350, 2, &before), DATA_WRITE_REFUSED);
 }
 
 static void test_batch_decode_is_all_or_nothing(void **state)
@@ -212,12 +213,12 @@ static void test_batch_decode_is_all_or_nothing(void **state)
     memcpy(block, factory_block, sizeof block);
     block[1] = 1;      /* control response on: valid */
     block[4] = 9;      /* baud index 9: invalid */
-    assert_false(user_config_decode(&regs.user, block));
+    assert_false(user_config_decode(&regs.user, block, USER_AREA_SIZE));
     assert_int_equal(regs.user.control_response, 0); /* nothing applied */
     block[4] = 8;
     block[3] = 0x77;   /* reserved bytes are stored as given */
     block[19] = 0x99; /* 45 */
-    assert_true(user_config_decode(&regs.user, block));
+    assert_true(user_config_decode(&regs.user, block, USER_AREA_SIZE));
     uint8_t back[USER_AREA_SIZE];
     user_config_encode(&regs.user, back);
     assert_memory_equal(back, block, USER_AREA_SIZE);
@@ -234,7 +235,7 @@ static void test_the_user_area_is_its_wire_image(void **state)
         const struct data_item *it = data_table_find(id);
         assert_non_null(it);
         assert_int_equal(it->offset, pos);
-        pos += it->size;
+        pos += data_item_size(it);
     }
     assert_int_equal(pos, USER_AREA_SIZE);
     for (unsigned seed = 0; seed < 64; seed++) {
@@ -250,7 +251,7 @@ static void test_the_user_area_is_its_wire_image(void **state)
             if (n != 0u) {
                 assert_memory_equal(one, &block[pos], n);
             }
-            pos += data_table_find(id)->size;
+            pos += data_item_size(data_table_find(id));
         }
     }
 }
@@ -265,7 +266,7 @@ static void test_every_field_is_naturally_aligned(void **state)
         const struct data_item *it = data_table_find((uint8_t)id);
         if (it != NULL) {
             found++;
-            assert_int_equal(it->offset % it->size, 0);
+            assert_int_equal(it->offset % data_item_size(it), 0);
         }
     }
     assert_true(found >= 30u);

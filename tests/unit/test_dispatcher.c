@@ -196,6 +196,39 @@ static void test_write_data_result_and_config_flag(void **state)
     assert_true(command_error());
 }
 
+/* A drive item (80-89) is kept like a user item, and the motion layer is
+ * told, so the feed-forward follows; a change the store refuses is put
+ * back, and the motion layer told again; a refused value tells nothing. */
+static bool persist_ok;
+static bool persist_stub(void *ctx, const struct user_config *cfg)
+{
+    (void)ctx;
+    (void)cfg;
+    return persist_ok;
+}
+
+static void test_a_drive_item_is_kept_and_followed(void **state)
+{
+    (void)state;
+    d.persist = persist_stub;
+    persist_ok = true;
+    motion_mock_drive_changes = 0;
+    RUN(4, OWN_ID, 86, 0x00, 0x02); /* gain_kp 512 */
+    ASSERT_ANSWER(4, OWN_ID, 86, 1);
+    assert_true(result.config_changed);
+    assert_int_equal(regs.user.gain_kp, 512);
+    assert_int_equal(motion_mock_drive_changes, 1);
+    persist_ok = false;
+    RUN(4, OWN_ID, 80, 0x00, 0x19); /* resistance 6400 mOhm, refused by the store */
+    ASSERT_ANSWER(4, OWN_ID, 80, 0);
+    assert_int_equal(regs.user.resistance_mohm, ITEM_RESISTANCE_MOHM_FACTORY);
+    assert_int_equal(motion_mock_drive_changes, 2);
+    RUN(4, OWN_ID, 86, 0x00, 0x04); /* 1024: above the most */
+    ASSERT_ANSWER(4, OWN_ID, 86, 0);
+    assert_int_equal(regs.user.gain_kp, 512);
+    assert_int_equal(motion_mock_drive_changes, 2);
+}
+
 /* Angle packets: request bytes in, the motion command out. */
 static void test_angle_packets_decode(void **state)
 {
@@ -534,6 +567,7 @@ int main(void)
         cmocka_unit_test_setup(test_addressed_packet_without_id, setup),
         cmocka_unit_test_setup(test_monitor_packets_20_21_are_ignored, setup),
         cmocka_unit_test_setup(test_write_data_result_and_config_flag, setup),
+        cmocka_unit_test_setup(test_a_drive_item_is_kept_and_followed, setup),
         cmocka_unit_test_setup(test_angle_packets_decode, setup),
         cmocka_unit_test_setup(test_wheel_packet_decodes, setup),
         cmocka_unit_test_setup(test_motion_answers_when_done_with_control_response, setup),

@@ -265,8 +265,8 @@ static void test_power_bounds_the_output(void **state)
 {
     (void)state;
     /* P R / V^2 in Q15 with R = 2.741 ohm, V = 7.4 V. */
-    assert_int_equal(duty_limit_for_power(500, 7400), 820);
-    assert_int_equal(duty_limit_for_power(10000, 7400), 16401);
+    assert_int_equal(duty_limit_for_power(500, 7400, ITEM_RESISTANCE_MOHM_FACTORY), 820);
+    assert_int_equal(duty_limit_for_power(10000, 7400, ITEM_RESISTANCE_MOHM_FACTORY), 16401);
     WRITE_ITEM(0, ITEM_POWER_LIMIT_MW, 10000); /* power protection back at 10 000 mW */
     /* Hold at 0 with 500 mW while a hand holds the horn 20 degrees away: the
      * output stands at 500 mW's duty. */
@@ -286,7 +286,7 @@ static void test_power_bounds_the_output(void **state)
     WRITE_ITEM(0, ITEM_POWER_LIMIT_MW, 1000); /* power protection 1000 mW */
     REQUEST(PKT_MOVE_ANGLE, 0, 0x00, 0x00, 0x14, 0x00, 0x00, 0x00);
     harness_run_ms(50);
-    assert_int_equal(hal.duty, -duty_limit_for_power(1000, 7400));
+    assert_int_equal(hal.duty, -duty_limit_for_power(1000, 7400, ITEM_RESISTANCE_MOHM_FACTORY));
 }
 
 /* A finished move's answer goes out in this ID's slot on the bus (servo.h):
@@ -421,7 +421,7 @@ static void test_wheel_turns_and_time(void **state)
  * present speed (the winding current, in duty terms). */
 static int32_t braking_effort(void)
 {
-    int64_t emf = ((int64_t)servo.motion.measured_velocity_q8 * GAIN_KV) >> 8;
+    int64_t emf = ((int64_t)servo.motion.measured_velocity_q8 * servo.motion.drive.kv) >> 8;
     return (int32_t)(emf > 32767 ? 32767 : emf) - hal.duty;
 }
 
@@ -447,7 +447,7 @@ static void test_damping_brakes_in_proportion_to_speed(void **state)
         harness_run_ms(1);
     }
     /* Bounded by the power: the braking current is at most P / V. */
-    assert_int_equal(braking_effort(), duty_limit_for_power(10000, 7400));
+    assert_int_equal(braking_effort(), duty_limit_for_power(10000, 7400, ITEM_RESISTANCE_MOHM_FACTORY));
     assert_true(motion_is_released(&servo.motion)); /* not angle control */
 }
 

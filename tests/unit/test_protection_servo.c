@@ -95,12 +95,12 @@ static void test_over_current_halves_the_output_while_moving(void **state)
     REQUEST(PKT_MOVE_ANGLE, 0, 0x10, 0x27, 0xE8, 0x03, 0x00, 0x00); /* a long move */
     harness_run_ms(50);
     /* Factory: 42's 10 W binds before 43's 4 A (4 A x 2 ohm > the supply). */
-    assert_int_equal(servo.motion.drive.duty_limit, duty_limit_for_power(10000, 7400));
+    assert_int_equal(servo.motion.drive.duty_limit, duty_limit_for_power(10000, 7400, ITEM_RESISTANCE_MOHM_FACTORY));
     WRITE_ITEM(0, ITEM_CURRENT_LIMIT_MA, 1000); /* 43 = 1000 mA: now it binds */
     REQUEST(PKT_MOVE_ANGLE, 0, 0x10, 0x27, 0xE8, 0x03, 0x00, 0x00);
     int16_t normal = servo.motion.drive.duty_limit;
-    assert_int_equal(normal, duty_limit_for_current(1000, 7400));
-    assert_true(normal < duty_limit_for_power(10000, 7400));
+    assert_int_equal(normal, duty_limit_for_current(1000, 7400, ITEM_RESISTANCE_MOHM_FACTORY));
+    assert_true(normal < duty_limit_for_power(10000, 7400, ITEM_RESISTANCE_MOHM_FACTORY));
     hal.sensors.current = 1200;
     harness_run_ms(60);
     REQUEST(PKT_READ_DATA, 0, ITEM_STATUS);

@@ -3,7 +3,9 @@
  * response, persistence, and sync Monitor turn-taking. Motion packets:
  * test_motion_packets.c. */
 #include <setjmp.h>
+#include <math.h>
 #include <stdarg.h>
+#include <stdlib.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -61,13 +63,13 @@ static void test_read_data_every_item(void **state)
         uint8_t content[8] = {0, id};
         uint8_t n = 2;
         if (id != 35 && id != 45) {
-            memcpy(&content[2], &block[pos], it->size);
-            n = (uint8_t)(n + it->size);
+            memcpy(&content[2], &block[pos], data_item_size(it));
+            n = (uint8_t)(n + data_item_size(it));
         }
         uint8_t frame[16];
         size_t fn = make_response(frame, 3, content, n);
         harness_assert_sent(frame, fn);
-        pos += it->size;
+        pos += data_item_size(it);
     }
     /* Status area: model, version, serial from the port. */
     REQUEST(PKT_READ_DATA, 0, ITEM_MODEL);
@@ -345,7 +347,7 @@ static void test_writes_in_a_loop_stay_within_the_wear_budget(void **state)
         hal.now_us += 149000u; /* no motion: ticks beyond the catch-up drop */
         harness_poll(2);
         ms += 150;
-        if (i % 8000u == 7999u) {
+        if (i % 12000u == 11999u) { /* each 30 min: a save (1 per per_save s) comes between */
             harness_restart();
         }
         assert_true(servo.store.sequence <= save_policy_budget(&servo.saver));
@@ -364,7 +366,8 @@ static void test_writes_in_a_loop_stay_within_the_wear_budget(void **state)
     assert_int_equal(servo.regs.user.start_force, held);
     assert_int_equal(store_field(ANSWER_READ_STORE_FLAGS), STORE_OVER_BUDGET);
     assert_int_equal(store_field(ANSWER_READ_STORE_RECORDS), servo.store.sequence);
-    uint32_t pages_started = (servo.store.sequence + 20u) / 21u; /* 21 records a page */
+    const uint32_t per_page = config_store_slots_per_page(&servo.store); /* 14 records of 72 B */
+    uint32_t pages_started = (servo.store.sequence + per_page - 1u) / per_page;
     assert_int_equal(store_field(ANSWER_READ_STORE_PAGE_ERASES), (pages_started + 1u) / 2u);
     assert_int_equal(store_field(ANSWER_READ_STORE_RATED_CYCLES), FLASH_RATED_CYCLES);
     assert_int_equal(store_field(ANSWER_READ_STORE_BUDGET), save_policy_budget(&servo.saver));
@@ -789,6 +792,45 @@ static void test_garbage_between_frames_and_responses_of_others(void **state)
     EXPECT_RESPONSE(PKT_PING, 0); /* exactly one answer: the inner ping was skipped */
 }
 
+/* kt ratio x 57.19 / V (the back-EMF duty of 1 decideg per tick): the
+ * reference check on controller.c's fixed-point derivation, in doubles. */
+static int32_t kv_expected(double kt_un_m_per_a, double ratio, double supply_mv)
+{
+    return (int32_t)(kt_un_m_per_a * 1e-6 * ratio * 1.745329 / (supply_mv * 1e-3) * 32768.0);
+}
+
+/* The drive train and the gains are data (items 80-89): the factory ones
+ * give the reference servo's feed-forward, a write changes what the
+ * controller uses at once, and both survive a restart and ResetUserData. */
+static void test_the_drive_train_is_data(void **state)
+{
+    (void)state;
+    const struct drive_limits *lim = &servo.motion.drive;
+    uint16_t v = servo.motion.drive_inputs.supply_mv;
+    assert_true(v >= 6000u);
+    assert_int_equal(lim->kp, 546);
+    assert_int_equal(lim->kd, 3000);
+    assert_true(abs(lim->kv - kv_expected(3714, 345, v)) <= 1);
+    /* ka: 1 g cm^2 x 345 x 1745.3 rad/s^2 / kt x R / V, as Q15 duty */
+    double ka = 1e-7 * 345 * 1745.329 / 3.714e-3 * 2.741 / (v * 1e-3) * 32768.0;
+    assert_true(fabs(lim->ka - ka) <= ka * 1e-4 + 1.0);
+    WRITE_ITEM(0, ITEM_KT_UN_M_PER_A, 1324); /* the micro-servo's motor */
+    WRITE_ITEM(0, ITEM_GEAR_RATIO, 300);
+    WRITE_ITEM(0, ITEM_GAIN_KP, 300);
+    assert_true(abs(lim->kv - kv_expected(1324, 300, v)) <= 1);
+    assert_int_equal(lim->kp, 300);
+    REQUEST(PKT_RESET_USER_DATA, 0);
+    EXPECT_RESPONSE(PKT_RESET_USER_DATA, 0, 1);
+    harness_restart();
+    assert_int_equal(servo.regs.user.gain_kp, 300);
+    assert_int_equal(servo.regs.user.gear_ratio, 300);
+    assert_int_equal(servo.motion.drive.kp, 300);
+    assert_true(abs(servo.motion.drive.kv - kv_expected(1324, 300, servo.motion.drive_inputs.supply_mv)) <= 1);
+    WRITE_ITEM(0, ITEM_GAIN_KP, 1024); /* above its most: refused */
+    EXPECT_RESPONSE(PKT_WRITE_DATA, 0, ITEM_GAIN_KP, 0);
+    assert_int_equal(servo.motion.drive.kp, 300);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -820,6 +862,7 @@ int main(void)
         cmocka_unit_test_setup(test_update_enter_restarts_into_the_bootloader, setup),
         cmocka_unit_test_setup(test_garbage_between_frames_and_responses_of_others, setup),
         cmocka_unit_test_setup(test_assign_id_by_serial_number, setup),
+        cmocka_unit_test_setup(test_the_drive_train_is_data, setup),
     };
     return cmocka_run_group_tests_name("servo", tests, NULL, NULL);
 }

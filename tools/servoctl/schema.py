@@ -23,7 +23,7 @@ ACCESS = ("read", "read-write", "reserved")
 FRAME_KEYS = {"request_header", "response_header", "broadcast_id", "max_id", "extended_length",
               "request_content_max", "answer_content_max"}
 # Each area's first ID: the maker's data table's two, and this firmware's own.
-AREAS = {"status": 1, "user": 32, "firmware": 64}
+AREAS = {"status": 1, "user": 32, "firmware": 64, "drive": 80}
 
 
 class SchemaError(ValueError):
@@ -185,7 +185,7 @@ def _item(raw: dict) -> Item:
         raise SchemaError(f"{where}: area is one of {', '.join(AREAS)}, not {item.area!r}")
     if item.size not in (1, 2, 4) or item.access not in ACCESS:
         raise SchemaError(f"{where}: size 1, 2 or 4 and access one of {', '.join(ACCESS)}")
-    if item.area == "user" or (item.area == "firmware" and item.access == "read-write"):
+    if item.area in ("user", "drive") or (item.area == "firmware" and item.access == "read-write"):
         low, high = _type_range(item.size, item.signed)
         if not low <= item.min <= item.factory <= item.max <= high:
             raise SchemaError(f"{where} ({item.name}): needs {low} <= min <= factory <= max <= {high}")

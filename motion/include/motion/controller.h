@@ -1,7 +1,8 @@
 /* Position/velocity controller: PI on position error, D on velocity error,
  * feed-forward of the planned velocity and acceleration;
- * output a Q15 duty kept within the running command's power. Gains:
- * motion/gains.h.
+ * output a Q15 duty kept within the running command's power. The gains and
+ * the drive train are data items 80-89 (struct user_config's drive area), turned into
+ * struct drive_limits when one of them or the supply changes.
  *
  * All in int32: each input is saturated to a power of two (one SSAT on the
  * Cortex-M3) that keeps its product with the gain within 31 bits, well
@@ -15,19 +16,27 @@
 
 #include <stdint.h>
 
+#include "registers/registers.h"
+
 struct controller {
     int32_t integral_q15;
     int8_t at_limit; /* the last output was held back by the limit: the way
                       * it wanted to go (+1/-1), else 0 */
 };
 
-/* What the drive can do at the present supply, worked out when the supply
- * or the limit changes (it divides), used every tick. */
+/* What the drive can do at the present supply, worked out when the supply,
+ * the limit or the drive train changes (it divides), used every tick. Every
+ * duty is Q15 (32767 = the supply); a gain's input is Q8 unless it says. */
 struct drive_limits {
     int32_t kv;         /* back-EMF duty per decideg per tick, Q8 input */
     int32_t ka;         /* duty per decideg per tick^2, Q16 input */
     int32_t friction;   /* duty that carries the Coulomb drag */
-    int32_t viscous;    /* and the viscous drag, per decideg per tick (Q8 input) */
+    int32_t viscous;    /* and the viscous drag, per decideg per tick */
+    /* Items 86-89 as they are in struct user_config (one copy). */
+    uint16_t kp;        /* duty per decideg of error */
+    uint16_t ki;        /* duty per decideg of error, each tick */
+    uint16_t kd;        /* duty per decideg per tick of velocity error */
+    uint16_t damping;   /* damping mode's duty per decideg per tick */
     int16_t duty_limit; /* Q15 duty of the current limit, 0..32767 */
 };
 
@@ -48,14 +57,17 @@ int16_t controller_position(struct controller *c, const struct controller_input 
 int16_t controller_damping(int32_t measured_velocity_q8, int16_t open_duty_q15, const struct drive_limits *lim);
 /* Keeps duty within the duty limit of the back-EMF duty at this speed. */
 int16_t controller_limit(int32_t duty, int32_t measured_velocity_q8, const struct drive_limits *lim);
-/* kv, ka and the drag at supply_mv (0: the nominal supply; below
- * GAIN_MIN_SUPPLY_MV, that). Planning-time: it divides. */
-void drive_limits_for_supply(struct drive_limits *lim, uint16_t supply_mv);
-/* The duty that drives the current limit P / V through the winding at
- * standstill: P R / V^2, Q15. Planning-time: it divides. */
-int16_t duty_limit_for_power(uint16_t power_mw, uint16_t supply_mv);
+/* The gains, and kv, ka and the drag of the drive train dt at supply_mv (not
+ * 0: motion_supply_mv; below GAIN_MIN_SUPPLY_MV, that). Planning-time: it
+ * divides. */
+void drive_limits_for_supply(struct drive_limits *lim, const struct user_config *dt,
+                             uint16_t supply_mv);
+/* The duty that drives the current limit P / V through the winding (of
+ * resistance r_mohm) at standstill: P R / V^2, Q15; supply_mv not 0.
+ * Planning-time: it divides. */
+int16_t duty_limit_for_power(uint16_t power_mw, uint16_t supply_mv, uint16_t r_mohm);
 /* The duty that drives current_ma through the winding at standstill:
- * I R / V, Q15. Planning-time: it divides. */
-int16_t duty_limit_for_current(uint16_t current_ma, uint16_t supply_mv);
+ * I R / V, Q15; supply_mv not 0. Planning-time: it divides. */
+int16_t duty_limit_for_current(uint16_t current_ma, uint16_t supply_mv, uint16_t r_mohm);
 
 #endif

@@ -295,6 +295,8 @@ static inline uint8_t motion_limiter(const struct motion *m)
 }
 /* Releases the output now (a stall in release mode). */
 void motion_release(struct motion *m);
+/* A drive item (80-89) was written: the gains and feed-forward follow. */
+void motion_drive_train_changed(struct motion *m);
 /* The controller's output was held back by its limit on the last tick:
  * the way it wanted to drive (+1/-1), else 0. Every tick asks: inline. */
 static inline int8_t motion_output_at_limit(const struct motion *m)

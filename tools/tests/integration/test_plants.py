@@ -94,3 +94,47 @@ def test_a_payload_slows_the_horn(tmp_path):
         assert sum(loaded[:6]) < sum(bare[:6]) - 100, (loaded, bare)
     finally:
         finish(sim, [1])
+
+
+# The 60 kg cm plant's drive train as data items 80-85, at the motor (its
+# file: 2.4 ohm, kt 5.063 mN m/A, 1:387, 1.257e-6 kg m^2, drags 6.33e-4 N m
+# and 2.811e-7 N m s/rad).
+DRIVE_60KG = {"motor_resistance": 2400, "torque_constant": 5063, "gear_ratio": 387, "rotor_inertia": 12570,
+              "coulomb_friction": 6330, "viscous_friction": 2811}
+
+
+def overshoot(sim, s, target=450, steps=75):
+    """How far past target (0.1 deg) a 500 ms move goes, and where it is 1.5 s on."""
+    s.move(0, interval_ms=300)
+    sim.sleep(1.0)
+    angles = trace(sim, s, target, steps=steps, step_s=0.02)
+    return max(angles) - target, angles[-1]
+
+
+def test_the_drive_train_and_gains_are_data_a_servo_keeps(tmp_path):
+    """Items 80-89 steer the controller: the factory ones (the reference's)
+    overshoot a 45 degree move on the 60 kg cm plant by 5 degrees; its own
+    drive train and a stiffer kd bring that under 1 degree; they survive a
+    restart and ResetUserData."""
+    sim = start(tmp_path, "class_60kgcm.toml")
+    try:
+        with sim.bus(timeout=0.2) as bus:
+            s = Servo(bus, 1)
+            for name, value in (("soft_start_on", 0), ("high_voltage", 12600), ("power_limit", 60000)):
+                s.write(name, value)
+            factory_over, _ = overshoot(sim, s)
+            assert factory_over >= 30, factory_over
+            for name, value in {**DRIVE_60KG, "gain_kd": 12000}.items():
+                s.write(name, value)
+            over, end = overshoot(sim, s)
+            assert over <= 10 and abs(end - 450) <= 5, (over, end)
+            s.reset_user_data()
+        sim.stop()
+        sim.start()
+        with sim.bus(timeout=0.2) as bus:
+            s = Servo(bus, 1)
+            assert {name: s.read(name) for name in DRIVE_60KG} == DRIVE_60KG
+            assert s.read("gain_kd") == 12000
+            assert s.read("power_limit") == 10000  # ResetUserData's: the user area only
+    finally:
+        finish(sim, [1])
