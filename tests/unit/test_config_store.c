@@ -45,12 +45,10 @@ static struct user_config config_n(unsigned n)
     return c;
 }
 
+/* The user and the drive areas alike. */
 static void assert_config_equal(const struct user_config *a, const struct user_config *b)
 {
-    uint8_t ea[USER_AREA_SIZE], eb[USER_AREA_SIZE];
-    user_config_encode(a, ea);
-    user_config_encode(b, eb);
-    assert_memory_equal(ea, eb, USER_AREA_SIZE);
+    assert_memory_equal(a, b, sizeof *a);
 }
 
 static struct user_config boot(struct config_store *s)
@@ -255,38 +253,46 @@ static void test_random_cuts_over_many_saves(void **state)
     assert_false(flash.misuse);
 }
 
-/* A store written by the firmware before format 2 (44-byte records, no
- * operating time) still loads; the first save starts a fresh page in
- * format 2 and the old page is left alone until its turn to be erased. */
+/* Five records of an older format in page 1, the newest holding old:
+ * format 1 (44 bytes, no operating time) or 2 (48 bytes, no drive area). */
+static void write_old_store(uint8_t format, const struct user_config *old)
+{
+    const uint32_t payload = format == 1u ? 8u : 12u, size = payload + USER_AREA_SIZE + 4u;
+    for (uint32_t seq = 1; seq <= 5; seq++) {
+        uint8_t *rec = &flash.mem[1][(seq - 1u) * size];
+        struct user_config c = seq == 5 ? *old : config_n(seq + 40u);
+        memset(rec, 0, payload);
+        rec[0] = 0xF1; /* magic 0xC0F1 */
+        rec[1] = 0xC0;
+        rec[2] = format;
+        rec[3] = USER_AREA_SIZE;
+        rec[4] = (uint8_t)seq;
+        user_config_encode(&c, &rec[payload]);
+        uint32_t crc = crc32(rec, payload + USER_AREA_SIZE);
+        for (uint32_t i = 0; i < 4u; i++) {
+            rec[payload + USER_AREA_SIZE + i] = (uint8_t)(crc >> (8u * i));
+        }
+    }
+}
+
+/* A store written by the firmware before format 2 still loads; the first
+ * save starts a fresh page in format 3 and the old page is left alone until
+ * its turn to be erased. */
 static void test_a_format_1_store_still_loads(void **state)
 {
     (void)state;
     struct user_config old = config_n(3);
-    for (uint32_t seq = 1; seq <= 5; seq++) {
-        uint8_t *rec = &flash.mem[1][(seq - 1u) * 44u];
-        struct user_config c = seq == 5 ? old : config_n(seq + 40u);
-        rec[0] = 0xF1; /* magic 0xC0F1 */
-        rec[1] = 0xC0;
-        rec[2] = 1;    /* format 1 */
-        rec[3] = USER_AREA_SIZE;
-        rec[4] = (uint8_t)seq;
-        rec[5] = rec[6] = rec[7] = 0;
-        user_config_encode(&c, &rec[8]);
-        uint32_t crc = crc32(rec, 40);
-        for (int i = 0; i < 4; i++) {
-            rec[40 + i] = (uint8_t)(crc >> (8 * i));
-        }
-    }
+    write_old_store(1, &old);
     struct config_store s;
     struct user_config back = boot(&s);
     assert_config_equal(&back, &old);
     assert_int_equal(s.sequence, 5);
     uint8_t id, baud;
-    config_peek_link(&flash.hal, &id, &baud); /* the bootloader reads format 2 only */
+    config_peek_link(&flash.hal, &id, &baud); /* the bootloader reads format 3 only */
     assert_int_equal(id, 0);
     struct user_config n = config_n(4);
     assert_int_equal(config_store_save(&s, &n, 77), CONFIG_SAVED);
-    config_peek_link(&flash.hal, &id, &baud); /* once rewritten in format 2 */
+    config_peek_link(&flash.hal, &id, &baud); /* once rewritten in format 3 */
     assert_int_equal(id, n.servo_id);
     assert_int_equal(flash.erases[0], 0); /* page 0 was blank: no erase spent */
     assert_int_equal(flash.erases[1], 0);
@@ -372,6 +378,49 @@ static void test_failed_flash_write_is_reported(void **state)
     assert_true(s.failed);
 }
 
+/* Format 2 (the user area alone) loads with the drive area at its factory
+ * values, and the first save writes both in format 3. */
+static void test_a_format_2_store_loads_with_the_factory_drive_area(void **state)
+{
+    (void)state;
+    struct user_config old = config_n(6); /* its drive area: factory */
+    write_old_store(2, &old);
+    struct config_store s;
+    struct user_config back = boot(&s);
+    assert_config_equal(&back, &old);
+    assert_true(s.legacy);
+    back.gain_kd = 1234;
+    assert_int_equal(config_store_save(&s, &back, 5), CONFIG_SAVED);
+    struct user_config again = boot(&s);
+    assert_false(s.legacy);
+    assert_config_equal(&again, &back);
+    uint8_t id, baud;
+    config_peek_link(&flash.hal, &id, &baud);
+    assert_int_equal(id, old.servo_id);
+}
+
+/* The drive area is kept with the user area: a change to it alone is a
+ * new record, and a record whose drive item is out of range is not loaded
+ * (the one before it is). */
+static void test_the_drive_area_is_kept_and_checked(void **state)
+{
+    (void)state;
+    struct config_store s;
+    struct user_config c = boot(&s);
+    c.resistance_mohm = 6400;
+    c.gear_ratio = 300;
+    assert_int_equal(config_store_save(&s, &c, 0), CONFIG_SAVED);
+    assert_int_equal(config_store_save(&s, &c, 0), CONFIG_UNCHANGED);
+    struct user_config back = boot(&s);
+    assert_config_equal(&back, &c);
+    struct user_config bad = c;
+    bad.gain_kp = 5000; /* above item 86's 1023 */
+    assert_false(user_config_valid(&bad));
+    assert_int_equal(config_store_save(&s, &bad, 0), CONFIG_SAVED);
+    back = boot(&s);
+    assert_config_equal(&back, &c);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -387,6 +436,8 @@ int main(void)
         cmocka_unit_test_setup(test_a_save_goes_in_steps_and_erases_only_ahead, setup),
         cmocka_unit_test_setup(test_the_bootloader_peeks_the_link_settings, setup),
         cmocka_unit_test_setup(test_failed_flash_write_is_reported, setup),
+        cmocka_unit_test_setup(test_a_format_2_store_loads_with_the_factory_drive_area, setup),
+        cmocka_unit_test_setup(test_the_drive_area_is_kept_and_checked, setup),
     };
     return cmocka_run_group_tests_name("config_store", tests, NULL, NULL);
 }
