@@ -1,5 +1,5 @@
 /* The servo's ID and baud rate from the config store, for the bootloader:
- * the newest format-2 record whose CRC checks, without the data table's
+ * the newest format-3 record whose CRC checks, without the data table's
  * full validation, so the bootloader links neither. */
 #ifndef STORAGE_CONFIG_PEEK_H
 #define STORAGE_CONFIG_PEEK_H

@@ -141,7 +141,7 @@ static bool next_slot(const struct config_store *s, uint8_t *page, uint16_t *slo
 {
     const uint16_t slots = config_store_slots_per_page(s);
     if (s->legacy) {
-        *page = (uint8_t)(s->page ^ 1u); /* a format-1 page takes no format-2 slots */
+        *page = (uint8_t)(s->page ^ 1u); /* an older format's page takes no format-3 slots */
     } else if (s->sequence != 0u) {
         for (uint16_t i = (uint16_t)(s->slot + 1u); i < slots; i++) {
             if (slot_erased(s, s->page, i)) {

@@ -245,6 +245,13 @@ def build_parser():
     c.add_argument("--mujoco", metavar="FILE",
                    help="also write a MuJoCo actuator model (MJCF) and say how closely it replays the steps")
 
+    c = sub.add_parser("tune", help="identify, then the gains for a bandwidth with their margins; stored")
+    c.add_argument("id", type=int)
+    c.add_argument("--bandwidth", type=float, default=0.0, metavar="HZ",
+                   help="the closed loop's natural frequency (default: 8 Hz, or 0.8 of what items 86-88 allow)")
+    c.add_argument("--duty", type=float, default=0.45, help="identify's largest duty (default 0.45)")
+    c.add_argument("--dry-run", action="store_true", help="only show the gains and margins: nothing written")
+
     c = sub.add_parser("sync-move", help="several servos start their moves in one frame")
     c.add_argument("targets", type=_target, nargs="+", metavar="ID:DEGREES")
     c.add_argument("--interval", type=int, default=1000, help="ms to get there (default 1000)")

@@ -103,6 +103,12 @@ def cmd_identify(bus, args):
     return identify(bus, args)
 
 
+def cmd_tune(bus, args):
+    from .tune import cmd_tune as tune  # scipy (identify): loaded for this command alone
+
+    return tune(bus, args)
+
+
 def cmd_bench(bus, args):
     from . import bench, image as img
 
@@ -455,6 +461,7 @@ COMMANDS = {
     "record": cmd_record,
     "stream": cmd_stream,
     "identify": cmd_identify,
+    "tune": cmd_tune,
     "sync-move": cmd_sync_move,
     "broadcast-move": cmd_broadcast_move,
     "async": cmd_async,

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import optimize
 
+from . import registers
 from .errors import ServoError
 
 DEFAULT_DUTIES = (0.15, 0.25, 0.35, 0.45)
@@ -92,6 +93,10 @@ def record_step(servo, duty: float, step_ms: int, sleep) -> Step:
             break
         if len(samples) > 20000:
             raise ServoError("the servo's clock did not advance during the step")
+    if not any(s.duty != 0.0 for s in samples):
+        held = ", ".join(registers.status_names(servo.read("status"))) or "nothing the status says"
+        raise ServoError(f"the servo did not drive the step at duty {duty:+.2f}: held by {held} "
+                         "(a protection holds the output: see items 39-43)")
     come_to_rest(servo, sleep)
     return Step(duty, samples)
 

@@ -86,7 +86,7 @@ PINGED_WRITES = 30
 def overruns_while_programming(tmp_path, rx, run):
     """Servo 1's receive overruns after writes at 1 Mbaud, each followed at
     once, without waiting for its answer, by a ping to servo 2: servo 1
-    programs its record (24 half-words, 1.7 ms) while the ping and servo
+    programs its record (36 half-words, 2.5 ms) while the ping and servo
     2's answer are on the wire."""
     sim = Simulator(ids=[1, 2], state_dir=str(tmp_path / f"{rx}-{run}"), rx=rx)
     sim.start()

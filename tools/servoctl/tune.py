@@ -1,0 +1,191 @@
+"""servoctl tune: the controller's gains from the identified drive train,
+for a closed-loop bandwidth, with their margins; checked with a step on the
+servo, and stored with the drive train (data items 80-88).
+
+The identified drive train at the output (identify.py) is, with the duty d
+as the input and the angle q as the output,
+
+    J q'' = G d - D q',    G = K V / R,   D = K^2 / R + B
+
+and the firmware's controller gives d = kp e + ki (integral of e) + kd
+(v_planned - q') plus the feed-forward of the plan (which the drive items
+carry). With the feedback alone, kp and kd place the closed loop's poles at
+the natural frequency w = 2 pi f and damping zeta:
+
+    kp = J w^2 / G,   kd = (2 zeta w J - D) / G
+
+and the integral's zero sits at w / 4, well below, where it removes the
+steady error a load leaves without shaping the step. The margins are the
+open loop's, (kp + kd s + ki / s) G / (s (J s + D)) e^(-s T), with T the
+1.5 ticks from a sample to its duty (the tick samples, the bridge holds the
+duty until the next).
+
+Units: the firmware's gains are Q15 duty per decidegree (kp), per
+decidegree each 1 ms tick (ki), and per decidegree per tick (kd)."""
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import registers
+from .errors import ServoError
+
+TICK_S = 0.001
+DECIDEG_RAD = math.pi / 1800.0
+Q15 = 32768.0
+DELAY_S = 1.5 * TICK_S
+ZETA = 0.7
+DEFAULT_MAX_HZ = 8.0      # no faster by default: the reference's factory gains are 8.4 Hz
+RANGE_SHARE = 0.8         # the default stays this far inside the gains' item ranges
+CHECK_TARGET_DECIDEG = 450
+CHECK_MS = 500
+
+
+@dataclass
+class Tuning:
+    bandwidth_hz: float
+    zeta: float
+    kp: int
+    ki: int
+    kd: int
+    phase_margin_deg: float
+    gain_margin_db: float
+    crossover_hz: float
+    items: dict            # data item name: value, the drive train (80-85) and the gains
+
+
+def _plant(drive):
+    k, r, b = drive.torque_constant.value, drive.resistance.value, drive.viscous.value
+    return k * drive.supply_v / r, k * k / r + b, drive.inertia.value  # G, D, J
+
+
+def _firmware(kp_si: float, ki_si: float, kd_si: float) -> tuple:
+    """SI gains (duty per rad, per rad s, per rad/s) in the firmware's units."""
+    return (kp_si * Q15 * DECIDEG_RAD, ki_si * Q15 * DECIDEG_RAD * TICK_S, kd_si * Q15 * DECIDEG_RAD / TICK_S)
+
+
+def _si(kp: float, ki: float, kd: float) -> tuple:
+    return kp / (Q15 * DECIDEG_RAD), ki / (Q15 * DECIDEG_RAD * TICK_S), kd * TICK_S / (Q15 * DECIDEG_RAD)
+
+
+def gains_for(drive, bandwidth_hz: float, zeta: float = ZETA) -> tuple:
+    """(kp, ki, kd) in firmware units, unrounded."""
+    g, d, j = _plant(drive)
+    w = 2.0 * math.pi * bandwidth_hz
+    kp = j * w * w / g
+    return _firmware(kp, kp * w / 4.0, max(0.0, (2.0 * zeta * w * j - d) / g))
+
+
+def _most(name: str) -> int:
+    return registers.find(name).high
+
+
+def range_limit_hz(drive, zeta: float = ZETA) -> float:
+    """The highest bandwidth whose kp and kd fit items 86 and 88."""
+    lo, hi = 0.01, 200.0
+    for _ in range(60):
+        mid = math.sqrt(lo * hi)
+        kp, ki, kd = gains_for(drive, mid, zeta)
+        fits = kp <= _most("gain_kp") and kd <= _most("gain_kd") and ki <= _most("gain_ki")
+        lo, hi = (mid, hi) if fits else (lo, mid)
+    return lo
+
+
+def margins(drive, kp: float, ki: float, kd: float) -> tuple:
+    """(phase margin in degrees, gain margin in dB, gain crossover in Hz) of
+    the loop with these firmware gains."""
+    g, d, j = _plant(drive)
+    kp_si, ki_si, kd_si = _si(kp, ki, kd)
+    w = np.logspace(-1, 4.5, 20000)
+    s = 1j * w
+    loop = (kp_si + kd_si * s + ki_si / s) * g / (s * (j * s + d)) * np.exp(-s * DELAY_S)
+    mag, phase = np.abs(loop), np.unwrap(np.angle(loop))
+    phase_deg = np.degrees(phase)
+    below = np.nonzero(mag < 1.0)[0]
+    if below.size == 0:
+        return math.nan, math.nan, math.nan
+    c = below[0]
+    pm = 180.0 + phase_deg[c]
+    after = np.nonzero(phase_deg[c:] <= -180.0)[0]
+    gm = -20.0 * math.log10(mag[c + after[0]]) if after.size else math.inf
+    return pm, gm, w[c] / (2.0 * math.pi)
+
+
+def drive_items(drive, gear_ratio: int) -> dict:
+    """Items 80-85 from the drive train at the output, referred to the motor
+    through the servo's gear ratio item (82): kt = K / ratio, the inertia
+    and the viscous drag / ratio^2, the Coulomb drag / ratio."""
+    n = float(gear_ratio)
+    values = {"motor_resistance": drive.resistance.value * 1e3,            # mOhm
+              "torque_constant": drive.torque_constant.value / n * 1e6,    # uN m/A
+              "rotor_inertia": drive.inertia.value / (n * n) * 1e10,       # mg cm^2
+              "coulomb_friction": max(drive.coulomb.value, 0.0) / n * 1e7,  # 0.1 uN m
+              "viscous_friction": max(drive.viscous.value, 0.0) / (n * n) * 1e10}  # 1e-10 N m s/rad
+    out = {}
+    for name, value in values.items():
+        item = registers.find(name)
+        v = int(round(value))
+        if not item.low <= v <= item.high:
+            raise ServoError(f"{name} would be {value:.4g} {item.unit}, outside {item.low}..{item.high}: "
+                             f"set gear_ratio (now {gear_ratio}) to the servo's own ratio first")
+        out[name] = v
+    return out
+
+
+def tune(drive, gear_ratio: int, bandwidth_hz: float = 0.0) -> Tuning:
+    """The items for the drive train at bandwidth_hz (0: the default, the
+    lesser of DEFAULT_MAX_HZ and RANGE_SHARE of what the gains' ranges
+    allow)."""
+    limit = range_limit_hz(drive)
+    if bandwidth_hz <= 0.0:
+        bandwidth_hz = min(DEFAULT_MAX_HZ, RANGE_SHARE * limit)
+    elif bandwidth_hz > limit:
+        raise ServoError(f"{bandwidth_hz:g} Hz needs gains beyond items 86-88's ranges on this drive train: "
+                         f"at most {limit:.2f} Hz")
+    kp, ki, kd = (int(round(x)) for x in gains_for(drive, bandwidth_hz))
+    ki = max(ki, 1)  # the integral stays on: a load's steady error goes
+    pm, gm, fc = margins(drive, kp, ki, kd)
+    items = {**drive_items(drive, gear_ratio), "gain_kp": kp, "gain_ki": ki, "gain_kd": kd}
+    return Tuning(bandwidth_hz, ZETA, kp, ki, kd, pm, gm, fc, items)
+
+
+def check_step(servo, sleep, target: int = CHECK_TARGET_DECIDEG, ms: int = CHECK_MS) -> tuple:
+    """A move of target decidegrees from 0 in ms: (overshoot past the
+    target, the error 1.5 s after it began), both in decidegrees, on the
+    servo's clock."""
+    servo.move(0, interval_ms=300)
+    sleep(1.0)
+    servo.move(target, interval_ms=ms)
+    way = 1 if target >= 0 else -1
+    angles = []
+    for _ in range(75):
+        sleep(0.02)
+        angles.append(way * servo.read_motion().angle_decideg)
+    return max(angles) - way * target, abs(angles[-1] - way * target)
+
+
+def cmd_tune(bus, args):
+    """servoctl tune ID: identify, the gains, their margins; unless
+    --dry-run, the items written (each kept in flash) and a step checked."""
+    from .identify import DEFAULT_DUTIES, identify
+    from .servo import Servo
+
+    servo = Servo(bus, args.id)
+    duties = tuple(args.duty * k / len(DEFAULT_DUTIES) for k in range(1, len(DEFAULT_DUTIES) + 1))
+    print(f"servo {args.id}: identifying (open-loop steps; the horn must turn freely)", flush=True)
+    drive = identify(servo, bus.sleep, duties, 0, lambda done, total: print(f"  step {done}/{total}", flush=True))
+    t = tune(drive, servo.read("gear_ratio"), args.bandwidth)
+    print(f"gains for {t.bandwidth_hz:.2f} Hz, damping {t.zeta}: kp {t.kp}, ki {t.ki}, kd {t.kd}")
+    print(f"  phase margin {t.phase_margin_deg:.0f} deg, gain margin {t.gain_margin_db:.1f} dB, "
+          f"crossover {t.crossover_hz:.2f} Hz")
+    for name, value in t.items.items():
+        print(f"  {name:18s} {value}")
+    if args.dry_run:
+        print("dry run: nothing written")
+        return 0
+    for name, value in t.items.items():
+        servo.write(name, value)
+    over, error = check_step(servo, bus.sleep)
+    print(f"written and kept; a {CHECK_TARGET_DECIDEG / 10:g} deg move in {CHECK_MS} ms: overshoot "
+          f"{max(over, 0) / 10:.1f} deg, {error / 10:.1f} deg from the target 1.5 s on")
+    return 0
