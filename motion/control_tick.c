@@ -214,6 +214,18 @@ static void guard_braking(struct motion *m)
     m->braking = 1;
 }
 
+/* The duty to the bridge, the other way where the gear ratio (item 82) is
+ * negative: a positive duty turns the horn the way angles grow. Inline in
+ * the tick, but where size comes first (the Cortex-M0). */
+#ifdef SERVO_SIZE_FIRST
+static void bridge(const struct motion *m, int16_t duty)
+#else
+static inline __attribute__((always_inline)) void bridge(const struct motion *m, int16_t duty)
+#endif
+{
+    m->hal->motor.drive(m->hal->ctx, m->drive.reversed ? (int16_t)-duty : duty);
+}
+
 void motion_tick(struct motion *m)
 {
     measure(m);
@@ -224,7 +236,7 @@ void motion_tick(struct motion *m)
     switch (m->mode) {
     case MODE_DAMPING:
         m->damping_duty_q15 = controller_damping(m->measured_velocity_q8, m->open_duty_q15, &m->drive);
-        m->hal->motor.drive(m->hal->ctx, m->damping_duty_q15);
+        bridge(m, m->damping_duty_q15);
         if (m->open_ticks != 0u && --m->open_ticks == 0u) {
             motion_coast(m);
         }
@@ -259,7 +271,7 @@ void motion_tick(struct motion *m)
     if (!real_time && !m->braking && m->lead_q8 > LEAD_FREE_Q8) {
         in.push = m->profile_at_next_tick_q8 > m->profile_at_tick_q8 ? 1 : m->profile_at_next_tick_q8 < m->profile_at_tick_q8 ? -1 : 0;
     }
-    m->hal->motor.drive(m->hal->ctx, controller_position(&m->controller, &in, &m->drive));
+    bridge(m, controller_position(&m->controller, &in, &m->drive));
     bool done = m->endless ? m->tick >= m->profile.accel_ticks
                            : profile_done(&m->profile, m->tick) && arrived(m);
     if (m->running && done) {

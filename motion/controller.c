@@ -128,7 +128,8 @@ void drive_limits_for_supply(struct drive_limits *lim, const struct user_config 
     if (supply_mv < GAIN_MIN_SUPPLY_MV) {
         supply_mv = GAIN_MIN_SUPPLY_MV;
     }
-    const uint32_t r = dt->resistance_mohm, ratio = dt->gear_ratio;
+    const uint32_t r = dt->resistance_mohm;
+    const uint32_t ratio = (uint32_t)(dt->gear_ratio < 0 ? -dt->gear_ratio : dt->gear_ratio);
     const uint32_t per_torque = (uint32_t)dt->kt_un_m_per_a * supply_mv; /* kt V */
     lim->kv = derived(dt->kt_un_m_per_a * ratio, KV_SCALE_Q6, (uint32_t)supply_mv << 6, DERIVED_MAX);
     int32_t ka = derived(dt->inertia_mg_cm2 * ratio, r * KA_SCALE, per_torque, KA_MAX);
@@ -136,6 +137,7 @@ void drive_limits_for_supply(struct drive_limits *lim, const struct user_config 
     lim->friction = derived(dt->coulomb_dun_m * r, FRICTION_SCALE, per_torque, DERIVED_MAX);
     lim->viscous = derived(dt->viscous_100pn_m_s * ratio, (r * VISCOUS_SCALE_Q5) >> 5, per_torque, DERIVED_MAX);
     memcpy(&lim->kp, &dt->gain_kp, GAINS_SIZE);
+    lim->reversed = dt->gear_ratio < 0;
 }
 
 /* x R << 15 / den, at most full duty (32767). */

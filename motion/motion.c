@@ -28,6 +28,7 @@ void motion_init(struct motion *m, const struct registers *regs, const struct ha
                         .stream_period_ms = STREAM_DEFAULT_PERIOD_MS};
     encoder_start(&m->encoder, hal->motor.read_encoder(hal->ctx));
     m->measured_q8 = counts_to_q8(m->encoder.counts);
+    motion_move_origin(m, regs->user.encoder_zero); /* item 90: the horn's zero */
     motion_update_limits(m);
     if (regs->user.power_on_lock) {
         hold_here(m);

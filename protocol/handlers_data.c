@@ -42,6 +42,7 @@ enum packet_outcome handle_read_data(const struct packet_call *c, struct respons
 {
     r->content[1] = c->content[1];
     c->d->regs->firmware.limiter = motion_limiter(c->d->motion); /* live: as read */
+    c->d->regs->firmware.encoder_count = motion_encoder_count(c->d->motion);
     uint8_t size = data_table_read(c->d->regs, c->content[1], &r->content[2]);
     r->length = (uint8_t)(2u + size);
     return OUTCOME_OK;

@@ -163,19 +163,22 @@ enum packet_outcome handle_read_motion(const struct packet_call *c, struct respo
 {
     struct motion_diagnostics d;
     motion_read_diagnostics(c->d->motion, &d);
+    /* Taken once: the content's byte stores could alias them, and every
+     * reload is two loads on the answer's path. */
+    const struct registers *regs = c->d->regs;
+    const uint32_t *next_tick = c->d->next_tick_us;
     uint8_t *p = r->content;
     le_put_u32(&p[1], (uint32_t)d.angle_decideg);
     le_put_u32(&p[5], (uint32_t)d.setpoint_decideg);
     le_put_u32(&p[9], (uint32_t)d.target_decideg);
     le_put_u16(&p[13], (uint16_t)d.velocity_decideg_s);
     le_put_u16(&p[15], (uint16_t)d.tracking_error_centideg);
-    le_put_u16(&p[17], c->d->regs->status.current_ma);
-    p[19] = c->d->regs->status.status;
+    le_put_u16(&p[17], regs->status.current_ma);
+    p[19] = regs->status.status;
     p[20] = d.flags;
     /* The snapshot is the last tick's: it ran one period before the next. */
-    const uint32_t *next_tick = c->d->next_tick_us;
     le_put_u32(&p[21], next_tick != NULL ? *next_tick - 1000000u / MOTION_TICK_HZ : 0u);
-    le_put_u16(&p[25], (uint16_t)c->d->regs->firmware.winding_decic);
+    le_put_u16(&p[25], (uint16_t)regs->firmware.winding_decic);
     le_put_u16(&p[27], (uint16_t)d.duty_q15);
     r->length = READ_MOTION_ANSWER_LENGTH;
     return OUTCOME_OK;

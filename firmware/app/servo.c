@@ -36,6 +36,7 @@ void servo_init(struct servo *s, const struct hal_port *hal)
     *s = (struct servo){.hal = hal};
     config_store_load(&s->store, hal->flash, &s->regs.user);
     firmware_area_factory(&s->regs.firmware);
+    s->sensors.current_zero = s->regs.user.current_zero_counts;
     /* A store older firmware wrote (formats 1 and 2) is rewritten in format
      * 3, the one the bootloader reads the ID and baud rate from. Then the spare
      * page is erased ahead, before the control loop runs: saves need no
@@ -181,6 +182,7 @@ static inline __attribute__((always_inline)) void handle_next_frame(struct servo
     }
     if (result.config_changed) {
         s->link_settings_pending = 1;
+        s->sensors.current_zero = s->regs.user.current_zero_counts; /* item 91 */
     }
     s->enter_bootloader |= result.enter_bootloader;
     if (result.answer && late) {

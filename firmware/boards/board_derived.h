@@ -16,7 +16,6 @@
     {                                                                      \
         .supply_mv_q12 = SENSOR_Q12_FROM_MICRO(BOARD_SUPPLY_UV_PER_COUNT),  \
         .current_ma_q12 = SENSOR_Q12_FROM_MICRO(BOARD_CURRENT_UA_PER_COUNT), \
-        .current_zero_counts = BOARD_CURRENT_ZERO_COUNTS,                  \
         .winding_heat_k = BOARD_WINDING_HEAT_K,                            \
         .winding_step_k = BOARD_WINDING_STEP_K,                            \
         .winding_limit_decic = BOARD_WINDING_LIMIT_DECIC,                  \

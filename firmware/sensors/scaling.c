@@ -37,9 +37,8 @@ static uint16_t voltage_mv(const struct sensor_calibration *cal, uint16_t supply
 }
 
 /* Below the amplifier's zero: no current, not a wrap-around. */
-TICK_HELPER uint16_t current_ma(const struct sensor_calibration *cal, uint16_t current_counts)
+TICK_HELPER uint16_t current_ma(const struct sensor_calibration *cal, uint16_t zero, uint16_t current_counts)
 {
-    uint16_t zero = cal->current_zero_counts;
     return scale_q12(current_counts > zero ? (uint16_t)(current_counts - zero) : 0u,
                      cal->current_ma_q12);
 }
@@ -90,7 +89,7 @@ __attribute__((cold, noinline)) static void prime(struct sensor_filter *f,
 enum sense_slot sensors_update(struct sensor_filter *f, const struct sensor_calibration *cal,
                                const struct sensor_raw *raw)
 {
-    uint16_t ma = current_ma(cal, raw->current);
+    uint16_t ma = current_ma(cal, f->current_zero, raw->current);
     if (!f->primed) {
         prime(f, cal, raw, ma);
     }

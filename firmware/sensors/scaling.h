@@ -33,6 +33,7 @@ struct sensor_filter {
     uint32_t current_q4;
     uint32_t temperature_q4;
     struct sensor_readings out;
+    uint16_t current_zero; /* the current amplifier's reading at no current (item 91) */
     uint8_t slot;   /* the turn of the next tick */
     uint8_t primed;
 };

@@ -20,7 +20,7 @@
 
 /* The header, the payload and the CRC, in whole 8-byte write blocks (the
  * largest a part programs at once): 72 bytes for the 32-byte user area and
- * the 20-byte drive area. */
+ * the 24-byte drive area. */
 #define CONFIG_RECORD_UNPADDED (12u + STORED_SIZE + 4u)
 #define CONFIG_RECORD_SIZE ((CONFIG_RECORD_UNPADDED + 7u) / 8u * 8u)
 

@@ -4,6 +4,7 @@
 
 #include "storage/config_record.h"
 #include "storage/crc32.h"
+#include "storage/flash_erased.h"
 #include "registers/byte_order.h"
 #include "registers/data_table.h"
 
@@ -49,15 +50,7 @@ static bool record_valid(const uint8_t *rec, const struct record_layout *l, stru
 
 static bool slot_erased(const struct config_store *s, uint8_t page, uint16_t slot)
 {
-    uint8_t rec[CONFIG_RECORD_SIZE];
-    s->flash->read(s->flash->ctx, slot_addr(s, page, slot, CONFIG_RECORD_SIZE), rec,
-                   CONFIG_RECORD_SIZE);
-    for (uint32_t i = 0; i < CONFIG_RECORD_SIZE; i++) {
-        if (rec[i] != 0xFFu) {
-            return false;
-        }
-    }
-    return true;
+    return flash_erased(s->flash, slot_addr(s, page, slot, CONFIG_RECORD_SIZE), CONFIG_RECORD_SIZE);
 }
 
 /* The newest valid record of one format in both pages, if newer than what
@@ -94,13 +87,7 @@ static uint8_t spare_page(const struct config_store *s)
 
 static bool page_erased(const struct config_store *s, uint8_t page)
 {
-    const uint16_t slots = config_store_slots_per_page(s);
-    for (uint16_t slot = 0; slot < slots; slot++) {
-        if (!slot_erased(s, page, slot)) {
-            return false;
-        }
-    }
-    return true;
+    return flash_erased(s->flash, s->flash->page_addr[page], s->flash->page_size);
 }
 
 bool config_store_load(struct config_store *s, const struct hal_flash *flash,
@@ -200,7 +187,9 @@ enum config_save_result config_store_step(struct config_store *s)
     /* Block by block in order: the CRC, in the last block, lands last. */
     uint32_t block = s->flash->write_block;
     uint32_t addr = slot_addr(s, s->job_page, s->job_slot, CONFIG_RECORD_SIZE) + s->job_next;
-    if (block == 0u || CONFIG_RECORD_SIZE % block != 0u ||
+    /* A block of 2, 4 or 8 (hal_flash.h) divides the record: a mask, where
+     * a division is a loop on the Cortex-M0 (and this runs per block). */
+    if (block == 0u || (block & (block - 1u)) != 0u || (CONFIG_RECORD_SIZE & (block - 1u)) != 0u ||
         !s->flash->program(s->flash->ctx, addr, &s->job[s->job_next])) {
         /* The sequence number is spent: should the record have landed after
          * all, no later record may share its number. */

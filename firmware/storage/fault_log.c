@@ -5,6 +5,7 @@
 
 #include "registers/byte_order.h"
 #include "storage/crc32.h"
+#include "storage/flash_erased.h"
 
 /* The record: magic u16, format u8, 0xFF, the entry's bytes
  * (FAULT_ENTRY_BYTES, struct fault_entry's image), 0xFF, CRC-32 over bytes
@@ -48,15 +49,6 @@ static bool record_valid(const uint8_t *rec)
            le_get_u32(&rec[FR_NUMBER]) != 0u && le_get_u32(&rec[FR_CRC]) == crc32(rec, FR_CRC);
 }
 
-static bool erased(const uint8_t *rec)
-{
-    for (uint32_t i = 0; i < FAULT_RECORD_SIZE; i++) {
-        if (rec[i] != 0xFFu) {
-            return false;
-        }
-    }
-    return true;
-}
 
 static void encode(const struct fault_entry *e, uint8_t *rec)
 {
@@ -90,14 +82,7 @@ static void show(struct fault_log *l, uint8_t what, uint8_t page, uint8_t slot)
 
 static bool page_erased(const struct fault_log *l, uint8_t page)
 {
-    uint8_t rec[FAULT_RECORD_SIZE];
-    for (uint8_t slot = 0; slot < slots_per_page(l); slot++) {
-        read_record(l, page, slot, rec);
-        if (!erased(rec)) {
-            return false;
-        }
-    }
-    return true;
+    return flash_erased(l->flash, l->flash->page_addr[page], l->flash->page_size);
 }
 
 /* Where the next record goes: the first erased slot after the newest in
@@ -105,11 +90,9 @@ static bool page_erased(const struct fault_log *l, uint8_t page)
  * the newest or the spare changes, not at each step: it reads the page. */
 static void plan_next(struct fault_log *l)
 {
-    uint8_t rec[FAULT_RECORD_SIZE];
     const uint8_t slots = slots_per_page(l);
     for (uint8_t i = (uint8_t)(l->slot + 1u); i < slots; i++) {
-        read_record(l, l->page, i, rec);
-        if (erased(rec)) {
+        if (flash_erased(l->flash, slot_addr(l, l->page, i), FAULT_RECORD_SIZE)) {
             l->next_page = l->page;
             l->next_slot = i;
             return;

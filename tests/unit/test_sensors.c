@@ -63,27 +63,35 @@ static void test_protocol_reference_points(void **state)
 
 /* The reference board: 3.3 V, 11:1 supply divider, 0.5 V/A current sense. */
 static const struct sensor_calibration board = {.supply_mv_q12 = SENSOR_Q12_FROM_MICRO(8862u),
-                                                .current_ma_q12 = SENSOR_Q12_FROM_MICRO(1611u),
-                                                .current_zero_counts = 12};
+                                                .current_ma_q12 = SENSOR_Q12_FROM_MICRO(1611u)};
+/* The board's current amplifier reads 12 at no current (item 91). */
+enum { CURRENT_ZERO = 12 };
 
-/* A filter primed by one tick of raw: the readings as they are, in units. */
-static struct sensor_readings primed(const struct sensor_calibration *cal, struct sensor_raw raw)
+/* A filter primed by one tick of raw, the current amplifier reading zero
+ * at zero: the readings as they are, in units. */
+static struct sensor_readings primed_at(const struct sensor_calibration *cal, uint16_t zero,
+                                        struct sensor_raw raw)
 {
-    struct sensor_filter f = {0};
+    struct sensor_filter f = {.current_zero = zero};
     sensors_update(&f, cal, &raw);
     return f.out;
+}
+
+static struct sensor_readings primed(const struct sensor_calibration *cal, struct sensor_raw raw)
+{
+    return primed_at(cal, 0, raw);
 }
 
 static void test_scaling_to_units(void **state)
 {
     (void)state;
-    struct sensor_readings r = primed(&board, (struct sensor_raw){.supply = 835, .current = 632, .ntc = 1500});
+    struct sensor_readings r = primed_at(&board, CURRENT_ZERO, (struct sensor_raw){.supply = 835, .current = 632, .ntc = 1500});
     assert_int_equal(r.voltage_mv, 7400);  /* 835 x 8.862 mV = 7399.8, rounded */
     assert_int_equal(r.current_ma, 999);   /* (632 - 12) x 1.611 mA = 998.8, rounded */
     assert_int_equal(r.power_mw, 7393); /* 7400 mV x 999 mA = 7392.6, to within 1/1024 V */
     assert_int_equal(r.temperature_adc, 1500);
     /* Below the amplifier's zero: no current, not a wrap-around. */
-    r = primed(&board, (struct sensor_raw){.supply = 4095, .current = 3, .ntc = 0});
+    r = primed_at(&board, CURRENT_ZERO, (struct sensor_raw){.supply = 4095, .current = 3, .ntc = 0});
     assert_int_equal(r.current_ma, 0);
     assert_int_equal(r.voltage_mv, 36290); /* 4095 x 8.862 mV = 36289.9 */
 }

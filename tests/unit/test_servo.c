@@ -831,6 +831,37 @@ static void test_the_drive_train_is_data(void **state)
     assert_int_equal(servo.motion.drive.kp, 300);
 }
 
+/* The calibration items (82's sign, 90, 91) are taken: the zero at
+ * power-up, the bridge driven the other way, the current's zero off every
+ * reading; item 71 is the encoder's raw count. */
+static void test_the_calibration_items_are_taken(void **state)
+{
+    (void)state;
+    hal.encoder_raw = 1000;
+    harness_run_ms(5); /* a tick reads it */
+    REQUEST(PKT_READ_DATA, 0, ITEM_ENCODER_COUNT);
+    EXPECT_ITEM(0, ITEM_ENCODER_COUNT, 1000);
+    WRITE_ITEM(0, ITEM_ENCODER_ZERO, 1000);
+    harness_restart();
+    struct motion_angle angle;
+    motion_read_angle(&servo.motion, &angle);
+    assert_int_equal(angle.single_turn_decideg, 0); /* 1000 counts is angle 0 from power-up */
+    hal.sensors.current = 40;
+    harness_run_ms(100);
+    assert_true(servo.regs.status.current_ma > 0);
+    WRITE_ITEM(0, ITEM_CURRENT_ZERO_COUNTS, 40);
+    harness_run_ms(100);
+    assert_int_equal(servo.regs.status.current_ma, 0);
+    REQUEST(PKT_DRIVE_DUTY, 0, 0xE8, 0x03, 100, 0); /* +1000 of 32767 for 100 ms */
+    harness_run_ms(10);
+    assert_true(hal.duty > 0);
+    WRITE_ITEM(0, ITEM_GEAR_RATIO, -345);
+    REQUEST(PKT_DRIVE_DUTY, 0, 0xE8, 0x03, 100, 0);
+    harness_run_ms(10);
+    assert_true(hal.duty < 0); /* the same command, the bridge the other way */
+    assert_int_equal(servo.motion.drive.kv, kv_expected(3714, 345, servo.motion.drive_inputs.supply_mv));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -863,6 +894,7 @@ int main(void)
         cmocka_unit_test_setup(test_garbage_between_frames_and_responses_of_others, setup),
         cmocka_unit_test_setup(test_assign_id_by_serial_number, setup),
         cmocka_unit_test_setup(test_the_drive_train_is_data, setup),
+        cmocka_unit_test_setup(test_the_calibration_items_are_taken, setup),
     };
     return cmocka_run_group_tests_name("servo", tests, NULL, NULL);
 }

@@ -245,6 +245,12 @@ def build_parser():
     c.add_argument("--mujoco", metavar="FILE",
                    help="also write a MuJoCo actuator model (MJCF) and say how closely it replays the steps")
 
+    c = sub.add_parser("calibrate", help="the current amplifier's zero, the direction and the zero angle, "
+                                         "found with the horn free and stored")
+    c.add_argument("id", type=int)
+    c.add_argument("--keep-zero", action="store_true",
+                   help="leave the zero (item 90) as it is (else: the horn's position now becomes angle 0)")
+
     c = sub.add_parser("tune", help="identify, then the gains for a bandwidth with their margins; stored")
     c.add_argument("id", type=int)
     c.add_argument("--bandwidth", type=float, default=0.0, metavar="HZ",

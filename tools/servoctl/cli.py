@@ -103,6 +103,12 @@ def cmd_identify(bus, args):
     return identify(bus, args)
 
 
+def cmd_calibrate(bus, args):
+    from .calibrate import cmd_calibrate as calibrate  # scipy (identify's come_to_rest): this command alone
+
+    return calibrate(bus, args)
+
+
 def cmd_tune(bus, args):
     from .tune import cmd_tune as tune  # scipy (identify): loaded for this command alone
 
@@ -462,6 +468,7 @@ COMMANDS = {
     "stream": cmd_stream,
     "identify": cmd_identify,
     "tune": cmd_tune,
+    "calibrate": cmd_calibrate,
     "sync-move": cmd_sync_move,
     "broadcast-move": cmd_broadcast_move,
     "async": cmd_async,

@@ -113,9 +113,12 @@ def margins(drive, kp: float, ki: float, kd: float) -> tuple:
 
 def drive_items(drive, gear_ratio: int) -> dict:
     """Items 80-85 from the drive train at the output, referred to the motor
-    through the servo's gear ratio item (82): kt = K / ratio, the inertia
-    and the viscous drag / ratio^2, the Coulomb drag / ratio."""
-    n = float(gear_ratio)
+    through the servo's gear ratio item (82; its sign is the direction,
+    calibrate's, and stays): kt = K / ratio, the inertia and the viscous
+    drag / ratio^2, the Coulomb drag / ratio."""
+    if gear_ratio == 0:
+        raise ServoError("gear_ratio is 0 (no feed-forward): set it to the servo's ratio first")
+    n = float(abs(gear_ratio))
     values = {"motor_resistance": drive.resistance.value * 1e3,            # mOhm
               "torque_constant": drive.torque_constant.value / n * 1e6,    # uN m/A
               "rotor_inertia": drive.inertia.value / (n * n) * 1e10,       # mg cm^2
@@ -127,7 +130,7 @@ def drive_items(drive, gear_ratio: int) -> dict:
         v = int(round(value))
         if not item.low <= v <= item.high:
             raise ServoError(f"{name} would be {value:.4g} {item.unit}, outside {item.low}..{item.high}: "
-                             f"set gear_ratio (now {gear_ratio}) to the servo's own ratio first")
+                             f"set gear_ratio (now {gear_ratio}) to the servo's own ratio first (its sign kept)")
         out[name] = v
     return out
 

@@ -56,8 +56,15 @@ def test_a_longer_delay_costs_phase_margin(monkeypatch):
     assert slower == pytest.approx(pm - 360.0 * fc * 0.0035, abs=0.05)
 
 
+def test_a_reversed_ratio_gives_the_same_items():
+    """Calibrate's sign on item 82 is the direction: the magnitudes are the ratio."""
+    assert drive_items(REFERENCE, -345) == drive_items(REFERENCE, 345)
+
+
 def test_what_cannot_be_done_is_refused_with_the_reason():
     with pytest.raises(ServoError, match=r"at most \d+\.\d+ Hz"):
         tune(REFERENCE, 345, bandwidth_hz=100.0)
     with pytest.raises(ServoError, match="set gear_ratio"):
         drive_items(REFERENCE, 1)  # the inertia at the motor would be 119 000 mg cm^2: beyond item 83
+    with pytest.raises(ServoError, match="gear_ratio is 0"):
+        drive_items(REFERENCE, 0)

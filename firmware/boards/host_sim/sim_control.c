@@ -234,6 +234,12 @@ static void control_command(const struct sim_control *c, int fd, char *line)
             s->plant.load_torque = value;
         } else if (strcmp(cmd, "payload") == 0) {
             s->plant.payload_inertia = value * 1e-7; /* g cm^2 to kg m^2 */
+        } else if (strcmp(cmd, "magnet") == 0) {
+            s->magnet_counts = (uint16_t)((long)floor(value / 360.0 * 4096.0 + 0.5) & 4095);
+        } else if (strcmp(cmd, "swapleads") == 0) {
+            s->leads_swapped = value != 0.0;
+        } else if (strcmp(cmd, "ampzero") == 0) {
+            s->amp_zero_counts = (uint16_t)value;
         } else if (strcmp(cmd, "ambient") == 0) {
             s->thermal.ambient_c = value;
         } else if (strcmp(cmd, "soak") == 0) {

@@ -71,7 +71,7 @@ static void motor_drive(void *ctx, int16_t duty)
 {
     struct sim_servo *s = ctx;
     run_models(s);
-    plant_drive(&s->plant, duty);
+    plant_drive(&s->plant, s->leads_swapped ? (int16_t)-duty : duty);
     s->driven = true;
 }
 
@@ -90,7 +90,7 @@ static uint16_t encoder_read(void *ctx)
 {
     struct sim_servo *s = ctx;
     run_models(s);
-    return plant_encoder(&s->plant);
+    return (uint16_t)((plant_encoder(&s->plant) + s->magnet_counts) & 4095u);
 }
 
 static uint16_t counts(double value, double per_count)
@@ -105,8 +105,9 @@ static void sensors_read(void *ctx, struct sensor_raw *out)
 {
     struct sim_servo *s = ctx;
     out->supply = counts(s->plant.p.supply_v * 1e6, BOARD_SUPPLY_UV_PER_COUNT);
-    out->current = (uint16_t)(counts(fabs(s->plant.current) * 1e6, BOARD_CURRENT_UA_PER_COUNT) +
-                              BOARD_CURRENT_ZERO_COUNTS);
+    unsigned current = counts(fabs(s->plant.current) * 1e6, BOARD_CURRENT_UA_PER_COUNT) + BOARD_CURRENT_ZERO_COUNTS +
+                       s->amp_zero_counts;
+    out->current = (uint16_t)(current > 4095u ? 4095u : current);
     out->ntc = (uint16_t)thermal_ntc_adc(&s->thermal);
 }
 

@@ -32,6 +32,12 @@ struct sim_boot {
 
 struct sim_servo {
     struct servo core;
+    /* How the board is built (control port: magnet, swapleads, ampzero):
+     * the encoder's count at the output's zero, the motor's leads swapped,
+     * the current amplifier's ADC count at no current. */
+    uint16_t magnet_counts;
+    bool leads_swapped;
+    uint16_t amp_zero_counts;
     struct hal_port port;
     struct plant plant;
     struct thermal thermal;

@@ -18,7 +18,6 @@ struct sensor_raw {
 struct sensor_calibration {
     uint16_t supply_mv_q12;       /* mV at the supply per count (divider, reference), Q12 */
     uint16_t current_ma_q12;      /* mA in the shunt per count (shunt, gain, reference), Q12 */
-    uint16_t current_zero_counts; /* reading at zero current (amplifier offset) */
     /* The winding's thermal model (protection/winding.h), from the motor's
      * data (board.h): I^2 (mA^2/16) to the rise it settles at, degC Q16,
      * x winding_heat_k / 256; a model step's share of its time constant,

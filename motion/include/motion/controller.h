@@ -37,6 +37,7 @@ struct drive_limits {
     uint16_t ki;        /* duty per decideg of error, each tick */
     uint16_t kd;        /* duty per decideg per tick of velocity error */
     uint16_t damping;   /* damping mode's duty per decideg per tick */
+    uint8_t reversed;   /* item 82 negative: the bridge is driven the other way */
     int16_t duty_limit; /* Q15 duty of the current limit, 0..32767 */
 };
 

@@ -293,9 +293,14 @@ static inline uint8_t motion_limiter(const struct motion *m)
     }
     return motion_own_limiter(m);
 }
+/* The encoder's raw count now, 0-4095 (item 71). */
+static inline uint16_t motion_encoder_count(const struct motion *m)
+{
+    return m->encoder.last;
+}
 /* Releases the output now (a stall in release mode). */
 void motion_release(struct motion *m);
-/* A drive item (80-89) was written: the gains and feed-forward follow. */
+/* A drive item (80-91) was written: the gains and feed-forward follow. */
 void motion_drive_train_changed(struct motion *m);
 /* The controller's output was held back by its limit on the last tick:
  * the way it wanted to drive (+1/-1), else 0. Every tick asks: inline. */

@@ -1,0 +1,143 @@
+"""servoctl calibrate: how this servo's parts are put together, found with
+the horn free and stored (data items 82's sign, 90 and 91).
+
+1. The current amplifier's zero (item 91): with the output released no
+   current flows, so the smallest zero at which the servo reads 0 mA is the
+   amplifier's output then, in ADC counts (a binary search, each step a
+   write and a wait for the current's 8 ms filter).
+2. The direction (item 82's sign): a short open-loop push at a positive
+   duty (DriveDuty, before anything runs closed loop: a loop the wrong way
+   round runs away). Where the angle falls, the gear ratio is negated and
+   the bridge is driven the other way from then on; a second push checks it.
+3. The zero (item 90): the horn is taken back to where it started, closed
+   loop, released, and the encoder's count there (item 71) becomes the
+   zero: after every power-up angles are from it. SetOriginPoint makes it so
+   now. So start with the horn at its zero mark, or pass --keep-zero.
+
+Time is the servo's (or the simulator's) clock: sleep(s)."""
+from dataclasses import dataclass
+
+from .errors import ServoError
+from .identify import come_to_rest
+
+PUSH_DUTY = 0.25
+PUSH_MS = 150
+CURRENT_SETTLE_S = 0.06   # the current's filter: 8 ms time constant
+ADC_MOST = 4095
+RETURN_MS = 600
+RETURN_TIMEOUT_S = 8.0
+STORE_SETTLE_S = 0.3
+
+
+@dataclass
+class Calibration:
+    current_zero: int       # ADC counts (item 91)
+    reversed: bool          # the gear ratio (item 82) is negative
+    gear_ratio: int
+    encoder_zero: int       # counts (item 90), or None where kept
+    push_decideg: int       # what the checking push moved, positive
+
+
+def current_zero(servo, sleep) -> int:
+    """The smallest item 91 at which the released servo reads no current."""
+    servo.stop("release")
+    lo, hi = 0, ADC_MOST  # the answer is in lo..hi
+    while lo < hi:
+        mid = (lo + hi) // 2
+        servo.write("current_zero", mid)
+        sleep(CURRENT_SETTLE_S)
+        if servo.read("current") == 0:
+            hi = mid
+        else:
+            lo = mid + 1
+    servo.write("current_zero", lo)
+    return lo
+
+
+def settle_store(sleep) -> None:
+    """A quiet moment with the output released: the store erases its spare
+    page then if its page has filled (20-40 ms, docs/decisions-hardware.md),
+    and not while a later request waits (a request that arrives during an
+    erase is carried out unanswered)."""
+    sleep(STORE_SETTLE_S)
+
+
+def push(servo, sleep, duty: float = PUSH_DUTY) -> int:
+    """Decidegrees an open-loop push at duty moved the horn (from rest)."""
+    before = servo.read_motion().angle_decideg
+    servo.drive_duty(duty, PUSH_MS)
+    sleep(PUSH_MS / 1000.0 + 0.02)
+    moved = servo.read_motion().angle_decideg - before
+    come_to_rest(servo, sleep)
+    return moved
+
+
+def direction(servo, sleep) -> tuple:
+    """(reversed, the gear ratio now, the checking push in decidegrees)."""
+    ratio = servo.read("gear_ratio")
+    moved = push(servo, sleep)
+    if abs(moved) < 5:
+        raise ServoError(f"a push at duty {PUSH_DUTY} moved the horn {moved / 10:.1f} deg: it must turn freely "
+                         "(and the supply be on)")
+    if moved < 0:
+        ratio = -ratio
+        servo.write("gear_ratio", ratio)
+        settle_store(sleep)
+        moved = push(servo, sleep)
+        if moved <= 0:
+            raise ServoError(f"the horn still turns backwards ({moved / 10:.1f} deg) with the bridge reversed")
+    return ratio < 0, ratio, moved
+
+
+def zero(servo, sleep, start_decideg: int) -> int:
+    """The horn back at start_decideg, released, and its encoder count
+    there stored as the zero (item 90), and taken as the origin now."""
+    servo.move(start_decideg, interval_ms=RETURN_MS)
+    waited = 0.0
+    while True:  # a soft start (item 49) may make it the 3 s of item 50
+        sleep(0.05)
+        waited += 0.05
+        snap = servo.read_motion()
+        if abs(snap.angle_decideg - start_decideg) <= 3 and abs(snap.velocity_decideg_s) < 20:
+            break
+        if waited > RETURN_TIMEOUT_S:
+            raise ServoError(f"the horn did not come back to {start_decideg / 10:.1f} deg within "
+                             f"{RETURN_TIMEOUT_S:g} s (it is at {snap.angle_decideg / 10:.1f})")
+    servo.stop("release")
+    sleep(0.05)
+    count = servo.read("encoder_count")
+    servo.write("encoder_zero", count)
+    servo.set_origin()
+    return count
+
+
+def calibrate(servo, sleep, keep_zero: bool = False) -> Calibration:
+    if servo.read("voltage") < 500:
+        raise ServoError("the supply reads below 0.5 V: calibrate needs the motor powered")
+    start = servo.read_motion().angle_decideg
+    amp = current_zero(servo, sleep)
+    settle_store(sleep)
+    reversed_, ratio, moved = direction(servo, sleep)
+    count = None if keep_zero else zero(servo, sleep, start)
+    return Calibration(amp, reversed_, ratio, count, moved)
+
+
+def cmd_calibrate(bus, args):
+    """servoctl calibrate ID: the current's zero, the direction, the zero;
+    each stored as it is found."""
+    from .servo import Servo
+
+    servo = Servo(bus, args.id)
+    where = "" if args.keep_zero else " (the horn at its zero mark: its position now becomes angle 0)"
+    print(f"servo {args.id}: calibrating with the horn free{where}", flush=True)
+    c = calibrate(servo, bus.sleep, args.keep_zero)
+    print(f"  current amplifier's zero  {c.current_zero} ADC counts (item 91)")
+    print(f"  direction                 {'reversed: the bridge is driven the other way' if c.reversed else 'as wired'}"
+          f" (gear_ratio {c.gear_ratio}); a push at duty {PUSH_DUTY} turns the horn "
+          f"+{c.push_decideg / 10:.1f} deg")
+    if c.encoder_zero is None:
+        print("  zero                      kept")
+    else:
+        print(f"  zero                      encoder count {c.encoder_zero} (item 90): angle 0 here, "
+              "now and after every power-up")
+    return 0
