@@ -1,6 +1,8 @@
-"""Bring-up on the simulator, for each shipped plant (issue 42, part 4):
-from the factory items (the reference servo's drive train and gains, wrong
-for the other two), identify, tune and store; then the motion-at-the-limits
+"""Bring-up on the simulator, for each shipped plant (issue 42, part 4),
+built as a servo may come (the encoder's magnet turned, the motor's leads
+swapped, the current amplifier off zero): from the factory items (the
+reference servo's drive train and gains, wrong for the other two),
+calibrate, identify, tune and store; then the motion-at-the-limits
 figures: a 45 degree move overshoots at most 1 degree and is within 0.5
 degree 1.5 s after it began, each way, and a hold is within 0.2 degree 1.5 s
 after a load of 0.3 of the stall torque has come, reversed, or gone. Time is
@@ -9,6 +11,7 @@ import tomllib
 
 import pytest
 
+from servoctl.calibrate import calibrate
 from servoctl.cli import main
 from servoctl.identify import identify
 from servoctl.servo import Servo
@@ -25,8 +28,13 @@ HOLD_MOST = 2         # 0.2 degree
 LOAD_SHARE = 0.3      # of the published stall torque
 
 
-def start(tmp_path, file):
+BUILT = ("magnet -40", "swapleads 1", "ampzero 18")  # how these servos came (control port)
+
+
+def start(tmp_path, file, built=()):
     sim = Simulator(state_dir=str(tmp_path / "state"), plant=str(PLANTS / file)).start()
+    for line in built:
+        assert sim.control(line).strip() == "ok", line
     with sim.bus(timeout=0.2) as bus:
         s = Servo(bus, 1)
         s.write("soft_start_on", 0)
@@ -53,10 +61,12 @@ def hold_errors(sim, s, stall_nm: float) -> list:
 def test_identify_tune_and_store_meet_the_figures(tmp_path, file):
     plant = tomllib.loads((PLANTS / file).read_text())
     truth = at_the_output(plant)
-    sim = start(tmp_path, file)
+    sim = start(tmp_path, file, BUILT)
     try:
         with sim.bus(timeout=0.2) as bus:
             s = Servo(bus, 1)
+            c = calibrate(s, sim.sleep)
+            assert c.current_zero == 18 and c.reversed, c
             factory = check_step(s, sim.sleep)
             drive = identify(s, sim.sleep)
             found = {"torque_constant": drive.torque_constant.value, "resistance": drive.resistance.value,
