@@ -182,6 +182,42 @@ static void test_a_payload_slows_the_output(void **state)
     assert_close(loaded.velocity, bare.velocity / 2.0, 0.02);
 }
 
+/* The gears' play: reversing, the gears cross it before the output moves;
+ * a load holds the output against one flank, so it follows at once. */
+static void test_backlash_is_crossed_before_the_output_moves(void **state)
+{
+    (void)state;
+    struct plant pl;
+    plant_init(&pl);
+    pl.p.backlash_deg = 2.0;
+    plant_drive(&pl, 9830); /* 0.3 of the supply */
+    plant_step(&pl, 0.3);
+    assert_close(pl.play, 1.0 * M_PI / 180.0, 1e-12); /* the gears lead by half the play */
+    plant_drive(&pl, -9830);
+    while (pl.velocity >= 0.0) { /* the gears carry the output on until they turn */
+        plant_step(&pl, 1e-4);
+    }
+    double held = pl.angle;
+    double turned_at = pl.angle + pl.play;
+    for (;;) {
+        plant_step(&pl, 1e-4);
+        if (pl.play <= -1.0 * M_PI / 180.0 + 1e-12) {
+            break; /* through: the output goes with them from this step */
+        }
+        assert_true(pl.angle == held); /* the output stays while the gears cross the play */
+    }
+    assert_close(turned_at - (pl.angle + pl.play), 2.0 * M_PI / 180.0, 0.02); /* from lead to lag */
+    plant_step(&pl, 0.1);
+    assert_true(pl.angle < held - 0.01); /* then it follows */
+    struct plant loaded;
+    plant_init(&loaded);
+    loaded.p.backlash_deg = 2.0;
+    loaded.load_torque = 0.2;
+    plant_drive(&loaded, 9830);
+    plant_step(&loaded, 0.01);
+    assert_close(loaded.play, 1.0 * M_PI / 180.0, 1e-12); /* pressed against the carrying flank */
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -191,6 +227,7 @@ int main(void)
         cmocka_unit_test(test_bad_files_are_refused_with_the_reason),
         cmocka_unit_test(test_a_missing_file_says_so),
         cmocka_unit_test(test_a_payload_slows_the_output),
+        cmocka_unit_test(test_backlash_is_crossed_before_the_output_moves),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

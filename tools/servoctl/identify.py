@@ -12,7 +12,11 @@ own clock. A brushed DC motor behind a gearbox, seen at the output
 so at each step's steady speed V d = R i + K w gives R and K, and
 K i = C + B w gives the Coulomb and viscous drags; from rest the speed
 rises as w_ss (1 - exp(-t / tau)) with tau = J / (K^2 / R + B), which gives
-the inertia. Every fit is least squares (scipy), and each value is given
+the inertia. Then a reversal each way at the lowest duty: the gears turn
+back through their play (backlash) before the output, on the far side of
+the encoder, follows; the play is the one that makes the model above, with
+that play between it and the output, follow the recorded angle after the
+reversal. Every fit is least squares (scipy), and each value is given
 with its standard error. ReadMotion's duty is what the bridge was given
 (after the current limit), so a step the limit clips is known and not used
 for the inertia."""
@@ -30,6 +34,9 @@ DEFAULT_STEP_MS = 700   # the least; longer where the rise is slower (step_lengt
 REST_POLL_S = 0.05    # how often come_to_rest looks at the horn
 STEADY_FROM = 0.6     # the steady part of a step: its last 40 %
 CLIP_TOLERANCE = 0.02
+REVERSAL_WINDOW_S = 0.4   # the reversal's record the play is fitted over
+REVERSAL_SUBSTEP_S = 0.00025
+MAX_BACKLASH_DEG = 10.0
 
 
 @dataclass
@@ -67,13 +74,18 @@ class DriveTrain:
     supply_v: float
     steps_used: int
     steps: list = None  # the recorded steps the fit came from
+    backlash: Estimate = None  # rad at the output; None where no reversal was recorded
 
     def rows(self):
-        return [("torque constant x ratio", self.torque_constant, "N m/A"),
+        rows = [("torque constant x ratio", self.torque_constant, "N m/A"),
                 ("resistance", self.resistance, "ohm"),
                 ("inertia at the output", self.inertia, "kg m^2"),
                 ("Coulomb drag at the output", self.coulomb, "N m"),
                 ("viscous drag at the output", self.viscous, "N m s/rad")]
+        if self.backlash is not None:
+            rows.append(("backlash at the output", Estimate(math.degrees(self.backlash.value),
+                                                           math.degrees(self.backlash.sigma)), "deg"))
+        return rows
 
 
 def record_step(servo, duty: float, step_ms: int, sleep) -> Step:
@@ -158,13 +170,19 @@ def _rise_tau(step: Step):
     t = np.array([s.t for s in rise])
     angle = np.array([s.angle for s in rise])
 
-    def model(t, a0, t0, tau, w):
+    way = math.copysign(1.0, step.duty)
+
+    def model(t, a0, t0, tau, w, play):
+        # The gears' travel from rest; the output, beyond the encoder, stays
+        # until they have crossed what play there was, then goes with them.
         x = np.maximum(t - t0, 0.0)
-        return a0 + w * (x - tau * (1.0 - np.exp(-x / tau)))
+        gears = w * (x - tau * (1.0 - np.exp(-x / tau)))
+        return a0 + way * np.maximum(way * gears - play, 0.0)
 
     w_guess = (angle[-1] - angle[0]) / max(t[-1] - t[0], 1e-3)
-    guess = (angle[0], t_on - 0.002, 0.02, w_guess)
-    bounds = ([-np.inf, t[0] - 0.05, 1e-4, -np.inf], [np.inf, t_on + 0.01, 5.0, np.inf])
+    guess = (angle[0], t_on - 0.002, 0.02, w_guess, 1e-4)
+    bounds = ([-np.inf, t[0] - 0.05, 1e-4, -np.inf, 0.0],
+              [np.inf, t_on + 0.01, 5.0, np.inf, math.radians(MAX_BACKLASH_DEG)])
     params, cov = optimize.curve_fit(model, t, angle, p0=guess, bounds=bounds, maxfev=20000)
     return float(params[2]), float(math.sqrt(max(cov[2, 2], 0.0)))
 
@@ -187,6 +205,91 @@ def fit(steps, supply_v: float) -> DriveTrain:
     sj = j * math.hypot(spread / tau, math.hypot(2 * sk / k, sr / r) * (k * k / r) / damping)
     return DriveTrain(Estimate(k, sk), Estimate(r, sr), Estimate(j, sj), Estimate(c, sc), Estimate(b, sb),
                       supply_v, len(taus), list(steps))
+
+
+def record_reversal(servo, duty: float, half_ms: int, sleep) -> Step:
+    """From rest: duty for half_ms, then at once -duty for half_ms, sampled
+    as a step is."""
+    first = servo.read_motion()
+    servo.drive_duty(duty, half_ms + 500)  # the reversal replaces it before it ends
+    samples = []
+    reversed_ = False
+    while True:
+        snap = servo.read_motion()
+        t = snap.seconds_since(first)
+        samples.append(Sample(t, math.radians(snap.angle_decideg / 10.0), snap.current_ma / 1000.0,
+                              snap.duty_q15 / 32767.0))
+        if not reversed_ and t >= half_ms / 1000.0:
+            servo.drive_duty(-duty, half_ms)
+            reversed_ = True
+        if t > 2.0 * half_ms / 1000.0 + 0.05 or len(samples) > 40000:
+            break
+    come_to_rest(servo, sleep)
+    return Step(duty, samples)
+
+
+def _follow(drive, samples, play: float, w0: float, lead: float, switch_t: float) -> np.ndarray:
+    """The output's angle at each sample, from the identified model driven
+    by the samples' duty (each held back to the sample before it; the first
+    interval's new duty from switch_t, when the reversal came), the gears
+    leading the output by lead x play / 2 and turning at w0 at the first
+    sample, with play between the gears and the output (which stays put in
+    it)."""
+    k, r, j = drive.torque_constant.value, drive.resistance.value, drive.inertia.value
+    g, d, c = k * drive.supply_v / r, k * k / r + drive.viscous.value, max(drive.coulomb.value, 0.0)
+    half = 0.5 * play
+    gap, v, out = lead * half, w0, samples[0].angle
+    predicted = [out]
+    for now, after in zip(samples, samples[1:]):
+        span = after.t - now.t
+        n = max(1, int(span / REVERSAL_SUBSTEP_S))
+        h = span / n
+        for m in range(n):
+            duty = now.duty if now is samples[0] and now.t + (m + 0.5) * h < switch_t else after.duty
+            push = g * duty
+            if v == 0.0 and abs(push) <= c:
+                continue  # static friction holds
+            direction = math.copysign(1.0, v if v != 0.0 else push)
+            before = v
+            v += (push - d * v - c * direction) / j * h
+            if before * v < 0.0:
+                v = 0.0  # friction stops, it does not reverse
+            ahead = gap + v * h
+            gap = min(max(ahead, -half), half)
+            out += ahead - gap
+        predicted.append(out)
+    return np.array(predicted)
+
+
+def _reversal_play(drive, step: Step):
+    """The play (rad) that lets the model follow the recorded angle from
+    just before the reversal on, or None where the record is too short. The
+    reversal's moment within its sample interval is fitted with it."""
+    s = step.samples
+    way = math.copysign(1.0, step.duty)
+    at = next((i for i, x in enumerate(s) if x.duty * way < 0.0), None)
+    if at is None or at < 12:
+        return None
+    before = s[at - 10:at]
+    w0 = float(np.polyfit([x.t for x in before], [x.angle for x in before], 1)[0])
+    end = next((i for i in range(at, len(s)) if s[i].t > s[at].t + REVERSAL_WINDOW_S or s[i].duty == 0.0), len(s))
+    window = s[at - 1:end]
+    if len(window) < 20:
+        return None
+    recorded = np.array([x.angle for x in window])
+    t0, t1 = window[0].t, window[1].t
+
+    def misfit(x):
+        play = min(max(x[0], 0.0), math.radians(MAX_BACKLASH_DEG))
+        switch_t = t0 + min(max(x[1], 0.0), 1.0) * (t1 - t0)
+        return float(np.sqrt(np.mean((_follow(drive, window, play, w0, way, switch_t) - recorded) ** 2)))
+
+    best = None
+    for start in (0.25, 0.75):  # two starts: the reversal early or late in its interval
+        found = optimize.minimize(misfit, x0=[math.radians(1.0), start], method="Nelder-Mead",
+                                  options={"xatol": 1e-5, "fatol": 1e-9, "maxiter": 400})
+        best = found if best is None or found.fun < best.fun else best
+    return min(max(float(best.x[0]), 0.0), math.radians(MAX_BACKLASH_DEG))
 
 
 def step_length_ms(servo, duty: float, sleep) -> int:
@@ -215,8 +318,19 @@ def identify(servo, sleep, duties=DEFAULT_DUTIES, step_ms: int = 0, progress=Non
     for n, duty in enumerate(plan):
         steps.append(record_step(servo, duty, step_ms, sleep))
         if progress is not None:
-            progress(n + 1, len(plan))
-    return fit(steps, supply_v)
+            progress(n + 1, len(plan) + 2)
+    drive = fit(steps, supply_v)
+    plays = []
+    for n, duty in enumerate((duties[0], -duties[0])):
+        play = _reversal_play(drive, record_reversal(servo, duty, step_ms, sleep))
+        if play is not None:
+            plays.append(play)
+        if progress is not None:
+            progress(len(plan) + n + 1, len(plan) + 2)
+    if plays:
+        spread = abs(plays[0] - plays[-1]) / 2.0 if len(plays) > 1 else math.radians(0.1)
+        drive.backlash = Estimate(float(np.mean(plays)), spread)
+    return drive
 
 
 def cmd_identify(bus, args):
@@ -226,8 +340,8 @@ def cmd_identify(bus, args):
 
     servo = Servo(bus, args.id)
     duties = tuple(args.duty * k / len(DEFAULT_DUTIES) for k in range(1, len(DEFAULT_DUTIES) + 1))
-    print(f"servo {args.id}: open-loop steps at duties {', '.join(f'±{d:.2f}' for d in duties)} "
-          "(the horn must turn freely: it goes round several times)", flush=True)
+    print(f"servo {args.id}: open-loop steps at duties {', '.join(f'±{d:.2f}' for d in duties)}, then a "
+          "reversal each way (the horn must turn freely: it goes round several times)", flush=True)
 
     def progress(done, total):
         print(f"  step {done}/{total}", flush=True)
@@ -236,7 +350,6 @@ def cmd_identify(bus, args):
     print(f"drive train at the output, {drive.supply_v:.2f} V supply, inertia from {drive.steps_used} rises:")
     for name, e, unit in drive.rows():
         print(f"  {name:28s} {e.value:11.4g} {unit:10s} ± {e.percent():.2g} %")
-    print("  backlash                     not identified (no reversal under load in these steps)")
     if args.mujoco:
         from . import actuator_model
 

@@ -127,7 +127,16 @@ static void step(struct plant *pl, double dt)
     if ((before > 0 && pl->velocity < 0) || (before < 0 && pl->velocity > 0)) {
         pl->velocity = 0.0; /* friction stops, it does not reverse */
     }
-    pl->angle += pl->velocity * dt;
+    /* The output moves with the gears once they are through the play; a
+     * load holds it against the flank that carries it. With no play this
+     * is angle += velocity dt. */
+    double half = 0.5 * p->backlash_deg * PI / 180.0;
+    double lo = pl->load_torque > 0.0 ? half : -half;
+    double hi = pl->load_torque < 0.0 ? -half : half;
+    double ahead = pl->play + pl->velocity * dt;
+    double play = ahead < lo ? lo : ahead > hi ? hi : ahead;
+    pl->angle += ahead - play;
+    pl->play = play;
     if (pl->has_stop && pl->angle > pl->stop_angle) {
         pl->angle = pl->stop_angle;
         pl->velocity = 0.0;

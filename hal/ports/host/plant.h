@@ -12,6 +12,9 @@
  *   once its back-EMF exceeds the supply plus two diode drops, which brakes
  *   a back-driven output hard;
  * - motor drag (the no-load current), Coulomb and viscous;
+ * - the gears' play (backlash): the output, on the far side of the
+ *   encoder, stays put while the gears cross it, unless a load holds it
+ *   against one flank; its own inertia is neglected there;
  * - a hard stop, and an external load torque.
  * The parameters and where each number comes from: plant.c. */
 #ifndef HOST_PLANT_H
@@ -30,12 +33,14 @@ struct plant_params {
     double drag_coulomb;    /* motor side, N m */
     double drag_viscous;    /* motor side, N m s/rad */
     double diode_v;         /* one body diode's forward drop */
+    double backlash_deg;    /* the gears' play at the output, degrees (0: none) */
 };
 
 struct plant {
     struct plant_params p;
     double angle;        /* output, rad, multi-turn, counter-clockwise positive */
-    double velocity;     /* output, rad/s */
+    double velocity;     /* gears at the output, rad/s: the output's, but in the play */
+    double play;         /* gears ahead of the output, rad, within +-backlash/2 */
     double current;      /* winding, A (negative: braking, or regenerating released) */
     double duty;         /* -1..1 */
     bool coast;          /* bridge off */

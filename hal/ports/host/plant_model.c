@@ -21,9 +21,11 @@ struct plant_key {
     const char *key;
     size_t offset;
     double lo, hi;
+    bool optional; /* 0 when the file leaves it out */
 };
 
-#define KEY(name, field, lo, hi) {name, offsetof(struct plant_model, field), lo, hi}
+#define KEY(name, field, lo, hi) {name, offsetof(struct plant_model, field), lo, hi, false}
+#define OPTIONAL_KEY(name, field, lo, hi) {name, offsetof(struct plant_model, field), lo, hi, true}
 static const struct plant_key keys[] = {
     KEY("supply_v", plant.supply_v, 1.0, 60.0),
     KEY("resistance_ohm", plant.resistance_ohm, 0.01, 1000.0),
@@ -34,6 +36,7 @@ static const struct plant_key keys[] = {
     KEY("coulomb_drag_nm", plant.drag_coulomb, 0.0, 1.0),
     KEY("viscous_drag_nm_s_per_rad", plant.drag_viscous, 0.0, 1.0),
     KEY("diode_drop_v", plant.diode_v, 0.0, 2.0),
+    OPTIONAL_KEY("backlash_deg", plant.backlash_deg, 0.0, 10.0),
     KEY("winding_case_k_per_w", thermal.winding_case_k_per_w, 0.1, 1000.0),
     KEY("winding_tau_s", thermal.winding_tau_s, 1.0, 1e4),
     KEY("case_ambient_k_per_w", thermal.case_ambient_k_per_w, 0.1, 1000.0),
@@ -218,8 +221,8 @@ bool plant_model_load(const char *path, struct plant_model *m, char *err, size_t
     fclose(f);
     r.line = 0u; /* what follows is about the whole file */
     for (size_t k = 0; ok && k < KEY_COUNT; k++) {
-        if (!seen[k]) {
-            ok = fail(&r, "%s is missing (every key is required)", keys[k].key);
+        if (!seen[k] && !keys[k].optional) {
+            ok = fail(&r, "%s is missing (every key but backlash_deg is required)", keys[k].key);
         }
     }
     if (ok && !named) {

@@ -3,9 +3,10 @@
  * numbers were derived from, which the model must reproduce.
  *
  * The file is a flat TOML subset, one key a line: `name = "..."`, then
- * `key = number  # where the number comes from`. Every key below is
- * required, once; a number without a comment is refused, because a model
- * is evidence only when each of its numbers says where it comes from. */
+ * `key = number  # where the number comes from`. Every key is required,
+ * once, but backlash_deg (0 when left out); a number without a comment is
+ * refused, because a model is evidence only when each of its numbers says
+ * where it comes from. */
 #ifndef HOST_PLANT_MODEL_H
 #define HOST_PLANT_MODEL_H
 

@@ -1,8 +1,10 @@
 """servoctl identify on the simulator, for each shipped plant file: the
-drive train found from open-loop steps (DriveDuty) is the file's, each
-constant within 15 %, whatever the compiled-in gains are (they are the
-reference servo's, wrong for the other two: identification runs open loop).
-Time is the simulator's (sim.sleep)."""
+drive train found from open-loop steps and reversals (DriveDuty) is the
+file's, each constant within 15 %, whatever the factory gains are (the
+reference servo's, wrong for the other two: identification runs open loop),
+and the gears' play too where a copy of the file gives them some. Time is
+the simulator's (sim.sleep)."""
+import math
 import re
 import tomllib
 
@@ -26,8 +28,21 @@ def at_the_output(plant: dict) -> dict:
             "viscous": plant["viscous_drag_nm_s_per_rad"] * n * n}
 
 
-def start(tmp_path, file):
-    sim = Simulator(state_dir=str(tmp_path / "state"), plant=str(PLANTS / file)).start()
+def relative_errors(drive, truth: dict) -> dict:
+    """Each identified constant's error against the file's, as a fraction."""
+    found = {"torque_constant": drive.torque_constant, "resistance": drive.resistance,
+             "inertia": drive.inertia, "coulomb": drive.coulomb, "viscous": drive.viscous}
+    return {k: found[k].value / truth[k] - 1.0 for k in truth}
+
+
+def start(tmp_path, file, backlash_deg: float = 0.0):
+    """servo_sim on a shipped plant; with backlash_deg, a copy of it whose
+    gears have that play."""
+    path = PLANTS / file
+    if backlash_deg:
+        path = tmp_path / file
+        path.write_text((PLANTS / file).read_text() + f"backlash_deg = {backlash_deg}  # the test's\n")
+    sim = Simulator(state_dir=str(tmp_path / "state"), plant=str(path)).start()
     with sim.bus(timeout=0.2) as bus:
         s = Servo(bus, 1)
         s.write("high_voltage", 12600)  # the 12 V servo's supply
@@ -42,12 +57,30 @@ def test_identify_finds_the_plant_files_drive_train(tmp_path, file):
     try:
         with sim.bus(timeout=0.2) as bus:
             drive = identify(Servo(bus, 1), sim.sleep)
-        found = {"torque_constant": drive.torque_constant, "resistance": drive.resistance,
-                 "inertia": drive.inertia, "coulomb": drive.coulomb, "viscous": drive.viscous}
-        errors = {k: found[k].value / truth[k] - 1.0 for k in truth}
+        errors = relative_errors(drive, truth)
         print(file, {k: f"{100 * e:+.1f} %" for k, e in errors.items()})
         assert all(abs(e) <= 0.15 for e in errors.values()), errors
         assert drive.steps_used == 8
+        assert math.degrees(drive.backlash.value) <= 0.1  # no play in the files' gears: within a count (0.088 deg)
+    finally:
+        finish(sim, [1])
+
+
+@pytest.mark.parametrize("file, play_deg", [("reference_st3215.toml", 2.0), ("micro_9g.toml", 1.0),
+                                            ("class_60kgcm.toml", 3.0)])
+def test_identify_finds_the_gears_play(tmp_path, file, play_deg):
+    """The plant with that backlash: the play from the reversals within 15 %,
+    and the rest of the drive train still within 15 % (the rise from rest
+    crosses what play there was before the output moves)."""
+    truth = at_the_output(tomllib.loads((PLANTS / file).read_text()))
+    sim = start(tmp_path, file, play_deg)
+    try:
+        with sim.bus(timeout=0.2) as bus:
+            drive = identify(Servo(bus, 1), sim.sleep)
+        errors = relative_errors(drive, truth)
+        errors["backlash"] = math.degrees(drive.backlash.value) / play_deg - 1.0
+        print(file, play_deg, {k: f"{100 * e:+.1f} %" for k, e in errors.items()})
+        assert all(abs(e) <= 0.15 for e in errors.values()), errors
     finally:
         finish(sim, [1])
 
@@ -64,8 +97,9 @@ def test_the_command_prints_each_constant_with_its_error_and_a_mujoco_model(tmp_
         assert main(["--port", sim.url, "identify", "1", "--duty", "0.3", "--mujoco", str(model)],
                     clock=sim.clock_s) == 0
         out = capsys.readouterr().out
-        assert "step 8/8" in out
-        for name in ("torque constant x ratio", "resistance", "inertia at the output", "Coulomb drag", "viscous drag"):
+        assert "step 10/10" in out
+        for name in ("torque constant x ratio", "resistance", "inertia at the output", "Coulomb drag", "viscous drag",
+                     "backlash at the output"):
             line = next(l for l in out.splitlines() if name in l)
             assert "±" in line and "%" in line, line
         m = mujoco.MjModel.from_xml_path(str(model))

@@ -19,7 +19,7 @@ from servoctl.sim import PLANTS, Simulator
 from servoctl.tune import check_step, tune
 
 from .conftest import finish
-from .test_identify import at_the_output
+from .test_identify import at_the_output, relative_errors
 
 PLANT_FILES = ["reference_st3215.toml", "micro_9g.toml", "class_60kgcm.toml"]
 OVERSHOOT_MOST = 10   # decidegrees: 1 degree
@@ -69,10 +69,8 @@ def test_identify_tune_and_store_meet_the_figures(tmp_path, file):
             assert c.current_zero == 18 and c.reversed, c
             factory = check_step(s, sim.sleep)
             drive = identify(s, sim.sleep)
-            found = {"torque_constant": drive.torque_constant.value, "resistance": drive.resistance.value,
-                     "inertia": drive.inertia.value, "coulomb": drive.coulomb.value,
-                     "viscous": drive.viscous.value}
-            assert all(abs(found[k] / truth[k] - 1.0) <= 0.15 for k in truth), (found, truth)
+            errors = relative_errors(drive, truth)
+            assert all(abs(e) <= 0.15 for e in errors.values()), errors
             t = tune(drive, s.read("gear_ratio"))
             assert t.phase_margin_deg >= 40 and t.gain_margin_db >= 10, t
             for name, value in t.items.items():
