@@ -17,7 +17,9 @@ back through their play (backlash) before the output, on the far side of
 the encoder, follows; the play is the one that makes the model above, with
 that play between it and the output, follow the recorded angle after the
 reversal. Every fit is least squares (scipy), and each value is given
-with its standard error. ReadMotion's duty is what the bridge was given
+with its standard error. Last, a chirp (a duty sine swept from 0.5 to 8 Hz,
+one short DriveDuty after another) checks the model across frequencies:
+driven by the duty the bridge was given, it must follow the servo's speed. ReadMotion's duty is what the bridge was given
 (after the current limit), so a step the limit clips is known and not used
 for the inertia."""
 import math
@@ -37,6 +39,10 @@ CLIP_TOLERANCE = 0.02
 REVERSAL_WINDOW_S = 0.4   # the reversal's record the play is fitted over
 REVERSAL_SUBSTEP_S = 0.00025
 MAX_BACKLASH_DEG = 10.0
+CHIRP_HZ = (0.5, 8.0)
+CHIRP_S = 4.0
+CHIRP_HOLD_MS = 40        # each DriveDuty of the chirp: released soon should the host stop
+SPEED_SMOOTHING = 5       # samples (17 ms) the speeds compared are averaged over
 
 
 @dataclass
@@ -75,6 +81,7 @@ class DriveTrain:
     steps_used: int
     steps: list = None  # the recorded steps the fit came from
     backlash: Estimate = None  # rad at the output; None where no reversal was recorded
+    chirp: tuple = None  # the model against a chirp: (speed's RMS error, fraction; angle's, rad)
 
     def rows(self):
         rows = [("torque constant x ratio", self.torque_constant, "N m/A"),
@@ -292,6 +299,43 @@ def _reversal_play(drive, step: Step):
     return min(max(float(best.x[0]), 0.0), math.radians(MAX_BACKLASH_DEG))
 
 
+def record_chirp(servo, duty: float, sleep) -> list:
+    """The duty a sine of amplitude duty, its frequency swept from
+    CHIRP_HZ[0] to [1] (exponentially) over CHIRP_S, a DriveDuty after each
+    ReadMotion sample; the samples."""
+    first = servo.read_motion()
+    samples, phase, last = [], 0.0, 0.0
+    f0, f1 = CHIRP_HZ
+    while True:
+        snap = servo.read_motion()
+        t = snap.seconds_since(first)
+        samples.append(Sample(t, math.radians(snap.angle_decideg / 10.0), snap.current_ma / 1000.0,
+                              snap.duty_q15 / 32767.0))
+        if t > CHIRP_S or len(samples) > 40000:
+            break
+        phase += 2.0 * math.pi * f0 * (f1 / f0) ** (t / CHIRP_S) * (t - last)
+        last = t
+        q15 = round(duty * math.sin(phase) * 32767) or 1  # DriveDuty takes no 0
+        servo.drive_duty(q15 / 32767.0, CHIRP_HOLD_MS)
+    come_to_rest(servo, sleep)
+    return samples
+
+
+def chirp_error(drive, samples) -> tuple:
+    """The rigid model driven by the recorded duty from the first sample:
+    (the speed's RMS error over its RMS, the angle's RMS error in rad)."""
+    window = [Sample(s.t, s.angle, s.current, s.duty) for s in samples]
+    predicted = _follow(drive, window, 0.0, 0.0, 1.0, window[0].t)
+    t = np.array([s.t for s in window])
+    angle = np.array([s.angle for s in window])
+    kernel = np.ones(SPEED_SMOOTHING) / SPEED_SMOOTHING
+    speed = np.convolve(np.gradient(angle, t), kernel, mode="same")
+    model = np.convolve(np.gradient(predicted, t), kernel, mode="same")
+    rms = float(np.sqrt(np.mean(speed ** 2)))
+    return (float(np.sqrt(np.mean((model - speed) ** 2))) / rms if rms > 0 else math.inf,
+            float(np.sqrt(np.mean((predicted - angle) ** 2))))
+
+
 def step_length_ms(servo, duty: float, sleep) -> int:
     """A step long enough to be steady for its last 40 %: 12 rise times,
     from a first step's rise (DEFAULT_STEP_MS at least, 10 s at most)."""
@@ -314,11 +358,12 @@ def identify(servo, sleep, duties=DEFAULT_DUTIES, step_ms: int = 0, progress=Non
         sleep(DEFAULT_STEP_MS / 1000.0)
         come_to_rest(servo, sleep)
     plan = [d * sign for d in duties for sign in (1.0, -1.0)]
+    total = len(plan) + 3  # the steps, two reversals, the chirp
     steps = []
     for n, duty in enumerate(plan):
         steps.append(record_step(servo, duty, step_ms, sleep))
         if progress is not None:
-            progress(n + 1, len(plan) + 2)
+            progress(n + 1, total)
     drive = fit(steps, supply_v)
     plays = []
     for n, duty in enumerate((duties[0], -duties[0])):
@@ -326,10 +371,13 @@ def identify(servo, sleep, duties=DEFAULT_DUTIES, step_ms: int = 0, progress=Non
         if play is not None:
             plays.append(play)
         if progress is not None:
-            progress(len(plan) + n + 1, len(plan) + 2)
+            progress(len(plan) + n + 1, total)
     if plays:
         spread = abs(plays[0] - plays[-1]) / 2.0 if len(plays) > 1 else math.radians(0.1)
         drive.backlash = Estimate(float(np.mean(plays)), spread)
+    drive.chirp = chirp_error(drive, record_chirp(servo, duties[-1] * 2.0 / 3.0, sleep))
+    if progress is not None:
+        progress(total, total)
     return drive
 
 
@@ -350,6 +398,9 @@ def cmd_identify(bus, args):
     print(f"drive train at the output, {drive.supply_v:.2f} V supply, inertia from {drive.steps_used} rises:")
     for name, e, unit in drive.rows():
         print(f"  {name:28s} {e.value:11.4g} {unit:10s} ± {e.percent():.2g} %")
+    speed_error, angle_error = drive.chirp
+    print(f"chirp {CHIRP_HZ[0]:g}-{CHIRP_HZ[1]:g} Hz at duty ±{duties[-1] * 2 / 3:.2f}: the model follows the "
+          f"servo's speed within {100 * speed_error:.1f} % RMS (its angle within {math.degrees(angle_error):.2f} deg)")
     if args.mujoco:
         from . import actuator_model
 

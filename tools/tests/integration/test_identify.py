@@ -62,6 +62,9 @@ def test_identify_finds_the_plant_files_drive_train(tmp_path, file):
         assert all(abs(e) <= 0.15 for e in errors.values()), errors
         assert drive.steps_used == 8
         assert math.degrees(drive.backlash.value) <= 0.1  # no play in the files' gears: within a count (0.088 deg)
+        speed_error, angle_error = drive.chirp  # the model across 0.5-8 Hz
+        print(file, f"chirp: speed {100 * speed_error:.1f} % RMS, angle {math.degrees(angle_error):.2f} deg RMS")
+        assert speed_error < 0.10 and math.degrees(angle_error) < 0.5
     finally:
         finish(sim, [1])
 
@@ -97,7 +100,7 @@ def test_the_command_prints_each_constant_with_its_error_and_a_mujoco_model(tmp_
         assert main(["--port", sim.url, "identify", "1", "--duty", "0.3", "--mujoco", str(model)],
                     clock=sim.clock_s) == 0
         out = capsys.readouterr().out
-        assert "step 10/10" in out
+        assert "step 11/11" in out and "chirp 0.5-8 Hz" in out
         for name in ("torque constant x ratio", "resistance", "inertia at the output", "Coulomb drag", "viscous drag",
                      "backlash at the output"):
             line = next(l for l in out.splitlines() if name in l)
