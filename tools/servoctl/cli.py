@@ -159,8 +159,9 @@ def _shown(item, raw: int, as_raw: bool) -> str:
 
 
 def _print_config(values: dict, as_raw: bool):
-    for item in registers.USER:
-        print(f"  {item.id:2d} {item.name:<18} {_shown(item, values[item.name], as_raw)}")
+    for item in registers.STORED:
+        if item.name in values:
+            print(f"  {item.id:2d} {item.name:<18} {_shown(item, values[item.name], as_raw)}")
 
 
 def cmd_config_diff(bus, args):
@@ -207,13 +208,13 @@ def cmd_config(bus, args):
         s.write(item.id, value)
         print(f"{item.name} = {_shown(item, value, args.raw)}")
     elif args.action == "dump":
-        values = s.read_all()
+        values = s.read_stored()
         if args.json:
             print(json.dumps(values if args.raw else config_file.config_json(values, config_file.servo_of(s))))
         else:
             _print_config(values, args.raw)
     elif args.action == "save":
-        config_file.write(args.file, config_file.config_json(s.read_all(), config_file.servo_of(s)))
+        config_file.write(args.file, config_file.config_json(s.read_stored(), config_file.servo_of(s)))
         print(f"saved the user area of servo {args.id} to {args.file}")
     elif args.action == "load":
         entry = config_file.parse_config(config_file.read(args.file), args.file, args.raw)

@@ -30,11 +30,11 @@ def _servo_label(servo: dict, fallback: str) -> str:
 def _from_servo(bus, servo_id: int) -> Side:
     s = Servo(bus, servo_id)
     serial = s.read("serial")
-    return Side(f"servo {servo_id} (serial 0x{serial:08x})", s.read_all(), serial, servo_id)
+    return Side(f"servo {servo_id} (serial 0x{serial:08x})", s.read_stored(), serial, servo_id)
 
 
 def _factory() -> Side:
-    return Side("factory", {i.name: i.default for i in registers.USER if i.writable})
+    return Side("factory", {i.name: i.default for i in registers.STORED if i.writable})
 
 
 def _file_sides(path: str) -> list:
@@ -83,7 +83,7 @@ def pair(a_sides: list, b_sides: list) -> list:
 
 def differences(a: Side, b: Side) -> dict:
     """{name: (a, b)} of the items both hold and that differ."""
-    return {i.name: (a.values[i.name], b.values[i.name]) for i in registers.USER
+    return {i.name: (a.values[i.name], b.values[i.name]) for i in registers.STORED
             if i.writable and i.name in a.values and i.name in b.values
             and a.values[i.name] != b.values[i.name]}
 

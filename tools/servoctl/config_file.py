@@ -19,12 +19,12 @@ from .protocol import UsageError, ValueOutOfRange
 
 CONFIG_FORMAT = 2
 BACKUP_FORMAT = 2
-_NAMES = {i.name for i in registers.USER}
+_NAMES = {i.name for i in registers.STORED}
 
 
 @dataclass
 class Entry:
-    """One servo's user area as a file holds it."""
+    """One servo's user area, and drive area where it has one, as a file holds it."""
     values: dict        # {name: protocol value}, all or some items
     servo: dict = None  # {"id", "model", "firmware", "serial"} when the file says
     raw: bool = False   # the file was in protocol units
@@ -55,7 +55,7 @@ def servo_of(s) -> dict:
 
 def entry_json(values: dict, servo: dict) -> dict:
     return {"servo": servo,
-            "items": {i.name: units.exact(i, values[i.name]) for i in registers.USER if i.name in values}}
+            "items": {i.name: units.exact(i, values[i.name]) for i in registers.STORED if i.name in values}}
 
 
 def config_json(values: dict, servo: dict) -> dict:

@@ -3,7 +3,7 @@ listed servo), a broadcast move, async begin and end, Sync Monitor, and the
 backup and restore of a whole bus. Angles in degrees, times in seconds."""
 
 from . import protocol as p
-from . import config_file
+from . import config_file, registers
 from .frame import check_target
 from .errors import NoReply, Refused, UsageError
 from .checks import MIN_RAMP_MS, check_profile, check_range, scaled, to_ms
@@ -111,7 +111,7 @@ def backup(bus: p.Bus, ids: list, path: str) -> None:
     entries = []
     for servo_id in ids:
         s = Servo(bus, servo_id)
-        entries.append((s.read_all(), config_file.servo_of(s)))
+        entries.append((s.read_stored(), config_file.servo_of(s)))
     config_file.write(path, config_file.backup_json(entries))
 
 
@@ -125,15 +125,22 @@ def id_is_free(bus: p.Bus, servo_id: int, new_id: int) -> None:
 
 
 def write_user_area(s: Servo, values: dict, with_link: bool = False) -> list:
-    """Writes values (all or some items, by name) over the servo's own.
-    The ID and baud rate stay unless with_link: another servo's file must
+    """Writes values (all or some items, by name) over the servo's own: the
+    user area, and the drive area where the servo has one. The ID and baud
+    rate stay unless with_link: another servo's file must
     not put two servos on one ID; with it, an ID already answering is
     refused. Returns the items kept that differed."""
     current = s.read_all()
     if with_link and "servo_id" in values:
         id_is_free(s.bus, s.id, values["servo_id"])
     keep = [] if with_link else ["servo_id", "baud"]
-    s.write_all(dict(current, **{k: v for k, v in values.items() if k not in keep}))
+    user = {i.name for i in registers.USER}
+    s.write_all(dict(current, **{k: v for k, v in values.items() if k not in keep and k in user}))
+    drive = [item for item in registers.DRIVE if item.name in values]
+    now = s.read_stored() if drive else {}
+    for item in drive:  # item by item, each a config save; the maker's servos have none
+        if item.name in now and now[item.name] != values[item.name]:
+            s.write(item.id, values[item.name])
     return [k for k in keep if k in values and values[k] != current[k]]
 
 

@@ -52,6 +52,7 @@ USER_AREA_SIZE = sum(item.size for item in USER)  # the WriteBatchData block
 FIRMWARE = [_item(i) for i in _SCHEMA.area("firmware")]  # this firmware's own, in RAM
 DRIVE = [_item(i) for i in _SCHEMA.area("drive")]  # the drive train and the gains, stored
 ITEMS = STATUS + USER + FIRMWARE + DRIVE
+STORED = USER + DRIVE  # what the config store keeps, and config files and backups carry
 BY_ID = {i.id: i for i in ITEMS}
 BY_NAME = {i.name: i for i in ITEMS}
 STATUS_BITS = [b.name for b in _SCHEMA.status_bits]

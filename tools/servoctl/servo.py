@@ -159,6 +159,18 @@ class Servo:
         content = self.bus.request(p.READ_BATCH, bytes([self.id]))
         return registers.decode_user_area(p.decode_answer(p.READ_BATCH, content)[1])
 
+    def read_stored(self) -> dict:
+        """The user area (one batch read) and the drive area (item by item);
+        a servo without the drive items (the maker's firmware) gives the
+        user area alone."""
+        values = self.read_all()
+        try:
+            for item in registers.DRIVE:
+                values[item.name] = self.read(item.id)
+        except ServoError:
+            return {k: v for k, v in values.items() if k not in {i.name for i in registers.DRIVE}}
+        return values
+
     def write_all(self, values: dict) -> None:
         block = registers.encode_user_area(values)
         content = self.bus.request(p.WRITE_BATCH, bytes([self.id]) + block)

@@ -83,3 +83,28 @@ def test_config_diff(tmp_path, capsys):
         assert rc == 1 and "stall_power" in out
         rc, _, err = run(sim, capsys, "config", "diff", "1", "nonsense")
         assert rc == 2 and "an ID, a config or backup file, or 'factory'" in err
+
+
+def test_a_tuned_servos_drive_area_goes_with_its_file(sim, capsys, tmp_path):
+    """The drive area (items 80-91: calibrate's and tune's) is in config
+    files and backups, and in config diff: a tuned servo's file brings its
+    tuning back, as a backup does."""
+    tuned = {"gain_kp": "700", "gain_kd": "12000", "gear_ratio": "-387", "encoder_zero": "1234"}
+    for name, text in tuned.items():
+        assert run(sim, capsys, "config", "set", "1", name, text)[0] == 0
+    f, b = tmp_path / "tuned.json", tmp_path / "all.json"
+    assert run(sim, capsys, "config", "save", "1", str(f))[0] == 0
+    assert run(sim, capsys, "backup", str(b), "--ids", "1")[0] == 0
+    items = json.loads(f.read_text())["items"]
+    assert items["gain_kd"] == "12000" and items["gear_ratio"] == "-387", items
+    for name in ("gain_kp", "gain_kd", "gear_ratio", "encoder_zero"):
+        assert run(sim, capsys, "config", "set", "1", name, "1")[0] == 0
+    rc, out, _ = run(sim, capsys, "config", "diff", "1", str(f))
+    assert rc == 1 and "gain_kd" in out and "encoder_zero" in out, out
+    assert run(sim, capsys, "config", "load", "1", str(f))[0] == 0
+    assert run(sim, capsys, "config", "get", "1", "gain_kd")[1].startswith("gain_kd = 12000")
+    assert run(sim, capsys, "config", "set", "1", "gain_kp", "1")[0] == 0
+    assert run(sim, capsys, "restore", str(b))[0] == 0
+    assert run(sim, capsys, "config", "get", "1", "gain_kp")[1].startswith("gain_kp = 700 ")
+    rc, out, _ = run(sim, capsys, "config", "diff", "1", "factory")
+    assert rc == 1 and "gear_ratio" in out and "gain_kp" in out, out

@@ -313,10 +313,10 @@ def test_read_commands_speak_json(sim, capsys):
     item = json.loads(run(sim, capsys, "config", "get", "1", "angle_max", "--json")[1])
     assert item == {"id": 51, "name": "angle_max", "raw": 1350, "value": "135.0 deg"}
     dump = json.loads(run(sim, capsys, "config", "dump", "1", "--json")[1])
-    assert dump["items"]["servo_id"] == "1" and len(dump["items"]) == 22
+    assert dump["items"]["servo_id"] == "1" and len(dump["items"]) == 22 + 12  # the user and drive areas
     assert dump["items"]["angle_max"] == "135.0 deg" and dump["servo"]["serial"] == "0x51a00001"
     raw = json.loads(run(sim, capsys, "config", "dump", "1", "--json", "--raw")[1])
-    assert raw["angle_max"] == 1350 and len(raw) == 22
+    assert raw["angle_max"] == 1350 and len(raw) == 22 + 12
 
 
 def test_ctrl_c_during_a_wait_releases_nothing(ready):
