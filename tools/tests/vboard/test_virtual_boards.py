@@ -116,6 +116,32 @@ def test_every_motion_packet(one):
     assert servo.angle() == pytest.approx(-200, abs=2)
 
 
+def test_the_drive_items_and_the_jerk_limit_on_the_real_images(one, board):
+    """The drive area (items 80-91) on the ARM images: a write is kept
+    through a power cycle and steers the controller (a reversed ratio turns
+    the bridge round: a positive duty then moves the horn down). The jerk
+    limit (item 70): the F103 takes it; the F030's image has no room for
+    S-curves and takes only 0."""
+    sim, bus, servo = one
+    servo.write("gain_kd", 3500)
+    servo.write("gear_ratio", -345)
+    sim.control("powercycle")
+    sim.sleep(0.5)
+    assert (servo.read("gain_kd"), servo.read("gear_ratio")) == (3500, -345)
+    before = servo.read_motion().angle_decideg
+    servo.drive_duty(0.25, 150)
+    sim.sleep(0.2)
+    assert servo.read_motion().angle_decideg < before - 5  # wired as built, driven the other way
+    servo.stop("release")
+    if board == "stm32f030k6":
+        with pytest.raises(ServoError):
+            servo.write("jerk_limit", 100)
+        assert servo.read("jerk_limit") == 0
+    else:
+        servo.write("jerk_limit", 100)
+        assert servo.read("jerk_limit") == 100
+
+
 def test_protections_under_injected_faults(one):
     sim, bus, servo = one
     sim.control("supply 3500")  # below 39's 4 V default
