@@ -12,7 +12,7 @@ own clock. A brushed DC motor behind a gearbox, seen at the output
 so at each step's steady speed V d = R i + K w gives R and K, and
 K i = C + B w gives the Coulomb and viscous drags; from rest the speed
 rises as w_ss (1 - exp(-t / tau)) with tau = J / (K^2 / R + B), which gives
-the inertia. Then a reversal each way at the lowest duty: the gears turn
+the inertia. Then two reversals each way at the lowest duty: the gears turn
 back through their play (backlash) before the output, on the far side of
 the encoder, follows; the play is the one that makes the model above, with
 that play between it and the output, follow the recorded angle after the
@@ -39,6 +39,7 @@ CLIP_TOLERANCE = 0.02
 REVERSAL_WINDOW_S = 0.4   # the reversal's record the play is fitted over
 REVERSAL_SUBSTEP_S = 0.00025
 MAX_BACKLASH_DEG = 10.0
+REVERSALS_EACH_WAY = 2
 CHIRP_HZ = (0.5, 8.0)
 CHIRP_S = 4.0
 CHIRP_HOLD_MS = 40        # each DriveDuty of the chirp: released soon should the host stop
@@ -358,7 +359,8 @@ def identify(servo, sleep, duties=DEFAULT_DUTIES, step_ms: int = 0, progress=Non
         sleep(DEFAULT_STEP_MS / 1000.0)
         come_to_rest(servo, sleep)
     plan = [d * sign for d in duties for sign in (1.0, -1.0)]
-    total = len(plan) + 3  # the steps, two reversals, the chirp
+    reversals = (duties[0], -duties[0]) * REVERSALS_EACH_WAY
+    total = len(plan) + len(reversals) + 1  # the steps, the reversals, the chirp
     steps = []
     for n, duty in enumerate(plan):
         steps.append(record_step(servo, duty, step_ms, sleep))
@@ -366,14 +368,14 @@ def identify(servo, sleep, duties=DEFAULT_DUTIES, step_ms: int = 0, progress=Non
             progress(n + 1, total)
     drive = fit(steps, supply_v)
     plays = []
-    for n, duty in enumerate((duties[0], -duties[0])):
+    for n, duty in enumerate(reversals):
         play = _reversal_play(drive, record_reversal(servo, duty, step_ms, sleep))
         if play is not None:
             plays.append(play)
         if progress is not None:
             progress(len(plan) + n + 1, total)
     if plays:
-        spread = abs(plays[0] - plays[-1]) / 2.0 if len(plays) > 1 else math.radians(0.1)
+        spread = float(np.std(plays, ddof=1) / math.sqrt(len(plays))) if len(plays) > 1 else math.radians(0.1)
         drive.backlash = Estimate(float(np.mean(plays)), spread)
     drive.chirp = chirp_error(drive, record_chirp(servo, duties[-1] * 2.0 / 3.0, sleep))
     if progress is not None:
@@ -388,8 +390,8 @@ def cmd_identify(bus, args):
 
     servo = Servo(bus, args.id)
     duties = tuple(args.duty * k / len(DEFAULT_DUTIES) for k in range(1, len(DEFAULT_DUTIES) + 1))
-    print(f"servo {args.id}: open-loop steps at duties {', '.join(f'±{d:.2f}' for d in duties)}, then a "
-          "reversal each way (the horn must turn freely: it goes round several times)", flush=True)
+    print(f"servo {args.id}: open-loop steps at duties {', '.join(f'±{d:.2f}' for d in duties)}, then "
+          "two reversals each way (the horn must turn freely: it goes round several times)", flush=True)
 
     def progress(done, total):
         print(f"  step {done}/{total}", flush=True)
