@@ -107,8 +107,6 @@ enum {
     KA_MAX = 1 << 30,
 };
 
-/* a x b / den, at most most: each factor within 32 bits (the items' 16-bit
- * ranges see to it), the product within 64. */
 /* The gains' four items, kp to damping, side by side in both structs. */
 #define GAINS_SIZE (4u * sizeof(uint16_t))
 _Static_assert(offsetof(struct user_config, gain_damping) - offsetof(struct user_config, gain_kp) ==
@@ -117,6 +115,8 @@ _Static_assert(offsetof(struct user_config, gain_damping) - offsetof(struct user
                        GAINS_SIZE - sizeof(uint16_t),
                "gains: items 86-89 in order, as struct drive_limits has them");
 
+/* a x b / den, at most most: each factor within 32 bits (the items' 16-bit
+ * ranges see to it), the product within 64. */
 static int32_t derived(uint32_t a, uint32_t b, uint32_t den, int32_t most)
 {
     uint64_t q = div64_u((uint64_t)a * b, den);

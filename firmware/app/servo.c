@@ -192,8 +192,7 @@ static inline __attribute__((always_inline)) void handle_next_frame(struct servo
     }
 }
 
-/* ReadStore's register group, on a change or a new second only: it
- * divides. */
+/* ReadStore's flags (enum store_flag). */
 static uint8_t store_flags(const struct servo *s)
 {
     return (uint8_t)((s->store.failed ? STORE_FAILED : 0u) |
@@ -201,6 +200,8 @@ static uint8_t store_flags(const struct servo *s)
                      (s->saver.awaits_erase ? STORE_AWAITS_ERASE : 0u));
 }
 
+/* ReadStore's register group, on a change or a new second only: it
+ * divides. */
 static void report_store(struct servo *s)
 {
     struct store_health *h = &s->regs.store;
@@ -225,8 +226,8 @@ static void report_store(struct servo *s)
 
 /* The dispatcher's persist hook: a changed user or drive area goes to flash
  * before the write is answered, all its write blocks at once (36
- * half-words, 1.9-2.5 ms on the STM32F1; the ticks catch up after, the DMA ring holds
- * what arrives). A change that cannot be made durable now is refused, and
+ * half-words, 1.4-2.5 ms on the STM32F1; the ticks catch up after, the DMA
+ * ring holds what arrives). A change that cannot be made durable now is refused, and
  * ReadStore says why: past the wear budget, no erased slot until the
  * output is released, or the flash refused. */
 static bool save_now(struct servo *s, const struct user_config *cfg)

@@ -53,6 +53,11 @@ class Sample:
     current: float    # A, magnitude (item 2)
     duty: float       # of the supply, as the bridge was given it
 
+    @classmethod
+    def of(cls, snap, t: float) -> "Sample":
+        """A ReadMotion snapshot taken t into the record."""
+        return cls(t, math.radians(snap.angle_decideg / 10.0), snap.current_ma / 1000.0, snap.duty_q15 / 32767.0)
+
 
 @dataclass
 class Step:
@@ -107,8 +112,7 @@ def record_step(servo, duty: float, step_ms: int, sleep) -> Step:
     while True:
         snap = servo.read_motion()
         t = snap.seconds_since(first)
-        samples.append(Sample(t, math.radians(snap.angle_decideg / 10.0), snap.current_ma / 1000.0,
-                              snap.duty_q15 / 32767.0))
+        samples.append(Sample.of(snap, t))
         if t > end_s:
             break
         if len(samples) > 20000:
@@ -225,8 +229,7 @@ def record_reversal(servo, duty: float, half_ms: int, sleep) -> Step:
     while True:
         snap = servo.read_motion()
         t = snap.seconds_since(first)
-        samples.append(Sample(t, math.radians(snap.angle_decideg / 10.0), snap.current_ma / 1000.0,
-                              snap.duty_q15 / 32767.0))
+        samples.append(Sample.of(snap, t))
         if not reversed_ and t >= half_ms / 1000.0:
             servo.drive_duty(-duty, half_ms)
             reversed_ = True
@@ -310,8 +313,7 @@ def record_chirp(servo, duty: float, sleep) -> list:
     while True:
         snap = servo.read_motion()
         t = snap.seconds_since(first)
-        samples.append(Sample(t, math.radians(snap.angle_decideg / 10.0), snap.current_ma / 1000.0,
-                              snap.duty_q15 / 32767.0))
+        samples.append(Sample.of(snap, t))
         if t > CHIRP_S or len(samples) > 40000:
             break
         phase += 2.0 * math.pi * f0 * (f1 / f0) ** (t / CHIRP_S) * (t - last)
@@ -325,10 +327,9 @@ def record_chirp(servo, duty: float, sleep) -> list:
 def chirp_error(drive, samples) -> tuple:
     """The rigid model driven by the recorded duty from the first sample:
     (the speed's RMS error over its RMS, the angle's RMS error in rad)."""
-    window = [Sample(s.t, s.angle, s.current, s.duty) for s in samples]
-    predicted = _follow(drive, window, 0.0, 0.0, 1.0, window[0].t)
-    t = np.array([s.t for s in window])
-    angle = np.array([s.angle for s in window])
+    predicted = _follow(drive, samples, 0.0, 0.0, 1.0, samples[0].t)
+    t = np.array([s.t for s in samples])
+    angle = np.array([s.angle for s in samples])
     kernel = np.ones(SPEED_SMOOTHING) / SPEED_SMOOTHING
     speed = np.convolve(np.gradient(angle, t), kernel, mode="same")
     model = np.convolve(np.gradient(predicted, t), kernel, mode="same")
