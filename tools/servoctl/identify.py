@@ -40,6 +40,7 @@ REVERSAL_WINDOW_S = 0.4   # the reversal's record the play is fitted over
 REVERSAL_SUBSTEP_S = 0.00025
 MAX_BACKLASH_DEG = 10.0
 REVERSALS_EACH_WAY = 2
+REVERSAL_HALF_MAX_MS = 9500  # DriveDuty takes 10 s at most
 CHIRP_HZ = (0.5, 8.0)
 CHIRP_S = 4.0
 CHIRP_HOLD_MS = 40        # each DriveDuty of the chirp: released soon should the host stop
@@ -369,8 +370,9 @@ def identify(servo, sleep, duties=DEFAULT_DUTIES, step_ms: int = 0, progress=Non
             progress(n + 1, total)
     drive = fit(steps, supply_v)
     plays = []
+    half_ms = min(step_ms, REVERSAL_HALF_MAX_MS)  # the first duty's DriveDuty outlasts it by 500 ms
     for n, duty in enumerate(reversals):
-        play = _reversal_play(drive, record_reversal(servo, duty, step_ms, sleep))
+        play = _reversal_play(drive, record_reversal(servo, duty, half_ms, sleep))
         if play is not None:
             plays.append(play)
         if progress is not None:
