@@ -76,6 +76,18 @@ def plain_moves(bus, ids, times):
     return math.sqrt(sum(e * e for e in errors) / len(errors)), max(map(abs, errors))
 
 
+def cycle_gaps(sim):
+    """Mean gaps of the latest cycles on the simulator's wire log, in us:
+    an answer's end to the host's next burst, the burst's end to the
+    first answer, an answer's end to the next."""
+    spans = [line.split() for line in sim.control("wire 1024").splitlines() if line != "end"]
+    gaps = {"host": [], "first": [], "between": []}
+    for (_, end, _, before), (start, _, _, sender) in zip(spans, spans[1:]):
+        kind = "host" if sender == "host" else "first" if before == "host" else "between"
+        gaps[kind].append(int(start) - int(end))
+    return [sum(g) / len(g) for g in gaps.values()]
+
+
 ids = list(range(1, 7))
 times = [k * PERIOD for k in range(int(SECONDS / PERIOD) + 1)]
 print("2. 6 servos at 1 Mbaud, the same path through servoctl (Sync Monitor each period):")
@@ -100,6 +112,8 @@ for count in (6, 16):
             for k in range(200):
                 loop.cycle({i: 10.0 * math.sin(k / 20) for i in ids})
             r = loop.rate()
+            host, first, between = cycle_gaps(sim)
         print(f"   {count:2} servos at {baud:7} baud: {r.rate_hz:6.0f} Hz of the wire's {r.wire_limit_hz:6.0f} "
-              f"({r.ratio:.2f}), {loop.missed} state(s) missed")
+              f"({r.ratio:.2f}), {loop.missed} state(s) missed; a cycle's gaps on the wire (mean us): "
+              f"host {host:.0f}, first answer {first:.0f}, between answers {between:.1f}")
 PY

@@ -73,11 +73,21 @@ def sync_monitor(bus: p.Bus, ids: list, timeout_s: float = None, arrivals: dict 
     """One SyncCommand Monitor: each listed servo answers in list order.
     {id: Monitor} of those that answered; arrivals, if given, gets {id:
     the bus clock when its answer arrived}."""
+    bus.send(*monitor_request(ids))
+    return monitor_answers(bus, ids, timeout_s, arrivals)
+
+
+def monitor_request(ids: list) -> tuple:
+    """(code, content) of a Sync Monitor of ids, to send alone or in a burst."""
     for servo_id in ids:
         check_range("servo ID", servo_id, 0, p.MAX_ID)
     if not ids or len(ids) > MAX_SYNC_RECORDS:
         raise UsageError(f"a sync monitor takes 1..{MAX_SYNC_RECORDS} servos")
-    bus.send(p.SYNC, bytes([p.MONITOR, 1, len(ids)] + list(ids)))
+    return p.SYNC, bytes([p.MONITOR, 1, len(ids)] + list(ids))
+
+
+def monitor_answers(bus: p.Bus, ids: list, timeout_s: float = None, arrivals: dict = None) -> dict:
+    """The answers to a Sync Monitor of ids just sent (sync_monitor)."""
     # Each answer is 21 bytes; an absent servo costs 3 ms of silence.
     wait = timeout_s if timeout_s is not None else 0.05 + len(ids) * (0.004 + 210 / bus.serial.baudrate)
     deadline = bus.clock() + wait  # one for the round: the clock is read as little as can be

@@ -48,6 +48,11 @@ def answer_frame_size(code: int) -> int:
     return len(RESPONSE_HEADER) + 3 + struct.calcsize(_SCHEMA.answer_format(code))
 
 
+def request_format(code: int) -> str:
+    """The struct format of a request's content (protocol/schema.toml)."""
+    return _SCHEMA.request_format(code)
+
+
 def encode_request(code: int, *values) -> bytes:
     """A request's content from its fields' values, as protocol/schema.toml
     lays them out."""
@@ -112,6 +117,10 @@ class Bus:
         # Reads never block (timeout 0); a wait for bytes is a select on
         # the port, which returns the moment one arrives.
         self._fd = sock.fileno() if sock is not None else getattr(self.serial, "fd", None)
+        # A socket (non-blocking, as pyserial opens it) is read and written
+        # directly: pyserial's wrappers add a select to every call, and a
+        # robot's loop makes some fifty calls a cycle.
+        self._sock = sock
         self._buffer = b""
         self.stray_bytes = 0  # bytes outside any frame: noise, or answers that collided
         self.stamp_arrivals = True
@@ -164,7 +173,8 @@ class Bus:
             if not self._fill(wait=False):
                 break
         self._buffer = b""
-        self._link(self.serial.write, b"".join(request_frame(c, content) for c, content in requests))
+        frames = b"".join(request_frame(c, content) for c, content in requests)
+        self._link(self.serial.write if self._sock is None else self._write_all, frames)
 
     def _fill(self, wait: bool = True) -> bool:
         """Reads what has arrived; with wait, first waits up to 5 ms for a
@@ -177,12 +187,36 @@ class Bus:
                 select.select([self._fd], [], [], 0.005)
             else:  # loop:// and other ports without a descriptor
                 time.sleep(0.0005)
-        data = self._link(self.serial.read, 4096)
+        data = self._link(self._read_now)
         if BUS_IN_USE in data:
             raise LinkError(f"{self.port} is in use by another program (another servoctl, a "
                             f"terminal, the maker's tool): close it, then try again")
         self._buffer += data
         return bool(data)
+
+    def _read_now(self) -> bytes:
+        """What has arrived, without waiting."""
+        if self._sock is None:
+            return self.serial.read(4096)
+        try:
+            data = self._sock.recv(4096)
+        except (BlockingIOError, InterruptedError):
+            return b""
+        if not data:
+            raise OSError("the other end closed the connection")
+        return data
+
+    def _write_all(self, data: bytes) -> None:
+        """data to the socket; a simulator whose line is still busy with
+        earlier bytes reads no more until it has room: waited for."""
+        import select
+
+        view = memoryview(data)
+        while view:
+            try:
+                view = view[self._sock.send(view):]
+            except (BlockingIOError, InterruptedError):
+                select.select([], [self._sock], [], 0.1)
 
     def read_response(self, code: int, servo_id, timeout=None, deadline=None):
         """Content of the next response with this packet number from this

@@ -6,12 +6,13 @@ against the wire's; stream_file runs a CSV trajectory and reports how
 closely the servos followed it."""
 import csv
 import math
+import struct
 from dataclasses import dataclass
 
 from . import protocol as p
 from .checks import check_range, scaled
 from .errors import UsageError
-from .group import MAX_SYNC_RECORDS, sync_monitor
+from .group import MAX_SYNC_RECORDS, monitor_answers, monitor_request
 
 MAX_ANGLE_DECIDEG = 3686400    # the multi-turn range (ReadMultiTurnAngle)
 MAX_SPEED_DECIDEG_S = 7500     # the firmware clamps beyond (schema.toml)
@@ -44,6 +45,10 @@ class Stream:
         self.period_ms = check_range("period", scaled(period_s, 1000, "period_s"), *PERIOD_RANGE_MS, "ms")
         self.sent = 0
         self._last = {}
+        # Every record of a send in one pack: a robot's loop builds this
+        # frame each cycle, between a state's arrival and the next write.
+        record = p.request_format(p.STREAM_SETPOINT)
+        self._records = struct.Struct(record[0] + record[1:] * len(self.ids))
 
     def frame_content(self, targets: dict, velocities: dict = None) -> tuple:
         """(code, content) of the next send: checks every value first."""
@@ -66,14 +71,15 @@ class Stream:
         for servo_id, angle, _ in records:
             self._last[servo_id] = angle
         code = p.STREAM_SETPOINT
+        body = self._records.pack(*(v for r in records for v in (*r, stamp)))
         if len(records) == 1:
-            return code, p.encode_request(code, *records[0], stamp)
-        body = b"".join(p.encode_request(code, *r, stamp) for r in records)
+            return code, body
         return p.SYNC, bytes([code, len(body) // len(records), len(records)]) + body
 
-    def send(self, targets: dict, velocities: dict = None) -> None:
-        code, content = self.frame_content(targets, velocities)
-        self.bus.send(code, content)
+    def send(self, targets: dict, velocities: dict = None, then=()) -> None:
+        """The setpoints, and the requests then (code, content) after them
+        in the same burst."""
+        self.bus.send_burst([self.frame_content(targets, velocities), *then])
         self.sent += 1
 
 
@@ -110,6 +116,7 @@ class RobotLoop:
         self.started = None
         self.missed = 0
         self.arrivals = {}  # {id: the bus clock when its last state arrived}
+        self._monitor = monitor_request(self.stream.ids)
 
     def cycle_bytes(self) -> int:
         ids = self.stream.ids
@@ -122,8 +129,10 @@ class RobotLoop:
     def cycle(self, targets: dict, velocities: dict = None) -> dict:
         if self.started is None:
             self.started = self.bus.clock()
-        self.stream.send(targets, velocities)
-        states = sync_monitor(self.bus, self.stream.ids, arrivals=self.arrivals)
+        # One write: the Sync Monitor follows the setpoints on the wire
+        # without a host's gap between them.
+        self.stream.send(targets, velocities, then=[self._monitor])
+        states = monitor_answers(self.bus, self.stream.ids, arrivals=self.arrivals)
         self.missed += len(self.stream.ids) - len(states)
         self.cycles += 1
         return states

@@ -16,6 +16,7 @@
 
 #include "host_baud.h"
 #include "sim_bus.h"
+#include "sim_clock.h"
 #include "sim_control.h"
 #include "sim_link.h"
 #include "sim_options.h"
@@ -76,6 +77,7 @@ static void run_to(uint64_t target)
             sim_servo_poll(&servos[i], bus.now_us);
         }
     } while (bus.now_us < target);
+    sim_clock_publish(bus.now_us);
 }
 
 static void on_signal(int sig)
@@ -94,6 +96,8 @@ int main(int argc, char **argv)
     mkdir(o.state_dir, 0755);
 
     sim_bus_init(&bus, sim_now_us());
+    char clock_path[256];
+    bool clock_mapped = sim_clock_open(o.state_dir, clock_path, sizeof clock_path);
     for (unsigned i = 0; i < o.id_count; i++) {
         servos[i].cpu = o.cpu;
         if (!sim_servo_start(&servos[i], &bus, i, o.ids[i], o.units[i], o.state_dir, &o.plant,
@@ -132,6 +136,9 @@ int main(int argc, char **argv)
         printf("servo_sim: link %s\n", o.link);
     }
     printf("servo_sim: control 127.0.0.1:%d\n", control.port);
+    if (clock_mapped) {
+        printf("servo_sim: clock %s\n", clock_path);
+    }
     printf("servo_sim: servos");
     for (unsigned i = 0; i < o.id_count; i++) {
         printf(" %u", o.ids[i]);

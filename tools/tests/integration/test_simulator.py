@@ -135,3 +135,20 @@ def test_a_request_the_moment_the_simulator_is_ready_finds_the_readings_taken(tm
     assert answer[:6] == p.response_frame(p.READ_DATA, bytes([1, 1, 0, 0]))[:6]
     voltage_mv = int.from_bytes(answer[6:8], "little")
     assert 7300 <= voltage_mv <= 7500, f"the supply read {voltage_mv} mV"
+
+
+def test_the_published_clock_is_the_control_ports_read_without_asking(sim):
+    """servo_sim's clock file (sim_clock.h) is what "clock" answers, and
+    reading it opens no control connection: a host that reads the clock
+    at every answer spends no simulated time on round trips."""
+    assert sim._clock_map is not None, "servo_sim published no clock file"
+    readings = [sim.clock_s() for _ in range(1000)]
+    assert readings == sorted(readings) and readings[-1] > 0
+    assert sim._clock_conn is None, "the clock was asked for on the control port"
+    for _ in range(20):
+        before = sim.clock_s()
+        asked = float(sim.control("clock").split()[0].split("=")[1]) / 1000
+        after = sim.clock_s()
+        assert before <= asked <= after
+    sim.sleep(0.05)  # waits on the mapped clock
+    assert sim.clock_s() - readings[-1] >= 0.05

@@ -1,0 +1,19 @@
+/* The bus clock where a host can read it without asking: a file in the
+ * state folder, mapped, holding the clock in microseconds (little-endian
+ * u64 at offset 0, written whole after every step). A host that reads the
+ * clock at every answer spends no simulated time on it, as a host on a
+ * real bus reads its own clock; "clock" on the control port stays. */
+#ifndef SIM_CLOCK_H
+#define SIM_CLOCK_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#define SIM_CLOCK_FILE "bus.clock"
+
+/* Maps state_dir/SIM_CLOCK_FILE; its path in path. False (and the clock
+ * only on the control port) where the system refuses. */
+bool sim_clock_open(const char *state_dir, char *path, unsigned path_size);
+void sim_clock_publish(uint64_t now_us);
+
+#endif

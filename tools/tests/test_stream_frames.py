@@ -1,0 +1,80 @@
+"""What a stream and a robot's loop put on the wire, byte for byte, and a
+simulator's socket read and written directly (protocol.Bus): no servo
+needed."""
+import socket
+import threading
+
+import pytest
+
+from servoctl import protocol as p
+from servoctl.protocol import LinkError, NoReply
+from servoctl.stream import RobotLoop, Stream
+
+
+class RecordingBus:
+    """Takes the requests; answers none of them."""
+
+    def __init__(self):
+        self.bursts = []
+        self.stamp_arrivals = True
+        self.serial = type("Port", (), {"baudrate": 1000000})()
+
+    def clock(self):
+        return 0.0
+
+    def send_burst(self, requests):
+        self.bursts.append(list(requests))
+
+    def read_response(self, code, servo_id, timeout=None, deadline=None):
+        raise NoReply("nobody here")
+
+
+def test_the_robot_loop_sends_its_setpoints_and_sync_monitor_in_one_write():
+    """One write a cycle: a host descheduled between two writes would leave
+    a gap on the wire between the setpoints and the Sync Monitor."""
+    bus = RecordingBus()
+    loop = RobotLoop(bus, [1, 2, 3], 0.02)
+    assert loop.cycle({1: 1.0, 2: 2.0, 3: 3.0}) == {}
+    assert loop.missed == 3
+    [(setpoints, monitor)] = bus.bursts
+    assert setpoints[0] == p.SYNC and setpoints[1][:3] == bytes([p.STREAM_SETPOINT, 9, 3])
+    assert monitor == (p.SYNC, bytes([p.MONITOR, 1, 3, 1, 2, 3]))
+
+
+@pytest.mark.parametrize("ids", [[7], [1, 2, 3, 4, 5, 6]])
+def test_a_streams_records_are_the_schemas_request(ids):
+    """The records packed at once are what encode_request lays out one by one."""
+    stream = Stream(RecordingBus(), ids, 0.02)
+    stream.sent = 3
+    code, content = stream.frame_content({i: 1.5 * i for i in ids}, {i: -2.0 * i for i in ids})
+    records = [p.encode_request(p.STREAM_SETPOINT, i, 15 * i, -20 * i, 60) for i in ids]
+    if len(ids) == 1:
+        assert (code, content) == (p.STREAM_SETPOINT, records[0])
+    else:
+        assert (code, content) == (p.SYNC, bytes([p.STREAM_SETPOINT, 9, len(ids)]) + b"".join(records))
+
+
+def test_a_socket_closed_by_the_simulator_is_a_link_error():
+    server = socket.socket()
+    server.bind(("127.0.0.1", 0))
+    server.listen(1)
+    got = []
+
+    def serve():
+        peer, _ = server.accept()
+        with peer:
+            got.append(peer.recv(64))
+            peer.sendall(p.response_frame(p.PING, bytes([4])))
+            got.append(peer.recv(64))  # the second request; then the connection goes
+
+    worker = threading.Thread(target=serve, daemon=True)
+    worker.start()
+    try:
+        with p.Bus(f"socket://127.0.0.1:{server.getsockname()[1]}", timeout=2.0) as bus:
+            assert bus.request(p.PING, bytes([4])) == bytes([4])
+            with pytest.raises(LinkError, match="closed the connection"):
+                bus.request(p.PING, bytes([4]))
+    finally:
+        worker.join(5)
+        server.close()
+    assert got == [p.request_frame(p.PING, bytes([4]))] * 2
