@@ -121,6 +121,7 @@ class Bus:
         # directly: pyserial's wrappers add a select to every call, and a
         # robot's loop makes some fifty calls a cycle.
         self._sock = sock
+        self._low_water = 1  # the socket's SO_RCVLOWAT (_wake_at)
         self._buffer = b""
         self.stray_bytes = 0  # bytes outside any frame: noise, or answers that collided
         self.stamp_arrivals = True
@@ -184,6 +185,8 @@ class Bus:
             if self._fd is not None:
                 import select
 
+                if self._sock is not None:
+                    self._wake_at(self._bytes_missing())
                 select.select([self._fd], [], [], 0.005)
             else:  # loop:// and other ports without a descriptor
                 time.sleep(0.0005)
@@ -193,6 +196,25 @@ class Bus:
                             f"terminal, the maker's tool): close it, then try again")
         self._buffer += data
         return bool(data)
+
+    def _bytes_missing(self) -> int:
+        """The fewest bytes that can complete the frame the buffer starts
+        (_take_frame has left it at a header, or empty)."""
+        buf = self._buffer
+        if len(buf) >= 4:
+            return max(1, 4 + buf[3] + 1 - len(buf))
+        return 5 - len(buf)  # header, code, length, checksum
+
+    def _wake_at(self, count: int) -> None:
+        """The socket reads as ready once count bytes are there: the host
+        wakes once a frame, not for each byte a simulator delivers as it
+        ends on the wire (and takes its CPU meanwhile). A read takes what
+        has come whatever the mark, and every wait is 5 ms at most."""
+        if count != self._low_water:
+            import socket
+
+            self._sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVLOWAT, count)
+            self._low_water = count
 
     def _read_now(self) -> bytes:
         """What has arrived, without waiting."""

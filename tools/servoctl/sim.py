@@ -185,6 +185,10 @@ class Simulator(_Child):
         simulator (a loaded PC slows it, it never stops it): ServoError."""
         if self._clock_map is not None:
             now = self._read_mapped_clock()
+            if now == self._clock_seen and self.process.poll() is not None:
+                # The file outlives the process: asked, the control port would refuse.
+                raise LinkError(f"servo_sim has stopped (exit status {self.process.returncode}): "
+                                f"its clock no longer moves")
         else:
             now = _fields(self._ask_clock())["sim_ms"] / 1000.0
         if now != self._clock_seen:
@@ -197,6 +201,8 @@ class Simulator(_Child):
         """The clock servo_sim publishes in a file (sim_clock.h): read in a
         microsecond, where asking the control port takes some 25 us of
         host time, which is simulated time on an idle PC."""
+        if self._clock_map is not None:
+            self._clock_map.close()  # a restarted simulator's file is mapped anew
         try:
             with open(path, "rb") as f:
                 self._clock_map = mmap.mmap(f.fileno(), 8, access=mmap.ACCESS_READ)
