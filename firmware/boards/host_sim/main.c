@@ -232,6 +232,9 @@ int main(int argc, char **argv)
     if (o.link) {
         unlink(o.link);
     }
+    if (clock_mapped) {
+        unlink(clock_path);
+    }
     printf("servo_sim: stopped (%lu collisions)\n", bus.collisions);
     return 0;
 }

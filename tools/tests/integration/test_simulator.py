@@ -152,3 +152,10 @@ def test_the_published_clock_is_the_control_ports_read_without_asking(sim):
         assert before <= asked <= after
     sim.sleep(0.05)  # waits on the mapped clock
     assert sim.clock_s() - readings[-1] >= 0.05
+
+
+def test_the_clock_file_goes_when_the_simulator_stops(tmp_path):
+    state = tmp_path / "state"
+    with Simulator(ids=[1], state_dir=str(state)):
+        assert (state / "bus.clock").stat().st_size == 8
+    assert not (state / "bus.clock").exists()
