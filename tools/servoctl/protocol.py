@@ -82,6 +82,11 @@ except ImportError:  # not on Windows
     _TERMIOS_ERRORS = ()
 
 
+# Host seconds a socket may take no bytes of a write before the link is
+# taken for dead (a simulator on a loaded PC takes them within a second).
+WRITE_STALL_S = 10.0
+
+
 class Bus:
     """A serial port (or pyserial URL such as socket://127.0.0.1:5000) with
     the request/response discipline of the protocol.
@@ -119,7 +124,7 @@ class Bus:
         self._fd = sock.fileno() if sock is not None else getattr(self.serial, "fd", None)
         # A socket (non-blocking, as pyserial opens it) is read and written
         # directly: pyserial's wrappers add a select to every call, and a
-        # robot's loop makes some fifty calls a cycle.
+        # robot's loop makes a call for each frame.
         self._sock = sock
         self._low_water = 1  # the socket's SO_RCVLOWAT (_wake_at)
         self._buffer = b""
@@ -230,14 +235,20 @@ class Bus:
 
     def _write_all(self, data: bytes) -> None:
         """data to the socket; a simulator whose line is still busy with
-        earlier bytes reads no more until it has room: waited for."""
+        earlier bytes reads no more until it has room: waited for, up to
+        WRITE_STALL_S of host time without a byte taken."""
         import select
 
         view = memoryview(data)
+        stalled_at = None
         while view:
             try:
                 view = view[self._sock.send(view):]
+                stalled_at = None
             except (BlockingIOError, InterruptedError):
+                stalled_at = stalled_at or time.monotonic()
+                if time.monotonic() - stalled_at > WRITE_STALL_S:
+                    raise OSError(f"nothing was taken for {WRITE_STALL_S:g} s") from None
                 select.select([], [self._sock], [], 0.1)
 
     def read_response(self, code: int, servo_id, timeout=None, deadline=None):
@@ -245,7 +256,7 @@ class Bus:
         servo (any servo if servo_id is None); other frames on the wire are
         skipped. It must come within timeout (the bus's if None), or by
         deadline on the bus clock. The bus clock is read as little as it
-        can be (the simulator's is a request to it): at the start, when
+        can be (a virtual board's is a request to it): at the start, when
         the line is idle, every 2 ms of a stream of other bytes, and to
         stamp the answer's arrival (arrived_at) if stamp_arrivals."""
         wait = self.timeout if timeout is None else timeout

@@ -78,3 +78,23 @@ def test_a_socket_closed_by_the_simulator_is_a_link_error():
         worker.join(5)
         server.close()
     assert got == [p.request_frame(p.PING, bytes([4]))] * 2
+
+
+def test_a_socket_that_takes_no_bytes_is_a_link_error_not_a_hang(monkeypatch):
+    """A peer that stops reading (a hung simulator): the write gives up
+    after WRITE_STALL_S of host time without a byte taken."""
+    monkeypatch.setattr(p, "WRITE_STALL_S", 0.3)
+    server = socket.socket()
+    server.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
+    server.bind(("127.0.0.1", 0))
+    server.listen(1)
+    try:
+        with p.Bus(f"socket://127.0.0.1:{server.getsockname()[1]}", timeout=0.1) as bus:
+            peer, _ = server.accept()  # never read
+            with peer:
+                ping = (p.PING, bytes([1]))
+                with pytest.raises(LinkError, match="nothing was taken for 0.3 s"):
+                    for _ in range(100):  # each burst 60 kB: the buffers fill in a few
+                        bus.send_burst([ping] * 10000)
+    finally:
+        server.close()
