@@ -69,6 +69,12 @@ def request_frame(code: int, content: bytes) -> bytes:
     return body + bytes([checksum(body)])
 
 
+def _frame_size(head: bytes) -> int:
+    """A response frame's bytes from its first four: header, code, the
+    content's length, the content, the checksum."""
+    return 4 + head[3] + 1
+
+
 def response_frame(code: int, content: bytes) -> bytes:
     body = RESPONSE_HEADER + bytes([code, len(content)]) + content
     return body + bytes([checksum(body)])
@@ -207,7 +213,7 @@ class Bus:
         (_take_frame has left it at a header, or empty)."""
         buf = self._buffer
         if len(buf) >= 4:
-            return max(1, 4 + buf[3] + 1 - len(buf))
+            return max(1, _frame_size(buf) - len(buf))
         return 5 - len(buf)  # header, code, length, checksum
 
     def _wake_at(self, count: int) -> None:
@@ -329,8 +335,7 @@ class Bus:
         self._buffer = buf
         if len(buf) < 5:
             return None
-        length = buf[3]
-        end = 4 + length + 1
+        end = _frame_size(buf)
         if len(buf) < end:
             return None
         self._buffer = buf[end:]
