@@ -113,8 +113,14 @@ void motion_coast(struct motion *m);
 /* ---- planning.c ---- */
 /* Runs a command now: its profile, or the mode it sets. */
 void motion_run(struct motion *m, const struct motion_command *cmd);
-/* The angle modes' top speed, 0.1 deg/s (docs/protocol.md, "Moves"). */
-enum { MAX_VELOCITY = 7500 };
+/* The angle modes' top speed, 0.1 deg/s, and their shortest ramp, ms
+ * (docs/protocol.md, "Moves"). */
+enum { MAX_VELOCITY = 7500, MIN_RAMP_MS = 20 };
+/* The one clamp of every position target (planning.c): angle_decideg
+ * (protocol frame) within +-range, then the angle limits (48, 51, 52) in the
+ * frame whose zero is base (decideg); sets angle_clamped. Q8 from the
+ * origin. */
+int32_t motion_target_q8(struct motion *m, int32_t angle_decideg, int32_t range, int32_t base);
 /* Starts following the profile just planned; then end (enum motion_end). */
 void motion_begin_profile(struct motion *m, uint8_t end);
 

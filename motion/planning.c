@@ -8,7 +8,6 @@
 /* Limits of docs/protocol.md, "Moves". */
 enum {
     SINGLE_TURN_LIMIT = 1800,
-    MIN_RAMP_MS = 20,
     MAX_INTERVAL_MS = 4096000,
     MIN_VELOCITY = 10,     /* 0.1 deg/s */
     MAX_WHEEL_SPEED = 750, /* deg/s, the angle modes' top speed */
@@ -85,23 +84,36 @@ static void plan_stop(struct motion *m, int64_t start, int64_t v0, uint32_t min_
 
 /* ---- commands ----------------------------------------------------------- */
 
-static int64_t angle_target(struct motion *m, const struct motion_command *cmd)
+/* Every position target passes here: angle and multi-turn moves (and so
+ * a SyncCommand's records, the async buffer's and the queue's, when they
+ * run) and streamed setpoints. The angle (protocol frame, 0.1 deg) is
+ * clamped to its packet's range, then, with the limits on (48), to 52..51
+ * in its own frame: base is the reading's turn a single-turn angle is taken
+ * in, 0 for a multi-turn one, so a multi-turn target stays within the
+ * limits of the reading itself (docs/decisions.md, "The angle limits hold
+ * for every target"). The limiter says angle when the target moved. */
+int32_t motion_target_q8(struct motion *m, int32_t angle_decideg, int32_t range, int32_t base)
 {
     const struct user_config *cfg = &m->regs->user;
-    if (cmd->multi_turn) {
-        int32_t angle = clamp_i32(cmd->angle_decideg, -MULTI_TURN_LIMIT, MULTI_TURN_LIMIT);
-        return (int64_t)angle * DECIDEG_Q32 + q8_to_q32(motion_center_offset_q8(m));
-    }
-    int32_t angle = clamp_i32(cmd->angle_decideg, -SINGLE_TURN_LIMIT, SINGLE_TURN_LIMIT);
+    int32_t angle = clamp_i32(angle_decideg, -range, range);
     if (cfg->angle_limit_on) {
         angle = clamp_i32(angle, cfg->angle_min_decideg, cfg->angle_max_decideg);
     }
-    m->angle_clamped = angle != cmd->angle_decideg;
-    /* A single-turn angle is within the turn the servo is in now. */
-    struct motion_angle now;
-    motion_read_angle(m, &now);
-    int32_t turn_base = now.multi_turn_decideg - now.single_turn_decideg;
-    return ((int64_t)turn_base + angle) * DECIDEG_Q32 + q8_to_q32(motion_center_offset_q8(m));
+    m->angle_clamped = angle != angle_decideg;
+    return (base + angle) * 256 + motion_center_offset_q8(m);
+}
+
+static int64_t angle_target(struct motion *m, const struct motion_command *cmd)
+{
+    int32_t base = 0, range = MULTI_TURN_LIMIT;
+    if (!cmd->multi_turn) {
+        /* A single-turn angle is within the turn the servo is in now. */
+        struct motion_angle now;
+        motion_read_angle(m, &now);
+        base = now.multi_turn_decideg - now.single_turn_decideg;
+        range = SINGLE_TURN_LIMIT;
+    }
+    return q8_to_q32(motion_target_q8(m, cmd->angle_decideg, range, base));
 }
 
 static void run_angle(struct motion *m, const struct motion_command *cmd)

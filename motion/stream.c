@@ -2,9 +2,19 @@
  * where the setpoint is (position and speed) to the host's, a cubic
  * (Hermite) one period long, walked at the tick rate; the segment's end
  * speed goes on until the next setpoint comes, and a period after that the
- * servo brakes to a hold (docs/streaming.md). Plans: divides. */
+ * servo brakes to a hold. A setpoint the cubic cannot reach within the
+ * stream's limits in its period is reached as a move at them instead
+ * (docs/streaming.md). Plans: divides. */
 #include "motion/motion_internal.h"
 #include "motion/saturate.h"
+
+/* The stream's limits, those of the angle modes: their top speed (750
+ * deg/s) and the steepest ramp a move asks, that speed in the shortest
+ * ramp (20 ms: 37 500 deg/s^2). Q8 decideg per tick, and per tick^2. */
+enum {
+    STREAM_SPEED_Q8 = MAX_VELOCITY * 256 / (int32_t)MOTION_TICK_HZ, /* 1920 */
+    STREAM_ACCEL_Q8 = STREAM_SPEED_Q8 / MIN_RAMP_MS,                /* 96 */
+};
 
 /* The period: item 69 if set, else the step between the host's stamps
  * (learned while a stream runs; 20 ms, 50 Hz, until then: motion_init). */
@@ -17,6 +27,46 @@ static uint32_t stream_period(struct motion *m, uint16_t host_ms)
     }
     uint32_t period = m->regs->firmware.stream_period_ms;
     return period != 0u ? period : m->stream_period_ms;
+}
+
+/* |v| <= limit, limit >= 0. */
+static bool within(int32_t v, int32_t limit)
+{
+    return (uint32_t)(v + limit) <= 2u * (uint32_t)limit;
+}
+
+/* The cubic over t ticks keeps within the limits. In Bezier form its speed
+ * is the quadratic through v0, w = 3 d / t - v0 - v1 and v1, never beyond
+ * the largest of the three (|v0|, |v1| are within the speed), and its
+ * acceleration is linear, from 2 (w - v0) / t to 2 (v1 - w) / t: each side
+ * x t (no division; every product within 2^27). */
+static bool segment_within(int32_t d, int32_t v0, int32_t v1, int32_t t)
+{
+    if (!within(d, PROFILE_MAX_SEGMENT_DISTANCE)) {
+        return false;
+    }
+    int32_t e = 3 * d - (v0 + v1) * t;
+    int32_t a = STREAM_ACCEL_Q8 * t * t / 2;
+    return within(e, STREAM_SPEED_Q8 * t) && within(e - v0 * t, a) && within(e - v1 * t, a);
+}
+
+/* From start moving at v0 to rest at target within the limits: a ramp of
+ * 2 x MIN_RAMP ticks from v0 to the cruise V, a ramp of MIN_RAMP to rest,
+ * and a cruise long enough that |V| is within the top speed (ramps and
+ * cruise at it cover d, the cruise rounded up). The first ramp changes
+ * the speed by at most twice the top speed, the second by it: neither is
+ * steeper than the limit. Any distance (a multi-turn target): |d| < 2^31,
+ * a 32-bit cruise. Not the fastest such move (that needs a square root,
+ * and a trim of the ramps for whole ticks, which the M0 has no room for):
+ * at most 60 ms slower. */
+static void plan_at_limits(struct profile *p, int32_t start, int32_t v0, int32_t target)
+{
+    int32_t d = target - start;
+    int32_t u = d < 0 ? -v0 : v0; /* towards the target */
+    int32_t rest = (d < 0 ? -d : d) - (u + STREAM_SPEED_Q8) * MIN_RAMP_MS - STREAM_SPEED_Q8 * MIN_RAMP_MS / 2;
+    uint32_t cruise = rest > 0 ? ((uint32_t)rest + STREAM_SPEED_Q8 - 1u) / STREAM_SPEED_Q8 : 0u;
+    profile_plan(p, q8_to_q32(start), q8_to_q32(v0), q8_to_q32(target),
+                 (struct profile_timing){2u * MIN_RAMP_MS, cruise, MIN_RAMP_MS});
 }
 
 enum motion_submit_result motion_stream(struct motion *m, const struct motion_setpoint *sp)
@@ -34,23 +84,25 @@ enum motion_submit_result motion_stream(struct motion *m, const struct motion_se
     int32_t v0 = 0;
     if (m->mode == MODE_POSITION) {
         start = m->setpoint_q8;
-        v0 = sat_q(start - m->last_setpoint_q8, PROFILE_MAX_SEGMENT_SPEED);
+        v0 = clamp_i32(start - m->last_setpoint_q8, -STREAM_SPEED_Q8, STREAM_SPEED_Q8);
     }
-    int32_t angle = clamp_i32(sp->angle_decideg, -MULTI_TURN_LIMIT, MULTI_TURN_LIMIT);
-    int32_t distance = sat_q(angle * 256 + motion_center_offset_q8(m) - start,
-                             PROFILE_MAX_SEGMENT_DISTANCE);
+    int32_t target = motion_target_q8(m, sp->angle_decideg, MULTI_TURN_LIMIT, 0);
     /* 0.1 deg/s to Q8 decideg per tick: x 256 / 1000, as 16777 / 2^16
      * (an arithmetic shift: toward minus infinity, under 2^-8 decideg). */
     int32_t v1 = (clamp_i32(sp->velocity_decideg_s, -MAX_VELOCITY, MAX_VELOCITY) * 16777) >> 16;
 
     m->queue.count = 0;
-    m->angle_clamped = 0;
     m->answer_packet = 0;
     m->power_mw = 0;
     motion_update_limits(m);
-    profile_plan_segment(&m->profile, start, v0, start + distance, v1, period);
+    bool cubic = segment_within(target - start, v0, v1, (int32_t)period);
+    if (cubic) {
+        profile_plan_segment(&m->profile, start, v0, target, v1, period);
+    } else {
+        plan_at_limits(&m->profile, start, v0, target);
+    }
     motion_begin_profile(m, END_HOLD);
-    m->endless = v1 != 0;
+    m->endless = cubic && v1 != 0;
     m->streaming = 1;
     m->endless_until = 2u * period;
     return MOTION_ACCEPTED;

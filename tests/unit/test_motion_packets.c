@@ -124,9 +124,43 @@ static void test_single_turn_targets_are_clamped_to_the_limits(void **state)
     assert_int_equal(angle_now(), 1800);
 }
 
+/* Issue 55, 1: the limits (on, 135.0 deg) hold multi-turn targets too, in
+ * the reading's own frame (a multi-turn 300.0 deg is not -60.0 deg of the
+ * next turn), and a SyncCommand's records; the limiter says angle. */
+static void test_multi_turn_and_sync_targets_keep_to_the_limits(void **state)
+{
+    (void)state;
+    REQUEST(PKT_MOVE_MULTI_TURN, 0, 0xB8, 0x0B, 0, 0, 0xF4, 0x01, 0, 0, 0, 0); /* 300.0 deg, 500 ms */
+    run_until_done(2000);
+    assert_int_equal(angle_now(), 1350);
+    assert_int_equal(motion_limiter(&servo.motion), LIMITER_ANGLE);
+    /* 15: -400 000.0 deg at 300 deg/s, 20 ms ramps */
+    REQUEST(PKT_MOVE_MULTI_TURN_BY_VELOCITY, 0, 0x00, 0xF7, 0xC2, 0xFF, 0xB8, 0x0B, 20, 0, 20, 0, 0, 0);
+    run_until_done(2000);
+    assert_int_equal(angle_now(), -1350);
+    assert_int_equal(motion_limiter(&servo.motion), LIMITER_ANGLE);
+    REQUEST(PKT_MOVE_MULTI_TURN, 0, 0xE8, 0x03, 0, 0, 0xF4, 0x01, 0, 0, 0, 0); /* 100.0 deg: within */
+    run_until_done(2000);
+    assert_int_equal(angle_now(), 1000);
+    assert_int_equal(motion_limiter(&servo.motion), LIMITER_NONE);
+    /* A SyncCommand of multi-turn moves: servo 4's and ours, 720.0 deg. */
+    const uint8_t sync[] = {PKT_MOVE_MULTI_TURN, 11, 2, 4, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0,
+                            0, 0x20, 0x1C, 0, 0, 0xF4, 0x01, 0, 0, 0, 0};
+    harness_request(PKT_SYNC_COMMAND, sync, sizeof sync);
+    run_until_done(2000);
+    assert_int_equal(angle_now(), 1350);
+    assert_int_equal(motion_limiter(&servo.motion), LIMITER_ANGLE);
+    /* The limits are in the reading's frame, after the center offset. */
+    WRITE_ITEM(0, ITEM_CENTER_OFFSET_DECIDEG, 100);
+    REQUEST(PKT_MOVE_MULTI_TURN, 0, 0xB8, 0x0B, 0, 0, 0xF4, 0x01, 0, 0, 0, 0);
+    run_until_done(2000);
+    assert_int_equal(angle_now(), 1350);
+}
+
 static void test_single_turn_angle_is_within_the_current_turn(void **state)
 {
     (void)state;
+    WRITE_ITEM(0, ITEM_ANGLE_LIMIT_ON, 0); /* multi-turn work: the limits would hold it in them */
     REQUEST(PKT_MOVE_MULTI_TURN, 0, 0x10, 0x0E, 0, 0, 0xB8, 0x0B, 0, 0, 0, 0); /* 360.0 deg, 3 s */
     run_until_done(4000);
     REQUEST(PKT_MOVE_ANGLE, 0, 0x84, 0x03, 0xF4, 0x01, 0x00, 0x00); /* 90.0 */
@@ -140,6 +174,7 @@ static void test_single_turn_angle_is_within_the_current_turn(void **state)
 static void test_multi_turn_target_is_clamped(void **state)
 {
     (void)state;
+    WRITE_ITEM(0, ITEM_ANGLE_LIMIT_ON, 0); /* multi-turn work: the limits would hold it in them */
     /* 400 000.0 deg asked, 368 640.0 deg (1024 turns) allowed; 10 s. */
     REQUEST(PKT_MOVE_MULTI_TURN, 0, 0x00, 0x09, 0x3D, 0x00, 0x10, 0x27, 0x00, 0x00, 0x00, 0x00);
     run_until_done(11000);
@@ -352,6 +387,7 @@ static void test_new_move_replaces_the_running_one_smoothly(void **state)
 static void test_reset_turns_and_origin_only_when_released(void **state)
 {
     (void)state;
+    WRITE_ITEM(0, ITEM_ANGLE_LIMIT_ON, 0); /* multi-turn work: the limits would hold it in them */
     WRITE_ITEM(0, ITEM_CONTROL_RESPONSE, 1);
     REQUEST(PKT_MOVE_MULTI_TURN, 0, 0x10, 0x1F, 0, 0, 0xB8, 0x0B, 0, 0, 0, 0); /* 795.2 deg */
     run_until_done(4000);
@@ -532,6 +568,7 @@ int main(void)
         cmocka_unit_test_setup(test_single_turn_targets_are_clamped_to_the_limits, setup),
         cmocka_unit_test_setup(test_single_turn_angle_is_within_the_current_turn, setup),
         cmocka_unit_test_setup(test_multi_turn_target_is_clamped, setup),
+        cmocka_unit_test_setup(test_multi_turn_and_sync_targets_keep_to_the_limits, setup),
         cmocka_unit_test_setup(test_interval_shorter_than_ramps_is_clamped, setup),
         cmocka_unit_test_setup(test_velocity_is_clamped, setup),
         cmocka_unit_test_setup(test_velocity_profile_worked_examples, setup),

@@ -155,23 +155,24 @@ static void test_a_late_stream_brakes_to_a_hold(void **state)
 static void test_the_period_is_learned_or_told(void **state)
 {
     (void)state;
+    /* Steps of 0.3 deg: segments within the stream's limits. */
     stream(0, 0, 0, 1000);
     assert_int_equal(servo.motion.profile.accel_ticks, 20); /* nothing learned yet: 50 Hz */
     harness_run_ms(10);
-    stream(0, 10, 0, 1010);
+    stream(0, 3, 0, 1010);
     assert_int_equal(servo.motion.stream_period_ms, 10);
     assert_int_equal(servo.motion.profile.accel_ticks, 10);
     harness_run_ms(10);
-    stream(0, 20, 0, 1020);
+    stream(0, 6, 0, 1020);
     assert_int_equal(servo.motion.profile.accel_ticks, 10);
     WRITE_ITEM(0, ITEM_STREAM_PERIOD_MS, 30); /* told: the stamps no longer count */
     harness_run_ms(10);
-    stream(0, 30, 0, 1030);
+    stream(0, 9, 0, 1030);
     assert_int_equal(servo.motion.profile.accel_ticks, 30);
     /* A stamp from another stream (a gap of more than PROFILE_MAX_SEGMENT)
      * teaches nothing. */
     WRITE_ITEM(0, ITEM_STREAM_PERIOD_MS, 0);
-    stream(0, 30, 0, 5000);
+    stream(0, 9, 0, 5000);
     assert_int_equal(servo.motion.profile.accel_ticks, 10);
 }
 
@@ -215,6 +216,164 @@ static void test_a_broadcast_setpoint_is_taken_silently(void **state)
     assert_false(servo.motion.running);
 }
 
+static int32_t read_item(enum data_item_id item)
+{
+    REQUEST(PKT_READ_DATA, 0, (uint8_t)item);
+    assert_true(hal.sent_length >= 8u);
+    return ANSWER_FIELD(PKT_READ_DATA, 2, hal.sent_length - 7u, 0);
+}
+
+/* Issue 55, 1: with the limits on (the factory's, 135 deg), a setpoint of
+ * 300 deg, alone or as a SyncCommand's record, leaves the horn at the
+ * limit, and the limiter says angle; one within them says nothing. */
+static void test_a_streamed_setpoint_keeps_to_the_angle_limits(void **state)
+{
+    (void)state;
+    stream(0, 3000, 0, 0);
+    harness_run_ms(1500);
+    printf("# a setpoint of 300 deg, limits +-135: the horn at %.2f deg\n", plant_angle_deg(&plant));
+    assert_true(fabs(plant_angle_deg(&plant) - 135.0) < 0.2);
+    assert_int_equal(read_item(ITEM_LIMITER), LIMITER_ANGLE);
+    uint32_t a = (uint32_t)-3000;
+    const uint8_t sync[] = {PKT_STREAM_SETPOINT, 9, 1, 0, (uint8_t)a, (uint8_t)(a >> 8), (uint8_t)(a >> 16),
+                            (uint8_t)(a >> 24), 0, 0, 20, 0};
+    harness_request(PKT_SYNC_COMMAND, sync, sizeof sync);
+    harness_run_ms(2000);
+    assert_true(fabs(plant_angle_deg(&plant) + 135.0) < 0.2);
+    assert_int_equal(read_item(ITEM_LIMITER), LIMITER_ANGLE);
+    stream(0, 100, 0, 40);
+    harness_run_ms(1500);
+    assert_true(fabs(plant_angle_deg(&plant) - 10.0) < 0.2);
+    assert_int_equal(read_item(ITEM_LIMITER), LIMITER_NONE);
+    /* Off, the stream goes beyond them. */
+    WRITE_ITEM(0, ITEM_ANGLE_LIMIT_ON, 0);
+    stream(0, 3000, 0, 60);
+    harness_run_ms(2000);
+    assert_true(fabs(plant_angle_deg(&plant) - 300.0) < 0.2);
+}
+
+/* The limits a stream keeps to (docs/streaming.md), deg/s and deg/s^2. */
+#define SPEED_LIMIT 750.0
+#define ACCEL_LIMIT 37500.0
+/* The walk's last step takes up its rounding (under 2^-32 decideg a
+ * tick): on a move across the whole multi-turn range, 5 deg/s^2. */
+#define WALK_ROUNDING 1.001
+
+struct peaks {
+    double speed, accel; /* deg/s, deg/s^2 */
+    uint32_t ticks;      /* until the plan rests or runs on at its end speed */
+};
+
+/* The plan the last setpoint made, walked as the tick walks it (Q32
+ * decideg per tick to deg/s: x 100 / 2^32), from the speed it started at. */
+static struct peaks plan_peaks(void)
+{
+    const struct profile *p = &servo.motion.profile;
+    struct profile_walk w;
+    profile_walk_begin(&w, p);
+    int64_t last = profile_origin(p), last_step = p->v0;
+    struct peaks k = {0, 0, 0};
+    uint32_t end = p->total_ticks != UINT32_MAX ? p->total_ticks : p->accel_ticks + 2u;
+    for (uint32_t t = 1; t <= end + 1u; t++) {
+        int64_t step = w.at - last;
+        double speed = fabs((double)step) / 4294967296.0 * 100.0;
+        double accel = fabs((double)(step - last_step)) / 4294967296.0 * 1e5;
+        k.speed = speed > k.speed ? speed : k.speed;
+        k.accel = accel > k.accel ? accel : k.accel;
+        last = w.at;
+        last_step = step;
+        profile_walk_next(&w, p);
+    }
+    k.ticks = end;
+    return k;
+}
+
+/* Issue 55, 1: a 100 deg step in 20 ms from rest asked 7 500 deg/s of the
+ * cubic. Now the setpoint is reached as a move at the stream's limits:
+ * 750 deg/s at most, 37 500 deg/s^2. */
+static void test_a_step_keeps_to_the_speed_and_acceleration_limits(void **state)
+{
+    (void)state;
+    stream(0, 0, 0, 0);
+    harness_run_ms(20);
+    stream(0, 1000, 0, 20);
+    struct peaks k = plan_peaks();
+    harness_run_ms(1000);
+    printf("# a 100 deg step in 20 ms: planned over %u ms, peak %.1f deg/s and %.0f deg/s^2; the horn at %.2f deg\n",
+           k.ticks, k.speed, k.accel, plant_angle_deg(&plant));
+    assert_true(k.speed <= SPEED_LIMIT && k.accel <= ACCEL_LIMIT * WALK_ROUNDING);
+    assert_true(k.ticks >= 100000u / 750u);
+    assert_true(fabs(plant_angle_deg(&plant) - 100.0) < 0.2);
+}
+
+/* Random setpoints (limits off: +-400 deg, +-900 deg/s asked, 5-100 ms
+ * periods, sent at any moment of the last segment, so from every speed
+ * the stream reaches): no plan asks more than the limits, whether a cubic
+ * or a move at them. */
+enum { TRIALS = 3000 };
+
+static void test_no_setpoint_asks_more_than_the_limits(void **state)
+{
+    (void)state;
+    WRITE_ITEM(0, ITEM_ANGLE_LIMIT_ON, 0);
+    uint64_t rng = 0x9E3779B97F4A7C15u;
+    struct peaks worst = {0, 0, 0};
+    unsigned moves = 0;
+    uint16_t host_ms = 0;
+    for (int trial = 0; trial < TRIALS; trial++) {
+        rng ^= rng << 13;
+        rng ^= rng >> 7;
+        rng ^= rng << 17;
+        uint32_t r = (uint32_t)(rng >> 20);
+        uint16_t period = (uint16_t)(5u + r % 96u);
+        int32_t angle = (int32_t)((r >> 7) % 8001u) - 4000;
+        /* Mostly near the last one (a stream), now and then far. */
+        if (r & 0x10000000u) {
+            angle = (int32_t)lround(setpoint_deg() * 10.0) + angle / 40;
+        }
+        int16_t velocity = (int16_t)((int32_t)((r >> 3) % 18001u) - 9000);
+        WRITE_ITEM(0, ITEM_STREAM_PERIOD_MS, period);
+        stream(0, angle, velocity, host_ms);
+        struct peaks k = plan_peaks();
+        moves += servo.motion.profile.accel_j == 0;
+        if (k.accel > ACCEL_LIMIT || k.speed > SPEED_LIMIT) {
+            printf("# over: trial %d, %d decideg at %d decideg/s, %u ms: %.2f deg/s, %.0f deg/s^2\n", trial, angle,
+                   velocity, period, k.speed, k.accel);
+        }
+        worst.speed = k.speed > worst.speed ? k.speed : worst.speed;
+        worst.accel = k.accel > worst.accel ? k.accel : worst.accel;
+        uint32_t wait = 1u + (r >> 11) % (2u * period);
+        host_ms = (uint16_t)(host_ms + wait);
+        harness_run_ms(wait);
+    }
+    printf("# %d random setpoints (%u as moves at the limits): the plans' peaks %.2f deg/s, %.0f deg/s^2\n", TRIALS,
+           moves, worst.speed, worst.accel);
+    assert_true(worst.speed <= SPEED_LIMIT);
+    assert_true(worst.accel <= ACCEL_LIMIT * WALK_ROUNDING);
+    assert_true(moves > TRIALS / 10 && moves < TRIALS * 9 / 10);
+}
+
+/* Issue 55, 6: a setpoint 2000 deg away stopped at 1638.5 deg (one
+ * segment's reach) without a word. It is reached, at the stream's top
+ * speed; the whole multi-turn range is planned the same way. */
+static void test_a_far_setpoint_is_reached(void **state)
+{
+    (void)state;
+    WRITE_ITEM(0, ITEM_ANGLE_LIMIT_ON, 0);
+    stream(0, 20000, 0, 0);
+    assert_int_equal(servo.motion.target_q8, 20000 * 256);
+    harness_run_ms(9000);
+    printf("# a setpoint 2000 deg away: the horn at %.2f deg\n", plant_angle_deg(&plant));
+    assert_true(fabs(plant_angle_deg(&plant) - 2000.0) < 0.2);
+    assert_false(servo.motion.running);
+    stream(0, -3686400, 0, 20);
+    struct peaks k = plan_peaks();
+    assert_int_equal(servo.motion.target_q8, -3686400 * 256);
+    printf("# and to -368 640 deg: over %u ms, peak %.2f deg/s, %.0f deg/s^2\n", k.ticks, k.speed, k.accel);
+    assert_true(k.speed <= SPEED_LIMIT && k.accel <= ACCEL_LIMIT * WALK_ROUNDING);
+    assert_true(k.ticks >= (uint32_t)((368640.0 + 2000.0) / SPEED_LIMIT * 1000.0));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -224,6 +383,10 @@ int main(void)
         cmocka_unit_test_setup(test_the_host_clock_wraps, plant_harness_setup),
         cmocka_unit_test_setup(test_a_stream_takes_over_a_move, plant_harness_setup),
         cmocka_unit_test_setup(test_a_broadcast_setpoint_is_taken_silently, plant_harness_setup),
+        cmocka_unit_test_setup(test_a_streamed_setpoint_keeps_to_the_angle_limits, plant_harness_setup),
+        cmocka_unit_test_setup(test_a_step_keeps_to_the_speed_and_acceleration_limits, plant_harness_setup),
+        cmocka_unit_test_setup(test_no_setpoint_asks_more_than_the_limits, plant_harness_setup),
+        cmocka_unit_test_setup(test_a_far_setpoint_is_reached, plant_harness_setup),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
