@@ -8,10 +8,11 @@ multi-turn because of its value or because of what else is in the command.
 The firmware takes a single-turn target within the turn the horn is in now
 (docs/decisions.md), so at 720 deg "10" would mean 730 deg. servoctl sends a
 single-turn move only to a servo in turn 0, where the two readings agree,
-and refuses otherwise, saying how to get back. The firmware clamps a
-single-turn target to the angle limits (48, 51, 52) but lets a multi-turn
-one pass them; servoctl refuses a target outside the limits in both modes,
-so that a limit set on a servo holds for every move servoctl makes."""
+and refuses otherwise, saying how to get back. The firmware clamps every
+target to the angle limits (48, 51, 52): a single-turn one within its turn,
+a multi-turn or streamed one in this frame; servoctl refuses a target
+outside the limits in both modes before sending, rather than let the
+servo stop short of it."""
 from dataclasses import dataclass
 
 from .protocol import BadAnswer, NoReply, Refused, ValueOutOfRange
@@ -59,10 +60,9 @@ def check_target(s, angle: int, multi_turn: bool) -> Where:
                       f"Nothing was sent") from None
     cfg = where.cfg
     if cfg["angle_limit_on"] and not cfg["angle_min"] <= angle <= cfg["angle_max"]:
-        mode = "; the servo does not limit a multi-turn move itself" if multi_turn else ""
         raise ValueOutOfRange(
             f"servo {s.id} limits its angle to {_deg(cfg['angle_min'])}..{_deg(cfg['angle_max'])} "
-            f"(angle_min, angle_max, angle_limit_on): {_deg(angle)} is outside them{mode}. "
+            f"(angle_min, angle_max, angle_limit_on): {_deg(angle)} is outside them. "
             f"Change the limits, or turn them off with 'servoctl config set {s.id} angle_limit_on 0'")
     base = turn_base(where.at)
     if not multi_turn and base != 0:

@@ -55,7 +55,7 @@ def test_move_to_beyond_a_turn_or_the_limits_is_refused_before_sending(sim):
         with pytest.raises(ValueOutOfRange, match="beyond a single turn.*multi_turn=True"):
             s.move_to(200.0, wait=True)
         with pytest.raises(ValueOutOfRange, match=r"limits its angle to -135.0 deg..135.0 deg.*"
-                                                  r"does not limit a multi-turn move"):
+                                                  r"outside them"):
             s.move_to(200.0, multi_turn=True, wait=True)
         with pytest.raises(ValueOutOfRange, match="outside them"):
             s.move_to(170.0, wait=True)  # was sent, and clamped by the servo

@@ -1,0 +1,49 @@
+"""Issue 55's stream repros (items 1 and 6) on both virtual boards, the
+shipped images as flashed: with the angle limits on (135 deg), a streamed
+setpoint of 300 deg leaves the horn at the limit and the limiter says
+angle; a setpoint 2000 deg away is planned to the end (it stopped at
+1638.5 deg) at no more than the stream's top speed. Time is the boards'
+simulated time."""
+import pytest
+
+from servoctl import protocol as p
+from servoctl.servo import Servo
+from servoctl.sim import Simulator
+
+from .test_virtual_boards import BOARDS, finish
+
+
+@pytest.fixture(params=BOARDS)
+def one(request, tmp_path):
+    sim = Simulator(ids=(1,), tcp=True, state_dir=str(tmp_path / "state"), board=request.param).start()
+    try:
+        with sim.bus(timeout=0.3) as bus:
+            servo = Servo(bus, 1)
+            servo.write("soft_start_on", 0)
+            yield sim, bus, servo
+    finally:
+        finish(sim, [1])
+
+
+def setpoint(bus, decideg, host_ms=0):
+    bus.send(p.STREAM_SETPOINT, p.encode_request(p.STREAM_SETPOINT, 1, decideg, 0, host_ms))
+
+
+def test_a_streamed_setpoint_keeps_to_the_limits(one):
+    sim, bus, servo = one
+    servo.write("angle_limit_on", 1)
+    servo.write("angle_max", 1350)
+    setpoint(bus, 3000)
+    sim.wait_until(lambda: servo.read_motion().flags & servo.read_motion().PROFILE_ENDED, 3.0)
+    sim.sleep(0.4)
+    snap = servo.read_motion()
+    assert 1345 <= snap.angle_decideg <= 1352, snap
+    assert snap.limiter == "angle", snap
+    servo.write("angle_limit_on", 0)
+    setpoint(bus, 20000, host_ms=20)
+    start = servo.read_motion()
+    assert start.target_decideg == 20000, start
+    sim.sleep(0.5)
+    later = servo.read_motion()
+    speed = (later.setpoint_decideg - start.setpoint_decideg) / 10 / later.seconds_since(start)
+    assert 0 < speed <= 750.5, speed
