@@ -61,9 +61,10 @@ static bool segment_within(int32_t d, int32_t v0, int32_t v1, int32_t t)
  * at most 60 ms slower. */
 static void plan_at_limits(struct profile *p, int32_t start, int32_t v0, int32_t target)
 {
-    int32_t d = target - start;
-    int32_t u = d < 0 ? -v0 : v0; /* towards the target */
-    int32_t rest = (d < 0 ? -d : d) - (u + STREAM_SPEED_Q8) * MIN_RAMP_MS - STREAM_SPEED_Q8 * MIN_RAMP_MS / 2;
+    /* |d - 20 v0| is |d| - 20 u (u: v0 towards the target), or, where the
+     * two differ, under 20 |v0|: no cruise either way. */
+    int32_t d = target - start - v0 * MIN_RAMP_MS;
+    int32_t rest = (d < 0 ? -d : d) - STREAM_SPEED_Q8 * MIN_RAMP_MS * 3 / 2;
     uint32_t cruise = rest > 0 ? ((uint32_t)rest + STREAM_SPEED_Q8 - 1u) / STREAM_SPEED_Q8 : 0u;
     profile_plan(p, q8_to_q32(start), q8_to_q32(v0), q8_to_q32(target),
                  (struct profile_timing){2u * MIN_RAMP_MS, cruise, MIN_RAMP_MS});
