@@ -39,15 +39,21 @@ static bool within(int32_t v, int32_t limit)
  * is the quadratic through v0, w = 3 d / t - v0 - v1 and v1, never beyond
  * the largest of the three (|v0|, |v1| are within the speed), and its
  * acceleration is linear, from 2 (w - v0) / t to 2 (v1 - w) / t: each side
- * x t (no division; every product within 2^27). */
+ * x t (no division). |w| within the speed needs |d| within it x t first
+ * (|v0 + v1| is), which keeps every product within 2^25 and d within a
+ * segment's reach (profile.h). */
+_Static_assert(STREAM_SPEED_Q8 * (int32_t)PROFILE_MAX_SEGMENT <= PROFILE_MAX_SEGMENT_DISTANCE,
+               "a segment within the speed is within a segment's reach");
+
 static bool segment_within(int32_t d, int32_t v0, int32_t v1, int32_t t)
 {
-    if (!within(d, PROFILE_MAX_SEGMENT_DISTANCE)) {
+    int32_t s = STREAM_SPEED_Q8 * t;
+    if (!within(d, s)) {
         return false;
     }
     int32_t e = 3 * d - (v0 + v1) * t;
     int32_t a = STREAM_ACCEL_Q8 * t * t / 2;
-    return within(e, STREAM_SPEED_Q8 * t) && within(e - v0 * t, a) && within(e - v1 * t, a);
+    return within(e, s) && within(e - v0 * t, a) && within(e - v1 * t, a);
 }
 
 /* From start moving at v0 to rest at target within the limits: a ramp of
