@@ -73,6 +73,7 @@ def test_ping_and_the_data_table(one):
 
 def test_every_motion_packet(one):
     sim, bus, servo = one
+    servo.write("angle_limit_on", 0)  # multi-turn moves below: the limits would hold them within
     servo.move(450, interval_ms=300)                                   # 11
     sim.sleep(0.6)
     assert servo.angle() == pytest.approx(450, abs=2)
@@ -82,7 +83,6 @@ def test_every_motion_packet(one):
     servo.move(100, interval_ms=200, ramps=False)                       # 8
     sim.sleep(0.5)
     assert servo.angle() == pytest.approx(100, abs=2)
-    servo.write("angle_limit_on", 0)  # multi-turn work: the limits would hold it within them
     servo.move(4500, interval_ms=2000, multi_turn=True)                 # 14
     sim.sleep(2.4)
     angle, turns = servo.multi_turn_angle()                              # 16
