@@ -48,7 +48,7 @@ static bool program(void *ctx, uint32_t addr, const uint8_t *data)
     return ok && *cell == value;
 }
 
-static void flash_read(void *ctx, uint32_t addr, uint8_t *dst, uint32_t len)
+void flash_f0f1_read(void *ctx, uint32_t addr, uint8_t *dst, uint32_t len)
 {
     (void)ctx;
     const volatile uint8_t *src = (const volatile uint8_t *)(uintptr_t)addr;
@@ -66,6 +66,6 @@ void flash_f0f1_init(struct hal_flash *f, uint32_t page_size, uint32_t page0, ui
         .erase_page = erase_page,
         .write_block = 2,
         .program = program,
-        .read = flash_read,
+        .read = flash_f0f1_read,
     };
 }
