@@ -296,6 +296,8 @@ static void every_packet(void)
     QUIET("set_origin", 23, ID, 0);
     QUIET("reset_multi_turn", 17, ID);
     QUIET("move_angle", 8, ID, 0x84, 0x03, 0xF4, 0x01, 0, 0);
+    /* Under position control ReadMotion has more to say (its flags). */
+    ANSWER("read_motion_moving", 0x40, ID);
     QUIET("move_interval", 11, ID, 0x08, 0x07, 0xE8, 0x03, 0x64, 0, 0x64, 0, 0, 0);
     QUIET("move_velocity", 12, ID, 0x84, 0x03, 0xE8, 0x03, 0x64, 0, 0x64, 0, 0, 0);
     QUIET("move_multi_turn", 13, ID, 0x10, 0x0E, 0, 0, 0xE8, 0x03, 0, 0, 0, 0);
