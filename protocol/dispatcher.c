@@ -69,7 +69,10 @@ static void dispatch_packet(const struct packet_desc *desc, struct packet_call *
 
 static bool length_ok(const struct packet_desc *desc, const struct rx_frame *frame)
 {
-    return frame->length >= desc->length.min && frame->length <= desc->length.max &&
+    /* Saturated: a bounded max is below LENGTH_UNBOUNDED, so a longer
+     * length is still over it, and no min is above it. */
+    uint32_t length = frame->length < LENGTH_UNBOUNDED ? frame->length : LENGTH_UNBOUNDED;
+    return length >= desc->length.min && length <= desc->length.max &&
            !(frame->flags & (FRAME_TRUNCATED | FRAME_BAD_SYNC));
 }
 
