@@ -30,10 +30,12 @@ static bool answers(const struct dispatcher *d, uint8_t flags)
 /* Runs one packet for this servo: a frame's, or the record a SyncCommand
  * carries for it. */
 static void dispatch_packet(const struct packet_desc *desc, struct packet_call *call,
-                            struct response *response)
+                            struct response *response, struct packet_origin origin)
 {
+    /* origin: the caller's copy, in registers (the call's escapes to the
+     * handler, so each of its fields would be loaded again after a store). */
+    call->origin = origin;
     struct dispatcher *d = call->d;
-    struct packet_origin origin = call->origin;
     d->heard++;
     /* Answering packets would make every servo talk at once. */
     if (origin.broadcast && !(desc->flags & PF_BROADCAST)) {
@@ -108,7 +110,6 @@ void dispatch(struct dispatcher *d, const struct rx_frame *frame, struct respons
     call.d = d;
     call.content = frame->content;
     call.length = frame->length;
-    call.origin = origin;
     call.result = result;
     if (desc->flags & PF_CARRIES_RECORDS) {
         /* SyncCommand: this servo's record is the packet. It carries no ID,
@@ -123,7 +124,7 @@ void dispatch(struct dispatcher *d, const struct rx_frame *frame, struct respons
         }
         call.content = &frame->content[3];
         call.length = frame->content[1];
-        call.origin.from_sync = true;
+        origin.from_sync = true;
     }
-    dispatch_packet(desc, &call, response);
+    dispatch_packet(desc, &call, response, origin);
 }
