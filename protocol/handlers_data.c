@@ -114,14 +114,17 @@ enum packet_outcome handle_monitor(const struct packet_call *c, struct response 
     const struct status_area *s = &c->d->regs->status;
     struct motion_angle angle;
     motion_read_angle(c->d->motion, &angle);
-    uint8_t *p = r->content;
-    le_put_u16(&p[1], s->voltage_mv);
-    le_put_u16(&p[3], s->current_ma);
-    le_put_u16(&p[5], s->power_mw);
-    le_put_u16(&p[7], s->temperature_adc);
-    p[9] = s->status;
-    le_put_u32(&p[10], (uint32_t)angle.multi_turn_decideg);
-    le_put_u16(&p[14], (uint16_t)angle.turns);
+    uint32_t current = s->current_ma;
+    uint32_t temperature = s->temperature_adc;
+    uint32_t turn_angle = (uint32_t)angle.multi_turn_decideg;
+    /* The fields a content word at a time (as ReadStore's): voltage at
+     * byte 1, current 3, power 5, temperature 7, status 9, angle 10, turns
+     * 14. */
+    uint32_t *w = &r->words[1];
+    w[0] = r->content[0] | (uint32_t)s->voltage_mv << 8 | current << 24;
+    w[1] = current >> 8 | (uint32_t)s->power_mw << 8 | temperature << 24;
+    w[2] = temperature >> 8 | (uint32_t)s->status << 8 | turn_angle << 16;
+    w[3] = turn_angle >> 16 | (uint32_t)(uint16_t)angle.turns << 16;
     r->length = 16;
     return OUTCOME_OK;
 }
