@@ -32,6 +32,7 @@
 #include "ports/stm32_common/flash_f0f1.h"
 #include "support/frames.h"
 #include "doubles/hal_double.h"
+#include "doubles/ideal_encoder.h"
 #include "app/servo.h"
 #include "ports/stm32f1/stm32f1_regs.h"
 #include "ports/stm32_common/systick_clock.h"
@@ -257,6 +258,49 @@ static void latency(const char *name, uint8_t code, const uint8_t *content, size
     servo_poll(&servo);
 }
 
+/* The horn follows the setpoint exactly (for the move below). */
+static uint16_t follow(void *model)
+{
+    (void)model;
+    return servo.motion.mode == MODE_POSITION ? ideal_encoder_raw(&servo.motion) : hal.encoder_raw;
+}
+
+/* A move's answer when it has finished (item 33 on): the main-loop pass
+ * that sends it, in the servo's slot on a quiet line, no control tick in
+ * it (bench_motion counts those). The move runs first, unmeasured. */
+static void finished_move_answer(void)
+{
+    uint8_t frame[80];
+    size_t n = make_request(frame, 8, (const uint8_t[]){OWN_ID, 0x10, 0x00, 0x0A, 0x00, 0, 0}, 7);
+    dma_writes(frame, n);
+    printf("packet 8 finished\n");
+    hal.encoder_model = follow;
+    servo.next_tick_us = servo.tick_due_us = hal.now_us; /* the control loop runs again */
+    for (unsigned ms = 0; !motion_has_finished(&servo.motion); ms++) {
+        if (ms == 10000u) {
+            fprintf(stderr, "answer_move_finished: the move did not finish\n");
+            exit(1);
+        }
+        hal.now_us += 1000u;
+        cpu_runs();
+    }
+    uint32_t until = hal.now_us + 0x7FFFFFFFu;
+    while (usart.tx_busy == 0u) {
+        if ((int32_t)(hal.now_us - until) >= 0) {
+            fprintf(stderr, "answer_move_finished: no answer was sent\n");
+            exit(1);
+        }
+        hal.now_us += 50u;
+        servo.next_tick_us = servo.tick_due_us = hal.now_us + 0x7FFFFFFFu; /* no control tick inside */
+        bench_begin();
+        servo_poll(&servo);
+        bench_end(usart.tx_busy != 0u ? "answer_move_finished" : "waiting_for_the_slot");
+    }
+    transmission_ends();
+    servo_poll(&servo);
+    hal.encoder_model = NULL;
+}
+
 #define ID OWN_ID
 #define BYTES(...) (const uint8_t[]){__VA_ARGS__}, sizeof((const uint8_t[]){__VA_ARGS__})
 /* A packet the protocol answers, and one it does not. */
@@ -329,6 +373,10 @@ static void every_packet(void)
     ANSWER("assign_id", 0x42, 0xFF, (uint8_t)serial, (uint8_t)(serial >> 8), (uint8_t)(serial >> 16),
         (uint8_t)(serial >> 24), ID);
     ANSWER("clear_faults", 0x44, ID);
+    /* Item 33 on: moves are answered when they have finished. */
+    ANSWER("write_control_response", 4, ID, 33, 1);
+    finished_move_answer();
+    ANSWER("write_control_response_off", 4, ID, 33, 0);
     /* Refused while the servo holds, but answered. */
     ANSWER("update_enter", 0x50, ID);
 }

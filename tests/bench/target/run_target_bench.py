@@ -50,7 +50,8 @@ RESPONSE_BUDGET_US = {"cortex-m3": 20, "cortex-m0": 30}
 # programmed: this budget is the CPU's part; the flash's own
 # 24 half-words x 40-70 us (DS5319) come on top (docs/decisions.md).
 DURABLE_WRITE_BUDGET_US = {"cortex-m3": 200, "cortex-m0": 600}
-DURABLE_WRITES = ("answer_write_data", "answer_write_batch", "answer_reset_user_data")
+DURABLE_WRITES = ("answer_write_data", "answer_write_batch", "answer_reset_user_data",
+                  "answer_write_control_response", "answer_write_control_response_off")
 
 
 def budget_of(cpu: str, key: str):
@@ -246,6 +247,10 @@ def unmeasured(measured: list) -> list:
             missing.append(f"{packet['name']} (not measured)")
         elif "answers" in flags and "answer" not in kinds:
             missing.append(f"{packet['name']} (its answer not measured)")
+    # A move's answer once it has finished (item 33): one packet's stands
+    # for all (the same pass sends each).
+    if not any("finished" in kinds for kinds in seen.values()):
+        missing.append("the answer of a finished move (not measured)")
     return missing
 
 
