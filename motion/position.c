@@ -66,10 +66,17 @@ static int16_t saturate_i16(int32_t v)
     return (int16_t)v;
 }
 
-/* Errors this large (1638 deg) already saturate the answer's centidegrees;
- * clamped to it, x 10 stays in 32 bits (no 64-bit multiply on the M0).
+/* The tracking error's centidegrees ((Q8 x 5) >> 7), saturated to
+ * +-INT16_MAX: one clamp of the Q8 error to the range that maps within
+ * (5 x 838860 >> 7 = 32767, 5 x -838835 >> 7 = -32767), so x 5 stays in
+ * 32 bits (no 64-bit multiply on the M0) and no second saturation follows.
  * Inline: ReadMotion's answer has no time for a call on the M0. */
-#define TRACKING_ERROR_SPAN_Q8 (INT32_C(1) << 22)
+#define TRACKING_ERROR_MAX_Q8 838860
+#define TRACKING_ERROR_MIN_Q8 (-838835)
+_Static_assert((5 * TRACKING_ERROR_MAX_Q8) >> 7 == INT16_MAX && (5 * (TRACKING_ERROR_MAX_Q8 + 1)) >> 7 > INT16_MAX &&
+                   (5 * TRACKING_ERROR_MIN_Q8) >> 7 == -INT16_MAX &&
+                   (5 * (TRACKING_ERROR_MIN_Q8 - 1)) >> 7 < -INT16_MAX,
+               "the clamp's ends map to the saturation's");
 
 void motion_read_diagnostics(const struct motion *m, struct motion_diagnostics *out)
 {
@@ -78,7 +85,9 @@ void motion_read_diagnostics(const struct motion *m, struct motion_diagnostics *
     int32_t setpoint = controlled ? m->setpoint_q8 : m->measured_q8;
     /* decideg per tick Q8 to decideg per s: x 1000 / 256 = x 125 / 32. */
     int32_t error_q8 = setpoint - m->measured_q8;
-    int64_t target = controlled ? m->profile.target : q8_to_q32(m->measured_q8);
+    /* Q32 to Q8 first, rounded after: the same decidegree (a shift's floor
+     * taken twice is the floor of both), without 64-bit sums on the M0. */
+    int32_t target = controlled ? (int32_t)(m->profile.target >> 24) : m->measured_q8;
     /* The flags and motion_limiter()'s value, each test made once. */
     uint32_t flags = DIAG_RELEASED;
     uint32_t limiter = LIMITER_NONE;
@@ -95,13 +104,13 @@ void motion_read_diagnostics(const struct motion *m, struct motion_diagnostics *
     *out = (struct motion_diagnostics){
         .angle_decideg = q8_to_decideg(m->measured_q8 - offset),
         .setpoint_decideg = q8_to_decideg(setpoint - offset),
-        .target_decideg = (int32_t)((target - q8_to_q32(offset) + (DECIDEG_Q32 / 2)) >> 32),
+        .target_decideg = q8_to_decideg(target - offset),
         /* Shifts, not divisions: they round down (by less than the last
          * digit), where a division by a power of two rounds to zero at some
          * instructions' cost on the M0. */
         .velocity_decideg_s = saturate_i16((m->measured_velocity_q8 * 125) >> 5),
         .duty_q15 = m->damping_duty_q15, /* 0 outside damping and open loop */
-        .tracking_error_centideg = saturate_i16((sat_q_inline(error_q8, TRACKING_ERROR_SPAN_Q8) * 5) >> 7),
+        .tracking_error_centideg = (int16_t)((clamp_i32(error_q8, TRACKING_ERROR_MIN_Q8, TRACKING_ERROR_MAX_Q8) * 5) >> 7),
         .flags = (uint8_t)(flags | limiter << LIMITER_SHIFT),
     };
 }

@@ -30,10 +30,12 @@ static bool answers(const struct dispatcher *d, uint8_t flags)
 /* Runs one packet for this servo: a frame's, or the record a SyncCommand
  * carries for it. */
 static void dispatch_packet(const struct packet_desc *desc, struct packet_call *call,
-                            struct response *response)
+                            struct response *response, struct packet_origin origin)
 {
+    /* origin: the caller's copy, in registers (the call's escapes to the
+     * handler, so each of its fields would be loaded again after a store). */
+    call->origin = origin;
     struct dispatcher *d = call->d;
-    struct packet_origin origin = call->origin;
     d->heard++;
     /* Answering packets would make every servo talk at once. */
     if (origin.broadcast && !(desc->flags & PF_BROADCAST)) {
@@ -69,7 +71,10 @@ static void dispatch_packet(const struct packet_desc *desc, struct packet_call *
 
 static bool length_ok(const struct packet_desc *desc, const struct rx_frame *frame)
 {
-    return frame->length >= desc->length.min && frame->length <= desc->length.max &&
+    /* Saturated: a bounded max is below LENGTH_UNBOUNDED, so a longer
+     * length is still over it, and no min is above it. */
+    uint32_t length = frame->length < LENGTH_UNBOUNDED ? frame->length : LENGTH_UNBOUNDED;
+    return length >= desc->length.min && length <= desc->length.max &&
            !(frame->flags & (FRAME_TRUNCATED | FRAME_BAD_SYNC));
 }
 
@@ -105,7 +110,6 @@ void dispatch(struct dispatcher *d, const struct rx_frame *frame, struct respons
     call.d = d;
     call.content = frame->content;
     call.length = frame->length;
-    call.origin = origin;
     call.result = result;
     if (desc->flags & PF_CARRIES_RECORDS) {
         /* SyncCommand: this servo's record is the packet. It carries no ID,
@@ -120,7 +124,7 @@ void dispatch(struct dispatcher *d, const struct rx_frame *frame, struct respons
         }
         call.content = &frame->content[3];
         call.length = frame->content[1];
-        call.origin.from_sync = true;
+        origin.from_sync = true;
     }
-    dispatch_packet(desc, &call, response);
+    dispatch_packet(desc, &call, response, origin);
 }

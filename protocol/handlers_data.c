@@ -1,4 +1,5 @@
 /* Packets that read or write the register file: 1-6 and Monitor (22). */
+#include <stddef.h>
 #include <string.h>
 
 #include "registers/data_table.h"
@@ -84,21 +85,26 @@ enum packet_outcome handle_write_batch(const struct packet_call *c, struct respo
 }
 
 enum { READ_STORE_ANSWER_LENGTH = 34 };
-_Static_assert(READ_STORE_ANSWER_LENGTH <= RESPONSE_CONTENT_MAX, "ReadStore fits a response");
+_Static_assert(READ_STORE_ANSWER_LENGTH == 2 + 8 * 4 && READ_STORE_ANSWER_LENGTH <= RESPONSE_CONTENT_MAX &&
+                   offsetof(struct response, content) == sizeof(uint32_t) &&
+                   __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__,
+               "ReadStore fits a response, its content whole words, little-endian");
 
 enum packet_outcome handle_read_store(const struct packet_call *c, struct response *r)
 {
     const struct store_health *h = &c->d->regs->store;
-    uint8_t *p = r->content;
-    p[1] = h->flags;
-    le_put_u32(&p[2], h->records);
-    le_put_u32(&p[6], h->page_erases);
-    le_put_u32(&p[10], h->rated_cycles);
-    le_put_u32(&p[14], h->budget);
-    le_put_u32(&p[18], h->op_seconds);
-    le_put_u32(&p[22], h->failures);
-    le_put_u32(&p[26], h->answers_dropped);
-    le_put_u32(&p[30], h->bytes_lost);
+    const uint32_t counts[] = {h->records, h->page_erases, h->rated_cycles, h->budget,
+                               h->op_seconds, h->failures, h->answers_dropped, h->bytes_lost};
+    /* ID and flags, then the counts from content byte 2: a word of the
+     * content holds one's high half and the next one's low half (the M0
+     * stores a byte a store where a count is put at a time). */
+    uint32_t *w = &r->words[1];
+    uint32_t half = r->content[0] | (uint32_t)h->flags << 8;
+    for (unsigned i = 0; i < sizeof counts / sizeof counts[0]; i++) {
+        w[i] = half | counts[i] << 16;
+        half = counts[i] >> 16;
+    }
+    w[8] = half;
     r->length = READ_STORE_ANSWER_LENGTH;
     return OUTCOME_OK;
 }
@@ -108,14 +114,17 @@ enum packet_outcome handle_monitor(const struct packet_call *c, struct response 
     const struct status_area *s = &c->d->regs->status;
     struct motion_angle angle;
     motion_read_angle(c->d->motion, &angle);
-    uint8_t *p = r->content;
-    le_put_u16(&p[1], s->voltage_mv);
-    le_put_u16(&p[3], s->current_ma);
-    le_put_u16(&p[5], s->power_mw);
-    le_put_u16(&p[7], s->temperature_adc);
-    p[9] = s->status;
-    le_put_u32(&p[10], (uint32_t)angle.multi_turn_decideg);
-    le_put_u16(&p[14], (uint16_t)angle.turns);
+    uint32_t current = s->current_ma;
+    uint32_t temperature = s->temperature_adc;
+    uint32_t turn_angle = (uint32_t)angle.multi_turn_decideg;
+    /* The fields a content word at a time (as ReadStore's): voltage at
+     * byte 1, current 3, power 5, temperature 7, status 9, angle 10, turns
+     * 14. */
+    uint32_t *w = &r->words[1];
+    w[0] = r->content[0] | (uint32_t)s->voltage_mv << 8 | current << 24;
+    w[1] = current >> 8 | (uint32_t)s->power_mw << 8 | temperature << 24;
+    w[2] = temperature >> 8 | (uint32_t)s->status << 8 | turn_angle << 16;
+    w[3] = turn_angle >> 16 | (uint32_t)(uint16_t)angle.turns << 16;
     r->length = 16;
     return OUTCOME_OK;
 }

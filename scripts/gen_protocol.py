@@ -61,8 +61,11 @@ def packet_codes_h(s: sch.Schema) -> str:
 
 
 def _length_rule(p: sch.Packet) -> str:
+    """A byte each (packet_table.h): no upper bound is LENGTH_UNBOUNDED."""
     least, most = p.length
-    return f"{{{least}, {'0xFFFFu' if most == 0xFFFF else most}}}"
+    if least >= 0xFF or (most >= 0xFF and most != 0xFFFF):
+        raise SystemExit(f"gen_protocol: {p.name}'s length {least}-{most} does not fit the packet table's bytes")
+    return f"{{{least}, {'LENGTH_UNBOUNDED' if most == 0xFFFF else most}}}"
 
 
 def packet_rows_h(s: sch.Schema) -> str:

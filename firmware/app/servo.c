@@ -159,17 +159,16 @@ static void show_executing(struct servo *s)
         motion_is_executing(&s->motion) ? (uint8_t)(status | STATUS_EXECUTING) : status;
 }
 
-static inline __attribute__((always_inline)) void handle_next_frame(struct servo *s, uint32_t now)
+/* late: the request arrived while a page erase stalled the CPU (after_erase).
+ * It is carried out, but its answer, tens of milliseconds late, could fall
+ * in another servo's slot: it is not sent, and ReadStore counts it. */
+static inline __attribute__((always_inline)) void handle_next_frame(struct servo *s, uint32_t now,
+                                                                    bool late)
 {
     const struct rx_frame *frame = frame_rx_peek(&s->rx);
     if (frame == NULL) {
         return;
     }
-    /* A request that arrived while a page erase stalled the CPU is carried
-     * out, but its answer, tens of milliseconds late, could fall in another
-     * servo's slot: it is not sent, and ReadStore counts it. */
-    bool late = s->stale_frames != 0u;
-    s->stale_frames = (uint8_t)(s->stale_frames - late);
     /* Nothing is being sent or waits to be (servo_poll): the response is
      * built in the transmit frame. */
     struct dispatch_result result;
@@ -383,13 +382,25 @@ static bool run_control_tick(struct servo *s, uint32_t now)
     return true;
 }
 
-/* What the port has received since the last pass, to the framer; a line
- * silent for the idle timeout drops a partial frame. */
+/* The ring to the framer; a line silent for the idle timeout drops a
+ * partial frame. One copy on the size-first image (the M0): every pass and
+ * after_erase call it. */
+#ifdef SERVO_SIZE_FIRST
+__attribute__((noinline))
+#else
+inline __attribute__((always_inline))
+#endif
+static void frame_ring(struct servo *s, struct hal_rx_ring *ring, uint32_t now)
+{
+    frame_rx_receive(&s->rx, ring, &s->rx_lost, now, s->rx_idle_us);
+}
+
+/* What the port has received since the last pass, to the framer. */
 static void receive(struct servo *s, uint32_t now)
 {
     struct hal_rx_ring *ring = s->hal->rx;
     hal_rx_sync(s->hal, now);
-    frame_rx_receive(&s->rx, ring, &s->rx_lost, now, s->rx_idle_us);
+    frame_ring(s, ring, now);
 }
 
 /* The pass after a page erase: the control loop resumes on a fresh
@@ -415,10 +426,9 @@ __attribute__((noinline, cold)) static void after_erase(struct servo *s, uint32_
         return;
     }
     for (;;) {
-        frame_rx_receive(&s->rx, ring, &s->rx_lost, now, s->rx_idle_us);
-        s->stale_frames = frame_rx_pending(&s->rx);
-        while (s->stale_frames != 0u) {
-            handle_next_frame(s, now);
+        frame_ring(s, ring, now);
+        for (uint8_t stale = frame_rx_pending(&s->rx); stale != 0u; stale--) {
+            handle_next_frame(s, now, true);
         }
         if (ring->read == ring->written) {
             return;
@@ -481,7 +491,7 @@ void servo_poll(struct servo *s)
     }
     /* Requests first: the host waits for their answers, while a finished
      * move's answer waits for a quiet line anyway. */
-    handle_next_frame(s, now);
+    handle_next_frame(s, now, false);
     if (!s->tx.sending && !s->tx.waiting) {
         answer_finished_move(s, now);
     }

@@ -80,7 +80,6 @@ struct servo {
     uint8_t erase_passed;        /* a page erase stalled the CPU in the last pass */
     uint8_t ring_covers_erase;   /* the ring holds an erase's bytes at this baud */
     uint8_t turn_guard_bytes;    /* a tick and a pass, in byte times at this baud */
-    uint8_t stale_frames;        /* frames that arrived during an erase: not answered */
     uint8_t heat_ticks;          /* ticks towards the winding's next sample */
     uint8_t fault_bits_seen;     /* status bits 2-7 as the fault history last saw them */
     uint8_t guard_seen;          /* protection.act_changes the motion has */

@@ -29,8 +29,10 @@
 #include "bench/bench_region.h"
 #include "registers/data_table.h"
 #include "ports/stm32_common/dma_rx.h"
+#include "ports/stm32_common/flash_f0f1.h"
 #include "support/frames.h"
 #include "doubles/hal_double.h"
+#include "doubles/ideal_encoder.h"
 #include "app/servo.h"
 #include "ports/stm32f1/stm32f1_regs.h"
 #include "ports/stm32_common/systick_clock.h"
@@ -186,6 +188,15 @@ static void __attribute__((noinline)) run_stream(void)
     }
 }
 
+/* The fault history's reads run the board's code (flash_f0f1.c), on the
+ * double's pages: where a page lies in RAM is the harness's part. */
+static void port_flash_read(void *ctx, uint32_t addr, uint8_t *dst, uint32_t len)
+{
+    struct flash_double *f = ctx;
+    uintptr_t in_ram = (uintptr_t)&f->mem[0][0] + (addr - f->hal.page_addr[0]);
+    flash_f0f1_read(NULL, (uint32_t)in_ram, dst, len);
+}
+
 static void fresh_servo(void)
 {
     hal_double_init(&hal);
@@ -201,6 +212,9 @@ static void fresh_servo(void)
     hal.port.rx_ctx = &dma;
     hal.port.bus.send = port_uart_send;
     hal.port.bus.tx_done = port_uart_tx_done;
+    _Static_assert(FLASH_DOUBLE_PAGE_MAX == 1024u, "the double's pages lie end to end");
+    hal.flash.hal.read = port_flash_read;
+    hal.fault_flash.hal.read = port_flash_read;
     servo_init(&servo, &hal.port);
     servo.regs.user.servo_id = OWN_ID;
     servo.link_settings_pending = 1; /* set directly, not by a request */
@@ -217,6 +231,9 @@ static void latency(const char *name, uint8_t code, const uint8_t *content, size
     uint8_t frame[80];
     size_t n = make_request(frame, code, content, length);
     uint32_t frames_before = servo.rx.stats.frames;
+    /* run_target_bench.py checks these against protocol/schema.toml: every
+     * packet measured, and answered exactly where the schema says. */
+    printf("packet %u %s\n", code, answers ? "answer" : "quiet");
     dma_writes(frame, n - 1u);
     cpu_runs(); /* the main loop takes all but the last byte */
     dma_writes(&frame[n - 1u], 1);
@@ -239,6 +256,49 @@ static void latency(const char *name, uint8_t code, const uint8_t *content, size
     }
     transmission_ends();
     servo_poll(&servo);
+}
+
+/* The horn follows the setpoint exactly (for the move below). */
+static uint16_t follow(void *model)
+{
+    (void)model;
+    return servo.motion.mode == MODE_POSITION ? ideal_encoder_raw(&servo.motion) : hal.encoder_raw;
+}
+
+/* A move's answer when it has finished (item 33 on): the main-loop pass
+ * that sends it, in the servo's slot on a quiet line, no control tick in
+ * it (bench_motion counts those). The move runs first, unmeasured. */
+static void finished_move_answer(void)
+{
+    uint8_t frame[80];
+    size_t n = make_request(frame, 8, (const uint8_t[]){OWN_ID, 0x10, 0x00, 0x0A, 0x00, 0, 0}, 7);
+    dma_writes(frame, n);
+    printf("packet 8 finished\n");
+    hal.encoder_model = follow;
+    servo.next_tick_us = servo.tick_due_us = hal.now_us; /* the control loop runs again */
+    for (unsigned ms = 0; !motion_has_finished(&servo.motion); ms++) {
+        if (ms == 10000u) {
+            fprintf(stderr, "answer_move_finished: the move did not finish\n");
+            exit(1);
+        }
+        hal.now_us += 1000u;
+        cpu_runs();
+    }
+    uint32_t until = hal.now_us + 0x7FFFFFFFu;
+    while (usart.tx_busy == 0u) {
+        if ((int32_t)(hal.now_us - until) >= 0) {
+            fprintf(stderr, "answer_move_finished: no answer was sent\n");
+            exit(1);
+        }
+        hal.now_us += 50u;
+        servo.next_tick_us = servo.tick_due_us = hal.now_us + 0x7FFFFFFFu; /* no control tick inside */
+        bench_begin();
+        servo_poll(&servo);
+        bench_end(usart.tx_busy != 0u ? "answer_move_finished" : "waiting_for_the_slot");
+    }
+    transmission_ends();
+    servo_poll(&servo);
+    hal.encoder_model = NULL;
 }
 
 #define ID OWN_ID
@@ -280,6 +340,8 @@ static void every_packet(void)
     QUIET("set_origin", 23, ID, 0);
     QUIET("reset_multi_turn", 17, ID);
     QUIET("move_angle", 8, ID, 0x84, 0x03, 0xF4, 0x01, 0, 0);
+    /* Under position control ReadMotion has more to say (its flags). */
+    ANSWER("read_motion_moving", 0x40, ID);
     QUIET("move_interval", 11, ID, 0x08, 0x07, 0xE8, 0x03, 0x64, 0, 0x64, 0, 0, 0);
     QUIET("move_velocity", 12, ID, 0x84, 0x03, 0xE8, 0x03, 0x64, 0, 0x64, 0, 0, 0);
     QUIET("move_multi_turn", 13, ID, 0x10, 0x0E, 0, 0, 0xE8, 0x03, 0, 0, 0, 0);
@@ -288,6 +350,8 @@ static void every_packet(void)
     QUIET("move_wheel", 7, ID, 0x01, 0x64, 0, 0, 0);
     QUIET("move_damping", 9, ID, 0xE8, 0x03);
     QUIET("stop", 24, ID, 0x11, 0, 0);
+    /* A host's stream: a setpoint 20 ms on (item 69 learns the period). */
+    QUIET("stream_setpoint", 0x45, ID, 0x84, 0x03, 0, 0, 0x64, 0, 0x14, 0);
     latency("request_begin_async", 18, NULL, 0, false);
     QUIET("move_angle_async", 8, ID, 0x00, 0x00, 0xF4, 0x01, 0, 0);
     QUIET("end_async", 19, 0);
@@ -302,11 +366,17 @@ static void every_packet(void)
     QUIET("update_write", 0x52, ID, 0);
     QUIET("update_verify", 0x53, ID, 0);
     QUIET("update_boot", 0x54, ID, 0);
+    /* Open loop for 100 ms: the bridge at a tenth of the supply. */
+    QUIET("drive_duty", 0x46, ID, 0xCD, 0x0C, 0x64, 0);
     ANSWER("reset_user_data", 2, ID);
     uint32_t serial = servo.regs.status.serial_number;
     ANSWER("assign_id", 0x42, 0xFF, (uint8_t)serial, (uint8_t)(serial >> 8), (uint8_t)(serial >> 16),
         (uint8_t)(serial >> 24), ID);
     ANSWER("clear_faults", 0x44, ID);
+    /* Item 33 on: moves are answered when they have finished. */
+    ANSWER("write_control_response", 4, ID, 33, 1);
+    finished_move_answer();
+    ANSWER("write_control_response_off", 4, ID, 33, 0);
     /* Refused while the servo holds, but answered. */
     ANSWER("update_enter", 0x50, ID);
 }

@@ -515,6 +515,52 @@ static void test_sync_monitor_answers_in_list_order(void **state)
     assert_int_equal(result.wait_responses, 3);
 }
 
+/* The table keeps a length in a byte: a SyncCommand longer than 255 bytes
+ * (unbounded) is still carried out, and a bounded packet announced 256 or
+ * 511 bytes long (a byte's wrap would make it 0 or 255) is still refused. */
+static void test_lengths_beyond_a_byte(void **state)
+{
+    (void)state;
+    static const struct motion_angle angle = {0};
+    const uint8_t header[] = {22, 1, 5};
+    const uint8_t record[] = {OWN_ID};
+    for (unsigned i = 0; i < 3; i++) {
+        static const uint16_t lengths[] = {255, 256, 0xFFFF};
+        setup(NULL);
+        will_return(motion_read_angle, &angle);
+        run_sync(header, record, 1, lengths[i], 0);
+        assert_true(result.answer);
+        assert_false(command_error());
+    }
+    for (unsigned i = 0; i < 3; i++) {
+        static const uint16_t lengths[] = {256, 257, 511};
+        setup(NULL);
+        struct rx_frame f = {.code = 1, .length = lengths[i], .stored = 1,
+                             .sync_index = FRAME_SYNC_NO_RECORD, .content = {OWN_ID}};
+        dispatch(&d, &f, &resp, &result);
+        assert_false(result.answer);
+        assert_true(command_error());
+    }
+}
+
+/* ReadStore's answer byte for byte: every count's four bytes at its place
+ * (each byte of the counts a different value). */
+static void test_read_store_answer_bytes(void **state)
+{
+    (void)state;
+    regs.store = (struct store_health){
+        .flags = 0x5A, .records = 0x04030201u, .page_erases = 0x08070605u,
+        .rated_cycles = 0x0C0B0A09u, .budget = 0x100F0E0Du, .op_seconds = 0x14131211u,
+        .failures = 0x18171615u, .answers_dropped = 0x1C1B1A19u, .bytes_lost = 0x201F1E1Du};
+    memset(&resp, 0xA5, sizeof resp);
+    RUN(0x41, OWN_ID);
+    uint8_t expected[34] = {OWN_ID, 0x5A};
+    for (unsigned i = 0; i < 32; i++) {
+        expected[2 + i] = (uint8_t)(i + 1);
+    }
+    assert_answer(0x41, expected, sizeof expected);
+}
+
 static void test_sync_not_listed_does_nothing(void **state)
 {
     (void)state;
@@ -582,6 +628,8 @@ int main(void)
         cmocka_unit_test_setup(test_monitor_bytes, setup),
         cmocka_unit_test_setup(test_sync_motion_record_runs_without_answer, setup),
         cmocka_unit_test_setup(test_sync_monitor_answers_in_list_order, setup),
+        cmocka_unit_test_setup(test_lengths_beyond_a_byte, setup),
+        cmocka_unit_test_setup(test_read_store_answer_bytes, setup),
         cmocka_unit_test_setup(test_sync_not_listed_does_nothing, setup),
         cmocka_unit_test_setup(test_sync_bad_records_are_errors, setup),
     };

@@ -9,11 +9,13 @@
 #include <stddef.h>
 #include <stdint.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include <cmocka.h>
 
 #include "motion/controller.h"
 #include "motion/gains.h"
+#include "protocol/packet_table.h"
 #include "support/by_name.h"
 #include "support/servo_harness.h"
 
@@ -280,6 +282,73 @@ static void test_read_motion_snapshot(void **state)
     REQUEST(PKT_READ_MOTION, 0, 0);
     EXPECT_SILENCE();
     assert_true(servo.regs.status.status & STATUS_COMMAND_ERROR);
+}
+
+/* ReadMotion's answer, byte for byte, against the fields worked out here
+ * from the motion state (docs/packets.md): the tracking error saturated at
+ * both ends and next to them, the target rounded to the nearest decidegree
+ * with a center offset, every field at its offset. */
+static int64_t floor_div(int64_t n, int64_t d)
+{
+    return n >= 0 ? n / d : -((-n + d - 1) / d);
+}
+
+static uint32_t le_bytes(const uint8_t *p, unsigned n)
+{
+    uint32_t v = 0;
+    for (unsigned i = n; i-- > 0;) {
+        v = v << 8 | p[i];
+    }
+    return v;
+}
+
+static void test_read_motion_answer_bytes(void **state)
+{
+    (void)state;
+    static const int32_t errors[] = {0, 1000, -1000, 838860, 838861, 1 << 22, 1 << 30,
+                                     -838835, -838836, -(1 << 22), -(1 << 30)};
+    static const int64_t targets[] = {0, INT64_C(3686400) << 32, -(INT64_C(3686400) << 32), 0x7FFFFFFF,
+                                      INT64_C(900) << 32, -(INT64_C(1234) << 32) + (INT64_C(1) << 31)};
+    struct motion *m = &servo.motion;
+    servo.regs.user.center_offset_decideg = -37;
+    servo.regs.status.current_ma = 0x1234;
+    servo.regs.firmware.winding_decic = -5;
+    m->mode = MODE_POSITION;
+    m->measured_q8 = 300 * 256 + 100;
+    m->measured_velocity_q8 = -1000;
+    m->damping_duty_q15 = -1234;
+    for (size_t e = 0; e < sizeof errors / sizeof errors[0]; e++) {
+        for (size_t t = 0; t < sizeof targets / sizeof targets[0]; t++) {
+            m->setpoint_q8 = m->measured_q8 + errors[e];
+            m->profile.target = targets[t];
+            struct response r;
+            memset(&r, 0xA5, sizeof r);
+            r.content[0] = 1;
+            struct dispatch_result result;
+            struct packet_call call = {.d = &servo.dispatcher, .content = r.content, .length = 1,
+                                       .result = &result};
+            assert_int_equal(handle_read_motion(&call, &r), OUTCOME_OK);
+            assert_int_equal(r.length, 29);
+            const uint8_t *p = r.content;
+            int32_t offset_q8 = -37 * 256;
+            int64_t error_cd = floor_div((int64_t)errors[e] * 5, 128);
+            error_cd = error_cd > INT16_MAX ? INT16_MAX : error_cd < -INT16_MAX ? -INT16_MAX : error_cd;
+            int64_t target = floor_div(targets[t] - (int64_t)offset_q8 * (INT64_C(1) << 24) + (INT64_C(1) << 31),
+                                       INT64_C(1) << 32);
+            assert_int_equal(p[0], 1);
+            assert_int_equal((int32_t)le_bytes(&p[1], 4), floor_div(m->measured_q8 - offset_q8 + 128, 256));
+            assert_int_equal((int32_t)le_bytes(&p[5], 4), floor_div(m->setpoint_q8 - offset_q8 + 128, 256));
+            assert_int_equal((int32_t)le_bytes(&p[9], 4), (int32_t)target);
+            assert_int_equal((int16_t)le_bytes(&p[13], 2), floor_div(-1000 * 125, 32));
+            assert_int_equal((int16_t)le_bytes(&p[15], 2), error_cd);
+            assert_int_equal(le_bytes(&p[17], 2), 0x1234);
+            assert_int_equal(p[19], servo.regs.status.status);
+            assert_int_equal(p[20] & DIAG_RELEASED, 0);
+            assert_int_equal(le_bytes(&p[21], 4), servo.next_tick_us - 1000u);
+            assert_int_equal((int16_t)le_bytes(&p[25], 2), -5);
+            assert_int_equal((int16_t)le_bytes(&p[27], 2), -1234);
+        }
+    }
 }
 
 static void test_center_offset_shifts_the_zero(void **state)
@@ -573,6 +642,7 @@ int main(void)
         cmocka_unit_test_setup(test_velocity_is_clamped, setup),
         cmocka_unit_test_setup(test_velocity_profile_worked_examples, setup),
         cmocka_unit_test_setup(test_read_motion_snapshot, setup),
+        cmocka_unit_test_setup(test_read_motion_answer_bytes, setup),
         cmocka_unit_test_setup(test_center_offset_shifts_the_zero, setup),
         cmocka_unit_test_setup(test_power_bounds_the_output, setup),
         cmocka_unit_test_setup(test_control_response_queues_and_answers_each, setup),

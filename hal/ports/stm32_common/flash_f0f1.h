@@ -10,5 +10,7 @@
 
 /* page_addr: the two pages reserved for the config store. */
 void flash_f0f1_init(struct hal_flash *f, uint32_t page_size, uint32_t page0, uint32_t page1);
+/* hal_flash.read: the flash is memory-mapped (the target benchmark runs it). */
+void flash_f0f1_read(void *ctx, uint32_t addr, uint8_t *dst, uint32_t len);
 
 #endif

@@ -55,9 +55,13 @@ struct packet_call {
 typedef enum packet_outcome (*packet_handler)(const struct packet_call *call,
                                               struct response *response);
 
-struct length_rule { /* a request's content length, inclusive both ends */
-    uint16_t min;
-    uint16_t max;
+/* A request's content length, inclusive both ends, a byte each (a row is
+ * 8 bytes, not 12: the M0's flash); max LENGTH_UNBOUNDED: no upper bound
+ * (the dispatcher compares a length saturated to it). */
+enum { LENGTH_UNBOUNDED = 0xFF };
+struct length_rule {
+    uint8_t min;
+    uint8_t max;
 };
 
 struct packet_desc {

@@ -26,6 +26,7 @@ import re
 import subprocess
 import sys
 import tempfile
+import tomllib
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -49,7 +50,8 @@ RESPONSE_BUDGET_US = {"cortex-m3": 20, "cortex-m0": 30}
 # programmed: this budget is the CPU's part; the flash's own
 # 24 half-words x 40-70 us (DS5319) come on top (docs/decisions.md).
 DURABLE_WRITE_BUDGET_US = {"cortex-m3": 200, "cortex-m0": 600}
-DURABLE_WRITES = ("answer_write_data", "answer_write_batch", "answer_reset_user_data")
+DURABLE_WRITES = ("answer_write_data", "answer_write_batch", "answer_reset_user_data",
+                  "answer_write_control_response", "answer_write_control_response_off")
 
 
 def budget_of(cpu: str, key: str):
@@ -200,6 +202,8 @@ def run(elf: Path, cpu: str, profile_region: str = "", by_line: bool = False) ->
     counts = [tuple(int(x) for x in line.split()) for line in lines[1:]]  # after "total I C"
     stats = dict(line.split() for line in proc.stdout.splitlines()
                  if len(line.split()) == 2 and not line.startswith("region "))
+    stats["packets"] = [tuple(line.split()[1:]) for line in proc.stdout.splitlines()
+                        if line.startswith("packet ")]
     if len(names) != len(counts):
         raise SystemExit(f"run_target_bench: {len(names)} regions named, {len(counts)} counted")
     # Each region less the harness's instructions in it (its cycles in the
@@ -224,6 +228,32 @@ def run(elf: Path, cpu: str, profile_region: str = "", by_line: bool = False) ->
     return regions, stats
 
 
+SCHEMA = ROOT / "protocol/schema.toml"
+
+
+def unmeasured(measured: list) -> list:
+    """Packets of protocol/schema.toml that bench_protocol.c's every_packet
+    leaves out, or measures without their answer: a new packet in the
+    schema fails the run until it is measured. measured: [(code, "answer" |
+    "quiet")] as the benchmark printed them."""
+    seen = {}
+    for code, kind in measured:
+        seen.setdefault(int(code), set()).add(kind)
+    missing = []
+    for packet in tomllib.loads(SCHEMA.read_text())["packet"]:
+        flags = packet.get("flags", [])
+        kinds = seen.get(packet["code"], set())
+        if not kinds:
+            missing.append(f"{packet['name']} (not measured)")
+        elif "answers" in flags and "answer" not in kinds:
+            missing.append(f"{packet['name']} (its answer not measured)")
+    # A move's answer once it has finished (item 33): one packet's stands
+    # for all (the same pass sends each).
+    if not any("finished" in kinds for kinds in seen.values()):
+        missing.append("the answer of a finished move (not measured)")
+    return missing
+
+
 def per_tick(motion: dict, region: str, nticks: int) -> tuple:
     """(instructions, cycles) of one tick of region."""
     return tuple(x / nticks for x in motion[region])
@@ -232,6 +262,10 @@ def per_tick(motion: dict, region: str, nticks: int) -> tuple:
 def figures(cpu: str, profile_region: str = "", by_line: bool = False) -> dict:
     """{figure: (instructions, cycles)}."""
     proto, pstats = run(CPUS[cpu] / "bench_protocol.elf", cpu, profile_region, by_line)
+    missing = unmeasured(pstats["packets"])
+    if missing:
+        raise SystemExit(f"run_target_bench: bench_protocol.c on {cpu} leaves out packets of "
+                         f"protocol/schema.toml: {', '.join(missing)}")
     motion, mstats = run(CPUS[cpu] / "bench_motion.elf", cpu, profile_region, by_line)
     nbytes, nticks = int(pstats["stream_bytes"]), int(mstats["ticks"])
     plans = {k: v for k, v in motion.items() if k.startswith("plan_") and not k.startswith("plan_jerk")}
