@@ -80,7 +80,7 @@ void motion_read_diagnostics(const struct motion *m, struct motion_diagnostics *
     int32_t error_q8 = setpoint - m->measured_q8;
     int64_t target = controlled ? m->profile.target : q8_to_q32(m->measured_q8);
     /* The flags and motion_limiter()'s value, each test made once. */
-    uint32_t flags = DIAG_RELEASED;
+    uint32_t flags = motion_is_released(m) ? DIAG_RELEASED : 0u; /* open loop: driven */
     uint32_t limiter = LIMITER_NONE;
     if (controlled) {
         int8_t at_limit = m->controller.at_limit;

@@ -21,10 +21,10 @@ static uint32_t stream_period(struct motion *m, uint16_t host_ms)
 
 enum motion_submit_result motion_stream(struct motion *m, const struct motion_setpoint *sp)
 {
-    m->commands++;
     if (m->inhibit) {
-        return MOTION_REFUSED;
+        return MOTION_REFUSED; /* not counted (motion_submit) */
     }
+    m->commands++;
     uint32_t period = stream_period(m, sp->host_ms);
     /* The stream's reference goes on from the setpoint, however the horn
      * lags (the profile's clock keeps the two together, and slows the
