@@ -121,6 +121,10 @@ struct drive_inputs {
 struct motion {
     const struct registers *regs;
     const struct hal_port *hal;
+    /* Where a byte's offset is small, the M0 loads it in one instruction. */
+    uint8_t async_open;        /* enum async_block */
+    uint8_t inhibit;           /* set by the protection monitors (motion_guard) */
+    uint8_t mode;              /* enum motion_mode */
     struct encoder_track encoder;
     int32_t origin_counts;     /* encoder counts of angle 0 (before offset 53) */
     /* The tick works in Q8 decidegrees (int32): the multi-turn range, +-3 686 400
@@ -162,7 +166,6 @@ struct motion {
     uint8_t angle_clamped;     /* the running move's target was clamped (51, 52) */
     uint16_t power_mw;         /* the running command's power, 0 = 42's value */
     uint8_t supply_check;      /* ticks since the supply was last looked at */
-    uint8_t mode;              /* enum motion_mode */
     uint8_t end;               /* enum motion_end */
     uint8_t running;           /* a command runs: status bit 0 */
     uint8_t endless;           /* wheel run, stream: finished once at speed */
@@ -174,13 +177,11 @@ struct motion {
     uint16_t stream_period_ms; /* learned from the stamps */
     uint8_t answer_packet;     /* owed when the running command finishes */
     uint8_t soft_start_pending;
-    uint8_t async_open;        /* enum async_block */
     struct motion_queue queue;
     struct motion_queue async;
     uint8_t answers[MOTION_ANSWERS_DEPTH];
     uint8_t answers_count;
     /* Set by the protection monitors (motion_guard). */
-    uint8_t inhibit;
     uint8_t derate;
     uint16_t power_cap_mw;
     uint32_t commands;         /* motion commands received */
