@@ -40,12 +40,16 @@ static enum motion_submit_result dispatch_command(struct motion *m, const struct
     return MOTION_ACCEPTED;
 }
 
+/* A refused command is not counted: it must not clear what the bus
+ * watchdog did (safety_after_frame). Nor are commands for a block that
+ * motion_stop cut short: they were sent for a plan that is gone, and run
+ * nothing until the next BeginAsync (or EndAsync). */
 enum motion_submit_result motion_submit(struct motion *m, const struct motion_command *cmd)
 {
-    m->commands++;
-    if (m->inhibit) {
+    if (m->inhibit || m->async_open == ASYNC_CUT) {
         return MOTION_REFUSED;
     }
+    m->commands++;
     if (m->async_open) {
         return queue_push(&m->async, cmd) ? MOTION_ACCEPTED : MOTION_QUEUE_FULL;
     }
@@ -56,14 +60,14 @@ void motion_stop(struct motion *m, uint8_t method)
 {
     const struct motion_command stop = {.kind = MOTION_STOP, .method = method};
     m->queue.count = 0;
-    m->async_open = 0;
+    m->async_open = m->async_open != 0u ? ASYNC_CUT : 0u;
     m->async.count = 0;
     motion_run(m, &stop);
 }
 
 void motion_begin_async(struct motion *m)
 {
-    m->async_open = 1;
+    m->async_open = ASYNC_OPEN;
     m->async.count = 0;
     m->async.head = 0;
 }

@@ -235,6 +235,7 @@ void motion_tick(struct motion *m)
     }
     switch (m->mode) {
     case MODE_DAMPING:
+    case MODE_OPEN_LOOP:
         m->damping_duty_q15 = controller_damping(m->measured_velocity_q8, m->open_duty_q15, &m->drive);
         bridge(m, m->damping_duty_q15);
         if (m->open_ticks != 0u && --m->open_ticks == 0u) {

@@ -89,7 +89,7 @@ void motion_read_diagnostics(const struct motion *m, struct motion_diagnostics *
      * taken twice is the floor of both), without 64-bit sums on the M0. */
     int32_t target = controlled ? (int32_t)(m->profile.target >> 24) : m->measured_q8;
     /* The flags and motion_limiter()'s value, each test made once. */
-    uint32_t flags = DIAG_RELEASED;
+    uint32_t flags = motion_is_released(m) ? DIAG_RELEASED : 0u; /* open loop: driven */
     uint32_t limiter = LIMITER_NONE;
     if (controlled) {
         int8_t at_limit = m->controller.at_limit;

@@ -78,10 +78,10 @@ static void plan_at_limits(struct profile *p, int32_t start, int32_t v0, int32_t
 
 enum motion_submit_result motion_stream(struct motion *m, const struct motion_setpoint *sp)
 {
-    m->commands++;
     if (m->inhibit) {
-        return MOTION_REFUSED;
+        return MOTION_REFUSED; /* not counted (motion_submit) */
     }
+    m->commands++;
     uint32_t period = stream_period(m, sp->host_ms);
     /* The stream's reference goes on from the setpoint, however the horn
      * lags (the profile's clock keeps the two together, and slows the

@@ -16,6 +16,7 @@ enum {
     FR_ENTRY = 4,
     FR_NUMBER = FR_ENTRY + offsetof(struct fault_entry, number),
     FR_WHAT = FR_ENTRY + offsetof(struct fault_entry, what),
+    FR_OP_SECONDS = FR_ENTRY + offsetof(struct fault_entry, op_seconds),
     FR_CRC = 28,
     FAULT_MAGIC = 0xFA17,
     FAULT_FORMAT = 1,
@@ -102,47 +103,64 @@ static void plan_next(struct fault_log *l)
     l->next_slot = 0;
 }
 
-/* The valid record with the largest number below `below`: its slot (page
- * x slots + slot), kind and number. */
-static bool find_below(const struct fault_log *l, uint32_t below, uint8_t *at, uint8_t *what,
-                       uint32_t *number)
+/* A record find_below found: its slot (page x slots + slot), kind,
+ * number and operating second. */
+struct found {
+    uint32_t number;
+    uint32_t op_seconds;
+    uint8_t at;
+    uint8_t what;
+};
+
+/* The valid record with the largest number below `below` (f->number 0:
+ * none). */
+static bool find_below(const struct fault_log *l, uint32_t below, struct found *f)
 {
     const uint8_t slots = slots_per_page(l);
     uint8_t rec[FAULT_RECORD_SIZE];
-    bool found = false;
-    *number = 0;
+    f->number = 0;
     for (uint8_t i = 0; i < 2u * slots; i++) {
         read_record(l, (uint8_t)(i / slots), (uint8_t)(i % slots), rec);
         uint32_t n = le_get_u32(&rec[FR_NUMBER]);
-        if (n < below && n > *number && record_valid(rec)) {
-            *number = n;
-            *at = i;
-            *what = rec[FR_WHAT];
-            found = true;
+        if (n < below && n > f->number && record_valid(rec)) {
+            f->number = n;
+            f->at = i;
+            f->what = rec[FR_WHAT];
+            f->op_seconds = le_get_u32(&rec[FR_OP_SECONDS]);
         }
     }
-    return found;
+    return f->number != 0u;
 }
 
-void fault_log_load(struct fault_log *l, const struct hal_flash *flash)
+uint32_t fault_log_load(struct fault_log *l, const struct hal_flash *flash)
 {
     *l = (struct fault_log){.flash = flash};
+    uint32_t latest = 0;
     if (flash == NULL) {
-        return;
+        return latest;
     }
     /* The newest record, then each next older one (a failed record's
      * number is spent, so numbers may skip), up to a clear or the history's
-     * length: at power-up, while nobody waits. */
-    uint8_t at = 0, what = 0;
-    uint32_t n = 0;
-    if (find_below(l, UINT32_MAX, &at, &what, &n)) {
-        l->newest = n;
-        l->page = (uint8_t)(at / slots_per_page(l));
-        l->slot = (uint8_t)(at % slots_per_page(l));
-        while (what != FAULT_CLEARED) {
+     * length: at power-up, while nobody waits. Each kind's newest of them
+     * sets its last_seen, so that the repeat rule goes on across power
+     * cycles, and so does the operating time (from the newest's). */
+    struct found f;
+    if (find_below(l, UINT32_MAX, &f)) {
+        l->newest = f.number;
+        l->page = (uint8_t)(f.at / slots_per_page(l));
+        l->slot = (uint8_t)(f.at % slots_per_page(l));
+        latest = f.op_seconds + 1u;
+        for (;;) {
+            uint8_t kind = f.what <= FAULT_WATCHDOG ? f.what : FAULT_WATCHDOG;
+            if (l->last_seen[kind] == 0u) {
+                l->last_seen[kind] = f.op_seconds + 1u;
+            }
+            if (f.what == FAULT_CLEARED) {
+                break;
+            }
             uint8_t slots = slots_per_page(l);
-            l->shown[l->shown_count++] = (uint8_t)((at / slots) << SHOWN_PAGE_SHIFT | at % slots);
-            if (l->shown_count == FAULT_HISTORY || !find_below(l, n, &at, &what, &n)) {
+            l->shown[l->shown_count++] = (uint8_t)((f.at / slots) << SHOWN_PAGE_SHIFT | f.at % slots);
+            if (l->shown_count == FAULT_HISTORY || !find_below(l, f.number, &f)) {
                 break;
             }
         }
@@ -156,18 +174,25 @@ void fault_log_load(struct fault_log *l, const struct hal_flash *flash)
     }
     l->spare_erased = page_erased(l, (uint8_t)(l->page ^ 1u));
     plan_next(l);
+    return latest;
 }
 
 bool fault_log_add(struct fault_log *l, const struct fault_entry *e)
 {
     uint8_t what = e->what <= FAULT_WATCHDOG ? e->what : FAULT_WATCHDOG;
-    /* last_seen: each kind's last record's operating second + 1; 0 none. */
+    /* last_seen: each kind's last record's operating second + 1; 0 none.
+     * A fault is held back as a repeat; a clear, promised within
+     * milliseconds, where its record could wait for an erase (no erased
+     * spare, and the page in use full or records queued before it: it is
+     * refused, and taken once they are written). */
     uint32_t since = e->op_seconds + 1u - l->last_seen[what];
-    bool repeat = what != FAULT_CLEARED && l->last_seen[what] != 0u && since < FAULT_REPEAT_S;
+    bool held_back = what == FAULT_CLEARED
+                         ? !l->spare_erased && (l->next_page != l->page || l->pending_count != 0u)
+                         : l->last_seen[what] != 0u && since < FAULT_REPEAT_S;
     uint32_t records = l->newest + l->pending_count;
-    bool over_budget = records >= FAULT_ALLOWANCE &&
-                       records >= FAULT_ALLOWANCE + e->op_seconds / FAULT_SECONDS_PER_RECORD;
-    if (l->flash == NULL || repeat || over_budget || l->pending_count == FAULT_PENDING_MAX) {
+    if (l->flash == NULL || held_back || l->pending_count == FAULT_PENDING_MAX ||
+        (records >= FAULT_ALLOWANCE &&
+         records >= FAULT_ALLOWANCE + e->op_seconds / FAULT_SECONDS_PER_RECORD)) {
         l->not_logged = (uint16_t)(l->not_logged + (l->not_logged != UINT16_MAX));
         return false;
     }
@@ -232,9 +257,16 @@ bool fault_log_step(struct fault_log *l)
     return true;
 }
 
+/* The spare may be erased as soon as it holds no fault shown (the oldest
+ * shown is in the page in use): ahead of need, as the config store's is,
+ * so that a page that fills while the output is driven (no erase then)
+ * finds the next one ready. Still one erase a page's turn: no more wear. */
 bool fault_log_spare_dirty(const struct fault_log *l)
 {
-    return l->flash != NULL && !l->spare_erased && !l->job_active && l->next_page != l->page;
+    uint8_t shown = l->shown_count;
+    bool spare_shown = shown != 0u && (l->shown[shown - 1u] >> SHOWN_PAGE_SHIFT) != l->page;
+    return l->flash != NULL && !l->spare_erased && !l->job_active &&
+           (l->next_page != l->page || !spare_shown);
 }
 
 bool fault_log_erase_spare(struct fault_log *l)

@@ -59,16 +59,19 @@ struct fault_log {
     uint32_t failures;      /* program or erase steps the flash refused */
 };
 
-/* Finds the newest records; flash NULL keeps nothing. */
-void fault_log_load(struct fault_log *l, const struct hal_flash *flash);
+/* Finds the newest records; flash NULL keeps nothing. Returns the
+ * operating second after the latest of them (0 none): the operating time
+ * goes on from there at power-up. */
+uint32_t fault_log_load(struct fault_log *l, const struct hal_flash *flash);
 /* Queues a fault (or a FAULT_CLEARED marker) to be written; the entry's
- * number is the log's to give. False when it is not logged (counted). */
+ * number is the log's to give. False when it is not logged (a fault is
+ * counted), and for a clear that would have to wait for an erase. */
 bool fault_log_add(struct fault_log *l, const struct fault_entry *e);
 /* Programs the next write block of a queued record, if any may go now:
  * true when flash work was done. */
 bool fault_log_step(struct fault_log *l);
-/* The page without the newest record must be erased before the log can
- * go on (the page in use is full). */
+/* The page without the newest record wants its erase: the page in use is
+ * full, or the spare holds no fault shown any more. */
 bool fault_log_spare_dirty(const struct fault_log *l);
 MUST_CHECK bool fault_log_erase_spare(struct fault_log *l);
 /* The index-th newest fault shown (0 the newest), as its bytes (struct

@@ -222,6 +222,114 @@ static void test_a_power_cut_at_any_step_loses_at_most_the_record_in_flight(void
     }
 }
 
+/* Steps only: the flash work of a servo whose output is driven, where no
+ * erase may stall the CPU. */
+static void step_without_erase(void)
+{
+    while (fault_log_step(&log_)) {
+    }
+}
+
+/* A clear is promised within milliseconds: where its record would wait for
+ * an erase (the page in use full, the spare not erased: a driven servo),
+ * it is refused, not queued and lost (issue 55). Faults wait for the erase
+ * in RAM, in order, and are written after it. */
+static void test_a_clear_that_would_wait_for_an_erase_is_refused(void **state)
+{
+    (void)state;
+    flash.mem[1][5] = 0x00; /* page 1 not blank: it needs an erase before use */
+    reload();
+    for (uint32_t n = 1; n <= 32; n++) { /* page 0 fills */
+        struct fault_entry e = fault(FAULT_STALL, 20u * n);
+        assert_true(fault_log_add(&log_, &e));
+        step_without_erase();
+    }
+    assert_int_equal(log_.newest, 32);
+    struct fault_entry late = fault(FAULT_OVER_POWER, 700);
+    assert_true(fault_log_add(&log_, &late)); /* waits in RAM */
+    step_without_erase();
+    assert_int_equal(log_.newest, 32);
+    struct fault_entry clear = {.what = FAULT_CLEARED, .op_seconds = 701};
+    assert_false(fault_log_add(&log_, &clear));
+    assert_true(fault_log_spare_dirty(&log_));
+    assert_true(fault_log_erase_spare(&log_)); /* released and quiet */
+    assert_true(fault_log_add(&log_, &clear));
+    assert_true(settle());
+    assert_int_equal(log_.newest, 34); /* the fault, then the clear */
+    assert_int_equal(log_.shown_count, 0);
+    reload();
+    assert_int_equal(log_.shown_count, 0);
+    assert_false(flash.misuse);
+}
+
+/* A clear with records queued before it, and no erased spare, could wait
+ * behind them: refused until they are written (a moment), then taken. */
+static void test_a_clear_behind_queued_records_waits_for_them(void **state)
+{
+    (void)state;
+    flash.mem[1][5] = 0x00;
+    reload();
+    for (uint32_t n = 1; n <= 31; n++) {
+        struct fault_entry e = fault(FAULT_STALL, 20u * n);
+        assert_true(fault_log_add(&log_, &e));
+        step_without_erase();
+    }
+    struct fault_entry e = fault(FAULT_OVER_POWER, 700);
+    assert_true(fault_log_add(&log_, &e)); /* the last slot */
+    struct fault_entry clear = {.what = FAULT_CLEARED, .op_seconds = 701};
+    assert_false(fault_log_add(&log_, &clear));
+    step_without_erase();
+    assert_false(fault_log_add(&log_, &clear)); /* the page is full now */
+}
+
+/* The spare is erased as soon as it shows no fault (16 newer ones are in
+ * the page in use), not when that page is full: a page that fills while
+ * the output is driven finds the next one erased. Still one erase a page
+ * change. */
+static void test_the_spare_is_erased_ahead_once_it_shows_nothing(void **state)
+{
+    (void)state;
+    log_faults(FAULT_STALL, 40); /* page 0 full, 8 on page 1 */
+    assert_false(fault_log_spare_dirty(&log_)); /* page 0 still shows 8 */
+    for (uint32_t n = 41; n <= 48; n++) {
+        struct fault_entry e = fault(FAULT_STALL, 20u * n);
+        assert_true(fault_log_add(&log_, &e));
+        step_without_erase();
+    }
+    assert_true(fault_log_spare_dirty(&log_)); /* 16 on page 1: page 0 shows none */
+    assert_true(fault_log_erase_spare(&log_));
+    for (uint32_t n = 49; n <= 80; n++) { /* driven from here: no erase */
+        struct fault_entry e = fault(FAULT_STALL, 20u * n);
+        assert_true(fault_log_add(&log_, &e));
+        step_without_erase();
+    }
+    assert_int_equal(log_.newest, 80);
+    assert_history(80, FAULT_HISTORY);
+    assert_int_equal(flash.erases[0] + flash.erases[1], 1);
+    reload();
+    assert_history(80, FAULT_HISTORY);
+}
+
+/* The repeat rule holds across a power cycle: each kind's last record
+ * sets it again at power-up. */
+static void test_a_repeat_is_a_repeat_after_a_power_cycle(void **state)
+{
+    (void)state;
+    struct fault_entry e = fault(FAULT_LOW_VOLTAGE, 100);
+    assert_true(fault_log_add(&log_, &e));
+    e = fault(FAULT_STALL, 103);
+    assert_true(fault_log_add(&log_, &e));
+    assert_true(settle());
+    reload();
+    e = fault(FAULT_LOW_VOLTAGE, 105);
+    assert_false(fault_log_add(&log_, &e));
+    e = fault(FAULT_STALL, 112);
+    assert_false(fault_log_add(&log_, &e));
+    e = fault(FAULT_LOW_VOLTAGE, 110);
+    assert_true(fault_log_add(&log_, &e));
+    assert_int_equal(log_.not_logged, 2);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -231,6 +339,10 @@ int main(void)
         cmocka_unit_test_setup(test_repeats_and_the_wear_budget_are_counted_not_written, setup),
         cmocka_unit_test_setup(test_a_refused_program_spends_a_slot_not_the_history, setup),
         cmocka_unit_test_setup(test_a_power_cut_at_any_step_loses_at_most_the_record_in_flight, setup),
+        cmocka_unit_test_setup(test_a_clear_that_would_wait_for_an_erase_is_refused, setup),
+        cmocka_unit_test_setup(test_a_clear_behind_queued_records_waits_for_them, setup),
+        cmocka_unit_test_setup(test_the_spare_is_erased_ahead_once_it_shows_nothing, setup),
+        cmocka_unit_test_setup(test_a_repeat_is_a_repeat_after_a_power_cycle, setup),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -50,9 +50,9 @@ static void test_the_duty_drives_the_horn_open_loop_then_lets_go(void **state)
            steady_speed(9830 / 32767.0) * 180 / M_PI);
     assert_true(fabs(w / steady_speed(9830 / 32767.0) - 1.0) < 0.02);
     assert_int_equal(motion_field(ANSWER_READ_MOTION_DUTY), 9830);
-    assert_int_equal(servo.motion.mode, MODE_DAMPING); /* driven */
+    assert_int_equal(servo.motion.mode, MODE_OPEN_LOOP); /* driven */
     harness_run_ms(44); /* 300 ms, to within the request's own time on the wire */
-    assert_int_equal(servo.motion.mode, MODE_DAMPING);
+    assert_int_equal(servo.motion.mode, MODE_OPEN_LOOP);
     harness_run_ms(10);
     assert_int_equal(servo.motion.mode, MODE_RELEASED);
     assert_int_equal(motion_field(ANSWER_READ_MOTION_DUTY), 0);

@@ -226,8 +226,10 @@ class Servo:
 
     def clear_faults(self) -> None:
         if p.decode_answer(p.CLEAR_FAULTS, self.bus.request(p.CLEAR_FAULTS, bytes([self.id])))[1] != 1:
-            raise Refused(f"servo {self.id} refused to clear its fault history (none kept, "
-                          f"or its wear budget allows no record now)")
+            raise Refused(f"servo {self.id} refused to clear its fault history: none kept, its "
+                          f"wear budget allows no record now, or the history's page is full while "
+                          f"the output is driven (release it, leave the bus quiet 100 ms, "
+                          f"clear again)")
 
     def status(self) -> int:
         return self.read("status")

@@ -80,10 +80,21 @@ struct motion_angle {
 /* Finish answers not yet sent. */
 #define MOTION_ANSWERS_DEPTH 4u
 
+/* A BeginAsync block: open, it buffers commands; cut short by motion_stop
+ * (the bus watchdog), it refuses them until the next BeginAsync or
+ * EndAsync. */
+enum async_block {
+    ASYNC_NONE,
+    ASYNC_OPEN,
+    ASYNC_CUT,
+};
+
+/* Released and damping first: motion_is_released() is one comparison. */
 enum motion_mode {
-    MODE_RELEASED, /* output off, turns freely */
-    MODE_POSITION, /* following a profile, then holding its end */
-    MODE_DAMPING,  /* braking in proportion to speed, or open loop (open_duty) */
+    MODE_RELEASED,  /* output off, turns freely */
+    MODE_DAMPING,   /* braking in proportion to speed (packet 9): never drives */
+    MODE_POSITION,  /* following a profile, then holding its end */
+    MODE_OPEN_LOOP, /* DriveDuty: damping's tick with open_duty in place of the brake */
 };
 
 /* What the servo does once a profile has run out. */
@@ -110,6 +121,10 @@ struct drive_inputs {
 struct motion {
     const struct registers *regs;
     const struct hal_port *hal;
+    /* Where a byte's offset is small, the M0 loads it in one instruction. */
+    uint8_t async_open;        /* enum async_block */
+    uint8_t inhibit;           /* set by the protection monitors (motion_guard) */
+    uint8_t mode;              /* enum motion_mode */
     struct encoder_track encoder;
     int32_t origin_counts;     /* encoder counts of angle 0 (before offset 53) */
     /* The tick works in Q8 decidegrees (int32): the multi-turn range, +-3 686 400
@@ -151,7 +166,6 @@ struct motion {
     uint8_t angle_clamped;     /* the running move's target was clamped (51, 52) */
     uint16_t power_mw;         /* the running command's power, 0 = 42's value */
     uint8_t supply_check;      /* ticks since the supply was last looked at */
-    uint8_t mode;              /* enum motion_mode */
     uint8_t end;               /* enum motion_end */
     uint8_t running;           /* a command runs: status bit 0 */
     uint8_t endless;           /* wheel run, stream: finished once at speed */
@@ -163,21 +177,19 @@ struct motion {
     uint16_t stream_period_ms; /* learned from the stamps */
     uint8_t answer_packet;     /* owed when the running command finishes */
     uint8_t soft_start_pending;
-    uint8_t async_open;
     struct motion_queue queue;
     struct motion_queue async;
     uint8_t answers[MOTION_ANSWERS_DEPTH];
     uint8_t answers_count;
     /* Set by the protection monitors (motion_guard). */
-    uint8_t inhibit;
     uint8_t derate;
     uint16_t power_cap_mw;
     uint32_t commands;         /* motion commands received */
-    /* Open loop (DriveDuty): MODE_DAMPING's duty instead of a brake, for
-     * open_ticks more ticks (0 with a brake: until another command). */
+    /* Open loop (DriveDuty, MODE_OPEN_LOOP): this duty instead of the
+     * brake, for open_ticks more ticks. */
     int16_t open_duty_q15;
     uint16_t open_ticks;
-    int16_t damping_duty_q15;  /* what MODE_DAMPING gave the bridge last; 0 in other modes */
+    int16_t damping_duty_q15;  /* what damping or open loop gave the bridge last; 0 in other modes */
 };
 
 /* Reads the encoder and takes the power-on state (46). regs and hal must
@@ -207,10 +219,13 @@ MUST_CHECK enum motion_submit_result motion_stream(struct motion *m, const struc
  * while the protections hold the output. */
 #define MOTION_OPEN_LOOP_MAX_MS 10000u
 MUST_CHECK enum motion_submit_result motion_drive_duty(struct motion *m, int16_t duty_q15, uint16_t ms);
-/* Not under position control (released or damping). */
+/* Nothing drives the output: released, or damping (a brake that only
+ * resists motion). Under position control or an applied duty (DriveDuty)
+ * it is driven: the bus watchdog watches it, the origin stays put
+ * (docs/safety.md). */
 static inline bool motion_is_released(const struct motion *m)
 {
-    return m->mode != MODE_POSITION;
+    return m->mode <= MODE_DAMPING;
 }
 void motion_read_angle(const struct motion *m, struct motion_angle *out);
 /* ResetMultiTurnAngle (17), SetOriginPoint (23): false unless released. */
@@ -233,7 +248,7 @@ enum motion_diagnostic_flag {
     DIAG_CLOCK_SLOWED = 1u << 1,  /* the horn cannot follow: the move runs late */
     DIAG_BRAKING = 1u << 2,       /* braking within the output's limit */
     DIAG_AT_LIMIT = 1u << 3,      /* the output is at its current or supply limit */
-    DIAG_RELEASED = 1u << 4,      /* not under position control */
+    DIAG_RELEASED = 1u << 4,      /* motion_is_released(): nothing drives the output */
     /* bits 5-7: motion_limiter() (LIMITER_SHIFT) */
 };
 
@@ -271,8 +286,9 @@ bool motion_is_idle(const struct motion *m);
 void motion_guard(struct motion *m, bool inhibit, bool derate, uint16_t power_cap_mw,
                   uint8_t cap_limiter);
 /* Stops now as StopOnControlMode's method does (enum stop_method), dropping
- * what is queued or buffered; no answer is owed and no command counted
- * (the bus watchdog). */
+ * what is queued or buffered and cutting an open BeginAsync block short;
+ * no answer is owed and no command counted (the bus watchdog, a late
+ * stream). */
 void motion_stop(struct motion *m, uint8_t method);
 /* What holds the output back at this tick (enum limiter, item 67): a
  * protection or the watchdog (the registers' held_by), else the limit the

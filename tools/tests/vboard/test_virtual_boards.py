@@ -4,6 +4,7 @@ their peripherals laid out from ST's SVD files), driven through servoctl and
 the maker's SDK exactly as the simulator is. Time is the boards' simulated
 time (sim.sleep, sim.wait_until)."""
 import struct
+import zlib
 
 import pytest
 import serial
@@ -13,7 +14,7 @@ from servoctl import group
 from servoctl import image as img
 from servoctl import protocol as p
 from servoctl import update as upd
-from servoctl.errors import ServoError
+from servoctl.errors import Refused, ServoError
 from servoctl.registers import ITEMS
 from servoctl.servo import Servo
 from servoctl.sim import PLANTS, Simulator
@@ -184,6 +185,68 @@ def test_the_safety_features_on_the_real_images(one):
     sim.sleep(0.1)
     assert servo.faults() == []
 
+
+
+def test_the_watchdog_stops_a_duty_when_the_host_falls_silent(one):
+    """DriveDuty counts as driven (issue 55): the watchdog stops it, and
+    ReadMotion does not call the output released while the duty is on."""
+    sim, bus, servo = one
+    servo.write("watchdog_action", 2)  # release
+    servo.write("watchdog_ms", 100)
+    servo.drive_duty(0.3, 10000)
+    sim.sleep(0.05)
+    m = servo.read_motion()  # the last frame
+    assert not m.flags & m.RELEASED and m.duty_q15 != 0
+    sim.sleep(0.4)  # silent: far less than the duty's 10 s
+    m = servo.read_motion()
+    assert m.flags & m.RELEASED and m.limiter == "watchdog" and m.duty_q15 == 0
+    assert servo.read_fault(0).kind == "watchdog"
+
+
+def _fault_record(number: int, what: int) -> bytes:
+    """A fault record as storage/fault_log.c writes it."""
+    entry = struct.pack("<IIiHHHhhB", number, number, 0, 7400, 0, 0, 250, 250, what)
+    head = struct.pack("<HBB", 0xFA17, 1, 0xFF) + entry + b"\xff"
+    return head + struct.pack("<I", zlib.crc32(head))
+
+
+def test_a_clear_on_a_full_page_while_driven_is_refused_then_taken(tmp_path, board):
+    """The image's fault pages with one slot left and the spare still
+    showing faults (written into the board's flash file between runs): a
+    watchdog fault while held fills the page, and ClearFaults is refused
+    until the servo is released and the bus quiet (issue 55)."""
+    sim = start(tmp_path, board)
+    finish(sim, [1])
+    h = board_h(board)
+    slots = h["BOARD_FLASH_PAGE"] // 32
+    page0 = bytes(30 * 32) + _fault_record(40, 6) + b"\xff" * (h["BOARD_FLASH_PAGE"] - 31 * 32)
+    page1 = b"".join(_fault_record(n, 2) for n in range(1, slots + 1))
+    with open(tmp_path / "state" / f"{board}-1.flash", "r+b") as f:
+        f.seek(h["BOARD_FAULT_PAGE0"] - h["BOARD_FLASH_BASE"])
+        f.write(page0 + page1)
+    sim = start(tmp_path, board)
+    try:
+        with sim.bus(timeout=0.3) as bus:
+            servo = Servo(bus, 1)
+            assert servo.read_fault(0).count == 16
+            servo.write("soft_start_on", 0)
+            servo.write("watchdog_action", 0)  # hold: driven all along
+            servo.write("watchdog_ms", 50)
+            servo.move(300, interval_ms=100)
+            sim.sleep(0.3)  # the watchdog holds; its fault fills the page
+            assert servo.read_fault(0).kind == "watchdog"
+            with pytest.raises(Refused):
+                servo.clear_faults()
+            assert servo.read_fault(0).count == 16
+            servo.stop("release")
+            sim.sleep(0.5)  # released and quiet: the spare page is erased
+            again_if_unanswered(servo.clear_faults)
+            sim.sleep(0.1)
+            sim.control("powercycle 1")
+            sim.sleep(0.5)  # the bootloader's window, then the application
+            assert servo.faults() == []
+    finally:
+        finish(sim, [1])
 
 def test_sync_monitor_and_sync_moves_on_a_bus(tmp_path, board):
     # The rounds get a second of simulated time, not servoctl's default of
