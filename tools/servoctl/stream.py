@@ -51,13 +51,8 @@ class Limits:
     speed: int = MAX_SPEED_DECIDEG_S
 
     @classmethod
-    def of(cls, s) -> "Limits":
-        """Read from the servo (servo.Servo): its user area."""
-        try:
-            cfg = s.read_all()
-        except NoReply as e:
-            raise NoReply(f"servo {s.id} did not answer ({e}): is it on the bus, at this baud rate? "
-                          f"Nothing was sent") from None
+    def of(cls, cfg: dict) -> "Limits":
+        """From a servo's user area (servo.Servo.read_all)."""
         if not cfg["angle_limit_on"]:
             return cls()
         return cls(cfg["angle_min"], cfg["angle_max"])
@@ -79,11 +74,22 @@ class Limits:
         return ""
 
 
-def read_limits(bus: p.Bus, ids) -> dict:
-    """{id: Limits} read from each servo."""
+def read_configs(bus: p.Bus, ids) -> dict:
+    """{id: the servo's user area}, one ReadBatchData each."""
     from .servo import Servo
 
-    return {servo_id: Limits.of(Servo(bus, servo_id)) for servo_id in ids}
+    out = {}
+    for servo_id in ids:
+        try:
+            out[servo_id] = Servo(bus, servo_id).read_all()
+        except NoReply as e:
+            raise NoReply(f"{e}: is servo {servo_id} on the bus, at this baud rate? Nothing was sent") from None
+    return out
+
+
+def read_limits(bus: p.Bus, ids) -> dict:
+    """{id: Limits} read from each servo."""
+    return {servo_id: Limits.of(cfg) for servo_id, cfg in read_configs(bus, ids).items()}
 
 
 class Stream:
@@ -303,7 +309,7 @@ class LeadIn:
     soft_start_s: float  # the longest soft start that could have stretched it (items 49, 50)
 
 
-def lead_in(bus: p.Bus, targets: dict, duration_s: float, poll_s: float = 0.01) -> LeadIn:
+def lead_in(bus: p.Bus, targets: dict, duration_s: float, configs: dict = None, poll_s: float = 0.01) -> LeadIn:
     """Moves every servo to targets ({id: degrees}, one multi-turn sync
     move of duration_s) and waits, on the bus's clock, until each has
     arrived: status bit 0 clear and within TOLERANCE_DEG. Every poll_s a
@@ -311,23 +317,23 @@ def lead_in(bus: p.Bus, targets: dict, duration_s: float, poll_s: float = 0.01) 
     64, 65) all the while. Soft start (49, 50) stretches the first move
     after power-up to its own time, and the wait allows for it: twice
     duration_s, plus the soft start, plus 2 s. A servo that did not arrive
-    raises Refused saying where it is and why: nothing is streamed."""
+    raises Refused saying where it is and why: nothing is streamed.
+    configs: {id: user area} as read_configs read them, else read now."""
     from .group import sync_move
     from .servo import MotionSnapshot, Servo
 
     ids = list(targets)
-    start, soft = {}, 0.0
-    for servo_id in ids:
-        s = Servo(bus, servo_id)
-        cfg = s.read_all()
-        if cfg["soft_start_on"]:
-            soft = max(soft, cfg["soft_start_time"] / 1000.0)
-        start[servo_id] = s.multi_turn_angle()[0]
+    configs = configs or read_configs(bus, ids)
+    soft = max(c["soft_start_time"] / 1000.0 if c["soft_start_on"] else 0.0 for c in configs.values())
+    states = sync_monitor(bus, ids)
+    missing = [i for i in ids if i not in states]
+    if missing:
+        raise NoReply(f"servo {missing[0]} did not answer a Sync Monitor: nothing was sent")
+    start = {i: states[i].angle_decideg for i in ids}
     sync_move(bus, targets, duration_s, multi_turn=True)
     limit = 2.0 * duration_s + soft + 2.0
     begun = bus.clock()
     seen = dict.fromkeys(ids, 0)
-    states = {}
     while True:
         bus.sleep(poll_s)
         states = sync_monitor(bus, ids)
@@ -441,9 +447,10 @@ def cmd_stream(bus, args):
 
     trajectory = read_trajectory(args.file)
     angles = trajectory.angles
-    limits = read_limits(bus, angles)
+    configs = read_configs(bus, angles)
+    limits = {i: Limits.of(cfg) for i, cfg in configs.items()}
     check_trajectory(trajectory, limits)
-    lead = lead_in(bus, {i: a[0] for i, a in angles.items()}, args.lead_in)
+    lead = lead_in(bus, {i: a[0] for i, a in angles.items()}, args.lead_in, configs)
     with Progress(transient=True, disable=not sys.stderr.isatty()) as progress:
         task = progress.add_task("streaming", total=len(trajectory.times))
         report = stream_file(bus, trajectory.times, angles,
