@@ -116,9 +116,9 @@ def test_the_lead_in_keeps_the_bus_watchdog_fed(sim, tmp_path, capsys):
     out = capsys.readouterr().out
     print(out)
     assert rc == 0
+    assert float(out.split("peak ")[1].split(" deg")[0]) < 5.0, out
     # A watchdog that acted in the lead-in would have stopped it short (rc 1).
     assert "servo 1: from 0.0 deg to 40.0 deg" in out, out
-    assert float(out.split("peak ")[1].split(" deg")[0]) < 5.0, out
 
 
 def test_a_lead_in_that_does_not_arrive_is_an_error_and_nothing_is_streamed(sim, tmp_path, capsys):
