@@ -157,9 +157,37 @@ static void test_the_error_saturates_instead_of_changing_sign(void **state)
     assert_true(furthest > 2330 * TURN); /* beyond int32 in Q8 */
 }
 
+/* Powered up, the horn is in the turn around its zero (item 90): the
+ * reading is -180..180 deg whichever side of the zero the encoder's count
+ * is (servo_sim and the F030 read -30 deg as 330 deg). */
+static void test_power_up_takes_the_turn_around_the_zero(void **state)
+{
+    (void)state;
+    static const struct {
+        uint16_t zero, raw;
+        int32_t decideg;
+    } cases[] = {
+        {0, 4096 - 342, -301}, {0, 342, 301},      {0, 2047, 1799}, {0, 2048, -1800},
+        {1000, 3500, -1403},   {1000, 2500, 1318}, {4000, 100, 172},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        WRITE_ITEM(0, ITEM_ENCODER_ZERO, cases[i].zero);
+        hal.encoder_model = NULL;
+        hal.encoder_raw = cases[i].raw;
+        harness_restart();
+        harness_run_ms(2);
+        int32_t angle;
+        int16_t turns;
+        read_multi_turn(&angle, &turns);
+        assert_int_equal(angle, cases[i].decideg);
+        assert_int_equal(turns, 0);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test_setup(test_power_up_takes_the_turn_around_the_zero, setup),
         cmocka_unit_test_setup(test_a_back_driven_reading_stays_in_range, setup),
         cmocka_unit_test_setup(test_a_wheel_move_across_the_end_keeps_its_length, setup),
         cmocka_unit_test_setup(test_the_error_saturates_instead_of_changing_sign, setup),

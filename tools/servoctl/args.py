@@ -234,7 +234,8 @@ def build_parser():
 
     c = sub.add_parser("stream", help="stream a trajectory (CSV: time s, one column of degrees per servo ID)")
     c.add_argument("file", help="CSV: a header 'time,ID,ID...', then evenly spaced rows")
-    c.add_argument("--lead-in", type=float, default=1.0, help="s to move to the first row first (default 1)")
+    c.add_argument("--lead-in", type=float, default=1.0,
+                   help="s to move to the first row first (default 1); waited for, soft start included")
 
     c = sub.add_parser("identify", help="the drive train's constants from open-loop duty steps (horn free)")
     c.add_argument("id", type=int)

@@ -3,7 +3,14 @@ trajectory, one setpoint per servo per period, which each servo
 interpolates at its 1 kHz tick. Stream sends them; RobotLoop is a robot's
 whole cycle (one SyncCommand of setpoints, one Sync Monitor) with its rate
 against the wire's; stream_file runs a CSV trajectory and reports how
-closely the servos followed it."""
+closely the servos followed it.
+
+Every setpoint is checked against what its servo allows before it is sent
+(Limits, read from the servo): its angle limits when they are on, and the
+servo's top speed (750 deg/s) between one setpoint and the next. One out of
+them is refused, never clamped: a clamped path is not the host's, and the
+servo, without the next setpoint, brakes to a hold where the last one
+was (docs/streaming.md). A file is checked whole before anything moves."""
 import csv
 import math
 import struct
@@ -11,8 +18,9 @@ from dataclasses import dataclass
 
 from . import protocol as p
 from .checks import check_range, scaled
-from .errors import UsageError
-from .group import MAX_SYNC_RECORDS, monitor_answers, monitor_request
+from .errors import NoReply, Refused, UsageError, ValueOutOfRange
+from .group import MAX_SYNC_RECORDS, monitor_answers, monitor_request, sync_monitor
+from .outcome import EXECUTING, INHIBITING, STALL, TOLERANCE_DEG
 
 MAX_ANGLE_DECIDEG = 3686400    # the multi-turn range (ReadMultiTurnAngle)
 MAX_SPEED_DECIDEG_S = 7500     # the firmware clamps beyond (schema.toml)
@@ -32,17 +40,75 @@ def _check_ids(ids) -> list:
     return ids
 
 
+@dataclass
+class Limits:
+    """What one servo allows a streamed setpoint, 0.1 deg and 0.1 deg/s:
+    angle_min..angle_max if its angle limits are on (items 48, 51, 52),
+    else None; and the top speed, the servo's own clamp for moves and
+    setpoints (docs/streaming.md), between a setpoint and the next."""
+    angle_min: int = None
+    angle_max: int = None
+    speed: int = MAX_SPEED_DECIDEG_S
+
+    @classmethod
+    def of(cls, cfg: dict) -> "Limits":
+        """From a servo's user area (servo.Servo.read_all)."""
+        if not cfg["angle_limit_on"]:
+            return cls()
+        return cls(cfg["angle_min"], cfg["angle_max"])
+
+    def check(self, servo_id: int, angle: int, last: int = None, period_ms: int = 0, velocity: int = 0) -> str:
+        """Why the setpoint angle (after last, a period_ms earlier; at
+        velocity) is refused, or "" if it is not."""
+        if self.angle_min is not None and not self.angle_min <= angle <= self.angle_max:
+            return (f"servo {servo_id} limits its angle to {self.angle_min / 10:.1f}..{self.angle_max / 10:.1f} deg "
+                    f"(angle_min, angle_max, angle_limit_on): a setpoint of {angle / 10:.1f} deg is outside them. "
+                    f"Change the limits, or turn them off with 'servoctl config set {servo_id} angle_limit_on 0'")
+        if last is not None and abs(angle - last) * 1000 > self.speed * period_ms:
+            return (f"servo {servo_id}: {abs(angle - last) / 10:.1f} deg in {period_ms} ms (from {last / 10:.1f} to "
+                    f"{angle / 10:.1f} deg) is {abs(angle - last) * 100 / period_ms:.0f} deg/s, beyond the "
+                    f"{self.speed / 10:.0f} deg/s the servo moves")
+        if abs(velocity) > self.speed:
+            return (f"servo {servo_id}: a velocity of {velocity / 10:g} deg/s is beyond the {self.speed / 10:.0f} "
+                    f"deg/s the servo moves")
+        return ""
+
+
+def read_configs(bus: p.Bus, ids) -> dict:
+    """{id: the servo's user area}, one ReadBatchData each."""
+    from .servo import Servo
+
+    out = {}
+    for servo_id in ids:
+        try:
+            out[servo_id] = Servo(bus, servo_id).read_all()
+        except NoReply as e:
+            raise NoReply(f"{e}: is servo {servo_id} on the bus, at this baud rate? Nothing was sent") from None
+    return out
+
+
+def read_limits(bus: p.Bus, ids) -> dict:
+    """{id: Limits} read from each servo."""
+    return {servo_id: Limits.of(cfg) for servo_id, cfg in read_configs(bus, ids).items()}
+
+
 class Stream:
     """Setpoints for ids every period_s: send({id: degrees}) once a period,
     one period ahead of where the servos should be (each servo reaches a
     setpoint a period after it arrives). Velocities, in degrees per second,
     are given or taken from the last two setpoints. One servo gets its own
-    packet; several, one SyncCommand frame, so they start together."""
+    packet; several, one SyncCommand frame, so they start together.
 
-    def __init__(self, bus: p.Bus, ids, period_s: float):
+    limits, {id: Limits}, are read from the servos if not given: a send
+    with a setpoint outside its servo's angle limits, a step from the last
+    setpoint faster than the servo moves, or a velocity beyond it, raises
+    ValueOutOfRange and sends nothing."""
+
+    def __init__(self, bus: p.Bus, ids, period_s: float, limits: dict = None):
         self.bus = bus
         self.ids = _check_ids(ids)
         self.period_ms = check_range("period", scaled(period_s, 1000, "period_s"), *PERIOD_RANGE_MS, "ms")
+        self.limits = read_limits(bus, self.ids) if limits is None else {i: limits[i] for i in self.ids}
         self.sent = 0
         self._last = {}
         # Every record of a send in one pack: a robot's loop builds this
@@ -60,13 +126,16 @@ class Stream:
         for servo_id in self.ids:
             angle = check_range("angle", scaled(targets[servo_id], 10, "degrees"),
                                 -MAX_ANGLE_DECIDEG, MAX_ANGLE_DECIDEG, "deg", 10)
+            last = self._last.get(servo_id)
             if velocities is not None:
                 speed = scaled(velocities[servo_id], 10, "velocity")
-            elif servo_id in self._last:
-                speed = round((angle - self._last[servo_id]) * 1000 / self.period_ms)
+            elif last is not None:
+                speed = round((angle - last) * 1000 / self.period_ms)
             else:
                 speed = 0
-            speed = max(-MAX_SPEED_DECIDEG_S, min(MAX_SPEED_DECIDEG_S, speed))
+            why = self.limits[servo_id].check(servo_id, angle, last, self.period_ms, speed)
+            if why:
+                raise ValueOutOfRange(f"{why}: nothing of this send was sent")
             records.append((servo_id, angle, speed))
         for servo_id, angle, _ in records:
             self._last[servo_id] = angle
@@ -109,8 +178,8 @@ class RobotLoop:
     cycles run with the wire's limit, every byte of both frames and of the
     answers back to back."""
 
-    def __init__(self, bus: p.Bus, ids, period_s: float):
-        self.stream = Stream(bus, ids, period_s)
+    def __init__(self, bus: p.Bus, ids, period_s: float, limits: dict = None):
+        self.stream = Stream(bus, ids, period_s, limits)
         self.bus = bus
         self.cycles = 0
         self.started = None
@@ -143,29 +212,162 @@ class RobotLoop:
         return LoopRate(self.cycles, seconds, limit)
 
 
-def read_trajectory(path: str):
-    """(times_s, {id: [degrees...]}) from a CSV: a header of "time" then
-    one servo ID per column; a row per setpoint, evenly spaced."""
+@dataclass
+class Trajectory:
+    """A CSV trajectory: times (s), {id: [degrees...]}, and each row's line
+    in its file, for the messages."""
+    times: list
+    angles: dict
+    lines: list = None
+    path: str = ""
+
+    @property
+    def period_ms(self) -> int:
+        return round((self.times[-1] - self.times[0]) / (len(self.times) - 1) * 1000)
+
+    def where(self, k: int) -> str:
+        return f"{self.path} line {self.lines[k]}" if self.lines else f"row {k}"
+
+
+def read_trajectory(path: str) -> Trajectory:
+    """A CSV: a header of "time" then one servo ID per column; a row per
+    setpoint, evenly spaced. Every row is checked, and an error names its
+    line: nothing is sent before the whole file has passed."""
     try:
         with open(path, newline="") as f:
-            rows = [r for r in csv.reader(f) if r and not r[0].lstrip().startswith("#")]
+            rows = [(n, r) for n, r in enumerate(csv.reader(f), 1)
+                    if r and not r[0].lstrip().startswith("#")]
     except OSError as e:
         raise UsageError(f"cannot read {path}: {e.strerror}") from None
+    except (csv.Error, UnicodeDecodeError) as e:
+        raise UsageError(f"{path}: not a CSV file ({e}): nothing was sent") from None
     if len(rows) < 3:
         raise UsageError(f"{path}: a header and at least two rows are needed")
+    line, header = rows[0]
     try:
-        ids = [int(c) for c in rows[0][1:]]
-        table = [[float(c) for c in r] for r in rows[1:]]
-    except ValueError as e:
-        raise UsageError(f"{path}: the header is 'time' and servo IDs, every row numbers ({e})") from None
-    _check_ids(ids)
-    if any(len(r) != len(ids) + 1 or not all(map(math.isfinite, r)) for r in table):
-        raise UsageError(f"{path}: every row has a time and one finite angle per servo ({len(ids)})")
+        ids = [int(c) for c in header[1:]]
+        _check_ids(ids)
+    except (ValueError, UsageError) as e:
+        raise UsageError(f"{path} line {line}: the header is 'time' and servo IDs ({e})") from None
+    table, lines = [], []
+    for line, r in rows[1:]:
+        def bad(why):
+            return UsageError(f"{path} line {line}: {why}; nothing was sent")
+        if len(r) != len(ids) + 1:
+            raise bad(f"every row has a time and one finite angle per servo ({len(ids)}), not {len(r)} values")
+        try:
+            values = [float(c) for c in r]
+        except ValueError as e:
+            raise bad(f"every row has a time and one finite angle per servo, all numbers ({e})") from None
+        if not all(map(math.isfinite, values)):
+            raise bad(f"every row has a time and one finite angle per servo, not {', '.join(r)}")
+        for servo_id, degrees in zip(ids, values[1:]):
+            try:
+                check_range("angle", scaled(degrees, 10, "degrees"), -MAX_ANGLE_DECIDEG, MAX_ANGLE_DECIDEG, "deg", 10)
+            except ValueOutOfRange as e:
+                raise bad(f"servo {servo_id}'s {e}") from None
+        table.append(values)
+        lines.append(line)
     times = [r[0] for r in table]
     period = (times[-1] - times[0]) / (len(times) - 1)
-    if period <= 0 or any(abs(b - a - period) > 1e-4 for a, b in zip(times, times[1:])):
-        raise UsageError(f"{path}: the times must be evenly spaced and rising")
-    return times, {servo_id: [r[k + 1] for r in table] for k, servo_id in enumerate(ids)}
+    if period <= 0:
+        raise UsageError(f"{path}: the times must be evenly spaced and rising; nothing was sent")
+    for k in range(1, len(times)):
+        if abs(times[k] - times[k - 1] - period) > 1e-4:
+            raise UsageError(f"{path} line {lines[k]}: the times must be evenly spaced and rising "
+                             f"({period * 1000:g} ms apart), not {times[k - 1]:g} then {times[k]:g} s; "
+                             f"nothing was sent")
+    try:
+        check_range("period", round(period * 1000), *PERIOD_RANGE_MS, "ms")
+    except ValueOutOfRange as e:
+        raise ValueOutOfRange(f"{path}: the rows' {e}; nothing was sent") from None
+    return Trajectory(times, {servo_id: [r[k + 1] for r in table] for k, servo_id in enumerate(ids)},
+                      lines, path)
+
+
+def check_trajectory(trajectory: Trajectory, limits: dict) -> None:
+    """Every row against every servo's Limits, as Stream checks a send,
+    before anything moves: a row outside them is refused with its line."""
+    period_ms = trajectory.period_ms
+    for servo_id, rows in trajectory.angles.items():
+        last = None
+        for k, degrees in enumerate(rows):
+            angle = scaled(degrees, 10, "degrees")
+            why = limits[servo_id].check(servo_id, angle, last, period_ms)
+            if why:
+                raise ValueOutOfRange(f"{trajectory.where(k)}: {why}; nothing was sent")
+            last = angle
+
+
+@dataclass
+class LeadIn:
+    """How the servos reached a stream's first row."""
+    start_deg: dict    # {id: where each was}
+    target_deg: dict   # {id: the first row}
+    end_deg: dict      # {id: where each arrived}
+    took_s: float      # on the bus's clock
+    soft_start_s: float  # the longest soft start that could have stretched it (items 49, 50)
+
+
+def lead_in(bus: p.Bus, targets: dict, duration_s: float, configs: dict = None, poll_s: float = 0.01) -> LeadIn:
+    """Moves every servo to targets ({id: degrees}, one multi-turn sync
+    move of duration_s) and waits, on the bus's clock, until each has
+    arrived: status bit 0 clear and within TOLERANCE_DEG. Every poll_s a
+    Sync Monitor asks every servo's state, and feeds a bus watchdog (items
+    64, 65) all the while. Soft start (49, 50) stretches the first move
+    after power-up to its own time, and the wait allows for it: twice
+    duration_s, plus the soft start, plus 2 s. A servo that did not arrive
+    raises Refused saying where it is and why: nothing is streamed.
+    configs: {id: user area} as read_configs read them, else read now."""
+    from .group import sync_move
+    from .servo import MotionSnapshot, Servo
+
+    ids = list(targets)
+    configs = configs or read_configs(bus, ids)
+    soft = max(c["soft_start_time"] / 1000.0 if c["soft_start_on"] else 0.0 for c in configs.values())
+    states = sync_monitor(bus, ids)
+    missing = [i for i in ids if i not in states]
+    if missing:
+        raise NoReply(f"servo {missing[0]} did not answer a Sync Monitor: nothing was sent")
+    start = {i: states[i].angle_decideg for i in ids}
+    sync_move(bus, targets, duration_s, multi_turn=True)
+    limit = 2.0 * duration_s + soft + 2.0
+    begun = bus.clock()
+    seen = dict.fromkeys(ids, 0)
+    while True:
+        bus.sleep(poll_s)
+        states = sync_monitor(bus, ids)
+        for servo_id, m in states.items():
+            seen[servo_id] |= m.status
+        if all(i in states and not states[i].status & EXECUTING for i in ids) or bus.clock() - begun >= limit:
+            break
+    took = bus.clock() - begun
+    for servo_id in ids:
+        if servo_id not in states:
+            raise NoReply(f"servo {servo_id} did not answer at the end of the lead-in: nothing was streamed")
+        m, target = states[servo_id], scaled(targets[servo_id], 10, "degrees")
+        off = abs(m.angle_decideg - target) / 10
+        if not m.status & EXECUTING and off <= TOLERANCE_DEG:
+            continue
+        if m.status & EXECUTING:
+            why = f"did not arrive within {limit:.1f} s"
+        elif seen[servo_id] & INHIBITING:
+            why = "was stopped by a protection"
+        elif seen[servo_id] & STALL:
+            why = "was blocked: it stalled (status bit 2)"
+        else:
+            why = "stopped short"
+        try:  # what held it back, where the servo can say (this firmware's ReadMotion)
+            limiter = Servo(bus, servo_id).read_motion().limiter
+            if limiter != MotionSnapshot.LIMITERS[0]:
+                why += f" (held back by: {limiter})"
+        except NoReply:
+            pass
+        raise Refused(f"servo {servo_id}: the lead-in to the first row ({target / 10:.1f} deg) {why}; "
+                      f"at {m.angle_decideg / 10:.1f} deg, {off:.1f} deg from it, after {took:.2f} s. "
+                      f"Nothing was streamed")
+    return LeadIn({i: a / 10 for i, a in start.items()}, dict(targets),
+                  {i: states[i].angle_decideg / 10 for i in ids}, took, soft)
 
 
 @dataclass
@@ -178,15 +380,22 @@ class StreamReport:
     missed: int       # states that did not come back
 
 
-def stream_file(bus: p.Bus, times, angles: dict, progress=None) -> StreamReport:
+def stream_file(bus: p.Bus, times, angles: dict, progress=None, limits: dict = None) -> StreamReport:
     """Streams the trajectory at its own period, the servos already at its
-    first row: each row is sent a period before its time (velocities by
-    central differences, 0 at the first and last rows), and each servo's state from the cycle's Sync
-    Monitor is compared with the trajectory at the moment it arrived."""
+    first row (lead_in): each row is sent a period before its time
+    (velocities by central differences, 0 at the first and last rows), and
+    each servo's state from the cycle's Sync Monitor is compared with the
+    trajectory at the moment it arrived. Every row is checked against the
+    servos' limits (read from them if not given) before the first is sent."""
     ids = list(angles)
     period = times[1] - times[0]
-    loop = RobotLoop(bus, ids, period)
+    loop = RobotLoop(bus, ids, period, limits)
+    check_trajectory(Trajectory(times, angles), loop.stream.limits)
     count = len(times)
+    period_ms = loop.stream.period_ms
+    # The rows as sent (0.1 deg): a velocity is theirs, so it is within
+    # the speed the rows were checked against.
+    sent = {i: [scaled(a, 10, "degrees") for a in angles[i]] for i in ids}
 
     def velocity(servo_id, k):
         # The servos start from rest and end at rest: no step of speed at
@@ -194,8 +403,8 @@ def stream_file(bus: p.Bus, times, angles: dict, progress=None) -> StreamReport:
         # reach the first row moving).
         if k in (0, count - 1):
             return 0.0
-        a = angles[servo_id]
-        return (a[k + 1] - a[k - 1]) / (2 * period)
+        a = sent[servo_id]
+        return (a[k + 1] - a[k - 1]) * 100 / (2 * period_ms)
 
     def reference(servo_id, t):
         k = min(max((t - times[0]) / period, 0.0), count - 1.0)
@@ -227,24 +436,38 @@ def stream_file(bus: p.Bus, times, angles: dict, progress=None) -> StreamReport:
 
 
 def cmd_stream(bus, args):
-    """servoctl stream FILE.csv: the servos move to the first row (a sync
-    move of --lead-in seconds), then follow the trajectory at its period;
-    prints each servo's tracking error and the cycle's rate."""
+    """servoctl stream FILE.csv: the whole file is checked first, against
+    each servo's limits too; the servos move to the first row (a sync move
+    of --lead-in seconds) and the command waits until they are there; then
+    they follow the trajectory at its period. Prints the lead-in, each
+    servo's tracking error and the cycle's rate."""
     import sys
 
     from rich.progress import Progress
 
-    from .group import sync_move
-
-    times, angles = read_trajectory(args.file)
-    period = times[1] - times[0]
-    check_range("period", scaled(period, 1000, "period"), *PERIOD_RANGE_MS, "ms")
-    sync_move(bus, {i: a[0] for i, a in angles.items()}, args.lead_in, multi_turn=True)
-    bus.sleep(args.lead_in + 0.2)
+    trajectory = read_trajectory(args.file)
+    angles = trajectory.angles
+    configs = read_configs(bus, angles)
+    limits = {i: Limits.of(cfg) for i, cfg in configs.items()}
+    check_trajectory(trajectory, limits)
+    lead = lead_in(bus, {i: a[0] for i, a in angles.items()}, args.lead_in, configs)
     with Progress(transient=True, disable=not sys.stderr.isatty()) as progress:
-        task = progress.add_task("streaming", total=len(times))
-        report = stream_file(bus, times, angles,
-                             lambda done, total: progress.update(task, completed=done))
+        task = progress.add_task("streaming", total=len(trajectory.times))
+        report = stream_file(bus, trajectory.times, angles,
+                             lambda done, total: progress.update(task, completed=done), limits)
+    period = report.period_s
+    stretched = ""
+    if lead.soft_start_s and lead.took_s > args.lead_in + 0.1:
+        stretched = (f" (soft start: the first move after power-up takes soft_start_time, "
+                     f"{lead.soft_start_s * 1000:.0f} ms)")
+    print(f"lead-in: at the first row after {lead.took_s:.2f} s{stretched}")
+    for servo_id in angles:
+        moved = lead.end_deg[servo_id] - lead.start_deg[servo_id]
+        print(f"  servo {servo_id}: from {lead.start_deg[servo_id]:.1f} deg to {lead.end_deg[servo_id]:.1f} deg "
+              f"({moved:+.1f} deg)")
+        if abs(moved) >= 180.0:
+            print(f"  warning: servo {servo_id} turned {abs(moved):.1f} deg to reach the first row: angles are "
+                  f"from its zero, in the turn around it at power-up (docs/servoctl.md)")
     print(f"{report.cycles} setpoints at {1 / period:g} Hz to {len(angles)} servo(s)")
     for servo_id in angles:
         print(f"  servo {servo_id}: tracking error RMS {report.rms_deg[servo_id]:.2f} deg, "

@@ -8,7 +8,7 @@ import pytest
 
 from servoctl import protocol as p
 from servoctl.protocol import LinkError, NoReply
-from servoctl.stream import RobotLoop, Stream
+from servoctl.stream import Limits, RobotLoop, Stream
 
 
 class RecordingBus:
@@ -33,7 +33,7 @@ def test_the_robot_loop_sends_its_setpoints_and_sync_monitor_in_one_write():
     """One write a cycle: a host descheduled between two writes would leave
     a gap on the wire between the setpoints and the Sync Monitor."""
     bus = RecordingBus()
-    loop = RobotLoop(bus, [1, 2, 3], 0.02)
+    loop = RobotLoop(bus, [1, 2, 3], 0.02, limits={i: Limits() for i in (1, 2, 3)})
     assert loop.cycle({1: 1.0, 2: 2.0, 3: 3.0}) == {}
     assert loop.missed == 3
     [(setpoints, monitor)] = bus.bursts
@@ -44,7 +44,7 @@ def test_the_robot_loop_sends_its_setpoints_and_sync_monitor_in_one_write():
 @pytest.mark.parametrize("ids", [[7], [1, 2, 3, 4, 5, 6]])
 def test_a_streams_records_are_the_schemas_request(ids):
     """The records packed at once are what encode_request lays out one by one."""
-    stream = Stream(RecordingBus(), ids, 0.02)
+    stream = Stream(RecordingBus(), ids, 0.02, limits={i: Limits() for i in ids})
     stream.sent = 3
     code, content = stream.frame_content({i: 1.5 * i for i in ids}, {i: -2.0 * i for i in ids})
     records = [p.encode_request(p.STREAM_SETPOINT, i, 15 * i, -20 * i, 60) for i in ids]

@@ -48,6 +48,11 @@ void adc_scan_init(void)
     ADC_CR2 = ADC_CR2_ADON | ADC_CR2_CONT | ADC_CR2_DMA | ADC_CR2_EXTSEL_SWSTART |
               ADC_CR2_EXTTRIG;
     ADC_CR2 |= ADC_CR2_SWSTART;
+    /* The first scan in RAM before servo_init reads the encoder: its
+     * power-up reading picks the turn the horn is in (motion_init). From
+     * 0 it was tracked there, up to a turn off with a zero (item 90). */
+    while (!(DMA1_ISR & DMA1_FLAGS(1u) & 2u)) { /* TCIF1 */
+    }
 }
 
 uint32_t unique_id_serial(void *ctx)

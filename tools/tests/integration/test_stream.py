@@ -11,7 +11,7 @@ from servoctl import protocol as p
 from servoctl.cli import main
 from servoctl.errors import UsageError, ValueOutOfRange
 from servoctl.servo import Servo
-from servoctl.stream import RobotLoop, Stream, read_trajectory
+from servoctl.stream import Limits, RobotLoop, Stream, read_trajectory
 
 from .conftest import finish, _start
 
@@ -96,7 +96,7 @@ def test_stream_refuses_what_it_cannot_send():
         Stream(NoBus(), [1], 2.0)
     with pytest.raises(UsageError, match="listed more than once"):
         Stream(NoBus(), [1, 1], 0.02)
-    s = Stream(NoBus(), [1, 2], 0.02)
+    s = Stream(NoBus(), [1, 2], 0.02, limits={1: Limits(), 2: Limits()})
     with pytest.raises(UsageError, match="a setpoint for every streamed servo"):
         s.frame_content({1: 0.0})
     with pytest.raises(ValueOutOfRange, match="angle must be"):

@@ -1,0 +1,60 @@
+"""Issue 55's stream repros on both virtual boards (the F103 and F030
+images as flashed), as on servo_sim (tests/integration/test_stream_safety.py):
+a row beyond the angle limits and a row that is not a number are refused
+with their line before anything moves; after a power cycle at -30 deg, with
+the factory's 3 s soft start and a 100 ms bus watchdog, the stream waits for
+its lead-in and the joint stays in its turn. Time is the boards' simulated
+time."""
+import math
+
+import pytest
+
+from servoctl.cli import main
+from servoctl.servo import Servo
+from servoctl.sim import Simulator
+
+BOARDS = ["stm32f103", "stm32f030k6"]
+
+
+def write_csv(path, rows, period_s=0.02):
+    lines = ["time,1"] + [f"{k * period_s:.3f},{a}" for k, a in enumerate(rows)]
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+@pytest.mark.parametrize("board", BOARDS)
+def test_the_stream_repros_on_the_real_images(tmp_path, board, capsys):
+    sim = Simulator(ids=[1], state_dir=str(tmp_path / "state"), board=board).start()
+    try:
+        def stream(path, lead_in=0.5):
+            return main(["--port", sim.url, "stream", str(path), "--lead-in", str(lead_in)], clock=sim.clock_s)
+
+        good = [f"{5 + k * 0.1:.3f}" for k in range(60)]
+        for bad, line in (("300", "line 62: servo 1 limits its angle"), ("x", "line 62: every row")):
+            rc = stream(write_csv(tmp_path / "bad.csv", good + [bad, "11"]))
+            err = capsys.readouterr().err
+            assert rc == 2 and line in err, err
+        sim.sleep(0.3)
+        assert abs(sim.state(1)["angle"]) < 0.5  # nothing moved
+
+        with sim.bus(timeout=0.3) as bus:
+            s = Servo(bus, 1)
+            assert s.read("soft_start_on") == 1
+            s.move(-300, interval_ms=500)
+            sim.sleep(3.8)  # the first move after power-up: the soft start's 3 s
+        sim.control("powercycle 1")
+        sim.sleep(0.6)
+        with sim.bus(timeout=0.3) as bus:
+            s = Servo(bus, 1)
+            assert s.multi_turn_angle()[0] == pytest.approx(-300, abs=3)  # not 330 deg
+            s.write("watchdog_ms", 100)
+        rows = [f"{-30 + 20 * math.sin(k / 10):.3f}" for k in range(60)]
+        rc = stream(write_csv(tmp_path / "t.csv", rows))
+        out = capsys.readouterr().out
+        print(out)
+        assert rc == 0
+        assert "soft start" in out and "servo 1: from -30.0 deg to -30.0 deg" in out, out
+        assert float(out.split("peak ")[1].split(" deg")[0]) < 5.0, out
+        assert abs(sim.state(1)["angle"] - float(rows[-1])) < 2.0
+    finally:
+        sim.stop()
