@@ -53,6 +53,16 @@ static bool write_item(const struct packet_call *c, uint8_t id, const uint8_t *d
 {
     struct user_config before;
     enum data_write_result w = data_table_write(c->d->regs, id, data, length, &before);
+    /* A drive item that would make a stable loop unstable is put back
+     * before the store sees it; ReadStore says why (bit 2). One already
+     * unstable (an older firmware's) takes any write: the way out. */
+    bool unstable = w == DATA_WRITE_CHANGED && id >= DRIVE_FIRST &&
+                    !drive_items_stable(&c->d->regs->user) && drive_items_stable(&before);
+    c->d->regs->store.write_refused = unstable ? STORE_UNSTABLE : 0u;
+    if (unstable) {
+        c->d->regs->user = before;
+        return false;
+    }
     bool ok = w == DATA_WRITE_SAME || (w == DATA_WRITE_CHANGED && keep_change(c, &before));
     if (w == DATA_WRITE_CHANGED && id >= DRIVE_FIRST) { /* kept or put back: the feed-forward follows */
         motion_drive_train_changed(c->d->motion);
@@ -90,7 +100,7 @@ enum packet_outcome handle_read_store(const struct packet_call *c, struct respon
 {
     const struct store_health *h = &c->d->regs->store;
     uint8_t *p = r->content;
-    p[1] = h->flags;
+    p[1] = h->write_refused ? h->write_refused : h->flags;
     le_put_u32(&p[2], h->records);
     le_put_u32(&p[6], h->page_erases);
     le_put_u32(&p[10], h->rated_cycles);

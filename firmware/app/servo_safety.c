@@ -10,7 +10,7 @@
  * own limit is added as item 67 or ReadMotion is read). */
 static void note_held_by(struct servo *s, uint8_t bits)
 {
-    s->regs.held_by = s->watchdog.fired                                          ? LIMITER_WATCHDOG
+    s->regs.held_by = s->watchdog.fired | s->swing.fired                         ? LIMITER_WATCHDOG
                       : (bits & (STATUS_LOW_VOLTAGE | STATUS_HIGH_VOLTAGE)) != 0u ? LIMITER_SUPPLY
                       : (bits & STATUS_OVER_TEMPERATURE) != 0u                    ? LIMITER_HEAT
                       : (bits & STATUS_STALL) != 0u && s->regs.user.stall_release ? LIMITER_STALL
@@ -121,6 +121,30 @@ __attribute__((noinline)) void safety_after_frame(struct servo *s)
     }
 }
 
+/* The oscillation monitor (item 72) under position control: a horn that
+ * runs away from its setpoint is released, a fault logged; item 67 says
+ * "watchdog" (a monitor acted) until the next motion command. */
+__attribute__((noinline)) static void watch_swing(struct servo *s)
+{
+    struct oscillation_monitor *o = &s->swing;
+    const struct motion *m = &s->motion;
+    if (o->fired && m->commands != o->commands_at_fire) {
+        o->fired = 0;
+        note_held_by(s, s->regs.status.status);
+    }
+    if (m->mode != MODE_POSITION) {
+        o->away_ticks = 0;
+    } else if (oscillation_watch(o, m->setpoint_q8 - m->measured_q8, m->measured_velocity_q8,
+                                 m->controller.at_limit, m->drive.kv, m->drive.duty_limit,
+                                 s->regs.firmware.oscillation_ms)) {
+        o->fired = 1;
+        o->commands_at_fire = m->commands;
+        motion_stop(&s->motion, STOP_RELEASE);
+        note_held_by(s, s->regs.status.status);
+        log_fault(s, FAULT_OSCILLATION);
+    }
+}
+
 /* In the pass of each control tick, after it: the bus watchdog (it acts
  * within a tick of its time) and, every SENSE_ROUND_TICKS, a sample of
  * the winding's heat. Neither is part of the control law, so neither
@@ -129,6 +153,9 @@ void safety_tend(struct servo *s)
 {
     if (s->regs.firmware.watchdog_ms != 0u) {
         watch_bus(s);
+    }
+    if (s->regs.firmware.oscillation_ms != 0u) {
+        watch_swing(s);
     }
     uint8_t trips = (uint8_t)(s->regs.status.status & FAULT_STATUS_BITS);
     if (trips != s->fault_bits_seen) {

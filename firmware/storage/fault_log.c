@@ -160,7 +160,7 @@ void fault_log_load(struct fault_log *l, const struct hal_flash *flash)
 
 bool fault_log_add(struct fault_log *l, const struct fault_entry *e)
 {
-    uint8_t what = e->what <= FAULT_WATCHDOG ? e->what : FAULT_WATCHDOG;
+    uint8_t what = e->what <= FAULT_OSCILLATION ? e->what : FAULT_OSCILLATION;
     /* last_seen: each kind's last record's operating second + 1; 0 none. */
     uint32_t since = e->op_seconds + 1u - l->last_seen[what];
     bool repeat = what != FAULT_CLEARED && l->last_seen[what] != 0u && since < FAULT_REPEAT_S;

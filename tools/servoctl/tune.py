@@ -186,8 +186,7 @@ def cmd_tune(bus, args):
     if args.dry_run:
         print("dry run: nothing written")
         return 0
-    for name, value in t.items.items():
-        servo.write(name, value)
+    servo.write_drive(t.items)  # refused, nothing written, if the loop they make would not be stable
     over, error = check_step(servo, bus.sleep)
     print(f"written and kept; a {CHECK_TARGET_DECIDEG / 10:g} deg move in {CHECK_MS} ms: overshoot "
           f"{max(over, 0) / 10:.1f} deg, {error / 10:.1f} deg from the target 1.5 s on")
