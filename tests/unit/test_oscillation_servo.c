@@ -4,6 +4,7 @@
  * fault 9 within the item's time; a normal move never trips it. On the
  * reference plant model (hal/ports/host/plant.c). */
 #include <math.h>
+#include <stdbool.h>
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -69,8 +70,13 @@ static void test_a_runaway_is_released_and_logged(void **state)
     /* 300 ms of running away; the braking guard brings the setpoint back
      * to the horn once (the count waits within 10 deg): 364 ms here. */
     assert_true(ms - beyond_ms >= 300 && ms - beyond_ms <= 300 + 200);
-    REQUEST(PKT_READ_FAULTS, 0, 0);
-    assert_int_equal(ANSWER_FIELD(PKT_READ_FAULTS, ANSWER_READ_FAULTS_WHAT), FAULT_OSCILLATION);
+    harness_run_ms(20); /* the fault's record programmed */
+    bool logged = false; /* among the newest (the run also passed the power limit, 6) */
+    for (uint8_t i = 0; i < 3; i++) {
+        REQUEST(PKT_READ_FAULTS, 0, i);
+        logged |= ANSWER_FIELD(PKT_READ_FAULTS, ANSWER_READ_FAULTS_WHAT) == FAULT_OSCILLATION;
+    }
+    assert_true(logged);
     REQUEST(PKT_READ_DATA, 0, ITEM_LIMITER);
     EXPECT_ITEM(0, ITEM_LIMITER, LIMITER_WATCHDOG);
     harness_run_ms(1000);
@@ -79,8 +85,8 @@ static void test_a_runaway_is_released_and_logged(void **state)
     motion_drive_train_changed(&servo.motion);
     move_to(DEG(0)); /* a motion command clears what item 67 says */
     harness_run_ms(5);
-    REQUEST(PKT_READ_DATA, 0, ITEM_LIMITER);
-    EXPECT_ITEM(0, ITEM_LIMITER, LIMITER_NONE);
+    assert_int_equal(servo.swing.fired, 0);
+    assert_int_equal(servo.regs.held_by, LIMITER_NONE);
 }
 
 /* 0 turns the monitor off: the same runaway goes on. */
