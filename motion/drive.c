@@ -91,3 +91,34 @@ void motion_coast(struct motion *m)
     m->controller.at_limit = 0;
     m->hal->motor.coast(m->hal->ctx);
 }
+
+/* ---- the oscillation monitor's detector (item 72, docs/safety.md) -------
+ * Counts two each tick the horn moves away from its setpoint, more than
+ * RUNAWAY_AMPLITUDE_Q8 off it and faster than RUNAWAY_CREEP_Q8, and back
+ * one each tick it is within the amplitude; trips at twice the item's time.
+ * A runaway trips in the item's time; a swing wider than about 1.4 x the
+ * amplitude (14 deg) does too, later: its outward quarters outweigh half
+ * its time within. Not counted: the output pushing
+ * back at its limit below the speed where the limit's band (the back-EMF of
+ * kv, +-duty_limit) turns the duty the way the horn runs: a load stronger
+ * than the motor, the stall monitor's. Above that speed the servo's own
+ * output drives the horn away (kv beyond the motor's: a runaway). */
+bool motion_runs_away(struct motion *m, uint16_t limit_ms)
+{
+    int32_t e = m->setpoint_q8 - m->measured_q8;
+    int32_t back = e > 0 ? 1 : -1; /* the way to the setpoint */
+    uint32_t n = m->runaway_ticks;
+    if (m->mode != MODE_POSITION) {
+        n = 0;
+    } else if (e * back <= RUNAWAY_AMPLITUDE_Q8) {
+        n -= n != 0u;
+    } else {
+        /* Speeds past 2^32 / 2^8 wrap: beyond any encoder's. */
+        uint32_t away = (uint32_t)(-m->measured_velocity_q8 * back);
+        bool held = m->controller.at_limit == back &&
+                    away * (uint32_t)(m->drive.kv >> 8) <= (uint32_t)m->drive.duty_limit;
+        n += 2u * ((int32_t)away > RUNAWAY_CREEP_Q8 && !held);
+    }
+    m->runaway_ticks = n;
+    return n >= 2u * limit_ms;
+}

@@ -13,11 +13,12 @@ enum packet_outcome handle_ping(const struct packet_call *c, struct response *r)
 }
 
 /* A change to the user or drive area is kept only once it is durable (the
- * store's persist hook); otherwise both go back to what they were. */
-static bool keep_change(const struct packet_call *c, const struct user_config *before)
+ * store's persist hook) and not refused; otherwise both go back to what
+ * they were. */
+static bool keep_change(const struct packet_call *c, const struct user_config *before, bool refused)
 {
     struct dispatcher *d = c->d;
-    if (d->persist != NULL && !d->persist(d->persist_ctx, &d->regs->user)) {
+    if (refused || (d->persist != NULL && !d->persist(d->persist_ctx, &d->regs->user))) {
         d->regs->user = *before;
         return false;
     }
@@ -28,7 +29,8 @@ static bool keep_change(const struct packet_call *c, const struct user_config *b
 /* The same for a change of many items, which may have changed nothing. */
 static bool commit_user(const struct packet_call *c, const struct user_config *before)
 {
-    return memcmp(before, &c->d->regs->user, sizeof *before) == 0 || keep_change(c, before);
+    c->d->regs->store.write_refused = 0;
+    return memcmp(before, &c->d->regs->user, sizeof *before) == 0 || keep_change(c, before, false);
 }
 
 enum packet_outcome handle_reset_user_data(const struct packet_call *c, struct response *r)
@@ -54,16 +56,13 @@ static bool write_item(const struct packet_call *c, uint8_t id, const uint8_t *d
     struct user_config before;
     enum data_write_result w = data_table_write(c->d->regs, id, data, length, &before);
     /* A drive item that would make a stable loop unstable is put back
-     * before the store sees it; ReadStore says why (bit 2). One already
-     * unstable (an older firmware's) takes any write: the way out. */
+     * before the store sees it (keep_change); ReadStore says why (bit 2).
+     * One already unstable (an older firmware's) takes any write: the way
+     * out. */
     bool unstable = w == DATA_WRITE_CHANGED && id >= DRIVE_FIRST &&
                     !drive_items_stable(&c->d->regs->user) && drive_items_stable(&before);
     c->d->regs->store.write_refused = unstable ? STORE_UNSTABLE : 0u;
-    if (unstable) {
-        c->d->regs->user = before;
-        return false;
-    }
-    bool ok = w == DATA_WRITE_SAME || (w == DATA_WRITE_CHANGED && keep_change(c, &before));
+    bool ok = w == DATA_WRITE_SAME || (w == DATA_WRITE_CHANGED && keep_change(c, &before, unstable));
     if (w == DATA_WRITE_CHANGED && id >= DRIVE_FIRST) { /* kept or put back: the feed-forward follows */
         motion_drive_train_changed(c->d->motion);
     }

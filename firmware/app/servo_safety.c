@@ -10,7 +10,7 @@
  * own limit is added as item 67 or ReadMotion is read). */
 static void note_held_by(struct servo *s, uint8_t bits)
 {
-    s->regs.held_by = s->watchdog.fired | s->swing.fired                         ? LIMITER_WATCHDOG
+    s->regs.held_by = s->watchdog.fired                                          ? LIMITER_WATCHDOG
                       : (bits & (STATUS_LOW_VOLTAGE | STATUS_HIGH_VOLTAGE)) != 0u ? LIMITER_SUPPLY
                       : (bits & STATUS_OVER_TEMPERATURE) != 0u                    ? LIMITER_HEAT
                       : (bits & STATUS_STALL) != 0u && s->regs.user.stall_release ? LIMITER_STALL
@@ -121,24 +121,14 @@ __attribute__((noinline)) void safety_after_frame(struct servo *s)
     }
 }
 
-/* The oscillation monitor (item 72) under position control: a horn that
- * runs away from its setpoint is released, a fault logged; item 67 says
- * "watchdog" (a monitor acted) until the next motion command. */
+/* The oscillation monitor (item 72): a horn that runs away from its
+ * setpoint is released and the fault logged. It sets the watchdog's latch:
+ * item 67 says 7 (a monitor acted) until the next motion command. */
 __attribute__((noinline)) static void watch_swing(struct servo *s)
 {
-    struct oscillation_monitor *o = &s->swing;
-    const struct motion *m = &s->motion;
-    if (o->fired && m->commands != o->commands_at_fire) {
-        o->fired = 0;
-        note_held_by(s, s->regs.status.status);
-    }
-    if (m->mode != MODE_POSITION) {
-        o->away_ticks = 0;
-    } else if (oscillation_watch(o, m->setpoint_q8 - m->measured_q8, m->measured_velocity_q8,
-                                 m->controller.at_limit, m->drive.kv, m->drive.duty_limit,
-                                 s->regs.firmware.oscillation_ms)) {
-        o->fired = 1;
-        o->commands_at_fire = m->commands;
+    if (motion_runs_away(&s->motion, s->regs.firmware.oscillation_ms)) {
+        s->watchdog.fired = 1;
+        s->watchdog.commands_at_fire = s->motion.commands;
         motion_stop(&s->motion, STOP_RELEASE);
         note_held_by(s, s->regs.status.status);
         log_fault(s, FAULT_OSCILLATION);

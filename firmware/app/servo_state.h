@@ -11,7 +11,6 @@
 #include "storage/save_policy.h"
 #include "hal/hal_port.h"
 #include "protection/bus_watchdog.h"
-#include "protection/oscillation.h"
 #include "protection/protection.h"
 #include "protection/winding.h"
 #include "sensors/scaling.h"
@@ -94,7 +93,6 @@ struct servo {
     uint32_t unsolicited_slot_us;  /* slot length at this baud */
     uint32_t unsolicited_first_us; /* quiet ahead of this ID's first slot */
     struct bus_watchdog watchdog;
-    struct oscillation_monitor swing; /* item 72 */
     struct save_policy saver;
     struct servo_tx tx;
     struct frame_rx rx;

@@ -1,5 +1,6 @@
-/* The oscillation monitor's detector (protection/oscillation.c) and the
- * drive items' own check (drive_items_stable, motion/controller.c), alone. */
+/* The oscillation monitor's detector (motion_runs_away, motion/drive.c) and
+ * the drive items' own check (drive_items_stable, motion/controller.c),
+ * alone. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -8,23 +9,38 @@
 #include <cmocka.h>
 
 #include "motion/controller.h"
-#include "protection/oscillation.h"
-#include "protection/protection.h"
+#include "motion/motion.h"
 #include "registers/data_table.h"
 
 enum {
-    OFF_Q8 = OSCILLATION_AMPLITUDE_Q8 + 256, /* 10.1 deg */
-    FAST_Q8 = 256,                           /* 100 deg/s */
-    KV = 9903,                               /* the reference's, 7.4 V */
-    BAND = 16400,                            /* 10 W's duty band */
+    OFF_Q8 = RUNAWAY_AMPLITUDE_Q8 + 256, /* 10.1 deg */
+    FAST_Q8 = 256,                       /* 100 deg/s */
+    KV = 9903,                           /* the reference's, 7.4 V */
+    BAND = 16400,                        /* 10 W's duty band */
 };
 
-/* n ticks of the same input; how many tripped. */
-static int ticks(struct oscillation_monitor *o, int n, int32_t e, int32_t w, int8_t at_limit)
+static struct motion m;
+
+static int setup(void **state)
 {
+    (void)state;
+    m = (struct motion){.mode = MODE_POSITION};
+    m.drive.kv = KV;
+    m.drive.duty_limit = BAND;
+    return 0;
+}
+
+/* n ticks of the same error (setpoint - horn), speed and limit; how many
+ * tripped. */
+static int ticks(int n, int32_t e, int32_t w, int8_t at_limit)
+{
+    m.setpoint_q8 = 0;
+    m.measured_q8 = -e;
+    m.measured_velocity_q8 = w;
+    m.controller.at_limit = at_limit;
     int trips = 0;
     for (int i = 0; i < n; i++) {
-        trips += oscillation_watch(o, e, w, at_limit, KV, BAND, 300);
+        trips += motion_runs_away(&m, 300);
     }
     return trips;
 }
@@ -33,45 +49,47 @@ static int ticks(struct oscillation_monitor *o, int n, int32_t e, int32_t w, int
 static void test_a_runaway_trips_at_the_items_time(void **state)
 {
     (void)state;
-    struct oscillation_monitor o = {0};
-    assert_int_equal(ticks(&o, 299, -OFF_Q8, FAST_Q8, 0), 0);
-    assert_int_equal(ticks(&o, 1, -OFF_Q8, FAST_Q8, 0), 1);
-    o = (struct oscillation_monitor){0};
-    assert_int_equal(ticks(&o, 299, OFF_Q8, -FAST_Q8, 0), 0);
-    assert_true(oscillation_watch(&o, OFF_Q8, -FAST_Q8, 0, KV, BAND, 300));
+    assert_int_equal(ticks(299, -OFF_Q8, FAST_Q8, 0), 0);
+    assert_int_equal(ticks(1, -OFF_Q8, FAST_Q8, 0), 1);
+    setup(NULL);
+    assert_int_equal(ticks(299, OFF_Q8, -FAST_Q8, 0), 0);
+    assert_int_equal(ticks(1, OFF_Q8, -FAST_Q8, 0), 1);
 }
 
-/* Coming back, creeping (the stall's speed), or within the amplitude: not
- * counted. */
-static void test_coming_back_creeping_or_near_is_not_counted(void **state)
+/* Coming back, creeping (the stall's speed), within the amplitude, or
+ * released: not counted. */
+static void test_coming_back_creeping_near_or_released_is_not_counted(void **state)
 {
     (void)state;
-    struct oscillation_monitor o = {0};
-    assert_int_equal(ticks(&o, 1000, -OFF_Q8, -FAST_Q8, 0), 0);    /* coming back */
-    assert_int_equal(ticks(&o, 1000, -OFF_Q8, STALL_SPEED_Q8, 0), 0); /* creeping */
-    assert_int_equal(ticks(&o, 1000, OSCILLATION_AMPLITUDE_Q8, -FAST_Q8, 0), 0);
-    assert_int_equal(o.away_ticks, 0);
+    assert_int_equal(ticks(1000, -OFF_Q8, -FAST_Q8, 0), 0);            /* coming back */
+    assert_int_equal(ticks(1000, -OFF_Q8, RUNAWAY_CREEP_Q8, 0), 0);     /* creeping */
+    assert_int_equal(ticks(1000, RUNAWAY_AMPLITUDE_Q8, -FAST_Q8, 0), 0); /* at 10 deg */
+    assert_int_equal(m.runaway_ticks, 0);
+    assert_int_equal(ticks(200, -OFF_Q8, FAST_Q8, 0), 0);
+    assert_int_equal(m.runaway_ticks, 400);
+    m.mode = MODE_RELEASED;
+    assert_int_equal(ticks(1000, -OFF_Q8, FAST_Q8, 0), 0);
+    assert_int_equal(m.runaway_ticks, 0);
 }
 
-/* A swing: outward halves add up across the swing; 200 ms back within the
- * amplitude start the count again. */
-static void test_a_swing_adds_up_and_a_rest_starts_again(void **state)
+/* A swing: its outward parts add up, its time within the amplitude takes
+ * half as much off. */
+static void test_a_swing_adds_up_and_a_rest_takes_off(void **state)
 {
     (void)state;
-    struct oscillation_monitor o = {0};
     int trips = 0;
-    for (int half = 0; half < 5; half++) { /* 5 x 50 ms out, 50 back, 50 near */
+    for (int half = 0; half < 5; half++) { /* 5 x 50 ms out, 50 back, 40 near */
         int32_t side = half % 2 ? 1 : -1;
-        trips += ticks(&o, 50, side * OFF_Q8, -side * FAST_Q8, 0);
-        trips += ticks(&o, 50, side * OFF_Q8, side * FAST_Q8, 0);
-        trips += ticks(&o, 50, 0, side * FAST_Q8, 0);
+        trips += ticks(50, side * OFF_Q8, -side * FAST_Q8, 0);
+        trips += ticks(50, side * OFF_Q8, side * FAST_Q8, 0);
+        trips += ticks(40, 0, side * FAST_Q8, 0);
     }
     assert_int_equal(trips, 0);
-    assert_int_equal(o.away_ticks, 250);
-    assert_int_equal(ticks(&o, 50, OFF_Q8, -FAST_Q8, 0), 1); /* the 300th */
-    o.away_ticks = 250;
-    assert_int_equal(ticks(&o, OSCILLATION_QUIET_TICKS, 0, 0, 0), 0);
-    assert_int_equal(o.away_ticks, 0);
+    assert_int_equal(m.runaway_ticks, 5 * (100 - 40));
+    assert_int_equal(ticks(300 - 150, OFF_Q8, -FAST_Q8, 0), 1); /* 600 = 2 x 300 */
+    m.runaway_ticks = 500;
+    assert_int_equal(ticks(600, 0, 0, 0), 0);
+    assert_int_equal(m.runaway_ticks, 0);
 }
 
 /* The output pushing back at its limit while a stronger load turns the horn
@@ -80,10 +98,10 @@ static void test_a_swing_adds_up_and_a_rest_starts_again(void **state)
 static void test_a_stronger_load_is_the_stall_monitors(void **state)
 {
     (void)state;
-    struct oscillation_monitor o = {0};
     int32_t band_speed_q8 = (BAND << 8) / KV; /* 1.66 decideg per tick */
-    assert_int_equal(ticks(&o, 1000, -OFF_Q8, band_speed_q8 - 2, -1), 0);
-    assert_int_equal(ticks(&o, 300, -OFF_Q8, band_speed_q8 + 2, -1), 1);
+    /* kv to 1/256 (kv >> 8): the band's speed to 3 % on the reference */
+    assert_int_equal(ticks(1000, -OFF_Q8, band_speed_q8 - 2, -1), 0);
+    assert_int_equal(ticks(300, -OFF_Q8, band_speed_q8 + band_speed_q8 / 32, -1), 1);
 }
 
 static void factory(struct user_config *dt)
@@ -153,10 +171,10 @@ static void test_the_shipped_plants_pass(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_a_runaway_trips_at_the_items_time),
-        cmocka_unit_test(test_coming_back_creeping_or_near_is_not_counted),
-        cmocka_unit_test(test_a_swing_adds_up_and_a_rest_starts_again),
-        cmocka_unit_test(test_a_stronger_load_is_the_stall_monitors),
+        cmocka_unit_test_setup(test_a_runaway_trips_at_the_items_time, setup),
+        cmocka_unit_test_setup(test_coming_back_creeping_near_or_released_is_not_counted, setup),
+        cmocka_unit_test_setup(test_a_swing_adds_up_and_a_rest_takes_off, setup),
+        cmocka_unit_test_setup(test_a_stronger_load_is_the_stall_monitors, setup),
         cmocka_unit_test(test_mistyped_drive_items_are_unstable),
         cmocka_unit_test(test_the_shipped_plants_pass),
     };
