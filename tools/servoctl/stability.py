@@ -14,7 +14,7 @@ items 86-88. A set is refused where
     mechanical time constant below the 1 ms tick); the PID loop on the
     declared plant short of twice Hurwitz's bound, (kv + viscous + kd) kp
     >= 2 ka ki;
-  - or tune's model (tune.margins, the 1.5 ticks of delay included) gives a
+  - or tune's model (loop_model.margins, tune's, the 1.5 ticks of delay included) gives a
     phase margin below MIN_PHASE_MARGIN_DEG or a gain margin below
     MIN_GAIN_MARGIN_DB.
 
@@ -26,6 +26,7 @@ from types import SimpleNamespace
 
 from . import registers
 from .errors import Refused
+from .loop_model import margins
 
 NOMINAL_SUPPLY_MV = 7400
 MIN_PHASE_MARGIN_DEG = 20.0
@@ -87,7 +88,6 @@ def reason(v: dict):
     why = firmware_reason(v)
     if why or v["gear_ratio"] == 0:
         return why
-    from .tune import margins
     pm, gm, _ = margins(declared_drive(v), v["gain_kp"], v["gain_ki"], v["gain_kd"])
     pm = (pm + 180.0) % 360.0 - 180.0  # an unwrapped phase can pass -180 deg and read 355
     if math.isnan(pm) or pm < MIN_PHASE_MARGIN_DEG or gm < MIN_GAIN_MARGIN_DB:
