@@ -7,7 +7,6 @@ documented time, with fault 9 logged. A normal 45 deg move on every shipped
 plant never trips it. Time is the simulator's."""
 import pytest
 
-from servoctl import stability
 from servoctl.cli import main
 from servoctl.errors import Refused
 from servoctl.servo import MotionSnapshot, Servo
@@ -94,19 +93,3 @@ def test_a_normal_45_deg_move_never_trips_it_on_any_shipped_plant(tmp_path, plan
         assert "oscillation" not in [f.kind for f in s.faults()]
     finally:
         finish(sim, [1])
-
-
-def test_write_order_keeps_each_step_stable():
-    """Moving the factory items to another plant's one at a time: each
-    step passes the servo's own check (tune and config load write so)."""
-    factory = {"motor_resistance": 2741, "torque_constant": 3714, "gear_ratio": 345, "rotor_inertia": 1000,
-               "coulomb_friction": 2786, "viscous_friction": 1481, "gain_kp": 546, "gain_ki": 8,
-               "gain_kd": 3000}
-    micro = {"motor_resistance": 6400, "torque_constant": 1324, "gear_ratio": 300, "rotor_inertia": 51,
-             "coulomb_friction": 662, "viscous_friction": 211, "gain_kp": 223, "gain_ki": 3, "gain_kd": 1104}
-    assert stability.firmware_reason(dict(factory, torque_constant=1324)) is not None  # this step alone fails
-    state = dict(factory)
-    for name in stability.write_order(factory, micro):
-        state[name] = micro[name]
-        assert stability.firmware_reason(state) is None, name
-    assert state == micro
