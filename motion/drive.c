@@ -105,19 +105,23 @@ void motion_coast(struct motion *m)
  * output drives the horn away (kv beyond the motor's: a runaway). */
 bool motion_runs_away(struct motion *m, uint16_t limit_ms)
 {
-    int32_t e = m->setpoint_q8 - m->measured_q8;
-    int32_t back = e > 0 ? 1 : -1; /* the way to the setpoint */
+    /* Seen from the side the horn is on: off > 0, away > 0 moving off. */
+    int32_t off = m->measured_q8 - m->setpoint_q8;
+    int32_t away = m->measured_velocity_q8;
+    int32_t pushing_back = m->controller.at_limit;
+    if (off < 0) {
+        off = -off;
+        away = -away;
+        pushing_back = -pushing_back;
+    }
     uint32_t n = m->runaway_ticks;
     if (m->mode != MODE_POSITION) {
         n = 0;
-    } else if (e * back <= RUNAWAY_AMPLITUDE_Q8) {
+    } else if (off <= RUNAWAY_AMPLITUDE_Q8) {
         n -= n != 0u;
-    } else {
-        /* Speeds past 2^32 / 2^8 wrap: beyond any encoder's. */
-        uint32_t away = (uint32_t)(-m->measured_velocity_q8 * back);
-        bool held = m->controller.at_limit == back &&
-                    away * (uint32_t)(m->drive.kv >> 8) <= (uint32_t)m->drive.duty_limit;
-        n += 2u * ((int32_t)away > RUNAWAY_CREEP_Q8 && !held);
+    } else if (away > RUNAWAY_CREEP_Q8 &&
+               (pushing_back >= 0 || (uint32_t)away * (uint32_t)(m->drive.kv >> 8) > (uint32_t)m->drive.duty_limit)) {
+        n += 2u; /* speeds past 2^32 / 2^8 wrap: beyond any encoder's */
     }
     m->runaway_ticks = n;
     return n >= 2u * limit_ms;
