@@ -140,6 +140,27 @@ void drive_limits_for_supply(struct drive_limits *lim, const struct user_config 
     lim->reversed = dt->gear_ratio < 0;
 }
 
+/* The drive items' own check (docs/safety.md, "Drive items the loop
+ * refuses"): the plant items 80-85 declare and the gains 86-88, at the
+ * nominal supply, as the controller would use them:
+ *  - kv within its fixed point (not clamped): the output's no-load speed at
+ *    least 50 deg/s at 7.4 V (kt x ratio at most 8.48 N m/A);
+ *  - ka >= kv: the motor's mechanical time constant (J R / kt^2) at least
+ *    the 1 ms tick the velocity feedback and the limit's back-EMF work at;
+ *  - the PID loop on that plant stable with margin: ka s^3 + (kv + viscous
+ *    + kd) s^2 + kp s + ki, by Hurwitz, (kv + viscous + kd) kp >= 2 ka ki.
+ * Ratio 0 declares no plant (no feed-forward): nothing to judge. Divides:
+ * for a write only. */
+bool drive_items_stable(const struct user_config *dt)
+{
+    struct drive_limits lim;
+    drive_limits_for_supply(&lim, dt, NOMINAL_SUPPLY_MV);
+    uint32_t damping = (uint32_t)(lim.kv + lim.viscous) + lim.kd; /* < 2^18 */
+    return dt->gear_ratio == 0 ||
+           (lim.kv < DERIVED_MAX && lim.ka >= lim.kv &&
+            ((uint32_t)lim.ka >> 10) * lim.ki <= (damping * lim.kp) >> 11);
+}
+
 /* x R << 15 / den, at most full duty (32767). */
 static int16_t duty_of(uint32_t x, uint16_t r_mohm, uint32_t den)
 {

@@ -91,3 +91,38 @@ void motion_coast(struct motion *m)
     m->controller.at_limit = 0;
     m->hal->motor.coast(m->hal->ctx);
 }
+
+/* ---- the oscillation monitor's detector (item 72, docs/safety.md) -------
+ * Counts two each tick the horn moves away from its setpoint, more than
+ * RUNAWAY_AMPLITUDE_Q8 off it and faster than RUNAWAY_CREEP_Q8, and back
+ * one each tick it is within the amplitude; trips at twice the item's time.
+ * A runaway trips in the item's time; a swing wider than about 1.4 x the
+ * amplitude (14 deg) does too, later: its outward quarters outweigh half
+ * its time within. Not counted: the output pushing
+ * back at its limit below the speed where the limit's band (the back-EMF of
+ * kv, +-duty_limit) turns the duty the way the horn runs: a load stronger
+ * than the motor, the stall monitor's. Above that speed the servo's own
+ * output drives the horn away (kv beyond the motor's: a runaway). */
+bool motion_runs_away(struct motion *m, uint16_t limit_ms)
+{
+    /* Seen from the side the horn is on: off > 0, away > 0 moving off. */
+    int32_t off = m->measured_q8 - m->setpoint_q8;
+    int32_t away = m->measured_velocity_q8;
+    int32_t pushing_back = m->controller.at_limit;
+    if (off < 0) {
+        off = -off;
+        away = -away;
+        pushing_back = -pushing_back;
+    }
+    uint32_t n = m->runaway_ticks;
+    if (m->mode != MODE_POSITION) {
+        n = 0;
+    } else if (off <= RUNAWAY_AMPLITUDE_Q8) {
+        n -= n != 0u;
+    } else if (away > RUNAWAY_CREEP_Q8 &&
+               (pushing_back >= 0 || (uint32_t)away * (uint32_t)(m->drive.kv >> 8) > (uint32_t)m->drive.duty_limit)) {
+        n += 2u; /* speeds past 2^32 / 2^8 wrap: beyond any encoder's */
+    }
+    m->runaway_ticks = n;
+    return n >= 2u * limit_ms;
+}

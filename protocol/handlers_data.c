@@ -14,11 +14,12 @@ enum packet_outcome handle_ping(const struct packet_call *c, struct response *r)
 }
 
 /* A change to the user or drive area is kept only once it is durable (the
- * store's persist hook); otherwise both go back to what they were. */
-static bool keep_change(const struct packet_call *c, const struct user_config *before)
+ * store's persist hook) and not refused; otherwise both go back to what
+ * they were. */
+static bool keep_change(const struct packet_call *c, const struct user_config *before, bool refused)
 {
     struct dispatcher *d = c->d;
-    if (d->persist != NULL && !d->persist(d->persist_ctx, &d->regs->user)) {
+    if (refused || (d->persist != NULL && !d->persist(d->persist_ctx, &d->regs->user))) {
         d->regs->user = *before;
         return false;
     }
@@ -29,7 +30,8 @@ static bool keep_change(const struct packet_call *c, const struct user_config *b
 /* The same for a change of many items, which may have changed nothing. */
 static bool commit_user(const struct packet_call *c, const struct user_config *before)
 {
-    return memcmp(before, &c->d->regs->user, sizeof *before) == 0 || keep_change(c, before);
+    c->d->regs->store.write_refused = 0;
+    return memcmp(before, &c->d->regs->user, sizeof *before) == 0 || keep_change(c, before, false);
 }
 
 enum packet_outcome handle_reset_user_data(const struct packet_call *c, struct response *r)
@@ -54,7 +56,14 @@ static bool write_item(const struct packet_call *c, uint8_t id, const uint8_t *d
 {
     struct user_config before;
     enum data_write_result w = data_table_write(c->d->regs, id, data, length, &before);
-    bool ok = w == DATA_WRITE_SAME || (w == DATA_WRITE_CHANGED && keep_change(c, &before));
+    /* A drive item that would make a stable loop unstable is put back
+     * before the store sees it (keep_change); ReadStore says why (bit 2).
+     * One already unstable (an older firmware's) takes any write: the way
+     * out. */
+    bool unstable = w == DATA_WRITE_CHANGED && id >= DRIVE_FIRST &&
+                    !drive_items_stable(&c->d->regs->user) && drive_items_stable(&before);
+    c->d->regs->store.write_refused = unstable ? STORE_UNSTABLE : 0u;
+    bool ok = w == DATA_WRITE_SAME || (w == DATA_WRITE_CHANGED && keep_change(c, &before, unstable));
     if (w == DATA_WRITE_CHANGED && id >= DRIVE_FIRST) { /* kept or put back: the feed-forward follows */
         motion_drive_train_changed(c->d->motion);
     }
@@ -99,7 +108,7 @@ enum packet_outcome handle_read_store(const struct packet_call *c, struct respon
      * content holds one's high half and the next one's low half (the M0
      * stores a byte a store where a count is put at a time). */
     uint32_t *w = &r->words[1];
-    uint32_t half = r->content[0] | (uint32_t)h->flags << 8;
+    uint32_t half = r->content[0] | (uint32_t)(h->write_refused ? h->write_refused : h->flags) << 8;
     for (unsigned i = 0; i < sizeof counts / sizeof counts[0]; i++) {
         w[i] = half | counts[i] << 16;
         half = counts[i] >> 16;

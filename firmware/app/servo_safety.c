@@ -123,6 +123,21 @@ __attribute__((noinline)) void safety_after_frame(struct servo *s)
     }
 }
 
+/* The oscillation monitor (item 72; inline: it runs every tick, and is
+ * smaller so on the M0): a horn that runs away from its
+ * setpoint is released and the fault logged. It sets the watchdog's latch:
+ * item 67 says 7 (a monitor acted) until the next motion command. */
+static void watch_swing(struct servo *s)
+{
+    if (motion_runs_away(&s->motion, s->regs.firmware.oscillation_ms)) {
+        s->watchdog.fired = 1;
+        s->watchdog.commands_at_fire = s->motion.commands;
+        motion_stop(&s->motion, STOP_RELEASE);
+        note_held_by(s, s->regs.status.status);
+        log_fault(s, FAULT_OSCILLATION);
+    }
+}
+
 /* In the pass of each control tick, after it: the bus watchdog (it acts
  * within a tick of its time) and, every SENSE_ROUND_TICKS, a sample of
  * the winding's heat. Neither is part of the control law, so neither
@@ -131,6 +146,9 @@ void safety_tend(struct servo *s)
 {
     if (s->regs.firmware.watchdog_ms != 0u) {
         watch_bus(s);
+    }
+    if (s->regs.firmware.oscillation_ms != 0u) {
+        watch_swing(s);
     }
     uint8_t trips = (uint8_t)(s->regs.status.status & FAULT_STATUS_BITS);
     if (trips != s->fault_bits_seen) {

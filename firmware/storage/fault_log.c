@@ -179,7 +179,7 @@ uint32_t fault_log_load(struct fault_log *l, const struct hal_flash *flash)
 
 bool fault_log_add(struct fault_log *l, const struct fault_entry *e)
 {
-    uint8_t what = e->what <= FAULT_WATCHDOG ? e->what : FAULT_WATCHDOG;
+    uint8_t what = e->what <= FAULT_OSCILLATION ? e->what : FAULT_OSCILLATION;
     /* last_seen: each kind's last record's operating second + 1; 0 none.
      * A fault is held back as a repeat; a clear, promised within
      * milliseconds, where its record could wait for an erase (no erased

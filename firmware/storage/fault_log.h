@@ -54,7 +54,7 @@ struct fault_log {
     uint8_t job_slot;
     uint16_t job_next;
     uint8_t job[FAULT_RECORD_SIZE];
-    uint32_t last_seen[FAULT_WATCHDOG + 1]; /* each kind's last record's second + 1; 0 none */
+    uint32_t last_seen[FAULT_OSCILLATION + 1]; /* each kind's last record's second + 1; 0 none */
     uint16_t not_logged;    /* repeats, over the budget, or no room: since power-up */
     uint32_t failures;      /* program or erase steps the flash refused */
 };

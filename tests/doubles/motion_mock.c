@@ -87,3 +87,10 @@ void motion_drive_train_changed(struct motion *m)
     (void)m;
     motion_mock_drive_changes++;
 }
+
+uint16_t motion_mock_unstable_kt;
+
+bool drive_items_stable(const struct user_config *dt)
+{
+    return dt->kt_un_m_per_a != motion_mock_unstable_kt;
+}

@@ -11,5 +11,7 @@ extern struct motion_setpoint motion_mock_last_setpoint;
 
 /* Calls of motion_drive_train_changed (a stored item changed) so far. */
 extern unsigned motion_mock_drive_changes;
+/* drive_items_stable says false for this torque constant (item 81); 0 none. */
+extern uint16_t motion_mock_unstable_kt;
 
 #endif

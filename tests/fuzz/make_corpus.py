@@ -39,7 +39,7 @@ SEEDS = {
     "ping": req(1, b"\x00"),
     "reset": req(2, b"\x00"),
     "read_every_item": b"".join(req(3, bytes([0, i])) for i in list(range(1, 9)) + list(range(32, 54))
-                               + list(range(64, 72)) + list(range(80, 92))),
+                               + list(range(64, 73)) + list(range(80, 92))),
     "write_items": req(4, b"\x00\x21\x01") + req(4, b"\x00\x32\xe8\x03") + req(4, b"\x00\x35\x10\x00"),
     "write_id_and_baud": req(4, b"\x00\x22\x07") + req(1, b"\x07") + req(4, b"\x07\x24\x08"),
     "batch": req(5, b"\x00") + req(6, b"\x00" + FACTORY),
@@ -179,6 +179,8 @@ SERVO_SEEDS = {
                                 + write(86, 1024, 2) + move(600, 200)) + ms(250)
                     + wire(req(0x46, struct.pack("<BhH", 0, 6000, 30))) + ms(40)
                     + wire(write(82, 345, 2) + write(91, 12, 2) + write(90, 2000, 2)) + ms(20)),
+    "unstable_drive_item": (USED, wire(write(81, 37140, 2) + req(0x41, b"\x00") + write(72, 50, 2)
+                                       + write(82, 3450, 2) + write(87, 80, 2) + move(450, 300)) + ms(200)),
     "wheel_run_stop": (USED, wire(req(7, struct.pack("<BBHH", 0, 0x01, 300, 0))) + ms(100)
                        + wire(req(7, struct.pack("<BBHH", 0, 0x00, 0, 0))) + ms(60)
                        + wire(write(47, 1) + req(7, struct.pack("<BBHH", 0, 0x81, 90, 0))) + ms(60)

@@ -132,6 +132,7 @@ static void test_the_error_saturates_instead_of_changing_sign(void **state)
     /* The multi-turn range is beyond the angle limits: off, straight in
      * the register (a WriteData's save would stall the loop mid-spin). */
     servo.regs.user.angle_limit_on = 0;
+    servo.regs.firmware.oscillation_ms = 0; /* the load's spin is no runaway of its own */
     REQUEST(PKT_STOP_ON_CONTROL_MODE, 0, 0x10, 0, 0);
     spin_at(1000);
     harness_run_ms(4180);

@@ -15,6 +15,8 @@ ADVICE = {
     "over_power": "the power passed item 42: lighten the load or slow the moves",
     "over_temperature": "the case reached item 41: let it cool; lower the duty or the load",
     "watchdog": "the host fell silent for longer than item 64: check the host and the bus",
+    "oscillation": "the horn ran or swung away from its setpoint (item 72): check the drive items "
+                   "(80-88) against the motor ('servoctl tune'), the encoder and the load",
 }
 
 

@@ -3,7 +3,7 @@ listed servo), a broadcast move, async begin and end, Sync Monitor, and the
 backup and restore of a whole bus. Angles in degrees, times in seconds."""
 
 from . import protocol as p
-from . import config_file, registers
+from . import config_file, registers, stability
 from .frame import check_target
 from .errors import NoReply, Refused, UsageError
 from .checks import MIN_RAMP_MS, check_profile, check_range, scaled, to_ms
@@ -148,9 +148,13 @@ def write_user_area(s: Servo, values: dict, with_link: bool = False) -> list:
     s.write_all(dict(current, **{k: v for k, v in values.items() if k not in keep and k in user}))
     drive = [item for item in registers.DRIVE if item.name in values]
     now = s.read_stored() if drive else {}
-    for item in drive:  # item by item, each a config save; the maker's servos have none
-        if item.name in now and now[item.name] != values[item.name]:
-            s.write(item.id, values[item.name])
+    changed = {i.name: values[i.name] for i in drive if i.name in now and now[i.name] != values[i.name]}
+    # item by item, each a config save (the maker's servos have none); the
+    # drive train and gains checked as a set and in an order that stays stable
+    s.write_drive({k: v for k, v in changed.items() if k in stability.ITEMS})
+    for name, value in changed.items():
+        if name not in stability.ITEMS:
+            s.write(name, value)
     return [k for k in keep if k in values and values[k] != current[k]]
 
 

@@ -4,7 +4,7 @@ from dataclasses import dataclass
 
 from . import frame, outcome
 from . import protocol as p
-from . import registers
+from . import registers, stability
 from .checks import check_range, scaled, to_ms
 from .errors import BadAnswer, Refused, ServoError, ValueOutOfRange
 from .move_request import MoveRequest
@@ -43,7 +43,9 @@ class MotionSnapshot:
     duty_q15: int  # the bridge's duty in damping and open loop (DriveDuty), after the limits; else 0
 
     PROFILE_ENDED, CLOCK_SLOWED, BRAKING, AT_LIMIT, RELEASED = 1, 2, 4, 8, 16
-    # What holds the output back (flags bits 5-7, item 67; docs/safety.md).
+    # What holds the output back (flags bits 5-7, item 67; docs/safety.md);
+    # "watchdog": a monitor released it, the bus watchdog or the oscillation
+    # monitor (the newest fault says which).
     LIMITERS = ("none", "power", "current", "stall", "supply", "heat", "angle", "watchdog")
 
     @classmethod
@@ -78,7 +80,7 @@ class Fault:
     what: int
 
     KINDS = {0: "none", 2: "stall", 3: "high_voltage", 4: "low_voltage", 5: "over_current",
-             6: "over_power", 7: "over_temperature", 8: "watchdog"}
+             6: "over_power", 7: "over_temperature", 8: "watchdog", 9: "oscillation"}
 
     @classmethod
     def decode(cls, content: bytes) -> "Fault":
@@ -104,13 +106,15 @@ class StoreHealth:
     answers_dropped: int  # requests that arrived during an erase: carried out, not answered
     bytes_lost: int       # received bytes overwritten before the servo took them
 
-    # The last change refused, and why (bit 2 is unused).
-    FLAGS = ("flash_refused", "over_wear_budget", "", "needs_erase")
+    # The last change refused, and why.
+    FLAGS = ("flash_refused", "over_wear_budget", "unstable", "needs_erase")
     # What the host can do about each (docs/decisions.md, "The config store").
     ADVICE = {
         "flash_refused": "its flash refused the write (a worn or failing page)",
         "over_wear_budget": "its flash wear budget allows no more saves yet (one per "
                             "so many seconds of operation; see 'servoctl store')",
+        "unstable": "the drive items would make its loop unstable (docs/safety.md, \"Drive items the "
+                    "loop refuses\")",
         "needs_erase": "its config page is full and the next is erased only while the servo "
                        "is released: release it ('servoctl stop ID'), leave the bus quiet for 0.1 s, "
                        "and write again",
@@ -148,9 +152,29 @@ class Servo:
             raise ServoError(f"servo {self.id} has no readable {item.name} ({item.id})")
         return item.unpack(data)
 
-    def write(self, key, value: int) -> None:
+    def write(self, key, value: int, check: bool = True) -> None:
+        """Writes one item; a drive or gain item (80-88) after the check that
+        the loop stays stable (stability.py) unless check is False (the
+        servo's own check still holds)."""
         item = registers.find(key)
         item.check(value)
+        if check and item.name in stability.ITEMS:
+            self.write_drive({item.name: value})
+            return
+        self._write(item, value)
+
+    def write_drive(self, values: dict) -> None:
+        """Drive and gain items (80-88, by name), each kept: refused, and
+        nothing written, where the set they make would make the loop
+        unstable; in an order in which each set along the way passes."""
+        if not values:
+            return
+        now = {name: self.read(name) for name in stability.ITEMS}
+        changes = {k: v for k, v in values.items() if now[k] != v}
+        for name in stability.write_order(now, changes):
+            self._write(registers.find(name), changes[name])
+
+    def _write(self, item, value: int) -> None:
         content = self.bus.request(p.WRITE_DATA, bytes([self.id, item.id]) + item.pack(value))
         if p.decode_answer(p.WRITE_DATA, content)[2] != 1:
             raise Refused(f"servo {self.id} refused {item.name} = {value}{self._why_refused()}")

@@ -25,15 +25,10 @@ decidegree each 1 ms tick (ki), and per decidegree per tick (kd)."""
 import math
 from dataclasses import dataclass
 
-import numpy as np
-
 from . import registers
 from .errors import ServoError
+from .loop_model import DECIDEG_RAD, Q15, TICK_S, _plant, _si, margins  # noqa: F401 (tune's own names too)
 
-TICK_S = 0.001
-DECIDEG_RAD = math.pi / 1800.0
-Q15 = 32768.0
-DELAY_S = 1.5 * TICK_S
 ZETA = 0.7
 DEFAULT_MAX_HZ = 8.0      # no faster by default: the reference's factory gains are 8.4 Hz
 RANGE_SHARE = 0.8         # the default stays this far inside the gains' item ranges
@@ -54,18 +49,9 @@ class Tuning:
     items: dict            # data item name: value, the drive train (80-85) and the gains
 
 
-def _plant(drive):
-    k, r, b = drive.torque_constant.value, drive.resistance.value, drive.viscous.value
-    return k * drive.supply_v / r, k * k / r + b, drive.inertia.value  # G, D, J
-
-
 def _firmware(kp_si: float, ki_si: float, kd_si: float) -> tuple:
     """SI gains (duty per rad, per rad s, per rad/s) in the firmware's units."""
     return (kp_si * Q15 * DECIDEG_RAD, ki_si * Q15 * DECIDEG_RAD * TICK_S, kd_si * Q15 * DECIDEG_RAD / TICK_S)
-
-
-def _si(kp: float, ki: float, kd: float) -> tuple:
-    return kp / (Q15 * DECIDEG_RAD), ki / (Q15 * DECIDEG_RAD * TICK_S), kd * TICK_S / (Q15 * DECIDEG_RAD)
 
 
 def gains_for(drive, bandwidth_hz: float, zeta: float = ZETA) -> tuple:
@@ -89,26 +75,6 @@ def range_limit_hz(drive, zeta: float = ZETA) -> float:
         fits = kp <= _most("gain_kp") and kd <= _most("gain_kd") and ki <= _most("gain_ki")
         lo, hi = (mid, hi) if fits else (lo, mid)
     return lo
-
-
-def margins(drive, kp: float, ki: float, kd: float) -> tuple:
-    """(phase margin in degrees, gain margin in dB, gain crossover in Hz) of
-    the loop with these firmware gains."""
-    g, d, j = _plant(drive)
-    kp_si, ki_si, kd_si = _si(kp, ki, kd)
-    w = np.logspace(-1, 4.5, 20000)
-    s = 1j * w
-    loop = (kp_si + kd_si * s + ki_si / s) * g / (s * (j * s + d)) * np.exp(-s * DELAY_S)
-    mag, phase = np.abs(loop), np.unwrap(np.angle(loop))
-    phase_deg = np.degrees(phase)
-    below = np.nonzero(mag < 1.0)[0]
-    if below.size == 0:
-        return math.nan, math.nan, math.nan
-    c = below[0]
-    pm = 180.0 + phase_deg[c]
-    after = np.nonzero(phase_deg[c:] <= -180.0)[0]
-    gm = -20.0 * math.log10(mag[c + after[0]]) if after.size else math.inf
-    return pm, gm, w[c] / (2.0 * math.pi)
 
 
 def drive_items(drive, gear_ratio: int) -> dict:
@@ -186,8 +152,7 @@ def cmd_tune(bus, args):
     if args.dry_run:
         print("dry run: nothing written")
         return 0
-    for name, value in t.items.items():
-        servo.write(name, value)
+    servo.write_drive(t.items)  # refused, nothing written, if the loop they make would not be stable
     over, error = check_step(servo, bus.sleep)
     print(f"written and kept; a {CHECK_TARGET_DECIDEG / 10:g} deg move in {CHECK_MS} ms: overshoot "
           f"{max(over, 0) / 10:.1f} deg, {error / 10:.1f} deg from the target 1.5 s on")

@@ -240,6 +240,9 @@ static void control_command(const struct sim_control *c, int fd, char *line)
             s->leads_swapped = value != 0.0;
         } else if (strcmp(cmd, "ampzero") == 0) {
             s->amp_zero_counts = (uint16_t)value;
+        } else if (strcmp(cmd, "forcekt") == 0) { /* past drive_items_stable */
+            s->core.regs.user.kt_un_m_per_a = (uint16_t)value;
+            motion_drive_train_changed(&s->core.motion);
         } else if (strcmp(cmd, "ambient") == 0) {
             s->thermal.ambient_c = value;
         } else if (strcmp(cmd, "soak") == 0) {

@@ -14,6 +14,7 @@
 #ifndef MOTION_CONTROLLER_H
 #define MOTION_CONTROLLER_H
 
+#include <stdbool.h>
 #include <stdint.h>
 
 #include "registers/registers.h"
@@ -63,6 +64,9 @@ int16_t controller_limit(int32_t duty, int32_t measured_velocity_q8, const struc
  * divides. */
 void drive_limits_for_supply(struct drive_limits *lim, const struct user_config *dt,
                              uint16_t supply_mv);
+/* Items 80-89 as dt has them make a loop the controller can hold (the
+ * rules: controller.c). Planning-time: it divides. */
+bool drive_items_stable(const struct user_config *dt);
 /* The duty that drives the current limit P / V through the winding (of
  * resistance r_mohm) at standstill: P R / V^2, Q15; supply_mv not 0.
  * Planning-time: it divides. */

@@ -185,6 +185,7 @@ struct motion {
     uint8_t derate;
     uint16_t power_cap_mw;
     uint32_t commands;         /* motion commands received */
+    uint32_t runaway_ticks;    /* motion_runs_away's count: 2 a tick away, -1 a tick near */
     /* Open loop (DriveDuty, MODE_OPEN_LOOP): this duty instead of the
      * brake, for open_ticks more ticks. */
     int16_t open_duty_q15;
@@ -290,6 +291,13 @@ void motion_guard(struct motion *m, bool inhibit, bool derate, uint16_t power_ca
  * no answer is owed and no command counted (the bus watchdog, a late
  * stream). */
 void motion_stop(struct motion *m, uint8_t method);
+/* The oscillation monitor's detector (drive.c), once a control tick: true
+ * once the ticks the horn has moved away from its setpoint, beyond
+ * RUNAWAY_AMPLITUDE_Q8 and faster than a creep, less half those it has been
+ * back within the amplitude, reach limit_ms (not 0). */
+#define RUNAWAY_AMPLITUDE_Q8 (100 << 8) /* 10 deg: above a move's overshoot on every shipped plant */
+#define RUNAWAY_CREEP_Q8 13             /* 5 deg/s, decideg per tick Q8: the stall monitor's */
+bool motion_runs_away(struct motion *m, uint16_t limit_ms);
 /* What holds the output back at this tick (enum limiter, item 67): a
  * protection or the watchdog (the registers' held_by), else the limit the
  * controller is at, else a clamped target, else none. */

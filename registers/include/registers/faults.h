@@ -5,7 +5,8 @@
 
 #include <stdint.h>
 
-/* What tripped: status bits 2-7 by their number, and the watchdog. */
+/* What tripped: status bits 2-7 by their number, the watchdog and the
+ * oscillation monitor. */
 enum fault_kind {
     FAULT_CLEARED = 0, /* a ClearFaults marker: older faults are not shown */
     FAULT_STALL = 2,
@@ -15,6 +16,7 @@ enum fault_kind {
     FAULT_OVER_POWER = 6,
     FAULT_OVER_TEMPERATURE = 7,
     FAULT_WATCHDOG = 8,
+    FAULT_OSCILLATION = 9, /* the oscillation monitor (item 72) released it */
 };
 
 /* The faults ReadFaults shows, newest first. */

@@ -15,6 +15,8 @@
 enum store_flag {
     STORE_FAILED = 1u << 0,      /* the flash refused the last save or erase */
     STORE_OVER_BUDGET = 1u << 1, /* the last change was refused: wear budget */
+    STORE_UNSTABLE = 1u << 2,    /* the last change was refused: the drive items
+                                  * would make the loop unstable (drive_items_stable) */
     STORE_AWAITS_ERASE = 1u << 3, /* the last change was refused: no erased slot */
 };
 
@@ -37,6 +39,7 @@ enum limiter {
 
 struct store_health {
     uint8_t flags;          /* enum store_flag */
+    uint8_t write_refused;  /* the last WriteData's own refusal: STORE_UNSTABLE or 0 */
     uint32_t records;       /* records written since the store was blank */
     uint32_t page_erases;   /* erases of the more worn page */
     uint32_t rated_cycles;  /* erases a page is rated for */
