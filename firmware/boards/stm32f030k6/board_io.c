@@ -25,12 +25,12 @@ void clock_f030_init(void)
 }
 
 /* Two bits a pin in MODER, four in AFR. */
-static void pin_mode(uint32_t pin, uint32_t mode)
+__attribute__((noinline)) static void pin_mode(uint32_t pin, uint32_t mode)
 {
     GPIOA_MODER = (GPIOA_MODER & ~(3u << (2u * pin))) | (mode << (2u * pin));
 }
 
-static void pin_af1(uint32_t pin)
+__attribute__((noinline)) static void pin_af1(uint32_t pin)
 {
     volatile uint32_t *afr = pin < 8u ? &GPIOA_AFRL : &GPIOA_AFRH;
     uint32_t shift = 4u * (pin % 8u);
