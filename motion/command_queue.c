@@ -5,7 +5,10 @@
 
 #include "motion/motion_internal.h"
 
-static bool queue_push(struct motion_queue *q, const struct motion_command *cmd)
+/* Push and pop are called, not inlined at each of their two callers: the
+ * M0's flash (a command is not timed). */
+__attribute__((noinline)) static bool queue_push(struct motion_queue *q,
+                                                 const struct motion_command *cmd)
 {
     if (q->count >= MOTION_QUEUE_DEPTH) {
         return false;
@@ -15,7 +18,7 @@ static bool queue_push(struct motion_queue *q, const struct motion_command *cmd)
     return true;
 }
 
-static const struct motion_command *queue_pop(struct motion_queue *q)
+__attribute__((noinline)) static const struct motion_command *queue_pop(struct motion_queue *q)
 {
     if (q->count == 0u) {
         return NULL;

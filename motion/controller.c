@@ -140,8 +140,9 @@ void drive_limits_for_supply(struct drive_limits *lim, const struct user_config 
     lim->reversed = dt->gear_ratio < 0;
 }
 
-/* x R << 15 / den, at most full duty (32767). */
-static int16_t duty_of(uint32_t x, uint16_t r_mohm, uint32_t den)
+/* x R << 15 / den, at most full duty (32767). Called by both limits, not
+ * inlined in each (on a change of the limits only). */
+__attribute__((noinline)) static int16_t duty_of(uint32_t x, uint16_t r_mohm, uint32_t den)
 {
     uint64_t duty = div64_u((uint64_t)x * r_mohm << 15, den);
     return (int16_t)(duty > 32767u ? 32767u : duty);

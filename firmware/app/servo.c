@@ -192,8 +192,9 @@ static inline __attribute__((always_inline)) void handle_next_frame(struct servo
     }
 }
 
-/* ReadStore's flags (enum store_flag). */
-static uint8_t store_flags(const struct servo *s)
+/* ReadStore's flags (enum store_flag). Called (a tick's report and a
+ * save's), not inlined twice. */
+__attribute__((noinline)) static uint8_t store_flags(const struct servo *s)
 {
     return (uint8_t)((s->store.failed ? STORE_FAILED : 0u) |
                      (s->saver.over_budget ? STORE_OVER_BUDGET : 0u) |
