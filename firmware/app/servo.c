@@ -6,6 +6,7 @@
 #include "app/identity.h"
 #include "app/servo_safety.h"
 #include "registers/data_table.h"
+#include "hal/size_first.h"
 
 static uint32_t idle_timeout_us(const struct servo *s, uint32_t baud)
 {
@@ -192,9 +193,9 @@ static inline __attribute__((always_inline)) void handle_next_frame(struct servo
     }
 }
 
-/* ReadStore's flags (enum store_flag). Called (a tick's report and a
+/* ReadStore's flags (enum store_flag). On the M0 called (a tick's report and a
  * save's), not inlined twice. */
-__attribute__((noinline)) static uint8_t store_flags(const struct servo *s)
+SIZE_FIRST_CALLED static uint8_t store_flags(const struct servo *s)
 {
     return (uint8_t)((s->store.failed ? STORE_FAILED : 0u) |
                      (s->saver.over_budget ? STORE_OVER_BUDGET : 0u) |
