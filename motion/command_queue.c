@@ -4,8 +4,11 @@
 #include <stddef.h>
 
 #include "motion/motion_internal.h"
+#include "hal/size_first.h"
 
-static bool queue_push(struct motion_queue *q, const struct motion_command *cmd)
+/* Push and pop: on the M0 called, not inlined at each of their two
+ * callers, for its flash (a command is not timed). */
+SIZE_FIRST_CALLED static bool queue_push(struct motion_queue *q, const struct motion_command *cmd)
 {
     if (q->count >= MOTION_QUEUE_DEPTH) {
         return false;
@@ -15,7 +18,7 @@ static bool queue_push(struct motion_queue *q, const struct motion_command *cmd)
     return true;
 }
 
-static const struct motion_command *queue_pop(struct motion_queue *q)
+SIZE_FIRST_CALLED static const struct motion_command *queue_pop(struct motion_queue *q)
 {
     if (q->count == 0u) {
         return NULL;

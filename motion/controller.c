@@ -7,6 +7,7 @@
 #include "motion/div64.h"
 #include "motion/gains.h"
 #include "motion/saturate.h"
+#include "hal/size_first.h"
 
 #if !defined(__ARM_FEATURE_SAT) && defined(SERVO_SIZE_FIRST)
 __attribute__((noinline)) int32_t sat_q(int32_t v, int32_t limit)
@@ -161,8 +162,9 @@ bool drive_items_stable(const struct user_config *dt)
             ((uint32_t)lim.ka >> 10) * lim.ki <= (damping * lim.kp) >> 11);
 }
 
-/* x R << 15 / den, at most full duty (32767). */
-static int16_t duty_of(uint32_t x, uint16_t r_mohm, uint32_t den)
+/* x R << 15 / den, at most full duty (32767). On the M0 called by both limits, not
+ * inlined in each (on a change of the limits only). */
+SIZE_FIRST_CALLED static int16_t duty_of(uint32_t x, uint16_t r_mohm, uint32_t den)
 {
     uint64_t duty = div64_u((uint64_t)x * r_mohm << 15, den);
     return (int16_t)(duty > 32767u ? 32767u : duty);

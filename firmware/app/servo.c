@@ -6,6 +6,7 @@
 #include "app/identity.h"
 #include "app/servo_safety.h"
 #include "registers/data_table.h"
+#include "hal/size_first.h"
 
 static uint32_t idle_timeout_us(const struct servo *s, uint32_t baud)
 {
@@ -108,15 +109,16 @@ static void wait_for_turn(struct servo *s, uint32_t now)
 static void queue_response(struct servo *s, uint8_t wait, uint32_t responses_base, uint32_t now)
 {
     s->tx.size = frame_tx_seal(&s->tx.frame);
+    if (wait == 0u) {
+        start_send(s);
+        return;
+    }
+    /* A Sync Monitor turn: what wait_for_turn reads, only while it waits. */
     s->tx.turns_left = wait;
     s->tx.responses_base = responses_base;
     s->tx.requests_base = s->rx.stats.requests_seen;
     s->tx.silence_from_us = now;
-    if (wait == 0u) {
-        start_send(s);
-    } else {
-        s->tx.waiting = 1;
-    }
+    s->tx.waiting = 1;
 }
 
 /* Nobody asked for a "move finished" answer just now, so nobody has left
@@ -191,8 +193,9 @@ static inline __attribute__((always_inline)) void handle_next_frame(struct servo
     }
 }
 
-/* ReadStore's flags (enum store_flag). */
-static uint8_t store_flags(const struct servo *s)
+/* ReadStore's flags (enum store_flag). On the M0 called (a tick's report and a
+ * save's), not inlined twice. */
+SIZE_FIRST_CALLED static uint8_t store_flags(const struct servo *s)
 {
     return (uint8_t)((s->store.failed ? STORE_FAILED : 0u) |
                      (s->saver.over_budget ? STORE_OVER_BUDGET : 0u) |

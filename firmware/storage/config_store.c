@@ -7,14 +7,15 @@
 #include "storage/flash_erased.h"
 #include "registers/byte_order.h"
 #include "registers/data_table.h"
+#include "hal/size_first.h"
 
 uint16_t config_store_slots_per_page(const struct config_store *s)
 {
     return (uint16_t)(s->flash->page_size / CONFIG_RECORD_SIZE);
 }
 
-static uint32_t slot_addr(const struct config_store *s, uint8_t page, uint16_t slot,
-                          uint32_t size)
+SIZE_FIRST_CALLED static uint32_t slot_addr(const struct config_store *s, uint8_t page,
+                                            uint16_t slot, uint32_t size)
 {
     return s->flash->page_addr[page] + (uint32_t)slot * size;
 }
@@ -80,7 +81,7 @@ static bool scan(struct config_store *s, const struct record_layout *l, struct u
 
 /* The page without the newest record; for a blank store page 0, where the
  * first record goes. */
-static uint8_t spare_page(const struct config_store *s)
+SIZE_FIRST_CALLED static uint8_t spare_page(const struct config_store *s)
 {
     return (uint8_t)(s->sequence != 0u ? s->page ^ 1u : 0u);
 }

@@ -24,13 +24,21 @@ void clock_f030_init(void)
     }
 }
 
+/* The application sets its pins through one copy of these (called at each
+ * pin); the bootloader, which sets one, inlines them. */
+#ifdef STARTUP_BOOTLOADER
+#define PIN_HELPER static
+#else
+#define PIN_HELPER __attribute__((noinline)) static
+#endif
+
 /* Two bits a pin in MODER, four in AFR. */
-static void pin_mode(uint32_t pin, uint32_t mode)
+PIN_HELPER void pin_mode(uint32_t pin, uint32_t mode)
 {
     GPIOA_MODER = (GPIOA_MODER & ~(3u << (2u * pin))) | (mode << (2u * pin));
 }
 
-static void pin_af1(uint32_t pin)
+PIN_HELPER void pin_af1(uint32_t pin)
 {
     volatile uint32_t *afr = pin < 8u ? &GPIOA_AFRL : &GPIOA_AFRH;
     uint32_t shift = 4u * (pin % 8u);
