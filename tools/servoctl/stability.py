@@ -25,7 +25,7 @@ import math
 from types import SimpleNamespace
 
 from . import registers
-from .errors import Refused
+from .errors import ValueOutOfRange
 from .loop_model import margins
 
 NOMINAL_SUPPLY_MV = 7400
@@ -104,7 +104,9 @@ def write_order(now: dict, changes: dict) -> list:
     final = dict(now, **changes)
     why = reason(final)
     if why:
-        raise Refused(f"{', '.join(f'{k} = {v}' for k, v in changes.items())} refused, not written: {why}")
+        factory = ", ".join(f"{k} {registers.find(k).default}" for k in changes)
+        raise ValueOutOfRange(f"{', '.join(f'{k} = {v}' for k, v in changes.items())} refused, not written: "
+                              f"{why} (factory: {factory}); nothing was sent")
     pending, order, state = dict(changes), [], dict(now)
     while pending:
         for name, value in pending.items():
@@ -112,8 +114,8 @@ def write_order(now: dict, changes: dict) -> list:
             if firmware_reason(trial) is None or firmware_reason(state) is not None:
                 break
         else:
-            raise Refused(f"no order of writing {', '.join(pending)} keeps the servo's loop stable "
-                          f"at each step: {firmware_reason(dict(state, **pending))}")
+            raise ValueOutOfRange(f"no order of writing {', '.join(pending)} keeps the servo's loop stable "
+                                  f"at each step: {firmware_reason(dict(state, **pending))}")
         order.append(name)
         state[name] = pending.pop(name)
     return order

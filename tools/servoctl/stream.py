@@ -229,6 +229,14 @@ class Trajectory:
         return f"{self.path} line {self.lines[k]}" if self.lines else f"row {k}"
 
 
+def _is_number(cell: str) -> bool:
+    try:
+        float(cell)
+    except ValueError:
+        return False
+    return True
+
+
 def read_trajectory(path: str) -> Trajectory:
     """A CSV: a header of "time" then one servo ID per column; a row per
     setpoint, evenly spaced. Every row is checked, and an error names its
@@ -257,8 +265,10 @@ def read_trajectory(path: str) -> Trajectory:
             raise bad(f"every row has a time and one finite angle per servo ({len(ids)}), not {len(r)} values")
         try:
             values = [float(c) for c in r]
-        except ValueError as e:
-            raise bad(f"every row has a time and one finite angle per servo, all numbers ({e})") from None
+        except ValueError:
+            cell = next(c for c in r if not _is_number(c))
+            raise bad(f"{cell.strip()!r} is not a number: every row has a time (s) and one angle (deg) "
+                      f"per servo") from None
         if not all(map(math.isfinite, values)):
             raise bad(f"every row has a time and one finite angle per servo, not {', '.join(r)}")
         for servo_id, degrees in zip(ids, values[1:]):

@@ -5,7 +5,7 @@ the same cases), tune's margins, and the order of writes."""
 import pytest
 
 from servoctl import registers, stability
-from servoctl.errors import Refused
+from servoctl.errors import ValueOutOfRange
 
 FACTORY = {i.name: i.default for i in registers.DRIVE if i.name in stability.ITEMS}
 # The shipped plants' items as tune gives them at 8 Hz (tests/unit/test_oscillation.c's).
@@ -66,5 +66,5 @@ def test_write_order_keeps_each_step_stable_and_refuses_a_bad_end():
             state[name] = target[name]
             assert not was_stable or stability.firmware_reason(state) is None, name
         assert state == target
-    with pytest.raises(Refused, match="torque_constant = 37140 refused, not written"):
+    with pytest.raises(ValueOutOfRange, match="torque_constant = 37140 refused, not written"):
         stability.write_order(FACTORY, {"torque_constant": 37140})

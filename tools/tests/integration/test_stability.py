@@ -28,7 +28,7 @@ def run(sim, capsys, *args):
 @pytest.mark.parametrize("name,value", TYPOS)
 def test_servoctl_refuses_a_mistyped_item_before_writing(sim, capsys, name, value):
     rc, _, err = run(sim, capsys, "config", "set", "1", name, str(value))
-    assert rc == 1 and "not written" in err and "no-load speed below 50 deg/s" in err, err
+    assert rc == 2 and "not written" in err and "nothing was sent" in err and "no-load speed below 50 deg/s" in err, err
     assert Servo(sim.bus(), 1).read(name) == FACTORY[name]
 
 

@@ -38,7 +38,7 @@ def ramp(first, last, count):
 
 @pytest.mark.parametrize("bad, why", [
     ("1e7", "angle must be -368640..368640 deg"),    # beyond the multi-turn range
-    ("abc", "all numbers"),
+    ("abc", "'abc' is not a number"),
     ("nan", "finite"),
     ("65", "deg/s, beyond the 750 deg/s"),            # 55 deg in 20 ms
     ("300", "angle_min, angle_max, angle_limit_on"),  # beyond angle_max 135 (factory)

@@ -4,7 +4,7 @@ right after says why; servoctl's check refuses them before writing. Time is
 the boards' simulated time."""
 import pytest
 
-from servoctl.errors import Refused
+from servoctl.errors import Refused, ValueOutOfRange
 from servoctl.servo import Servo
 from servoctl.sim import Simulator
 
@@ -21,7 +21,7 @@ def test_mistyped_drive_items_are_refused_on_the_real_images(tmp_path, board):
         with sim.bus(timeout=0.3) as bus:
             s = Servo(bus, 1)
             for name, value, factory in TYPOS:
-                with pytest.raises(Refused, match="not written"):
+                with pytest.raises(ValueOutOfRange, match="not written"):
                     s.write(name, value)  # servoctl's check
                 with pytest.raises(Refused, match="would make its loop unstable"):
                     s.write(name, value, check=False)  # the firmware's
