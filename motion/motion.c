@@ -28,12 +28,15 @@ void motion_init(struct motion *m, const struct registers *regs, const struct ha
                         .stream_period_ms = STREAM_DEFAULT_PERIOD_MS};
     encoder_start(&m->encoder, hal->motor.read_encoder(hal->ctx));
     m->measured_q8 = counts_to_q8(m->encoder.counts);
-    /* Item 90 is the horn's zero. Powered up, the horn is in the turn
-     * around it, -180..180 deg (before 53), as ReadAngle reads it: the
-     * zero moves by the whole turns that put the count within half a turn
-     * of it (a mask floors; ENCODER_COUNTS is a power of two). */
+    /* Item 90 is the horn's zero. Powered up, the horn is in the turn in
+     * which it reads -180..180 deg, as ReadAngle reads it, after the center
+     * offset (53; decideg to counts: x 4096 / 3600, as 1165 / 2^10, within
+     * a count): the zero moves by the whole turns that put the count within
+     * half a turn of zero + offset (a mask floors; ENCODER_COUNTS is a power
+     * of two). */
     int32_t zero = regs->user.encoder_zero;
-    zero += (m->encoder.counts - zero + ENCODER_COUNTS / 2) & -ENCODER_COUNTS;
+    int32_t offset_counts = (regs->user.center_offset_decideg * 1165) >> 10;
+    zero += (m->encoder.counts - zero - offset_counts + ENCODER_COUNTS / 2) & -ENCODER_COUNTS;
     motion_move_origin(m, zero);
     motion_update_limits(m);
     if (regs->user.power_on_lock) {

@@ -166,13 +166,16 @@ static void test_power_up_takes_the_turn_around_the_zero(void **state)
     (void)state;
     static const struct {
         uint16_t zero, raw;
+        int16_t offset; /* item 53: the reading is in -180..180 deg after it */
         int32_t decideg;
     } cases[] = {
-        {0, 4096 - 342, -301}, {0, 342, 301},      {0, 2047, 1799}, {0, 2048, -1800},
-        {1000, 3500, -1403},   {1000, 2500, 1318}, {4000, 100, 172},
+        {0, 4096 - 342, 0, -301}, {0, 342, 0, 301},      {0, 2047, 0, 1799}, {0, 2048, 0, -1800},
+        {1000, 3500, 0, -1403},   {1000, 2500, 0, 1318}, {4000, 100, 0, 172},
+        {0, 2617, 1000, 1300},    {0, 1479, -1000, -1300}, {1000, 3617, 1000, 1300},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         WRITE_ITEM(0, ITEM_ENCODER_ZERO, cases[i].zero);
+        WRITE_ITEM(0, ITEM_CENTER_OFFSET_DECIDEG, cases[i].offset);
         hal.encoder_model = NULL;
         hal.encoder_raw = cases[i].raw;
         harness_restart();
