@@ -56,6 +56,34 @@ static bool segment_within(int32_t d, int32_t v0, int32_t v1, int32_t t)
     return within(e, s) && within(e - v0 * t, a) && within(e - v1 * t, a);
 }
 
+/* With the angle limits on (48), the segment's path keeps within them
+ * (those of the multi-turn reading, after the center offset 53), its run-on
+ * included: the cubic lies within the hull of its Bezier points (start,
+ * start + v0 t / 3, target - v1 t / 3, target), here taken at t / 2 (further
+ * out on the same side: a hull that holds the true one); after it the end
+ * speed runs on for a period and then brakes, counted at two thirds of the
+ * stream's ramp (v^2 / 2^7, a longer way). The target is within them
+ * already (motion_target_q8); a start outside (the limits were off, or
+ * changed) may come back, no further out. Products within 2^22 (segment_within's
+ * bounds). Where the path does not keep within them, the limiter says
+ * angle. */
+static bool path_within(struct motion *m, int32_t start, int32_t target, int32_t v0, int32_t v1,
+                        int32_t t)
+{
+    const struct user_config *cfg = &m->regs->user;
+    if (!cfg->angle_limit_on) {
+        return true;
+    }
+    int32_t lo = (cfg->angle_min_decideg + cfg->center_offset_decideg) * 256;
+    uint32_t span = (uint32_t)(cfg->angle_max_decideg - cfg->angle_min_decideg) * 256u;
+    int32_t v1t = v1 * t;
+    bool within = (uint32_t)(start + ((v0 * t) >> 1) - lo) <= span &&
+                  (uint32_t)(target - (v1t >> 1) - lo) <= span &&
+                  (uint32_t)(target + v1t + ((v1 * (v1 < 0 ? -v1 : v1)) >> 7) - lo) <= span;
+    m->angle_clamped |= !within;
+    return within;
+}
+
 /* From start moving at v0 to rest at target within the limits: a ramp of
  * 2 x MIN_RAMP ticks from v0 to the cruise V, a ramp of MIN_RAMP to rest,
  * and a cruise long enough that |V| is within the top speed (ramps and
@@ -102,7 +130,8 @@ enum motion_submit_result motion_stream(struct motion *m, const struct motion_se
     m->answer_packet = 0;
     m->power_mw = 0;
     motion_update_limits(m);
-    bool cubic = segment_within(target - start, v0, v1, (int32_t)period);
+    bool cubic = segment_within(target - start, v0, v1, (int32_t)period) &&
+                 path_within(m, start, target, v0, v1, (int32_t)period);
     if (cubic) {
         profile_plan_segment(&m->profile, start, v0, target, v1, period);
     } else {

@@ -252,6 +252,43 @@ static void test_a_streamed_setpoint_keeps_to_the_angle_limits(void **state)
     assert_true(fabs(plant_angle_deg(&plant) - 300.0) < 0.2);
 }
 
+/* The horn's extremes over ms. */
+static void run_extremes(uint32_t ms, double *lowest, double *highest)
+{
+    for (uint32_t t = 0; t < ms; t++) {
+        harness_run_ms(1);
+        double a = plant_angle_deg(&plant);
+        *lowest = a < *lowest ? a : *lowest;
+        *highest = a > *highest ? a : *highest;
+    }
+}
+
+/* A stream's path keeps within the limits between its setpoints too: a
+ * setpoint at the limit whose end speed runs on past it (a 1 s period,
+ * 750 deg/s at 135 deg: before, the run-on took the horn to 893 deg), and
+ * one whose cubic bulges past it and then runs on the other way (100 deg,
+ * then 135 deg at -600 deg/s: before, 216 deg, then -470 deg). */
+static void test_a_streams_path_keeps_within_the_limits(void **state)
+{
+    (void)state;
+    double lowest = 0.0, highest = 0.0;
+    stream(0, 0, 0, 0);
+    harness_run_ms(500);
+    stream(0, 1350, 7500, 1000);
+    run_extremes(3000, &lowest, &highest);
+    printf("# 135 deg at 750 deg/s, a 1 s period: the horn within %.2f..%.2f deg\n", lowest, highest);
+    assert_true(highest < 135.5 && lowest > -0.5);
+    assert_int_equal(read_item(ITEM_LIMITER), LIMITER_ANGLE);
+    stream(0, 1000, 0, 4000);
+    harness_run_ms(1500);
+    lowest = highest = plant_angle_deg(&plant);
+    stream(0, 1350, -6000, 5000);
+    run_extremes(3000, &lowest, &highest);
+    printf("# 100, then 135 deg at -600 deg/s: the horn within %.2f..%.2f deg\n", lowest, highest);
+    assert_true(highest < 135.5 && lowest > -135.5);
+    assert_int_equal(read_item(ITEM_LIMITER), LIMITER_ANGLE);
+}
+
 /* The limits a stream keeps to (docs/streaming.md), deg/s and deg/s^2. */
 #define SPEED_LIMIT 750.0
 #define ACCEL_LIMIT 37500.0
@@ -387,6 +424,7 @@ int main(void)
         cmocka_unit_test_setup(test_a_step_keeps_to_the_speed_and_acceleration_limits, plant_harness_setup),
         cmocka_unit_test_setup(test_no_setpoint_asks_more_than_the_limits, plant_harness_setup),
         cmocka_unit_test_setup(test_a_far_setpoint_is_reached, plant_harness_setup),
+        cmocka_unit_test_setup(test_a_streams_path_keeps_within_the_limits, plant_harness_setup),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -57,3 +57,34 @@ def test_a_setpoint_2000_deg_away_is_reached(sim, bus, servo):
     print(f"2000 deg: reached {snap.angle_decideg / 10} deg in {took:.2f} s")
     assert abs(snap.angle_decideg - 20000) <= 5, snap
     assert took >= 2000 / 750, took  # never faster than the stream's top speed
+
+
+def horn_extremes(sim, servo, seconds):
+    """The horn's lowest and highest reading (0.1 deg) over seconds of
+    simulated time, read every 10 ms."""
+    low = high = servo.read_motion().angle_decideg
+    end = sim.clock_s() + seconds
+    while sim.clock_s() < end:
+        angle = servo.read_motion().angle_decideg
+        low, high = min(low, angle), max(high, angle)
+        sim.sleep(0.01)
+    return low, high
+
+
+def test_a_streams_path_keeps_within_the_limits_between_setpoints(sim, bus, servo):
+    """The factory limits (+-135 deg): a setpoint at the limit whose end
+    speed would run on past it (750 deg/s, a period of 1 s learned from the
+    stamps: it reached 893 deg), and one whose cubic would bulge past it
+    and run on the other way (216 deg, then -470 deg)."""
+    servo.write("angle_limit_on", 1)
+    setpoint(bus, 1, 0, host_ms=0)
+    settled(sim, servo, 2.0)
+    setpoint(bus, 1, 1350, velocity=7500, host_ms=1000)
+    low, high = horn_extremes(sim, servo, 3.0)
+    assert -5 <= low and high <= 1352, (low, high)
+    assert servo.read_motion().limiter == "angle"
+    setpoint(bus, 1, 1000, host_ms=2000)
+    settled(sim, servo, 2.0)
+    setpoint(bus, 1, 1350, velocity=-6000, host_ms=3000)
+    low, high = horn_extremes(sim, servo, 3.0)
+    assert -1352 <= low and high <= 1352, (low, high)

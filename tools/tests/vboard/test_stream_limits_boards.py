@@ -25,8 +25,8 @@ def one(request, tmp_path):
         finish(sim, [1])
 
 
-def setpoint(bus, decideg, host_ms=0):
-    bus.send(p.STREAM_SETPOINT, p.encode_request(p.STREAM_SETPOINT, 1, decideg, 0, host_ms))
+def setpoint(bus, decideg, host_ms=0, velocity=0):
+    bus.send(p.STREAM_SETPOINT, p.encode_request(p.STREAM_SETPOINT, 1, decideg, velocity, host_ms))
 
 
 def test_a_streamed_setpoint_keeps_to_the_limits(one):
@@ -47,3 +47,20 @@ def test_a_streamed_setpoint_keeps_to_the_limits(one):
     later = servo.read_motion()
     speed = (later.setpoint_decideg - start.setpoint_decideg) / 10 / later.seconds_since(start)
     assert 0 < speed <= 750.5, speed
+
+
+def test_a_streams_path_keeps_within_the_limits_between_setpoints(one):
+    """A setpoint at the factory limit (135 deg) whose end speed, 750 deg/s
+    over a learned 1 s period, ran on to 890 deg on both boards."""
+    sim, bus, servo = one
+    servo.write("angle_limit_on", 1)
+    setpoint(bus, 0)
+    sim.sleep(1.0)
+    setpoint(bus, 1350, host_ms=1000, velocity=7500)
+    high = servo.read_motion().angle_decideg
+    end = sim.clock_s() + 3.0
+    while sim.clock_s() < end:
+        high = max(high, servo.read_motion().angle_decideg)
+        sim.sleep(0.01)
+    assert high <= 1352, high
+    assert servo.read_motion().limiter == "angle"
