@@ -117,10 +117,16 @@ void motion_run(struct motion *m, const struct motion_command *cmd);
  * (docs/protocol.md, "Moves"). */
 enum { MAX_VELOCITY = 7500, MIN_RAMP_MS = 20 };
 /* The one clamp of every position target (planning.c): angle_decideg
- * (protocol frame) within +-range, then the angle limits (48, 51, 52) in the
- * frame whose zero is base (decideg); sets angle_clamped. Q8 from the
- * origin. */
-int32_t motion_target_q8(struct motion *m, int32_t angle_decideg, int32_t range, int32_t base);
+ * (protocol frame) within +-range, then, where item 48 is at least from,
+ * the angle limits (51, 52) in the frame whose zero is base (decideg); sets
+ * angle_clamped. Q8 from the origin. */
+int32_t motion_target_q8(struct motion *m, int32_t angle_decideg, int32_t range, int32_t base,
+                         uint8_t from);
+/* Item 48's values, the least from which a kind of target keeps to the
+ * limits: 1 (the maker's "on") single-turn moves and streamed setpoints; 2
+ * multi-turn moves too, which the maker's servo never limits (its limits
+ * are of angle mode; its SDK moves a factory servo, limits on, to 720 deg). */
+enum { LIMITS_ON = 1, LIMITS_ALL_TARGETS = 2 };
 /* Starts following the profile just planned; then end (enum motion_end). */
 void motion_begin_profile(struct motion *m, uint8_t end);
 

@@ -87,16 +87,18 @@ static void plan_stop(struct motion *m, int64_t start, int64_t v0, uint32_t min_
 /* Every position target passes here: angle and multi-turn moves (and so
  * a SyncCommand's records, the async buffer's and the queue's, when they
  * run) and streamed setpoints. The angle (protocol frame, 0.1 deg) is
- * clamped to its packet's range, then, with the limits on (48), to 52..51
- * in its own frame: base is the reading's turn a single-turn angle is taken
+ * clamped to its packet's range, then, with the limits on for its kind
+ * (item 48 at least from: LIMITS_ON, LIMITS_ALL_TARGETS), to 52..51 in its
+ * own frame: base is the reading's turn a single-turn angle is taken
  * in, 0 for a multi-turn one, so a multi-turn target stays within the
  * limits of the reading itself (docs/decisions.md, "The angle limits hold
  * for every target"). The limiter says angle when the target moved. */
-int32_t motion_target_q8(struct motion *m, int32_t angle_decideg, int32_t range, int32_t base)
+int32_t motion_target_q8(struct motion *m, int32_t angle_decideg, int32_t range, int32_t base,
+                         uint8_t from)
 {
     const struct user_config *cfg = &m->regs->user;
     int32_t angle = clamp_i32(angle_decideg, -range, range);
-    if (cfg->angle_limit_on) {
+    if (cfg->angle_limit_on >= from) {
         angle = clamp_i32(angle, cfg->angle_min_decideg, cfg->angle_max_decideg);
     }
     m->angle_clamped = angle != angle_decideg;
@@ -106,14 +108,16 @@ int32_t motion_target_q8(struct motion *m, int32_t angle_decideg, int32_t range,
 static int64_t angle_target(struct motion *m, const struct motion_command *cmd)
 {
     int32_t base = 0, range = MULTI_TURN_LIMIT;
+    uint8_t from = LIMITS_ALL_TARGETS;
     if (!cmd->multi_turn) {
+        from = LIMITS_ON;
         /* A single-turn angle is within the turn the servo is in now. */
         struct motion_angle now;
         motion_read_angle(m, &now);
         base = now.multi_turn_decideg - now.single_turn_decideg;
         range = SINGLE_TURN_LIMIT;
     }
-    return q8_to_q32(motion_target_q8(m, cmd->angle_decideg, range, base));
+    return q8_to_q32(motion_target_q8(m, cmd->angle_decideg, range, base, from));
 }
 
 static void run_angle(struct motion *m, const struct motion_command *cmd)

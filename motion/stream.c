@@ -121,7 +121,7 @@ enum motion_submit_result motion_stream(struct motion *m, const struct motion_se
         start = m->setpoint_q8;
         v0 = clamp_i32(start - m->last_setpoint_q8, -STREAM_SPEED_Q8, STREAM_SPEED_Q8);
     }
-    int32_t target = motion_target_q8(m, sp->angle_decideg, MULTI_TURN_LIMIT, 0);
+    int32_t target = motion_target_q8(m, sp->angle_decideg, MULTI_TURN_LIMIT, 0, LIMITS_ON);
     /* 0.1 deg/s to Q8 decideg per tick: x 256 / 1000, as 16777 / 2^16
      * (an arithmetic shift: toward minus infinity, under 2^-8 decideg). */
     int32_t v1 = (clamp_i32(sp->velocity_decideg_s, -MAX_VELOCITY, MAX_VELOCITY) * 16777) >> 16;

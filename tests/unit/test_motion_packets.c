@@ -126,13 +126,20 @@ static void test_single_turn_targets_are_clamped_to_the_limits(void **state)
     assert_int_equal(angle_now(), 1800);
 }
 
-/* Issue 55, 1: the limits (on, 135.0 deg) hold multi-turn targets too, in
- * the reading's own frame (a multi-turn 300.0 deg is not -60.0 deg of the
- * next turn), and a SyncCommand's records; the limiter says angle. */
+/* Issue 55, 1: with item 48 at 2 the limits (135.0 deg) hold multi-turn
+ * targets too, in the reading's own frame (a multi-turn 300.0 deg is not
+ * -60.0 deg of the next turn), and a SyncCommand's records; the limiter
+ * says angle. At 1, the maker's "on" and the factory's, a multi-turn move
+ * passes them, as the maker's servo lets it. */
 static void test_multi_turn_and_sync_targets_keep_to_the_limits(void **state)
 {
     (void)state;
     REQUEST(PKT_MOVE_MULTI_TURN, 0, 0xB8, 0x0B, 0, 0, 0xF4, 0x01, 0, 0, 0, 0); /* 300.0 deg, 500 ms */
+    run_until_done(2000);
+    assert_int_equal(angle_now(), 3000);
+    assert_int_equal(motion_limiter(&servo.motion), LIMITER_NONE);
+    WRITE_ITEM(0, ITEM_ANGLE_LIMIT_ON, 2);
+    REQUEST(PKT_MOVE_MULTI_TURN, 0, 0xB8, 0x0B, 0, 0, 0xF4, 0x01, 0, 0, 0, 0);
     run_until_done(2000);
     assert_int_equal(angle_now(), 1350);
     assert_int_equal(motion_limiter(&servo.motion), LIMITER_ANGLE);

@@ -8,11 +8,12 @@ multi-turn because of its value or because of what else is in the command.
 The firmware takes a single-turn target within the turn the horn is in now
 (docs/decisions.md), so at 720 deg "10" would mean 730 deg. servoctl sends a
 single-turn move only to a servo in turn 0, where the two readings agree,
-and refuses otherwise, saying how to get back. The firmware clamps every
-target to the angle limits (48, 51, 52): a single-turn one within its turn,
-a multi-turn or streamed one in this frame; servoctl refuses a target
-outside the limits in both modes before sending, rather than let the
-servo stop short of it."""
+and refuses otherwise, saying how to get back. The firmware clamps a
+single-turn target to the angle limits (48, 51, 52) within its turn and a
+streamed one in this frame, and a multi-turn one too where item 48 is 2 (1,
+the maker's "on", lets it pass, as the maker's servo does); servoctl refuses
+a target outside the limits in both modes before sending, rather than let
+the servo stop short of it."""
 from dataclasses import dataclass
 
 from .protocol import BadAnswer, NoReply, Refused, ValueOutOfRange

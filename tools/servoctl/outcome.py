@@ -48,13 +48,15 @@ class Plan:
 def plan_move(s, asked: int, request: MoveRequest, where: Where = None) -> Plan:
     """Where the move will end and how long it is planned to take, from the
     servo's own settings (as frame.check_target read them, or read now):
-    angle limits (48, 51, 52) clamp the target, single- or multi-turn (in
-    the frame the angles are read in); soft start (49, 50) may stretch it."""
+    angle limits (48, 51, 52) clamp the target (a multi-turn one where item
+    48 is 2, in the frame the angles are read in); soft start (49, 50) may
+    stretch it."""
     if where is None:
         where = Where(s.read_all(), s.multi_turn_angle()[0])
     cfg, start = where.cfg, where.at
     target = asked
-    if cfg["angle_limit_on"]:
+    # Item 48: 1 (the maker's on) clamps a single-turn target, 2 a multi-turn one too.
+    if cfg["angle_limit_on"] >= (2 if request.multi_turn else 1):
         target = min(max(asked, cfg["angle_min"]), cfg["angle_max"])
     # A single-turn target is taken within the turn the servo is in.
     target_abs = target if request.multi_turn else turn_base(start) + target

@@ -35,8 +35,6 @@ def timed_move(servo, sim, **move):
     (dict(angle_decideg=-4000, velocity=2800, acc_ms=50, dec_ms=50, multi_turn=True), None),
 ])
 def test_moves_end_on_target_and_on_time(servo, sim, move, expected_ms):
-    if move.get("multi_turn"):
-        servo.write("angle_limit_on", 0)  # multi-turn work: the limits would hold it within them
     start = servo.multi_turn_angle()[0]
     if expected_ms is None:  # velocity-based: the firmware's own timing rule
         a, c, d = velocity_timing(move["angle_decideg"] - start, 0.0, move["velocity"] / 1000.0,
@@ -55,7 +53,6 @@ def test_moves_end_on_target_and_on_time(servo, sim, move, expected_ms):
 def test_a_move_faster_than_the_motor_arrives_late_without_overshoot(servo, sim):
     """720 deg in 1 s asks 800 deg/s of a servo that makes 312: it takes longer,
     status bit 0 stays set until the horn is there, and it does not overshoot."""
-    servo.write("angle_limit_on", 0)
     servo.move(angle_decideg=7200, interval_ms=1000, multi_turn=True)
     furthest = 0.0
 

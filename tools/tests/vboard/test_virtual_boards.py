@@ -74,7 +74,6 @@ def test_ping_and_the_data_table(one):
 
 def test_every_motion_packet(one):
     sim, bus, servo = one
-    servo.write("angle_limit_on", 0)  # multi-turn moves below: the limits would hold them within
     servo.move(450, interval_ms=300)                                   # 11
     sim.sleep(0.6)
     assert servo.angle() == pytest.approx(450, abs=2)
