@@ -171,8 +171,8 @@ class Servo:
             return
         now = {name: self.read(name) for name in stability.ITEMS}
         changes = {k: v for k, v in values.items() if now[k] != v}
-        for name in stability.write_order(now, changes):
-            self._write(registers.find(name), changes[name])
+        for name, value in stability.write_order(now, changes):
+            self._write(registers.find(name), value)
 
     def _write(self, item, value: int) -> None:
         content = self.bus.request(p.WRITE_DATA, bytes([self.id, item.id]) + item.pack(value))

@@ -20,7 +20,8 @@ items 86-88. A set is refused where
 
 Ratio 0 declares no plant (no feed-forward): nothing to judge. Items are
 written one at a time, each kept: write_order finds an order in which each
-set along the way passes too."""
+set along the way passes too, by way of gain_ki 0 where no plain order
+does."""
 import math
 from types import SimpleNamespace
 
@@ -96,28 +97,72 @@ def reason(v: dict):
     return None
 
 
+def _search(now: dict, pending: dict):
+    """A depth-first search over the orders of writing pending (name:
+    value) from now, each write judged as the servo judges it (refused
+    where it takes a passing set to a failing one; a set already failing
+    takes any). The (name, value) writes in order, or None and the deepest
+    refusal met: (the items written before, the item, why)."""
+    dead, blocked = set(), [(), None, None]
+
+    def go(state: dict, done: tuple):
+        left = [n for n in pending if n not in done]
+        if not left:
+            return []
+        if frozenset(done) in dead:
+            return None
+        was_failing = firmware_reason(state) is not None
+        for name in left:
+            trial = dict(state, **{name: pending[name]})
+            why = firmware_reason(trial)
+            if why is None or was_failing:
+                rest = go(trial, done + (name,))
+                if rest is not None:
+                    return [(name, pending[name])] + rest
+            elif blocked[1] is None or len(done) >= len(blocked[0]):
+                blocked[:] = [done, name, why]
+        dead.add(frozenset(done))
+        return None
+
+    return go(dict(now), ()), tuple(blocked)
+
+
 def write_order(now: dict, changes: dict) -> list:
-    """The items of changes (name: value) in an order where each set along
-    the way passes the servo's own check (each write is kept, so each is
-    judged); refused, naming why, where the final set fails or no order
-    passes."""
+    """The writes, (name, value), that take the servo from now to now with
+    changes (name: value), in an order where each set along the way passes
+    the servo's own check (each write is kept, so each is judged); refused,
+    naming why, where the final set fails or no order passes.
+
+    Rule 3 (ki) is not monotone in the drive items: kt raises kv and lowers
+    ka but also the viscous term; the ratio raises ka and kv both. So two
+    tuned servos' sets can have no plain order (a micro servo's items to a
+    60 kg cm servo's). Then gain_ki is written 0 first (rule 3 then holds
+    whatever the rest; rules 1-2 do not read ki), the others in an order
+    that passes rules 1-2, and gain_ki last. With ki 0 an order always
+    exists but for the integer rounding: rules 1-2 are monotone in kt, J, R
+    and |ratio| (kt x |ratio| < bound; J R / kt^2 >= bound), so the items
+    that ease them first, then those that tighten them, each set as eased
+    as the final one; the search finds it, or names the intermediate set's
+    failing rule. The ki 0 sets last a write each: the loop runs PD there,
+    which the rules judge stable."""
     final = dict(now, **changes)
     why = reason(final)
     if why:
         factory = ", ".join(f"{k} {registers.find(k).default}" for k in changes)
         raise ValueOutOfRange(f"{', '.join(f'{k} = {v}' for k, v in changes.items())} refused, not written: "
                               f"{why} (factory: {factory}); nothing was sent")
-    pending, order, state = dict(changes), [], dict(now)
-    while pending:
-        for name, value in pending.items():
-            trial = dict(state, **{name: value})
-            if firmware_reason(trial) is None or firmware_reason(state) is not None:
-                break
-        else:
-            raise ValueOutOfRange(f"no order of writing {', '.join(pending)} keeps the servo's loop stable "
-                                  f"at each step: {firmware_reason(dict(state, **pending))}")
-        order.append(name)
-        state[name] = pending.pop(name)
+    order, blocked = _search(now, changes)
+    if order is None and now["gain_ki"] != 0:
+        rest = {k: v for k, v in changes.items() if k != "gain_ki"}
+        # ki 0 from now is kept: rule 3 holds with ki 0, rules 1-2 are now's.
+        via, blocked = _search(dict(now, gain_ki=0), rest)
+        if via is not None:
+            order = [("gain_ki", 0)] + via + ([("gain_ki", final["gain_ki"])] if final["gain_ki"] else [])
+    if order is None:
+        done, name, why = blocked
+        after = f"after {', '.join(done)}" if done else "first"
+        raise ValueOutOfRange(f"no order of writing {', '.join(changes)} keeps the servo's loop stable at each step "
+                              f"(gain_ki 0 first included): {name} written {after} would be refused: {why}")
     return order
 
 

@@ -10,7 +10,11 @@ Every setpoint is checked against what its servo allows before it is sent
 servo's top speed (750 deg/s) between one setpoint and the next. One out of
 them is refused, never clamped: a clamped path is not the host's, and the
 servo, without the next setpoint, brakes to a hold where the last one
-was (docs/streaming.md). A file is checked whole before anything moves."""
+was (docs/streaming.md). A file is checked whole before anything moves.
+
+A stream feeds each servo's bus watchdog (item 64) once a period: a period
+longer than half its watchdog_ms is refused before anything is sent (the
+servo would take its watchdog_action between setpoints)."""
 import csv
 import math
 import struct
@@ -18,7 +22,7 @@ from dataclasses import dataclass
 
 from . import protocol as p
 from .checks import check_range, scaled
-from .errors import NoReply, Refused, UsageError, ValueOutOfRange
+from .errors import NoReply, Refused, ServoError, UsageError, ValueOutOfRange
 from .group import MAX_SYNC_RECORDS, monitor_answers, monitor_request, sync_monitor
 from .outcome import EXECUTING, INHIBITING, STALL, TOLERANCE_DEG
 
@@ -44,18 +48,38 @@ def _check_ids(ids) -> list:
 class Limits:
     """What one servo allows a streamed setpoint, 0.1 deg and 0.1 deg/s:
     angle_min..angle_max if its angle limits are on (items 48, 51, 52),
-    else None; and the top speed, the servo's own clamp for moves and
-    setpoints (docs/streaming.md), between a setpoint and the next."""
+    else None; the top speed, the servo's own clamp for moves and
+    setpoints (docs/streaming.md), between a setpoint and the next; and its
+    bus watchdog's watchdog_ms (item 64, ms; 0 off), which a stream's
+    period must keep fed."""
     angle_min: int = None
     angle_max: int = None
     speed: int = MAX_SPEED_DECIDEG_S
+    watchdog_ms: int = 0
 
     @classmethod
     def of(cls, cfg: dict) -> "Limits":
-        """From a servo's user area (servo.Servo.read_all)."""
+        """From a servo's user area (servo.Servo.read_all) and, where
+        read_configs found it, its watchdog_ms."""
+        watchdog_ms = cfg.get("watchdog_ms", 0)
         if not cfg["angle_limit_on"]:
-            return cls()
-        return cls(cfg["angle_min"], cfg["angle_max"])
+            return cls(watchdog_ms=watchdog_ms)
+        return cls(cfg["angle_min"], cfg["angle_max"], watchdog_ms=watchdog_ms)
+
+    def check_period(self, servo_id: int, period_ms: int) -> str:
+        """Why a stream at period_ms would starve this servo's bus watchdog,
+        or "". A stream feeds it once a period (the setpoints and the Sync
+        Monitor, back to back), so the period must be at most half
+        watchdog_ms: a cycle late by up to a period (the host's jitter, the
+        wire's time, a lost frame) still feeds it in time."""
+        if not self.watchdog_ms or 2 * period_ms <= self.watchdog_ms:
+            return ""
+        longer = 2 * period_ms
+        return (f"servo {servo_id}'s bus watchdog (watchdog_ms {self.watchdog_ms} ms) would act between "
+                f"setpoints {period_ms} ms apart: a stream feeds it once a period, and the period must be at "
+                f"most half watchdog_ms ({self.watchdog_ms // 2} ms) to allow for the wire and the host's "
+                f"jitter. Use a period of at most {self.watchdog_ms // 2} ms, or a longer watchdog "
+                f"('servoctl config set {servo_id} watchdog_ms {longer}', or 0 for off)")
 
     def check(self, servo_id: int, angle: int, last: int = None, period_ms: int = 0, velocity: int = 0) -> str:
         """Why the setpoint angle (after last, a period_ms earlier; at
@@ -75,15 +99,21 @@ class Limits:
 
 
 def read_configs(bus: p.Bus, ids) -> dict:
-    """{id: the servo's user area}, one ReadBatchData each."""
+    """{id: the servo's user area, one ReadBatchData each, and its
+    watchdog_ms (item 64; 0 where the servo has none)}."""
     from .servo import Servo
 
     out = {}
     for servo_id in ids:
+        s = Servo(bus, servo_id)
         try:
-            out[servo_id] = Servo(bus, servo_id).read_all()
+            out[servo_id] = s.read_all()
         except NoReply as e:
             raise NoReply(f"{e}: is servo {servo_id} on the bus, at this baud rate? Nothing was sent") from None
+        try:  # item 64, outside the user area: this firmware's, the maker's has none
+            out[servo_id]["watchdog_ms"] = s.read("watchdog_ms")
+        except ServoError:
+            out[servo_id]["watchdog_ms"] = 0
     return out
 
 
@@ -102,13 +132,17 @@ class Stream:
     limits, {id: Limits}, are read from the servos if not given: a send
     with a setpoint outside its servo's angle limits, a step from the last
     setpoint faster than the servo moves, or a velocity beyond it, raises
-    ValueOutOfRange and sends nothing."""
+    ValueOutOfRange and sends nothing. A period longer than half a
+    servo's watchdog_ms (in the limits: read ones have it, given ones say
+    it or 0) raises UsageError when the Stream is made: a loop at that
+    period would starve the watchdog by design."""
 
     def __init__(self, bus: p.Bus, ids, period_s: float, limits: dict = None):
         self.bus = bus
         self.ids = _check_ids(ids)
         self.period_ms = check_range("period", scaled(period_s, 1000, "period_s"), *PERIOD_RANGE_MS, "ms")
         self.limits = read_limits(bus, self.ids) if limits is None else {i: limits[i] for i in self.ids}
+        check_period(self.limits, self.period_ms)
         self.sent = 0
         self._last = {}
         # Every record of a send in one pack: a robot's loop builds this
@@ -295,10 +329,21 @@ def read_trajectory(path: str) -> Trajectory:
                       lines, path)
 
 
+def check_period(limits: dict, period_ms: int, where: str = "") -> None:
+    """A stream at period_ms against every servo's watchdog_ms (Limits.check_period):
+    refused, UsageError, before anything is sent."""
+    for servo_id, lim in limits.items():
+        why = lim.check_period(servo_id, period_ms)
+        if why:
+            raise UsageError(f"{where}{why}; nothing was sent")
+
+
 def check_trajectory(trajectory: Trajectory, limits: dict) -> None:
     """Every row against every servo's Limits, as Stream checks a send,
-    before anything moves: a row outside them is refused with its line."""
+    before anything moves: a row outside them is refused with its line;
+    the file's period against each servo's bus watchdog first."""
     period_ms = trajectory.period_ms
+    check_period(limits, period_ms, f"{trajectory.path}: " if trajectory.path else "")
     for servo_id, rows in trajectory.angles.items():
         last = None
         for k, degrees in enumerate(rows):

@@ -2,6 +2,9 @@
 the servo's own rules as the firmware works them out (drive_items_stable,
 mirrored in the same integer arithmetic: tests/unit/test_oscillation.c has
 the same cases), tune's margins, and the order of writes."""
+import random
+from unittest.mock import patch
+
 import pytest
 
 from servoctl import registers, stability
@@ -57,14 +60,63 @@ def test_derived_as_the_firmware():
     assert stability.derived(FACTORY) == {"kv": 9902, "ka": 196777, "viscous": 291}
 
 
+def _walk(now: dict, target: dict) -> dict:
+    """The writes write_order gives from now to target, each judged as the
+    servo judges it (a passing set must stay passing); the set at the end."""
+    state = dict(now)
+    for name, value in stability.write_order(now, {k: v for k, v in target.items() if now[k] != v}):
+        was_stable = stability.firmware_reason(state) is None
+        state[name] = value
+        assert not was_stable or stability.firmware_reason(state) is None, (name, value)
+    return state
+
+
 def test_write_order_keeps_each_step_stable_and_refuses_a_bad_end():
     for target in PLANTS.values():
-        state = dict(FACTORY)
-        changes = {k: v for k, v in target.items() if FACTORY[k] != v}
-        for name in stability.write_order(FACTORY, changes):
-            was_stable = stability.firmware_reason(state) is None
-            state[name] = target[name]
-            assert not was_stable or stability.firmware_reason(state) is None, name
-        assert state == target
+        assert _walk(FACTORY, target) == target
     with pytest.raises(ValueOutOfRange, match="torque_constant = 37140 refused, not written"):
         stability.write_order(FACTORY, {"torque_constant": 37140})
+
+
+@pytest.mark.parametrize("start,end", [("micro", "60kgcm"), ("60kgcm", "micro")])
+def test_write_order_between_the_tuned_plants_goes_by_way_of_ki_zero(start, end):
+    """One shipped plant's tuned items onto the other's (config load): no
+    plain order passes rule 3 at each step (was refused, "...: None"); with
+    gain_ki 0 first, the rest, then gain_ki, each step passes."""
+    order = stability.write_order(PLANTS[start], {k: v for k, v in PLANTS[end].items()
+                                                  if PLANTS[start][k] != v})
+    assert order[0] == ("gain_ki", 0) and order[-1] == ("gain_ki", PLANTS[end]["gain_ki"])
+    assert _walk(PLANTS[start], PLANTS[end]) == PLANTS[end]
+
+
+def test_write_order_finds_a_path_between_any_two_passing_sets():
+    """Random passing sets (the servo's rules; tune's margins aside): rules
+    1-2 are monotone in kt, J, R and |ratio|, so with ki 0 an order exists."""
+    rng = random.Random(55)
+    bounds = {"motor_resistance": (500, 20000), "torque_constant": (500, 20000), "gear_ratio": (-600, 600),
+              "rotor_inertia": (10, 50000), "coulomb_friction": (0, 10000), "viscous_friction": (0, 10000),
+              "gain_kp": (1, 1023), "gain_ki": (0, 60), "gain_kd": (0, 32767)}
+
+    def passing():
+        while True:
+            v = {k: rng.randint(*b) for k, b in bounds.items()}
+            if v["gear_ratio"] and stability.firmware_reason(v) is None:
+                return v
+    for _ in range(300):
+        now, target = passing(), passing()
+        with patch.object(stability, "reason", stability.firmware_reason):
+            assert _walk(now, target) == target
+
+
+def test_no_order_names_the_rule_an_intermediate_set_fails():
+    """Where no order passes (a toy rule: kp and kd may not both be above
+    100, nor both at most 100), the refusal names the step and its rule,
+    never "None"."""
+    def toy(v):
+        return None if (v["gain_kp"] > 100) != (v["gain_kd"] > 100) else "toy rule: kp and kd on one side"
+    now = dict(FACTORY, gain_kp=50, gain_kd=200)
+    with patch.object(stability, "firmware_reason", toy), patch.object(stability, "reason", toy):
+        with pytest.raises(ValueOutOfRange) as e:
+            stability.write_order(now, {"gain_kp": 200, "gain_kd": 50})
+    assert str(e.value).endswith("gain_kd written first would be refused: toy rule: kp and kd on one side")
+    assert not str(e.value).endswith("None")

@@ -98,3 +98,15 @@ def test_a_socket_that_takes_no_bytes_is_a_link_error_not_a_hang(monkeypatch):
                         bus.send_burst([ping] * 10000)
     finally:
         server.close()
+
+
+def test_the_period_against_the_bus_watchdog():
+    """A stream feeds a servo's watchdog once a period: at most half its
+    watchdog_ms is taken (a cycle a period late still feeds it), longer is
+    refused naming what to do; a watchdog off (0) takes any period."""
+    assert Limits(watchdog_ms=100).check_period(3, 50) == ""
+    why = Limits(watchdog_ms=100).check_period(3, 51)
+    assert "servo 3's bus watchdog (watchdog_ms 100 ms)" in why and "at most 50 ms" in why
+    assert "'servoctl config set 3 watchdog_ms 102'" in why
+    assert Limits().check_period(3, 1000) == ""
+    assert Limits.of({"angle_limit_on": 0, "watchdog_ms": 40}) == Limits(watchdog_ms=40)

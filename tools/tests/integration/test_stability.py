@@ -93,3 +93,53 @@ def test_a_normal_45_deg_move_never_trips_it_on_any_shipped_plant(tmp_path, plan
         assert "oscillation" not in [f.kind for f in s.faults()]
     finally:
         finish(sim, [1])
+
+
+# The shipped plants' items as tune gives them at 8 Hz (tools/tests/test_stability.py's).
+TUNED = {
+    "micro_9g.toml": {"motor_resistance": 6400, "torque_constant": 1324, "gear_ratio": 300, "rotor_inertia": 51,
+                      "coulomb_friction": 662, "viscous_friction": 211, "gain_kp": 223, "gain_ki": 3,
+                      "gain_kd": 1104},
+    "class_60kgcm.toml": {"motor_resistance": 2400, "torque_constant": 5063, "gear_ratio": 387,
+                          "rotor_inertia": 12570, "coulomb_friction": 6330, "viscous_friction": 2811,
+                          "gain_kp": 533, "gain_ki": 3, "gain_kd": 24297},
+}
+
+
+def test_one_tuned_plants_file_loads_onto_the_other(tmp_path, capsys):
+    """A micro servo's tuned config loads onto a tuned 60 kg cm servo and
+    back, and after config reset: no plain order of writes passes the
+    servo's rule 3 at each step (it was refused, "...: None"); by way of
+    gain_ki 0 it does, each write kept by the servo itself."""
+    sims = {}
+    try:
+        for plant in TUNED:
+            sims[plant] = Simulator(state_dir=str(tmp_path / plant), plant=str(PLANTS / plant)).start()
+            with sims[plant].bus(timeout=0.2) as bus:
+                Servo(bus, 1).write_drive(TUNED[plant])  # as tune writes them
+            assert run(sims[plant], capsys, "config", "save", "1", str(tmp_path / f"{plant}.json"))[0] == 0
+        for plant, other in (("micro_9g.toml", "class_60kgcm.toml"), ("class_60kgcm.toml", "micro_9g.toml"),
+                             ("micro_9g.toml", "micro_9g.toml")):  # the last: back
+            sim = sims[plant]
+            rc, _, err = run(sim, capsys, "config", "load", "1", str(tmp_path / f"{other}.json"))
+            assert rc == 0, err
+            with sim.bus(timeout=0.2) as bus:
+                s = Servo(bus, 1)
+                assert {name: s.read(name) for name in TUNED[other]} == TUNED[other]
+                assert s.read_store().flag_names() == []
+        sim = sims["class_60kgcm.toml"]  # holds the micro's items now
+        assert run(sim, capsys, "config", "reset", "1")[0] == 0
+        rc, _, err = run(sim, capsys, "config", "load", "1", str(tmp_path / "class_60kgcm.toml.json"))
+        assert rc == 0, err
+        with sim.bus(timeout=0.2) as bus:
+            assert {name: Servo(bus, 1).read(name) for name in TUNED["class_60kgcm.toml"]} == \
+                TUNED["class_60kgcm.toml"]
+    finally:
+        judged = []
+        for sim in sims.values():  # each stopped, whatever the other's finish says
+            try:
+                finish(sim, [1])
+            except AssertionError as e:
+                judged.append(e)
+        if judged:
+            raise judged[0]

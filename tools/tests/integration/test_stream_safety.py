@@ -8,9 +8,9 @@ import math
 import pytest
 
 from servoctl.cli import main
-from servoctl.errors import ValueOutOfRange
+from servoctl.errors import UsageError, ValueOutOfRange
 from servoctl.servo import Servo
-from servoctl.stream import Limits, Stream
+from servoctl.stream import Limits, RobotLoop, Stream
 
 
 def write_csv(path, rows, period_s=0.02):
@@ -169,3 +169,33 @@ def test_the_report_warns_of_a_lead_in_of_half_a_turn_or_more(sim, tmp_path, cap
     out = capsys.readouterr().out
     assert rc == 0
     assert "warning: servo 1 turned 200." in out and "deg to reach the first row" in out, out
+
+
+def test_a_period_that_would_starve_the_watchdog_is_refused_before_anything_is_sent(sim, tmp_path, capsys):
+    """docs/safety.md's 100 ms watchdog, action release, and a file 0.5 s a
+    row: c285aa0 streamed it, the servo was released once a row, and the
+    command exited 0. Now the file's period is checked against each
+    servo's watchdog_ms first (at most half of it): exit 2, nothing sent.
+    Stream and RobotLoop check it when made, from the limits they read."""
+    with sim.bus(timeout=0.2) as bus:
+        s = Servo(bus, 1)
+        s.write("soft_start_on", 0)
+        s.write("watchdog_ms", 100)
+        s.write("watchdog_action", 2)  # release
+    rc = stream(sim, write_csv(tmp_path / "slow.csv", ramp(30.0, 40.0, 9), period_s=0.5))
+    captured = capsys.readouterr()
+    assert rc == 2, captured
+    for said in ("servo 1's bus watchdog (watchdog_ms 100 ms)", "setpoints 500 ms apart",
+                 "a period of at most 50 ms", "config set 1 watchdog_ms 1000", "nothing was sent"):
+        assert said in captured.err, captured.err
+    assert "lead-in" not in captured.out and "setpoints at" not in captured.out, captured.out
+    with sim.bus(timeout=0.2) as bus:
+        still_where_it_was(sim, bus, 0.0)  # no lead-in to 30 deg
+        for period_s in (0.5, 0.051):
+            with pytest.raises(UsageError, match=f"setpoints {round(period_s * 1000)} ms apart"):
+                Stream(bus, [1], period_s)
+            with pytest.raises(UsageError, match="watchdog_ms 100 ms"):
+                RobotLoop(bus, [1], period_s)
+        assert Stream(bus, [1], 0.05).limits[1].watchdog_ms == 100  # half: taken
+        Servo(bus, 1).write("watchdog_ms", 0)
+        assert Stream(bus, [1], 0.5).limits[1].watchdog_ms == 0  # off: any period
