@@ -109,16 +109,15 @@ static void wait_for_turn(struct servo *s, uint32_t now)
 static void queue_response(struct servo *s, uint8_t wait, uint32_t responses_base, uint32_t now)
 {
     s->tx.size = frame_tx_seal(&s->tx.frame);
-    if (wait == 0u) {
-        start_send(s);
-        return;
-    }
-    /* A Sync Monitor turn: what wait_for_turn reads, only while it waits. */
     s->tx.turns_left = wait;
     s->tx.responses_base = responses_base;
     s->tx.requests_base = s->rx.stats.requests_seen;
     s->tx.silence_from_us = now;
-    s->tx.waiting = 1;
+    if (wait == 0u) {
+        start_send(s);
+    } else {
+        s->tx.waiting = 1;
+    }
 }
 
 /* Nobody asked for a "move finished" answer just now, so nobody has left
