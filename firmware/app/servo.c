@@ -109,16 +109,15 @@ static void wait_for_turn(struct servo *s, uint32_t now)
 static void queue_response(struct servo *s, uint8_t wait, uint32_t responses_base, uint32_t now)
 {
     s->tx.size = frame_tx_seal(&s->tx.frame);
-    if (wait == 0u) {
-        start_send(s);
-        return;
-    }
-    /* A Sync Monitor turn: what wait_for_turn reads, only while it waits. */
     s->tx.turns_left = wait;
     s->tx.responses_base = responses_base;
     s->tx.requests_base = s->rx.stats.requests_seen;
     s->tx.silence_from_us = now;
-    s->tx.waiting = 1;
+    if (wait == 0u) {
+        start_send(s);
+    } else {
+        s->tx.waiting = 1;
+    }
 }
 
 /* Nobody asked for a "move finished" answer just now, so nobody has left
@@ -385,25 +384,13 @@ static bool run_control_tick(struct servo *s, uint32_t now)
     return true;
 }
 
-/* The ring to the framer; a line silent for the idle timeout drops a
- * partial frame. One copy on the size-first image (the M0): every pass and
- * after_erase call it. */
-#ifdef SERVO_SIZE_FIRST
-__attribute__((noinline))
-#else
-inline __attribute__((always_inline))
-#endif
-static void frame_ring(struct servo *s, struct hal_rx_ring *ring, uint32_t now)
-{
-    frame_rx_receive(&s->rx, ring, &s->rx_lost, now, s->rx_idle_us);
-}
-
-/* What the port has received since the last pass, to the framer. */
+/* What the port has received since the last pass, to the framer; a line
+ * silent for the idle timeout drops a partial frame. */
 static void receive(struct servo *s, uint32_t now)
 {
     struct hal_rx_ring *ring = s->hal->rx;
     hal_rx_sync(s->hal, now);
-    frame_ring(s, ring, now);
+    frame_rx_receive(&s->rx, ring, &s->rx_lost, now, s->rx_idle_us);
 }
 
 /* The pass after a page erase: the control loop resumes on a fresh
@@ -429,7 +416,7 @@ __attribute__((noinline, cold)) static void after_erase(struct servo *s, uint32_
         return;
     }
     for (;;) {
-        frame_ring(s, ring, now);
+        frame_rx_receive(&s->rx, ring, &s->rx_lost, now, s->rx_idle_us);
         for (uint8_t stale = frame_rx_pending(&s->rx); stale != 0u; stale--) {
             handle_next_frame(s, now, true);
         }

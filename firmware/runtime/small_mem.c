@@ -22,13 +22,7 @@ void *memcpy(void *restrict dst, const void *restrict src, size_t n)
      * way to an answer) come from word-aligned registers: read a word at a
      * time, stored a byte at a time, since the destination may be at any
      * byte and the Cortex-M0 faults on an unaligned word. */
-    if ((((uintptr_t)s | (uintptr_t)d) & 3u) == 0u) {
-        /* Both aligned (a fault history entry into ReadFaults' answer):
-         * a word a load and a store. */
-        for (; end - s >= 4; s += 4, d += 4) {
-            *(any_word *)(void *)d = *(const any_word *)(const void *)s;
-        }
-    } else if (((uintptr_t)s & 3u) == 0u) {
+    if (((uintptr_t)s & 3u) == 0u) {
         for (; end - s >= 4; s += 4, d += 4) {
             uint32_t w = *(const any_word *)(const void *)s;
             d[0] = (uint8_t)w;
