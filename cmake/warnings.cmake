@@ -11,9 +11,12 @@ set(SERVO_TEST_WARNINGS -Wall -Wextra -Werror -Wshadow -Wno-unused-parameter)
 
 # A firmware target: its warnings, and on a size-first image (the Cortex-M0)
 # SERVO_SIZE_FIRST, where the per-tick helpers are called rather than inlined.
+# Public: it shapes structs too (struct profile has no smoothing fields
+# there), so whatever links a firmware library (the target benchmark) sees
+# them as it does.
 function(servo_firmware_target target)
   target_compile_options(${target} PRIVATE ${SERVO_FIRMWARE_WARNINGS})
   if(SERVO_SIZE_FIRST)
-    target_compile_definitions(${target} PRIVATE SERVO_SIZE_FIRST)
+    target_compile_definitions(${target} PUBLIC SERVO_SIZE_FIRST)
   endif()
 endfunction()

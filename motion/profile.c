@@ -5,6 +5,14 @@
 /* Right shifts of negative values are arithmetic with gcc and clang, the
  * only compilers this code is built with (implementation-defined in C11). */
 
+/* A plan without a window (profile_smooth adds one where there is
+ * smoothing at all). */
+#if PROFILE_SMOOTHING
+#define NO_WINDOW(p) ((p)->smooth_ticks = 0)
+#else
+#define NO_WINDOW(p) ((void)(p))
+#endif
+
 static int64_t div_round(int64_t num, int64_t den)
 {
     return div64_round(num, den);
@@ -48,7 +56,7 @@ void profile_plan(struct profile *p, int64_t start, int64_t v0, int64_t target,
     p->accel_j = 0;
     p->decel_k = n3 ? div_round(v * 256, 2 * n3) : 0;
     p->accel_ticks = (uint32_t)n1;
-    p->smooth_ticks = 0;
+    NO_WINDOW(p);
     p->cruise_end = (uint32_t)(n1 + nc);
     p->total_ticks = (uint32_t)(n1 + nc + n3);
 }
@@ -64,7 +72,7 @@ void profile_plan_endless(struct profile *p, int64_t start, int64_t v0, int64_t 
     p->accel_j = 0;
     p->decel_k = 0;
     p->accel_ticks = accel;
-    p->smooth_ticks = 0;
+    NO_WINDOW(p);
     p->cruise_end = UINT32_MAX;
     p->total_ticks = UINT32_MAX;
 }
@@ -90,7 +98,7 @@ void profile_plan_segment(struct profile *p, int32_t start_q8, int32_t v0_q8, in
     p->accel_j = div_round(((v0_q8 + v1_q8) * t - 2 * d) * q32, tt * t);
     p->decel_k = 0;
     p->accel_ticks = ticks;
-    p->smooth_ticks = 0;
+    NO_WINDOW(p);
     /* At rest at the end: a move that ends there, which the braking guard
      * watches. Else on at v1 for ever. */
     p->cruise_end = v1_q8 != 0 ? UINT32_MAX : ticks;
@@ -155,7 +163,12 @@ static uint32_t phase_end(const struct profile *p, unsigned phase)
 /* A smoothed phase's jerk ([0]) or its sixth ([1]): the ramps' only. */
 static int64_t phase_jerk(const struct profile *p, unsigned phase, unsigned sixth)
 {
+#if PROFILE_SMOOTHING
     return phase & 1u ? p->smooth_jerk[phase >> 1][sixth] : 0;
+#else
+    (void)p, (void)phase, (void)sixth;
+    return 0;
+#endif
 }
 
 void profile_walk_start(struct profile_walk *w, const struct profile *p, uint32_t tick)
@@ -263,6 +276,7 @@ uint32_t profile_smooth_ticks(const struct profile *p, uint32_t jerk_q24)
 
 void profile_smooth(struct profile *p, uint32_t smooth_ticks)
 {
+#if PROFILE_SMOOTHING
     p->smooth_ticks = smooth_ticks;
     if (smooth_ticks == 0u) {
         return;
@@ -275,4 +289,7 @@ void profile_smooth(struct profile *p, uint32_t smooth_ticks)
         p->smooth_jerk[i][0] = jerk;
         p->smooth_jerk[i][1] = (jerk * 10923) >> 16;
     }
+#else
+    (void)p, (void)smooth_ticks;
+#endif
 }

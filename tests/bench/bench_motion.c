@@ -157,9 +157,10 @@ int main(void)
                                                 .dec_ms = 200};
     plan("plan_short_stroke", &short_stroke);
 
-    /* Jerk-limited moves (item 70, 20 (deg/s^2)/ms; not in the Cortex-M0
-     * image): from rest, then over the moving setpoint 300 ticks on. */
-    if (PROFILE_SMOOTHING) {
+    /* Jerk-limited moves (item 70, 20 (deg/s^2)/ms): from rest, then over
+     * the moving setpoint 300 ticks on. On every CPU: the Cortex-M0's
+     * library plans them as trapezoids (run_target_bench.py shows nan). */
+    {
         fresh();
         regs.firmware.jerk_limit = 20;
         plan("plan_jerk_rest", &velocity);

@@ -125,6 +125,15 @@ struct motion {
     uint8_t async_open;        /* enum async_block */
     uint8_t inhibit;           /* set by the protection monitors (motion_guard) */
     uint8_t mode;              /* enum motion_mode */
+    uint8_t braking;           /* the profile is the braking guard's: left alone */
+    uint8_t answers_count;     /* finished moves owed an answer (answers) */
+    uint8_t endless;           /* wheel run, stream: finished once at speed */
+    uint8_t end;               /* enum motion_end */
+    uint8_t drive_limiter;     /* enum limiter: what sets the duty limit */
+    uint8_t streaming;         /* a stream's segment runs, or its end speed goes on */
+    uint8_t angle_clamped;     /* the running move's target was clamped (51, 52) */
+    uint8_t supply_check;      /* ticks since the supply was last looked at */
+    uint8_t running;           /* a command runs: status bit 0 */
     struct encoder_track encoder;
     int32_t origin_counts;     /* encoder counts of angle 0 (before offset 53) */
     /* The tick works in Q8 decidegrees (int32): the multi-turn range, +-3 686 400
@@ -142,7 +151,6 @@ struct motion {
     uint16_t tick_frac;
     uint16_t clock_rate;
     int32_t lead_q8;           /* setpoint ahead of the horn, low-passed, decideg Q8 */
-    uint8_t braking;           /* the profile is the braking guard's: left alone */
     int32_t profile_at_tick_q8;      /* profile position at tick */
     int32_t profile_at_next_tick_q8; /* and at tick + 1 */
     int32_t setpoint_q8;
@@ -161,15 +169,8 @@ struct motion {
     struct drive_limits drive; /* current margin (power, 43, protection), kv, ka */
     int32_t brake_floor_duty;  /* the least braking duty a load leaves (motion_brake_duty) */
     struct drive_inputs drive_inputs;
-    uint8_t drive_limiter;     /* enum limiter: what sets the duty limit */
     uint8_t cap_limiter;       /* enum limiter: whose power_cap_mw it is */
-    uint8_t angle_clamped;     /* the running move's target was clamped (51, 52) */
     uint16_t power_mw;         /* the running command's power, 0 = 42's value */
-    uint8_t supply_check;      /* ticks since the supply was last looked at */
-    uint8_t end;               /* enum motion_end */
-    uint8_t running;           /* a command runs: status bit 0 */
-    uint8_t endless;           /* wheel run, stream: finished once at speed */
-    uint8_t streaming;         /* a stream's segment runs, or its end speed goes on */
     /* An endless profile is looked at again at this tick: a wheel's clock
      * restarts, a stream whose next setpoint has not come brakes. */
     uint32_t endless_until;
@@ -180,7 +181,6 @@ struct motion {
     struct motion_queue queue;
     struct motion_queue async;
     uint8_t answers[MOTION_ANSWERS_DEPTH];
-    uint8_t answers_count;
     /* Set by the protection monitors (motion_guard). */
     uint8_t derate;
     uint16_t power_cap_mw;
