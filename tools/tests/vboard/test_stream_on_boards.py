@@ -30,7 +30,7 @@ def test_the_stream_repros_on_the_real_images(tmp_path, board, capsys):
             return main(["--port", sim.url, "stream", str(path), "--lead-in", str(lead_in)], clock=sim.clock_s)
 
         good = [f"{5 + k * 0.1:.3f}" for k in range(60)]
-        for bad, line in (("300", "line 62: servo 1 limits its angle"), ("x", "line 62: every row")):
+        for bad, line in (("300", "line 62: servo 1 limits its angle"), ("x", "line 62: 'x' is not a number")):
             rc = stream(write_csv(tmp_path / "bad.csv", good + [bad, "11"]))
             err = capsys.readouterr().err
             assert rc == 2 and line in err, err
