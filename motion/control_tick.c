@@ -226,30 +226,6 @@ static inline __attribute__((always_inline)) void bridge(const struct motion *m,
     m->hal->motor.drive(m->hal->ctx, m->drive.reversed ? (int16_t)-duty : duty);
 }
 
-/* A stream's setpoint keeps within the angle limits on its way, not only at
- * its setpoints: a cubic may bulge past its end, its end speed run on past
- * it (planned moves never pass their targets, which motion_target_q8
- * clamps). There it stops (the walk's acceleration feed-forward goes on for
- * the rest of its phase; the position loop holds the bound against it). A
- * setpoint already outside
- * (the limits were off, or changed) may come back, but goes no further out
- * than it was. The limits are a stream's, of the multi-turn reading (turn
- * 0, after the center offset 53). */
-static void keep_stream_within_limits(struct motion *m)
-{
-    const struct user_config *cfg = &m->regs->user;
-    int32_t offset = cfg->center_offset_decideg;
-    int32_t hi = (cfg->angle_max_decideg + offset) * 256;
-    int32_t lo = (cfg->angle_min_decideg + offset) * 256;
-    int32_t last = m->last_setpoint_q8;
-    int32_t sp = m->setpoint_q8;
-    int32_t bound = clamp_i32(sp, last < lo ? last : lo, last > hi ? last : hi);
-    if (bound != sp) {
-        m->setpoint_q8 = bound;
-        m->angle_clamped = 1;
-    }
-}
-
 void motion_tick(struct motion *m)
 {
     measure(m);
@@ -279,9 +255,6 @@ void motion_tick(struct motion *m)
     m->last_setpoint_q8 = m->setpoint_q8;
     advance_clock(m);
     guard_braking(m);
-    if (m->streaming && m->regs->user.angle_limit_on) {
-        keep_stream_within_limits(m);
-    }
     int32_t step = m->setpoint_q8 - m->last_setpoint_q8;
     /* The acceleration feed-forward only while the clock keeps real time:
      * a rate change is no acceleration the horn should be given (the
