@@ -159,6 +159,19 @@ SERVO_SEEDS = {
     # the period told (item 69) and a setpoint at rest far away.
     "stream_then_late": (USED, b"".join(wire(stream(50 * k, 2500, 20 * k)) + ms(20) for k in range(12))
                          + ms(120) + wire(write(69, 30, 2) + stream(-900, 0, 400)) + ms(300)),
+    # Streams within and at the limits: a gentle 50 Hz ramp the cubic follows,
+    # a setpoint at the angle limit whose end speed would run on past it (a
+    # 1 s period from the stamps), a step beyond the speed, the limits off and
+    # a setpoint 2000 deg away, then item 48 = 2 and a multi-turn move past
+    # the limits (issue 55).
+    "stream_within_and_at_the_limits": (USED, horn(FOLLOW)
+                                        + b"".join(wire(stream(10 * k, 500, 20 * k)) + ms(20) for k in range(15))
+                                        + wire(stream(1350, 7500, 1300)) + ms(300)
+                                        + wire(stream(1000, -6000, 2300)) + ms(60)
+                                        + wire(stream(0, 0, 2320)) + ms(100)
+                                        + wire(write(48, 0) + stream(20000, 0, 2340)) + ms(200)
+                                        + wire(write(48, 2) + req(13, struct.pack("<BiIH", 0, 3000, 300, 0)))
+                                        + ms(400) + wire(req(0x40, b"\x00"))),
     # Jerk-limited moves (item 70): from rest, over the moving setpoint (a
     # velocity move 200 ms in), a short stroke, to their ends.
     "jerk_limited_moves": (USED, wire(write(70, 20, 2) + req(11, struct.pack("<BhHHHH", 0, 900, 400, 100, 100, 0)))
