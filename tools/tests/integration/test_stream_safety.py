@@ -4,7 +4,6 @@ lead-in is waited for (soft start included), checked, and keeps a bus
 watchdog fed; a power cycle does not put the joint a turn away. Time is the
 simulator's."""
 import math
-import re
 
 import pytest
 
@@ -13,12 +12,7 @@ from servoctl.errors import UsageError, ValueOutOfRange
 from servoctl.servo import Servo
 from servoctl.stream import Limits, RobotLoop, Stream
 
-
-def lead_in_of(out: str):
-    """servoctl stream's report of servo 1's lead-in: (from, to) in deg."""
-    m = re.search(r"servo 1: from (-?[0-9.]+) deg to (-?[0-9.]+) deg", out)
-    assert m, out
-    return float(m.group(1)), float(m.group(2))
+from ..stream_report import lead_in_of
 
 
 def write_csv(path, rows, period_s=0.02):

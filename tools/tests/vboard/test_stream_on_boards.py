@@ -6,7 +6,6 @@ the factory's 3 s soft start and a 100 ms bus watchdog, the stream waits for
 its lead-in and the joint stays in its turn. Time is the boards' simulated
 time."""
 import math
-import re
 
 import pytest
 
@@ -14,14 +13,10 @@ from servoctl.cli import main
 from servoctl.servo import Servo
 from servoctl.sim import Simulator
 
+from ..stream_report import lead_in_of
+
 BOARDS = ["stm32f103", "stm32f030k6"]
 
-
-def lead_in_of(out: str):
-    """servoctl stream's report of servo 1's lead-in: (from, to) in deg."""
-    m = re.search(r"servo 1: from (-?[0-9.]+) deg to (-?[0-9.]+) deg", out)
-    assert m, out
-    return float(m.group(1)), float(m.group(2))
 
 
 def write_csv(path, rows, period_s=0.02):
