@@ -6,11 +6,14 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
 
-echo; echo "== building: host (simulator, tests) and the STM32F103 image"
+echo; echo "== building: host (simulator, tests) and both boards' images"
 cmake --preset host >/dev/null
 cmake --build --preset host >/dev/null
-cmake --preset arm >/dev/null
-cmake --build --preset arm | grep -E '^image:' || true
+# Both images, so `servoctl sim --board stm32f103|stm32f030k6` works after the demo.
+for preset in arm arm-m0; do
+    cmake --preset "$preset" >/dev/null
+    cmake --build --preset "$preset" | grep -E '^image:' || true
+done
 
 out=demo-output
 mkdir -p "$out"
