@@ -21,9 +21,11 @@ import struct
 from dataclasses import dataclass
 
 from . import protocol as p
-from .checks import check_range, scaled
+from .checks import check_range, scaled, to_ms
+from .frame import jerk_limit
 from .errors import NoReply, Refused, ServoError, UsageError, ValueOutOfRange
 from .group import MAX_SYNC_RECORDS, monitor_answers, monitor_request, sync_monitor
+from .move_request import MoveRequest
 from .outcome import EXECUTING, INHIBITING, STALL, TOLERANCE_DEG
 
 MAX_ANGLE_DECIDEG = 3686400    # the multi-turn range (ReadMultiTurnAngle)
@@ -371,7 +373,8 @@ def lead_in(bus: p.Bus, targets: dict, duration_s: float, configs: dict = None, 
     Sync Monitor asks every servo's state, and feeds a bus watchdog (items
     64, 65) all the while. Soft start (49, 50) stretches the first move
     after power-up to its own time, and the wait allows for it: twice
-    duration_s, plus the soft start, plus 2 s. A servo that did not arrive
+    the planned time (a jerk limit's window included), plus the soft
+    start, plus 2 s. A servo that did not arrive
     raises Refused saying where it is and why: nothing is streamed.
     configs: {id: user area} as read_configs read them, else read now."""
     from .group import sync_move
@@ -385,8 +388,11 @@ def lead_in(bus: p.Bus, targets: dict, duration_s: float, configs: dict = None, 
     if missing:
         raise NoReply(f"servo {missing[0]} did not answer a Sync Monitor: nothing was sent")
     start = {i: states[i].angle_decideg for i in ids}
+    # A jerk limit (item 70) lengthens each servo's move by its window.
+    planned = max(MoveRequest(interval_ms=to_ms(duration_s, "duration_s")).planned_s(
+        scaled(targets[i], 10, "degrees") - start[i], jerk_limit(Servo(bus, i))) for i in ids)
     sync_move(bus, targets, duration_s, multi_turn=True)
-    limit = 2.0 * duration_s + soft + 2.0
+    limit = 2.0 * planned + soft + 2.0
     begun = bus.clock()
     seen = dict.fromkeys(ids, 0)
     while True:
