@@ -209,16 +209,13 @@ def cmd_config(bus, args):
         s.write(item.id, value)
         print(f"{item.name} = {_shown(item, value, args.raw)}")
     elif args.action == "dump":
-        values = dict(s.read_stored(), **config_file.ram_of(s))  # every item a user can set
+        values = config_file.settable(s)
         if args.json:
             print(json.dumps(values if args.raw else config_file.config_json(values, config_file.servo_of(s))))
         else:
             _print_config(values, args.raw)
     elif args.action == "save":
-        ram = config_file.ram_of(s)
-        config_file.write(args.file, config_file.config_json(dict(s.read_stored(), **ram), config_file.servo_of(s)))
-        print(f"saved the user area of servo {args.id} to {args.file}"
-              + (f" ({len(ram)} RAM items too: {config_file.RAM_NOTE})" if ram else ""))
+        print(config_file.save(args.file, s))
     elif args.action == "load":
         entry = config_file.parse_config(config_file.read(args.file), args.file, args.raw)
         kept = group.write_user_area(s, entry.values, args.with_link)  # validated before sending

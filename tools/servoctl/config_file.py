@@ -75,6 +75,20 @@ def ram_of(s) -> dict:
     return values
 
 
+def settable(s) -> dict:
+    """Every item a user can set on the servo: stored ones and RAM ones."""
+    return dict(s.read_stored(), **ram_of(s))
+
+
+def save(path: str, s) -> str:
+    """config save: the servo's settable items to path; what was saved."""
+    values = settable(s)
+    write(path, config_json(values, servo_of(s)))
+    ram = sum(i.name in values for i in registers.RAM)
+    return (f"saved the user area of servo {s.id} to {path}"
+            + (f" ({ram} RAM items too: {RAM_NOTE})" if ram else ""))
+
+
 def entry_json(values: dict, servo: dict) -> dict:
     out = {"servo": servo,
            "items": {i.name: units.exact(i, values[i.name]) for i in registers.STORED if i.name in values}}

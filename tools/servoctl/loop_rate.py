@@ -1,6 +1,7 @@
 """A robot loop's cycle on the wire: its bytes, the most cycles a second
 the wire carries at a baud rate, and the refusal of a period it cannot
 carry (stream.RobotLoop and servoctl stream)."""
+import warnings
 from dataclasses import dataclass
 
 from . import protocol as p
@@ -57,3 +58,11 @@ def check_wire(ids: list, period_s: float, baud: int, where: str = "") -> None:
             f"{where}{1.0 / period_s:g} Hz is beyond the wire: a cycle for {len(ids)} servo(s) (setpoints, "
             f"Sync Monitor, answers) is {cycle_bytes(ids)} bytes, {1000.0 / limit:.2f} ms at {baud} baud, "
             f"so the wire allows at most {limit:.1f} Hz. Use a longer period, a higher baud rate or fewer servos")
+
+
+def warn_late(cycle: int, late_s: float, period_s: float, rate: LoopRate, baud: int) -> None:
+    """LoopLate for a cycle that began late_s after it was due."""
+    warnings.warn(LoopLate(
+        f"RobotLoop: cycle {cycle} began {late_s * 1000:.1f} ms late: the loop cannot keep its "
+        f"{period_s * 1000:g} ms period ({rate.rate_hz:.1f} Hz run of {1 / period_s:g} Hz; the wire allows "
+        f"{rate.wire_limit_hz:.1f} Hz at {baud} baud)"), stacklevel=4)

@@ -25,7 +25,8 @@ from .checks import check_range, scaled, to_ms
 from .frame import jerk_limit
 from .errors import NoReply, Refused, ServoError, UsageError, ValueOutOfRange
 from .group import MAX_SYNC_RECORDS, monitor_answers, monitor_request, sync_monitor
-from .loop_rate import BITS_PER_BYTE, LoopLate, LoopRate, check_wire, cycle_bytes, wire_limit_hz  # noqa: F401
+from .loop_rate import (BITS_PER_BYTE, LoopLate, LoopRate, check_wire, cycle_bytes,  # noqa: F401
+                        warn_late, wire_limit_hz)
 from .move_request import MoveRequest
 from .outcome import EXECUTING, INHIBITING, STALL, TOLERANCE_DEG
 
@@ -222,15 +223,8 @@ class RobotLoop:
         elif now < self.due:
             self.bus.sleep(self.due - now)
         elif now - self.due >= self.period_s:
-            import warnings
-
             self.late += 1
-            r = self.rate()
-            warnings.warn(LoopLate(
-                f"RobotLoop: cycle {self.cycles + 1} began {(now - self.due) * 1000:.1f} ms late: the loop "
-                f"cannot keep its {self.period_s * 1000:g} ms period ({r.rate_hz:.1f} Hz run of "
-                f"{1 / self.period_s:g} Hz; the wire allows {r.wire_limit_hz:.1f} Hz at "
-                f"{self.bus.serial.baudrate} baud)"), stacklevel=3)
+            warn_late(self.cycles + 1, now - self.due, self.period_s, self.rate(), self.bus.serial.baudrate)
             self.due = now  # on from here: no burst to catch up
         self.due += self.period_s
 
