@@ -128,14 +128,18 @@ def _items(path: str, items, raw: bool) -> dict:
     return values
 
 
+def _values(path: str, entry: dict) -> dict:
+    """An entry's items in units, and its RAM items where it has them."""
+    return dict(_items(path, entry.get("items"), False), **_items(path, entry.get("ram_items", {}), False))
+
+
 def parse_config(data, path: str, raw_ok: bool) -> Entry:
     """A config file's contents (already JSON-decoded)."""
     if isinstance(data, dict) and "servoctl_config" in data:
         if data["servoctl_config"] != CONFIG_FORMAT:
             raise UsageError(f"{path}: config format {data['servoctl_config']!r}; this servoctl reads "
                              f"{CONFIG_FORMAT}")
-        ram = _items(path, data.get("ram_items", {}), False)
-        return Entry(dict(_items(path, data.get("items"), False), **ram), data.get("servo"))
+        return Entry(_values(path, data), data.get("servo"))
     if not isinstance(data, dict):
         raise UsageError(f"{path} is not a config file: expected an object")
     if all(isinstance(v, str) for v in data.values()):
@@ -161,7 +165,7 @@ def parse_backup(data, path: str) -> list:
     for n, e in enumerate(servos):
         if not isinstance(e, dict) or not isinstance((e.get("servo") or {}).get("id"), int):
             raise ValueOutOfRange(f"{path}: servo entry {n} has no ID")
-        entries.append(Entry(_items(path, e.get("items"), False), e["servo"]))
+        entries.append(Entry(_values(path, e), e["servo"]))
     return entries
 
 

@@ -121,7 +121,7 @@ def backup(bus: p.Bus, ids: list, path: str) -> None:
     entries = []
     for servo_id in ids:
         s = Servo(bus, servo_id)
-        entries.append((s.read_stored(), config_file.servo_of(s)))
+        entries.append((config_file.settable(s), config_file.servo_of(s)))  # RAM items too
     config_file.write(path, config_file.backup_json(entries))
 
 

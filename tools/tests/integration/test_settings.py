@@ -75,3 +75,14 @@ def test_monitor_gives_the_limiter_alike_with_sync_and_without(sim, capsys):
     synced = [json.loads(line) for line in
               run(sim, capsys, "monitor", "1", "--sync", "--json", "--count", "2", "--every", "0.02")[1].splitlines()]
     assert [r["limiter"] for r in plain] == [r["limiter"] for r in synced] == ["none", "none"]
+
+
+def test_a_backup_carries_the_ram_items_and_restores_them(sim, capsys, tmp_path):
+    assert run(sim, capsys, "config", "set", "1", "watchdog_action", "release")[0] == 0
+    backup = tmp_path / "bus.json"
+    assert run(sim, capsys, "backup", str(backup), "--ids", "1")[0] == 0
+    assert json.loads(backup.read_text())["servos"][0]["ram_items"]["watchdog_action"] == "2"
+    sim.control("powercycle 1")
+    sim.sleep(0.5)
+    assert run(sim, capsys, "restore", str(backup))[0] == 0
+    assert run(sim, capsys, "config", "get", "1", "watchdog_action")[1].strip() == "watchdog_action = 2 (release)"
