@@ -108,7 +108,7 @@ for count in (6, 16):
     for baud in (1000000, 115200):
         ids = list(range(1, count + 1))
         with at_baud(ids, baud) as sim, sim.bus(baud=baud, timeout=0.1) as bus:
-            loop = RobotLoop(bus, ids, PERIOD)
+            loop = RobotLoop(bus, ids, PERIOD, pace=False)  # as fast as the wire goes
             for k in range(200):
                 loop.cycle({i: 10.0 * math.sin(k / 20) for i in ids})
             r = loop.rate()

@@ -276,7 +276,7 @@ def build_parser():
     c = sub.add_parser("async", help="begin: servos buffer moves; end: all start; cancel: drop")
     c.add_argument("action", choices=["begin", "end", "cancel"])
 
-    c = sub.add_parser("backup", help="every servo's user and drive areas to one file")
+    c = sub.add_parser("backup", help="every servo's user and drive areas, and RAM items, to one file")
     c.add_argument("file")
     c.add_argument("--ids", type=id_number, nargs="+", help="these servos (default: scan)")
 

@@ -159,9 +159,10 @@ def _shown(item, raw: int, as_raw: bool) -> str:
 
 
 def _print_config(values: dict, as_raw: bool):
-    for item in registers.STORED:
+    for item in registers.STORED + registers.RAM:
         if item.name in values:
-            print(f"  {item.id:2d} {item.name:<18} {_shown(item, values[item.name], as_raw)}")
+            ram = "  (RAM: lost at power-up)" if item in registers.RAM else ""
+            print(f"  {item.id:2d} {item.name:<18} {_shown(item, values[item.name], as_raw)}{ram}")
 
 
 def cmd_config_diff(bus, args):
@@ -208,18 +209,18 @@ def cmd_config(bus, args):
         s.write(item.id, value)
         print(f"{item.name} = {_shown(item, value, args.raw)}")
     elif args.action == "dump":
-        values = s.read_stored()
+        values = config_file.settable(s)
         if args.json:
             print(json.dumps(values if args.raw else config_file.config_json(values, config_file.servo_of(s))))
         else:
             _print_config(values, args.raw)
     elif args.action == "save":
-        config_file.write(args.file, config_file.config_json(s.read_stored(), config_file.servo_of(s)))
-        print(f"saved the user area of servo {args.id} to {args.file}")
+        print(config_file.save(args.file, s))
     elif args.action == "load":
         entry = config_file.parse_config(config_file.read(args.file), args.file, args.raw)
         kept = group.write_user_area(s, entry.values, args.with_link)  # validated before sending
         notes = [f"kept {', '.join(f'{k} {s.read(k)}' for k in kept)}; --with-link to change"] if kept else []
+        notes += [f"{n} in RAM: lost at power-up"] if (n := sum(i.name in entry.values for i in registers.RAM)) else []
         if entry.raw:
             notes.append("a raw file: protocol units")
         if entry.serial is not None and entry.serial != s.read("serial"):

@@ -3,23 +3,31 @@ it reads back exactly ("135.0 deg", "4000 mW", "75.4 degC", "115200 baud"),
 and the servo it came from (ID, model, firmware, serial number), so a file
 says what it means and whose it was.
 
-    {"servoctl_config": 2, "servo": {...}, "items": {"angle_max": "135.0 deg", ...}}
+    {"servoctl_config": 2, "servo": {...}, "items": {"angle_max": "135.0 deg", ...},
+     "ram_items": {"watchdog_ms": "0 ms", ...}, "ram_items_note": RAM_NOTE}
     {"servoctl_backup": 2, "servos": [{"servo": {...}, "items": {...}}, ...]}
 
 A value with no unit follows the command line's rule (units.py): taken only
 where the item has one natural unit. Files in protocol units (a flat
 {name: number}, and backups of format 1) still load, marked as raw: a plain
 config file only with --raw, since {"angle_max": 45} could mean 45 deg or
-the 4.5 deg it is in protocol units."""
+the 4.5 deg it is in protocol units.
+
+"ram_items" are this firmware's settable items in RAM (64-72: watchdog,
+derating, stream period, jerk limit, oscillation monitor): a dump lists
+them so it shows every item a user can set, and config load writes them
+back, but the servo keeps them only until it is powered down."""
 import json
 from dataclasses import dataclass
 
 from . import registers, units
+from .errors import NoReply, ServoError
 from .protocol import UsageError, ValueOutOfRange
 
 CONFIG_FORMAT = 2
 BACKUP_FORMAT = 2
-_NAMES = {i.name for i in registers.STORED}
+_NAMES = {i.name for i in registers.STORED + registers.RAM}
+RAM_NOTE = "in RAM: lost at power-up (factory values then); config load sets them again"
 
 
 @dataclass
@@ -53,9 +61,39 @@ def servo_of(s) -> dict:
             "serial": f"0x{s.read('serial'):08x}"}
 
 
+def ram_of(s) -> dict:
+    """The servo's RAM items (registers.RAM) it has; none from a servo
+    without them (the maker's)."""
+    values = {}
+    for item in registers.RAM:
+        try:
+            values[item.name] = s.read(item.id)
+        except NoReply:
+            raise
+        except ServoError:
+            continue
+    return values
+
+
+def settable(s) -> dict:
+    """Every item a user can set on the servo: stored ones and RAM ones."""
+    return dict(s.read_stored(), **ram_of(s))
+
+
+def save(path: str, s) -> str:
+    """config save: the servo's settable items to path; what was saved."""
+    values = settable(s)
+    write(path, config_json(values, servo_of(s)))
+    ram = sum(i.name in values for i in registers.RAM)
+    return (f"saved the user area of servo {s.id} to {path}"
+            + (f" ({ram} RAM items too: {RAM_NOTE})" if ram else ""))
+
+
 def entry_json(values: dict, servo: dict) -> dict:
-    return {"servo": servo,
-            "items": {i.name: units.exact(i, values[i.name]) for i in registers.STORED if i.name in values}}
+    out = {"servo": servo,
+           "items": {i.name: units.exact(i, values[i.name]) for i in registers.STORED if i.name in values}}
+    ram = {i.name: units.exact(i, values[i.name]) for i in registers.RAM if i.name in values}
+    return dict(out, ram_items=ram, ram_items_note=RAM_NOTE) if ram else out
 
 
 def config_json(values: dict, servo: dict) -> dict:
@@ -90,13 +128,18 @@ def _items(path: str, items, raw: bool) -> dict:
     return values
 
 
+def _values(path: str, entry: dict) -> dict:
+    """An entry's items in units, and its RAM items where it has them."""
+    return dict(_items(path, entry.get("items"), False), **_items(path, entry.get("ram_items", {}), False))
+
+
 def parse_config(data, path: str, raw_ok: bool) -> Entry:
     """A config file's contents (already JSON-decoded)."""
     if isinstance(data, dict) and "servoctl_config" in data:
         if data["servoctl_config"] != CONFIG_FORMAT:
             raise UsageError(f"{path}: config format {data['servoctl_config']!r}; this servoctl reads "
                              f"{CONFIG_FORMAT}")
-        return Entry(_items(path, data.get("items"), False), data.get("servo"))
+        return Entry(_values(path, data), data.get("servo"))
     if not isinstance(data, dict):
         raise UsageError(f"{path} is not a config file: expected an object")
     if all(isinstance(v, str) for v in data.values()):
@@ -122,7 +165,7 @@ def parse_backup(data, path: str) -> list:
     for n, e in enumerate(servos):
         if not isinstance(e, dict) or not isinstance((e.get("servo") or {}).get("id"), int):
             raise ValueOutOfRange(f"{path}: servo entry {n} has no ID")
-        entries.append(Entry(_items(path, e.get("items"), False), e["servo"]))
+        entries.append(Entry(_values(path, e), e["servo"]))
     return entries
 
 

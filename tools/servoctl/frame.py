@@ -16,6 +16,7 @@ a target outside the limits in both modes before sending, rather than let
 the servo stop short of it."""
 from dataclasses import dataclass
 
+from .errors import ServoError
 from .protocol import BadAnswer, NoReply, Refused, ValueOutOfRange
 
 SINGLE_TURN = (-1800, 1800)  # 0.1 deg
@@ -39,9 +40,22 @@ def _deg(decideg: int) -> str:
 @dataclass
 class Where:
     """What a move is checked against: the servo's user area and its
-    multi-turn angle (0.1 deg) when it was checked."""
+    multi-turn angle (0.1 deg) when it was checked, and its jerk limit
+    (item 70; 0: the trapezoid, or a servo without the item)."""
     cfg: dict
     at: int
+    jerk: int = 0
+
+
+def jerk_limit(s) -> int:
+    """Item 70, which stretches every angle move (profile.smooth_window);
+    0 from a servo without it (the maker's firmware)."""
+    try:
+        return s.read("jerk_limit")
+    except NoReply:
+        raise
+    except ServoError:
+        return 0
 
 
 def check_target(s, angle: int, multi_turn: bool) -> Where:
@@ -53,7 +67,7 @@ def check_target(s, angle: int, multi_turn: bool) -> Where:
             f"servo {s.id}: {_deg(angle)} is beyond a single turn (-180.0..180.0 deg); a move there is a multi-turn "
             f"move: add --multi-turn (move_to(..., multi_turn=True))")
     try:
-        where = Where(s.read_all(), s.multi_turn_angle()[0])
+        where = Where(s.read_all(), s.multi_turn_angle()[0], jerk_limit(s))
     except BadAnswer:
         raise
     except NoReply:

@@ -121,7 +121,7 @@ def backup(bus: p.Bus, ids: list, path: str) -> None:
     entries = []
     for servo_id in ids:
         s = Servo(bus, servo_id)
-        entries.append((s.read_stored(), config_file.servo_of(s)))
+        entries.append((config_file.settable(s), config_file.servo_of(s)))  # RAM items too
     config_file.write(path, config_file.backup_json(entries))
 
 
@@ -136,7 +136,8 @@ def id_is_free(bus: p.Bus, servo_id: int, new_id: int) -> None:
 
 def write_user_area(s: Servo, values: dict, with_link: bool = False) -> list:
     """Writes values (all or some items, by name) over the servo's own: the
-    user area, and the drive area where the servo has one. The ID and baud
+    user area, the drive area where the servo has one, and the RAM items
+    (64-72) the values hold. The ID and baud
     rate stay unless with_link: another servo's file must
     not put two servos on one ID; with it, an ID already answering is
     refused. Returns the items kept that differed."""
@@ -155,6 +156,9 @@ def write_user_area(s: Servo, values: dict, with_link: bool = False) -> list:
     for name, value in changed.items():
         if name not in stability.ITEMS:
             s.write(name, value)
+    for item in registers.RAM:  # lost at power-up (config_file.RAM_NOTE)
+        if item.name in values:
+            s.write(item.name, values[item.name])
     return [k for k in keep if k in values and values[k] != current[k]]
 
 

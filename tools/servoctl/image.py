@@ -33,6 +33,7 @@ class Board:
     id: int
     flash: tuple = None  # (first, end) of the application's code; None: not executed (host_sim)
     ram: tuple = None    # (first, end) of its RAM
+    cpu: str = ""        # board.cmake's SERVO_BOARD_CPU: cortex-m0 builds the size-first image
 
 
 def _defines(board_h: Path) -> dict:
@@ -50,7 +51,9 @@ def _read_board(folder: Path):
     slot = d["BOARD_SLOT_BASE"]
     flash = (slot + HEADER_SIZE_IN_SLOT, slot + d["BOARD_SLOT_PAGES"] * d["BOARD_FLASH_PAGE"])
     ram = (d["BOARD_RAM_BASE"], d["BOARD_RAM_BASE"] + d["BOARD_RAM_SIZE"] - STAY_WORD_BYTES)
-    return Board(folder.name, d["BOARD_ID"], flash, ram)
+    cmake = folder / "board.cmake"
+    cpu = re.search(r"set\(SERVO_BOARD_CPU (\S+)\)", cmake.read_text()) if cmake.is_file() else None
+    return Board(folder.name, d["BOARD_ID"], flash, ram, cpu.group(1) if cpu else "")
 
 
 def boards() -> dict:

@@ -45,6 +45,11 @@ def _safety(s: Servo) -> dict:
         watchdog, action = s.read("watchdog_ms"), s.read("watchdog_action")
         return {"winding_c": s.read("winding_temperature") / 10, "derating": s.read("derating"),
                 "limiter": MotionSnapshot.LIMITERS[s.read("limiter")],
-                "watchdog": f"{watchdog} ms, then {('hold', 'damp', 'release')[action]}" if watchdog else "off"}
+                "watchdog": f"{watchdog} ms, then {_action(action)}" if watchdog else "off"}
     except ServoError:
         return {}
+
+
+def _action(value: int) -> str:
+    """Item 65 by the schema's name for it ("hold"), which config set takes."""
+    return registers.find("watchdog_action").name_of(value) or str(value)

@@ -38,8 +38,8 @@ class Sampler:
         self.t0 = bus.clock()
 
     def _limiter(self, servo_id: int) -> str:
-        """Item 66 by name; "" from a servo without it (the maker's). One
-        request more a servo: only where each is asked alone (not --sync)."""
+        """Item 67 by name; "" from a servo without it (the maker's). One
+        request more a servo, with --sync too (after its round)."""
         try:
             return MotionSnapshot.LIMITERS[Servo(self.bus, servo_id).read("limiter")]
         except (NoReply, ServoError):
@@ -54,6 +54,8 @@ class Sampler:
         if self.sync:
             monitors = group.sync_monitor(self.bus, self.ids, arrivals=arrivals)
             silent = {i: f"servo {i}: no answer in its Sync Monitor slot" for i in self.ids if i not in monitors}
+            # Monitor's answer has no limiter: read after the round, as alone.
+            limiters = {servo_id: self._limiter(servo_id) for servo_id in monitors}
         else:
             monitors = {}
             for servo_id in self.ids:

@@ -5,7 +5,7 @@ from dataclasses import dataclass
 from typing import Optional
 
 from .checks import MIN_RAMP_MS, check_profile
-from .profile import velocity_timing
+from .profile import positions, smooth_window, smoothed, smoothed_phases, velocity_timing
 
 
 @dataclass(frozen=True)
@@ -32,5 +32,17 @@ class MoveRequest:
         interval = max(self.interval_ms, acc + dec)
         return acc, interval - acc - dec, dec
 
-    def planned_s(self, distance_decideg: int) -> float:
-        return sum(self.phases_ms(distance_decideg)) / 1000.0
+    def planned_ms(self, distance_decideg: int, jerk_limit: int = 0) -> tuple:
+        """(acceleration, cruise, deceleration, window) in ms: the phases,
+        and the window a jerk limit (item 70) averages them over, which
+        the move takes longer (motion/planning.c)."""
+        phases = smoothed_phases(*self.phases_ms(distance_decideg), jerk_limit)
+        return phases + (smooth_window(distance_decideg, *phases, jerk_limit),)
+
+    def planned_s(self, distance_decideg: int, jerk_limit: int = 0) -> float:
+        return sum(self.planned_ms(distance_decideg, jerk_limit)) / 1000.0
+
+    def plan(self, start: int, target: int, jerk_limit: int = 0) -> list:
+        """The planned position (0.1 deg) at every ms, as the servo runs it."""
+        *phases, window = self.planned_ms(target - start, jerk_limit)
+        return smoothed(positions(start, target, *phases), window)

@@ -4,7 +4,7 @@ module is below it: Servo.move_to waits with it)."""
 from dataclasses import dataclass
 
 from . import registers
-from .frame import Where, turn_base
+from .frame import Where, jerk_limit, turn_base
 from .errors import BadAnswer, NoReply, Refused
 from .move_request import MoveRequest
 
@@ -41,7 +41,7 @@ class Plan:
     target: int       # 0.1 deg, after the angle limits
     target_abs: int   # 0.1 deg, multi-turn: where the horn should end
     clamped: bool
-    planned_s: float  # the profile's length
+    planned_s: float  # the profile's length (a jerk limit's window included)
     soft_start_s: float
 
 
@@ -50,9 +50,9 @@ def plan_move(s, asked: int, request: MoveRequest, where: Where = None) -> Plan:
     servo's own settings (as frame.check_target read them, or read now):
     angle limits (48, 51, 52) clamp the target (a multi-turn one where item
     48 is 2, in the frame the angles are read in); soft start (49, 50) may
-    stretch it."""
+    stretch it; a jerk limit (70) lengthens it by its window."""
     if where is None:
-        where = Where(s.read_all(), s.multi_turn_angle()[0])
+        where = Where(s.read_all(), s.multi_turn_angle()[0], jerk_limit(s))
     cfg, start = where.cfg, where.at
     target = asked
     # Item 48: 1 (the maker's on) clamps a single-turn target, 2 a multi-turn one too.
@@ -60,7 +60,7 @@ def plan_move(s, asked: int, request: MoveRequest, where: Where = None) -> Plan:
         target = min(max(asked, cfg["angle_min"]), cfg["angle_max"])
     # A single-turn target is taken within the turn the servo is in.
     target_abs = target if request.multi_turn else turn_base(start) + target
-    planned = request.planned_s(target_abs - start)
+    planned = request.planned_s(target_abs - start, where.jerk)
     soft = cfg["soft_start_time"] / 1000.0 if cfg["soft_start_on"] else 0.0
     return Plan(start, asked, target, target_abs, target != asked, planned, soft)
 

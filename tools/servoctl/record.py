@@ -8,7 +8,6 @@ import os
 from . import args as args_
 from . import frame, outcome, registers
 from .errors import Refused, UsageError
-from .profile import positions
 from .servo import Servo
 
 
@@ -25,10 +24,10 @@ def cmd_record(bus, args):
     check_writable(args.out + ".csv")
     s = Servo(bus, args.id)
     target = args_.decideg(args.angle)
-    frame.check_target(s, target, args.multi_turn)
+    where = frame.check_target(s, target, args.multi_turn)
     start = s.monitor().angle_decideg
     request = args_.move_request(args)
-    plan = positions(start, target, *request.phases_ms(target - start))
+    plan = request.plan(start, target, where.jerk)  # the S-curve where item 70 is set
     # Samples are stamped with the servo's own clock (ReadMotion's time), so
     # a host or simulator that falls behind does not bend the time axis.
     before = s.read_motion()

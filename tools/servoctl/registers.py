@@ -1,6 +1,7 @@
 """The servo's data table, from protocol/schema.toml (docs/protocol.md):
 names, sizes, units and ranges, so values are checked before they are sent."""
 from dataclasses import dataclass
+import re
 import struct
 
 from . import schema
@@ -21,6 +22,13 @@ class Item:
     default: int = 0
     help: str = ""
     quantity: str = ""    # what units.py shows it in: angle, temperature, baud, ...
+    names: tuple = ()     # ((value, name), ...): the values the schema's help names
+    size_first_max: int = -1  # the most the Cortex-M0 image takes (-1: high); size_first_why says why
+    size_first_why: str = ""
+
+    def name_of(self, value: int) -> str:
+        """The schema's name for a value ("hold"), or "" where it has none."""
+        return dict(self.names).get(value, "")
 
     def pack(self, value: int) -> bytes:
         fmt = {1: "b", 2: "h", 4: "i"}[self.size]
@@ -39,10 +47,28 @@ class Item:
                 f"not {value}")
 
 
+_NAMED = re.compile(r"^(\d+) ([a-z]+)$")
+
+
+def _names(help_text: str) -> tuple:
+    """A help that names values, "0 hold, 1 damp, 2 release" (every part a
+    number and one word): ((0, "hold"), ...); () otherwise."""
+    parts = [_NAMED.match(part.strip()) for part in help_text.split(",")] if help_text else []
+    if not parts or not all(parts):
+        return ()
+    return tuple((int(m.group(1)), m.group(2)) for m in parts)
+
+
 def _item(i: schema.Item) -> Item:
     return Item(i.id, i.name, i.size, signed=i.signed, unit=i.unit, writable=i.access == "read-write",
                 public=i.access != "reserved", low=i.min, high=i.max, default=i.factory,
-                help=i.help, quantity=i.quantity)
+                help=i.help, quantity=i.quantity, names=_names(i.help), size_first_max=i.size_first_max,
+                size_first_why=_cortex_m0(i.what))
+
+
+def _cortex_m0(what: str) -> str:
+    """The schema's sentence on what the Cortex-M0 image leaves out."""
+    return next((part.strip() for part in what.split(". ") if "Cortex-M0" in part), "")
 
 
 _SCHEMA = schema.load()
@@ -53,6 +79,7 @@ FIRMWARE = [_item(i) for i in _SCHEMA.area("firmware")]  # this firmware's own, 
 DRIVE = [_item(i) for i in _SCHEMA.area("drive")]  # the drive train and the gains, stored
 ITEMS = STATUS + USER + FIRMWARE + DRIVE
 STORED = USER + DRIVE  # what the config store keeps, and config files and backups carry
+RAM = [i for i in FIRMWARE if i.writable]  # settable, lost at power-up: config dump lists them too
 BY_ID = {i.id: i for i in ITEMS}
 BY_NAME = {i.name: i for i in ITEMS}
 STATUS_BITS = [b.name for b in _SCHEMA.status_bits]

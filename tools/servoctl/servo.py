@@ -177,7 +177,8 @@ class Servo:
     def _write(self, item, value: int) -> None:
         content = self.bus.request(p.WRITE_DATA, bytes([self.id, item.id]) + item.pack(value))
         if p.decode_answer(p.WRITE_DATA, content)[2] != 1:
-            raise Refused(f"servo {self.id} refused {item.name} = {value}{self._why_refused()}")
+            raise Refused(f"servo {self.id} refused {item.name} = {value}"
+                          f"{self._size_first(item, value) or self._why_refused()}")
 
     def read_all(self) -> dict:
         content = self.bus.request(p.READ_BATCH, bytes([self.id]))
@@ -204,6 +205,23 @@ class Servo:
     def reset_user_data(self) -> None:
         if p.decode_answer(p.RESET_USER_DATA, self.bus.request(p.RESET_USER_DATA, bytes([self.id])))[1] != 1:
             raise Refused(f"servo {self.id} refused the reset{self._why_refused()}")
+
+    def _size_first(self, item, value: int) -> str:
+        """": <why>" where value is beyond what the Cortex-M0 image takes
+        (the schema's size_first_max) and this servo runs it (its board,
+        from UpdateStatus); "" otherwise."""
+        if not 0 <= item.size_first_max < value:
+            return ""
+        from . import image, update
+        try:
+            board = update.status(self.bus, self.id).board
+        except p.LinkError:
+            raise
+        except ServoError:  # no answer, or not one this tool knows
+            return ""
+        if next((b.cpu for b in image.boards().values() if b.id == board), "") != "cortex-m0":
+            return ""
+        return f": it runs the Cortex-M0 image ({image.board_named(board)}). {item.size_first_why}"
 
     def _why_refused(self) -> str:
         """Why the servo's store refused the last change, from ReadStore:

@@ -21,15 +21,18 @@ import struct
 from dataclasses import dataclass
 
 from . import protocol as p
-from .checks import check_range, scaled
+from .checks import check_range, scaled, to_ms
+from .frame import jerk_limit
 from .errors import NoReply, Refused, ServoError, UsageError, ValueOutOfRange
 from .group import MAX_SYNC_RECORDS, monitor_answers, monitor_request, sync_monitor
+from .loop_rate import (BITS_PER_BYTE, LoopLate, LoopRate, check_wire, cycle_bytes,  # noqa: F401
+                        warn_late, wire_limit_hz)
+from .move_request import MoveRequest
 from .outcome import EXECUTING, INHIBITING, STALL, TOLERANCE_DEG
 
 MAX_ANGLE_DECIDEG = 3686400    # the multi-turn range (ReadMultiTurnAngle)
 MAX_SPEED_DECIDEG_S = 7500     # the firmware clamps beyond (schema.toml)
 PERIOD_RANGE_MS = (1, 1000)    # item 69's
-BITS_PER_BYTE = 10             # 8N1
 
 
 def _check_ids(ids) -> list:
@@ -186,51 +189,49 @@ class Stream:
         self.sent += 1
 
 
-def wire_bytes(code: int, content: bytes) -> int:
-    return len(p.request_frame(code, content))
-
-
-@dataclass
-class LoopRate:
-    cycles: int
-    seconds: float           # on the bus's clock
-    wire_limit_hz: float     # the cycle's bytes back to back at the baud rate
-
-    @property
-    def rate_hz(self) -> float:
-        return self.cycles / self.seconds if self.seconds > 0 else 0.0
-
-    @property
-    def ratio(self) -> float:
-        return self.rate_hz / self.wire_limit_hz
-
-
 class RobotLoop:
-    """A robot's cycle as fast as the bus goes: setpoints to every servo
-    (one SyncCommand of StreamSetpoint) and every servo's state back (one
-    Sync Monitor). cycle() returns {id: Monitor}; rate() compares the
-    cycles run with the wire's limit, every byte of both frames and of the
-    answers back to back."""
+    """A robot's cycle at its period: setpoints to every servo (one
+    SyncCommand of StreamSetpoint) and every servo's state back (one Sync
+    Monitor). A period the wire cannot carry (check_wire) is refused when
+    the loop is made; cycle() waits, on the bus's clock, until its cycle is
+    due, and warns (LoopLate, with the wire's limit) when one begins a
+    period or more late. pace=False runs the cycles as fast as the bus
+    goes (a benchmark of the wire; stream_file keeps its own time).
+    cycle() returns {id: Monitor}; rate() compares the cycles run with the
+    wire's limit, every byte of both frames and of the answers back to back."""
 
-    def __init__(self, bus: p.Bus, ids, period_s: float, limits: dict = None):
+    def __init__(self, bus: p.Bus, ids, period_s: float, limits: dict = None, pace: bool = True):
         self.stream = Stream(bus, ids, period_s, limits)
-        self.bus = bus
+        if pace:
+            check_wire(self.stream.ids, period_s, bus.serial.baudrate)
+        self.bus, self.period_s, self.pace = bus, period_s, pace
         self.cycles = 0
         self.started = None
+        self.due = None
+        self.late = 0       # cycles that began a period or more after they were due
         self.missed = 0
         self.arrivals = {}  # {id: the bus clock when its last state arrived}
         self._monitor = monitor_request(self.stream.ids)
 
     def cycle_bytes(self) -> int:
-        ids = self.stream.ids
-        setpoints = p.SYNC, bytes([p.STREAM_SETPOINT, 9, len(ids)]) + bytes(9 * len(ids))
-        monitor = p.SYNC, bytes([p.MONITOR, 1, len(ids)] + ids)
-        if len(ids) == 1:
-            setpoints = p.STREAM_SETPOINT, bytes(9)
-        return wire_bytes(*setpoints) + wire_bytes(*monitor) + len(ids) * p.answer_frame_size(p.MONITOR)
+        return cycle_bytes(self.stream.ids)
+
+    def _wait_turn(self) -> None:
+        now = self.bus.clock()
+        if self.due is None:
+            self.started = self.due = now
+        elif now < self.due:
+            self.bus.sleep(self.due - now)
+        elif now - self.due >= self.period_s:
+            self.late += 1
+            warn_late(self.cycles + 1, now - self.due, self.period_s, self.rate(), self.bus.serial.baudrate)
+            self.due = now  # on from here: no burst to catch up
+        self.due += self.period_s
 
     def cycle(self, targets: dict, velocities: dict = None) -> dict:
-        if self.started is None:
+        if self.pace:
+            self._wait_turn()
+        elif self.started is None:
             self.started = self.bus.clock()
         # One write: the Sync Monitor follows the setpoints on the wire
         # without a host's gap between them.
@@ -242,8 +243,7 @@ class RobotLoop:
 
     def rate(self) -> LoopRate:
         seconds = self.bus.clock() - self.started if self.started is not None else 0.0
-        limit = self.bus.serial.baudrate / BITS_PER_BYTE / self.cycle_bytes()
-        return LoopRate(self.cycles, seconds, limit)
+        return LoopRate(self.cycles, seconds, wire_limit_hz(self.stream.ids, self.bus.serial.baudrate))
 
 
 @dataclass
@@ -371,7 +371,8 @@ def lead_in(bus: p.Bus, targets: dict, duration_s: float, configs: dict = None, 
     Sync Monitor asks every servo's state, and feeds a bus watchdog (items
     64, 65) all the while. Soft start (49, 50) stretches the first move
     after power-up to its own time, and the wait allows for it: twice
-    duration_s, plus the soft start, plus 2 s. A servo that did not arrive
+    the planned time (a jerk limit's window included), plus the soft
+    start, plus 2 s. A servo that did not arrive
     raises Refused saying where it is and why: nothing is streamed.
     configs: {id: user area} as read_configs read them, else read now."""
     from .group import sync_move
@@ -385,8 +386,11 @@ def lead_in(bus: p.Bus, targets: dict, duration_s: float, configs: dict = None, 
     if missing:
         raise NoReply(f"servo {missing[0]} did not answer a Sync Monitor: nothing was sent")
     start = {i: states[i].angle_decideg for i in ids}
+    # A jerk limit (item 70) lengthens each servo's move by its window.
+    planned = max(MoveRequest(interval_ms=to_ms(duration_s, "duration_s")).planned_s(
+        scaled(targets[i], 10, "degrees") - start[i], jerk_limit(Servo(bus, i))) for i in ids)
     sync_move(bus, targets, duration_s, multi_turn=True)
-    limit = 2.0 * duration_s + soft + 2.0
+    limit = 2.0 * planned + soft + 2.0
     begun = bus.clock()
     seen = dict.fromkeys(ids, 0)
     while True:
@@ -444,7 +448,8 @@ def stream_file(bus: p.Bus, times, angles: dict, progress=None, limits: dict = N
     servos' limits (read from them if not given) before the first is sent."""
     ids = list(angles)
     period = times[1] - times[0]
-    loop = RobotLoop(bus, ids, period, limits)
+    check_wire(ids, period, bus.serial.baudrate)
+    loop = RobotLoop(bus, ids, period, limits, pace=False)  # paced here, against the rows' times
     check_trajectory(Trajectory(times, angles), loop.stream.limits)
     count = len(times)
     period_ms = loop.stream.period_ms
@@ -492,7 +497,7 @@ def stream_file(bus: p.Bus, times, angles: dict, progress=None, limits: dict = N
 
 def cmd_stream(bus, args):
     """servoctl stream FILE.csv: the whole file is checked first, against
-    each servo's limits too; the servos move to the first row (a sync move
+    each servo's limits and the wire's rate too; the servos move to the first row (a sync move
     of --lead-in seconds) and the command waits until they are there; then
     they follow the trajectory at its period. Prints the lead-in, each
     servo's tracking error and the cycle's rate."""
@@ -505,6 +510,8 @@ def cmd_stream(bus, args):
     configs = read_configs(bus, angles)
     limits = {i: Limits.of(cfg) for i, cfg in configs.items()}
     check_trajectory(trajectory, limits)
+    check_wire(list(angles), trajectory.times[1] - trajectory.times[0], bus.serial.baudrate,
+               f"{args.file}: ")  # before the lead-in: nothing moves
     lead = lead_in(bus, {i: a[0] for i, a in angles.items()}, args.lead_in, configs)
     with Progress(transient=True, disable=not sys.stderr.isatty()) as progress:
         task = progress.add_task("streaming", total=len(trajectory.times))
@@ -527,8 +534,9 @@ def cmd_stream(bus, args):
     for servo_id in angles:
         print(f"  servo {servo_id}: tracking error RMS {report.rms_deg[servo_id]:.2f} deg, "
               f"peak {report.peak_deg[servo_id]:.2f} deg")
-    r = report.rate
-    print(f"  cycle (setpoints + Sync Monitor) ran at {r.rate_hz:.1f} Hz; the wire allows "
+    r = report.rate  # the wire could carry the file's rate (check_wire): a shortfall is the host's
+    short = f" (warning: below the file's {1 / period:g} Hz: the host fell behind)" if r.rate_hz < 0.95 / period else ""
+    print(f"  cycle (setpoints + Sync Monitor) ran at {r.rate_hz:.1f} Hz{short}; the wire allows "
           f"{r.wire_limit_hz:.0f} Hz at {bus.serial.baudrate} baud")
     if report.missed:
         print(f"  {report.missed} state(s) did not come back: those cycles are not counted")

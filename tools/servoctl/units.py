@@ -47,6 +47,8 @@ def _split(item, text: str):
 
 
 def _units_hint(item) -> str:
+    if item.names:
+        return f" (or {', '.join(name for _, name in item.names)})"
     if item.quantity in SCALES:
         return " in " + " or ".join(_SPELLING[s] for s in SCALES[item.quantity][1] if s)
     return {"temperature": " in degC", "baud": " (a baud rate)"}.get(item.quantity, "")
@@ -54,7 +56,11 @@ def _units_hint(item) -> str:
 
 def to_raw(item, text) -> int:
     """The protocol value for what the user typed; range-checked, with the
-    range said in the same units."""
+    range said in the same units. A value the schema names ("hold") is
+    taken by its name too."""
+    named = {name: value for value, name in item.names}
+    if str(text).strip().lower() in named:
+        return named[str(text).strip().lower()]
     value, suffix = _split(item, text)
     q = item.quantity
     if q in SCALES:
@@ -134,6 +140,5 @@ def show(item, raw: int) -> str:
         return ntc.describe(raw)
     if q == "baud":
         return f"{registers.BAUD_RATES.get(raw, '?')} baud (code {raw})"
-    if q in SCALES:
-        return exact(item, raw)
-    return f"{raw}{' ' + item.unit if item.unit else ''}"
+    shown = exact(item, raw) if q in SCALES else f"{raw}{' ' + item.unit if item.unit else ''}"
+    return f"{shown} ({item.name_of(raw)})" if item.name_of(raw) else shown

@@ -316,7 +316,7 @@ def test_read_commands_speak_json(sim, capsys):
     assert dump["items"]["servo_id"] == "1" and len(dump["items"]) == 22 + 12  # the user and drive areas
     assert dump["items"]["angle_max"] == "135.0 deg" and dump["servo"]["serial"] == "0x51a00001"
     raw = json.loads(run(sim, capsys, "config", "dump", "1", "--json", "--raw")[1])
-    assert raw["angle_max"] == 1350 and len(raw) == 22 + 12
+    assert raw["angle_max"] == 1350 and len(raw) == 22 + 12 + 6  # and the RAM items (64-66, 69, 70, 72)
 
 
 def test_ctrl_c_during_a_wait_releases_nothing(ready):
