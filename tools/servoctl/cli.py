@@ -8,7 +8,7 @@ import sys
 import time
 
 from . import args as args_
-from . import checks, config_diff, config_file, frame, group, ids, ntc, outcome, registers, scan, units
+from . import checks, config_diff, config_file, frame, group, ids, link_rate, ntc, outcome, registers, scan, units
 from . import protocol as p
 from .args import build_parser
 from .errors import BadAnswer, NoReply, Refused, ServoError, UsageError
@@ -207,6 +207,9 @@ def cmd_config(bus, args):
             group.id_is_free(bus, args.id, value)
         s.write(item.id, value)
         print(f"{item.name} = {_shown(item, value, args.raw)}")
+        rate = registers.BAUD_RATES.get(value) if item.name == "baud" else None
+        if rate is not None and (link_rate.is_socket(bus.port) or rate != bus.serial.baudrate):
+            print(link_rate.after_change(bus, args.id, rate, args.sim_control))
     elif args.action == "dump":
         values = s.read_stored()
         if args.json:
@@ -524,7 +527,8 @@ def _run(args, clock=None) -> int:
         args.file = args.rest[0] if args.action in ("save", "load") else None
     if not args.port:
         raise UsageError("no port: give --port or set SERVOCTL_PORT")
-    with Bus(args.port, args.baud, args.timeout, clock=clock) as bus:
+    baud = link_rate.open_rate(args.port, args.baud, args.sim_control)
+    with Bus(args.port, baud, args.timeout, clock=clock) as bus:
         try:
             return COMMANDS[args.command](bus, args)
         except BadAnswer:
