@@ -108,7 +108,7 @@ def probe(bus: p.Bus, servo_id: int, window_s: float):
             found.serials.append(struct.unpack_from("<I", content, 2)[0])
         else:
             found.garbled += 1
-    if bus.port.startswith("socket://") and not found.shared:
+    if str(getattr(bus, "port", "")).startswith("socket://") and not found.shared:
         # A TCP link's baudrate is pyserial's, not the wire's (the far end
         # sets that, e.g. hostbaud): the servo's own item 36 is the truth.
         answers, _, _ = bus.gather(p.READ_DATA, bytes([servo_id, _BAUD.id]), window_s)

@@ -4,10 +4,12 @@ simulated time (as servo_sim's, firmware/boards/host_sim/sim_bus.h).
 A byte takes 10 bit times at its sender's rate and reaches every receiver
 (the sender's own USART too: it hears itself unless its receiver is off)
 when its stop bit ends. A byte that overlaps another sender's byte already
-on the wire garbles it, by servo_sim's rule (sim_bus.h): the receivers get
-the byte already there ANDed with it (the line is low while either drives
-it low) and nothing of its own framing; `garbled` counts such bytes, and
-`collisions` a board's byte sent over another board's. The host's bytes go out paced at the
+on the wire garbles it, by servo_sim's rule (sim_bus.c, overlap): the
+receivers, framed on the byte already there, sample the middle of its bits
+while the line is low if either drives it low, and get nothing of the later
+byte's own framing; two drivers are never in step, a bit apart at least.
+`garbled` counts such bytes, `collisions` a board's byte sent over another
+board's. The host's bytes go out paced at the
 host's rate (115200 until `hostbaud` says otherwise) after whatever is on
 the wire; the bus reads the host only while less than 10 ms of its bytes
 wait, as behind a real UART. The host is a TCP client (pyserial
@@ -30,6 +32,20 @@ HOST_TURNAROUND_S = 125e-6
 # A second TCP client while one holds the bus is told so (servo_sim's
 # words, which servoctl recognises) and ignored until it leaves.
 BUS_IN_USE = b"vboard: the bus is in use by another client\n"
+
+
+def _level(byte: int, bit: int) -> int:
+    """The level a byte drives at bit `bit` of its frame (0 start, 1-8 data
+    LSB first, 9 stop); idle (1) outside it."""
+    return 0 if bit == 0 else (byte >> (bit - 1)) & 1 if 1 <= bit <= 8 else 1
+
+
+def overlap(heard: int, other: int, lag_bits: float) -> int:
+    """sim_bus.c's overlap: what a receiver framed on `heard` samples when
+    `other` started lag_bits bit times after it (before, if negative): the
+    wired AND at the middle of each bit, never in step (a bit off at least)."""
+    bits = int(abs(lag_bits) * 2 + 1) // 2 * (1 if lag_bits >= 0 else -1) or 1
+    return sum((_level(heard, i + 1) & _level(other, i + 1 - bits)) << i for i in range(8))
 
 
 class Bus:
@@ -178,10 +194,10 @@ class Bus:
 
     def _garble(self, start_s, end_s, byte, sender) -> bool:
         """The wire's rule (sim_bus.c, garble): a byte overlapping another
-        sender's byte on the wire is ANDed into it and not heard itself."""
+        sender's byte on the wire garbles it and is not heard itself."""
         hit = [e for e in self.events if e[4] != sender and e[5] < end_s - 1e-9 and e[0] > start_s + 1e-9]
         for e in hit:
-            e[2] &= byte
+            e[2] = overlap(e[2], byte, (start_s - e[5]) * FRAME_BITS / (e[0] - e[5]))
         self.garbled += bool(hit)
         self.collisions += sender != HOST and any(e[4] != HOST for e in hit)
         return bool(hit)

@@ -3,11 +3,12 @@
  * moment it sends it; the host's bytes reach every servo paced the same
  * way (a pty or socket delivers them in bursts a UART never would), after
  * whatever is already on the wire. Bytes of two senders that overlap
- * garble each other, as on a real wire: the receivers get the first
- * sender's bytes ANDed with the later one's (the line is low while either
- * drives it low), and nothing of the later one's own framing (sim_bus.c,
- * garble; tools/vboard/bus.py keeps the same rule). Six servos at one ID
- * answer a ReadData of their serial numbers as one damaged frame. `garbled`
+ * garble each other, as on a real wire: a receiver framed on the byte
+ * already there samples the middle of its bits while the line is low if
+ * either drives it low, and gets nothing of the later byte's own framing;
+ * two drivers are never in step, a bit apart at least (sim_bus.c, overlap;
+ * tools/vboard/bus.py keeps the same rule). Servos at one ID answer as one
+ * damaged frame, as real ones do. `garbled`
  * counts bytes that overlapped; `collisions` the bytes a servo sent over
  * another servo's, logged: answers must never do that.
  *
