@@ -207,9 +207,7 @@ def cmd_config(bus, args):
             group.id_is_free(bus, args.id, value)
         s.write(item.id, value)
         print(f"{item.name} = {_shown(item, value, args.raw)}")
-        rate = registers.BAUD_RATES.get(value) if item.name == "baud" else None
-        if rate is not None and (link_rate.is_socket(bus.port) or rate != bus.serial.baudrate):
-            print(link_rate.after_change(bus, args.id, rate, args.sim_control))
+        link_rate.after_set(bus, args, item.name, value)
     elif args.action == "dump":
         values = s.read_stored()
         if args.json:
@@ -439,7 +437,7 @@ def cmd_sim(args):
     try:
         sim.start()
         print(f"simulator running: bus {sim.url}, control 127.0.0.1:{sim.control_port}", flush=True)
-        print(f"  e.g. servoctl --port {sim.url} scan --last 10     (Ctrl-C stops it)", flush=True)
+        print(f"  e.g. servoctl --port {sim.url} --sim-control {sim.control_port} scan  (Ctrl-C stops)", flush=True)
         sim.process.wait()
     except KeyboardInterrupt:
         pass

@@ -7,6 +7,7 @@ SERVOCTL_SIM_CONTROL), servoctl sets it there for --baud and after a
 `config set N baud`. Without it, --baud on socket:// is refused (it would
 be ignored) and a baud change says what to do, instead of losing the bus
 with no word."""
+from . import registers
 from .errors import UsageError
 
 DEFAULT_BAUD = 115200
@@ -40,6 +41,13 @@ def open_rate(port, baud, sim_control) -> int:
                          f"--sim-control PORT and servoctl does it")
     _control(sim_control, f"hostbaud {baud}")
     return baud
+
+
+def after_set(bus, args, name: str, value: int) -> None:
+    """After `config set N name value`: a baud change says what to do."""
+    rate = registers.BAUD_RATES.get(value) if name == "baud" else None
+    if rate is not None and (is_socket(bus.port) or rate != bus.serial.baudrate):
+        print(after_change(bus, args.id, rate, args.sim_control))
 
 
 def after_change(bus, servo_id: int, rate: int, sim_control) -> str:
