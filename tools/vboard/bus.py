@@ -4,7 +4,7 @@ simulated time (as servo_sim's, firmware/boards/host_sim/sim_bus.h).
 A byte takes 10 bit times at its sender's rate and reaches every receiver
 (the sender's own USART too: it hears itself unless its receiver is off)
 when its stop bit ends. A byte that overlaps another sender's byte already
-on the wire garbles it, by servo_sim's rule (sim_bus.c, overlap): the
+on the wire garbles it, by servo_sim's rule (its C, wire_overlap.h): the
 receivers, framed on the byte already there, sample the middle of its bits
 while the line is low if either drives it low, and get nothing of the later
 byte's own framing; two drivers are never in step, a bit apart at least.
@@ -20,6 +20,8 @@ import pty
 import socket
 import tty
 
+from .native import wire_overlap
+
 FRAME_BITS = 10
 HOST = -1
 BACKLOG_S = 0.01
@@ -32,20 +34,6 @@ HOST_TURNAROUND_S = 125e-6
 # A second TCP client while one holds the bus is told so (servo_sim's
 # words, which servoctl recognises) and ignored until it leaves.
 BUS_IN_USE = b"vboard: the bus is in use by another client\n"
-
-
-def _level(byte: int, bit: int) -> int:
-    """The level a byte drives at bit `bit` of its frame (0 start, 1-8 data
-    LSB first, 9 stop); idle (1) outside it."""
-    return 0 if bit == 0 else (byte >> (bit - 1)) & 1 if 1 <= bit <= 8 else 1
-
-
-def overlap(heard: int, other: int, lag_bits: float) -> int:
-    """sim_bus.c's overlap: what a receiver framed on `heard` samples when
-    `other` started lag_bits bit times after it (before, if negative): the
-    wired AND at the middle of each bit, never in step (a bit off at least)."""
-    bits = int(abs(lag_bits) * 2 + 1) // 2 * (1 if lag_bits >= 0 else -1) or 1
-    return sum((_level(heard, i + 1) & _level(other, i + 1 - bits)) << i for i in range(8))
 
 
 class Bus:
@@ -197,7 +185,7 @@ class Bus:
         sender's byte on the wire garbles it and is not heard itself."""
         hit = [e for e in self.events if e[4] != sender and e[5] < end_s - 1e-9 and e[0] > start_s + 1e-9]
         for e in hit:
-            e[2] = overlap(e[2], byte, (start_s - e[5]) * FRAME_BITS / (e[0] - e[5]))
+            e[2] = wire_overlap(e[2], byte, start_s - e[5], e[0] - e[5])
         self.garbled += bool(hit)
         self.collisions += sender != HOST and any(e[4] != HOST for e in hit)
         return bool(hit)

@@ -1,5 +1,7 @@
 #include "sim_bus.h"
 
+#include "ports/host/wire_overlap.h"
+
 #include <errno.h>
 #include <stdbool.h>
 #include <stdio.h>
@@ -26,33 +28,10 @@ static struct sim_bus_byte *queued(struct sim_bus *b, unsigned i)
     return &b->queue[(b->head + i) % SIM_BUS_QUEUE];
 }
 
-/* The level a byte drives at bit `bit` of its frame (0 the start bit, 1-8
- * data, least significant first, 9 the stop bit); idle (1) outside it. */
-static unsigned level(uint8_t byte, int bit)
-{
-    return bit == 0 ? 0u : (bit >= 1 && bit <= 8) ? (byte >> (bit - 1)) & 1u : 1u;
-}
-
-/* The wire's rule (sim_bus.h; tools/vboard/bus.py's overlap is the same):
- * a receiver framed on `heard` samples the middle of each of its bits; the
- * line is low while any driver drives it low. `other` started lag_us after
- * it (before it, if negative). Two drivers are never in step (their clocks
- * and latencies differ): one within half a bit of the other is a bit off. */
-static uint8_t overlap(uint8_t heard, uint8_t other, int64_t lag_us, uint64_t byte_us)
-{
-    int64_t bits = (lag_us * 20 + (lag_us >= 0 ? (int64_t)byte_us : -(int64_t)byte_us)) /
-                   (2 * (int64_t)byte_us); /* lag_us / bit time, rounded */
-    bits = bits == 0 ? 1 : bits;
-    unsigned out = 0;
-    for (int i = 0; i < 8; i++) {
-        out |= (level(heard, i + 1) & level(other, i + 1 - (int)bits)) << i;
-    }
-    return (uint8_t)out;
-}
-
 /* A byte that overlaps a byte of another sender already on the wire is not
  * heard as a byte of its own: the receivers, framed on the byte already
- * there, get it garbled by this one (overlap). True when it overlapped. */
+ * there, get it garbled by this one (wire_overlap.h, the virtual boards'
+ * rule too). True when it overlapped. */
 static bool garble(struct sim_bus *b, uint8_t sender, uint8_t byte, uint64_t start, uint64_t end)
 {
     bool overlapped = false;
@@ -63,7 +42,8 @@ static bool garble(struct sim_bus *b, uint8_t sender, uint8_t byte, uint64_t sta
             break; /* ends are in order: nothing earlier reaches this byte */
         }
         if (e->sender != sender && e->start_us < end) {
-            e->byte = overlap(e->byte, byte, (int64_t)(start - e->start_us), e->at_us - e->start_us);
+            e->byte = wire_overlap(e->byte, byte, (int64_t)(start - e->start_us) * 1000,
+                                   (int64_t)(e->at_us - e->start_us) * 1000);
             e->garbled = 1;
             overlapped = true;
             with_servo |= e->sender != SIM_HOST;

@@ -34,3 +34,16 @@ def test_new_servos_at_one_id_collide_alike_on_every_simulator(tmp_path, capsys,
         assert sim.state(0)["garbled"] > 0
     finally:
         sim.stop()
+
+
+def test_the_wires_overlap_rule():
+    """hal/ports/host/wire_overlap.c, which both simulators use: a receiver
+    samples the wired AND in the middle of the first byte's bits; a driver
+    in step with another is taken as a bit behind it."""
+    from vboard.native import wire_overlap
+
+    byte_s = 10 / 115200
+    assert wire_overlap(0xFF, 0xFF, 0.0, byte_s) == 0xFE  # the later start bit at data bit 0
+    assert wire_overlap(0x55, 0x00, 9 * byte_s / 10, byte_s) == 0x55  # only the stop bit overlaps
+    assert wire_overlap(0x55, 0xFF, 3 * byte_s / 10, byte_s) == 0x55 & 0b11111011
+    assert wire_overlap(0xFF, 0x00, -byte_s / 10, byte_s) == 0x80  # a bit ahead: its stop bit last
