@@ -24,9 +24,10 @@ for baud in (1000000, 115200):
         with sim.bus() as bus:
             for i in ids:
                 Servo(bus, i).write("baud", code)  # answered at 115200, then it switches
-        sim.control(f"hostbaud {baud}")
         sim.sleep(0.05)
-        argv = ["--port", sim.url, "--baud", str(baud), "bench", "--ids", *map(str, ids),
+        # socket:// carries no rate: servoctl sets the simulator's (hostbaud).
+        argv = ["--port", sim.url, "--sim-control", str(sim.control_port), "--baud", str(baud),
+                "bench", "--ids", *map(str, ids),
                 "--update-id", "1"]
         if main(argv, clock=sim.clock_s) != 0:
             raise SystemExit(1)

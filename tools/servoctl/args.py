@@ -108,8 +108,12 @@ def build_parser():
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--port", default=os.environ.get("SERVOCTL_PORT"),
                     help="serial port or pyserial URL (socket://HOST:PORT); env SERVOCTL_PORT")
-    ap.add_argument("--baud", type=_baud, default=115200,
-                    help=f"bits/s, one of item 36's: {', '.join(map(str, registers.BAUD_RATES.values()))}")
+    ap.add_argument("--baud", type=_baud, default=None,
+                    help=f"bits/s, one of item 36's: {', '.join(map(str, registers.BAUD_RATES.values()))} "
+                         f"(default 115200; on socket:// set through --sim-control)")
+    ap.add_argument("--sim-control", default=os.environ.get("SERVOCTL_SIM_CONTROL"), metavar="PORT",
+                    help="a simulator's control port: servoctl sets its host baud rate there for "
+                         "--baud and a baud change on socket://; env SERVOCTL_SIM_CONTROL")
     ap.add_argument("--timeout", type=_reply_timeout, default=0.1,
                     help="reply timeout, seconds (0.001..10)")
     ap.add_argument("--version", action="version", version=f"servoctl {__version__}")

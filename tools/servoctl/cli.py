@@ -8,7 +8,7 @@ import sys
 import time
 
 from . import args as args_
-from . import checks, config_diff, config_file, frame, group, ids, ntc, outcome, registers, scan, units
+from . import checks, config_diff, config_file, frame, group, ids, link_rate, ntc, outcome, registers, scan, units
 from . import protocol as p
 from .args import build_parser
 from .errors import BadAnswer, NoReply, Refused, ServoError, UsageError
@@ -208,6 +208,7 @@ def cmd_config(bus, args):
             group.id_is_free(bus, args.id, value)
         s.write(item.id, value)
         print(f"{item.name} = {_shown(item, value, args.raw)}")
+        link_rate.after_set(bus, args, item.name, value)
     elif args.action == "dump":
         values = config_file.settable(s)
         if args.json:
@@ -437,7 +438,7 @@ def cmd_sim(args):
     try:
         sim.start()
         print(f"simulator running: bus {sim.url}, control 127.0.0.1:{sim.control_port}", flush=True)
-        print(f"  e.g. servoctl --port {sim.url} scan --last 10     (Ctrl-C stops it)", flush=True)
+        print(f"  e.g. servoctl --port {sim.url} --sim-control {sim.control_port} scan  (Ctrl-C stops)", flush=True)
         sim.process.wait()
     except KeyboardInterrupt:
         pass
@@ -525,7 +526,8 @@ def _run(args, clock=None) -> int:
         args.file = args.rest[0] if args.action in ("save", "load") else None
     if not args.port:
         raise UsageError("no port: give --port or set SERVOCTL_PORT")
-    with Bus(args.port, args.baud, args.timeout, clock=clock) as bus:
+    baud = link_rate.open_rate(args.port, args.baud, args.sim_control)
+    with Bus(args.port, baud, args.timeout, clock=clock) as bus:
         try:
             return COMMANDS[args.command](bus, args)
         except BadAnswer:

@@ -45,24 +45,28 @@ def assign(bus: p.Bus, serial: int, new_id: int) -> None:
 def bring_up(bus: p.Bus, from_id: int, first_id: int, count: int, wait_s: float, say) -> list:
     """Numbers new servos: each servo answering at from_id (the factory ID)
     whose serial number is known gets the next free ID from first_id on.
-    Several new servos on the bus at once are numbered in turn when each
-    one's answer came through whole; when they collide, say() asks for one
-    at a time. Returns [(serial, id)]."""
+    Several new servos on the bus at once answer together and their
+    answers collide (on a real wire and on the simulators' alike): say()
+    asks for one at a time, and the error at the deadline says why.
+    Returns [(serial, id)]."""
     window = scan.reply_window_s(bus.serial.baudrate)
     done = []
     next_id = first_id
     while len(done) < count:
         deadline = bus.clock() + wait_s
         found = None
-        asked = False
+        asked = collided = False
         while found is None:
             if bus.clock() > deadline:
-                raise NoReply(f"no servo alone at ID {from_id} within {wait_s:g} s; "
+                why = (f" (two or more answer there at once, and their answers collide: connect "
+                       f"one new servo at a time)") if collided else ""
+                raise NoReply(f"no servo alone at ID {from_id} within {wait_s:g} s{why}; "
                               f"{len(done)} numbered")
             f = scan.probe(bus, from_id, window)
             if f is not None and f.mode == "application" and f.serials and f.serials_complete:
                 found = f  # alone, or several whose serial numbers all came through
             elif f is not None and f.shared:
+                collided = True
                 say(f"two or more servos answer at ID {from_id} and their answers collide: "
                     f"connect one new servo at a time")
                 bus.sleep(1.0)

@@ -12,6 +12,7 @@ from . import update
 from .protocol import BadAnswer, NoReply
 
 _SERIAL = registers.find("serial")
+_BAUD = registers.find("baud")
 ANSWER_MAX_BYTES = 21  # UpdateStatus's answer, the longest a probe asks for
 
 
@@ -107,6 +108,12 @@ def probe(bus: p.Bus, servo_id: int, window_s: float):
             found.serials.append(struct.unpack_from("<I", content, 2)[0])
         else:
             found.garbled += 1
+    if str(getattr(bus, "port", "")).startswith("socket://") and not found.shared:
+        # A TCP link's baudrate is pyserial's, not the wire's (the far end
+        # sets that, e.g. hostbaud): the servo's own item 36 is the truth.
+        answers, _, _ = bus.gather(p.READ_DATA, bytes([servo_id, _BAUD.id]), window_s)
+        if len(answers) == 1 and len(answers[0]) == 2 + _BAUD.size:
+            found.baud = registers.BAUD_RATES.get(answers[0][2], found.baud)
     return found
 
 

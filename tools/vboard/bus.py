@@ -3,8 +3,13 @@ simulated time (as servo_sim's, firmware/boards/host_sim/sim_bus.h).
 
 A byte takes 10 bit times at its sender's rate and reaches every receiver
 (the sender's own USART too: it hears itself unless its receiver is off)
-when its stop bit ends. A board that starts a byte while another's is on
-the wire is a collision, counted. The host's bytes go out paced at the
+when its stop bit ends. A byte that overlaps another sender's byte already
+on the wire garbles it, by servo_sim's rule (its C, wire_overlap.h): the
+receivers, framed on the byte already there, sample the middle of its bits
+while the line is low if either drives it low, and get nothing of the later
+byte's own framing; two drivers are never in step, a bit apart at least.
+`garbled` counts such bytes, `collisions` a board's byte sent over another
+board's. The host's bytes go out paced at the
 host's rate (115200 until `hostbaud` says otherwise) after whatever is on
 the wire; the bus reads the host only while less than 10 ms of its bytes
 wait, as behind a real UART. The host is a TCP client (pyserial
@@ -14,6 +19,8 @@ import os
 import pty
 import socket
 import tty
+
+from .native import wire_overlap
 
 FRAME_BITS = 10
 HOST = -1
@@ -40,6 +47,7 @@ class Bus:
         self.host_queue_until_s = 0.0
         self.to_host = bytearray()
         self.collisions = 0
+        self.garbled = 0
         self.last_activity_s = -1.0   # end of the last byte queued
         self.heard_by_host_s = -1.0   # when the host last got a byte (HOST_TURNAROUND_S)
         self.last_sent_s = {}         # station -> when its last byte started
@@ -158,29 +166,41 @@ class Bus:
         end = start + FRAME_BITS / self.host_baud
         self.host_queue_until_s = end
         self.wire_until_s = max(self.wire_until_s, end)
-        self._push(end, byte, self.host_baud, HOST)
+        self._push(start, end, byte, self.host_baud, HOST)
 
     # ---- the boards' side -------------------------------------------------
     def send(self, station: int, byte: int, baud: int, start_s: float) -> None:
-        if start_s < self.wire_until_s - 1e-9 and self.last_sender not in (None, station):
-            self.collisions += 1
         end = start_s + FRAME_BITS / baud
+        busy = start_s < self.wire_until_s - 1e-9
         self.wire_until_s = max(self.wire_until_s, end)
         self.last_sender = station
         self.last_sent_s[station] = start_s
-        self._push(end, byte, baud, station)
+        if busy and self._garble(start_s, end, byte, station):
+            self.last_activity_s = max(self.last_activity_s, end)
+        else:
+            self._push(start_s, end, byte, baud, station)
 
-    def _push(self, end_s, byte, baud, sender) -> None:
+    def _garble(self, start_s, end_s, byte, sender) -> bool:
+        """The wire's rule (sim_bus.c, garble): a byte overlapping another
+        sender's byte on the wire garbles it and is not heard itself."""
+        hit = [e for e in self.events if e[4] != sender and e[5] < end_s - 1e-9 and e[0] > start_s + 1e-9]
+        for e in hit:
+            e[2] = wire_overlap(e[2], byte, start_s - e[5], e[0] - e[5])
+        self.garbled += bool(hit)
+        self.collisions += sender != HOST and any(e[4] != HOST for e in hit)
+        return bool(hit)
+
+    def _push(self, start_s, end_s, byte, baud, sender) -> None:
         self.last_activity_s = max(self.last_activity_s, end_s)
         self.seq += 1
-        heapq.heappush(self.events, (end_s, self.seq, byte, baud, sender))
+        heapq.heappush(self.events, [end_s, self.seq, byte, baud, sender, start_s])
 
     def next_event_s(self) -> float:
         return self.events[0][0] if self.events else float("inf")
 
     def deliver_until(self, t_s: float) -> None:
         while self.events and self.events[0][0] <= t_s:
-            end_s, _, byte, baud, sender = heapq.heappop(self.events)
+            end_s, _, byte, baud, sender, _ = heapq.heappop(self.events)
             for usart in self.stations:
                 usart.receive(byte, baud)
             if sender != HOST and abs(baud - self.host_baud) <= 0.03 * self.host_baud:

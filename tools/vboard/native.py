@@ -1,5 +1,6 @@
 """The host build's models through ctypes (native/vboard_native.c): the
-simulator's motor and winding, and the config store's factory record."""
+simulator's motor and winding, the config store's factory record, and the
+wire's rule where two drivers overlap."""
 import ctypes
 import os
 from pathlib import Path
@@ -31,6 +32,8 @@ def _library():
     lib.vboard_motor_ntc_adc.restype = ctypes.c_uint
     lib.vboard_factory_config.argtypes = [ctypes.c_char_p, ctypes.c_uint32, ctypes.c_uint32, ctypes.c_uint8]
     lib.vboard_stored_id.argtypes = [ctypes.c_char_p, ctypes.c_uint32, ctypes.c_uint32]
+    lib.wire_overlap.argtypes = [ctypes.c_uint8, ctypes.c_uint8, ctypes.c_int64, ctypes.c_int64]
+    lib.wire_overlap.restype = ctypes.c_uint8
     return lib
 
 
@@ -83,6 +86,12 @@ class Motor:
 
 def factory_config(pages, page_size: int, page0: int, servo_id: int) -> bool:
     return bool(lib().vboard_factory_config(pages, page_size, page0, servo_id))
+
+
+def wire_overlap(heard: int, other: int, lag_s: float, byte_s: float) -> int:
+    """servo_sim's rule where two drivers overlap (hal/ports/host/wire_overlap.h):
+    the byte a receiver framed on `heard` gets when `other` started lag_s after it."""
+    return lib().wire_overlap(heard, other, round(lag_s * 1e9), round(byte_s * 1e9))
 
 
 def stored_id(pages: bytes, page_size: int, page0: int) -> int:

@@ -124,7 +124,7 @@ class Runner:
                 b.power_cycle()
             elif cmd == "state":
                 s = b.state()
-                s.update(collisions=self.bus.collisions, host_baud=self.bus.host_baud,
+                s.update(collisions=self.bus.collisions, garbled=self.bus.garbled, host_baud=self.bus.host_baud,
                          most_behind_ms=round(self.most_behind_s * 1000, 1))
                 out.append(" ".join(f"{k}={v}" for k, v in s.items()))
             else:

@@ -1,5 +1,7 @@
 #include "sim_bus.h"
 
+#include "ports/host/wire_overlap.h"
+
 #include <errno.h>
 #include <stdbool.h>
 #include <stdio.h>
@@ -7,7 +9,7 @@
 
 void sim_bus_init(struct sim_bus *b, uint64_t now_us)
 {
-    *b = (struct sim_bus){.host_fd = -1, .last_sender = -1, .now_us = now_us, .host_baud = 115200u};
+    *b = (struct sim_bus){.host_fd = -1, .now_us = now_us, .host_baud = 115200u};
 }
 
 uint64_t sim_bus_step_to(const struct sim_bus *b, uint64_t wall_us)
@@ -16,45 +18,95 @@ uint64_t sim_bus_step_to(const struct sim_bus *b, uint64_t wall_us)
     return wall_us < limit ? wall_us : limit;
 }
 
-/* Bytes go on the one wire one byte time apart, after whatever is on it,
- * so the queue's times never run backwards. */
-static uint64_t enqueue(struct sim_bus *b, uint8_t sender, const uint8_t *data, unsigned len,
-                        uint32_t baud, uint64_t now_us)
+static uint64_t byte_time_us(uint32_t baud)
 {
-    uint64_t byte_us = baud ? (10000000u + baud - 1u) / baud : 87u;
-    uint64_t t = now_us > b->wire_until_us ? now_us : b->wire_until_us;
+    return baud ? (10000000u + baud - 1u) / baud : 87u;
+}
+
+static struct sim_bus_byte *queued(struct sim_bus *b, unsigned i)
+{
+    return &b->queue[(b->head + i) % SIM_BUS_QUEUE];
+}
+
+/* A byte that overlaps a byte of another sender already on the wire is not
+ * heard as a byte of its own: the receivers, framed on the byte already
+ * there, get it garbled by this one (wire_overlap.h, the virtual boards'
+ * rule too). True when it overlapped. */
+static bool garble(struct sim_bus *b, uint8_t sender, uint8_t byte, uint64_t start, uint64_t end)
+{
+    bool overlapped = false;
+    bool with_servo = false;
+    for (unsigned i = b->count; i-- > 0;) {
+        struct sim_bus_byte *e = queued(b, i);
+        if (e->at_us <= start) {
+            break; /* ends are in order: nothing earlier reaches this byte */
+        }
+        if (e->sender != sender && e->start_us < end) {
+            e->byte = wire_overlap(e->byte, byte, (int64_t)(start - e->start_us) * 1000,
+                                   (int64_t)(e->at_us - e->start_us) * 1000);
+            e->garbled = 1;
+            overlapped = true;
+            with_servo |= e->sender != SIM_HOST;
+        }
+    }
+    b->garbled += overlapped;
+    b->collisions += with_servo && sender != SIM_HOST;
+    return overlapped;
+}
+
+/* Puts a byte into the queue in the order of the bytes' ends. */
+static void insert(struct sim_bus *b, struct sim_bus_byte byte)
+{
+    unsigned i = b->count++;
+    while (i > 0 && queued(b, i - 1u)->at_us > byte.at_us) {
+        *queued(b, i) = *queued(b, i - 1u);
+        i--;
+    }
+    *queued(b, i) = byte;
+}
+
+/* Bytes go on the wire one byte time apart from start_us, each garbling
+ * whatever of another sender's it overlaps. */
+static uint64_t enqueue(struct sim_bus *b, uint8_t sender, const uint8_t *data, unsigned len,
+                        uint32_t baud, uint64_t start_us)
+{
+    uint64_t byte_us = byte_time_us(baud);
+    uint64_t t = start_us;
     struct sim_bus_span *last = &b->spans[(b->span_count - 1u) % SIM_BUS_SPANS];
     if (b->span_count == 0u || last->sender != sender || last->end_us != t) {
         last = &b->spans[b->span_count++ % SIM_BUS_SPANS];
         *last = (struct sim_bus_span){.start_us = t, .end_us = t, .sender = sender};
     }
     for (unsigned i = 0; i < len; i++) {
-        if (b->count == SIM_BUS_QUEUE) {
-            b->dropped++; /* never on the wire: it takes no wire time */
+        uint64_t from = t;
+        t += byte_us;
+        if (garble(b, sender, data[i], from, t)) {
             continue;
         }
-        t += byte_us;
-        b->queue[(b->head + b->count) % SIM_BUS_QUEUE] =
-            (struct sim_bus_byte){.at_us = t, .baud = baud, .byte = data[i], .sender = sender};
-        b->count++;
+        if (b->count == SIM_BUS_QUEUE) {
+            b->dropped++;
+            continue;
+        }
+        insert(b, (struct sim_bus_byte){.start_us = from, .at_us = t, .baud = baud,
+                                        .byte = data[i], .sender = sender});
     }
-    b->wire_until_us = t;
+    b->wire_until_us = t > b->wire_until_us ? t : b->wire_until_us;
     last->end_us = t;
     last->bytes = (uint16_t)(last->bytes + len);
     return t;
 }
 
+/* A servo's bytes go on the wire when it sends them, whatever is there: it
+ * cannot hear a byte before its stop bit. */
 uint64_t sim_bus_send(struct sim_bus *b, unsigned sender, const uint8_t *data, unsigned len,
                       uint32_t baud, uint64_t now_us)
 {
-    if (now_us < b->servo_until_us && b->last_sender != (int)sender) {
-        b->collisions++;
-        fprintf(stderr, "servo_sim: collision: servo %u started while servo %d was sending\n",
-                b->stations[sender].log_id, b->stations[b->last_sender].log_id);
-    }
+    unsigned long before = b->collisions;
     uint64_t t = enqueue(b, (uint8_t)sender, data, len, baud, now_us);
-    b->servo_until_us = t;
-    b->last_sender = (int)sender;
+    if (b->collisions != before) {
+        fprintf(stderr, "servo_sim: collision: servo %u talked over another servo's answer "
+                "(%lu bytes garbled)\n", b->stations[sender].log_id, b->collisions - before);
+    }
     return t;
 }
 
@@ -115,9 +167,12 @@ void sim_bus_attach(struct sim_bus *b, struct sim_station station)
     }
 }
 
+/* The host's bytes wait for a quiet wire (what the simulator reads of a
+ * pty or socket was written before it could be put on the wire). */
 void sim_bus_from_host(struct sim_bus *b, const uint8_t *data, unsigned len, uint64_t now_us)
 {
-    (void)enqueue(b, SIM_HOST, data, len, b->host_baud, now_us);
+    uint64_t start = now_us > b->wire_until_us ? now_us : b->wire_until_us;
+    (void)enqueue(b, SIM_HOST, data, len, b->host_baud, start);
 }
 
 unsigned sim_bus_room(const struct sim_bus *b)

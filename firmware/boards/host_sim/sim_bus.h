@@ -1,9 +1,16 @@
 /* The shared half-duplex wire of the simulator: what one servo sends reaches
- * the host and every other servo one byte time after another, after whatever
- * is already on the wire; the host's bytes reach every servo paced the same
- * way (a pty or socket delivers them in bursts a UART never would). A
- * servo that starts sending while another's bytes are on the wire is a
- * collision, counted and logged: on a real bus it would garble both.
+ * the host and every other servo one byte time after another, from the
+ * moment it sends it; the host's bytes reach every servo paced the same
+ * way (a pty or socket delivers them in bursts a UART never would), after
+ * whatever is already on the wire. Bytes of two senders that overlap
+ * garble each other, as on a real wire: a receiver framed on the byte
+ * already there samples the middle of its bits while the line is low if
+ * either drives it low, and gets nothing of the later byte's own framing;
+ * two drivers are never in step, a bit apart at least (sim_bus.c, overlap;
+ * tools/vboard/bus.py keeps the same rule). Servos at one ID answer as one
+ * damaged frame, as real ones do. `garbled`
+ * counts bytes that overlapped; `collisions` the bytes a servo sent over
+ * another servo's, logged: answers must never do that.
  *
  * Each byte goes at its sender's baud rate and only a receiver at the same
  * rate gets it (at another rate a UART sees framing errors, dropped here).
@@ -53,10 +60,12 @@ struct sim_bus_span {
 #define SIM_BUS_SPANS 1024u /* the wire's log keeps the latest */
 
 struct sim_bus_byte {
-    uint64_t at_us;
+    uint64_t start_us;
+    uint64_t at_us; /* its stop bit's end: the queue is in this order */
     uint32_t baud;
     uint8_t byte;
     uint8_t sender;
+    uint8_t garbled; /* another sender's byte overlapped it */
 };
 
 struct sim_bus {
@@ -64,14 +73,13 @@ struct sim_bus {
     unsigned head;
     unsigned count;
     uint64_t wire_until_us;   /* end of the last byte queued, host's or servo's */
-    uint64_t servo_until_us;  /* end of the last servo byte queued */
     uint64_t now_us;          /* every byte due by then has been delivered */
-    int last_sender;          /* servo that queued it */
     int host_fd;              /* -1: no host connected */
     uint32_t host_baud;       /* the host's UART rate */
     struct sim_station stations[SIM_MAX_SERVOS];
     unsigned station_count;
-    unsigned long collisions;
+    unsigned long collisions; /* servo bytes sent over another servo's */
+    unsigned long garbled;    /* bytes sent over another sender's (the host's too) */
     unsigned long dropped;    /* queue overflow (servo bytes; the host is held back) */
     unsigned long baud_mismatches; /* bytes no station at that rate received */
     struct sim_bus_span spans[SIM_BUS_SPANS];

@@ -70,7 +70,7 @@ static void state_of(const struct sim_control *c, const struct sim_servo *s, cha
              "id=%u sim_ms=%.3f last_move_ms=%.3f last_sent_ms=%.3f "
              "angle=%.3f velocity=%.2f current=%.3f winding=%.2f case=%.2f ambient=%.1f "
              "supply=%.3f "
-             "load=%.3f payload=%.1f stop=%s status=0x%02x reported=%d collisions=%lu dropped_ticks=%u "
+             "load=%.3f payload=%.1f stop=%s status=0x%02x reported=%d collisions=%lu garbled=%lu dropped_ticks=%u "
              "most_behind_ms=%.1f baud=%u host_baud=%u baud_mismatches=%lu rx_overruns=%u "
              "rx_lost=%u flash_stall_ms=%.2f saves=%u mode=%s version=0x%04x resets_power=%u "
              "heard_ms=%.3f coasted_ms=%.3f winding_estimate=%.1f serial=0x%08x\n",
@@ -80,7 +80,7 @@ static void state_of(const struct sim_control *c, const struct sim_servo *s, cha
              s->plant.current, s->thermal.winding_c, s->thermal.case_c, s->thermal.ambient_c,
              s->plant.p.supply_v,
              s->plant.load_torque, s->plant.payload_inertia * 1e7, s->plant.has_stop ? "on" : "off", s->core.regs.status.status,
-             a.multi_turn_decideg, c->bus->collisions, s->core.ticks_dropped,
+             a.multi_turn_decideg, c->bus->collisions, c->bus->garbled, s->core.ticks_dropped,
              (double)*c->most_behind_us / 1000.0, (unsigned)s->baud, (unsigned)c->bus->host_baud,
              c->bus->baud_mismatches, (unsigned)s->rx.overruns, (unsigned)s->core.rx_lost,
              (double)s->flash_stall_us / 1000.0, (unsigned)s->core.store.sequence,

@@ -23,22 +23,27 @@ def run(sim, capsys, *args):
 
 def test_two_servos_on_one_id_are_found_out(tmp_path, capsys):
     """Servo 3 is given ID 2 behind servoctl's back (a raw WriteData). Both
-    answer at 2 from then on: scan names both serial numbers and exits 1.
+    answer at 2 from then on, at once, and their answers garble each other
+    on the wire as on a real one (never in step: no answer comes through
+    whole). scan says two or more servos hold ID 2, how to learn their
+    serial numbers, and exits 1.
     (Not the sim3 fixture: this bus collides on purpose.)"""
     with Simulator(ids=[1, 2, 3], state_dir=str(tmp_path / "state")) as sim:
         with sim.bus() as bus:
             Servo(bus, 3).write("servo_id", 2)
         rc, out, err = run(sim, capsys, "scan", "--last", "5")
         assert rc == 1, out + err
-        assert ("servo 2 at 115200 baud: TWO OR MORE SERVOS hold this ID "
-                "(serials 0x51a00002, 0x51a00003). Give one a free ID by its serial number: "
-                "'servoctl id assign 0x51a00003 N'") in out, out
+        assert "servo 2 at 115200 baud: TWO OR MORE SERVOS hold this ID (0 good and " in out, out
+        assert ("garbled answers). Connect them one at a time to learn their serial numbers "
+                "('servoctl scan'), then 'servoctl id assign SERIAL N'") in out, out
         assert "servo 1 at 115200 baud, serial 0x51a00001" in out
+        assert "at least 3 servo(s) found" in out
         assert "IDs held by two or more servos: 2" in err
+        assert sim.state(1)["garbled"] > 0
         rc, out, _ = run(sim, capsys, "scan", "--last", "5", "--json")
         found = {f["id"]: f for f in json.loads(out)}
         assert rc == 1 and found[2]["shared"] and not found[1]["shared"]
-        assert found[2]["serials"] == [0x51A00002, 0x51A00003]
+        assert found[2]["serials"] == []
         # AssignId reaches one of them by its serial number.
         rc, _, err = run(sim, capsys, "id", "assign", "0x51a00003", "1")
         assert rc == 1 and "ID 1 already answers on this bus" in err, err
@@ -134,18 +139,24 @@ def test_all_bauds_over_a_socket_scans_once(sim, capsys):
 
 def test_a_bus_of_new_servos_is_counted_numbered_and_addressed_by_bus_id(tmp_path, capsys):
     """Four servos as they leave the factory, all at ID 0 (servo_sim
-    refused an ID given twice). Their answers come through whole on the
-    simulated wire, so their serial numbers are known: scan counts four
-    servos, not one ID, and bringup numbers all four without asking for
-    them one at a time. The control port then addresses a servo by the ID
-    it holds now, or by its serial number, not by the ID it started with."""
+    refused an ID given twice). They answer together and their answers
+    garble each other on the wire, as on the virtual boards' and a real
+    one: scan finds ID 0 shared, and bringup, which needs each new servo's
+    serial number, asks for one at a time and fails with the reason. By
+    their serial numbers they are numbered one by one (id assign). The
+    control port then addresses a servo by the ID it holds now, or by its
+    serial number, not by the ID it started with."""
     with Simulator(ids=[0, 0, 0, 0], state_dir=str(tmp_path / "state")) as sim:
         serials = [0x51A00000, 0x51A00100, 0x51A00200, 0x51A00300]
         rc, out, err = run(sim, capsys, "scan", "--last", "3")
-        assert rc == 1 and "4 servo(s) found" in out and "IDs held by two or more servos: 0" in err, out + err
-        rc, out, err = run(sim, capsys, "id", "bringup", "--first", "1", "--count", "4", "--wait-s", "5")
-        assert rc == 0, out + err
-        assert "one new servo at a time" not in out and "4 servo(s) numbered" in out, out
+        assert rc == 1 and "at least 2 servo(s) found" in out and "IDs held by two or more servos: 0" in err, out + err
+        rc, out, err = run(sim, capsys, "id", "bringup", "--first", "1", "--count", "4", "--wait-s", "1")
+        assert rc == 3 and "connect one new servo at a time" in out, out + err
+        assert ("no servo alone at ID 0 within 1 s (two or more answer there at once, and their "
+                "answers collide: connect one new servo at a time); 0 numbered") in err, err
+        for n, serial in enumerate(serials, 1):
+            rc, out, err = run(sim, capsys, "id", "assign", f"0x{serial:08x}", str(n))
+            assert rc == 0, out + err
         rc, out, _ = run(sim, capsys, "scan", "--last", "5", "--json")
         found = json.loads(out)
         assert rc == 0 and [f["id"] for f in found] == [1, 2, 3, 4]

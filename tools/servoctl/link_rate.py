@@ -1,0 +1,65 @@
+"""The host's baud rate on a socket:// link. A TCP link carries bytes, not a
+rate: the far end (servo_sim, a virtual board, a serial server) decides
+what rate its wire runs at, and pyserial's baudrate on a socket does
+nothing. A simulator takes its host's rate on its control port
+(`hostbaud BAUD`); given that port (--sim-control, env
+SERVOCTL_SIM_CONTROL), servoctl sets it there for --baud and after a
+`config set N baud`. Without it, --baud on socket:// is refused (it would
+be ignored) and a baud change says what to do, instead of losing the bus
+with no word."""
+from . import registers
+from .errors import UsageError
+
+DEFAULT_BAUD = 115200
+
+
+def is_socket(port) -> bool:
+    return bool(port) and port.startswith("socket://")
+
+
+def _control(address: str, line: str) -> str:
+    from .sim import control_command
+
+    host, _, port = address.rpartition(":")
+    if host not in ("", "127.0.0.1", "localhost"):
+        raise UsageError(f"--sim-control is a simulator's control port on this PC (PORT or "
+                         f"127.0.0.1:PORT), not {address}")
+    try:
+        return control_command(int(port), line)
+    except ValueError:
+        raise UsageError(f"--sim-control takes a port number, not {address!r}") from None
+
+
+def open_rate(port, baud, sim_control) -> int:
+    """The rate to open the link at: --baud, or 115200. On socket:// an
+    explicit --baud is set on the simulator's control port, or refused."""
+    if baud is None or not is_socket(port):
+        return baud or DEFAULT_BAUD
+    if not sim_control:
+        raise UsageError(f"socket:// carries no baud rate: --baud {baud} would be ignored. On a "
+                         f"simulator, send 'hostbaud {baud}' to its control port, or give "
+                         f"--sim-control PORT and servoctl does it")
+    _control(sim_control, f"hostbaud {baud}")
+    return baud
+
+
+def after_set(bus, args, name: str, value: int) -> None:
+    """After `config set N name value`: a baud change says what to do."""
+    rate = registers.BAUD_RATES.get(value) if name == "baud" else None
+    if rate is not None and (is_socket(bus.port) or rate != bus.serial.baudrate):
+        print(after_change(bus, args.id, rate, args.sim_control))
+
+
+def after_change(bus, servo_id: int, rate: int, sim_control) -> str:
+    """What to do now that a servo speaks `rate`, or what was done (the
+    simulator's host rate set on its control port)."""
+    if not is_socket(bus.port):
+        return f"servo {servo_id} now speaks {rate} baud: give --baud {rate} from now on"
+    if sim_control:
+        _control(sim_control, f"hostbaud {rate}")
+        bus.serial.baudrate = rate
+        return (f"servo {servo_id} now speaks {rate} baud: the simulator's host rate is set to "
+                f"{rate} too (hostbaud on its control port)")
+    return (f"servo {servo_id} now speaks {rate} baud, and socket:// carries no baud rate: on a "
+            f"simulator, send 'hostbaud {rate}' to its control port (or give --sim-control PORT "
+            f"and servoctl does it) to reach it again")
