@@ -345,7 +345,7 @@ def test_a_new_id_already_on_the_bus_is_refused(sim3, capsys):
     """'config set 4 servo_id 2' on a bus with servo 2 made two servos
     answer at 2, silently, exit 0."""
     rc, _, err = run(sim3, capsys, "config", "set", "3", "servo_id", "2")
-    assert rc == 1 and "ID 2 already answers on this bus: servo 3 keeps its ID" in err, err
+    assert rc == 2 and "ID 2 already answers on this bus: servo 3 keeps its ID" in err, err
     rc, out, _ = run(sim3, capsys, "scan", "--last", "5")
     assert "3 servo(s) found" in out and "servo 3 at" in out
     assert sim3.state(1)["collisions"] == 0

@@ -188,7 +188,7 @@ def test_servoctl_update_refuses_what_cannot_be_right(sim, capsys, tmp_path):
     foreign = tmp_path / "f103.img"
     foreign.write_bytes(img.build(b"\x00" * 64, 0x0042, img.BOARDS["stm32f103"]))
     rc, text, _ = run(sim, capsys, "update", str(foreign), "1")
-    assert rc == Refused.exit_code
+    assert rc == UsageError.exit_code  # refused before sending, as every value is
     assert "servo 1 is host_sim (0x5100); the image is for stm32f103 (0x0103)" in text, text
     not_an_image = tmp_path / "app.bin"
     not_an_image.write_bytes(b"\x00" * 600)
