@@ -30,7 +30,7 @@ def fmt_status(status: int) -> str:
 # ---- commands --------------------------------------------------------------
 
 def cmd_scan(bus, args):
-    from rich.progress import Progress
+    from .console import progress as Progress  # a closed pipe ends quietly (main)
 
     rates = [bus.serial.baudrate]  # the one asked for first
     if args.all_bauds and bus.port.startswith("socket://"):
@@ -371,7 +371,9 @@ def _version(v) -> str:
 
 
 def cmd_update(bus, args):
-    from rich.progress import BarColumn, DownloadColumn, Progress, TextColumn, TimeRemainingColumn
+    from rich.progress import BarColumn, DownloadColumn, TextColumn, TimeRemainingColumn
+
+    from .console import progress as Progress
 
     from . import image as img
     from . import update as upd

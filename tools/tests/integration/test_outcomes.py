@@ -411,6 +411,22 @@ def test_what_a_new_user_types_gets_a_line_not_a_traceback(ready, capsys):
     assert rc == 0 and "500 deg/s is more than the motor turns unloaded at 7.4 V (about 312 deg/s)" in err
 
 
+@pytest.mark.parametrize("command", [["scan", "--last", "40"], ["info", "1"], ["config", "dump", "1"],
+                                     ["faults", "1"], ["store", "1"]])
+def test_a_closed_pipe_ends_every_command_quietly(sim3, command):
+    """`servoctl scan | head -1` exited 1 without a word (rich's console
+    exits 1 on a closed pipe). A reader that has what it wanted and closes
+    the pipe ends every command that prints quietly, exit 0, as Unix tools
+    do: here it closes after the first line, and what is printed after it
+    meets the closed pipe."""
+    proc = subprocess.Popen([sys.executable, "-m", "servoctl.cli", "--port", sim3.url, *command],
+                            cwd=TOOLS, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    assert proc.stdout.readline()
+    proc.stdout.close()
+    err = proc.stderr.read()
+    assert proc.wait(timeout=120) == 0 and err == "", (proc.returncode, err)
+
+
 def test_a_reader_that_stops_reading_gets_no_traceback(ready):
     """`servoctl monitor 1 | head -1`: the pipe closes under servoctl, which
     goes on writing rows until it meets the closed pipe."""
