@@ -46,6 +46,7 @@ def cmd_scan(bus, args):
             for rate in rates:
                 bus.serial.baudrate = rate
                 window = args.reply_timeout or scan.reply_window_s(rate)
+                scan.wake(bus)  # no servo is missed for a page erase
                 for servo_id in range(args.first, args.last + 1):
                     if (f := scan.probe(bus, servo_id, window)) is not None:
                         found.append(f)
