@@ -374,10 +374,9 @@ def _version(v) -> str:
 def cmd_update(bus, args):
     from rich.progress import BarColumn, DownloadColumn, TextColumn, TimeRemainingColumn
 
-    from .console import progress as Progress
-
     from . import image as img
     from . import update as upd
+    from .console import progress as Progress
 
     # `update IMAGE ID...` or `update ID... IMAGE`: the image is the one
     # that is not a number.
