@@ -30,7 +30,7 @@ def fmt_status(status: int) -> str:
 # ---- commands --------------------------------------------------------------
 
 def cmd_scan(bus, args):
-    from rich.progress import Progress
+    from .console import progress as Progress  # a closed pipe ends quietly (main)
 
     rates = [bus.serial.baudrate]  # the one asked for first
     if args.all_bauds and bus.port.startswith("socket://"):
@@ -46,6 +46,7 @@ def cmd_scan(bus, args):
             for rate in rates:
                 bus.serial.baudrate = rate
                 window = args.reply_timeout or scan.reply_window_s(rate)
+                scan.wake(bus)  # no servo is missed for a page erase
                 for servo_id in range(args.first, args.last + 1):
                     if (f := scan.probe(bus, servo_id, window)) is not None:
                         found.append(f)
@@ -373,10 +374,11 @@ def _version(v) -> str:
 
 
 def cmd_update(bus, args):
-    from rich.progress import BarColumn, DownloadColumn, Progress, TextColumn, TimeRemainingColumn
+    from rich.progress import BarColumn, DownloadColumn, TextColumn, TimeRemainingColumn
 
     from . import image as img
     from . import update as upd
+    from .console import progress as Progress
 
     # `update IMAGE ID...` or `update ID... IMAGE`: the image is the one
     # that is not a number.

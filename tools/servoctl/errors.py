@@ -23,6 +23,14 @@ class ValueOutOfRange(UsageError):
     pass
 
 
+class NotSent(UsageError, Refused):
+    """servoctl refused a value before sending it, one the servo's state or
+    kind makes wrong: a target in another turn, an ID another servo
+    answers at, an image for another board or larger than its slot.
+    Nothing was changed: the exit code of every value refused before
+    sending (2), and a Refused for the Python API."""
+
+
 class NoReply(ServoError):
     """No servo answered (absent, another ID, another baud rate)."""
     exit_code = 3

@@ -16,8 +16,8 @@ a target outside the limits in both modes before sending, rather than let
 the servo stop short of it."""
 from dataclasses import dataclass
 
-from .errors import ServoError
-from .protocol import BadAnswer, NoReply, Refused, ValueOutOfRange
+from .errors import NotSent, ServoError
+from .protocol import BadAnswer, NoReply, ValueOutOfRange
 
 SINGLE_TURN = (-1800, 1800)  # 0.1 deg
 TURN = 3600
@@ -81,7 +81,7 @@ def check_target(s, angle: int, multi_turn: bool) -> Where:
             f"Change the limits, or turn them off with 'servoctl config set {s.id} angle_limit_on 0'")
     base = turn_base(where.at)
     if not multi_turn and base != 0:
-        raise Refused(
+        raise NotSent(
             f"servo {s.id} is at {_deg(where.at)}, outside the single turn (-180.0..180.0 deg): a "
             f"single-turn angle is taken within the turn it is in, so {_deg(angle)} would end at "
             f"{_deg(base + angle)}. Add --multi-turn (move_to(..., multi_turn=True)) to go to "

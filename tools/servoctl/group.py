@@ -5,7 +5,7 @@ backup and restore of a whole bus. Angles in degrees, times in seconds."""
 from . import protocol as p
 from . import config_file, registers, stability
 from .frame import check_target
-from .errors import NoReply, Refused, UsageError
+from .errors import NoReply, NotSent, UsageError
 from .checks import MIN_RAMP_MS, check_profile, check_range, scaled, to_ms
 from .servo import Monitor, Servo
 
@@ -130,7 +130,7 @@ def id_is_free(bus: p.Bus, servo_id: int, new_id: int) -> None:
     at new_id: two servos on one ID cannot be told apart again (every
     request to it is answered twice, and collides)."""
     if new_id != servo_id and Servo(bus, new_id).ping():
-        raise Refused(f"ID {new_id} already answers on this bus: servo {servo_id} keeps its ID. "
+        raise NotSent(f"ID {new_id} already answers on this bus: servo {servo_id} keeps its ID. "
                       f"Pick a free one ('servoctl scan' lists those in use)")
 
 

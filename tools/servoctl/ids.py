@@ -5,6 +5,7 @@ one servo at a time."""
 
 from . import protocol as p
 from . import scan
+from .errors import NotSent
 from .protocol import NoReply, Refused, UsageError
 from .servo import Servo
 
@@ -28,7 +29,7 @@ def assign(bus: p.Bus, serial: int, new_id: int) -> None:
         raise UsageError(f"servo IDs are 0..{p.MAX_ID}, not {new_id}")
     holder = scan.probe(bus, new_id, scan.reply_window_s(bus.serial.baudrate))
     if holder is not None and serial not in holder.serials:
-        raise Refused(f"ID {new_id} already answers on this bus ({holder.describe()}): pick a free one")
+        raise NotSent(f"ID {new_id} already answers on this bus ({holder.describe()}): pick a free one")
     bus.send(p.ASSIGN_ID, p.encode_request(p.ASSIGN_ID, p.BROADCAST, serial, new_id))
     try:
         answer = bus.read_response(p.ASSIGN_ID, None)

@@ -22,6 +22,16 @@ CODES = {pkt.py: pkt.code for pkt in _SCHEMA.packets}
 globals().update(CODES)
 
 
+# Requests that only read: one that gets no answer is sent once more
+# (Bus.request). A request that lands in a servo's page erase is carried out
+# but not answered (docs/decisions-hardware.md, "Flash and the real-time
+# budget"); a read asked again changes nothing. Writes are confirmed by a
+# read instead (Servo._write_kept).
+REPEATABLE = frozenset(CODES[name] for name in (
+    "PING", "READ_DATA", "READ_BATCH", "READ_ANGLE", "READ_MULTI_TURN", "MONITOR",
+    "READ_MOTION", "READ_STORE", "READ_FAULTS"))
+
+
 # What servo_sim and the virtual boards tell a second TCP client while
 # another holds the bus (one program on a port at a time, as on a serial one).
 BUS_IN_USE = b"the bus is in use by another client"
@@ -135,6 +145,7 @@ class Bus:
         self._low_water = 1  # the socket's SO_RCVLOWAT (_wake_at)
         self._buffer = b""
         self.stray_bytes = 0  # bytes outside any frame: noise, or answers that collided
+        self.sent_again = 0  # requests sent a second time, their first unanswered (request)
         self.stamp_arrivals = True
         # The bus clock when the last response returned was taken off the
         # port: when the answer arrived, not when it was used.
@@ -342,8 +353,17 @@ class Bus:
         frame = buf[:end]
         return frame[2], frame[4:-1], checksum(frame[:-1]) == frame[-1]
 
-    def request(self, code: int, content: bytes, timeout=None) -> bytes:
+    def request(self, code: int, content: bytes, timeout=None, again=None) -> bytes:
         """Sends a request for the servo named by content[0] and returns its
-        answer's content."""
+        answer's content. Unanswered, it is sent once more if again (by
+        default, if it only reads: REPEATABLE): it may have landed in a page
+        erase, carried out but not answered."""
+        self.send(code, content)
+        try:
+            return self.read_response(code, content[0], timeout)
+        except NoReply:
+            if not (code in REPEATABLE if again is None else again):
+                raise
+        self.sent_again += 1
         self.send(code, content)
         return self.read_response(code, content[0], timeout)

@@ -78,6 +78,20 @@ def count_line(found: list) -> str:
     return f"{'at least ' if at_least else ''}{n} servo(s) found"
 
 
+# A page erase's longest (DS5319: 40 ms), docs/decisions-hardware.md.
+ERASE_MAX_S = 0.04
+
+
+def wake(bus: p.Bus) -> None:
+    """Before a sweep: a servo in a page erase answers nothing (it begins
+    one once released and quiet for 0.1 s), and a sweep asks each ID once.
+    A Ping to broadcast, which no servo answers, ends the quiet, so no
+    erase begins for 0.1 s; one already running is waited out. The sweep's
+    requests then follow each other closer than 0.1 s."""
+    bus.send(p.PING, bytes([p.BROADCAST]))
+    bus.sleep(ERASE_MAX_S + 0.005)
+
+
 def probe(bus: p.Bus, servo_id: int, window_s: float):
     """What answers at servo_id (a Found), or None if nothing does."""
     pings, garbled, stray = bus.gather(p.PING, bytes([servo_id]), window_s)

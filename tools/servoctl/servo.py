@@ -128,6 +128,14 @@ class StoreHealth:
         return [name for bit, name in enumerate(self.FLAGS) if name and self.flags >> bit & 1]
 
 
+def _answers(read) -> bool:
+    """read(), False when it goes unanswered."""
+    try:
+        return read()
+    except p.NoReply:
+        return False
+
+
 class Servo:
     def __init__(self, bus: p.Bus, servo_id: int):
         self.bus = bus
@@ -135,7 +143,8 @@ class Servo:
 
     # ---- queries -------------------------------------------------------
     def ping(self, timeout=None) -> bool:
-        """True if the servo answers within timeout (the bus's if None)."""
+        """True if the servo answers within timeout (the bus's if None), asked
+        twice if need be (Bus.request: it may be in a page erase)."""
         try:
             self.bus.request(p.PING, bytes([self.id]), timeout=timeout)
             return True
@@ -175,10 +184,50 @@ class Servo:
             self._write(registers.find(name), value)
 
     def _write(self, item, value: int) -> None:
-        content = self.bus.request(p.WRITE_DATA, bytes([self.id, item.id]) + item.pack(value))
-        if p.decode_answer(p.WRITE_DATA, content)[2] != 1:
+        if item.name == "baud":  # read back only at the new rate: not sent again
+            took = None
+        elif item.name == "servo_id":  # read back at the new ID
+            took = lambda: _answers(lambda: Servo(self.bus, value).read(item.id) == value)  # noqa: E731
+        else:
+            took = lambda: self.read(item.id) == value  # noqa: E731
+        if not self._write_kept(p.WRITE_DATA, bytes([self.id, item.id]) + item.pack(value), took):
             raise Refused(f"servo {self.id} refused {item.name} = {value}"
                           f"{self._size_first(item, value) or self._why_refused()}")
+
+    def _write_kept(self, code: int, content: bytes, took) -> bool:
+        """Sends a write (content, its result the answer's last field) and
+        returns whether the servo took it. A write without an answer may have
+        landed in a page erase: carried out, not answered
+        (docs/decisions-hardware.md). took() then reads back whether the
+        servo holds what was written; if not, the write is sent once more
+        and its answer is the servo's word. A write that cannot be read back
+        (took None) is not sent again: its NoReply says how many answers
+        the servo counts as not sent (ReadStore)."""
+        try:
+            return p.decode_answer(code, self.bus.request(code, content))[-1] == 1
+        except p.NoReply as lost:
+            if took is None:
+                raise self._unanswered(lost) from None
+            try:
+                if took():
+                    return True
+            except p.NoReply:  # the read went unanswered too: nobody there
+                raise lost from None
+        self.bus.sent_again += 1
+        return p.decode_answer(code, self.bus.request(code, content, again=False))[-1] == 1
+
+    def _unanswered(self, lost: p.NoReply) -> p.NoReply:
+        """lost, with what ReadStore counts: requests carried out during a
+        page erase and not answered, this one perhaps among them."""
+        try:
+            dropped = self.read_store().answers_dropped
+        except p.LinkError:
+            raise
+        except ServoError:  # no answer, or not one this tool knows
+            return lost
+        return p.NoReply(f"{lost}; servo {self.id} answers now and counts {dropped} request(s) carried "
+                         f"out during a page erase and not answered: this one may be among them "
+                         f"(see 'servoctl store {self.id}')")
 
     def read_all(self) -> dict:
         content = self.bus.request(p.READ_BATCH, bytes([self.id]))
@@ -198,12 +247,17 @@ class Servo:
 
     def write_all(self, values: dict) -> None:
         block = registers.encode_user_area(values)
-        content = self.bus.request(p.WRITE_BATCH, bytes([self.id]) + block)
-        if p.decode_answer(p.WRITE_BATCH, content)[1] != 1:
+        now = registers.decode_user_area(block)
+        settable = [item.name for item in registers.USER if item.writable]
+
+        def took():  # read back where the servo answers after it: at its new ID
+            back = _answers(lambda: Servo(self.bus, now["servo_id"]).read_all())
+            return bool(back) and all(back[name] == now[name] for name in settable)
+        if not self._write_kept(p.WRITE_BATCH, bytes([self.id]) + block, took):
             raise Refused(f"servo {self.id} refused the user area block{self._why_refused()}")
 
     def reset_user_data(self) -> None:
-        if p.decode_answer(p.RESET_USER_DATA, self.bus.request(p.RESET_USER_DATA, bytes([self.id])))[1] != 1:
+        if not self._write_kept(p.RESET_USER_DATA, bytes([self.id]), None):
             raise Refused(f"servo {self.id} refused the reset{self._why_refused()}")
 
     def _size_first(self, item, value: int) -> str:
@@ -267,7 +321,8 @@ class Servo:
         return [first] + [self.read_fault(i) for i in range(1, first.count)]
 
     def clear_faults(self) -> None:
-        if p.decode_answer(p.CLEAR_FAULTS, self.bus.request(p.CLEAR_FAULTS, bytes([self.id])))[1] != 1:
+        # Read back: the history is empty once cleared.
+        if not self._write_kept(p.CLEAR_FAULTS, bytes([self.id]), lambda: self.read_fault(0).what == 0):
             raise Refused(f"servo {self.id} refused to clear its fault history: none kept, its "
                           f"wear budget allows no record now, or the history's page is full while "
                           f"the output is driven (release it, leave the bus quiet 100 ms, "

@@ -503,7 +503,7 @@ def cmd_stream(bus, args):
     servo's tracking error and the cycle's rate."""
     import sys
 
-    from rich.progress import Progress
+    from .console import progress as Progress  # a closed pipe ends quietly (cli.main)
 
     trajectory = read_trajectory(args.file)
     angles = trajectory.angles

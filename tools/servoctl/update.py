@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 from . import protocol as _p
 from .image import CHECKED, Image, board_named
+from .errors import NotSent
 from .protocol import BadAnswer, NoReply, Refused
 
 UPDATE_ENTER, UPDATE_ERASE, UPDATE_WRITE = _p.UPDATE_ENTER, _p.UPDATE_ERASE, _p.UPDATE_WRITE
@@ -161,7 +162,7 @@ def write_image(bus, servo_id: int, image: Image, st: Status, progress=lambda do
     if len(image.data) > st.page_size * st.pages:
         if st.verdict == 0:  # nothing erased yet: back to the application
             bus.request(UPDATE_BOOT, bytes([servo_id]))
-        raise Refused(f"the image ({len(image.data)} B) is larger than the slot "
+        raise NotSent(f"the image ({len(image.data)} B) is larger than the slot "
                       f"({st.page_size * st.pages} B)")
     pages = (len(image.data) + st.page_size - 1) // st.page_size
     step = st.largest_write - st.largest_write % st.write_block
@@ -191,7 +192,7 @@ def update(bus, servo_id: int, image: Image, progress=lambda done, total: None) 
     version before (None if no application ran) and after."""
     st = status(bus, servo_id)
     if image.board != st.board:  # before anything changes
-        raise Refused(f"servo {servo_id} is {board_named(st.board)}; the image is for "
+        raise NotSent(f"servo {servo_id} is {board_named(st.board)}; the image is for "
                       f"{board_named(image.board)}")
     before = st.version if st.mode == MODE_APP or st.verdict == 0 else None
     if st.mode == MODE_APP:

@@ -88,7 +88,7 @@ def test_move_from_720_degrees(sim, capsys):
     park(sim, capsys, 1, 720)
     rc, _, err = run(sim, capsys, "move", "1", "10", "--wait")
     at = re.search(r"is at (-?[\d.]+) deg.*would end at (-?[\d.]+) deg", err)
-    assert rc == 1 and at and abs(float(at[1]) - 720.0) < 0.5, err
+    assert rc == 2 and at and abs(float(at[1]) - 720.0) < 0.5, err  # refused before sending: 2
     assert float(at[2]) == pytest.approx(float(at[1]) + 10.0, abs=0.15)  # 0.1 deg steps
     assert "--multi-turn" in err
     sim.sleep(0.3)
@@ -120,7 +120,7 @@ def test_a_sync_move_target_means_the_same_whatever_else_is_in_it(sim3, capsys):
     assert rc == 2 and "servo 3 limits its angle" in err, err
     # Servo 1 is in turn 1 now: a single-turn record to it would not mean 20 deg.
     rc, _, err = run(sim3, capsys, "sync-move", "1:20", "2:0")
-    assert rc == 1 and "servo 1 is at" in err and abs(said_at(err) - 200.0) <= 0.5, err
+    assert rc == 2 and "servo 1 is at" in err and abs(said_at(err) - 200.0) <= 0.5, err
     rc, _, err = run(sim3, capsys, "sync-move", "1:90", "1:-90")
     assert rc == 2 and "servo 1 is given more than one target" in err, err
 
@@ -131,7 +131,7 @@ def test_a_broadcast_move_checks_every_servo_first(sim3, capsys):
         prepare(sim3, capsys, i, limits=i != 3)
     park(sim3, capsys, 3, 360)
     rc, _, err = run(sim3, capsys, "broadcast-move", "20", "--interval", "300")
-    assert rc == 1 and "servo 3 is at" in err and abs(said_at(err) - 360.0) <= 0.5, err
+    assert rc == 2 and "servo 3 is at" in err and abs(said_at(err) - 360.0) <= 0.5, err
     sim3.sleep(0.6)
     assert [round(angle(sim3, i)) for i in (1, 2, 3)] == [0, 0, 360]
     assert run(sim3, capsys, "move", "3", "0", "--multi-turn", "--velocity", "600", "--wait")[0] == 0

@@ -345,7 +345,7 @@ def test_a_new_id_already_on_the_bus_is_refused(sim3, capsys):
     """'config set 4 servo_id 2' on a bus with servo 2 made two servos
     answer at 2, silently, exit 0."""
     rc, _, err = run(sim3, capsys, "config", "set", "3", "servo_id", "2")
-    assert rc == 1 and "ID 2 already answers on this bus: servo 3 keeps its ID" in err, err
+    assert rc == 2 and "ID 2 already answers on this bus: servo 3 keeps its ID" in err, err
     rc, out, _ = run(sim3, capsys, "scan", "--last", "5")
     assert "3 servo(s) found" in out and "servo 3 at" in out
     assert sim3.state(1)["collisions"] == 0
@@ -409,6 +409,22 @@ def test_what_a_new_user_types_gets_a_line_not_a_traceback(ready, capsys):
     assert rc == 0, err
     rc, _, err = run(ready, capsys, "move", "1", "0", "--multi-turn", "--velocity", "500")
     assert rc == 0 and "500 deg/s is more than the motor turns unloaded at 7.4 V (about 312 deg/s)" in err
+
+
+@pytest.mark.parametrize("command", [["scan", "--last", "40"], ["info", "1"], ["config", "dump", "1"],
+                                     ["faults", "1"], ["store", "1"]])
+def test_a_closed_pipe_ends_every_command_quietly(sim3, command):
+    """`servoctl scan | head -1` exited 1 without a word (rich's console
+    exits 1 on a closed pipe). A reader that has what it wanted and closes
+    the pipe ends every command that prints quietly, exit 0, as Unix tools
+    do: here it closes after the first line, and what is printed after it
+    meets the closed pipe."""
+    proc = subprocess.Popen([sys.executable, "-m", "servoctl.cli", "--port", sim3.url, *command],
+                            cwd=TOOLS, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    assert proc.stdout.readline()
+    proc.stdout.close()
+    err = proc.stderr.read()
+    assert proc.wait(timeout=120) == 0 and err == "", (proc.returncode, err)
 
 
 def test_a_reader_that_stops_reading_gets_no_traceback(ready):

@@ -46,7 +46,7 @@ def test_two_servos_on_one_id_are_found_out(tmp_path, capsys):
         assert found[2]["serials"] == []
         # AssignId reaches one of them by its serial number.
         rc, _, err = run(sim, capsys, "id", "assign", "0x51a00003", "1")
-        assert rc == 1 and "ID 1 already answers on this bus" in err, err
+        assert rc == 2 and "ID 1 already answers on this bus" in err, err  # nothing sent
         rc, out, _ = run(sim, capsys, "id", "assign", "0x51a00003", "7")
         assert rc == 0 and "servo serial 0x51a00003 is now ID 7" in out
         rc, out, _ = run(sim, capsys, "scan", "--last", "9", "--json")

@@ -184,11 +184,22 @@ def test_servoctl_image_and_update_several_servos(sim3, capsys, tmp_path):
         assert [firmware(bus, i) for i in (1, 2, 3)] == [NEW, OLD, NEW]
 
 
+def test_an_image_larger_than_the_slot_is_refused_before_writing(sim, capsys, tmp_path):
+    """Refused before a byte of it is written: exit 2, as every value
+    servoctl refuses before sending; the old application runs on."""
+    big = tmp_path / "big.img"  # 256 KB: more than any slot
+    big.write_bytes(img.build(b"\x01" * 256 * 1024, NEW, img.BOARDS["host_sim"]))
+    rc, text, _ = run(sim, capsys, "update", str(big), "1")
+    assert rc == UsageError.exit_code and "larger than the slot" in text, text
+    with sim.bus(timeout=0.2) as bus:
+        assert firmware(bus, 1) == OLD
+
+
 def test_servoctl_update_refuses_what_cannot_be_right(sim, capsys, tmp_path):
     foreign = tmp_path / "f103.img"
     foreign.write_bytes(img.build(b"\x00" * 64, 0x0042, img.BOARDS["stm32f103"]))
     rc, text, _ = run(sim, capsys, "update", str(foreign), "1")
-    assert rc == Refused.exit_code
+    assert rc == UsageError.exit_code  # refused before sending, as every value is
     assert "servo 1 is host_sim (0x5100); the image is for stm32f103 (0x0103)" in text, text
     not_an_image = tmp_path / "app.bin"
     not_an_image.write_bytes(b"\x00" * 600)

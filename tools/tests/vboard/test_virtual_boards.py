@@ -20,8 +20,6 @@ from servoctl.servo import Servo
 from servoctl.sim import PLANTS, Simulator
 from vboard.board import board_h, images
 
-from ..erase_rule import again_if_unanswered
-
 BOARDS = ["stm32f103", "stm32f030k6"]
 
 
@@ -230,10 +228,10 @@ def test_a_clear_on_a_full_page_while_driven_is_refused_then_taken(tmp_path, boa
             assert servo.read_fault(0).count == 16
             # A request that comes during a page erase (the spare fault page's
             # once it shows nothing, the config store's) is carried out but
-            # not answered (docs/decisions-hardware.md): each is safe to repeat.
-            again_if_unanswered(lambda: servo.write("soft_start_on", 0))
-            again_if_unanswered(lambda: servo.write("watchdog_action", 0))  # hold: driven all along
-            again_if_unanswered(lambda: servo.write("watchdog_ms", 50))
+            # not answered (docs/decisions-hardware.md): servoctl reads it back.
+            servo.write("soft_start_on", 0)
+            servo.write("watchdog_action", 0)  # hold: driven all along
+            servo.write("watchdog_ms", 50)
             servo.move(300, interval_ms=100)
             sim.sleep(0.3)  # the watchdog holds; its fault fills the page
             assert servo.read_fault(0).kind == "watchdog"
@@ -242,7 +240,7 @@ def test_a_clear_on_a_full_page_while_driven_is_refused_then_taken(tmp_path, boa
             assert servo.read_fault(0).count == 16
             servo.stop("release")
             sim.sleep(0.5)  # released and quiet: the spare page is erased
-            again_if_unanswered(servo.clear_faults)
+            servo.clear_faults()  # one unanswered is read back (ReadFaults)
             sim.sleep(0.1)
             sim.control("powercycle 1")
             sim.sleep(0.5)  # the bootloader's window, then the application
@@ -383,8 +381,8 @@ def fill_until_the_spare_page_is_dirty(servo):
     n = 0
     while True:
         n += 1
-        again_if_unanswered(lambda: servo.write("current_limit", 3000 + n % 2))
-        records = again_if_unanswered(servo.read_store).records
+        servo.write("current_limit", 3000 + n % 2)
+        records = servo.read_store().records
         if records % SLOTS == 1 and records > 1:
             return
 
