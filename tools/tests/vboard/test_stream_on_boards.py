@@ -1,4 +1,4 @@
-"""Issue 55's stream repros on both virtual boards (the F103 and F030
+"""The stream's safety checks on both virtual boards (the F103 and F030
 images as flashed), as on servo_sim (tests/integration/test_stream_safety.py):
 a row beyond the angle limits and a row that is not a number are refused
 with their line before anything moves; after a power cycle at -30 deg, with

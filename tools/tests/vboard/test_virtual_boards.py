@@ -188,7 +188,7 @@ def test_the_safety_features_on_the_real_images(one):
 
 
 def test_the_watchdog_stops_a_duty_when_the_host_falls_silent(one):
-    """DriveDuty counts as driven (issue 55): the watchdog stops it, and
+    """DriveDuty counts as driven: the watchdog stops it, and
     ReadMotion does not call the output released while the duty is on."""
     sim, bus, servo = one
     servo.write("watchdog_action", 2)  # release
@@ -214,7 +214,7 @@ def test_a_clear_on_a_full_page_while_driven_is_refused_then_taken(tmp_path, boa
     """The image's fault pages with one slot left and the spare still
     showing faults (written into the board's flash file between runs): a
     watchdog fault while held fills the page, and ClearFaults is refused
-    until the servo is released and the bus quiet (issue 55)."""
+    until the servo is released and the bus quiet."""
     sim = start(tmp_path, board)
     finish(sim, [1])
     h = board_h(board)
