@@ -10,7 +10,7 @@ echo; echo "== building: host (simulator, tests) and the STM32F103 image"
 cmake --preset host >/dev/null
 cmake --build --preset host >/dev/null
 cmake --preset arm >/dev/null
-cmake --build --preset arm | grep -E '^image:' || true
+cmake --build --preset arm | grep -E '^image ' || true
 
 out=demo-output
 mkdir -p "$out"
