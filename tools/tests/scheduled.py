@@ -1,8 +1,10 @@
 """Frames put on the simulated wire at simulated times, through the control
-port's hostsend (servo_sim's and the virtual boards'), and the answers read
-back. A test that times its frames this way judges what the servo does with
-them, when it got them: a host that a loaded PC runs late changes nothing
-(docs/testing.md, "Under load")."""
+port's hostsend (servo_sim's and the virtual boards'). A test that times its
+frames this way judges what the servo does with them, when it got them: a
+host that a loaded PC runs late changes nothing (docs/testing.md, "Under
+load"). Only frames that nothing answers are queued far ahead: the wire is
+the host's until its last queued byte, and an answer would wait behind it
+(and servo_sim calls the next servo's answer a collision)."""
 import math
 import socket
 import time
@@ -13,6 +15,7 @@ from servoctl.stream import Limits, Stream
 
 LINE_BYTES = 100  # hostsend's most bytes a line
 LEAD_S = 0.5      # from the schedule's making to its first frame, simulated
+QUEUE_BYTES = 8192  # servo_sim's wire holds that many bytes queued (SIM_BUS_QUEUE)
 
 
 def schedule(sim, frames) -> None:
@@ -20,6 +23,7 @@ def schedule(sim, frames) -> None:
     them through one control connection, so the last is queued as soon as
     the first. Fails if the clock had passed the first frame's time by
     then (the frames would not be where the test put them)."""
+    assert sum(len(data) for _, data in frames) <= QUEUE_BYTES, "more than the simulated wire queues"
     lines = [f"hostsend {at_s * 1000:.3f} {data[k:k + LINE_BYTES].hex()}\n"
              for at_s, data in frames for k in range(0, len(data), LINE_BYTES)]
     with socket.create_connection(("127.0.0.1", sim.control_port), timeout=30) as conn:
