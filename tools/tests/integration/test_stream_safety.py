@@ -98,8 +98,9 @@ def test_the_stream_waits_for_a_soft_started_lead_in(sim, tmp_path, capsys):
     out = capsys.readouterr().out
     print(out)
     assert rc == 0
-    peak = float(out.split("peak ")[1].split(" deg")[0])
-    assert peak < 5.0, out
+    # At the first row when the stream began (the report's peak error is the
+    # host's too: a loaded PC sends late, and it grows).
+    assert lead_in_of(out)[1] == pytest.approx(60.0, abs=0.5), out
     assert "soft start" in out
     assert sim.clock_s() - begun > 3.0 + 99 * 0.02
 
@@ -118,7 +119,6 @@ def test_the_lead_in_keeps_the_bus_watchdog_fed(sim, tmp_path, capsys):
     out = capsys.readouterr().out
     print(out)
     assert rc == 0
-    assert float(out.split("peak ")[1].split(" deg")[0]) < 5.0, out
     # A watchdog that acted in the lead-in would have stopped it short (rc 1).
     assert "servo 1: from 0.0 deg to 40.0 deg" in out, out
 
