@@ -18,6 +18,25 @@ function(servo_board_linker_script out template)
   set(${out} ${ld} PARENT_SCOPE)
 endfunction()
 
+# servo_board_limits(): the limits an image of the board whose folder calls
+# it is checked against, its own, unless its board.cmake sets them: the
+# application's slot (board.h: BOARD_SLOT_PAGES x BOARD_FLASH_PAGE) less the
+# update image's 256-byte header (firmware/bootloader/app_image.h), and the
+# part's RAM (BOARD_RAM_SIZE).
+macro(servo_board_limits)
+  file(STRINGS ${CMAKE_CURRENT_SOURCE_DIR}/board.h _board_defines REGEX "^#define BOARD_(SLOT_PAGES|FLASH_PAGE|RAM_SIZE) ")
+  foreach(_line ${_board_defines})
+    string(REGEX MATCH "^#define (BOARD_[A-Z_]+) ([0-9]+)" _ ${_line})
+    set(_${CMAKE_MATCH_1} ${CMAKE_MATCH_2})
+  endforeach()
+  if(NOT DEFINED SERVO_BOARD_FLASH_LIMIT)
+    math(EXPR SERVO_BOARD_FLASH_LIMIT "${_BOARD_SLOT_PAGES} * ${_BOARD_FLASH_PAGE} - 256")
+  endif()
+  if(NOT DEFINED SERVO_BOARD_RAM_LIMIT)
+    set(SERVO_BOARD_RAM_LIMIT ${_BOARD_RAM_SIZE})
+  endif()
+endmacro()
+
 # servo_arm_image(NAME SOURCES src... [LIBS lib...]): the image of the board
 # whose folder calls it (board.cmake: its startup code and port library;
 # board.h: its flash map, read by the linker script made from it), a .bin
@@ -30,10 +49,7 @@ function(servo_arm_image name)
   endif()
   servo_board_linker_script(I_LINKER app)
   get_filename_component(board ${CMAKE_CURRENT_SOURCE_DIR} NAME)
-  if(NOT DEFINED SERVO_BOARD_FLASH_LIMIT)
-    set(SERVO_BOARD_FLASH_LIMIT 32768)
-    set(SERVO_BOARD_RAM_LIMIT 8192)
-  endif()
+  servo_board_limits()
   add_executable(${name}.elf ${I_SOURCES} ${SERVO_BOARD_SOURCES} ${SERVO_BOARD_STARTUP})
   target_link_libraries(${name}.elf PRIVATE ${I_LIBS} ${SERVO_BOARD_PORT} servo_app)
   if(SERVO_SIZE_FIRST)
@@ -93,6 +109,7 @@ function(servo_arm_bootloader name)
   target_link_libraries(${name}.elf PRIVATE ${SERVO_BOARD_PORT} servo_bootloader_core)
   target_include_directories(${name}.elf PRIVATE ${PROJECT_SOURCE_DIR}/firmware)
   servo_firmware_target(${name}.elf)
+  servo_board_limits()
   servo_board_linker_script(boot_ld boot)
   get_filename_component(board ${CMAKE_CURRENT_SOURCE_DIR} NAME)
   add_dependencies(${name}.elf ${board}_boot_ld)

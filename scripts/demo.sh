@@ -12,7 +12,7 @@ cmake --build --preset host >/dev/null
 # Both images, so `servoctl sim --board stm32f103|stm32f030k6` works after the demo.
 for preset in arm arm-m0; do
     cmake --preset "$preset" >/dev/null
-    cmake --build --preset "$preset" | grep -E '^image:' || true
+    cmake --build --preset "$preset" | grep -E '^image ' || true
 done
 
 out=demo-output

@@ -14,6 +14,6 @@ echo
 echo "STM32F030K6 (Cortex-M0):"
 python3 cmake/footprint.py build/arm-m0/firmware/boards/stm32f030k6/servo_stm32f030k6.map
 echo
-echo "Bootloaders (4 KB each; the M0's also against its part's 4 KB RAM):"
-sh cmake/check-image.sh build/arm/firmware/boards/stm32f103/servo_stm32f103_boot.elf 4096
+echo "Bootloaders (4 KB each, and each part's RAM: 20 KB, 4 KB):"
+sh cmake/check-image.sh build/arm/firmware/boards/stm32f103/servo_stm32f103_boot.elf 4096 20480
 sh cmake/check-image.sh build/arm-m0/firmware/boards/stm32f030k6/servo_stm32f030k6_boot.elf 4096 4096

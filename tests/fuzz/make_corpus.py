@@ -163,7 +163,7 @@ SERVO_SEEDS = {
     # a setpoint at the angle limit whose end speed would run on past it (a
     # 1 s period from the stamps), a step beyond the speed, the limits off and
     # a setpoint 2000 deg away, then item 48 = 2 and a multi-turn move past
-    # the limits (issue 55).
+    # the limits.
     "stream_within_and_at_the_limits": (USED, horn(FOLLOW)
                                         + b"".join(wire(stream(10 * k, 500, 20 * k)) + ms(20) for k in range(15))
                                         + wire(stream(1350, 7500, 1300)) + ms(300)

@@ -16,7 +16,8 @@ build() {
 }
 fail=0
 build
-sh "$root/cmake/check-image.sh" "$tmp/probe.elf" >/dev/null 2>&1 || { echo "clean image rejected"; fail=1; }
+sh "$root/cmake/check-image.sh" "$tmp/probe.elf" >"$tmp/out" 2>&1 || { echo "clean image rejected"; fail=1; }
+grep -q "^image probe.elf: " "$tmp/out" || { echo "the image is not named"; fail=1; }
 build -DUSE_FLOAT
 if sh "$root/cmake/check-image.sh" "$tmp/probe.elf" 2>"$tmp/err" >/dev/null; then
   echo "soft-float image accepted"; fail=1

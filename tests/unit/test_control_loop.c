@@ -143,7 +143,7 @@ static void test_a_hold_does_not_sag(void **state)
             assert_int_equal(status, 0);
         }
     }
-    /* Beyond: the 1 N m, and 1.5 N m. */
+    /* Beyond: 1 N m, and 1.5 N m. */
     const double beyond[] = {1.0, 1.5};
     for (size_t l = 0; l < sizeof beyond / sizeof beyond[0]; l++) {
         assert_true(beyond[l] > lift);

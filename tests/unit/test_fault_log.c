@@ -232,7 +232,7 @@ static void step_without_erase(void)
 
 /* A clear is promised within milliseconds: where its record would wait for
  * an erase (the page in use full, the spare not erased: a driven servo),
- * it is refused, not queued and lost (issue 55). Faults wait for the erase
+ * it is refused, not queued and lost. Faults wait for the erase
  * in RAM, in order, and are written after it. */
 static void test_a_clear_that_would_wait_for_an_erase_is_refused(void **state)
 {

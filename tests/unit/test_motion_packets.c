@@ -126,7 +126,7 @@ static void test_single_turn_targets_are_clamped_to_the_limits(void **state)
     assert_int_equal(angle_now(), 1800);
 }
 
-/* Issue 55, 1: with item 48 at 2 the limits (135.0 deg) hold multi-turn
+/* With item 48 at 2 the limits (135.0 deg) hold multi-turn
  * targets too, in the reading's own frame (a multi-turn 300.0 deg is not
  * -60.0 deg of the next turn), and a SyncCommand's records; the limiter
  * says angle. At 1, the maker's "on" and the factory's, a multi-turn move

@@ -110,7 +110,7 @@ static void factory(struct user_config *dt)
     assert_true(drive_items_stable(dt));
 }
 
-/* The issue's mistyped items (issue 55): each refused; the factory items,
+/* Mistyped drive items: each refused; the factory items,
  * a reversed ratio and ratio 0 (no plant declared) are not. */
 static void test_mistyped_drive_items_are_unstable(void **state)
 {

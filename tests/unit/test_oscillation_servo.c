@@ -1,4 +1,4 @@
-/* Issue 55: a mistyped drive item is refused and ReadStore says why; one
+/* A mistyped drive item is refused and ReadStore says why; one
  * that gets past the check anyway (an older firmware's store) makes the horn
  * run away, and the oscillation monitor (item 72) releases it and logs
  * fault 9 within the item's time; a normal move never trips it. On the

@@ -246,8 +246,8 @@ static bool command_error(void)
 
 /* DriveDuty drives the bridge: ReadMotion does not call it released, the
  * origin stays put, and the watchdog lets it go within two ticks of its
- * time (issue 55: a host that died mid-identify left the motor driven for
- * up to 10 s). */
+ * time (a host that died mid-identify had left the motor driven for up
+ * to 10 s). */
 static void test_an_applied_duty_is_driven_and_watched(void **state)
 {
     (void)state;
@@ -428,7 +428,7 @@ static void fill_the_history_but_a_slot(void)
 
 /* A page that fills while the output is driven waits for the erase (the
  * output released, the bus quiet): a ClearFaults then would wait with it,
- * so it is refused, and taken once the erase is done (issue 55: it was
+ * so it is refused, and taken once the erase is done (it was
  * answered "done" and neither applied nor kept). A fault that comes while
  * it waits is kept and written after the erase. */
 static void test_a_clear_on_a_full_page_while_driven_is_refused_then_taken(void **state)

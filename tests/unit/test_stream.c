@@ -223,7 +223,7 @@ static int32_t read_item(enum data_item_id item)
     return ANSWER_FIELD(PKT_READ_DATA, 2, hal.sent_length - 7u, 0);
 }
 
-/* Issue 55, 1: with the limits on (the factory's, 135 deg), a setpoint of
+/* With the limits on (the factory's, 135 deg), a setpoint of
  * 300 deg, alone or as a SyncCommand's record, leaves the horn at the
  * limit, and the limiter says angle; one within them says nothing. */
 static void test_a_streamed_setpoint_keeps_to_the_angle_limits(void **state)
@@ -325,7 +325,7 @@ static struct peaks plan_peaks(void)
     return k;
 }
 
-/* Issue 55, 1: a 100 deg step in 20 ms from rest asked 7 500 deg/s of the
+/* A 100 deg step in 20 ms from rest asked 7 500 deg/s of the
  * cubic. Now the setpoint is reached as a move at the stream's limits:
  * 750 deg/s at most, 37 500 deg/s^2. */
 static void test_a_step_keeps_to_the_speed_and_acceleration_limits(void **state)
@@ -390,7 +390,7 @@ static void test_no_setpoint_asks_more_than_the_limits(void **state)
     assert_true(moves > TRIALS / 10 && moves < TRIALS * 9 / 10);
 }
 
-/* Issue 55, 6: a setpoint 2000 deg away stopped at 1638.5 deg (one
+/* A setpoint 2000 deg away stopped at 1638.5 deg (one
  * segment's reach) without a word. It is reached, at the stream's top
  * speed; the whole multi-turn range is planned the same way. */
 static void test_a_far_setpoint_is_reached(void **state)

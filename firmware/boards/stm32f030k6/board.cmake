@@ -1,8 +1,8 @@
 # The Cortex-M0 servo board: STM32F030K6 (48 MHz, 32 KB flash, 4 KB RAM),
 # its pins in README.md; ID, flash map and front end in board.h.
-# Budgets (cmake/check-image.sh): the part's 4 KB RAM; 24 KB flash for the
-# application, so the 4 KB bootloader, the application, the 2 KB store and 2 KB spare
-# fit 32 KB.
+# Limits (cmake/check-image.sh), as its board.h gives them: the part's 4 KB RAM; 24 KB flash for the
+# application, so the 4 KB bootloader, the application, the 2 KB fault history
+# and the 2 KB store fit 32 KB.
 set(SERVO_BOARD_CPU cortex-m0)
 set(SERVO_BOARD_PORT servo_stm32f0)                      # hal/ports/stm32f0
 set(SERVO_BOARD_STARTUP ${PROJECT_SOURCE_DIR}/firmware/startup/startup_stm32f030.c)

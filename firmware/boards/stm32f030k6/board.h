@@ -37,8 +37,9 @@
  * no request waits. */
 #define BOARD_RX_RING_BYTES 512
 #define BOARD_BOOT_RX_RING_BYTES 256
-/* The longest control tick and a main-loop pass at 48 MHz (the target
- * bench's servo_tick_worst and idle_poll, docs/benchmark.md): 39.1 + 6.2 us. */
+/* The longest control tick and a main-loop pass at 48 MHz, rounded up to
+ * whole us: the target bench's servo_tick_worst + idle_poll, in cycles
+ * (docs/benchmark.md; tools/tests/test_doc_figures.py checks it). */
 #define BOARD_TICK_AND_PASS_US 46
 /* The analogue front end: the reference board's (stm32f103/board.h). */
 #define BOARD_SUPPLY_UV_PER_COUNT 8862

@@ -31,8 +31,9 @@
  * waits: 256 bytes. */
 #define BOARD_RX_RING_BYTES 4096
 #define BOARD_BOOT_RX_RING_BYTES 256
-/* The longest control tick and a main-loop pass at 72 MHz (the target
- * bench's servo_tick_worst and idle_poll, docs/benchmark.md): 13.7 + 3.6 us. */
+/* The longest control tick and a main-loop pass at 72 MHz, rounded up to
+ * whole us: the target bench's servo_tick_worst + idle_poll, in cycles
+ * (docs/benchmark.md; tools/tests/test_doc_figures.py checks it). */
 #define BOARD_TICK_AND_PASS_US 18
 
 /* The analogue front end: 3.3 V ADC reference; supply through a 100k/10k

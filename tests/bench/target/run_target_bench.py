@@ -313,6 +313,7 @@ def main():
     ap.add_argument("--lines", action="store_true", help="with --profile: by source line instead")
     ap.add_argument("--cpu", default="cortex-m3", choices=sorted(CPUS), help="with --profile: which CPU's")
     ap.add_argument("--markdown", action="store_true", help="also print the table in Markdown (docs/benchmark.md)")
+    ap.add_argument("--doc", type=Path, help="fail when this document's table (docs/benchmark.md) is not the one measured")
     args = ap.parse_args()
     if not PLUGIN.exists():
         sys.exit(f"run_target_bench: {PLUGIN} is missing: cmake --build --preset host")
@@ -330,19 +331,45 @@ def main():
         over += [f"{key} (M3)"] * over3 + [f"{key} (M0)"] * over0
         print(f"{key:<28} {i3:>9.2f} {c3:>10.1f} {c3 / CLOCK_MHZ['cortex-m3']:>7.1f} {i0:>9.1f} "
               f"{c0:>10.1f} {c0 / CLOCK_MHZ['cortex-m0']:>7.1f}  {mark3} | {mark0}")
+    table = markdown(m3, m0)
     if args.markdown:
-        print("\n| figure | M3 instr | M3 cycles (µs) | M0 instr | M0 cycles (µs) | budget M3 / M0 |")
-        print("|---|---:|---:|---:|---:|---|")
-        for key in m3:
-            (i3, c3), (i0, c0) = m3[key], m0[key]
-            marks = " / ".join(judge(cpu, key, *fig)[0] or "–" for cpu, fig in
-                               (("cortex-m3", m3[key]), ("cortex-m0", m0[key])))
-            print(f"| {key} | {i3:.2f} | {c3:.0f} ({c3 / CLOCK_MHZ['cortex-m3']:.1f}) | {i0:.1f} | "
-                  f"{c0:.0f} ({c0 / CLOCK_MHZ['cortex-m0']:.1f}) | {marks if marks != '– / –' else ''} |")
+        print("\n" + "\n".join(table))
     if args.json:
         args.json.write_text(json.dumps(results, indent=2))
     if over and args.check:
         sys.exit(f"run_target_bench: over budget: {', '.join(over)}")
+    if args.doc:
+        differ = doc_differs(args.doc, table)
+        if differ:
+            sys.exit(f"run_target_bench: {args.doc}'s table is not what the benchmark measures now "
+                     f"(--markdown prints it):\n" + "\n".join(differ))
+        print(f"run_target_bench: {args.doc}'s table is the benchmark's")
+
+
+def markdown(m3: dict, m0: dict) -> list:
+    """The figures as docs/benchmark.md's table, a line each."""
+    lines = ["| figure | M3 instr | M3 cycles (µs) | M0 instr | M0 cycles (µs) | budget M3 / M0 |",
+             "|---|---:|---:|---:|---:|---|"]
+    for key in m3:
+        (i3, c3), (i0, c0) = m3[key], m0[key]
+        marks = " / ".join(judge(cpu, key, *fig)[0] or "–" for cpu, fig in
+                           (("cortex-m3", m3[key]), ("cortex-m0", m0[key])))
+        lines.append(f"| {key} | {i3:.2f} | {c3:.0f} ({c3 / CLOCK_MHZ['cortex-m3']:.1f}) | {i0:.1f} | "
+                     f"{c0:.0f} ({c0 / CLOCK_MHZ['cortex-m0']:.1f}) | {marks if marks != '– / –' else ''} |")
+    return lines
+
+
+def doc_differs(doc: Path, table: list) -> list:
+    """The lines where doc's table (the one that starts with the same
+    header) and the measured one differ: '- doc' / '+ measured'."""
+    lines = doc.read_text().splitlines()
+    start = lines.index(table[0]) if table[0] in lines else len(lines)
+    end = start
+    while end < len(lines) and lines[end].startswith("|"):
+        end += 1
+    kept = lines[start:end]
+    return [f"- {a}\n+ {b}" for a, b in zip(kept + [""] * len(table), table) if a != b] + \
+        [f"- {a}" for a in kept[len(table):]]
 
 
 if __name__ == "__main__":

@@ -46,7 +46,7 @@ def test_each_plant_runs_on_its_supply_and_moves(tmp_path, plant):
             s.move(0, interval_ms=300)
             sim.sleep(0.5)
             angles = trace(sim, s, 450)
-            assert abs(angles[-1] - 450) <= 15, angles  # factory gains: tuning is issue 42's tune
+            assert abs(angles[-1] - 450) <= 15, angles  # factory gains, not tuned (servoctl tune)
             assert s.read("status") == 0
     finally:
         finish(sim, [1])

@@ -141,7 +141,7 @@ def test_faults_are_read_back_in_order_after_a_power_cycle(sim, capsys):
 
 
 def test_the_watchdog_stops_a_duty_when_the_host_falls_silent(sim, servo):
-    """DriveDuty counts as driven (issue 55): a host that dies mid-identify
+    """DriveDuty counts as driven: a host that dies mid-identify
     no longer leaves the bridge driven for up to 10 s."""
     servo.write("watchdog_action", 2)  # release
     servo.write("watchdog_ms", 100)
@@ -182,7 +182,7 @@ def test_a_clear_on_a_full_page_while_driven_is_refused_then_taken(tmp_path, cap
     """The fault page fills while the output is held: the spare page waits
     for the output released and a quiet bus (a page erase stalls the CPU),
     and a ClearFaults meanwhile is refused, where it was answered "done"
-    and then neither applied nor kept (issue 55). Released, it is taken."""
+    and then neither applied nor kept. Released, it is taken."""
     (tmp_path / "state").mkdir()
     (tmp_path / "state" / "servo-1.faults").write_bytes(_history_with_one_slot_left())
     sim = _start(tmp_path, [1])

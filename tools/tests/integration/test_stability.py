@@ -1,4 +1,4 @@
-"""Issue 55, item 2: one mistyped drive item made the servo run away. Now
+"""One mistyped drive item made the servo run away. Now
 servoctl refuses it before writing (stability.py, tune's model) and the
 servo refuses it too (drive_items_stable: ReadStore's bit 2 says why); one
 that gets past both (servo_sim's forcekt, as an older firmware's store

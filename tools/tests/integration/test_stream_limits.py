@@ -1,4 +1,4 @@
-"""The servo's own limits on streamed setpoints (issue 55, items 1 and 6),
+"""The servo's own limits on streamed setpoints,
 on servo_sim: raw StreamSetpoint packets, as any host may send them, past
 whatever servoctl checks first. With the angle limits on, a setpoint past
 them leaves the horn at the limit and the limiter says angle, alone or as
@@ -32,7 +32,7 @@ def settled(sim, servo, timeout_s):
 def test_a_streamed_setpoint_past_the_angle_limit_stops_at_it(sim, bus, servo):
     servo.write("angle_limit_on", 1)
     servo.write("angle_max", 1350)
-    setpoint(bus, 1, 3000)  # 300 deg: the issue's CSV row
+    setpoint(bus, 1, 3000)  # 300 deg, beyond angle_max
     snap = settled(sim, servo, 3.0)
     assert 1345 <= snap.angle_decideg <= 1352, snap
     assert snap.target_decideg == 1350, snap

@@ -1,4 +1,4 @@
-"""Bring-up on the simulator, for each shipped plant (issue 42, part 4),
+"""Bring-up on the simulator, for each shipped plant,
 built as a servo may come (the encoder's magnet turned, the motor's leads
 swapped, the current amplifier off zero): from the factory items (the
 reference servo's drive train and gains, wrong for the other two),

@@ -176,7 +176,7 @@ def test_servoctl_image_and_update_several_servos(sim3, capsys, tmp_path):
     rc, text, _ = run(sim3, capsys, "image", str(binary), "--version", "0x0042", "--board", "host_sim",
                       "-o", str(out))
     assert rc == 0 and "version 0x0042" in text
-    rc, text, err = run(sim3, capsys, "update", "1", "3", str(out))  # IDs first, as in the issue
+    rc, text, err = run(sim3, capsys, "update", "1", "3", str(out))  # IDs first, as a user types them
     assert rc == 0, err
     assert "servo 1: version 0x0010 -> 0x0042" in text
     assert "servo 3: version 0x0010 -> 0x0042" in text

@@ -1,4 +1,4 @@
-"""Issue 55, item 2, on the shipped ARM images (both virtual boards): the
+"""Mistyped drive items on the shipped ARM images (both virtual boards): the
 mistyped drive items are refused by the firmware's own check, and ReadStore
 right after says why; servoctl's check refuses them before writing. Time is
 the boards' simulated time."""

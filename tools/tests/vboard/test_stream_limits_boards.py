@@ -1,4 +1,4 @@
-"""Issue 55's stream repros (items 1 and 6) on both virtual boards, the
+"""The servo's own limits on streamed setpoints on both virtual boards, the
 shipped images as flashed: with the angle limits on (135 deg), a streamed
 setpoint of 300 deg leaves the horn at the limit and the limiter says
 angle; a setpoint 2000 deg away is planned to the end (it stopped at

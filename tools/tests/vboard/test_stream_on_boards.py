@@ -1,4 +1,4 @@
-"""Issue 55's stream repros on both virtual boards (the F103 and F030
+"""The stream's safety checks on both virtual boards (the F103 and F030
 images as flashed), as on servo_sim (tests/integration/test_stream_safety.py):
 a row beyond the angle limits and a row that is not a number are refused
 with their line before anything moves; after a power cycle at -30 deg, with
@@ -57,7 +57,6 @@ def test_the_stream_repros_on_the_real_images(tmp_path, board, capsys):
         print(out)
         assert rc == 0
         assert "soft start" in out and lead_in_of(out) == pytest.approx((-30.0, -30.0), abs=0.15), out
-        assert float(out.split("peak ")[1].split(" deg")[0]) < 5.0, out
         assert abs(sim.state(1)["angle"] - float(rows[-1])) < 2.0
     finally:
         sim.stop()

@@ -20,6 +20,8 @@ from servoctl.servo import Servo
 from servoctl.sim import PLANTS, Simulator
 from vboard.board import board_h, images
 
+from ..scheduled import followed
+
 BOARDS = ["stm32f103", "stm32f030k6"]
 
 
@@ -185,7 +187,7 @@ def test_the_safety_features_on_the_real_images(one):
 
 
 def test_the_watchdog_stops_a_duty_when_the_host_falls_silent(one):
-    """DriveDuty counts as driven (issue 55): the watchdog stops it, and
+    """DriveDuty counts as driven: the watchdog stops it, and
     ReadMotion does not call the output released while the duty is on."""
     sim, bus, servo = one
     servo.write("watchdog_action", 2)  # release
@@ -211,7 +213,7 @@ def test_a_clear_on_a_full_page_while_driven_is_refused_then_taken(tmp_path, boa
     """The image's fault pages with one slot left and the spare still
     showing faults (written into the board's flash file between runs): a
     watchdog fault while held fills the page, and ClearFaults is refused
-    until the servo is released and the bus quiet (issue 55)."""
+    until the servo is released and the bus quiet."""
     sim = start(tmp_path, board)
     finish(sim, [1])
     h = board_h(board)
@@ -269,19 +271,20 @@ def test_sync_monitor_and_sync_moves_on_a_bus(tmp_path, board):
 
 def test_a_streamed_trajectory_is_followed(one):
     """StreamSetpoint on the image as flashed: a 0.5 Hz +-60 deg cosine at
-    50 Hz for 1.5 s, from rest at its peak, followed as on servo_sim."""
+    50 Hz for 1.5 s, from rest at its peak, its frames put on the simulated
+    wire at their times (tests/scheduled.py), followed as on servo_sim:
+    the horn against the path as it was given, whatever the load on the
+    host (a host run late by a loaded PC had made it 14 and 42 deg RMS)."""
     import math
-
-    from servoctl.stream import stream_file
 
     sim, bus, servo = one
     times = [k * 0.02 for k in range(76)]
     angles = {1: [60.0 * math.cos(math.pi * t) for t in times]}
     group.sync_move(bus, {1: 60.0}, duration_s=0.5, multi_turn=True)
     sim.sleep(0.7)
-    report = stream_file(bus, times, angles)
-    assert report.missed == 0
-    assert report.rms_deg[1] < 0.8 and report.peak_deg[1] < 5.0, report  # the peak: a late host's
+    rms, peak, samples = followed(sim, times, angles)[1]
+    print(f"RMS {rms:.2f} deg, peak {peak:.2f} deg of {samples} samples")
+    assert samples >= 10 and rms < 0.3 and peak < 1.0, (rms, peak, samples)
 
 
 def test_the_makers_sdk(tmp_path, board):

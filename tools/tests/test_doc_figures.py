@@ -1,0 +1,146 @@
+"""Figures and commands in the docs against what produces them, so they
+cannot drift: docs/footprint.md against the linker maps and images of the
+build (scripts/footprint.sh's own reading), the README's robot loop against
+docs/streaming.md's table (scripts/stream_bench.sh), each board's
+BOARD_TICK_AND_PASS_US against docs/benchmark.md's table (which the test
+command checks against the target benchmark: run_target_bench.py --doc),
+every `servoctl config set` in the docs against servoctl's own parser, the
+Python servoctl needs against tools/pyproject.toml, building.md's list of
+docs against docs/. Reads files only: it costs the suite well under a
+second."""
+import math
+import re
+import subprocess
+import sys
+import tomllib
+from pathlib import Path
+
+import pytest
+
+from servoctl import registers, units
+
+ROOT = Path(__file__).resolve().parents[2]
+DOCS = ROOT / "docs"
+F103 = ROOT / "build/arm/firmware/boards/stm32f103"
+F030 = ROOT / "build/arm-m0/firmware/boards/stm32f030k6"
+CLOCK_MHZ = {"stm32f103": 72, "stm32f030k6": 48}  # run_target_bench.py's CLOCK_MHZ, by board
+
+
+def number(text: str) -> int:
+    """A figure as the docs write it: '25 028 B', '**24 248 B**'."""
+    return int(re.sub(r"[^0-9]", "", text))
+
+
+def table(text: str, header: str) -> list:
+    """The rows (lists of cells) of the Markdown table whose header line
+    starts with header."""
+    rows, inside = [], False
+    for line in text.splitlines():
+        if line.startswith(header):
+            inside = True
+            continue
+        if inside and not line.startswith("|"):
+            break
+        if inside and not line.startswith("|---"):
+            rows.append([c.strip() for c in line.strip("|").split("|")])
+    assert rows, f"no table with the header {header!r}"
+    return rows
+
+
+def table_rows(text: str, header: str) -> dict:
+    """{first cell: the other cells} of that table."""
+    return {cells[0]: cells[1:] for cells in table(text, header)}
+
+
+def footprint_modules(map_path: Path) -> dict:
+    out = subprocess.run([sys.executable, str(ROOT / "cmake/footprint.py"), str(map_path)],
+                         capture_output=True, text=True, check=True).stdout
+    return {name: int(cells[0].strip("*")) for name, cells in table_rows(out, "| module |").items()}
+
+
+def image_flash(elf: Path) -> int:
+    line = subprocess.run(["sh", str(ROOT / "cmake/check-image.sh"), str(elf)],
+                          capture_output=True, text=True).stdout
+    return int(re.search(r"flash (\d+) B", line).group(1))
+
+
+needs_arm = pytest.mark.skipif(not (F103 / "servo_stm32f103.map").exists() or not (F030 / "servo_stm32f030k6.map").exists(),
+                               reason="no ARM build (cmake --build --preset arm, arm-m0)")
+
+
+@needs_arm
+def test_footprint_md_is_what_the_build_links():
+    doc = (DOCS / "footprint.md").read_text()
+    f103, f030 = footprint_modules(F103 / "servo_stm32f103.map"), footprint_modules(F030 / "servo_stm32f030k6.map")
+    modules = table_rows(doc, "| module |")
+    wrong = [f"{name}: {cells[:2]} in the doc, {[f103.get(name, 0), f030.get(name, 0)]} built"
+             for name, cells in modules.items()
+             if [number(c) for c in cells[:2]] != [f103.get(name, 0), f030.get(name, 0)]]
+    missing = sorted((set(f103) | set(f030)) - set(modules))
+    assert not wrong and not missing, f"docs/footprint.md (bash scripts/footprint.sh): {wrong} {missing}"
+    images = table_rows(doc, "| image |")
+    for row, elf in (("reference board, STM32F103 (Cortex-M3)", F103 / "servo_stm32f103.elf"),
+                     ("Cortex-M0 board, STM32F030K6 (`arm-m0`)", F030 / "servo_stm32f030k6.elf"),
+                     ("bootloader, STM32F103", F103 / "servo_stm32f103_boot.elf"),
+                     ("bootloader, STM32F030K6", F030 / "servo_stm32f030k6_boot.elf")):
+        assert number(images[row][0]) == image_flash(elf), f"docs/footprint.md: {row}"
+
+
+def test_the_readme_gives_the_robot_loop_of_streaming_md():
+    ratios = [float(x) for cells in table((DOCS / "streaming.md").read_text(), "| servos |")
+              for x in re.findall(r"[0-9]\.[0-9]+", cells[4])]
+    readme = (ROOT / "README.md").read_text()
+    said = re.search(r"a robot loop at ([0-9.]+)–([0-9.]+) of the wire", readme)
+    assert said and (float(said.group(1)), float(said.group(2))) == (min(ratios), max(ratios)), \
+        (said and said.group(0), min(ratios), max(ratios))
+
+
+@pytest.mark.parametrize("board, column", [("stm32f103", 1), ("stm32f030k6", 3)])
+def test_each_boards_tick_and_pass_is_the_benchmarks(board, column):
+    """BOARD_TICK_AND_PASS_US: the longest control tick and a main-loop
+    pass (servo_tick_worst + idle_poll) at the board's clock, rounded up."""
+    rows = table_rows((DOCS / "benchmark.md").read_text(), "| figure | M3 instr |")
+    cycles = sum(number(rows[key][column].split("(")[0]) for key in ("servo_tick_worst", "idle_poll"))
+    header = (ROOT / "firmware/boards" / board / "board.h").read_text()
+    given = int(re.search(r"#define BOARD_TICK_AND_PASS_US (\d+)", header).group(1))
+    assert given == math.ceil(cycles / CLOCK_MHZ[board]), (board, given, cycles / CLOCK_MHZ[board])
+
+
+def test_every_config_set_in_the_docs_is_taken():
+    """What a reader copies from the docs, servoctl takes (units.to_raw,
+    as `servoctl config set` parses it); docs/bring-up.md's high_voltage
+    12600 was refused: it needs a unit."""
+    seen = 0
+    for path in [ROOT / "README.md", *sorted(DOCS.glob("*.md"))]:
+        text = re.sub(r"\s+", " ", path.read_text())
+        for m in re.finditer(r"servoctl (?:--[a-z-]+ \S+ )*config set (\d+|ID|N) ([a-z_0-9]+) ([^\s`']+)", text):
+            if m.group(3).startswith(("-", "<", "N")):
+                continue
+            seen += 1
+            try:
+                units.to_raw(registers.find(m.group(2)), m.group(3))
+            except Exception as e:  # noqa: BLE001 - the message names the doc
+                pytest.fail(f"{path.name}: `{m.group(0)}` is refused: {e}")
+    assert seen >= 5
+
+
+def test_pyproject_asks_the_python_servoctl_needs():
+    needs = (3, 11) if any("import tomllib" in p.read_text() for p in (ROOT / "tools/servoctl").glob("*.py")) else (3, 9)
+    project = tomllib.loads((ROOT / "tools/pyproject.toml").read_text())["project"]
+    floor = tuple(int(x) for x in re.match(r">=\s*(\d+)\.(\d+)", project["requires-python"]).groups())
+    assert floor >= needs, project["requires-python"]
+
+
+def test_building_md_lists_every_doc():
+    listed = set(re.findall(r"`([a-z-]+\.md)`", (DOCS / "building.md").read_text()))
+    missing = sorted(p.name for p in DOCS.glob("*.md") if p.name not in listed)
+    assert not missing, f"docs/building.md's list of docs leaves out {missing}"
+
+
+def test_no_test_names_an_issue_number():
+    """A test says what it checks: an issue's number goes stale."""
+    found = [f"{p.relative_to(ROOT)}:{n}" for base in ("tools/tests", "tests/unit", "tests/fuzz", "tests/bench")
+             for p in sorted((ROOT / base).rglob("*")) if p.suffix in (".py", ".c", ".h", ".sh")
+             for n, line in enumerate(p.read_text(errors="replace").splitlines(), 1)
+             if re.search(r"\bissues? \d+", line, re.IGNORECASE)]
+    assert not found, found
