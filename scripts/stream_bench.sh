@@ -71,10 +71,9 @@ def plain_moves(bus, ids, times):
         bus.send(p.SYNC, bytes([p.ANGLE, len(body) // len(ids), len(ids)]) + body)
         arrivals = {}
         states = sync_monitor(bus, ids, arrivals=arrivals)
-        for n, i in enumerate(ids):
-            if k and i in states:
-                at = arrivals[i] - (n + 1) * answer_s - start
-                errors.append(states[i].angle_decideg / 10 - path(at))
+        if k and states:  # when the states were taken (servoctl.stream.stream_file)
+            at = min(arrivals[i] - (n + 1) * answer_s for n, i in enumerate(ids) if i in states) - start
+            errors += [states[i].angle_decideg / 10 - path(at) for i in ids if i in states]
     return math.sqrt(sum(e * e for e in errors) / len(errors)), max(map(abs, errors))
 
 
