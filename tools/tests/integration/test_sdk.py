@@ -18,6 +18,7 @@ import serial
 # here rather than skipping quietly.
 from fashionstar_uart_sdk import PortHandler, SyncPositionControlOptions, UartServoManager
 
+from servoctl.servo import Servo
 from servoctl.sim import Simulator
 
 from .conftest import finish
@@ -38,14 +39,15 @@ def baud(request):
 def rig(tmp_path, baud):
     sim = Simulator(ids=IDS, tcp=False, state_dir=str(tmp_path / "state"), nice=SIMULATOR_NICE).start()
     try:
-        uart = serial.Serial(sim.url, 115200, timeout=0)
+        # Set up through servoctl, which waits on the simulated clock (the
+        # SDK waits 100 ms of the PC's): soft start off, then the rate.
+        with sim.bus(timeout=0.2) as bus:
+            for i in IDS:
+                Servo(bus, i).write("soft_start_on", 0)
+                if baud != 115200:
+                    Servo(bus, i).write("baud", BAUD_INDEX[baud])  # answered at 115200, then it switches
+        uart = serial.Serial(sim.url, baud, timeout=0)
         manager = UartServoManager(uart)
-        if baud != 115200:
-            for i in IDS:  # answered at 115200, then the servo switches
-                assert manager.write_data(i, 36, bytes([BAUD_INDEX[baud]]))
-            uart.baudrate = baud
-        for i in IDS:
-            assert manager.write_data(i, 49, b"\x00")  # soft start off
         yield sim, manager
         uart.close()
     finally:
