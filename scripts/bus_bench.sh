@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # servoctl at the wire's speed: Sync Monitor rounds of 16 simulated servos
 # and the update of a 20 KB image, at 1 000 000 and 115 200 baud, each
-# against the limit the packets' sizes (and the flash) set. Times are the
-# simulator's clock. Not part of the test command (about a minute).
+# against the limit the packets' sizes (and the flash) set, the host behind
+# the simulated USB adapter (the default) and on the raw link (each byte as it
+# ends on the wire; docs/simulator.md). Times are the simulator's clock. Not
+# part of the test command (about two minutes).
 #   bash scripts/bus_bench.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -18,8 +20,10 @@ from servoctl.servo import Servo
 from servoctl.sim import Simulator
 
 ids = list(range(1, 17))
-for baud in (1000000, 115200):
-    with Simulator(ids=ids, state_dir=tempfile.mkdtemp(prefix="bus-bench-")) as sim:
+for link, baud in [(link, baud) for link in ("usb", "raw") for baud in (1000000, 115200)]:
+    if baud == 1000000:
+        print(f"host link {link}:", flush=True)
+    with Simulator(ids=ids, state_dir=tempfile.mkdtemp(prefix="bus-bench-"), host_link=link) as sim:
         code = {rate: c for c, rate in registers.BAUD_RATES.items()}[baud]
         with sim.bus() as bus:
             for i in ids:

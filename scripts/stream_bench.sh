@@ -8,7 +8,9 @@
 #     servoctl: the RMS error of each servo's Sync Monitor state;
 #  3. the robot loop (one SyncCommand of setpoints and one Sync Monitor a
 #     cycle, servoctl.stream.RobotLoop) for 6 and 16 servos at 1 000 000 and
-#     115 200 baud: its rate against the wire limit.
+#     115 200 baud: its rate against the wire limit, the host behind the
+#     simulated USB adapter (the default) and on the raw link (each byte as
+#     it ends on the wire: servoctl against the wire alone; docs/simulator.md).
 # Times are the simulator's clock. Not part of the test command (a minute).
 #   bash scripts/stream_bench.sh
 set -euo pipefail
@@ -34,9 +36,9 @@ PERIOD, SECONDS = 0.02, 4.0
 
 
 @contextlib.contextmanager
-def at_baud(ids, baud):
+def at_baud(ids, baud, host_link=None):
     """Simulated servos at baud, soft start off; stopped whatever happens."""
-    with Simulator(ids=ids, state_dir=tempfile.mkdtemp(prefix="stream-bench-")) as sim:
+    with Simulator(ids=ids, state_dir=tempfile.mkdtemp(prefix="stream-bench-"), host_link=host_link) as sim:
         set_up(sim, ids, baud)
         yield sim
 
@@ -69,10 +71,9 @@ def plain_moves(bus, ids, times):
         bus.send(p.SYNC, bytes([p.ANGLE, len(body) // len(ids), len(ids)]) + body)
         arrivals = {}
         states = sync_monitor(bus, ids, arrivals=arrivals)
-        for n, i in enumerate(ids):
-            if k and i in states:
-                at = arrivals[i] - (n + 1) * answer_s - start
-                errors.append(states[i].angle_decideg / 10 - path(at))
+        if k and states:  # when the states were taken (servoctl.stream.stream_file)
+            at = min(arrivals[i] - (n + 1) * answer_s for n, i in enumerate(ids) if i in states) - start
+            errors += [states[i].angle_decideg / 10 - path(at) for i in ids if i in states]
     return math.sqrt(sum(e * e for e in errors) / len(errors)), max(map(abs, errors))
 
 
@@ -104,16 +105,17 @@ for streamed in (True, False):
     print(f"   {how} RMS error {rms:.2f} deg, peak {peak:.2f} deg (the worst servo)")
 
 print("3. the robot loop through servoctl's Python API (RobotLoop.cycle, 200 cycles):")
-for count in (6, 16):
-    for baud in (1000000, 115200):
-        ids = list(range(1, count + 1))
-        with at_baud(ids, baud) as sim, sim.bus(baud=baud, timeout=0.1) as bus:
-            loop = RobotLoop(bus, ids, PERIOD, pace=False)  # as fast as the wire goes
-            for k in range(200):
-                loop.cycle({i: 10.0 * math.sin(k / 20) for i in ids})
-            r = loop.rate()
-            host, first, between = cycle_gaps(sim)
-        print(f"   {count:2} servos at {baud:7} baud: {r.rate_hz:6.0f} Hz of the wire's {r.wire_limit_hz:6.0f} "
-              f"({r.ratio:.2f}), {loop.missed} state(s) missed; a cycle's gaps on the wire (mean us): "
-              f"host {host:.0f}, first answer {first:.0f}, between answers {between:.1f}")
+for count, baud, link in [(c, b, l) for l in ("usb", "raw") for c in (6, 16) for b in (1000000, 115200)]:
+    if count == 6 and baud == 1000000:
+        print(f"   host link {link}:")
+    ids = list(range(1, count + 1))
+    with at_baud(ids, baud, link) as sim, sim.bus(baud=baud, timeout=0.1) as bus:
+        loop = RobotLoop(bus, ids, PERIOD, pace=False)  # as fast as the wire goes
+        for k in range(200):
+            loop.cycle({i: 10.0 * math.sin(k / 20) for i in ids})
+        r = loop.rate()
+        host, first, between = cycle_gaps(sim)
+    print(f"   {count:2} servos at {baud:7} baud: {r.rate_hz:6.0f} Hz of the wire's {r.wire_limit_hz:6.0f} "
+          f"({r.ratio:.2f}), {loop.missed} state(s) missed; a cycle's gaps on the wire (mean us): "
+          f"host {host:.0f}, first answer {first:.0f}, between answers {between:.1f}")
 PY

@@ -309,7 +309,10 @@ def build_parser():
     c.add_argument("--id", dest="ids", type=int, action="append")
     c.add_argument("--tcp", type=int, nargs="?", const=0, default=None, metavar="PORT",
                    help="a TCP port instead of a pty (any free port if none given)")
-    c.add_argument("--link", help="symlink to the pty")
+    c.add_argument("--link", help="symlink to the pty (not with --tcp)")
+    c.add_argument("--host-link", metavar="usb|ftdi[:MS]|raw",
+                   help="how the host's USB-serial adapter hands over the bytes off the wire: usb "
+                        "(default), ftdi (a 16 ms latency timer, or MS) or raw (docs/simulator.md)")
     c.add_argument("--state", help="folder for the flash files")
     c.add_argument("--plant", help="the servo's motor, gears and heat from a plant file "
                                    "(hal/ports/host/plants/*.toml; default: the reference servo)")

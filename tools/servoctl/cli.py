@@ -435,7 +435,7 @@ def cmd_sim(args):
     tcp_port = args.tcp if args.tcp else None
     sim = Simulator(ids=args.ids or [1], tcp=args.tcp is not None, link=args.link,
                     state_dir=args.state, tcp_port=tcp_port, plant=args.plant,
-                    board=None if args.board == "host" else args.board)
+                    board=None if args.board == "host" else args.board, host_link=args.host_link)
     previous = signal.signal(signal.SIGTERM, _interrupt)
     try:
         sim.start()

@@ -68,7 +68,7 @@ class Simulator(_Child):
 
     def __init__(self, ids=(1,), tcp=True, link=None, state_dir=None, supply_mv=None,
                  ambient_c=None, tcp_port=None, rx=None, board=None, app_image=None, nice=None,
-                 cpu=None, plant=None):
+                 cpu=None, plant=None, host_link=None):
         self.ids = list(ids)
         self.tcp = tcp or tcp_port is not None
         self.tcp_port = tcp_port
@@ -83,6 +83,10 @@ class Simulator(_Child):
         self.app_image = app_image  # a virtual board's slot, if not the build's image
         self.plant = plant  # a plant file (hal/ports/host/plants); None: the reference servo
         self.plant_name = None  # the plant's name, as servo_sim prints it
+        # How the host's USB-serial adapter hands over the bytes off the
+        # wire: "usb" (the simulators' default), "ftdi", "ftdi:MS" or "raw"
+        # (servo_sim --help, docs/simulator.md). None: the default.
+        self.host_link = host_link
         # A niceness for the simulator (below 0 needs root): a client that
         # times its answers on the wall clock (the maker's SDK) then meets
         # a servo that keeps up on a loaded PC. None: as started.
@@ -118,6 +122,8 @@ class Simulator(_Child):
             cmd += ["--ambient", str(self.ambient_c)]
         if self.plant is not None:
             cmd += ["--plant", str(self.plant)]
+        if self.host_link is not None:
+            cmd += ["--host-link", self.host_link]
         if self.rx is not None:
             cmd += ["--rx", self.rx]
         if self.cpu is not None:

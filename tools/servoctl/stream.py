@@ -475,18 +475,21 @@ def stream_file(bus: p.Bus, times, angles: dict, progress=None, limits: dict = N
     errors = {i: [] for i in ids}
     # This firmware takes every servo's state as the Sync Monitor request
     # ends (servo.c: the answer waits for its turn ready): the nth answer
-    # arrives n answers' wire time after that.
+    # ends n answers' wire time after that. A USB adapter hands answers
+    # over together, so the nth arrives at the earliest then: the earliest
+    # such estimate is the instant, late by the adapter's wait alone.
     answer_s = p.answer_frame_size(p.MONITOR) * BITS_PER_BYTE / bus.serial.baudrate
     start = bus.clock() + period  # row 0 is for a period after it is sent
     for k in range(count):
         bus.sleep(max(0.0, start + (k - 1) * period - bus.clock()))
         states = loop.cycle({i: angles[i][k] for i in ids}, {i: velocity(i, k) for i in ids})
-        if k > 0:  # a state is compared with the trajectory when it was taken
-            for n, servo_id in enumerate(ids):
+        if k > 0 and states:  # a state is compared with the trajectory when it was taken
+            taken = min(loop.arrivals[i] - (n + 1) * answer_s for n, i in enumerate(ids) if i in states)
+            for servo_id in ids:
                 if servo_id not in states:
                     continue
                 m = states[servo_id]
-                at = times[0] + loop.arrivals[servo_id] - (n + 1) * answer_s - start
+                at = times[0] + taken - start
                 errors[servo_id].append(m.angle_decideg / 10 - reference(servo_id, at))
         if progress:
             progress(k + 1, count)

@@ -13,7 +13,8 @@ board's. The host's bytes go out paced at the
 host's rate (115200 until `hostbaud` says otherwise) after whatever is on
 the wire; the bus reads the host only while less than 10 ms of its bytes
 wait, as behind a real UART. The host is a TCP client (pyserial
-socket://) or a pseudo-terminal."""
+socket://) or a pseudo-terminal, behind a USB-serial adapter (usb.py) that
+hands it the bytes off the wire in USB packets."""
 import heapq
 import os
 import pty
@@ -21,12 +22,13 @@ import socket
 import tty
 
 from .native import wire_overlap
+from .usb import Adapter
 
 FRAME_BITS = 10
 HOST = -1
 BACKLOG_S = 0.01
-# The fastest a host answers a byte it has heard: a USB adapter hands it
-# over at the next high-speed microframe, 125 us (USB 2.0, 8.4.2.1). A
+# The fastest a host answers a byte it has been handed (usb.py): its next
+# request goes out at the next high-speed microframe, 125 us (USB 2.0). A
 # host faster than the servo's turnaround (its receiver back on a few us
 # after its last stop bit) would not exist; without this the runner, ahead
 # of the wall clock, stamped a reply at the very instant the answer ended.
@@ -37,7 +39,8 @@ BUS_IN_USE = b"vboard: the bus is in use by another client\n"
 
 
 class Bus:
-    def __init__(self):
+    def __init__(self, host_link: str = "usb"):
+        self.adapter = Adapter(host_link)  # ValueError: a mode that is none
         self.stations = []        # USART models
         self.events = []          # (end_s, seq, byte, baud, sender)
         self.seq = 0
@@ -49,7 +52,7 @@ class Bus:
         self.collisions = 0
         self.garbled = 0
         self.last_activity_s = -1.0   # end of the last byte queued
-        self.heard_by_host_s = -1.0   # when the host last got a byte (HOST_TURNAROUND_S)
+        self.heard_by_host_s = -1.0   # when the host was last handed bytes (HOST_TURNAROUND_S)
         self.last_sent_s = {}         # station -> when its last byte started
         self.host_fd = None
         self.listen = None
@@ -130,7 +133,7 @@ class Bus:
                 conn.setblocking(False)
                 self._conn = conn
                 self.host_fd = conn.fileno()
-        self.flush_to_host()
+        self.flush_to_host(now_s)
 
     def _read_host(self, now_s: float) -> None:
         if self.host_queue_until_s - now_s < BACKLOG_S:
@@ -146,7 +149,12 @@ class Bus:
             for byte in data or b"":
                 self.queue_host(byte, max(now_s, self.heard_by_host_s + HOST_TURNAROUND_S))
 
-    def flush_to_host(self) -> None:
+    def flush_to_host(self, now_s: float) -> None:
+        """Writes what the adapter has handed over by now_s."""
+        data, at_s = self.adapter.take(now_s)
+        if at_s is not None:
+            self.to_host += data
+            self.heard_by_host_s = at_s
         if self.to_host and self.host_fd is not None:
             try:
                 n = os.write(self.host_fd, bytes(self.to_host))
@@ -158,6 +166,7 @@ class Bus:
         self._conn.close()
         self.host_fd = None
         self.to_host.clear()
+        self.adapter.held.clear()
 
     def queue_host(self, byte: int, now_s: float) -> None:
         """A host byte on the wire from now_s, after the host's earlier
@@ -196,7 +205,9 @@ class Bus:
         heapq.heappush(self.events, [end_s, self.seq, byte, baud, sender, start_s])
 
     def next_event_s(self) -> float:
-        return self.events[0][0] if self.events else float("inf")
+        """The next byte's end on the wire, or the adapter's next hand-over."""
+        wire = self.events[0][0] if self.events else float("inf")
+        return min(wire, self.adapter.due_s())
 
     def deliver_until(self, t_s: float) -> None:
         while self.events and self.events[0][0] <= t_s:
@@ -204,8 +215,7 @@ class Bus:
             for usart in self.stations:
                 usart.receive(byte, baud)
             if sender != HOST and abs(baud - self.host_baud) <= 0.03 * self.host_baud:
-                self.to_host.append(byte)
-                self.heard_by_host_s = end_s
+                self.adapter.hold(byte, end_s, baud)
 
     def close(self) -> None:
         if self.link_path and os.path.lexists(self.link_path):

@@ -2,6 +2,7 @@
 
     python -m vboard --board stm32f103 [--id N ...] [--tcp PORT | --link PATH]
                      [--state DIR] [--supply MV] [--ambient DEGC] [--plant FILE]
+                     [--host-link usb|ftdi[:MS]|raw]
 
 prints `vboard: bus URL`, `vboard: control 127.0.0.1:PORT`, `vboard: servos
 ...` and `vboard: ready`, so servoctl and the tests drive it as they drive
@@ -22,6 +23,7 @@ from servoctl import schema
 
 from .board import PARTS, Board, images
 from .bus import Bus
+from .usb import Adapter
 
 MAX_SLICE_S = 1e-3  # longest the CPUs run between two looks at the host and the models
 # The control port's commands (protocol/control_port.toml, as servo_sim's): what
@@ -32,7 +34,7 @@ HELP = schema.load().help_line("vboard")
 
 class Runner:
     def __init__(self, args):
-        self.bus = Bus()
+        self.bus = Bus(args.host_link)
         self.state_dir = args.state or tempfile.mkdtemp(prefix="vboard-")
         os.makedirs(self.state_dir, exist_ok=True)
         supply_v = None if args.supply is None else args.supply / 1000.0
@@ -206,7 +208,7 @@ class Runner:
             if self.now_s > self._wall():
                 continue
             self.step()
-            self.bus.flush_to_host()  # an answer leaves as its last byte ends, not a loop later
+            self.bus.flush_to_host(self.now_s)  # handed over when the adapter does, not a loop later
             self.most_behind_s = max(self.most_behind_s, self._wall() - self.now_s)
 
     def step(self) -> None:
@@ -228,13 +230,22 @@ def main(argv=None) -> int:
     ap.add_argument("--board", choices=sorted(PARTS), required=True)
     ap.add_argument("--id", type=int, action="append", help="a board with this servo ID (repeat for a bus)")
     ap.add_argument("--tcp", type=int, help="the bus on 127.0.0.1:PORT (0: any free port)")
-    ap.add_argument("--link", help="the bus's pseudo-terminal, linked here")
+    ap.add_argument("--link", help="the bus's pseudo-terminal, linked here (not with --tcp)")
+    ap.add_argument("--host-link", default="usb",
+                    help="how the host's USB-serial adapter hands over the bytes off the wire: usb "
+                         "(default), ftdi[:MS] (an FTDI latency timer, default 16 ms) or raw (vboard/usb.py)")
     ap.add_argument("--state", help="the boards' flash files live here (kept across runs)")
     ap.add_argument("--supply", type=float, help="supply, mV (default: the plant's, 7400 for the reference)")
     ap.add_argument("--plant", help="the motor, gears and heat from a plant file (hal/ports/host/plants/*.toml)")
     ap.add_argument("--ambient", type=float, default=25.0, help="ambient temperature, degC")
     ap.add_argument("--app", help="the update image a blank board's slot gets (default: the build's)")
     args = ap.parse_args(argv)
+    if args.link and args.tcp is not None:
+        ap.error("--link names a pseudo-terminal, and --tcp makes none: give one or the other")
+    try:
+        Adapter(args.host_link)
+    except ValueError as e:
+        ap.error(str(e))
     args.id = args.id or [1]
     build = PARTS[args.board].build
     wanted = [images(args.board)[0]] + ([] if args.app else [images(args.board)[1]])

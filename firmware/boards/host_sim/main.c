@@ -96,6 +96,7 @@ int main(int argc, char **argv)
     mkdir(o.state_dir, 0755);
 
     sim_bus_init(&bus, sim_now_us());
+    bus.usb = o.host_link;
     char clock_path[256];
     bool clock_mapped = sim_clock_open(o.state_dir, clock_path, sizeof clock_path);
     for (unsigned i = 0; i < o.id_count; i++) {

@@ -125,10 +125,18 @@ static void write_host(struct sim_bus *b, const uint8_t *data, unsigned len)
     }
 }
 
-void sim_bus_deliver(struct sim_bus *b, uint64_t now_us)
+/* What the host's adapter hands over by now_us goes to the host. */
+static void hand_over(struct sim_bus *b, uint64_t now_us)
 {
     uint8_t out[256];
-    unsigned n = 0;
+    unsigned n;
+    while ((n = sim_usb_take(&b->usb, now_us, out, sizeof out)) > 0u) {
+        write_host(b, out, n);
+    }
+}
+
+void sim_bus_deliver(struct sim_bus *b, uint64_t now_us)
+{
     while (b->count > 0 && b->queue[b->head].at_us <= now_us) {
         const struct sim_bus_byte *e = &b->queue[b->head];
         /* Each byte carries the time it ended on the wire, as a receive
@@ -144,17 +152,13 @@ void sim_bus_deliver(struct sim_bus *b, uint64_t now_us)
         }
         if (e->sender != SIM_HOST && b->host_baud == e->baud) {
             received = true;
-            out[n++] = e->byte;
-            if (n == sizeof out) {
-                write_host(b, out, n);
-                n = 0;
-            }
+            sim_usb_hold(&b->usb, e->byte, e->at_us, e->baud);
         }
         b->baud_mismatches += !received;
         b->head = (b->head + 1u) % SIM_BUS_QUEUE;
         b->count--;
     }
-    write_host(b, out, n);
+    hand_over(b, now_us);
     if (now_us > b->now_us) {
         b->now_us = now_us;
     }
@@ -180,21 +184,26 @@ unsigned sim_bus_room(const struct sim_bus *b)
     return SIM_BUS_QUEUE - b->count;
 }
 
+/* The next byte's end on the wire, or the adapter's next hand-over. */
+static uint64_t next_event(const struct sim_bus *b)
+{
+    uint64_t at = b->count == 0 ? SIM_USB_NONE : b->queue[b->head].at_us;
+    uint64_t usb = sim_usb_due(&b->usb);
+    return usb < at ? usb : at;
+}
+
 int64_t sim_bus_next_due(const struct sim_bus *b, uint64_t now_us)
 {
-    if (b->count == 0) {
+    uint64_t at = next_event(b);
+    if (at == SIM_USB_NONE) {
         return -1;
     }
-    uint64_t at = b->queue[b->head].at_us;
     return at > now_us ? (int64_t)(at - now_us) : 0;
 }
 
 uint64_t sim_bus_next_at(const struct sim_bus *b, uint64_t until_us)
 {
-    if (b->count == 0) {
-        return until_us;
-    }
-    uint64_t at = b->queue[b->head].at_us;
+    uint64_t at = next_event(b);
     at = at > b->now_us ? at : b->now_us;
     return at < until_us ? at : until_us;
 }

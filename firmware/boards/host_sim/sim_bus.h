@@ -1,7 +1,8 @@
 /* The shared half-duplex wire of the simulator: what one servo sends reaches
- * the host and every other servo one byte time after another, from the
- * moment it sends it; the host's bytes reach every servo paced the same
- * way (a pty or socket delivers them in bursts a UART never would), after
+ * every other servo one byte time after another, from the moment it
+ * sends it, and the host through its USB-serial adapter (sim_usb.h); the
+ * host's bytes reach every servo paced the same way (a pty or socket
+ * delivers them in bursts a UART never would), after
  * whatever is already on the wire. Bytes of two senders that overlap
  * garble each other, as on a real wire: a receiver framed on the byte
  * already there samples the middle of its bits while the line is low if
@@ -33,6 +34,8 @@
 #define SIM_BUS_H
 
 #include <stdint.h>
+
+#include "sim_usb.h"
 
 #define SIM_BUS_QUEUE 8192u
 #define SIM_MAX_SERVOS 254u /* IDs 0..253, and 254 */
@@ -75,6 +78,7 @@ struct sim_bus {
     uint64_t wire_until_us;   /* end of the last byte queued, host's or servo's */
     uint64_t now_us;          /* every byte due by then has been delivered */
     int host_fd;              /* -1: no host connected */
+    struct sim_usb usb;       /* the host's USB-serial adapter (sim_usb.h) */
     uint32_t host_baud;       /* the host's UART rate */
     struct sim_station stations[SIM_MAX_SERVOS];
     unsigned station_count;
@@ -100,10 +104,11 @@ uint64_t sim_bus_step_to(const struct sim_bus *b, uint64_t wall_us);
 /* Delivers every byte due by now_us and moves the bus clock there. */
 void sim_bus_deliver(struct sim_bus *b, uint64_t now_us);
 void sim_bus_from_host(struct sim_bus *b, const uint8_t *data, unsigned len, uint64_t now_us);
-/* Microseconds until the next queued byte is due; -1 if none. */
+/* Microseconds until the next queued byte, or the host adapter's next
+ * hand-over, is due; -1 if none. */
 int64_t sim_bus_next_due(const struct sim_bus *b, uint64_t now_us);
 /* When the bus clock next has something to do on the way to until_us: the
- * next byte's time (not before now), or until_us. */
+ * next byte's time or the adapter's hand-over (not before now), or until_us. */
 uint64_t sim_bus_next_at(const struct sim_bus *b, uint64_t until_us);
 
 #endif

@@ -8,14 +8,14 @@ static void usage(FILE *out)
 {
     fputs("usage: servo_sim [--id N]... [--tcp PORT | --link PATH] [--control PORT]\n"
           "                 [--state DIR] [--supply MV] [--ambient DEGC] [--rx dma|interrupt]\n"
-          "                 [--cpu m3|m0] [--plant FILE]\n"
+          "                 [--cpu m3|m0] [--plant FILE] [--host-link usb|ftdi[:MS]|raw]\n"
           "Runs the servo firmware on simulated servos sharing one bus.\n"
           "  --id N         a servo with ID N (repeat for more; default 1). An ID given\n"
           "                 again is one more servo at it, as new servos all hold ID 0\n"
           "                 (serial 0x51a0UUNN: NN the ID given, UU the servos given it before)\n"
           "  --tcp PORT     the bus on 127.0.0.1:PORT (pyserial socket://; 0: any free port,\n"
           "                 printed) instead of a pty\n"
-          "  --link PATH    also make PATH a symlink to the pty\n"
+          "  --link PATH    also make PATH a symlink to the pty (not with --tcp)\n"
           "  --control PORT fault injection on 127.0.0.1:PORT (default: any free port)\n"
           "  --state DIR    where each servo's flash file lives (default ./sim-state)\n"
           "  --supply MV    supply voltage (default: the plant's, 7400 for the reference)\n"
@@ -27,6 +27,11 @@ static void usage(FILE *out)
           "                 the reference board's STM32F103 (default) or the STM32F030's\n"
           "  --plant FILE   every servo's motor, gears and heat from a plant file\n"
           "                 (hal/ports/host/plants/*.toml; default: the reference servo's)\n"
+          "  --host-link usb|ftdi[:MS]|raw  how the host's USB-serial adapter hands it\n"
+          "                 the bytes off the wire: usb (default) a packet once the line\n"
+          "                 is quiet for 4 character times, at the next 1 ms USB frame;\n"
+          "                 ftdi an FTDI chip's latency timer (MS, default 16); raw every\n"
+          "                 byte as it ends on the wire\n"
           "Control commands, one per line, optional servo last: its bus ID as it is now\n"
           "(every servo that holds it), or its serial number (0x51a0UUNN):\n"
           "  supply MV | load NM | payload GCM2 | stop DEG | stop off | magnet DEG | swapleads N |\n"
@@ -94,6 +99,11 @@ void sim_options_parse(int argc, char **argv, struct sim_options *o)
             o->control_port = parse_int(v, "--control", 1, 65535);
         } else if (strcmp(a, "--link") == 0) {
             o->link = v;
+        } else if (strcmp(a, "--host-link") == 0) {
+            if (!sim_usb_parse(v, &o->host_link)) {
+                fprintf(stderr, "servo_sim: --host-link is usb, ftdi, ftdi:MS (1 to 255) or raw, not '%s'\n", v);
+                exit(2);
+            }
         } else if (strcmp(a, "--state") == 0) {
             o->state_dir = v;
         } else if (strcmp(a, "--supply") == 0) {
@@ -123,6 +133,11 @@ void sim_options_parse(int argc, char **argv, struct sim_options *o)
             usage(stderr);
             exit(2);
         }
+    }
+    if (o->link != NULL && o->tcp_port >= 0) {
+        fprintf(stderr, "servo_sim: --link names a pseudo-terminal, and --tcp makes none: "
+                        "give one or the other\n");
+        exit(2);
     }
     if (o->supply_v < 0.0) {
         o->supply_v = o->plant.plant.supply_v;

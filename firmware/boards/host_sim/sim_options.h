@@ -9,6 +9,7 @@
 #include "ports/host/plant_model.h"
 #include "sim_bus.h"
 #include "sim_cpu.h"
+#include "sim_usb.h"
 
 struct sim_options {
     uint8_t ids[SIM_MAX_SERVOS];
@@ -23,6 +24,7 @@ struct sim_options {
     double ambient_c;
     bool rx_interrupt;
     const struct sim_cpu *cpu;
+    struct sim_usb host_link; /* the host's adapter (--host-link), usb by default */
 };
 
 /* Parses argv; prints the usage and exits on --help or a bad option. */
