@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Installs what building and testing need, only what is missing: Debian
 # packages (as root, or through sudo), the project's Python virtual
-# environment in .venv, and the LeRobot plugin's in .venv-lerobot. Safe to run
-# again.
+# environment in .venv. Safe to run again. (The LeRobot plugin's heavy
+# environment is the test command's: scripts/lerobot_env.sh.)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -30,12 +30,6 @@ fi
 if ! .venv/bin/python -m pip install -q --disable-pip-version-check -r tools/requirements.txt \
      || ! .venv/bin/python -m pip install -q --disable-pip-version-check -e tools; then
   echo "setup: pip could not install tools/requirements.txt or the servoctl package" >&2
-  exit 1
-fi
-# The maker's LeRobot plugin pulls in torch: its own environment, made once
-# (several GB; LEROBOT_ENV=0 skips it, and its test says so).
-if ! bash scripts/lerobot_env.sh; then
-  echo "setup: pip could not make .venv-lerobot (scripts/lerobot_env.sh)" >&2
   exit 1
 fi
 echo "setup: ready"

@@ -12,6 +12,9 @@
 set -uo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh || { echo "setup failed: nothing was tested" >&2; exit 1; }
+# The maker's LeRobot plugin's environment (torch: several GB), once a
+# machine; the demo does without it.
+bash scripts/lerobot_env.sh || { echo "setup failed: scripts/lerobot_env.sh" >&2; exit 1; }
 mkdir -p build
 
 passed=0

@@ -4,7 +4,7 @@ their real code from PyPI) drives a simulated 7-servo arm, IDs 0-6 at
 motor), read the observation, send an action, read it back.
 
 LeRobot pulls in torch, so the plugin lives in its own environment,
-.venv-lerobot, which scripts/setup.sh makes once (scripts/lerobot_env.sh);
+.venv-lerobot, which the test command makes once (scripts/lerobot_env.sh);
 the plugin runs there, in a child process, against servo_sim's pty."""
 import json
 import subprocess
@@ -23,7 +23,7 @@ IDS = list(range(7))
 BAUD_1M = 8  # item 36's index for 1 000 000 baud
 
 
-@pytest.mark.skipif(not PYTHON.exists(), reason="no .venv-lerobot: scripts/setup.sh makes it "
+@pytest.mark.skipif(not PYTHON.exists(), reason="no .venv-lerobot: the test command makes it "
                     "(scripts/lerobot_env.sh; LEROBOT_ENV=0 had it skipped)")
 def test_the_makers_lerobot_plugin_drives_a_simulated_arm(tmp_path):
     # The SDK under the plugin waits on the wall clock (100 ms an answer):
