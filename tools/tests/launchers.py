@@ -1,11 +1,12 @@
 """The tests' launchers beyond servoctl's Simulator: the real ARM images on
-QEMU (QemuBoard), and the repository's files the tests start simulators
-with (PLANTS). Not shipped: servoctl finds a simulator as docs/simulator.md
+QEMU (QemuBoard), a stand-in servo on a TCP port (FakeServo), and the
+repository's files the tests start simulators with (PLANTS). Not shipped: servoctl finds a simulator as docs/simulator.md
 says; the tests find the repository from here."""
 import os
 from pathlib import Path
 import socket
 import subprocess
+import threading
 import time
 
 from servoctl.protocol import Bus, LinkError, ServoError
@@ -119,3 +120,20 @@ class QemuBoard(_Child):
         self.stop()
         raise ServoError(f"the firmware on qemu did not answer within {BOOT_TIMEOUT_S} s of QEMU's CPU time")
 
+
+class FakeServo:
+    """A stand-in for servos on a TCP port (pyserial socket://, url): the
+    subclass's _serve() answers, on a thread of its own, from the start."""
+
+    def __init__(self, backlog: int = 1):
+        self.server = socket.socket()
+        self.server.bind(("127.0.0.1", 0))
+        self.server.listen(backlog)
+        self.url = f"socket://127.0.0.1:{self.server.getsockname()[1]}"
+        threading.Thread(target=self._serve, daemon=True).start()
+
+    def _serve(self):
+        raise NotImplementedError
+
+    def close(self):
+        self.server.close()
