@@ -1,13 +1,15 @@
-"""The command line of servoctl: its parser, and the argparse types that
-check a value before anything is sent."""
+"""The command line of servoctl: its parser, the argparse types that check
+a value, and the rules of a command's operands that argparse cannot say:
+all checked before anything is sent."""
 import argparse
 import dataclasses
 import math
 import os
 
-from . import __version__, outcome, registers, units
+from . import __version__, ids, outcome, registers, units
 from . import protocol as p
 from .checks import MIN_RAMP_MS
+from .errors import UsageError
 from .move_request import MoveRequest
 
 # The description servoctl --help shows.
@@ -101,6 +103,69 @@ def _target(text: str):
         return int(servo_id), finite(degrees)
     except (ValueError, argparse.ArgumentTypeError):
         raise argparse.ArgumentTypeError(f"not ID:DEGREES: {text!r}") from None
+
+
+# ---- operand rules: what argparse cannot say of a command's operands,
+# checked by the command before anything is sent ----------------------------
+
+def id_operands(args):
+    """id assign SERIAL ID: (serial, new ID); id bringup: no operands."""
+    if args.action == "assign":
+        if len(args.rest) != 2:
+            raise UsageError("id assign takes SERIAL ID (scan shows serial numbers)")
+        return ids.serial_number(args.rest[0]), id_number(args.rest[1])
+    if args.rest:
+        raise UsageError("id bringup takes no arguments: --from-id, --first, --count, --wait-s")
+    return None
+
+
+def config_operands(args) -> None:
+    """config ACTION ID REST...: the operands by name on args (target,
+    other, id, name, value, file), each action's count checked."""
+    need = {"get": 1, "set": 2, "dump": 0, "save": 1, "load": 1, "reset": 0, "diff": 1}[args.action]
+    if len(args.rest) != need:
+        raise UsageError(f"config {args.action} takes {need} argument(s)")
+    args.target, args.other = args.id, args.rest[0] if args.action == "diff" else None
+    if args.action != "diff":
+        try:
+            args.id = id_number(args.id)
+        except argparse.ArgumentTypeError as e:
+            raise UsageError(str(e)) from None
+    args.name = args.rest[0] if args.action in ("get", "set") else None
+    args.value = args.rest[1] if args.action == "set" else None
+    args.file = args.rest[0] if args.action in ("save", "load") else None
+
+
+def raw_value(item, text: str) -> int:
+    """config set --raw: a whole number in protocol units."""
+    try:
+        return int(text, 0)
+    except ValueError:
+        raise UsageError(f"{item.name} takes a whole number in protocol units, "
+                         f"not {text!r}") from None
+
+
+def distinct_targets(targets) -> dict:
+    """sync-move's ID:DEGREES: {id: degrees}, one target a servo."""
+    ids_ = [servo_id for servo_id, _ in targets]
+    twice = sorted({i for i in ids_ if ids_.count(i) > 1})
+    if twice:
+        raise UsageError(f"servo {', '.join(map(str, twice))} is given more than one target")
+    return dict(targets)
+
+
+def update_operands(targets) -> tuple:
+    """`update IMAGE ID...` or `update ID... IMAGE`: the image is the one
+    that is not a number. ([IDs], image)."""
+    ids_, images = [], []
+    for arg in targets:
+        (ids_ if arg.isascii() and arg.isdigit() else images).append(arg)
+    if len(images) != 1 or not ids_:
+        raise UsageError("update takes one image and one or more servo IDs")
+    for servo_id in ids_:
+        if not 0 <= int(servo_id) <= p.MAX_ID:
+            raise UsageError(f"servo ID {servo_id} is not 0-{p.MAX_ID}")
+    return [int(i) for i in ids_], images[0]
 
 
 def build_parser():

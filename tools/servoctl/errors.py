@@ -1,6 +1,8 @@
 """Every error servoctl reports, each with the exit code of the command line
 (docs/servoctl.md, the exit codes). The lowest module: every other may raise these."""
 
+EXIT_INTERRUPTED = 130  # the command line's exit code after Ctrl-C
+
 
 class ServoError(Exception):
     """Base of every error servoctl reports. exit_code is the command

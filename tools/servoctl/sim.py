@@ -1,5 +1,7 @@
-"""Starts servo_sim (the firmware on simulated servos) and talks to its
-fault-injection channel."""
+"""Starts servo_sim (the firmware on simulated servos), or a virtual board,
+and talks to its fault-injection channel: `servoctl sim` and the Python API
+(docs/simulator.md). The tests' own launchers (QEMU, the repository's
+plant files) are tools/tests/launchers.py's."""
 import mmap
 import os
 from pathlib import Path
@@ -13,32 +15,39 @@ import threading
 import time
 
 from .protocol import Bus, LinkError, ServoError
-from .servo import Servo
 
-REPO = Path(__file__).resolve().parents[2]
-PLANTS = REPO / "hal" / "ports" / "host" / "plants"  # the shipped plant files (--plant)
-BOOT_TIMEOUT_S = 10
+# The folder servoctl is installed in (tools/ of a checkout): vboard,
+# shipped with it, is imported from there by the virtual board's process.
+PACKAGES = Path(__file__).resolve().parent.parent
 # Host seconds a simulator's clock may stand still before a wait gives up
 # on it (a simulator falls behind on a busy PC; it does not stop).
 STALLED_S = 30.0
 _CLOCK_US = struct.Struct("<Q")  # servo_sim's clock file: microseconds
-DEFAULT_BINARY = REPO / "build" / "host" / "firmware" / "boards" / "host_sim" / "servo_sim"
+HOST_BUILD = Path("build", "host", "firmware", "boards", "host_sim", "servo_sim")  # of a checkout
+
+
+def checkout_binary(start=None):
+    """HOST_BUILD in start (the working directory if None) or the nearest
+    folder above it that has one: the host build of the checkout servoctl
+    is run in, wherever servoctl itself is installed; None if none has."""
+    here = Path(start or os.getcwd()).resolve()
+    return next((f / HOST_BUILD for f in (here, *here.parents) if (f / HOST_BUILD).exists()), None)
 
 
 def find_binary() -> Path:
-    """servo_sim: $SERVO_SIM, else the repository's host build, else the
-    PATH (an installed servoctl has no repository around it)."""
+    """servo_sim: $SERVO_SIM, else the host build of the checkout servoctl
+    is run in (checkout_binary), else the PATH (docs/simulator.md)."""
     if "SERVO_SIM" in os.environ:
         candidates = [Path(os.environ["SERVO_SIM"])]
     else:
-        on_path = shutil.which("servo_sim")
-        candidates = [DEFAULT_BINARY] + ([Path(on_path)] if on_path else [])
+        in_checkout, on_path = checkout_binary(), shutil.which("servo_sim")
+        candidates = [p for p in (in_checkout, on_path and Path(on_path)) if p] or [HOST_BUILD]
     for path in candidates:
         if path.exists():
             return path
-    raise ServoError(f"no simulator at {candidates[0]}: build it with "
-                     f"'cmake --preset host && cmake --build --preset host', "
-                     f"put servo_sim on the PATH, or point SERVO_SIM at it")
+    raise ServoError(f"no simulator at {candidates[0]} (nor in a folder above {os.getcwd()}): build it with "
+                     f"'cmake --preset host && cmake --build --preset host' and run servoctl in the "
+                     f"checkout, put servo_sim on the PATH, or point SERVO_SIM at it")
 
 
 class _Child:
@@ -129,7 +138,7 @@ class Simulator(_Child):
         if self.cpu is not None:
             cmd += ["--cpu", self.cpu]
         env = dict(os.environ, PYTHONPATH=os.pathsep.join(
-            [str(REPO / "tools")] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]))
+            [str(PACKAGES)] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]))
         self.process = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                                         text=True, env=env)
         try:
@@ -321,107 +330,3 @@ def _stop(process) -> str:
         process.kill()
         _, err = process.communicate()
     return err
-
-
-def _read(path: str) -> str:
-    with open(path) as f:
-        return f.read()
-
-
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
-QEMU_BOARD = REPO / "build" / "arm" / "firmware" / "boards" / "qemu_stm32vl"
-QEMU_BOOTLOADER = QEMU_BOARD / "servo_qemu_stm32vl_boot.elf"
-QEMU_IMAGE = QEMU_BOARD / "servo_qemu_stm32vl.img"
-QEMU_SLOT = 0x08001000  # where the application's image goes (qemu_stm32vl/board.h)
-
-
-class QemuBoard(_Child):
-    """The real ARM images on QEMU's stm32vldiscovery: the bootloader at the
-    start of flash, the application's update image in its slot; USART1 on a
-    TCP port (pyserial socket://)."""
-
-    def __init__(self, image=None, bootloader=None):
-        self.image = Path(image or os.environ.get("SERVO_QEMU_IMAGE", QEMU_IMAGE))
-        self.bootloader = Path(bootloader or QEMU_BOOTLOADER)
-        self.process = None
-        self.url = None
-        self._vcpu = ""  # the vCPU thread's task id; "" for the whole process
-
-    def cpu_s(self) -> float:
-        """The CPU seconds QEMU's vCPU thread has had: the emulated board's
-        progress (its firmware never sleeps, so the vCPU runs whenever the
-        host lets it). QEMU's main loop thread spins too, so the whole
-        process's time would run ahead of the guest by up to two. A Bus on
-        this clock gives a starved QEMU the time it needs."""
-        try:
-            stat = _read(f"/proc/{self.process.pid}/task/{self._vcpu}/stat" if self._vcpu
-                         else f"/proc/{self.process.pid}/stat")
-        except OSError as e:
-            raise LinkError(f"qemu is gone: {e.strerror}") from None
-        fields = stat.rsplit(")", 1)[1].split()
-        return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
-
-    def _find_vcpu(self) -> str:
-        """The task id of QEMU's vCPU thread ("CPU 0/TCG"), which QEMU starts
-        before it runs the guest; "" if none shows within 5 s."""
-        task = f"/proc/{self.process.pid}/task"
-        give_up = time.monotonic() + 5.0
-        while time.monotonic() < give_up and self.process.poll() is None:
-            try:
-                for t in os.listdir(task):
-                    if _read(f"{task}/{t}/comm").startswith("CPU "):
-                        return t
-            except OSError:
-                pass
-            time.sleep(0.01)
-        return ""
-
-    def bus(self, **kw) -> Bus:
-        """A Bus to the board that waits on QEMU's progress (cpu_s)."""
-        return Bus(self.url, clock=self.cpu_s, **kw)
-
-    def start(self) -> "QemuBoard":
-        for path in (self.image, self.bootloader):
-            if not path.exists():
-                raise ServoError(f"no image at {path}: build it with "
-                                 f"'cmake --preset arm && cmake --build --preset arm'")
-        port = _free_port()
-        self.process = subprocess.Popen(
-            ["qemu-system-arm", "-M", "stm32vldiscovery", "-kernel", str(self.bootloader),
-             "-name", "servo,debug-threads=on",  # the vCPU thread by name: cpu_s
-             "-device", f"loader,file={self.image},addr={QEMU_SLOT:#x}",
-             "-nographic", "-monitor", "none",
-             "-serial", f"tcp:127.0.0.1:{port},server=on,wait=off,nodelay=on"],
-            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-        self.url = f"socket://127.0.0.1:{port}"
-        self._vcpu = self._find_vcpu()
-        # QEMU opens the port before the guest has booted, so the board is
-        # ready only once the firmware answers: within BOOT_TIMEOUT_S of
-        # QEMU's own CPU time, however long a loaded machine takes for it.
-        bus = None
-        hung_at = time.monotonic() + 30 * BOOT_TIMEOUT_S  # QEMU itself stuck
-        try:
-            while self.cpu_s() < BOOT_TIMEOUT_S and time.monotonic() < hung_at:
-                if self.process.poll() is not None:
-                    raise ServoError(f"qemu exited: {self.process.stderr.read().strip()}")
-                try:
-                    bus = bus or self.bus(timeout=0.2)
-                except ServoError:  # the port is not open yet
-                    time.sleep(0.05)
-                    continue
-                try:  # the application, not the bootloader, answers ReadData
-                    Servo(bus, 0).read("serial")
-                    return self
-                except ServoError:
-                    continue
-        finally:
-            if bus is not None:
-                bus.close()
-        self.stop()
-        raise ServoError(f"the firmware on qemu did not answer within {BOOT_TIMEOUT_S} s of QEMU's CPU time")
-

@@ -2,7 +2,6 @@
 whose answers are short (with a good checksum: garbled, another firmware,
 two servos on one ID), and a link that drops in a way pyserial reports as
 termios.error, which is not an OSError."""
-import socket
 import termios
 import threading
 
@@ -11,17 +10,15 @@ import pytest
 from servoctl import protocol as p
 from servoctl.cli import main
 
+from .launchers import FakeServo
 
-class ShortAnswers:
+
+class ShortAnswers(FakeServo):
     """A servo on a TCP socket that answers every request to it with its ID
     alone: a frame whose checksum is right and whose content is short."""
 
     def __init__(self):
-        self.server = socket.socket()
-        self.server.bind(("127.0.0.1", 0))
-        self.server.listen(4)
-        self.url = f"socket://127.0.0.1:{self.server.getsockname()[1]}"
-        threading.Thread(target=self._serve, daemon=True).start()
+        super().__init__(backlog=4)
 
     def _serve(self):
         while True:
@@ -46,9 +43,6 @@ class ShortAnswers:
                     buf = buf[end:]
                     if content:
                         peer.sendall(p.response_frame(code, content[:1]))
-
-    def close(self):
-        self.server.close()
 
 
 @pytest.fixture

@@ -18,7 +18,8 @@ from unicorn import arm_const as arm
 from . import svd
 from .adc import AdcF0, AdcF1
 from .clocks import Rcc
-from .core import FIRST_IRQ, Core, Stop
+from .core import Core, Stop
+from .system_space import FIRST_IRQ
 from .dma import Dma
 from .flash import Flash
 from .model import Model

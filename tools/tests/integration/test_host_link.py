@@ -13,8 +13,9 @@ import pytest
 import serial
 
 from servoctl import protocol as p
-from servoctl.sim import REPO, Simulator, find_binary
+from servoctl.sim import Simulator, find_binary
 
+from ..launchers import REPO
 from .conftest import finish
 
 BOARDS = [None, "stm32f103"]  # servo_sim, a virtual board

@@ -14,8 +14,9 @@ from servoctl.cli import main
 from servoctl.errors import ServoError
 from servoctl.identify import identify
 from servoctl.servo import Servo
-from servoctl.sim import PLANTS, Simulator
+from servoctl.sim import Simulator
 
+from ..launchers import PLANTS
 from .conftest import finish
 
 

@@ -203,8 +203,9 @@ def test_servo_sim_is_found_on_the_path_outside_the_repository(tmp_path, monkeyp
 
     real = simmod.find_binary()
     (tmp_path / "servo_sim").symlink_to(real)
+    (tmp_path / "no-repository").mkdir()
     monkeypatch.delenv("SERVO_SIM", raising=False)
-    monkeypatch.setattr(simmod, "DEFAULT_BINARY", tmp_path / "no-repository" / "servo_sim")
+    monkeypatch.chdir(tmp_path / "no-repository")  # a folder of no checkout
     monkeypatch.setenv("PATH", f"{tmp_path}{os.pathsep}{os.environ['PATH']}")
     assert simmod.find_binary() == tmp_path / "servo_sim"
     monkeypatch.setenv("PATH", "/nonexistent")

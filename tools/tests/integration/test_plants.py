@@ -8,8 +8,9 @@ import pytest
 
 from servoctl.errors import ServoError
 from servoctl.servo import Servo
-from servoctl.sim import PLANTS, Simulator
+from servoctl.sim import Simulator
 
+from ..launchers import PLANTS
 from .conftest import finish
 
 # file: (name's start, supply in mV)

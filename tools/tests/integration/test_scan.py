@@ -3,8 +3,6 @@ noticed (their answers arrive twice, or garbled), a servo waiting in its
 bootloader is named as such with the command that recovers it, and a
 socket:// link, which carries no baud rate, is scanned once."""
 import json
-import socket
-import threading
 
 import pytest
 
@@ -13,6 +11,8 @@ from servoctl import update as upd
 from servoctl.cli import main
 from servoctl.servo import Servo
 from servoctl.sim import Simulator
+
+from ..launchers import FakeServo
 
 
 def run(sim, capsys, *args):
@@ -73,16 +73,9 @@ def test_bringup_numbers_new_servos_one_at_a_time(tmp_path, capsys):
             assert Servo(bus, 6).read("serial") == 0x51A00000
 
 
-class GarbledTwins:
+class GarbledTwins(FakeServo):
     """Two servos on one ID as a real wire delivers them: their answers
     overlap and arrive as one damaged frame (a bad checksum)."""
-
-    def __init__(self):
-        self.server = socket.socket()
-        self.server.bind(("127.0.0.1", 0))
-        self.server.listen(1)
-        self.url = f"socket://127.0.0.1:{self.server.getsockname()[1]}"
-        threading.Thread(target=self._serve, daemon=True).start()
 
     def _serve(self):
         try:
@@ -95,9 +88,6 @@ class GarbledTwins:
                     frame = bytearray(p.response_frame(data[2], data[4:-1]))
                     frame[-1] ^= 0x55  # two answers on top of each other
                     peer.sendall(bytes(frame))
-
-    def close(self):
-        self.server.close()
 
 
 def test_garbled_answers_at_one_id_are_reported_as_shared(capsys):

@@ -10,8 +10,9 @@ import pytest
 from servoctl.cli import main
 from servoctl.errors import Refused
 from servoctl.servo import MotionSnapshot, Servo
-from servoctl.sim import PLANTS, Simulator
+from servoctl.sim import Simulator
 
+from ..launchers import PLANTS
 from .conftest import finish
 
 TYPOS = [("torque_constant", 37140), ("gear_ratio", 3450), ("gear_ratio", 32767), ("torque_constant", 65535)]

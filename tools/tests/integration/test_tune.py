@@ -15,9 +15,10 @@ from servoctl.calibrate import calibrate
 from servoctl.cli import main
 from servoctl.identify import identify
 from servoctl.servo import Servo
-from servoctl.sim import PLANTS, Simulator
+from servoctl.sim import Simulator
 from servoctl.tune import check_step, tune
 
+from ..launchers import PLANTS
 from .conftest import finish
 from .test_identify import at_the_output, relative_errors
 

@@ -13,9 +13,10 @@ from pathlib import Path
 import pytest
 
 from servoctl.servo import Servo
-from servoctl.sim import REPO, Simulator
+from servoctl.sim import Simulator
 
 from ..integration.conftest import finish
+from ..launchers import REPO
 
 PYTHON = REPO / ".venv-lerobot" / "bin" / "python"
 DRIVER = Path(__file__).with_name("drive_arm.py")

@@ -8,7 +8,8 @@ import pytest
 
 from servoctl import protocol as p
 from servoctl.servo import Servo
-from servoctl.sim import QemuBoard
+
+from ..launchers import QemuBoard
 
 
 @pytest.fixture(scope="module")

@@ -14,7 +14,8 @@ import struct
 import pytest
 from unicorn import arm_const as arm
 
-from vboard.core import FIRST_IRQ, NVIC_IPR, SCB_SHPR3, SCB_VTOR, SYSTICK, Core
+from vboard.core import Core
+from vboard.system_space import FIRST_IRQ, NVIC_IPR, SCB_SHPR3, SCB_VTOR, SYSTICK
 
 FLASH, RAM = 0x08000000, 0x20000000
 HZ = 1_000_000  # one instruction a microsecond (cpi 1): run(n us) runs n instructions

@@ -17,9 +17,10 @@ from servoctl import update as upd
 from servoctl.errors import Refused, ServoError
 from servoctl.registers import ITEMS
 from servoctl.servo import Servo
-from servoctl.sim import PLANTS, Simulator
+from servoctl.sim import Simulator
 from vboard.board import board_h, images
 
+from ..launchers import PLANTS
 from ..scheduled import followed
 
 BOARDS = ["stm32f103", "stm32f030k6"]

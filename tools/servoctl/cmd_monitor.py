@@ -1,0 +1,29 @@
+"""servoctl monitor: several servos sampled live, as a table, JSON lines or
+a plot (live.py; loaded for this command alone)."""
+import os
+import sys
+
+from .errors import NoReply
+from .record import check_writable
+
+
+def cmd_monitor(bus, args):
+    from .live import has_display, monitor
+
+    if args.plot_file:
+        check_writable(args.plot_file)
+    plot = args.plot
+    if plot and not has_display():
+        print("servoctl: warning: --plot: no display (DISPLAY and WAYLAND_DISPLAY are unset), so no "
+              "window; sampling without it. --plot-file FILE saves the plot instead", file=sys.stderr)
+        plot = False
+    never = {}
+    try:
+        never = monitor(bus, args.ids, args.every, args.count, args.sync, args.json, plot, args.plot_file)
+    except KeyboardInterrupt:
+        pass  # the way to stop a monitor
+    if args.plot_file:
+        print(f"plot {os.path.abspath(args.plot_file)}", file=sys.stderr if args.json else sys.stdout)
+    if never:
+        raise NoReply("; ".join(why or f"servo {i} never answered" for i, why in sorted(never.items())))
+    return 0

@@ -1,0 +1,66 @@
+"""servoctl's commands that move one servo: move, wheel, damping, stop,
+origin."""
+import sys
+
+from . import args as args_
+from . import checks, frame, outcome
+from .errors import Refused
+from .servo import Servo
+
+
+def cmd_move(bus, args):
+    s = Servo(bus, args.id)
+    request = args_.move_request(args)
+    asked = args_.decideg(args.angle)
+    where = frame.check_target(s, asked, args.multi_turn)
+    if args.velocity is not None and (why := checks.speed_warning(args.velocity, s.read("voltage"))):
+        print(f"servoctl: {why}", file=sys.stderr)
+    plan = outcome.plan_move(s, asked, request, where) if args.wait else None
+    s.send_move(asked, request)
+    outcome.taken(s, "the move")
+    if not args.wait:
+        return 0
+    result = outcome.wait_for_arrival(s, plan, args.tolerance, args.timeout_s)
+    if not result.arrived:
+        raise Refused(f"servo {args.id}: {result.reason}")
+    print(f"servo {args.id}: at {result.angle / 10:.1f} deg after {result.took_s * 1000:.0f} ms "
+          f"({outcome.planned_text(plan, result.took_s)})")
+    return 0
+
+
+def cmd_wheel(bus, args):
+    s = Servo(bus, args.id)
+    s.wheel(args.action, args.speed, args.value, args.cw)
+    outcome.taken(s, f"wheel {args.action}")
+    return 0
+
+
+def cmd_damping(bus, args):
+    s = Servo(bus, args.id)
+    s.damping(args.power)
+    outcome.taken(s, "damping")
+    return 0
+
+
+def cmd_stop(bus, args):
+    s = Servo(bus, args.id)
+    s.stop(args.mode, args.power)
+    outcome.taken(s, f"stop ({args.mode})")
+    return 0
+
+
+def cmd_origin(bus, args):
+    s = Servo(bus, args.id)
+    if args.reset_turns:
+        s.reset_multi_turn()
+    else:
+        s.set_origin()
+    bus.sleep(0.01)
+    try:
+        outcome.taken(s, "a new origin")
+    except Refused:
+        raise Refused(f"servo {args.id} refused a new origin: release it first with "
+                      f"'servoctl stop {args.id}'") from None
+    angle, turns = s.multi_turn_angle()
+    print(f"servo {args.id}: now {angle / 10:.1f} deg, {turns} turns")
+    return 0

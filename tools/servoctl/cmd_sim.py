@@ -1,0 +1,32 @@
+"""servoctl sim: the simulator, or a virtual board, for a person at the
+command line."""
+
+
+def _interrupt(signum, frame):
+    raise KeyboardInterrupt
+
+
+def cmd_sim(args):
+    """Runs servo_sim until Ctrl-C or SIGTERM; either stops it cleanly and
+    removes a state folder it made."""
+    import signal
+
+    from .sim import Simulator
+
+    tcp_port = args.tcp if args.tcp else None
+    sim = Simulator(ids=args.ids or [1], tcp=args.tcp is not None, link=args.link,
+                    state_dir=args.state, tcp_port=tcp_port, plant=args.plant,
+                    board=None if args.board == "host" else args.board, host_link=args.host_link)
+    previous = signal.signal(signal.SIGTERM, _interrupt)
+    try:
+        sim.start()
+        print(f"simulator running: bus {sim.url}, control 127.0.0.1:{sim.control_port}", flush=True)
+        print(f"  e.g. servoctl --port {sim.url} --sim-control {sim.control_port} scan  (Ctrl-C stops)", flush=True)
+        sim.process.wait()
+    except KeyboardInterrupt:
+        pass
+    finally:
+        sim.stop()
+        signal.signal(signal.SIGTERM, previous)
+    print("simulator stopped")
+    return 0

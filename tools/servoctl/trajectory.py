@@ -1,0 +1,108 @@
+"""A stream's CSV trajectory (servoctl stream FILE): read and checked whole,
+every row against every servo's Limits, before anything moves."""
+import csv
+import math
+from dataclasses import dataclass
+
+from .checks import check_range, scaled
+from .errors import UsageError, ValueOutOfRange
+from .setpoints import MAX_ANGLE_DECIDEG, PERIOD_RANGE_MS, check_ids, check_period
+
+
+@dataclass
+class Trajectory:
+    """A CSV trajectory: times (s), {id: [degrees...]}, and each row's line
+    in its file, for the messages."""
+    times: list
+    angles: dict
+    lines: list = None
+    path: str = ""
+
+    @property
+    def period_ms(self) -> int:
+        return round((self.times[-1] - self.times[0]) / (len(self.times) - 1) * 1000)
+
+    def where(self, k: int) -> str:
+        return f"{self.path} line {self.lines[k]}" if self.lines else f"row {k}"
+
+
+def _is_number(cell: str) -> bool:
+    try:
+        float(cell)
+    except ValueError:
+        return False
+    return True
+
+
+def read_trajectory(path: str) -> Trajectory:
+    """A CSV: a header of "time" then one servo ID per column; a row per
+    setpoint, evenly spaced. Every row is checked, and an error names its
+    line: nothing is sent before the whole file has passed."""
+    try:
+        with open(path, newline="") as f:
+            rows = [(n, r) for n, r in enumerate(csv.reader(f), 1)
+                    if r and not r[0].lstrip().startswith("#")]
+    except OSError as e:
+        raise UsageError(f"cannot read {path}: {e.strerror}") from None
+    except (csv.Error, UnicodeDecodeError) as e:
+        raise UsageError(f"{path}: not a CSV file ({e}): nothing was sent") from None
+    if len(rows) < 3:
+        raise UsageError(f"{path}: a header and at least two rows are needed")
+    line, header = rows[0]
+    try:
+        ids = [int(c) for c in header[1:]]
+        check_ids(ids)
+    except (ValueError, UsageError) as e:
+        raise UsageError(f"{path} line {line}: the header is 'time' and servo IDs ({e})") from None
+    table, lines = [], []
+    for line, r in rows[1:]:
+        def bad(why):
+            return UsageError(f"{path} line {line}: {why}; nothing was sent")
+        if len(r) != len(ids) + 1:
+            raise bad(f"every row has a time and one finite angle per servo ({len(ids)}), not {len(r)} values")
+        try:
+            values = [float(c) for c in r]
+        except ValueError:
+            cell = next(c for c in r if not _is_number(c))
+            raise bad(f"{cell.strip()!r} is not a number: every row has a time (s) and one angle (deg) "
+                      f"per servo") from None
+        if not all(map(math.isfinite, values)):
+            raise bad(f"every row has a time and one finite angle per servo, not {', '.join(r)}")
+        for servo_id, degrees in zip(ids, values[1:]):
+            try:
+                check_range("angle", scaled(degrees, 10, "degrees"), -MAX_ANGLE_DECIDEG, MAX_ANGLE_DECIDEG, "deg", 10)
+            except ValueOutOfRange as e:
+                raise bad(f"servo {servo_id}'s {e}") from None
+        table.append(values)
+        lines.append(line)
+    times = [r[0] for r in table]
+    period = (times[-1] - times[0]) / (len(times) - 1)
+    if period <= 0:
+        raise UsageError(f"{path}: the times must be evenly spaced and rising; nothing was sent")
+    for k in range(1, len(times)):
+        if abs(times[k] - times[k - 1] - period) > 1e-4:
+            raise UsageError(f"{path} line {lines[k]}: the times must be evenly spaced and rising "
+                             f"({period * 1000:g} ms apart), not {times[k - 1]:g} then {times[k]:g} s; "
+                             f"nothing was sent")
+    try:
+        check_range("period", round(period * 1000), *PERIOD_RANGE_MS, "ms")
+    except ValueOutOfRange as e:
+        raise ValueOutOfRange(f"{path}: the rows' {e}; nothing was sent") from None
+    return Trajectory(times, {servo_id: [r[k + 1] for r in table] for k, servo_id in enumerate(ids)},
+                      lines, path)
+
+
+def check_trajectory(trajectory: Trajectory, limits: dict) -> None:
+    """Every row against every servo's Limits, as Stream checks a send,
+    before anything moves: a row outside them is refused with its line;
+    the file's period against each servo's bus watchdog first."""
+    period_ms = trajectory.period_ms
+    check_period(limits, period_ms, f"{trajectory.path}: " if trajectory.path else "")
+    for servo_id, rows in trajectory.angles.items():
+        last = None
+        for k, degrees in enumerate(rows):
+            angle = scaled(degrees, 10, "degrees")
+            why = limits[servo_id].check(servo_id, angle, last, period_ms)
+            if why:
+                raise ValueOutOfRange(f"{trajectory.where(k)}: {why}; nothing was sent")
+            last = angle
