@@ -1,10 +1,10 @@
-"""The servo's data table, from protocol/schema.toml (docs/protocol.md):
+"""The servo's data table, from protocol/servo_schema (docs/protocol.md):
 names, sizes, units and ranges, so values are checked before they are sent."""
 from dataclasses import dataclass
 import re
 import struct
 
-from . import schema
+import servo_schema as schema
 from .protocol import ValueOutOfRange
 
 

@@ -31,7 +31,7 @@ from .move_request import MoveRequest
 from .outcome import EXECUTING, INHIBITING, STALL, TOLERANCE_DEG
 
 MAX_ANGLE_DECIDEG = 3686400    # the multi-turn range (ReadMultiTurnAngle)
-MAX_SPEED_DECIDEG_S = 7500     # the firmware clamps beyond (schema.toml)
+MAX_SPEED_DECIDEG_S = 7500     # the firmware clamps beyond (protocol/servo_schema)
 PERIOD_RANGE_MS = (1, 1000)    # item 69's
 
 

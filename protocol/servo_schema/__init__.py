@@ -1,7 +1,9 @@
-"""The protocol's one declaration, protocol/schema.toml, read and checked:
-the packets, the data items and the status bits that the firmware's tables
-(scripts/gen_protocol.py), servoctl and docs/protocol.md all come from.
-Standard library only: the build runs it with the system's Python."""
+"""The protocol's one declaration, the TOML files beside this one (frame.toml,
+items_*.toml, packets_*.toml), read and checked: the packets, the data items
+and the status bits that the firmware's tables (scripts/gen_protocol.py),
+servoctl and docs/protocol.md all come from. Standard library only: the
+firmware's build runs it with the system's Python, and imports nothing of
+servoctl's."""
 import dataclasses
 import functools
 import re
@@ -9,10 +11,12 @@ import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
-SCHEMA = Path(__file__).resolve().parents[2] / "protocol" / "schema.toml"
-# The simulators' control port, beside it: not the servo's protocol, but
-# declared once for servo_sim and the virtual boards the same way.
-CONTROL_PORT = "control_port.toml"
+SCHEMA = Path(__file__).resolve().parent
+# The simulators' control port, beside this folder: not the servo's
+# protocol, but declared once for servo_sim and the virtual boards the same way.
+CONTROL_PORT = SCHEMA.parent / "control_port.toml"
+# No line of the schema's files is longer (scripts/check_layers.py).
+LINE_LIMIT = 120
 FLAGS = ("addressed", "answers", "answers_if_control_response", "broadcast", "query", "syncable",
          "one_answers", "carries_records")
 # The fields of fixed size, by their struct code (lower case: signed).
@@ -27,7 +31,7 @@ AREAS = {"status": 1, "user": 32, "firmware": 64, "drive": 80}
 
 
 class SchemaError(ValueError):
-    """schema.toml says something that cannot be: the sentence says what."""
+    """The schema says something that cannot be: the sentence says what."""
 
 
 @dataclass(frozen=True)
@@ -270,11 +274,32 @@ def _unique(kind: str, values) -> None:
         seen.add(v)
 
 
-def parse(text: str, control_text: str | None = None) -> Schema:
-    """The schema from its text, and the control port's commands from
-    control_text (else from the schema's own control key, if any)."""
+def files() -> tuple:
+    """The schema's files, in the order they are read."""
+    return tuple(sorted(SCHEMA.glob("*.toml")))
+
+
+def _merged(texts) -> dict:
+    """One schema from its files' texts: the lists (items, packets, status
+    bits) of every file one after the other, the tables (frame) key by key."""
+    out = {}
+    for text in texts:
+        for key, value in tomllib.loads(text).items():
+            if isinstance(value, list):
+                out.setdefault(key, []).extend(value)
+            elif isinstance(value, dict) and not set(value) & set(out.setdefault(key, {})):
+                out[key].update(value)
+            else:
+                raise SchemaError(f"{key} is declared twice")
+    return out
+
+
+def parse(text, control_text: str | None = None) -> Schema:
+    """The schema from its text (a file's, or a sequence of the files'),
+    and the control port's commands from control_text (else from the
+    schema's own control key, if any)."""
     try:
-        raw = tomllib.loads(text)
+        raw = _merged([text] if isinstance(text, str) else text)
         if control_text is not None:
             raw["control"] = raw.get("control", []) + tomllib.loads(control_text).get("control", [])
     except tomllib.TOMLDecodeError as e:
@@ -311,7 +336,6 @@ def parse(text: str, control_text: str | None = None) -> Schema:
 
 
 @functools.lru_cache(maxsize=None)
-def load(path: str = str(SCHEMA)) -> Schema:
-    control = Path(path).with_name(CONTROL_PORT)
-    return parse(Path(path).read_text(encoding="utf-8"),
-                 control.read_text(encoding="utf-8") if control.exists() else None)
+def load() -> Schema:
+    return parse([path.read_text(encoding="utf-8") for path in files()],
+                 CONTROL_PORT.read_text(encoding="utf-8") if CONTROL_PORT.exists() else None)
