@@ -11,8 +11,10 @@ The C headers: protocol/packet_codes.h (every packet's code, which carry a
 servo ID), protocol/packet_rows.h (each packet table's rows and the
 handlers' prototypes), registers/schema_items.h (the register structs,
 the status bits, each item's ID, row and range), protocol/packet_fields.h
-(where each fixed field of an answer lies: for the unit tests) and
-sim/control_commands.h (servo_sim's control port)."""
+(where each fixed field of an answer lies: for the unit tests),
+registers/field_ranges.h (each request field's range, where the schema
+gives one) and sim/control_commands.h (servo_sim's control port)."""
+import re
 import struct
 import sys
 from pathlib import Path
@@ -166,6 +168,24 @@ def packet_fields_h(s: sch.Schema) -> str:
             + "".join(rows) + "\n#endif\n")
 
 
+def field_ranges_h(s: sch.Schema) -> str:
+    """FIELD_<packet>_<field>_MIN and _MAX of each request field the schema
+    gives a range: among the registers' headers, as the motion layer (below
+    the protocol) clamps to them."""
+    def number(value: int, f: sch.Field) -> str:
+        return (f"({value})" if value < 0 else f"{value}") if f.type.startswith("i") else f"{value}u"
+    rows = []
+    for p in s.packets:
+        for f in (f for f in p.request if f.limits is not None):
+            name = f"FIELD_{p.c}_{f.name.upper()}"
+            rows.append(f"#define {name}_MIN {number(f.limits[0], f)} /* {p.name}'s {f.name}: {f.out} */\n"
+                        f"#define {name}_MAX {number(f.limits[1], f)}\n")
+    return (NOTICE + "#ifndef REGISTERS_FIELD_RANGES_H\n#define REGISTERS_FIELD_RANGES_H\n\n"
+            "/* Each request field's range, where it is narrower than its type's: a\n"
+            " * value beyond it is clamped, or the request refused, as the comment says. */\n"
+            + "".join(rows) + "\n#endif\n")
+
+
 def control_commands_h(s: sch.Schema) -> str:
     """servo_sim's control commands: each one's name and the value it takes."""
     def row(c: sch.Control) -> str:
@@ -209,6 +229,25 @@ def _size_text(fields, user_area: int) -> str:
     return f"{least} byte{'' if most == 1 else 's'}" if least == most else f"{least} to {most} bytes"
 
 
+def _range_text(f: sch.Field) -> str:
+    return f"{f.limits[0]}..{f.limits[1]}"
+
+
+def _meaning(f: sch.Field) -> str:
+    """A field's meaning, and its range where the schema gives one."""
+    if f.limits is None:
+        return f.what
+    return f"{f.what}; {_range_text(f)}" + {"clamp": ", clamped", "refuse": ", refused beyond", "": ""}[f.out]
+
+
+def _rules(s: sch.Schema) -> str:
+    """rules.md, its {Packet.field} made that request field's range."""
+    rules = RULES.read_text(encoding="utf-8")
+    by_name = {p.name: p for p in s.packets}
+    return re.sub(r"\{(\w+)\.(\w+)\}", lambda m: _range_text(s.field(by_name[m[1]].code, m[2])),
+                  rules[rules.index("\n") + 1:].strip())
+
+
 def _packet_table(p: sch.Packet, user_area: int) -> list:
     """One table: the request's fields, then the answer's."""
     rows = ["| | field | type | unit | meaning |", "|---|---|---|---|---|"]
@@ -217,7 +256,7 @@ def _packet_table(p: sch.Packet, user_area: int) -> list:
         if not fields:
             rows.append(f"| {head} | | | | |")
         for k, f in enumerate(fields):
-            rows.append(f"| {head if k == 0 else ''} | {f.name} | {f.type} | {f.unit} | {_cell(f.what)} |")
+            rows.append(f"| {head if k == 0 else ''} | {f.name} | {f.type} | {f.unit} | {_cell(_meaning(f))} |")
     return rows + [""]
 
 
@@ -311,8 +350,7 @@ def protocol_md(s: sch.Schema) -> str:
             (", or off" if c.off else "") if c.value else ""
         out.append(f"| `{_cell(c.usage)}` | {value} | {'yes' if 'servo_sim' in c.on else 'no'} | "
                    f"{'yes' if 'vboard' in c.on else 'no'} | {_cell(c.what)} |")
-    rules = RULES.read_text(encoding="utf-8")
-    out += ["", "## Rules", "", rules[rules.index("\n") + 1:].strip(), ""]
+    out += ["", "## Rules", "", _rules(s), ""]
     return "\n".join(out).rstrip("\n") + "\n"
 
 
@@ -344,6 +382,7 @@ def main(argv=None) -> int:
         write(out / "protocol" / "packet_rows.h", packet_rows_h(s))
         write(out / "registers" / "schema_items.h", schema_items_h(s))
         write(out / "protocol" / "packet_fields.h", packet_fields_h(s))
+        write(out / "registers" / "field_ranges.h", field_ranges_h(s))
         write(out / "sim" / "control_commands.h", control_commands_h(s))
         return 0
     folder = Path(args[1])

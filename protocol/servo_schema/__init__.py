@@ -40,6 +40,15 @@ class Field:
     type: str
     unit: str
     what: str
+    limits: tuple = None  # (least, most) the schema gives; None: its type's whole range
+    out: str = ""         # a request's value beyond them: "clamp"ed or "refuse"d
+
+    @property
+    def range(self) -> tuple:
+        """(least, most): the schema's, else the type's (None for a field of varying size)."""
+        if self.limits is not None:
+            return self.limits
+        return _type_range(FIELD_TYPES[self.type], self.type.startswith("i")) if self.type in STRUCT_CODES else None
 
 
 @dataclass(frozen=True)
@@ -139,6 +148,10 @@ class Schema:
                 return None
         return out
 
+    def field(self, code: int, name: str, part: str = "request") -> Field:
+        """A field of a packet's request (or answer)."""
+        return next(f for f in getattr(self.packet(code), part) if f.name == name)
+
     def tables(self) -> dict:
         """{table: its packets, in code order}, tables in the order they first appear."""
         out = {}
@@ -147,14 +160,35 @@ class Schema:
         return {name: tuple(rows) for name, rows in out.items()}
 
 
-def _fields(where: str, rows) -> tuple:
+OUT = ("clamp", "refuse")  # what the servo does with a request's value beyond its field's range
+
+
+def _fields(where: str, rows, request: bool) -> tuple:
+    """A request's or an answer's fields: [name, type, unit, meaning], and
+    where the type's range is not the field's, {min, max} (a request's also
+    out: clamp or refuse)."""
     out = []
     for row in rows:
-        if len(row) != 4 or row[1] not in FIELD_TYPES:
-            raise SchemaError(f"{where}: a field is [name, type, unit, meaning] with a type of "
+        if len(row) not in (4, 5) or row[1] not in FIELD_TYPES:
+            raise SchemaError(f"{where}: a field is [name, type, unit, meaning] (and its range) with a type of "
                               f"{', '.join(FIELD_TYPES)}, not {row!r}")
-        out.append(Field(*row))
+        field = Field(*row[:4])
+        if len(row) == 5:
+            field = _ranged(f"{where}, field {row[0]}", field, row[4], request)
+        out.append(field)
     return tuple(out)
+
+
+def _ranged(where: str, field: Field, raw, request: bool) -> Field:
+    keys = {"min", "max", "out"} if request else {"min", "max"}
+    if not isinstance(raw, dict) or set(raw) != keys or field.type not in STRUCT_CODES:
+        raise SchemaError(f"{where}: a range is {{{', '.join(sorted(keys))}}} of a number's field, not {raw!r}")
+    low, high = field.range
+    if not (isinstance(raw["min"], int) and isinstance(raw["max"], int) and low <= raw["min"] <= raw["max"] <= high):
+        raise SchemaError(f"{where}: its range needs {low} <= min <= max <= {high}")
+    if request and raw["out"] not in OUT:
+        raise SchemaError(f"{where}: out is {' or '.join(OUT)}, not {raw['out']!r}")
+    return dataclasses.replace(field, limits=(raw["min"], raw["max"]), out=raw.get("out", ""))
 
 
 def _length(where: str, value) -> tuple:
@@ -205,7 +239,8 @@ def _packet(raw: dict) -> Packet:
         pkt = Packet(code=raw["code"], name=raw["name"], c=c, py=raw.get("py", c), source=raw["source"],
                      table=raw["table"], flags=tuple(raw.get("flags", ())),
                      length=_length(where, raw.get("length")), handler=raw.get("handler", ""), what=raw["what"],
-                     request=_fields(where, raw.get("request", ())), answer=_fields(where, raw.get("answer", ())))
+                     request=_fields(where, raw.get("request", ()), True),
+                     answer=_fields(where, raw.get("answer", ()), False))
     except KeyError as e:
         raise SchemaError(f"{where}: no {e.args[0]}") from None
     unknown = [f for f in pkt.flags if f not in FLAGS]
@@ -328,6 +363,12 @@ def parse(text, control_text: str | None = None) -> Schema:
     packets = tuple(_sized(p, user_area, frame) for p in packets)
     schema = Schema(frame, bits, items, packets, tuple(_control(c) for c in raw.get("control", [])))
     _unique("control commands", [c.name for c in schema.controls])
+    ranges = {}
+    for p in packets:  # one handler reads a field of one name and type one way
+        for f in p.request:
+            if ranges.setdefault((p.handler, f.name, f.type), (f.range, f.out, p.name))[:2] != (f.range, f.out):
+                raise SchemaError(f"packet {p.name}: field {f.name} ranges other than in "
+                                  f"{ranges[(p.handler, f.name, f.type)][2]}, which handle_{p.handler}() reads too")
     for table, rows in schema.tables().items():
         codes = [p.code for p in rows]
         if codes != list(range(codes[0], codes[0] + len(codes))):

@@ -4,6 +4,7 @@ made from it. The reference is committed and must be what the schema makes
 now; a schema that cannot be
 is refused with a sentence that says why; and a new data item and a new
 packet need the schema and the packet's handler, nothing else."""
+import importlib.util
 import os
 import shutil
 import subprocess
@@ -56,6 +57,11 @@ LAST_ITEM = "what = \"shifts the zero every angle read and written refers to\"\n
     (_with(SCHEMA, LAST_ITEM, LAST_ITEM + NEW_ITEM),
      "ReadBatchData.*an answer of 35 bytes does not fit the frame's answer_content_max"),
     ("[frame\n", "not TOML"),
+    (_with(SCHEMA, "{min = -1800, max = 1800,", "{min = -40000, max = 1800,"), "range needs -32768 <= min"),
+    (_with(SCHEMA, 'max = 1, out = "refuse"}', 'max = 1, out = "wrap"}'), "out is clamp or refuse"),
+    (_with(SCHEMA, '{min = 0, max = 16}', '{min = 0, max = 16, out = "clamp"}'), "a range is {max, min}"),
+    (_with(SCHEMA, '"cruise speed", {min = 10,', '"cruise speed", {min = 11,'),
+     "field target_velocity ranges other than in"),
 ])
 def test_a_schema_that_cannot_be_is_refused_with_its_reason(broken, said):
     with pytest.raises(schema.SchemaError, match=said):
@@ -149,3 +155,40 @@ def test_a_new_item_and_a_new_packet_need_the_schema_and_the_handler_only(tmp_pa
     assert "| 54 | test_hold_ms | 2 | u16 | read-write | 0..1000 | 250 | ms |" in text
     assert "## 0x47 Echo" in (docs / "protocol-packets.md").read_text(encoding="utf-8")
     shutil.rmtree(build)
+
+
+_spec = importlib.util.spec_from_file_location("gen_protocol", GEN)
+gen_protocol = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(gen_protocol)
+
+
+def test_a_request_fields_range_is_the_firmwares_and_servoctls():
+    """The range is the schema's: the C header the firmware clamps and
+    refuses by, servoctl's checks and the reference's words come from it."""
+    from servoctl import protocol as p
+    s = schema.load()
+    header = gen_protocol.field_ranges_h(s)
+    assert "#define FIELD_MOVE_MULTI_TURN_ANGLE_MIN (-3686400) /* MoveOnMultiTurnAngleMode's angle: clamp */" in header
+    assert "#define FIELD_DRIVE_DUTY_TIME_MAX 10000u\n" in header
+    assert p.field_range(p.STREAM_SETPOINT, "velocity") == (-7500, 7500)
+    assert p.field_range(p.ANGLE, "interval") == (0, 65535)  # no range given: the type's
+    assert "| angle | i32 | 0.1deg | target; -3686400..3686400, clamped |" in \
+        (ROOT / "docs/protocol-packets.md").read_text(encoding="utf-8")
+
+
+# What the schema says once, and no source says again: the ranges of the
+# moves' fields, and the status bits as masks.
+ONCE = {"3686400": ("motion", "protocol", "tools/servoctl"), "4096000": ("motion", "protocol", "tools/servoctl"),
+        "7500": ("motion", "protocol", "tools/servoctl"), "1 << ": ("tools/servoctl/outcome.py",),
+        "= 1, 2, 4, 8, 16": ("tools/tests/integration/test_spec.py",)}
+
+
+def test_the_schemas_numbers_are_written_nowhere_else():
+    found = []
+    for text, places in ONCE.items():
+        for place in places:
+            paths = [ROOT / place] if place.endswith(".py") else \
+                [f for f in (ROOT / place).rglob("*") if f.suffix in (".c", ".h", ".py")]
+            found += [f"{path.relative_to(ROOT)}: {text}" for path in paths
+                      if text in path.read_text(encoding="utf-8")]
+    assert found == []
