@@ -7,7 +7,7 @@ import zlib
 from dataclasses import dataclass
 from pathlib import Path
 
-from .protocol import UsageError
+from .errors import UsageError
 
 MAGIC = 0x50415653  # "SVAP"
 FORMAT = 1

@@ -58,6 +58,12 @@ def answer_frame_size(code: int) -> int:
     return len(RESPONSE_HEADER) + 3 + struct.calcsize(_SCHEMA.answer_format(code))
 
 
+def field_range(code: int, name: str) -> tuple:
+    """(least, most) of a request's field: the range the servo clamps or
+    refuses beyond (protocol/servo_schema), else its type's."""
+    return _SCHEMA.field(code, name).range
+
+
 def request_format(code: int) -> str:
     """The struct format of a request's content (protocol/servo_schema)."""
     return _SCHEMA.request_format(code)

@@ -30,8 +30,10 @@ from .loop_rate import (BITS_PER_BYTE, LoopLate, LoopRate, check_wire, cycle_byt
 from .move_request import MoveRequest
 from .outcome import EXECUTING, INHIBITING, STALL, TOLERANCE_DEG
 
-MAX_ANGLE_DECIDEG = 3686400    # the multi-turn range (ReadMultiTurnAngle)
-MAX_SPEED_DECIDEG_S = 7500     # the firmware clamps beyond (protocol/servo_schema)
+# The ranges of StreamSetpoint's angle (multi-turn, as ReadMultiTurnAngle)
+# and velocity, +-: the firmware clamps beyond (protocol/servo_schema).
+MAX_ANGLE_DECIDEG = p.field_range(p.STREAM_SETPOINT, "angle")[1]
+MAX_SPEED_DECIDEG_S = p.field_range(p.STREAM_SETPOINT, "velocity")[1]
 PERIOD_RANGE_MS = (1, 1000)    # item 69's
 
 
