@@ -150,7 +150,10 @@ class Schema:
 
     def field(self, code: int, name: str, part: str = "request") -> Field:
         """A field of a packet's request (or answer)."""
-        return next(f for f in getattr(self.packet(code), part) if f.name == name)
+        fields = {f.name: f for f in getattr(self.packet(code), part)}
+        if name not in fields:
+            raise KeyError(f"packet {code:#04x}'s {part} has no field {name!r}: {', '.join(fields)}")
+        return fields[name]
 
     def tables(self) -> dict:
         """{table: its packets, in code order}, tables in the order they first appear."""
