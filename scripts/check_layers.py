@@ -67,6 +67,8 @@ SCHEMA_FILES = ("protocol/servo_schema/*.toml", "protocol/*.toml")
 SCHEMA_LINE_LIMIT = 120
 # A Python script a CMake file runs, from the project's or the file's folder.
 BUILD_SCRIPT = re.compile(r"\$\{(PROJECT|CMAKE_CURRENT)_SOURCE_DIR\}/([\w/.-]+\.py)")
+# A CMake file that runs Python with tools/ on its path, or a module by name (-m).
+BUILD_MODULE = re.compile(r"PYTHONPATH=\S*/tools\b|\$\{Python3_EXECUTABLE\}\s+-m\s+[\w.]+|Interpreter\s+-m\s+[\w.]+")
 
 INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"', re.M)
 
@@ -249,14 +251,18 @@ def long_schema_lines(root):
                     yield path.relative_to(root).as_posix(), n, len(line)
 
 
-def build_scripts(root):
-    """The Python scripts the firmware's build runs, named in its CMake files."""
+def build_scripts(root, unnamed=None):
+    """The Python scripts the firmware's build runs, named in its CMake files;
+    unnamed (a list) gets where one runs Python it does not name by path."""
     out = set()
     for cmake in sorted(root.rglob("CMakeLists.txt")) + sorted(root.rglob("*.cmake")):
         rel = cmake.relative_to(root).as_posix()
         if rel.startswith(("build/", ".")) or "/." in rel:
             continue
-        for where, name in BUILD_SCRIPT.findall(cmake.read_text(errors="replace")):
+        text = cmake.read_text(errors="replace")
+        if unnamed is not None:
+            unnamed += [f"build import: {rel} runs {m}" for m in BUILD_MODULE.findall(text)]
+        for where, name in BUILD_SCRIPT.findall(text):
             script = (root if where == "PROJECT" else cmake.parent) / name
             if script.is_file():
                 out.add(script.resolve())
@@ -270,7 +276,7 @@ def build_import_breaches(root):
     standard library."""
     tools = {p.parent.name for p in (root / "tools").glob("*/__init__.py")}
     out, seen = [], set()
-    todo = list(build_scripts(root))
+    todo = list(build_scripts(root, out))
     while todo:
         path = todo.pop()
         if path in seen:

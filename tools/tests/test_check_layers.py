@@ -131,7 +131,9 @@ def test_two_headers_of_one_name_are_found(tmp_path):
 def test_the_build_importing_from_tools_is_found(tmp_path):
     """The Python the firmware's build runs (a script a CMake file names,
     and the modules of the tree it imports) imports no package of tools/,
-    puts no tools/ folder on its path, and needs only the standard library."""
+    puts no tools/ folder on its path, and needs only the standard library;
+    and the build runs no Python module by name nor with tools/ on its path
+    (before: the image step ran servoctl.image)."""
     root = tree(tmp_path)
     write(root, "tools/servoctl/__init__.py", "")
     write(root, "CMakeLists.txt", "add_custom_command(OUTPUT x COMMAND ${Python3_EXECUTABLE} "
@@ -145,6 +147,11 @@ def test_the_build_importing_from_tools_is_found(tmp_path):
         "build import: protocol/reader/__init__.py imports servoctl, from tools/",
         "build import: protocol/reader/__init__.py imports yaml, not in the standard library",
         "build import: scripts/gen.py puts tools/ on its path"]
+    write(root, "cmake/image.cmake", "add_custom_command(TARGET x POST_BUILD COMMAND ${CMAKE_COMMAND} -E env "
+                                     "PYTHONPATH=${PROJECT_SOURCE_DIR}/tools ${Python3_EXECUTABLE} -m servoctl.image)\n")
+    assert sorted(check_layers.check(root)[0])[:2] == [
+        "build import: cmake/image.cmake runs ${Python3_EXECUTABLE} -m servoctl.image",
+        "build import: cmake/image.cmake runs PYTHONPATH=${PROJECT_SOURCE_DIR}/tools"]
 
 
 def test_a_long_schema_line_is_found(tmp_path):
