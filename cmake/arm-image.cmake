@@ -71,8 +71,8 @@ function(servo_arm_image name)
             $<TARGET_FILE:${name}.elf> ${CMAKE_BINARY_DIR}
     # The update image (header, then the application): what the bootloader
     # starts, servoctl update writes, and the slot holds.
-    COMMAND ${CMAKE_COMMAND} -E env PYTHONPATH=${PROJECT_SOURCE_DIR}/tools
-            ${Python3_EXECUTABLE} -m servoctl.image ${CMAKE_CURRENT_BINARY_DIR}/${name}.bin
+    COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/firmware/bootloader/servo_image/__init__.py
+            ${CMAKE_CURRENT_BINARY_DIR}/${name}.bin
             --version ${SERVO_FIRMWARE_VERSION} --board ${board}
             -o ${CMAKE_CURRENT_BINARY_DIR}/${name}.img
     VERBATIM)

@@ -9,9 +9,10 @@
 
 #include "motion/motion.h"
 #include "motion/saturate.h"
+#include "registers/field_ranges.h"
 
 enum {
-    MULTI_TURN_LIMIT = 3686400, /* docs/protocol.md, "Moves" */
+    MULTI_TURN_LIMIT = FIELD_MOVE_MULTI_TURN_ANGLE_MAX, /* the schema's, +-: docs/protocol.md, "Moves" */
     DECIDEG_PER_TURN = 3600,
     SUPPLY_HYSTERESIS_MV = 128, /* the limits follow the supply past this */
     CLOCK_REAL_TIME = 256,      /* clock_rate, Q8 */
@@ -114,8 +115,11 @@ void motion_coast(struct motion *m);
 /* Runs a command now: its profile, or the mode it sets. */
 void motion_run(struct motion *m, const struct motion_command *cmd);
 /* The angle modes' top speed, 0.1 deg/s, and their shortest ramp, ms
- * (docs/protocol.md, "Moves"). */
-enum { MAX_VELOCITY = 7500, MIN_RAMP_MS = 20 };
+ * (the schema's ranges: docs/protocol.md, "Moves"). */
+enum {
+    MAX_VELOCITY = FIELD_MOVE_ANGLE_BY_VELOCITY_TARGET_VELOCITY_MAX,
+    MIN_RAMP_MS = FIELD_MOVE_ANGLE_BY_INTERVAL_ACC_INTERVAL_MIN,
+};
 /* The one clamp of every position target (planning.c): angle_decideg
  * (protocol frame) within +-range, then, where item 48 is at least from,
  * the angle limits (51, 52) in the frame whose zero is base (decideg); sets

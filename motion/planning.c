@@ -5,14 +5,22 @@
 #include "motion/gains.h"
 #include "motion/motion_internal.h"
 
-/* Limits of docs/protocol.md, "Moves". */
+/* Limits of docs/protocol.md, "Moves": the schema's ranges of the fields. */
 enum {
-    SINGLE_TURN_LIMIT = 1800,
-    MAX_INTERVAL_MS = 4096000,
-    MIN_VELOCITY = 10,     /* 0.1 deg/s */
-    MAX_WHEEL_SPEED = 750, /* deg/s, the angle modes' top speed */
+    SINGLE_TURN_LIMIT = FIELD_MOVE_ANGLE_ANGLE_MAX,
+    MAX_INTERVAL_MS = FIELD_MOVE_MULTI_TURN_INTERVAL_MAX,
+    MIN_VELOCITY = FIELD_MOVE_ANGLE_BY_VELOCITY_TARGET_VELOCITY_MIN, /* 0.1 deg/s */
+    MAX_WHEEL_SPEED = FIELD_MOVE_WHEEL_SPEED_MAX, /* deg/s, the angle modes' top speed */
     WHEEL_RAMP_MS = 20,
 };
+/* The clamps below take a range of +-its most, and one ramp's least for both. */
+_Static_assert(FIELD_MOVE_ANGLE_ANGLE_MIN == -SINGLE_TURN_LIMIT &&
+                   FIELD_MOVE_MULTI_TURN_ANGLE_MIN == -MULTI_TURN_LIMIT,
+               "the angle ranges are symmetric");
+_Static_assert(FIELD_MOVE_ANGLE_BY_INTERVAL_DEC_INTERVAL_MIN == MIN_RAMP_MS &&
+                   FIELD_MOVE_ANGLE_BY_INTERVAL_ACC_INTERVAL_MAX == PROFILE_MAX_RAMP &&
+                   FIELD_MOVE_ANGLE_BY_INTERVAL_DEC_INTERVAL_MAX == PROFILE_MAX_RAMP,
+               "one ramp range");
 
 static uint32_t clamp_u32(uint32_t v, uint32_t lo, uint32_t hi)
 {

@@ -8,6 +8,13 @@
 #include "motion/motion_internal.h"
 #include "motion/saturate.h"
 
+/* A setpoint's angle and velocity take the angle moves' ranges. */
+_Static_assert(FIELD_STREAM_SETPOINT_ANGLE_MAX == MULTI_TURN_LIMIT &&
+                   FIELD_STREAM_SETPOINT_ANGLE_MIN == -MULTI_TURN_LIMIT &&
+                   FIELD_STREAM_SETPOINT_VELOCITY_MAX == MAX_VELOCITY &&
+                   FIELD_STREAM_SETPOINT_VELOCITY_MIN == -MAX_VELOCITY,
+               "StreamSetpoint's ranges are the moves'");
+
 /* The stream's limits, those of the angle modes: their top speed (750
  * deg/s) and the steepest ramp a move asks, that speed in the shortest
  * ramp (20 ms: 37 500 deg/s^2). Q8 decideg per tick, and per tick^2. */

@@ -3,6 +3,7 @@
 #include <string.h>
 
 #include "registers/data_table.h"
+#include "registers/field_ranges.h"
 #include "protocol/packet_table.h"
 #include "protocol/wire.h"
 
@@ -142,6 +143,10 @@ enum packet_outcome handle_monitor(const struct packet_call *c, struct response 
  * the one with the serial number, so it reaches one servo among several
  * that share an ID; the others stay silent. The ID is written as WriteData
  * of item 34 writes it. */
+/* AssignId's new ID is written as item 34, and refused beyond its range. */
+_Static_assert(FIELD_ASSIGN_ID_NEW_ID_MIN == ITEM_SERVO_ID_MIN && FIELD_ASSIGN_ID_NEW_ID_MAX == ITEM_SERVO_ID_MAX,
+               "AssignId's new ID ranges as item 34");
+
 enum packet_outcome handle_assign_id(const struct packet_call *c, struct response *r)
 {
     if (le_get_u32(&c->content[1]) != c->d->regs->status.serial_number) {

@@ -7,6 +7,12 @@
 #include "protocol/packet_table.h"
 #include "protocol/wire.h"
 #include "hal/size_first.h"
+#include "registers/field_ranges.h"
+
+/* StopOnControlMode's methods, as the schema ranges them. */
+_Static_assert(STOP_RELEASE == FIELD_STOP_ON_CONTROL_MODE_METHOD_MIN &&
+                   STOP_DAMPING == FIELD_STOP_ON_CONTROL_MODE_METHOD_MAX,
+               "the stop methods are the schema's");
 
 /* Ramps of the packets that carry none (8, 13): docs/protocol.md, "Moves". */
 enum { DEFAULT_RAMP_MS = 20 };
@@ -228,7 +234,7 @@ enum packet_outcome handle_end_async(const struct packet_call *c, struct respons
 {
     (void)r;
     uint8_t cancel = c->content[0];
-    if (cancel > 1u) {
+    if (cancel > FIELD_END_ASYNC_CANCEL_MAX) {
         return OUTCOME_ERROR;
     }
     motion_end_async(c->d->motion, cancel == 1u);

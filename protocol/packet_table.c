@@ -6,7 +6,7 @@
 #include "protocol/packet_rows.h"
 
 /* Three tables, each a run of consecutive codes, their rows made from
- * protocol/schema.toml: the maker's and its clients' packets (1-25), this
+ * protocol/servo_schema: the maker's and its clients' packets (1-25), this
  * firmware's own from 0x40, and the update packets from 0x50. The update
  * packets other than UpdateEnter and UpdateStatus are the bootloader's: an
  * application leaves them unanswered (a tool then knows to send

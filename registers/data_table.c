@@ -21,7 +21,7 @@
 #define RESERVED_SIGNED DATA_SIGNED
 
 /* Rows in ID order; status area first, then the user area in wire order,
- * then the firmware area, then the drive area (protocol/schema.toml). */
+ * then the firmware area, then the drive area (protocol/servo_schema). */
 static const struct data_item items[] = {DATA_ITEM_ROWS};
 
 enum {

@@ -5,9 +5,12 @@ Each source folder is a layer; a layer may include only the layers below it
 (LAYERS). No module (a .c with its .h) may reach itself through the
 includes of others (a circle), nor through the symbols its object file
 uses and the others define (`--objects BUILD`: a build's objects, read
-with nm), nor may servoctl's modules through their imports; and no file
+with nm), nor may servoctl's modules through their imports; no file
 people read (source, build files, documents) outside the tests and the
-generated files may pass LINE_LIMIT lines (SPLITTING: those being split).
+generated files may pass LINE_LIMIT lines (SPLITTING: those being split),
+nor a line of the protocol's schema SCHEMA_LINE_LIMIT characters; and the
+Python the firmware's build runs imports nothing from tools/ (the PC
+tools) and nothing outside the standard library.
 
 Exit 1 with one line per breach; `--graph` prints the layer graph found."""
 import argparse
@@ -69,8 +72,15 @@ SPLITTING = {
     "firmware/app/servo.c": (514, "issue 57 item 3 splits it: main loop, bus turns, store upkeep"),
     "firmware/boards/host_sim/sim_servo.c": (430, "issue 57 item 3 splits it"),
     "protocol/wire/frame_rx.c": (441, "issue 57 item 3 splits it"),
-    "protocol/schema.toml": (550, "issue 57 items 2-3 split it (the schema under protocol/)"),
 }
+
+# The protocol's schema: its files and the simulators' control port.
+SCHEMA_FILES = ("protocol/servo_schema/*.toml", "protocol/*.toml")
+SCHEMA_LINE_LIMIT = 120
+# A Python script a CMake file runs, from the project's or the file's folder.
+BUILD_SCRIPT = re.compile(r"\$\{(PROJECT|CMAKE_CURRENT)_SOURCE_DIR\}/([\w/.-]+\.py)")
+# A CMake file that runs Python with tools/ on its path, or a module by name (-m).
+BUILD_MODULE = re.compile(r"PYTHONPATH=\S*/tools\b|\$\{Python3_EXECUTABLE\}\s+-m\s+[\w.]+|Interpreter\s+-m\s+[\w.]+")
 
 INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"', re.M)
 
@@ -247,6 +257,64 @@ def long_files(root):
             yield rel, len(lines)
 
 
+def long_schema_lines(root):
+    for pattern in SCHEMA_FILES:
+        for path in sorted(root.glob(pattern)):
+            for n, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1):
+                if len(line) > SCHEMA_LINE_LIMIT:
+                    yield path.relative_to(root).as_posix(), n, len(line)
+
+
+def build_scripts(root, unnamed=None):
+    """The Python scripts the firmware's build runs, named in its CMake files;
+    unnamed (a list) gets where one runs Python it does not name by path."""
+    out = set()
+    for cmake in sorted(root.rglob("CMakeLists.txt")) + sorted(root.rglob("*.cmake")):
+        rel = cmake.relative_to(root).as_posix()
+        if rel.startswith(("build/", ".")) or "/." in rel:
+            continue
+        text = cmake.read_text(errors="replace")
+        if unnamed is not None:
+            unnamed += [f"build import: {rel} runs {m}" for m in BUILD_MODULE.findall(text)]
+        for where, name in BUILD_SCRIPT.findall(text):
+            script = (root if where == "PROJECT" else cmake.parent) / name
+            if script.is_file():
+                out.add(script.resolve())
+    return sorted(out)
+
+
+def build_import_breaches(root):
+    """The build's scripts, and the modules of this tree they import, import
+    no package of tools/ (servoctl, vboard: the build must not need the PC
+    tool), put no tools/ folder on their path, and need nothing beyond the
+    standard library."""
+    tools = {p.parent.name for p in (root / "tools").glob("*/__init__.py")}
+    out, seen = [], set()
+    todo = list(build_scripts(root, out))
+    while todo:
+        path = todo.pop()
+        if path in seen:
+            continue
+        seen.add(path)
+        rel = path.relative_to(root.resolve()).as_posix()
+        tree = ast.parse(path.read_text(encoding="utf-8"), str(path))
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Constant) and node.value == "tools":
+                out.append(f"build import: {rel} puts tools/ on its path")
+            names = [a.name for a in node.names] if isinstance(node, ast.Import) else \
+                [node.module] if isinstance(node, ast.ImportFrom) and node.level == 0 and node.module else []
+            for name in (n.split(".")[0] for n in names):
+                local = [d / name for d in (path.parent, root / "protocol", root / "scripts")]
+                found = [f for d in local for f in (d / "__init__.py", d.with_suffix(".py")) if f.is_file()]
+                if name in tools:
+                    out.append(f"build import: {rel} imports {name}, from tools/")
+                elif found:
+                    todo.append(found[0].resolve())
+                elif name not in sys.stdlib_module_names:
+                    out.append(f"build import: {rel} imports {name}, not in the standard library")
+    return sorted(set(out))
+
+
 def check(root, build=None):
     breaches = include_breaches(root)
     graph = include_graph(root)
@@ -275,6 +343,9 @@ def check(root, build=None):
     for rel, n in long_files(root):
         limit, why = SPLITTING.get(rel, (LINE_LIMIT, ""))
         breaches.append(f"long file: {rel} has {n} lines (limit {limit}{'; ' + why if why else ''})")
+    for rel, n, length in long_schema_lines(root):
+        breaches.append(f"long schema line: {rel}:{n} has {length} characters (limit {SCHEMA_LINE_LIMIT})")
+    breaches += build_import_breaches(root)
     return breaches, graph
 
 

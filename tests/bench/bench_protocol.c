@@ -231,7 +231,7 @@ static void latency(const char *name, uint8_t code, const uint8_t *content, size
     uint8_t frame[80];
     size_t n = make_request(frame, code, content, length);
     uint32_t frames_before = servo.rx.stats.frames;
-    /* run_target_bench.py checks these against protocol/schema.toml: every
+    /* run_target_bench.py checks these against protocol/servo_schema: every
      * packet measured, and answered exactly where the schema says. */
     printf("packet %u %s\n", code, answers ? "answer" : "quiet");
     dma_writes(frame, n - 1u);

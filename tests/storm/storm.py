@@ -50,7 +50,7 @@ sys.path.insert(0, str(ROOT / "tools"))
 
 from servoctl import protocol as p  # noqa: E402
 from servoctl.protocol import checksum, request_frame  # noqa: E402
-from servoctl.sim import control_command  # noqa: E402
+from servoctl.sim import Simulator, control_command  # noqa: E402
 
 try:
     from rich.console import Console
@@ -67,55 +67,29 @@ RELEASE = 0x10  # StopOnControl: stop and release
 NO_HEADER = bytes(b for b in range(256) if b not in (0x12, 0x05))
 
 
-class Sim:
-    """servo_sim on a TCP port, its stderr in a log file."""
+class Sim(Simulator):
+    """servo_sim on a TCP port, its stderr in a log file; its clock and
+    control port are servoctl's Simulator's (the clock file it maps, the
+    control port else)."""
 
     def __init__(self, binary: Path, state: Path, log: Path):
+        super().__init__(ids=IDS, state_dir=str(state))
         self.binary, self.state, self.log = binary, state, log
-        self.process = None
 
     def start(self):
         self.errors = open(self.log, "a")
-        with socket.socket() as probe:
-            probe.bind(("127.0.0.1", 0))
-            port = probe.getsockname()[1]
-        self.process = subprocess.Popen(
-            [str(self.binary), "--state", str(self.state), "--tcp", str(port),
-             *sum((["--id", str(i)] for i in IDS), [])],
-            stdout=subprocess.PIPE, stderr=self.errors, text=True)
-        self.url = self.control = self.clock_sock = None
-        for line in self.process.stdout:
-            words = line.split()
-            if words[1:2] == ["bus"]:
-                self.url = words[2]
-            elif words[1:2] == ["control"]:
-                self.control = int(words[2].rsplit(":", 1)[1])
-            elif words[1:2] == ["ready"]:
-                break
+        cmd = [str(self.binary), "--state", str(self.state), "--tcp", "0",
+               *sum((["--id", str(i)] for i in IDS), [])]
+        self.process = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=self.errors, text=True)
+        self._until_ready(cmd)
         host, port = self.url.replace("socket://", "").split(":")
         self.sock = socket.create_connection((host, int(port)))
         self.sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
         self.sock.settimeout(0.005)
+        return self
 
     def command(self, line: str) -> str:
-        return control_command(self.control, line, timeout=5)
-
-    def clock_s(self) -> float:
-        """The simulated clock, seconds, over a control connection kept
-        open. Every wait for an answer is judged on it: on a loaded PC the
-        simulator falls behind the host, and a host-time deadline would
-        call a late answer lost."""
-        if self.clock_sock is None:
-            self.clock_sock = socket.create_connection(("127.0.0.1", self.control), timeout=5)
-            self.clock_sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-        self.clock_sock.sendall(b"clock\n")
-        reply = b""
-        while not reply.endswith(b"\n"):
-            chunk = self.clock_sock.recv(256)
-            if not chunk:
-                raise ConnectionError("servo_sim closed its control port")
-            reply += chunk
-        return float(re.search(rb"sim_ms=([0-9.]+)", reply).group(1)) / 1000.0
+        return control_command(self.control_port, line, timeout=5)
 
     def state_of(self, servo_id: int) -> dict:
         out = {}
@@ -124,22 +98,20 @@ class Sim:
             out[key] = value
         return out
 
-    def _close(self):
+    def _end(self, sig):
+        """Closes the bus, sends sig, and lets Simulator.stop close the
+        clock and reap the process."""
         self.sock.close()
-        if self.clock_sock is not None:
-            self.clock_sock.close()
+        self.process.send_signal(sig)
+        self.process.wait(timeout=10)
+        super().stop()
+        self.errors.close()
 
     def kill(self):
-        self._close()
-        self.process.send_signal(signal.SIGKILL)
-        self.process.wait()
-        self.errors.close()
+        self._end(signal.SIGKILL)
 
     def stop(self):
-        self._close()
-        self.process.send_signal(signal.SIGTERM)
-        self.process.wait(timeout=10)
-        self.errors.close()
+        self._end(signal.SIGTERM)
 
 
 class Host:

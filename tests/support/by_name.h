@@ -1,5 +1,5 @@
 /* Requests built and answers read by packet and item name (the names
- * protocol/schema.toml gives them), for the servo harness's tests. */
+ * protocol/servo_schema gives them), for the servo harness's tests. */
 #ifndef TEST_BY_NAME_H
 #define TEST_BY_NAME_H
 

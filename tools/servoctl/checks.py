@@ -3,6 +3,7 @@ within the packet's range, and profiles the firmware would not clamp. Every
 message says the range and the unit."""
 import math
 
+from . import protocol as p
 from .errors import ValueOutOfRange
 
 
@@ -20,7 +21,9 @@ def check_range(name: str, value: int, low: int, high: int, unit: str = "", per_
     return value
 
 
-MIN_RAMP_MS = 20  # docs/protocol.md: acc >= 20, dec >= 20, interval >= acc + dec
+# The shortest ramp the firmware keeps (the schema's acc_interval range):
+# acc and dec at least this, interval >= acc + dec (docs/protocol.md).
+MIN_RAMP_MS = p.field_range(p.ANGLE_BY_INTERVAL, "acc_interval")[0]
 
 
 def check_profile(acc_ms: int, dec_ms: int, interval_ms: int = None, velocity: int = None) -> None:
@@ -34,7 +37,7 @@ def check_profile(acc_ms: int, dec_ms: int, interval_ms: int = None, velocity: i
         raise ValueOutOfRange(f"a move of {interval_ms} ms cannot hold its ramps ({acc_ms} + {dec_ms} ms): "
                               f"give {acc_ms + dec_ms} ms or more (the servo would stretch it)")
     if velocity is not None:
-        check_range("speed", velocity, 10, 7500, "deg/s", 10)
+        check_range("speed", velocity, *p.field_range(p.ANGLE_BY_VELOCITY, "target_velocity"), "deg/s", 10)
 
 
 def scaled(value: float, factor: int, name: str) -> int:

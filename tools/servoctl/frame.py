@@ -17,9 +17,9 @@ the servo stop short of it."""
 from dataclasses import dataclass
 
 from .errors import NotSent, ServoError
-from .protocol import BadAnswer, NoReply, ValueOutOfRange
+from .protocol import BadAnswer, NoReply, ValueOutOfRange, ANGLE, field_range
 
-SINGLE_TURN = (-1800, 1800)  # 0.1 deg
+SINGLE_TURN = field_range(ANGLE, "angle")  # 0.1 deg: a single-turn move's target
 TURN = 3600
 
 

@@ -28,15 +28,15 @@ def sync_move(bus: p.Bus, targets: dict, duration_s: float, power_w: float = 0.0
     power = check_range("power", scaled(power_w, 1000, "power_w"), 0, 65535, "mW")
     if multi:
         code = p.MULTI_TURN
-        check_range("interval", interval, 0, 4096000, "ms")
+        check_range("interval", interval, *p.field_range(code, "interval"), "ms")
     else:
         code = p.ANGLE
-        check_range("interval", interval, 0, 65535, "ms")
+        check_range("interval", interval, *p.field_range(code, "interval"), "ms")
     records = b""
     for servo_id, degrees in targets.items():
         check_range("servo ID", servo_id, 0, p.MAX_ID)
         angle = scaled(degrees, 10, "degrees")
-        check_range("angle", angle, -3686400, 3686400, "deg", 10)
+        check_range("angle", angle, *p.field_range(p.MULTI_TURN, "angle"), "deg", 10)
         check_target(Servo(bus, servo_id), angle, multi)
         records += p.encode_request(code, servo_id, angle, interval, power)
     bus.send(p.SYNC, bytes([code, len(records) // len(targets), len(targets)]) + records)
@@ -48,8 +48,8 @@ def broadcast_move(bus: p.Bus, degrees: float, duration_s: float, power_w: float
     ids are the servos on the bus: each is checked first (frame.check_target:
     in turn 0, the angle within its limits), and nothing is sent unless all
     pass."""
-    angle = check_range("angle", scaled(degrees, 10, "degrees"), -1800, 1800, "deg", 10)
-    interval = check_range("interval", to_ms(duration_s, "duration_s"), 0, 65535, "ms")
+    angle = check_range("angle", scaled(degrees, 10, "degrees"), *p.field_range(p.ANGLE, "angle"), "deg", 10)
+    interval = check_range("interval", to_ms(duration_s, "duration_s"), *p.field_range(p.ANGLE, "interval"), "ms")
     check_profile(MIN_RAMP_MS, MIN_RAMP_MS, interval)
     power = check_range("power", scaled(power_w, 1000, "power_w"), 0, 65535, "mW")
     if not ids:

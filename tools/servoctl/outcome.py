@@ -9,12 +9,13 @@ from .errors import BadAnswer, NoReply, Refused
 from .move_request import MoveRequest
 
 TOLERANCE_DEG = 0.5
+_BIT = registers.STATUS_MASK
 # Status bits under which the servo refuses motion (docs/protocol.md,
 # "Protection"): high and low voltage, over-temperature.
-INHIBITING = (1 << 3) | (1 << 4) | (1 << 7)
-STALL = 1 << 2
-COMMAND_ERROR = 1 << 1
-EXECUTING = 1 << 0
+INHIBITING = _BIT["high_voltage"] | _BIT["low_voltage"] | _BIT["over_temperature"]
+STALL = _BIT["stall"]
+COMMAND_ERROR = _BIT["command_error"]
+EXECUTING = _BIT["executing"]
 
 
 def taken(s, what: str) -> int:

@@ -1,9 +1,9 @@
-"""Frames of the servo protocol (docs/protocol.md, from protocol/schema.toml)
+"""Frames of the servo protocol (docs/protocol.md, from protocol/servo_schema)
 and a bus that sends requests and waits for the matching response."""
 import struct
 import time
 
-from . import schema as _schema
+import servo_schema as _schema
 
 # The errors are errors.py's; named here too, as p.NoReply and the like.
 from .errors import (BadAnswer, BadChecksum, LinkError, NoReply, Refused,  # noqa: F401
@@ -42,7 +42,7 @@ def checksum(data: bytes) -> int:
 
 
 def decode_answer(code: int, content: bytes) -> tuple:
-    """An answer's fields, as protocol/schema.toml lays them out, once its
+    """An answer's fields, as protocol/servo_schema lays them out, once its
     length is the packet's: any other length is an error that says so,
     never a traceback."""
     fmt = _SCHEMA.answer_format(code)
@@ -58,13 +58,19 @@ def answer_frame_size(code: int) -> int:
     return len(RESPONSE_HEADER) + 3 + struct.calcsize(_SCHEMA.answer_format(code))
 
 
+def field_range(code: int, name: str) -> tuple:
+    """(least, most) of a request's field: the range the servo clamps or
+    refuses beyond (protocol/servo_schema), else its type's."""
+    return _SCHEMA.field(code, name).range
+
+
 def request_format(code: int) -> str:
-    """The struct format of a request's content (protocol/schema.toml)."""
+    """The struct format of a request's content (protocol/servo_schema)."""
     return _SCHEMA.request_format(code)
 
 
 def encode_request(code: int, *values) -> bytes:
-    """A request's content from its fields' values, as protocol/schema.toml
+    """A request's content from its fields' values, as protocol/servo_schema
     lays them out."""
     return struct.pack(_SCHEMA.request_format(code), *values)
 

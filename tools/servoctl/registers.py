@@ -1,10 +1,10 @@
-"""The servo's data table, from protocol/schema.toml (docs/protocol.md):
+"""The servo's data table, from protocol/servo_schema (docs/protocol.md):
 names, sizes, units and ranges, so values are checked before they are sent."""
 from dataclasses import dataclass
 import re
 import struct
 
-from . import schema
+import servo_schema as schema
 from .protocol import ValueOutOfRange
 
 
@@ -83,6 +83,7 @@ RAM = [i for i in FIRMWARE if i.writable]  # settable, lost at power-up: config 
 BY_ID = {i.id: i for i in ITEMS}
 BY_NAME = {i.name: i for i in ITEMS}
 STATUS_BITS = [b.name for b in _SCHEMA.status_bits]
+STATUS_MASK = {b.name: 1 << b.bit for b in _SCHEMA.status_bits}  # each status bit's mask, by name
 BAUD_RATES = {1: 9600, 2: 19200, 3: 38400, 4: 57600, 5: 115200, 6: 250000, 7: 500000, 8: 1000000}
 
 

@@ -232,22 +232,22 @@ class Servo:
         check_range("acceleration time", acc_ms, 0, 65535, "ms")
         check_range("deceleration time", dec_ms, 0, 65535, "ms")
         if multi_turn:
-            check_range("angle", angle_decideg, -3686400, 3686400, "deg", 10)
+            check_range("angle", angle_decideg, *p.field_range(p.MULTI_TURN, "angle"), "deg", 10)
         else:
-            check_range("angle", angle_decideg, -1800, 1800, "deg", 10)
+            check_range("angle", angle_decideg, *p.field_range(p.ANGLE, "angle"), "deg", 10)
         if (interval_ms is None) == (velocity is None):
             raise ValueOutOfRange("give either an interval or a velocity")
         if velocity is not None:
-            check_range("speed", velocity, 10, 7500, "deg/s", 10)
             code = p.MULTI_TURN_BY_VELOCITY if multi_turn else p.ANGLE_BY_VELOCITY
+            check_range("speed", velocity, *p.field_range(code, "target_velocity"), "deg/s", 10)
             content = p.encode_request(code, self.id, angle_decideg, velocity, acc_ms, dec_ms, power_mw)
         elif not ramps:
-            check_range("interval", interval_ms, 0, 4096000 if multi_turn else 65535, "ms")
             code = p.MULTI_TURN if multi_turn else p.ANGLE
+            check_range("interval", interval_ms, *p.field_range(code, "interval"), "ms")
             content = p.encode_request(code, self.id, angle_decideg, interval_ms, power_mw)
         else:
-            check_range("interval", interval_ms, 0, 4096000 if multi_turn else 65535, "ms")
             code = p.MULTI_TURN_BY_INTERVAL if multi_turn else p.ANGLE_BY_INTERVAL
+            check_range("interval", interval_ms, *p.field_range(code, "interval"), "ms")
             content = p.encode_request(code, self.id, angle_decideg, interval_ms, acc_ms, dec_ms, power_mw)
         return self._move(code, content, wait)
 
@@ -273,11 +273,11 @@ class Servo:
 
     def drive_duty(self, duty: float, ms: int) -> None:
         """Open loop (DriveDuty, this firmware's 0x46): the bridge at duty (-1..1
-        of the supply) for ms (1-10000), then released. The current limit and
+        of the supply) for ms (the range of DriveDuty's time), then released. The current limit and
         the protections hold it; the angle limits do not."""
         if not -1.0 <= duty <= 1.0:
             raise ValueOutOfRange(f"duty takes -1 to 1 (of the supply), not {duty!r}")
-        check_range("time", ms, 1, 10000, "ms")
+        check_range("time", ms, *p.field_range(p.DRIVE_DUTY, "time"), "ms")
         q15 = round(duty * 32767)
         if q15 == 0:
             raise ValueOutOfRange(f"duty {duty} rounds to 0 (1/32767 of the supply is the least)")

@@ -17,14 +17,17 @@ import struct
 from dataclasses import dataclass
 
 from . import protocol as p
+from . import registers
 from .checks import check_range, scaled
 from .errors import NoReply, ServoError, UsageError, ValueOutOfRange
 from .group import MAX_SYNC_RECORDS, monitor_answers, monitor_request
 from .loop_rate import LoopRate, check_wire, cycle_bytes, warn_late, wire_limit_hz
 
-MAX_ANGLE_DECIDEG = 3686400    # the multi-turn range (ReadMultiTurnAngle)
-MAX_SPEED_DECIDEG_S = 7500     # the firmware clamps beyond (schema.toml)
-PERIOD_RANGE_MS = (1, 1000)    # item 69's
+# The ranges of StreamSetpoint's angle (multi-turn, as ReadMultiTurnAngle)
+# and velocity, +-: the firmware clamps beyond (protocol/servo_schema).
+MAX_ANGLE_DECIDEG = p.field_range(p.STREAM_SETPOINT, "angle")[1]
+MAX_SPEED_DECIDEG_S = p.field_range(p.STREAM_SETPOINT, "velocity")[1]
+PERIOD_RANGE_MS = (1, registers.find("stream_period_ms").high)  # item 69's, but for its 0 (off)
 
 
 def check_ids(ids) -> list:

@@ -136,3 +136,39 @@ def test_two_headers_of_one_name_are_found(tmp_path):
     breaches, _ = check_layers.check(root)
     assert breaches == ["header name: port_uart.h is hal/ports/stm32f0/port_uart.h, "
                         "hal/ports/stm32f1/port_uart.h"]
+
+
+def test_the_build_importing_from_tools_is_found(tmp_path):
+    """The Python the firmware's build runs (a script a CMake file names,
+    and the modules of the tree it imports) imports no package of tools/,
+    puts no tools/ folder on its path, and needs only the standard library;
+    and the build runs no Python module by name nor with tools/ on its path
+    (before: the image step ran servoctl.image)."""
+    root = tree(tmp_path)
+    write(root, "tools/servoctl/__init__.py", "")
+    write(root, "CMakeLists.txt", "add_custom_command(OUTPUT x COMMAND ${Python3_EXECUTABLE} "
+                                  "${PROJECT_SOURCE_DIR}/scripts/gen.py c out)\n")
+    write(root, "protocol/reader/__init__.py", "import tomllib\n")
+    write(root, "scripts/gen.py", "import sys\nsys.path.insert(0, 'protocol')\nimport reader\n")
+    assert check_layers.check(root)[0] == []
+    write(root, "protocol/reader/__init__.py", "import tomllib\nimport yaml\nfrom servoctl import errors\n")
+    write(root, "scripts/gen.py", "import sys\nsys.path.insert(0, 'tools')\nimport reader\n")
+    assert sorted(check_layers.check(root)[0]) == [
+        "build import: protocol/reader/__init__.py imports servoctl, from tools/",
+        "build import: protocol/reader/__init__.py imports yaml, not in the standard library",
+        "build import: scripts/gen.py puts tools/ on its path"]
+    write(root, "cmake/image.cmake", "add_custom_command(TARGET x POST_BUILD COMMAND ${CMAKE_COMMAND} -E env "
+                                     "PYTHONPATH=${PROJECT_SOURCE_DIR}/tools ${Python3_EXECUTABLE} -m servoctl.image)\n")
+    assert sorted(check_layers.check(root)[0])[:2] == [
+        "build import: cmake/image.cmake runs ${Python3_EXECUTABLE} -m servoctl.image",
+        "build import: cmake/image.cmake runs PYTHONPATH=${PROJECT_SOURCE_DIR}/tools"]
+
+
+def test_a_long_schema_line_is_found(tmp_path):
+    root = tree(tmp_path)
+    write(root, "protocol/servo_schema/items.toml", "# " + "x" * 118 + "\n")
+    write(root, "protocol/control_port.toml", "# short\n")
+    assert check_layers.check(root)[0] == []
+    write(root, "protocol/control_port.toml", "# short\n# " + "x" * 119 + "\n")
+    assert check_layers.check(root)[0] == [
+        "long schema line: protocol/control_port.toml:2 has 121 characters (limit 120)"]

@@ -19,7 +19,7 @@ import sys
 import tempfile
 import time
 
-from servoctl import schema
+import servo_schema as schema
 
 from .board import PARTS, Board, images
 from .bus import Bus

@@ -1,5 +1,5 @@
 /* The controller's fixed constants, with their units. The gains and the
- * drive train's constants are data items 80-89 (protocol/schema.toml: their
+ * drive train's constants are data items 80-89 (protocol/servo_schema: their
  * factory values are the reference servo's, hal/ports/host/plants/
  * reference_st3215.toml), stored with the user area and turned into the
  * feed-forward when one changes (controller.c, drive_limits_for_supply).

@@ -13,6 +13,7 @@
 #include "motion/encoder.h"
 #include "motion/profile.h"
 #include "registers/registers.h"
+#include "registers/field_ranges.h"
 #include "hal/must_check.h"
 
 enum motion_kind {
@@ -218,7 +219,8 @@ MUST_CHECK enum motion_submit_result motion_stream(struct motion *m, const struc
  * ms (1..MOTION_OPEN_LOOP_MAX_MS), then released. The output's current
  * limit and the protections hold it; the angle limits do not. Refused
  * while the protections hold the output. */
-#define MOTION_OPEN_LOOP_MAX_MS 10000u
+#define MOTION_OPEN_LOOP_MAX_MS FIELD_DRIVE_DUTY_TIME_MAX
+_Static_assert(FIELD_DRIVE_DUTY_TIME_MIN == 1u, "DriveDuty refuses a time of 0 only");
 MUST_CHECK enum motion_submit_result motion_drive_duty(struct motion *m, int16_t duty_q15, uint16_t ms);
 /* Nothing drives the output: released, or damping (a brake that only
  * resists motion). Under position control or an applied duty (DriveDuty)

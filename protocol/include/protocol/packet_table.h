@@ -72,7 +72,7 @@ struct packet_desc {
 };
 
 const struct packet_desc *packet_find(uint8_t code);
-/* Every handler a packet table names (protocol/schema.toml). */
+/* Every handler a packet table names (protocol/servo_schema). */
 PACKET_HANDLERS_DECLARED
 
 /* The "id, result" answer most packets give (the dispatcher has put the

@@ -7,7 +7,7 @@
 
 /* struct status_area, enum status_bit, struct user_config, USER_AREA_SIZE,
  * struct firmware_area and each writable item's range: made from
- * protocol/schema.toml. */
+ * protocol/servo_schema. */
 #include "registers/schema_items.h"
 
 /* How the config store is doing (ReadStore, 0x41, docs/packets.md): kept

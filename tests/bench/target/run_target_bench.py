@@ -26,7 +26,6 @@ import re
 import subprocess
 import sys
 import tempfile
-import tomllib
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -228,11 +227,12 @@ def run(elf: Path, cpu: str, profile_region: str = "", by_line: bool = False) ->
     return regions, stats
 
 
-SCHEMA = ROOT / "protocol/schema.toml"
+sys.path.insert(0, str(ROOT / "protocol"))
+import servo_schema  # noqa: E402  (the schema's reader, standard library only)
 
 
 def unmeasured(measured: list) -> list:
-    """Packets of protocol/schema.toml that bench_protocol.c's every_packet
+    """Packets of the schema (protocol/servo_schema) that bench_protocol.c's every_packet
     leaves out, or measures without their answer: a new packet in the
     schema fails the run until it is measured. measured: [(code, "answer" |
     "quiet")] as the benchmark printed them."""
@@ -240,13 +240,12 @@ def unmeasured(measured: list) -> list:
     for code, kind in measured:
         seen.setdefault(int(code), set()).add(kind)
     missing = []
-    for packet in tomllib.loads(SCHEMA.read_text())["packet"]:
-        flags = packet.get("flags", [])
-        kinds = seen.get(packet["code"], set())
+    for packet in servo_schema.load().packets:
+        kinds = seen.get(packet.code, set())
         if not kinds:
-            missing.append(f"{packet['name']} (not measured)")
-        elif "answers" in flags and "answer" not in kinds:
-            missing.append(f"{packet['name']} (its answer not measured)")
+            missing.append(f"{packet.name} (not measured)")
+        elif packet.has("answers") and "answer" not in kinds:
+            missing.append(f"{packet.name} (its answer not measured)")
     # A move's answer once it has finished (item 33): one packet's stands
     # for all (the same pass sends each).
     if not any("finished" in kinds for kinds in seen.values()):
@@ -265,7 +264,7 @@ def figures(cpu: str, profile_region: str = "", by_line: bool = False) -> dict:
     missing = unmeasured(pstats["packets"])
     if missing:
         raise SystemExit(f"run_target_bench: bench_protocol.c on {cpu} leaves out packets of "
-                         f"protocol/schema.toml: {', '.join(missing)}")
+                         f"the schema: {', '.join(missing)}")
     motion, mstats = run(CPUS[cpu] / "bench_motion.elf", cpu, profile_region, by_line)
     nbytes, nticks = int(pstats["stream_bytes"]), int(mstats["ticks"])
     plans = {k: v for k, v in motion.items() if k.startswith("plan_") and not k.startswith("plan_jerk")}

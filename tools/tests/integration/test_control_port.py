@@ -4,7 +4,7 @@ answer the same line the same way: a value out of its declared range, off
 where only stop takes it, an unknown command."""
 import pytest
 
-from servoctl import schema
+import servo_schema as schema
 from servoctl.errors import ServoError
 from servoctl.sim import Simulator
 

@@ -8,11 +8,12 @@ import pytest
 from servoctl import protocol as p
 from servoctl.profile import velocity_timing
 from servoctl.protocol import Bus, NoReply
+from servoctl.registers import STATUS_MASK
 from servoctl.servo import Servo
 from servoctl.sim import Simulator
 
-EXECUTING, COMMAND_ERROR, STALL, HIGH_V, LOW_V = 1, 2, 4, 8, 16
-OVER_TEMPERATURE = 128
+EXECUTING, COMMAND_ERROR, STALL, HIGH_V, LOW_V, OVER_TEMPERATURE = (STATUS_MASK[name] for name in (
+    "executing", "command_error", "stall", "high_voltage", "low_voltage", "over_temperature"))
 
 
 def timed_move(servo, sim, **move):

@@ -15,7 +15,7 @@
 #include "hal/hal_rx_ring.h"
 #include "protocol/packet_codes.h"
 
-/* Largest request content kept (protocol/schema.toml). A longer request is
+/* Largest request content kept (protocol/servo_schema). A longer request is
  * consumed by its length and delivered with FRAME_TRUNCATED so the
  * dispatcher can reject it as a length error. */
 #define FRAME_CONTENT_MAX REQUEST_CONTENT_MAX

@@ -1,7 +1,9 @@
-"""The protocol's one declaration, protocol/schema.toml, read and checked:
-the packets, the data items and the status bits that the firmware's tables
-(scripts/gen_protocol.py), servoctl and docs/protocol.md all come from.
-Standard library only: the build runs it with the system's Python."""
+"""The protocol's one declaration, the TOML files beside this one (frame.toml,
+items_*.toml, packets_*.toml), read and checked: the packets, the data items
+and the status bits that the firmware's tables (scripts/gen_protocol.py),
+servoctl and docs/protocol.md all come from. Standard library only: the
+firmware's build runs it with the system's Python, and imports nothing of
+servoctl's."""
 import dataclasses
 import functools
 import re
@@ -9,10 +11,12 @@ import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
-SCHEMA = Path(__file__).resolve().parents[2] / "protocol" / "schema.toml"
-# The simulators' control port, beside it: not the servo's protocol, but
-# declared once for servo_sim and the virtual boards the same way.
-CONTROL_PORT = "control_port.toml"
+SCHEMA = Path(__file__).resolve().parent
+# The simulators' control port, beside this folder: not the servo's
+# protocol, but declared once for servo_sim and the virtual boards the same way.
+CONTROL_PORT = SCHEMA.parent / "control_port.toml"
+# No line of the schema's files is longer (scripts/check_layers.py).
+LINE_LIMIT = 120
 FLAGS = ("addressed", "answers", "answers_if_control_response", "broadcast", "query", "syncable",
          "one_answers", "carries_records")
 # The fields of fixed size, by their struct code (lower case: signed).
@@ -27,7 +31,7 @@ AREAS = {"status": 1, "user": 32, "firmware": 64, "drive": 80}
 
 
 class SchemaError(ValueError):
-    """schema.toml says something that cannot be: the sentence says what."""
+    """The schema says something that cannot be: the sentence says what."""
 
 
 @dataclass(frozen=True)
@@ -36,6 +40,15 @@ class Field:
     type: str
     unit: str
     what: str
+    limits: tuple = None  # (least, most) the schema gives; None: its type's whole range
+    out: str = ""         # a request's value beyond them: "clamp"ed or "refuse"d
+
+    @property
+    def range(self) -> tuple:
+        """(least, most): the schema's, else the type's (None for a field of varying size)."""
+        if self.limits is not None:
+            return self.limits
+        return _type_range(FIELD_TYPES[self.type], self.type.startswith("i")) if self.type in STRUCT_CODES else None
 
 
 @dataclass(frozen=True)
@@ -135,6 +148,13 @@ class Schema:
                 return None
         return out
 
+    def field(self, code: int, name: str, part: str = "request") -> Field:
+        """A field of a packet's request (or answer)."""
+        fields = {f.name: f for f in getattr(self.packet(code), part)}
+        if name not in fields:
+            raise KeyError(f"packet {code:#04x}'s {part} has no field {name!r}: {', '.join(fields)}")
+        return fields[name]
+
     def tables(self) -> dict:
         """{table: its packets, in code order}, tables in the order they first appear."""
         out = {}
@@ -143,14 +163,35 @@ class Schema:
         return {name: tuple(rows) for name, rows in out.items()}
 
 
-def _fields(where: str, rows) -> tuple:
+OUT = ("clamp", "refuse")  # what the servo does with a request's value beyond its field's range
+
+
+def _fields(where: str, rows, request: bool) -> tuple:
+    """A request's or an answer's fields: [name, type, unit, meaning], and
+    where the type's range is not the field's, {min, max} (a request's also
+    out: clamp or refuse)."""
     out = []
     for row in rows:
-        if len(row) != 4 or row[1] not in FIELD_TYPES:
-            raise SchemaError(f"{where}: a field is [name, type, unit, meaning] with a type of "
+        if len(row) not in (4, 5) or row[1] not in FIELD_TYPES:
+            raise SchemaError(f"{where}: a field is [name, type, unit, meaning] (and its range) with a type of "
                               f"{', '.join(FIELD_TYPES)}, not {row!r}")
-        out.append(Field(*row))
+        field = Field(*row[:4])
+        if len(row) == 5:
+            field = _ranged(f"{where}, field {row[0]}", field, row[4], request)
+        out.append(field)
     return tuple(out)
+
+
+def _ranged(where: str, field: Field, raw, request: bool) -> Field:
+    keys = {"min", "max", "out"} if request else {"min", "max"}
+    if not isinstance(raw, dict) or set(raw) != keys or field.type not in STRUCT_CODES:
+        raise SchemaError(f"{where}: a range is {{{', '.join(sorted(keys))}}} of a number's field, not {raw!r}")
+    low, high = field.range
+    if not (isinstance(raw["min"], int) and isinstance(raw["max"], int) and low <= raw["min"] <= raw["max"] <= high):
+        raise SchemaError(f"{where}: its range needs {low} <= min <= max <= {high}")
+    if request and raw["out"] not in OUT:
+        raise SchemaError(f"{where}: out is {' or '.join(OUT)}, not {raw['out']!r}")
+    return dataclasses.replace(field, limits=(raw["min"], raw["max"]), out=raw.get("out", ""))
 
 
 def _length(where: str, value) -> tuple:
@@ -201,7 +242,8 @@ def _packet(raw: dict) -> Packet:
         pkt = Packet(code=raw["code"], name=raw["name"], c=c, py=raw.get("py", c), source=raw["source"],
                      table=raw["table"], flags=tuple(raw.get("flags", ())),
                      length=_length(where, raw.get("length")), handler=raw.get("handler", ""), what=raw["what"],
-                     request=_fields(where, raw.get("request", ())), answer=_fields(where, raw.get("answer", ())))
+                     request=_fields(where, raw.get("request", ()), True),
+                     answer=_fields(where, raw.get("answer", ()), False))
     except KeyError as e:
         raise SchemaError(f"{where}: no {e.args[0]}") from None
     unknown = [f for f in pkt.flags if f not in FLAGS]
@@ -270,11 +312,32 @@ def _unique(kind: str, values) -> None:
         seen.add(v)
 
 
-def parse(text: str, control_text: str | None = None) -> Schema:
-    """The schema from its text, and the control port's commands from
-    control_text (else from the schema's own control key, if any)."""
+def files() -> tuple:
+    """The schema's files, in the order they are read."""
+    return tuple(sorted(SCHEMA.glob("*.toml")))
+
+
+def _merged(texts) -> dict:
+    """One schema from its files' texts: the lists (items, packets, status
+    bits) of every file one after the other, the tables (frame) key by key."""
+    out = {}
+    for text in texts:
+        for key, value in tomllib.loads(text).items():
+            if isinstance(value, list):
+                out.setdefault(key, []).extend(value)
+            elif isinstance(value, dict) and not set(value) & set(out.setdefault(key, {})):
+                out[key].update(value)
+            else:
+                raise SchemaError(f"{key} is declared twice")
+    return out
+
+
+def parse(text, control_text: str | None = None) -> Schema:
+    """The schema from its text (a file's, or a sequence of the files'),
+    and the control port's commands from control_text (else from the
+    schema's own control key, if any)."""
     try:
-        raw = tomllib.loads(text)
+        raw = _merged([text] if isinstance(text, str) else text)
         if control_text is not None:
             raw["control"] = raw.get("control", []) + tomllib.loads(control_text).get("control", [])
     except tomllib.TOMLDecodeError as e:
@@ -303,6 +366,12 @@ def parse(text: str, control_text: str | None = None) -> Schema:
     packets = tuple(_sized(p, user_area, frame) for p in packets)
     schema = Schema(frame, bits, items, packets, tuple(_control(c) for c in raw.get("control", [])))
     _unique("control commands", [c.name for c in schema.controls])
+    ranges = {}
+    for p in packets:  # one handler reads a field of one name and type one way
+        for f in p.request:
+            if ranges.setdefault((p.handler, f.name, f.type), (f.range, f.out, p.name))[:2] != (f.range, f.out):
+                raise SchemaError(f"packet {p.name}: field {f.name} ranges other than in "
+                                  f"{ranges[(p.handler, f.name, f.type)][2]}, which handle_{p.handler}() reads too")
     for table, rows in schema.tables().items():
         codes = [p.code for p in rows]
         if codes != list(range(codes[0], codes[0] + len(codes))):
@@ -311,7 +380,6 @@ def parse(text: str, control_text: str | None = None) -> Schema:
 
 
 @functools.lru_cache(maxsize=None)
-def load(path: str = str(SCHEMA)) -> Schema:
-    control = Path(path).with_name(CONTROL_PORT)
-    return parse(Path(path).read_text(encoding="utf-8"),
-                 control.read_text(encoding="utf-8") if control.exists() else None)
+def load() -> Schema:
+    return parse([path.read_text(encoding="utf-8") for path in files()],
+                 CONTROL_PORT.read_text(encoding="utf-8") if CONTROL_PORT.exists() else None)
