@@ -26,3 +26,14 @@ def test_a_family_is_declared_once(tmp_path):
     (tmp_path / "board.cmake").write_text(
         "include(${PROJECT_SOURCE_DIR}/cmake/family-stm32f0.cmake)\nset(SERVO_BOARD_CPU cortex-m4)\n")
     assert board_facts.cpu(tmp_path) == "cortex-m4"
+
+
+def test_a_board_h_s_includes_are_followed():
+    """The reference servo's front end is declared once
+    (boards/common/reference_servo.h) and read for every board that includes
+    it; host_sim's own ID overrides the reference board's it includes."""
+    for name in ("stm32f103", "stm32f030k6", "qemu_stm32vl", "host_sim"):
+        facts = board_facts.defines(name)
+        assert facts["BOARD_SUPPLY_UV_PER_COUNT"] == 8862, name
+        assert facts["BOARD_MOTOR_MOHM"] == 2741, name
+    assert board_facts.defines("host_sim")["BOARD_ID"] == 0x5100

@@ -12,10 +12,8 @@
 #define BOARDS_COMMON_APP_START_H
 
 #include "app/servo.h"
+#include "boards/common/app_hooks.h"
 #include "boards/test_build.h"
-#include "bootloader/app_image.h"
-#include "bootloader/boot_flow.h"
-#include "ports/stm32_common/boot_jump.h"
 #include "ports/stm32_common/cortex_sleep.h"
 #include "ports/stm32_common/flash_f0f1.h"
 #include "ports/stm32_common/systick_clock.h"
@@ -29,20 +27,6 @@ static struct hal_flash flash;
 static struct hal_flash fault_flash;
 
 static const struct sensor_calibration calibration = BOARD_SENSOR_CALIBRATION;
-
-/* Data ID 7: the version of the image the bootloader started. */
-static uint16_t image_version(void *ctx)
-{
-    (void)ctx;
-    return app_image_version_in_place(BOARD_SLOT_BASE);
-}
-
-/* UpdateEnter: the word that keeps the bootloader, then a restart. */
-static void enter_bootloader(void *ctx)
-{
-    (void)ctx;
-    boot_restart_with(BOOT_STAY_WORD_ADDR(BOARD_RAM_END), BOOT_STAY_MAGIC);
-}
 
 /* The board's wiring: which driver does what, in one place. */
 static const struct hal_port port = {
