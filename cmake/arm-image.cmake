@@ -90,7 +90,8 @@ function(servo_arm_bootloader name)
   # (firmware/runtime/small_mem.c), and the board's port with the drivers
   # it shares (unused ones drop out at the link).
   set(boot ${PROJECT_SOURCE_DIR}/firmware/bootloader)
-  set(small ${PROJECT_SOURCE_DIR}/protocol/wire/frame_rx.c ${PROJECT_SOURCE_DIR}/firmware/runtime/small_mem.c ${boot}/bootloader.c
+  set(small ${PROJECT_SOURCE_DIR}/protocol/wire/frame_rx.c ${PROJECT_SOURCE_DIR}/protocol/wire/frame_rx_queue.c
+      ${PROJECT_SOURCE_DIR}/firmware/runtime/small_mem.c ${boot}/bootloader.c
       ${boot}/boot_packets.c ${boot}/boot_flow.c ${boot}/app_image.c ${boot}/slot_write.c
       ${PROJECT_SOURCE_DIR}/firmware/storage/config_peek.c ${PROJECT_SOURCE_DIR}/firmware/storage/crc32.c)
   foreach(lib ${SERVO_BOARD_PORT} servo_stm32_common)
@@ -122,4 +123,16 @@ function(servo_arm_bootloader name)
     COMMAND sh ${PROJECT_SOURCE_DIR}/cmake/check-image.sh $<TARGET_FILE:${name}.elf> 4096
             ${SERVO_BOARD_RAM_LIMIT}
     VERBATIM)
+endfunction()
+
+# servo_board_images(): the images of the board whose folder calls it: its
+# bootloader (boot_main.c), its application (main.c), and a test build of
+# the application stuck 300 ms after reset, for the watchdog
+# (firmware/boards/test_build.h).
+function(servo_board_images)
+  get_filename_component(board ${CMAKE_CURRENT_SOURCE_DIR} NAME)
+  servo_arm_bootloader(servo_${board}_boot SOURCES boot_main.c)
+  servo_arm_image(servo_${board} SOURCES main.c)
+  servo_arm_image(servo_${board}_stuck SOURCES main.c)
+  target_compile_definitions(servo_${board}_stuck.elf PRIVATE SERVO_TEST_STUCK_AFTER_MS=300)
 endfunction()

@@ -4,16 +4,14 @@
 #include <string.h>
 
 #include "app/identity.h"
+#include "app/servo_jobs.h"
 #include "app/servo_safety.h"
 #include "registers/data_table.h"
-#include "hal/size_first.h"
 
 static uint32_t idle_timeout_us(const struct servo *s, uint32_t baud)
 {
     return frame_rx_port_idle_us(frame_rx_idle_us(baud), s->hal->rx_gap_tolerance_us);
 }
-
-static bool persist_config(void *ctx, const struct user_config *cfg);
 
 static void apply_link_settings(struct servo *s)
 {
@@ -65,91 +63,11 @@ void servo_init(struct servo *s, const struct hal_port *hal)
     s->dispatcher.bootloader_present = hal->enter_bootloader != NULL;
     s->dispatcher.board = hal->board;
     s->dispatcher.next_tick_us = &s->next_tick_us;
-    s->dispatcher.persist = persist_config;
+    s->dispatcher.persist = servo_persist_config;
     s->dispatcher.persist_ctx = s;
     safety_init(s);
     s->active_baud_index = 0; /* forces the first apply to set the UART */
     apply_link_settings(s);
-}
-
-static void start_send(struct servo *s)
-{
-    s->tx.waiting = 0;
-    s->tx.sending = 1;
-    s->hal->bus.send(s->hal->ctx, frame_tx_bytes(&s->tx.frame), s->tx.size);
-}
-
-/* Sync Monitor: each listed servo answers after the ones listed before it.
- * A turn passes when their response has gone by, or when the line has been
- * silent for SYNC_SLOT_SILENCE_US (that servo is absent). */
-static void wait_for_turn(struct servo *s, uint32_t now)
-{
-    uint32_t seen = s->rx.stats.responses_skipped - s->tx.responses_base;
-    uint32_t last_byte = s->hal->rx->heard_us;
-    if (now - last_byte < now - s->tx.silence_from_us) {
-        s->tx.silence_from_us = last_byte; /* the line was busy since */
-    }
-    /* The answer on the line is the last before this turn and ends sooner
-     * than a tick and a pass take: a tick started now would hold the turn
-     * back (on the M0 a tick is 4 byte times at 1 Mbaud), so a tick due
-     * waits for this servo's answer to start, a tick and a pass at most
-     * (the schedule stays: the tick after is due on time). */
-    bool imminent = seen + 1u >= s->tx.turns_left &&
-                    frame_rx_skip_ends_within(&s->rx, s->turn_guard_bytes);
-    s->tick_due_us = s->next_tick_us + (imminent ? s->hal->tick_and_pass_us : 0u);
-    if (seen >= s->tx.turns_left) {
-        start_send(s);
-    } else if (now - s->tx.silence_from_us >= SYNC_SLOT_SILENCE_US) {
-        s->tx.turns_left--;
-        s->tx.silence_from_us = now;
-    }
-}
-
-/* s->tx.frame holds the response. */
-static void queue_response(struct servo *s, uint8_t wait, uint32_t responses_base, uint32_t now)
-{
-    s->tx.size = frame_tx_seal(&s->tx.frame);
-    s->tx.turns_left = wait;
-    s->tx.responses_base = responses_base;
-    s->tx.requests_base = s->rx.stats.requests_seen;
-    s->tx.silence_from_us = now;
-    if (wait == 0u) {
-        start_send(s);
-    } else {
-        s->tx.waiting = 1;
-    }
-}
-
-/* Nobody asked for a "move finished" answer just now, so nobody has left
- * the line free for it: it goes out in this ID's slot (servo.h). Divides
- * while an answer waits, once a pass. */
-static bool in_unsolicited_slot(const struct servo *s, uint32_t now)
-{
-    uint32_t heard = now - s->hal->rx->heard_us;
-    uint32_t said = now - s->tx.ended_us;
-    uint32_t quiet = heard < said ? heard : said;
-    if (quiet < s->unsolicited_first_us) {
-        return false;
-    }
-    uint32_t cycle = UNSOLICITED_SLOTS * s->unsolicited_slot_us;
-    return (quiet - s->unsolicited_first_us) % cycle < UNSOLICITED_WINDOW_US;
-}
-
-static void answer_finished_move(struct servo *s, uint32_t now)
-{
-    if (!motion_has_finished(&s->motion) || !in_unsolicited_slot(s, now)) {
-        return;
-    }
-    uint8_t packet = motion_take_finished(&s->motion);
-    if (packet == 0u) {
-        return;
-    }
-    struct response *r = &s->tx.frame;
-    r->code = packet;
-    r->length = 2;
-    r->content[0] = s->active_id;
-    r->content[1] = 1;
-    queue_response(s, 0, 0, now);
 }
 
 /* Status bit 0 follows the motion: after each tick and each command. */
@@ -188,132 +106,10 @@ static inline __attribute__((always_inline)) void handle_next_frame(struct servo
     if (result.answer && late) {
         s->answers_dropped++;
     } else if (result.answer) {
-        queue_response(s, result.wait_responses, responses_base, now);
+        servo_queue_response(s, result.wait_responses, responses_base, now);
     }
 }
 
-/* ReadStore's flags (enum store_flag). On the M0 called (a tick's report and a
- * save's), not inlined twice. */
-SIZE_FIRST_CALLED static uint8_t store_flags(const struct servo *s)
-{
-    return (uint8_t)((s->store.failed ? STORE_FAILED : 0u) |
-                     (s->saver.over_budget ? STORE_OVER_BUDGET : 0u) |
-                     (s->saver.awaits_erase ? STORE_AWAITS_ERASE : 0u));
-}
-
-/* ReadStore's register group, on a change or a new second only: it
- * divides. */
-static void report_store(struct servo *s)
-{
-    struct store_health *h = &s->regs.store;
-    uint8_t flags = store_flags(s);
-    uint32_t op_seconds = save_policy_op_seconds(&s->saver);
-    h->answers_dropped = s->answers_dropped;
-    h->bytes_lost = s->rx_lost;
-    h->fault_count = s->faults.shown_count;
-    h->faults_not_logged = s->faults.not_logged;
-    if (flags == h->flags && op_seconds == h->op_seconds && h->rated_cycles != 0u &&
-        s->store.sequence == h->records && s->store.write_failures == h->failures) {
-        return;
-    }
-    h->flags = flags;
-    h->records = s->store.sequence;
-    h->page_erases = config_store_page_erases(&s->store);
-    h->rated_cycles = FLASH_RATED_CYCLES;
-    h->budget = save_policy_budget(&s->saver);
-    h->op_seconds = op_seconds;
-    h->failures = s->store.write_failures;
-}
-
-/* The dispatcher's persist hook: a changed user or drive area goes to flash
- * before the write is answered, all its write blocks at once (36
- * half-words, 1.4-2.5 ms on the STM32F1; the ticks catch up after, the DMA
- * ring holds what arrives). A change that cannot be made durable now is refused, and
- * ReadStore says why: past the wear budget, no erased slot until the
- * output is released, or the flash refused. */
-static bool save_now(struct servo *s, const struct user_config *cfg)
-{
-    uint32_t now = s->hal->bus.now_us(s->hal->ctx);
-    s->saver.over_budget = !save_policy_allows(&s->saver, &s->store);
-    if (s->saver.over_budget) {
-        return false;
-    }
-    enum config_save_result r =
-        config_store_begin(&s->store, cfg, save_policy_op_seconds(&s->saver));
-    if (r == CONFIG_NEEDS_ERASE) {
-        s->saver.awaits_erase = 1;
-        return false;
-    }
-    while (r == CONFIG_STARTED || r == CONFIG_BUSY) {
-        r = config_store_step(&s->store);
-    }
-    bool ok = r != CONFIG_WRITE_FAILED;
-    save_policy_outcome(&s->saver, ok, now);
-    return ok;
-}
-
-static bool persist_config(void *ctx, const struct user_config *cfg)
-{
-    struct servo *s = ctx;
-    bool ok = save_now(s, cfg);
-    /* A ReadStore right after the answer says why; the rest of its group
-     * follows at the next tick (report_store). */
-    s->regs.store.flags = store_flags(s);
-    return ok;
-}
-
-/* A page erase stalls the CPU for 20-40 ms: bytes wait in the DMA ring,
- * ticks do not run. Only while the output is released and the line is
- * quiet (servo.h, STORE_ERASE_*). */
-static bool erase_may_stall(const struct servo *s, uint32_t now)
-{
-    const struct hal_rx_ring *ring = s->hal->rx;
-    const uint32_t quiet = STORE_ERASE_QUIET_US;
-    return motion_is_idle(&s->motion) && !s->tx.sending && !s->tx.waiting &&
-           ring->written == ring->read && now - ring->heard_us >= quiet &&
-           now - s->tx.ended_us >= quiet && save_policy_may_retry(&s->saver, &s->store, now);
-}
-
-/* The spare page's erase: 20-40 ms with the CPU stalled, the output
- * released. The pass after it (after_erase) resumes the control loop on a
- * fresh schedule (these ticks are not dropped ones), and carries out the
- * frames that arrived meanwhile without answering them: an answer that
- * late could fall in another servo's slot. */
-static void erase_spare(struct servo *s, uint32_t now)
-{
-    s->erase_from = s->hal->rx->written;
-    bool ok;
-    if (config_store_spare_dirty(&s->store)) {
-        ok = config_store_erase_spare(&s->store);
-        save_policy_outcome(&s->saver, ok, now);
-        s->saver.awaits_erase = (uint8_t)(s->saver.awaits_erase && !ok);
-    } else {
-        ok = fault_log_erase_spare(&s->faults);
-        save_policy_outcome(&s->saver, ok, now); /* its retry wait, shared */
-    }
-    if (!ok) {
-        s->regs.status.status |= STATUS_COMMAND_ERROR;
-    }
-    s->erase_passed = 1;
-}
-
-/* Once a control tick: counts operating time and erases the spare page
- * when that costs nothing. */
-static void tend_store(struct servo *s, uint32_t now, bool ticked)
-{
-    if (!ticked) {
-        return;
-    }
-    safety_tend(s);
-    save_policy_count_time(&s->saver, now);
-    if ((config_store_spare_dirty(&s->store) || fault_log_spare_dirty(&s->faults)) &&
-        erase_may_stall(s, now)) {
-        erase_spare(s, now);
-    } else {
-        fault_log_step(&s->faults); /* a write block a tick: 70 us at most */
-    }
-    report_store(s);
-}
 
 _Static_assert(offsetof(struct status_area, current_ma) - offsetof(struct status_area, voltage_mv) ==
                    offsetof(struct sensor_readings, current_ma) &&
@@ -464,13 +260,16 @@ void servo_poll(struct servo *s)
         }
     }
     receive(s, now);
-    tend_store(s, now, ticked);
+    if (ticked) {
+        safety_tend(s); /* the monitors' upkeep, once a control tick */
+        servo_tend_store(s, now);
+    }
     if (s->tx.sending) {
         return; /* half duplex: nothing else goes out meanwhile */
     }
     if (s->tx.waiting) {
         if (s->rx.stats.requests_seen == s->tx.requests_base) {
-            wait_for_turn(s, now);
+            servo_wait_for_turn(s, now);
             return;
         }
         /* A new request (to anyone) while this servo waits for its Sync
@@ -483,7 +282,7 @@ void servo_poll(struct servo *s)
      * move's answer waits for a quiet line anyway. */
     handle_next_frame(s, now, false);
     if (!s->tx.sending && !s->tx.waiting) {
-        answer_finished_move(s, now);
+        servo_answer_finished_move(s, now);
     }
 }
 

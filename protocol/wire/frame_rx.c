@@ -2,21 +2,9 @@
 
 #include <stddef.h>
 
+#include "protocol/frame_rx_states.h"
 #include "protocol/packet_codes.h"
 #include "protocol/wire.h"
-
-enum rx_state {
-    RX_HDR0,      /* 0: frame_rx_in_frame() knows it */
-    RX_HDR1,
-    RX_CODE,
-    RX_LENGTH,
-    RX_LENGTH_LO, /* extended length, low byte */
-    RX_LENGTH_HI,
-    RX_CONTENT,   /* a request this servo keeps */
-    RX_CHECKSUM,
-    RX_SKIP,      /* a frame not kept: remaining counts its checksum too */
-};
-_Static_assert(RX_SKIP == FRAME_RX_SKIPPING, "frame_rx.h names the skipping state");
 
 /* The bursts' fast paths (a header, a run of content or garbage at once,
  * the hot helpers inlined) buy the receive path its budget. FRAME_RX_SMALL
@@ -31,29 +19,6 @@ _Static_assert(RX_SKIP == FRAME_RX_SKIPPING, "frame_rx.h names the skipping stat
 
 /* SyncCommand content: cmd, record_len, count, then the records. */
 enum { SYNC_HEADER_SIZE = 3 };
-
-static uint8_t next_slot(uint8_t i)
-{
-    return (uint8_t)((i + 1u) % FRAME_QUEUE_SLOTS);
-}
-
-void frame_rx_init(struct frame_rx *rx, const volatile uint8_t *own_id)
-{
-    *rx = (struct frame_rx){0};
-    rx->own_id = own_id;
-    rx->state = RX_HDR0;
-}
-
-uint32_t frame_rx_idle_us(uint32_t baud)
-{
-    const uint32_t floor_us = 1000u;
-    if (baud == 0u) {
-        return floor_us;
-    }
-    /* 10 bytes of 10 bits each, rounded up. */
-    uint32_t us = (100u * 1000000u + baud - 1u) / baud;
-    return us > floor_us ? us : floor_us;
-}
 
 static struct rx_frame *work_slot(struct frame_rx *rx)
 {
@@ -422,20 +387,4 @@ uint32_t frame_rx_feed_until_full(struct frame_rx *rx, const uint8_t *data, uint
 void frame_rx_feed(struct frame_rx *rx, uint8_t byte)
 {
     frame_rx_feed_bytes(rx, &byte, 1);
-}
-
-void frame_rx_line_idle(struct frame_rx *rx)
-{
-    if (rx->state != RX_HDR0) {
-        rx->stats.idle_timeouts++;
-        rx->state = RX_HDR0;
-    }
-}
-
-
-void frame_rx_release(struct frame_rx *rx)
-{
-    if (rx->tail != rx->head) {
-        rx->tail = next_slot(rx->tail);
-    }
 }

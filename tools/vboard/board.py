@@ -9,10 +9,10 @@ what a factory would program into a blank chip: the bootloader, the
 application's update image in the slot and a config record with the
 board's ID; a --state folder keeps it across runs, as on a real chip."""
 import ctypes
-import re
 from dataclasses import dataclass
 from pathlib import Path
 
+from servo_image import board_facts
 from unicorn import arm_const as arm
 
 from . import svd
@@ -67,8 +67,8 @@ ADC_INPUTS = {0: "supply", 1: "current", 2: "ntc", 3: "encoder"}  # firmware/boa
 
 
 def board_h(board: str) -> dict:
-    text = (REPO / "firmware/boards" / board / "board.h").read_text()
-    return {k: int(v, 0) for k, v in re.findall(r"^#define (BOARD_\w+) (0x[0-9a-fA-F]+|\d+)\b", text, re.M)}
+    """board.h's numbers (servo_image.board_facts: the one reader of a board's facts)."""
+    return board_facts.defines(board)
 
 
 def images(board: str) -> tuple:

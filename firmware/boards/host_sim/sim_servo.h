@@ -129,6 +129,10 @@ uint64_t sim_servo_wake_at(const struct sim_servo *s);
  * of what it did to the flash starts at now_us. */
 void sim_servo_poll(struct sim_servo *s, uint64_t now_us);
 
+/* A main-loop pass of the bootloader (sim_servo.c): false once it has
+ * started the application. */
+bool sim_servo_boot_poll(struct sim_servo *s);
+
 /* The power goes and comes back: the servo restarts through its
  * bootloader (200 ms listening, or for good without a valid image). */
 void sim_servo_power_cycle(struct sim_servo *s);

@@ -20,15 +20,8 @@
 #define BOARD_RAM_BASE 0x20000000
 #define BOARD_RAM_SIZE 8192
 
-/* The modelled front end: the reference board's (stm32f103/board.h). */
-#define BOARD_SUPPLY_UV_PER_COUNT 8862
-#define BOARD_CURRENT_UA_PER_COUNT 1611
-#define BOARD_CURRENT_ZERO_COUNTS 0
-/* The motor: the reference servo's (stm32f103/board.h). */
-#define BOARD_MOTOR_MOHM 2741
-#define BOARD_WINDING_CASE_MK_PER_W 3100
-#define BOARD_WINDING_TAU_MS 12000
-#define BOARD_WINDING_LIMIT_DECIC 1250
+/* The analogue front end and the motor: the reference servo's. */
+#include "boards/common/reference_servo.h"
 
 /* The receive ring (hal/hal_rx_ring.h): QEMU's board has no flash
  * controller, so nothing stalls the CPU for longer than a main-loop pass. */

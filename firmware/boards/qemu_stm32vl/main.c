@@ -4,10 +4,8 @@
 #include "board.h"
 #include "plant_fixed.h"
 #include "qemu_board.h"
-#include "bootloader/app_image.h"
-#include "bootloader/boot_flow.h"
-#include "ports/stm32_common/boot_jump.h"
 #include "app/servo.h"
+#include "boards/common/app_hooks.h"
 #include "ports/stm32f1/stm32f1_regs.h"
 #include "ports/stm32_common/systick_clock.h"
 #include "ports/stm32f1/stm32f1_uart.h"
@@ -88,20 +86,6 @@ static uint32_t serial_number(void *ctx)
 {
     (void)ctx;
     return 0x0E3A0001u;
-}
-
-/* Data ID 7: the version of the image the bootloader started. */
-static uint16_t image_version(void *ctx)
-{
-    (void)ctx;
-    return app_image_version_in_place(BOARD_SLOT_BASE);
-}
-
-/* UpdateEnter: the word that keeps the bootloader, then a restart. */
-static void enter_bootloader(void *ctx)
-{
-    (void)ctx;
-    boot_restart_with(BOOT_STAY_WORD_ADDR(BOARD_RAM_END), BOOT_STAY_MAGIC);
 }
 
 /* The board's wiring: which driver or model does what, in one place. */

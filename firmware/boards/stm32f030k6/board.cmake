@@ -3,9 +3,7 @@
 # Limits (cmake/check-image.sh), as its board.h gives them: the part's 4 KB RAM; 24 KB flash for the
 # application, so the 4 KB bootloader, the application, the 2 KB fault history
 # and the 2 KB store fit 32 KB.
-set(SERVO_BOARD_CPU cortex-m0)
-set(SERVO_BOARD_PORT servo_stm32f0)                      # hal/ports/stm32f0
-set(SERVO_BOARD_STARTUP ${PROJECT_SOURCE_DIR}/firmware/startup/startup_stm32f030.c)
+include(${PROJECT_SOURCE_DIR}/cmake/family-stm32f0.cmake)  # CPU, port, startup
 set(SERVO_BOARD_RAM_LIMIT 4096)
 set(SERVO_BOARD_FLASH_LIMIT 24320) # the application: its 24 KB slot less the update image's 256-byte header (board.h)
 set(SERVO_BOARD_SOURCES ${CMAKE_CURRENT_LIST_DIR}/board_io.c)         # pins, clocks, ADC, PWM: this board's

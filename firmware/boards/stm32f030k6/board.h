@@ -41,15 +41,8 @@
  * whole us: the target bench's servo_tick_worst + idle_poll, in cycles
  * (docs/benchmark.md; tools/tests/test_doc_figures.py checks it). */
 #define BOARD_TICK_AND_PASS_US 46
-/* The analogue front end: the reference board's (stm32f103/board.h). */
-#define BOARD_SUPPLY_UV_PER_COUNT 8862
-#define BOARD_CURRENT_UA_PER_COUNT 1611
-#define BOARD_CURRENT_ZERO_COUNTS 0
-/* The motor: the reference servo's (stm32f103/board.h). */
-#define BOARD_MOTOR_MOHM 2741
-#define BOARD_WINDING_CASE_MK_PER_W 3100
-#define BOARD_WINDING_TAU_MS 12000
-#define BOARD_WINDING_LIMIT_DECIC 1250
+/* The analogue front end and the motor: the reference servo's. */
+#include "boards/common/reference_servo.h"
 
 /* Pins: this folder's README.md; the port (hal/ports/stm32f0) drives them. */
 

@@ -1,29 +1,18 @@
-/* The reference board: STM32F103 servo controller (pin map: README.md). */
+/* The reference board: STM32F103 servo controller (pin map: README.md).
+ * What differs from the other STM32 boards; the start-up path and the main
+ * loop are the boards' shared one (boards/common/app_start.h). */
 #include "board.h"
 #include "board_io.h"
-#include "ports/stm32_common/flash_f0f1.h"
-#include "bootloader/app_image.h"
-#include "bootloader/boot_flow.h"
-#include "ports/stm32_common/boot_jump.h"
-#include "ports/stm32_common/cortex_sleep.h"
-#include "app/servo.h"
 #include "ports/stm32f1/stm32f1_regs.h"
-#include "ports/stm32_common/systick_clock.h"
-#include "boards/test_build.h"
 #include "ports/stm32f1/stm32f1_uart.h"
 #include "ports/stm32f1/usart_hd.h"
 
-static struct servo servo;
-static struct usart_hd usart;
-static uint8_t rx_bytes[BOARD_RX_RING_BYTES];
-static struct hal_rx_ring rx_ring = HAL_RX_RING_OVER(rx_bytes);
-static struct dma_rx rx_dma;
-static struct hal_flash flash;
-static struct hal_flash fault_flash;
+#define BOARD_USART struct usart_hd
+#define BOARD_BUS PORT_UART_BUS_ALL_DMA
+#define BOARD_CORE_HZ F103_CORE_HZ
+#define board_clock_init clock_f103_init
 
-static const struct sensor_calibration calibration = BOARD_SENSOR_CALIBRATION;
-
-static void gpio_init(void)
+static void board_pins_init(void)
 {
     bus_pins_init();
     /* PA0-PA3 analogue; PA6, PA7 TIM3 CH1/CH2 push-pull. */
@@ -32,55 +21,12 @@ static void gpio_init(void)
                 (GPIO_AF_PUSH_PULL_50MHZ << 28) | (0x4u << 16) | (0x4u << 20);
 }
 
-/* Data ID 7: the version of the image the bootloader started. */
-static uint16_t image_version(void *ctx)
-{
-    (void)ctx;
-    return app_image_version_in_place(BOARD_SLOT_BASE);
-}
+/* Sends by DMA; its transmission's end is the USART interrupt's. */
+#define board_uart_start(usart, ring, dma)                    \
+    do {                                                      \
+        port_uart_init((usart), (ring), (dma), F103_PCLK2_HZ); \
+        port_uart_send_by_dma(usart);                         \
+    } while (0)
+#define board_interrupts_on() (NVIC_ISER(USART1_IRQ / 32u) = 1u << (USART1_IRQ % 32u))
 
-/* UpdateEnter: the word that keeps the bootloader, then a restart. */
-static void enter_bootloader(void *ctx)
-{
-    (void)ctx;
-    boot_restart_with(BOOT_STAY_WORD_ADDR(BOARD_RAM_END), BOOT_STAY_MAGIC);
-}
-
-/* The board's wiring: which driver does what, in one place. */
-static const struct hal_port port = {
-    .ctx = &usart,
-    .bus = PORT_UART_BUS_ALL_DMA,
-    .rx = &rx_ring,
-    .rx_ctx = &rx_dma,
-    .motor = BOARD_MOTOR,
-    .calibration = &calibration,
-    .flash = &flash,
-    .fault_flash = &fault_flash,
-    .serial_number = unique_id_serial,
-    .image_version = image_version,
-    .enter_bootloader = enter_bootloader,
-    .board = BOARD_ID,
-    .tick_and_pass_us = BOARD_TICK_AND_PASS_US,
-};
-
-int main(void)
-{
-    clock_f103_init();
-    gpio_init();
-    systick_clock_init(F103_CORE_HZ);
-    adc_scan_init();
-    pwm_bridge_init();
-    flash_f0f1_init(&flash, BOARD_FLASH_PAGE, BOARD_CONFIG_PAGE0, BOARD_CONFIG_PAGE1);
-    flash_f0f1_init(&fault_flash, BOARD_FLASH_PAGE, BOARD_FAULT_PAGE0, BOARD_FAULT_PAGE1);
-    port_uart_init(&usart, &rx_ring, &rx_dma, F103_PCLK2_HZ);
-    port_uart_send_by_dma(&usart);
-    servo_init(&servo, &port);
-    NVIC_ISER(USART1_IRQ / 32u) = 1u << (USART1_IRQ % 32u);
-    iwdg_start();
-    for (;;) {
-        servo_poll(&servo);
-        test_build_main_loop();
-        iwdg_kick();
-        CORTEX_SLEEP_IF(servo_may_sleep(&servo));
-    }
-}
+#include "boards/common/app_start.h"

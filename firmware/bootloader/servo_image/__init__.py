@@ -4,11 +4,12 @@ The layout is firmware/bootloader/app_image.h's. Standard library only,
 beside the bootloader: the firmware's build makes each board's image with
 it (run as a script), and servoctl's image and update commands use it
 (servoctl.image, whose errors are servoctl's)."""
-import re
 import struct
 import zlib
 from dataclasses import dataclass
 from pathlib import Path
+
+from . import board_facts
 
 
 
@@ -24,7 +25,7 @@ CHECKED = 24  # bytes the header's own CRC covers
 # The build's boards: each folder with a board.h (BOARD_ID, the header's
 # board field; the flash map and RAM the application's linker script is made
 # from: firmware/linker/app.ld.in).
-BOARDS_DIR = Path(__file__).resolve().parents[2] / "boards"
+BOARDS_DIR = board_facts.BOARDS_DIR
 HEADER_SIZE_IN_SLOT = 256  # the image header before the application (app.ld.in)
 STAY_WORD_BYTES = 16       # RAM's last bytes, left out of the application's
 # Vector 7 (reserved by the core) carries "SB" and the board's ID
@@ -40,17 +41,11 @@ class Board:
     id: int
     flash: tuple = None  # (first, end) of the application's code; None: not executed (host_sim)
     ram: tuple = None    # (first, end) of its RAM
-    cpu: str = ""        # board.cmake's SERVO_BOARD_CPU: cortex-m0 builds the size-first image
-
-
-def _defines(board_h: Path) -> dict:
-    """board.h's plain numbers: #define BOARD_X 0x... or decimal."""
-    return {name: int(value, 0) for name, value in
-            re.findall(r"^#define (BOARD_\w+) (0x[0-9a-fA-F]+|\d+)\b", board_h.read_text(), re.M)}
+    cpu: str = ""        # its chip family's CPU (board_facts.cpu): cortex-m0 builds the size-first image
 
 
 def _read_board(folder: Path):
-    d = _defines(folder / "board.h")
+    d = board_facts.defines(folder)
     if "BOARD_ID" not in d:
         return None
     if d.get("BOARD_SIMULATED"):
@@ -58,9 +53,7 @@ def _read_board(folder: Path):
     slot = d["BOARD_SLOT_BASE"]
     flash = (slot + HEADER_SIZE_IN_SLOT, slot + d["BOARD_SLOT_PAGES"] * d["BOARD_FLASH_PAGE"])
     ram = (d["BOARD_RAM_BASE"], d["BOARD_RAM_BASE"] + d["BOARD_RAM_SIZE"] - STAY_WORD_BYTES)
-    cmake = folder / "board.cmake"
-    cpu = re.search(r"set\(SERVO_BOARD_CPU (\S+)\)", cmake.read_text()) if cmake.is_file() else None
-    return Board(folder.name, d["BOARD_ID"], flash, ram, cpu.group(1) if cpu else "")
+    return Board(folder.name, d["BOARD_ID"], flash, ram, board_facts.cpu(folder))
 
 
 def boards() -> dict:

@@ -1,0 +1,25 @@
+/* The application's hooks every STM32 board's hal_port names the same way
+ * (app_start.h, and the QEMU board's main.c): the version of the image the
+ * bootloader started, and UpdateEnter's restart into the bootloader. */
+#ifndef BOARDS_COMMON_APP_HOOKS_H
+#define BOARDS_COMMON_APP_HOOKS_H
+
+#include "bootloader/app_image.h"
+#include "bootloader/boot_flow.h"
+#include "ports/stm32_common/boot_jump.h"
+
+/* Data ID 7: the version of the image the bootloader started. */
+static uint16_t image_version(void *ctx)
+{
+    (void)ctx;
+    return app_image_version_in_place(BOARD_SLOT_BASE);
+}
+
+/* UpdateEnter: the word that keeps the bootloader, then a restart. */
+static void enter_bootloader(void *ctx)
+{
+    (void)ctx;
+    boot_restart_with(BOOT_STAY_WORD_ADDR(BOARD_RAM_END), BOOT_STAY_MAGIC);
+}
+
+#endif
