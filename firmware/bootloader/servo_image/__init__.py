@@ -9,7 +9,10 @@ import zlib
 from dataclasses import dataclass
 from pathlib import Path
 
-from . import board_facts
+if __package__:
+    from . import board_facts
+else:  # the build runs this file as a script: its folder is on the path
+    import board_facts
 
 
 
