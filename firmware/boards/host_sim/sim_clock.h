@@ -2,7 +2,13 @@
  * state folder, mapped, holding the clock in microseconds (little-endian
  * u64 at offset 0, written whole after every step). A host that reads the
  * clock at every answer spends no simulated time on it, as a host on a
- * real bus reads its own clock; "clock" on the control port stays. */
+ * real bus reads its own clock; "clock" on the control port stays.
+ *
+ * At offset 8 the host may write (u64, microseconds) the bus time it is
+ * waiting for: until the clock reaches it, the simulator runs as fast as it
+ * can instead of following the wall clock (sim_now_us() skips ahead), then
+ * follows the wall clock again from there. 0, the file's start, never
+ * skips: a host that does not write it has a real-time simulator. */
 #ifndef SIM_CLOCK_H
 #define SIM_CLOCK_H
 
@@ -15,5 +21,7 @@
  * only on the control port) where the system refuses. */
 bool sim_clock_open(const char *state_dir, char *path, unsigned path_size);
 void sim_clock_publish(uint64_t now_us);
+/* The bus time the host waits for (offset 8); 0 if none or unmapped. */
+uint64_t sim_clock_host_waits(void);
 
 #endif
