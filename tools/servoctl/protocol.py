@@ -127,8 +127,10 @@ class Bus:
         self.timeout = timeout
         self.clock = clock or time.monotonic
         # A simulator whose clock may run ahead while this host waits on it
-        # (Simulator.run_ahead_to): told each time the bus looks at the clock.
-        self.run_ahead = run_ahead
+        # (Simulator.run_ahead_to): told each time the bus looks at the
+        # clock; unless given, the clock's own simulator's (servoctl's
+        # commands run with clock=sim.clock_s).
+        self.run_ahead = run_ahead or getattr(getattr(clock, "__self__", None), "bus_run_ahead", None)
         self.port = port
         try:
             # Exclusive: a second program on the port would take answers
@@ -307,6 +309,7 @@ class Bus:
                     bad = fcode
                 elif fcode == code and (servo_id is None or content[:1] == bytes([servo_id])):
                     self.arrived_at = self.clock() if self.stamp_arrivals else None
+                    self._look(0.0)  # the answer came: the simulator waits for the host's next bytes
                     return content
                 continue
             # A host that was not scheduled until after the deadline reads
@@ -340,6 +343,7 @@ class Bus:
                 elif fcode == code and answer[:1] == content[:1]:
                     good.append(answer)
             if last_look:
+                self._look(0.0)
                 return good, bad, self.stray_bytes + len(self._buffer)
             last_look = self._look(deadline) > deadline
             if last_look and self._buffer and not finishing:
@@ -351,10 +355,11 @@ class Bus:
 
     def _look(self, deadline: float) -> float:
         """The bus clock; a simulator that runs ahead while the host waits
-        may run to just past the deadline, at most RUN_AHEAD_S past now."""
+        may run to just past the deadline, at most RUN_AHEAD_S past now
+        (deadline 0: no more)."""
         now = self.clock()
         if self.run_ahead is not None:
-            self.run_ahead(min(deadline + 0.001, now + RUN_AHEAD_S))
+            self.run_ahead(min(deadline + 0.001, now + RUN_AHEAD_S), answer=True)
         return now
 
     def _take_frame(self):

@@ -191,7 +191,7 @@ class Simulator(_Child):
 
     def bus(self, **kw) -> Bus:
         """A Bus to the simulated servos that waits on the simulated clock."""
-        return Bus(self.url, clock=self.clock_s, run_ahead=self.run_ahead_to if self.fast else None, **kw)
+        return Bus(self.url, clock=self.clock_s, **kw)
 
     def control(self, line: str) -> str:
         """Sends one control command; returns the reply."""
@@ -298,11 +298,17 @@ class Simulator(_Child):
     def _runs_ahead(self) -> bool:
         return self.fast and self._clock_map is not None and self._clock_map.size() >= 16
 
-    def run_ahead_to(self, until_s: float) -> None:
+    @property
+    def bus_run_ahead(self):
+        """What a Bus on this simulator's clock tells where it waits for."""
+        return self.run_ahead_to if self.fast else None
+
+    def run_ahead_to(self, until_s: float, answer: bool = False) -> None:
         """A fast simulator's clock runs as fast as it can up to until_s
-        (simulated seconds) and follows the wall clock from there."""
+        (simulated seconds), with answer only until it has answered the
+        host's last bytes, and follows the wall clock from there."""
         if self._runs_ahead():
-            _CLOCK_US.pack_into(self._clock_map, 8, max(0, int(until_s * 1e6)))
+            _CLOCK_US.pack_into(self._clock_map, 8, max(0, int(until_s * 1e6)) | (answer << 63))
 
     def state(self, servo_id: int) -> dict:
         """The models' state of one servo: angle (deg), velocity, current,

@@ -27,9 +27,7 @@ static struct sim_bus bus;
 static uint64_t most_behind_us;
 static struct sim_servo servos[SIM_MAX_SERVOS];
 static volatile sig_atomic_t stop_requested;
-/* The bus time the host last said it waits for (sim_clock.h), and how many
- * bytes it had been sent then. */
-static uint64_t host_waits;
+/* How many bytes the host had been sent when it last sent bytes itself. */
 static unsigned long host_bytes_then;
 /* A second TCP client while one holds the bus is told so and then ignored
  * until it leaves: a serial port has one program at a time, and two hosts
@@ -178,8 +176,11 @@ int main(int argc, char **argv)
         uint64_t wall = sim_now_us();
         int64_t due = sim_bus_next_due(&bus, wall);
         long wait_us = (due >= 0 && due < SIM_BUS_STEP_US) ? (long)due : SIM_BUS_STEP_US;
-        if (sim_bus_step_to(&bus, wall) < wall ||
-            (sim_clock_host_waits() > wall && bus.host_bytes == host_bytes_then)) {
+        uint64_t waits = sim_clock_host_waits();
+        bool answered = (waits & SIM_CLOCK_UNTIL_ANSWER) && bus.host_bytes != host_bytes_then &&
+                        bus.count == 0;
+        waits &= ~SIM_CLOCK_UNTIL_ANSWER;
+        if (sim_bus_step_to(&bus, wall) < wall || (waits > wall && !answered)) {
             wait_us = 0;
         }
         struct timespec timeout = {.tv_sec = 0, .tv_nsec = wait_us * 1000};
@@ -197,6 +198,7 @@ int main(int argc, char **argv)
             ssize_t n = read(bus.host_fd, buf, sizeof buf);
             if (n > 0) {
                 sim_bus_from_host(&bus, buf, (unsigned)n, bus.now_us);
+                host_bytes_then = bus.host_bytes;
             } else if (listen_fd >= 0 && (n == 0 || errno != EAGAIN)) {
                 close(bus.host_fd); /* the TCP client left: wait for the next */
                 bus.host_fd = -1;
@@ -229,15 +231,12 @@ int main(int argc, char **argv)
         }
         sim_control_serve(&control, &fds[control_slot]);
         /* A host waiting for a later bus time: one step of it at once (its
-         * bytes are still read between steps), not in real time; until the
-         * host has been sent bytes and the wire is quiet (an answer came),
-         * then the host has its turn. */
-        uint64_t waits = sim_clock_host_waits();
-        if (waits != host_waits) {
-            host_waits = waits;
-            host_bytes_then = bus.host_bytes;
-        }
-        bool answered = bus.host_bytes != host_bytes_then && bus.count == 0;
+         * bytes are still read between steps), not in real time; one that
+         * waits for an answer has its turn once it has been sent bytes
+         * since it last wrote and the wire is quiet. */
+        waits = sim_clock_host_waits();
+        answered = (waits & SIM_CLOCK_UNTIL_ANSWER) && bus.host_bytes != host_bytes_then && bus.count == 0;
+        waits &= ~SIM_CLOCK_UNTIL_ANSWER;
         uint64_t wall_now = sim_now_us();
         if (!answered && waits > wall_now && bus.now_us + SIM_BUS_STEP_US >= wall_now) {
             uint64_t skip = waits - wall_now;

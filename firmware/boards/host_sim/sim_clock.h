@@ -8,7 +8,10 @@
  * waiting for: until the clock reaches it, the simulator runs as fast as it
  * can instead of following the wall clock (sim_now_us() skips ahead), then
  * follows the wall clock again from there. 0, the file's start, never
- * skips: a host that does not write it has a real-time simulator. */
+ * skips: a host that does not write it has a real-time simulator. With
+ * SIM_CLOCK_UNTIL_ANSWER set, the host waits for an answer: the simulator
+ * stops running ahead once it has sent the host bytes since the host's
+ * last and the wire is quiet. */
 #ifndef SIM_CLOCK_H
 #define SIM_CLOCK_H
 
@@ -16,6 +19,7 @@
 #include <stdint.h>
 
 #define SIM_CLOCK_FILE "bus.clock"
+#define SIM_CLOCK_UNTIL_ANSWER (UINT64_C(1) << 63)
 
 /* Maps state_dir/SIM_CLOCK_FILE; its path in path. False (and the clock
  * only on the control port) where the system refuses. */

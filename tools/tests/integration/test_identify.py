@@ -43,7 +43,7 @@ def start(tmp_path, file, backlash_deg: float = 0.0):
     if backlash_deg:
         path = tmp_path / file
         path.write_text((PLANTS / file).read_text() + f"backlash_deg = {backlash_deg}  # the test's\n")
-    sim = Simulator(fast=True, state_dir=str(tmp_path / "state"), plant=str(path)).start()
+    sim = Simulator(state_dir=str(tmp_path / "state"), plant=str(path)).start()
     with sim.bus(timeout=0.2) as bus:
         s = Servo(bus, 1)
         s.write("high_voltage", 12600)  # the 12 V servo's supply
