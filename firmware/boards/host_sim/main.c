@@ -82,6 +82,14 @@ static void run_to(uint64_t target)
     sim_clock_publish(bus.now_us);
 }
 
+/* A host that waits for an answer (sim_clock.h) has it: it has been sent
+ * bytes since its last, and the wire and its adapter hold none. */
+static bool host_answered(uint64_t waits)
+{
+    return (waits & SIM_CLOCK_UNTIL_ANSWER) && bus.host_bytes != host_bytes_then && bus.count == 0 &&
+           sim_usb_due(&bus.usb) == SIM_USB_NONE;
+}
+
 static void on_signal(int sig)
 {
     (void)sig;
@@ -177,8 +185,7 @@ int main(int argc, char **argv)
         int64_t due = sim_bus_next_due(&bus, wall);
         long wait_us = (due >= 0 && due < SIM_BUS_STEP_US) ? (long)due : SIM_BUS_STEP_US;
         uint64_t waits = sim_clock_host_waits();
-        bool answered = (waits & SIM_CLOCK_UNTIL_ANSWER) && bus.host_bytes != host_bytes_then &&
-                        bus.count == 0;
+        bool answered = host_answered(waits);
         waits &= ~SIM_CLOCK_UNTIL_ANSWER;
         if (sim_bus_step_to(&bus, wall) < wall || (waits > wall && !answered)) {
             wait_us = 0;
@@ -235,7 +242,7 @@ int main(int argc, char **argv)
          * waits for an answer has its turn once it has been sent bytes
          * since it last wrote and the wire is quiet. */
         waits = sim_clock_host_waits();
-        answered = (waits & SIM_CLOCK_UNTIL_ANSWER) && bus.host_bytes != host_bytes_then && bus.count == 0;
+        answered = host_answered(waits);
         waits &= ~SIM_CLOCK_UNTIL_ANSWER;
         uint64_t wall_now = sim_now_us();
         if (!answered && waits > wall_now && bus.now_us + SIM_BUS_STEP_US >= wall_now) {
