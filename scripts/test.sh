@@ -146,15 +146,26 @@ step "target arithmetic: the planner's 64-bit division and the run-time's divisi
 
 # pytest counts each test. Most tests wait on simulated servos, not on the
 # CPU: PYTEST_WORKERS (default 4) run side by side (pytest-xdist), each
-# test file on one worker, so a file's shared simulator or QEMU board starts once.
+# test file on one worker, so a file's shared simulator or QEMU board starts
+# once. Then the tests timed on the wall clock (marked wall_clock: the
+# maker's SDK), alone.
 printf '\n== %s\n' "PC tool, simulator, maker's SDK and QEMU board tests (pytest)"
 started=$SECONDS
-(cd tools && ../.venv/bin/python -m pytest -q -p no:cacheprovider -n "${PYTEST_WORKERS:-4}" --dist loadfile) \
-  | tee build/pytest.log
+pytest_both() {
+  cd tools
+  local rc=0
+  ../.venv/bin/python -m pytest -q -p no:cacheprovider -n "${PYTEST_WORKERS:-4}" --dist loadfile \
+    -m "not wall_clock" || rc=$?
+  ../.venv/bin/python -m pytest -q -p no:cacheprovider -m wall_clock || rc=$?
+  return $rc
+}
+pytest_both | tee build/pytest.log
 tools_rc=${PIPESTATUS[0]}
 took "pytest" "$started"
-tools_passed=$(grep -oE '[0-9]+ passed' build/pytest.log | tail -1 | cut -d' ' -f1)
-tools_failed=$(tail -1 build/pytest.log | grep -oE '[0-9]+ (failed|errors?)\b' | awk '{n += $1} END {print n + 0}')
+# Each run's closing line: "N failed, N passed, ... in S s".
+totals=$(grep -E '^(=+ )?[0-9]+ [a-z]+.* in [0-9.]+s' build/pytest.log)
+tools_passed=$(grep -oE '[0-9]+ passed' <<<"$totals" | awk '{n += $1} END {print n + 0}')
+tools_failed=$(grep -oE '[0-9]+ (failed|errors?)\b' <<<"$totals" | awk '{n += $1} END {print n + 0}')
 count "${tools_passed:-0}" "${tools_failed:-0}"
 if [ "$tools_rc" -ne 0 ]; then
   failures+=("pytest (exit $tools_rc)")
