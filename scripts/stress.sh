@@ -33,7 +33,10 @@ done
 failed=0
 for run in $(seq "$runs"); do
     log="$logs/run-$run.log"
-    if (cd tools && ../.venv/bin/python -m pytest -q -p no:cacheprovider) >"$log" 2>&1; then
+    # As scripts/test.sh runs it: on workers, then the wall-clock tests alone.
+    if (cd tools && ../.venv/bin/python -m pytest -q -p no:cacheprovider -n "${PYTEST_WORKERS:-4}" \
+          --dist loadfile -m "not wall_clock" &&
+        ../.venv/bin/python -m pytest -q -p no:cacheprovider -m wall_clock) >"$log" 2>&1; then
         echo "run $run/$runs under $busy busy processes: $(tail -1 "$log")"
     else
         failed=$((failed + 1))

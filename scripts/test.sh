@@ -21,6 +21,12 @@ passed=0
 failed=0
 failures=()
 count() { passed=$((passed + $1)); failed=$((failed + $2)); }
+# took NAME STARTED: the step's time, in the log and in the closing list.
+times=()
+took() {
+  echo "-- $1: $((SECONDS - $2)) s"
+  times+=("$(printf '%5d s  %.60s' $((SECONDS - $2)) "$1")")
+}
 
 # step NAME COMMAND...: runs the command (with set -e inside), counts it as
 # one check, and names it if it failed.
@@ -28,9 +34,12 @@ step() {
   local name=$1
   shift
   printf '\n== %s\n' "$name"
+  local started=$SECONDS
   # Not in an if: bash ignores set -e in a condition's subshell.
   (set -e; "$@")
-  if [ $? -eq 0 ]; then
+  local rc=$?
+  took "$name" "$started"
+  if [ $rc -eq 0 ]; then
     count 1 0
   else
     count 0 1
@@ -109,8 +118,10 @@ fuzz_run() {
 # Unit tests count each CTest program.
 printf '\n== %s\n' "unit tests (host, AddressSanitizer + UndefinedBehaviorSanitizer)"
 rm -f build/host/ctest.log
+started=$SECONDS
 (set -e; unit_tests)
 unit_rc=$?
+took "unit tests" "$started"
 unit_passed=$(sed -nE 's/.*tests passed, ([0-9]+) tests failed out of ([0-9]+).*/\2 \1/p' build/host/ctest.log 2>/dev/null)
 if [ -n "$unit_passed" ]; then
   read -r total bad <<<"$unit_passed"
@@ -133,12 +144,28 @@ step "target benchmark: every packet and the control tick in Thumb instructions 
 step "target arithmetic: the planner's 64-bit division and the run-time's division and multiplication on the Cortex-M3 and M0 under QEMU, against products" \
   target_arith
 
-# pytest counts each test.
+# pytest counts each test. Most tests wait on simulated servos, not on the
+# CPU: PYTEST_WORKERS (default 4) run side by side (pytest-xdist), each
+# test file on one worker, so a file's shared simulator or QEMU board starts
+# once. Then the tests timed on the wall clock (marked wall_clock: the
+# maker's SDK), alone.
 printf '\n== %s\n' "PC tool, simulator, maker's SDK and QEMU board tests (pytest)"
-(cd tools && ../.venv/bin/python -m pytest -q -p no:cacheprovider) | tee build/pytest.log
+started=$SECONDS
+pytest_both() {
+  cd tools
+  local rc=0
+  ../.venv/bin/python -m pytest -q -p no:cacheprovider -n "${PYTEST_WORKERS:-4}" --dist loadfile \
+    -m "not wall_clock" || rc=$?
+  ../.venv/bin/python -m pytest -q -p no:cacheprovider -m wall_clock || rc=$?
+  return $rc
+}
+pytest_both | tee build/pytest.log
 tools_rc=${PIPESTATUS[0]}
-tools_passed=$(grep -oE '[0-9]+ passed' build/pytest.log | tail -1 | cut -d' ' -f1)
-tools_failed=$(tail -1 build/pytest.log | grep -oE '[0-9]+ (failed|errors?)\b' | awk '{n += $1} END {print n + 0}')
+took "pytest" "$started"
+# Each run's closing line: "N failed, N passed, ... in S s".
+totals=$(grep -E '^(=+ )?[0-9]+ [a-z]+.* in [0-9.]+s' build/pytest.log)
+tools_passed=$(grep -oE '[0-9]+ passed' <<<"$totals" | awk '{n += $1} END {print n + 0}')
+tools_failed=$(grep -oE '[0-9]+ (failed|errors?)\b' <<<"$totals" | awk '{n += $1} END {print n + 0}')
 count "${tools_passed:-0}" "${tools_failed:-0}"
 if [ "$tools_rc" -ne 0 ]; then
   failures+=("pytest (exit $tools_rc)")
@@ -150,6 +177,9 @@ step "line coverage of motion, protection and the config store by the fuzz corpu
   bash scripts/fuzz_coverage.sh
 
 echo
+printf 'step times:\n'
+printf '  %s\n' "${times[@]}"
+echo "total: $SECONDS s"
 for f in "${failures[@]}"; do
   echo "FAILED: $f"
 done

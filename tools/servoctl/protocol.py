@@ -107,6 +107,9 @@ except ImportError:  # not on Windows
 # Host seconds a socket may take no bytes of a write before the link is
 # taken for dead (a simulator on a loaded PC takes them within a second).
 WRITE_STALL_S = 10.0
+# The most simulated seconds a simulator runs ahead of the bus's last look at
+# its clock while the bus waits for an answer (Bus.run_ahead).
+RUN_AHEAD_S = 0.02
 
 
 class Bus:
@@ -118,11 +121,16 @@ class Bus:
     bus; for the simulator its own clock (Simulator.clock_s), which falls
     behind the wall clock on a busy PC while the servos keep their timing."""
 
-    def __init__(self, port: str, baud: int = 115200, timeout: float = 0.1, clock=None):
+    def __init__(self, port: str, baud: int = 115200, timeout: float = 0.1, clock=None, run_ahead=None):
         import serial  # pyserial
 
         self.timeout = timeout
         self.clock = clock or time.monotonic
+        # A simulator whose clock may run ahead while this host waits on it
+        # (Simulator.run_ahead_to): told each time the bus looks at the
+        # clock; unless given, the clock's own simulator's (servoctl's
+        # commands run with clock=sim.clock_s).
+        self.run_ahead = run_ahead or getattr(getattr(clock, "__self__", None), "bus_run_ahead", None)
         self.port = port
         try:
             # Exclusive: a second program on the port would take answers
@@ -169,6 +177,8 @@ class Bus:
             time.sleep(seconds)
             return
         end = self.clock() + seconds
+        if self.run_ahead is not None:
+            self.run_ahead(end)
         while (left := end - self.clock()) > 0:
             time.sleep(min(left, 0.005))
 
@@ -215,7 +225,7 @@ class Bus:
 
                 if self._sock is not None:
                     self._wake_at(self._bytes_missing())
-                select.select([self._fd], [], [], 0.005)
+                select.select([self._fd], [], [], 0.005 if self.run_ahead is None else 0.001)
             else:  # loop:// and other ports without a descriptor
                 time.sleep(0.0005)
         data = self._link(self._read_now)
@@ -285,6 +295,8 @@ class Bus:
         wait = self.timeout if timeout is None else timeout
         if deadline is None:
             deadline = self.clock() + wait
+        if self.run_ahead is not None:
+            self._look(deadline)
         bad = None
         last_look = False
         got = True  # the deadline was just read
@@ -297,6 +309,7 @@ class Bus:
                     bad = fcode
                 elif fcode == code and (servo_id is None or content[:1] == bytes([servo_id])):
                     self.arrived_at = self.clock() if self.stamp_arrivals else None
+                    self._look(0.0)  # the answer came: the simulator waits for the host's next bytes
                     return content
                 continue
             # A host that was not scheduled until after the deadline reads
@@ -307,7 +320,7 @@ class Bus:
                     raise BadChecksum(f"{who}: response to packet {code} had a bad checksum")
                 raise NoReply(f"{who}: no reply to packet {code} within {wait * 1000:.0f} ms")
             if not got or time.monotonic() >= check_at:
-                last_look = self.clock() > deadline
+                last_look = self._look(deadline) > deadline
                 check_at = time.monotonic() + 0.002
             got = self._fill(wait=not last_look)
 
@@ -319,6 +332,8 @@ class Bus:
         self.stray_bytes = 0
         good, bad = [], 0
         deadline = self.clock() + window_s
+        if self.run_ahead is not None:
+            self._look(deadline)
         last_look = finishing = False
         while True:
             while (frame := self._take_frame()) is not None:
@@ -328,14 +343,24 @@ class Bus:
                 elif fcode == code and answer[:1] == content[:1]:
                     good.append(answer)
             if last_look:
+                self._look(0.0)
                 return good, bad, self.stray_bytes + len(self._buffer)
-            last_look = self.clock() > deadline
+            last_look = self._look(deadline) > deadline
             if last_look and self._buffer and not finishing:
                 # A frame begun in the window is read whole, not counted as
                 # garbage: the longest answer's time more, and 5 ms.
                 finishing, last_look = True, False
                 deadline = self.clock() + ANSWER_FRAME_MAX * 10 / self.serial.baudrate + 0.005
             self._fill(wait=not last_look)
+
+    def _look(self, deadline: float) -> float:
+        """The bus clock; a simulator that runs ahead while the host waits
+        may run to just past the deadline, at most RUN_AHEAD_S past now
+        (deadline 0: no more)."""
+        now = self.clock()
+        if self.run_ahead is not None:
+            self.run_ahead(min(deadline + 0.001, now + RUN_AHEAD_S), answer=True)
+        return now
 
     def _take_frame(self):
         """(code, content, checksum_ok) of a complete response frame at the

@@ -77,7 +77,7 @@ class Simulator(_Child):
 
     def __init__(self, ids=(1,), tcp=True, link=None, state_dir=None, supply_mv=None,
                  ambient_c=None, tcp_port=None, rx=None, board=None, app_image=None, nice=None,
-                 cpu=None, plant=None, host_link=None):
+                 cpu=None, plant=None, host_link=None, fast=False):
         self.ids = list(ids)
         self.tcp = tcp or tcp_port is not None
         self.tcp_port = tcp_port
@@ -96,6 +96,10 @@ class Simulator(_Child):
         # wire: "usb" (the simulators' default), "ftdi", "ftdi:MS" or "raw"
         # (servo_sim --help, docs/simulator.md). None: the default.
         self.host_link = host_link
+        # The tests': servo_sim's clock runs as fast as it can while this
+        # host waits on it (sleep, wait_until, a bus's answers), bounded by
+        # run_ahead_to; it follows the wall clock otherwise (sim_clock.h).
+        self.fast = fast
         # A niceness for the simulator (below 0 needs root): a client that
         # times its answers on the wall clock (the maker's SDK) then meets
         # a servo that keeps up on a loaded PC. None: as started.
@@ -219,8 +223,9 @@ class Simulator(_Child):
         if self._clock_map is not None:
             self._clock_map.close()  # a restarted simulator's file is mapped anew
         try:
-            with open(path, "rb") as f:
-                self._clock_map = mmap.mmap(f.fileno(), 8, access=mmap.ACCESS_READ)
+            with open(path, "r+b" if self.fast else "rb") as f:
+                self._clock_map = mmap.mmap(f.fileno(), 16 if self.fast else 8,
+                                            access=mmap.ACCESS_WRITE if self.fast else mmap.ACCESS_READ)
         except (OSError, ValueError):
             self._clock_map = None  # the control port still answers
 
@@ -261,7 +266,7 @@ class Simulator(_Child):
     def sleep(self, seconds: float) -> None:
         """Returns once the simulated clock has moved on by seconds: what
         time.sleep would be on an idle PC, whatever the load."""
-        self._wait(lambda: False, seconds, 0.005)
+        self._wait(lambda: False, seconds, seconds if self._runs_ahead() else 0.005)
 
     def wait_until(self, predicate, timeout_s: float, step_s: float = 0.005) -> float:
         """Polls predicate until it is true; returns the simulated seconds
@@ -277,10 +282,33 @@ class Simulator(_Child):
         while True:
             if predicate():
                 return True, self.clock_s() - start
-            waited = self.clock_s() - start
+            now = self.clock_s()
+            waited = now - start
             if waited >= timeout_s:
                 return False, waited
-            time.sleep(min(step_s, timeout_s - waited))
+            if not self._runs_ahead():
+                time.sleep(min(step_s, timeout_s - waited))
+                continue
+            # The predicate is looked at as often in simulated time.
+            until = min(now + step_s, start + timeout_s)
+            self.run_ahead_to(until)
+            while self.clock_s() < until:
+                time.sleep(0.0002)
+
+    def _runs_ahead(self) -> bool:
+        return self.fast and self._clock_map is not None and self._clock_map.size() >= 16
+
+    @property
+    def bus_run_ahead(self):
+        """What a Bus on this simulator's clock tells where it waits for."""
+        return self.run_ahead_to if self.fast else None
+
+    def run_ahead_to(self, until_s: float, answer: bool = False) -> None:
+        """A fast simulator's clock runs as fast as it can up to until_s
+        (simulated seconds), with answer only until it has answered the
+        host's last bytes, and follows the wall clock from there."""
+        if self._runs_ahead():
+            _CLOCK_US.pack_into(self._clock_map, 8, max(0, int(until_s * 1e6)) | (answer << 63))
 
     def state(self, servo_id: int) -> dict:
         """The models' state of one servo: angle (deg), velocity, current,

@@ -8,16 +8,21 @@ pytest_plugins = ["pytester"]
 GUARD = (Path(__file__).parent / "conftest.py").read_text()
 
 
-def test_a_process_left_running_fails_the_run_and_is_stopped(pytester, monkeypatch, tmp_path):
-    marker = tmp_path / "sleeper.pid"
-    pytester.makeconftest(GUARD)
-    pytester.makepyfile(test_leaks=f"""
+def _leaking(marker: Path) -> str:
+    """A test that passes and leaves a process running, its pid in marker."""
+    return f"""
 import subprocess, sys
 
 def test_passes_but_leaks():
     p = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(120)"])
     open({str(marker)!r}, "w").write(str(p.pid))
+"""
 
+
+def test_a_process_left_running_fails_the_run_and_is_stopped(pytester, monkeypatch, tmp_path):
+    marker = tmp_path / "sleeper.pid"
+    pytester.makeconftest(GUARD)
+    pytester.makepyfile(test_leaks=_leaking(marker) + """
 def test_fails_and_leaks():
     subprocess.Popen([sys.executable, "-c", "import time; time.sleep(120)"])
     assert False
@@ -27,5 +32,31 @@ def test_fails_and_leaks():
     assert result.ret == 1
     result.stdout.fnmatch_lines(["*process guard: test_leaks.py::test_passes_but_leaks left running*"])
     assert "test_fails_and_leaks left running" not in result.stdout.str()
+    pid = int(marker.read_text())
+    assert not Path(f"/proc/{pid}").exists() or "Z" in Path(f"/proc/{pid}/stat").read_text().split()[2]
+
+
+def test_on_xdist_workers_a_leak_fails_the_run_and_no_worker_takes_another_s(pytester, monkeypatch,
+                                                                             tmp_path):
+    """scripts/test.sh runs the suite on workers: a leak on a worker still
+    fails the run and names its test, and a test on one worker never sees
+    (nor stops) a process another worker's test has running meanwhile."""
+    marker = tmp_path / "sleeper.pid"
+    pytester.makeconftest(GUARD)
+    pytester.makepyfile(test_leaks=_leaking(marker), test_busy="""
+import subprocess, sys, time
+
+def test_its_process_lives_through_the_other_workers_tests():
+    p = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(120)"])
+    time.sleep(3)
+    assert p.poll() is None
+    p.kill()
+    p.wait()
+""")
+    monkeypatch.delenv("SERVO_TEST_RUN")
+    result = pytester.runpytest_subprocess("-p", "no:cacheprovider", "-n", "2", "--dist", "loadfile")
+    assert result.ret == 1
+    result.stdout.fnmatch_lines(["*process guard: test_leaks.py::test_passes_but_leaks left running*"])
+    result.assert_outcomes(passed=2)
     pid = int(marker.read_text())
     assert not Path(f"/proc/{pid}").exists() or "Z" in Path(f"/proc/{pid}/stat").read_text().split()[2]

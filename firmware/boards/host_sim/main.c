@@ -27,6 +27,8 @@ static struct sim_bus bus;
 static uint64_t most_behind_us;
 static struct sim_servo servos[SIM_MAX_SERVOS];
 static volatile sig_atomic_t stop_requested;
+/* How many bytes the host had been sent when it last sent bytes itself. */
+static unsigned long host_bytes_then;
 /* A second TCP client while one holds the bus is told so and then ignored
  * until it leaves: a serial port has one program at a time, and two hosts
  * on a half-duplex bus would talk over each other. The words are what
@@ -78,6 +80,14 @@ static void run_to(uint64_t target)
         }
     } while (bus.now_us < target);
     sim_clock_publish(bus.now_us);
+}
+
+/* A host that waits for an answer (sim_clock.h) has it: it has been sent
+ * bytes since its last, and the wire and its adapter hold none. */
+static bool host_answered(uint64_t waits)
+{
+    return (waits & SIM_CLOCK_UNTIL_ANSWER) && bus.host_bytes != host_bytes_then && bus.count == 0 &&
+           sim_usb_due(&bus.usb) == SIM_USB_NONE;
 }
 
 static void on_signal(int sig)
@@ -174,7 +184,10 @@ int main(int argc, char **argv)
         uint64_t wall = sim_now_us();
         int64_t due = sim_bus_next_due(&bus, wall);
         long wait_us = (due >= 0 && due < SIM_BUS_STEP_US) ? (long)due : SIM_BUS_STEP_US;
-        if (sim_bus_step_to(&bus, wall) < wall) {
+        uint64_t waits = sim_clock_host_waits();
+        bool answered = host_answered(waits);
+        waits &= ~SIM_CLOCK_UNTIL_ANSWER;
+        if (sim_bus_step_to(&bus, wall) < wall || (waits > wall && !answered)) {
             wait_us = 0;
         }
         struct timespec timeout = {.tv_sec = 0, .tv_nsec = wait_us * 1000};
@@ -192,6 +205,7 @@ int main(int argc, char **argv)
             ssize_t n = read(bus.host_fd, buf, sizeof buf);
             if (n > 0) {
                 sim_bus_from_host(&bus, buf, (unsigned)n, bus.now_us);
+                host_bytes_then = bus.host_bytes;
             } else if (listen_fd >= 0 && (n == 0 || errno != EAGAIN)) {
                 close(bus.host_fd); /* the TCP client left: wait for the next */
                 bus.host_fd = -1;
@@ -223,7 +237,19 @@ int main(int argc, char **argv)
             }
         }
         sim_control_serve(&control, &fds[control_slot]);
+        /* A host waiting for a later bus time: one step of it at once (its
+         * bytes are still read between steps), not in real time; one that
+         * waits for an answer has its turn once it has been sent bytes
+         * since it last wrote and the wire is quiet. */
+        waits = sim_clock_host_waits();
+        answered = host_answered(waits);
+        waits &= ~SIM_CLOCK_UNTIL_ANSWER;
         uint64_t wall_now = sim_now_us();
+        if (!answered && waits > wall_now && bus.now_us + SIM_BUS_STEP_US >= wall_now) {
+            uint64_t skip = waits - wall_now;
+            sim_skip_us(skip < SIM_BUS_STEP_US ? skip : SIM_BUS_STEP_US);
+            wall_now = sim_now_us();
+        }
         uint64_t target = sim_bus_step_to(&bus, wall_now);
         if (wall_now - target > most_behind_us) {
             most_behind_us = wall_now - target;

@@ -122,6 +122,7 @@ static void write_host(struct sim_bus *b, const uint8_t *data, unsigned len)
         }
         data += n;
         len -= (unsigned)n;
+        b->host_bytes += (unsigned long)n;
     }
 }
 

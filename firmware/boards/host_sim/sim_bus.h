@@ -86,6 +86,7 @@ struct sim_bus {
     unsigned long garbled;    /* bytes sent over another sender's (the host's too) */
     unsigned long dropped;    /* queue overflow (servo bytes; the host is held back) */
     unsigned long baud_mismatches; /* bytes no station at that rate received */
+    unsigned long host_bytes; /* bytes the host was sent */
     struct sim_bus_span spans[SIM_BUS_SPANS];
     unsigned long span_count; /* in all: the latest SIM_BUS_SPANS are kept */
 };

@@ -18,8 +18,8 @@ bool sim_clock_open(const char *state_dir, char *path, unsigned path_size)
         return false;
     }
     void *map = MAP_FAILED;
-    if (ftruncate(fd, (off_t)sizeof(uint64_t)) == 0) {
-        map = mmap(NULL, sizeof(uint64_t), PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
+    if (ftruncate(fd, (off_t)(2 * sizeof(uint64_t))) == 0) {
+        map = mmap(NULL, 2 * sizeof(uint64_t), PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
     }
     close(fd); /* the mapping keeps the file */
     if (map == MAP_FAILED) {
@@ -36,4 +36,9 @@ void sim_clock_publish(uint64_t now_us)
     if (published != NULL) {
         atomic_store_explicit(published, now_us, memory_order_release);
     }
+}
+
+uint64_t sim_clock_host_waits(void)
+{
+    return published != NULL ? atomic_load_explicit(&published[1], memory_order_acquire) : 0u;
 }

@@ -2,7 +2,16 @@
  * state folder, mapped, holding the clock in microseconds (little-endian
  * u64 at offset 0, written whole after every step). A host that reads the
  * clock at every answer spends no simulated time on it, as a host on a
- * real bus reads its own clock; "clock" on the control port stays. */
+ * real bus reads its own clock; "clock" on the control port stays.
+ *
+ * At offset 8 the host may write (u64, microseconds) the bus time it is
+ * waiting for: until the clock reaches it, the simulator runs as fast as it
+ * can instead of following the wall clock (sim_now_us() skips ahead), then
+ * follows the wall clock again from there. 0, the file's start, never
+ * skips: a host that does not write it has a real-time simulator. With
+ * SIM_CLOCK_UNTIL_ANSWER set, the host waits for an answer: the simulator
+ * stops running ahead once it has sent the host bytes since the host's
+ * last and the wire is quiet. */
 #ifndef SIM_CLOCK_H
 #define SIM_CLOCK_H
 
@@ -10,10 +19,13 @@
 #include <stdint.h>
 
 #define SIM_CLOCK_FILE "bus.clock"
+#define SIM_CLOCK_UNTIL_ANSWER (UINT64_C(1) << 63)
 
 /* Maps state_dir/SIM_CLOCK_FILE; its path in path. False (and the clock
  * only on the control port) where the system refuses. */
 bool sim_clock_open(const char *state_dir, char *path, unsigned path_size);
 void sim_clock_publish(uint64_t now_us);
+/* The bus time the host waits for (offset 8); 0 if none or unmapped. */
+uint64_t sim_clock_host_waits(void);
 
 #endif

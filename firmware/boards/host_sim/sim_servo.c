@@ -12,6 +12,13 @@
 #include "sim_bus.h"
 #include "bootloader/slot_write.h"
 
+static uint64_t skipped_us;
+
+void sim_skip_us(uint64_t us)
+{
+    skipped_us += us;
+}
+
 uint64_t sim_now_us(void)
 {
     static uint64_t start;
@@ -21,7 +28,7 @@ uint64_t sim_now_us(void)
     if (start == 0) {
         start = us - 1000u; /* never 0 */
     }
-    return us - start;
+    return us - start + skipped_us;
 }
 
 /* Runs motor and winding up to now with the drive last set; the bus clock

@@ -97,8 +97,10 @@ struct sim_servo {
     bool driven;
 };
 
-/* Monotonic microseconds since the simulator started. */
+/* Monotonic microseconds since the simulator started, plus every skip. */
 uint64_t sim_now_us(void);
+/* Moves sim_now_us() on by us at once (sim_clock.h: a host that waits). */
+void sim_skip_us(uint64_t us);
 
 /* Opens the servo's flash files in state_dir (giving a blank chip the ID
  * `id`) and starts its core. unit counts the servos started before it with

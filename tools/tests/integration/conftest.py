@@ -4,7 +4,13 @@ servos ever talked over each other.
 
 Time in these tests is the simulator's (sim.sleep, sim.wait_until, the
 sim_ms and last_move_ms of sim.state): it falls behind the wall clock on a
-busy machine, and a test that judged host time would fail there."""
+busy machine, and a test that judged host time would fail there.
+
+The simulator of the sim and sim3 fixtures is fast (Simulator(fast=True)):
+its clock runs as fast as it can while the test waits on it, and follows
+the wall clock otherwise. A module whose test paces the host on the wall
+clock (streams at a rate, loops that time.sleep) sets REAL_TIME = True:
+its simulator then only follows the wall clock."""
 import pytest
 
 from servoctl.protocol import Bus
@@ -12,8 +18,8 @@ from servoctl.servo import Servo
 from servoctl.sim import Simulator
 
 
-def _start(tmp_path, ids, tcp=True):
-    sim = Simulator(ids=ids, tcp=tcp, state_dir=str(tmp_path / "state"))
+def _start(tmp_path, ids, tcp=True, fast=True):
+    sim = Simulator(ids=ids, tcp=tcp, state_dir=str(tmp_path / "state"), fast=fast)
     sim.start()
     return sim
 
@@ -30,16 +36,20 @@ def finish(sim, ids):
     assert "runtime error" not in err and "AddressSanitizer" not in err, err
 
 
+def _fast(request) -> bool:
+    return not getattr(request.module, "REAL_TIME", False)
+
+
 @pytest.fixture
-def sim(tmp_path):
-    s = _start(tmp_path, [1])
+def sim(tmp_path, request):
+    s = _start(tmp_path, [1], fast=_fast(request))
     yield s
     finish(s, [1])
 
 
 @pytest.fixture
-def sim3(tmp_path):
-    s = _start(tmp_path, [1, 2, 3])
+def sim3(tmp_path, request):
+    s = _start(tmp_path, [1, 2, 3], fast=_fast(request))
     yield s
     finish(s, [1, 2, 3])
 

@@ -10,6 +10,11 @@ from servoctl.protocol import checksum, request_frame
 from servoctl.servo import Servo
 
 
+# The simulator keeps real time (conftest.py): the tests read what the
+# host's socket holds once the simulated time is over, and a simulator
+# that ran ahead had sent it in a burst TCP still holds back.
+REAL_TIME = True
+
 def frames_in(data: bytes):
     """(code, content, checksum ok) of every response frame in data, and how
     many bytes were not part of one."""

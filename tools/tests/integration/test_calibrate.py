@@ -15,7 +15,7 @@ AMP_ZERO = 25
 
 
 def start(tmp_path, *controls):
-    sim = Simulator(state_dir=str(tmp_path / "state")).start()
+    sim = Simulator(fast=True, state_dir=str(tmp_path / "state")).start()
     for line in controls:
         assert sim.control(line).strip() == "ok", line
     return sim

@@ -59,7 +59,7 @@ def test_every_value_survives_the_file_exactly(sim, capsys, tmp_path):
 
 
 def test_config_diff(tmp_path, capsys):
-    with Simulator(ids=[1, 2], state_dir=str(tmp_path / "state")) as sim:
+    with Simulator(fast=True, ids=[1, 2], state_dir=str(tmp_path / "state")) as sim:
         assert run(sim, capsys, "config", "set", "2", "stall_power", "2.5W")[0] == 0
         rc, out, _ = run(sim, capsys, "config", "diff", "1", "2")
         assert rc == 1, out

@@ -27,7 +27,7 @@ def write_while_moving(tmp_path, rx, writes, run=0, cut=False):
     the simulator is killed (kill -9, a power cut) right after the last
     answer and started again; the state is then the restarted servo's."""
     state_dir = str(tmp_path / f"{rx}-{run}")
-    sim = Simulator(ids=[1, 2], state_dir=state_dir, rx=rx)
+    sim = Simulator(fast=True, ids=[1, 2], state_dir=state_dir, rx=rx)
     sim.start()
     try:
         with sim.bus(timeout=0.2) as bus:
@@ -57,7 +57,7 @@ def write_while_moving(tmp_path, rx, writes, run=0, cut=False):
         if cut:
             sim.process.kill()
             sim.process.wait()
-            sim = Simulator(ids=[1, 2], state_dir=state_dir, rx=rx)
+            sim = Simulator(fast=True, ids=[1, 2], state_dir=state_dir, rx=rx)
             sim.start()
             sim.control("hostbaud 1000000")
             with sim.bus(baud=1000000, timeout=0.2) as bus:
@@ -89,7 +89,7 @@ def overruns_while_programming(tmp_path, rx, run):
     once, without waiting for its answer, by a ping to servo 2: servo 1
     programs its record (36 half-words, 2.5 ms) while the ping and servo
     2's answer are on the wire."""
-    sim = Simulator(ids=[1, 2], state_dir=str(tmp_path / f"{rx}-{run}"), rx=rx)
+    sim = Simulator(fast=True, ids=[1, 2], state_dir=str(tmp_path / f"{rx}-{run}"), rx=rx)
     sim.start()
     try:
         with sim.bus(timeout=0.2) as bus:
@@ -137,7 +137,7 @@ def test_an_answer_that_would_leave_late_is_dropped_and_counted(tmp_path, capsys
 
     from servoctl.cli import main
 
-    sim = Simulator(ids=[1], state_dir=str(tmp_path / "state"))
+    sim = Simulator(fast=True, ids=[1], state_dir=str(tmp_path / "state"))
     sim.start()
     try:
         with sim.bus(timeout=0.2) as bus:
@@ -186,7 +186,7 @@ def test_a_driven_servo_refuses_a_change_it_cannot_store_and_says_why(tmp_path):
     the servo erases the next page and takes the change."""
     import pytest
 
-    sim = Simulator(ids=[1], state_dir=str(tmp_path / "state"))
+    sim = Simulator(fast=True, ids=[1], state_dir=str(tmp_path / "state"))
     sim.start()
     try:
         with sim.bus(timeout=0.2) as bus:

@@ -10,7 +10,7 @@ IDS = list(range(254))
 
 
 def test_a_full_bus_scans_and_sync_monitors_without_collisions(tmp_path, capsys):
-    with Simulator(ids=IDS, state_dir=str(tmp_path / "state")) as sim:
+    with Simulator(fast=True, ids=IDS, state_dir=str(tmp_path / "state")) as sim:
         # The ASan build runs 254 servos at about real time; a scan allows
         # 20 ms an ID.
         rc = main(["--port", sim.url, "scan", "--reply-timeout", "0.02", "--json"], clock=sim.clock_s)

@@ -359,7 +359,7 @@ def test_id_254_is_a_servo_id(tmp_path, capsys):
     and update (IDs are 0..254)."""
     from servoctl.sim import Simulator
 
-    sim = Simulator(ids=[254], tcp=True, state_dir=str(tmp_path / "state"))
+    sim = Simulator(fast=True, ids=[254], tcp=True, state_dir=str(tmp_path / "state"))
     sim.start()
     try:
         rc, out, _ = run(sim, capsys, "scan", "--first", "250")
@@ -383,7 +383,7 @@ def test_a_sync_monitor_keeps_the_answers_after_an_absent_servo(tmp_path, capsys
     from servoctl import group
     from servoctl.sim import Simulator
 
-    with Simulator(ids=[1, 3, 5], state_dir=str(tmp_path / "state")) as sim:
+    with Simulator(fast=True, ids=[1, 3, 5], state_dir=str(tmp_path / "state")) as sim:
         with sim.bus(timeout=0.2) as bus:
             assert sorted(group.sync_monitor(bus, [1, 2, 3])) == [1, 3]
             assert list(group.sync_monitor(bus, [5, 4, 3, 2, 1])) == [5, 3, 1]

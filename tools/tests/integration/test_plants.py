@@ -19,7 +19,7 @@ SHIPPED = {"reference_st3215.toml": ("reference ST3215", 7400), "micro_9g.toml":
 
 
 def start(tmp_path, plant, **kw):
-    return Simulator(state_dir=str(tmp_path / "state"), plant=str(PLANTS / plant), **kw).start()
+    return Simulator(fast=True, state_dir=str(tmp_path / "state"), plant=str(PLANTS / plant), **kw).start()
 
 
 def trace(sim, servo, target, steps=30, step_s=0.04):
@@ -73,7 +73,7 @@ def test_a_refused_plant_file_says_why(tmp_path):
     text = (PLANTS / "reference_st3215.toml").read_text()
     bad.write_text(re.sub(r"(?m)^(gear_ratio = 345)\s*#.*$", r"\1", text))
     with pytest.raises(ServoError, match=r"line \d+: gear_ratio has no source"):
-        Simulator(state_dir=str(tmp_path / "state"), plant=str(bad)).start()
+        Simulator(fast=True, state_dir=str(tmp_path / "state"), plant=str(bad)).start()
 
 
 def test_a_payload_slows_the_horn(tmp_path):

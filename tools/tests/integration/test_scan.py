@@ -28,7 +28,7 @@ def test_two_servos_on_one_id_are_found_out(tmp_path, capsys):
     whole). scan says two or more servos hold ID 2, how to learn their
     serial numbers, and exits 1.
     (Not the sim3 fixture: this bus collides on purpose.)"""
-    with Simulator(ids=[1, 2, 3], state_dir=str(tmp_path / "state")) as sim:
+    with Simulator(fast=True, ids=[1, 2, 3], state_dir=str(tmp_path / "state")) as sim:
         with sim.bus() as bus:
             Servo(bus, 3).write("servo_id", 2)
         rc, out, err = run(sim, capsys, "scan", "--last", "5")
@@ -64,7 +64,7 @@ def test_bringup_numbers_new_servos_one_at_a_time(tmp_path, capsys):
     """A new servo answers at the factory ID 0; bringup gives it the first
     free ID from --first on (5 is taken) and waits for the next, which,
     here, never comes."""
-    with Simulator(ids=[0, 5], state_dir=str(tmp_path / "state")) as sim:
+    with Simulator(fast=True, ids=[0, 5], state_dir=str(tmp_path / "state")) as sim:
         rc, out, _ = run(sim, capsys, "id", "bringup", "--first", "5", "--count", "1")
         assert rc == 0 and "servo serial 0x51a00000 is now ID 6" in out, out
         rc, out, err = run(sim, capsys, "id", "bringup", "--count", "1", "--wait-s", "1")
@@ -136,7 +136,7 @@ def test_a_bus_of_new_servos_is_counted_numbered_and_addressed_by_bus_id(tmp_pat
     their serial numbers they are numbered one by one (id assign). The
     control port then addresses a servo by the ID it holds now, or by its
     serial number, not by the ID it started with."""
-    with Simulator(ids=[0, 0, 0, 0], state_dir=str(tmp_path / "state")) as sim:
+    with Simulator(fast=True, ids=[0, 0, 0, 0], state_dir=str(tmp_path / "state")) as sim:
         serials = [0x51A00000, 0x51A00100, 0x51A00200, 0x51A00300]
         rc, out, err = run(sim, capsys, "scan", "--last", "3")
         assert rc == 1 and "at least 2 servo(s) found" in out and "IDs held by two or more servos: 0" in err, out + err
@@ -168,7 +168,7 @@ def test_a_bus_of_new_servos_is_counted_numbered_and_addressed_by_bus_id(tmp_pat
 
 def test_state_of_a_full_bus_is_every_line(tmp_path):
     """state with 254 servos stopped at 4095 bytes, mid-line."""
-    with Simulator(ids=list(range(254)), state_dir=str(tmp_path / "state")) as sim:
+    with Simulator(fast=True, ids=list(range(254)), state_dir=str(tmp_path / "state")) as sim:
         lines = sim.control("state").splitlines()
         assert [int(line.split()[0].split("=")[1]) for line in lines] == list(range(254))
         assert all(line.split()[-1].startswith("serial=") for line in lines)

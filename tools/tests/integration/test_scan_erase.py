@@ -13,7 +13,7 @@ SLOTS = 21  # config records in a page
 
 
 def test_a_scan_into_an_erase_finds_the_servo(tmp_path, capsys):
-    sim = Simulator(ids=[1], state_dir=str(tmp_path / "state")).start()
+    sim = Simulator(fast=True, ids=[1], state_dir=str(tmp_path / "state")).start()
     try:
         with sim.bus(timeout=0.2) as bus:
             s = Servo(bus, 1)

@@ -23,6 +23,8 @@ from servoctl.sim import Simulator
 
 from .conftest import finish
 
+pytestmark = pytest.mark.wall_clock  # the SDK's windows are host time
+
 IDS = (0, 1, 2)
 BAUD_INDEX = {115200: 5, 1000000: 8}  # item 36
 # The SDK waits on the wall clock (100 ms an answer): the simulator gets the

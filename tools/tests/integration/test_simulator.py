@@ -16,7 +16,7 @@ from servoctl.sim import Simulator
 
 @pytest.fixture
 def pty_sim(tmp_path):
-    with Simulator(ids=[1, 2], tcp=False, state_dir=str(tmp_path / "state")) as sim:
+    with Simulator(fast=True, ids=[1, 2], tcp=False, state_dir=str(tmp_path / "state")) as sim:
         yield sim
 
 
@@ -119,7 +119,7 @@ def test_a_request_the_moment_the_simulator_is_ready_finds_the_readings_taken(tm
     import signal
     import socket
 
-    with Simulator(ids=[1], state_dir=str(tmp_path / "state")) as sim:
+    with Simulator(fast=True, ids=[1], state_dir=str(tmp_path / "state")) as sim:
         host, port = sim.url.removeprefix("socket://").split(":")
         with socket.create_connection((host, int(port))) as link:
             os.kill(sim.process.pid, signal.SIGSTOP)
@@ -156,6 +156,6 @@ def test_the_published_clock_is_the_control_ports_read_without_asking(sim):
 
 def test_the_clock_file_goes_when_the_simulator_stops(tmp_path):
     state = tmp_path / "state"
-    with Simulator(ids=[1], state_dir=str(state)):
-        assert (state / "bus.clock").stat().st_size == 8
+    with Simulator(fast=True, ids=[1], state_dir=str(state)):
+        assert (state / "bus.clock").stat().st_size == 16  # the clock and the host's wait
     assert not (state / "bus.clock").exists()

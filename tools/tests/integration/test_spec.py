@@ -138,13 +138,13 @@ def test_stall_in_both_modes(servo, sim, release):
 
 def test_config_survives_a_restart(tmp_path):
     state = str(tmp_path / "state")
-    with Simulator(ids=[5], state_dir=state) as sim, sim.bus() as bus:
+    with Simulator(fast=True, ids=[5], state_dir=state) as sim, sim.bus() as bus:
         s = Servo(bus, 5)
         s.write("stall_power", 1234)
         s.write("angle_max", 900)
         s.write("servo_id", 6)
         sim.sleep(0.05)
-    with Simulator(ids=[5], state_dir=state) as sim, sim.bus() as bus:
+    with Simulator(fast=True, ids=[5], state_dir=state) as sim, sim.bus() as bus:
         assert not Servo(bus, 5).ping()
         s = Servo(bus, 6)
         assert s.read("stall_power") == 1234

@@ -25,7 +25,7 @@ def power_cut(sim, ids, state_dir):
     """kill -9 and start again on the same flash files."""
     sim.process.kill()
     sim.process.wait()
-    return Simulator(ids=ids, state_dir=state_dir).start()
+    return Simulator(fast=True, ids=ids, state_dir=state_dir).start()
 
 
 def test_changes_survive_a_cut_while_another_servos_monitor_traffic_never_pauses(tmp_path):
@@ -34,7 +34,7 @@ def test_changes_survive_a_cut_while_another_servos_monitor_traffic_never_pauses
     answer; once its free slots are spent it refuses further ones (and
     says why) rather than acknowledge what it cannot keep."""
     state_dir = str(tmp_path / "state")
-    sim = Simulator(ids=[1, 2], state_dir=state_dir).start()
+    sim = Simulator(fast=True, ids=[1, 2], state_dir=state_dir).start()
     try:
         with sim.bus(timeout=0.2) as bus:
             one, two = Servo(bus, 1), Servo(bus, 2)
@@ -59,7 +59,7 @@ def test_changes_survive_a_cut_while_another_servos_monitor_traffic_never_pauses
 
 def test_a_new_id_survives_a_cut(tmp_path):
     state_dir = str(tmp_path / "state")
-    sim = Simulator(ids=[1], state_dir=state_dir).start()
+    sim = Simulator(fast=True, ids=[1], state_dir=state_dir).start()
     try:
         with sim.bus(timeout=0.2) as bus:
             Servo(bus, 1).write("servo_id", 9)  # answered by ID 1, then 9
@@ -113,7 +113,7 @@ def test_sync_commands_sent_into_an_erase_are_carried_out(tmp_path, baud):
     the last to 30 degrees. The reference board's 4 KB ring holds every
     byte the 40 ms erase brings in at either rate (its board.h): servo 1
     carries them out, and loses nothing."""
-    sim = Simulator(ids=[1, 2], state_dir=str(tmp_path / "state")).start()
+    sim = Simulator(fast=True, ids=[1, 2], state_dir=str(tmp_path / "state")).start()
     try:
         with sim.bus(timeout=0.2) as bus:
             for i in (1, 2):
@@ -157,7 +157,7 @@ def test_sixty_four_servos_save_and_sync_monitor_without_a_collision(tmp_path):
     tick dropped, and every change kept."""
     ids = list(range(1, 65))
     savers = ids[::8]
-    sim = Simulator(ids=ids, state_dir=str(tmp_path / "state")).start()
+    sim = Simulator(fast=True, ids=ids, state_dir=str(tmp_path / "state")).start()
     try:
         with sim.bus(timeout=0.3) as bus:
             servos = {i: Servo(bus, i) for i in ids}

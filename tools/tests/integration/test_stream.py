@@ -17,12 +17,16 @@ from servoctl.stream import Limits, RobotLoop, Stream, read_trajectory
 from ..scheduled import followed
 from .conftest import finish, _start
 
+# Host-paced (a stream at its rate on the wall clock): the simulator keeps
+# real time (conftest.py).
+REAL_TIME = True
+
 IDS = [1, 2, 3]
 
 
 @pytest.fixture
 def sim3(tmp_path):
-    s = _start(tmp_path, IDS)
+    s = _start(tmp_path, IDS, fast=False)
     yield s
     finish(s, IDS)
 

@@ -8,6 +8,10 @@ simulator's."""
 from servoctl import protocol as p
 from servoctl.servo import Servo
 
+# Host-paced (a stream at its rate on the wall clock): the simulator keeps
+# real time (conftest.py).
+REAL_TIME = True
+
 
 def setpoint(bus, servo_id, decideg, velocity=0, host_ms=0):
     bus.send(p.STREAM_SETPOINT, p.encode_request(p.STREAM_SETPOINT, servo_id, decideg, velocity, host_ms))

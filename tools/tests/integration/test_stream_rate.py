@@ -4,6 +4,10 @@ simulated clock."""
 from servoctl.cli import main
 from servoctl.stream import RobotLoop
 
+# Host-paced (a stream at its rate on the wall clock): the simulator keeps
+# real time (conftest.py).
+REAL_TIME = True
+
 
 def test_a_stream_faster_than_the_wire_is_refused_before_the_lead_in(sim, tmp_path, capsys):
     """500 Hz to one servo at 115 200 baud: a cycle is 44 bytes, so the

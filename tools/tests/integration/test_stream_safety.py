@@ -14,6 +14,10 @@ from servoctl.stream import Limits, RobotLoop, Stream
 
 from ..stream_report import lead_in_of
 
+# Host-paced (a stream at its rate on the wall clock): the simulator keeps
+# real time (conftest.py).
+REAL_TIME = True
+
 
 def write_csv(path, rows, period_s=0.02):
     """rows: one angle (deg, or a text) per row, for servo 1."""

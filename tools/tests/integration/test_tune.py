@@ -33,7 +33,7 @@ BUILT = ("magnet -40", "swapleads 1", "ampzero 18")  # how these servos came (co
 
 
 def start(tmp_path, file, built=()):
-    sim = Simulator(state_dir=str(tmp_path / "state"), plant=str(PLANTS / file)).start()
+    sim = Simulator(fast=True, state_dir=str(tmp_path / "state"), plant=str(PLANTS / file)).start()
     for line in built:
         assert sim.control(line).strip() == "ok", line
     with sim.bus(timeout=0.2) as bus:

@@ -269,13 +269,13 @@ def test_a_slot_left_invalid_stays_invalid_across_a_kill(tmp_path):
     from servoctl.sim import Simulator
 
     state = str(tmp_path / "state")
-    with Simulator(ids=[1], state_dir=state) as sim, sim.bus(timeout=0.2) as bus:
+    with Simulator(fast=True, ids=[1], state_dir=state) as sim, sim.bus(timeout=0.2) as bus:
         assert bus.request(upd.UPDATE_ENTER, bytes([1]))[1] == 1
         upd._wait_for_mode(bus, 1, upd.MODE_BOOTLOADER)
         assert bus.request(upd.UPDATE_ERASE, bytes([1, 0, 0]))[1] == 1
         sim.process.kill()  # kill -9: no clean stop
         sim.process.wait()
-    with Simulator(ids=[1], state_dir=state) as sim, sim.bus(timeout=0.2) as bus:
+    with Simulator(fast=True, ids=[1], state_dir=state) as sim, sim.bus(timeout=0.2) as bus:
         st = upd.status(bus, 1)
         assert (st.mode, st.verdict) == (upd.MODE_BOOTLOADER, 1)  # no image
         assert sim.state(1)["mode"] == "bootloader"

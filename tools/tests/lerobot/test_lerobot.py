@@ -24,6 +24,7 @@ IDS = list(range(7))
 BAUD_1M = 8  # item 36's index for 1 000 000 baud
 
 
+@pytest.mark.wall_clock  # the maker's SDK underneath times on host time
 @pytest.mark.skipif(not PYTHON.exists(), reason="no .venv-lerobot: the test command makes it "
                     "(scripts/lerobot_env.sh; LEROBOT_ENV=0 had it skipped)")
 def test_the_makers_lerobot_plugin_drives_a_simulated_arm(tmp_path):

@@ -288,6 +288,7 @@ def test_a_streamed_trajectory_is_followed(one):
     assert samples >= 10 and rms < 0.3 and peak < 1.0, (rms, peak, samples)
 
 
+@pytest.mark.wall_clock  # the SDK's windows are host time
 def test_the_makers_sdk(tmp_path, board):
     # The SDK waits on the wall clock (100 ms an answer): the board gets the
     # priority of a real-time twin, so it keeps up on a loaded PC (root only).
