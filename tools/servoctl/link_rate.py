@@ -50,6 +50,14 @@ def after_set(bus, args, name: str, value: int) -> None:
         print(after_change(bus, args.id, rate, args.sim_control))
 
 
+def after_load(bus, args, servo_id: int, before: int, now: int) -> list:
+    """After `config load --with-link`: a baud change as after_set; the
+    notes the load reports (the servo's new ID)."""
+    if now != before:
+        print(after_change(bus, servo_id, registers.BAUD_RATES[now], args.sim_control))
+    return [f"now ID {servo_id}"] if servo_id != args.id else []
+
+
 def after_change(bus, servo_id: int, rate: int, sim_control) -> str:
     """What to do now that a servo speaks `rate`, or what was done (the
     simulator's host rate set on its control port)."""
