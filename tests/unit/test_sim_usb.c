@@ -12,7 +12,7 @@
 
 #include <cmocka.h>
 
-#include "sim_usb.h"
+#include "boards/host_sim/sim_usb.h"
 
 #define MAX_BYTES 512u
 
