@@ -8,7 +8,7 @@ import sys
 import time
 
 from . import args as args_
-from . import checks, config_diff, config_file, frame, group, ids, link_rate, ntc, outcome, registers, scan, units
+from . import checks, config_diff, config_file, console, frame, group, ids, link_rate, ntc, outcome, registers, scan, units
 from . import protocol as p
 from .args import build_parser
 from .errors import BadAnswer, NoReply, Refused, ServoError, UsageError
@@ -490,7 +490,8 @@ def main(argv=None, clock=None) -> int:
     passes its own (servoctl.sim.Simulator.clock_s)."""
     args = build_parser().parse_args(argv)
     try:
-        code = _run(args, clock)
+        with console.pipe_guard(args):  # a command that changes servos finishes
+            code = _run(args, clock)
         sys.stdout.flush()  # a reader that stopped reading is met here, not at exit
         return code
     except ServoError as e:
@@ -503,8 +504,7 @@ def main(argv=None, clock=None) -> int:
         print("servoctl: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
     except BrokenPipeError:
-        # `servoctl info 2 | head -3`: the reader has what it wanted. What
-        # is left to print goes nowhere, quietly, as with any Unix filter.
+        # `servoctl info 2 | head -3`: the reader has what it wanted, quietly.
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
 
