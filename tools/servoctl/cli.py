@@ -78,7 +78,7 @@ def cmd_ping(bus, args):
     if Servo(bus, args.id).ping():
         print(f"servo {args.id}: answered")
         return 0
-    print(f"servo {args.id}: no reply" + link_rate.no_reply_hint(args.port, args.sim_control, bus.serial.baudrate))
+    print(f"servo {args.id}: no reply" + link_rate.no_reply_hint(bus, args.port, args.sim_control, bus.serial.baudrate))
     return NoReply.exit_code
 
 
@@ -543,7 +543,7 @@ def _run(args, clock=None) -> int:
                 why = scan.in_bootloader(bus, servo_id)
                 if why:
                     raise NoReply(why) from None
-            raise NoReply(f"{sys.exc_info()[1]}{link_rate.no_reply_hint(args.port, args.sim_control, baud)}") from None
+            raise NoReply(f"{sys.exc_info()[1]}{link_rate.no_reply_hint(bus, args.port, args.sim_control, baud)}") from None
 
 
 if __name__ == "__main__":

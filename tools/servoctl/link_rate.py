@@ -73,11 +73,12 @@ def after_change(bus, servo_id: int, rate: int, sim_control) -> str:
             f"and servoctl does it) to reach it again")
 
 
-def no_reply_hint(port, sim_control, rate: int) -> str:
-    """What a NoReply on socket:// adds: the simulator's host rate, read on
-    its control port where given, else that it may have been changed (a
-    --sim-control --baud earlier outlives that servoctl)."""
-    if not is_socket(port):
+def no_reply_hint(bus, port, sim_control, rate: int) -> str:
+    """What a NoReply on socket:// where no answer at all came adds: the
+    simulator's host rate, read on its control port where given, else that
+    it may have been changed (a --sim-control --baud earlier outlives that
+    servoctl)."""
+    if not is_socket(port) or getattr(bus, "heard", False):
         return ""
     if sim_control:
         try:

@@ -145,6 +145,7 @@ class Bus:
         self._low_water = 1  # the socket's SO_RCVLOWAT (_wake_at)
         self._buffer = b""
         self.stray_bytes = 0  # bytes outside any frame: noise, or answers that collided
+        self.heard = False  # a whole frame came: the host and the line agree on the rate
         self.sent_again = 0  # requests sent a second time, their first unanswered (request)
         self.stamp_arrivals = True
         # The bus clock when the last response returned was taken off the
@@ -268,10 +269,11 @@ class Bus:
                     raise OSError(f"nothing was taken for {WRITE_STALL_S:g} s") from None
                 select.select([], [self._sock], [], 0.1)
 
-    def read_response(self, code: int, servo_id, timeout=None, deadline=None):
+    def read_response(self, code: int, servo_id, timeout=None, deadline=None, item=None):
         """Content of the next response with this packet number from this
-        servo (any servo if servo_id is None); other frames on the wire are
-        skipped. It must come within timeout (the bus's if None), or by
+        servo (any servo if servo_id is None), about item where given (a
+        ReadData's: a late answer to an earlier read of another item is
+        not this one's); other frames on the wire are skipped. It must come within timeout (the bus's if None), or by
         deadline on the bus clock. The bus clock is read as little as it
         can be (a virtual board's is a request to it): at the start, when
         the line is idle, every 2 ms of a stream of other bytes, and to
@@ -279,6 +281,7 @@ class Bus:
         wait = self.timeout if timeout is None else timeout
         if deadline is None:
             deadline = self.clock() + wait
+        want = b"" if servo_id is None else bytes([servo_id] + ([] if item is None else [item]))
         bad = None
         last_look = False
         got = True  # the deadline was just read
@@ -289,7 +292,7 @@ class Bus:
                 fcode, content, ok = frame
                 if not ok:
                     bad = fcode
-                elif fcode == code and (servo_id is None or content[:1] == bytes([servo_id])):
+                elif fcode == code and content[:len(want)] == want[:max(1, len(content))]:  # short: told
                     self.arrived_at = self.clock() if self.stamp_arrivals else None
                     return content
                 continue
@@ -328,7 +331,7 @@ class Bus:
                 # A frame begun in the window is read whole, not counted as
                 # garbage: the longest answer's time more, and 5 ms.
                 finishing, last_look = True, False
-                deadline = self.clock() + ANSWER_FRAME_MAX * 10 / self.serial.baudrate + 0.005
+                deadline = self.clock() + self._longest_answer_s()
             self._fill(wait=not last_look)
 
     def _take_frame(self):
@@ -351,6 +354,7 @@ class Bus:
             return None
         self._buffer = buf[end:]
         frame = buf[:end]
+        self.heard |= checksum(frame[:-1]) == frame[-1]
         return frame[2], frame[4:-1], checksum(frame[:-1]) == frame[-1]
 
     def request(self, code: int, content: bytes, timeout=None, again=None) -> bytes:
@@ -358,12 +362,26 @@ class Bus:
         answer's content. Unanswered, it is sent once more if again (by
         default, if it only reads: REPEATABLE): it may have landed in a page
         erase, carried out but not answered."""
+        item = {"item": content[1]} if code == READ_DATA else {}
         self.send(code, content)
         try:
-            return self.read_response(code, content[0], timeout)
+            return self.read_response(code, content[0], timeout, **item)
         except NoReply:
             if not (code in REPEATABLE if again is None else again):
                 raise
         self.sent_again += 1
+        self.drain()
         self.send(code, content)
-        return self.read_response(code, content[0], timeout)
+        return self.read_response(code, content[0], timeout, **item)
+
+    def _longest_answer_s(self) -> float:
+        return ANSWER_FRAME_MAX * 10 / self.serial.baudrate + 0.005
+
+    def drain(self) -> None:
+        """Waits out an answer still on its way (the longest's time on the
+        wire and 5 ms, on the bus clock) and drops it: after a NoReply, a
+        late answer is not taken for the next request's."""
+        deadline = self.clock() + self._longest_answer_s()
+        while self.clock() <= deadline:
+            self._fill(wait=True)
+        self._buffer = b""

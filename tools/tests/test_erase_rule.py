@@ -69,7 +69,11 @@ class ErasingBus(p.Bus):
             return struct.pack(fmt, content[0], 0, 1, 0, 10000, 1000, 0, 0, self.dropped, 0)
         return bytes([content[0]])  # Ping
 
-    def read_response(self, code, servo_id, timeout=None, deadline=None):
+    def drain(self):  # a late answer is dropped before a request is sent again
+        self.drained = getattr(self, "drained", 0) + 1
+        self.late, self.answer = None, (None, None)
+
+    def read_response(self, code, servo_id, timeout=None, deadline=None, item=None):
         sent, answer = self.answer
         self.answer = (None, None)
         if sent != code or answer is None:
@@ -133,3 +137,31 @@ def test_a_lost_clear_faults_is_read_back_and_sent_again():
     bus = ErasingBus(lose=1)
     Servo(bus, 1).clear_faults()
     assert bus.values["faults"] == 0 and bus.sent == [p.CLEAR_FAULTS, p.READ_FAULTS, p.CLEAR_FAULTS]
+
+
+class LateAnswerBus(p.Bus):
+    """loop:// with the answers given: each request is followed on the line
+    by the frames queued for it (a late answer to an earlier request first)."""
+
+    def __init__(self, answers):
+        super().__init__("loop://", 115200, timeout=0.05)
+        self.answers = answers
+
+    def send(self, code, content):
+        super().send(code, content)
+        self.serial.write(b"".join(p.response_frame(c, a) for c, a in self.answers.pop(0)))
+
+
+def test_a_late_answer_about_another_item_is_not_this_reads():
+    """current_limit's answer comes late, after the read of power_limit
+    (the same size) was sent: it is not taken as power_limit's."""
+    cur, power = registers.find("current_limit"), registers.find("power_limit")
+    late = (p.READ_DATA, bytes([1, cur.id]) + cur.pack(3000))
+    with LateAnswerBus([[late, (p.READ_DATA, bytes([1, power.id]) + power.pack(9000))]]) as bus:
+        assert Servo(bus, 1).read("power_limit") == 9000
+
+
+def test_a_late_answer_is_drained_before_a_read_is_sent_again():
+    bus = ErasingBus(drop=1)
+    Servo(bus, 1).read("current_limit")
+    assert bus.drained == 1
