@@ -131,3 +131,22 @@ def test_with_link_writes_everything_then_moves_the_servo(sim, capsys, tmp_path)
     rc, out, err = run(sim, capsys, "--baud", "1000000", "--sim-control", control, "config", "load", "5", str(f),
                        "--with-link")
     assert rc == 0 and "(now ID 1;" in out and sim.state(1)["host_baud"] == 115200, out + err
+
+
+def test_ram_items_carry_their_units_in_files(sim, capsys, tmp_path):
+    """RAM items were written as bare numbers ("watchdog_ms": "0") and
+    "500 ms" was refused: they carry and take units as the user area's do;
+    a bare number (a file written before) is still ms."""
+    f = tmp_path / "ram.json"
+    assert run(sim, capsys, "config", "save", "1", str(f))[0] == 0
+    doc = json.loads(f.read_text())
+    assert doc["ram_items"]["oscillation_ms"] == "300 ms" and doc["ram_items"]["watchdog_action"] == "1"
+    doc["ram_items"].update(watchdog_ms="0.5 s", oscillation_ms="250 ms")
+    f.write_text(json.dumps(doc))
+    rc, out, err = run(sim, capsys, "config", "load", "1", str(f))
+    assert rc == 0, out + err
+    assert run(sim, capsys, "config", "get", "1", "watchdog_ms")[1].startswith("watchdog_ms = 500")
+    doc["ram_items"].update(watchdog_ms="0", oscillation_ms="300")
+    f.write_text(json.dumps(doc))
+    assert run(sim, capsys, "config", "load", "1", str(f))[0] == 0
+    assert run(sim, capsys, "config", "get", "1", "oscillation_ms")[1].startswith("oscillation_ms = 300")
