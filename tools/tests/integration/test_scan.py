@@ -211,3 +211,15 @@ def test_a_closed_pipe_does_not_cut_bringup_short(tmp_path, monkeypatch):
         assert rc == 3
         with sim.bus() as bus:
             assert Servo(bus, 1).read("serial") == 0x51A00000
+
+
+def test_an_absent_servo_is_not_taken_for_the_one_at_its_new_id(tmp_path):
+    """Servo 7 is absent and servo 2 answers: writing 7's ID (alone or in
+    the user area's block) is unanswered, not read back as taken at 2."""
+    with Simulator(ids=[1, 2], state_dir=str(tmp_path / "state")) as sim, sim.bus() as bus:
+        block = Servo(bus, 1).read_all()
+        for write in (lambda: Servo(bus, 7).write("servo_id", 2),
+                      lambda: Servo(bus, 7).write_all(dict(block, servo_id=2))):
+            with pytest.raises(p.NoReply):
+                write()
+        assert Servo(bus, 1).read("servo_id") == 1 and Servo(bus, 2).read("serial") == 0x51A00002
