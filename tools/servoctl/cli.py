@@ -7,7 +7,7 @@ import os
 import sys
 
 from . import args as args_
-from . import link_rate, scan
+from . import console, link_rate, scan
 from .args import build_parser
 from .cmd_bus import cmd_bench, cmd_id, cmd_ping, cmd_scan
 from .cmd_config import cmd_config, cmd_store
@@ -60,7 +60,8 @@ def main(argv=None, clock=None) -> int:
     passes its own (servoctl.sim.Simulator.clock_s)."""
     args = build_parser().parse_args(argv)
     try:
-        code = _run(args, clock)
+        with console.pipe_guard(args):  # a command that changes servos finishes
+            code = _run(args, clock)
         sys.stdout.flush()  # a reader that stopped reading is met here, not at exit
         return code
     except ServoError as e:
@@ -73,8 +74,7 @@ def main(argv=None, clock=None) -> int:
         print("servoctl: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
     except BrokenPipeError:
-        # `servoctl info 2 | head -3`: the reader has what it wanted. What
-        # is left to print goes nowhere, quietly, as with any Unix filter.
+        # `servoctl info 2 | head -3`: the reader has what it wanted, quietly.
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
 
@@ -102,7 +102,7 @@ def _run(args, clock=None) -> int:
                 why = scan.in_bootloader(bus, servo_id)
                 if why:
                     raise NoReply(why) from None
-            raise
+            raise NoReply(f"{sys.exc_info()[1]}{link_rate.no_reply_hint(bus, args.port, args.sim_control, baud)}") from None
 
 
 if __name__ == "__main__":

@@ -4,7 +4,7 @@ import json
 import sys
 
 from . import args as args_
-from . import ids, registers, scan
+from . import ids, link_rate, registers, scan
 from .errors import EXIT_INTERRUPTED, NoReply, Refused
 from .servo import Servo
 
@@ -58,7 +58,7 @@ def cmd_ping(bus, args):
     if Servo(bus, args.id).ping():
         print(f"servo {args.id}: answered")
         return 0
-    print(f"servo {args.id}: no reply")
+    print(f"servo {args.id}: no reply" + link_rate.no_reply_hint(bus, args.port, args.sim_control, bus.serial.baudrate))
     return NoReply.exit_code
 
 

@@ -92,12 +92,14 @@ def cmd_config(bus, args):
         print(config_file.save(args.file, s))
     elif args.action == "load":
         entry = config_file.parse_config(config_file.read(args.file), args.file, args.raw)
+        serial, baud = s.read("serial"), s.read("baud")  # before: the load may move the servo
         kept = group.write_user_area(s, entry.values, args.with_link)  # validated before sending
-        notes = [f"kept {', '.join(f'{k} {s.read(k)}' for k in kept)}; --with-link to change"] if kept else []
+        notes = link_rate.after_load(bus, args, s.id, baud, entry.values.get("baud", baud))
+        notes += [f"kept {', '.join(f'{k} {s.read(k)}' for k in kept)}; --with-link to change"] if kept else []
         notes += [f"{n} in RAM: lost at power-up"] if (n := sum(i.name in entry.values for i in registers.RAM)) else []
         if entry.raw:
             notes.append("a raw file: protocol units")
-        if entry.serial is not None and entry.serial != s.read("serial"):
+        if entry.serial is not None and entry.serial != serial:
             notes.append(f"the file is servo serial 0x{entry.serial:08x}'s")
         note = f" ({'; '.join(notes)})" if notes else ""
         print(f"loaded {len(entry.values)} item(s) from {args.file} into servo {args.id}{note}")

@@ -18,7 +18,7 @@ derating, stream period, jerk limit, oscillation monitor): a dump lists
 them so it shows every item a user can set, and config load writes them
 back, but the servo keeps them only until it is powered down."""
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from . import registers, units
 from .errors import NoReply, ServoError
@@ -27,6 +27,7 @@ from .protocol import UsageError, ValueOutOfRange
 CONFIG_FORMAT = 2
 BACKUP_FORMAT = 2
 _NAMES = {i.name for i in registers.STORED + registers.RAM}
+_RAM = {i.name for i in registers.RAM}
 RAM_NOTE = "in RAM: lost at power-up (factory values then); config load sets them again"
 
 
@@ -92,7 +93,7 @@ def save(path: str, s) -> str:
 def entry_json(values: dict, servo: dict) -> dict:
     out = {"servo": servo,
            "items": {i.name: units.exact(i, values[i.name]) for i in registers.STORED if i.name in values}}
-    ram = {i.name: units.exact(i, values[i.name]) for i in registers.RAM if i.name in values}
+    ram = {i.name: units.exact(_in_file(i), values[i.name]) for i in registers.RAM if i.name in values}
     return dict(out, ram_items=ram, ram_items_note=RAM_NOTE) if ram else out
 
 
@@ -105,6 +106,13 @@ def backup_json(entries: list) -> dict:
     return {"servoctl_backup": BACKUP_FORMAT, "servos": [entry_json(v, s) for v, s in entries]}
 
 
+def _in_file(item):
+    """item as files write it: a RAM item in ms ("500 ms") a time, as the
+    user area's are (the command line takes it as a plain number)."""
+    ram_ms = item.unit == "ms" and not item.quantity and item.name in _RAM
+    return replace(item, quantity="time") if ram_ms else item
+
+
 def _items(path: str, items, raw: bool) -> dict:
     if not isinstance(items, dict):
         raise UsageError(f"{path}: expected {{name: value}} items")
@@ -113,7 +121,9 @@ def _items(path: str, items, raw: bool) -> dict:
         raise UsageError(f"{path}: unknown item(s) {', '.join(unknown)}")
     values = {}
     for name, value in items.items():
-        item = registers.find(name)
+        item = _in_file(registers.find(name))
+        if not raw and item.quantity == "time" and name in _RAM and str(value).strip().isdigit():
+            value = f"{value} ms"  # written before RAM items carried units: ms
         if raw:
             if not isinstance(value, int) or isinstance(value, bool):
                 raise UsageError(f"{path}: {name} must be a whole number in protocol units, not {value!r}")

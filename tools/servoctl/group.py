@@ -140,13 +140,15 @@ def write_user_area(s: Servo, values: dict, with_link: bool = False) -> list:
     (64-72) the values hold. The ID and baud
     rate stay unless with_link: another servo's file must
     not put two servos on one ID; with it, an ID already answering is
-    refused. Returns the items kept that differed."""
+    refused, and the ID and baud rate are written last (s then has the new
+    ID; the caller sets the bus's rate). Returns the items kept that
+    differed."""
     current = s.read_all()
-    if with_link and "servo_id" in values:
-        id_is_free(s.bus, s.id, values["servo_id"])
-    keep = [] if with_link else ["servo_id", "baud"]
+    link = {k: values[k] for k in ("servo_id", "baud") if k in values and values[k] != current[k]}
+    if with_link and "servo_id" in link:
+        id_is_free(s.bus, s.id, link["servo_id"])
     user = {i.name for i in registers.USER}
-    s.write_all(dict(current, **{k: v for k, v in values.items() if k not in keep and k in user}))
+    s.write_all(dict(current, **{k: v for k, v in values.items() if k not in link and k in user}))
     drive = [item for item in registers.DRIVE if item.name in values]
     now = s.read_stored() if drive else {}
     changed = {i.name: values[i.name] for i in drive if i.name in now and now[i.name] != values[i.name]}
@@ -159,7 +161,12 @@ def write_user_area(s: Servo, values: dict, with_link: bool = False) -> list:
     for item in registers.RAM:  # lost at power-up (config_file.RAM_NOTE)
         if item.name in values:
             s.write(item.name, values[item.name])
-    return [k for k in keep if k in values and values[k] != current[k]]
+    if not with_link:
+        return list(link)
+    if link:  # last: from here on the servo answers at its new ID and rate only
+        s.write_all(dict(s.read_all(), **link))
+        s.id = link.get("servo_id", s.id)
+    return []
 
 
 def restore(bus: p.Bus, path: str, with_link: bool = False) -> list:

@@ -8,7 +8,7 @@ SERVOCTL_SIM_CONTROL), servoctl sets it there for --baud and after a
 be ignored) and a baud change says what to do, instead of losing the bus
 with no word."""
 from . import registers
-from .errors import UsageError
+from .errors import ServoError, UsageError
 
 DEFAULT_BAUD = 115200
 
@@ -50,6 +50,14 @@ def after_set(bus, args, name: str, value: int) -> None:
         print(after_change(bus, args.id, rate, args.sim_control))
 
 
+def after_load(bus, args, servo_id: int, before: int, now: int) -> list:
+    """After `config load --with-link`: a baud change as after_set; the
+    notes the load reports (the servo's new ID)."""
+    if now != before:
+        print(after_change(bus, servo_id, registers.BAUD_RATES[now], args.sim_control))
+    return [f"now ID {servo_id}"] if servo_id != args.id else []
+
+
 def after_change(bus, servo_id: int, rate: int, sim_control) -> str:
     """What to do now that a servo speaks `rate`, or what was done (the
     simulator's host rate set on its control port)."""
@@ -63,3 +71,24 @@ def after_change(bus, servo_id: int, rate: int, sim_control) -> str:
     return (f"servo {servo_id} now speaks {rate} baud, and socket:// carries no baud rate: on a "
             f"simulator, send 'hostbaud {rate}' to its control port (or give --sim-control PORT "
             f"and servoctl does it) to reach it again")
+
+
+def no_reply_hint(bus, port, sim_control, rate: int) -> str:
+    """What a NoReply on socket:// where no answer at all came adds: the
+    simulator's host rate, read on its control port where given, else that
+    it may have been changed (a --sim-control --baud earlier outlives that
+    servoctl)."""
+    if not is_socket(port) or getattr(bus, "heard", False):
+        return ""
+    if sim_control:
+        try:
+            words = dict(w.split("=", 1) for w in _control(sim_control, "state").split() if "=" in w)
+        except ServoError:  # a hint only: the NoReply is the error
+            words = {}
+        host = words.get("host_baud")
+        if host and host.isdigit() and int(host) != rate:
+            return (f"; the simulator's host rate is {host} baud, not {rate}: give --baud {host} "
+                    f"--sim-control {sim_control}")
+        return ""
+    return ("; if the simulator's host rate was changed (hostbaud, or an earlier --sim-control with "
+            "--baud), give --baud and --sim-control to set it")

@@ -1,99 +1,19 @@
-"""Frames of the servo protocol (docs/protocol.md, from protocol/servo_schema)
-and a bus that sends requests and waits for the matching response."""
+"""The bus: sends requests and waits for the matching response, on a serial
+port or a simulator's socket. The frames themselves are codec.py's, named
+here too (p.request_frame, p.PING and the like)."""
 import struct
 import time
 
-import servo_schema as _schema
-
+from . import codec as _codec
+from .codec import (ANSWER_FRAME_MAX, BROADCAST, BUS_IN_USE, CODES, MAX_ID, REPEATABLE,  # noqa: F401
+                    REQUEST_HEADER, RESPONSE_HEADER, _frame_size, answer_frame_size, checksum,
+                    decode_answer, encode_request, field_range, request_format, request_frame,
+                    response_frame)
 # The errors are errors.py's; named here too, as p.NoReply and the like.
 from .errors import (BadAnswer, BadChecksum, LinkError, NoReply, Refused,  # noqa: F401
                      ServoError, UsageError, ValueOutOfRange)
 
-_SCHEMA = _schema.load()
-REQUEST_HEADER = bytes(_SCHEMA.frame["request_header"])
-RESPONSE_HEADER = bytes(_SCHEMA.frame["response_header"])
-BROADCAST = _SCHEMA.frame["broadcast_id"]
-MAX_ID = _SCHEMA.frame["max_id"]  # servo IDs are 0..254; 0xFF is broadcast
-# The longest answer frame: header, code, length, content, checksum.
-ANSWER_FRAME_MAX = len(RESPONSE_HEADER) + 3 + _SCHEMA.frame["answer_content_max"]
-# Every packet's code by servoctl's name for it, as module constants:
-# protocol.PING, protocol.WRITE_DATA, protocol.UPDATE_STATUS, ...
-CODES = {pkt.py: pkt.code for pkt in _SCHEMA.packets}
-globals().update(CODES)
-
-
-# Requests that only read: one that gets no answer is sent once more
-# (Bus.request). A request that lands in a servo's page erase is carried out
-# but not answered (docs/decisions-hardware.md, "Flash and the real-time
-# budget"); a read asked again changes nothing. Writes are confirmed by a
-# read instead (Servo._write_kept).
-REPEATABLE = frozenset(CODES[name] for name in (
-    "PING", "READ_DATA", "READ_BATCH", "READ_ANGLE", "READ_MULTI_TURN", "MONITOR",
-    "READ_MOTION", "READ_STORE", "READ_FAULTS"))
-
-
-# What servo_sim and the virtual boards tell a second TCP client while
-# another holds the bus (one program on a port at a time, as on a serial one).
-BUS_IN_USE = b"the bus is in use by another client"
-
-
-def checksum(data: bytes) -> int:
-    return sum(data) % 256
-
-
-def decode_answer(code: int, content: bytes) -> tuple:
-    """An answer's fields, as protocol/servo_schema lays them out, once its
-    length is the packet's: any other length is an error that says so,
-    never a traceback."""
-    fmt = _SCHEMA.answer_format(code)
-    if len(content) != struct.calcsize(fmt):
-        who = content[0] if content else "?"
-        raise BadAnswer(f"servo {who}: a {_SCHEMA.packet(code).name} answer of {len(content)} bytes, "
-                        f"not {struct.calcsize(fmt)} (garbled, another firmware, or two servos on one ID)")
-    return struct.unpack(fmt, content)
-
-
-def answer_frame_size(code: int) -> int:
-    """The bytes of a packet's answer frame on the wire (its fields fixed)."""
-    return len(RESPONSE_HEADER) + 3 + struct.calcsize(_SCHEMA.answer_format(code))
-
-
-def field_range(code: int, name: str) -> tuple:
-    """(least, most) of a request's field: the range the servo clamps or
-    refuses beyond (protocol/servo_schema), else its type's."""
-    return _SCHEMA.field(code, name).range
-
-
-def request_format(code: int) -> str:
-    """The struct format of a request's content (protocol/servo_schema)."""
-    return _SCHEMA.request_format(code)
-
-
-def encode_request(code: int, *values) -> bytes:
-    """A request's content from its fields' values, as protocol/servo_schema
-    lays them out."""
-    return struct.pack(_SCHEMA.request_format(code), *values)
-
-
-def request_frame(code: int, content: bytes) -> bytes:
-    """A request frame; content of 255 bytes or more uses the extended length."""
-    if len(content) >= 255:
-        head = REQUEST_HEADER + bytes([code, 0xFF]) + struct.pack("<H", len(content))
-    else:
-        head = REQUEST_HEADER + bytes([code, len(content)])
-    body = head + content
-    return body + bytes([checksum(body)])
-
-
-def _frame_size(head: bytes) -> int:
-    """A response frame's bytes from its first four: header, code, the
-    content's length, the content, the checksum."""
-    return 4 + head[3] + 1
-
-
-def response_frame(code: int, content: bytes) -> bytes:
-    body = RESPONSE_HEADER + bytes([code, len(content)]) + content
-    return body + bytes([checksum(body)])
+globals().update(_codec.CODES)  # protocol.PING, protocol.WRITE_DATA, ...
 
 
 try:  # a pty whose other end is gone fails in termios, which is not an OSError
@@ -159,6 +79,7 @@ class Bus:
         self._low_water = 1  # the socket's SO_RCVLOWAT (_wake_at)
         self._buffer = b""
         self.stray_bytes = 0  # bytes outside any frame: noise, or answers that collided
+        self.heard = False  # a whole frame came: the host and the line agree on the rate
         self.sent_again = 0  # requests sent a second time, their first unanswered (request)
         self.stamp_arrivals = True
         # The bus clock when the last response returned was taken off the
@@ -284,10 +205,11 @@ class Bus:
                     raise OSError(f"nothing was taken for {WRITE_STALL_S:g} s") from None
                 select.select([], [self._sock], [], 0.1)
 
-    def read_response(self, code: int, servo_id, timeout=None, deadline=None):
+    def read_response(self, code: int, servo_id, timeout=None, deadline=None, item=None):
         """Content of the next response with this packet number from this
-        servo (any servo if servo_id is None); other frames on the wire are
-        skipped. It must come within timeout (the bus's if None), or by
+        servo (any servo if servo_id is None), about item where given (a
+        ReadData's: a late answer to an earlier read of another item is
+        not this one's); other frames on the wire are skipped. It must come within timeout (the bus's if None), or by
         deadline on the bus clock. The bus clock is read as little as it
         can be (a virtual board's is a request to it): at the start, when
         the line is idle, every 2 ms of a stream of other bytes, and to
@@ -297,6 +219,7 @@ class Bus:
             deadline = self.clock() + wait
         if self.run_ahead is not None:
             self._look(deadline)
+        want = b"" if servo_id is None else bytes([servo_id] + ([] if item is None else [item]))
         bad = None
         last_look = False
         got = True  # the deadline was just read
@@ -307,7 +230,7 @@ class Bus:
                 fcode, content, ok = frame
                 if not ok:
                     bad = fcode
-                elif fcode == code and (servo_id is None or content[:1] == bytes([servo_id])):
+                elif fcode == code and content[:len(want)] == want[:max(1, len(content))]:  # short: told
                     self.arrived_at = self.clock() if self.stamp_arrivals else None
                     self._look(0.0)  # the answer came: the simulator waits for the host's next bytes
                     return content
@@ -350,7 +273,7 @@ class Bus:
                 # A frame begun in the window is read whole, not counted as
                 # garbage: the longest answer's time more, and 5 ms.
                 finishing, last_look = True, False
-                deadline = self.clock() + ANSWER_FRAME_MAX * 10 / self.serial.baudrate + 0.005
+                deadline = self.clock() + self._longest_answer_s()
             self._fill(wait=not last_look)
 
     def _look(self, deadline: float) -> float:
@@ -382,6 +305,7 @@ class Bus:
             return None
         self._buffer = buf[end:]
         frame = buf[:end]
+        self.heard |= checksum(frame[:-1]) == frame[-1]
         return frame[2], frame[4:-1], checksum(frame[:-1]) == frame[-1]
 
     def request(self, code: int, content: bytes, timeout=None, again=None) -> bytes:
@@ -389,12 +313,26 @@ class Bus:
         answer's content. Unanswered, it is sent once more if again (by
         default, if it only reads: REPEATABLE): it may have landed in a page
         erase, carried out but not answered."""
+        item = {"item": content[1]} if code == READ_DATA else {}
         self.send(code, content)
         try:
-            return self.read_response(code, content[0], timeout)
+            return self.read_response(code, content[0], timeout, **item)
         except NoReply:
             if not (code in REPEATABLE if again is None else again):
                 raise
         self.sent_again += 1
+        self.drain()
         self.send(code, content)
-        return self.read_response(code, content[0], timeout)
+        return self.read_response(code, content[0], timeout, **item)
+
+    def _longest_answer_s(self) -> float:
+        return ANSWER_FRAME_MAX * 10 / self.serial.baudrate + 0.005
+
+    def drain(self) -> None:
+        """Waits out an answer still on its way (the longest's time on the
+        wire and 5 ms, on the bus clock) and drops it: after a NoReply, a
+        late answer is not taken for the next request's."""
+        deadline = self.clock() + self._longest_answer_s()
+        while self.clock() <= deadline:
+            self._fill(wait=True)
+        self._buffer = b""

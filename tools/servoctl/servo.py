@@ -67,13 +67,18 @@ class Servo:
     def _write(self, item, value: int) -> None:
         if item.name == "baud":  # read back only at the new rate: not sent again
             took = None
-        elif item.name == "servo_id":  # read back at the new ID
-            took = lambda: _answers(lambda: Servo(self.bus, value).read(item.id) == value)  # noqa: E731
+        elif item.name == "servo_id":  # read back at the new ID: by this servo's serial number
+            took = self._is_at(value, self.read("serial"))
         else:
             took = lambda: self.read(item.id) == value  # noqa: E731
         if not self._write_kept(p.WRITE_DATA, bytes([self.id, item.id]) + item.pack(value), took):
             raise Refused(f"servo {self.id} refused {item.name} = {value}"
                           f"{self._size_first(item, value) or self._why_refused()}")
+
+    def _is_at(self, new_id: int, serial: int):
+        """A read-back: whether this servo (its serial number, read before
+        the write) answers at new_id; not another servo that held new_id."""
+        return lambda: _answers(lambda: Servo(self.bus, new_id).read("serial") == serial)
 
     def _write_kept(self, code: int, content: bytes, took) -> bool:
         """Sends a write (content, its result the answer's last field) and
@@ -131,8 +136,10 @@ class Servo:
         now = registers.decode_user_area(block)
         settable = [item.name for item in registers.USER if item.writable]
 
+        at_new_id = self._is_at(now["servo_id"], self.read("serial"))
+
         def took():  # read back where the servo answers after it: at its new ID
-            back = _answers(lambda: Servo(self.bus, now["servo_id"]).read_all())
+            back = at_new_id() and _answers(lambda: Servo(self.bus, now["servo_id"]).read_all())
             return bool(back) and all(back[name] == now[name] for name in settable)
         if not self._write_kept(p.WRITE_BATCH, bytes([self.id]) + block, took):
             raise Refused(f"servo {self.id} refused the user area block{self._why_refused()}")

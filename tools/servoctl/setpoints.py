@@ -13,6 +13,7 @@ was (docs/streaming.md). A file is checked whole before anything moves.
 A stream feeds each servo's bus watchdog (item 64) once a period: a period
 longer than half its watchdog_ms is refused before anything is sent (the
 servo would take its watchdog_action between setpoints)."""
+import math
 import struct
 from dataclasses import dataclass
 
@@ -215,12 +216,13 @@ class RobotLoop:
         now = self.bus.clock()
         if self.due is None:
             self.started = self.due = now
-        elif now < self.due:
+        elif now > self.due:  # on the period's grid: the next slot, never two cycles back to back
+            if now - self.due >= self.period_s:
+                self.late += 1
+                warn_late(self.cycles + 1, now - self.due, self.period_s, self.rate(), self.bus.serial.baudrate)
+            self.due += math.ceil((now - self.due) / self.period_s - 1e-9) * self.period_s
+        if now < self.due:
             self.bus.sleep(self.due - now)
-        elif now - self.due >= self.period_s:
-            self.late += 1
-            warn_late(self.cycles + 1, now - self.due, self.period_s, self.rate(), self.bus.serial.baudrate)
-            self.due = now  # on from here: no burst to catch up
         self.due += self.period_s
 
     def cycle(self, targets: dict, velocities: dict = None) -> dict:

@@ -91,3 +91,18 @@ def test_an_unpaced_loop_runs_as_fast_as_the_bus_goes():
     for _ in range(3):
         robot.cycle({i: 0.0 for i in SIX})
     assert robot.late == 0 and len(bus.sends) == 3
+
+
+def test_a_stall_shorter_than_a_period_keeps_the_period_grid():
+    """The host away for most of a period: the next cycle waits for its
+    slot on the period's grid, not two cycles back to back."""
+    bus = ClockBus(1000000)
+    robot = loop(bus, SIX, 0.02)
+    robot.cycle({i: 0.0 for i in SIX})  # at 0, 2 ms on the wire
+    bus.now += 0.0195  # cycle 2 was due at 20 ms: now 21.5 ms
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # less than a period behind: no warning
+        for _ in range(3):
+            robot.cycle({i: 0.0 for i in SIX})
+    assert bus.sends == pytest.approx([0.0, 0.04, 0.06, 0.08])
+    assert robot.late == 0

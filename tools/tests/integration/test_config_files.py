@@ -109,3 +109,44 @@ def test_a_tuned_servos_drive_area_goes_with_its_file(sim, capsys, tmp_path):
     assert run(sim, capsys, "config", "get", "1", "gain_kp")[1].startswith("gain_kp = 700 ")
     rc, out, _ = run(sim, capsys, "config", "diff", "1", "factory")
     assert rc == 1 and "gear_ratio" in out and "gain_kp" in out, out
+
+
+def test_with_link_writes_everything_then_moves_the_servo(sim, capsys, tmp_path):
+    """--with-link: a file with another ID and rate loads whole (RAM and
+    drive items too), the ID and rate written last, the host following."""
+    f = tmp_path / "c.json"
+    assert run(sim, capsys, "config", "save", "1", str(f))[0] == 0
+    doc = json.loads(f.read_text())
+    doc["items"].update(servo_id="5", baud="1000000 baud", gain_kp="500", power_limit="9000 mW")
+    doc["ram_items"]["oscillation_ms"] = "250"
+    f.write_text(json.dumps(doc))
+    control = str(sim.control_port)
+    rc, out, err = run(sim, capsys, "--sim-control", control, "config", "load", "1", str(f), "--with-link")
+    assert rc == 0 and "(now ID 5;" in out and "host rate is set to 1000000 too" in out, out + err
+    for name, shown in (("gain_kp", "500"), ("power_limit", "9000 mW"), ("oscillation_ms", "250")):
+        rc, out, err = run(sim, capsys, "--baud", "1000000", "--sim-control", control, "config", "get", "5", name)
+        assert rc == 0 and out.startswith(f"{name} = {shown}"), out + err
+    doc["items"].update(servo_id="1", baud="115200 baud")  # back as it was, the same way
+    f.write_text(json.dumps(doc))
+    rc, out, err = run(sim, capsys, "--baud", "1000000", "--sim-control", control, "config", "load", "5", str(f),
+                       "--with-link")
+    assert rc == 0 and "(now ID 1;" in out and sim.state(1)["host_baud"] == 115200, out + err
+
+
+def test_ram_items_carry_their_units_in_files(sim, capsys, tmp_path):
+    """RAM items were written as bare numbers ("watchdog_ms": "0") and
+    "500 ms" was refused: they carry and take units as the user area's do;
+    a bare number (a file written before) is still ms."""
+    f = tmp_path / "ram.json"
+    assert run(sim, capsys, "config", "save", "1", str(f))[0] == 0
+    doc = json.loads(f.read_text())
+    assert doc["ram_items"]["oscillation_ms"] == "300 ms" and doc["ram_items"]["watchdog_action"] == "1"
+    doc["ram_items"].update(watchdog_ms="0.5 s", oscillation_ms="250 ms")
+    f.write_text(json.dumps(doc))
+    rc, out, err = run(sim, capsys, "config", "load", "1", str(f))
+    assert rc == 0, out + err
+    assert run(sim, capsys, "config", "get", "1", "watchdog_ms")[1].startswith("watchdog_ms = 500")
+    doc["ram_items"].update(watchdog_ms="0", oscillation_ms="300")
+    f.write_text(json.dumps(doc))
+    assert run(sim, capsys, "config", "load", "1", str(f))[0] == 0
+    assert run(sim, capsys, "config", "get", "1", "oscillation_ms")[1].startswith("oscillation_ms = 300")

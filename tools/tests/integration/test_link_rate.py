@@ -44,3 +44,17 @@ def test_scan_reports_the_rate_the_servo_speaks(sim, capsys):
     assert rc == 0 and "servo 1 at 1000000 baud, serial 0x51a00001" in out, out + err
     rc, out, _ = run(sim, capsys, "scan", "--last", "2", "--json")
     assert rc == 0 and '"baud": 1000000' in out
+
+
+def test_no_reply_on_a_socket_names_the_simulators_host_rate(sim, capsys):
+    """--sim-control with --baud leaves the simulator's host rate changed
+    after servoctl exits: a later plain command's "no reply" says so."""
+    control = str(sim.control_port)
+    run(sim, capsys, "--baud", "1000000", "--sim-control", control, "ping", "1")  # the servo at 115200
+    rc, out, _ = run(sim, capsys, "ping", "1")
+    assert rc == 3 and "no reply; if the simulator's host rate was changed" in out, out
+    rc, _, err = run(sim, capsys, "info", "1")
+    assert rc == 3 and "if the simulator's host rate was changed" in err, err
+    rc, _, err = run(sim, capsys, "--sim-control", control, "info", "1")
+    assert rc == 3 and "the simulator's host rate is 1000000 baud, not 115200" in err, err
+    sim.control("hostbaud 115200")

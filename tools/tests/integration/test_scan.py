@@ -3,6 +3,7 @@ noticed (their answers arrive twice, or garbled), a servo waiting in its
 bootloader is named as such with the command that recovers it, and a
 socket:// link, which carries no baud rate, is scanned once."""
 import json
+import os
 
 import pytest
 
@@ -172,3 +173,42 @@ def test_state_of_a_full_bus_is_every_line(tmp_path):
         lines = sim.control("state").splitlines()
         assert [int(line.split()[0].split("=")[1]) for line in lines] == list(range(254))
         assert all(line.split()[-1].startswith("serial=") for line in lines)
+
+
+def test_a_closed_pipe_does_not_cut_bringup_short(tmp_path, monkeypatch):
+    """`servoctl id bringup --count 2 | head -1`: the reader goes after the
+    first line; bringup still waits for the second servo and its exit code
+    (3: none came) is its own, not the closed pipe's 0."""
+    read_end, write_end = os.pipe()
+    os.close(read_end)
+
+    class ClosedPipe:
+        def write(self, text):
+            raise BrokenPipeError("the reader closed the pipe")
+
+        def flush(self):
+            pass
+
+        def fileno(self):
+            return write_end
+
+    with Simulator(ids=[0], state_dir=str(tmp_path / "state")) as sim:
+        monkeypatch.setattr(sys, "stdout", ClosedPipe())
+        rc = main(["--port", sim.url, "id", "bringup", "--count", "2", "--wait-s", "1"], clock=sim.clock_s)
+        monkeypatch.undo()
+        os.close(write_end)
+        assert rc == 3
+        with sim.bus() as bus:
+            assert Servo(bus, 1).read("serial") == 0x51A00000
+
+
+def test_an_absent_servo_is_not_taken_for_the_one_at_its_new_id(tmp_path):
+    """Servo 7 is absent and servo 2 answers: writing 7's ID (alone or in
+    the user area's block) is unanswered, not read back as taken at 2."""
+    with Simulator(ids=[1, 2], state_dir=str(tmp_path / "state")) as sim, sim.bus() as bus:
+        block = Servo(bus, 1).read_all()
+        for write in (lambda: Servo(bus, 7).write("servo_id", 2),
+                      lambda: Servo(bus, 7).write_all(dict(block, servo_id=2))):
+            with pytest.raises(p.NoReply):
+                write()
+        assert Servo(bus, 1).read("servo_id") == 1 and Servo(bus, 2).read("serial") == 0x51A00002
