@@ -4,6 +4,7 @@ bootloader is named as such with the command that recovers it, and a
 socket:// link, which carries no baud rate, is scanned once."""
 import json
 import os
+import sys
 
 import pytest
 
