@@ -36,6 +36,13 @@ def relative_errors(drive, truth: dict) -> dict:
     return {k: found[k].value / truth[k] - 1.0 for k in truth}
 
 
+# The chirp is paced by the host (a DriveDuty after each ReadMotion): behind
+# the default USB adapter each exchange waits for a 1 ms USB frame, and the
+# chirp's angle error on micro_9g reads 0.54 deg against the 0.5 asked
+# (docs/bring-up.md, "identify"). The fits are judged on the raw link.
+HOST_LINK = "raw"
+
+
 def start(tmp_path, file, backlash_deg: float = 0.0):
     """servo_sim on a shipped plant; with backlash_deg, a copy of it whose
     gears have that play."""
@@ -43,7 +50,7 @@ def start(tmp_path, file, backlash_deg: float = 0.0):
     if backlash_deg:
         path = tmp_path / file
         path.write_text((PLANTS / file).read_text() + f"backlash_deg = {backlash_deg}  # the test's\n")
-    sim = Simulator(state_dir=str(tmp_path / "state"), plant=str(path)).start()
+    sim = Simulator(state_dir=str(tmp_path / "state"), plant=str(path), host_link=HOST_LINK).start()
     with sim.bus(timeout=0.2) as bus:
         s = Servo(bus, 1)
         s.write("high_voltage", 12600)  # the 12 V servo's supply

@@ -20,7 +20,7 @@ from servoctl.tune import check_step, tune
 
 from ..launchers import PLANTS
 from .conftest import finish
-from .test_identify import at_the_output, relative_errors
+from .test_identify import HOST_LINK, at_the_output, relative_errors
 
 PLANT_FILES = ["reference_st3215.toml", "micro_9g.toml", "class_60kgcm.toml"]
 OVERSHOOT_MOST = 10   # decidegrees: 1 degree
@@ -33,7 +33,9 @@ BUILT = ("magnet -40", "swapleads 1", "ampzero 18")  # how these servos came (co
 
 
 def start(tmp_path, file, built=()):
-    sim = Simulator(fast=True, state_dir=str(tmp_path / "state"), plant=str(PLANTS / file)).start()
+    # Real time on the raw link: identify's chirp is paced by the host
+    # (test_identify.py, HOST_LINK).
+    sim = Simulator(state_dir=str(tmp_path / "state"), plant=str(PLANTS / file), host_link=HOST_LINK).start()
     for line in built:
         assert sim.control(line).strip() == "ok", line
     with sim.bus(timeout=0.2) as bus:
