@@ -17,17 +17,33 @@ def is_socket(port) -> bool:
     return bool(port) and port.startswith("socket://")
 
 
-def _control(address: str, line: str) -> str:
-    from .sim import control_command
-
+def _control_port(address: str) -> int:
     host, _, port = address.rpartition(":")
     if host not in ("", "127.0.0.1", "localhost"):
         raise UsageError(f"--sim-control is a simulator's control port on this PC (PORT or "
                          f"127.0.0.1:PORT), not {address}")
     try:
-        return control_command(int(port), line)
+        return int(port)
     except ValueError:
         raise UsageError(f"--sim-control takes a port number, not {address!r}") from None
+
+
+def _control(address: str, line: str) -> str:
+    from .sim import control_command
+
+    return control_command(_control_port(address), line)
+
+
+def simulator(sim_control):
+    """The simulator whose control port is given (servoctl.sim.Simulator,
+    for its clock_s), or None: with it, servoctl's bus waits on the
+    simulated clock, so a simulator that runs behind the wall clock on a
+    busy PC is not taken for a servo that does not answer."""
+    if not sim_control:
+        return None
+    from .sim import Simulator
+
+    return Simulator.running(_control_port(sim_control))
 
 
 def open_rate(port, baud, sim_control) -> int:

@@ -1,0 +1,61 @@
+"""servoctl given a simulator's control port (--sim-control) waits on the
+simulator's clock: a simulator that falls behind the wall clock (a busy PC;
+here one stopped for a while, SIGSTOP) is not taken for a servo that does
+not answer. Without the control port servoctl waits on the host's clock,
+and the same lag is a NoReply."""
+import os
+import signal
+import threading
+
+from servoctl.cli import main
+from servoctl.sim import Simulator
+
+
+def _lagging(sim, host_s: float) -> threading.Timer:
+    """The simulator stopped now, for host_s of host time: its clock stands
+    still while a request is outstanding, as on a PC too busy to run it."""
+    os.kill(sim.process.pid, signal.SIGSTOP)
+    resume = threading.Timer(host_s, os.kill, (sim.process.pid, signal.SIGCONT))
+    resume.start()
+    return resume
+
+
+def _ping_behind(sim, capsys, *options):
+    resume = _lagging(sim, 0.3)
+    try:
+        rc = main(["--port", sim.url, *options, "ping", "1"])
+    finally:
+        resume.join()
+    out = capsys.readouterr()
+    return rc, out.out + out.err
+
+
+def test_a_lagging_simulator_answers_within_its_own_clocks_timeout(tmp_path, capsys):
+    with Simulator(ids=[1], state_dir=str(tmp_path / "state")) as sim:
+        rc, out = _ping_behind(sim, capsys)
+        assert rc == 3 and "servo 1: no reply" in out, out  # the host's 100 ms passed
+        rc, out = _ping_behind(sim, capsys, "--sim-control", str(sim.control_port))
+        assert rc == 0 and "servo 1: answered" in out, out
+        assert sim.state(1)["collisions"] == 0
+
+
+def test_sim_prints_both_exports():
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    tools = Path(__file__).resolve().parents[2]
+    proc = subprocess.Popen([sys.executable, "-m", "servoctl.cli", "sim", "--tcp", "0"], cwd=tools,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        first, export = proc.stdout.readline(), proc.stdout.readline()
+    finally:
+        proc.terminate()
+        proc.communicate(timeout=15)
+    url, control = first.split()[3].rstrip(","), first.split()[5].rsplit(":", 1)[1]
+    assert export.split() == ["export", f"SERVOCTL_PORT={url}", f"SERVOCTL_SIM_CONTROL={control}"], export
+
+
+def test_sim_refuses_tcp_with_link_as_a_usage_error(tmp_path, capsys):
+    assert main(["sim", "--tcp", "0", "--link", str(tmp_path / "servo")]) == 2
+    assert "not with --tcp" in capsys.readouterr().err
