@@ -7,6 +7,8 @@ SERVOCTL_SIM_CONTROL), servoctl sets it there for --baud and after a
 `config set N baud`. Without it, --baud on socket:// is refused (it would
 be ignored) and a baud change says what to do, instead of losing the bus
 with no word."""
+import contextlib
+
 from . import registers
 from .errors import ServoError, UsageError
 
@@ -57,6 +59,24 @@ def open_rate(port, baud, sim_control) -> int:
                          f"--sim-control PORT and servoctl does it")
     _control(sim_control, f"hostbaud {baud}")
     return baud
+
+
+def set_rate(bus, sim_control, rate: int) -> None:
+    """The host's rate on the bus: the port's, and on socket:// with the
+    control port given the simulator's host rate (hostbaud) too."""
+    if is_socket(bus.port) and sim_control and rate != bus.serial.baudrate:
+        _control(sim_control, f"hostbaud {rate}")
+    bus.serial.baudrate = rate
+
+
+@contextlib.contextmanager
+def restored(bus, sim_control):
+    """The host's rate as it was once the block ends (scan --all-bauds)."""
+    rate = bus.serial.baudrate
+    try:
+        yield
+    finally:
+        set_rate(bus, sim_control, rate)
 
 
 def after_set(bus, args, name: str, value: int) -> None:

@@ -59,3 +59,16 @@ def test_sim_prints_both_exports():
 def test_sim_refuses_tcp_with_link_as_a_usage_error(tmp_path, capsys):
     assert main(["sim", "--tcp", "0", "--link", str(tmp_path / "servo")]) == 2
     assert "not with --tcp" in capsys.readouterr().err
+
+
+def test_all_bauds_over_a_socket_sweeps_the_simulators_host_rate(tmp_path, capsys):
+    """Given the control port, scan --all-bauds sets each rate there
+    (hostbaud) and finds a servo at 1 Mbaud; the host rate is put back."""
+    with Simulator(ids=[1], state_dir=str(tmp_path / "state"), fast=True) as sim:
+        assert main(["--port", sim.url, "config", "set", "1", "baud", "1000000"], clock=sim.clock_s) == 0
+        capsys.readouterr()
+        assert main(["--port", sim.url, "--sim-control", str(sim.control_port), "scan", "--all-bauds",
+                     "--last", "2"], clock=sim.clock_s) == 0
+        out = capsys.readouterr()
+        assert "servo 1 at 1000000 baud" in out.out, out.out + out.err
+        assert sim.state(1)["host_baud"] == 115200  # as it was
