@@ -56,9 +56,14 @@ def cmd_ping(bus, args):
         answered = Servo(bus, args.id).ping()
         print(json.dumps({"id": args.id, "answered": answered}))
         return 0 if answered else 3
+    garbled = bus.stray_bytes + bus.bad_frames
     if Servo(bus, args.id).ping():
         print(f"servo {args.id}: answered")
         return 0
+    if bus.stray_bytes + bus.bad_frames > garbled:  # bytes came, no whole answer
+        print(f"servo {args.id}: garbled answer: two or more servos may share ID {args.id}; "
+              f"see 'servoctl scan'")
+        return Refused.exit_code
     print(f"servo {args.id}: no reply" + link_rate.no_reply_hint(bus, args.port, args.sim_control, bus.serial.baudrate))
     return NoReply.exit_code
 

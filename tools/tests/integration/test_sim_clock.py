@@ -72,3 +72,14 @@ def test_all_bauds_over_a_socket_sweeps_the_simulators_host_rate(tmp_path, capsy
         out = capsys.readouterr()
         assert "servo 1 at 1000000 baud" in out.out, out.out + out.err
         assert sim.state(1)["host_baud"] == 115200  # as it was
+
+
+def test_ping_of_a_shared_id_says_the_answer_was_garbled(tmp_path, capsys):
+    """Three servos at ID 0 answer a Ping at once and garble each other on
+    the wire: not "no reply" (exit 3) but what scan would say, exit 1."""
+    with Simulator(fast=True, ids=[0, 0, 0], state_dir=str(tmp_path / "state")) as sim:
+        rc = main(["--port", sim.url, "ping", "0"], clock=sim.clock_s)
+        out = capsys.readouterr().out
+        assert rc == 1, out
+        assert ("servo 0: garbled answer: two or more servos may share ID 0; see 'servoctl scan'"
+                in out), out
