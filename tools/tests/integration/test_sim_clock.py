@@ -7,6 +7,8 @@ import os
 import signal
 import threading
 
+import pytest
+
 from servoctl.cli import main
 from servoctl.sim import Simulator
 
@@ -30,12 +32,22 @@ def _ping_behind(sim, capsys, *options):
     return rc, out.out + out.err
 
 
-def test_a_lagging_simulator_answers_within_its_own_clocks_timeout(tmp_path, capsys):
-    with Simulator(ids=[1], state_dir=str(tmp_path / "state")) as sim:
+@pytest.mark.parametrize("board", [None, "stm32f030k6"])
+def test_a_lagging_simulator_answers_within_its_own_clocks_timeout(tmp_path, capsys, board):
+    """servo_sim and a virtual board (whose clock is its control port's
+    `clock` only) alike; scan's windows too, on the board."""
+    with Simulator(ids=[1], state_dir=str(tmp_path / "state"), board=board) as sim:
         rc, out = _ping_behind(sim, capsys)
         assert rc == 3 and "servo 1: no reply" in out, out  # the host's 100 ms passed
         rc, out = _ping_behind(sim, capsys, "--sim-control", str(sim.control_port))
         assert rc == 0 and "servo 1: answered" in out, out
+        resume = _lagging(sim, 0.3)
+        try:
+            rc = main(["--port", sim.url, "--sim-control", str(sim.control_port), "scan", "--last", "3"])
+        finally:
+            resume.join()
+        out = capsys.readouterr().out
+        assert rc == 0 and "servo 1 at 115200 baud" in out and "1 servo(s) found" in out, out
         assert sim.state(1)["collisions"] == 0
 
 
