@@ -56,7 +56,8 @@ COMMANDS = {
 
 def main(argv=None, clock=None) -> int:
     """The one boundary where every error becomes a line and an exit code.
-    clock: the bus's clock (protocol.Bus), the host's if None; a simulator
+    clock: the bus's clock (protocol.Bus); if None, the simulator's given
+    --sim-control (link_rate.simulator), else the host's; a simulator
     passes its own (servoctl.sim.Simulator.clock_s)."""
     args = build_parser().parse_args(argv)
     try:
@@ -89,6 +90,15 @@ def _run(args, clock=None) -> int:
     if not args.port:
         raise UsageError("no port: give --port or set SERVOCTL_PORT")
     baud = link_rate.open_rate(args.port, args.baud, args.sim_control)
+    sim = None if clock else link_rate.simulator(args.sim_control)
+    try:
+        return _on_bus(args, baud, clock or (sim and sim.clock_s))
+    finally:
+        if sim is not None:
+            sim.stop()  # its clock's connection
+
+
+def _on_bus(args, baud, clock) -> int:
     with Bus(args.port, baud, args.timeout, clock=clock) as bus:
         try:
             return COMMANDS[args.command](bus, args)

@@ -13,18 +13,19 @@ def cmd_scan(bus, args):
     from .console import progress as Progress  # a closed pipe ends quietly (main)
 
     rates = [bus.serial.baudrate]  # the one asked for first
-    if args.all_bauds and bus.port.startswith("socket://"):
-        print("servoctl: socket:// carries no baud rate (the far end sets it): scanning once",
-              file=sys.stderr)
+    if args.all_bauds and link_rate.is_socket(bus.port) and not args.sim_control:
+        print("servoctl: socket:// carries no baud rate (the far end sets it): scanning once; "
+              "give --sim-control PORT and a simulator's host rate is swept", file=sys.stderr)
     elif args.all_bauds:
         rates += [r for r in sorted(registers.BAUD_RATES.values()) if r != rates[0]]
     found = []
     interrupted = False
-    with Progress(transient=True, disable=not sys.stderr.isatty()) as progress:
+    with Progress(transient=True, disable=not sys.stderr.isatty()) as progress, \
+            link_rate.restored(bus, args.sim_control):
         task = progress.add_task("scanning", total=len(rates) * (args.last - args.first + 1))
         try:
             for rate in rates:
-                bus.serial.baudrate = rate
+                link_rate.set_rate(bus, args.sim_control, rate)
                 window = args.reply_timeout or scan.reply_window_s(rate)
                 scan.wake(bus)  # no servo is missed for a page erase
                 for servo_id in range(args.first, args.last + 1):
@@ -55,9 +56,14 @@ def cmd_ping(bus, args):
         answered = Servo(bus, args.id).ping()
         print(json.dumps({"id": args.id, "answered": answered}))
         return 0 if answered else 3
+    garbled = bus.stray_bytes + bus.bad_frames
     if Servo(bus, args.id).ping():
         print(f"servo {args.id}: answered")
         return 0
+    if bus.stray_bytes + bus.bad_frames > garbled:  # bytes came, no whole answer
+        print(f"servo {args.id}: garbled answer: two or more servos may share ID {args.id}; "
+              f"see 'servoctl scan'")
+        return Refused.exit_code
     print(f"servo {args.id}: no reply" + link_rate.no_reply_hint(bus, args.port, args.sim_control, bus.serial.baudrate))
     return NoReply.exit_code
 

@@ -11,8 +11,11 @@ def cmd_sim(args):
     removes a state folder it made."""
     import signal
 
+    from .errors import UsageError
     from .sim import Simulator
 
+    if args.tcp is not None and args.link:
+        raise UsageError("--link names the simulator's pty: not with --tcp")
     tcp_port = args.tcp if args.tcp else None
     sim = Simulator(ids=args.ids or [1], tcp=args.tcp is not None, link=args.link,
                     state_dir=args.state, tcp_port=tcp_port, plant=args.plant,
@@ -21,6 +24,8 @@ def cmd_sim(args):
     try:
         sim.start()
         print(f"simulator running: bus {sim.url}, control 127.0.0.1:{sim.control_port}", flush=True)
+        # Both: with the control port servoctl waits on the simulator's clock.
+        print(f"  export SERVOCTL_PORT={sim.url} SERVOCTL_SIM_CONTROL={sim.control_port}", flush=True)
         print(f"  e.g. servoctl --port {sim.url} --sim-control {sim.control_port} scan  (Ctrl-C stops)", flush=True)
         sim.process.wait()
     except KeyboardInterrupt:

@@ -7,6 +7,8 @@ SERVOCTL_SIM_CONTROL), servoctl sets it there for --baud and after a
 `config set N baud`. Without it, --baud on socket:// is refused (it would
 be ignored) and a baud change says what to do, instead of losing the bus
 with no word."""
+import contextlib
+
 from . import registers
 from .errors import ServoError, UsageError
 
@@ -17,17 +19,33 @@ def is_socket(port) -> bool:
     return bool(port) and port.startswith("socket://")
 
 
-def _control(address: str, line: str) -> str:
-    from .sim import control_command
-
+def _control_port(address: str) -> int:
     host, _, port = address.rpartition(":")
     if host not in ("", "127.0.0.1", "localhost"):
         raise UsageError(f"--sim-control is a simulator's control port on this PC (PORT or "
                          f"127.0.0.1:PORT), not {address}")
     try:
-        return control_command(int(port), line)
+        return int(port)
     except ValueError:
         raise UsageError(f"--sim-control takes a port number, not {address!r}") from None
+
+
+def _control(address: str, line: str) -> str:
+    from .sim import control_command
+
+    return control_command(_control_port(address), line)
+
+
+def simulator(sim_control):
+    """The simulator whose control port is given (servoctl.sim.Simulator,
+    for its clock_s), or None: with it, servoctl's bus waits on the
+    simulated clock, so a simulator that runs behind the wall clock on a
+    busy PC is not taken for a servo that does not answer."""
+    if not sim_control:
+        return None
+    from .sim import Simulator
+
+    return Simulator.running(_control_port(sim_control))
 
 
 def open_rate(port, baud, sim_control) -> int:
@@ -41,6 +59,24 @@ def open_rate(port, baud, sim_control) -> int:
                          f"--sim-control PORT and servoctl does it")
     _control(sim_control, f"hostbaud {baud}")
     return baud
+
+
+def set_rate(bus, sim_control, rate: int) -> None:
+    """The host's rate on the bus: the port's, and on socket:// with the
+    control port given the simulator's host rate (hostbaud) too."""
+    if is_socket(bus.port) and sim_control and rate != bus.serial.baudrate:
+        _control(sim_control, f"hostbaud {rate}")
+    bus.serial.baudrate = rate
+
+
+@contextlib.contextmanager
+def restored(bus, sim_control):
+    """The host's rate as it was once the block ends (scan --all-bauds)."""
+    rate = bus.serial.baudrate
+    try:
+        yield
+    finally:
+        set_rate(bus, sim_control, rate)
 
 
 def after_set(bus, args, name: str, value: int) -> None:

@@ -66,12 +66,19 @@ def plan_move(s, asked: int, request: MoveRequest, where: Where = None) -> Plan:
     return Plan(start, asked, target, target_abs, target != asked, planned, soft)
 
 
+# What a move stretched to soft_start_time may take beyond it: arriving
+# (status bit 0 falls once the horn is nearly still) and the 10 ms polls.
+SOFT_START_SETTLE_S = 0.3
+
+
 def planned_text(plan: Plan, took_s: float) -> str:
     """'planned N ms', and soft start named when it can explain a move that
     took longer: it stretches the first angle move after power-up (items
-    49/50)."""
+    49/50) to soft_start_time, no further. A move that took longer than
+    that (one that did not arrive: the wait includes the soft start) was
+    slowed by something else, whether it was the first move or not."""
     text = f"planned {plan.planned_s * 1000:.0f} ms"
-    if plan.soft_start_s and took_s > plan.planned_s + 0.1:
+    if plan.soft_start_s and plan.planned_s + 0.1 < took_s <= plan.soft_start_s + SOFT_START_SETTLE_S:
         text += (f"; soft start is on ({plan.soft_start_s * 1000:.0f} ms, soft_start_on/soft_start_time)"
                  f" and stretches the first move after power-up")
     return text

@@ -79,6 +79,7 @@ class Bus:
         self._low_water = 1  # the socket's SO_RCVLOWAT (_wake_at)
         self._buffer = b""
         self.stray_bytes = 0  # bytes outside any frame: noise, or answers that collided
+        self.bad_frames = 0  # frames with a bad checksum: noise, or answers that collided
         self.heard = False  # a whole frame came: the host and the line agree on the rate
         self.sent_again = 0  # requests sent a second time, their first unanswered (request)
         self.stamp_arrivals = True
@@ -230,6 +231,7 @@ class Bus:
                 fcode, content, ok = frame
                 if not ok:
                     bad = fcode
+                    self.bad_frames += 1
                 elif fcode == code and content[:len(want)] == want[:max(1, len(content))]:  # short: told
                     self.arrived_at = self.clock() if self.stamp_arrivals else None
                     self._look(0.0)  # the answer came: the simulator waits for the host's next bytes
@@ -335,4 +337,7 @@ class Bus:
         deadline = self.clock() + self._longest_answer_s()
         while self.clock() <= deadline:
             self._fill(wait=True)
+        while (frame := self._take_frame()) is not None:  # garbled answers counted
+            self.bad_frames += not frame[2]
+        self.stray_bytes += len(self._buffer)
         self._buffer = b""

@@ -112,6 +112,15 @@ class Simulator(_Child):
         self._clock_lock = threading.Lock()
         self._clock_map = None  # servo_sim's clock file, mapped (sim_clock.h)
 
+    @classmethod
+    def running(cls, control_port: int) -> "Simulator":
+        """A simulator another process started (`servoctl sim`, a virtual
+        board), reached by its control port: its clock (clock_s) for a
+        Bus, and control. stop() closes the connection, nothing else."""
+        sim = cls(state_dir=os.devnull)  # not made here: not removed
+        sim.control_port = control_port
+        return sim
+
     def start(self) -> "Simulator":
         if self.board is not None:
             if self.rx is not None or self.cpu is not None:

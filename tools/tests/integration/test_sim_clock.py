@@ -1,0 +1,97 @@
+"""servoctl given a simulator's control port (--sim-control) waits on the
+simulator's clock: a simulator that falls behind the wall clock (a busy PC;
+here one stopped for a while, SIGSTOP) is not taken for a servo that does
+not answer. Without the control port servoctl waits on the host's clock,
+and the same lag is a NoReply."""
+import os
+import signal
+import threading
+
+import pytest
+
+from servoctl.cli import main
+from servoctl.sim import Simulator
+
+
+def _lagging(sim, host_s: float) -> threading.Timer:
+    """The simulator stopped now, for host_s of host time: its clock stands
+    still while a request is outstanding, as on a PC too busy to run it."""
+    os.kill(sim.process.pid, signal.SIGSTOP)
+    resume = threading.Timer(host_s, os.kill, (sim.process.pid, signal.SIGCONT))
+    resume.start()
+    return resume
+
+
+def _ping_behind(sim, capsys, *options):
+    resume = _lagging(sim, 0.3)
+    try:
+        rc = main(["--port", sim.url, *options, "ping", "1"])
+    finally:
+        resume.join()
+    out = capsys.readouterr()
+    return rc, out.out + out.err
+
+
+@pytest.mark.parametrize("board", [None, "stm32f030k6"])
+def test_a_lagging_simulator_answers_within_its_own_clocks_timeout(tmp_path, capsys, board):
+    """servo_sim and a virtual board (whose clock is its control port's
+    `clock` only) alike; scan's windows too, on the board."""
+    with Simulator(ids=[1], state_dir=str(tmp_path / "state"), board=board) as sim:
+        rc, out = _ping_behind(sim, capsys)
+        assert rc == 3 and "servo 1: no reply" in out, out  # the host's 100 ms passed
+        rc, out = _ping_behind(sim, capsys, "--sim-control", str(sim.control_port))
+        assert rc == 0 and "servo 1: answered" in out, out
+        resume = _lagging(sim, 0.3)
+        try:
+            rc = main(["--port", sim.url, "--sim-control", str(sim.control_port), "scan", "--last", "3"])
+        finally:
+            resume.join()
+        out = capsys.readouterr().out
+        assert rc == 0 and "servo 1 at 115200 baud" in out and "1 servo(s) found" in out, out
+        assert sim.state(1)["collisions"] == 0
+
+
+def test_sim_prints_both_exports():
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    tools = Path(__file__).resolve().parents[2]
+    proc = subprocess.Popen([sys.executable, "-m", "servoctl.cli", "sim", "--tcp", "0"], cwd=tools,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        first, export = proc.stdout.readline(), proc.stdout.readline()
+    finally:
+        proc.terminate()
+        proc.communicate(timeout=15)
+    url, control = first.split()[3].rstrip(","), first.split()[5].rsplit(":", 1)[1]
+    assert export.split() == ["export", f"SERVOCTL_PORT={url}", f"SERVOCTL_SIM_CONTROL={control}"], export
+
+
+def test_sim_refuses_tcp_with_link_as_a_usage_error(tmp_path, capsys):
+    assert main(["sim", "--tcp", "0", "--link", str(tmp_path / "servo")]) == 2
+    assert "not with --tcp" in capsys.readouterr().err
+
+
+def test_all_bauds_over_a_socket_sweeps_the_simulators_host_rate(tmp_path, capsys):
+    """Given the control port, scan --all-bauds sets each rate there
+    (hostbaud) and finds a servo at 1 Mbaud; the host rate is put back."""
+    with Simulator(ids=[1], state_dir=str(tmp_path / "state"), fast=True) as sim:
+        assert main(["--port", sim.url, "config", "set", "1", "baud", "1000000"], clock=sim.clock_s) == 0
+        capsys.readouterr()
+        assert main(["--port", sim.url, "--sim-control", str(sim.control_port), "scan", "--all-bauds",
+                     "--last", "2"], clock=sim.clock_s) == 0
+        out = capsys.readouterr()
+        assert "servo 1 at 1000000 baud" in out.out, out.out + out.err
+        assert sim.state(1)["host_baud"] == 115200  # as it was
+
+
+def test_ping_of_a_shared_id_says_the_answer_was_garbled(tmp_path, capsys):
+    """Three servos at ID 0 answer a Ping at once and garble each other on
+    the wire: not "no reply" (exit 3) but what scan would say, exit 1."""
+    with Simulator(fast=True, ids=[0, 0, 0], state_dir=str(tmp_path / "state")) as sim:
+        rc = main(["--port", sim.url, "ping", "0"], clock=sim.clock_s)
+        out = capsys.readouterr().out
+        assert rc == 1, out
+        assert ("servo 0: garbled answer: two or more servos may share ID 0; see 'servoctl scan'"
+                in out), out
