@@ -1,7 +1,6 @@
 """The bus: sends requests and waits for the matching response, on a serial
 port or a simulator's socket. The frames themselves are codec.py's, named
 here too (p.request_frame, p.PING and the like)."""
-import struct
 import time
 
 from . import codec as _codec
