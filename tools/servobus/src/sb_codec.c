@@ -136,6 +136,10 @@ static sb_error encode_fields(const sb_packet_desc *p, bool request, const sb_va
             size = item->size;
             least = item->min;
             most = item->max;
+            if (!request) { /* what a servo reads back: the item's type's range */
+                most = item->is_signed ? (INT64_C(1) << (8u * size - 1u)) - 1 : (INT64_C(1) << (8u * size)) - 1;
+                least = item->is_signed ? -most - 1 : 0;
+            }
         } else if (!number) {
             size = v[k].len;
             if ((f[k].type == SB_USER_AREA && size != SB_USER_AREA_SIZE) || (size > 0 && v[k].bytes == NULL))
