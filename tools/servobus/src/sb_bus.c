@@ -109,7 +109,7 @@ sb_error sb_send(sb_bus *bus, const uint8_t *frame, size_t len)
     return rc < 0 ? link_error(rc, len > 2 ? frame[2] : 0) : sb_ok();
 }
 
-/* sb_receive, waking once want_after more bytes than this frame's are there. */
+/* sb_receive; the transport may wait for want_after bytes (0: this frame's). */
 static sb_error receive(sb_bus *bus, uint8_t code, int servo, uint64_t deadline_us, uint8_t *content, size_t *len,
                         size_t want_after)
 {
@@ -146,7 +146,9 @@ static sb_error receive(sb_bus *bus, uint8_t code, int servo, uint64_t deadline_
                 e.packet = code;
                 return e;
             }
-            rc = bus->t.read(bus->t.ctx, bus->pending, sizeof bus->pending, sb_parser_missing(&bus->rx) + want_after,
+            /* want_after: the bytes of every frame still to come, from this one's first. */
+            size_t want = want_after > bus->rx.len ? want_after - bus->rx.len : sb_parser_missing(&bus->rx);
+            rc = bus->t.read(bus->t.ctx, bus->pending, sizeof bus->pending, want,
                              (uint32_t)(left < WAIT_SLICE_US ? left : WAIT_SLICE_US));
             if (rc < 0) {
                 e = link_error(rc, code);
@@ -186,7 +188,7 @@ sb_error sb_sync_monitor_answers(sb_bus *bus, const uint8_t *ids, size_t count, 
         uint8_t content[SB_ANSWER_CONTENT_MAX];
         size_t len = 0, k;
         sb_monitor_answer a;
-        e = receive(bus, SB_PKT_MONITOR, -1, deadline, content, &len, (left - 1) * answer);
+        e = receive(bus, SB_PKT_MONITOR, -1, deadline, content, &len, left * answer);
         if (e.status != SB_OK)
             break;
         e = sb_decode_monitor(content, len, &a);

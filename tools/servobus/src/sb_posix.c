@@ -19,6 +19,14 @@
 
 #include "servobus_posix.h"
 
+/* The most bytes a wait on a socket asks for before it wakes (SO_RCVLOWAT).
+ * A simulator sends each byte as it ends on the wire, a TCP segment each:
+ * asked for more than its first congestion window (ten segments) holds,
+ * a wait for a whole round stalls until its time-out in a connection's
+ * first cycles (scripts/c_loop_bench.sh measured 5 ms a cycle at 21 or
+ * more, none at 10). */
+#define LOW_WATER_MOST 8u
+
 uint64_t sb_monotonic_us(void *ctx)
 {
     struct timespec ts;
@@ -203,9 +211,11 @@ static int posix_read(void *ctx, uint8_t *buf, size_t cap, size_t want, uint32_t
     if (wait_us > 0) {
         struct pollfd pf = {p->fd, POLLIN, 0};
         struct timespec ts = {(time_t)(wait_us / 1000000u), (long)(wait_us % 1000000u) * 1000L};
-        /* The socket reads as ready once want bytes are there: one wake-up
-         * a frame (or a round), not one for each byte a simulator hands over. */
-        if (p->is_socket && (int)want != p->low_water && want > 0 && want < (1u << 16)) {
+        /* The socket reads as ready once want bytes are there, not at each
+         * byte a simulator hands over (LOW_WATER_MOST at most). */
+        if (want > LOW_WATER_MOST)
+            want = LOW_WATER_MOST;
+        if (p->is_socket && (int)want != p->low_water && want > 0) {
             int lw = (int)want;
             if (setsockopt(p->fd, SOL_SOCKET, SO_RCVLOWAT, &lw, sizeof lw) == 0)
                 p->low_water = lw;
