@@ -78,6 +78,20 @@ static uint64_t now_us(void *ctx)
     return (uint64_t)before * 1000u + ticks / (SYSCLK_HZ / 1000000u);
 }
 
+/* A received byte, or -1. Reading DR after SR clears RXNE (and an
+ * overrun) on silicon; RXNE is also written 0 (rc_w0), which is how the
+ * virtual board's USART model clears it (tools/vboard/usart.py). */
+static int uart_recv(void *ctx)
+{
+    uint32_t byte;
+    (void)ctx;
+    if (!(USART1_SR & (1u << 5)))
+        return -1;
+    byte = USART1_DR & 0xFFu;
+    USART1_SR = ~(1u << 5);
+    return (int)byte;
+}
+
 /* The callbacks: bytes out (waiting for the last stop bit, then dropping
  * the echo a one-wire bus hands back), a byte in if one is there. */
 static void uart_send(void *ctx, const uint8_t *data, size_t len)
@@ -90,17 +104,8 @@ static void uart_send(void *ctx, const uint8_t *data, size_t len)
     }
     while (!(USART1_SR & (1u << 6))) { /* TC */
     }
-    while (USART1_SR & (1u << 5)) /* RXNE: our own bytes */
-        (void)USART1_DR;
-}
-
-static int uart_recv(void *ctx)
-{
-    (void)ctx;
-    uint32_t sr = USART1_SR;
-    if (sr & (1u << 3)) /* overrun: the byte is lost, read to clear */
-        (void)USART1_DR;
-    return (sr & (1u << 5)) ? (int)(USART1_DR & 0xFFu) : -1;
+    while (uart_recv(ctx) >= 0) { /* our own bytes */
+    }
 }
 
 static void bus_init(void)
