@@ -96,7 +96,7 @@ def servobus_h(s) -> str:
         elif not p.has("carries_records"):
             decls.append(f"sb_error sb_send_{n}(sb_bus *bus{', ' + req[:-2] if req else ''});\n")
     return (NOTICE + "#ifndef SERVOBUS_SB_SCHEMA_H\n#define SERVOBUS_SB_SCHEMA_H\n\n"
-            "#include <stddef.h>\n#include <stdint.h>\n\n#include \"servobus_types.h\"\n\n"
+            "#include <stddef.h>\n#include <stdint.h>\n\n#include \"servobus/servobus_types.h\"\n\n"
             "#ifdef __cplusplus\nextern \"C\" {\n#endif\n\n"
             f"#define SB_REQUEST_HEADER_0 {s.frame['request_header'][0]:#04x}\n"
             f"#define SB_REQUEST_HEADER_1 {s.frame['request_header'][1]:#04x}\n"
@@ -171,7 +171,7 @@ def servobus_c(s) -> str:
             ((-(1 << (8 * i.size - 1)), (1 << (8 * i.size - 1)) - 1) if i.signed else (0, (1 << (8 * i.size)) - 1))
         items.append(f'    {{{i.id}, {i.size}, {int(i.signed)}, {ACCESS[i.access]}, {_n(low)}, {_n(high)}, '
                      f'"{i.name}"}},\n')
-    return (NOTICE + "#include <string.h>\n\n#include \"servobus.h\"\n\n" + "".join(tables)
+    return (NOTICE + "#include <string.h>\n\n#include \"servobus/servobus.h\"\n\n" + "".join(tables)
             + f"\nconst sb_packet_desc sb_packets[SB_PACKET_COUNT] = {{\n{''.join(rows)}}};\n"
             + f"\nconst sb_item_desc sb_items[SB_ITEM_COUNT] = {{\n{''.join(items)}}};\n"
             + "".join(_functions(p) for p in s.packets))

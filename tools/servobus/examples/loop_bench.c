@@ -7,8 +7,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "servobus_posix.h"
-#include "sim_clock.h"
+#include "servobus/servobus_posix.h"
+#include "examples/sb_sim_clock.h"
 
 int main(int argc, char **argv)
 {

@@ -15,8 +15,8 @@
 #include <thread>
 #include <vector>
 
-#include "servobus_posix.h"
-#include "sim_clock.h"
+#include "servobus/servobus_posix.h"
+#include "examples/sb_sim_clock.h"
 
 namespace {
 

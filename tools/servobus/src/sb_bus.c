@@ -3,7 +3,7 @@
  * transport; errors in words. */
 #include <string.h>
 
-#include "servobus.h"
+#include "servobus/servobus.h"
 
 #define WAIT_SLICE_US 5000u /* the longest single wait on the transport */
 

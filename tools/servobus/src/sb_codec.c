@@ -2,7 +2,7 @@
  * (sb_schema.c), its fields checked against their ranges. */
 #include <string.h>
 
-#include "servobus.h"
+#include "servobus/servobus.h"
 
 #define fail sb_error_of
 

@@ -1,7 +1,7 @@
 /* SyncCommand, the stream of setpoints and the robot loop; errors in words. */
 #include <string.h>
 
-#include "servobus.h"
+#include "servobus/servobus.h"
 
 #define SETPOINT_LEN 9u /* a StreamSetpoint's content */
 

@@ -17,7 +17,7 @@
 #include <linux/serial.h>
 #endif
 
-#include "servobus_posix.h"
+#include "servobus/servobus_posix.h"
 
 /* The most bytes a wait on a socket asks for before it wakes (SO_RCVLOWAT).
  * A simulator sends each byte as it ends on the wire, a TCP segment each:

@@ -1,6 +1,6 @@
 #include <string.h>
 
-#include "fake_servo.h"
+#include "tests/fake_servo.h"
 
 static void answer(fake_bus *f, uint8_t code, const sb_value *v, size_t count)
 {

@@ -4,7 +4,7 @@
 #ifndef SERVOBUS_FAKE_SERVO_H
 #define SERVOBUS_FAKE_SERVO_H
 
-#include "servobus.h"
+#include "servobus/servobus.h"
 
 typedef struct fake_bus {
     uint64_t now_us;

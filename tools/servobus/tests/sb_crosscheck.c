@@ -9,7 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "servobus.h"
+#include "servobus/servobus.h"
 
 #define MAX_FIELDS 16
 #define MAX_BYTES 1024

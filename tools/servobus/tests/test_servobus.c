@@ -8,7 +8,7 @@
 
 #include <cmocka.h>
 
-#include "servobus.h"
+#include "servobus/servobus.h"
 
 static void ping_frame_is_the_protocols(void **state)
 {

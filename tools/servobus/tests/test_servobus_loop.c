@@ -8,7 +8,7 @@
 
 #include <cmocka.h>
 
-#include "fake_servo.h"
+#include "tests/fake_servo.h"
 
 static fake_bus fake;
 static sb_bus bus;

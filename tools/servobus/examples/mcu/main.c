@@ -7,7 +7,7 @@
  * saw is in `master` for a debugger. */
 #include <stdint.h>
 
-#include "servobus.h"
+#include "servobus/servobus.h"
 
 #define REG(addr) (*(volatile uint32_t *)(uintptr_t)(addr))
 #define RCC_CR REG(0x40021000u)

@@ -12,7 +12,7 @@
 #ifndef SERVOBUS_H
 #define SERVOBUS_H
 
-#include "servobus_types.h"
+#include "servobus/servobus_types.h"
 #include "servobus/sb_schema.h"
 
 #ifdef __cplusplus

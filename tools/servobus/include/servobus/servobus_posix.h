@@ -5,7 +5,7 @@
 #ifndef SERVOBUS_POSIX_H
 #define SERVOBUS_POSIX_H
 
-#include "servobus.h"
+#include "servobus/servobus.h"
 
 #ifdef __cplusplus
 extern "C" {

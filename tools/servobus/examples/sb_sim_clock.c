@@ -4,8 +4,8 @@
 #include <sys/mman.h>
 #include <unistd.h>
 
-#include "servobus_posix.h"
-#include "sim_clock.h"
+#include "servobus/servobus_posix.h"
+#include "examples/sb_sim_clock.h"
 
 static const volatile uint64_t *clock_word;
 
