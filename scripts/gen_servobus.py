@@ -73,9 +73,10 @@ def _flags(p) -> str:
 
 def servobus_h(s) -> str:
     user_area = sum(i.size for i in s.area("user"))
-    codes = "".join(f"    SB_PKT_{p.c} = {p.code}, /* {p.name} */\n" for p in s.packets)
+    # No comma after the last enumerator: C++98 takes none.
+    codes = ",\n".join(f"    SB_PKT_{p.c} = {p.code} /* {p.name} */" for p in s.packets) + "\n"
     flags = "".join(f"#define SB_PF_{f.upper()} {1 << k}u\n" for k, f in enumerate(FLAGS))
-    items = "".join(f"    SB_ITEM_{i.field.upper()} = {i.id},\n" for i in s.items)
+    items = ",\n".join(f"    SB_ITEM_{i.field.upper()} = {i.id}" for i in s.items) + "\n"
     decls = []
     for p in s.packets:
         n = _name(p)
