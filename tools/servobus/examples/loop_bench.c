@@ -1,5 +1,6 @@
 /* The C robot loop as fast as the wire goes, for scripts/c_loop_bench.sh:
- *   sb_loop_bench HOST:PORT CLOCK_FILE BAUD COUNT CYCLES
+ *   sb_loop_bench HOST:PORT|/dev/PORT CLOCK_FILE BAUD COUNT CYCLES
+ * (a path: a serial port, or servo_sim's pseudo-terminal)
  * prints "cycles C seconds S rate R wire W ratio Q missed M" on servo_sim's
  * clock (the simulated servos' time). */
 #include <math.h>
@@ -25,16 +26,19 @@ int main(int argc, char **argv)
     uint32_t baud;
     sb_error e;
     char words[200];
-    if (argc != 6 || (colon = strrchr(argv[1], ':')) == NULL) {
-        fprintf(stderr, "usage: %s HOST:PORT CLOCK_FILE BAUD COUNT CYCLES\n", argv[0]);
+    colon = argc == 6 ? strrchr(argv[1], ':') : NULL;
+    if (argc != 6 || (colon == NULL && argv[1][0] != '/')) {
+        fprintf(stderr, "usage: %s HOST:PORT|/dev/PORT CLOCK_FILE BAUD COUNT CYCLES\n", argv[0]);
         return 2;
     }
-    *colon = '\0';
     baud = (uint32_t)strtoul(argv[3], NULL, 10);
     count = (size_t)strtoul(argv[4], NULL, 10);
     cycles = strtol(argv[5], NULL, 10);
-    if (count == 0 || count > SB_MAX_SERVOS || sim_clock_open(argv[2]) != 0 || sb_tcp_open(&link, argv[1],
-                                                                                          (unsigned)atoi(colon + 1)) != 0) {
+    if (colon != NULL)
+        *colon = '\0';
+    if (count == 0 || count > SB_MAX_SERVOS || sim_clock_open(argv[2]) != 0 ||
+        (colon != NULL ? sb_tcp_open(&link, argv[1], (unsigned)atoi(colon + 1))
+                       : sb_serial_open(&link, argv[1], baud)) != 0) {
         fprintf(stderr, "loop_bench: bad arguments, no clock file or no simulator\n");
         return 2;
     }

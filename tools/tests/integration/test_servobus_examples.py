@@ -8,8 +8,10 @@ import subprocess
 from pathlib import Path
 
 from servoctl.servo import Servo
+from servoctl.sim import Simulator
 
 from ..launchers import REPO
+from .conftest import finish
 
 REAL_TIME = True
 EXAMPLES = REPO / "build" / "host" / "tools" / "servobus"
@@ -45,3 +47,15 @@ def test_the_c_robot_loop_reads_every_state(sim3):
     # Its rate against the wire's limit is the benchmark's (docs/c-library.md);
     # here only that a cycle is never shorter than its bytes on the wire.
     assert 0.0 < float(words["ratio"]) <= 1.0, done.stdout
+
+
+def test_the_serial_transport_on_servo_sims_pseudo_terminal(tmp_path):
+    """sb_serial_open (termios raw 8N1; no low-latency mode or latency
+    timer on a pty) carries the C loop as the TCP socket does."""
+    sim = Simulator(ids=[1, 2], tcp=False, state_dir=str(tmp_path / "state")).start()
+    try:
+        done = _run(["sb_loop_bench", sim.url, str(tmp_path / "state" / "bus.clock"), "115200", "2", "20"])
+    finally:
+        finish(sim, [1, 2])
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "cycles 20 " in done.stdout and "missed 0" in done.stdout, done.stdout
