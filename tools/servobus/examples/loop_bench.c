@@ -54,6 +54,8 @@ int main(int argc, char **argv)
         for (size_t k = 0; k < count; k++)
             angles[k] = (int32_t)lround(100.0 * sin((double)c / 20.0)); /* 10 deg, as stream_bench.sh's */
         e = sb_loop_cycle(&loop, angles, NULL, states, got);
+        if (e.status == SB_E_NO_ANSWER)
+            e = sb_ok(); /* counted in loop.missed */
     }
     if (e.status != SB_OK) {
         sb_error_text(&e, words, sizeof words);
