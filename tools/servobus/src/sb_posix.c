@@ -7,6 +7,7 @@
 #include <netinet/tcp.h>
 #include <poll.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <sys/ioctl.h>
 #include <sys/socket.h>
@@ -96,13 +97,21 @@ static speed_t speed_of(uint32_t baud)
     }
 }
 
+/* The adapter's latency-timer file for a port's path (NAME of /dev/NAME),
+ * under $SERVOBUS_SYSFS if set (the tests'), else /sys. */
+static void timer_file(const char *path, char *out, size_t cap)
+{
+    const char *name = strrchr(path, '/'), *root = getenv("SERVOBUS_SYSFS");
+    snprintf(out, cap, "%s/class/tty/%s/device/latency_timer", root != NULL ? root : "/sys",
+             name != NULL ? name + 1 : path);
+}
+
 int sb_serial_latency_timer(const char *path)
 {
-    const char *name = strrchr(path, '/');
-    char sys[160];
+    char sys[256];
     FILE *f;
     int ms = -1;
-    snprintf(sys, sizeof sys, "/sys/class/tty/%s/device/latency_timer", name != NULL ? name + 1 : path);
+    timer_file(path, sys, sizeof sys);
     f = fopen(sys, "r");
     if (f == NULL)
         return -1;
@@ -115,23 +124,25 @@ int sb_serial_latency_timer(const char *path)
 /* An FTDI adapter holds what it received until its latency timer runs out
  * (16 ms by default): at 1 ms a robot loop gets its answers a frame late,
  * at 16 ms it crawls. */
-static void check_latency_timer(sb_posix *p, const char *path)
+void sb_serial_check_latency(sb_posix *p, const char *path)
 {
     const char *name = strrchr(path, '/');
-    char sys[160];
+    char sys[256];
     FILE *f;
     name = name != NULL ? name + 1 : path;
+    p->advice[0] = '\0';
     p->latency_timer_ms = sb_serial_latency_timer(path);
     if (p->latency_timer_ms <= 1)
         return;
-    snprintf(sys, sizeof sys, "/sys/class/tty/%s/device/latency_timer", name);
+    timer_file(path, sys, sizeof sys);
     f = fopen(sys, "w");
-    if (f != NULL && fputs("1\n", f) >= 0 && fclose(f) == 0) {
+    if (f != NULL) {
+        bool written = fputs("1\n", f) >= 0;
+        written = fclose(f) == 0 && written;
         p->latency_timer_ms = sb_serial_latency_timer(path);
-        return;
+        if (written && p->latency_timer_ms <= 1)
+            return;
     }
-    if (f != NULL)
-        fclose(f);
     snprintf(p->advice, sizeof p->advice,
              "%s's latency timer is %d ms: every answer waits for it. Run "
              "'echo 1 | sudo tee /sys/bus/usb-serial/devices/%s/latency_timer' "
@@ -175,7 +186,7 @@ int sb_serial_open(sb_posix *p, const char *path, uint32_t baud)
     }
 #endif
     tcflush(p->fd, TCIOFLUSH);
-    check_latency_timer(p, path);
+    sb_serial_check_latency(p, path);
     return 0;
 }
 

@@ -30,6 +30,10 @@ int sb_serial_open(sb_posix *p, const char *path, uint32_t baud);
 /* The latency timer of a USB-serial adapter behind path (e.g. ttyUSB0),
  * in ms, from /sys/class/tty/NAME/device/latency_timer; -1 if it has none. */
 int sb_serial_latency_timer(const char *path);
+/* What sb_serial_open does about it: above 1 ms, sets it to 1 where the
+ * process may (latency_timer_ms then says 1), else fills advice with the
+ * fix. ($SERVOBUS_SYSFS, if set, stands for /sys: the tests'.) */
+void sb_serial_check_latency(sb_posix *p, const char *path);
 void sb_posix_close(sb_posix *p);
 sb_transport sb_posix_transport(sb_posix *p);
 uint64_t sb_monotonic_us(void *ctx);
