@@ -93,7 +93,7 @@ def sources(root):
 # Where an include's name is looked up: each layer's headers are named
 # from one of these (firmware/storage/crc32.h is "storage/crc32.h").
 INCLUDE_ROOTS = ("hal/include", "motion/include", "protocol/wire/include", "protocol/include",
-                 "registers/include", "firmware", "hal", "tests", "")
+                 "registers/include", "firmware", "hal", "tests", "tools/servobus/include", "tools/servobus", "")
 BOARD_FOLDER = re.compile(r"^firmware/boards/[^/]+/")
 
 

@@ -6,7 +6,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-PACKAGES=(cmake ninja-build gcc pkg-config libcmocka-dev clang libclang-rt-14-dev
+PACKAGES=(cmake ninja-build gcc g++ pkg-config libcmocka-dev clang libclang-rt-14-dev
           gcc-arm-none-eabi libnewlib-arm-none-eabi valgrind python3-venv qemu-system-arm)
 
 missing=()

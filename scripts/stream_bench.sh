@@ -21,38 +21,16 @@ cmake --build --preset host --target servo_sim test_stream >/dev/null
 echo "1. one servo on the plant model (tests/unit/test_stream.c):"
 build/host/tests/test_stream 2>/dev/null | sed -n 's/^# /   /p' | head -1
 exec .venv/bin/python - <<'PY'
-import contextlib
 import math
-import tempfile
+import sys
 
+sys.path.insert(0, "scripts")
+from bench_sim import at_baud, cycle_gaps  # the simulated servos at a rate, a cycle's gaps
 from servoctl import protocol as p
-from servoctl import registers
 from servoctl.group import sync_move, sync_monitor
-from servoctl.servo import Servo
-from servoctl.sim import Simulator
 from servoctl.stream import RobotLoop, stream_file
 
 PERIOD, SECONDS = 0.02, 4.0
-
-
-@contextlib.contextmanager
-def at_baud(ids, baud, host_link=None):
-    """Simulated servos at baud, soft start off; stopped whatever happens."""
-    with Simulator(ids=ids, state_dir=tempfile.mkdtemp(prefix="stream-bench-"), host_link=host_link) as sim:
-        set_up(sim, ids, baud)
-        yield sim
-
-
-def set_up(sim, ids, baud):
-    code = {rate: c for c, rate in registers.BAUD_RATES.items()}[baud]
-    with sim.bus() as bus:
-        for i in ids:
-            Servo(bus, i).write("soft_start_on", 0)
-            if baud != 115200:
-                Servo(bus, i).write("baud", code)  # answered at 115200, then it switches
-    if baud != 115200:
-        sim.control(f"hostbaud {baud}")
-        sim.sleep(0.05)
 
 
 def path(t):
@@ -75,18 +53,6 @@ def plain_moves(bus, ids, times):
             at = min(arrivals[i] - (n + 1) * answer_s for n, i in enumerate(ids) if i in states) - start
             errors += [states[i].angle_decideg / 10 - path(at) for i in ids if i in states]
     return math.sqrt(sum(e * e for e in errors) / len(errors)), max(map(abs, errors))
-
-
-def cycle_gaps(sim):
-    """Mean gaps of the latest cycles on the simulator's wire log, in us:
-    an answer's end to the host's next burst, the burst's end to the
-    first answer, an answer's end to the next."""
-    spans = [line.split() for line in sim.control("wire 1024").splitlines() if line != "end"]
-    gaps = {"host": [], "first": [], "between": []}
-    for (_, end, _, before), (start, _, _, sender) in zip(spans, spans[1:]):
-        kind = "host" if sender == "host" else "first" if before == "host" else "between"
-        gaps[kind].append(int(start) - int(end))
-    return [sum(g) / len(g) for g in gaps.values()]
 
 
 ids = list(range(1, 7))

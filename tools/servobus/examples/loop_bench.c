@@ -1,0 +1,72 @@
+/* The C robot loop as fast as the wire goes, for scripts/c_loop_bench.sh:
+ *   sb_loop_bench HOST:PORT|/dev/PORT CLOCK_FILE BAUD COUNT CYCLES
+ * (a path: a serial port, or servo_sim's pseudo-terminal)
+ * prints "cycles C seconds S rate R wire W ratio Q missed M" on servo_sim's
+ * clock (the simulated servos' time). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "servobus/servobus_posix.h"
+#include "examples/sb_sim_clock.h"
+
+int main(int argc, char **argv)
+{
+    sb_posix link;
+    sb_bus bus;
+    sb_loop loop;
+    uint8_t ids[SB_MAX_SERVOS];
+    int32_t angles[SB_MAX_SERVOS];
+    sb_monitor_answer states[SB_MAX_SERVOS];
+    bool got[SB_MAX_SERVOS];
+    char *colon;
+    size_t count;
+    long cycles;
+    uint32_t baud;
+    sb_error e;
+    char words[200];
+    colon = argc == 6 ? strrchr(argv[1], ':') : NULL;
+    if (argc != 6 || (colon == NULL && argv[1][0] != '/')) {
+        fprintf(stderr, "usage: %s HOST:PORT|/dev/PORT CLOCK_FILE BAUD COUNT CYCLES\n", argv[0]);
+        return 2;
+    }
+    baud = (uint32_t)strtoul(argv[3], NULL, 10);
+    count = (size_t)strtoul(argv[4], NULL, 10);
+    cycles = strtol(argv[5], NULL, 10);
+    if (colon != NULL)
+        *colon = '\0';
+    if (count == 0 || count > SB_MAX_SERVOS || sim_clock_open(argv[2]) != 0 ||
+        (colon != NULL ? sb_tcp_open(&link, argv[1], (unsigned)atoi(colon + 1))
+                       : sb_serial_open(&link, argv[1], baud)) != 0) {
+        fprintf(stderr, "loop_bench: bad arguments, no clock file or no simulator\n");
+        return 2;
+    }
+    {
+        sb_transport t = sb_posix_transport(&link);
+        t.now_us = sim_clock_us;
+        sb_bus_init(&bus, t, baud);
+    }
+    for (size_t k = 0; k < count; k++)
+        ids[k] = (uint8_t)(k + 1);
+    e = sb_loop_init(&loop, &bus, ids, count, 20);
+    for (long c = 0; c < cycles && e.status == SB_OK; c++) {
+        for (size_t k = 0; k < count; k++)
+            angles[k] = (int32_t)lround(100.0 * sin((double)c / 20.0)); /* 10 deg, as stream_bench.sh's */
+        e = sb_loop_cycle(&loop, angles, NULL, states, got);
+        if (e.status == SB_E_NO_ANSWER)
+            e = sb_ok(); /* counted in loop.missed */
+    }
+    if (e.status != SB_OK) {
+        sb_error_text(&e, words, sizeof words);
+        fprintf(stderr, "loop_bench: %s\n", words);
+        return 1;
+    }
+    {
+        double rate = sb_loop_rate_hz(&loop), wire = sb_wire_limit_hz(count, baud);
+        printf("cycles %lu seconds %.4f rate %.1f wire %.1f ratio %.4f missed %lu\n", (unsigned long)loop.cycles,
+               (double)loop.cycles / rate, rate, wire, rate / wire, (unsigned long)loop.missed);
+    }
+    sb_posix_close(&link);
+    return 0;
+}

@@ -1,0 +1,168 @@
+/* servobus: the servo protocol for hosts, in C99 (docs/c-library.md).
+ *
+ * Every packet of protocol/servo_schema (the maker's and this firmware's)
+ * is encoded and decoded from the schema's own tables (sb_schema.h, made
+ * by scripts/gen_protocol.py), every field checked against its range before
+ * anything is sent. The bus, the Sync Monitor, SyncCommand, the stream of
+ * setpoints and the robot loop run over any sb_transport: a serial port or
+ * a TCP socket (servobus_posix.h), or a microcontroller's UART
+ * (sb_uart_transport). No allocation, no OS: every buffer is the caller's
+ * or in these structs. Errors are values (sb_error) naming the servo, the
+ * packet and the field; sb_error_text says them in words. */
+#ifndef SERVOBUS_H
+#define SERVOBUS_H
+
+#include "servobus/servobus_types.h"
+#include "servobus/sb_schema.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* The most servos a stream or a robot loop takes. */
+#ifndef SB_MAX_SERVOS
+#define SB_MAX_SERVOS 32
+#endif
+#define SB_BITS_PER_BYTE 10u /* 8N1 */
+#define SB_TX_MAX (16u + 10u * SB_MAX_SERVOS + 8u + SB_MAX_SERVOS)
+#define SB_RX_MAX 256u
+
+sb_error sb_ok(void);
+/* An error naming servo (-1: none), packet (0: none) and field (NULL: none). */
+sb_error sb_error_of(sb_status status, int servo, uint8_t packet, const char *field);
+/* A transport from its parts (sb_transport's fields). */
+sb_transport sb_transport_make(void *ctx, int (*write)(void *, const uint8_t *, size_t),
+                               int (*read)(void *, uint8_t *, size_t, size_t, uint32_t), uint64_t (*now_us)(void *));
+/* The error in words, NUL-terminated in buf: "servo 3: ReadAngle: no answer
+ * within 100000 us". Returns the length written (cut to cap - 1). */
+size_t sb_error_text(const sb_error *e, char *buf, size_t cap);
+const sb_packet_desc *sb_packet(uint8_t code); /* NULL: not in the schema */
+const sb_item_desc *sb_item(uint8_t id);       /* NULL: not in the schema */
+
+/* ---- the codec: any packet from its fields' values (schema order) ----- */
+/* A request's content / whole frame. Each number is checked against its
+ * field's range (the schema's, else its type's): beyond it, SB_E_RANGE and
+ * nothing written. An item's value (WriteData) takes the item's size and
+ * range; a request's length against the packet's. */
+sb_error sb_encode_content(uint8_t code, const sb_value *v, size_t count, uint8_t *out, size_t cap, size_t *len);
+sb_error sb_encode_request(uint8_t code, const sb_value *v, size_t count, uint8_t *frame, size_t cap, size_t *len);
+/* An answer's frame (a servo's side: the tests' fake servos, cross-checks). */
+sb_error sb_encode_answer(uint8_t code, const sb_value *v, size_t count, uint8_t *frame, size_t cap, size_t *len);
+/* A frame around a content: header, code, length (extended from 255), checksum. */
+sb_error sb_frame(bool request, uint8_t code, const uint8_t *content, size_t clen, uint8_t *frame, size_t cap,
+                  size_t *len);
+/* Content into values (bytes point into content). count: the packet's
+ * fields exactly. Lengths and answer ranges checked: SB_E_BAD_ANSWER. */
+sb_error sb_decode_answer(uint8_t code, const uint8_t *content, size_t len, sb_value *v, size_t count);
+sb_error sb_decode_request(uint8_t code, const uint8_t *content, size_t len, sb_value *v, size_t count);
+uint8_t sb_checksum(const uint8_t *data, size_t len);
+
+/* A frame finder over a stream of bytes: sb_parse returns 1 when a frame
+ * (header as given) ends in the bytes fed so far, with its code and
+ * content; bytes outside frames and frames with a bad checksum are counted. */
+typedef struct sb_parser {
+    uint8_t header[2];
+    uint8_t buf[SB_RX_MAX];
+    size_t len;
+    uint32_t stray_bytes;
+    uint32_t bad_frames;
+} sb_parser;
+void sb_parser_init(sb_parser *p, bool requests);
+/* Takes what it can of data (*used: how much); 1: a frame (code, content
+ * valid until the next call), 0: none yet. */
+int sb_parse(sb_parser *p, const uint8_t *data, size_t len, size_t *used, uint8_t *code, const uint8_t **content,
+             size_t *clen);
+/* The bytes that would complete the frame the parser is in (at least 1). */
+size_t sb_parser_missing(const sb_parser *p);
+
+/* ---- the bus ---------------------------------------------------------- */
+struct sb_bus {
+    sb_transport t;
+    uint32_t baud;       /* for the wire's times */
+    uint32_t timeout_us; /* an answer's, after the request (default 100 ms) */
+    sb_parser rx;
+    uint8_t pending[SB_RX_MAX]; /* read but not yet parsed */
+    size_t pending_len;
+    uint64_t arrived_us; /* the bus clock when the last answer was taken */
+    uint8_t tx[SB_TX_MAX];
+};
+void sb_bus_init(sb_bus *bus, sb_transport t, uint32_t baud);
+/* Drops what waits unread, then writes frame in one write. */
+sb_error sb_send(sb_bus *bus, const uint8_t *frame, size_t len);
+/* The next answer of packet code from servo (-1: any) by deadline_us (bus
+ * clock); other frames skipped. content: SB_ANSWER_CONTENT_MAX bytes. */
+sb_error sb_receive(sb_bus *bus, uint8_t code, int servo, uint64_t deadline_us, uint8_t *content, size_t *len);
+/* sb_send the frame in bus->tx (len bytes), then sb_receive within timeout_us. */
+sb_error sb_request(sb_bus *bus, size_t len, uint8_t code, int servo, uint8_t *content, size_t *clen);
+/* The bytes of a packet's answer frame (its fields fixed), or 0. */
+size_t sb_answer_frame_size(uint8_t code);
+
+/* ---- SyncCommand and the Sync Monitor ---------------------------------- */
+/* A SyncCommand frame of count records of cmd (a syncable packet), each
+ * record_len bytes of records, made by sb_content_<packet>. */
+sb_error sb_sync_frame(uint8_t cmd, const uint8_t *records, size_t record_len, size_t count, uint8_t *frame,
+                       size_t cap, size_t *len);
+sb_error sb_sync_command(sb_bus *bus, uint8_t cmd, const uint8_t *records, size_t record_len, size_t count);
+/* Monitors every servo of ids with one request; their answers as they come.
+ * got[k] says whether ids[k] answered; an error names the first that did
+ * not (the others' states are kept). */
+sb_error sb_sync_monitor(sb_bus *bus, const uint8_t *ids, size_t count, sb_monitor_answer *states, bool *got);
+/* The same after a frame already sent (a robot loop's burst). */
+sb_error sb_sync_monitor_answers(sb_bus *bus, const uint8_t *ids, size_t count, sb_monitor_answer *states,
+                                 bool *got);
+
+/* ---- the stream of setpoints (StreamSetpoint) -------------------------- */
+typedef struct sb_stream {
+    uint8_t ids[SB_MAX_SERVOS];
+    size_t count;
+    uint16_t period_ms;
+    uint32_t sent;
+    int32_t last[SB_MAX_SERVOS]; /* the last angle sent (0.1 deg) */
+    int32_t angle_min[SB_MAX_SERVOS], angle_max[SB_MAX_SERVOS]; /* each servo's limits (0.1 deg) */
+} sb_stream;
+sb_error sb_stream_init(sb_stream *s, const uint8_t *ids, size_t count, uint16_t period_ms);
+/* The next setpoints' frame: angles in 0.1 deg, velocities in 0.1 deg/s
+ * (NULL: from the last two setpoints). An angle beyond its field or its
+ * servo's limits, a step faster than the servo moves, a velocity beyond
+ * the field's range: SB_E_RANGE naming the servo, nothing made. */
+sb_error sb_stream_frame(sb_stream *s, const int32_t *angles, const int16_t *velocities, uint8_t *frame,
+                         size_t cap, size_t *len);
+
+/* ---- the robot loop ----------------------------------------------------- */
+/* A cycle: one SyncCommand of setpoints and one Sync Monitor in one write,
+ * then every servo's state. */
+typedef struct sb_loop {
+    sb_bus *bus;
+    sb_stream stream;
+    uint8_t monitor[8u + SB_MAX_SERVOS];
+    size_t monitor_len;
+    uint32_t cycles;
+    uint32_t missed; /* states that did not come */
+    uint64_t started_us;
+} sb_loop;
+sb_error sb_loop_init(sb_loop *l, sb_bus *bus, const uint8_t *ids, size_t count, uint16_t period_ms);
+sb_error sb_loop_cycle(sb_loop *l, const int32_t *angles, const int16_t *velocities, sb_monitor_answer *states,
+                       bool *got);
+/* A cycle's bytes on the wire (both requests and every answer), and the
+ * most cycles a second the wire carries at baud (servoctl's loop_rate.py). */
+size_t sb_cycle_bytes(size_t count);
+double sb_wire_limit_hz(size_t count, uint32_t baud);
+/* Cycles a second since the first cycle, on the bus clock. */
+double sb_loop_rate_hz(const sb_loop *l);
+
+/* ---- a microcontroller's UART: a pair of callbacks ---------------------- */
+/* send: the bytes onto the bus (returns once they are sent or queued);
+ * recv: the next received byte, or -1 if none; now_us: a microsecond clock. */
+typedef struct sb_uart {
+    void (*send)(void *ctx, const uint8_t *data, size_t len);
+    int (*recv)(void *ctx);
+    uint64_t (*now_us)(void *ctx);
+    void *ctx;
+} sb_uart;
+sb_transport sb_uart_transport(sb_uart *uart);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

@@ -1,0 +1,258 @@
+/* The bus: frames found in the bytes the transport hands over, answers
+ * matched to requests on the bus's clock; a microcontroller's UART as a
+ * transport; errors in words. */
+#include <string.h>
+
+#include "servobus/servobus.h"
+
+#define WAIT_SLICE_US 5000u /* the longest single wait on the transport */
+
+/* ---- the frame finder ---------------------------------------------------- */
+void sb_parser_init(sb_parser *p, bool requests)
+{
+    memset(p, 0, sizeof *p);
+    p->header[0] = requests ? SB_REQUEST_HEADER_0 : SB_RESPONSE_HEADER_0;
+    p->header[1] = requests ? SB_REQUEST_HEADER_1 : SB_RESPONSE_HEADER_1;
+}
+
+/* The frame's whole size once its head is in, else 0. */
+static size_t frame_size(const sb_parser *p)
+{
+    if (p->len < 4)
+        return 0;
+    if (p->buf[3] != SB_EXTENDED_LENGTH)
+        return 5u + p->buf[3];
+    return p->len < 6 ? 0 : 7u + ((size_t)p->buf[4] | (size_t)p->buf[5] << 8);
+}
+
+size_t sb_parser_missing(const sb_parser *p)
+{
+    size_t size = frame_size(p);
+    if (size == 0)
+        return p->len < 5 ? 5u - p->len : 1u;
+    return size > p->len ? size - p->len : 1u;
+}
+
+int sb_parse(sb_parser *p, const uint8_t *data, size_t len, size_t *used, uint8_t *code, const uint8_t **content,
+             size_t *clen)
+{
+    size_t k = 0;
+    if (p->len > 0 && frame_size(p) == p->len)
+        p->len = 0; /* the frame returned last time */
+    while (k < len) {
+        uint8_t b = data[k++];
+        size_t size;
+        if (p->len < 2 && b != p->header[p->len]) {
+            p->stray_bytes += (uint32_t)p->len + (b == p->header[0] ? 0u : 1u);
+            p->len = b == p->header[0] ? 1u : 0u;
+            if (b == p->header[0])
+                p->buf[0] = b;
+            continue;
+        }
+        p->buf[p->len++] = b;
+        size = frame_size(p);
+        if (size == 0 || p->len < size) {
+            if (size > SB_RX_MAX) { /* no answer is this long: not a frame */
+                p->stray_bytes += (uint32_t)p->len;
+                p->len = 0;
+            }
+            continue;
+        }
+        if (sb_checksum(p->buf, size - 1u) != p->buf[size - 1u]) {
+            p->bad_frames++;
+            p->len = 0;
+            continue;
+        }
+        *used = k;
+        *code = p->buf[2];
+        *content = p->buf + (p->buf[3] == SB_EXTENDED_LENGTH ? 6 : 4);
+        *clen = size - (p->buf[3] == SB_EXTENDED_LENGTH ? 7u : 5u);
+        return 1;
+    }
+    *used = k;
+    return 0;
+}
+
+/* ---- the bus ------------------------------------------------------------- */
+void sb_bus_init(sb_bus *bus, sb_transport t, uint32_t baud)
+{
+    memset(bus, 0, sizeof *bus);
+    bus->t = t;
+    bus->baud = baud;
+    bus->timeout_us = 100000u;
+    sb_parser_init(&bus->rx, false);
+}
+
+static sb_error link_error(int rc, uint8_t code)
+{
+    sb_error e = sb_ok();
+    e.status = SB_E_LINK;
+    e.packet = code;
+    e.os_error = -rc;
+    return e;
+}
+
+sb_error sb_send(sb_bus *bus, const uint8_t *frame, size_t len)
+{
+    int rc;
+    /* What waits unread is dropped: a late answer is not the next one's. */
+    for (int k = 0; k < 64; k++) {
+        rc = bus->t.read(bus->t.ctx, bus->pending, sizeof bus->pending, 1, 0);
+        if (rc < 0)
+            return link_error(rc, len > 2 ? frame[2] : 0);
+        if (rc == 0)
+            break;
+    }
+    bus->pending_len = 0;
+    bus->rx.len = 0;
+    rc = bus->t.write(bus->t.ctx, frame, len);
+    return rc < 0 ? link_error(rc, len > 2 ? frame[2] : 0) : sb_ok();
+}
+
+/* sb_receive; the transport may wait for want_after bytes (0: this frame's). */
+static sb_error receive(sb_bus *bus, uint8_t code, int servo, uint64_t deadline_us, uint8_t *content, size_t *len,
+                        size_t want_after)
+{
+    uint32_t bad = bus->rx.bad_frames;
+    sb_error e = sb_ok();
+    for (;;) {
+        while (bus->pending_len > 0) {
+            size_t used = 0, clen = 0;
+            uint8_t fcode = 0;
+            const uint8_t *fcontent = NULL;
+            int got = sb_parse(&bus->rx, bus->pending, bus->pending_len, &used, &fcode, &fcontent, &clen);
+            memmove(bus->pending, bus->pending + used, bus->pending_len - used);
+            bus->pending_len -= used;
+            if (got && fcode == code && (servo < 0 || (clen > 0 && fcontent[0] == servo))) {
+                if (clen > SB_ANSWER_CONTENT_MAX) {
+                    e.status = SB_E_BAD_ANSWER;
+                    e.servo = (int16_t)fcontent[0];
+                    e.packet = code;
+                    return e;
+                }
+                memcpy(content, fcontent, clen);
+                *len = clen;
+                bus->arrived_us = bus->t.now_us(bus->t.ctx);
+                return e;
+            }
+        }
+        {
+            uint64_t now = bus->t.now_us(bus->t.ctx);
+            uint64_t left = deadline_us > now ? deadline_us - now : 0;
+            int rc;
+            if (left == 0) {
+                e.status = bus->rx.bad_frames != bad ? SB_E_BAD_CHECKSUM : SB_E_NO_ANSWER;
+                e.servo = (int16_t)servo;
+                e.packet = code;
+                return e;
+            }
+            /* want_after: the bytes of every frame still to come, from this one's first. */
+            size_t want = want_after > bus->rx.len ? want_after - bus->rx.len : sb_parser_missing(&bus->rx);
+            rc = bus->t.read(bus->t.ctx, bus->pending, sizeof bus->pending, want,
+                             (uint32_t)(left < WAIT_SLICE_US ? left : WAIT_SLICE_US));
+            if (rc < 0) {
+                e = link_error(rc, code);
+                e.servo = (int16_t)servo;
+                return e;
+            }
+            bus->pending_len = (size_t)rc;
+        }
+    }
+}
+
+sb_error sb_receive(sb_bus *bus, uint8_t code, int servo, uint64_t deadline_us, uint8_t *content, size_t *len)
+{
+    return receive(bus, code, servo, deadline_us, content, len, 0);
+}
+
+sb_error sb_request(sb_bus *bus, size_t len, uint8_t code, int servo, uint8_t *content, size_t *clen)
+{
+    sb_error e = sb_send(bus, bus->tx, len);
+    if (e.status != SB_OK) {
+        e.servo = (int16_t)servo;
+        return e;
+    }
+    return receive(bus, code, servo, bus->t.now_us(bus->t.ctx) + bus->timeout_us, content, clen, 0);
+}
+
+sb_error sb_sync_monitor_answers(sb_bus *bus, const uint8_t *ids, size_t count, sb_monitor_answer *states, bool *got)
+{
+    size_t answer = sb_answer_frame_size(SB_PKT_MONITOR), left = count;
+    /* Each answer on the wire, and 4 ms for each (an absent servo's silence). */
+    uint64_t wait = 50000u + count * (4000u + (uint64_t)answer * SB_BITS_PER_BYTE * 1000000u / bus->baud);
+    uint64_t deadline = bus->t.now_us(bus->t.ctx) + wait;
+    sb_error e = sb_ok();
+    for (size_t k = 0; k < count; k++)
+        got[k] = false;
+    while (left > 0) {
+        uint8_t content[SB_ANSWER_CONTENT_MAX];
+        size_t len = 0, k;
+        sb_monitor_answer a;
+        e = receive(bus, SB_PKT_MONITOR, -1, deadline, content, &len, left * answer);
+        if (e.status != SB_OK)
+            break;
+        e = sb_decode_monitor(content, len, &a);
+        if (e.status != SB_OK)
+            break;
+        for (k = 0; k < count && (ids[k] != a.id || got[k]); k++) {
+        }
+        if (k < count) { /* else another round's, or not asked for */
+            states[k] = a;
+            got[k] = true;
+            left--;
+        }
+    }
+    if (e.status == SB_E_NO_ANSWER || e.status == SB_E_BAD_CHECKSUM)
+        for (size_t k = 0; k < count; k++)
+            if (!got[k]) {
+                e.servo = ids[k]; /* the first that did not answer */
+                break;
+            }
+    return e;
+}
+
+sb_error sb_sync_monitor(sb_bus *bus, const uint8_t *ids, size_t count, sb_monitor_answer *states, bool *got)
+{
+    size_t len = 0;
+    sb_error e = sb_sync_frame(SB_PKT_MONITOR, ids, 1, count, bus->tx, sizeof bus->tx, &len);
+    if (e.status == SB_OK)
+        e = sb_send(bus, bus->tx, len);
+    return e.status == SB_OK ? sb_sync_monitor_answers(bus, ids, count, states, got) : e;
+}
+
+/* ---- a microcontroller's UART -------------------------------------------- */
+static int uart_write(void *ctx, const uint8_t *data, size_t len)
+{
+    sb_uart *u = (sb_uart *)ctx;
+    u->send(u->ctx, data, len);
+    return 0;
+}
+
+static int uart_read(void *ctx, uint8_t *buf, size_t cap, size_t want, uint32_t wait_us)
+{
+    sb_uart *u = (sb_uart *)ctx;
+    uint64_t start = u->now_us(u->ctx);
+    size_t n = 0;
+    while (n < cap) {
+        int c = u->recv(u->ctx);
+        if (c >= 0) {
+            buf[n++] = (uint8_t)c;
+            if (n >= want)
+                break;
+        } else if (n > 0 || u->now_us(u->ctx) - start >= wait_us) {
+            break;
+        }
+    }
+    return (int)n;
+}
+
+static uint64_t uart_now(void *ctx)
+{
+    sb_uart *u = (sb_uart *)ctx;
+    return u->now_us(u->ctx);
+}
+
+sb_transport sb_uart_transport(sb_uart *uart)
+{
+    return sb_transport_make(uart, uart_write, uart_read, uart_now);
+}

@@ -1,0 +1,246 @@
+/* SyncCommand, the stream of setpoints and the robot loop; errors in words. */
+#include <string.h>
+
+#include "servobus/servobus.h"
+
+#define SETPOINT_LEN 9u /* a StreamSetpoint's content */
+
+static sb_error usage(int servo, uint8_t code, const char *field)
+{
+    return sb_error_of(SB_E_USAGE, servo, code, field);
+}
+
+sb_error sb_sync_frame(uint8_t cmd, const uint8_t *records, size_t record_len, size_t count, uint8_t *frame,
+                       size_t cap, size_t *len)
+{
+    const sb_packet_desc *p = sb_packet(cmd);
+    size_t clen = 3u + record_len * count;
+    if (p == NULL || !(p->flags & SB_PF_SYNCABLE) || record_len != p->length_min || record_len != p->length_max)
+        return usage(-1, SB_PKT_SYNC_COMMAND, "cmd");
+    if (count == 0 || count > 255u)
+        return usage(-1, SB_PKT_SYNC_COMMAND, "count");
+    if (7u + clen > cap) {
+        sb_error e = usage(-1, SB_PKT_SYNC_COMMAND, NULL);
+        e.status = SB_E_SPACE;
+        return e;
+    }
+    memmove(frame + 9, records, record_len * count); /* the content at 6, then moved to its place */
+    frame[6] = cmd;
+    frame[7] = (uint8_t)record_len;
+    frame[8] = (uint8_t)count;
+    return sb_frame(true, SB_PKT_SYNC_COMMAND, frame + 6, clen, frame, cap, len);
+}
+
+sb_error sb_sync_command(sb_bus *bus, uint8_t cmd, const uint8_t *records, size_t record_len, size_t count)
+{
+    size_t len = 0;
+    sb_error e = sb_sync_frame(cmd, records, record_len, count, bus->tx, sizeof bus->tx, &len);
+    return e.status == SB_OK ? sb_send(bus, bus->tx, len) : e;
+}
+
+/* ---- the stream ----------------------------------------------------------- */
+sb_error sb_stream_init(sb_stream *s, const uint8_t *ids, size_t count, uint16_t period_ms)
+{
+    const sb_field_desc *angle = &sb_packet(SB_PKT_STREAM_SETPOINT)->request[1];
+    memset(s, 0, sizeof *s);
+    if (count == 0 || count > SB_MAX_SERVOS)
+        return usage(-1, SB_PKT_STREAM_SETPOINT, "ids");
+    if (period_ms == 0)
+        return usage(-1, SB_PKT_STREAM_SETPOINT, "period");
+    for (size_t k = 0; k < count; k++) {
+        if (ids[k] > SB_MAX_ID)
+            return usage(ids[k], SB_PKT_STREAM_SETPOINT, "id");
+        for (size_t j = 0; j < k; j++)
+            if (ids[j] == ids[k])
+                return usage(ids[k], SB_PKT_STREAM_SETPOINT, "id"); /* listed twice */
+        s->ids[k] = ids[k];
+        s->angle_min[k] = (int32_t)angle->min;
+        s->angle_max[k] = (int32_t)angle->max;
+    }
+    s->count = count;
+    s->period_ms = period_ms;
+    return sb_ok();
+}
+
+static sb_error refused(int servo, const char *field, int64_t value, int64_t least, int64_t most)
+{
+    sb_error e = usage(servo, SB_PKT_STREAM_SETPOINT, field);
+    e.status = SB_E_RANGE;
+    e.value = value;
+    e.least = least;
+    e.most = most;
+    return e;
+}
+
+sb_error sb_stream_frame(sb_stream *s, const int32_t *angles, const int16_t *velocities, uint8_t *frame, size_t cap,
+                         size_t *len)
+{
+    uint8_t records[SETPOINT_LEN * SB_MAX_SERVOS];
+    int64_t top = sb_packet(SB_PKT_STREAM_SETPOINT)->request[2].max; /* the servo's top speed, 0.1 deg/s */
+    sb_error e = sb_ok();
+    for (size_t k = 0; k < s->count; k++) {
+        sb_value v[4];
+        size_t rlen = 0;
+        int64_t step = s->sent > 0 ? (int64_t)angles[k] - s->last[k] : 0;
+        memset(v, 0, sizeof v);
+        v[0].n = s->ids[k];
+        v[1].n = angles[k];
+        v[2].n = velocities != NULL ? velocities[k] : (step * 1000 + (step < 0 ? -1 : 1) * s->period_ms / 2) / s->period_ms;
+        v[3].n = (int64_t)((s->sent * (uint32_t)s->period_ms) & 0xFFFFu);
+        if (angles[k] < s->angle_min[k] || angles[k] > s->angle_max[k])
+            return refused(s->ids[k], "angle", angles[k], s->angle_min[k], s->angle_max[k]);
+        if ((step < 0 ? -step : step) * 1000 > top * s->period_ms)
+            return refused(s->ids[k], "angle step", step, -top * s->period_ms / 1000, top * s->period_ms / 1000);
+        e = sb_encode_content(SB_PKT_STREAM_SETPOINT, v, 4, records + k * SETPOINT_LEN, SETPOINT_LEN, &rlen);
+        if (e.status != SB_OK)
+            return e;
+    }
+    if (s->count == 1)
+        e = sb_frame(true, SB_PKT_STREAM_SETPOINT, records, SETPOINT_LEN, frame, cap, len);
+    else
+        e = sb_sync_frame(SB_PKT_STREAM_SETPOINT, records, SETPOINT_LEN, s->count, frame, cap, len);
+    if (e.status != SB_OK)
+        return e;
+    for (size_t k = 0; k < s->count; k++)
+        s->last[k] = angles[k];
+    s->sent++;
+    return e;
+}
+
+/* ---- the robot loop ------------------------------------------------------- */
+sb_error sb_loop_init(sb_loop *l, sb_bus *bus, const uint8_t *ids, size_t count, uint16_t period_ms)
+{
+    sb_error e;
+    memset(l, 0, sizeof *l);
+    l->bus = bus;
+    e = sb_stream_init(&l->stream, ids, count, period_ms);
+    if (e.status != SB_OK)
+        return e;
+    return sb_sync_frame(SB_PKT_MONITOR, ids, 1, count, l->monitor, sizeof l->monitor, &l->monitor_len);
+}
+
+sb_error sb_loop_cycle(sb_loop *l, const int32_t *angles, const int16_t *velocities, sb_monitor_answer *states,
+                       bool *got)
+{
+    sb_bus *bus = l->bus;
+    size_t len = 0;
+    sb_error e = sb_stream_frame(&l->stream, angles, velocities, bus->tx, sizeof bus->tx - l->monitor_len, &len);
+    if (e.status != SB_OK)
+        return e;
+    if (l->cycles == 0)
+        l->started_us = bus->t.now_us(bus->t.ctx);
+    /* One write: the Sync Monitor follows the setpoints without a gap. */
+    memcpy(bus->tx + len, l->monitor, l->monitor_len);
+    e = sb_send(bus, bus->tx, len + l->monitor_len);
+    if (e.status != SB_OK)
+        return e;
+    e = sb_sync_monitor_answers(bus, l->stream.ids, l->stream.count, states, got);
+    for (size_t k = 0; k < l->stream.count; k++)
+        l->missed += got[k] ? 0u : 1u;
+    l->cycles++;
+    return e;
+}
+
+static size_t frame_bytes(size_t content)
+{
+    return (content >= SB_EXTENDED_LENGTH ? 7u : 5u) + content;
+}
+
+size_t sb_cycle_bytes(size_t count)
+{
+    size_t setpoints = count == 1 ? frame_bytes(SETPOINT_LEN) : frame_bytes(3u + SETPOINT_LEN * count);
+    return setpoints + frame_bytes(3u + count) + count * sb_answer_frame_size(SB_PKT_MONITOR);
+}
+
+double sb_wire_limit_hz(size_t count, uint32_t baud)
+{
+    return (double)baud / SB_BITS_PER_BYTE / (double)sb_cycle_bytes(count);
+}
+
+double sb_loop_rate_hz(const sb_loop *l)
+{
+    uint64_t now = l->bus->t.now_us(l->bus->t.ctx);
+    return now > l->started_us ? (double)l->cycles * 1e6 / (double)(now - l->started_us) : 0.0;
+}
+
+/* ---- errors in words -------------------------------------------------------- */
+typedef struct text {
+    char *buf;
+    size_t cap, len;
+} text;
+
+static void put(text *t, const char *s)
+{
+    while (*s != '\0') {
+        if (t->len + 1 < t->cap)
+            t->buf[t->len++] = *s;
+        s++;
+    }
+    if (t->cap > 0)
+        t->buf[t->len < t->cap ? t->len : t->cap - 1] = '\0';
+}
+
+static void put_number(text *t, int64_t n)
+{
+    char digits[24];
+    size_t k = sizeof digits - 1;
+    uint64_t u = n < 0 ? 0u - (uint64_t)n : (uint64_t)n;
+    digits[k] = '\0';
+    do {
+        digits[--k] = (char)('0' + u % 10u);
+        u /= 10u;
+    } while (u > 0);
+    if (n < 0)
+        digits[--k] = '-';
+    put(t, digits + k);
+}
+
+static const char *const WHAT[] = {
+    "ok", "out of range", "not allowed", "not a packet of the protocol", "no such writable data item",
+    "the buffer is too small", "no answer", "an answer with a bad checksum", "a bad answer", "the link failed",
+};
+
+size_t sb_error_text(const sb_error *e, char *buf, size_t cap)
+{
+    text t = {buf, cap, 0};
+    const sb_packet_desc *p = e->packet != 0 ? sb_packet(e->packet) : NULL;
+    put(&t, "");
+    if (e->servo >= 0) {
+        put(&t, "servo ");
+        put_number(&t, e->servo);
+        put(&t, ": ");
+    }
+    if (p != NULL) {
+        put(&t, p->name);
+        put(&t, ": ");
+    } else if (e->packet != 0) {
+        put(&t, "packet ");
+        put_number(&t, e->packet);
+        put(&t, ": ");
+    }
+    if (e->field != NULL) {
+        put(&t, e->field);
+        put(&t, " ");
+    }
+    put(&t, (size_t)e->status < sizeof WHAT / sizeof WHAT[0] ? WHAT[e->status] : "unknown error");
+    if (e->status == SB_E_RANGE) {
+        put(&t, ": ");
+        put_number(&t, e->value);
+        put(&t, " is beyond ");
+        put_number(&t, e->least);
+        put(&t, "..");
+        put_number(&t, e->most);
+        put(&t, "; nothing was sent");
+    } else if (e->status == SB_E_NO_ANSWER) {
+        put(&t, " in time (is it on the bus, at this baud rate?)");
+    } else if (e->status == SB_E_LINK) {
+        put(&t, " (errno ");
+        put_number(&t, e->os_error);
+        put(&t, ")");
+    } else if (e->status == SB_E_UNKNOWN_ITEM) {
+        put(&t, " (item ");
+        put_number(&t, e->value);
+        put(&t, ")");
+    }
+    return t.len;
+}

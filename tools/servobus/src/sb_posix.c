@@ -1,0 +1,248 @@
+/* servobus's POSIX transports: a TCP socket and a serial port. */
+#define _GNU_SOURCE
+#include <errno.h>
+#include <fcntl.h>
+#include <netdb.h>
+#include <netinet/in.h>
+#include <netinet/tcp.h>
+#include <poll.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/ioctl.h>
+#include <sys/socket.h>
+#include <termios.h>
+#include <time.h>
+#include <unistd.h>
+#ifdef __linux__
+#include <linux/serial.h>
+#endif
+
+#include "servobus/servobus_posix.h"
+
+/* The most bytes a wait on a socket asks for before it wakes (SO_RCVLOWAT).
+ * A simulator sends each byte as it ends on the wire, a TCP segment each:
+ * asked for more than its first congestion window (ten segments) holds,
+ * a wait for a whole round stalls until its time-out in a connection's
+ * first cycles (scripts/c_loop_bench.sh measured 5 ms a cycle at 21 or
+ * more, none at 10). */
+#define LOW_WATER_MOST 8u
+
+uint64_t sb_monotonic_us(void *ctx)
+{
+    struct timespec ts;
+    (void)ctx;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (uint64_t)ts.tv_sec * 1000000u + (uint64_t)ts.tv_nsec / 1000u;
+}
+
+static void reset(sb_posix *p)
+{
+    memset(p, 0, sizeof *p);
+    p->fd = -1;
+    p->low_water = 1;
+    p->latency_timer_ms = -1;
+}
+
+int sb_tcp_open(sb_posix *p, const char *host, unsigned port)
+{
+    struct addrinfo hints, *res = NULL, *a;
+    char service[8];
+    int one = 1, rc;
+    reset(p);
+    memset(&hints, 0, sizeof hints);
+    hints.ai_family = AF_UNSPEC;
+    hints.ai_socktype = SOCK_STREAM;
+    snprintf(service, sizeof service, "%u", port);
+    rc = getaddrinfo(host, service, &hints, &res);
+    if (rc != 0)
+        return -EHOSTUNREACH;
+    rc = -ECONNREFUSED;
+    for (a = res; a != NULL; a = a->ai_next) {
+        int fd = socket(a->ai_family, a->ai_socktype, a->ai_protocol);
+        if (fd < 0)
+            continue;
+        if (connect(fd, a->ai_addr, a->ai_addrlen) == 0) {
+            p->fd = fd;
+            rc = 0;
+            break;
+        }
+        rc = -errno;
+        close(fd);
+    }
+    freeaddrinfo(res);
+    if (rc != 0)
+        return rc;
+    p->is_socket = true;
+    setsockopt(p->fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one); /* no Nagle delay on small frames */
+    return 0;
+}
+
+static speed_t speed_of(uint32_t baud)
+{
+    switch (baud) {
+    case 9600: return B9600;
+    case 19200: return B19200;
+    case 38400: return B38400;
+    case 57600: return B57600;
+    case 115200: return B115200;
+    case 230400: return B230400;
+#ifdef B500000
+    case 500000: return B500000;
+#endif
+#ifdef B1000000
+    case 1000000: return B1000000;
+#endif
+    default: return 0;
+    }
+}
+
+/* The adapter's latency-timer file for a port's path (NAME of /dev/NAME),
+ * under $SERVOBUS_SYSFS if set (the tests'), else /sys. */
+static void timer_file(const char *path, char *out, size_t cap)
+{
+    const char *name = strrchr(path, '/'), *root = getenv("SERVOBUS_SYSFS");
+    snprintf(out, cap, "%s/class/tty/%s/device/latency_timer", root != NULL ? root : "/sys",
+             name != NULL ? name + 1 : path);
+}
+
+int sb_serial_latency_timer(const char *path)
+{
+    char sys[256];
+    FILE *f;
+    int ms = -1;
+    timer_file(path, sys, sizeof sys);
+    f = fopen(sys, "r");
+    if (f == NULL)
+        return -1;
+    if (fscanf(f, "%d", &ms) != 1)
+        ms = -1;
+    fclose(f);
+    return ms;
+}
+
+/* An FTDI adapter holds what it received until its latency timer runs out
+ * (16 ms by default): at 1 ms a robot loop gets its answers a frame late,
+ * at 16 ms it crawls. */
+void sb_serial_check_latency(sb_posix *p, const char *path)
+{
+    const char *name = strrchr(path, '/');
+    char sys[256];
+    FILE *f;
+    name = name != NULL ? name + 1 : path;
+    p->advice[0] = '\0';
+    p->latency_timer_ms = sb_serial_latency_timer(path);
+    if (p->latency_timer_ms <= 1)
+        return;
+    timer_file(path, sys, sizeof sys);
+    f = fopen(sys, "w");
+    if (f != NULL) {
+        bool written = fputs("1\n", f) >= 0;
+        written = fclose(f) == 0 && written;
+        p->latency_timer_ms = sb_serial_latency_timer(path);
+        if (written && p->latency_timer_ms <= 1)
+            return;
+    }
+    snprintf(p->advice, sizeof p->advice,
+             "%s's latency timer is %d ms: every answer waits for it. Run "
+             "'echo 1 | sudo tee /sys/bus/usb-serial/devices/%s/latency_timer' "
+             "(or a udev rule setting ATTR{latency_timer}=\"1\")", name, p->latency_timer_ms, name);
+}
+
+int sb_serial_open(sb_posix *p, const char *path, uint32_t baud)
+{
+    struct termios tio;
+    speed_t speed = speed_of(baud);
+    reset(p);
+    if (speed == 0)
+        return -EINVAL;
+    p->fd = open(path, O_RDWR | O_NOCTTY | O_NONBLOCK);
+    if (p->fd < 0)
+        return -errno;
+    if (tcgetattr(p->fd, &tio) != 0) {
+        int rc = -errno;
+        sb_posix_close(p);
+        return rc;
+    }
+    cfmakeraw(&tio);
+    tio.c_cflag |= CLOCAL | CREAD;
+    tio.c_cflag &= ~(tcflag_t)(CSTOPB | PARENB | CRTSCTS);
+    tio.c_cc[VMIN] = 0;
+    tio.c_cc[VTIME] = 0;
+    cfsetispeed(&tio, speed);
+    cfsetospeed(&tio, speed);
+    if (tcsetattr(p->fd, TCSANOW, &tio) != 0) {
+        int rc = -errno;
+        sb_posix_close(p);
+        return rc;
+    }
+#ifdef ASYNC_LOW_LATENCY
+    {
+        struct serial_struct ss;
+        if (ioctl(p->fd, TIOCGSERIAL, &ss) == 0) {
+            ss.flags = (int)((unsigned)ss.flags | (unsigned)ASYNC_LOW_LATENCY);
+            p->low_latency = ioctl(p->fd, TIOCSSERIAL, &ss) == 0;
+        }
+    }
+#endif
+    tcflush(p->fd, TCIOFLUSH);
+    sb_serial_check_latency(p, path);
+    return 0;
+}
+
+void sb_posix_close(sb_posix *p)
+{
+    if (p->fd >= 0)
+        close(p->fd);
+    p->fd = -1;
+}
+
+static int posix_write(void *ctx, const uint8_t *data, size_t len)
+{
+    sb_posix *p = (sb_posix *)ctx;
+    while (len > 0) {
+        ssize_t n = p->is_socket ? send(p->fd, data, len, MSG_NOSIGNAL) : write(p->fd, data, len);
+        if (n < 0) {
+            struct pollfd pf = {p->fd, POLLOUT, 0};
+            if (errno != EAGAIN && errno != EINTR)
+                return -errno;
+            poll(&pf, 1, 100);
+            continue;
+        }
+        data += n;
+        len -= (size_t)n;
+    }
+    return 0;
+}
+
+static int posix_read(void *ctx, uint8_t *buf, size_t cap, size_t want, uint32_t wait_us)
+{
+    sb_posix *p = (sb_posix *)ctx;
+    ssize_t n;
+    if (wait_us > 0) {
+        struct pollfd pf = {p->fd, POLLIN, 0};
+        struct timespec ts = {(time_t)(wait_us / 1000000u), (long)(wait_us % 1000000u) * 1000L};
+        /* The socket reads as ready once want bytes are there, not at each
+         * byte a simulator hands over (LOW_WATER_MOST at most). */
+        if (want > LOW_WATER_MOST)
+            want = LOW_WATER_MOST;
+        if (p->is_socket && (int)want != p->low_water && want > 0) {
+            int lw = (int)want;
+            if (setsockopt(p->fd, SOL_SOCKET, SO_RCVLOWAT, &lw, sizeof lw) == 0)
+                p->low_water = lw;
+        }
+        if (ppoll(&pf, 1, &ts, NULL) < 0 && errno != EINTR)
+            return -errno;
+    }
+    n = p->is_socket ? recv(p->fd, buf, cap, MSG_DONTWAIT) : read(p->fd, buf, cap);
+    if (n < 0)
+        return errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR ? 0 : -errno;
+    if (n == 0 && p->is_socket)
+        return -ECONNRESET; /* the other end closed the connection */
+    return (int)n;
+}
+
+sb_transport sb_posix_transport(sb_posix *p)
+{
+    return sb_transport_make(p, posix_write, posix_read, sb_monotonic_us);
+}

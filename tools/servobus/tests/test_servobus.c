@@ -1,0 +1,174 @@
+/* servobus's codec: frames, every field's range, answers checked, the
+ * frame finder, errors in words. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "servobus/servobus.h"
+
+static void ping_frame_is_the_protocols(void **state)
+{
+    uint8_t f[16];
+    size_t len = 0;
+    sb_ping_request r = {7};
+    assert_int_equal(sb_encode_ping(&r, f, sizeof f, &len).status, SB_OK);
+    assert_int_equal(len, 6);
+    uint8_t want[] = {0x12, 0x4C, 0x01, 0x01, 0x07, (uint8_t)(0x12 + 0x4C + 1 + 1 + 7)};
+    assert_memory_equal(f, want, sizeof want);
+}
+
+static void a_field_beyond_its_range_is_refused_naming_servo_packet_field(void **state)
+{
+    uint8_t f[32];
+    size_t len = 99;
+    char text[160];
+    sb_move_angle_request r = {3, 1801, 100, 0};
+    sb_error e = sb_encode_move_angle(&r, f, sizeof f, &len);
+    assert_int_equal(e.status, SB_E_RANGE);
+    assert_int_equal(e.servo, 3);
+    assert_int_equal(e.packet, SB_PKT_MOVE_ANGLE);
+    assert_string_equal(e.field, "angle");
+    assert_int_equal(e.least, -1800);
+    assert_int_equal(e.most, 1800);
+    assert_int_equal(len, 99); /* nothing written */
+    sb_error_text(&e, text, sizeof text);
+    assert_string_equal(text, "servo 3: MoveOnAngleMode: angle out of range: 1801 is beyond -1800..1800; nothing was sent");
+    r.angle = 1800;
+    assert_int_equal(sb_encode_move_angle(&r, f, sizeof f, &len).status, SB_OK);
+    /* A ramp below the schema's 20 ms, an EndAsync other than 0 or 1. */
+    sb_move_angle_by_interval_request ri = {1, 0, 100, 19, 20, 0};
+    e = sb_encode_move_angle_by_interval(&ri, f, sizeof f, &len);
+    assert_int_equal(e.status, SB_E_RANGE);
+    assert_string_equal(e.field, "acc_interval");
+    sb_end_async_request ea = {2};
+    e = sb_encode_end_async(&ea, f, sizeof f, &len);
+    assert_int_equal(e.status, SB_E_RANGE);
+    assert_int_equal(e.servo, -1); /* EndAsync names no servo */
+}
+
+static void write_data_takes_the_items_size_and_range(void **state)
+{
+    uint8_t f[32];
+    size_t len = 0;
+    sb_write_data_request r = {1, SB_ITEM_ANGLE_MAX_DECIDEG, -1800, 0};
+    assert_int_equal(sb_encode_write_data(&r, f, sizeof f, &len).status, SB_OK);
+    assert_int_equal(len, 4 + 4 + 1); /* id, data_id, two bytes */
+    assert_int_equal(f[6], 0xF8); /* -1800 */
+    assert_int_equal(f[7], 0xF8);
+    r.data = -1801;
+    assert_int_equal(sb_encode_write_data(&r, f, sizeof f, &len).status, SB_E_RANGE);
+    r.data_id = 35; /* reserved */
+    r.data = 0;
+    assert_int_equal(sb_encode_write_data(&r, f, sizeof f, &len).status, SB_E_UNKNOWN_ITEM);
+    r.data_id = 1; /* read-only */
+    assert_int_equal(sb_encode_write_data(&r, f, sizeof f, &len).status, SB_E_UNKNOWN_ITEM);
+}
+
+static void answers_are_checked(void **state)
+{
+    sb_monitor_answer m;
+    uint8_t c[16] = {5, 0xE8, 0x1C, 0, 0, 0, 0, 0, 0, 1, 0xFF, 0xFF, 0xFF, 0xFF, 2, 0};
+    sb_error e = sb_decode_monitor(c, sizeof c, &m);
+    assert_int_equal(e.status, SB_OK);
+    assert_int_equal(m.id, 5);
+    assert_int_equal(m.voltage, 7400);
+    assert_int_equal(m.status, 1);
+    assert_int_equal(m.angle, -1);
+    assert_int_equal(m.turns, 2);
+    e = sb_decode_monitor(c, 15, &m);
+    assert_int_equal(e.status, SB_E_BAD_ANSWER);
+    assert_int_equal(e.servo, 5);
+    /* ReadFaults' count is 0..16 (the schema's range on an answer field). */
+    uint8_t fault[32];
+    memset(fault, 0, sizeof fault);
+    fault[0] = 2;
+    fault[1] = 17;
+    sb_read_faults_answer fa;
+    e = sb_decode_read_faults(fault, 27, &fa);
+    assert_int_equal(e.status, SB_E_BAD_ANSWER);
+    assert_string_equal(e.field, "count");
+    fault[1] = 16;
+    assert_int_equal(sb_decode_read_faults(fault, 27, &fa).status, SB_OK);
+}
+
+static void read_data_answers_at_the_items_size(void **state)
+{
+    sb_read_data_answer a;
+    uint8_t c[4] = {1, SB_ITEM_ANGLE_MIN_DECIDEG, 0x08, 0xF9};
+    assert_int_equal(sb_decode_read_data(c, 4, &a).status, SB_OK);
+    assert_int_equal(a.data, -1784);
+    assert_int_equal(a.data_size, 2);
+    assert_int_equal(sb_decode_read_data(c, 3, &a).status, SB_E_BAD_ANSWER);
+    uint8_t hidden[2] = {1, 35}; /* a reserved item: no value */
+    assert_int_equal(sb_decode_read_data(hidden, 2, &a).status, SB_OK);
+    assert_int_equal(a.data_size, 0);
+}
+
+static void the_frame_finder_skips_garbage_and_bad_frames(void **state)
+{
+    uint8_t stream[64];
+    size_t n = 0, len = 0, used = 0, clen = 0;
+    sb_value v[2] = {{4, NULL, 0}, {-5, NULL, 0}};
+    stream[n++] = 0x05;
+    stream[n++] = 0x99; /* not a header */
+    assert_int_equal(sb_encode_answer(SB_PKT_READ_ANGLE, v, 2, stream + n, sizeof stream - n, &len).status, SB_OK);
+    memcpy(stream + n + len, stream + n, len);
+    stream[n + len - 1] ^= 1; /* the first copy's checksum broken */
+    n += 2 * len;
+    sb_parser p;
+    sb_parser_init(&p, false);
+    uint8_t code = 0;
+    const uint8_t *content = NULL;
+    assert_int_equal(sb_parse(&p, stream, n, &used, &code, &content, &clen), 1);
+    assert_int_equal(used, n);
+    assert_int_equal(code, SB_PKT_READ_ANGLE);
+    assert_int_equal(clen, 3);
+    assert_int_equal(content[0], 4);
+    assert_int_equal(p.bad_frames, 1);
+    assert_int_equal(p.stray_bytes, 2);
+    assert_int_equal(sb_parse(&p, stream, 0, &used, &code, &content, &clen), 0);
+}
+
+static void a_long_sync_command_takes_the_extended_length(void **state)
+{
+    uint8_t records[30 * 9], f[300];
+    size_t len = 0;
+    memset(records, 0, sizeof records);
+    assert_int_equal(sb_sync_frame(SB_PKT_STREAM_SETPOINT, records, 9, 30, f, sizeof f, &len).status, SB_OK);
+    assert_int_equal(len, 6 + 3 + 270 + 1);
+    assert_int_equal(f[3], 0xFF);
+    assert_int_equal(f[4] | f[5] << 8, 273);
+    assert_int_equal(f[6], SB_PKT_STREAM_SETPOINT);
+    assert_int_equal(sb_sync_frame(SB_PKT_PING, records, 1, 1, f, sizeof f, &len).status, SB_E_USAGE);
+    assert_int_equal(sb_sync_frame(SB_PKT_MONITOR, records, 2, 1, f, sizeof f, &len).status, SB_E_USAGE);
+    assert_int_equal(sb_sync_frame(SB_PKT_MONITOR, records, 1, 300, f, sizeof f, &len).status, SB_E_USAGE);
+}
+
+static void the_wire_limit_is_servoctls(void **state)
+{
+    /* docs/streaming.md: 495 and 195 cycles/s at 1 Mbaud for 6 and 16 servos. */
+    assert_int_equal(sb_cycle_bytes(6), 62 + 14 + 6 * 21);
+    assert_int_equal((int)sb_wire_limit_hz(6, 1000000), 495);
+    assert_int_equal((int)sb_wire_limit_hz(16, 1000000), 195);
+    assert_int_equal(sb_answer_frame_size(SB_PKT_MONITOR), 21);
+    assert_int_equal(sb_answer_frame_size(SB_PKT_READ_DATA), 0);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(ping_frame_is_the_protocols),
+        cmocka_unit_test(a_field_beyond_its_range_is_refused_naming_servo_packet_field),
+        cmocka_unit_test(write_data_takes_the_items_size_and_range),
+        cmocka_unit_test(answers_are_checked),
+        cmocka_unit_test(read_data_answers_at_the_items_size),
+        cmocka_unit_test(the_frame_finder_skips_garbage_and_bad_frames),
+        cmocka_unit_test(a_long_sync_command_takes_the_extended_length),
+        cmocka_unit_test(the_wire_limit_is_servoctls),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,177 @@
+/* servobus's bus on fake servos: a request's answer, the Sync Monitor with
+ * a servo missing, the stream's checks, the robot loop, the UART callbacks. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "tests/fake_servo.h"
+
+static fake_bus fake;
+static sb_bus bus;
+
+static int set_up(void **state)
+{
+    fake_init(&fake, 1000000);
+    sb_bus_init(&bus, fake_transport(&fake), 1000000);
+    return 0;
+}
+
+static void a_call_returns_the_servos_answer(void **state)
+{
+    fake.present[3] = true;
+    sb_read_angle_request r = {3};
+    sb_read_angle_answer a;
+    assert_int_equal(sb_call_read_angle(&bus, &r, &a).status, SB_OK);
+    assert_int_equal(a.id, 3);
+    assert_int_equal(a.angle, -123);
+    sb_ping_request p = {4};
+    sb_ping_answer pa;
+    uint64_t before = fake.now_us;
+    sb_error e = sb_call_ping(&bus, &p, &pa);
+    assert_int_equal(e.status, SB_E_NO_ANSWER);
+    assert_int_equal(e.servo, 4);
+    assert_int_equal(e.packet, SB_PKT_PING);
+    assert_true(fake.now_us - before >= bus.timeout_us); /* on the bus's clock */
+    char text[120];
+    sb_error_text(&e, text, sizeof text);
+    assert_string_equal(text, "servo 4: Ping: no answer in time (is it on the bus, at this baud rate?)");
+}
+
+static void a_bad_checksum_is_told(void **state)
+{
+    fake.present[3] = true;
+    fake.garble_next = true;
+    sb_ping_request p = {3};
+    sb_ping_answer pa;
+    sb_error e = sb_call_ping(&bus, &p, &pa);
+    assert_int_equal(e.status, SB_E_BAD_CHECKSUM);
+    assert_int_equal(e.servo, 3);
+}
+
+static void a_sync_monitor_names_the_servo_that_did_not_answer(void **state)
+{
+    uint8_t ids[3] = {1, 2, 3};
+    sb_monitor_answer states[3];
+    bool got[3];
+    fake.present[1] = fake.present[3] = true;
+    sb_error e = sb_sync_monitor(&bus, ids, 3, states, got);
+    assert_int_equal(e.status, SB_E_NO_ANSWER);
+    assert_int_equal(e.servo, 2);
+    assert_int_equal(e.packet, SB_PKT_MONITOR);
+    assert_true(got[0] && !got[1] && got[2]);
+    assert_int_equal(states[2].id, 3);
+    fake.present[2] = true;
+    assert_int_equal(sb_sync_monitor(&bus, ids, 3, states, got).status, SB_OK);
+}
+
+static void the_robot_loop_sends_setpoints_and_reads_every_state(void **state)
+{
+    uint8_t ids[6] = {1, 2, 3, 4, 5, 6};
+    int32_t angles[6] = {0, 10, 20, 30, 40, 50};
+    sb_monitor_answer states[6];
+    bool got[6];
+    sb_loop loop;
+    for (int k = 1; k <= 6; k++)
+        fake.present[k] = true;
+    assert_int_equal(sb_loop_init(&loop, &bus, ids, 6, 20).status, SB_OK);
+    for (int c = 0; c < 3; c++) {
+        for (int k = 0; k < 6; k++)
+            angles[k] += 100;
+        assert_int_equal(sb_loop_cycle(&loop, angles, NULL, states, got).status, SB_OK);
+    }
+    assert_int_equal(loop.cycles, 3);
+    assert_int_equal(loop.missed, 0);
+    assert_int_equal(fake.setpoint_frames, 3);
+    assert_int_equal(fake.setpoint[6], 350);
+    assert_int_equal(fake.velocity[6], 5000); /* 10 deg in 20 ms */
+    assert_int_equal(fake.stamp[6], 40);
+    assert_int_equal(states[5].angle, 350);
+    assert_true(sb_loop_rate_hz(&loop) > 0.5 * sb_wire_limit_hz(6, 1000000));
+}
+
+static void the_stream_refuses_what_the_servo_would_not_follow(void **state)
+{
+    uint8_t ids[2] = {1, 2};
+    int32_t angles[2] = {0, 0};
+    uint8_t f[64];
+    size_t len = 0;
+    sb_stream s;
+    assert_int_equal(sb_stream_init(&s, ids, 2, 10).status, SB_OK);
+    assert_int_equal(sb_stream_frame(&s, angles, NULL, f, sizeof f, &len).status, SB_OK);
+    angles[1] = 76; /* 7.6 deg in 10 ms: 760 deg/s */
+    sb_error e = sb_stream_frame(&s, angles, NULL, f, sizeof f, &len);
+    assert_int_equal(e.status, SB_E_RANGE);
+    assert_int_equal(e.servo, 2);
+    assert_string_equal(e.field, "angle step");
+    assert_int_equal(s.sent, 1);
+    s.angle_max[0] = 50;
+    angles[0] = 51;
+    angles[1] = 0;
+    e = sb_stream_frame(&s, angles, NULL, f, sizeof f, &len);
+    assert_int_equal(e.servo, 1);
+    assert_string_equal(e.field, "angle");
+    int16_t speeds[2] = {0, 7501};
+    angles[0] = 0;
+    e = sb_stream_frame(&s, angles, speeds, f, sizeof f, &len);
+    assert_int_equal(e.status, SB_E_RANGE);
+    assert_string_equal(e.field, "velocity");
+    uint8_t twice[2] = {1, 1};
+    assert_int_equal(sb_stream_init(&s, twice, 2, 10).status, SB_E_USAGE);
+}
+
+/* The UART callbacks: the fake's bytes handed over one at a time. */
+static uint8_t uart_in[256];
+static size_t uart_in_len, uart_in_at;
+
+static void uart_send(void *ctx, const uint8_t *data, size_t len)
+{
+    fake_bus *f = (fake_bus *)ctx;
+    sb_transport t = fake_transport(f);
+    t.write(f, data, len);
+    uart_in_len = uart_in_at = 0;
+    int n;
+    while ((n = t.read(f, uart_in + uart_in_len, sizeof uart_in - uart_in_len, 1, 0)) > 0)
+        uart_in_len += (size_t)n;
+}
+
+static int uart_recv(void *ctx)
+{
+    (void)ctx;
+    return uart_in_at < uart_in_len ? uart_in[uart_in_at++] : -1;
+}
+
+static uint64_t uart_now(void *ctx)
+{
+    return ++((fake_bus *)ctx)->now_us;
+}
+
+static void the_uart_callbacks_carry_a_request(void **state)
+{
+    sb_uart u = {uart_send, uart_recv, uart_now, &fake};
+    sb_bus ubus;
+    sb_bus_init(&ubus, sb_uart_transport(&u), 1000000);
+    fake.present[9] = true;
+    sb_ping_request p = {9};
+    sb_ping_answer a;
+    assert_int_equal(sb_call_ping(&ubus, &p, &a).status, SB_OK);
+    assert_int_equal(a.id, 9);
+    p.id = 8;
+    assert_int_equal(sb_call_ping(&ubus, &p, &a).status, SB_E_NO_ANSWER);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test_setup(a_call_returns_the_servos_answer, set_up),
+        cmocka_unit_test_setup(a_bad_checksum_is_told, set_up),
+        cmocka_unit_test_setup(a_sync_monitor_names_the_servo_that_did_not_answer, set_up),
+        cmocka_unit_test_setup(the_robot_loop_sends_setpoints_and_reads_every_state, set_up),
+        cmocka_unit_test_setup(the_stream_refuses_what_the_servo_would_not_follow, set_up),
+        cmocka_unit_test_setup(the_uart_callbacks_carry_a_request, set_up),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

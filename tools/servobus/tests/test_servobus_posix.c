@@ -1,0 +1,97 @@
+/* servobus's serial transport and a USB-serial adapter's latency timer:
+ * read from sysfs (a folder standing for /sys here), set to 1 ms where it
+ * is slower. */
+#define _GNU_SOURCE
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cmocka.h>
+
+#include "servobus/servobus_posix.h"
+
+static char root[64];
+static char timer[200];
+
+static void put(const char *text)
+{
+    FILE *f = fopen(timer, "w");
+    assert_non_null(f);
+    fputs(text, f);
+    fclose(f);
+}
+
+static int set_up(void **state)
+{
+    char dir[160];
+    strcpy(root, "/tmp/servobus-sysfs-XXXXXX");
+    assert_non_null(mkdtemp(root));
+    snprintf(dir, sizeof dir, "%s/class", root);
+    mkdir(dir, 0755);
+    snprintf(dir, sizeof dir, "%s/class/tty", root);
+    mkdir(dir, 0755);
+    snprintf(dir, sizeof dir, "%s/class/tty/ttyUSB7", root);
+    mkdir(dir, 0755);
+    snprintf(dir, sizeof dir, "%s/class/tty/ttyUSB7/device", root);
+    mkdir(dir, 0755);
+    snprintf(timer, sizeof timer, "%s/latency_timer", dir);
+    setenv("SERVOBUS_SYSFS", root, 1);
+    return 0;
+}
+
+static int tear_down(void **state)
+{
+    char cmd[128];
+    snprintf(cmd, sizeof cmd, "rm -rf %s", root);
+    unsetenv("SERVOBUS_SYSFS");
+    return system(cmd);
+}
+
+static void the_latency_timer_is_read_and_set_to_1_ms(void **state)
+{
+    sb_posix p;
+    memset(&p, 0, sizeof p);
+    assert_int_equal(sb_serial_latency_timer("/dev/ttyUSB7"), -1);
+    put("16\n");
+    assert_int_equal(sb_serial_latency_timer("/dev/ttyUSB7"), 16);
+    sb_serial_check_latency(&p, "/dev/ttyUSB7");
+    assert_int_equal(p.latency_timer_ms, 1);
+    assert_int_equal(sb_serial_latency_timer("/dev/ttyUSB7"), 1);
+    assert_string_equal(p.advice, "");
+}
+
+static void a_timer_that_cannot_be_set_names_the_fix(void **state)
+{
+    sb_posix p;
+    memset(&p, 0, sizeof p);
+    /* A file no one may write, root included, that reads as a number
+     * above 1: a read-only sysctl (its kernel's major version). */
+    assert_int_equal(symlink("/proc/sys/kernel/osrelease", timer), 0);
+    sb_serial_check_latency(&p, "/dev/ttyUSB7");
+    assert_true(p.latency_timer_ms > 1);
+    assert_non_null(strstr(p.advice, "echo 1 | sudo tee /sys/bus/usb-serial/devices/ttyUSB7/latency_timer"));
+    assert_non_null(strstr(p.advice, "ttyUSB7's latency timer is "));
+}
+
+static void a_rate_termios_has_not_is_refused(void **state)
+{
+    sb_posix p;
+    assert_int_equal(sb_serial_open(&p, "/dev/null", 250000), -22); /* -EINVAL */
+    assert_true(sb_serial_open(&p, "/nonexistent/tty", 115200) < 0);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test_setup_teardown(the_latency_timer_is_read_and_set_to_1_ms, set_up, tear_down),
+        cmocka_unit_test_setup_teardown(a_timer_that_cannot_be_set_names_the_fix, set_up, tear_down),
+        cmocka_unit_test(a_rate_termios_has_not_is_refused),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

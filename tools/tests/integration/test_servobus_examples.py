@@ -1,0 +1,63 @@
+"""servobus's host examples (tools/servobus/examples, docs/c-library.md)
+against servo_sim: the ros2_control-style read()/write() cycle in C++, and
+the C robot loop of scripts/c_loop_bench.sh. Both wait on the simulator's
+clock (its file, state_dir/bus.clock): a loaded PC slows them, it does not
+fail them. The simulator follows the wall clock (REAL_TIME): the examples
+pace themselves on it."""
+import subprocess
+from pathlib import Path
+
+from servoctl.servo import Servo
+from servoctl.sim import Simulator
+
+from ..launchers import REPO
+from .conftest import finish
+
+REAL_TIME = True
+EXAMPLES = REPO / "build" / "host" / "tools" / "servobus"
+
+
+def _run(args, timeout=120):
+    """An example, stopped whatever happens (subprocess.run kills it on a timeout)."""
+    return subprocess.run([str(EXAMPLES / args[0]), *args[1:]], capture_output=True, text=True, timeout=timeout)
+
+
+def _where(sim):
+    return sim.url.removeprefix("socket://"), str(Path(sim.state_dir) / "bus.clock")
+
+
+def test_the_ros2_control_style_cycle_moves_three_joints(sim3):
+    with sim3.bus(timeout=0.2) as bus:
+        for i in (1, 2, 3):
+            Servo(bus, i).write("soft_start_on", 0)
+    address, clock = _where(sim3)
+    done = _run(["sb_ros2_cycle", address, "--clock", clock, "--ids", "1,2,3", "--seconds", "1", "--period-ms", "10"])
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "cycles 100 joints 3 missed" in done.stdout, done.stdout
+    assert "AddressSanitizer" not in done.stderr and "runtime error" not in done.stderr
+    assert abs(sim3.state(2)["angle"] - 10.0) < 1.5  # 10 degrees on from 0
+
+
+def test_the_c_robot_loop_reads_every_state(sim3):
+    address, clock = _where(sim3)
+    done = _run(["sb_loop_bench", address, clock, "115200", "3", "40"])
+    assert done.returncode == 0, done.stdout + done.stderr
+    words = dict(zip(*[iter(done.stdout.split())] * 2))
+    # A state missed only where a loaded PC stalls the host past a round's time-out.
+    assert words["cycles"] == "40" and int(words["missed"]) <= 3, done.stdout
+    # Its rate against the wire's limit is the benchmark's (docs/c-library.md);
+    # here only that a cycle is never shorter than its bytes on the wire.
+    assert 0.0 < float(words["ratio"]) <= 1.0, done.stdout
+
+
+def test_the_serial_transport_on_servo_sims_pseudo_terminal(tmp_path):
+    """sb_serial_open (termios raw 8N1; no low-latency mode or latency
+    timer on a pty) carries the C loop as the TCP socket does."""
+    sim = Simulator(ids=[1, 2], tcp=False, state_dir=str(tmp_path / "state")).start()
+    try:
+        done = _run(["sb_loop_bench", sim.url, str(tmp_path / "state" / "bus.clock"), "115200", "2", "20"])
+    finally:
+        finish(sim, [1, 2])
+    assert done.returncode == 0, done.stdout + done.stderr
+    words = dict(zip(*[iter(done.stdout.split())] * 2))
+    assert words["cycles"] == "20" and int(words["missed"]) <= 2, done.stdout
