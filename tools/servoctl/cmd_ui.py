@@ -1,0 +1,58 @@
+"""servoctl ui: the bench in a web browser, a page served on this computer
+for the bus servoctl is connected to (servoctl/ui: the server, the bus
+thread and the page). Its first line of output is the page's address with
+its token; Ctrl-C stops it."""
+import asyncio
+import secrets
+import signal
+import sys
+import webbrowser
+
+from . import __version__
+
+
+def global_argv(args) -> list:
+    """The options every command the page runs is parsed with: this bus's."""
+    argv = ["--port", args.port, "--timeout", str(args.timeout)]
+    if args.sim_control:
+        argv += ["--sim-control", str(args.sim_control)]
+    if args.baud:
+        argv += ["--baud", str(args.baud)]
+    return argv
+
+
+def cmd_ui(bus, args):
+    from .ui.server import Page, serve  # aiohttp loads for this command alone
+    from .ui.worker import Worker
+
+    token = secrets.token_urlsafe(18)
+    about = {"port": args.port, "simulator": bool(args.sim_control), "version": __version__}
+    page = Page(None, token, about)
+    worker = Worker(bus, global_argv(args), page.publish)
+    page.worker = worker
+
+    def ready(port: int):
+        host = "127.0.0.1" if args.bind in ("0.0.0.0", "::", "") else args.bind
+        url = f"http://{host}:{port}/?token={token}"
+        print(f"servoctl ui: {url}", flush=True)
+        if args.bind not in ("127.0.0.1", "localhost", "::1"):
+            print(f"servoctl ui: warning: listening on {args.bind}: anyone who reaches it with the "
+                  f"token drives the bus", file=sys.stderr, flush=True)
+        print("servoctl ui: Ctrl-C stops", file=sys.stderr, flush=True)
+        if not args.no_browser:
+            webbrowser.open(url)
+
+    async def main():
+        stop = asyncio.Event()
+        loop = asyncio.get_running_loop()
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            loop.add_signal_handler(sig, stop.set)
+        await serve(page, args.bind, args.listen, ready, stop)
+
+    worker.start()
+    try:
+        asyncio.run(main())
+    finally:
+        worker.stop()
+    print("servoctl ui: stopped", file=sys.stderr)
+    return 0

@@ -1,0 +1,40 @@
+// The Bring-up view: calibrate, identify and tune as steps with their
+// progress and figures (servoctl's own lines as they are printed), the
+// fault history with clear, the bus watchdog, firmware updates of several
+// servos in a row (with a bootloader caught at power-up for recovery).
+"use strict";
+(() => {
+  const {$, runInto, picked} = UI;
+
+  async function step(argv) {
+    const prog = $("#br-prog");
+    prog.hidden = false;
+    document.querySelectorAll("#view-bringup button").forEach((b) => { b.dataset.was = b.disabled; b.disabled = true; });
+    try {
+      return await runInto($("#bringup-out"), argv);
+    } finally {
+      prog.hidden = true;
+      document.querySelectorAll("#view-bringup button").forEach((b) => { b.disabled = b.dataset.was === "true"; });
+    }
+  }
+
+  document.addEventListener("DOMContentLoaded", () => {
+    $("#br-cal").addEventListener("click", () =>
+      step(["calibrate", picked()].concat($("#br-keep").checked ? ["--keep-zero"] : [])));
+    $("#br-id").addEventListener("click", () => step(["identify", picked()]));
+    $("#br-tune").addEventListener("click", () =>
+      step(["tune", picked(), "--bandwidth", $("#br-bw").value].concat($("#br-dry").checked ? ["--dry-run"] : [])));
+    $("#fl-read").addEventListener("click", () => step(["faults", picked()]));
+    $("#fl-clear").addEventListener("click", () => step(["faults", picked(), "--clear"]));
+    $("#wd-set").addEventListener("click", async () => {
+      const r = await step(["config", "set", picked(), "watchdog_action", $("#wd-action").value]);
+      if (!r.code) await step(["config", "set", picked(), "watchdog_ms", $("#wd-ms").value]);
+    });
+    $("#up-go").addEventListener("click", () => {
+      const ids = $("#up-ids").value.split(/[\s,]+/).filter((s) => s);
+      const argv = ["update", ...ids, $("#up-file").value];
+      if (Number($("#up-catch").value) > 0) argv.push("--catch", $("#up-catch").value);
+      step(argv);
+    });
+  });
+})();
