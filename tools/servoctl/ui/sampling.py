@@ -6,11 +6,12 @@ estimate), stamped with the bus clock at each answer's arrival (the
 simulator's clock given --sim-control), as `servoctl monitor` stamps them."""
 import math
 
-from .. import registers, units
+from .. import group, registers, units
 from ..errors import ServoError
 from ..live import _celsius
 from ..servo import Servo
 
+HEX = {"model", "firmware", "serial"}  # shown as servoctl info shows them
 NO_MOTION = "the maker's firmware has no ReadMotion (0x40): no target or winding estimate"
 
 
@@ -35,7 +36,8 @@ def items_of(bus, servo_id: int) -> list:
                "names": [n for _, n in item.names], "m0": item.size_first_why}
         try:
             raw = batch[item.name] if item.name in batch else s.read(item.id)
-            row.update(raw=raw, value=units.show(item, raw), edit=_edit_text(item, raw))
+            shown = f"0x{raw:0{2 * item.size}x}" if item.name in HEX else units.show(item, raw)
+            row.update(raw=raw, value=shown, edit=_edit_text(item, raw))
         except ServoError as e:
             row.update(missing=f"not on this servo's firmware: {e}")
         out.append(row)
@@ -62,36 +64,56 @@ class Sampler:
     def __init__(self, bus, ids):
         self.bus, self.ids = bus, list(ids)
         self.t0 = bus.clock()
-        self.no_motion = set()
+        self.no_motion, self.has_motion = set(), set()
         self.last = {}
+        self.silent = {}
+        self.rounds = 0
 
     def take(self) -> list:
+        """One round: Monitor of each servo (one Sync Monitor for several),
+        then ReadMotion (target, speed, winding) of each of one or two
+        servos; of more, of one in turn, so that six keep 50 rounds a
+        second at 115200 baud."""
+        arrivals = {}
+        self.rounds += 1
+        if len(self.ids) > 1:
+            monitors = group.sync_monitor(self.bus, self.ids, arrivals=arrivals)
+        else:
+            monitors = {}
+            try:
+                monitors[self.ids[0]] = Servo(self.bus, self.ids[0]).monitor()
+                arrivals[self.ids[0]] = self.bus.arrived_at
+            except ServoError as e:
+                self.silent = {self.ids[0]: str(e)}
         rows = []
         for servo_id in self.ids:
-            s = Servo(self.bus, servo_id)
-            try:
-                m = s.monitor()
-            except ServoError as e:
-                rows.append({"id": servo_id, "t": round(self.bus.clock() - self.t0, 4), "silent": str(e)})
+            m = monitors.get(servo_id)
+            if m is None:
+                why = self.silent.get(servo_id) if len(self.ids) == 1 else None
+                rows.append({"id": servo_id, "t": round(self.bus.clock() - self.t0, 4),
+                             "silent": why or f"servo {servo_id}: no answer in its Sync Monitor slot"})
                 self.last.pop(servo_id, None)
                 continue
-            t = (self.bus.arrived_at or self.bus.clock()) - self.t0
-            angle = m.angle_decideg / 10.0
-            row = {"id": servo_id, "t": round(t, 4), "angle": angle, "voltage": m.voltage_mv / 1000.0,
-                   "current": m.current_ma / 1000.0, "power": m.power_mw / 1000.0,
-                   "temperature": _num(_celsius(m.temperature_adc)),
-                   "status": registers.status_names(m.status)}
-            before = self.last.get(servo_id)
-            self.last[servo_id] = (t, angle)
-            row["speed"] = round((angle - before[1]) / (t - before[0]), 1) if before and t > before[0] else None
-            if servo_id not in self.no_motion:
-                try:
-                    r = s.read_motion()
-                    row.update(target=r.target_decideg / 10.0, setpoint=r.setpoint_decideg / 10.0,
-                               speed=r.velocity_decideg_s / 10.0, winding=r.winding_decic / 10.0,
-                               limiter=r.limiter)
-                except ServoError:
+            rows.append(self._row(servo_id, m, (arrivals.get(servo_id) or self.bus.clock()) - self.t0))
+        return rows
+
+    def _row(self, servo_id: int, m, t: float) -> dict:
+        angle = m.angle_decideg / 10.0
+        row = {"id": servo_id, "t": round(t, 4), "angle": angle, "voltage": m.voltage_mv / 1000.0,
+               "current": m.current_ma / 1000.0, "power": m.power_mw / 1000.0,
+               "temperature": _num(_celsius(m.temperature_adc)), "status": registers.status_names(m.status)}
+        before = self.last.get(servo_id)
+        self.last[servo_id] = (t, angle)
+        row["speed"] = round((angle - before[1]) / (t - before[0]), 1) if before and t > before[0] else None
+        turn = len(self.ids) <= 2 or servo_id == self.ids[self.rounds % len(self.ids)]
+        if turn and servo_id not in self.no_motion:
+            try:
+                r = Servo(self.bus, servo_id).read_motion()
+                row.update(target=r.target_decideg / 10.0, setpoint=r.setpoint_decideg / 10.0,
+                           speed=r.velocity_decideg_s / 10.0, winding=r.winding_decic / 10.0, limiter=r.limiter)
+                self.has_motion.add(servo_id)
+            except ServoError:
+                if servo_id not in self.has_motion:  # never answered it: not a lost answer
                     self.no_motion.add(servo_id)
                     row["note"] = NO_MOTION
-            rows.append(row)
-        return rows
+        return row

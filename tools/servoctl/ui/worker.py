@@ -19,7 +19,7 @@ from . import sampling
 # monitor, a stream and the ui itself run until stopped; sim and image need
 # no bus.
 RUNNABLE = set(cli.COMMANDS) - {"monitor", "stream", "record", "ui"}
-TABLE_EVERY_S = 1.0  # the live table's info round, bus time
+TABLE_EVERY_S = (1.0, 3.0)  # the live table's info round, bus time: idle, plotting
 
 
 class _Lines(io.TextIOBase):
@@ -118,9 +118,10 @@ class Worker:
         self.table()
 
     def table(self):
-        """Every known servo's info (servoctl info --json), or why it is silent."""
+        """Every known servo's info (servoctl info --json), or why it is
+        silent; a servo being plotted is left to its samples."""
         rows = []
-        for servo_id in self.known:
+        for servo_id in (i for i in self.known if i not in self.plot_ids):
             r = self.run_quiet(["info", str(servo_id), "--json"])
             if r["code"] == 0:
                 rows.append(json.loads(r["out"]))
@@ -186,5 +187,5 @@ class Worker:
             self.stopping.wait(1.0)
             return
         if self.known and now >= self._next_table:
-            self._next_table = now + TABLE_EVERY_S
+            self._next_table = now + TABLE_EVERY_S[bool(self.plot_ids)]
             self.table()

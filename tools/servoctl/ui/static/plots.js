@@ -83,6 +83,8 @@
 
   on("plotting", (m) => {
     ids = m.ids;
+    rows = [];    // a new round of sampling: its clock starts at 0
+    notes = {};
     build();
     dirty = true;
   });
@@ -100,7 +102,7 @@
     const known = Object.keys(state.servos).map(Number).filter((i) => !state.servos[i].gone);
     box.innerHTML = "";
     known.forEach((id) => box.append(el("label", {}, el("input", {type: "checkbox", value: id,
-      ...(id === UI.picked() ? {checked: ""} : {})}), ` ${id} `)));
+      ...((ids.length ? ids.includes(id) : id === UI.picked()) ? {checked: ""} : {})}), ` ${id} `)));
   }
 
   document.addEventListener("DOMContentLoaded", () => {

@@ -1,0 +1,183 @@
+"""servoctl ui in a real browser: headless Debian chromium, driven by
+Playwright, against servo_sim with 6 servos. The page loads, a scan lists
+the servos, an item edited on the page is on the servo, a move moves the
+simulated horn, the plot shows samples, stop-all stops a wheel, a servo
+unplugged mid-session is shown gone, a second tab is told who drives, the
+token and origin checks refuse, and Ctrl-C stops the server cleanly.
+Horn and wheel are judged on the simulator's state and clock.
+
+SERVO_UI_SCREENSHOTS=DIR saves a screenshot of each view there (docs/ui:
+`SERVO_UI_SCREENSHOTS=docs/ui`); without it nothing is written."""
+import os
+import shutil
+import time
+import urllib.error
+import urllib.request
+from pathlib import Path
+
+import pytest
+
+from servoctl.servo import Servo
+from servoctl.sim import Simulator
+from ..ui_launch import CHROMIUM, UiProcess, launch_chromium, navigation_ms
+
+playwright_api = pytest.importorskip("playwright.sync_api")
+IDS = [1, 2, 3, 4, 5, 6]
+SHOTS = os.environ.get("SERVO_UI_SCREENSHOTS")
+WAIT_MS = 15000  # host time for the page to show what the bus thread did
+
+
+@pytest.fixture(scope="module")
+def bench():
+    if not Path(CHROMIUM).exists():
+        pytest.fail(f"no {CHROMIUM}: scripts/setup.sh installs Debian's chromium")
+    with Simulator(ids=IDS) as sim, UiProcess(sim) as ui, playwright_api.sync_playwright() as pw:
+        context, profile = launch_chromium(pw)
+        try:
+            page = context.new_page()
+            page.goto(ui.url)
+            yield sim, ui, context, page
+        finally:
+            context.close()
+            shutil.rmtree(profile, ignore_errors=True)
+
+
+def _shot(page, name: str):
+    if SHOTS:
+        Path(SHOTS).mkdir(parents=True, exist_ok=True)
+        page.screenshot(path=str(Path(SHOTS) / f"{name}.png"))
+
+
+def _view(page, name: str):
+    page.click(f"#tabs button[data-view={name}]")
+
+
+def _status(url: str, origin: str = None) -> int:
+    req = urllib.request.Request(url, headers={"Origin": origin} if origin else {})
+    try:
+        with urllib.request.urlopen(req, timeout=5) as r:
+            return r.status
+    except urllib.error.HTTPError as e:
+        return e.code
+
+
+def test_first_line_is_the_address_with_its_token(bench):
+    _, ui, _, _ = bench
+    assert ui.first_line.startswith("servoctl ui: http://127.0.0.1:") and len(ui.token) >= 20
+
+
+def test_page_loads_and_a_scan_lists_the_servos(bench):
+    _, _, _, page = bench
+    page.wait_for_function("document.querySelectorAll('#bus-table tbody tr').length === 6", timeout=WAIT_MS)
+    page.wait_for_function("[...document.querySelectorAll('#bus-table td.state')]"
+                           ".every(td => td.textContent === 'answering')", timeout=WAIT_MS)
+    assert page.inner_text("#bus-table tr[data-id='4'] td:nth-child(2)") == "0x51a00004"
+    assert navigation_ms(page)["load_ms"] > 0
+    assert page.inner_text("#role") == "this tab drives the bus"
+    _shot(page, "bus")
+
+
+def test_an_item_edited_on_the_page_is_refused_as_servoctl_says_then_set(bench):
+    _, _, _, page = bench
+    _view(page, "servo")
+    field = page.locator("#items tr[data-item=angle_max] input")
+    field.wait_for(timeout=WAIT_MS)
+    field.fill("400")
+    field.press("Enter")
+    why = page.locator("#items tr[data-item=angle_max] td.why")
+    why.filter(has_text="servoctl: error: angle_max (51) must be").wait_for(timeout=WAIT_MS)
+    field.fill("120")
+    field.press("Enter")
+    why.filter(has_text="angle_max = 120.0 deg").wait_for(timeout=WAIT_MS)
+    assert "RAM" in page.inner_text("#items tr[data-item=watchdog_ms]")
+    _shot(page, "servo")  # read back at the end, on the servo (test_ctrl_c_...)
+
+
+def test_the_plot_shows_samples(bench):
+    _, _, _, page = bench
+    _view(page, "plots")
+    page.check("#plot-ids input[value='1']")
+    page.check("#plot-ids input[value='2']")
+    page.click("#plot-start")
+    page.wait_for_function("servoUiPlots.count() >= 100", timeout=WAIT_MS)
+    rates = page.evaluate("servoUiPlots.rates()")
+    assert set(rates) == {"1", "2"} and all(r > 0 for r in rates.values())
+    head, first = page.evaluate("servoUiPlots.csv()").splitlines()[:2]
+    assert head.startswith("t_s,id,angle_deg,target_deg") and first.split(",")[1] in ("1", "2")
+    page.click("#plot-pause")
+    assert page.evaluate("servoUiPlots.paused()")
+    page.click("#plot-pause")
+
+
+def test_a_move_on_the_page_moves_the_horn(bench):
+    sim, _, _, page = bench
+    _view(page, "motion")
+    page.fill("#mv-angle", "45")
+    page.fill("#mv-value", "300")
+    page.click("#mv-go")
+    sim.wait_until(lambda: abs(sim.state(1)["angle"] - 45) < 1.0, timeout_s=5)
+    _shot(page, "motion")
+    _view(page, "plots")  # sampled since the last test: the move on its plots
+    page.wait_for_timeout(300)
+    _shot(page, "plots")
+
+
+def test_stop_all_stops_a_wheel(bench):
+    sim, _, _, page = bench
+    page.evaluate("UI.run(['wheel', 3, 'run', '--speed', 180])")
+    sim.wait_until(lambda: abs(sim.state(3)["velocity"]) > 100, timeout_s=5)
+    page.select_option("#stop-mode", "damping")
+    page.click("#stop-all")  # on every view's header
+    sim.wait_until(lambda: abs(sim.state(3)["velocity"]) < 2, timeout_s=3)
+    page.locator("#log div", has_text="stop-all: 6 servo(s) damped").wait_for(timeout=WAIT_MS)
+
+
+def test_a_servo_unplugged_mid_session_is_shown_gone(bench):
+    sim, _, _, page = bench
+    page.evaluate("servoUiPlots && UI.send({op: 'plot', ids: []})")
+    _view(page, "bus")
+    assert sim.control("unplug 1 5").strip() == "ok"
+    try:
+        page.locator("#bus-table tr.gone[data-id='5'] td.state", has_text="gone: ").wait_for(timeout=WAIT_MS)
+    finally:
+        sim.control("unplug 0 5")
+    page.locator("#bus-table tr[data-id='5']:not(.gone)").wait_for(timeout=WAIT_MS)
+
+
+def test_bring_up_view_shows_the_fault_history(bench):
+    _, _, _, page = bench
+    _view(page, "bringup")
+    page.click("#fl-read")
+    page.locator("#bringup-out", has_text="servo 1:").wait_for(timeout=WAIT_MS)
+    _shot(page, "bringup")
+
+
+def test_a_second_tab_is_told_who_drives(bench):
+    _, ui, context, _ = bench
+    second = context.new_page()
+    try:
+        second.goto(ui.url)
+        second.locator("#role", has_text="drives the bus").wait_for(timeout=WAIT_MS)
+        assert "watching: the tab opened at" in second.inner_text("#role")
+    finally:
+        second.close()
+
+
+def test_no_token_or_another_origin_is_refused(bench):
+    _, ui, _, _ = bench
+    assert _status(ui.url) == 200
+    assert _status(ui.base + "/") == 403
+    assert _status(ui.base + "/?token=" + "x" * len(ui.token)) == 403
+    assert _status(ui.base + "/static/app.js") == 403
+    assert _status(ui.url, origin="http://evil.example") == 403
+    ws = ui.base + "/ws?token=" + ui.token
+    assert _status(ws, origin="http://evil.example") == 403
+    assert _status(ws) == 403  # a WebSocket without an Origin
+
+
+def test_ctrl_c_stops_cleanly_and_the_edit_is_on_the_servo(bench):
+    sim, ui, _, _ = bench
+    code, err = ui.stop()
+    assert code == 0 and "servoctl ui: stopped" in err, err
+    with sim.bus() as bus:
+        assert Servo(bus, 1).read("angle_max") == 1200
