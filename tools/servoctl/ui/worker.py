@@ -12,7 +12,7 @@ import threading
 
 from .. import cli
 from ..args import build_parser
-from ..errors import ServoError
+from ..errors import EXIT_INTERRUPTED, ServoError
 from . import sampling
 
 # Commands the page may run as they are: those that end on their own. A
@@ -56,6 +56,10 @@ class Worker:
         self.plot_ids = []  # sampled while the queue is empty
         self.sampler = None
         self.stopping = threading.Event()
+        self.interrupt = threading.Event()  # stop-all: the running command ends at its next bus step
+        self.busy, self.current = False, None
+        for name in ("request", "send", "sleep", "gather"):
+            setattr(bus, name, self._interruptible(getattr(bus, name)))
         self.thread = threading.Thread(target=self._loop, name="servoctl-ui-bus", daemon=True)
         self._next_table = 0.0
 
@@ -72,7 +76,16 @@ class Worker:
 
     def submit_urgent(self, fn, *a):
         self.urgent.put((fn, a))
+        if self.busy and self.current != self.stop_all:
+            self.interrupt.set()
         self.jobs.put(("wake", ()))
+
+    def _interruptible(self, step):
+        def step_unless_stopped(*a, **kw):
+            if self.interrupt.is_set():
+                raise KeyboardInterrupt
+            return step(*a, **kw)
+        return step_unless_stopped
 
     # What the page asks for -------------------------------------------------
 
@@ -90,7 +103,11 @@ class Worker:
                 args = build_parser().parse_args(self.global_argv + list(argv))
                 if args.command == "config":
                     cli.args_.config_operands(args)
+                args.on_progress = self._progress(tag)
                 code = cli.run_command(self.bus, args)
+            except KeyboardInterrupt:
+                print("servoctl: interrupted by stop-all", file=err)
+                code = EXIT_INTERRUPTED
             except SystemExit as e:  # argparse's usage error, printed to err
                 code = e.code if isinstance(e.code, int) else 2
             except ServoError as e:
@@ -100,6 +117,18 @@ class Worker:
                 print(f"servoctl: error: {e}", file=err)
                 code = 2
         return self._result(tag, argv, code, out.text(), err.text())
+
+    def _progress(self, tag):
+        """update's progress, a line each tenth of an image."""
+        said = {}
+
+        def say(servo_id, done, total):
+            tenth = done * 10 // max(total, 1)
+            if said.get(servo_id) != tenth:
+                said[servo_id] = tenth
+                self.publish({"type": "progress", "tag": tag, "id": servo_id, "done": done, "total": total,
+                              "text": f"servo {servo_id}: {done} of {total} B"})
+        return say
 
     def _result(self, tag, argv, code, out, err) -> dict:
         msg = {"type": "result", "tag": tag, "argv": argv, "command": "servoctl " + shlex.join(argv),
@@ -145,10 +174,21 @@ class Worker:
         self.publish({"type": "plotting", "ids": self.plot_ids})
 
     def stop_all(self, mode: str):
-        """Every known servo damped or released (servoctl stop ID --mode)."""
+        """Every known servo damped or released (servoctl stop ID --mode);
+        the commands still queued are dropped, unrun."""
+        self.interrupt.clear()
+        while True:
+            try:
+                job = self.jobs.get_nowait()
+            except queue.Empty:
+                break
+            if job and job[0] == self.run:
+                argv, tag = job[1]
+                self._result(tag, argv, EXIT_INTERRUPTED, "", "servoctl ui: not run: stop-all came first")
         ids = self.known or self.plot_ids
         said = [self.run_quiet(["stop", str(i), "--mode", mode]) for i in ids]
         failed = [r["err"] for r in said if r["code"]]
+        self.interrupt.clear()  # one set as this began: it interrupts nothing later
         self.publish({"type": "stopped", "mode": mode, "ids": ids, "failed": failed})
 
     # The thread -------------------------------------------------------------
@@ -164,16 +204,24 @@ class Worker:
             if job is None:
                 return
             if job == "idle":
-                self._idle()
+                try:
+                    self._idle()
+                except KeyboardInterrupt:
+                    self.interrupt.clear()  # stop-all, a moment late: it runs next
             elif job[0] != "wake":
                 self._do(job)
 
     def _do(self, job):
         fn, a = job
+        self.busy, self.current = True, fn
         try:
             fn(*a)
+        except KeyboardInterrupt:
+            self.publish({"type": "error", "text": "servoctl ui: interrupted by stop-all"})
         except Exception as e:  # noqa: BLE001 - the page hears it; the thread goes on
             self.publish({"type": "error", "text": f"servoctl ui: {type(e).__name__}: {e}"})
+        finally:
+            self.busy = False
 
     def _idle(self):
         if self.sampler is not None:

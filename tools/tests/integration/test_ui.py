@@ -17,6 +17,7 @@ from pathlib import Path
 
 import pytest
 
+from servoctl import image as img
 from servoctl.servo import Servo
 from servoctl.sim import Simulator
 from ..ui_launch import CHROMIUM, UiProcess, launch_chromium, navigation_ms
@@ -132,6 +133,19 @@ def test_stop_all_stops_a_wheel(bench):
     page.locator("#log div", has_text="stop-all: 6 servo(s) damped").wait_for(timeout=WAIT_MS)
 
 
+def test_stop_all_ends_a_running_command_first(bench):
+    """A move that waits for its arrival is cut short: stop-all does not
+    wait behind it."""
+    sim, _, _, page = bench
+    page.evaluate("() => { window.waiting = UI.run(['move', 1, -90, '--interval', 4000, '--wait']); }")
+    sim.wait_until(lambda: sim.state(1)["angle"] < 35, timeout_s=3)
+    page.click("#stop-all")  # damping, as chosen before
+    said = page.evaluate("window.waiting")
+    assert said["code"] == 130 and "servoctl: interrupted by stop-all" in said["err"], said
+    sim.wait_until(lambda: abs(sim.state(1)["velocity"]) < 2, timeout_s=3)
+    assert sim.state(1)["angle"] > -60
+
+
 def test_a_servo_unplugged_mid_session_is_shown_gone(bench):
     sim, _, _, page = bench
     page.evaluate("servoUiPlots && UI.send({op: 'plot', ids: []})")
@@ -144,12 +158,46 @@ def test_a_servo_unplugged_mid_session_is_shown_gone(bench):
     page.locator("#bus-table tr[data-id='5']:not(.gone)").wait_for(timeout=WAIT_MS)
 
 
-def test_bring_up_view_shows_the_fault_history(bench):
-    _, _, _, page = bench
+def test_bring_up_updates_two_servos_in_a_row_and_reads_faults(bench, tmp_path):
+    sim, _, _, page = bench
+    image = tmp_path / "firmware-0x0042.img"
+    image.write_bytes(img.build(bytes(range(256)) * 6, 0x0042, img.BOARDS["host_sim"]))
+    page.select_option("#stop-mode", "release")  # an update restarts a servo: never one that holds
+    page.click("#stop-all")
+    page.locator("#log div", has_text="stop-all: 6 servo(s) released").wait_for(timeout=WAIT_MS)
     _view(page, "bringup")
-    page.click("#fl-read")
-    page.locator("#bringup-out", has_text="servo 1:").wait_for(timeout=WAIT_MS)
+    page.fill("#up-file", str(image))
+    page.fill("#up-ids", "5 6")
+    page.click("#up-go")
+    out = page.locator("#bringup-out")
+    page.wait_for_function("document.querySelector('#bringup-out').textContent.includes('servo 6:')",
+                           timeout=30000)
+    assert "servo 6: version 0x0010 -> 0x0042" in out.inner_text(), out.inner_text()
+    assert "servo 5: version 0x0010 -> 0x0042" in out.inner_text()
+    done, _, total = page.inner_text("#up-at").removeprefix("servo 6: ").split()[:3]
+    assert done == total  # the progress shown reached the whole image
+    assert [sim.state(i)["version"] for i in (5, 6)] == [0x42, 0x42]
     _shot(page, "bringup")
+    page.click("#fl-read")
+    out.filter(has_text="servo 1: no faults").wait_for(timeout=WAIT_MS)
+
+
+def test_the_maker_firmware_s_missing_features_are_greyed_with_the_reason(bench):
+    """servoctl info of a servo that answers none of items 64-67 (the
+    maker's firmware) has no winding_c: the page greys what needs them."""
+    _, _, context, _ = bench
+    page = context.new_page()  # a watching tab: nothing it does reaches the bus
+    try:
+        page.goto(bench[1].url)
+        page.wait_for_function("UI.state.about.port !== undefined", timeout=WAIT_MS)
+        page.evaluate("""() => { UI.setServos([1]); UI.handle({type: 'table', rows: [{id: 1, voltage_v: 7.4,
+            current_a: 0, power_w: 0, temperature_adc: 2048, temperature_c: 25, status: [], angle_deg: 0,
+            turns: 0, model: 3840, firmware: 16, serial: 1}]}); }""")
+        fault = page.locator("#view-bringup fieldset.off", has_text="Fault history")
+        assert "items 64-67 (the maker's firmware)" in fault.get_attribute("data-why")
+        assert page.locator("#fl-read").is_disabled()
+    finally:
+        page.close()
 
 
 def test_a_second_tab_is_told_who_drives(bench):

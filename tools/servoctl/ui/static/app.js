@@ -32,16 +32,17 @@ const UI = (() => {
   function connect() {
     const proto = location.protocol === "https:" ? "wss:" : "ws:";
     ws = new WebSocket(`${proto}//${location.host}/ws?token=${encodeURIComponent(token)}`);
-    ws.onmessage = (ev) => {
-      const msg = JSON.parse(ev.data);
-      if (msg.type === "line" && waiting[msg.tag] && waiting[msg.tag].onLine) waiting[msg.tag].onLine(msg);
-      if (msg.type === "result") {
-        log(`$ ${msg.command}  -> exit ${msg.code}`, msg.code ? "refused" : "");
-        if (waiting[msg.tag]) { waiting[msg.tag].resolve(msg); delete waiting[msg.tag]; }
-      }
-      (handlers[msg.type] || []).forEach((fn) => fn(msg));
-    };
+    ws.onmessage = (ev) => handle(JSON.parse(ev.data));
     ws.onclose = () => { setRole("closed", "the server has stopped (servoctl ui ended)"); };
+  }
+
+  function handle(msg) {
+    if (msg.type === "line" && waiting[msg.tag] && waiting[msg.tag].onLine) waiting[msg.tag].onLine(msg);
+    if (msg.type === "result") {
+      log(`$ ${msg.command}  -> exit ${msg.code}`, msg.code ? "refused" : "");
+      if (waiting[msg.tag]) { waiting[msg.tag].resolve(msg); delete waiting[msg.tag]; }
+    }
+    (handlers[msg.type] || []).forEach((fn) => fn(msg));
   }
 
   function send(obj) {
@@ -139,6 +140,6 @@ const UI = (() => {
     (handlers["view"] || []).forEach((fn) => fn({view}));
   }
 
-  return {$, el, on, send, run, runInto, log, state, picked, setServos, whyNot, greyOwn, show,
+  return {$, el, on, handle, send, run, runInto, log, state, picked, setServos, whyNot, greyOwn, show,
           role: () => role};
 })();

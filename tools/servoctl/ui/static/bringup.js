@@ -8,6 +8,7 @@
 
   async function step(argv) {
     const prog = $("#br-prog");
+    prog.removeAttribute("value");  // no figure yet: indeterminate
     prog.hidden = false;
     document.querySelectorAll("#view-bringup button").forEach((b) => { b.dataset.was = b.disabled; b.disabled = true; });
     try {
@@ -17,6 +18,14 @@
       document.querySelectorAll("#view-bringup button").forEach((b) => { b.disabled = b.dataset.was === "true"; });
     }
   }
+
+  UI.on("progress", (m) => {  // an update's bytes, a tenth at a time
+    const prog = $("#br-prog");
+    prog.max = m.total;
+    prog.value = m.done;
+    prog.title = m.text;
+    $("#up-at").textContent = m.text;
+  });
 
   document.addEventListener("DOMContentLoaded", () => {
     $("#br-cal").addEventListener("click", () =>
