@@ -9,6 +9,7 @@ import sys
 import webbrowser
 
 from . import __version__
+from .errors import UsageError
 
 
 def global_argv(args) -> list:
@@ -23,6 +24,7 @@ def global_argv(args) -> list:
 
 def cmd_ui(bus, args):
     from .ui.server import Page, serve  # aiohttp loads for this command alone
+    from .live import has_display
     from .ui.worker import Worker
 
     token = secrets.token_urlsafe(18)
@@ -39,8 +41,13 @@ def cmd_ui(bus, args):
             print(f"servoctl ui: warning: listening on {args.bind}: anyone who reaches it with the "
                   f"token drives the bus", file=sys.stderr, flush=True)
         print("servoctl ui: Ctrl-C stops", file=sys.stderr, flush=True)
-        if not args.no_browser:
-            webbrowser.open(url)
+        if args.no_browser:
+            return
+        if not has_display():  # a console browser would take this terminal
+            print("servoctl ui: no display (DISPLAY and WAYLAND_DISPLAY are unset): open the address "
+                  "in a browser", file=sys.stderr, flush=True)
+        elif not webbrowser.open(url):
+            print("servoctl ui: no browser found: open the address in one", file=sys.stderr, flush=True)
 
     async def main():
         stop = asyncio.Event()
@@ -52,6 +59,8 @@ def cmd_ui(bus, args):
     worker.start()
     try:
         asyncio.run(main())
+    except OSError as e:  # the port is taken, the address is not this computer's
+        raise UsageError(f"ui: cannot listen on {args.bind} port {args.listen}: {e.strerror or e}") from None
     finally:
         worker.stop()
     print("servoctl ui: stopped", file=sys.stderr)

@@ -142,7 +142,7 @@ class Worker:
             found = json.loads(r["out"].splitlines()[-1]) if r["out"] else []
         except (ValueError, IndexError):
             found = []
-        self.known = sorted({f["id"] for f in found if f["mode"] == "application"})
+        self.known = sorted({f["id"] for f in found if f["mode"] == "application" and not f["shared"]})
         self.publish({"type": "scan", "found": found, "err": r["err"], "code": r["code"]})
         self.table()
 

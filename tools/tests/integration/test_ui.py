@@ -29,18 +29,25 @@ WAIT_MS = 15000  # host time for the page to show what the bus thread did
 
 
 @pytest.fixture(scope="module")
-def bench():
+def browser():
     if not Path(CHROMIUM).exists():
         pytest.fail(f"no {CHROMIUM}: scripts/setup.sh installs Debian's chromium")
-    with Simulator(ids=IDS) as sim, UiProcess(sim) as ui, playwright_api.sync_playwright() as pw:
+    with playwright_api.sync_playwright() as pw:
         context, profile = launch_chromium(pw)
         try:
-            page = context.new_page()
-            page.goto(ui.url)
-            yield sim, ui, context, page
+            yield context
         finally:
             context.close()
             shutil.rmtree(profile, ignore_errors=True)
+
+
+@pytest.fixture(scope="module")
+def bench(browser):
+    with Simulator(ids=IDS) as sim, UiProcess(sim) as ui:
+        page = browser.new_page()
+        page.goto(ui.url)
+        yield sim, ui, browser, page
+        page.close()
 
 
 def _shot(page, name: str):
@@ -229,3 +236,25 @@ def test_ctrl_c_stops_cleanly_and_the_edit_is_on_the_servo(bench):
     assert code == 0 and "servoctl ui: stopped" in err, err
     with sim.bus() as bus:
         assert Servo(bus, 1).read("angle_max") == 1200
+
+
+def test_a_shared_id_is_shown_and_one_servo_given_a_free_id_by_its_serial(browser):
+    """Two servos at ID 1 answer at once and garble each other (as real
+    ones do), so no serial comes through; the user types one's (its label)."""
+    with Simulator(ids=[1, 1]) as sim, UiProcess(sim) as ui:
+        page = browser.new_page()
+        try:
+            page.goto(ui.url)
+            row = page.locator("#bus-table tr.shared[data-id='1']")
+            row.locator("td.state", has_text="ID 1 shared").wait_for(timeout=WAIT_MS)
+            row.locator("input.serial").fill("0x51a00101")
+            row.locator("input.new-id").fill("7")
+            _shot(page, "shared")
+            row.locator("button").click()
+            page.locator("#bus-table tr[data-id='7'] td.state", has_text="answering").wait_for(timeout=WAIT_MS)
+            assert page.locator("#bus-table tr.shared").count() == 0
+        finally:
+            page.close()
+            ui.stop()
+        with sim.bus() as bus:
+            assert Servo(bus, 7).read("serial") == 0x51A00101

@@ -12,14 +12,18 @@
     const body = $("#bus-table tbody");
     body.innerHTML = "";
     for (const f of found) {
-      const info = rows[f.id];
+      const info = f.shared ? undefined : rows[f.id];
       const tr = el("tr", {"data-id": f.id});
       if (f.shared) tr.className = "shared";
       if (info && info.gone) tr.className = "gone";
       const serials = el("td");
       if (f.shared) {
         f.serials.forEach((s) => serials.append(assignControl(s)));
-        if (!f.serials.length) serials.append("two or more servos, serials garbled: connect them one at a time");
+        if (!f.serials.length) {
+          serials.append(el("div", {class: "note", text: "their answers collide, so no serial number came " +
+            "through: type one (its label), or connect them one at a time and scan"}));
+        }
+        serials.append(assignControl(null));
       } else {
         serials.textContent = f.serials.map((s) => hex(s, 8)).join(", ");
       }
@@ -43,15 +47,18 @@
     return info ? "answering" : "";
   }
 
+  // servoctl id assign SERIAL ID: a serial heard, or (serial null) one typed.
   function assignControl(serial) {
-    const free = nextFree();
-    const input = el("input", {type: "number", min: 0, max: 253, value: free, size: 4});
+    const input = el("input", {type: "number", min: 0, max: 253, value: nextFree(), size: 4, class: "new-id"});
+    const typed = serial === null ? el("input", {size: 11, placeholder: "0x51a00000", class: "serial"}) : null;
+    const said = el("span", {class: "note"});
     const b = el("button", {text: "assign", onclick: async () => {
-      const r = await run(["id", "assign", hex(serial, 8), input.value]);
-      log(r.code ? r.err : r.out, r.code ? "refused" : "done");
-      scan(false);
+      const r = await run(["id", "assign", typed ? typed.value : hex(serial, 8), input.value]);
+      said.textContent = r.code ? r.err : r.out;
+      said.className = r.code ? "refused" : "done";
+      if (!r.code) scan(false);
     }});
-    return el("div", {}, `${hex(serial, 8)} → ID `, input, b);
+    return el("div", {}, typed || hex(serial, 8), " → ID ", input, b, said);
   }
 
   function nextFree() {
