@@ -67,7 +67,9 @@ class Worker:
         self.thread.start()
 
     def stop(self):
+        """Ctrl-C: a command still running ends at its next bus step."""
         self.stopping.set()
+        self.interrupt.set()
         self.jobs.put(None)
         self.thread.join(timeout=5)
 

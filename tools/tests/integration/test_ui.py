@@ -25,7 +25,7 @@ from ..ui_launch import CHROMIUM, UiProcess, launch_chromium, navigation_ms
 playwright_api = pytest.importorskip("playwright.sync_api")
 IDS = [1, 2, 3, 4, 5, 6]
 SHOTS = os.environ.get("SERVO_UI_SCREENSHOTS")
-WAIT_MS = 15000  # host time for the page to show what the bus thread did
+WAIT_MS = 30000  # host time for the page to show what the bus thread did (a bound: on failure)
 
 
 @pytest.fixture(scope="module")
@@ -123,7 +123,7 @@ def test_a_move_on_the_page_moves_the_horn(bench):
     page.fill("#mv-angle", "45")
     page.fill("#mv-value", "300")
     page.click("#mv-go")
-    sim.wait_until(lambda: abs(sim.state(1)["angle"] - 45) < 1.0, timeout_s=5)
+    sim.wait_until(lambda: abs(sim.state(1)["angle"] - 45) < 1.0, timeout_s=10)
     _shot(page, "motion")
     _view(page, "plots")  # sampled since the last test: the move on its plots
     page.wait_for_timeout(300)
@@ -133,10 +133,10 @@ def test_a_move_on_the_page_moves_the_horn(bench):
 def test_stop_all_stops_a_wheel(bench):
     sim, _, _, page = bench
     page.evaluate("UI.run(['wheel', 3, 'run', '--speed', 180])")
-    sim.wait_until(lambda: abs(sim.state(3)["velocity"]) > 100, timeout_s=5)
+    sim.wait_until(lambda: abs(sim.state(3)["velocity"]) > 100, timeout_s=10)
     page.select_option("#stop-mode", "damping")
     page.click("#stop-all")  # on every view's header
-    sim.wait_until(lambda: abs(sim.state(3)["velocity"]) < 2, timeout_s=3)
+    sim.wait_until(lambda: abs(sim.state(3)["velocity"]) < 2, timeout_s=10)
     page.locator("#log div", has_text="stop-all: 6 servo(s) damped").wait_for(timeout=WAIT_MS)
 
 
@@ -144,12 +144,12 @@ def test_stop_all_ends_a_running_command_first(bench):
     """A move that waits for its arrival is cut short: stop-all does not
     wait behind it."""
     sim, _, _, page = bench
-    page.evaluate("() => { window.waiting = UI.run(['move', 1, -90, '--interval', 4000, '--wait']); }")
-    sim.wait_until(lambda: sim.state(1)["angle"] < 35, timeout_s=3)
+    page.evaluate("() => { window.waiting = UI.run(['move', 1, -90, '--interval', 8000, '--wait']); }")
+    sim.wait_until(lambda: sim.state(1)["angle"] < 35, timeout_s=10)
     page.click("#stop-all")  # damping, as chosen before
     said = page.evaluate("window.waiting")
     assert said["code"] == 130 and "servoctl: interrupted by stop-all" in said["err"], said
-    sim.wait_until(lambda: abs(sim.state(1)["velocity"]) < 2, timeout_s=3)
+    sim.wait_until(lambda: abs(sim.state(1)["velocity"]) < 2, timeout_s=10)
     assert sim.state(1)["angle"] > -60
 
 
