@@ -98,6 +98,9 @@ def test_an_item_edited_on_the_page_is_refused_as_servoctl_says_then_set(bench):
     field.press("Enter")
     why.filter(has_text="angle_max = 120.0 deg").wait_for(timeout=WAIT_MS)
     assert "RAM" in page.inner_text("#items tr[data-item=watchdog_ms]")
+    page.click("#cfg-diff")  # with factory
+    page.locator("#servo-out", has_text="angle_max").wait_for(timeout=WAIT_MS)
+    assert "120.0 deg" in page.inner_text("#servo-out")
     _shot(page, "servo")  # read back at the end, on the servo (test_ctrl_c_...)
 
 

@@ -19,6 +19,10 @@
     }
   }
 
+  UI.on("line", (m) => {  // identify's and tune's "  step 3/8"
+    const at = /^\s*step (\d+)\/(\d+)/.exec(m.text);
+    if (at) { $("#br-prog").max = Number(at[2]); $("#br-prog").value = Number(at[1]); }
+  });
   UI.on("progress", (m) => {  // an update's bytes, a tenth at a time
     const prog = $("#br-prog");
     prog.max = m.total;
@@ -26,6 +30,17 @@
     prog.title = m.text;
     $("#up-at").textContent = m.text;
   });
+
+  function showWatchdog() {  // servoctl info's "100 ms, then hold", or "off"
+    const s = UI.state.servos[picked()];
+    const w = s && s.info && s.info.watchdog;
+    if (!w) return;
+    const at = /^(\d+) ms, then (\w+)/.exec(w);
+    $("#wd-ms").value = at ? `${at[1]}ms` : "0ms";
+    if (at) $("#wd-action").value = at[2];
+  }
+  UI.on("view", (m) => { if (m.view === "bringup") showWatchdog(); });
+  UI.on("picked", showWatchdog);
 
   document.addEventListener("DOMContentLoaded", () => {
     $("#br-cal").addEventListener("click", () =>

@@ -60,8 +60,10 @@
       await runInto(out, ["config", "load", picked(), $("#cfg-file").value]);
       read();
     });
-    $("#cfg-diff").addEventListener("click", () =>
-      runInto(out, ["config", "diff", picked(), $("#cfg-other").value || "factory"]));
+    $("#cfg-diff").addEventListener("click", async () => {
+      const r = await runInto(out, ["config", "diff", picked(), $("#cfg-other").value || "factory"]);
+      if (r.code === 1) out.classList.remove("refused");  // exit 1: they differ, as listed
+    });
     $("#bk-save").addEventListener("click", () => {
       const ids = Object.keys(UI.state.servos).filter((i) => !UI.state.servos[i].gone);
       runInto(out, ["backup", $("#bk-file").value].concat(ids.length ? ["--ids", ...ids] : []));
