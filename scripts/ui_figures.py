@@ -7,6 +7,7 @@ servos plotted. servo_sim with 6 servos at 115200 baud, headless Debian
 chromium (tools/tests/ui_launch.py).
 
     .venv/bin/python scripts/ui_figures.py   (after the host build)"""
+import os
 import statistics
 import sys
 import time
@@ -46,6 +47,7 @@ def main() -> int:
             print(f"| live plot, {len(ids)} servo(s): samples a second of each (simulated clock) | "
                   f"{low:.0f} at least ({', '.join(f'{v:.0f}' for v in rates.values())}) |")
         page.evaluate("UI.send({op: 'plot', ids: []})")
+        print(f"| the machine's load average (1 min) when done | {os.getloadavg()[0]:.1f} on {os.cpu_count()} CPUs |")
         context.close()
     return 0
 
