@@ -29,7 +29,8 @@ def cmd_ui(bus, args):
 
     token = secrets.token_urlsafe(18)
     about = {"port": args.port, "simulator": bool(args.sim_control), "version": __version__}
-    page = Page(None, token, about)
+    loopback = args.bind in ("127.0.0.1", "localhost", "::1")
+    page = Page(None, token, about, hosts={"127.0.0.1", "localhost", "::1"} if loopback else None)
     worker = Worker(bus, global_argv(args), page.publish)
     page.worker = worker
 
@@ -37,7 +38,7 @@ def cmd_ui(bus, args):
         host = "127.0.0.1" if args.bind in ("0.0.0.0", "::", "") else args.bind
         url = f"http://{host}:{port}/?token={token}"
         print(f"servoctl ui: {url}", flush=True)
-        if args.bind not in ("127.0.0.1", "localhost", "::1"):
+        if not loopback:
             print(f"servoctl ui: warning: listening on {args.bind}: anyone who reaches it with the "
                   f"token drives the bus", file=sys.stderr, flush=True)
         print("servoctl ui: Ctrl-C stops", file=sys.stderr, flush=True)

@@ -17,8 +17,9 @@ ASSETS = {p.name for p in STATIC.iterdir() if p.is_file()}
 
 
 class Page:
-    def __init__(self, worker, token: str, about: dict):
+    def __init__(self, worker, token: str, about: dict, hosts=None):
         self.worker, self.token, self.about = worker, token, about
+        self.hosts = hosts  # the names the page may be asked by (DNS rebinding); None: any
         self.sockets = []   # every open tab's WebSocket, in order of opening
         self.driver = None  # the tab that drives the bus
         self.who = {}       # ws: how the other tabs are told of it
@@ -30,6 +31,9 @@ class Page:
         given = request.query.get("token", "")
         if not hmac.compare_digest(given.encode(), self.token.encode()):
             return "refused: the address lacks this session's token (see servoctl ui's first line)"
+        host = (request.url.host or "").strip("[]")
+        if self.hosts is not None and host not in self.hosts:
+            return f"refused: a request for host {host!r}, not this computer's (DNS rebinding?)"
         origin = request.headers.get("Origin")
         own = f"{request.scheme}://{request.host}"
         if origin is None and need_origin:
@@ -76,7 +80,7 @@ class Page:
                     ask = json.loads(msg.data)
                 except ValueError:
                     continue
-                if ws is not self.driver:
+                if ws is not self.driver and ask.get("op") != "stopall":  # any tab may stop
                     await ws.send_json({"type": "busy", "holder": self.who[self.driver],
                                         "text": f"{self.who[self.driver]} drives the bus"})
                     continue

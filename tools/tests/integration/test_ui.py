@@ -60,8 +60,9 @@ def _view(page, name: str):
     page.click(f"#tabs button[data-view={name}]")
 
 
-def _status(url: str, origin: str = None) -> int:
-    req = urllib.request.Request(url, headers={"Origin": origin} if origin else {})
+def _status(url: str, origin: str = None, host: str = None) -> int:
+    req = urllib.request.Request(url, headers={**({"Origin": origin} if origin else {}),
+                                               **({"Host": host} if host else {})})
     try:
         with urllib.request.urlopen(req, timeout=5) as r:
             return r.status
@@ -217,6 +218,9 @@ def test_a_second_tab_is_told_who_drives(bench):
         second.goto(ui.url)
         second.locator("#role", has_text="drives the bus").wait_for(timeout=WAIT_MS)
         assert "watching: the tab opened at" in second.inner_text("#role")
+        second.select_option("#stop-mode", "release")
+        second.click("#stop-all")  # a watching tab may still stop every servo
+        second.locator("#log div", has_text="stop-all: 6 servo(s) released").wait_for(timeout=WAIT_MS)
     finally:
         second.close()
 
@@ -231,6 +235,9 @@ def test_no_token_or_another_origin_is_refused(bench):
     ws = ui.base + "/ws?token=" + ui.token
     assert _status(ws, origin="http://evil.example") == 403
     assert _status(ws) == 403  # a WebSocket without an Origin
+    port = ui.base.rsplit(":", 1)[1]
+    assert _status(ui.url, host=f"evil.example:{port}") == 403  # a name rebound to 127.0.0.1
+    assert _status(ui.url, host=f"localhost:{port}") == 200
 
 
 def test_ctrl_c_stops_cleanly_and_the_edit_is_on_the_servo(bench):

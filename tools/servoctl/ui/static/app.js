@@ -80,7 +80,7 @@ const UI = (() => {
     badge.textContent = r === "driver" ? "this tab drives the bus" :
       r === "viewer" ? `watching: ${holder}` : holder || r;
     document.body.classList.toggle("viewer", r !== "driver");
-    $("#stop-all").disabled = r !== "driver";
+    $("#stop-all").disabled = r === "closed";  // a watching tab may stop every servo too
   }
 
   on("hello", (m) => {
