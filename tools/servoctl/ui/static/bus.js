@@ -5,6 +5,7 @@
   const {$, el, on, send, run, state, log} = UI;
   let found = [];   // servoctl scan --json
   let rows = {};    // id: servoctl info --json, or {gone, why}
+  let sharedCells = {};  // id: the serial cell of a shared ID
 
   const hex = (n, w) => "0x" + Number(n).toString(16).padStart(w, "0");
 
@@ -16,15 +17,18 @@
       const tr = el("tr", {"data-id": f.id});
       if (f.shared) tr.className = "shared";
       if (info && info.gone) tr.className = "gone";
-      const serials = el("td");
-      if (f.shared) {
+      // A shared ID's cell keeps what the user types in it across the live
+      // table's redraws: made once a scan.
+      let serials = f.shared ? sharedCells[f.id] : el("td");
+      if (f.shared && !serials) {
+        serials = sharedCells[f.id] = el("td");
         f.serials.forEach((s) => serials.append(assignControl(s)));
         if (!f.serials.length) {
           serials.append(el("div", {class: "note", text: "their answers collide, so no serial number came " +
             "through: type one (its label), or connect them one at a time and scan"}));
         }
         serials.append(assignControl(null));
-      } else {
+      } else if (!f.shared) {
         serials.textContent = f.serials.map((s) => hex(s, 8)).join(", ");
       }
       const ok = info && !info.gone;
@@ -75,6 +79,7 @@
   on("scan", (m) => {
     found = m.found;
     rows = {};
+    sharedCells = {};
     const n = found.length;
     const lines = (m.err || "").split("\n").filter((l) => l);
     $("#scan-line").textContent = n ? `${n} ID(s) answered` + (lines.length ? `; ${lines.join("; ")}` : "")
