@@ -4,6 +4,7 @@ schema's names, ranges and factory values), and samples of Monitor with
 ReadMotion (angle, target, speed, current, power, temperature, the winding's
 estimate), stamped with the bus clock at each answer's arrival (the
 simulator's clock given --sim-control), as `servoctl monitor` stamps them."""
+import collections
 import math
 
 from .. import group, registers, units
@@ -11,6 +12,7 @@ from ..errors import ServoError
 from ..live import _celsius
 from ..servo import Servo
 
+SPEED_BASE_S = 0.05
 HEX = {"model", "firmware", "serial"}  # shown as servoctl info shows them
 NO_MOTION = "the maker's firmware has no ReadMotion (0x40): no target or winding estimate"
 
@@ -103,9 +105,14 @@ class Sampler:
         row = {"id": servo_id, "t": round(t, 4), "angle": angle, "voltage": m.voltage_mv / 1000.0,
                "current": m.current_ma / 1000.0, "power": m.power_mw / 1000.0,
                "temperature": _num(_celsius(m.temperature_adc)), "status": registers.status_names(m.status)}
-        before = self.last.get(servo_id)
-        self.last[servo_id] = (t, angle)
-        row["speed"] = round((angle - before[1]) / (t - before[0]), 1) if before and t > before[0] else None
+        # Speed from two angles SPEED_BASE_S apart at least: 0.1 deg steps
+        # between samples 10 ms apart would read 0 or 10 deg/s.
+        seen = self.last.setdefault(servo_id, collections.deque())
+        seen.append((t, angle))
+        while len(seen) > 2 and t - seen[1][0] >= SPEED_BASE_S:
+            seen.popleft()
+        t0, a0 = seen[0]
+        row["speed"] = round((angle - a0) / (t - t0), 1) if t - t0 >= SPEED_BASE_S / 2 else None
         alone = len(self.ids) == 1
         turn = alone or (self.rounds % 2 == 0 and servo_id == self.ids[self.rounds // 2 % len(self.ids)])
         if turn and servo_id not in self.no_motion:
