@@ -7,7 +7,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 PACKAGES=(cmake ninja-build gcc g++ pkg-config libcmocka-dev clang libclang-rt-14-dev
-          gcc-arm-none-eabi libnewlib-arm-none-eabi valgrind python3-venv qemu-system-arm)
+          gcc-arm-none-eabi libnewlib-arm-none-eabi valgrind python3-venv qemu-system-arm
+          chromium chromium-driver)  # chromium: servoctl ui's browser tests
 
 missing=()
 for p in "${PACKAGES[@]}"; do

@@ -16,6 +16,7 @@ from .cmd_group import cmd_async, cmd_backup, cmd_broadcast_move, cmd_restore, c
 from .cmd_monitor import cmd_monitor
 from .cmd_motion import cmd_damping, cmd_move, cmd_origin, cmd_stop, cmd_wheel
 from .cmd_sim import cmd_sim
+from .cmd_ui import cmd_ui
 from .cmd_update import cmd_image, cmd_update
 from .errors import EXIT_INTERRUPTED, BadAnswer, NoReply, ServoError, UsageError
 from .faults import cmd_faults
@@ -51,6 +52,7 @@ COMMANDS = {
     "backup": cmd_backup,
     "restore": cmd_restore,
     "update": cmd_update,
+    "ui": cmd_ui,
 }
 
 
@@ -100,19 +102,25 @@ def _run(args, clock=None) -> int:
 
 def _on_bus(args, baud, clock) -> int:
     with Bus(args.port, baud, args.timeout, clock=clock) as bus:
-        try:
-            return COMMANDS[args.command](bus, args)
-        except BadAnswer:
-            raise
-        except NoReply:
-            # A servo in its bootloader answers Ping and the update packets
-            # only: say so, and what recovers it, instead of "no reply".
-            servo_id = getattr(args, "id", None)
-            if isinstance(servo_id, int) and args.command not in ("update", "ping"):
-                why = scan.in_bootloader(bus, servo_id)
-                if why:
-                    raise NoReply(why) from None
-            raise NoReply(f"{sys.exc_info()[1]}{link_rate.no_reply_hint(bus, args.port, args.sim_control, baud)}") from None
+        return run_command(bus, args)
+
+
+def run_command(bus, args) -> int:
+    """One parsed command on an open bus (servoctl ui runs its page's
+    requests here too): a silent servo's NoReply says why it may be."""
+    try:
+        return COMMANDS[args.command](bus, args)
+    except BadAnswer:
+        raise
+    except NoReply:
+        # A servo in its bootloader answers Ping and the update packets
+        # only: say so, and what recovers it, instead of "no reply".
+        servo_id = getattr(args, "id", None)
+        if isinstance(servo_id, int) and args.command not in ("update", "ping"):
+            why = scan.in_bootloader(bus, servo_id)
+            if why:
+                raise NoReply(why) from None
+        raise NoReply(f"{sys.exc_info()[1]}{link_rate.no_reply_hint(bus, args.port, args.sim_control, bus.serial.baudrate)}") from None
 
 
 if __name__ == "__main__":

@@ -21,6 +21,7 @@ def cmd_update(bus, args):
     ids, image_file = args_.update_operands(args.targets)
     image = img.load(image_file)
     failed = []
+    say = getattr(args, "on_progress", lambda servo_id, done, total: None)  # servoctl ui's bar
     for servo_id in ids:
         if args.catch:
             print(f"servo {servo_id}: power it up now (waiting {args.catch:g} s for its bootloader)",
@@ -32,8 +33,9 @@ def cmd_update(bus, args):
             with Progress(*columns, transient=True, disable=not sys.stderr.isatty()) as progress:
                 task = progress.add_task("update", total=len(image.data))
                 before, after = upd.update(bus, servo_id, image,
-                                           lambda done, total: progress.update(task, completed=done,
-                                                                               total=total))
+                                           lambda done, total: (progress.update(task, completed=done,
+                                                                                total=total),
+                                                                say(servo_id, done, total)))
         except ServoError as e:
             print(f"servo {servo_id}: failed: {e}")
             failed.append(e)

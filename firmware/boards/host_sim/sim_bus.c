@@ -101,6 +101,9 @@ static uint64_t enqueue(struct sim_bus *b, uint8_t sender, const uint8_t *data, 
 uint64_t sim_bus_send(struct sim_bus *b, unsigned sender, const uint8_t *data, unsigned len,
                       uint32_t baud, uint64_t now_us)
 {
+    if (b->stations[sender].unplugged) { /* its bytes reach no wire */
+        return now_us + (uint64_t)len * byte_time_us(baud);
+    }
     unsigned long before = b->collisions;
     uint64_t t = enqueue(b, (uint8_t)sender, data, len, baud, now_us);
     if (b->collisions != before) {
@@ -146,7 +149,7 @@ void sim_bus_deliver(struct sim_bus *b, uint64_t now_us)
         bool received = false;
         for (unsigned s = 0; s < b->station_count; s++) {
             const struct sim_station *st = &b->stations[s];
-            if (s != e->sender && *st->baud == e->baud) {
+            if (s != e->sender && !st->unplugged && *st->baud == e->baud) {
                 st->receive(st->ctx, e->byte, e->at_us);
                 received = true;
             }

@@ -50,6 +50,7 @@ struct sim_station {
     const uint32_t *baud; /* the station's rate now */
     void (*receive)(void *ctx, uint8_t byte, uint64_t at_us);
     uint8_t log_id;
+    bool unplugged; /* off the bus (control port: unplug): hears and sends nothing */
 };
 
 /* One sender's bytes back to back on the wire: from the first start bit

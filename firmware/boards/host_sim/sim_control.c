@@ -255,6 +255,8 @@ static void control_command(const struct sim_control *c, int fd, char *line)
         } else if (strcmp(cmd, "failprogram") == 0) {
             s->flash.fail_programs = s->slot_flash.fail_programs = s->fault_flash.fail_programs =
                 (uint32_t)value;
+        } else if (strcmp(cmd, "unplug") == 0) {
+            c->bus->stations[s->index].unplugged = value != 0.0;
         } else if (strcmp(cmd, "powercycle") == 0) {
             sim_servo_power_cycle(s);
         } else { /* state: a line a servo, however many (no buffer to outgrow) */

@@ -46,3 +46,15 @@ def test_both_simulators_answer_a_line_alike(answers):
     assert said["supply x"] == "error: the value must be a number"
     assert said["supply"] == "error: missing value"
     assert said["nosuch"] == said["nosuch 3"] == "error: unknown command (try help)"
+
+
+def test_unplug_takes_a_servo_off_the_bus_and_back():
+    """servo_sim's unplug: the servo neither hears nor answers, the others
+    still do; plugged back in, it answers again."""
+    from servoctl.servo import Servo
+
+    with Simulator(ids=[1, 2], fast=True) as sim, sim.bus(run_ahead=sim.bus_run_ahead) as bus:
+        assert sim.control("unplug 1 1").strip() == "ok"
+        assert not Servo(bus, 1).ping(timeout=0.05) and Servo(bus, 2).ping()
+        assert sim.control("unplug 0 1").strip() == "ok"
+        assert Servo(bus, 1).ping()

@@ -1,0 +1,145 @@
+// servoctl ui: the page's core. One WebSocket to servoctl; every action is a
+// servoctl command the server runs with servoctl's own library, so what the
+// page says when a value is refused is what servoctl says.
+"use strict";
+const UI = (() => {
+  const token = document.body.dataset.token;
+  const handlers = {};        // message type: [fn]
+  const waiting = {};         // tag: {resolve, onLine}
+  let ws = null, tag = 0, role = "connecting";
+  const state = {servos: {}, picked: null, about: {}};
+
+  const $ = (sel) => document.querySelector(sel);
+  const el = (tagName, attrs = {}, ...kids) => {
+    const e = document.createElement(tagName);
+    for (const [k, v] of Object.entries(attrs)) {
+      if (k === "class") e.className = v; else if (k === "text") e.textContent = v;
+      else if (k.startsWith("on")) e.addEventListener(k.slice(2), v); else e.setAttribute(k, v);
+    }
+    for (const k of kids) e.append(k);
+    return e;
+  };
+  const on = (type, fn) => (handlers[type] = handlers[type] || []).push(fn);
+
+  function log(text, cls) {
+    const l = $("#log");
+    const line = el("div", {text, class: cls || ""});
+    l.append(line);
+    while (l.childNodes.length > 200) l.firstChild.remove();
+    l.scrollTop = l.scrollHeight;
+  }
+
+  function connect() {
+    const proto = location.protocol === "https:" ? "wss:" : "ws:";
+    ws = new WebSocket(`${proto}//${location.host}/ws?token=${encodeURIComponent(token)}`);
+    ws.onmessage = (ev) => handle(JSON.parse(ev.data));
+    ws.onclose = () => { setRole("closed", "the server has stopped (servoctl ui ended)"); };
+  }
+
+  function handle(msg) {
+    if (msg.type === "line" && waiting[msg.tag] && waiting[msg.tag].onLine) waiting[msg.tag].onLine(msg);
+    if (msg.type === "result") {
+      log(`$ ${msg.command}  -> exit ${msg.code}`, msg.code ? "refused" : "");
+      if (waiting[msg.tag]) { waiting[msg.tag].resolve(msg); delete waiting[msg.tag]; }
+    }
+    (handlers[msg.type] || []).forEach((fn) => fn(msg));
+  }
+
+  function send(obj) {
+    if (!ws || ws.readyState !== 1) return false;
+    ws.send(JSON.stringify(obj));
+    return true;
+  }
+
+  // Runs one servoctl command line (without "servoctl" and the bus options):
+  // resolves with {code, out, err}; onLine hears each line as it is printed.
+  function run(argv, onLine) {
+    const t = ++tag;
+    return new Promise((resolve) => {
+      waiting[t] = {resolve, onLine};
+      if (!send({op: "run", argv: argv.map(String), tag: t})) {
+        delete waiting[t];
+        resolve({code: -1, out: "", err: "not connected"});
+      }
+    });
+  }
+
+  // A command's output into a <pre>: its lines as they come, the error red.
+  async function runInto(pre, argv) {
+    pre.textContent = `$ servoctl ${argv.join(" ")}\n`;
+    const r = await run(argv, (m) => { pre.textContent += m.text + "\n"; pre.scrollTop = pre.scrollHeight; });
+    pre.classList.toggle("refused", r.code !== 0);
+    if (!r.out && !r.err) pre.textContent += r.code ? `exit ${r.code}\n` : "done\n";
+    return r;
+  }
+
+  function setRole(r, holder) {
+    role = r;
+    const badge = $("#role");
+    badge.className = "role " + r;
+    badge.textContent = r === "driver" ? "this tab drives the bus" :
+      r === "viewer" ? `watching: ${holder}` : holder || r;
+    document.body.classList.toggle("viewer", r !== "driver");
+    $("#stop-all").disabled = r === "closed";  // a watching tab may stop every servo too
+  }
+
+  on("hello", (m) => {
+    state.about = m;
+    $("#bus-port").textContent = `${m.port}${m.simulator ? " (simulator)" : ""}`;
+    setRole(m.role, m.holder ? `${m.holder} drives the bus` : "");
+  });
+  on("busy", (m) => { setRole("viewer", m.text); log(m.text, "refused"); });
+  on("error", (m) => log(m.text, "refused"));
+  on("stopped", (m) => log(`stop-all: ${m.ids.length} servo(s) ${m.mode === "damping" ? "damped" : "released"}` +
+      (m.failed.length ? `; ${m.failed.join("; ")}` : ""), m.failed.length ? "refused" : "done"));
+
+  // The servo the Servo, Motion and Bring-up views act on.
+  function picked() { return state.picked; }
+  function setServos(ids) {
+    const sel = $("#servo-pick");
+    const keep = state.picked;
+    sel.innerHTML = "";
+    if (!ids.length) sel.append(el("option", {value: "", text: "(none found)"}));
+    for (const id of ids) sel.append(el("option", {value: id, text: `ID ${id}`}));
+    state.picked = ids.includes(keep) ? keep : (ids.length ? ids[0] : null);
+    if (state.picked !== null) sel.value = state.picked;
+    (handlers["picked"] || []).forEach((fn) => fn({id: state.picked}));
+  }
+  function whyNot(id) {
+    // What this firmware's own features need: a servo that answers none of
+    // items 64-67 (the maker's firmware) has none of them.
+    const s = state.servos[id];
+    return s && s.info && s.info.winding_c === undefined
+      ? `servo ${id} answers none of items 64-67 (the maker's firmware): this firmware's feature` : "";
+  }
+  function greyOwn() {
+    const why = state.picked === null ? "" : whyNot(state.picked);
+    document.querySelectorAll("[data-needs=own]").forEach((f) => {
+      f.classList.toggle("off", !!why);
+      f.dataset.why = why;
+      f.querySelectorAll("button,input,select").forEach((b) => { b.disabled = !!why; });
+    });
+  }
+
+  document.addEventListener("DOMContentLoaded", () => {
+    $("#servo-pick").addEventListener("change", (e) => {
+      state.picked = e.target.value === "" ? null : Number(e.target.value);
+      (handlers["picked"] || []).forEach((fn) => fn({id: state.picked}));
+    });
+    on("picked", greyOwn);
+    document.querySelectorAll("#tabs button").forEach((b) => b.addEventListener("click", () => show(b.dataset.view)));
+    $("#stop-all").addEventListener("click", () => {
+      send({op: "stopall", mode: $("#stop-mode").value});
+    });
+    connect();
+  });
+
+  function show(view) {
+    document.querySelectorAll("#tabs button").forEach((b) => b.classList.toggle("on", b.dataset.view === view));
+    document.querySelectorAll(".view").forEach((v) => { v.hidden = v.id !== `view-${view}`; });
+    (handlers["view"] || []).forEach((fn) => fn({view}));
+  }
+
+  return {$, el, on, handle, send, run, runInto, log, state, picked, setServos, whyNot, greyOwn, show,
+          role: () => role};
+})();

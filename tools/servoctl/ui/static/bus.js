@@ -1,0 +1,113 @@
+// The Bus view: scan (one or every baud rate), the live table of servos
+// (servoctl info each second), shared IDs resolved by serial, bring-up.
+"use strict";
+(() => {
+  const {$, el, on, send, run, state, log} = UI;
+  let found = [];   // servoctl scan --json
+  let rows = {};    // id: servoctl info --json, or {gone, why}
+  let sharedCells = {};  // id: the serial cell of a shared ID
+
+  const hex = (n, w) => "0x" + Number(n).toString(16).padStart(w, "0");
+
+  function render() {
+    const body = $("#bus-table tbody");
+    body.innerHTML = "";
+    for (const f of found) {
+      const info = f.shared ? undefined : rows[f.id];
+      const tr = el("tr", {"data-id": f.id});
+      if (f.shared) tr.className = "shared";
+      if (info && info.gone) tr.className = "gone";
+      // A shared ID's cell keeps what the user types in it across the live
+      // table's redraws: made once a scan.
+      let serials = f.shared ? sharedCells[f.id] : el("td");
+      if (f.shared && !serials) {
+        serials = sharedCells[f.id] = el("td");
+        f.serials.forEach((s) => serials.append(assignControl(s)));
+        if (!f.serials.length) {
+          serials.append(el("div", {class: "note", text: "their answers collide, so no serial number came " +
+            "through: type one (its label), or connect them one at a time and scan"}));
+        }
+        serials.append(assignControl(null));
+      } else if (!f.shared) {
+        serials.textContent = f.serials.map((s) => hex(s, 8)).join(", ");
+      }
+      const ok = info && !info.gone;
+      tr.append(el("td", {text: f.id}), serials,
+        el("td", {text: ok ? hex(info.model, 4) : ""}), el("td", {text: ok ? hex(info.firmware, 4) : ""}),
+        el("td", {text: ok ? info.voltage_v.toFixed(2) : ""}),
+        el("td", {text: ok && info.temperature_c !== null ? info.temperature_c.toFixed(1) : ""}),
+        el("td", {text: ok ? (info.status.join(", ") || "ok") : ""}),
+        el("td", {text: ok ? (info.limiter || "—") : ""}),
+        el("td", {class: "state", text: stateText(f, info)}));
+      body.append(tr);
+    }
+  }
+
+  function stateText(f, info) {
+    if (f.mode === "bootloader") return "in its bootloader: update installs an application";
+    if (f.shared) return `ID ${f.id} shared: give each a free ID by its serial`;
+    if (info && info.gone) return `gone: ${info.why}`;
+    if (info && info.winding_c === undefined) return "answering (maker's firmware)";
+    return info ? "answering" : "";
+  }
+
+  // servoctl id assign SERIAL ID: a serial heard, or (serial null) one typed.
+  function assignControl(serial) {
+    const input = el("input", {type: "number", min: 0, max: 253, value: nextFree(), size: 4, class: "new-id"});
+    const typed = serial === null ? el("input", {size: 11, placeholder: "0x51a00000", class: "serial"}) : null;
+    const said = el("span", {class: "note"});
+    const b = el("button", {text: "assign", onclick: async () => {
+      const r = await run(["id", "assign", typed ? typed.value : hex(serial, 8), input.value]);
+      said.textContent = r.code ? r.err : r.out;
+      said.className = r.code ? "refused" : "done";
+      if (!r.code) scan(false);
+    }});
+    return el("div", {}, typed || hex(serial, 8), " → ID ", input, b, said);
+  }
+
+  function nextFree() {
+    const used = new Set(found.map((f) => f.id));
+    for (let i = 1; i < 254; i++) if (!used.has(i)) return i;
+    return 253;
+  }
+
+  function scan(allBauds) {
+    $("#scan-line").textContent = allBauds ? "scanning every baud rate…" : "scanning…";
+    send({op: "scan", all_bauds: allBauds});
+  }
+
+  on("scan", (m) => {
+    found = m.found;
+    rows = {};
+    sharedCells = {};
+    const n = found.length;
+    const lines = (m.err || "").split("\n").filter((l) => l);
+    $("#scan-line").textContent = n ? `${n} ID(s) answered` + (lines.length ? `; ${lines.join("; ")}` : "")
+      : "no servo answered" + (lines.length ? `: ${lines.join("; ")}` : "");
+    UI.setServos(found.filter((f) => f.mode === "application" && !f.shared).map((f) => f.id));
+    render();
+  });
+
+  on("table", (m) => {
+    for (const r of m.rows) {
+      rows[r.id] = r;
+      state.servos[r.id] = {info: r.gone ? (state.servos[r.id] || {}).info : r, gone: !!r.gone, why: r.why};
+    }
+    render();
+    UI.greyOwn();
+  });
+
+  document.addEventListener("DOMContentLoaded", () => {
+    $("#scan").addEventListener("click", () => scan(false));
+    $("#scan-all").addEventListener("click", () => scan(true));
+    $("#bu-go").addEventListener("click", async () => {
+      const argv = ["id", "bringup", "--from-id", $("#bu-from").value, "--first", $("#bu-first").value,
+        "--count", $("#bu-count").value, "--wait-s", $("#bu-wait").value];
+      $("#scan-line").textContent = "bring-up: connect the new servos one after another…";
+      const r = await run(argv, (l) => { $("#scan-line").textContent = l.text; });
+      $("#scan-line").textContent = r.code ? r.err : r.out.split("\n").pop();
+      scan(false);
+    });
+  });
+  UI.on("hello", (m) => { if (m.role === "driver" && !found.length) scan(false); });
+})();
