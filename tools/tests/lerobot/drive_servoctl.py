@@ -115,7 +115,7 @@ def calibration(out: dict) -> None:
                 if state["target"] is None:
                     return True
                 for i in IDS:
-                    Servo(bus, i).move(round(state["target"] * 10), interval_ms=200)
+                    Servo(bus, i).move(round(state["target"] * 10), interval_ms=500)
             bus.sleep(0.02)
             return False
         robot.prompt, robot.stop_recording = (lambda _: ""), stop
@@ -159,7 +159,13 @@ def main() -> int:
     makers_path(out)
     calibration(out)
     leader(out)
-    out["compare"] = compare.run(compare.Ours())
+    # The comparison's run of ours; again (up to 3 runs) where the host sent more than half
+    # its frames late (compare.LATE_S), and the figures would rest on too few.
+    for _ in range(3):
+        out["compare"] = compare.run(compare.Ours())
+        kept, total = map(int, out["compare"]["samples_kept"].split("/"))
+        if 2 * kept >= total:
+            break
     print(json.dumps(out))
     return 0
 
