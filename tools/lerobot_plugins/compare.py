@@ -91,19 +91,19 @@ def prepare(fast: bool) -> Simulator:
     return sim
 
 
+def config(robot_type: str, sim, cal_dir, **kw):
+    """The robot's LeRobot config, found by its type as LeRobot's scripts find it."""
+    return RobotConfig.get_choice_class(robot_type)(port=sim.url, id="compare", calibration_dir=cal_dir, **kw)
+
+
 class Ours:
     name = "servoctl_arm (ours)"
     fast = True
 
     def make(self, sim, cal_dir):
-        cfg = RobotConfig.get_choice_class("servoctl_arm")(port=sim.url, id="compare", calibration_dir=cal_dir,
-                                                         fps=FPS)
-        robot = make_robot_from_config(cfg)
+        robot = make_robot_from_config(config("servoctl_arm", sim, cal_dir, fps=FPS))
         robot.clock = sim.clock_s  # the simulated clock, which it runs ahead while it waits
         return robot
-
-    def connect(self, robot):
-        robot.connect(calibrate=False)
 
     def action(self, robot, deg: dict) -> dict:
         return {f"{NAMES[i]}.pos": d for i, d in deg.items()}
@@ -117,8 +117,7 @@ class Makers:
     fast = False
 
     def make(self, sim, cal_dir):
-        cfg = RobotConfig.get_choice_class("lerobot_robot_viola")(port=sim.url, id="compare", calibration_dir=cal_dir,
-                                                                use_degrees=True)
+        cfg = config("lerobot_robot_viola", sim, cal_dir, use_degrees=True)
         robot = make_robot_from_config(cfg)
         # A user's arm is calibrated: its file (the plugin's own defaults) is there, so
         # connect() does what it does for them.
@@ -126,9 +125,6 @@ class Makers:
                              for n, c in robot.bus._build_default_calibration().items()}
         robot._save_calibration()
         return make_robot_from_config(cfg)
-
-    def connect(self, robot):
-        robot.connect(calibrate=False)
 
     def action(self, robot, deg: dict) -> dict:
         bus = robot.bus
@@ -157,7 +153,7 @@ def connect_movement(sim, plugin, robot) -> float:
     thread = threading.Thread(target=sample, daemon=True)
     thread.start()
     try:
-        plugin.connect(robot)
+        robot.connect(calibrate=False)
     finally:
         done.set()
         thread.join()
@@ -224,6 +220,8 @@ def tracking(samples, t0, start) -> dict:
     """RMS and worst of horn minus path over the sine (after its first
     0.5 s), at the lag (0-500 ms, 5 ms steps) with the least RMS."""
     pts = [(s[i][0] - t0, s[i][1], i) for s in samples for i in IDS if s[i][0] - t0 >= LEAD_S + 0.5]
+    if not pts:  # every frame late: nothing to judge
+        return {"rms_deg": math.nan, "worst_deg": math.nan, "lag_ms": math.nan}
     best = None
     for lag_ms in range(0, 501, 5):
         errs = [h - path_deg(t - lag_ms / 1000.0, start[i]) for t, h, i in pts]

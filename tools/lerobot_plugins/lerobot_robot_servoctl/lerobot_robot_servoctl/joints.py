@@ -6,6 +6,7 @@ import logging
 
 from lerobot.motors import MotorCalibration
 from lerobot.utils.errors import DeviceNotConnectedError
+from lerobot.utils.utils import enter_pressed
 from servoctl import link_rate
 from servoctl.arm import Arm, JointSilent
 from servoctl.protocol import Bus
@@ -113,3 +114,32 @@ class Calibrated:
     def _off(self, name: str) -> float:
         c = self.cal.get(name)
         return c.homing_offset / 10.0 if c is not None else 0.0
+
+
+class OnArm:
+    """What servoctl_arm and servoctl_leader do alike: their state, their
+    calibration, and the host's share of it (Calibrated)."""
+
+    def _on_arm(self, config) -> None:
+        self.config = config
+        self.arm = None
+        # The bus's clock: None is the simulator's (sim_control) or the host's.
+        self.clock = None
+        # calibrate()'s questions and its ENTER: replaceable (a script, a test).
+        self.prompt, self.stop_recording = input, enter_pressed
+
+    @property
+    def is_calibrated(self) -> bool:
+        if self.arm is not None and self.arm.firmware == "servoctl":
+            return self.arm.ranges_stored()
+        return bool(self.calibration)
+
+    def calibrate(self) -> None:
+        with answering(self):
+            self.calibration = calibrate(self, self.arm, self.prompt, self.stop_recording)
+        self._save_calibration()
+        print(f"{self}: calibration saved to {self.calibration_fpath}")
+
+    def _calibrated(self) -> Calibrated:
+        # This firmware keeps its own zero and limits: the file is the servos' record.
+        return Calibrated({} if self.arm.firmware == "servoctl" else self.calibration)

@@ -17,7 +17,6 @@ from functools import cached_property
 from lerobot.robots import Robot
 from lerobot.robots.utils import ensure_safe_goal_position
 from lerobot.utils.errors import DeviceAlreadyConnectedError, DeviceNotConnectedError
-from lerobot.utils.utils import enter_pressed
 from servoctl.arm import Arm
 
 from . import joints as j
@@ -26,18 +25,13 @@ from .config_servoctl_arm import ServoctlArmConfig
 log = logging.getLogger(__name__)
 
 
-class ServoctlArm(Robot):
+class ServoctlArm(j.OnArm, Robot):
     config_class = ServoctlArmConfig
     name = "servoctl_arm"
 
     def __init__(self, config: ServoctlArmConfig):
         super().__init__(config)
-        self.config = config
-        self.arm = None
-        # The bus's clock: None is the simulator's (sim_control) or the host's.
-        self.clock = None
-        # calibrate()'s questions and its ENTER: replaceable (a script, a test).
-        self.prompt, self.stop_recording = input, enter_pressed
+        self._on_arm(config)
         from lerobot.cameras.utils import make_cameras_from_configs
 
         self.cameras = make_cameras_from_configs(config.cameras)
@@ -81,24 +75,8 @@ class ServoctlArm(Robot):
             cam.connect()
         log.info("%s connected (%s firmware), holding where it is", self, arm.firmware)
 
-    @property
-    def is_calibrated(self) -> bool:
-        if self.arm is not None and self.arm.firmware == "servoctl":
-            return self.arm.ranges_stored()
-        return bool(self.calibration)
-
-    def calibrate(self) -> None:
-        with j.answering(self):
-            self.calibration = j.calibrate(self, self.arm, self.prompt, self.stop_recording)
-        self._save_calibration()
-        print(f"{self}: calibration saved to {self.calibration_fpath}")
-
     def configure(self) -> None:
         pass
-
-    def _calibrated(self) -> j.Calibrated:
-        # This firmware keeps its own zero and limits: the file is the servos' record.
-        return j.Calibrated({} if self.arm.firmware == "servoctl" else self.calibration)
 
     def get_observation(self) -> dict:
         if not self.is_connected:

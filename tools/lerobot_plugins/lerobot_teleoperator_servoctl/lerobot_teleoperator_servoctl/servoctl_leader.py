@@ -10,7 +10,6 @@ import logging
 
 from lerobot.teleoperators import Teleoperator
 from lerobot.utils.errors import DeviceAlreadyConnectedError, DeviceNotConnectedError
-from lerobot.utils.utils import enter_pressed
 from lerobot_robot_servoctl import joints as j
 from servoctl.arm import Arm
 from servoctl.servo import Servo
@@ -20,16 +19,13 @@ from .config_servoctl_leader import ServoctlLeaderConfig
 log = logging.getLogger(__name__)
 
 
-class ServoctlLeader(Teleoperator):
+class ServoctlLeader(j.OnArm, Teleoperator):
     config_class = ServoctlLeaderConfig
     name = "servoctl_leader"
 
     def __init__(self, config: ServoctlLeaderConfig):
         super().__init__(config)
-        self.config = config
-        self.arm = None
-        self.clock = None  # the bus's clock, as ServoctlArm's
-        self.prompt, self.stop_recording = input, enter_pressed
+        self._on_arm(config)
 
     @property
     def action_features(self) -> dict:
@@ -70,18 +66,9 @@ class ServoctlLeader(Teleoperator):
             else:
                 Servo(self.arm.bus, servo_id).stop("release")
 
-    @property
-    def is_calibrated(self) -> bool:
-        if self.arm is not None and self.arm.firmware == "servoctl":
-            return self.arm.ranges_stored()
-        return bool(self.calibration)
-
     def calibrate(self) -> None:
-        with j.answering(self):
-            self.calibration = j.calibrate(self, self.arm, self.prompt, self.stop_recording)
-        self._save_calibration()
+        super().calibrate()
         self._let_go()
-        print(f"{self}: calibration saved to {self.calibration_fpath}")
 
     def configure(self) -> None:
         pass
@@ -99,9 +86,8 @@ class ServoctlLeader(Teleoperator):
     def get_action(self) -> dict:
         if not self.is_connected:
             raise DeviceNotConnectedError(f"{self} is not connected.")
-        cal = j.Calibrated({} if self.arm.firmware == "servoctl" else self.calibration)
         with j.answering(self):
-            pos = cal.observed(self.arm.positions())
+            pos = self._calibrated().observed(self.arm.positions())
         name, follower = self.config.gripper, self.config.follower_gripper_range
         mine = self.gripper_range() if follower is not None and name in pos else None
         if mine is not None and mine[1] > mine[0]:
