@@ -6,15 +6,21 @@ FOLLOWER_CONTROL, LEADER_PORT, LEADER_CONTROL: a shell's `source`), prints
 the lerobot-teleoperate command that drives them and runs until Ctrl-C or
 SIGTERM, which stop both.
 
-    .venv/bin/python tools/lerobot_plugins/sim_arms.py [--follower 5100] [--leader 5200]"""
+    .venv/bin/python tools/lerobot_plugins/sim_arms.py [--follower 5100] [--leader 5200]
+
+and, while they run, a hand on the leader: a torque on one released joint
+for a moment, then both arms' horn angles once the follower has followed:
+
+    .venv/bin/python tools/lerobot_plugins/sim_arms.py --nudge JOINT_ID"""
 import argparse
 import signal
 import sys
+import time
 from pathlib import Path
 
 from servoctl import link_rate
 from servoctl.servo import Servo
-from servoctl.sim import Simulator
+from servoctl.sim import Simulator, control_command
 
 IDS = range(7)
 ENV = Path(__file__).resolve().parents[2] / "build" / "sim-arms.env"
@@ -31,11 +37,28 @@ def arm(tcp_port: int) -> Simulator:
     return sim
 
 
+def nudge(servo_id: int, torque_nm: float = 0.5, seconds: float = 0.2) -> None:
+    """The leader's joint pushed (its control port's load), then let be."""
+    env = dict(line.split("=", 1) for line in ENV.read_text().split())
+    leader, follower = int(env["LEADER_CONTROL"]), int(env["FOLLOWER_CONTROL"])
+    control_command(leader, f"load {torque_nm} {servo_id}")
+    time.sleep(seconds)
+    control_command(leader, f"load 0 {servo_id}")
+    time.sleep(1.0)
+    for name, port in (("leader", leader), ("follower", follower)):
+        angles = [line.split()[4].split("=")[1] for line in control_command(port, "state").splitlines()]
+        print(f"{name:8} horns (deg): {' '.join(f'{float(a):7.1f}' for a in angles)}")
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--follower", type=int, default=5100, help="the follower's TCP port")
     ap.add_argument("--leader", type=int, default=5200, help="the leader's TCP port")
+    ap.add_argument("--nudge", type=int, metavar="JOINT_ID", help="push the running leader's joint, then show both")
     args = ap.parse_args(argv)
+    if args.nudge is not None:
+        nudge(args.nudge)
+        return 0
     sims = []
     signal.signal(signal.SIGTERM, lambda *_: sys.exit(0))
     try:
