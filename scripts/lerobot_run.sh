@@ -18,6 +18,8 @@ hash=$(cd "$ROOT/tools/lerobot_plugins" && find "${PLUGINS[@]}" -name build -pru
 TARGET="$ROOT/build/lerobot-plugins/$hash"
 if [ ! -d "$TARGET" ]; then
   mkdir -p "$ROOT/build/lerobot-plugins"
+  # setuptools builds in the source tree, and would pack a stale build/ along.
+  for p in "${PLUGINS[@]}"; do rm -rf "$ROOT/tools/lerobot_plugins/$p/build"; done
   NEW=$(mktemp -d "$ROOT/build/lerobot-plugins/.new.XXXXXX")
   "$PY" -m pip install -q --disable-pip-version-check --no-deps --no-build-isolation --no-compile \
     --target "$NEW" "${PLUGINS[@]/#/$ROOT/tools/lerobot_plugins/}" >&2

@@ -91,6 +91,13 @@ def makers_path(out: dict) -> None:
         out["maker_period_ms"] = robot.arm.measured_period_s * 1000
         sim.sleep(0.2)
         out["maker_moved"] = robot.get_observation()["Motor_2.pos"] - start
+        # Calibrated there (no joint moved through a range: ENTER at once): a LeRobot
+        # file of offsets, the servos' own limits untouched.
+        robot.prompt, robot.stop_recording = (lambda _: ""), (lambda: True)
+        robot.calibrate()
+        out["maker_cal"] = {n: c.homing_offset for n, c in robot.calibration.items()}
+        out["maker_cal_obs"] = robot.get_observation()
+        out["maker_limits"] = [Servo(robot.arm.bus, i).read("angle_max") for i in IDS]
         robot.disconnect()
     finally:
         sim.stop()

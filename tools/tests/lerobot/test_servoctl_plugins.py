@@ -63,6 +63,15 @@ def test_on_the_makers_protocol_moves_are_fitted_to_the_frame_period(seen):
     assert seen["maker_moved"] == pytest.approx(30.0, abs=0.5)
 
 
+def test_on_the_makers_protocol_calibration_is_a_lerobot_file(seen):
+    # The arm stood at -20, -12, -4 + 30, ... deg: those are the offsets, in 0.1 deg, and
+    # every joint reads 0 from them; the servos' limits are as they were.
+    stood = {**{f"Motor_{k}": 80 * k - 200 for k in range(6)}, "Motor_2": 260, "gripper": 280}
+    assert seen["maker_cal"] == pytest.approx(stood, abs=2)  # a held horn settles by 0.1 deg
+    assert all(abs(d) <= 0.2 for d in seen["maker_cal_obs"].values()), seen["maker_cal_obs"]
+    assert seen["maker_limits"] == [1350] * 7
+
+
 def test_calibration_stores_the_zero_and_the_ranges_on_the_servos(seen):
     # Zeroed where they stood, then swung +-30 deg: the ranges are the servos' limits.
     for lo, hi, on in seen["cal_limits"]:
