@@ -26,6 +26,7 @@ import argparse
 import dataclasses
 import json
 import math
+import shutil
 import sys
 import tempfile
 import threading
@@ -53,7 +54,7 @@ ACCEL_WINDOW_S = 0.020
 # loaded PC runs Python late, and the servo, which times each segment from its setpoint's
 # arrival, corrects the difference in the next (docs/streaming.md). The samples from its due
 # time to RECOVER_FRAMES frames later are left out of the figures, and counted.
-LATE_S, RECOVER_FRAMES = 0.002, 4
+LATE_S, RECOVER_FRAMES = 0.001, 4
 BAUD_1M = 8  # item 36's index for 1 000 000 baud
 
 
@@ -78,16 +79,20 @@ def horns(sim) -> dict:
 def prepare(fast: bool) -> Simulator:
     """The arm at 1 Mbaud, soft start off, each horn at START and released."""
     sim = Simulator(ids=IDS, tcp=False, fast=fast, nice=None if fast else -10).start()
-    with sim.bus(timeout=0.2) as bus:
-        for i in IDS:
-            s = Servo(bus, i)
-            s.write("soft_start_on", 0)
-            s.move(round(START[i] * 10), interval_ms=300)
-        sim.sleep(0.5)
-        for i in IDS:
-            Servo(bus, i).stop("release")
-            Servo(bus, i).write("baud", BAUD_1M)  # answered at 115200, then it switches
-    sim.sleep(0.1)
+    try:
+        with sim.bus(timeout=0.2) as bus:
+            for i in IDS:
+                s = Servo(bus, i)
+                s.write("soft_start_on", 0)
+                s.move(round(START[i] * 10), interval_ms=300)
+            sim.sleep(0.5)
+            for i in IDS:
+                Servo(bus, i).stop("release")
+                Servo(bus, i).write("baud", BAUD_1M)  # answered at 115200, then it switches
+        sim.sleep(0.1)
+    except BaseException:
+        sim.stop()  # nothing is left running
+        raise
     return sim
 
 
@@ -182,9 +187,10 @@ def silence(sim, servo_id: int) -> None:
 def run(plugin) -> dict:
     sim = prepare(plugin.fast)
     cal = Path(tempfile.mkdtemp(prefix="lerobot-cal-"))
-    robot = plugin.make(sim, cal)
+    robot = None
     result = {"plugin": plugin.name}
     try:
+        robot = plugin.make(sim, cal)
         result["connect_move_deg"] = connect_movement(sim, plugin, robot)
         start = plugin.read(robot, robot.get_observation())
         samples, late, reads = [], [], {i: set() for i in IDS}
@@ -209,10 +215,12 @@ def run(plugin) -> dict:
         result["silent"] = silent_run(sim, plugin, robot)
     finally:
         try:
-            robot.disconnect()
+            if robot is not None:
+                robot.disconnect()
         except Exception:  # noqa: BLE001 - a silent servo may keep it from finishing
             pass
         sim.stop()
+        shutil.rmtree(cal, ignore_errors=True)
     return result
 
 

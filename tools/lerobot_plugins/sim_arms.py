@@ -20,7 +20,7 @@ from pathlib import Path
 
 from servoctl import link_rate
 from servoctl.servo import Servo
-from servoctl.sim import Simulator, control_command
+from servoctl.sim import Simulator, _fields, control_command
 
 IDS = range(7)
 ENV = Path(__file__).resolve().parents[2] / "build" / "sim-arms.env"
@@ -46,8 +46,8 @@ def nudge(servo_id: int, torque_nm: float = 0.5, seconds: float = 0.2) -> None:
     control_command(leader, f"load 0 {servo_id}")
     time.sleep(1.0)
     for name, port in (("leader", leader), ("follower", follower)):
-        angles = [line.split()[4].split("=")[1] for line in control_command(port, "state").splitlines()]
-        print(f"{name:8} horns (deg): {' '.join(f'{float(a):7.1f}' for a in angles)}")
+        angles = [_fields(line)["angle"] for line in control_command(port, "state").splitlines() if line.strip()]
+        print(f"{name:8} horns (deg): {' '.join(f'{a:7.1f}' for a in angles)}")
 
 
 def main(argv=None) -> int:

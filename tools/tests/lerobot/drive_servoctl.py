@@ -6,6 +6,7 @@ make_teleoperator_from_config, on simulated 7-servo arms (IDs 0-6, 1
 Mbaud, servo_sim on its simulated clock, fast). Prints one JSON line of
 what it saw."""
 import json
+import shutil
 import sys
 import tempfile
 from pathlib import Path
@@ -23,9 +24,12 @@ from servoctl.servo import Servo  # noqa: E402
 IDS = compare.IDS
 
 
+CAL = Path(tempfile.mkdtemp(prefix="lerobot-cal-"))  # the calibration files; removed at the end
+
+
 def follower(sim, **kw):
     cfg = RobotConfig.get_choice_class("servoctl_arm")(port=sim.url, id="test", calibration_dir=Path(
-        tempfile.mkdtemp(prefix="lerobot-cal-")), **kw)
+        tempfile.mkdtemp(dir=CAL)), **kw)
     robot = make_robot_from_config(cfg)
     robot.clock = sim.clock_s
     return robot
@@ -141,7 +145,7 @@ def leader(out: dict) -> None:
     sim = compare.prepare(fast=True)
     try:
         cfg = TeleoperatorConfig.get_choice_class("servoctl_leader")(
-            port=sim.url, id="test", calibration_dir=Path(tempfile.mkdtemp(prefix="lerobot-cal-")),
+            port=sim.url, id="test", calibration_dir=Path(tempfile.mkdtemp(dir=CAL)),
             follower_gripper_range=(-10.0, 40.0))
         teleop = make_teleoperator_from_config(cfg)
         teleop.clock = sim.clock_s
@@ -162,19 +166,30 @@ def leader(out: dict) -> None:
 def main() -> int:
     register_third_party_plugins()
     out = {}
-    follower_session(out)
-    makers_path(out)
-    calibration(out)
-    leader(out)
-    # The comparison's run of ours; again (up to 3 runs) where the host sent more than half
-    # its frames late (compare.LATE_S), and the figures would rest on too few.
-    for _ in range(3):
-        out["compare"] = compare.run(compare.Ours())
-        kept, total = map(int, out["compare"]["samples_kept"].split("/"))
-        if 2 * kept >= total:
-            break
+    try:
+        follower_session(out)
+        makers_path(out)
+        calibration(out)
+        leader(out)
+        ours(out)
+    finally:
+        shutil.rmtree(CAL, ignore_errors=True)
     print(json.dumps(out))
     return 0
+
+
+def ours(out: dict) -> None:
+    # The comparison's run of ours; again (up to 3 runs) where the host sent more than half
+    # its frames late (compare.LATE_S), and the figures would rest on too few.
+    def kept(run):
+        k, total = map(int, run["samples_kept"].split("/"))
+        return k / total
+    for _ in range(3):
+        run = compare.run(compare.Ours())
+        if "compare" not in out or kept(run) > kept(out["compare"]):
+            out["compare"] = run
+        if kept(run) >= 0.5:
+            break
 
 
 if __name__ == "__main__":
