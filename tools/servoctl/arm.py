@@ -1,0 +1,278 @@
+"""An arm of named joints on one bus, for a robot framework's loop (the
+LeRobot plugins in tools/lerobot_plugins; docs/lerobot.md): degrees in
+and out, a frame at a time.
+
+- Which firmware: this one (it answers item 64, the bus watchdog) or the
+  maker's (it does not).
+- hold_here(): torque on where each joint is; nothing moves.
+- positions(): every joint's angle from one Sync Monitor (0.1 deg), fresh
+  or JointSilent naming the joints that did not answer in their slot;
+  a joint whose servo released its output (supply, heat) raises
+  JointFault with its fault history.
+- send(): this firmware gets streamed setpoints (the servo joins them with
+  a cubic, docs/streaming.md); the maker's gets angle moves in one
+  SyncCommand, each timed to the frame period measured between sends.
+- On this firmware the bus watchdog (items 64, 65) is armed while the arm
+  is driven, and put back as it was on close.
+
+Time is the bus's clock (the simulator's on servo_sim)."""
+from . import protocol as p
+from . import registers
+from .errors import NoReply, ServoError, UsageError
+from .group import sync_monitor
+from .servo import Servo
+from .setpoints import MAX_SPEED_DECIDEG_S, Stream, read_limits
+
+WATCHDOG_ACTIONS = {"hold": 0, "damp": 1, "release": 2}  # item 65
+# Status bits with which the servo has let its output go (frame.toml).
+RELEASED_BY = ("high_voltage", "low_voltage", "over_temperature")
+# The maker's moves: the shortest and longest time fitted to the frames.
+MOVE_MS = (10, 1000)
+
+
+class JointSilent(NoReply):
+    """A joint's servo did not answer in its slot: no stale value is given."""
+
+    def __init__(self, message: str, joints: list):
+        super().__init__(message)
+        self.joints = joints
+
+
+class JointFault(ServoError):
+    """A joint's servo has let its output go: the message has its faults."""
+
+
+def fault_text(servo: Servo, newest: int = 3) -> str:
+    """The newest faults of the servo's history, as a phrase; what is
+    known when it cannot be read (the maker's firmware keeps none)."""
+    try:
+        faults = servo.faults()[:newest]
+    except NoReply:
+        return "its fault history could not be read (no answer)"
+    except ServoError:
+        return "it keeps no fault history (the maker's firmware)"
+    if not faults:
+        return "no fault in its history"
+    said = ", ".join(f"#{f.number} {f.kind} at {f.angle_decideg / 10:.1f} deg, {f.voltage_mv / 1000:.2f} V, "
+                     f"{f.winding_decic / 10:.0f} C winding" for f in faults)
+    return f"its newest faults: {said} ('servoctl faults {servo.id}')"
+
+
+def detect_firmware(bus: p.Bus, servo_id: int) -> str:
+    """"servoctl" (this firmware: item 64 reads) or "maker"."""
+    try:
+        Servo(bus, servo_id).read("watchdog_ms")
+        return "servoctl"
+    except NoReply:
+        raise
+    except ServoError:
+        return "maker"
+
+
+class Arm:
+    """joints: {name: servo ID}. fps: the frames a second the host's loop
+    sends (a stream's period). firmware: "auto", "servoctl" or "maker"
+    (the maker's path runs on this firmware too: its packets are the
+    maker's). watchdog_ms 0 leaves the watchdog as it is."""
+
+    def __init__(self, bus: p.Bus, joints: dict, fps: float = 30.0, firmware: str = "auto",
+                 watchdog_ms: int = 500, watchdog_action: str = "hold"):
+        if not joints:
+            raise UsageError("an arm needs at least one joint")
+        if watchdog_action not in WATCHDOG_ACTIONS:
+            raise UsageError(f"watchdog_action is one of {', '.join(WATCHDOG_ACTIONS)}, not {watchdog_action!r}")
+        if firmware not in ("auto", "servoctl", "maker"):
+            raise UsageError(f"firmware is auto, servoctl or maker, not {firmware!r}")
+        self.bus, self.joints = bus, dict(joints)
+        self.ids = list(self.joints.values())
+        self.names = {i: n for n, i in self.joints.items()}
+        self.period_s = 1.0 / fps
+        self.firmware = firmware
+        self.watchdog_ms, self.watchdog_action = watchdog_ms, watchdog_action
+        self.limits = {}
+        self.stream = None
+        self.targets = {}  # {name: degrees}: the last sent, or where hold_here held
+        self._before = {}  # the targets before those
+        self._watchdog_before = {}
+        self._times = []  # the bus clock at the last sends, up to 3
+        self.measured_period_s = self.period_s
+        self.frames = 0
+
+    # ---- the session -------------------------------------------------
+    def open(self) -> "Arm":
+        """Finds the firmware and every joint's limits; arms the watchdog.
+        Nothing moves, and the output is not driven yet."""
+        self.positions()  # every joint answers, or JointSilent names those that do not
+        if self.firmware == "auto":
+            self.firmware = detect_firmware(self.bus, self.ids[0])
+        self.limits = read_limits(self.bus, self.ids)
+        if self.firmware == "servoctl":
+            self._arm_watchdog()
+        return self
+
+    def _arm_watchdog(self) -> None:
+        if not self.watchdog_ms:
+            return
+        action = WATCHDOG_ACTIONS[self.watchdog_action]
+        for servo_id in self.ids:
+            s = Servo(self.bus, servo_id)
+            before = (s.read("watchdog_ms"), s.read("watchdog_action"))
+            if before != (self.watchdog_ms, action):  # a write is a flash record: only when it changes
+                self._watchdog_before[servo_id] = before
+                s.write("watchdog_ms", self.watchdog_ms)
+                s.write("watchdog_action", action)
+            self.limits[servo_id].watchdog_ms = self.watchdog_ms
+
+    def hold_here(self) -> dict:
+        """Torque on where every joint is (StopOnControlMode's hold: no
+        target, so nothing moves); the first target is that pose."""
+        for servo_id in self.ids:
+            Servo(self.bus, servo_id).stop("hold")
+        self.targets, self._before = self.positions(), {}
+        if self.firmware == "servoctl":
+            self.stream = Stream(self.bus, self.ids, self.period_s, self.limits)
+        self._times = []
+        return dict(self.targets)
+
+    def close(self, release: bool = True) -> None:
+        """Releases the joints (or leaves them holding) and puts each
+        watchdog back as it was."""
+        errors = []
+        if release:
+            for servo_id in self.ids:
+                Servo(self.bus, servo_id).stop("release")
+        for servo_id, (ms, action) in self._watchdog_before.items():
+            try:
+                s = Servo(self.bus, servo_id)
+                s.write("watchdog_ms", ms)
+                s.write("watchdog_action", action)
+            except ServoError as e:
+                errors.append(f"{self.names[servo_id]}: {e}")
+        self._watchdog_before = {}
+        self.stream = None
+        if errors:
+            raise ServoError("the bus watchdog could not be put back: " + "; ".join(errors))
+
+    # ---- calibration (this firmware: stored on the servos) -------------
+    def set_zero_here(self) -> dict:
+        """Each joint released, its encoder count now stored as its zero
+        (item 90) and taken as the origin (SetOriginPoint): it reads 0 deg
+        here from now on, after a power-up too. {name: the count}."""
+        counts = {}
+        for name, servo_id in self.joints.items():
+            s = Servo(self.bus, servo_id)
+            s.stop("release")
+            counts[name] = s.read("encoder_count")
+            s.write("encoder_zero", counts[name])
+            s.set_origin()
+        return counts
+
+    def store_ranges(self, ranges: dict) -> None:
+        """{name: (lowest, highest) deg} stored as each servo's angle limits
+        (items 52, 51, switched on by 48), which every move and setpoint
+        keeps to, the servo's own."""
+        for name, (low, high) in ranges.items():
+            s = Servo(self.bus, self.joints[name])
+            lo, hi = round(low * 10), round(high * 10)
+            if hi - lo < 10:
+                raise UsageError(f"{name} moved {abs(hi - lo) / 10:.1f} deg: move each joint through its range")
+            s.write("angle_limit_on", 0)
+            s.write("angle_min", lo)
+            s.write("angle_max", hi)
+            s.write("angle_limit_on", 1)
+        self.limits = read_limits(self.bus, self.ids)
+
+    def ranges_stored(self) -> bool:
+        """Whether every joint's servo keeps its angle limits on."""
+        return all(lim.angle_min is not None for lim in self.limits.values())
+
+    # ---- a frame -----------------------------------------------------
+    def positions(self) -> dict:
+        """{name: degrees} from one Sync Monitor, 0.1 deg; JointSilent or
+        JointFault rather than an old value."""
+        states = sync_monitor(self.bus, self.ids)
+        silent = [i for i in self.ids if i not in states]
+        if silent:
+            named = ", ".join(f"{self.names[i]} (servo {i})" for i in silent)
+            raise JointSilent(f"{named} did not answer in its slot of the Sync Monitor: no position is "
+                              f"given for it (is it powered, its cable in? "
+                              f"{fault_text(Servo(self.bus, silent[0]))})", [self.names[i] for i in silent])
+        for servo_id, m in states.items():
+            released = [b for b in registers.status_names(m.status) if b in RELEASED_BY]
+            if released:
+                raise JointFault(f"{self.names[servo_id]} (servo {servo_id}) has released its output "
+                                 f"({', '.join(released)}); {fault_text(Servo(self.bus, servo_id))}")
+        self.frames += 1
+        return {self.names[i]: states[i].angle_decideg / 10.0 for i in self.ids}
+
+    def clamp(self, targets: dict) -> dict:
+        """targets ({name: degrees}) within what each servo takes from the
+        last target in one frame: its angle limits, and its top speed
+        (750 deg/s) over a frame period. Not rounded: the packets carry
+        0.1 deg, and the speeds come from the targets as asked."""
+        out = {}
+        step = (MAX_SPEED_DECIDEG_S - 100) / 10.0 * self.period_s  # 10 deg/s short of it: rounding
+        for name, deg in targets.items():
+            lim = self.limits[self.joints[name]]
+            deg = float(deg)
+            if lim.angle_min is not None:
+                deg = min(max(deg, lim.angle_min / 10.0), lim.angle_max / 10.0)
+            last = self.targets.get(name)
+            if last is not None and self.firmware == "servoctl":
+                deg = min(max(deg, last - step), last + step)
+            out[name] = deg
+        return out
+
+    def send(self, targets: dict) -> dict:
+        """Every joint's next target (a missing one keeps its last); returns
+        what was sent, clamped as clamp() does."""
+        unknown = sorted(set(targets) - set(self.joints))
+        if unknown:
+            raise UsageError(f"no joint named {', '.join(unknown)} (the arm's: {', '.join(self.joints)})")
+        if not self.targets:
+            raise UsageError("hold_here() first: the arm's first target is where it is")
+        sent = self.clamp({**self.targets, **targets})
+        now = self.bus.clock()
+        if self._times:
+            # The frame period as the host keeps it: the maker's moves are fitted to it.
+            self.measured_period_s += 0.3 * (min(now - self._times[-1], 1.0) - self.measured_period_s)
+        self._times = (self._times + [now])[-3:]
+        if self.firmware == "servoctl":
+            self.stream.send({self.joints[n]: d for n, d in sent.items()}, self._velocities(sent))
+        else:
+            self._send_moves(sent)
+        self._before = self.targets
+        self.targets = sent
+        return {n: round(d, 1) for n, d in sent.items()}
+
+    def _velocities(self, sent: dict) -> dict:
+        """{id: deg/s} at each new setpoint, from the last three and the
+        times they were sent (a host's frames come a few ms early or late,
+        and a speed from the nominal period would be off by as much): the
+        second-order backward difference, the speed at the newest (the
+        first-order one gives it half a frame late, and each segment would
+        end at a speed the next must correct); 0 after a hold; within the
+        servo's top speed."""
+        top = (MAX_SPEED_DECIDEG_S - 100) / 10.0
+        out = {}
+        t = self._times
+        for name, deg in sent.items():
+            last, before = self.targets.get(name), self._before.get(name)
+            if len(t) < 2 or last is None:
+                v = 0.0
+            elif len(t) < 3 or before is None:
+                v = (deg - last) / max(t[-1] - t[-2], 1e-3)
+            else:
+                h1, h2 = max(t[-1] - t[-2], 1e-3), max(t[-2] - t[-3], 1e-3)
+                v = (deg * (2 * h1 + h2) / (h1 * (h1 + h2)) - last * (h1 + h2) / (h1 * h2)
+                     + before * h1 / (h2 * (h1 + h2)))
+            out[self.joints[name]] = min(max(v, -top), top)
+        return out
+
+    def _send_moves(self, sent: dict) -> None:
+        """The maker's protocol: one SyncCommand of MoveOnAngleMode, each move
+        as long as a frame, so it ends as the next begins."""
+        ms = min(max(round(self.measured_period_s * 1000), MOVE_MS[0]), MOVE_MS[1])
+        records = b"".join(p.encode_request(p.ANGLE, self.joints[n], round(d * 10), ms, 0) for n, d in sent.items())
+        self.bus.send(p.SYNC, bytes([p.ANGLE, len(records) // len(sent), len(sent)]) + records)
+
