@@ -50,6 +50,9 @@ class Bus:
         # clock; unless given, the clock's own simulator's (servoctl's
         # commands run with clock=sim.clock_s).
         self.run_ahead = run_ahead or getattr(getattr(clock, "__self__", None), "bus_run_ahead", None)
+        # A paced simulator is told the bytes sent, so it takes them when
+        # they were sent (Simulator.bus_sent).
+        self.note_sent = getattr(getattr(clock, "__self__", None), "bus_sent", None)
         self.port = port
         try:
             # Exclusive: a second program on the port would take answers
@@ -135,6 +138,8 @@ class Bus:
         self._buffer = b""
         frames = b"".join(request_frame(c, content) for c, content in requests)
         self._link(self.serial.write if self._sock is None else self._write_all, frames)
+        if self.note_sent is not None:
+            self.note_sent(len(frames))
 
     def _fill(self, wait: bool = True) -> bool:
         """Reads what has arrived; with wait, first waits up to 5 ms for a
@@ -334,6 +339,8 @@ class Bus:
         wire and 5 ms, on the bus clock) and drops it: after a NoReply, a
         late answer is not taken for the next request's."""
         deadline = self.clock() + self._longest_answer_s()
+        if self.run_ahead is not None:
+            self.run_ahead(deadline + 0.001)
         while self.clock() <= deadline:
             self._fill(wait=True)
         while (frame := self._take_frame()) is not None:  # garbled answers counted
