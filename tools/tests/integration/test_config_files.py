@@ -96,7 +96,7 @@ def test_a_tuned_servos_drive_area_goes_with_its_file(sim, capsys, tmp_path):
     assert run(sim, capsys, "config", "save", "1", str(f))[0] == 0
     assert run(sim, capsys, "backup", str(b), "--ids", "1")[0] == 0
     items = json.loads(f.read_text())["items"]
-    assert items["gain_kd"] == "12000" and items["gear_ratio"] == "-387", items
+    assert items["gain_kd"] == "12000 Q15 duty/(0.1deg/tick)" and items["gear_ratio"] == "-387", items
     # Other values (a 1 in each would make the loop unstable: refused, docs/safety.md)
     for name, text in {"gain_kp": "546", "gain_kd": "3000", "gear_ratio": "345", "encoder_zero": "1"}.items():
         assert run(sim, capsys, "config", "set", "1", name, text)[0] == 0
@@ -150,3 +150,4 @@ def test_ram_items_carry_their_units_in_files(sim, capsys, tmp_path):
     f.write_text(json.dumps(doc))
     assert run(sim, capsys, "config", "load", "1", str(f))[0] == 0
     assert run(sim, capsys, "config", "get", "1", "oscillation_ms")[1].startswith("oscillation_ms = 300")
+
