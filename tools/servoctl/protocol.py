@@ -31,6 +31,31 @@ WRITE_STALL_S = 10.0
 RUN_AHEAD_S = 0.02
 
 
+# The URL schemes pyserial opens; socket:// and rfc2217:// need HOST:PORT.
+_SCHEMES = ("socket", "rfc2217", "loop", "spy", "hwgrep", "alt", "cp2110")
+PORT_FORMS = ("a serial device (/dev/ttyUSB0, /dev/serial/by-id/..., COM3) or socket://HOST:PORT "
+              "(a simulator's bus, as `servoctl sim` prints it: socket://127.0.0.1:5000)")
+
+
+def check_port(port: str) -> None:
+    """A port servoctl can open, by its form: UsageError naming the forms
+    taken otherwise (pyserial's own words were "'<=' not supported between
+    instances of 'int' and 'NoneType'"). Whether it is there is the
+    opening's to say."""
+    scheme, sep, rest = str(port).partition("://")
+    if not sep:
+        if not str(port).strip():
+            raise UsageError(f"--port is empty: give {PORT_FORMS}")
+        return
+    if scheme.lower() not in _SCHEMES:
+        raise UsageError(f"--port {port!r}: no such kind of port ({scheme}://): give {PORT_FORMS}")
+    if scheme.lower() in ("socket", "rfc2217"):
+        host, colon, number = rest.split("?", 1)[0].split("/", 1)[0].rpartition(":")
+        if not colon or not host or not number.isdigit() or not 1 <= int(number) <= 65535:
+            raise UsageError(f"--port {port!r} is not {scheme}://HOST:PORT with a port of 1-65535: give "
+                             f"{PORT_FORMS}")
+
+
 class Bus:
     """A serial port (or pyserial URL such as socket://127.0.0.1:5000) with
     the request/response discipline of the protocol.
@@ -54,6 +79,7 @@ class Bus:
         # they were sent (Simulator.bus_sent).
         self.note_sent = getattr(getattr(clock, "__self__", None), "bus_sent", None)
         self.port = port
+        check_port(port)
         try:
             # Exclusive: a second program on the port would take answers
             # meant for this one (a flock on a serial device; other URLs
