@@ -1,6 +1,7 @@
 """The bus: sends requests and waits for the matching response, on a serial
 port or a simulator's socket. The frames themselves are codec.py's, named
 here too (p.request_frame, p.PING and the like)."""
+import math
 import time
 
 from . import codec as _codec
@@ -128,6 +129,7 @@ class Bus:
             return
         end = self.clock() + seconds
         if self.run_ahead is not None:
+            end = math.ceil(end * 1e6 - 1e-3) / 1e6  # sim.on_us_grid: where a paced one stops
             self.run_ahead(end)
         while (left := end - self.clock()) > 0:
             time.sleep(min(left, 0.005))
@@ -311,10 +313,13 @@ class Bus:
     def _look(self, deadline: float) -> float:
         """The bus clock; a simulator that runs ahead while the host waits
         may run to just past the deadline, at most RUN_AHEAD_S past now
-        (deadline 0: no more)."""
+        (deadline 0: no more). A paced one (note_sent) to the deadline: it
+        stops at the answer itself, and a bound taken from the clock as the
+        host happens to read it would make its stops the host's."""
         now = self.clock()
         if self.run_ahead is not None:
-            self.run_ahead(min(deadline + 0.001, now + RUN_AHEAD_S), answer=True)
+            ahead = RUN_AHEAD_S if self.note_sent is None else math.inf
+            self.run_ahead(min(deadline + 0.001, now + ahead), answer=True)
         return now
 
     def _take_frame(self):

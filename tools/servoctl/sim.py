@@ -305,18 +305,21 @@ class Simulator(_Child):
     def _wait(self, predicate, timeout_s: float, step_s: float):
         """(predicate met, simulated seconds waited)."""
         start = self.clock_s()
+        end = start + timeout_s
+        if self._runs_ahead():
+            end = on_us_grid(end)  # where it stops: reached, not a float's width short
         while True:
             if predicate():
                 return True, self.clock_s() - start
             now = self.clock_s()
             waited = now - start
-            if waited >= timeout_s:
+            if now >= end:
                 return False, waited
             if not self._runs_ahead():
                 time.sleep(min(step_s, timeout_s - waited))
                 continue
             # The predicate is looked at as often in simulated time.
-            until = min(now + step_s, start + timeout_s)
+            until = min(on_us_grid(now + step_s), end)
             self.run_ahead_to(until)
             while self.clock_s() < until:
                 time.sleep(0.0002)
@@ -346,14 +349,24 @@ class Simulator(_Child):
         one stands still there)."""
         if self._runs_ahead():
             flags = answer << 63
-            # A microsecond past: a paced simulator stops there, and a wait
-            # for until_s must see it reached, whatever the float's rounding.
-            _CLOCK_US.pack_into(self._clock_map, 8, max(0, math.ceil(until_s * 1e6) + 1) | flags)
+            # A paced simulator stops at this microsecond: a wait for a time
+            # on the grid (on_us_grid) sees it reached once it has stopped.
+            _CLOCK_US.pack_into(self._clock_map, 8, max(0, math.ceil(until_s * 1e6 - 1e-3)) | flags)
 
     def state(self, servo_id: int) -> dict:
         """The models' state of one servo: angle (deg), velocity, current,
         winding temperature, supply, status, collisions, ..."""
         return _fields(self.control(f"state {servo_id}"))
+
+
+def on_us_grid(t: float) -> float:
+    """t rounded up to a whole microsecond, as the clock file counts: a
+    paced simulator stops at the bound run_ahead_to writes for it, and the
+    clock read there (its microseconds / 1e6) equals it, so a host that
+    waits until the clock reaches t goes on only once the simulator has
+    stopped there, not while it is still on its way (a race that made a
+    paced run differ by the host's speed)."""
+    return math.ceil(t * 1e6 - 1e-3) / 1e6
 
 
 def _fields(line: str) -> dict:

@@ -29,6 +29,8 @@ static struct sim_servo servos[SIM_MAX_SERVOS];
 static volatile sig_atomic_t stop_requested;
 /* How many bytes the host had been sent when it last sent bytes itself. */
 static unsigned long host_bytes_then;
+/* --clock paced (sim_clock.h). */
+static bool paced_clock;
 /* Bytes read from the host in all (a paced host's offset 16, sim_clock.h). */
 static uint64_t host_read_total;
 /* A second TCP client while one holds the bus is told so and then ignored
@@ -92,7 +94,14 @@ static void run_to(uint64_t target, bool until_answer)
             uint64_t wake = sim_servo_wake_at(&servos[i]);
             next = wake < next ? wake : next;
         }
-        sim_bus_deliver(&bus, next > bus.now_us ? next : bus.now_us);
+        uint64_t at = next > bus.now_us ? next : bus.now_us;
+        if (paced_clock && at > bus.now_us) {
+            /* Before the bytes it hands the host: a host that reads the clock
+             * once it has its answer reads the answer's time, not a step's
+             * before it. */
+            sim_clock_publish(at);
+        }
+        sim_bus_deliver(&bus, at);
         for (unsigned i = 0; i < bus.station_count; i++) {
             sim_servo_poll(&servos[i], bus.now_us);
         }
@@ -120,6 +129,7 @@ int main(int argc, char **argv)
 {
     struct sim_options o;
     sim_options_parse(argc, argv, &o);
+    paced_clock = o.paced;
     signal(SIGINT, on_signal);
     signal(SIGTERM, on_signal);
     signal(SIGPIPE, SIG_IGN);
