@@ -16,6 +16,7 @@ import threading
 import time
 
 from .protocol import Bus, LinkError, ServoError
+from .sim_control import control_command, fields as _fields  # noqa: F401 (control_command: link_rate's)
 
 # The folder servoctl is installed in (tools/ of a checkout): vboard,
 # shipped with it, is imported from there by the virtual board's process.
@@ -367,37 +368,6 @@ def on_us_grid(t: float) -> float:
     stopped there, not while it is still on its way (a race that made a
     paced run differ by the host's speed)."""
     return math.ceil(t * 1e6 - 1e-3) / 1e6
-
-
-def _fields(line: str) -> dict:
-    """key=value pairs of a control reply: numbers as numbers."""
-    out = {}
-    for pair in line.split():
-        key, value = pair.split("=", 1)
-        try:
-            out[key] = float(value) if "." in value else int(value, 0)
-        except ValueError:
-            out[key] = value
-    return out
-
-
-def control_command(port: int, line: str, timeout: float = 2.0) -> str:
-    """One line to servo_sim's control port on 127.0.0.1:port; its reply.
-    An "error: ..." reply raises ServoError."""
-    try:
-        with socket.create_connection(("127.0.0.1", port), timeout=timeout) as s:
-            s.sendall(line.encode() + b"\n")
-            s.shutdown(socket.SHUT_WR)
-            reply = b""
-            while chunk := s.recv(4096):
-                reply += chunk
-    except OSError as e:
-        raise LinkError(f"servo_sim's control port 127.0.0.1:{port}: {e.strerror or e} "
-                        f"(has the simulator stopped?)") from None
-    text = reply.decode()
-    if text.startswith("error"):
-        raise ServoError(f"servo_sim: {text.strip()}")
-    return text
 
 
 def _stop(process) -> str:
