@@ -19,7 +19,8 @@ out=demo-output
 mkdir -p "$out"
 state=$(mktemp -d)
 port=$(.venv/bin/python -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
-./build/host/firmware/boards/host_sim/servo_sim --id 1 --tcp "$port" --state "$state" >"$out/sim.log" 2>&1 &
+# A new servo: ID 0 at 115200 baud, as it comes from the factory (README.md).
+./build/host/firmware/boards/host_sim/servo_sim --id 0 --tcp "$port" --state "$state" >"$out/sim.log" 2>&1 &
 sim=$!
 trap 'kill $sim 2>/dev/null || true; rm -rf "$state"' EXIT
 for _ in $(seq 100); do grep -q ready "$out/sim.log" 2>/dev/null && break; sleep 0.05; done
@@ -30,9 +31,9 @@ echo; echo "== a simulated servo on $SERVOCTL_PORT"
 
 step() { echo; echo "\$ servoctl $*"; "$servoctl" "$@"; }
 step scan --last 10
-step info 1
-step config set 1 soft_start_on 0
-step move 1 100 --velocity 300 --acc 100 --dec 200 --wait
-step record 1 -45 --velocity 200 --acc 100 --dec 100 --out "$out/record"
+step info 0
+step config set 0 soft_start_on 0
+step move 0 100 --velocity 300 --acc 100 --dec 200 --wait
+step record 0 -45 --velocity 200 --acc 100 --dec 100 --out "$out/record"
 echo
 echo "demo: done; the recorded move is plotted in $(pwd)/$out/record.png"

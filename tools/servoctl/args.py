@@ -12,6 +12,10 @@ from .checks import MIN_RAMP_MS
 from .errors import UsageError
 from .move_request import MoveRequest
 
+# The most tracking error (RMS) `servoctl stream` takes for a servo that
+# followed its file (docs/streaming.md, "The verdict").
+STREAM_TOLERANCE_DEG = 1.0
+
 # The description servoctl --help shows.
 DESCRIPTION = """servoctl: talk to a UART bus servo on a serial port or the simulator.
 
@@ -305,6 +309,11 @@ def build_parser():
     c.add_argument("file", help="CSV: a header 'time,ID,ID...', then evenly spaced rows")
     c.add_argument("--lead-in", type=float, default=1.0,
                    help="s to move to the first row first (default 1); waited for, soft start included")
+    c.add_argument("--tolerance", type=finite, default=STREAM_TOLERANCE_DEG,
+                   help=f"most tracking error (RMS, degrees) a servo may have; beyond it, or with the "
+                        f"setpoints sent late, exit 1 (default {STREAM_TOLERANCE_DEG})")
+    c.add_argument("--report-only", action="store_true",
+                   help="print the figures and exit 0 however the servos followed")
 
     c = sub.add_parser("identify", help="the drive train's constants from open-loop duty steps (horn free)")
     c.add_argument("id", type=int)

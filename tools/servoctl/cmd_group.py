@@ -1,7 +1,9 @@
 """servoctl's commands on several servos at once: sync-move, broadcast-move,
 async, and the whole bus's settings to a file and back (backup, restore)."""
+import sys
+
 from . import args as args_
-from . import group, outcome, scan
+from . import group, link_rate, outcome, scan
 from . import protocol as p
 from .errors import NoReply
 from .servo import Servo
@@ -48,6 +50,17 @@ def cmd_backup(bus, args):
 
 
 def cmd_restore(bus, args):
-    done = group.restore(bus, args.file, args.with_link)
+    """With --with-link the host follows the servos' rates: during the
+    restore, and after it to the rate they were moved to."""
+    done, moved = group.restore(bus, args.file, args.with_link,
+                                lambda rate: link_rate.set_rate(bus, args.sim_control, rate))
     print(f"restored {len(done)} servo(s) ({', '.join(map(str, done))}) from {args.file}")
+    rates = set(moved.values())
+    if len(rates) > 1:
+        print(f"servoctl: warning: the servos now speak different rates "
+              f"({', '.join(f'servo {i}: {r}' for i, r in moved.items())}): one bus runs at one rate",
+              file=sys.stderr)
+    elif rates:
+        who = "servo" if len(moved) == 1 else "servos"
+        print(link_rate.after_change(bus, f"{who} {', '.join(map(str, moved))}", rates.pop(), args.sim_control))
     return 0

@@ -3,7 +3,7 @@ a plot (live.py; loaded for this command alone)."""
 import os
 import sys
 
-from .errors import NoReply
+from .errors import EXIT_INTERRUPTED, NoReply
 from .record import check_writable
 
 
@@ -17,13 +17,16 @@ def cmd_monitor(bus, args):
         print("servoctl: warning: --plot: no display (DISPLAY and WAYLAND_DISPLAY are unset), so no "
               "window; sampling without it. --plot-file FILE saves the plot instead", file=sys.stderr)
         plot = False
-    never = {}
+    never, interrupted = {}, False
     try:
         never = monitor(bus, args.ids, args.every, args.count, args.sync, args.json, plot, args.plot_file)
-    except KeyboardInterrupt:
-        pass  # the way to stop a monitor
+    except KeyboardInterrupt:  # the way to stop a monitor: its plot still saved, then 130
+        interrupted = True
     if args.plot_file:
         print(f"plot {os.path.abspath(args.plot_file)}", file=sys.stderr if args.json else sys.stdout)
+    if interrupted:
+        print("servoctl: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
     if never:
         raise NoReply("; ".join(why or f"servo {i} never answered" for i, why in sorted(never.items())))
     return 0

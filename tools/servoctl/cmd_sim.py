@@ -1,17 +1,23 @@
 """servoctl sim: the simulator, or a virtual board, for a person at the
 command line."""
+import sys
 
 
-def _interrupt(signum, frame):
-    raise KeyboardInterrupt
+class _Terminated(Exception):
+    """SIGTERM: the simulator stopped as asked, exit 0."""
+
+
+def _terminate(signum, frame):
+    raise _Terminated
 
 
 def cmd_sim(args):
-    """Runs servo_sim until Ctrl-C or SIGTERM; either stops it cleanly and
-    removes a state folder it made."""
+    """Runs servo_sim until Ctrl-C (exit 130, as every command interrupted)
+    or SIGTERM (exit 0); either stops it cleanly and removes a state folder
+    it made."""
     import signal
 
-    from .errors import UsageError
+    from .errors import EXIT_INTERRUPTED, UsageError
     from .sim import Simulator
 
     if args.tcp is not None and args.link:
@@ -20,7 +26,8 @@ def cmd_sim(args):
     sim = Simulator(ids=args.ids or [1], tcp=args.tcp is not None, link=args.link,
                     state_dir=args.state, tcp_port=tcp_port, plant=args.plant,
                     board=None if args.board == "host" else args.board, host_link=args.host_link)
-    previous = signal.signal(signal.SIGTERM, _interrupt)
+    previous = signal.signal(signal.SIGTERM, _terminate)
+    code = 0
     try:
         sim.start()
         print(f"simulator running: bus {sim.url}, control 127.0.0.1:{sim.control_port}", flush=True)
@@ -29,9 +36,13 @@ def cmd_sim(args):
         print(f"  e.g. servoctl --port {sim.url} --sim-control {sim.control_port} scan  (Ctrl-C stops)", flush=True)
         sim.process.wait()
     except KeyboardInterrupt:
+        code = EXIT_INTERRUPTED
+    except _Terminated:
         pass
     finally:
         sim.stop()
         signal.signal(signal.SIGTERM, previous)
     print("simulator stopped")
-    return 0
+    if code:
+        print("servoctl: interrupted", file=sys.stderr)
+    return code

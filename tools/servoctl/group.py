@@ -169,11 +169,34 @@ def write_user_area(s: Servo, values: dict, with_link: bool = False) -> list:
     return []
 
 
-def restore(bus: p.Bus, path: str, with_link: bool = False) -> list:
+def restore(bus: p.Bus, path: str, with_link: bool = False, set_rate=None) -> tuple:
     """Writes each servo's saved user area back to the servo with that ID
     (every entry checked first). IDs and baud rates stay as they are unless
-    with_link. Returns the IDs."""
+    with_link; then the host follows: a servo that does not answer at the
+    host's rate is looked for at the rates earlier servos were moved to (and
+    the rate the restore began at), set_rate(baud) setting the host's.
+    Returns (the IDs, {ID: the baud rate it was moved to})."""
     entries = config_file.parse_backup(config_file.read(path), path)
+    began, moved = bus.serial.baudrate, {}
     for entry in entries:
-        write_user_area(Servo(bus, entry.servo_id), entry.values, with_link)
-    return [entry.servo_id for entry in entries]
+        s = Servo(bus, entry.servo_id)
+        if with_link and set_rate is not None:
+            _reach(s, [*moved.values(), began], set_rate)
+        before = s.read("baud") if with_link else None
+        write_user_area(s, entry.values, with_link)
+        if with_link and entry.values.get("baud", before) != before:
+            moved[s.id] = registers.BAUD_RATES[entry.values["baud"]]
+    return [entry.servo_id for entry in entries], moved
+
+
+def _reach(s: Servo, rates, set_rate) -> None:
+    """The host at a rate s answers at: its own first, then rates, latest
+    first; left at its own if none answers (the write says NoReply)."""
+    own = s.bus.serial.baudrate
+    for rate in dict.fromkeys([own, *reversed(rates)]):
+        if rate != s.bus.serial.baudrate:
+            set_rate(rate)
+        if s.ping():
+            return
+    if s.bus.serial.baudrate != own:
+        set_rate(own)

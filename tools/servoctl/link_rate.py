@@ -83,28 +83,29 @@ def after_set(bus, args, name: str, value: int) -> None:
     """After `config set N name value`: a baud change says what to do."""
     rate = registers.BAUD_RATES.get(value) if name == "baud" else None
     if rate is not None and (is_socket(bus.port) or rate != bus.serial.baudrate):
-        print(after_change(bus, args.id, rate, args.sim_control))
+        print(after_change(bus, f"servo {args.id}", rate, args.sim_control))
 
 
 def after_load(bus, args, servo_id: int, before: int, now: int) -> list:
     """After `config load --with-link`: a baud change as after_set; the
     notes the load reports (the servo's new ID)."""
     if now != before:
-        print(after_change(bus, servo_id, registers.BAUD_RATES[now], args.sim_control))
+        print(after_change(bus, f"servo {servo_id}", registers.BAUD_RATES[now], args.sim_control))
     return [f"now ID {servo_id}"] if servo_id != args.id else []
 
 
-def after_change(bus, servo_id: int, rate: int, sim_control) -> str:
-    """What to do now that a servo speaks `rate`, or what was done (the
-    simulator's host rate set on its control port)."""
+def after_change(bus, who: str, rate: int, sim_control) -> str:
+    """What to do now that a servo ("servo 3", "servos 1, 2") speaks `rate`,
+    or what was done (the simulator's host rate set on its control port)."""
+    speaks = "speaks" if who.startswith("servo ") else "speak"
     if not is_socket(bus.port):
-        return f"servo {servo_id} now speaks {rate} baud: give --baud {rate} from now on"
+        return f"{who} now {speaks} {rate} baud: give --baud {rate} from now on"
     if sim_control:
         _control(sim_control, f"hostbaud {rate}")
         bus.serial.baudrate = rate
-        return (f"servo {servo_id} now speaks {rate} baud: the simulator's host rate is set to "
+        return (f"{who} now {speaks} {rate} baud: the simulator's host rate is set to "
                 f"{rate} too (hostbaud on its control port)")
-    return (f"servo {servo_id} now speaks {rate} baud, and socket:// carries no baud rate: on a "
+    return (f"{who} now {speaks} {rate} baud, and socket:// carries no baud rate: on a "
             f"simulator, send 'hostbaud {rate}' to its control port (or give --sim-control PORT "
             f"and servoctl does it) to reach it again")
 

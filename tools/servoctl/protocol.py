@@ -1,6 +1,7 @@
 """The bus: sends requests and waits for the matching response, on a serial
 port or a simulator's socket. The frames themselves are codec.py's, named
 here too (p.request_frame, p.PING and the like)."""
+import math
 import time
 
 from . import codec as _codec
@@ -31,6 +32,31 @@ WRITE_STALL_S = 10.0
 RUN_AHEAD_S = 0.02
 
 
+# The URL schemes pyserial opens; socket:// and rfc2217:// need HOST:PORT.
+_SCHEMES = ("socket", "rfc2217", "loop", "spy", "hwgrep", "alt", "cp2110")
+PORT_FORMS = ("a serial device (/dev/ttyUSB0, /dev/serial/by-id/..., COM3) or socket://HOST:PORT "
+              "(a simulator's bus, as `servoctl sim` prints it: socket://127.0.0.1:5000)")
+
+
+def check_port(port: str) -> None:
+    """A port servoctl can open, by its form: UsageError naming the forms
+    taken otherwise (pyserial's own words were "'<=' not supported between
+    instances of 'int' and 'NoneType'"). Whether it is there is the
+    opening's to say."""
+    scheme, sep, rest = str(port).partition("://")
+    if not sep:
+        if not str(port).strip():
+            raise UsageError(f"--port is empty: give {PORT_FORMS}")
+        return
+    if scheme.lower() not in _SCHEMES:
+        raise UsageError(f"--port {port!r}: no such kind of port ({scheme}://): give {PORT_FORMS}")
+    if scheme.lower() in ("socket", "rfc2217"):
+        host, colon, number = rest.split("?", 1)[0].split("/", 1)[0].rpartition(":")
+        if not colon or not host or not number.isdigit() or not 1 <= int(number) <= 65535:
+            raise UsageError(f"--port {port!r} is not {scheme}://HOST:PORT with a port of 1-65535: give "
+                             f"{PORT_FORMS}")
+
+
 class Bus:
     """A serial port (or pyserial URL such as socket://127.0.0.1:5000) with
     the request/response discipline of the protocol.
@@ -50,7 +76,11 @@ class Bus:
         # clock; unless given, the clock's own simulator's (servoctl's
         # commands run with clock=sim.clock_s).
         self.run_ahead = run_ahead or getattr(getattr(clock, "__self__", None), "bus_run_ahead", None)
+        # A paced simulator is told the bytes sent, so it takes them when
+        # they were sent (Simulator.bus_sent).
+        self.note_sent = getattr(getattr(clock, "__self__", None), "bus_sent", None)
         self.port = port
+        check_port(port)
         try:
             # Exclusive: a second program on the port would take answers
             # meant for this one (a flock on a serial device; other URLs
@@ -99,6 +129,7 @@ class Bus:
             return
         end = self.clock() + seconds
         if self.run_ahead is not None:
+            end = math.ceil(end * 1e6 - 1e-3) / 1e6  # sim.on_us_grid: where a paced one stops
             self.run_ahead(end)
         while (left := end - self.clock()) > 0:
             time.sleep(min(left, 0.005))
@@ -135,6 +166,8 @@ class Bus:
         self._buffer = b""
         frames = b"".join(request_frame(c, content) for c, content in requests)
         self._link(self.serial.write if self._sock is None else self._write_all, frames)
+        if self.note_sent is not None:
+            self.note_sent(len(frames))
 
     def _fill(self, wait: bool = True) -> bool:
         """Reads what has arrived; with wait, first waits up to 5 ms for a
@@ -280,10 +313,13 @@ class Bus:
     def _look(self, deadline: float) -> float:
         """The bus clock; a simulator that runs ahead while the host waits
         may run to just past the deadline, at most RUN_AHEAD_S past now
-        (deadline 0: no more)."""
+        (deadline 0: no more). A paced one (note_sent) to the deadline: it
+        stops at the answer itself, and a bound taken from the clock as the
+        host happens to read it would make its stops the host's."""
         now = self.clock()
         if self.run_ahead is not None:
-            self.run_ahead(min(deadline + 0.001, now + RUN_AHEAD_S), answer=True)
+            ahead = RUN_AHEAD_S if self.note_sent is None else math.inf
+            self.run_ahead(min(deadline + 0.001, now + ahead), answer=True)
         return now
 
     def _take_frame(self):
@@ -334,6 +370,8 @@ class Bus:
         wire and 5 ms, on the bus clock) and drops it: after a NoReply, a
         late answer is not taken for the next request's."""
         deadline = self.clock() + self._longest_answer_s()
+        if self.run_ahead is not None:
+            self.run_ahead(deadline + 0.001)
         while self.clock() <= deadline:
             self._fill(wait=True)
         while (frame := self._take_frame()) is not None:  # garbled answers counted

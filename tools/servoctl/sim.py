@@ -2,6 +2,7 @@
 and talks to its fault-injection channel: `servoctl sim` and the Python API
 (docs/simulator.md). The tests' own launchers (QEMU, the repository's
 plant files) are tools/tests/launchers.py's."""
+import math
 import mmap
 import os
 from pathlib import Path
@@ -15,6 +16,7 @@ import threading
 import time
 
 from .protocol import Bus, LinkError, ServoError
+from .sim_control import control_command, fields as _fields  # noqa: F401 (control_command: link_rate's)
 
 # The folder servoctl is installed in (tools/ of a checkout): vboard,
 # shipped with it, is imported from there by the virtual board's process.
@@ -22,6 +24,10 @@ PACKAGES = Path(__file__).resolve().parent.parent
 # Host seconds a simulator's clock may stand still before a wait gives up
 # on it (a simulator falls behind on a busy PC; it does not stop).
 STALLED_S = 30.0
+# Host seconds a simulator may take to start: a virtual board (Python,
+# unicorn, its images) takes a few on an idle PC, and over 20 on one
+# loaded as a shared CI machine is (scripts/stress.sh).
+READY_S = 60
 _CLOCK_US = struct.Struct("<Q")  # servo_sim's clock file: microseconds
 HOST_BUILD = Path("build", "host", "firmware", "boards", "host_sim", "servo_sim")  # of a checkout
 
@@ -77,7 +83,7 @@ class Simulator(_Child):
 
     def __init__(self, ids=(1,), tcp=True, link=None, state_dir=None, supply_mv=None,
                  ambient_c=None, tcp_port=None, rx=None, board=None, app_image=None, nice=None,
-                 cpu=None, plant=None, host_link=None, fast=False):
+                 cpu=None, plant=None, host_link=None, fast=False, paced=False):
         self.ids = list(ids)
         self.tcp = tcp or tcp_port is not None
         self.tcp_port = tcp_port
@@ -100,6 +106,11 @@ class Simulator(_Child):
         # host waits on it (sleep, wait_until, a bus's answers), bounded by
         # run_ahead_to; it follows the wall clock otherwise (sim_clock.h).
         self.fast = fast
+        # The tests' where the host paces an experiment (identify): servo_sim
+        # runs only while this host waits on it, and never follows the wall
+        # clock, so a loaded PC cannot change what the servos see
+        # (servo_sim --clock paced; sim_clock.h).
+        self.paced = paced
         # A niceness for the simulator (below 0 needs root): a client that
         # times its answers on the wall clock (the maker's SDK) then meets
         # a servo that keeps up on a loaded PC. None: as started.
@@ -111,6 +122,7 @@ class Simulator(_Child):
         self._clock_conn = None
         self._clock_lock = threading.Lock()
         self._clock_map = None  # servo_sim's clock file, mapped (sim_clock.h)
+        self._sent_bytes = 0  # on the bus, in all: a paced servo_sim's offset 16
 
     @classmethod
     def running(cls, control_port: int) -> "Simulator":
@@ -123,8 +135,9 @@ class Simulator(_Child):
 
     def start(self) -> "Simulator":
         if self.board is not None:
-            if self.rx is not None or self.cpu is not None:
-                raise ServoError("a virtual board runs as its MCU does: --rx and --cpu are servo_sim's")
+            if self.rx is not None or self.cpu is not None or self.paced:
+                raise ServoError("a virtual board runs as its MCU does: --rx, --cpu and a paced clock are "
+                                 "servo_sim's")
             cmd = [sys.executable, "-m", "vboard", "--board", self.board, "--state", self.state_dir]
             if self.app_image is not None:
                 cmd += ["--app", str(self.app_image)]
@@ -146,6 +159,8 @@ class Simulator(_Child):
             cmd += ["--plant", str(self.plant)]
         if self.host_link is not None:
             cmd += ["--host-link", self.host_link]
+        if self.paced:
+            cmd += ["--clock", "paced"]
         if self.rx is not None:
             cmd += ["--rx", self.rx]
         if self.cpu is not None:
@@ -166,7 +181,7 @@ class Simulator(_Child):
                 os.setpriority(os.PRIO_PROCESS, self.process.pid, self.nice)
             except OSError:
                 pass  # not permitted: it runs as started
-        deadline = time.monotonic() + 20
+        deadline = time.monotonic() + READY_S
         while time.monotonic() < deadline:
             line = self.process.stdout.readline()
             if not line:
@@ -183,7 +198,8 @@ class Simulator(_Child):
                 self._map_clock(words[2])
             elif words[1:2] == ["ready"]:
                 return self
-        raise ServoError("servo_sim did not become ready within 20 s")
+        raise ServoError(f"{'servo_sim' if self.board is None else 'vboard'} did not become ready within "
+                         f"{READY_S} s")
 
     def stop(self) -> str:
         """Stops servo_sim; a state folder it made itself goes with it."""
@@ -231,10 +247,12 @@ class Simulator(_Child):
         host time, which is simulated time on an idle PC."""
         if self._clock_map is not None:
             self._clock_map.close()  # a restarted simulator's file is mapped anew
+        self._sent_bytes = 0
         try:
-            with open(path, "r+b" if self.fast else "rb") as f:
-                self._clock_map = mmap.mmap(f.fileno(), 16 if self.fast else 8,
-                                            access=mmap.ACCESS_WRITE if self.fast else mmap.ACCESS_READ)
+            writes = self.fast or self.paced
+            with open(path, "r+b" if writes else "rb") as f:
+                self._clock_map = mmap.mmap(f.fileno(), 24 if self.paced else 16 if writes else 8,
+                                            access=mmap.ACCESS_WRITE if writes else mmap.ACCESS_READ)
         except (OSError, ValueError):
             self._clock_map = None  # the control port still answers
 
@@ -288,36 +306,53 @@ class Simulator(_Child):
     def _wait(self, predicate, timeout_s: float, step_s: float):
         """(predicate met, simulated seconds waited)."""
         start = self.clock_s()
+        end = start + timeout_s
+        if self._runs_ahead():
+            end = on_us_grid(end)  # where it stops: reached, not a float's width short
         while True:
             if predicate():
                 return True, self.clock_s() - start
             now = self.clock_s()
             waited = now - start
-            if waited >= timeout_s:
+            if now >= end:
                 return False, waited
             if not self._runs_ahead():
                 time.sleep(min(step_s, timeout_s - waited))
                 continue
             # The predicate is looked at as often in simulated time.
-            until = min(now + step_s, start + timeout_s)
+            until = min(on_us_grid(now + step_s), end)
             self.run_ahead_to(until)
             while self.clock_s() < until:
                 time.sleep(0.0002)
 
     def _runs_ahead(self) -> bool:
-        return self.fast and self._clock_map is not None and self._clock_map.size() >= 16
+        return (self.fast or self.paced) and self._clock_map is not None and self._clock_map.size() >= 16
+
+    @property
+    def bus_sent(self):
+        """What a Bus on this simulator's clock tells how many bytes it has
+        sent (a paced simulator waits until it has read them all)."""
+        return self._host_sent if self.paced and self._clock_map is not None else None
+
+    def _host_sent(self, count: int) -> None:
+        self._sent_bytes += count
+        _CLOCK_US.pack_into(self._clock_map, 16, self._sent_bytes)
 
     @property
     def bus_run_ahead(self):
         """What a Bus on this simulator's clock tells where it waits for."""
-        return self.run_ahead_to if self.fast else None
+        return self.run_ahead_to if self.fast or self.paced else None
 
     def run_ahead_to(self, until_s: float, answer: bool = False) -> None:
         """A fast simulator's clock runs as fast as it can up to until_s
         (simulated seconds), with answer only until it has answered the
-        host's last bytes, and follows the wall clock from there."""
+        host's last bytes, and follows the wall clock from there (a paced
+        one stands still there)."""
         if self._runs_ahead():
-            _CLOCK_US.pack_into(self._clock_map, 8, max(0, int(until_s * 1e6)) | (answer << 63))
+            flags = answer << 63
+            # A paced simulator stops at this microsecond: a wait for a time
+            # on the grid (on_us_grid) sees it reached once it has stopped.
+            _CLOCK_US.pack_into(self._clock_map, 8, max(0, math.ceil(until_s * 1e6 - 1e-3)) | flags)
 
     def state(self, servo_id: int) -> dict:
         """The models' state of one servo: angle (deg), velocity, current,
@@ -325,35 +360,14 @@ class Simulator(_Child):
         return _fields(self.control(f"state {servo_id}"))
 
 
-def _fields(line: str) -> dict:
-    """key=value pairs of a control reply: numbers as numbers."""
-    out = {}
-    for pair in line.split():
-        key, value = pair.split("=", 1)
-        try:
-            out[key] = float(value) if "." in value else int(value, 0)
-        except ValueError:
-            out[key] = value
-    return out
-
-
-def control_command(port: int, line: str, timeout: float = 2.0) -> str:
-    """One line to servo_sim's control port on 127.0.0.1:port; its reply.
-    An "error: ..." reply raises ServoError."""
-    try:
-        with socket.create_connection(("127.0.0.1", port), timeout=timeout) as s:
-            s.sendall(line.encode() + b"\n")
-            s.shutdown(socket.SHUT_WR)
-            reply = b""
-            while chunk := s.recv(4096):
-                reply += chunk
-    except OSError as e:
-        raise LinkError(f"servo_sim's control port 127.0.0.1:{port}: {e.strerror or e} "
-                        f"(has the simulator stopped?)") from None
-    text = reply.decode()
-    if text.startswith("error"):
-        raise ServoError(f"servo_sim: {text.strip()}")
-    return text
+def on_us_grid(t: float) -> float:
+    """t rounded up to a whole microsecond, as the clock file counts: a
+    paced simulator stops at the bound run_ahead_to writes for it, and the
+    clock read there (its microseconds / 1e6) equals it, so a host that
+    waits until the clock reaches t goes on only once the simulator has
+    stopped there, not while it is still on its way (a race that made a
+    paced run differ by the host's speed)."""
+    return math.ceil(t * 1e6 - 1e-3) / 1e6
 
 
 def _stop(process) -> str:

@@ -175,7 +175,8 @@ def cmd_stream(bus, args):
     each servo's limits and the wire's rate too; the servos move to the first row (a sync move
     of --lead-in seconds) and the command waits until they are there; then
     they follow the trajectory at its period. Prints the lead-in, each
-    servo's tracking error and the cycle's rate."""
+    servo's tracking error and the cycle's rate; exit 1 if a servo's error
+    is beyond --tolerance or the cycles fell behind the file (_verdict)."""
     import sys
 
     from .console import progress as Progress  # a closed pipe ends quietly (cli.main)
@@ -210,9 +211,36 @@ def cmd_stream(bus, args):
         print(f"  servo {servo_id}: tracking error RMS {report.rms_deg[servo_id]:.2f} deg, "
               f"peak {report.peak_deg[servo_id]:.2f} deg")
     r = report.rate  # the wire could carry the file's rate (check_wire): a shortfall is the host's
-    short = f" (warning: below the file's {1 / period:g} Hz: the host fell behind)" if r.rate_hz < 0.95 / period else ""
+    short = f" (below the file's {1 / period:g} Hz: the host fell behind)" if _late(report) else ""
     print(f"  cycle (setpoints + Sync Monitor) ran at {r.rate_hz:.1f} Hz{short}; the wire allows "
           f"{r.wire_limit_hz:.0f} Hz at {bus.serial.baudrate} baud")
     if report.missed:
         print(f"  {report.missed} state(s) did not come back: those cycles are not counted")
-    return 0
+    return _verdict(report, args.tolerance, args.report_only)
+
+
+# A stream whose cycles ran below this share of the file's rate was sent
+# late: its setpoints reached the servos after their times.
+LATE_BELOW = 0.95
+
+
+def _late(report) -> bool:
+    return report.rate.rate_hz < LATE_BELOW / report.period_s
+
+
+def _verdict(report, tolerance: float, report_only: bool) -> int:
+    """0 if every servo followed the file within tolerance (RMS, degrees)
+    and the setpoints went out at the file's rate; else 1, saying which
+    (docs/streaming.md, "The verdict"). report_only: 0 whatever."""
+    import sys
+
+    off = {i: rms for i, rms in report.rms_deg.items() if not rms <= tolerance}  # NaN: no state came back
+    why = [f"servo {i} followed the file {rms:.2f} deg RMS, beyond the tolerance of {tolerance:g} deg"
+           for i, rms in off.items()]
+    if _late(report):
+        why.append(f"the setpoints went out at {report.rate.rate_hz:.1f} Hz against the file's "
+                   f"{1 / report.period_s:g} Hz: the host sent them late")
+    if not why or report_only:
+        return 0
+    print(f"servoctl: error: {'; '.join(why)}", file=sys.stderr)
+    return 1

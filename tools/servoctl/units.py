@@ -15,6 +15,9 @@ exactly is refused with the nearest ones it can, never rounded silently.
     power        mW ("2500mW", "2.5W")
     time         ms ("3000ms", "3s")
     baud         the index 1..8 on the wire; the rate ("115200", "1000000baud")
+    (none)       a whole number in the item's own unit, if it has one, written
+                 with it in files ("2741 mOhm", "2786 x 0.1 uN m"), taken
+                 with it or bare (items 70, 80-91)
 """
 import math
 import re
@@ -61,7 +64,7 @@ def to_raw(item, text) -> int:
     named = {name: value for value, name in item.names}
     if str(text).strip().lower() in named:
         return named[str(text).strip().lower()]
-    value, suffix = _split(item, text)
+    value, suffix = _split(item, _own_unit_off(item, str(text)))
     q = item.quantity
     if q in SCALES:
         shown, factors = SCALES[q]
@@ -89,12 +92,24 @@ def to_raw(item, text) -> int:
         raw = rates[value]
     else:
         if suffix or value != int(value):
-            raise UsageError(f"{item.name} takes a whole number, not {text!r}")
+            own = f" (of {item.unit})" if item.unit else ""
+            raise UsageError(f"{item.name} takes a whole number{own}, not {text!r}")
         raw = int(value)
     if not item.low <= raw <= item.high:
         raise ValueOutOfRange(f"{item.name} ({item.id}) must be {show(item, item.low)}.."
                               f"{show(item, item.high)}, not {text}")
     return raw
+
+
+def _own_unit_off(item, text: str) -> str:
+    """text without the item's own unit at its end ("2741 mOhm"), for an
+    item of no quantity that has one: how files write it (exact)."""
+    unit = item.unit if not item.quantity else ""
+    bare = text.strip()
+    if unit and bare.lower().endswith(unit.lower()) and len(bare) > len(unit):
+        head = bare[:-len(unit)].rstrip()
+        return head[:-1] if unit[0].isdigit() and head.endswith("x") else head
+    return text
 
 
 def _exact(item, value: float, factor: int, text) -> int:
@@ -129,6 +144,8 @@ def exact(item, raw: int) -> str:
         return f"{raw} ADC"
     if q == "baud":
         return f"{registers.BAUD_RATES[raw]} baud"
+    if item.unit:  # a unit that is a number itself is a multiple: "300 x 0.1 uN m"
+        return f"{raw} {'x ' if item.unit[0].isdigit() else ''}{item.unit}"
     return str(raw)
 
 

@@ -144,3 +144,16 @@ def test_no_test_names_an_issue_number():
              for n, line in enumerate(p.read_text(errors="replace").splitlines(), 1)
              if re.search(r"\bissues? \d+", line, re.IGNORECASE)]
     assert not found, found
+
+
+def test_the_readme_and_the_demo_start_a_servo_as_it_comes():
+    """The README says a new servo is at the schema's factory ID and rate;
+    the demo starts its simulated servo there and drives that ID (it
+    started ID 1 while the README said 0)."""
+    servo_id, baud = registers.find("servo_id").default, registers.BAUD_RATES[registers.find("baud").default]
+    readme = (ROOT / "README.md").read_text()
+    assert f"a new servo is at ID {servo_id}, {baud} baud" in readme
+    demo = (ROOT / "scripts/demo.sh").read_text()
+    assert re.findall(r"servo_sim --id (\d+)", demo) == [str(servo_id)]
+    driven = re.findall(r"^step (?:info|config set|move|record) (\d+)", demo, re.M)
+    assert driven and set(driven) == {str(servo_id)}, driven

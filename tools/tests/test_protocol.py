@@ -3,7 +3,7 @@ import pytest
 
 from servoctl import protocol as p
 from servoctl import registers
-from servoctl.protocol import Bus, BadChecksum, NoReply, ValueOutOfRange
+from servoctl.protocol import Bus, BadChecksum, NoReply, UsageError, ValueOutOfRange
 
 
 def test_frames():
@@ -71,3 +71,18 @@ def test_an_answer_that_arrived_by_the_deadline_is_read_whole():
                 peer.sendall(p.response_frame(p.PING, bytes([1])))
                 time.sleep(0.05)  # on the host's socket before the bus looks
                 assert bus.read_response(p.PING, 1) == bytes([1])
+
+
+@pytest.mark.parametrize("port", ["socket://127.0.0.1", "socket://127.0.0.1:abc", "socket://:5000",
+                                  "socket://localhost:0", "sockt://127.0.0.1:5000", "rfc2217://"])
+def test_a_malformed_port_is_servoctls_usage_error(port, capsys):
+    """pyserial said "'<=' not supported between instances of 'int' and
+    'NoneType'" (exit 4, a link failure): servoctl names the forms it
+    takes, exit 2, nothing opened."""
+    from servoctl.cli import main
+
+    assert main(["--port", port, "ping", "1"]) == 2
+    err = capsys.readouterr().err
+    assert "socket://HOST:PORT" in err and "/dev/ttyUSB0" in err and "not supported" not in err, err
+    with pytest.raises(UsageError):
+        Bus(port)

@@ -110,3 +110,19 @@ def test_the_period_against_the_bus_watchdog():
     assert "'servoctl config set 3 watchdog_ms 102'" in why
     assert Limits().check_period(3, 1000) == ""
     assert Limits.of({"angle_limit_on": 0, "watchdog_ms": 40}) == Limits(watchdog_ms=40)
+
+
+def test_a_stream_sent_late_fails_with_its_rate(capsys):
+    """servoctl stream's verdict (stream._verdict): cycles below 0.95 of the
+    file's rate were sent late, exit 1 with the rate run, even where every
+    servo followed what it got; --report-only exits 0."""
+    from servoctl.loop_rate import LoopRate
+    from servoctl.stream import StreamReport, _verdict
+
+    def report(cycles):
+        return StreamReport(0.02, 101, {1: 0.2}, {1: 0.5}, LoopRate(cycles, 2.0, 260.0), 0)
+
+    assert _verdict(report(96), 1.0, False) == 0  # 48 Hz: within 0.95 of 50
+    assert _verdict(report(80), 1.0, False) == 1
+    assert "went out at 40.0 Hz against the file's 50 Hz" in capsys.readouterr().err
+    assert _verdict(report(80), 1.0, True) == 0

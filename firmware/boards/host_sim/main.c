@@ -29,6 +29,10 @@ static struct sim_servo servos[SIM_MAX_SERVOS];
 static volatile sig_atomic_t stop_requested;
 /* How many bytes the host had been sent when it last sent bytes itself. */
 static unsigned long host_bytes_then;
+/* --clock paced (sim_clock.h). */
+static bool paced_clock;
+/* Bytes read from the host in all (a paced host's offset 16, sim_clock.h). */
+static uint64_t host_read_total;
 /* A second TCP client while one holds the bus is told so and then ignored
  * until it leaves: a serial port has one program at a time, and two hosts
  * on a half-duplex bus would talk over each other. The words are what
@@ -38,6 +42,11 @@ enum { REFUSED_MAX = 4 };
 /* How long the servos run before the simulator says it is ready: their
  * first control ticks (1 ms apart) have run by then. */
 enum { READY_AFTER_US = 5000 };
+/* How often a paced simulator standing still looks at the host's clock
+ * word (sim_clock.h) when no byte wakes it. */
+enum { PACED_POLL_US = 200 };
+/* A paced clock's start: the wall clock's at the start, a millisecond. */
+enum { PACED_START_US = 1000 };
 static int refused[REFUSED_MAX] = {-1, -1, -1, -1};
 
 static void tell_in_use(int fd)
@@ -61,12 +70,23 @@ static void refuse(int fd)
     close(fd);
 }
 
+/* A host that waits for an answer (sim_clock.h) has it: it has been sent
+ * bytes since its last, and the wire and its adapter hold none. */
+static bool host_answered(uint64_t waits)
+{
+    return (waits & SIM_CLOCK_UNTIL_ANSWER) && bus.host_bytes != host_bytes_then && bus.count == 0 &&
+           sim_usb_due(&bus.usb) == SIM_USB_NONE;
+}
+
 /* The servos and the wire up to target on the bus clock, event by event:
  * each byte as it ends on the wire, and each servo's main-loop pass when
  * its CPU would run it (sim_servo_wake_at): when the loop was late, the
  * bytes it catches up on do not all land before a servo has seen the
- * first, and an answer leaves when the target's CPU would have sent it. */
-static void run_to(uint64_t target)
+ * first, and an answer leaves when the target's CPU would have sent it.
+ * until_answer (paced, sim_clock.h): up to the event that completes the
+ * host's answer, at most; where the host then is does not depend on when
+ * it sends its next bytes. */
+static void run_to(uint64_t target, bool until_answer)
 {
     do {
         uint64_t next = sim_bus_next_at(&bus, target);
@@ -74,20 +94,29 @@ static void run_to(uint64_t target)
             uint64_t wake = sim_servo_wake_at(&servos[i]);
             next = wake < next ? wake : next;
         }
-        sim_bus_deliver(&bus, next > bus.now_us ? next : bus.now_us);
+        uint64_t at = next > bus.now_us ? next : bus.now_us;
+        if (paced_clock && at > bus.now_us) {
+            /* Before the bytes it hands the host: a host that reads the clock
+             * once it has its answer reads the answer's time, not a step's
+             * before it. */
+            sim_clock_publish(at);
+        }
+        sim_bus_deliver(&bus, at);
         for (unsigned i = 0; i < bus.station_count; i++) {
             sim_servo_poll(&servos[i], bus.now_us);
+        }
+        if (until_answer && host_answered(SIM_CLOCK_UNTIL_ANSWER)) {
+            break;
         }
     } while (bus.now_us < target);
     sim_clock_publish(bus.now_us);
 }
 
-/* A host that waits for an answer (sim_clock.h) has it: it has been sent
- * bytes since its last, and the wire and its adapter hold none. */
-static bool host_answered(uint64_t waits)
+/* A paced simulator runs while its host waits for a later time, or for an
+ * answer not yet given, once it has read every byte the host has sent. */
+static bool paced_may_run(bool answered, uint64_t waits)
 {
-    return (waits & SIM_CLOCK_UNTIL_ANSWER) && bus.host_bytes != host_bytes_then && bus.count == 0 &&
-           sim_usb_due(&bus.usb) == SIM_USB_NONE;
+    return !answered && waits > bus.now_us && sim_clock_host_sent() <= host_read_total;
 }
 
 static void on_signal(int sig)
@@ -100,12 +129,14 @@ int main(int argc, char **argv)
 {
     struct sim_options o;
     sim_options_parse(argc, argv, &o);
+    paced_clock = o.paced;
     signal(SIGINT, on_signal);
     signal(SIGTERM, on_signal);
     signal(SIGPIPE, SIG_IGN);
     mkdir(o.state_dir, 0755);
 
-    sim_bus_init(&bus, sim_now_us());
+    uint64_t wall_start = sim_now_us();
+    sim_bus_init(&bus, o.paced ? PACED_START_US : wall_start); /* paced: every run alike */
     bus.usb = o.host_link;
     char clock_path[256];
     bool clock_mapped = sim_clock_open(o.state_dir, clock_path, sizeof clock_path);
@@ -137,8 +168,9 @@ int main(int argc, char **argv)
      * power-up, however long the PC then keeps this process waiting. */
     uint64_t ready_at = bus.now_us + READY_AFTER_US;
     while (bus.now_us < ready_at) {
-        uint64_t to = sim_bus_step_to(&bus, sim_now_us());
-        run_to(to < ready_at ? to : ready_at);
+        /* Paced: in whole steps, whatever the wall clock (sim_clock.h). */
+        uint64_t to = o.paced ? bus.now_us + SIM_BUS_STEP_US : sim_bus_step_to(&bus, sim_now_us());
+        run_to(to < ready_at ? to : ready_at, false);
     }
 
     printf("servo_sim: plant %s\n", o.plant.name);
@@ -187,7 +219,9 @@ int main(int argc, char **argv)
         uint64_t waits = sim_clock_host_waits();
         bool answered = host_answered(waits);
         waits &= ~SIM_CLOCK_UNTIL_ANSWER;
-        if (sim_bus_step_to(&bus, wall) < wall || (waits > wall && !answered)) {
+        if (o.paced) {
+            wait_us = paced_may_run(answered, waits) ? 0 : PACED_POLL_US;
+        } else if (sim_bus_step_to(&bus, wall) < wall || (waits > wall && !answered)) {
             wait_us = 0;
         }
         struct timespec timeout = {.tv_sec = 0, .tv_nsec = wait_us * 1000};
@@ -206,6 +240,7 @@ int main(int argc, char **argv)
             if (n > 0) {
                 sim_bus_from_host(&bus, buf, (unsigned)n, bus.now_us);
                 host_bytes_then = bus.host_bytes;
+                host_read_total += (uint64_t)n;
             } else if (listen_fd >= 0 && (n == 0 || errno != EAGAIN)) {
                 close(bus.host_fd); /* the TCP client left: wait for the next */
                 bus.host_fd = -1;
@@ -243,6 +278,15 @@ int main(int argc, char **argv)
          * since it last wrote and the wire is quiet. */
         waits = sim_clock_host_waits();
         answered = host_answered(waits);
+        if (o.paced) {
+            bool until_answer = (waits & SIM_CLOCK_UNTIL_ANSWER) != 0u;
+            waits &= ~SIM_CLOCK_UNTIL_ANSWER;
+            if (paced_may_run(answered, waits)) {
+                uint64_t step = bus.now_us + SIM_BUS_STEP_US;
+                run_to(step < waits ? step : waits, until_answer);
+            }
+            continue; /* paced: never the wall clock's */
+        }
         waits &= ~SIM_CLOCK_UNTIL_ANSWER;
         uint64_t wall_now = sim_now_us();
         if (!answered && waits > wall_now && bus.now_us + SIM_BUS_STEP_US >= wall_now) {
@@ -254,7 +298,7 @@ int main(int argc, char **argv)
         if (wall_now - target > most_behind_us) {
             most_behind_us = wall_now - target;
         }
-        run_to(target);
+        run_to(target, false);
     }
     if (o.link) {
         unlink(o.link);

@@ -18,8 +18,8 @@ bool sim_clock_open(const char *state_dir, char *path, unsigned path_size)
         return false;
     }
     void *map = MAP_FAILED;
-    if (ftruncate(fd, (off_t)(2 * sizeof(uint64_t))) == 0) {
-        map = mmap(NULL, 2 * sizeof(uint64_t), PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
+    if (ftruncate(fd, (off_t)(3 * sizeof(uint64_t))) == 0) {
+        map = mmap(NULL, 3 * sizeof(uint64_t), PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
     }
     close(fd); /* the mapping keeps the file */
     if (map == MAP_FAILED) {
@@ -41,4 +41,9 @@ void sim_clock_publish(uint64_t now_us)
 uint64_t sim_clock_host_waits(void)
 {
     return published != NULL ? atomic_load_explicit(&published[1], memory_order_acquire) : 0u;
+}
+
+uint64_t sim_clock_host_sent(void)
+{
+    return published != NULL ? atomic_load_explicit(&published[2], memory_order_acquire) : 0u;
 }

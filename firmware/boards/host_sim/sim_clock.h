@@ -11,7 +11,14 @@
  * skips: a host that does not write it has a real-time simulator. With
  * SIM_CLOCK_UNTIL_ANSWER set, the host waits for an answer: the simulator
  * stops running ahead once it has sent the host bytes since the host's
- * last and the wire is quiet. */
+ * last and the wire is quiet. Started with --clock paced, the simulator
+ * never follows the wall clock: it stands still once it has reached the
+ * time the host waits for (or answered it), so what the host does between
+ * its waits takes no simulated time, however long a loaded PC makes it
+ * (tests whose host paces an experiment: identify). At offset 16 such a
+ * host writes how many bytes it has sent on the bus in all: a paced
+ * simulator runs only once it has read them all, so a request is taken
+ * when it was sent, however late the PC hands it over. */
 #ifndef SIM_CLOCK_H
 #define SIM_CLOCK_H
 
@@ -27,5 +34,7 @@ bool sim_clock_open(const char *state_dir, char *path, unsigned path_size);
 void sim_clock_publish(uint64_t now_us);
 /* The bus time the host waits for (offset 8); 0 if none or unmapped. */
 uint64_t sim_clock_host_waits(void);
+/* The bytes a paced host says it has sent (offset 16); 0 if none. */
+uint64_t sim_clock_host_sent(void);
 
 #endif

@@ -9,6 +9,7 @@ static void usage(FILE *out)
     fputs("usage: servo_sim [--id N]... [--tcp PORT | --link PATH] [--control PORT]\n"
           "                 [--state DIR] [--supply MV] [--ambient DEGC] [--rx dma|interrupt]\n"
           "                 [--cpu m3|m0] [--plant FILE] [--host-link usb|ftdi[:MS]|raw]\n"
+          "                 [--clock wall|paced]\n"
           "Runs the servo firmware on simulated servos sharing one bus.\n"
           "  --id N         a servo with ID N (repeat for more; default 1). An ID given\n"
           "                 again is one more servo at it, as new servos all hold ID 0\n"
@@ -32,6 +33,10 @@ static void usage(FILE *out)
           "                 is quiet for 4 character times, at the next 1 ms USB frame;\n"
           "                 ftdi an FTDI chip's latency timer (MS, default 16); raw every\n"
           "                 byte as it ends on the wire\n"
+          "  --clock wall|paced  wall (default): the simulated clock follows the wall\n"
+          "                 clock; paced: it runs only while the host waits on it\n"
+          "                 (the clock file, sim_clock.h) and stands still between\n"
+          "                 its waits (tests whose host paces an experiment)\n"
           "Control commands, one per line, optional servo last: its bus ID as it is now\n"
           "(every servo that holds it), or its serial number (0x51a0UUNN):\n"
           "  supply MV | load NM | payload GCM2 | stop DEG | stop off | magnet DEG | swapleads N |\n"
@@ -99,6 +104,12 @@ void sim_options_parse(int argc, char **argv, struct sim_options *o)
             o->control_port = parse_int(v, "--control", 1, 65535);
         } else if (strcmp(a, "--link") == 0) {
             o->link = v;
+        } else if (strcmp(a, "--clock") == 0) {
+            if (strcmp(v, "wall") != 0 && strcmp(v, "paced") != 0) {
+                fprintf(stderr, "servo_sim: --clock is wall or paced, not '%s'\n", v);
+                exit(2);
+            }
+            o->paced = strcmp(v, "paced") == 0;
         } else if (strcmp(a, "--host-link") == 0) {
             if (!sim_usb_parse(v, &o->host_link)) {
                 fprintf(stderr, "servo_sim: --host-link is usb, ftdi, ftdi:MS (1 to 255) or raw, not '%s'\n", v);

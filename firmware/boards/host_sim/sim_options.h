@@ -25,6 +25,7 @@ struct sim_options {
     bool rx_interrupt;
     const struct sim_cpu *cpu;
     struct sim_usb host_link; /* the host's adapter (--host-link), usb by default */
+    bool paced;               /* --clock paced: the host's waits alone move the clock */
 };
 
 /* Parses argv; prints the usage and exits on --help or a bad option. */

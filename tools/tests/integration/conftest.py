@@ -10,7 +10,10 @@ The simulator of the sim and sim3 fixtures is fast (Simulator(fast=True)):
 its clock runs as fast as it can while the test waits on it, and follows
 the wall clock otherwise. A module whose test paces the host on the wall
 clock (streams at a rate, loops that time.sleep) sets REAL_TIME = True:
-its simulator then only follows the wall clock."""
+its simulator then only follows the wall clock. One whose host paces the
+servos on the simulated clock alone (servoctl stream: bus.sleep) sets
+PACED = True: its simulator runs only while the host waits on it
+(Simulator(paced=True)), so a loaded PC cannot make the host late."""
 import pytest
 
 from servoctl.protocol import Bus
@@ -18,8 +21,8 @@ from servoctl.servo import Servo
 from servoctl.sim import Simulator
 
 
-def _start(tmp_path, ids, tcp=True, fast=True):
-    sim = Simulator(ids=ids, tcp=tcp, state_dir=str(tmp_path / "state"), fast=fast)
+def _start(tmp_path, ids, tcp=True, fast=True, paced=False):
+    sim = Simulator(ids=ids, tcp=tcp, state_dir=str(tmp_path / "state"), fast=fast and not paced, paced=paced)
     sim.start()
     return sim
 
@@ -40,16 +43,20 @@ def _fast(request) -> bool:
     return not getattr(request.module, "REAL_TIME", False)
 
 
+def _paced(request) -> bool:
+    return getattr(request.module, "PACED", False)
+
+
 @pytest.fixture
 def sim(tmp_path, request):
-    s = _start(tmp_path, [1], fast=_fast(request))
+    s = _start(tmp_path, [1], fast=_fast(request), paced=_paced(request))
     yield s
     finish(s, [1])
 
 
 @pytest.fixture
 def sim3(tmp_path, request):
-    s = _start(tmp_path, [1, 2, 3], fast=_fast(request))
+    s = _start(tmp_path, [1, 2, 3], fast=_fast(request), paced=_paced(request))
     yield s
     finish(s, [1, 2, 3])
 

@@ -36,7 +36,7 @@ def wire_spans(sim) -> list:
 
 @pytest.mark.parametrize("cpu", ["m3", "m0"])
 def test_sync_monitor_answers_follow_within_two_byte_times(tmp_path, cpu):
-    sim = Simulator(ids=IDS, state_dir=str(tmp_path / "state"), cpu=cpu).start()
+    sim = Simulator(ids=IDS, state_dir=str(tmp_path / "state"), cpu=cpu, paced=True).start()
     try:
         code = {rate: c for c, rate in registers.BAUD_RATES.items()}[1000000]
         with sim.bus() as bus:

@@ -96,7 +96,7 @@ def test_a_tuned_servos_drive_area_goes_with_its_file(sim, capsys, tmp_path):
     assert run(sim, capsys, "config", "save", "1", str(f))[0] == 0
     assert run(sim, capsys, "backup", str(b), "--ids", "1")[0] == 0
     items = json.loads(f.read_text())["items"]
-    assert items["gain_kd"] == "12000" and items["gear_ratio"] == "-387", items
+    assert items["gain_kd"] == "12000 Q15 duty/(0.1deg/tick)" and items["gear_ratio"] == "-387", items
     # Other values (a 1 in each would make the loop unstable: refused, docs/safety.md)
     for name, text in {"gain_kp": "546", "gain_kd": "3000", "gear_ratio": "345", "encoder_zero": "1"}.items():
         assert run(sim, capsys, "config", "set", "1", name, text)[0] == 0
@@ -150,3 +150,23 @@ def test_ram_items_carry_their_units_in_files(sim, capsys, tmp_path):
     f.write_text(json.dumps(doc))
     assert run(sim, capsys, "config", "load", "1", str(f))[0] == 0
     assert run(sim, capsys, "config", "get", "1", "oscillation_ms")[1].startswith("oscillation_ms = 300")
+
+
+def test_restore_with_link_follows_the_servos_rates(sim3, capsys, tmp_path):
+    """A backup of three servos at 1 Mbaud restored with --with-link on a
+    bus at 115 200 where servo 2 already speaks 1 Mbaud: the host follows,
+    reaching each servo at its rate, and speaks the servos' new rate after
+    (before: servo 2 was not reached, and nothing followed the change)."""
+    b = tmp_path / "b.json"
+    assert run(sim3, capsys, "backup", str(b), "--ids", "1", "2", "3")[0] == 0
+    doc = json.loads(b.read_text())
+    for entry in doc["servos"]:
+        entry["items"]["baud"] = "1000000 baud"
+    b.write_text(json.dumps(doc))
+    assert run(sim3, capsys, "config", "set", "2", "baud", "1000000")[0] == 0  # the host's stays
+    control = str(sim3.control_port)
+    rc, out, err = run(sim3, capsys, "--sim-control", control, "restore", str(b), "--with-link")
+    assert rc == 0 and "servos 1, 3 now speak 1000000 baud" in out, out + err
+    assert sim3.state(1)["host_baud"] == 1000000
+    rc, out, err = run(sim3, capsys, "--baud", "1000000", "--sim-control", control, "scan", "--last", "4")
+    assert rc == 0 and "3 servo(s) found" in out, out + err

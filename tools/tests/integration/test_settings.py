@@ -28,7 +28,7 @@ def test_a_dump_lists_every_settable_item_and_loads_back(sim, capsys, tmp_path):
         assert "RAM: lost at power-up" in line, line
     rc, out, _ = run(sim, capsys, "config", "dump", "1", "--json")
     dump = json.loads(out)
-    assert dump["ram_items"]["jerk_limit"] == "5" and dump["ram_items"]["watchdog_ms"] == "500 ms"
+    assert dump["ram_items"]["jerk_limit"] == "5 (deg/s^2)/ms" and dump["ram_items"]["watchdog_ms"] == "500 ms"
     assert "lost at power-up" in dump["ram_items_note"]
     assert {i.name for i in settable} <= set(dump["items"]) | set(dump["ram_items"])
     # The dump loads back: the RAM items set again after a power cycle lost them.

@@ -95,3 +95,39 @@ def test_ping_of_a_shared_id_says_the_answer_was_garbled(tmp_path, capsys):
         assert rc == 1, out
         assert ("servo 0: garbled answer: two or more servos may share ID 0; see 'servoctl scan'"
                 in out), out
+
+
+def _step_record(tmp_path, name: str, host_late_s: float) -> list:
+    """One of identify's open-loop steps (ReadMotion after ReadMotion, as
+    fast as the host goes) on a paced servo_sim, each request sent
+    host_late_s of host time late: a host a loaded PC holds up."""
+    import time
+
+    from servoctl.identify import record_step
+    from servoctl.servo import Servo
+
+    with Simulator(state_dir=str(tmp_path / name), host_link="raw", paced=True) as sim:
+        with sim.bus(timeout=0.2) as bus:
+            sends = bus.send_burst
+
+            def late(requests):
+                time.sleep(host_late_s)
+                sends(requests)
+
+            bus.send_burst = late
+            step = record_step(Servo(bus, 1), 0.3, 300, sim.sleep)  # then damped to rest: sim.sleep
+            sim.wait_until(lambda: sim.state(1)["velocity"] == 0.0, 1.0)
+            ended = sim.clock_s()
+        assert sim.state(1)["collisions"] == 0
+    return [(s.t, s.angle, s.current, s.duty) for s in step.samples] + [ended]
+
+
+def test_a_paced_simulator_sees_the_same_host_whatever_its_speed(tmp_path):
+    """Simulator(paced=True) (servo_sim --clock paced) runs only while the
+    host waits on it: a host-paced experiment (identify's, test_identify.py)
+    records the same samples, to the last bit, from a host that sends each
+    request 3 ms late as from one that does not. On a simulator that follows
+    the wall clock the late host samples a third as often."""
+    on_time = _step_record(tmp_path, "on-time", 0.0)
+    assert len(on_time) > 80 and max(abs(s[1]) for s in on_time[:-1]) > 0.2  # it turned (rad)
+    assert _step_record(tmp_path, "late", 0.003) == on_time

@@ -20,7 +20,7 @@ from servoctl.tune import check_step, tune
 
 from ..launchers import PLANTS
 from .conftest import finish
-from .test_identify import HOST_LINK, at_the_output, relative_errors
+from .test_identify import HOST_LINK, PACED, at_the_output, relative_errors
 
 PLANT_FILES = ["reference_st3215.toml", "micro_9g.toml", "class_60kgcm.toml"]
 OVERSHOOT_MOST = 10   # decidegrees: 1 degree
@@ -33,9 +33,10 @@ BUILT = ("magnet -40", "swapleads 1", "ampzero 18")  # how these servos came (co
 
 
 def start(tmp_path, file, built=()):
-    # Real time on the raw link: identify's chirp is paced by the host
-    # (test_identify.py, HOST_LINK).
-    sim = Simulator(state_dir=str(tmp_path / "state"), plant=str(PLANTS / file), host_link=HOST_LINK).start()
+    # Paced, on the raw link: identify's experiments are paced by the host
+    # (test_identify.py, HOST_LINK and PACED).
+    sim = Simulator(state_dir=str(tmp_path / "state"), plant=str(PLANTS / file), host_link=HOST_LINK,
+                    paced=PACED).start()
     for line in built:
         assert sim.control(line).strip() == "ok", line
     with sim.bus(timeout=0.2) as bus:

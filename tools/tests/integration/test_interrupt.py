@@ -1,0 +1,68 @@
+"""Ctrl-C ends every long-running command with exit 130, as the exit-code
+table (docs/servoctl.md) says: a monitor and `servoctl sim` ended with 0
+(a monitor's plot is still saved, a simulator still stopped cleanly). Each
+command runs as a user's would, in its own process, sent SIGINT once it
+is under way."""
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from servoctl.sim import Simulator
+
+TOOLS = Path(__file__).resolve().parents[2]
+
+
+def _interrupted(argv, started) -> tuple:
+    """servoctl argv in a process, SIGINT once it has printed a line holding
+    started (its stdout or stderr), or started seconds after it began (a
+    command that prints nothing until it ends); (exit code, what it
+    printed)."""
+    proc = subprocess.Popen([sys.executable, "-m", "servoctl.cli", *argv], cwd=TOOLS, stdout=subprocess.PIPE,
+                            stderr=subprocess.STDOUT, text=True)
+    try:
+        seen = []
+        if not isinstance(started, str):
+            time.sleep(started)
+            proc.send_signal(signal.SIGINT)
+            started = None
+        deadline = time.monotonic() + 60
+        while started and time.monotonic() < deadline:
+            line = proc.stdout.readline()
+            if not line:
+                break
+            seen.append(line)
+            if started in line:
+                proc.send_signal(signal.SIGINT)
+                break
+        out, _ = proc.communicate(timeout=30)
+        return proc.returncode, "".join(seen) + out
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+
+
+@pytest.fixture
+def url(tmp_path):
+    with Simulator(ids=[1], state_dir=str(tmp_path / "state")) as sim:
+        yield sim.url
+
+
+@pytest.mark.parametrize("argv, started", [
+    (["monitor", "1", "--json"], '"id": 1'),
+    (["scan", "--last", "253"], "servo 1 at"),
+    (["record", "1", "90", "--interval", "20000", "--out", "{tmp}/rec"], 3.0),  # a 20 s move
+])
+def test_a_command_on_the_bus_interrupted_exits_130(url, tmp_path, argv, started):
+    argv = [a.replace("{tmp}", str(tmp_path)) for a in argv]
+    rc, out = _interrupted(["--port", url, *argv], started)
+    assert rc == 130 and "servoctl: interrupted" in out, (rc, out)
+
+
+def test_the_simulator_interrupted_exits_130_and_stops(tmp_path):
+    rc, out = _interrupted(["sim", "--tcp", "0", "--state", str(tmp_path / "state")], "simulator running")
+    assert rc == 130 and "simulator stopped" in out and "servoctl: interrupted" in out, (rc, out)
