@@ -11,6 +11,7 @@ import shlex
 import threading
 
 from .. import cli
+from .. import protocol as p
 from ..args import build_parser
 from ..errors import EXIT_INTERRUPTED, ServoError
 from . import sampling
@@ -188,8 +189,15 @@ class Worker:
                 argv, tag = job[1]
                 self._result(tag, argv, EXIT_INTERRUPTED, "", "servoctl ui: not run: stop-all came first")
         ids = self.known or self.plot_ids
+        failed = []
+        try:  # every servo at this baud rate first: one not in the last scan (none yet, a
+            # shared or a new ID) is stopped too; then each known one, its answer checked
+            method = {"release": 0x10, "damping": 0x12}[mode]  # as Servo.stop's
+            self.bus.send(p.STOP_ON_CONTROL, p.encode_request(p.STOP_ON_CONTROL, p.BROADCAST, method, 0))
+        except ServoError as e:
+            failed.append(f"broadcast stop: {e}")
         said = [self.run_quiet(["stop", str(i), "--mode", mode]) for i in ids]
-        failed = [r["err"] for r in said if r["code"]]
+        failed += [r["err"] for r in said if r["code"]]
         self.interrupt.clear()  # one set as this began: it interrupts nothing later
         self.publish({"type": "stopped", "mode": mode, "ids": ids, "failed": failed})
 
