@@ -13,6 +13,7 @@ import threading
 from .. import cli
 from .. import protocol as p
 from ..args import build_parser
+from ..checks import check_range
 from ..errors import EXIT_INTERRUPTED, ServoError
 from . import sampling
 
@@ -172,7 +173,10 @@ class Worker:
         self.publish({"type": "items", "id": servo_id, "items": sampling.items_of(self.bus, servo_id)})
 
     def plot(self, ids: list):
-        self.plot_ids = [int(i) for i in ids]
+        ids = [int(i) for i in ids]
+        for servo_id in ids:
+            check_range("servo ID", servo_id, 0, p.MAX_ID)
+        self.plot_ids = ids
         self.sampler = sampling.Sampler(self.bus, self.plot_ids) if self.plot_ids else None
         self.publish({"type": "plotting", "ids": self.plot_ids})
 
@@ -218,6 +222,9 @@ class Worker:
                     self._idle()
                 except KeyboardInterrupt:
                     self.interrupt.clear()  # stop-all, a moment late: it runs next
+                except Exception as e:  # noqa: BLE001 - a lost link: the page hears it, stop-all still runs
+                    self.publish({"type": "error", "text": f"servoctl ui: {type(e).__name__}: {e}"})
+                    self.stopping.wait(1.0)
             elif job[0] != "wake":
                 self._do(job)
 
