@@ -16,9 +16,11 @@ and out, a frame at a time.
   is driven, and put back as it was on close.
 
 Time is the bus's clock (the simulator's on servo_sim)."""
+import math
+
 from . import protocol as p
 from . import registers
-from .errors import NoReply, ServoError, UsageError
+from .errors import NoReply, ServoError, UsageError, ValueOutOfRange
 from .group import sync_monitor
 from .servo import Servo
 from .setpoints import MAX_SPEED_DECIDEG_S, Stream, read_limits
@@ -215,6 +217,8 @@ class Arm:
         for name, deg in targets.items():
             lim = self.limits[self.joints[name]]
             deg = float(deg)
+            if not math.isfinite(deg):  # a policy's NaN or inf: refused, never "to the limit"
+                raise ValueOutOfRange(f"{name}: a target takes a finite number of degrees, not {deg}")
             if lim.angle_min is not None:
                 deg = min(max(deg, lim.angle_min / 10.0), lim.angle_max / 10.0)
             last = self.targets.get(name)
