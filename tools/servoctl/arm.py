@@ -127,10 +127,17 @@ class Arm:
 
     def hold_here(self) -> dict:
         """Torque on where every joint is (StopOnControlMode's hold: no
-        target, so nothing moves); the first target is that pose."""
+        target, so nothing moves); the first target is that pose. A joint
+        beyond one turn (after wheel mode) is refused, left holding: its
+        targets are single-turn, and the first would spin it back."""
         for servo_id in self.ids:
             Servo(self.bus, servo_id).stop("hold")
-        self.targets, self._before = self.positions(), {}
+        here = self.positions()
+        turned = [f"{n} (servo {self.joints[n]}) at {d:.1f} deg" for n, d in here.items() if abs(d) > 180]
+        if turned:  # the first target would be taken within one turn: the joint would spin back
+            raise UsageError(f"{', '.join(turned)}: beyond one turn (wheel mode or multi-turn moves); "
+                             f"release it and reset its turns ('servoctl origin ID --reset-turns') first")
+        self.targets, self._before = here, {}
         if self.firmware == "servoctl":
             self.stream = Stream(self.bus, self.ids, self.period_s, self.limits)
         self._times = []

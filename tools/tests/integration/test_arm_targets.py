@@ -3,7 +3,8 @@ not a number is refused on both protocols, and nothing is sent."""
 import pytest
 
 from servoctl.arm import Arm
-from servoctl.errors import ValueOutOfRange
+from servoctl.errors import UsageError, ValueOutOfRange
+from servoctl.servo import Servo
 from servoctl.sim import Simulator
 
 
@@ -18,3 +19,21 @@ def test_a_target_of_nan_or_inf_is_refused_and_nothing_moves(firmware):
         assert arm.targets == held
         sim.sleep(0.3)
         assert abs(sim.state(1)["angle"] - held["a"]) < 0.2  # the maker's took inf as its limit, 135 deg
+
+
+@pytest.mark.parametrize("firmware", ["servoctl", "maker"])
+def test_a_joint_beyond_one_turn_is_refused_when_held_not_spun_back(firmware):
+    """After wheel mode a joint reads 1000 deg and more: its targets were
+    clamped to its angle limits, and on the maker's protocol a frame that
+    only held the arm spun the joint 175 deg within a second."""
+    with Simulator(ids=[1, 2], fast=True) as sim:
+        bus = sim.bus()
+        Servo(bus, 1).wheel("run", 360)  # still turning as the arm is held
+        sim.sleep(1.5)
+        with pytest.raises(UsageError, match="--reset-turns"):
+            Arm(bus, {"a": 1, "b": 2}, firmware=firmware, watchdog_ms=0).open().hold_here()
+        sim.sleep(0.3)
+        turned = sim.state(1)["angle"]
+        assert turned > 400 and abs(sim.state(1)["velocity"]) < 1  # stopped, holding
+        sim.sleep(0.5)
+        assert abs(sim.state(1)["angle"] - turned) < 1
