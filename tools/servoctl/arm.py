@@ -166,11 +166,15 @@ class Arm:
     def set_zero_here(self) -> dict:
         """Each joint released, its encoder count now stored as its zero
         (item 90) and taken as the origin (SetOriginPoint): it reads 0 deg
-        here from now on, after a power-up too. {name: the count}."""
+        here from now on, after a power-up too; its angle limits off until
+        store_ranges() stores the range. {name: the count}."""
         counts = {}
         for name, servo_id in self.joints.items():
             s = Servo(self.bus, servo_id)
             s.stop("release")
+            # The stored limits are the old zero's angles: off until store_ranges puts
+            # the new ones (a calibration cut short then reads as none, not as shifted).
+            s.write("angle_limit_on", 0)
             counts[name] = s.read("encoder_count")
             s.write("encoder_zero", counts[name])
             s.set_origin()

@@ -37,3 +37,20 @@ def test_a_joint_beyond_one_turn_is_refused_when_held_not_spun_back(firmware):
         assert turned > 400 and abs(sim.state(1)["velocity"]) < 1  # stopped, holding
         sim.sleep(0.5)
         assert abs(sim.state(1)["angle"] - turned) < 1
+
+
+def test_a_calibration_cut_short_leaves_no_limits_of_the_old_zero():
+    """A new zero with the range not stored after it (ENTER with nothing
+    moved, Ctrl-C) kept the old limits on, counted as calibrated: 25 deg
+    off, in the new zero's frame."""
+    with Simulator(ids=[1], fast=True) as sim:
+        bus = sim.bus()
+        arm = Arm(bus, {"a": 1}, firmware="servoctl", watchdog_ms=0).open()
+        arm.store_ranges({"a": (-30, 30)})
+        Servo(bus, 1).move_to(25, duration_s=0.3, wait=True)
+        arm.set_zero_here()
+        with pytest.raises(UsageError, match="moved 0.5 deg"):
+            arm.store_ranges({"a": (0.0, 0.5)})
+        assert not Arm(bus, {"a": 1}, firmware="servoctl", watchdog_ms=0).open().ranges_stored()
+        arm.store_ranges({"a": (-20, 20)})
+        assert arm.ranges_stored() and Servo(bus, 1).read("angle_max") == 200
