@@ -9,6 +9,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/file.h>
 #include <sys/ioctl.h>
 #include <sys/socket.h>
 #include <termios.h>
@@ -159,6 +160,12 @@ int sb_serial_open(sb_posix *p, const char *path, uint32_t baud)
     p->fd = open(path, O_RDWR | O_NOCTTY | O_NONBLOCK);
     if (p->fd < 0)
         return -errno;
+    /* One program on a bus: the lock servoctl (pyserial's exclusive) takes too. */
+    if (flock(p->fd, LOCK_EX | LOCK_NB) != 0) {
+        int rc = errno == EWOULDBLOCK ? -EBUSY : -errno;
+        sb_posix_close(p);
+        return rc;
+    }
     if (tcgetattr(p->fd, &tio) != 0) {
         int rc = -errno;
         sb_posix_close(p);
