@@ -204,18 +204,25 @@ void sb_posix_close(sb_posix *p)
     p->fd = -1;
 }
 
+/* A link that takes no byte this long fails the write (a wedged adapter, a
+ * peer that stopped reading), rather than hanging the program's loop. */
+#define WRITE_STALL_MS 1000
+
 static int posix_write(void *ctx, const uint8_t *data, size_t len)
 {
     sb_posix *p = (sb_posix *)ctx;
+    int stalled_ms = 0;
     while (len > 0) {
-        ssize_t n = p->is_socket ? send(p->fd, data, len, MSG_NOSIGNAL) : write(p->fd, data, len);
+        ssize_t n = p->is_socket ? send(p->fd, data, len, MSG_NOSIGNAL | MSG_DONTWAIT) : write(p->fd, data, len);
         if (n < 0) {
             struct pollfd pf = {p->fd, POLLOUT, 0};
-            if (errno != EAGAIN && errno != EINTR)
+            if (errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR)
                 return -errno;
-            poll(&pf, 1, 100);
+            if (errno != EINTR && poll(&pf, 1, 100) == 0 && (stalled_ms += 100) >= WRITE_STALL_MS)
+                return -ETIMEDOUT;
             continue;
         }
+        stalled_ms = 0;
         data += n;
         len -= (size_t)n;
     }
