@@ -16,9 +16,11 @@ and out, a frame at a time.
   is driven, and put back as it was on close.
 
 Time is the bus's clock (the simulator's on servo_sim)."""
+import math
+
 from . import protocol as p
 from . import registers
-from .errors import NoReply, ServoError, UsageError
+from .errors import NoReply, ServoError, UsageError, ValueOutOfRange
 from .group import sync_monitor
 from .servo import Servo
 from .setpoints import MAX_SPEED_DECIDEG_S, Stream, read_limits
@@ -125,10 +127,17 @@ class Arm:
 
     def hold_here(self) -> dict:
         """Torque on where every joint is (StopOnControlMode's hold: no
-        target, so nothing moves); the first target is that pose."""
+        target, so nothing moves); the first target is that pose. A joint
+        beyond one turn (after wheel mode) is refused, left holding: its
+        targets are single-turn, and the first would spin it back."""
         for servo_id in self.ids:
             Servo(self.bus, servo_id).stop("hold")
-        self.targets, self._before = self.positions(), {}
+        here = self.positions()
+        turned = [f"{n} (servo {self.joints[n]}) at {d:.1f} deg" for n, d in here.items() if abs(d) > 180]
+        if turned:  # the first target would be taken within one turn: the joint would spin back
+            raise UsageError(f"{', '.join(turned)}: beyond one turn (wheel mode or multi-turn moves); "
+                             f"release it and reset its turns ('servoctl origin ID --reset-turns') first")
+        self.targets, self._before = here, {}
         if self.firmware == "servoctl":
             self.stream = Stream(self.bus, self.ids, self.period_s, self.limits)
         self._times = []
@@ -157,11 +166,15 @@ class Arm:
     def set_zero_here(self) -> dict:
         """Each joint released, its encoder count now stored as its zero
         (item 90) and taken as the origin (SetOriginPoint): it reads 0 deg
-        here from now on, after a power-up too. {name: the count}."""
+        here from now on, after a power-up too; its angle limits off until
+        store_ranges() stores the range. {name: the count}."""
         counts = {}
         for name, servo_id in self.joints.items():
             s = Servo(self.bus, servo_id)
             s.stop("release")
+            # The stored limits are the old zero's angles: off until store_ranges puts
+            # the new ones (a calibration cut short then reads as none, not as shifted).
+            s.write("angle_limit_on", 0)
             counts[name] = s.read("encoder_count")
             s.write("encoder_zero", counts[name])
             s.set_origin()
@@ -215,6 +228,8 @@ class Arm:
         for name, deg in targets.items():
             lim = self.limits[self.joints[name]]
             deg = float(deg)
+            if not math.isfinite(deg):  # a policy's NaN or inf: refused, never "to the limit"
+                raise ValueOutOfRange(f"{name}: a target takes a finite number of degrees, not {deg}")
             if lim.angle_min is not None:
                 deg = min(max(deg, lim.angle_min / 10.0), lim.angle_max / 10.0)
             last = self.targets.get(name)

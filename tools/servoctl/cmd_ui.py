@@ -36,6 +36,8 @@ def cmd_ui(bus, args):
 
     def ready(port: int):
         host = "127.0.0.1" if args.bind in ("0.0.0.0", "::", "") else args.bind
+        if ":" in host:  # an IPv6 address goes in brackets (RFC 3986): http://[::1]:PORT/
+            host = f"[{host}]"
         url = f"http://{host}:{port}/?token={token}"
         print(f"servoctl ui: {url}", flush=True)
         if not loopback:

@@ -151,3 +151,38 @@ def test_blocks_and_sync_commands():
     for line, answer in zip(lines, got[len(lines):]):
         assert answer == "ok " + line[4:], line
     assert frames[-1][3] == 0xFF  # 273 content bytes: the extended length
+
+
+def test_answers_of_another_length_are_refused_by_both():
+    """Every fixed answer one byte longer or shorter than the schema's:
+    C says SB_E_BAD_ANSWER where servoctl raises BadAnswer (a decoder that
+    took trailing bytes passed every other case here)."""
+    lines, cases = [], []
+    for p in S.packets:
+        if not fixed(p, "answer") or not p.answer:
+            continue
+        content = struct.pack(S.answer_format(p.code), *edge_cases(p.answer)[0][0])
+        for bad in (content + b"\x00", content[:-1]):
+            lines.append(f"dans {codec.response_frame(p.code, bad).hex()}")
+            cases.append((p, bad))
+    for line, got, (p, bad) in zip(lines, c_side(lines), cases):
+        assert got.split()[:2] == ["err", str(SB_E_BAD_ANSWER)], (p.name, line, got)
+        with pytest.raises(codec.BadAnswer):
+            codec.decode_answer(p.code, bad)
+    assert len(cases) > 40
+
+
+def test_the_extended_length_begins_at_255_content_bytes():
+    """A SyncCommand of 254, 255 and 256 content bytes: the short length
+    to 254, the extended from 255 (0xFF is its mark), as servoctl's."""
+    lines, frames = [], []
+    for count in (251, 252, 253):
+        records = bytes((k * 7) % 256 for k in range(count))
+        lines.append(f"req 25 22 1 {count} {word(records)}")
+        frames.append(codec.request_frame(codec.CODES["SYNC"], bytes([22, 1, count]) + records))
+    got = c_side(lines + [f"dreq {f.hex()}" for f in frames])
+    for line, answer, frame in zip(lines, got, frames):
+        assert answer == f"ok {frame.hex()}", line
+    for line, answer in zip(lines, got[len(lines):]):
+        assert answer == "ok " + line[4:], line
+    assert [f[3] for f in frames] == [254, 0xFF, 0xFF] and len(frames[1]) == 255 + 7

@@ -9,6 +9,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/file.h>
 #include <sys/ioctl.h>
 #include <sys/socket.h>
 #include <termios.h>
@@ -159,6 +160,12 @@ int sb_serial_open(sb_posix *p, const char *path, uint32_t baud)
     p->fd = open(path, O_RDWR | O_NOCTTY | O_NONBLOCK);
     if (p->fd < 0)
         return -errno;
+    /* One program on a bus: the lock servoctl (pyserial's exclusive) takes too. */
+    if (flock(p->fd, LOCK_EX | LOCK_NB) != 0) {
+        int rc = errno == EWOULDBLOCK ? -EBUSY : -errno;
+        sb_posix_close(p);
+        return rc;
+    }
     if (tcgetattr(p->fd, &tio) != 0) {
         int rc = -errno;
         sb_posix_close(p);
@@ -197,18 +204,25 @@ void sb_posix_close(sb_posix *p)
     p->fd = -1;
 }
 
+/* A link that takes no byte this long fails the write (a wedged adapter, a
+ * peer that stopped reading), rather than hanging the program's loop. */
+#define WRITE_STALL_MS 1000
+
 static int posix_write(void *ctx, const uint8_t *data, size_t len)
 {
     sb_posix *p = (sb_posix *)ctx;
+    int stalled_ms = 0;
     while (len > 0) {
-        ssize_t n = p->is_socket ? send(p->fd, data, len, MSG_NOSIGNAL) : write(p->fd, data, len);
+        ssize_t n = p->is_socket ? send(p->fd, data, len, MSG_NOSIGNAL | MSG_DONTWAIT) : write(p->fd, data, len);
         if (n < 0) {
             struct pollfd pf = {p->fd, POLLOUT, 0};
-            if (errno != EAGAIN && errno != EINTR)
+            if (errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR)
                 return -errno;
-            poll(&pf, 1, 100);
+            if (errno != EINTR && poll(&pf, 1, 100) == 0 && (stalled_ms += 100) >= WRITE_STALL_MS)
+                return -ETIMEDOUT;
             continue;
         }
+        stalled_ms = 0;
         data += n;
         len -= (size_t)n;
     }

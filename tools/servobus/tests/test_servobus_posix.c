@@ -9,6 +9,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <fcntl.h>
+#include <pty.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -86,12 +89,59 @@ static void a_rate_termios_has_not_is_refused(void **state)
     assert_true(sb_serial_open(&p, "/nonexistent/tty", 115200) < 0);
 }
 
+/* servoctl (pyserial's exclusive=True) holds the port: two programs on one
+ * bus would garble each other's frames. */
+static void a_port_another_program_holds_is_refused(void **state)
+{
+    int master = -1, slave = -1, other;
+    char name[128];
+    sb_posix p;
+    (void)state;
+    assert_int_equal(openpty(&master, &slave, name, NULL, NULL), 0);
+    other = open(name, O_RDWR | O_NOCTTY);
+    assert_true(other >= 0);
+    assert_int_equal(flock(other, LOCK_EX | LOCK_NB), 0);
+    assert_int_equal(sb_serial_open(&p, name, 115200), -16); /* -EBUSY */
+    assert_int_equal(p.fd, -1);
+    close(other);
+    assert_int_equal(sb_serial_open(&p, name, 115200), 0);
+    sb_posix_close(&p);
+    close(slave);
+    close(master);
+}
+
+/* A link that stops taking bytes (nobody reads the pty's master: a wedged
+ * adapter) fails the write in about a second; it hung the loop for ever. */
+static void a_write_the_link_never_takes_fails(void **state)
+{
+    int master = -1, slave = -1, rc = 0;
+    char name[128];
+    uint8_t frame[200];
+    sb_posix p;
+    sb_transport t;
+    (void)state;
+    memset(frame, 0x55, sizeof frame);
+    assert_int_equal(openpty(&master, &slave, name, NULL, NULL), 0);
+    assert_int_equal(sb_serial_open(&p, name, 115200), 0);
+    t = sb_posix_transport(&p);
+    alarm(20); /* the original waited for ever: ctest sees the alarm */
+    for (int k = 0; k < 100000 && rc == 0; k++)
+        rc = t.write(t.ctx, frame, sizeof frame);
+    alarm(0);
+    assert_int_equal(rc, -110); /* -ETIMEDOUT */
+    sb_posix_close(&p);
+    close(slave);
+    close(master);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test_setup_teardown(the_latency_timer_is_read_and_set_to_1_ms, set_up, tear_down),
         cmocka_unit_test_setup_teardown(a_timer_that_cannot_be_set_names_the_fix, set_up, tear_down),
         cmocka_unit_test(a_rate_termios_has_not_is_refused),
+        cmocka_unit_test(a_port_another_program_holds_is_refused),
+        cmocka_unit_test(a_write_the_link_never_takes_fails),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

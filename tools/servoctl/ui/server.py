@@ -80,11 +80,16 @@ class Page:
                     ask = json.loads(msg.data)
                 except ValueError:
                     continue
+                if not isinstance(ask, dict):  # [1], 5, "x": not a request; the tab stays
+                    continue
                 if ws is not self.driver and ask.get("op") != "stopall":  # any tab may stop
                     await ws.send_json({"type": "busy", "holder": self.who[self.driver],
                                         "text": f"{self.who[self.driver]} drives the bus"})
                     continue
-                self._dispatch(ask)
+                try:
+                    self._dispatch(ask)
+                except (KeyError, TypeError, ValueError) as e:  # {"op": "items"} without its id
+                    await ws.send_json({"type": "error", "text": f"servoctl ui: a malformed request: {e!r}"})
         finally:
             self.sockets.remove(ws)
             self.who.pop(ws, None)

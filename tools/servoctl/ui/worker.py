@@ -11,7 +11,9 @@ import shlex
 import threading
 
 from .. import cli
+from .. import protocol as p
 from ..args import build_parser
+from ..checks import check_range
 from ..errors import EXIT_INTERRUPTED, ServoError
 from . import sampling
 
@@ -171,7 +173,10 @@ class Worker:
         self.publish({"type": "items", "id": servo_id, "items": sampling.items_of(self.bus, servo_id)})
 
     def plot(self, ids: list):
-        self.plot_ids = [int(i) for i in ids]
+        ids = [int(i) for i in ids]
+        for servo_id in ids:
+            check_range("servo ID", servo_id, 0, p.MAX_ID)
+        self.plot_ids = ids
         self.sampler = sampling.Sampler(self.bus, self.plot_ids) if self.plot_ids else None
         self.publish({"type": "plotting", "ids": self.plot_ids})
 
@@ -188,8 +193,15 @@ class Worker:
                 argv, tag = job[1]
                 self._result(tag, argv, EXIT_INTERRUPTED, "", "servoctl ui: not run: stop-all came first")
         ids = self.known or self.plot_ids
+        failed = []
+        try:  # every servo at this baud rate first: one not in the last scan (none yet, a
+            # shared or a new ID) is stopped too; then each known one, its answer checked
+            method = {"release": 0x10, "damping": 0x12}[mode]  # as Servo.stop's
+            self.bus.send(p.STOP_ON_CONTROL, p.encode_request(p.STOP_ON_CONTROL, p.BROADCAST, method, 0))
+        except ServoError as e:
+            failed.append(f"broadcast stop: {e}")
         said = [self.run_quiet(["stop", str(i), "--mode", mode]) for i in ids]
-        failed = [r["err"] for r in said if r["code"]]
+        failed += [r["err"] for r in said if r["code"]]
         self.interrupt.clear()  # one set as this began: it interrupts nothing later
         self.publish({"type": "stopped", "mode": mode, "ids": ids, "failed": failed})
 
@@ -210,6 +222,9 @@ class Worker:
                     self._idle()
                 except KeyboardInterrupt:
                     self.interrupt.clear()  # stop-all, a moment late: it runs next
+                except Exception as e:  # noqa: BLE001 - a lost link: the page hears it, stop-all still runs
+                    self.publish({"type": "error", "text": f"servoctl ui: {type(e).__name__}: {e}"})
+                    self.stopping.wait(1.0)
             elif job[0] != "wake":
                 self._do(job)
 

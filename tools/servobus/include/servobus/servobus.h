@@ -19,10 +19,19 @@
 extern "C" {
 #endif
 
-/* The most servos a stream or a robot loop takes. */
+/* The most servos a stream or a robot loop takes (a plain number). */
 #ifndef SB_MAX_SERVOS
 #define SB_MAX_SERVOS 32
 #endif
+/* A program built with another SB_MAX_SERVOS than the library's would
+ * disagree with it on the structs' sizes (sb_bus_init wrote past a smaller
+ * sb_bus): the functions that set them up carry the number in their link
+ * names, so such a program does not link (sb_bus_init_max_16 undefined). */
+#define SB_ABI_PASTE(a, b) a##b
+#define SB_ABI_NAME(a, b) SB_ABI_PASTE(a, b)
+#define sb_bus_init SB_ABI_NAME(sb_bus_init_max_, SB_MAX_SERVOS)
+#define sb_stream_init SB_ABI_NAME(sb_stream_init_max_, SB_MAX_SERVOS)
+#define sb_loop_init SB_ABI_NAME(sb_loop_init_max_, SB_MAX_SERVOS)
 #define SB_BITS_PER_BYTE 10u /* 8N1 */
 #define SB_TX_MAX (16u + 10u * SB_MAX_SERVOS + 8u + SB_MAX_SERVOS)
 #define SB_RX_MAX 256u

@@ -1,0 +1,54 @@
+"""servoctl ui's bus thread (ui/worker.py) without a browser: what the
+page's requests do on servo_sim, judged on the simulator's state."""
+import time
+
+from servoctl.protocol import Bus
+from servoctl.sim import Simulator
+from servoctl.ui.worker import Worker
+
+
+def _worker(sim, said):
+    argv = ["--port", sim.url, "--sim-control", str(sim.control_port)]
+    return Worker(sim.bus(), argv, said.append)
+
+
+def test_stop_all_stops_a_servo_the_last_scan_did_not_list():
+    """Servos left out of the last scan (none yet, a shared ID, a new ID
+    given since) are stopped too: stop-all is the user's emergency stop."""
+    with Simulator(ids=[1, 2], fast=True) as sim:
+        said = []
+        w = _worker(sim, said)
+        assert w.run(["wheel", "2", "run", "--speed", "180"])["code"] == 0
+        sim.wait_until(lambda: abs(sim.state(2)["velocity"]) > 100, timeout_s=10)
+        w.known = [1]  # a scan that missed servo 2
+        w.stop_all("damping")
+        sim.wait_until(lambda: abs(sim.state(2)["velocity"]) < 2, timeout_s=5)
+        assert said[-1]["type"] == "stopped" and not said[-1]["failed"], said[-1]
+
+
+def test_the_bus_thread_outlives_a_lost_link_and_a_bad_plot_request():
+    """A link that fails while several servos are plotted (a USB adapter
+    pulled), or a plot of ID 300, is told to the page; the thread that
+    runs stop-all goes on (it died, and every request after was lost)."""
+    with Simulator(ids=[1, 2], fast=True) as sim:
+        said = []
+        w = Worker(Bus(sim.url, timeout=0.05), [], said.append)
+        w.start()
+        try:
+            w.submit(w.plot, [1, 300])
+            _heard(said, lambda m: m["type"] == "error" and "not 300" in m["text"])
+            w.submit(w.plot, [1, 2])
+            _heard(said, lambda m: m["type"] == "samples")
+            sim.stop()  # the bus's far end closes
+            _heard(said, lambda m: m["type"] == "error" and "LinkError" in m["text"])
+            assert w.thread.is_alive()
+        finally:
+            w.stop()
+        assert not w.thread.is_alive()
+
+
+def _heard(said, what):
+    deadline = time.monotonic() + 10  # host time: a bound on failure only
+    while not any(what(m) for m in list(said)):
+        assert time.monotonic() < deadline, said[-3:]
+        time.sleep(0.01)
