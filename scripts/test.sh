@@ -50,7 +50,9 @@ step() {
 unit_tests() {
   cmake --preset host >/dev/null
   cmake --build --preset host
-  ctest --preset host | tee build/host/ctest.log
+  # Side by side: the unit tests wait on nothing, and test_profile alone
+  # takes a CPU a while.
+  ctest --preset host -j "$(nproc)" | tee build/host/ctest.log
 }
 
 arm_m3_images() {
@@ -139,29 +141,70 @@ step "registers: every definition of hal/ports against ST's SVD files (STM32F103
 step "ARM images (STM32F103, and the QEMU board): budget and soft-float checks" arm_m3_images
 step "Cortex-M0 image (STM32F030K6) and its bootloader: 4 KB RAM, 24 KB flash budget, 4 KB bootloader, soft-float" \
   arm_m0_images
-step "target benchmark: every packet and the control tick in Thumb instructions on the Cortex-M3 and M0 under QEMU, against the budgets and docs/benchmark.md" \
-  target_bench
-step "target arithmetic: the planner's 64-bit division and the run-time's division and multiplication on the Cortex-M3 and M0 under QEMU, against products" \
-  target_arith
+# beside NAME COMMAND...: a step run beside pytest (below), as step runs
+# one: its output in the job's log, its outcome and time in BESIDE_RESULTS.
+BESIDE_LOG=build/beside-pytest.log
+BESIDE_RESULTS=build/beside-pytest.results
+beside() {
+  local name=$1
+  shift
+  printf '\n== %s\n' "$name"
+  local started=$SECONDS
+  (set -e; "$@")
+  local rc=$?
+  echo "-- $name: $((SECONDS - started)) s"
+  printf '%s\t%s\t%s\n' "$rc" "$((SECONDS - started))" "$name" >>"$BESIDE_RESULTS"
+}
+
+# The steps that need nothing of pytest's and pytest nothing of theirs: one
+# after another beside pytest's parallel pass, on the CPU its tests leave
+# (most wait on simulated servos), and done before the wall_clock tests.
+beside_steps() {
+  beside "target benchmark: every packet and the control tick in Thumb instructions on the Cortex-M3 and M0 under QEMU, against the budgets and docs/benchmark.md" \
+    target_bench
+  beside "target arithmetic: the planner's 64-bit division and the run-time's division and multiplication on the Cortex-M3 and M0 under QEMU, against products" \
+    target_arith
+  beside "fuzzing the whole servo: ${FUZZ_RUNS:-200000} inputs (libFuzzer, ASan + UBSan, -O2)" fuzz_run
+  beside "line coverage of motion, protection and the config store by the fuzz corpus (>= 90 %)" \
+    bash scripts/fuzz_coverage.sh
+}
 
 # pytest counts each test. Most tests wait on simulated servos, not on the
 # CPU: PYTEST_WORKERS (default 4) run side by side (pytest-xdist), each
 # test file on one worker, so a file's shared simulator or QEMU board starts
-# once. Then the tests timed on the wall clock (marked wall_clock: the
-# maker's SDK), alone.
-printf '\n== %s\n' "PC tool, simulator, maker's SDK and QEMU board tests (pytest)"
+# once, with the steps above beside them. Then the tests timed on the wall
+# clock (marked wall_clock: the maker's SDK), alone.
+printf '\n== %s\n' "PC tool, simulator, maker's SDK and QEMU board tests (pytest), and beside it the target benchmark and arithmetic, the fuzz run and its coverage (their output after pytest's)"
 started=$SECONDS
+: >"$BESIDE_RESULTS"
 pytest_both() {
+  beside_steps >"$BESIDE_LOG" 2>&1 &
+  local beside_pid=$!
   cd tools
   local rc=0
   ../.venv/bin/python -m pytest -q -p no:cacheprovider -n "${PYTEST_WORKERS:-4}" --dist loadfile \
     -m "not wall_clock" || rc=$?
+  wait "$beside_pid"
   ../.venv/bin/python -m pytest -q -p no:cacheprovider -m wall_clock || rc=$?
   return $rc
 }
 pytest_both | tee build/pytest.log
 tools_rc=${PIPESTATUS[0]}
-took "pytest" "$started"
+took "pytest (with the steps beside it)" "$started"
+cat "$BESIDE_LOG"
+while IFS=$'\t' read -r rc secs name; do
+  times+=("$(printf '%5d s  %.60s (beside pytest)' "$secs" "$name")")
+  if [ "$rc" -eq 0 ]; then
+    count 1 0
+  else
+    count 0 1
+    failures+=("$name")
+  fi
+done <"$BESIDE_RESULTS"
+if [ "$(wc -l <"$BESIDE_RESULTS")" -ne 4 ]; then
+  count 0 1
+  failures+=("the steps beside pytest did not all finish ($BESIDE_LOG)")
+fi
 # Each run's closing line: "N failed, N passed, ... in S s".
 totals=$(grep -E '^(=+ )?[0-9]+ [a-z]+.* in [0-9.]+s' build/pytest.log)
 tools_passed=$(grep -oE '[0-9]+ passed' <<<"$totals" | awk '{n += $1} END {print n + 0}')
@@ -172,9 +215,6 @@ if [ "$tools_rc" -ne 0 ]; then
   [ "${tools_failed:-0}" -gt 0 ] || count 0 1
 fi
 
-step "fuzzing the whole servo: ${FUZZ_RUNS:-200000} inputs (libFuzzer, ASan + UBSan, -O2)" fuzz_run
-step "line coverage of motion, protection and the config store by the fuzz corpus (>= 90 %)" \
-  bash scripts/fuzz_coverage.sh
 
 echo
 printf 'step times:\n'
