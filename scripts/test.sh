@@ -28,9 +28,19 @@ took() {
   times+=("$(printf '%5d s  %.60s' $((SECONDS - $2)) "$1")")
 }
 
-# step NAME COMMAND...: runs the command (with set -e inside), counts it as
-# one check, and names it if it failed.
-step() {
+# outcome RC NAME: a step's outcome, counted as one check; named if it failed.
+outcome() {
+  if [ "$1" -eq 0 ]; then
+    count 1 0
+  else
+    count 0 1
+    failures+=("$2")
+  fi
+}
+
+# run_step NAME COMMAND...: prints the name, runs the command (with set -e
+# inside) and prints its time (also in step_s); returns its status.
+run_step() {
   local name=$1
   shift
   printf '\n== %s\n' "$name"
@@ -38,13 +48,17 @@ step() {
   # Not in an if: bash ignores set -e in a condition's subshell.
   (set -e; "$@")
   local rc=$?
-  took "$name" "$started"
-  if [ $rc -eq 0 ]; then
-    count 1 0
-  else
-    count 0 1
-    failures+=("$name")
-  fi
+  step_s=$((SECONDS - started))
+  echo "-- $name: $step_s s"
+  return $rc
+}
+
+# step NAME COMMAND...: runs the command, counts it as one check, and
+# names it if it failed.
+step() {
+  run_step "$@"
+  outcome $? "$1"
+  times+=("$(printf '%5d s  %.60s' "$step_s" "$1")")
 }
 
 unit_tests() {
@@ -146,14 +160,8 @@ step "Cortex-M0 image (STM32F030K6) and its bootloader: 4 KB RAM, 24 KB flash bu
 BESIDE_LOG=build/beside-pytest.log
 BESIDE_RESULTS=build/beside-pytest.results
 beside() {
-  local name=$1
-  shift
-  printf '\n== %s\n' "$name"
-  local started=$SECONDS
-  (set -e; "$@")
-  local rc=$?
-  echo "-- $name: $((SECONDS - started)) s"
-  printf '%s\t%s\t%s\n' "$rc" "$((SECONDS - started))" "$name" >>"$BESIDE_RESULTS"
+  run_step "$@"
+  printf '%s\t%s\t%s\n' "$?" "$step_s" "$1" >>"$BESIDE_RESULTS"
 }
 
 # The steps that need nothing of pytest's and pytest nothing of theirs: one
@@ -194,12 +202,7 @@ took "pytest (with the steps beside it)" "$started"
 cat "$BESIDE_LOG"
 while IFS=$'\t' read -r rc secs name; do
   times+=("$(printf '%5d s  %.60s (beside pytest)' "$secs" "$name")")
-  if [ "$rc" -eq 0 ]; then
-    count 1 0
-  else
-    count 0 1
-    failures+=("$name")
-  fi
+  outcome "$rc" "$name"
 done <"$BESIDE_RESULTS"
 if [ "$(wc -l <"$BESIDE_RESULTS")" -ne 4 ]; then
   count 0 1
