@@ -12,10 +12,12 @@
 set -uo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh || { echo "setup failed: nothing was tested" >&2; exit 1; }
-# The maker's LeRobot plugin's environment (torch: several GB), once a
-# machine; the demo does without it.
-bash scripts/lerobot_env.sh || { echo "setup failed: scripts/lerobot_env.sh" >&2; exit 1; }
 mkdir -p build
+# The maker's LeRobot plugin's environment (torch: several GB), once a
+# machine; the demo does without it. Made (or, already made, checked by
+# importing the plugin, torch and all) beside the builds; pytest waits for it.
+bash scripts/lerobot_env.sh >build/lerobot-env.log 2>&1 &
+lerobot_env_pid=$!
 
 passed=0
 failed=0
@@ -182,6 +184,12 @@ beside_steps() {
 # test file on one worker, so a file's shared simulator or QEMU board starts
 # once, with the steps above beside them. Then the tests timed on the wall
 # clock (marked wall_clock: the maker's SDK), alone.
+if ! wait "$lerobot_env_pid"; then
+  cat build/lerobot-env.log >&2
+  echo "setup failed: scripts/lerobot_env.sh (pytest not run)" >&2
+  exit 1
+fi
+cat build/lerobot-env.log
 printf '\n== %s\n' "PC tool, simulator, maker's SDK and QEMU board tests (pytest), and beside it the target benchmark and arithmetic, the fuzz run and its coverage (their output after pytest's)"
 started=$SECONDS
 : >"$BESIDE_RESULTS"
