@@ -203,9 +203,9 @@ class Runner:
             if until == limit_s and all(b.in_application() for b in self.boards):
                 until = self.now_s + settle_s
         self.wall0 = time.monotonic() - self.now_s
+        self.clock.publish(self.now_s)  # before ready: a host's first look is not at 0
 
     def run(self) -> None:
-        self.clock.publish(self.now_s)
         while not self.stop_requested:
             ahead = self.now_s - self._wall()
             timeout = min(ahead, 0.002) if ahead > 0 and self._host_waits() is None else 0

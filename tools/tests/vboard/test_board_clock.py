@@ -24,3 +24,27 @@ def test_the_boards_clock_is_published_and_a_fast_host_waits_on_it(tmp_path):
             sim.wait_until(lambda: abs(servo.angle() - 300) <= 2, 1.0)
         assert sim.state(1)["collisions"] == 0
     assert not (state / "bus.clock").exists()  # a board stopped (SIGTERM) removes it
+
+
+def test_the_clock_is_published_before_ready(tmp_path):
+    """The board's power-up (its bootloader's window, the application's
+    start) is simulated time before `ready`: the file says so by then. It
+    read 0 until the loop's first slice, so a host's first look put its
+    reply window's end in the past (a write at the start of a fast test
+    met NoReply at once, 1 of 15 starts)."""
+    import argparse
+    import struct
+
+    from vboard.run import Runner
+
+    args = argparse.Namespace(board="stm32f030k6", id=[1], tcp=0, link=None, host_link="usb",
+                              state=str(tmp_path / "state"), supply=None, plant=None, ambient=25.0, app=None)
+    runner = Runner(args)
+    try:
+        runner.power_up()
+        published = struct.unpack("<Q", (tmp_path / "state" / "bus.clock").read_bytes()[:8])[0]
+        assert published == int(runner.now_s * 1e6) and runner.now_s >= 0.1, (published, runner.now_s)
+    finally:
+        runner.bus.close()
+        runner.control.close()
+        runner.clock.close()
