@@ -7,6 +7,9 @@
 # Every step runs whatever an earlier one did; each failure is named at the
 # end, and the last line counts the checks: "summary: N passed, N failed"
 # (each CTest program and pytest test, and each other step as one).
+# The unit tests, the target benchmark and arithmetic, the fuzz run and its
+# coverage need nothing of pytest's: they run beside its parallel pass, on
+# the CPU its tests leave, their output printed after pytest's.
 # FUZZ_RUNS sets the fuzz run's length in inputs (default 200000): a fixed
 # amount of fuzzing, which a busy machine makes slower, not smaller.
 set -uo pipefail
@@ -63,9 +66,12 @@ step() {
   times+=("$(printf '%5d s  %.60s' "$step_s" "$1")")
 }
 
-unit_tests() {
+host_build() {
   cmake --preset host >/dev/null
   cmake --build --preset host
+}
+
+unit_tests() {
   # Side by side: the unit tests wait on nothing, and test_profile alone
   # takes a CPU a while.
   ctest --preset host -j "$(nproc)" | tee build/host/ctest.log
@@ -133,23 +139,8 @@ fuzz_run() {
   fi
 }
 
-# Unit tests count each CTest program.
-printf '\n== %s\n' "unit tests (host, AddressSanitizer + UndefinedBehaviorSanitizer)"
-rm -f build/host/ctest.log
-started=$SECONDS
-(set -e; unit_tests)
-unit_rc=$?
-took "unit tests" "$started"
-unit_passed=$(sed -nE 's/.*tests passed, ([0-9]+) tests failed out of ([0-9]+).*/\2 \1/p' build/host/ctest.log 2>/dev/null)
-if [ -n "$unit_passed" ]; then
-  read -r total bad <<<"$unit_passed"
-  count $((total - bad)) "$bad"
-  [ "$bad" -eq 0 ] && [ "$unit_rc" -eq 0 ] || failures+=("unit tests")
-else
-  count 0 1
-  failures+=("unit tests (did not build or run)")
-fi
-
+step "host build: the simulator, the virtual boards' models, the unit tests (AddressSanitizer + UndefinedBehaviorSanitizer)" \
+  host_build
 step "layers: no include from a lower layer to a higher one, no circle (of includes, or of symbols in the host build's objects), no file over 400 lines outside the tests and generated files, no schema line over 120 characters, the build importing nothing from tools/" \
   python3 scripts/check_layers.py --objects build/host
 step "registers: every definition of hal/ports against ST's SVD files (STM32F103xx, STM32F030)" \
@@ -168,8 +159,11 @@ beside() {
 
 # The steps that need nothing of pytest's and pytest nothing of theirs: one
 # after another beside pytest's parallel pass, on the CPU its tests leave
-# (most wait on simulated servos), and done before the wall_clock tests.
+# (most wait on simulated servos), and done before the wall_clock tests. The
+# unit tests count each CTest program (below), not as one step.
 beside_steps() {
+  run_step "unit tests (host, AddressSanitizer + UndefinedBehaviorSanitizer)" unit_tests
+  printf '%s\t%s\n' "$?" "$step_s" >build/host/ctest.rc
   beside "target benchmark: every packet and the control tick in Thumb instructions on the Cortex-M3 and M0 under QEMU, against the budgets and docs/benchmark.md" \
     target_bench
   beside "target arithmetic: the planner's 64-bit division and the run-time's division and multiplication on the Cortex-M3 and M0 under QEMU, against products" \
@@ -190,9 +184,10 @@ if ! wait "$lerobot_env_pid"; then
   exit 1
 fi
 cat build/lerobot-env.log
-printf '\n== %s\n' "PC tool, simulator, maker's SDK and QEMU board tests (pytest), and beside it the target benchmark and arithmetic, the fuzz run and its coverage (their output after pytest's)"
+printf '\n== %s\n' "PC tool, simulator, maker's SDK and QEMU board tests (pytest), and beside it the unit tests, the target benchmark and arithmetic, the fuzz run and its coverage (their output after pytest's)"
 started=$SECONDS
 : >"$BESIDE_RESULTS"
+rm -f build/host/ctest.log build/host/ctest.rc
 pytest_both() {
   beside_steps >"$BESIDE_LOG" 2>&1 &
   local beside_pid=$!
@@ -208,6 +203,18 @@ pytest_both | tee build/pytest.log
 tools_rc=${PIPESTATUS[0]}
 took "pytest (with the steps beside it)" "$started"
 cat "$BESIDE_LOG"
+# Unit tests count each CTest program.
+read -r unit_rc unit_s <build/host/ctest.rc || unit_rc=1
+times+=("$(printf '%5d s  %.60s (beside pytest)' "${unit_s:-0}" "unit tests")")
+unit_passed=$(sed -nE 's/.*tests passed, ([0-9]+) tests failed out of ([0-9]+).*/\2 \1/p' build/host/ctest.log 2>/dev/null)
+if [ -n "$unit_passed" ]; then
+  read -r total bad <<<"$unit_passed"
+  count $((total - bad)) "$bad"
+  [ "$bad" -eq 0 ] && [ "$unit_rc" -eq 0 ] || failures+=("unit tests")
+else
+  count 0 1
+  failures+=("unit tests (did not build or run)")
+fi
 while IFS=$'\t' read -r rc secs name; do
   times+=("$(printf '%5d s  %.60s (beside pytest)' "$secs" "$name")")
   outcome "$rc" "$name"
