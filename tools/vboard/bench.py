@@ -29,7 +29,7 @@ DRAIN_S = 5e-3           # the last request and its answer, and the servo's turn
 
 def runner_for(board: str, ids, state_dir: str) -> Runner:
     args = SimpleNamespace(board=board, id=list(ids), state=state_dir, supply=7400.0, ambient=25.0, plant=None,
-                           app=None, tcp=0, link=None)
+                           app=None, tcp=0, link=None, host_link="usb")
     runner = Runner(args)
     runner.power_up()
     return runner
@@ -48,11 +48,13 @@ def measure(runner: Runner, seconds: float, ping_ids=()) -> tuple:
                 runner.bus.queue_host(byte, next_ping)
             k, sent, next_ping = k + 1, sent + 1, next_ping + PING_PERIOD_S
         runner.step()
+        runner.bus.flush_to_host(runner.now_s)  # what the adapter has handed over
     wall = time.perf_counter() - start_wall
     speed = (runner.now_s - start_sim) / wall
     drained = max(runner.now_s, next_ping) + DRAIN_S
     while runner.now_s < drained:
         runner.step()
+        runner.bus.flush_to_host(runner.now_s)
     return speed, sent, len(runner.bus.to_host) // ANSWER
 
 
@@ -72,6 +74,8 @@ def main(argv=None) -> int:
                     speed, sent, heard = measure(runner, args.seconds, pings)
                 finally:
                     runner.bus.close()
+                    runner.control.close()
+                    runner.clock.close()
             answered = f"{heard}/{sent}" if sent else "-"
             print(f"{board:<12} {name:<8} {speed:>22.2f}x {answered:>10}", flush=True)
             worst = min(worst, speed)

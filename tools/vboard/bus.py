@@ -54,6 +54,8 @@ class Bus:
         self.last_activity_s = -1.0   # end of the last byte queued
         self.heard_by_host_s = -1.0   # when the host was last handed bytes (HOST_TURNAROUND_S)
         self.last_sent_s = {}         # station -> when its last byte started
+        self.host_bytes = 0           # bytes handed to the host so far
+        self.host_bytes_then = 0      # ... when the host last sent bytes itself
         self.host_fd = None
         self.listen = None
         self.master_fd = None
@@ -146,6 +148,8 @@ class Bus:
             if data == b"" and self.listen is not None:
                 self._drop_client()
                 return
+            if data:
+                self.host_bytes_then = self.host_bytes
             for byte in data or b"":
                 self.queue_host(byte, max(now_s, self.heard_by_host_s + HOST_TURNAROUND_S))
 
@@ -155,6 +159,7 @@ class Bus:
         if at_s is not None:
             self.to_host += data
             self.heard_by_host_s = at_s
+            self.host_bytes += len(data)
         if self.to_host and self.host_fd is not None:
             try:
                 n = os.write(self.host_fd, bytes(self.to_host))
@@ -203,6 +208,11 @@ class Bus:
         self.last_activity_s = max(self.last_activity_s, end_s)
         self.seq += 1
         heapq.heappush(self.events, [end_s, self.seq, byte, baud, sender, start_s])
+
+    def host_answered(self) -> bool:
+        """The host has been handed bytes since it last sent any, and the
+        wire and the adapter hold none (servo_sim's host_answered)."""
+        return self.host_bytes != self.host_bytes_then and not self.events and not self.adapter.held
 
     def next_event_s(self) -> float:
         """The next byte's end on the wire, or the adapter's next hand-over."""

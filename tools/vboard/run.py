@@ -10,10 +10,14 @@ servo_sim. The control port takes servo_sim's commands (help lists them).
 
 Simulated time follows the wall clock when the boards keep up, and falls
 behind it when they do not (the emulated CPUs are slower than silicon on
-most PCs); the bus's byte timing is simulated time either way."""
+most PCs); the bus's byte timing is simulated time either way. The clock
+is published in the state folder's bus.clock (`vboard: clock PATH`, as
+servo_sim's), where a host that waits on it (the tests) may tell the boards
+to run ahead as fast as the emulator goes (clock_file.py)."""
 import argparse
 import os
 import select
+import signal
 import socket
 import sys
 import tempfile
@@ -23,6 +27,7 @@ import servo_schema as schema
 
 from .board import PARTS, Board, images
 from .bus import Bus
+from .clock_file import ClockFile
 from .usb import Adapter
 
 MAX_SLICE_S = 1e-3  # longest the CPUs run between two looks at the host and the models
@@ -51,6 +56,8 @@ class Runner:
         self.now_s = 0.0
         self.wall0 = time.monotonic()
         self.most_behind_s = 0.0
+        self.clock = ClockFile(self.state_dir)
+        self.stop_requested = False
 
     # ---- control port -----------------------------------------------------
     def command(self, line: str) -> str:
@@ -196,26 +203,42 @@ class Runner:
             if until == limit_s and all(b.in_application() for b in self.boards):
                 until = self.now_s + settle_s
         self.wall0 = time.monotonic() - self.now_s
+        self.clock.publish(self.now_s)  # before ready: a host's first look is not at 0
 
     def run(self) -> None:
-        while True:
+        while not self.stop_requested:
             ahead = self.now_s - self._wall()
-            timeout = min(ahead, 0.002) if ahead > 0 else 0
+            timeout = min(ahead, 0.002) if ahead > 0 and self._host_waits() is None else 0
             fds = [self.control] + list(self.clients) + self.bus.fds()
             readable, _, _ = select.select(fds, [], [], timeout)
             self.serve_control(readable)
             self.bus.poll_host(self.now_s)
+            waits = self._host_waits()
+            if waits is not None and self.now_s > self._wall():
+                self.wall0 -= self.now_s - self._wall()  # the wall clock skips to the boards'
             if self.now_s > self._wall():
                 continue
-            self.step()
+            self.step(waits)
             self.bus.flush_to_host(self.now_s)  # handed over when the adapter does, not a loop later
+            self.clock.publish(self.now_s)
             self.most_behind_s = max(self.most_behind_s, self._wall() - self.now_s)
 
-    def step(self) -> None:
+    def _host_waits(self):
+        """The bus time a host waiting on the clock file wants reached at
+        once (None: the wall clock's pace): not yet reached, and, for a host
+        waiting for an answer, not yet answered."""
+        until_s, answer = self.clock.host_waits()
+        if until_s <= self.now_s or (answer and self.bus.host_answered()):
+            return None
+        return until_s
+
+    def step(self, until_s=None) -> None:
         """One slice: every board on to the next byte's end on the bus
-        (one a board starts sending included), or MAX_SLICE_S, and the
-        bytes that ended by then delivered."""
+        (one a board starts sending included), MAX_SLICE_S or until_s, and
+        the bytes that ended by then delivered."""
         target = min(self.now_s + MAX_SLICE_S, max(self.bus.next_event_s(), self.now_s + 1e-7))
+        if until_s is not None:
+            target = min(target, until_s)
         for b in self.boards:
             b.run_until(target, MAX_SLICE_S)
             # A byte sent: the boards after this one stop at its end; those
@@ -265,19 +288,24 @@ def main(argv=None) -> int:
         for b in stuck:
             print(f"vboard: board {b.servo_id} locked up at power-up ({b.state()['pc']}): its flash "
                   f"file in {runner.state_dir} holds no bootloader that runs", file=sys.stderr)
+        runner.clock.close()
         return 1
     print(f"vboard: bus {runner.url}")
     if args.link:
         print(f"vboard: link {args.link}")
     print(f"vboard: control 127.0.0.1:{runner.control.getsockname()[1]}")
+    print(f"vboard: clock {runner.clock.path}")
     print("vboard: servos " + " ".join(str(i) for i in args.id))
     print("vboard: ready", flush=True)
+    # Stopped between two slices, not inside the emulator's hooks.
+    signal.signal(signal.SIGTERM, lambda *_: setattr(runner, "stop_requested", True))
     try:
         runner.run()
     except KeyboardInterrupt:
         pass
     finally:
         runner.bus.close()
+        runner.clock.close()
         print(f"vboard: stopped ({runner.bus.collisions} collisions)", flush=True)
     return 0
 

@@ -29,6 +29,9 @@ IDS = (0, 1, 2)
 BAUD_INDEX = {115200: 5, 1000000: 8}  # item 36
 # The SDK waits on the wall clock (100 ms an answer): the simulator gets the
 # priority of a real-time twin, so it keeps up on a loaded PC (root only).
+# It is fast (Simulator(fast=True)) for the test's own waits between the
+# SDK's calls (sim.sleep), which the SDK never writes into: while a call
+# waits for its answer, the simulator follows the wall clock.
 SIMULATOR_NICE = -10
 
 
@@ -39,7 +42,8 @@ def baud(request):
 
 @pytest.fixture
 def rig(tmp_path, baud):
-    sim = Simulator(ids=IDS, tcp=False, state_dir=str(tmp_path / "state"), nice=SIMULATOR_NICE).start()
+    sim = Simulator(ids=IDS, tcp=False, state_dir=str(tmp_path / "state"), nice=SIMULATOR_NICE,
+                    fast=True).start()
     try:
         # Set up through servoctl, which waits on the simulated clock (the
         # SDK waits 100 ms of the PC's): soft start off, then the rate.

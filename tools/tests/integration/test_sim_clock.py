@@ -34,8 +34,8 @@ def _ping_behind(sim, capsys, *options):
 
 @pytest.mark.parametrize("board", [None, "stm32f030k6"])
 def test_a_lagging_simulator_answers_within_its_own_clocks_timeout(tmp_path, capsys, board):
-    """servo_sim and a virtual board (whose clock is its control port's
-    `clock` only) alike; scan's windows too, on the board."""
+    """servo_sim and a virtual board alike; scan's windows too, on the
+    board."""
     with Simulator(ids=[1], state_dir=str(tmp_path / "state"), board=board) as sim:
         rc, out = _ping_behind(sim, capsys)
         assert rc == 3 and "servo 1: no reply" in out, out  # the host's 100 ms passed

@@ -8,9 +8,9 @@ simulator's."""
 from servoctl import protocol as p
 from servoctl.servo import Servo
 
-# Host-paced (a stream at its rate on the wall clock): the simulator keeps
-# real time (conftest.py).
-REAL_TIME = True
+# No host paces these setpoints on the wall clock: each carries its own time
+# (host_ms) and the test waits on the simulated clock, so the simulator is
+# the fixtures' fast one (conftest.py).
 
 
 def setpoint(bus, servo_id, decideg, velocity=0, host_ms=0):

@@ -3,7 +3,8 @@ on both virtual boards (the F103 and F030 images): the horn in the turn
 around its zero (item 90), -180..180 deg, whichever side of the zero the
 encoder's count is. servo_sim and the F030 read -30 deg as 330 deg, and the
 F103 read its first encoder value before the ADC's first scan (up to a turn
-off with a zero). Time is each target's simulated time."""
+off with a zero). Time is each target's simulated time, run ahead while the
+test waits on it (fast)."""
 import pytest
 
 from servoctl.servo import Servo
@@ -16,7 +17,7 @@ def angles_after_power_cycles(tmp_path, board, zero, angles, offset=0) -> list:
     """The same sequence on one target: the zero set, then for each angle a
     move there and a power cycle; (multi-turn angle, ReadAngle) read after
     each, in 0.1 deg."""
-    sim = Simulator(ids=[1], state_dir=str(tmp_path / (board or "host")), board=board).start()
+    sim = Simulator(ids=[1], state_dir=str(tmp_path / (board or "host")), board=board, fast=True).start()
     try:
         with sim.bus(timeout=0.3) as bus:
             s = Servo(bus, 1)

@@ -16,7 +16,7 @@ SIMULATORS = [("servo_sim", 6), ("stm32f103", 2), ("stm32f030k6", 2)]
 @pytest.mark.parametrize("board,count", SIMULATORS)
 def test_new_servos_at_one_id_collide_alike_on_every_simulator(tmp_path, capsys, board, count):
     sim = Simulator(ids=[0] * count, state_dir=str(tmp_path / "state"),
-                    board=None if board == "servo_sim" else board).start()
+                    board=None if board == "servo_sim" else board, fast=True).start()
     try:
         def run(*args):
             rc = main(["--port", sim.url, *args], clock=sim.clock_s)

@@ -16,7 +16,7 @@ TYPOS = [("torque_constant", 37140, 3714), ("gear_ratio", 3450, 345), ("gear_rat
 
 @pytest.mark.parametrize("board", BOARDS)
 def test_mistyped_drive_items_are_refused_on_the_real_images(tmp_path, board):
-    sim = Simulator(ids=[1], state_dir=str(tmp_path / "state"), board=board).start()
+    sim = Simulator(ids=[1], state_dir=str(tmp_path / "state"), board=board, fast=True).start()
     try:
         with sim.bus(timeout=0.3) as bus:
             s = Servo(bus, 1)

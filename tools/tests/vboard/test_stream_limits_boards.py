@@ -3,7 +3,8 @@ shipped images as flashed: with the angle limits on (135 deg), a streamed
 setpoint of 300 deg leaves the horn at the limit and the limiter says
 angle; a setpoint 2000 deg away is planned to the end (it stopped at
 1638.5 deg) at no more than the stream's top speed. Time is the boards'
-simulated time."""
+simulated time, run ahead while the test waits on it (fast): the setpoints
+carry their own times (host_ms), no host paces them on the wall clock."""
 import pytest
 
 from servoctl import protocol as p
@@ -15,7 +16,8 @@ from .test_virtual_boards import BOARDS, finish
 
 @pytest.fixture(params=BOARDS)
 def one(request, tmp_path):
-    sim = Simulator(ids=(1,), tcp=True, state_dir=str(tmp_path / "state"), board=request.param).start()
+    sim = Simulator(ids=(1,), tcp=True, state_dir=str(tmp_path / "state"), board=request.param,
+                    fast=True).start()
     try:
         with sim.bus(timeout=0.3) as bus:
             servo = Servo(bus, 1)

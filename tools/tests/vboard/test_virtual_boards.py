@@ -2,7 +2,8 @@
 virtual boards (tools/vboard: the STM32F103 and the STM32F030 emulated,
 their peripherals laid out from ST's SVD files), driven through servoctl and
 the maker's SDK exactly as the simulator is. Time is the boards' simulated
-time (sim.sleep, sim.wait_until)."""
+time (sim.sleep, sim.wait_until), which runs ahead while a test waits on it
+(Simulator(fast=True)) but for the maker's SDK's."""
 import struct
 import zlib
 
@@ -26,8 +27,12 @@ from ..scheduled import followed
 BOARDS = ["stm32f103", "stm32f030k6"]
 
 
-def start(tmp_path, board, ids=(1,), tcp=True, nice=None):
-    return Simulator(ids=ids, tcp=tcp, state_dir=str(tmp_path / "state"), board=board, nice=nice).start()
+def start(tmp_path, board, ids=(1,), tcp=True, nice=None, fast=True):
+    """Boards that run ahead while the test waits on their clock (fast),
+    as servo_sim's in the integration tests; real time for a host that
+    times its answers on the wall clock (the maker's SDK)."""
+    return Simulator(ids=ids, tcp=tcp, state_dir=str(tmp_path / "state"), board=board, nice=nice,
+                     fast=fast).start()
 
 
 def finish(sim, ids):
@@ -292,7 +297,7 @@ def test_a_streamed_trajectory_is_followed(one):
 def test_the_makers_sdk(tmp_path, board):
     # The SDK waits on the wall clock (100 ms an answer): the board gets the
     # priority of a real-time twin, so it keeps up on a loaded PC (root only).
-    sim = start(tmp_path, board, tcp=False, nice=-10)
+    sim = start(tmp_path, board, tcp=False, nice=-10, fast=False)
     uart = serial.Serial(sim.url, 115200, timeout=0)
     m = UartServoManager(uart)
     assert m.write_data(1, 49, b"\x00")
@@ -376,7 +381,7 @@ def test_the_watchdog_resets_a_firmware_stuck_in_a_loop(tmp_path, board):
     after each reset; the IWDG (125 ms) resets the chip, again and again,
     and in between it answers."""
     stuck = images(board)[1].with_name(f"servo_{board}_stuck.img")
-    sim = Simulator(ids=[1], state_dir=str(tmp_path / "state"), board=board, app_image=stuck).start()
+    sim = Simulator(ids=[1], state_dir=str(tmp_path / "state"), board=board, app_image=stuck, fast=True).start()
     sim.sleep(1.5)
     state = sim.state(1)
     assert state["resets_watchdog"] >= 2
@@ -544,7 +549,7 @@ def test_a_plant_file_gives_the_board_its_motor(tmp_path):
     micro-servo at its 4.8 V, read by the board's own ADC; a payload on its
     horn; a refused file stops the board with the reason."""
     sim = Simulator(ids=[1], state_dir=str(tmp_path / "state"), board="stm32f103",
-                    plant=str(PLANTS / "micro_9g.toml")).start()
+                    plant=str(PLANTS / "micro_9g.toml"), fast=True).start()
     try:
         with sim.bus(timeout=0.3) as bus:
             s = Servo(bus, 1)
