@@ -339,7 +339,9 @@ void servo_poll(struct servo *s)
  * once). What is timed finer than the tick (a Sync Monitor turn, the
  * finished move's slot, the link settings after an answer) keeps the loop
  * awake too. */
-bool servo_may_sleep(struct servo *s)
+/* Nothing for a pass to do before an interrupt comes, the line's bytes
+ * apart; *now: the clock's reading, the ring brought up to date. */
+static inline __attribute__((always_inline)) bool nothing_due(struct servo *s, uint32_t *now)
 {
     if (s->erase_passed || s->tx.waiting || s->link_settings_pending || s->enter_bootloader ||
         frame_rx_pending(&s->rx) != 0u ||
@@ -349,12 +351,24 @@ bool servo_may_sleep(struct servo *s)
     if (s->tx.sending && s->hal->bus.tx_done(s->hal->ctx)) {
         return false;
     }
-    uint32_t now = s->hal->bus.now_us(s->hal->ctx);
-    if ((int32_t)(now - s->next_tick_us) >= 0) {
+    *now = s->hal->bus.now_us(s->hal->ctx);
+    if ((int32_t)(*now - s->next_tick_us) >= 0) {
         return false;
     }
+    hal_rx_sync(s->hal, *now);
+    return true;
+}
+
+bool servo_may_sleep(struct servo *s)
+{
     /* Bytes not yet framed were heard just now: they keep it awake too
      * (a full queue's wait in the ring, its frames pending). */
-    hal_rx_sync(s->hal, now);
-    return now - s->hal->rx->heard_us >= SERVO_AWAKE_AFTER_LINE_US;
+    uint32_t now;
+    return nothing_due(s, &now) && now - s->hal->rx->heard_us >= SERVO_AWAKE_AFTER_LINE_US;
+}
+
+bool servo_awaits_bytes(struct servo *s)
+{
+    uint32_t now;
+    return nothing_due(s, &now) && s->hal->rx->written == s->hal->rx->read;
 }
