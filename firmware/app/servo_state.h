@@ -51,7 +51,7 @@
 #define SERVO_MAX_CATCH_UP 4u
 /* While the line has been heard this recently the main loop does not sleep:
  * a request is framed as its bytes land, and its answer leaves within two
- * byte times of its end (docs/decisions.md, "The first answer"). */
+ * byte times of its end (docs/sleep.md, "The first answer"). */
 #define SERVO_AWAKE_AFTER_LINE_US UNSOLICITED_QUIET_US
 /* Control tick period. */
 #define CONTROL_TICK_US (1000000u / MOTION_TICK_HZ)

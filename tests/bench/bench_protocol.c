@@ -382,7 +382,7 @@ static void every_packet(void)
 }
 
 /* A Sync Monitor round of six servos, as a robot loop's host sends it
- * (docs/decisions.md, "The first answer"): the main loop, awake while the
+ * (docs/sleep.md, "The first answer"): the main loop, awake while the
  * line is in use, frames the request as its bytes land. Listed first, this servo builds its
  * answer in the pass that frames its record (sync_prepare) and sends it in
  * the pass that frames the checksum byte (sync_first_pass); listed second,

@@ -1,5 +1,5 @@
 /* A Sync Monitor round's first answer within two byte times of the
- * request's end (docs/decisions.md, "The first answer"): the answer is
+ * request's end (docs/sleep.md, "The first answer"): the answer is
  * built while the request arrives, once this servo's record is in, and
  * leaves in the pass that frames the checksum byte; a request whose
  * checksum fails, or that is cut, never lets it go; a tick that falls due

@@ -51,7 +51,7 @@ RESPONSE_BUDGET_US = {"cortex-m3": 20, "cortex-m0": 30}
 DURABLE_WRITE_BUDGET_US = {"cortex-m3": 200, "cortex-m0": 600}
 # A Sync Monitor round at 1 Mbaud: its first answer within 2 byte times of
 # the request's last stop bit, each later one within 2 of the one before
-# (docs/decisions.md, "The first answer").
+# (docs/sleep.md, "The first answer").
 BYTE_US = 10
 TURNAROUND_BUDGET_US = 2 * BYTE_US
 TURNAROUNDS = ("first_answer", "next_answer")
