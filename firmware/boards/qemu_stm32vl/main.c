@@ -97,12 +97,9 @@ static const struct hal_port port = {
               .read_sensors = sensors_read},
     .calibration = &calibration,
     .flash = &flash,
-    .image_version = image_version,
-    .enter_bootloader = enter_bootloader,
-    .board = BOARD_ID,
-    .tick_and_pass_us = BOARD_TICK_AND_PASS_US,
     .serial_number = serial_number,
     .rx_gap_tolerance_us = QEMU_RX_GAP_TOLERANCE_US,
+    APP_HOOKS_PORT_FIELDS,
 };
 
 int main(void)
