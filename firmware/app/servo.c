@@ -96,10 +96,10 @@ static __attribute__((noinline)) void prepare_answer(struct servo *s)
     struct frame_rx *rx = &s->rx;
     const struct rx_frame *f = frame_rx_under_way(rx);
     uint32_t ended = rx->stats.requests_seen + 1u;
+    /* This servo's record begun: the header before it is this frame's. */
     if (s->prepared_requests != ended && f->code == PKT_SYNC_COMMAND &&
-        f->content[0] == PKT_MONITOR && f->content[1] == 1u) {
-        /* No answer until this servo's record is in (the dispatcher finds
-         * none before): the next pass tries again. */
+        f->sync_index != FRAME_SYNC_NO_RECORD && f->content[0] == PKT_MONITOR &&
+        f->content[1] == 1u) {
         dispatch(&s->dispatcher, f, &s->tx.frame, &s->prepared);
         if (s->prepared.answer) {
             s->prepared_requests = ended; /* the answer sealed: ready to go */
