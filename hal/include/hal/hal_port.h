@@ -78,7 +78,8 @@ struct hal_port {
      * (the target bench's worst figures, docs/benchmark.md): a tick that
      * starts less than this before a Sync Monitor turn would delay the
      * answer, so it waits for the answer to start (servo_turns.c), as one
-     * does for a request to this servo about to end (servo.c). 0: never. */
+     * does for a request to this servo about to end (servo.c). 0: no wait
+     * for a turn; for a request, its last two bytes only. */
     uint8_t tick_and_pass_us;
 };
 
