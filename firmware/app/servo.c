@@ -269,6 +269,7 @@ void servo_poll(struct servo *s)
 {
     /* One reading of the clock per pass: the ticks due by then run now. */
     uint32_t now = s->hal->bus.now_us(s->hal->ctx);
+    s->polled_us = now;
     if (s->erase_passed) {
         /* Framing what came during the erase takes a while on the M0 (2 ms
          * for 500 bytes): this pass's clock reading is stale after it, and
@@ -361,6 +362,11 @@ static inline __attribute__((always_inline)) bool nothing_due(struct servo *s, u
 
 bool servo_may_sleep(struct servo *s)
 {
+    /* The line in use as the pass just run saw it: awake, without reading
+     * the clock and the ring again (a loop that polls goes round sooner). */
+    if (s->polled_us - s->hal->rx->heard_us < SERVO_AWAKE_AFTER_LINE_US) {
+        return false;
+    }
     /* Bytes not yet framed were heard just now: they keep it awake too
      * (a full queue's wait in the ring, its frames pending). */
     uint32_t now;

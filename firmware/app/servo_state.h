@@ -90,6 +90,7 @@ struct servo {
     uint16_t heat_cap_mw;        /* the derating's power cap; 0 = none */
     uint32_t erase_from;         /* the ring's written count as the erase began */
     uint32_t prepared_requests;  /* rx.stats.requests_seen once its request has ended */
+    uint32_t polled_us;          /* the last pass's clock reading */
     uint32_t ticks_dropped;      /* control ticks skipped by a late main loop */
     uint32_t sync_turns_abandoned; /* Sync Monitor answers dropped for a new request */
     uint32_t rx_lost;            /* bytes the DMA wrote over before the main loop took them */

@@ -14,7 +14,7 @@
 static const struct sim_cpu cpus[] = {
     {.name = "m3", .pass_ns = 252 * 1000 / 72 + 1, .tick_ns = 989 * 1000 / 72 + 1,
      .answer_ns = 1153 * 1000 / 72 + 1, .sync_answer_ns = 765 * 1000 / 72 + 1, .tick_and_pass_us = 18},
-    {.name = "m0", .pass_ns = 290 * 1000 / 48 + 1, .tick_ns = 1881 * 1000 / 48 + 1,
+    {.name = "m0", .pass_ns = 293 * 1000 / 48 + 1, .tick_ns = 1881 * 1000 / 48 + 1,
      .answer_ns = 1439 * 1000 / 48 + 1, .sync_answer_ns = 373 * 1000 / 48 + 1, .prepares = true,
      .tick_and_pass_us = 47},
 };

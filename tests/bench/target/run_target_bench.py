@@ -270,13 +270,21 @@ def first_answer(proto: dict, cpu: str, bytes_after: int) -> tuple:
     """(instructions, cycles) from a Sync Monitor's last stop bit to its
     first answer handed to the UART, bytes_after bytes after the record of
     the servo listed first."""
-    idle, prepare, send = proto["idle_poll"], proto["sync_prepare"], proto["sync_first_pass"]
-    # The preparation behind a missed pass, past the last stop bit: the
-    # pass after it takes the checksum byte; else a pass may just miss it.
-    late = idle[1] + prepare[1] - bytes_after * BYTE_US * CLOCK_MHZ[cpu]
+    prepare, send = proto["sync_prepare"], proto["sync_first_pass"]
+    # The preparation behind a missed round, past the last stop bit: the
+    # pass after it takes the checksum byte; else the byte may land just
+    # after a pass read the ring: a round, then the rest of a pass.
+    late = proto["awake_loop"][1] + prepare[1] - bytes_after * BYTE_US * CLOCK_MHZ[cpu]
     if late > 0:
-        return idle[0] + prepare[0] + send[0], late + send[1]
-    return idle[0] + send[0], idle[1] + send[1]
+        return proto["awake_loop"][0] + prepare[0] + send[0], late + send[1]
+    return after_a_missed_read(proto, send)
+
+
+def after_a_missed_read(proto: dict, pass_: tuple) -> tuple:
+    """A pass that sends, its byte landed just after the last pass read the
+    ring: a main-loop round (awake_loop), then the pass but what comes
+    before its reading of the ring (pass_to_ring)."""
+    return tuple(r + p - b for r, p, b in zip(proto["awake_loop"], pass_, proto["pass_to_ring"]))
 
 
 def figures(cpu: str, profile_region: str = "", by_line: bool = False) -> dict:
@@ -321,14 +329,16 @@ def figures(cpu: str, profile_region: str = "", by_line: bool = False) -> dict:
     # sync_monitor_round): the pass that builds this servo's answer as its
     # record lands (the M0's; the M3 builds it from the checksum byte on),
     # and each answer's way out after the byte that lets it go, behind the
-    # idle pass that may have just missed that byte (the worst). The first
+    # main loop's round that may have just missed that byte (awake_loop: a
+    # pass and servo_may_sleep, the line in use; the worst). The first
     # answer also waits for its preparation when that (behind a missed
     # pass) outlasts the bytes after the record: first_answer with the
     # round's five records after it, first_answer_of_two with one.
-    out.update({"sync_prepare": proto["sync_prepare"],
+    out.update({"awake_loop": proto["awake_loop"], "pass_to_ring": proto["pass_to_ring"],
+                "sync_prepare": proto["sync_prepare"],
                 "first_answer": first_answer(proto, cpu, int(pstats["sync_bytes_after_record"])),
                 "first_answer_of_two": first_answer(proto, cpu, 2),
-                "next_answer": tuple(a + b for a, b in zip(proto["idle_poll"], proto["sync_next_pass"]))})
+                "next_answer": after_a_missed_read(proto, proto["sync_next_pass"])})
     out.update({k: v for k, v in proto.items() if k.startswith(("answer_", "request_"))})
     out.update(plans)
     out.update(jerk_plans)
