@@ -64,6 +64,9 @@ static void dispatch_packet(const struct packet_desc *desc, struct packet_call *
     struct dispatch_result *result = call->result;
     result->answer = may_answer && answers(d, desc->flags) &&
                      (outcome == OUTCOME_OK || outcome == OUTCOME_FAILED);
+    if (result->answer) {
+        (void)frame_tx_seal(response); /* ready to go: the caller may hold it for a turn */
+    }
     if (origin.from_sync) {
         result->wait_responses = origin.sync_index;
     }

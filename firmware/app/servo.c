@@ -1,6 +1,7 @@
 #include "app/servo.h"
 
 #include <stddef.h>
+#include <stdint.h>
 #include <string.h>
 
 #include "app/identity.h"
@@ -78,35 +79,62 @@ static void show_executing(struct servo *s)
         motion_is_executing(&s->motion) ? (uint8_t)(status | STATUS_EXECUTING) : status;
 }
 
+/* A Sync Monitor that lists this servo, under way with this servo's record
+ * in: it is dispatched now, while the rest of it arrives, and its answer
+ * leaves once the checksum byte has landed and matched (handle_next_frame).
+ * Monitor records change nothing but the count of requests heard, so one
+ * whose checksum then fails has done no harm. prepared_requests is the
+ * framer's count of requests once this one has ended, whole or not
+ * (frame_rx_line_idle counts a cut one): the answer is this request's if
+ * the frame handled next ended at that count. The Cortex-M0 needs it for
+ * two byte times; the M3 answers within them from the checksum byte on,
+ * and its receive path has no instruction to spare for it. */
+#if !defined(__arm__) || defined(__ARM_ARCH_6M__)
+#define SERVO_PREPARES_ANSWERS 1
+static __attribute__((noinline)) void prepare_answer(struct servo *s)
+{
+    struct frame_rx *rx = &s->rx;
+    const struct rx_frame *f = frame_rx_under_way(rx);
+    uint32_t ended = rx->stats.requests_seen + 1u;
+    /* This servo's record begun: the header before it is this frame's. */
+    if (s->prepared_requests != ended && f->code == PKT_SYNC_COMMAND &&
+        f->sync_index != FRAME_SYNC_NO_RECORD && f->content[0] == PKT_MONITOR &&
+        f->content[1] == 1u) {
+        dispatch(&s->dispatcher, f, &s->tx.frame, &s->prepared);
+        if (s->prepared.answer) {
+            s->prepared_requests = ended; /* the answer sealed: ready to go */
+        }
+    }
+}
+#else
+#define SERVO_PREPARES_ANSWERS 0
+#endif
+
 /* late: the request arrived while a page erase stalled the CPU (after_erase).
  * It is carried out, but its answer, tens of milliseconds late, could fall
  * in another servo's slot: it is not sent, and ReadStore counts it. */
-static inline __attribute__((always_inline)) void handle_next_frame(struct servo *s, uint32_t now,
-                                                                    bool late)
+static SERVO_ONE_COPY void handle_next_frame(struct servo *s, uint32_t now, bool late)
 {
-    const struct rx_frame *frame = frame_rx_peek(&s->rx);
-    if (frame == NULL) {
-        return;
+    const struct rx_frame *frame = &s->rx.slots[s->rx.tail]; /* the callers know there is one */
+    struct dispatch_result *result = &s->prepared;
+    if (!SERVO_PREPARES_ANSWERS || s->rx.stats.requests_seen != s->prepared_requests) {
+        dispatch(&s->dispatcher, frame, &s->tx.frame, result);
     }
-    /* Nothing is being sent or waits to be (servo_poll): the response is
-     * built in the transmit frame. */
-    struct dispatch_result result;
-    dispatch(&s->dispatcher, frame, &s->tx.frame, &result);
     uint32_t responses_base = frame->responses_seen;
     frame_rx_release(&s->rx);
     show_executing(s);
     if (s->watchdog.fired) {
         safety_after_frame(s); /* a motion command clears what the watchdog did */
     }
-    if (result.config_changed) {
+    if (result->config_changed) {
         s->link_settings_pending = 1;
         s->sensors.current_zero = s->regs.user.current_zero_counts; /* item 91 */
     }
-    s->enter_bootloader |= result.enter_bootloader;
-    if (result.answer && late) {
+    s->enter_bootloader |= result->enter_bootloader;
+    if (result->answer && late) {
         s->answers_dropped++;
-    } else if (result.answer) {
-        servo_queue_response(s, result.wait_responses, responses_base, now);
+    } else if (result->answer) {
+        servo_queue_response(s, result->wait_responses, responses_base, now);
     }
 }
 
@@ -164,6 +192,14 @@ static bool run_control_tick(struct servo *s, uint32_t now)
 {
     if ((int32_t)(now - s->tick_due_us) < 0) {
         return false; /* most passes */
+    }
+    /* A request for this servo about to end: a tick now (with the pass
+     * after it) could hold back its answer, or the answer's preparation,
+     * beyond two byte times. The tick waits for the request's end, two byte
+     * times and two a tick and a pass take at most (the schedule stays:
+     * the tick after is due on time). */
+    if (frame_rx_kept_ends_within(&s->rx, 2u * s->turn_guard_bytes + 2u)) {
+        return false;
     }
     unsigned n = 0;
     for (; (int32_t)(now - s->next_tick_us) >= 0; n++) {
@@ -233,6 +269,7 @@ void servo_poll(struct servo *s)
 {
     /* One reading of the clock per pass: the ticks due by then run now. */
     uint32_t now = s->hal->bus.now_us(s->hal->ctx);
+    s->polled_us = now;
     if (s->erase_passed) {
         /* Framing what came during the erase takes a while on the M0 (2 ms
          * for 500 bytes): this pass's clock reading is stale after it, and
@@ -280,7 +317,14 @@ void servo_poll(struct servo *s)
     }
     /* Requests first: the host waits for their answers, while a finished
      * move's answer waits for a quiet line anyway. */
-    handle_next_frame(s, now, false);
+    if (frame_rx_peek(&s->rx) != NULL) {
+        handle_next_frame(s, now, false);
+    }
+#if SERVO_PREPARES_ANSWERS
+    else if (frame_rx_kept_ends_within(&s->rx, UINT32_MAX)) {
+        prepare_answer(s);
+    }
+#endif
     if (!s->tx.sending && !s->tx.waiting) {
         servo_answer_finished_move(s, now);
     }
@@ -289,11 +333,16 @@ void servo_poll(struct servo *s)
 /* The interrupts that end a sleep: the control tick (SysTick), a line gone
  * idle after bytes (the bus USART's IDLE), a transmission's end, a lap of
  * the receive DMA. The DMA takes a request's bytes without waking the CPU,
- * so a request is framed once the line has been idle for a byte time
- * after it (or at the next tick, when another frame follows at once);
- * what is timed finer than the tick (a Sync Monitor turn, the finished
- * move's slot, the link settings after an answer) keeps the loop awake. */
-bool servo_may_sleep(struct servo *s)
+ * so the loop stays awake while the line is in use (heard within
+ * SERVO_AWAKE_AFTER_LINE_US): it frames a request as its bytes land. After
+ * a longer quiet a request is framed once the line has been idle for a
+ * byte time after it (or at the next tick, when another frame follows at
+ * once). What is timed finer than the tick (a Sync Monitor turn, the
+ * finished move's slot, the link settings after an answer) keeps the loop
+ * awake too. */
+/* Nothing for a pass to do before an interrupt comes, the line's bytes
+ * apart; *now: the clock's reading, the ring brought up to date. */
+static inline __attribute__((always_inline)) bool nothing_due(struct servo *s, uint32_t *now)
 {
     if (s->erase_passed || s->tx.waiting || s->link_settings_pending || s->enter_bootloader ||
         frame_rx_pending(&s->rx) != 0u ||
@@ -303,11 +352,29 @@ bool servo_may_sleep(struct servo *s)
     if (s->tx.sending && s->hal->bus.tx_done(s->hal->ctx)) {
         return false;
     }
-    uint32_t now = s->hal->bus.now_us(s->hal->ctx);
-    if ((int32_t)(now - s->next_tick_us) >= 0) {
+    *now = s->hal->bus.now_us(s->hal->ctx);
+    if ((int32_t)(*now - s->next_tick_us) >= 0) {
         return false;
     }
-    const struct hal_rx_ring *ring = s->hal->rx;
-    hal_rx_sync(s->hal, now);
-    return ring->written == ring->read;
+    hal_rx_sync(s->hal, *now);
+    return true;
+}
+
+bool servo_may_sleep(struct servo *s)
+{
+    /* The line in use as the pass just run saw it: awake, without reading
+     * the clock and the ring again (a loop that polls goes round sooner). */
+    if (s->polled_us - s->hal->rx->heard_us < SERVO_AWAKE_AFTER_LINE_US) {
+        return false;
+    }
+    /* Bytes not yet framed were heard just now: they keep it awake too
+     * (a full queue's wait in the ring, its frames pending). */
+    uint32_t now;
+    return nothing_due(s, &now) && now - s->hal->rx->heard_us >= SERVO_AWAKE_AFTER_LINE_US;
+}
+
+bool servo_awaits_bytes(struct servo *s)
+{
+    uint32_t now;
+    return nothing_due(s, &now) && s->hal->rx->written == s->hal->rx->read;
 }

@@ -27,6 +27,10 @@ void servo_poll(struct servo *s);
  * sleep (WFI) in the same masked stretch, so that an interrupt after the
  * check still ends the sleep. */
 bool servo_may_sleep(struct servo *s);
+/* Whether the main loop, awake, has nothing to do but frame bytes as they
+ * land (servo_may_sleep's answer but for a line in use): a simulator need
+ * run no pass until a byte lands, the tick or a transmission's end. */
+bool servo_awaits_bytes(struct servo *s);
 
 /* One control tick: sensors, protection, motion. servo_poll runs it every
  * CONTROL_TICK_US. */

@@ -19,7 +19,15 @@
 #define SERVO_JOB
 #endif
 
-/* s->tx.frame holds the response: it goes out now (wait 0) or after wait
+/* What two places call, as one copy on the Cortex-M0, whose flash is full
+ * (a call more on the answer's path); inlined elsewhere. */
+#if defined(__ARM_ARCH_6M__)
+#define SERVO_ONE_COPY __attribute__((noinline))
+#else
+#define SERVO_ONE_COPY inline __attribute__((always_inline))
+#endif
+
+/* s->tx.frame holds the response, sealed: it goes out now (wait 0) or after wait
  * other servos' responses (Sync Monitor). */
 SERVO_JOB void servo_queue_response(struct servo *s, uint8_t wait, uint32_t responses_base, uint32_t now);
 /* A queued response waits for its Sync Monitor turn: once a pass. */

@@ -49,11 +49,14 @@
 #define STORE_ERASE_MAX_US 40000u
 /* Ticks a late main loop catches up before it drops the rest. */
 #define SERVO_MAX_CATCH_UP 4u
+/* While the line has been heard this recently the main loop does not sleep:
+ * a request is framed as its bytes land, and its answer leaves within two
+ * byte times of its end (docs/sleep.md, "The first answer"). */
+#define SERVO_AWAKE_AFTER_LINE_US UNSOLICITED_QUIET_US
 /* Control tick period. */
 #define CONTROL_TICK_US (1000000u / MOTION_TICK_HZ)
 
 struct servo_tx {
-    uint8_t size;
     uint8_t sending;           /* handed to the UART, not yet off the wire */
     uint8_t waiting;           /* ready, waiting for its turn (sync Monitor) */
     uint8_t turns_left;        /* other responses still to let pass */
@@ -73,6 +76,7 @@ struct servo {
     uint32_t next_tick_us;       /* the control tick's schedule */
     uint32_t tick_due_us;        /* when it runs: later while a Sync Monitor turn is near */
     uint32_t rx_idle_us;         /* line idle this long drops a partial frame */
+    struct dispatch_result prepared; /* the request under way's, its answer in tx.frame */
     volatile uint8_t active_id;  /* the ID answered to now */
     uint8_t active_baud_index;
     uint8_t link_settings_pending; /* the user area changed: ID or baud may have */
@@ -85,6 +89,8 @@ struct servo {
     uint8_t guard_seen;          /* protection.act_changes the motion has */
     uint16_t heat_cap_mw;        /* the derating's power cap; 0 = none */
     uint32_t erase_from;         /* the ring's written count as the erase began */
+    uint32_t prepared_requests;  /* rx.stats.requests_seen once its request has ended */
+    uint32_t polled_us;          /* the last pass's clock reading */
     uint32_t ticks_dropped;      /* control ticks skipped by a late main loop */
     uint32_t sync_turns_abandoned; /* Sync Monitor answers dropped for a new request */
     uint32_t rx_lost;            /* bytes the DMA wrote over before the main loop took them */

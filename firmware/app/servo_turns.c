@@ -9,7 +9,7 @@ static void start_send(struct servo *s)
 {
     s->tx.waiting = 0;
     s->tx.sending = 1;
-    s->hal->bus.send(s->hal->ctx, frame_tx_bytes(&s->tx.frame), s->tx.size);
+    s->hal->bus.send(s->hal->ctx, frame_tx_bytes(&s->tx.frame), frame_tx_size(&s->tx.frame));
 }
 
 /* Sync Monitor: each listed servo answers after the ones listed before it.
@@ -38,10 +38,9 @@ SERVO_JOB void servo_wait_for_turn(struct servo *s, uint32_t now)
     }
 }
 
-/* s->tx.frame holds the response. */
+/* s->tx.frame holds the response, sealed. */
 SERVO_JOB void servo_queue_response(struct servo *s, uint8_t wait, uint32_t responses_base, uint32_t now)
 {
-    s->tx.size = frame_tx_seal(&s->tx.frame);
     s->tx.turns_left = wait;
     s->tx.responses_base = responses_base;
     s->tx.requests_base = s->rx.stats.requests_seen;
@@ -82,5 +81,6 @@ SERVO_JOB void servo_answer_finished_move(struct servo *s, uint32_t now)
     r->length = 2;
     r->content[0] = s->active_id;
     r->content[1] = 1;
+    (void)frame_tx_seal(r);
     servo_queue_response(s, 0, 0, now);
 }

@@ -8,15 +8,9 @@
  * USART's interrupt (84 bytes of its 4 KB shorter). */
 #include <stdint.h>
 
-#include "startup/board_mark.h"
-#include "startup/startup_memory.h"
+#include "startup/core_vectors.h"
 #include "ports/stm32f0/stm32f0_regs.h"
 
-int main(void);
-void Reset_Handler(void);
-void Default_Handler(void);
-void SysTick_Handler(void) __attribute__((weak, alias("Default_Handler")));
-void USART1_IRQHandler(void) __attribute__((weak, alias("Default_Handler")));
 void DMA1_Channel2_3_IRQHandler(void) __attribute__((weak, alias("Default_Handler")));
 
 #ifdef STARTUP_BOOTLOADER
@@ -24,18 +18,11 @@ void DMA1_Channel2_3_IRQHandler(void) __attribute__((weak, alias("Default_Handle
 #else
 #define LAST_IRQ USART1_IRQ
 #endif
-enum { CORE_VECTORS = 16, VECTORS = CORE_VECTORS + LAST_IRQ + 1 };
+enum { VECTORS = CORE_VECTORS + LAST_IRQ + 1 };
 
 __attribute__((section(".isr_vector"), used))
 static void (*const vector_table[VECTORS])(void) = {
-    [0] = (void (*)(void))(uintptr_t)&_estack,
-    [1] = Reset_Handler,
-    [2] = Default_Handler,  /* NMI */
-    [3] = Default_Handler,  /* HardFault */
-    [BOARD_MARK_VECTOR] = BOARD_MARK,
-    [11] = Default_Handler, /* SVCall */
-    [14] = Default_Handler, /* PendSV */
-    [15] = SysTick_Handler,
+    CORE_VECTOR_ENTRIES,
     [CORE_VECTORS + DMA1_CH3_IRQ] = DMA1_Channel2_3_IRQHandler,
 #ifndef STARTUP_BOOTLOADER
     [CORE_VECTORS + USART1_IRQ] = USART1_IRQHandler,

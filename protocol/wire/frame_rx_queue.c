@@ -1,6 +1,5 @@
-/* The framer's set-up, the line's idle timeout and the release of a
- * frame the dispatcher has taken (protocol/frame_rx.h); the state machine
- * is frame_rx.c's. */
+/* The framer's set-up and the line's idle timeout (protocol/frame_rx.h);
+ * the state machine is frame_rx.c's. */
 #include "protocol/frame_rx.h"
 #include "protocol/frame_rx_states.h"
 
@@ -25,14 +24,10 @@ uint32_t frame_rx_idle_us(uint32_t baud)
 void frame_rx_line_idle(struct frame_rx *rx)
 {
     if (rx->state != RX_HDR0) {
+        /* A request this servo kept, cut: seen, whole or not (the count a
+         * prepared answer waits for, servo.c). */
+        rx->stats.requests_seen += rx->state == RX_CONTENT || rx->state == RX_CHECKSUM;
         rx->stats.idle_timeouts++;
         rx->state = RX_HDR0;
-    }
-}
-
-void frame_rx_release(struct frame_rx *rx)
-{
-    if (rx->tail != rx->head) {
-        rx->tail = next_slot(rx->tail);
     }
 }

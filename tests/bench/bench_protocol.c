@@ -381,6 +381,85 @@ static void every_packet(void)
     ANSWER("update_enter", 0x50, ID);
 }
 
+/* Ends the region pass_to_ring at a pass's reading of the ring (the
+ * harness's part, not counted), once. */
+static bool ring_marked;
+static void rx_sync_marked(void *rx_dma, uint32_t now_us)
+{
+    if (ring_marked) {
+        ring_marked = false;
+        bench_end("pass_to_ring");
+    }
+    dma_rx_sync(rx_dma, now_us);
+}
+
+/* A Sync Monitor round of six servos, as a robot loop's host sends it
+ * (docs/sleep.md, "The first answer"): the main loop, awake while the
+ * line is in use, frames the request as its bytes land. Listed first, this servo builds its
+ * answer in the pass that frames its record (sync_prepare) and sends it in
+ * the pass that frames the checksum byte (sync_first_pass); listed second,
+ * it sends in the pass that frames the first one's answer's last byte
+ * (sync_next_pass). run_target_bench.py adds the idle pass that may have
+ * just missed the byte, and judges the sum against 2 byte times. */
+static void sync_monitor_round(void)
+{
+    uint8_t frame[80];
+    size_t n = make_request(frame, 25, (const uint8_t[]){22, 1, 6, OWN_ID, 9, 10, 11, 12, 13}, 9);
+    servo.next_tick_us = servo.tick_due_us = hal.now_us + 0x7FFFFFFFu; /* no control tick inside */
+    printf("sync_bytes_after_record %u\n", 6u); /* five records and the checksum */
+    dma_writes(frame, n - 7u);
+    cpu_runs();
+    dma_writes(&frame[n - 7u], 1); /* this servo's record */
+    bench_begin();
+    servo_poll(&servo);
+    bench_end("sync_prepare");
+    for (size_t i = n - 6u; i < n - 1u; i++) {
+        dma_writes(&frame[i], 1);
+        cpu_runs();
+    }
+    dma_writes(&frame[n - 1u], 1); /* the checksum */
+    bench_begin();
+    servo_poll(&servo);
+    bench_end("sync_first_pass");
+    bool first = usart.tx_busy != 0u;
+    transmission_ends();
+    servo_poll(&servo);
+    n = make_request(frame, 25, (const uint8_t[]){22, 1, 2, 9, OWN_ID}, 5);
+    dma_writes(frame, n);
+    cpu_runs();
+    bool waits = servo.tx.waiting && !usart.tx_busy;
+    uint8_t content[16] = {9};
+    size_t m = make_response(frame, 22, content, sizeof content); /* servo 9's answer */
+    dma_writes(frame, m - 1u);
+    cpu_runs();
+    dma_writes(&frame[m - 1u], 1);
+    bench_begin();
+    servo_poll(&servo);
+    bench_end("sync_next_pass");
+    bool sent = usart.tx_busy != 0u;
+    transmission_ends();
+    servo_poll(&servo);
+    /* The main loop's round while the line is in use, nothing to do: a pass
+     * and the question whether it may sleep (app_start.h's loop). */
+    bench_begin();
+    servo_poll(&servo);
+    bool slept = servo_may_sleep(&servo);
+    bench_end("awake_loop");
+    /* What of a pass comes before it reads the ring: a byte that lands
+     * just after that read waits a round, then the rest of a pass. */
+    hal.port.bus.rx_sync = rx_sync_marked;
+    ring_marked = true;
+    bench_begin();
+    servo_poll(&servo);
+    hal.port.bus.rx_sync = dma_rx_sync;
+    if (!first || !waits || !sent || slept) {
+        fprintf(stderr, "sync_monitor_round: %s\n", !first ? "the first answer was not sent"
+                        : !waits ? "the second servo did not wait for its turn"
+                        : !sent ? "no answer in its turn" : "it would sleep on a line in use");
+        exit(1);
+    }
+}
+
 int main(void)
 {
     systick_clock_init(72000000u);
@@ -402,5 +481,7 @@ int main(void)
 
     fresh_servo();
     every_packet();
+    fresh_servo();
+    sync_monitor_round();
     return 0;
 }

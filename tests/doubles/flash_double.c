@@ -116,15 +116,7 @@ void flash_double_init(struct flash_double *f, uint32_t page_size)
 {
     memset(f, 0, sizeof *f);
     memset(f->mem, 0xFF, sizeof f->mem);
-    f->hal = (struct hal_flash){
-        .ctx = f,
-        .page_size = page_size,
-        .page_addr = {FLASH_DOUBLE_BASE, FLASH_DOUBLE_BASE + page_size},
-        .erase_page = erase_page,
-        .write_block = 2,
-        .program = program,
-        .read = read,
-    };
+    f->hal = hal_flash_two_pages(f, page_size, FLASH_DOUBLE_BASE, erase_page, program, read);
     f->cut_at = -1;
 }
 

@@ -46,9 +46,11 @@ static void test_bytes_not_yet_framed_keep_it_awake(void **state)
     assert_false(servo_may_sleep(&servo));
 }
 
-/* Half a request framed: the rest comes by DMA, and the line going idle
- * after it wakes the loop. */
-static void test_half_a_request_framed_lets_it_sleep(void **state)
+/* Half a request framed: the loop stays awake to frame the rest as it
+ * lands (the DMA would not wake it), and does so while the line is in use;
+ * after SERVO_AWAKE_AFTER_LINE_US of quiet it sleeps again, and a request
+ * then is framed when the line going idle after it wakes the loop. */
+static void test_a_line_in_use_keeps_it_awake(void **state)
 {
     (void)state;
     settle();
@@ -56,6 +58,16 @@ static void test_half_a_request_framed_lets_it_sleep(void **state)
     harness_feed(half, sizeof half);
     harness_poll(1);
     assert_true(frame_rx_in_frame(&servo.rx));
+    assert_false(servo_may_sleep(&servo));
+    uint32_t heard = hal.now_us;
+    for (;;) {
+        harness_run_ms(1);
+        settle(); /* 1010 us on */
+        if (hal.now_us - heard >= SERVO_AWAKE_AFTER_LINE_US) {
+            break;
+        }
+        assert_false(servo_may_sleep(&servo));
+    }
     assert_true(servo_may_sleep(&servo));
 }
 
@@ -65,6 +77,9 @@ static void test_an_answer_that_has_left_unnoticed_keeps_it_awake(void **state)
     settle();
     hal.tx_busy = true;
     REQUEST(PKT_PING, 0); /* Ping (the harness servo holds the factory ID 0) */
+    assert_true(servo.tx.sending);
+    harness_run_ms(SERVO_AWAKE_AFTER_LINE_US / 1000u); /* the line quiet since */
+    settle();
     assert_true(servo.tx.sending);
     assert_true(servo_may_sleep(&servo)); /* the end of the answer is an interrupt */
     hal.tx_busy = false;
@@ -98,7 +113,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test_setup(test_an_idle_servo_sleeps_until_its_tick_is_due, setup),
         cmocka_unit_test_setup(test_bytes_not_yet_framed_keep_it_awake, setup),
-        cmocka_unit_test_setup(test_half_a_request_framed_lets_it_sleep, setup),
+        cmocka_unit_test_setup(test_a_line_in_use_keeps_it_awake, setup),
         cmocka_unit_test_setup(test_an_answer_that_has_left_unnoticed_keeps_it_awake, setup),
         cmocka_unit_test_setup(test_a_sync_monitor_turn_keeps_it_awake, setup),
         cmocka_unit_test_setup(test_a_new_link_setting_keeps_it_awake_until_applied, setup),

@@ -22,4 +22,9 @@ static void enter_bootloader(void *ctx)
     boot_restart_with(BOOT_STAY_WORD_ADDR(BOARD_RAM_END), BOOT_STAY_MAGIC);
 }
 
+/* A hal_port's fields every STM32 application fills alike. */
+#define APP_HOOKS_PORT_FIELDS                                                 \
+    .image_version = image_version, .enter_bootloader = enter_bootloader,     \
+    .board = BOARD_ID, .tick_and_pass_us = BOARD_TICK_AND_PASS_US
+
 #endif

@@ -39,10 +39,7 @@ static const struct hal_port port = {
     .flash = &flash,
     .fault_flash = &fault_flash,
     .serial_number = unique_id_serial,
-    .image_version = image_version,
-    .enter_bootloader = enter_bootloader,
-    .board = BOARD_ID,
-    .tick_and_pass_us = BOARD_TICK_AND_PASS_US,
+    APP_HOOKS_PORT_FIELDS,
 };
 
 int main(void)

@@ -7,7 +7,10 @@
  *   board_clock_init()          the clock tree
  *   board_boot_uart_start(usart, ring, dma)  the USART, its receive DMA, sending polled
  *   board_boot_stop_dma()       stops the receive DMA's channel
- *   board_boot_service(usart)   optional: what the loop runs each pass */
+ *   board_boot_service(usart)   optional: what the loop runs each pass
+ *   board_boot_flash_init(config, slot)  optional: the config pages' and the
+ *                               slot's flash (else the F0/F1 flash driver's)
+ *   BOARD_RX_GAP_TOLERANCE_US   optional: hal_port.rx_gap_tolerance_us */
 #ifndef BOARDS_COMMON_BOOT_START_H
 #define BOARDS_COMMON_BOOT_START_H
 
@@ -31,6 +34,9 @@ static const struct hal_port port = {
     .rx = &rx_ring,
     .rx_ctx = &rx_dma,
     .flash = &config_flash,
+#ifdef BOARD_RX_GAP_TOLERANCE_US
+    .rx_gap_tolerance_us = BOARD_RX_GAP_TOLERANCE_US,
+#endif
 };
 
 /* The bootloader's peripherals stop before the application takes over:
@@ -41,6 +47,15 @@ static void start_app(const struct app_slot *s)
     board_boot_stop_dma();
     boot_jump(s->base + APP_HEADER_SIZE);
 }
+
+#ifndef board_boot_flash_init
+/* The same flash: any page by its address. */
+static void board_boot_flash_init(struct hal_flash *config, struct hal_flash *slot_pages)
+{
+    flash_f0f1_init(config, BOARD_FLASH_PAGE, BOARD_CONFIG_PAGE0, BOARD_CONFIG_PAGE1);
+    *slot_pages = *config;
+}
+#endif
 
 #ifdef board_boot_service
 static void service(void)
@@ -58,8 +73,7 @@ int main(void)
     board_clock_init();
     bus_pins_init();
     systick_clock_init(BOARD_CORE_HZ);
-    flash_f0f1_init(&config_flash, BOARD_FLASH_PAGE, BOARD_CONFIG_PAGE0, BOARD_CONFIG_PAGE1);
-    slot_flash = config_flash; /* the same flash: any page by its address */
+    board_boot_flash_init(&config_flash, &slot_flash);
     slot = (struct app_slot){.flash = &slot_flash, .base = BOARD_SLOT_BASE, .pages = BOARD_SLOT_PAGES};
     board_boot_uart_start(&usart, &rx_ring, &rx_dma);
     const struct boot_board board = {.port = &port, .slot = &slot, .board = BOARD_ID,

@@ -6,6 +6,7 @@
 #ifndef SIM_CPU_H
 #define SIM_CPU_H
 
+#include <stdbool.h>
 #include <stdint.h>
 
 struct sim_cpu {
@@ -13,6 +14,12 @@ struct sim_cpu {
     uint32_t pass_ns;   /* a main-loop pass with nothing to do */
     uint32_t tick_ns;   /* a control tick, the longest */
     uint32_t answer_ns; /* a request to an answer ready, the longest but a durable write's */
+    /* The pass that frames a Sync Monitor's checksum byte and sends this
+     * servo's answer, beyond an idle pass: the M3 builds the answer then,
+     * the M0 before the checksum came (prepares: servo.c,
+     * SERVO_PREPARES_ANSWERS, in a pass that costs answer_ns). */
+    uint32_t sync_answer_ns;
+    bool prepares;
     uint8_t tick_and_pass_us; /* what the board tells the firmware (hal_port.h) */
 };
 

@@ -75,6 +75,12 @@ struct sim_servo {
     uint64_t next_pass_us;
     uint64_t idle_at_us; /* the line's IDLE after the last byte; 0: none due */
     bool asleep;
+    /* Awake while the line is in use, with nothing to do but frame bytes
+     * as they land (servo_awaits_bytes): the next pass runs half a pass
+     * after the next byte lands (landed_us), unless an interrupt's comes
+     * first. */
+    bool polling;
+    uint64_t landed_us; /* 0: none since the last pass */
     const uint8_t *tx_data;
     uint16_t tx_len;
     bool rx_interrupt;

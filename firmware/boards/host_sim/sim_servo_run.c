@@ -12,6 +12,9 @@ static void receive(void *ctx, uint8_t byte, uint64_t at_us)
      * byte time after the last byte (RM0008 27.3.3). */
     s->asleep = s->asleep && !s->rx_interrupt;
     s->idle_at_us = at_us + (10000000u + s->baud - 1u) / s->baud;
+    if (s->polling && s->landed_us == 0u) {
+        s->landed_us = at_us;
+    }
     if (s->rx_interrupt) {
         if (at_us < s->cpu_free_us) {
             if (s->uart_full) {
@@ -59,10 +62,15 @@ uint64_t sim_servo_wake_at(const struct sim_servo *s)
 {
     uint64_t now = s->bus->now_us;
     uint64_t free = s->cpu_free_us > s->next_pass_us ? s->cpu_free_us : s->next_pass_us;
-    if (!s->asleep) {
+    if (!s->asleep && !s->polling) {
         return free > now ? free : now;
     }
     uint64_t wake = bus_time_of(now, s->core.tick_due_us);
+    if (s->landed_us != 0u) {
+        /* A polling loop finds a byte half a pass after it lands, on average. */
+        uint64_t found = s->landed_us + (s->cpu->pass_ns / 2u + 500u) / 1000u;
+        wake = found < wake ? found : wake;
+    }
     if (s->idle_at_us != 0u && s->idle_at_us < wake) {
         wake = s->idle_at_us;
     }
@@ -70,6 +78,24 @@ uint64_t sim_servo_wake_at(const struct sim_servo *s)
         wake = s->tx_done_us; /* the transmission's end */
     }
     return wake > free ? wake : free;
+}
+
+/* What a pass's requests cost beyond the pass: a request to its answer,
+ * a Sync Monitor's checksum to this servo's answer (the core builds that
+ * answer ahead on either CPU; on one whose image does not, the building is
+ * free and the pass at the checksum builds it). */
+static uint64_t request_cost_ns(const struct sim_servo *s, uint32_t heard_before,
+                                uint32_t frames_before)
+{
+    const struct servo *c = &s->core;
+    bool heard = c->dispatcher.heard != heard_before;
+    bool framed = c->rx.stats.frames != frames_before;
+    bool prepared_now = heard && !framed && c->prepared_requests == c->rx.stats.requests_seen + 1u;
+    bool prepared_sent = !heard && framed && c->prepared_requests == c->rx.stats.requests_seen;
+    if (prepared_now && !s->cpu->prepares) {
+        return 0u;
+    }
+    return prepared_sent ? s->cpu->sync_answer_ns : (heard || framed) * (uint64_t)s->cpu->answer_ns;
 }
 
 /* One main-loop pass at now_us, then what it cost on the target's CPU:
@@ -81,14 +107,14 @@ static void run_pass(struct sim_servo *s, uint64_t now_us)
     uint32_t heard_before = s->core.dispatcher.heard;
     uint32_t frames_before = s->core.rx.stats.frames;
     bool in_app = !s->in_bootloader; /* the core's counters are this pass's */
+    s->landed_us = 0;
     if (!s->in_bootloader || !sim_servo_boot_poll(s)) {
         servo_poll(&s->core);
     }
     uint64_t cost_ns = s->cpu->pass_ns;
     if (in_app && !s->in_bootloader) {
         cost_ns += (uint64_t)((s->core.next_tick_us - ticks_before) / CONTROL_TICK_US) * s->cpu->tick_ns;
-        cost_ns += (s->core.dispatcher.heard != heard_before ||
-                    s->core.rx.stats.frames != frames_before) * (uint64_t)s->cpu->answer_ns;
+        cost_ns += request_cost_ns(s, heard_before, frames_before);
     }
     uint64_t cost_us = (cost_ns + 500u) / 1000u;
     s->next_pass_us = now_us + (cost_us != 0u ? cost_us : 1u);
@@ -102,6 +128,7 @@ static void run_pass(struct sim_servo *s, uint64_t now_us)
         s->tx_data = NULL;
     }
     s->asleep = !s->in_bootloader && servo_may_sleep(&s->core);
+    s->polling = !s->in_bootloader && !s->asleep && servo_awaits_bytes(&s->core);
     if (s->idle_at_us <= now_us) {
         s->idle_at_us = 0;
     }

@@ -97,12 +97,9 @@ static const struct hal_port port = {
               .read_sensors = sensors_read},
     .calibration = &calibration,
     .flash = &flash,
-    .image_version = image_version,
-    .enter_bootloader = enter_bootloader,
-    .board = BOARD_ID,
-    .tick_and_pass_us = BOARD_TICK_AND_PASS_US,
     .serial_number = serial_number,
     .rx_gap_tolerance_us = QEMU_RX_GAP_TOLERANCE_US,
+    APP_HOOKS_PORT_FIELDS,
 };
 
 int main(void)
@@ -110,14 +107,7 @@ int main(void)
     for (uint32_t i = 0; i < sizeof flash_mem; i++) {
         flash_mem[i] = 0xFF;
     }
-    flash = (struct hal_flash){
-        .page_size = FLASH_PAGE,
-        .page_addr = {RAM_FLASH_BASE, RAM_FLASH_BASE + FLASH_PAGE},
-        .erase_page = ram_erase,
-        .write_block = 2,
-        .program = ram_program,
-        .read = ram_read,
-    };
+    flash = hal_flash_two_pages(NULL, FLASH_PAGE, RAM_FLASH_BASE, ram_erase, ram_program, ram_read);
     systick_clock_init(QEMU_CORE_HZ);
     port_uart_init(&usart, &rx_ring, NULL, QEMU_CORE_HZ); /* no DMA model: by interrupt */
     usart_hd_tx_polled(&usart); /* QEMU 7.2's USART raises no transmit interrupts */

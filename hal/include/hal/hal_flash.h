@@ -20,4 +20,15 @@ struct hal_flash {
     void (*read)(void *ctx, uint32_t addr, uint8_t *dst, uint32_t len);
 };
 
+/* Two pages from page0 on, programmed two bytes a step (the STM32F0/F1's
+ * half-words), by these operations on ctx. */
+static inline struct hal_flash hal_flash_two_pages(void *ctx, uint32_t page_size, uint32_t page0,
+                                                   bool (*erase_page)(void *, uint32_t),
+                                                   bool (*program)(void *, uint32_t, const uint8_t *),
+                                                   void (*read)(void *, uint32_t, uint8_t *, uint32_t))
+{
+    return (struct hal_flash){.ctx = ctx, .page_size = page_size, .page_addr = {page0, page0 + page_size},
+                              .erase_page = erase_page, .write_block = 2, .program = program, .read = read};
+}
+
 #endif

@@ -77,7 +77,9 @@ struct hal_port {
     /* This CPU's longest control tick and main-loop pass together, in us
      * (the target bench's worst figures, docs/benchmark.md): a tick that
      * starts less than this before a Sync Monitor turn would delay the
-     * answer, so it waits for the answer to start (servo.c). 0: never. */
+     * answer, so it waits for the answer to start (servo_turns.c), as one
+     * does for a request to this servo about to end (servo.c). 0: no wait
+     * for a turn; for a request, its last two bytes only. */
     uint8_t tick_and_pass_us;
 };
 

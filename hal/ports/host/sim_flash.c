@@ -72,14 +72,6 @@ bool sim_flash_open(struct sim_flash *f, const char *path, uint32_t base, uint32
             return false;
         }
     }
-    f->hal = (struct hal_flash){
-        .ctx = f,
-        .page_size = SIM_FLASH_PAGE,
-        .page_addr = {base, base + SIM_FLASH_PAGE},
-        .erase_page = erase_page,
-        .write_block = 2,
-        .program = program,
-        .read = flash_read,
-    };
+    f->hal = hal_flash_two_pages(f, SIM_FLASH_PAGE, base, erase_page, program, flash_read);
     return true;
 }

@@ -41,3 +41,9 @@ uint32_t systick_now_us(void)
     }
     return ms * 1000u + (((reload - val) * us_per_tick_q16) >> 16);
 }
+
+uint32_t systick_bus_now_us(void *ctx)
+{
+    (void)ctx;
+    return systick_now_us();
+}

@@ -8,5 +8,7 @@
 void systick_clock_init(uint32_t core_hz);
 /* Safe from any interrupt priority. */
 uint32_t systick_now_us(void);
+/* The same, shaped as hal_port.bus.now_us (ctx unused). */
+uint32_t systick_bus_now_us(void *ctx);
 
 #endif

@@ -1,7 +1,6 @@
 #include "ports/stm32f0/stm32f0_uart.h"
 
 #include "ports/stm32f0/stm32f0_regs.h"
-#include "ports/stm32_common/systick_clock.h"
 
 static struct usart_v2_hd *bus_usart;
 static struct dma_rx *bus_dma;
@@ -17,32 +16,6 @@ void DMA1_Channel2_3_IRQHandler(void)
 {
     DMA1_IFCR = DMA1_FLAGS(3u);
     dma_rx_lap(bus_dma);
-}
-
-uint32_t port_now_us(void *ctx)
-{
-    (void)ctx;
-    return systick_now_us();
-}
-
-void port_uart_send(void *ctx, const uint8_t *data, uint16_t len)
-{
-    usart_v2_hd_send(ctx, data, len);
-}
-
-void port_uart_send_polled(void *ctx, const uint8_t *data, uint16_t len)
-{
-    usart_v2_hd_send_polled(ctx, data, len);
-}
-
-bool port_uart_tx_done(void *ctx)
-{
-    return usart_v2_hd_tx_done(ctx);
-}
-
-void port_uart_set_baud(void *ctx, uint32_t baud)
-{
-    usart_v2_hd_set_baud(ctx, baud);
 }
 
 void port_uart_init(struct usart_v2_hd *usart, struct hal_rx_ring *ring, struct dma_rx *dma,

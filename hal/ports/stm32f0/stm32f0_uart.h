@@ -6,21 +6,16 @@
 #define STM32F0_PORT_UART_H
 
 #include "ports/stm32_common/dma_rx.h"
+#include "ports/stm32_common/systick_clock.h"
 #include "hal/hal_port.h"
 #include "ports/stm32f0/usart_v2_hd.h"
 
 enum port_uart_send {
-    PORT_UART_SEND_DMA, /* port_uart_send: by DMA1 channel 2, the USART's interrupt at the end */
-    /* port_uart_send_polled: whole, from the main loop, for the bootloader,
+    PORT_UART_SEND_DMA, /* usart_v2_hd_send: by DMA1 channel 2, the USART's interrupt at the end */
+    /* usart_v2_hd_send_polled: whole, from the main loop, for the bootloader,
      * whose vector table has no USART entry */
     PORT_UART_SEND_POLLED,
 };
-
-uint32_t port_now_us(void *ctx);
-void port_uart_send(void *ctx, const uint8_t *data, uint16_t len);
-void port_uart_send_polled(void *ctx, const uint8_t *data, uint16_t len);
-bool port_uart_tx_done(void *ctx);
-void port_uart_set_baud(void *ctx, uint32_t baud);
 
 /* Starts USART1 for the bus (single wire, 115200 until data ID 36 says
  * otherwise) receiving into ring by dma; enables the DMA's interrupt, and
@@ -30,11 +25,11 @@ void port_uart_init(struct usart_v2_hd *usart, struct hal_rx_ring *ring, struct 
 
 /* A hal_port's bus on this port (rx_ctx: the dma_rx), sending by DMA or,
  * for the bootloader, whole from the main loop. */
-#define PORT_UART_BUS                                                                  \
-    {.now_us = port_now_us, .send = port_uart_send, .tx_done = port_uart_tx_done,     \
-     .set_baud = port_uart_set_baud, .rx_sync = dma_rx_sync}
-#define PORT_UART_BUS_POLLED                                                           \
-    {.now_us = port_now_us, .send = port_uart_send_polled, .tx_done = port_uart_tx_done, \
-     .set_baud = port_uart_set_baud, .rx_sync = dma_rx_sync}
+#define PORT_UART_BUS                                                                 \
+    {.now_us = systick_bus_now_us, .send = usart_v2_hd_send, .tx_done = usart_v2_hd_tx_done, \
+     .set_baud = usart_v2_hd_set_baud, .rx_sync = dma_rx_sync}
+#define PORT_UART_BUS_POLLED                                                                 \
+    {.now_us = systick_bus_now_us, .send = usart_v2_hd_send_polled,                        \
+     .tx_done = usart_v2_hd_tx_done, .set_baud = usart_v2_hd_set_baud, .rx_sync = dma_rx_sync}
 
 #endif

@@ -14,8 +14,9 @@ static uint32_t brr(uint32_t pclk_hz, uint32_t baud)
     return (pclk_hz + baud / 2u) / baud;
 }
 
-void usart_v2_hd_set_baud(struct usart_v2_hd *u, uint32_t baud)
+void usart_v2_hd_set_baud(void *usart, uint32_t baud)
 {
+    struct usart_v2_hd *u = usart;
     /* BRR and the mode bits take writes only while the USART is off
      * (RM0360 23.7.4): a byte on the wire now is lost, as with any
      * baud change (data ID 36 answers first, then changes). */
@@ -42,8 +43,9 @@ void usart_v2_hd_init(struct usart_v2_hd *u, uintptr_t base, uint32_t pclk_hz, u
     USART_CR1(base) = RUNNING;
 }
 
-void usart_v2_hd_send(struct usart_v2_hd *u, const uint8_t *data, uint16_t len)
+void usart_v2_hd_send(void *usart, const uint8_t *data, uint16_t len)
 {
+    struct usart_v2_hd *u = usart;
     if (len == 0u) {
         return;
     }
@@ -55,8 +57,9 @@ void usart_v2_hd_send(struct usart_v2_hd *u, const uint8_t *data, uint16_t len)
     dma_tx_start(u->tx_dma, data, len);
 }
 
-void usart_v2_hd_send_polled(struct usart_v2_hd *u, const uint8_t *data, uint16_t len)
+void usart_v2_hd_send_polled(void *usart, const uint8_t *data, uint16_t len)
 {
+    struct usart_v2_hd *u = usart;
     if (len == 0u) {
         return; /* TC, cleared after the last send, would never come */
     }
@@ -72,9 +75,9 @@ void usart_v2_hd_send_polled(struct usart_v2_hd *u, const uint8_t *data, uint16_
     USART_CR1(u->base) = RUNNING;
 }
 
-bool usart_v2_hd_tx_done(const struct usart_v2_hd *u)
+bool usart_v2_hd_tx_done(void *usart)
 {
-    return !u->tx_busy;
+    return !((const struct usart_v2_hd *)usart)->tx_busy;
 }
 
 /* The line gone idle after a request (it woke the main loop), and the last

@@ -23,15 +23,17 @@ struct usart_v2_hd {
  * channel tx_dma (0: none, usart_v2_hd_send_polled only). */
 void usart_v2_hd_init(struct usart_v2_hd *u, uintptr_t base, uint32_t pclk_hz, uint32_t baud,
                       uintptr_t tx_dma);
-void usart_v2_hd_set_baud(struct usart_v2_hd *u, uint32_t baud);
+/* usart: the struct usart_v2_hd, here and in send, send_polled and
+ * tx_done, so that a hal_port's bus names these directly (stm32f0_uart.h). */
+void usart_v2_hd_set_baud(void *usart, uint32_t baud);
 /* Starts sending by DMA; data must stay valid until usart_v2_hd_tx_done(). */
-void usart_v2_hd_send(struct usart_v2_hd *u, const uint8_t *data, uint16_t len);
-bool usart_v2_hd_tx_done(const struct usart_v2_hd *u);
+void usart_v2_hd_send(void *usart, const uint8_t *data, uint16_t len);
+bool usart_v2_hd_tx_done(void *usart);
 /* The USART's interrupt handler calls this. */
 void usart_v2_hd_irq(struct usart_v2_hd *u);
 /* The whole of data, waiting for each byte and for the last stop bit, so
  * no interrupt is needed: for a main loop that has nothing else to do
  * meanwhile (the bootloader's; its 4 KB have no room for more). */
-void usart_v2_hd_send_polled(struct usart_v2_hd *u, const uint8_t *data, uint16_t len);
+void usart_v2_hd_send_polled(void *usart, const uint8_t *data, uint16_t len);
 
 #endif

@@ -21,35 +21,9 @@ void DMA1_Channel5_IRQHandler(void)
     dma_rx_lap(bus_dma);
 }
 
-uint32_t port_now_us(void *ctx)
-{
-    (void)ctx;
-    return systick_now_us();
-}
-
-void port_uart_send(void *ctx, const uint8_t *data, uint16_t len)
-{
-    usart_hd_send(ctx, data, len);
-}
-
-bool port_uart_tx_done(void *ctx)
-{
-    return usart_hd_tx_done(ctx);
-}
-
-void port_uart_set_baud(void *ctx, uint32_t baud)
-{
-    usart_hd_set_baud(ctx, baud);
-}
-
 void port_uart_send_by_dma(struct usart_hd *usart)
 {
     usart_hd_tx_dma(usart, DMA1_CCR4_ADDR);
-}
-
-void port_uart_send_dma(void *ctx, const uint8_t *data, uint16_t len)
-{
-    usart_hd_send_dma(ctx, data, len);
 }
 
 void port_uart_init(struct usart_hd *usart, struct hal_rx_ring *ring, struct dma_rx *dma,

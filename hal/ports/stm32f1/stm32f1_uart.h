@@ -6,13 +6,9 @@
 #define STM32F1_PORT_UART_H
 
 #include "ports/stm32_common/dma_rx.h"
+#include "ports/stm32_common/systick_clock.h"
 #include "hal/hal_port.h"
 #include "ports/stm32f1/usart_hd.h"
-
-uint32_t port_now_us(void *ctx);
-void port_uart_send(void *ctx, const uint8_t *data, uint16_t len);
-bool port_uart_tx_done(void *ctx);
-void port_uart_set_baud(void *ctx, uint32_t baud);
 
 /* Starts USART1 for the bus (single wire, 115200 until data ID 36 says
  * otherwise) receiving into ring: by dma (DMA1 channel 5, its interrupt
@@ -24,19 +20,18 @@ void port_uart_init(struct usart_hd *usart, struct hal_rx_ring *ring, struct dma
 /* Sends by DMA1 channel 4 (after port_uart_init with a dma), for a hal_port
  * whose bus is PORT_UART_BUS_ALL_DMA. */
 void port_uart_send_by_dma(struct usart_hd *usart);
-void port_uart_send_dma(void *ctx, const uint8_t *data, uint16_t len);
 
 /* A hal_port's bus on this port: received by DMA (rx_ctx: the dma_rx), or
  * byte by byte in the USART's interrupt. */
-#define PORT_UART_BUS_DMA                                                              \
-    {.now_us = port_now_us, .send = port_uart_send, .tx_done = port_uart_tx_done,     \
-     .set_baud = port_uart_set_baud, .rx_sync = dma_rx_sync}
+#define PORT_UART_BUS_DMA                                                            \
+    {.now_us = systick_bus_now_us, .send = usart_hd_send, .tx_done = usart_hd_tx_done, \
+     .set_baud = usart_hd_set_baud, .rx_sync = dma_rx_sync}
 /* ... and sent by DMA (port_uart_send_by_dma). */
-#define PORT_UART_BUS_ALL_DMA                                                          \
-    {.now_us = port_now_us, .send = port_uart_send_dma, .tx_done = port_uart_tx_done, \
-     .set_baud = port_uart_set_baud, .rx_sync = dma_rx_sync}
-#define PORT_UART_BUS_INTERRUPT                                                        \
-    {.now_us = port_now_us, .send = port_uart_send, .tx_done = port_uart_tx_done,     \
-     .set_baud = port_uart_set_baud}
+#define PORT_UART_BUS_ALL_DMA                                                            \
+    {.now_us = systick_bus_now_us, .send = usart_hd_send_dma, .tx_done = usart_hd_tx_done, \
+     .set_baud = usart_hd_set_baud, .rx_sync = dma_rx_sync}
+#define PORT_UART_BUS_INTERRUPT                                                      \
+    {.now_us = systick_bus_now_us, .send = usart_hd_send, .tx_done = usart_hd_tx_done, \
+     .set_baud = usart_hd_set_baud}
 
 #endif

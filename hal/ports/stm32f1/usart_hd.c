@@ -3,10 +3,15 @@
 #include "ports/stm32_common/dma_tx.h"
 #include "ports/stm32f1/stm32f1_regs.h"
 
-void usart_hd_set_baud(struct usart_hd *u, uint32_t baud)
+/* 16x oversampling: BRR is the divider in 1/16ths, i.e. pclk / baud. */
+static void set_brr(const struct usart_hd *u, uint32_t baud)
 {
-    /* 16x oversampling: BRR is the divider in 1/16ths, i.e. pclk / baud. */
     USART_BRR(u->base) = (u->pclk_hz + baud / 2u) / baud;
+}
+
+void usart_hd_set_baud(void *usart, uint32_t baud)
+{
+    set_brr(usart, baud);
 }
 
 void usart_hd_init(struct usart_hd *u, uintptr_t base, uint32_t pclk_hz, uint32_t baud,
@@ -24,7 +29,7 @@ void usart_hd_init(struct usart_hd *u, uintptr_t base, uint32_t pclk_hz, uint32_
     u->rx = rx;
     u->clock_us = clock_us;
     USART_CR1(base) = 0;
-    usart_hd_set_baud(u, baud);
+    set_brr(u, baud);
     USART_CR3(base) = single_wire ? USART_CR3_HDSEL : 0u;
     /* Clear the status flags. On silicon this only clears stale flags; QEMU
      * (7.2) misplaces TXE in its reset value and reports it only once SR has
@@ -63,8 +68,9 @@ void usart_hd_no_echo(struct usart_hd *u)
     u->hears_own_bytes = false;
 }
 
-void usart_hd_send(struct usart_hd *u, const uint8_t *data, uint16_t len)
+void usart_hd_send(void *usart, const uint8_t *data, uint16_t len)
 {
+    struct usart_hd *u = usart;
     if (len == 0u) {
         return;
     }
@@ -80,8 +86,9 @@ void usart_hd_send(struct usart_hd *u, const uint8_t *data, uint16_t len)
     USART_CR1(u->base) = u->tx_irq ? (cr1 | USART_CR1_TXEIE) : cr1;
 }
 
-void usart_hd_send_dma(struct usart_hd *u, const uint8_t *data, uint16_t len)
+void usart_hd_send_dma(void *usart, const uint8_t *data, uint16_t len)
 {
+    struct usart_hd *u = usart;
     if (len == 0u) {
         return;
     }
@@ -134,9 +141,9 @@ void usart_hd_service(struct usart_hd *u)
     }
 }
 
-bool usart_hd_tx_done(const struct usart_hd *u)
+bool usart_hd_tx_done(void *usart)
 {
-    return !u->tx_busy;
+    return !((const struct usart_hd *)usart)->tx_busy;
 }
 
 /* Receive interrupt, without DMA. Drain: on silicon this sees one byte

@@ -36,7 +36,7 @@ void usart_hd_rx_dma(struct usart_hd *u);
  * the interrupt comes once, when the last has left (TC). */
 void usart_hd_tx_dma(struct usart_hd *u, uintptr_t channel);
 /* Starts sending by DMA; data must stay valid until usart_hd_tx_done(). */
-void usart_hd_send_dma(struct usart_hd *u, const uint8_t *data, uint16_t len);
+void usart_hd_send_dma(void *usart, const uint8_t *data, uint16_t len);
 /* Transmit from the main loop instead (usart_hd_service), for USART models
  * that raise no transmit interrupts (QEMU 7.2). Receive stays on the
  * interrupt. */
@@ -48,10 +48,12 @@ void usart_hd_service(struct usart_hd *u);
  * while it is off, and a reply's last byte can be answered before the line
  * would have been turned around. */
 void usart_hd_no_echo(struct usart_hd *u);
-void usart_hd_set_baud(struct usart_hd *u, uint32_t baud);
+/* usart: the struct usart_hd, here and in send, send_dma and tx_done, so
+ * that a hal_port's bus names these directly (stm32f1_uart.h). */
+void usart_hd_set_baud(void *usart, uint32_t baud);
 /* Starts sending; data must stay valid until usart_hd_tx_done(). */
-void usart_hd_send(struct usart_hd *u, const uint8_t *data, uint16_t len);
-bool usart_hd_tx_done(const struct usart_hd *u);
+void usart_hd_send(void *usart, const uint8_t *data, uint16_t len);
+bool usart_hd_tx_done(void *usart);
 /* The USART's interrupt handler calls this. */
 void usart_hd_irq(struct usart_hd *u);
 

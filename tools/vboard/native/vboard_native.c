@@ -152,15 +152,7 @@ static void ram_read(void *ctx, uint32_t addr, uint8_t *dst, uint32_t len)
 
 static struct hal_flash ram_flash_of(struct ram_flash *ram, uint32_t page_size, uint32_t page0_addr)
 {
-    return (struct hal_flash){
-        .ctx = ram,
-        .page_size = page_size,
-        .page_addr = {page0_addr, page0_addr + page_size},
-        .erase_page = ram_erase,
-        .write_block = 2,
-        .program = ram_program,
-        .read = ram_read,
-    };
+    return hal_flash_two_pages(ram, page_size, page0_addr, ram_erase, ram_program, ram_read);
 }
 
 /* pages: the two config pages, erased, page0_addr first: the record of the

@@ -104,6 +104,25 @@ static inline bool frame_rx_skip_ends_within(const struct frame_rx *rx, uint32_t
 {
     return rx->state == FRAME_RX_SKIPPING && rx->skip_left <= bytes;
 }
+/* The framer's states while it keeps a request for this servo: its
+ * content, then its checksum. */
+#define FRAME_RX_CONTENT 6u
+#define FRAME_RX_CHECKSUM 7u
+/* A request this servo keeps is under way (in the work slot,
+ * frame_rx_under_way) and ends within `bytes` more bytes, its checksum's
+ * among them. */
+static inline bool frame_rx_kept_ends_within(const struct frame_rx *rx, uint32_t bytes)
+{
+    /* In FRAME_RX_CHECKSUM no content remains. */
+    return (uint8_t)(rx->state - FRAME_RX_CONTENT) <= FRAME_RX_CHECKSUM - FRAME_RX_CONTENT &&
+           rx->remaining < bytes;
+}
+/* The request under way: whole up to what has arrived, its checksum not
+ * yet checked. */
+static inline const struct rx_frame *frame_rx_under_way(const struct frame_rx *rx)
+{
+    return &rx->slots[rx->head];
+}
 /* A frame has begun and not ended. */
 static inline bool frame_rx_in_frame(const struct frame_rx *rx)
 {
@@ -116,7 +135,12 @@ static inline const struct rx_frame *frame_rx_peek(const struct frame_rx *rx)
 {
     return rx->tail == rx->head ? (const struct rx_frame *)0 : &rx->slots[rx->tail];
 }
-void frame_rx_release(struct frame_rx *rx);
+static inline void frame_rx_release(struct frame_rx *rx)
+{
+    if (rx->tail != rx->head) {
+        rx->tail = (uint8_t)((rx->tail + 1u) % FRAME_QUEUE_SLOTS);
+    }
+}
 /* Complete frames waiting for frame_rx_peek. */
 static inline uint8_t frame_rx_pending(const struct frame_rx *rx)
 {

@@ -20,6 +20,8 @@ enum rx_state {
     RX_SKIP,      /* a frame not kept: remaining counts its checksum too */
 };
 _Static_assert(RX_SKIP == FRAME_RX_SKIPPING, "frame_rx.h names the skipping state");
+_Static_assert(RX_CONTENT == FRAME_RX_CONTENT && RX_CHECKSUM == FRAME_RX_CHECKSUM,
+               "frame_rx.h names the states of a kept request");
 
 static inline uint8_t next_slot(uint8_t i)
 {

@@ -31,6 +31,12 @@ _Static_assert(offsetof(struct response, content) == 4u, "content follows the 4-
  * returns its size. */
 uint8_t frame_tx_seal(struct response *r);
 
+/* A sealed frame's size, as frame_tx_seal() returned it. */
+static inline uint8_t frame_tx_size(const struct response *r)
+{
+    return (uint8_t)(4u + r->length + 1u); /* header, content, checksum */
+}
+
 /* The frame's bytes, frame_tx_seal()'s size of them. */
 static inline const uint8_t *frame_tx_bytes(const struct response *r)
 {
