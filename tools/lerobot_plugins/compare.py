@@ -243,8 +243,9 @@ def peak_accel(samples, t0) -> float:
     """The largest change of a horn's speed over ACCEL_WINDOW_S, deg/s^2,
     from the first frame on (connect's own moves are its own figure):
     the acceleration a horn's load feels, not the ripple of one control
-    tick (the maker's 350 ms moves ramp in 50 ms, and show)."""
-    peak = 0.0
+    tick (the maker's 350 ms moves ramp in 50 ms, and show). NaN where no
+    two samples were kept to judge (every frame late), as tracking()."""
+    peak = math.nan
     j = 0
     for a in samples:
         while j < len(samples) and samples[j][0][0] - a[0][0] < ACCEL_WINDOW_S:
@@ -255,7 +256,8 @@ def peak_accel(samples, t0) -> float:
         for i in IDS:
             dt = b[i][0] - a[i][0]
             if dt < ACCEL_WINDOW_S + 2 * SAMPLE_S and a[i][0] >= t0:  # neighbours, not across a gap
-                peak = max(peak, abs(b[i][2] - a[i][2]) / dt)
+                accel = abs(b[i][2] - a[i][2]) / dt
+                peak = accel if math.isnan(peak) else max(peak, accel)
     return peak
 
 

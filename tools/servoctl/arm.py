@@ -207,9 +207,16 @@ class Arm:
         silent = [i for i in self.ids if i not in states]
         if silent:
             named = ", ".join(f"{self.names[i]} (servo {i})" for i in silent)
-            raise JointSilent(f"{named} did not answer in its slot of the Sync Monitor: no position is "
-                              f"given for it (is it powered, its cable in? "
-                              f"{fault_text(Servo(self.bus, silent[0]))})", [self.names[i] for i in silent])
+            names = [self.names[i] for i in silent]
+            if not states:  # none at all: the link's rate or the IDs, more likely than every cable
+                baud = self.bus.serial.baudrate
+                raise JointSilent(f"no joint answered: {named}; no position is given (is the arm powered, "
+                                  f"are its servos at these IDs and at {baud} baud, as the bus is? a new "
+                                  f"servo is at ID 0 and 115200 baud)", names)
+            one = len(silent) == 1
+            raise JointSilent(f"{named} did not answer in {'its slot' if one else 'their slots'} of the Sync "
+                              f"Monitor: no position is given for {'it' if one else 'them'} (is it powered, its "
+                              f"cable in? {fault_text(Servo(self.bus, silent[0]))})", names)
         for servo_id, m in states.items():
             released = [b for b in registers.status_names(m.status) if b in RELEASED_BY]
             if released:

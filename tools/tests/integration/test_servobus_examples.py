@@ -61,3 +61,38 @@ def test_the_serial_transport_on_servo_sims_pseudo_terminal(tmp_path):
     assert done.returncode == 0, done.stdout + done.stderr
     words = dict(zip(*[iter(done.stdout.split())] * 2))
     assert words["cycles"] == "20" and int(words["missed"]) <= 2, done.stdout
+
+
+USER_PROGRAM = r"""
+#include <stdio.h>
+#include "servobus/servobus_posix.h"
+int main(int argc, char **argv) {
+    sb_posix link;
+    sb_bus bus;
+    (void)argc;
+    if (sb_tcp_open(&link, "127.0.0.1", (unsigned)atoi(argv[1])) != 0) return 2;
+    sb_bus_init(&bus, sb_posix_transport(&link), 115200);
+    sb_read_multi_turn_angle_request r = {1};
+    sb_read_multi_turn_angle_answer a;
+    sb_error e = sb_call_read_multi_turn_angle(&bus, &r, &a);
+    if (e.status != SB_OK) { char w[160]; sb_error_text(&e, w, sizeof w); puts(w); return 1; }
+    printf("servo %d at %ld\n", a.id, (long)a.angle);
+    return 0;
+}
+"""
+
+
+def test_a_users_program_builds_as_documented(sim3, tmp_path):
+    """docs/c-library.md's command for a program of one's own: the
+    library's sources beside it, no sanitizers needed."""
+    (tmp_path / "my_program.c").write_text("#include <stdlib.h>\n" + USER_PROGRAM)
+    build = subprocess.run(["bash", "-c", "gcc -std=c99 -Itools/servobus/include -Ibuild/host/generated_servobus "
+                            f"{tmp_path}/my_program.c tools/servobus/src/sb_*.c "
+                            f"build/host/generated_servobus/servobus/sb_schema.c -o {tmp_path}/my_program"],
+                           cwd=REPO, capture_output=True, text=True, timeout=120)
+    assert build.returncode == 0, build.stderr
+    assert "gcc -std=c99 -Itools/servobus/include -Ibuild/host/generated_servobus my_program.c" in \
+        (REPO / "docs" / "c-library.md").read_text()  # the command the docs give, as built here
+    done = subprocess.run([str(tmp_path / "my_program"), sim3.url.rsplit(":", 1)[1]], capture_output=True,
+                          text=True, timeout=60)
+    assert done.returncode == 0 and done.stdout.startswith("servo 1 at "), done.stdout + done.stderr

@@ -266,6 +266,16 @@ def test_a_shared_id_is_shown_and_one_servo_given_a_free_id_by_its_serial(browse
             page.goto(ui.url)
             row = page.locator("#bus-table tr.shared[data-id='1']")
             row.locator("td.state", has_text="ID 1 shared").wait_for(timeout=WAIT_MS)
+            # Numbering them fails while both are on the bus: the page keeps servoctl's reason
+            # (the scan after it must not put it out of sight).
+            page.eval_on_selector("#bus-table tr.shared input.serial", "(e) => { e.dataset.old = '1'; }")
+            page.fill("#bu-from", "1")
+            page.fill("#bu-wait", "1")
+            page.click("#bu-go")
+            page.locator("#log div", has_text="id bringup").wait_for(timeout=WAIT_MS)
+            page.wait_for_function("(() => { const e = document.querySelector('#bus-table tr.shared input.serial');"
+                                   " return e && !e.dataset.old; })()", timeout=WAIT_MS)  # the scan after it
+            page.locator("#view-bus", has_text="no servo alone at ID 1 within 1 s").wait_for(timeout=WAIT_MS)
             row.locator("input.serial").fill("0x51a00101")
             row.locator("input.new-id").fill("7")
             page.wait_for_timeout(1500)  # servo 2's live table redraws: what was typed stays

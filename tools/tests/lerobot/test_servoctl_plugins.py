@@ -11,6 +11,7 @@ The follower's loop is the host's, as LeRobot's is: a frame a loaded PC
 sends late is left out of the tracking figures and counted
 (compare.py), so the test runs with the wall-clock tests, alone."""
 import json
+import math
 import subprocess
 
 import pytest
@@ -104,3 +105,9 @@ def test_the_follower_meets_the_comparisons_targets(seen):
     assert c["read_step_deg"] == pytest.approx(0.1)
     assert c["silent"]["frames"] is not None and c["silent"]["frames"] <= 3
     assert "Motor_3 (servo 3) did not answer" in c["silent"]["error"]
+
+
+def test_the_comparison_gives_no_acceleration_where_it_kept_no_samples(seen):
+    # A run whose every frame the host sent late keeps no samples: its tracking error is
+    # NaN, and so is its peak acceleration (not 0 deg/s^2, a figure never measured).
+    assert math.isnan(seen["peak_accel_none_kept"])

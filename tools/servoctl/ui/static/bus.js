@@ -103,9 +103,13 @@
     $("#bu-go").addEventListener("click", async () => {
       const argv = ["id", "bringup", "--from-id", $("#bu-from").value, "--first", $("#bu-first").value,
         "--count", $("#bu-count").value, "--wait-s", $("#bu-wait").value];
-      $("#scan-line").textContent = "bring-up: connect the new servos one after another…";
-      const r = await run(argv, (l) => { $("#scan-line").textContent = l.text; });
-      $("#scan-line").textContent = r.code ? r.err : r.out.split("\n").pop();
+      // Its own line: the scan after it rewrites the scan's line, and the reason stays.
+      const said = $("#bu-said");
+      said.className = "note";
+      said.textContent = "bring-up: connect the new servos one after another…";
+      const r = await run(argv, (l) => { said.textContent = l.text; });
+      said.textContent = (r.code ? r.err : r.out).trim().split("\n").pop();
+      said.className = r.code ? "refused" : "done";
       scan(false);
     });
   });
