@@ -36,10 +36,10 @@ extern "C" {
 #define SB_TX_MAX (16u + 10u * SB_MAX_SERVOS + 8u + SB_MAX_SERVOS)
 #define SB_RX_MAX 256u
 /* The servos' documented turnaround (docs/decisions.md, "Sync Monitor
- * turn-taking"): an answer starts within SB_TURNAROUND_US plus 2 byte
- * times of the line's last activity (measured: 47 us at 1 Mbaud, 104 us at
- * 115 200), and a listed servo silent for SB_SYNC_SILENCE_US passes its turn
- * (the firmware's SYNC_SLOT_SILENCE_US). */
+ * turn-taking", docs/sleep.md "The first answer"): an answer starts
+ * within SB_TURNAROUND_US plus 2 byte times of the line's last activity,
+ * and a listed servo silent for SB_SYNC_SILENCE_US passes its turn (the
+ * firmware's SYNC_SLOT_SILENCE_US). */
 #define SB_TURNAROUND_US 50u
 #define SB_SYNC_SILENCE_US 3000u
 /* sb_bus.answer_margin_us's default: the host's link on top of the wire (a
