@@ -370,12 +370,12 @@ def build_parser():
                    help="first wait this long for the servo's bootloader: power the servo up "
                         "meanwhile (recovers a servo whose application does not answer)")
 
-    c = sub.add_parser("ui", help="the bench in a web browser: a page on this bus (bus, servo, motion, "
-                                  "plots, bring-up); its address with its token is the first line")
+    c = sub.add_parser("ui", help="the bench in a web browser: a page on this bus (bus, servo, motion, plots, "
+                                  "bring-up); its address with its token is the first line; docs/ui.md")
     c.add_argument("--listen", type=int, default=0, metavar="PORT", help="TCP port (default: a free one)")
-    c.add_argument("--bind", default="127.0.0.1", metavar="ADDR",
-                   help="address to listen on (default 127.0.0.1: this computer only)")
+    c.add_argument("--bind", default="127.0.0.1", metavar="ADDR", help="address to listen on (default: this PC only)")
     c.add_argument("--no-browser", action="store_true", help="only print the address")
+    c.add_argument("--files", metavar="DIR", help="the only folder the page's files are in (default: here)")
 
     c = sub.add_parser("image", help="make an update image from an application binary")
     c.add_argument("binary", help="the application from its vector table (objcopy -O binary)")

@@ -6,7 +6,6 @@ import asyncio
 import secrets
 import signal
 import sys
-import webbrowser
 
 from . import __version__
 from .errors import UsageError
@@ -25,14 +24,16 @@ def global_argv(args) -> list:
 def cmd_ui(bus, args):
     from .ui.server import Page, serve  # aiohttp loads for this command alone
     from .live import has_display
+    from .ui.opener import PageOpener
     from .ui.worker import Worker
 
     token = secrets.token_urlsafe(18)
     about = {"port": args.port, "simulator": bool(args.sim_control), "version": __version__}
     loopback = args.bind in ("127.0.0.1", "localhost", "::1")
     page = Page(None, token, about, hosts={"127.0.0.1", "localhost", "::1"} if loopback else None)
-    worker = Worker(bus, global_argv(args), page.publish)
+    worker = Worker(bus, global_argv(args), page.publish, files=args.files)
     page.worker = worker
+    opener = PageOpener()
 
     def ready(port: int):
         host = "127.0.0.1" if args.bind in ("0.0.0.0", "::", "") else args.bind
@@ -43,13 +44,13 @@ def cmd_ui(bus, args):
         if not loopback:
             print(f"servoctl ui: warning: listening on {args.bind}: anyone who reaches it with the "
                   f"token drives the bus", file=sys.stderr, flush=True)
-        print("servoctl ui: Ctrl-C stops", file=sys.stderr, flush=True)
+        print(f"servoctl ui: the page's files are in {worker.files.root}; Ctrl-C stops", file=sys.stderr, flush=True)
         if args.no_browser:
             return
         if not has_display():  # a console browser would take this terminal
             print("servoctl ui: no display (DISPLAY and WAYLAND_DISPLAY are unset): open the address "
                   "in a browser", file=sys.stderr, flush=True)
-        elif not webbrowser.open(url):
+        elif not opener.open(url):  # a local file that forwards: no token on the browser's command line
             print("servoctl ui: no browser found: open the address in one", file=sys.stderr, flush=True)
 
     async def main():
@@ -66,5 +67,6 @@ def cmd_ui(bus, args):
         raise UsageError(f"ui: cannot listen on {args.bind} port {args.listen}: {e.strerror or e}") from None
     finally:
         worker.stop()
+        opener.close()
     print("servoctl ui: stopped", file=sys.stderr)
     return 0

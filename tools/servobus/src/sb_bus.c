@@ -80,7 +80,14 @@ void sb_bus_init(sb_bus *bus, sb_transport t, uint32_t baud)
     bus->t = t;
     bus->baud = baud;
     bus->timeout_us = 100000u;
+    bus->answer_margin_us = SB_ANSWER_MARGIN_US;
     sb_parser_init(&bus->rx, false);
+}
+
+/* bytes' time on the wire at the bus's baud rate */
+static uint64_t wire_us(const sb_bus *bus, size_t bytes)
+{
+    return bus->baud > 0 ? ((uint64_t)bytes * SB_BITS_PER_BYTE * 1000000u + bus->baud - 1u) / bus->baud : 0u;
 }
 
 static sb_error link_error(int rc, uint8_t code)
@@ -105,6 +112,7 @@ sb_error sb_send(sb_bus *bus, const uint8_t *frame, size_t len)
     }
     bus->pending_len = 0;
     bus->rx.len = 0;
+    bus->sent_end_us = bus->t.now_us(bus->t.ctx) + wire_us(bus, len);
     rc = bus->t.write(bus->t.ctx, frame, len);
     return rc < 0 ? link_error(rc, len > 2 ? frame[2] : 0) : sb_ok();
 }
@@ -115,6 +123,7 @@ static sb_error receive(sb_bus *bus, uint8_t code, int servo, uint64_t deadline_
 {
     uint32_t bad = bus->rx.bad_frames;
     sb_error e = sb_ok();
+    bool looked = false; /* the deadline passed: one last look at what came meanwhile */
     for (;;) {
         while (bus->pending_len > 0) {
             size_t used = 0, clen = 0;
@@ -140,6 +149,14 @@ static sb_error receive(sb_bus *bus, uint8_t code, int servo, uint64_t deadline_
             uint64_t now = bus->t.now_us(bus->t.ctx);
             uint64_t left = deadline_us > now ? deadline_us - now : 0;
             int rc;
+            if (left == 0 && !looked) { /* the host may have slept past the deadline: bytes wait */
+                looked = true;
+                rc = bus->t.read(bus->t.ctx, bus->pending, sizeof bus->pending, 1, 0);
+                if (rc > 0) {
+                    bus->pending_len = (size_t)rc;
+                    continue;
+                }
+            }
             if (left == 0) {
                 e.status = bus->rx.bad_frames != bad ? SB_E_BAD_CHECKSUM : SB_E_NO_ANSWER;
                 e.servo = (int16_t)servo;
@@ -175,39 +192,76 @@ sb_error sb_request(sb_bus *bus, size_t len, uint8_t code, int servo, uint8_t *c
     return receive(bus, code, servo, bus->t.now_us(bus->t.ctx) + bus->timeout_us, content, clen, 0);
 }
 
+/* The slot in the list an answer of id takes, or count (not asked for). */
+static size_t slot_of(const uint8_t *ids, size_t count, uint8_t id)
+{
+    size_t k = 0;
+    while (k < count && ids[k] != id)
+        k++;
+    return k;
+}
+
 sb_error sb_sync_monitor_answers(sb_bus *bus, const uint8_t *ids, size_t count, sb_monitor_answer *states, bool *got)
 {
-    size_t answer = sb_answer_frame_size(SB_PKT_MONITOR), left = count;
-    /* Each answer on the wire, and 4 ms for each (an absent servo's silence). */
-    uint64_t wait = 50000u + count * (4000u + (uint64_t)answer * SB_BITS_PER_BYTE * 1000000u / bus->baud);
-    uint64_t deadline = bus->t.now_us(bus->t.ctx) + wait;
+    size_t answer = sb_answer_frame_size(SB_PKT_MONITOR), left = count, next = 0, silent = 0;
+    /* An answer's wait from the line's last activity: the servo's
+     * turnaround, its bytes, the link's margin; each listed servo before it
+     * that stays silent adds the silence that passes its turn. */
+    uint64_t slot = SB_TURNAROUND_US + wire_us(bus, 2u + answer) + bus->answer_margin_us;
+    uint64_t last = bus->sent_end_us;
+    uint32_t bad = bus->rx.bad_frames;
+    bool jumped = false; /* the last answer taken came before a listed servo's that had not passed its turn */
     sb_error e = sb_ok();
     for (size_t k = 0; k < count; k++)
         got[k] = false;
-    while (left > 0) {
+    /* After an answer that jumped ahead (a late one of the round before, or
+     * a servo's after silences shorter than the margin), one more slot. */
+    while (left > 0 && (next < count || jumped)) {
         uint8_t content[SB_ANSWER_CONTENT_MAX];
         size_t len = 0, k;
         sb_monitor_answer a;
-        e = receive(bus, SB_PKT_MONITOR, -1, deadline, content, &len, left * answer);
+        e = receive(bus, SB_PKT_MONITOR, -1, last + silent * SB_SYNC_SILENCE_US + slot, content, &len,
+                    left * answer);
+        if ((e.status == SB_E_NO_ANSWER || e.status == SB_E_BAD_CHECKSUM) && next >= count)
+            break;
+        if (e.status == SB_E_NO_ANSWER || e.status == SB_E_BAD_CHECKSUM) {
+            silent++; /* ids[next] passes its turn; the next answers after the silence */
+            next++;
+            continue;
+        }
         if (e.status != SB_OK)
             break;
         e = sb_decode_monitor(content, len, &a);
         if (e.status != SB_OK)
             break;
-        for (k = 0; k < count && (ids[k] != a.id || got[k]); k++) {
-        }
-        if (k < count) { /* else another round's, or not asked for */
-            states[k] = a;
-            got[k] = true;
-            left--;
-        }
+        k = slot_of(ids, count, a.id);
+        if (k == count)
+            continue; /* not asked for */
+        /* A round answers in the list's order: what was taken of ids[k] or
+         * later came before this, so it was an earlier round's, late. */
+        for (size_t j = k; j < count; j++)
+            if (got[j]) {
+                got[j] = false;
+                left++;
+            }
+        states[k] = a;
+        got[k] = true;
+        left--;
+        last = bus->arrived_us;
+        silent = 0;
+        jumped = k > next;
+        next = k + 1;
     }
-    if (e.status == SB_E_NO_ANSWER || e.status == SB_E_BAD_CHECKSUM)
+    if (e.status == SB_OK || e.status == SB_E_NO_ANSWER || e.status == SB_E_BAD_CHECKSUM) {
+        e = sb_ok();
         for (size_t k = 0; k < count; k++)
-            if (!got[k]) {
-                e.servo = ids[k]; /* the first that did not answer */
+            if (!got[k]) { /* the first that did not answer */
+                e.status = bus->rx.bad_frames != bad ? SB_E_BAD_CHECKSUM : SB_E_NO_ANSWER;
+                e.servo = ids[k];
+                e.packet = SB_PKT_MONITOR;
                 break;
             }
+    }
     return e;
 }
 

@@ -2,6 +2,17 @@
 
 #include "tests/fake_servo.h"
 
+/* len bytes just put in out, their last off the wire us after the line's last activity */
+static void queue(fake_bus *f, size_t len, uint64_t us)
+{
+    if (f->answers == sizeof f->ends / sizeof f->ends[0])
+        return;
+    f->out_len += len;
+    f->line_us += us;
+    f->ends[f->answers] = f->out_len;
+    f->ready_us[f->answers++] = f->line_us;
+}
+
 static void answer(fake_bus *f, uint8_t code, const sb_value *v, size_t count)
 {
     size_t len = 0;
@@ -12,7 +23,8 @@ static void answer(fake_bus *f, uint8_t code, const sb_value *v, size_t count)
         f->out[f->out_len + len - 1] ^= 0x55u;
         f->garble_next = false;
     }
-    f->out_len += len;
+    queue(f, len, (f->first ? FAKE_FIRST_US : FAKE_NEXT_US) + len * 10000000u / f->baud);
+    f->first = false;
 }
 
 static void monitor(fake_bus *f, uint8_t id)
@@ -25,6 +37,8 @@ static void monitor(fake_bus *f, uint8_t id)
     v[6].n = f->setpoint[id];
     if (f->present[id])
         answer(f, SB_PKT_MONITOR, v, 8);
+    else
+        f->line_us += SB_SYNC_SILENCE_US; /* the next listed servo waits out its silence */
 }
 
 static void take(fake_bus *f, uint8_t code, const uint8_t *c, size_t len)
@@ -64,7 +78,15 @@ static int fake_write(void *ctx, const uint8_t *data, size_t len)
     sb_parser p;
     size_t at = 0;
     sb_parser_init(&p, true);
+    if (f->late_len > 0) { /* a late answer, its last byte off the wire as the request starts */
+        memcpy(f->out + f->out_len, f->late, f->late_len);
+        f->line_us = f->now_us;
+        queue(f, f->late_len, 0);
+        f->late_len = 0;
+    }
     f->now_us += len * 10000000u / f->baud;
+    f->line_us = f->now_us;
+    f->first = true;
     while (at < len) {
         size_t used = 0, clen = 0;
         uint8_t code = 0;
@@ -76,21 +98,34 @@ static int fake_write(void *ctx, const uint8_t *data, size_t len)
     return 0;
 }
 
+/* What is off the wire by now: whole answers (a wait moves the clock to
+ * the next one's end, or by wait_us). */
 static int fake_read(void *ctx, uint8_t *buf, size_t cap, size_t want, uint32_t wait_us)
 {
     fake_bus *f = (fake_bus *)ctx;
-    size_t n = f->out_len - f->out_at;
+    size_t k = 0, n;
     (void)want;
-    if (n == 0) {
+    while (k < f->answers && f->ends[k] <= f->out_at)
+        k++;
+    if (k == f->answers) {
         f->now_us += wait_us;
-        f->out_len = f->out_at = 0;
+        f->out_len = f->out_at = f->answers = 0;
         return 0;
     }
+    if (f->ready_us[k] > f->now_us) {
+        if (f->ready_us[k] - f->now_us > wait_us) {
+            f->now_us += wait_us;
+            return 0;
+        }
+        f->now_us = f->ready_us[k];
+    }
+    while (k + 1 < f->answers && f->ready_us[k + 1] <= f->now_us)
+        k++;
+    n = f->ends[k] - f->out_at;
     if (n > cap)
         n = cap;
     memcpy(buf, f->out + f->out_at, n);
     f->out_at += n;
-    f->now_us += n * 10000000u / f->baud;
     return (int)n;
 }
 

@@ -93,6 +93,92 @@ static void the_robot_loop_sends_setpoints_and_reads_every_state(void **state)
     assert_true(sb_loop_rate_hz(&loop) > 0.5 * sb_wire_limit_hz(6, 1000000));
 }
 
+/* The robot loop on six fake servos, all plugged in. */
+static sb_loop six;
+static int32_t six_angles[6];
+static sb_monitor_answer six_states[6];
+static bool six_got[6];
+
+static void start_six(void)
+{
+    static const uint8_t ids[6] = {1, 2, 3, 4, 5, 6};
+    for (int k = 1; k <= 6; k++)
+        fake.present[k] = true;
+    memset(six_angles, 0, sizeof six_angles);
+    assert_int_equal(sb_loop_init(&six, &bus, ids, 6, 20).status, SB_OK);
+}
+
+/* A cycle of six, on the fake's clock: its status, and the microseconds it took. */
+static uint64_t cycle_us(sb_error *e)
+{
+    uint64_t before = fake.now_us;
+    for (int k = 0; k < 6; k++)
+        six_angles[k] += 10;
+    *e = sb_loop_cycle(&six, six_angles, NULL, six_states, six_got);
+    return fake.now_us - before;
+}
+
+static void a_silent_servo_costs_one_slot_not_a_time_out(void **state)
+{
+    sb_error e;
+    char text[120];
+    /* the wire's cycle: both requests and six answers at 1 Mbaud (10 us a byte) */
+    uint64_t wire = sb_cycle_bytes(6) * 10u, all, last_silent, mid_silent;
+    start_six();
+    assert_int_equal(bus.answer_margin_us, SB_ANSWER_MARGIN_US);
+    all = cycle_us(&e);
+    assert_int_equal(e.status, SB_OK);
+    assert_true(all < wire + 200u);
+    fake.present[6] = false; /* the last servo unplugged: every later cycle waits a slot for it, no more */
+    for (int c = 0; c < 5; c++) {
+        last_silent = cycle_us(&e);
+        assert_int_equal(e.status, SB_E_NO_ANSWER);
+        assert_int_equal(e.servo, 6);
+        assert_int_equal(e.packet, SB_PKT_MONITOR);
+        assert_true(six_got[0] && six_got[4] && !six_got[5]);
+        assert_int_equal(six_states[4].angle, six_angles[4]);
+        assert_true(last_silent <= all + SB_TURNAROUND_US + SB_ANSWER_MARGIN_US + 200u);
+    }
+    sb_error_text(&e, text, sizeof text);
+    assert_string_equal(text, "servo 6: Monitor: no answer in time (is it on the bus, at this baud rate?)");
+    fake.present[6] = true;
+    fake.present[3] = false; /* one in the middle: the servos' own silence, then the rest answer */
+    mid_silent = cycle_us(&e);
+    assert_int_equal(e.servo, 3);
+    assert_true(six_got[3] && six_got[5] && !six_got[2]);
+    assert_int_equal(six_states[5].angle, six_angles[5]);
+    assert_true(mid_silent <= all + SB_SYNC_SILENCE_US + 200u);
+    bus.answer_margin_us = 300; /* the user's margin */
+    fake.present[3] = true;
+    fake.present[6] = false;
+    last_silent = cycle_us(&e);
+    assert_int_equal(e.servo, 6);
+    assert_true(last_silent <= all + SB_TURNAROUND_US + 300u + 200u);
+    assert_int_equal(six.missed, 7);
+}
+
+static void a_late_answer_to_the_round_before_is_dropped(void **state)
+{
+    sb_error e;
+    sb_value v[8];
+    size_t len = 0;
+    start_six();
+    cycle_us(&e);
+    assert_int_equal(e.status, SB_OK);
+    /* servo 6's answer to the last round, off the wire after the bus drained its input */
+    memset(v, 0, sizeof v);
+    v[0].n = 6;
+    v[1].n = 7400;
+    v[6].n = -999;
+    assert_int_equal(sb_encode_answer(SB_PKT_MONITOR, v, 8, fake.late, sizeof fake.late, &len).status, SB_OK);
+    fake.late_len = len;
+    cycle_us(&e);
+    assert_int_equal(e.status, SB_OK);
+    assert_true(six_got[5]);
+    assert_int_equal(six_states[5].angle, six_angles[5]); /* this round's, not -999 */
+    assert_int_equal(six_states[0].angle, six_angles[0]);
+}
+
 static void the_stream_refuses_what_the_servo_would_not_follow(void **state)
 {
     uint8_t ids[2] = {1, 2};
@@ -134,7 +220,7 @@ static void uart_send(void *ctx, const uint8_t *data, size_t len)
     t.write(f, data, len);
     uart_in_len = uart_in_at = 0;
     int n;
-    while ((n = t.read(f, uart_in + uart_in_len, sizeof uart_in - uart_in_len, 1, 0)) > 0)
+    while ((n = t.read(f, uart_in + uart_in_len, sizeof uart_in - uart_in_len, 1, 100000)) > 0)
         uart_in_len += (size_t)n;
 }
 
@@ -170,6 +256,8 @@ int main(void)
         cmocka_unit_test_setup(a_bad_checksum_is_told, set_up),
         cmocka_unit_test_setup(a_sync_monitor_names_the_servo_that_did_not_answer, set_up),
         cmocka_unit_test_setup(the_robot_loop_sends_setpoints_and_reads_every_state, set_up),
+        cmocka_unit_test_setup(a_silent_servo_costs_one_slot_not_a_time_out, set_up),
+        cmocka_unit_test_setup(a_late_answer_to_the_round_before_is_dropped, set_up),
         cmocka_unit_test_setup(the_stream_refuses_what_the_servo_would_not_follow, set_up),
         cmocka_unit_test_setup(the_uart_callbacks_carry_a_request, set_up),
     };

@@ -6,6 +6,7 @@ queue. Results go back through publish (called on this thread)."""
 import contextlib
 import io
 import json
+import os
 import queue
 import shlex
 import threading
@@ -16,6 +17,7 @@ from ..args import build_parser
 from ..checks import check_range
 from ..errors import EXIT_INTERRUPTED, ServoError
 from . import sampling
+from .files import Folder
 
 # Commands the page may run as they are: those that end on their own. A
 # monitor, a stream and the ui itself run until stopped; sim and image need
@@ -50,8 +52,9 @@ class _Lines(io.TextIOBase):
 
 
 class Worker:
-    def __init__(self, bus, global_argv: list, publish):
+    def __init__(self, bus, global_argv: list, publish, files=None):
         self.bus, self.global_argv, self.publish = bus, list(global_argv), publish
+        self.files = Folder(files if files is not None else os.getcwd())  # the only files the page names
         self.jobs = queue.Queue()
         self.urgent = queue.Queue()  # stop-all
         self.known = []     # the live table's IDs (after a scan)
@@ -107,6 +110,7 @@ class Worker:
                 args = build_parser().parse_args(self.global_argv + list(argv))
                 if args.command == "config":
                     cli.args_.config_operands(args)
+                self.files.confine(args)
                 args.on_progress = self._progress(tag)
                 code = cli.run_command(self.bus, args)
             except KeyboardInterrupt:

@@ -96,3 +96,20 @@ def test_a_users_program_builds_as_documented(sim3, tmp_path):
     done = subprocess.run([str(tmp_path / "my_program"), sim3.url.rsplit(":", 1)[1]], capture_output=True,
                           text=True, timeout=60)
     assert done.returncode == 0 and done.stdout.startswith("servo 1 at "), done.stdout + done.stderr
+
+
+def test_a_silent_servo_costs_the_c_loop_a_slot_not_a_time_out(sim3):
+    """Issue 60's attacker: an unplugged servo held every cycle of the C
+    loop ~60 ms (a fixed 50 ms + 4 ms a servo). Now its answer is waited
+    for as long as the wire takes (its bytes, the servos' turnaround, the
+    margin, and a middle servo's 3 ms silence before the next takes its
+    turn). Judged on the simulator's clock: a mean cycle under 20 ms."""
+    address, clock = _where(sim3)
+    for silent in ("2", "3"):  # one in the middle, the last
+        assert sim3.control(f"unplug 1 {silent}").strip() == "ok"
+        done = _run(["sb_loop_bench", address, clock, "115200", "3", "20"])
+        assert sim3.control(f"unplug 0 {silent}").strip() == "ok"
+        assert done.returncode == 0, done.stdout + done.stderr
+        words = dict(zip(*[iter(done.stdout.split())] * 2))
+        assert words["cycles"] == "20" and int(words["missed"]) >= 20, done.stdout
+        assert float(words["seconds"]) / 20 < 0.020, done.stdout

@@ -42,8 +42,10 @@ def browser():
 
 
 @pytest.fixture(scope="module")
-def bench(browser):
-    with Simulator(ids=IDS) as sim, UiProcess(sim) as ui:
+def bench(browser, tmp_path_factory):
+    files = tmp_path_factory.mktemp("ui-files")  # the only folder the page names files in
+    with Simulator(ids=IDS) as sim, UiProcess(sim, ["--files", str(files)]) as ui:
+        ui.files = files
         page = browser.new_page()
         page.goto(ui.url)
         yield sim, ui, browser, page
@@ -86,8 +88,8 @@ def test_page_loads_and_a_scan_lists_the_servos(bench):
     _shot(page, "bus")
 
 
-def test_an_item_edited_on_the_page_is_refused_as_servoctl_says_then_set(bench, tmp_path):
-    _, _, _, page = bench
+def test_an_item_edited_on_the_page_is_refused_as_servoctl_says_then_set(bench):
+    _, ui, _, page = bench
     _view(page, "servo")
     field = page.locator("#items tr[data-item=angle_max] input")
     field.wait_for(timeout=WAIT_MS)
@@ -102,11 +104,14 @@ def test_an_item_edited_on_the_page_is_refused_as_servoctl_says_then_set(bench, 
     page.click("#cfg-diff")  # with factory
     page.locator("#servo-out", has_text="angle_max").wait_for(timeout=WAIT_MS)
     assert "120.0 deg" in page.inner_text("#servo-out")
-    page.fill("#bk-file", str(tmp_path / "bus.json"))
+    page.fill("#bk-file", str(ui.files / "bus.json"))
     page.click("#bk-save")
     page.locator("#servo-out", has_text="saved 6 servo(s) (1, 2, 3, 4, 5, 6)").wait_for(timeout=WAIT_MS)
     page.click("#bk-restore")
     page.locator("#servo-out", has_text="restored 6 servo(s)").wait_for(timeout=WAIT_MS)
+    page.fill("#bk-file", "/etc/passwd")  # outside the ui's folder (--files): refused, said on the page
+    page.click("#bk-restore")
+    page.locator("#servo-out", has_text=f"the page names files in {ui.files} only").wait_for(timeout=WAIT_MS)
     _shot(page, "servo")  # read back at the end, on the servo (test_ctrl_c_...)
 
 
@@ -174,9 +179,9 @@ def test_a_servo_unplugged_mid_session_is_shown_gone(bench):
     page.locator("#bus-table tr[data-id='5']:not(.gone)").wait_for(timeout=WAIT_MS)
 
 
-def test_bring_up_updates_two_servos_in_a_row_and_reads_faults(bench, tmp_path):
-    sim, _, _, page = bench
-    image = tmp_path / "firmware-0x0042.img"
+def test_bring_up_updates_two_servos_in_a_row_and_reads_faults(bench):
+    sim, ui, _, page = bench
+    image = ui.files / "firmware-0x0042.img"
     image.write_bytes(img.build(bytes(range(256)) * 6, 0x0042, img.BOARDS["host_sim"]))
     page.select_option("#stop-mode", "release")  # an update restarts a servo: never one that holds
     page.click("#stop-all")

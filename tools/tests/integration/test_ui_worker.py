@@ -47,6 +47,23 @@ def test_the_bus_thread_outlives_a_lost_link_and_a_bad_plot_request():
         assert not w.thread.is_alive()
 
 
+def test_the_page_names_files_in_its_folder_only(tmp_path):
+    """Issue 59's attacker: with the token, config save/load, backup and
+    restore read and wrote any file the server's user could. Now only
+    files in the ui's folder (--files DIR); the refusal says so."""
+    (tmp_path / "bench").mkdir()
+    with Simulator(ids=[1], fast=True) as sim:
+        said = []
+        w = Worker(sim.bus(), ["--port", sim.url], said.append, files=tmp_path / "bench")
+        for argv in (["config", "save", "1", "../escape.json"], ["backup", str(tmp_path / "escape.json")],
+                     ["restore", "/etc/passwd"], ["config", "diff", "1", "/etc/passwd"]):
+            done = w.run(argv)
+            assert done["code"] == 2 and f"the page names files in {tmp_path / 'bench'} only" in done["err"], done
+        assert not (tmp_path / "escape.json").exists()
+        assert w.run(["config", "save", "1", "servo.json"])["code"] == 0
+        assert (tmp_path / "bench" / "servo.json").exists()
+
+
 def _heard(said, what):
     deadline = time.monotonic() + 10  # host time: a bound on failure only
     while not any(what(m) for m in list(said)):

@@ -35,6 +35,16 @@ extern "C" {
 #define SB_BITS_PER_BYTE 10u /* 8N1 */
 #define SB_TX_MAX (16u + 10u * SB_MAX_SERVOS + 8u + SB_MAX_SERVOS)
 #define SB_RX_MAX 256u
+/* The servos' documented turnaround (docs/decisions.md, "Sync Monitor
+ * turn-taking", docs/sleep.md "The first answer"): an answer starts
+ * within SB_TURNAROUND_US plus 2 byte times of the line's last activity,
+ * and a listed servo silent for SB_SYNC_SILENCE_US passes its turn (the
+ * firmware's SYNC_SLOT_SILENCE_US). */
+#define SB_TURNAROUND_US 50u
+#define SB_SYNC_SILENCE_US 3000u
+/* sb_bus.answer_margin_us's default: the host's link on top of the wire (a
+ * USB-serial adapter hands bytes over each 1 ms frame). */
+#define SB_ANSWER_MARGIN_US 2000u
 
 sb_error sb_ok(void);
 /* An error naming servo (-1: none), packet (0: none) and field (NULL: none). */
@@ -89,6 +99,10 @@ struct sb_bus {
     sb_transport t;
     uint32_t baud;       /* for the wire's times */
     uint32_t timeout_us; /* an answer's, after the request (default 100 ms) */
+    /* A Sync Monitor answer's wait beyond its bytes and the servos'
+     * turnaround (default SB_ANSWER_MARGIN_US): the link's latency. */
+    uint32_t answer_margin_us;
+    uint64_t sent_end_us; /* the bus clock when the last request's bytes end on the wire */
     sb_parser rx;
     uint8_t pending[SB_RX_MAX]; /* read but not yet parsed */
     size_t pending_len;
@@ -114,7 +128,12 @@ sb_error sb_sync_frame(uint8_t cmd, const uint8_t *records, size_t record_len, s
 sb_error sb_sync_command(sb_bus *bus, uint8_t cmd, const uint8_t *records, size_t record_len, size_t count);
 /* Monitors every servo of ids with one request; their answers as they come.
  * got[k] says whether ids[k] answered; an error names the first that did
- * not (the others' states are kept). */
+ * not (the others' states are kept). Each answer is waited for as long as
+ * the wire takes: its bytes at the baud rate, the servos' turnaround, a
+ * silent servo's SB_SYNC_SILENCE_US before the next takes its turn, and
+ * answer_margin_us; a silent servo costs one such slot, not a time-out.
+ * Answers come in the list's order: an answer of ids[k] drops any taken of
+ * ids[k] or later (a previous round's, late). */
 sb_error sb_sync_monitor(sb_bus *bus, const uint8_t *ids, size_t count, sb_monitor_answer *states, bool *got);
 /* The same after a frame already sent (a robot loop's burst). */
 sb_error sb_sync_monitor_answers(sb_bus *bus, const uint8_t *ids, size_t count, sb_monitor_answer *states,
