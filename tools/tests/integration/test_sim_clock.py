@@ -97,24 +97,28 @@ def test_ping_of_a_shared_id_says_the_answer_was_garbled(tmp_path, capsys):
                 in out), out
 
 
+def _sent_late(bus, host_late_s: float) -> None:
+    """Each request the bus sends held up host_late_s of host time first."""
+    import time
+
+    sends = bus.send_burst
+
+    def late(requests):
+        time.sleep(host_late_s)
+        sends(requests)
+    bus.send_burst = late
+
+
 def _step_record(tmp_path, name: str, host_late_s: float) -> list:
     """One of identify's open-loop steps (ReadMotion after ReadMotion, as
     fast as the host goes) on a paced servo_sim, each request sent
     host_late_s of host time late: a host a loaded PC holds up."""
-    import time
-
     from servoctl.identify import record_step
     from servoctl.servo import Servo
 
     with Simulator(state_dir=str(tmp_path / name), host_link="raw", paced=True) as sim:
         with sim.bus(timeout=0.2) as bus:
-            sends = bus.send_burst
-
-            def late(requests):
-                time.sleep(host_late_s)
-                sends(requests)
-
-            bus.send_burst = late
+            _sent_late(bus, host_late_s)
             step = record_step(Servo(bus, 1), 0.3, 300, sim.sleep)  # then damped to rest: sim.sleep
             sim.wait_until(lambda: sim.state(1)["velocity"] == 0.0, 1.0)
             ended = sim.clock_s()
@@ -136,19 +140,11 @@ def test_a_paced_simulator_sees_the_same_host_whatever_its_speed(tmp_path):
 def _monitor_past_a_silent_slot(tmp_path, name: str, host_late_s: float) -> tuple:
     """Sync Monitors of 1, 2, 3 (2 absent) on a paced servo_sim, each sent
     host_late_s of host time late: (who answered, the clock after each)."""
-    import time
-
     from servoctl import group
 
     with Simulator(state_dir=str(tmp_path / name), ids=[1, 3], paced=True) as sim:
         with sim.bus(timeout=0.2) as bus:
-            sends = bus.send_burst
-
-            def late(requests):
-                time.sleep(host_late_s)
-                sends(requests)
-
-            bus.send_burst = late
+            _sent_late(bus, host_late_s)
             seen = []
             for _ in range(3):
                 seen.append((sorted(group.sync_monitor(bus, [1, 2, 3])), sim.clock_s()))
