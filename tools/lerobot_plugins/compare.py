@@ -8,7 +8,8 @@ Each plugin, made by LeRobot's make_robot_from_config, runs a follower loop
 at 30 Hz: a lead-in from where the arm is to -45 deg, then a 0.5 Hz +-45
 deg sine on every joint (from rest: -45 cos), then one servo stops
 answering (servo_sim's `unplug 1 ID`: its plug pulled from the bus, as a
-cable that comes loose). Measured from the simulator's models, sampled every 5 ms:
+cable that comes loose). Measured from the simulator's models, sampled
+every 5 ms:
 
 - tracking error, RMS and worst, of the horns against the sine at the lag
   that fits each plugin best (a follower is always a little behind);
@@ -221,6 +222,8 @@ def tracking(samples, t0, start) -> dict:
     """RMS and worst of horn minus path over the sine (after its first
     0.5 s), at the lag (0-500 ms, 5 ms steps) with the least RMS."""
     pts = [(s[i][0] - t0, s[i][1], i) for s in samples for i in IDS if s[i][0] - t0 >= LEAD_S + 0.5]
+    if not pts:  # no samples: nothing to judge
+        return {"rms_deg": math.nan, "worst_deg": math.nan, "lag_ms": math.nan}
     best = None
     for lag_ms in range(0, 501, 5):
         errs = [h - path_deg(t - lag_ms / 1000.0, start[i]) for t, h, i in pts]
@@ -234,8 +237,8 @@ def peak_accel(samples, t0) -> float:
     """The largest change of a horn's speed over ACCEL_WINDOW_S, deg/s^2,
     from the first frame on (connect's own moves are its own figure):
     the acceleration a horn's load feels, not the ripple of one control
-    tick (the maker's 350 ms moves ramp in 50 ms, and show). NaN where no
-    two samples were kept to judge (every frame late), as tracking()."""
+    tick (the maker's 350 ms moves ramp in 50 ms, and show). NaN where there
+    are no two samples to judge, as tracking()."""
     peak = math.nan
     j = 0
     for a in samples:
