@@ -7,8 +7,9 @@ LeRobot environment (scripts/lerobot_compare.sh; docs/lerobot.md):
 Each plugin, made by LeRobot's make_robot_from_config, runs a follower loop
 at 30 Hz: a lead-in from where the arm is to -45 deg, then a 0.5 Hz +-45
 deg sine on every joint (from rest: -45 cos), then one servo stops
-answering (its baud rate changed under the host's feet, as a cable that
-comes loose). Measured from the simulator's models, sampled every 5 ms:
+answering (servo_sim's `unplug 1 ID`: its plug pulled from the bus, as a
+cable that comes loose). Measured from the simulator's models, sampled
+every 5 ms:
 
 - tracking error, RMS and worst, of the horns against the sine at the lag
   that fits each plugin best (a follower is always a little behind);
@@ -18,10 +19,15 @@ comes loose). Measured from the simulator's models, sampled every 5 ms:
 - the frames until an error once a servo is silent (or the frames it was
   still "read").
 
-Ours runs on the simulated clock (servo_sim runs ahead while the host
-waits); the maker's SDK times on the host's, so its simulator keeps real
-time. The servos start at different angles (START) so that a move at
-connect shows."""
+Ours runs on a paced simulator (servo_sim --clock paced): the simulated
+clock moves only while the host waits on it (for an answer, or for the
+next frame), so what the host does between its waits takes no simulated
+time, and ours gives the same figures on an idle and a loaded PC. The
+maker's SDK times its reads on the host's clock and knows nothing of the
+simulator's clock, which a paced servo_sim would never see move: its
+simulator keeps real time, and its figures move with the load. The
+servos start at different angles (START) so that a move at connect
+shows."""
 import argparse
 import dataclasses
 import json
@@ -36,10 +42,8 @@ from pathlib import Path
 from lerobot.robots.config import RobotConfig
 from lerobot.robots.utils import make_robot_from_config
 from lerobot.utils.import_utils import register_third_party_plugins
-from servoctl import protocol as p
-from servoctl import registers
 from servoctl.servo import Servo
-from servoctl.sim import Simulator, _fields
+from servoctl.sim import Simulator, _fields, on_us_grid
 
 IDS = list(range(7))
 NAMES = {**{k: f"Motor_{k}" for k in range(6)}, 6: "gripper"}
@@ -49,12 +53,6 @@ SILENT_ID, WATCH_FRAMES = 3, 30
 START = {i: 8.0 * i - 20.0 for i in IDS}  # where each horn is before connect(), deg
 SAMPLE_S = 0.005
 ACCEL_WINDOW_S = 0.020
-# A frame begun LATE_S (simulated) earlier or later in its period than the median frame, or
-# whose send took longer than LATE_S from the moment its target was taken, was the host's: a
-# loaded PC runs Python late, and the servo, which times each segment from its setpoint's
-# arrival, corrects the difference in the next (docs/streaming.md). The samples from its due
-# time to RECOVER_FRAMES frames later are left out of the figures, and counted.
-LATE_S, RECOVER_FRAMES = 0.001, 4
 BAUD_1M = 8  # item 36's index for 1 000 000 baud
 
 
@@ -76,9 +74,11 @@ def horns(sim) -> dict:
     return out
 
 
-def prepare(fast: bool) -> Simulator:
-    """The arm at 1 Mbaud, soft start off, each horn at START and released."""
-    sim = Simulator(ids=IDS, tcp=False, fast=fast, nice=None if fast else -10).start()
+def prepare(paced: bool) -> Simulator:
+    """The arm at 1 Mbaud, soft start off, each horn at START and released.
+    paced: servo_sim --clock paced (the host's waits alone move its clock);
+    else it keeps real time (a client that times on the host's clock)."""
+    sim = Simulator(ids=IDS, tcp=False, paced=paced, nice=None if paced else -10).start()
     try:
         with sim.bus(timeout=0.2) as bus:
             for i in IDS:
@@ -103,11 +103,11 @@ def config(robot_type: str, sim, cal_dir, **kw):
 
 class Ours:
     name = "servoctl_arm (ours)"
-    fast = True
+    paced = True
 
     def make(self, sim, cal_dir):
         robot = make_robot_from_config(config("servoctl_arm", sim, cal_dir, fps=FPS))
-        robot.clock = sim.clock_s  # the simulated clock, which it runs ahead while it waits
+        robot.clock = sim.clock_s  # the simulated clock, which moves while its bus waits
         return robot
 
     def action(self, robot, deg: dict) -> dict:
@@ -119,7 +119,7 @@ class Ours:
 
 class Makers:
     name = "lerobot-robot-viola (maker's)"
-    fast = False
+    paced = False
 
     def make(self, sim, cal_dir):
         cfg = config("lerobot_robot_viola", sim, cal_dir, use_degrees=True)
@@ -169,7 +169,9 @@ def connect_movement(sim, plugin, robot) -> float:
 
 def wait_sampling(sim, until: float, samples: list) -> None:
     """Samples the horns every SAMPLE_S until the next frame is due, and
-    returns as it is: nothing of the host's between then and the frame."""
+    returns as it is: nothing of the host's between then and the frame.
+    Until the microsecond after: where a paced simulator stops (on_us_grid)."""
+    until = on_us_grid(until)
     while (now := sim.clock_s()) < until:
         if until - now > SAMPLE_S / 2:
             samples.append(horns(sim))
@@ -177,23 +179,21 @@ def wait_sampling(sim, until: float, samples: list) -> None:
 
 
 def silence(sim, servo_id: int) -> None:
-    """The servo stops hearing the host: a WriteData of its baud rate (to
-    115200) put on the wire 1 ms from now, as a cable come loose would."""
-    item = registers.find("baud")
-    frame = p.request_frame(p.WRITE_DATA, bytes([servo_id, item.id]) + item.pack(5))
-    sim.control(f"hostsend {sim.clock_s() * 1000 + 1:.3f} {frame.hex()}")
+    """The servo's plug pulled from the bus (servo_sim's `unplug 1 ID`): it
+    hears and sends nothing from now on, as a cable come loose."""
+    sim.control(f"unplug 1 {servo_id}")
 
 
 def run(plugin) -> dict:
-    sim = prepare(plugin.fast)
+    sim = prepare(plugin.paced)
     cal = Path(tempfile.mkdtemp(prefix="lerobot-cal-"))
     robot = None
-    result = {"plugin": plugin.name}
+    result = {"plugin": plugin.name, "clock": "paced" if plugin.paced else "real time"}
     try:
         robot = plugin.make(sim, cal)
         result["connect_move_deg"] = connect_movement(sim, plugin, robot)
         start = plugin.read(robot, robot.get_observation())
-        samples, late, reads = [], [], {i: set() for i in IDS}
+        samples, reads = [], {i: set() for i in IDS}
         t0 = sim.clock_s()
         frames = round((LEAD_S + SINE_S) * FPS)
         for k in range(frames):
@@ -202,15 +202,9 @@ def run(plugin) -> dict:
                     reads[i].add(round(d, 4))
             now = sim.clock_s() - t0
             robot.send_action(plugin.action(robot, {i: path_deg(now, start[i]) for i in IDS}))
-            done = sim.clock_s() - t0
-            late.append((now - k / FPS, done - now, k / FPS))
-            wait_sampling(sim, t0 + (k + 1) / FPS, samples)
-        usual = sorted(x for x, _, _ in late)[len(late) // 2]
-        late = [t for x, took, t in late if abs(x - usual) > LATE_S or took > LATE_S]
-        kept = [s for s in samples if not any(0 <= s[0][0] - t0 - t < RECOVER_FRAMES / FPS for t in late)]
-        result["late_frames"], result["samples_kept"] = len(late), f"{len(kept)}/{len(samples)}"
-        result.update(tracking(kept, t0, start))
-        result["peak_accel_dps2"] = peak_accel(kept, t0)
+            wait_sampling(sim, t0 + (k + 1) / FPS, samples)  # the frame's wait: on the simulated clock
+        result.update(tracking(samples, t0, start))
+        result["peak_accel_dps2"] = peak_accel(samples, t0)
         result["read_step_deg"] = min(min(b - a for a, b in zip(v, v[1:])) for v in map(sorted, reads.values()))
         result["silent"] = silent_run(sim, plugin, robot)
     finally:
@@ -228,7 +222,7 @@ def tracking(samples, t0, start) -> dict:
     """RMS and worst of horn minus path over the sine (after its first
     0.5 s), at the lag (0-500 ms, 5 ms steps) with the least RMS."""
     pts = [(s[i][0] - t0, s[i][1], i) for s in samples for i in IDS if s[i][0] - t0 >= LEAD_S + 0.5]
-    if not pts:  # every frame late: nothing to judge
+    if not pts:  # no samples: nothing to judge
         return {"rms_deg": math.nan, "worst_deg": math.nan, "lag_ms": math.nan}
     best = None
     for lag_ms in range(0, 501, 5):
@@ -243,8 +237,8 @@ def peak_accel(samples, t0) -> float:
     """The largest change of a horn's speed over ACCEL_WINDOW_S, deg/s^2,
     from the first frame on (connect's own moves are its own figure):
     the acceleration a horn's load feels, not the ripple of one control
-    tick (the maker's 350 ms moves ramp in 50 ms, and show). NaN where no
-    two samples were kept to judge (every frame late), as tracking()."""
+    tick (the maker's 350 ms moves ramp in 50 ms, and show). NaN where there
+    are no two samples to judge, as tracking()."""
     peak = math.nan
     j = 0
     for a in samples:
@@ -264,7 +258,6 @@ def peak_accel(samples, t0) -> float:
 def silent_run(sim, plugin, robot) -> dict:
     """Frames (30 Hz) until the plugin raises once a servo is silent."""
     silence(sim, SILENT_ID)
-    sim.sleep(0.005)  # the write's frame and answer off the wire
     t0 = sim.clock_s()
     last = None
     for k in range(1, WATCH_FRAMES + 1):
@@ -285,7 +278,7 @@ def table(results) -> str:
             ("peak horn acceleration (deg/s^2)", "peak_accel_dps2", "{:.0f}", "<= 2000"),
             ("horn movement during connect (deg)", "connect_move_deg", "{:.2f}", "<= 0.2"),
             ("read resolution (deg)", "read_step_deg", "{:.3f}", "0.1"),
-            ("frames the host sent late (left out)", "late_frames", "{}", "")]
+            ("simulator's clock", "clock", "{}", "")]
     head = "| | " + " | ".join(r["plugin"] for r in results) + " | target (ours) |"
     lines = [head, "|---|" + "---:|" * len(results) + "---|"]
     for label, key, fmt, target in rows:

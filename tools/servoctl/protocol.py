@@ -79,6 +79,7 @@ class Bus:
         # A paced simulator is told the bytes sent, so it takes them when
         # they were sent (Simulator.bus_sent).
         self.note_sent = getattr(getattr(clock, "__self__", None), "bus_sent", None)
+        self.note_read = getattr(getattr(clock, "__self__", None), "bus_read", None)  # and those read
         self.port = port
         check_port(port)
         try:
@@ -187,6 +188,8 @@ class Bus:
             raise LinkError(f"{self.port} is in use by another program (another servoctl, a "
                             f"terminal, the maker's tool): close it, then try again")
         self._buffer += data
+        if data and self.note_read is not None:
+            self.note_read(len(data))
         return bool(data)
 
     def _bytes_missing(self) -> int:
@@ -277,6 +280,8 @@ class Bus:
                     raise BadChecksum(f"{who}: response to packet {code} had a bad checksum")
                 raise NoReply(f"{who}: no reply to packet {code} within {wait * 1000:.0f} ms")
             if not got or time.monotonic() >= check_at:
+                if self.note_read is not None:
+                    self.note_read(0, waits_for_more=True)  # every byte read looked at: none is it
                 last_look = self._look(deadline) > deadline
                 check_at = time.monotonic() + 0.002
             got = self._fill(wait=not last_look)

@@ -123,6 +123,7 @@ class Simulator(_Child):
         self._clock_lock = threading.Lock()
         self._clock_map = None  # servo_sim's clock file, mapped (sim_clock.h)
         self._sent_bytes = 0  # on the bus, in all: a paced servo_sim's offset 16
+        self._read_bytes = 0  # off the bus, in all: its offset 24
 
     @classmethod
     def running(cls, control_port: int) -> "Simulator":
@@ -247,11 +248,11 @@ class Simulator(_Child):
         host time, which is simulated time on an idle PC."""
         if self._clock_map is not None:
             self._clock_map.close()  # a restarted simulator's file is mapped anew
-        self._sent_bytes = 0
+        self._sent_bytes = self._read_bytes = 0
         try:
             writes = self.fast or self.paced
             with open(path, "r+b" if writes else "rb") as f:
-                self._clock_map = mmap.mmap(f.fileno(), 24 if self.paced else 16 if writes else 8,
+                self._clock_map = mmap.mmap(f.fileno(), 32 if self.paced else 16 if writes else 8,
                                             access=mmap.ACCESS_WRITE if writes else mmap.ACCESS_READ)
         except (OSError, ValueError):
             self._clock_map = None  # the control port still answers
@@ -337,6 +338,19 @@ class Simulator(_Child):
     def _host_sent(self, count: int) -> None:
         self._sent_bytes += count
         _CLOCK_US.pack_into(self._clock_map, 16, self._sent_bytes)
+
+    @property
+    def bus_read(self):
+        """What a Bus on this simulator's clock tells of the bytes it reads,
+        and when it has looked at all of them and waits for more (a Sync
+        Monitor's answers past an absent servo): a paced simulator then runs
+        on from an answer it has given."""
+        return self._host_read if self.paced and self._clock_map is not None else None
+
+    def _host_read(self, count: int, waits_for_more: bool = False) -> None:
+        self._read_bytes += count
+        if waits_for_more:
+            _CLOCK_US.pack_into(self._clock_map, 24, self._read_bytes)
 
     @property
     def bus_run_ahead(self):

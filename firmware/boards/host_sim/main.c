@@ -71,11 +71,12 @@ static void refuse(int fd)
 }
 
 /* A host that waits for an answer (sim_clock.h) has it: it has been sent
- * bytes since its last, and the wire and its adapter hold none. */
+ * bytes since its last, bytes it has not read yet (a paced host says what
+ * it has read), and the wire and its adapter hold none. */
 static bool host_answered(uint64_t waits)
 {
-    return (waits & SIM_CLOCK_UNTIL_ANSWER) && bus.host_bytes != host_bytes_then && bus.count == 0 &&
-           sim_usb_due(&bus.usb) == SIM_USB_NONE;
+    return (waits & SIM_CLOCK_UNTIL_ANSWER) && bus.host_bytes != host_bytes_then &&
+           bus.host_bytes > sim_clock_host_received() && bus.count == 0 && sim_usb_due(&bus.usb) == SIM_USB_NONE;
 }
 
 /* The servos and the wire up to target on the bus clock, event by event:

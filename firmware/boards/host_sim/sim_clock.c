@@ -18,8 +18,8 @@ bool sim_clock_open(const char *state_dir, char *path, unsigned path_size)
         return false;
     }
     void *map = MAP_FAILED;
-    if (ftruncate(fd, (off_t)(3 * sizeof(uint64_t))) == 0) {
-        map = mmap(NULL, 3 * sizeof(uint64_t), PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
+    if (ftruncate(fd, (off_t)(4 * sizeof(uint64_t))) == 0) {
+        map = mmap(NULL, 4 * sizeof(uint64_t), PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
     }
     close(fd); /* the mapping keeps the file */
     if (map == MAP_FAILED) {
@@ -46,4 +46,9 @@ uint64_t sim_clock_host_waits(void)
 uint64_t sim_clock_host_sent(void)
 {
     return published != NULL ? atomic_load_explicit(&published[2], memory_order_acquire) : 0u;
+}
+
+uint64_t sim_clock_host_received(void)
+{
+    return published != NULL ? atomic_load_explicit(&published[3], memory_order_acquire) : 0u;
 }

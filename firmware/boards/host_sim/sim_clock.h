@@ -18,7 +18,11 @@
  * (tests whose host paces an experiment: identify). At offset 16 such a
  * host writes how many bytes it has sent on the bus in all: a paced
  * simulator runs only once it has read them all, so a request is taken
- * when it was sent, however late the PC hands it over. */
+ * when it was sent, however late the PC hands it over. At offset 24 it
+ * writes how many bytes it has read off the bus in all: one that waits for
+ * an answer having read every byte it was sent waits for more (a Sync
+ * Monitor's answers after an absent servo's silent slot), and the
+ * simulator runs on to them. */
 #ifndef SIM_CLOCK_H
 #define SIM_CLOCK_H
 
@@ -36,5 +40,7 @@ void sim_clock_publish(uint64_t now_us);
 uint64_t sim_clock_host_waits(void);
 /* The bytes a paced host says it has sent (offset 16); 0 if none. */
 uint64_t sim_clock_host_sent(void);
+/* The bytes a paced host says it has read (offset 24); 0 if none. */
+uint64_t sim_clock_host_received(void);
 
 #endif

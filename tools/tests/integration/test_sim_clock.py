@@ -97,24 +97,28 @@ def test_ping_of_a_shared_id_says_the_answer_was_garbled(tmp_path, capsys):
                 in out), out
 
 
+def _sent_late(bus, host_late_s: float) -> None:
+    """Each request the bus sends held up host_late_s of host time first."""
+    import time
+
+    sends = bus.send_burst
+
+    def late(requests):
+        time.sleep(host_late_s)
+        sends(requests)
+    bus.send_burst = late
+
+
 def _step_record(tmp_path, name: str, host_late_s: float) -> list:
     """One of identify's open-loop steps (ReadMotion after ReadMotion, as
     fast as the host goes) on a paced servo_sim, each request sent
     host_late_s of host time late: a host a loaded PC holds up."""
-    import time
-
     from servoctl.identify import record_step
     from servoctl.servo import Servo
 
     with Simulator(state_dir=str(tmp_path / name), host_link="raw", paced=True) as sim:
         with sim.bus(timeout=0.2) as bus:
-            sends = bus.send_burst
-
-            def late(requests):
-                time.sleep(host_late_s)
-                sends(requests)
-
-            bus.send_burst = late
+            _sent_late(bus, host_late_s)
             step = record_step(Servo(bus, 1), 0.3, 300, sim.sleep)  # then damped to rest: sim.sleep
             sim.wait_until(lambda: sim.state(1)["velocity"] == 0.0, 1.0)
             ended = sim.clock_s()
@@ -131,3 +135,28 @@ def test_a_paced_simulator_sees_the_same_host_whatever_its_speed(tmp_path):
     on_time = _step_record(tmp_path, "on-time", 0.0)
     assert len(on_time) > 80 and max(abs(s[1]) for s in on_time[:-1]) > 0.2  # it turned (rad)
     assert _step_record(tmp_path, "late", 0.003) == on_time
+
+
+def _monitor_past_a_silent_slot(tmp_path, name: str, host_late_s: float) -> tuple:
+    """Sync Monitors of 1, 2, 3 (2 absent) on a paced servo_sim, each sent
+    host_late_s of host time late: (who answered, the clock after each)."""
+    from servoctl import group
+
+    with Simulator(state_dir=str(tmp_path / name), ids=[1, 3], paced=True) as sim:
+        with sim.bus(timeout=0.2) as bus:
+            _sent_late(bus, host_late_s)
+            seen = []
+            for _ in range(3):
+                seen.append((sorted(group.sync_monitor(bus, [1, 2, 3])), sim.clock_s()))
+    return seen
+
+
+def test_a_paced_sync_monitor_runs_on_past_an_absent_servos_slot(tmp_path):
+    """Servo 2's slot passes in silence and servo 3 answers after it. A
+    paced servo_sim stood still once servo 1 had answered, so the host
+    waited for 3 (and for the round's end) on a clock that never moved,
+    until the stalled-clock error; the host now says it has read all it was
+    sent, and the simulator runs on, the same for a late host."""
+    on_time = _monitor_past_a_silent_slot(tmp_path, "on-time", 0.0)
+    assert [who for who, _ in on_time] == [[1, 3]] * 3
+    assert _monitor_past_a_silent_slot(tmp_path, "late", 0.003) == on_time

@@ -45,11 +45,22 @@ def open_bus(config, clock=None) -> Bus:
     """The bus at config.baud. On a simulator's socket:// link the rate is
     set through its control port (config.sim_control), and the bus waits on
     the simulated clock (clock, or the simulator's); a socket without it
-    carries no rate, and the host's clock is used."""
+    carries no rate, and the host's clock is used. The simulator's clock
+    (a control connection kept open) is closed with the bus."""
     sim = link_rate.simulator(config.sim_control)
     if sim is not None and link_rate.is_socket(config.port):
         link_rate.open_rate(config.port, config.baud, config.sim_control)
-    return Bus(config.port, config.baud, timeout=0.05, clock=clock or (sim and sim.clock_s))
+    bus = Bus(config.port, config.baud, timeout=0.05, clock=clock or (sim and sim.clock_s))
+    if sim is not None:
+        close = bus.close
+
+        def close_both():
+            try:
+                close()
+            finally:
+                sim.stop()  # Simulator.running: its connection, not the simulator
+        bus.close = close_both
+    return bus
 
 
 def record_ranges(arm: Arm, stop) -> dict:
