@@ -8,7 +8,9 @@ between runs of at most a slice. A WFI ends the run and the core sleeps
 (B1.5.19): time then passes without running code until an enabled
 exception is pending, which wakes it whatever PRIMASK says; with PRIMASK
 set, a CPSIE I right after the WFI is carried out here and the exception
-taken, or else a few instructions run before it is.
+taken. Whenever PRIMASK holds back a pending exception, awake or after a
+wake, the run ends at the CPSIE I that clears it: the exception is taken
+right after that instruction, as on silicon, not at the slice's end.
 
 Its memory and register writes are memory.py's (MemoryMap), its
 exceptions exceptions.py's (Exceptions), the system control space's
@@ -30,12 +32,12 @@ from .system_space import (NVIC_ICER, NVIC_ICPR, NVIC_ISER, NVIC_ISPR, SCB_AIRCR
 
 CORE_REGS = tuple(getattr(arm, f"UC_ARM_REG_R{n}") for n in range(13)) + (arm.UC_ARM_REG_SP, arm.UC_ARM_REG_LR)
 WFI, CPSIE_I = 0xBF30, 0xB662
-WAKE_RUN = 16  # instructions run after a wake with PRIMASK set before the exception is taken
 
 
 class InstructionCount(ctypes.Structure):
     """native/instruction_count.c's struct vboard_count."""
-    _fields_ = [("executed", ctypes.c_uint64), ("limit", ctypes.c_uint64), ("stop", ctypes.c_void_p)]
+    _fields_ = [("executed", ctypes.c_uint64), ("limit", ctypes.c_uint64), ("stop", ctypes.c_void_p),
+                ("read", ctypes.c_void_p), ("until_cpsie", ctypes.c_uint32), ("at_cpsie", ctypes.c_uint32)]
 
 
 def plain_store_size(hw: int, hw2: int) -> tuple:
@@ -110,7 +112,8 @@ class Core(MemoryMap, Exceptions, SystemControlSpace):
         self.taken = {}              # exception number -> how many times it was taken
         self.lines = {}              # exception number -> its level-sensitive line (assert_irq)
         self.slept_s = 0.0           # time spent asleep since power-up
-        self.count = InstructionCount(0, 0, ctypes.cast(uclib.uc_emu_stop, ctypes.c_void_p))
+        self.count = InstructionCount(0, 0, ctypes.cast(uclib.uc_emu_stop, ctypes.c_void_p),
+                                      ctypes.cast(uclib.uc_mem_read, ctypes.c_void_p), 0, 0)
         self._count_hook = ctypes.c_size_t()
         counter = ctypes.cast(native_lib().vboard_count_instruction, ctypes.c_void_p)
         if uclib.uc_hook_add(self.uc._uch, ctypes.byref(self._count_hook), UC_HOOK_CODE, counter,
@@ -172,14 +175,17 @@ class Core(MemoryMap, Exceptions, SystemControlSpace):
                     self.set_reg(arm.UC_ARM_REG_PC, (pc + 2) | 1)
                     self.cycles += self.cpi
                     self.time_s += self.cpi / self.hz
-                else:
-                    count = min(count, WAKE_RUN)
         if self._hooks_stale:
             self._hook_writes()
         self._take_exception()
         self._update_systick()
         pc = self.reg(arm.UC_ARM_REG_PC) | 1
         self.count.executed, self.count.limit = 0, count
+        # Masked with an exception waiting: it is taken right after the
+        # CPSIE I, so the run ends before that (native/instruction_count.c).
+        masked = self.pending and self.reg(arm.UC_ARM_REG_PRIMASK) & 1
+        self.count.until_cpsie = bool(masked and self.wake_pending())
+        self.count.at_cpsie = 0
         faulted = False
         self.running = self.ran = True
         try:
@@ -192,8 +198,13 @@ class Core(MemoryMap, Exceptions, SystemControlSpace):
             self._fault(str(e))
         self.running = False
         executed = self.count.executed
+        if self.count.at_cpsie and not faulted:  # carried out here; the exception is taken next run
+            self.set_reg(arm.UC_ARM_REG_PRIMASK, 0)
+            self.set_reg(arm.UC_ARM_REG_PC, (self.reg(arm.UC_ARM_REG_PC) + 2) | 1)
+            executed += 1
         ran = executed * self.cpi
-        if executed < count and not (faulted or self.fixes or self.stall_s or self.reset_cause or self.deferred):
+        if executed < count and not (faulted or self.fixes or self.stall_s or self.reset_cause or self.deferred
+                                     or self.count.at_cpsie):
             self.asleep = self._after_wfi()
         for action in self.deferred:
             action()

@@ -8,6 +8,7 @@ program:
     IRQ 0   0x200: adds r1,#1; cmp r1,#200; bne 0x200; bx lr
     SysTick 0x300: adds r4,#1; bx lr  (r4 is not stacked: the count stays)
     sleeper 0x400: cpsid i; wfi; cpsie i; adds r5,#1; b 0x400
+    masked  0x500: cpsid i; adds r6,#1; cpsie i; 0x506: adds r0,#1; b 0x506
 """
 import struct
 
@@ -35,6 +36,7 @@ def core():
     c.write(FLASH + 0x200, bytes.fromhex("0131" "c829" "fcd1" "7047"))
     c.write(FLASH + 0x300, bytes.fromhex("0134" "7047"))
     c.write(FLASH + 0x400, bytes.fromhex("72b6" "30bf" "62b6" "0135" "f9e7"))
+    c.write(FLASH + 0x500, bytes.fromhex("72b6" "0136" "62b6" "0130" "fde7"))
     c.reset(FLASH)
     c.wr32(SCB_VTOR, FLASH)
     c.wr32(NVIC_IPR, 0x80)           # IRQ 0 at 0x80
@@ -84,6 +86,24 @@ def test_primask_holds_every_interrupt(core):
     core.raise_irq(0)
     core.run(20e-6)
     assert reg(core, "IPSR") == 0 and FIRST_IRQ in core.pending
+
+
+def test_an_interrupt_primask_held_is_taken_right_after_cpsie(core):
+    """Awake, not after a WFI: the run ends at the CPSIE I, and the next
+    takes the interrupt before the instruction after it (B1.4.3), however
+    long the slice (a busy main loop's interrupt was taken a slice late)."""
+    core.set_reg(arm.UC_ARM_REG_PC, FLASH + 0x501)
+    core.run(1e-6)  # cpsid i
+    assert reg(core, "PRIMASK") == 1
+    core.raise_irq(0)
+    start = core.now_s()
+    core.run(1e-3)  # adds r6, cpsie i: no further
+    assert core.now_s() - start == pytest.approx(2e-6)
+    assert reg(core, "PRIMASK") == 0 and reg(core, "R0") == 0 and reg(core, "R6") == 1
+    core.run(10e-6)
+    assert reg(core, "IPSR") == FIRST_IRQ
+    frame = struct.unpack("<8I", core.uc.mem_read(reg(core, "SP"), 32))
+    assert frame[0] == 0 and frame[6] == FLASH + 0x506  # before the thread's next instruction
 
 
 def test_a_fault_that_cannot_be_stacked_locks_the_core_up(core):
