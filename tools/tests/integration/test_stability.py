@@ -75,7 +75,7 @@ def test_a_runaway_is_released_within_the_items_time_and_logged(sim):
 def test_a_normal_45_deg_move_never_trips_it_on_any_shipped_plant(tmp_path, plant):
     """The factory items (the reference's) on each plant, the 60 kg cm one
     overshooting 4-5 deg with them, and then the items tune gives it."""
-    sim = Simulator(fast=True, ids=[1], state_dir=str(tmp_path / "state"), plant=PLANTS / plant).start()
+    sim = Simulator(paced=True, ids=[1], state_dir=str(tmp_path / "state"), plant=PLANTS / plant).start()
     try:
         s = Servo(sim.bus(), 1)
         s.write("soft_start_on", 0)
