@@ -283,7 +283,13 @@ def test_a_shared_id_is_shown_and_one_servo_given_a_free_id_by_its_serial(browse
             page.locator("#view-bus", has_text="no servo alone at ID 1 within 1 s").wait_for(timeout=WAIT_MS)
             row.locator("input.serial").fill("0x51a00101")
             row.locator("input.new-id").fill("7")
-            page.wait_for_timeout(1500)  # servo 2's live table redraws: what was typed stays
+            # Servo 2's live table redraws (each second) while the user is at the row: the row
+            # stays in the page (taken out and put back, it lost its field's focus and a click
+            # whose press and release straddled a redraw), and what was typed stays.
+            page.eval_on_selector("#bus-table tr.shared", "(e) => { e.kept = 1; window.seen = UI.state.servos[2]; }")
+            page.wait_for_function("UI.state.servos[2] !== window.seen", timeout=WAIT_MS)
+            assert page.evaluate("document.querySelector('#bus-table tr.shared').kept === 1"
+                                 " && document.activeElement.classList.contains('new-id')")
             _shot(page, "shared")
             row.locator("button").click()
             page.locator("#bus-table tr[data-id='7'] td.state", has_text="answering").wait_for(timeout=WAIT_MS)

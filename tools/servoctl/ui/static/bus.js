@@ -5,42 +5,51 @@
   const {$, el, on, send, run, state, log} = UI;
   let found = [];   // servoctl scan --json
   let rows = {};    // id: servoctl info --json, or {gone, why}
-  let sharedCells = {};  // id: the serial cell of a shared ID
+  let shown = [];   // found[i]: its row's cells, made once a scan
 
   const hex = (n, w) => "0x" + Number(n).toString(16).padStart(w, "0");
 
-  function render() {
+  // The rows, made once a scan. The live table's redraws (each second) only
+  // change their text: a row taken out of the page and put back would lose
+  // the focus of a field the user types in, and a click whose press and
+  // release straddle it (the browser drops a click whose button left the
+  // page in between), so a shared ID's "assign" did nothing.
+  function build() {
     const body = $("#bus-table tbody");
     body.innerHTML = "";
-    for (const f of found) {
-      const info = f.shared ? undefined : rows[f.id];
-      const tr = el("tr", {"data-id": f.id});
-      if (f.shared) tr.className = "shared";
-      if (info && info.gone) tr.className = "gone";
-      // A shared ID's cell keeps what the user types in it across the live
-      // table's redraws: made once a scan.
-      let serials = f.shared ? sharedCells[f.id] : el("td");
-      if (f.shared && !serials) {
-        serials = sharedCells[f.id] = el("td");
+    shown = found.map((f) => {
+      const serials = el("td");
+      if (f.shared) {
         f.serials.forEach((s) => serials.append(assignControl(s)));
         if (!f.serials.length) {
           serials.append(el("div", {class: "note", text: "their answers collide, so no serial number came " +
             "through: type one (its label), or connect them one at a time and scan"}));
         }
         serials.append(assignControl(null));
-      } else if (!f.shared) {
+      } else {
         serials.textContent = f.serials.map((s) => hex(s, 8)).join(", ");
       }
-      const ok = info && !info.gone;
-      tr.append(el("td", {text: f.id}), serials,
-        el("td", {text: ok ? hex(info.model, 4) : ""}), el("td", {text: ok ? hex(info.firmware, 4) : ""}),
-        el("td", {text: ok ? info.voltage_v.toFixed(2) : ""}),
-        el("td", {text: ok && info.temperature_c !== null ? info.temperature_c.toFixed(1) : ""}),
-        el("td", {text: ok ? (info.status.join(", ") || "ok") : ""}),
-        el("td", {text: ok ? (info.limiter || "—") : ""}),
-        el("td", {class: "state", text: stateText(f, info)}));
+      const cells = [0, 1, 2, 3, 4, 5, 6].map(() => el("td"));
+      cells[6].className = "state";
+      const tr = el("tr", {"data-id": f.id}, el("td", {text: f.id}), serials, ...cells);
       body.append(tr);
-    }
+      return {tr, cells};
+    });
+    render();
+  }
+
+  function render() {
+    found.forEach((f, i) => {
+      const {tr, cells} = shown[i];
+      const info = f.shared ? undefined : rows[f.id];
+      const cls = f.shared ? "shared" : info && info.gone ? "gone" : "";
+      if (tr.className !== cls) tr.className = cls;
+      const ok = info && !info.gone;
+      [ok ? hex(info.model, 4) : "", ok ? hex(info.firmware, 4) : "", ok ? info.voltage_v.toFixed(2) : "",
+        ok && info.temperature_c !== null ? info.temperature_c.toFixed(1) : "",
+        ok ? (info.status.join(", ") || "ok") : "", ok ? (info.limiter || "—") : "", stateText(f, info),
+      ].forEach((text, c) => { if (cells[c].textContent !== text) cells[c].textContent = text; });
+    });
   }
 
   function stateText(f, info) {
@@ -79,13 +88,12 @@
   on("scan", (m) => {
     found = m.found;
     rows = {};
-    sharedCells = {};
     const n = found.length;
     const lines = (m.err || "").split("\n").filter((l) => l);
     $("#scan-line").textContent = n ? `${n} ID(s) answered` + (lines.length ? `; ${lines.join("; ")}` : "")
       : "no servo answered" + (lines.length ? `: ${lines.join("; ")}` : "");
     UI.setServos(found.filter((f) => f.mode === "application" && !f.shared).map((f) => f.id));
-    render();
+    build();
   });
 
   on("table", (m) => {
