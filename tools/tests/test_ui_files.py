@@ -23,7 +23,7 @@ def _confined(folder, *argv):
 
 def test_the_page_names_files_in_its_folder_only(tmp_path):
     """Anyone with the token read and wrote any file the server's user
-    could (config save/load/diff, backup, restore, update): issue 59's attacker."""
+    could (config save/load/diff, backup, restore, update)."""
     root, outside = tmp_path / "bench", tmp_path / "secret"
     root.mkdir()
     outside.mkdir()

@@ -99,7 +99,7 @@ def test_a_users_program_builds_as_documented(sim3, tmp_path):
 
 
 def test_a_silent_servo_costs_the_c_loop_a_slot_not_a_time_out(sim3):
-    """Issue 60's attacker: an unplugged servo held every cycle of the C
+    """An unplugged servo held every cycle of the C
     loop ~60 ms (a fixed 50 ms + 4 ms a servo). Now its answer is waited
     for as long as the wire takes (its bytes, the servos' turnaround, the
     margin, and a middle servo's 3 ms silence before the next takes its

@@ -48,7 +48,7 @@ def test_the_bus_thread_outlives_a_lost_link_and_a_bad_plot_request():
 
 
 def test_the_page_names_files_in_its_folder_only(tmp_path):
-    """Issue 59's attacker: with the token, config save/load, backup and
+    """With the token, config save/load, backup and
     restore read and wrote any file the server's user could. Now only
     files in the ui's folder (--files DIR); the refusal says so."""
     (tmp_path / "bench").mkdir()
