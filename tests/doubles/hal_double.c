@@ -82,18 +82,7 @@ void hal_double_init(struct hal_double *h)
     h->sensors = (struct sensor_raw){.supply = 7400, .current = 0, .ntc = 2048};
     h->calibration = (struct sensor_calibration){.supply_mv_q12 = SENSOR_Q12_FROM_MICRO(1000u),
                                                  .current_ma_q12 = SENSOR_Q12_FROM_MICRO(1000u)};
-    h->port = (struct hal_port){
-        .ctx = h,
-        .bus = {.now_us = now_us, .send = uart_send, .tx_done = uart_tx_done,
-                .set_baud = uart_set_baud},
-        .rx = &h->rx,
-        .motor = {.drive = motor_drive, .coast = motor_coast, .read_encoder = encoder_read,
-                  .read_sensors = sensors_read},
-        .calibration = &h->calibration,
-        .flash = &h->flash.hal,
-        .fault_flash = &h->fault_flash.hal,
-        .serial_number = serial_number,
-    };
+    h->port = (struct hal_port){HAL_PORT_HOST_FIELDS(h), .calibration = &h->calibration};
 }
 
 void hal_double_clear_sent(struct hal_double *h)

@@ -260,16 +260,8 @@ bool sim_servo_start(struct sim_servo *s, struct sim_bus *bus, unsigned index, u
     s->plant.p.supply_v = supply_v;
     s->stepped_us = bus->now_us;
     s->port = (struct hal_port){
-        .ctx = s,
-        .bus = {.now_us = now_us, .send = uart_send, .tx_done = uart_tx_done,
-                .set_baud = uart_set_baud},
-        .rx = &s->rx,
-        .motor = {.drive = motor_drive, .coast = motor_coast, .read_encoder = encoder_read,
-                  .read_sensors = sensors_read},
+        HAL_PORT_HOST_FIELDS(s),
         .calibration = &calibration,
-        .flash = &s->flash.hal,
-        .fault_flash = &s->fault_flash.hal,
-        .serial_number = serial_number,
         .image_version = image_version,
         .enter_bootloader = enter_bootloader,
         .board = SIM_BOARD,

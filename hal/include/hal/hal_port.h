@@ -83,6 +83,17 @@ struct hal_port {
     uint8_t tick_and_pass_us;
 };
 
+/* The fields of a host port (servo_sim's servo, the unit tests' double)
+ * whose owner has rx, flash and fault_flash members and whose operations
+ * have the names below; the calibration and what is optional are its own. */
+#define HAL_PORT_HOST_FIELDS(owner)                                                     \
+    .ctx = (owner), .rx = &(owner)->rx, .flash = &(owner)->flash.hal,                   \
+    .fault_flash = &(owner)->fault_flash.hal, .serial_number = serial_number,           \
+    .bus = {.now_us = now_us, .send = uart_send, .tx_done = uart_tx_done,               \
+            .set_baud = uart_set_baud},                                                 \
+    .motor = {.drive = motor_drive, .coast = motor_coast, .read_encoder = encoder_read, \
+              .read_sensors = sensors_read}
+
 /* Brings the receive ring up to date (a port whose DMA fills it). */
 static inline void hal_rx_sync(const struct hal_port *h, uint32_t now_us)
 {

@@ -4,10 +4,6 @@ winding's estimate against the simulator's true winding, a hot duty cycle
 that derating lets finish, the fault history across a power cycle, a
 DriveDuty whose host falls silent, and ClearFaults on a full page while the
 output is driven. Every time here is the simulator's."""
-import struct
-import zlib
-
-import pytest
 
 from servoctl import group
 from servoctl.errors import Refused
@@ -15,6 +11,8 @@ from servoctl.cli import main
 from servoctl.servo import MotionSnapshot, Servo
 
 from tests.integration.conftest import _start, finish
+from tests.store_pages import (a_clear_is_refused_on_a_full_page, fault_record,
+                               released_a_clear_is_taken)
 
 OVER_TEMPERATURE = 128
 
@@ -162,19 +160,12 @@ def test_the_watchdog_stops_a_duty_when_the_host_falls_silent(sim, servo):
 SLOTS = 32  # a page's records: 1024-byte pages (servo_sim) of 32-byte records
 
 
-def _record(number: int, what: int) -> bytes:
-    """A fault record as storage/fault_log.c writes it."""
-    entry = struct.pack("<IIiHHHhhB", number, number, 0, 7400, 0, 0, 250, 250, what)
-    head = struct.pack("<HBB", 0xFA17, 1, 0xFF) + entry + b"\xff"
-    return head + struct.pack("<I", zlib.crc32(head))
-
-
 def _history_with_one_slot_left() -> bytes:
     """Page 1 full of faults 1-32 (the 15 older of the 16 shown); page 0 in
     use with its slots but the last spent (failed programs) and fault 40 in
     slot 30. The spare still shows faults, so no erase is due at power-up."""
-    page0 = bytes(30 * 32) + _record(40, 6) + b"\xff" * 32
-    page1 = b"".join(_record(n, 2) for n in range(1, SLOTS + 1))
+    page0 = bytes(30 * 32) + fault_record(40, 6) + b"\xff" * 32
+    page1 = b"".join(fault_record(n, 2) for n in range(1, SLOTS + 1))
     return page0 + page1
 
 
@@ -188,27 +179,10 @@ def test_a_clear_on_a_full_page_while_driven_is_refused_then_taken(tmp_path, cap
     sim = _start(tmp_path, [1])
     try:
         with sim.bus(timeout=0.2) as bus:
-            servo = Servo(bus, 1)
-            assert servo.read_fault(0).count == 16
-            servo.write("soft_start_on", 0)
-            servo.write("watchdog_action", 0)  # hold: driven all along
-            servo.write("watchdog_ms", 50)
-            servo.move(angle_decideg=300, interval_ms=100)
-            sim.sleep(0.3)  # the watchdog holds; its fault fills the page
-            assert servo.read_fault(0).kind == "watchdog"
-            with pytest.raises(Refused):
-                servo.clear_faults()
+            a_clear_is_refused_on_a_full_page(Servo(bus, 1), sim)
         assert main(["--port", sim.url, "faults", "1", "--clear"], clock=sim.clock_s) == Refused.exit_code
         assert "page is full while the output is driven" in capsys.readouterr().err
         with sim.bus(timeout=0.2) as bus:
-            servo = Servo(bus, 1)
-            assert servo.read_fault(0).count == 16  # nothing cleared
-            servo.stop("release")
-            sim.sleep(0.5)  # released and quiet: the spare page is erased
-            servo.clear_faults()
-            sim.sleep(0.1)
-            sim.control("powercycle")
-            sim.sleep(0.5)
-            assert servo.faults() == []
+            released_a_clear_is_taken(Servo(bus, 1), sim, "powercycle")
     finally:
         finish(sim, [1])

@@ -4,13 +4,14 @@ silently and sends no answer late (docs/decisions.md, "The config store").
 
 The simulator stalls a servo's CPU for each flash operation at DS5319's
 longest times (40 ms a page erase, 70 us a half-word)."""
-import struct
 
 import pytest
 
 from servoctl import protocol as p
 from servoctl.servo import Refused, Servo
 from servoctl.sim import Simulator
+
+from tests.store_pages import bus_to_baud, sync_move_frame, without_soft_start
 
 
 SLOTS = 21  # records in a 1 KB page (48 bytes each)
@@ -92,16 +93,6 @@ def send_at(sim, at_s, frame):
         assert sim.control(f"hostsend {at_s * 1000.0:.3f} {frame[k:k + 100].hex()}").startswith("ok")
 
 
-def sync_move_frame(angle_decideg):
-    """A SyncCommand of 64 interval moves (packet 11, 11-byte records), IDs
-    1..64: 707 bytes, longer than the 256-byte ring servos once had."""
-    records = b"".join(struct.pack("<BhHHHH", i, angle_decideg, 300, 50, 50, 0) for i in range(1, 65))
-    return p.request_frame(p.SYNC, bytes([p.ANGLE_BY_INTERVAL, 11, 64]) + records)
-
-
-BAUD_INDEX = {115200: 5, 1000000: 8}
-
-
 @pytest.mark.parametrize("baud", [115200, 1000000])
 def test_sync_commands_sent_into_an_erase_are_carried_out(tmp_path, baud):
     """Both servos have a dirty spare page. Servo 2 holds its position, so
@@ -115,14 +106,9 @@ def test_sync_commands_sent_into_an_erase_are_carried_out(tmp_path, baud):
     carries them out, and loses nothing."""
     sim = Simulator(fast=True, ids=[1, 2], state_dir=str(tmp_path / "state")).start()
     try:
-        with sim.bus(timeout=0.2) as bus:
-            for i in (1, 2):
-                Servo(bus, i).write("baud", BAUD_INDEX[baud])  # answered at 115200
-        sim.control(f"hostbaud {baud}")
+        bus_to_baud(sim, (1, 2), baud, timeout=0.2)
         with sim.bus(baud=baud, timeout=0.2) as bus:
-            one, two = Servo(bus, 1), Servo(bus, 2)
-            for s in (one, two):
-                s.write("soft_start_on", 0)
+            one, two = without_soft_start(bus, (1, 2))
             fill_until_the_spare_page_is_dirty(two, sim)
             two.move(0, interval_ms=100)
             two.hold()

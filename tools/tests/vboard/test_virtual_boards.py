@@ -5,7 +5,6 @@ the maker's SDK exactly as the simulator is. Time is the boards' simulated
 time (sim.sleep, sim.wait_until), which runs ahead while a test waits on it
 (Simulator(fast=True)) but for the maker's SDK's."""
 import struct
-import zlib
 
 import pytest
 import serial
@@ -15,7 +14,7 @@ from servoctl import group
 from servoctl import image as img
 from servoctl import protocol as p
 from servoctl import update as upd
-from servoctl.errors import Refused, ServoError
+from servoctl.errors import ServoError
 from servoctl.registers import ITEMS
 from servoctl.servo import Servo
 from servoctl.sim import Simulator
@@ -23,6 +22,8 @@ from vboard.board import board_h, images
 
 from ..launchers import PLANTS
 from ..scheduled import followed
+from ..store_pages import (a_clear_is_refused_on_a_full_page, bus_to_baud, fault_record,
+                          released_a_clear_is_taken, sync_move_frame, without_soft_start)
 
 BOARDS = ["stm32f103", "stm32f030k6"]
 
@@ -208,13 +209,6 @@ def test_the_watchdog_stops_a_duty_when_the_host_falls_silent(one):
     assert servo.read_fault(0).kind == "watchdog"
 
 
-def _fault_record(number: int, what: int) -> bytes:
-    """A fault record as storage/fault_log.c writes it."""
-    entry = struct.pack("<IIiHHHhhB", number, number, 0, 7400, 0, 0, 250, 250, what)
-    head = struct.pack("<HBB", 0xFA17, 1, 0xFF) + entry + b"\xff"
-    return head + struct.pack("<I", zlib.crc32(head))
-
-
 def test_a_clear_on_a_full_page_while_driven_is_refused_then_taken(tmp_path, board):
     """The image's fault pages with one slot left and the spare still
     showing faults (written into the board's flash file between runs): a
@@ -224,8 +218,8 @@ def test_a_clear_on_a_full_page_while_driven_is_refused_then_taken(tmp_path, boa
     finish(sim, [1])
     h = board_h(board)
     slots = h["BOARD_FLASH_PAGE"] // 32
-    page0 = bytes(30 * 32) + _fault_record(40, 6) + b"\xff" * (h["BOARD_FLASH_PAGE"] - 31 * 32)
-    page1 = b"".join(_fault_record(n, 2) for n in range(1, slots + 1))
+    page0 = bytes(30 * 32) + fault_record(40, 6) + b"\xff" * (h["BOARD_FLASH_PAGE"] - 31 * 32)
+    page1 = b"".join(fault_record(n, 2) for n in range(1, slots + 1))
     with open(tmp_path / "state" / f"{board}-1.flash", "r+b") as f:
         f.seek(h["BOARD_FAULT_PAGE0"] - h["BOARD_FLASH_BASE"])
         f.write(page0 + page1)
@@ -233,26 +227,11 @@ def test_a_clear_on_a_full_page_while_driven_is_refused_then_taken(tmp_path, boa
     try:
         with sim.bus(timeout=0.3) as bus:
             servo = Servo(bus, 1)
-            assert servo.read_fault(0).count == 16
             # A request that comes during a page erase (the spare fault page's
             # once it shows nothing, the config store's) is carried out but
             # not answered (docs/decisions-hardware.md): servoctl reads it back.
-            servo.write("soft_start_on", 0)
-            servo.write("watchdog_action", 0)  # hold: driven all along
-            servo.write("watchdog_ms", 50)
-            servo.move(300, interval_ms=100)
-            sim.sleep(0.3)  # the watchdog holds; its fault fills the page
-            assert servo.read_fault(0).kind == "watchdog"
-            with pytest.raises(Refused):
-                servo.clear_faults()
-            assert servo.read_fault(0).count == 16
-            servo.stop("release")
-            sim.sleep(0.5)  # released and quiet: the spare page is erased
-            servo.clear_faults()  # one unanswered is read back (ReadFaults)
-            sim.sleep(0.1)
-            sim.control("powercycle 1")
-            sim.sleep(0.5)  # the bootloader's window, then the application
-            assert servo.faults() == []
+            a_clear_is_refused_on_a_full_page(servo, sim)
+            released_a_clear_is_taken(servo, sim, "powercycle 1")
     finally:
         finish(sim, [1])
 
@@ -390,7 +369,6 @@ def test_the_watchdog_resets_a_firmware_stuck_in_a_loop(tmp_path, board):
 
 
 SLOTS = 21  # config records in a 1 KB page, on both boards
-BAUD_INDEX = {115200: 5, 1000000: 8}
 
 
 def fill_until_the_spare_page_is_dirty(servo):
@@ -403,12 +381,6 @@ def fill_until_the_spare_page_is_dirty(servo):
         records = servo.read_store().records
         if records % SLOTS == 1 and records > 1:
             return
-
-
-def sync_move_frame(angle_decideg):
-    """A SyncCommand of 64 interval moves, IDs 1..64: 707 bytes."""
-    records = b"".join(struct.pack("<BhHHHH", i, angle_decideg, 300, 50, 50, 0) for i in range(1, 65))
-    return p.request_frame(p.SYNC, bytes([p.ANGLE_BY_INTERVAL, 11, 64]) + records)
 
 
 @pytest.mark.parametrize("baud", [115200, 1000000])
@@ -430,15 +402,9 @@ def test_sync_commands_sent_into_an_erase(tmp_path, board, baud):
     covered = board == "stm32f103" or baud <= 115200
     sim = start(tmp_path, board, ids=(1, 2))
     try:
-        with sim.bus(timeout=0.3) as bus:
-            for i in (1, 2):
-                Servo(bus, i).write("baud", BAUD_INDEX[baud])  # answered at 115200
-        sim.control(f"hostbaud {baud}")
+        bus_to_baud(sim, (1, 2), baud, timeout=0.3)
         with sim.bus(baud=baud, timeout=0.3) as bus:
-            one, two = Servo(bus, 1), Servo(bus, 2)
-            for s in (one, two):
-                s.write("soft_start_on", 0)
-                s.hold()  # a held servo never erases
+            one, two = without_soft_start(bus, (1, 2), hold=True)
             fill_until_the_spare_page_is_dirty(two)
             two.move(0, interval_ms=100)
             fill_until_the_spare_page_is_dirty(one)

@@ -3,6 +3,7 @@ the bus, the joints' default layout, the errors LeRobot is given and the
 calibration, on servoctl's Arm (servoctl/arm.py; docs/lerobot.md)."""
 import contextlib
 import logging
+from dataclasses import dataclass, field
 
 from lerobot.motors import MotorCalibration
 from lerobot.utils.errors import DeviceNotConnectedError
@@ -21,6 +22,23 @@ DEFAULT_JOINTS = {**{f"Motor_{k}": k for k in range(6)}, "gripper": 6}
 
 def default_joints() -> dict:
     return dict(DEFAULT_JOINTS)
+
+
+@dataclass
+class ArmBusConfig:
+    """The settings of servoctl_arm's and servoctl_leader's bus and joints
+    (each plugin's config adds its own; docs/lerobot.md)."""
+    # A serial port (/dev/ttyUSB0) or a pyserial URL (socket://127.0.0.1:5000, a simulator).
+    port: str
+    baud: int = 1_000_000
+    # Joint name -> servo ID; the maker's 7-joint layout, the last the gripper. A leader's
+    # are the follower's names, so its actions fit the follower.
+    joints: dict[str, int] = field(default_factory=default_joints)
+    # "auto" (asks the servos), "servoctl" (this firmware) or "maker" (the maker's packets only).
+    firmware: str = "auto"
+    # A simulator's control port (servoctl sim prints it): the baud rate of a socket://
+    # link is set there and the bus waits on the simulated clock.
+    sim_control: str | None = None
 
 
 class JointNotAnsweringError(DeviceNotConnectedError):
@@ -131,7 +149,8 @@ class OnArm:
     """What servoctl_arm and servoctl_leader do alike: their state, their
     calibration, and the host's share of it (Calibrated)."""
 
-    def _on_arm(self, config) -> None:
+    def __init__(self, config):
+        super().__init__(config)  # LeRobot's Robot or Teleoperator
         self.config = config
         self.arm = None
         # The bus's clock: None is the simulator's (sim_control) or the host's.

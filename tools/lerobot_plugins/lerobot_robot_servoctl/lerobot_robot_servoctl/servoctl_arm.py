@@ -30,8 +30,7 @@ class ServoctlArm(j.OnArm, Robot):
     name = "servoctl_arm"
 
     def __init__(self, config: ServoctlArmConfig):
-        super().__init__(config)
-        self._on_arm(config)
+        super().__init__(config)  # j.OnArm's, then Robot's
         from lerobot.cameras.utils import make_cameras_from_configs
 
         self.cameras = make_cameras_from_configs(config.cameras)

@@ -23,10 +23,6 @@ class ServoctlLeader(j.OnArm, Teleoperator):
     config_class = ServoctlLeaderConfig
     name = "servoctl_leader"
 
-    def __init__(self, config: ServoctlLeaderConfig):
-        super().__init__(config)
-        self._on_arm(config)
-
     @property
     def action_features(self) -> dict:
         return {f"{n}.pos": float for n in self.config.joints}
