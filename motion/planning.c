@@ -240,19 +240,14 @@ void motion_run(struct motion *m, const struct motion_command *cmd)
     m->answer_packet = cmd->answer_when_done ? cmd->packet : 0u;
     m->power_mw = cmd->power_mw;
     motion_update_limits(m);
-    switch (cmd->kind) {
-    case MOTION_ANGLE:
+    if (cmd->kind == MOTION_ANGLE) {
         run_angle(m, cmd);
-        break;
-    case MOTION_WHEEL:
+    } else if (cmd->kind == MOTION_WHEEL) {
         run_wheel(m, cmd);
-        break;
-    case MOTION_DAMPING:
+    } else if (cmd->kind == MOTION_DAMPING) {
         m->mode = MODE_DAMPING;
         m->running = 0;
-        break;
-    default:
+    } else {
         run_stop(m, cmd);
-        break;
     }
 }
