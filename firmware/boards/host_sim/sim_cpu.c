@@ -12,8 +12,8 @@
  * beyond an answer's is not modelled. tick_and_pass_us: the boards'
  * BOARD_TICK_AND_PASS_US (stm32f103/board.h, stm32f030k6/board.h). */
 static const struct sim_cpu cpus[] = {
-    {.name = "m3", .pass_ns = 252 * 1000 / 72 + 1, .tick_ns = 989 * 1000 / 72 + 1,
-     .answer_ns = 1153 * 1000 / 72 + 1, .sync_answer_ns = 722 * 1000 / 72 + 1, .tick_and_pass_us = 18},
+    {.name = "m3", .pass_ns = 261 * 1000 / 72 + 1, .tick_ns = 989 * 1000 / 72 + 1,
+     .answer_ns = 1153 * 1000 / 72 + 1, .sync_answer_ns = 721 * 1000 / 72 + 1, .tick_and_pass_us = 18},
     {.name = "m0", .pass_ns = 284 * 1000 / 48 + 1, .tick_ns = 1881 * 1000 / 48 + 1,
      .answer_ns = 1439 * 1000 / 48 + 1, .sync_answer_ns = 287 * 1000 / 48 + 1, .sends_ahead = true,
      .tick_and_pass_us = 47},

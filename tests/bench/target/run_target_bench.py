@@ -323,13 +323,14 @@ def figures(cpu: str, profile_region: str = "", by_line: bool = False) -> dict:
     # it go (up to the UART's start), behind the main loop's round that may
     # have just missed that byte (awake_loop: a pass and servo_may_sleep,
     # the line in use; the worst). The first answer leaves in the pass that
-    # frames the checksum byte wherever the record lies: listed first of
-    # two (first_answer_of_two) as of six. On the M0 the rest of that
-    # answer is built behind its first bytes (sync_first_build).
-    first = after_a_missed_read(proto, proto["sync_first_pass"])
+    # frames the checksum byte wherever the record lies; listed first of
+    # two (first_answer_of_two) that pass may frame the other record too.
+    # On the M0 the rest of that answer is built behind its first bytes
+    # (sync_first_build, the longer of the two rounds').
     out.update({"awake_loop": proto["awake_loop"], "pass_to_ring": proto["pass_to_ring"],
-                "first_answer": first, "first_answer_of_two": first,
-                "sync_first_build": proto["sync_first_build"],
+                "first_answer": after_a_missed_read(proto, proto["sync_first_pass"]),
+                "first_answer_of_two": after_a_missed_read(proto, proto["sync_first_pass_of_two"]),
+                "sync_first_build": max(proto["sync_first_build"], proto["sync_first_build_of_two"]),
                 "next_answer": after_a_missed_read(proto, proto["sync_next_pass"])})
     out.update({k: v for k, v in proto.items() if k.startswith(("answer_", "request_"))})
     out.update(plans)
