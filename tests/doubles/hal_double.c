@@ -13,6 +13,7 @@ static void uart_send(void *ctx, const uint8_t *data, uint16_t len)
     h->sending = data;
     h->sending_at = h->sent_length;
     h->sending_length = len;
+    memcpy(h->head_at_send, data, len < sizeof h->head_at_send ? len : sizeof h->head_at_send);
     for (uint16_t i = 0; i < len && h->sent_length < HAL_DOUBLE_SENT_MAX; i++) {
         h->sent[h->sent_length++] = data[i];
     }

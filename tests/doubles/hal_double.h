@@ -27,6 +27,7 @@ struct hal_double {
     const uint8_t *sending;
     size_t sending_at;
     uint16_t sending_length;
+    uint8_t head_at_send[5]; /* its first bytes as they were at the send */
     bool tx_busy;         /* bus.tx_done answers !tx_busy */
     uint32_t baud;        /* last bus.set_baud */
     unsigned baud_changes;

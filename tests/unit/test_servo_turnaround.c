@@ -69,6 +69,8 @@ static void test_the_first_answer_leaves_with_the_checksum(void **state)
     assert_int_equal(sent[3], 16);
     assert_int_equal(sent[4], 0); /* this servo's ID */
     assert_int_equal(sent[5] | sent[6] << 8, servo.regs.status.voltage_mv);
+    /* Header and ID were in place when the UART took the frame. */
+    assert_memory_equal(hal.head_at_send, sent, sizeof hal.head_at_send);
     uint8_t sum = 0;
     for (size_t i = 0; i + 1u < hal.sent_length; i++) {
         sum = (uint8_t)(sum + sent[i]);
