@@ -45,7 +45,6 @@ static void dispatch_packet(const struct packet_desc *desc, struct packet_call *
     call->code = desc->code;
     call->answer_when_done = alone && d->regs->user.control_response;
     response->code = desc->code;
-    response->length = 0;
     /* Every answer starts with the ID its request carried (content points
      * into a frame or a sync record, never at less than one byte). */
     response->content[0] = call->content[0];
@@ -128,6 +127,12 @@ void dispatch(struct dispatcher *d, const struct rx_frame *frame, struct respons
         call.content = &frame->content[3];
         call.length = frame->content[1];
         origin.from_sync = true;
+    } else {
+        /* An answer's length unless its handler sets one. A sync record
+         * answers only with Monitor's, whose handler does: its header may
+         * be on its way out already (servo.c, send_ahead), and no byte
+         * there changes while it goes. */
+        response->length = 0;
     }
     dispatch_packet(desc, &call, response, origin);
 }

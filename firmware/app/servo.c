@@ -7,6 +7,7 @@
 #include "app/identity.h"
 #include "app/servo_jobs.h"
 #include "app/servo_safety.h"
+#include "protocol/wire.h"
 #include "registers/data_table.h"
 
 static uint32_t idle_timeout_us(const struct servo *s, uint32_t baud)
@@ -79,35 +80,39 @@ static void show_executing(struct servo *s)
         motion_is_executing(&s->motion) ? (uint8_t)(status | STATUS_EXECUTING) : status;
 }
 
-/* A Sync Monitor that lists this servo, under way with this servo's record
- * in: it is dispatched now, while the rest of it arrives, and its answer
- * leaves once the checksum byte has landed and matched (handle_next_frame).
- * Monitor records change nothing but the count of requests heard, so one
- * whose checksum then fails has done no harm. prepared_requests is the
- * framer's count of requests once this one has ended, whole or not
- * (frame_rx_line_idle counts a cut one): the answer is this request's if
- * the frame handled next ended at that count. The Cortex-M0 needs it for
- * two byte times; the M3 answers within them from the checksum byte on,
- * and its receive path has no instruction to spare for it. */
+/* A Sync Monitor that lists this servo first: its answer is certain (the
+ * dispatcher answers every such record: a Monitor record of one byte in a
+ * consistent SyncCommand), so the pass that frames the checksum byte
+ * writes its header and ID and hands the frame to the UART first, then
+ * builds the rest behind the bytes going out. The DMA takes the content's
+ * second byte four byte times after the start; the build takes less than
+ * three on the Cortex-M0 (docs/sleep.md, "The first answer"), and every
+ * byte it writes at the front is the value already there (dispatch.c
+ * leaves a sync record's answer length to its handler). The M3 answers
+ * within two byte times built first, and leaves it out. */
 #if !defined(__arm__) || defined(__ARM_ARCH_6M__)
-#define SERVO_PREPARES_ANSWERS 1
-static __attribute__((noinline)) void prepare_answer(struct servo *s)
+#define SERVO_SENDS_AHEAD 1
+enum { MONITOR_ANSWER_LENGTH = 16 };
+static __attribute__((noinline)) bool send_ahead(struct servo *s, const struct rx_frame *f,
+                                                 uint32_t now)
 {
-    struct frame_rx *rx = &s->rx;
-    const struct rx_frame *f = frame_rx_under_way(rx);
-    uint32_t ended = rx->stats.requests_seen + 1u;
-    /* This servo's record begun: the header before it is this frame's. */
-    if (s->prepared_requests != ended && f->code == PKT_SYNC_COMMAND &&
-        f->sync_index != FRAME_SYNC_NO_RECORD && f->content[0] == PKT_MONITOR &&
-        f->content[1] == 1u) {
-        dispatch(&s->dispatcher, f, &s->tx.frame, &s->prepared);
-        if (s->prepared.answer) {
-            s->prepared_requests = ended; /* the answer sealed: ready to go */
-        }
+    /* Called for a record index 0: a SyncCommand's, its header consistent
+     * (the framer looks for records only then). */
+    if (f->content[0] != PKT_MONITOR || f->content[1] != 1u) {
+        return false;
     }
+    struct response *r = &s->tx.frame;
+    r->words[0] = WIRE_RESPONSE_HDR0 | (uint32_t)WIRE_RESPONSE_HDR1 << 8 |
+                  (uint32_t)PKT_MONITOR << 16 | (uint32_t)MONITOR_ANSWER_LENGTH << 24;
+    r->content[0] = f->content[3]; /* the record: this servo's ID */
+    servo_queue_response(s, 0, f->responses_seen, now);
+    dispatch(&s->dispatcher, f, r, &s->dispatched);
+    s->dispatched.answer = 0; /* on its way already */
+    return true;
 }
 #else
-#define SERVO_PREPARES_ANSWERS 0
+#define SERVO_SENDS_AHEAD 0
+#define send_ahead(s, f, now) false
 #endif
 
 /* late: the request arrived while a page erase stalled the CPU (after_erase).
@@ -116,8 +121,8 @@ static __attribute__((noinline)) void prepare_answer(struct servo *s)
 static SERVO_ONE_COPY void handle_next_frame(struct servo *s, uint32_t now, bool late)
 {
     const struct rx_frame *frame = &s->rx.slots[s->rx.tail]; /* the callers know there is one */
-    struct dispatch_result *result = &s->prepared;
-    if (!SERVO_PREPARES_ANSWERS || s->rx.stats.requests_seen != s->prepared_requests) {
+    struct dispatch_result *result = &s->dispatched;
+    if (!SERVO_SENDS_AHEAD || frame->sync_index != 0u || late || !send_ahead(s, frame, now)) {
         dispatch(&s->dispatcher, frame, &s->tx.frame, result);
     }
     uint32_t responses_base = frame->responses_seen;
@@ -320,11 +325,6 @@ void servo_poll(struct servo *s)
     if (frame_rx_peek(&s->rx) != NULL) {
         handle_next_frame(s, now, false);
     }
-#if SERVO_PREPARES_ANSWERS
-    else if (frame_rx_kept_ends_within(&s->rx, UINT32_MAX)) {
-        prepare_answer(s);
-    }
-#endif
     if (!s->tx.sending && !s->tx.waiting) {
         servo_answer_finished_move(s, now);
     }

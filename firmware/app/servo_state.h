@@ -76,7 +76,7 @@ struct servo {
     uint32_t next_tick_us;       /* the control tick's schedule */
     uint32_t tick_due_us;        /* when it runs: later while a Sync Monitor turn is near */
     uint32_t rx_idle_us;         /* line idle this long drops a partial frame */
-    struct dispatch_result prepared; /* the request under way's, its answer in tx.frame */
+    struct dispatch_result dispatched; /* the last frame's (servo.c, handle_next_frame) */
     volatile uint8_t active_id;  /* the ID answered to now */
     uint8_t active_baud_index;
     uint8_t link_settings_pending; /* the user area changed: ID or baud may have */
@@ -89,7 +89,6 @@ struct servo {
     uint8_t guard_seen;          /* protection.act_changes the motion has */
     uint16_t heat_cap_mw;        /* the derating's power cap; 0 = none */
     uint32_t erase_from;         /* the ring's written count as the erase began */
-    uint32_t prepared_requests;  /* rx.stats.requests_seen once its request has ended */
     uint32_t polled_us;          /* the last pass's clock reading */
     uint32_t ticks_dropped;      /* control ticks skipped by a late main loop */
     uint32_t sync_turns_abandoned; /* Sync Monitor answers dropped for a new request */

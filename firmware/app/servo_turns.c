@@ -41,15 +41,15 @@ SERVO_JOB void servo_wait_for_turn(struct servo *s, uint32_t now)
 /* s->tx.frame holds the response, sealed. */
 SERVO_JOB void servo_queue_response(struct servo *s, uint8_t wait, uint32_t responses_base, uint32_t now)
 {
+    if (wait == 0u) {
+        start_send(s); /* the turn's bookkeeping is for a wait only */
+        return;
+    }
     s->tx.turns_left = wait;
     s->tx.responses_base = responses_base;
     s->tx.requests_base = s->rx.stats.requests_seen;
     s->tx.silence_from_us = now;
-    if (wait == 0u) {
-        start_send(s);
-    } else {
-        s->tx.waiting = 1;
-    }
+    s->tx.waiting = 1;
 }
 
 /* Nobody asked for a "move finished" answer just now, so nobody has left

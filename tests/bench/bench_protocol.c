@@ -128,10 +128,20 @@ static uint32_t port_now_us(void *ctx)
     return hal.now_us;
 }
 
+/* Set: the region under way ends once the answer is handed to the UART
+ * (named split_name), and the rest of the pass's begins. */
+static bool split_at_send;
+static const char *split_name;
+
 static void port_uart_send(void *ctx, const uint8_t *data, uint16_t len)
 {
     (void)ctx;
     usart_hd_send_dma(&usart, data, len);
+    if (split_at_send) {
+        split_at_send = false;
+        bench_end(split_name);
+        bench_begin();
+    }
 }
 
 static bool port_uart_tx_done(void *ctx)
@@ -395,32 +405,34 @@ static void rx_sync_marked(void *rx_dma, uint32_t now_us)
 
 /* A Sync Monitor round of six servos, as a robot loop's host sends it
  * (docs/sleep.md, "The first answer"): the main loop, awake while the
- * line is in use, frames the request as its bytes land. Listed first, this servo builds its
- * answer in the pass that frames its record (sync_prepare) and sends it in
- * the pass that frames the checksum byte (sync_first_pass); listed second,
+ * line is in use, frames the request as its bytes land. Listed first, this servo sends its
+ * answer in the pass that frames the checksum byte (sync_first_pass, up to
+ * the UART's start; on the M0 the rest of the answer is built behind its
+ * first bytes, sync_first_build: the rest of the pass); listed second,
  * it sends in the pass that frames the first one's answer's last byte
- * (sync_next_pass). run_target_bench.py adds the idle pass that may have
+ * (sync_next_pass); listed first of two, the pass that frames the other
+ * record and the checksum (sync_first_pass_of_two). run_target_bench.py
+ * adds the idle pass that may have
  * just missed the byte, and judges the sum against 2 byte times. */
 static void sync_monitor_round(void)
 {
     uint8_t frame[80];
     size_t n = make_request(frame, 25, (const uint8_t[]){22, 1, 6, OWN_ID, 9, 10, 11, 12, 13}, 9);
     servo.next_tick_us = servo.tick_due_us = hal.now_us + 0x7FFFFFFFu; /* no control tick inside */
-    printf("sync_bytes_after_record %u\n", 6u); /* five records and the checksum */
     dma_writes(frame, n - 7u);
     cpu_runs();
     dma_writes(&frame[n - 7u], 1); /* this servo's record */
-    bench_begin();
     servo_poll(&servo);
-    bench_end("sync_prepare");
     for (size_t i = n - 6u; i < n - 1u; i++) {
         dma_writes(&frame[i], 1);
         cpu_runs();
     }
     dma_writes(&frame[n - 1u], 1); /* the checksum */
+    split_name = "sync_first_pass";
+    split_at_send = true;
     bench_begin();
     servo_poll(&servo);
-    bench_end("sync_first_pass");
+    bench_end("sync_first_build");
     bool first = usart.tx_busy != 0u;
     transmission_ends();
     servo_poll(&servo);
@@ -452,6 +464,20 @@ static void sync_monitor_round(void)
     bench_begin();
     servo_poll(&servo);
     hal.port.bus.rx_sync = dma_rx_sync;
+    /* Listed first of two: the pass after the record's may find the other
+     * record and the checksum landed (the worst), frame both and send. */
+    n = make_request(frame, 25, (const uint8_t[]){22, 1, 2, OWN_ID, 9}, 5);
+    dma_writes(frame, n - 2u);
+    cpu_runs();
+    dma_writes(&frame[n - 2u], 2);
+    split_name = "sync_first_pass_of_two";
+    split_at_send = true;
+    bench_begin();
+    servo_poll(&servo);
+    bench_end("sync_first_build_of_two");
+    first = first && usart.tx_busy != 0u;
+    transmission_ends();
+    servo_poll(&servo);
     if (!first || !waits || !sent || slept) {
         fprintf(stderr, "sync_monitor_round: %s\n", !first ? "the first answer was not sent"
                         : !waits ? "the second servo did not wait for its turn"

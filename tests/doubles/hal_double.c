@@ -10,10 +10,23 @@ static uint32_t now_us(void *ctx)
 static void uart_send(void *ctx, const uint8_t *data, uint16_t len)
 {
     struct hal_double *h = ctx;
+    h->sending = data;
+    h->sending_at = h->sent_length;
+    h->sending_length = len;
+    memcpy(h->head_at_send, data, len < sizeof h->head_at_send ? len : sizeof h->head_at_send);
     for (uint16_t i = 0; i < len && h->sent_length < HAL_DOUBLE_SENT_MAX; i++) {
         h->sent[h->sent_length++] = data[i];
     }
     h->sends++;
+}
+
+void hal_double_dma_reads(struct hal_double *h)
+{
+    for (size_t i = 0; h->sending != NULL && i < h->sending_length &&
+                       h->sending_at + i < h->sent_length; i++) {
+        h->sent[h->sending_at + i] = h->sending[i];
+    }
+    h->sending = NULL;
 }
 
 static bool uart_tx_done(void *ctx)
@@ -89,4 +102,5 @@ void hal_double_clear_sent(struct hal_double *h)
 {
     h->sent_length = 0;
     h->sends = 0;
+    h->sending = NULL;
 }

@@ -22,6 +22,12 @@ struct hal_double {
     uint8_t sent[HAL_DOUBLE_SENT_MAX];
     size_t sent_length;
     unsigned sends;       /* bus.send calls */
+    /* The last send's bytes, read again as a DMA reads them, while they
+     * go out: an answer may be built behind its first bytes. */
+    const uint8_t *sending;
+    size_t sending_at;
+    uint16_t sending_length;
+    uint8_t head_at_send[5]; /* its first bytes as they were at the send */
     bool tx_busy;         /* bus.tx_done answers !tx_busy */
     uint32_t baud;        /* last bus.set_baud */
     unsigned baud_changes;
@@ -41,6 +47,8 @@ struct hal_double {
 };
 
 void hal_double_init(struct hal_double *h);
+/* The last send's bytes as its buffer holds them now (the poll's end). */
+void hal_double_dma_reads(struct hal_double *h);
 /* Forgets what was sent so far. */
 void hal_double_clear_sent(struct hal_double *h);
 /* An enter_bootloader op that counts its calls (port.enter_bootloader is

@@ -31,6 +31,7 @@ void harness_poll(unsigned n)
 {
     for (unsigned i = 0; i < n; i++) {
         servo_poll(&servo);
+        hal_double_dma_reads(&hal);
     }
 }
 
@@ -41,6 +42,7 @@ void harness_feed(const uint8_t *bytes, size_t n)
     for (size_t i = 0; i < n; i++) {
         if (hal.rx.written - hal.rx.read == hal_rx_ring_size(&hal.rx)) {
             servo_poll(&servo);
+            hal_double_dma_reads(&hal);
         }
         hal.now_us += HARNESS_BYTE_US;
         servo_on_rx_byte(&servo, bytes[i], hal.now_us);
@@ -61,6 +63,7 @@ void harness_run_ms(uint32_t ms)
     for (uint32_t i = 0; i < 4u * ms; i++) {
         hal.now_us += 250u;
         servo_poll(&servo);
+        hal_double_dma_reads(&hal);
     }
 }
 

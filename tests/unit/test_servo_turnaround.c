@@ -1,10 +1,11 @@
 /* A Sync Monitor round's first answer within two byte times of the
- * request's end (docs/sleep.md, "The first answer"): the answer is
- * built while the request arrives, once this servo's record is in, and
- * leaves in the pass that frames the checksum byte; a request whose
- * checksum fails, or that is cut, never lets it go; a tick that falls due
- * as a request for this servo ends waits for its answer. At 1 Mbaud, with
- * the M0's tick and pass (46 us). */
+ * request's end (docs/sleep.md, "The first answer"): listed first, the
+ * servo hands the answer's header and ID to the UART in the pass that
+ * frames the checksum byte and builds the rest behind them (the double
+ * reads the buffer at the pass's end, as the DMA reads it while it goes);
+ * a request whose checksum fails, or that is cut, is never answered; a
+ * tick that falls due as a request for this servo ends waits for its
+ * answer. At 1 Mbaud, with the M0's tick and pass (46 us). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -47,26 +48,29 @@ static int setup(void **state)
     return 0;
 }
 
-/* Built once, as its record lands; sent in the pass that frames the
- * checksum, with no dispatch then. */
-static void test_the_first_answer_is_built_before_the_checksum(void **state)
+/* Dispatched once, in the pass that frames the checksum, which sends it:
+ * the bytes on the wire are the whole answer. */
+static void test_the_first_answer_leaves_with_the_checksum(void **state)
 {
     (void)state;
     uint32_t heard = servo.dispatcher.heard;
-    feed_at_1mbaud(request, request_length - 7u); /* up to this servo's record */
-    assert_int_equal(servo.dispatcher.heard, heard);
-    feed_at_1mbaud(&request[request_length - 7u], 6);
-    assert_int_equal(servo.dispatcher.heard, heard + 1u); /* dispatched once, before the end */
+    feed_at_1mbaud(request, request_length - 1u);
+    assert_int_equal(servo.dispatcher.heard, heard); /* nothing before the end */
     EXPECT_SILENCE();
     feed_at_1mbaud(&request[request_length - 1u], 1);
     assert_int_equal(servo.dispatcher.heard, heard + 1u);
     assert_true(servo.tx.sending);
     const uint8_t *sent = hal.sent;
+    assert_int_equal(hal.sends, 1u);
     assert_int_equal(hal.sent_length, 4u + 16u + 1u); /* Monitor's 16 bytes */
     assert_int_equal(sent[0], 0x05);
     assert_int_equal(sent[1], 0x1C);
     assert_int_equal(sent[2], PKT_MONITOR);
+    assert_int_equal(sent[3], 16);
     assert_int_equal(sent[4], 0); /* this servo's ID */
+    assert_int_equal(sent[5] | sent[6] << 8, servo.regs.status.voltage_mv);
+    /* Header and ID were in place when the UART took the frame. */
+    assert_memory_equal(hal.head_at_send, sent, sizeof hal.head_at_send);
     uint8_t sum = 0;
     for (size_t i = 0; i + 1u < hal.sent_length; i++) {
         sum = (uint8_t)(sum + sent[i]);
@@ -74,9 +78,8 @@ static void test_the_first_answer_is_built_before_the_checksum(void **state)
     assert_int_equal(sent[hal.sent_length - 1u], sum);
 }
 
-/* The answer of a request whose checksum fails never leaves, and is never
- * taken for the next request's. */
-static void test_a_prepared_answer_with_a_bad_checksum_is_dropped(void **state)
+/* A request whose checksum fails is never answered, and the next one is. */
+static void test_a_request_with_a_bad_checksum_is_not_answered(void **state)
 {
     (void)state;
     feed_at_1mbaud(request, request_length - 1u);
@@ -89,7 +92,7 @@ static void test_a_prepared_answer_with_a_bad_checksum_is_dropped(void **state)
 }
 
 /* Nor that of a request the line's quiet cut short. */
-static void test_a_prepared_answer_of_a_cut_request_is_dropped(void **state)
+static void test_a_cut_request_is_not_answered(void **state)
 {
     (void)state;
     feed_at_1mbaud(request, request_length - 1u);
@@ -128,9 +131,9 @@ static void test_a_tick_waits_for_a_request_about_to_end(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test_setup(test_the_first_answer_is_built_before_the_checksum, setup),
-        cmocka_unit_test_setup(test_a_prepared_answer_with_a_bad_checksum_is_dropped, setup),
-        cmocka_unit_test_setup(test_a_prepared_answer_of_a_cut_request_is_dropped, setup),
+        cmocka_unit_test_setup(test_the_first_answer_leaves_with_the_checksum, setup),
+        cmocka_unit_test_setup(test_a_request_with_a_bad_checksum_is_not_answered, setup),
+        cmocka_unit_test_setup(test_a_cut_request_is_not_answered, setup),
         cmocka_unit_test_setup(test_a_tick_waits_for_a_request_about_to_end, setup),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -14,12 +14,12 @@ struct sim_cpu {
     uint32_t pass_ns;   /* a main-loop pass with nothing to do */
     uint32_t tick_ns;   /* a control tick, the longest */
     uint32_t answer_ns; /* a request to an answer ready, the longest but a durable write's */
-    /* The pass that frames a Sync Monitor's checksum byte and sends this
-     * servo's answer, beyond an idle pass: the M3 builds the answer then,
-     * the M0 before the checksum came (prepares: servo.c,
-     * SERVO_PREPARES_ANSWERS, in a pass that costs answer_ns). */
+    /* The pass that frames a Sync Monitor's checksum byte, beyond an idle
+     * pass, up to the start of this servo's answer (listed first): the M3
+     * builds the answer before, the M0 after (sends_ahead: servo.c,
+     * send_ahead; that pass costs answer_ns in all). */
     uint32_t sync_answer_ns;
-    bool prepares;
+    bool sends_ahead;
     uint8_t tick_and_pass_us; /* what the board tells the firmware (hal_port.h) */
 };
 

@@ -80,22 +80,32 @@ uint64_t sim_servo_wake_at(const struct sim_servo *s)
     return wake > free ? wake : free;
 }
 
-/* What a pass's requests cost beyond the pass: a request to its answer,
- * a Sync Monitor's checksum to this servo's answer (the core builds that
- * answer ahead on either CPU; on one whose image does not, the building is
- * free and the pass at the checksum builds it). */
+/* A pass that framed a Sync Monitor (this servo listed first) and sent
+ * its answer: on either CPU the answer leaves sync_answer_ns into the
+ * pass; the M0 builds the rest of it behind its first bytes, the M3
+ * before. */
+static bool sent_sync_answer(const struct sim_servo *s, uint32_t frames_before)
+{
+    const struct servo *c = &s->core;
+    const struct rx_frame *f = &c->rx.slots[(c->rx.tail + FRAME_QUEUE_SLOTS - 1u) % FRAME_QUEUE_SLOTS];
+    return s->tx_data != NULL && c->rx.stats.frames == frames_before + 1u && f->code == PKT_SYNC_COMMAND;
+}
+
+/* What a pass's requests cost beyond the pass, and when in it the answer
+ * it sends leaves (*send_ns). */
 static uint64_t request_cost_ns(const struct sim_servo *s, uint32_t heard_before,
-                                uint32_t frames_before)
+                                uint32_t frames_before, uint64_t *send_ns)
 {
     const struct servo *c = &s->core;
     bool heard = c->dispatcher.heard != heard_before;
     bool framed = c->rx.stats.frames != frames_before;
-    bool prepared_now = heard && !framed && c->prepared_requests == c->rx.stats.requests_seen + 1u;
-    bool prepared_sent = !heard && framed && c->prepared_requests == c->rx.stats.requests_seen;
-    if (prepared_now && !s->cpu->prepares) {
-        return 0u;
+    uint64_t cost = (heard || framed) * (uint64_t)s->cpu->answer_ns;
+    *send_ns = cost;
+    if (sent_sync_answer(s, frames_before)) {
+        *send_ns = s->cpu->sync_answer_ns;
+        cost = s->cpu->sends_ahead ? s->cpu->answer_ns : s->cpu->sync_answer_ns;
     }
-    return prepared_sent ? s->cpu->sync_answer_ns : (heard || framed) * (uint64_t)s->cpu->answer_ns;
+    return cost;
 }
 
 /* One main-loop pass at now_us, then what it cost on the target's CPU:
@@ -112,17 +122,23 @@ static void run_pass(struct sim_servo *s, uint64_t now_us)
         servo_poll(&s->core);
     }
     uint64_t cost_ns = s->cpu->pass_ns;
-    if (in_app && !s->in_bootloader) {
+    uint64_t send_ns = 0; /* when in the pass its answer leaves */
+    bool timed = in_app && !s->in_bootloader;
+    if (timed) {
         cost_ns += (uint64_t)((s->core.next_tick_us - ticks_before) / CONTROL_TICK_US) * s->cpu->tick_ns;
-        cost_ns += request_cost_ns(s, heard_before, frames_before);
+        uint64_t answer_ns = 0;
+        uint64_t request_ns = request_cost_ns(s, heard_before, frames_before, &answer_ns);
+        send_ns = cost_ns + answer_ns;
+        cost_ns += request_ns;
     }
     uint64_t cost_us = (cost_ns + 500u) / 1000u;
+    uint64_t send_us = timed ? (send_ns + 500u) / 1000u : cost_us;
     s->next_pass_us = now_us + (cost_us != 0u ? cost_us : 1u);
     if (s->tx_data != NULL) {
         /* After the flash work of this pass too: a flash step stalls the
          * CPU (RM0008 3.3.3), so an answer to a write that programmed
          * flash leaves once the programming is done. */
-        uint64_t at = now_us + cost_us + flash_stall_us(s);
+        uint64_t at = now_us + send_us + flash_stall_us(s);
         s->last_sent_us = at;
         s->tx_done_us = sim_bus_send(s->bus, s->index, s->tx_data, s->tx_len, s->baud, at);
         s->tx_data = NULL;

@@ -22,7 +22,10 @@ struct hal_bus {
     /* Free-running microsecond clock; wraps at 2^32. */
     uint32_t (*now_us)(void *ctx);
     /* Starts sending len bytes and returns at once; data stays valid until
-     * tx_done() says true. The port turns the half-duplex line around. */
+     * tx_done() says true. The port turns the half-duplex line around. It
+     * reads each byte as it goes out (DMA, an interrupt), not all at the
+     * start: the M0's Sync Monitor answer is built behind its first bytes
+     * (servo.c, send_ahead). */
     void (*send)(void *ctx, const uint8_t *data, uint16_t len);
     /* True once the last stop bit of the last send has left the wire. */
     bool (*tx_done)(void *ctx);

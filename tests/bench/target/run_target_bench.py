@@ -54,7 +54,12 @@ DURABLE_WRITE_BUDGET_US = {"cortex-m3": 200, "cortex-m0": 600}
 # (docs/sleep.md, "The first answer").
 BYTE_US = 10
 TURNAROUND_BUDGET_US = 2 * BYTE_US
-TURNAROUNDS = ("first_answer", "next_answer")
+TURNAROUNDS = ("first_answer", "first_answer_of_two", "next_answer")
+# The M0 hands a Sync Monitor's first answer to the UART with its header
+# and ID written, and builds the rest behind them (servo.c, send_ahead):
+# the DMA takes the content's second byte 4 byte times after the start.
+# The build must end within 3, a byte time left for interrupts.
+BUILD_BEHIND_BUDGET_US = 3 * BYTE_US
 DURABLE_WRITES = ("answer_write_data", "answer_write_batch", "answer_reset_user_data",
                   "answer_write_control_response", "answer_write_control_response_off")
 
@@ -65,6 +70,8 @@ def budget_of(cpu: str, key: str):
         return BUDGETS[cpu][key], "instr"
     if key in TURNAROUNDS:
         return TURNAROUND_BUDGET_US, "us"
+    if key == "sync_first_build":
+        return BUILD_BEHIND_BUDGET_US, "us"
     if key in DURABLE_WRITES:
         return DURABLE_WRITE_BUDGET_US[cpu], "us + flash"
     if key.startswith("answer_"):
@@ -266,20 +273,6 @@ def per_tick(motion: dict, region: str, nticks: int) -> tuple:
     return tuple(x / nticks for x in motion[region])
 
 
-def first_answer(proto: dict, cpu: str, bytes_after: int) -> tuple:
-    """(instructions, cycles) from a Sync Monitor's last stop bit to its
-    first answer handed to the UART, bytes_after bytes after the record of
-    the servo listed first."""
-    prepare, send = proto["sync_prepare"], proto["sync_first_pass"]
-    # The preparation behind a missed round, past the last stop bit: the
-    # pass after it takes the checksum byte; else the byte may land just
-    # after a pass read the ring: a round, then the rest of a pass.
-    late = proto["awake_loop"][1] + prepare[1] - bytes_after * BYTE_US * CLOCK_MHZ[cpu]
-    if late > 0:
-        return proto["awake_loop"][0] + prepare[0] + send[0], late + send[1]
-    return after_a_missed_read(proto, send)
-
-
 def after_a_missed_read(proto: dict, pass_: tuple) -> tuple:
     """A pass that sends, its byte landed just after the last pass read the
     ring: a main-loop round (awake_loop), then the pass but what comes
@@ -326,18 +319,18 @@ def figures(cpu: str, profile_region: str = "", by_line: bool = False) -> dict:
         **({"plan_jerk": max(jerk_plans.values())} if jerk_plans else {}),
     }
     # A Sync Monitor round of six servos (bench_protocol.c,
-    # sync_monitor_round): the pass that builds this servo's answer as its
-    # record lands (the M0's; the M3 builds it from the checksum byte on),
-    # and each answer's way out after the byte that lets it go, behind the
-    # main loop's round that may have just missed that byte (awake_loop: a
-    # pass and servo_may_sleep, the line in use; the worst). The first
-    # answer also waits for its preparation when that (behind a missed
-    # pass) outlasts the bytes after the record: first_answer with the
-    # round's five records after it, first_answer_of_two with one.
+    # sync_monitor_round): each answer's way out after the byte that lets
+    # it go (up to the UART's start), behind the main loop's round that may
+    # have just missed that byte (awake_loop: a pass and servo_may_sleep,
+    # the line in use; the worst). The first answer leaves in the pass that
+    # frames the checksum byte wherever the record lies; listed first of
+    # two (first_answer_of_two) that pass may frame the other record too.
+    # On the M0 the rest of that answer is built behind its first bytes
+    # (sync_first_build, the longer of the two rounds').
     out.update({"awake_loop": proto["awake_loop"], "pass_to_ring": proto["pass_to_ring"],
-                "sync_prepare": proto["sync_prepare"],
-                "first_answer": first_answer(proto, cpu, int(pstats["sync_bytes_after_record"])),
-                "first_answer_of_two": first_answer(proto, cpu, 2),
+                "first_answer": after_a_missed_read(proto, proto["sync_first_pass"]),
+                "first_answer_of_two": after_a_missed_read(proto, proto["sync_first_pass_of_two"]),
+                "sync_first_build": max(proto["sync_first_build"], proto["sync_first_build_of_two"]),
                 "next_answer": after_a_missed_read(proto, proto["sync_next_pass"])})
     out.update({k: v for k, v in proto.items() if k.startswith(("answer_", "request_"))})
     out.update(plans)
