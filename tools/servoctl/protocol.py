@@ -130,7 +130,7 @@ class Bus:
             return
         end = self.clock() + seconds
         if self.run_ahead is not None:
-            end = math.ceil(end * 1e6 - 1e-3) / 1e6  # sim.on_us_grid: where a paced one stops
+            end = _on_us_grid(end)
             self.run_ahead(end)
         while (left := end - self.clock()) > 0:
             time.sleep(min(left, 0.005))
@@ -282,7 +282,7 @@ class Bus:
             if not got or time.monotonic() >= check_at:
                 if self.note_read is not None:
                     self.note_read(0, waits_for_more=True)  # every byte read looked at: none is it
-                last_look = self._look(deadline) > deadline
+                last_look = self._look(deadline)
                 check_at = time.monotonic() + 0.002
             got = self._fill(wait=not last_look)
 
@@ -307,7 +307,7 @@ class Bus:
             if last_look:
                 self._look(0.0)
                 return good, bad, self.stray_bytes + len(self._buffer)
-            last_look = self._look(deadline) > deadline
+            last_look = self._look(deadline)
             if last_look and self._buffer and not finishing:
                 # A frame begun in the window is read whole, not counted as
                 # garbage: the longest answer's time more, and 5 ms.
@@ -315,17 +315,23 @@ class Bus:
                 deadline = self.clock() + self._longest_answer_s()
             self._fill(wait=not last_look)
 
-    def _look(self, deadline: float) -> float:
-        """The bus clock; a simulator that runs ahead while the host waits
-        may run to just past the deadline, at most RUN_AHEAD_S past now
-        (deadline 0: no more). A paced one (note_sent) to the deadline: it
-        stops at the answer itself, and a bound taken from the clock as the
-        host happens to read it would make its stops the host's."""
+    def _look(self, deadline: float) -> bool:
+        """Whether the bus clock has passed deadline. A simulator that runs
+        ahead while the host waits may run to just past it, at most
+        RUN_AHEAD_S past now (deadline 0: no more). A paced one (note_sent)
+        to just past it: it stops at the answer itself, and a bound taken
+        from the clock as the host happens to read it would make its stops
+        the host's. Its wait ends there, not at an event on the way that a
+        host read first (a loaded PC): the next request lands on time."""
         now = self.clock()
-        if self.run_ahead is not None:
-            ahead = RUN_AHEAD_S if self.note_sent is None else math.inf
-            self.run_ahead(min(deadline + 0.001, now + ahead), answer=True)
-        return now
+        if self.run_ahead is None:
+            return now > deadline
+        if self.note_sent is None:
+            self.run_ahead(min(deadline + 0.001, now + RUN_AHEAD_S), answer=True)
+            return now > deadline
+        stop = _on_us_grid(deadline + 0.001)
+        self.run_ahead(stop, answer=True)
+        return now >= stop
 
     def _take_frame(self):
         """(code, content, checksum_ok) of a complete response frame at the
@@ -375,11 +381,19 @@ class Bus:
         wire and 5 ms, on the bus clock) and drops it: after a NoReply, a
         late answer is not taken for the next request's."""
         deadline = self.clock() + self._longest_answer_s()
+        stop = _on_us_grid(deadline + 0.001)
         if self.run_ahead is not None:
-            self.run_ahead(deadline + 0.001)
-        while self.clock() <= deadline:
+            self.run_ahead(stop)
+        paced = self.run_ahead is not None and self.note_sent is not None  # it stops there (_look)
+        while self.clock() < stop if paced else self.clock() <= deadline:
             self._fill(wait=True)
         while (frame := self._take_frame()) is not None:  # garbled answers counted
             self.bad_frames += not frame[2]
         self.stray_bytes += len(self._buffer)
         self._buffer = b""
+
+
+def _on_us_grid(t: float) -> float:
+    """t rounded up to a whole microsecond (sim.on_us_grid): where a paced
+    simulator told to run to t stops, and the clock it then shows."""
+    return math.ceil(t * 1e6 - 1e-3) / 1e6

@@ -4,8 +4,10 @@ repository's files the tests start simulators with (PLANTS). Not shipped: servoc
 says; the tests find the repository from here."""
 import os
 from pathlib import Path
+import signal
 import socket
 import subprocess
+import sys
 import threading
 import time
 
@@ -27,6 +29,16 @@ def _free_port() -> int:
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
         return s.getsockname()[1]
+
+
+def servoctl_child(*argv, **popen) -> subprocess.Popen:
+    """servoctl argv in a child process that Ctrl-C interrupts, as at a
+    user's terminal, even where the tests run in the background: a shell
+    starts a background job with SIGINT ignored, each process it starts
+    inherits that, and Python then installs no KeyboardInterrupt handler,
+    so the child would run on through the test's SIGINT. popen: Popen's."""
+    return subprocess.Popen([sys.executable, "-m", "servoctl.cli", *argv], cwd=REPO / "tools", text=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL), **popen)
 
 
 QEMU_BOARD = REPO / "build" / "arm" / "firmware" / "boards" / "qemu_stm32vl"

@@ -18,6 +18,7 @@ hands it the bytes off the wire in USB packets."""
 import heapq
 import os
 import pty
+import select
 import socket
 import tty
 
@@ -61,6 +62,7 @@ class Bus:
         self.master_fd = None
         self.link_path = None
         self.refused = []
+        self._next = None  # a client come while the last one leaves (_in_place_of_one_leaving)
 
     def attach(self, usart) -> int:
         self.stations.append(usart)
@@ -123,6 +125,8 @@ class Bus:
                 conn, _ = self.listen.accept()
             except BlockingIOError:
                 conn = None
+            if conn is not None and self.host_fd is not None and self._in_place_of_one_leaving(conn):
+                conn = None
             if conn is not None and self.host_fd is not None:
                 conn.setblocking(False)
                 try:
@@ -131,11 +135,29 @@ class Bus:
                     pass
                 self.refused.append(conn)
             elif conn is not None:
-                conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-                conn.setblocking(False)
-                self._conn = conn
-                self.host_fd = conn.fileno()
+                self._take(conn)
         self.flush_to_host(now_s)
+
+    def _take(self, conn) -> None:
+        conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        conn.setblocking(False)
+        self._conn = conn
+        self.host_fd = conn.fileno()
+
+    def _in_place_of_one_leaving(self, conn) -> bool:
+        """A client that came while the one on the bus has hung up, its last
+        bytes still unread (a loaded PC held this process up while one
+        servoctl sent a request and left and the next started): kept, and
+        taken once those bytes are read and the leaving seen, not told the
+        bus is in use. False for any other (refused)."""
+        if self._next is not None:
+            return False
+        hung_up = select.poll()
+        hung_up.register(self.host_fd, select.POLLRDHUP)
+        if not hung_up.poll(0):
+            return False
+        self._next = conn
+        return True
 
     def _read_host(self, now_s: float) -> None:
         if self.host_queue_until_s - now_s < BACKLOG_S:
@@ -172,6 +194,9 @@ class Bus:
         self.host_fd = None
         self.to_host.clear()
         self.adapter.held.clear()
+        if self._next is not None:
+            self._next, conn = None, self._next
+            self._take(conn)
 
     def queue_host(self, byte: int, now_s: float) -> None:
         """A host byte on the wire from now_s, after the host's earlier

@@ -48,6 +48,26 @@ enum { PACED_POLL_US = 200 };
 /* A paced clock's start: the wall clock's at the start, a millisecond. */
 enum { PACED_START_US = 1000 };
 static int refused[REFUSED_MAX] = {-1, -1, -1, -1};
+/* A client that came while the one on the bus had hung up, its last bytes
+ * still unread (a loaded PC held this process up while one host sent a
+ * request and left and the next started): taken once those bytes are read
+ * and the leaving seen, not told the bus is in use. -1: none. */
+static int next_fd = -1;
+
+/* The TCP client on the bus has hung up (its bytes may still be unread). */
+static bool host_hung_up(void)
+{
+    struct pollfd p = {.fd = bus.host_fd, .events = POLLRDHUP};
+    return poll(&p, 1, 0) == 1 && (p.revents & (POLLRDHUP | POLLHUP | POLLERR));
+}
+
+static void take_client(int fd)
+{
+    int one = 1; /* a UART does not wait to fill packets */
+    setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
+    fcntl(fd, F_SETFL, O_NONBLOCK);
+    bus.host_fd = fd;
+}
 
 static void tell_in_use(int fd)
 {
@@ -245,6 +265,10 @@ int main(int argc, char **argv)
             } else if (listen_fd >= 0 && (n == 0 || errno != EAGAIN)) {
                 close(bus.host_fd); /* the TCP client left: wait for the next */
                 bus.host_fd = -1;
+                if (next_fd >= 0) {
+                    take_client(next_fd);
+                    next_fd = -1;
+                }
             }
         }
         for (int i = 0; i < REFUSED_MAX; i++) { /* a refused client left, or wrote: drained */
@@ -263,13 +287,12 @@ int main(int argc, char **argv)
          * its place are seen in that order. */
         if (listen_slot >= 0 && (fds[listen_slot].revents & POLLIN)) {
             int fd = accept(listen_fd, NULL, NULL);
-            if (fd >= 0 && bus.host_fd >= 0) {
+            if (fd >= 0 && bus.host_fd >= 0 && next_fd < 0 && host_hung_up()) {
+                next_fd = fd;
+            } else if (fd >= 0 && bus.host_fd >= 0) {
                 refuse(fd);
             } else if (fd >= 0) {
-                int one = 1; /* a UART does not wait to fill packets */
-                setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
-                fcntl(fd, F_SETFL, O_NONBLOCK);
-                bus.host_fd = fd;
+                take_client(fd);
             }
         }
         sim_control_serve(&control, &fds[control_slot]);

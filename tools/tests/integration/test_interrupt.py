@@ -2,18 +2,27 @@
 table (docs/servoctl.md) says: a monitor and `servoctl sim` ended with 0
 (a monitor's plot is still saved, a simulator still stopped cleanly). Each
 command runs as a user's would, in its own process, sent SIGINT once it
-is under way."""
+is under way. The tests themselves run with SIGINT ignored, as a shell
+starts a background job (a CI run, `stress.sh &`): the command is started
+as from a user's terminal all the same (launchers.servoctl_child)."""
 import signal
 import subprocess
-import sys
 import time
-from pathlib import Path
 
 import pytest
 
 from servoctl.sim import Simulator
 
-TOOLS = Path(__file__).resolve().parents[2]
+from ..launchers import servoctl_child
+
+
+@pytest.fixture(autouse=True)
+def run_in_the_background():
+    """SIGINT ignored in this process while the test runs, as in a
+    background job: what its children inherit unless told otherwise."""
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    yield
+    signal.signal(signal.SIGINT, previous)
 
 
 def _interrupted(argv, started) -> tuple:
@@ -21,8 +30,7 @@ def _interrupted(argv, started) -> tuple:
     started (its stdout or stderr), or once started() is true (a command
     that prints nothing until it ends: judged by what it did, not by how
     long a loaded PC took to start it); (exit code, what it printed)."""
-    proc = subprocess.Popen([sys.executable, "-m", "servoctl.cli", *argv], cwd=TOOLS, stdout=subprocess.PIPE,
-                            stderr=subprocess.STDOUT, text=True)
+    proc = servoctl_child(*argv, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
     try:
         seen = []
         deadline = time.monotonic() + 60

@@ -14,6 +14,8 @@ import pytest
 from servoctl import __version__
 from servoctl.cli import main
 
+from ..launchers import servoctl_child
+
 TOOLS = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 
@@ -132,18 +134,9 @@ def test_version(capsys):
     assert e.value.code == 0 and capsys.readouterr().out.strip() == f"servoctl {__version__}"
 
 
-def servoctl_child(*argv):
-    """servoctl in a child process that Ctrl-C interrupts: SIGINT as a
-    terminal delivers it, even where the tests run in the background (a
-    shell starts background jobs with SIGINT ignored, and Python keeps it
-    so)."""
-    return subprocess.Popen([sys.executable, "-m", "servoctl.cli", *argv], cwd=TOOLS,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
-
-
 def test_ctrl_c_stops_cleanly(sim):
-    proc = servoctl_child("--port", sim.url, "scan", "--reply-timeout", "0.05")  # 254 IDs: 12 s
+    proc = servoctl_child("--port", sim.url, "scan", "--reply-timeout", "0.05",  # 254 IDs: 12 s
+                          stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     # Interrupted once it has found servo 1 (a loaded PC may take seconds
     # to start Python); stdout ends when it exits.
     first = proc.stdout.readline()
@@ -321,7 +314,8 @@ def test_read_commands_speak_json(sim, capsys):
 
 
 def test_ctrl_c_during_a_wait_releases_nothing(ready):
-    proc = servoctl_child("--port", ready.url, "move", "1", "90", "--interval", "3000", "--wait")
+    proc = servoctl_child("--port", ready.url, "move", "1", "90", "--interval", "3000", "--wait",
+                          stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     # Interrupted once it is waiting: the horn is on its way (a loaded PC
     # may take seconds to start Python).
     ready.wait_until(lambda: ready.state(1)["angle"] > 5.0, 60)

@@ -13,21 +13,31 @@ from servoctl.cli import main
 from servoctl.sim import Simulator
 
 
-def _lagging(sim, host_s: float) -> threading.Timer:
-    """The simulator stopped now, for host_s of host time: its clock stands
-    still while a request is outstanding, as on a PC too busy to run it."""
+def _lagging(sim, host_s) -> threading.Timer:
+    """The simulator stopped now, for host_s of host time (None: until the
+    caller resumes it): its clock stands still while a request is
+    outstanding, as on a PC too busy to run it."""
     os.kill(sim.process.pid, signal.SIGSTOP)
-    resume = threading.Timer(host_s, os.kill, (sim.process.pid, signal.SIGCONT))
-    resume.start()
+    resume = threading.Timer(host_s or 0, os.kill, (sim.process.pid, signal.SIGCONT))
+    if host_s is not None:
+        resume.start()
     return resume
 
 
 def _ping_behind(sim, capsys, *options):
-    resume = _lagging(sim, 0.3)
+    """ping 1 with the simulator stopped: with the control port (options)
+    for 0.3 s of host time, its answer then awaited on its clock; without
+    it, until the host has given up on its own clock, however long a
+    loaded PC takes to run it (resumed by a timer, the simulator could
+    answer a host held up that long in time)."""
+    resume = _lagging(sim, 0.3 if options else None)
     try:
         rc = main(["--port", sim.url, *options, "ping", "1"])
     finally:
-        resume.join()
+        if options:
+            resume.join()
+        else:
+            os.kill(sim.process.pid, signal.SIGCONT)
     out = capsys.readouterr()
     return rc, out.out + out.err
 
@@ -160,3 +170,52 @@ def test_a_paced_sync_monitor_runs_on_past_an_absent_servos_slot(tmp_path):
     on_time = _monitor_past_a_silent_slot(tmp_path, "on-time", 0.0)
     assert [who for who, _ in on_time] == [[1, 3]] * 3
     assert _monitor_past_a_silent_slot(tmp_path, "late", 0.003) == on_time
+
+
+def _held_up_on_its_way(sim, bus) -> None:
+    """Each time the bus tells the paced simulator to run to a later time
+    T, it first runs to 0.5 ms before T and is stopped there for 0.1 s of
+    host time (SIGSTOP), as a loaded PC holds it up: a host that reads the
+    clock then sees it past its deadline (T is 1 ms past it) and not yet
+    where the simulator stops."""
+    import time
+
+    from servoctl.sim import on_us_grid
+
+    run_ahead = bus.run_ahead
+
+    def held_up(until_s, answer=False):
+        on_the_way = on_us_grid(until_s - 0.0005)  # where it stops: no float's hair short
+        if sim.clock_s() < on_the_way:
+            run_ahead(on_the_way, answer)
+            while sim.clock_s() < on_the_way:
+                time.sleep(0.0002)
+            _lagging(sim, 0.1)  # resumed by its timer
+        run_ahead(until_s, answer)
+    bus.run_ahead = held_up
+
+
+@pytest.mark.parametrize("wait", ["read_response", "drain"])
+def test_a_paced_wait_ends_where_the_simulator_stops_not_on_its_way(tmp_path, wait):
+    """A wait with no answer (servo 2 is absent) ends once the paced clock
+    stands where the host told it to stop, however late a loaded PC lets
+    it get there: a host that took an event on the way for the end let its
+    next request land at a time of the PC's making (a Sync Monitor's
+    rounds differed by 0.938 ms under load)."""
+    from servoctl import protocol as p
+    from servoctl.errors import NoReply
+    from servoctl.sim import on_us_grid
+
+    with Simulator(state_dir=str(tmp_path / "state"), ids=[1], paced=True) as sim:
+        with sim.bus(timeout=0.02) as bus:
+            _held_up_on_its_way(sim, bus)
+            start = sim.clock_s()
+            if wait == "drain":
+                bus.drain()
+                end = start + bus._longest_answer_s()
+            else:
+                bus.send(p.PING, bytes([2]))
+                with pytest.raises(NoReply):
+                    bus.read_response(p.PING, 2)
+                end = start + 0.02
+            assert sim.clock_s() == on_us_grid(end + 0.001)

@@ -68,6 +68,30 @@ def test_a_second_client_of_the_tcp_bus_is_told_it_is_in_use(tmp_path, capsys, b
         assert main(["--port", sim.url, "ping", "1"], clock=sim.clock_s) == 0  # and again at once
 
 
+@pytest.mark.parametrize("board", [None, "stm32f103"])
+def test_the_next_client_is_served_after_one_that_left_while_the_simulator_was_held_up(tmp_path, board):
+    """One client sends a Ping and leaves, and the next connects, while a
+    loaded PC holds the simulator up (SIGSTOP): the simulator reads the
+    first one's last bytes and its leaving before it takes the next, which
+    it serves (both told it the bus was in use: servoctl's exit 4)."""
+    import os
+    import signal
+    import socket
+
+    ping = p.request_frame(p.PING, bytes([1]))
+    with Simulator(ids=[1], state_dir=str(tmp_path / "state"), board=board) as sim:
+        address = ("127.0.0.1", int(sim.url.rsplit(":", 1)[1]))
+        os.kill(sim.process.pid, signal.SIGSTOP)
+        try:
+            with socket.create_connection(address) as first:
+                first.sendall(ping)
+            second = sim.bus()
+        finally:
+            os.kill(sim.process.pid, signal.SIGCONT)
+        with second as bus:  # sent again if it met the first one's answer on the wire
+            assert Servo(bus, 1).ping()
+
+
 def test_a_flood_is_held_back_not_queued_for_hours(pty_sim):
     """Two seconds of garbage written as fast as the pty takes it: at
     115200 baud the line carries about 23 kB of it; the rest waits in the

@@ -94,6 +94,7 @@ def test_an_item_edited_on_the_page_is_refused_as_servoctl_says_then_set(bench):
     field = page.locator("#items tr[data-item=angle_max] input")
     field.wait_for(timeout=WAIT_MS)
     field.fill("400")
+    page.evaluate(f"UI.setServos({IDS})")  # a scan's answer meanwhile, the same servos: the edit kept
     field.press("Enter")
     why = page.locator("#items tr[data-item=angle_max] td.why")
     why.filter(has_text="servoctl: error: angle_max (51) must be").wait_for(timeout=WAIT_MS)

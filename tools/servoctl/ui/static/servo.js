@@ -5,8 +5,11 @@
 (() => {
   const {$, el, on, send, run, runInto, picked} = UI;
 
+  let shown = null;  // whose items the table shows, or is about to
+
   function read() {
     const id = picked();
+    shown = id;
     if (id === null) return;
     $("#items tbody").innerHTML = "";
     send({op: "items", id});
@@ -70,6 +73,10 @@
     });
     $("#bk-restore").addEventListener("click", () => runInto(out, ["restore", $("#bk-file").value]));
   });
-  on("picked", () => { if (!$("#view-servo").hidden) read(); });
-  on("view", (m) => { if (m.view === "servo" && !$("#items tbody").children.length) read(); });
+  // A scan that keeps the picked servo (a late one, or after a bring-up) leaves
+  // its table, and what a user is typing there, as it is.
+  on("picked", (m) => { if (!$("#view-servo").hidden && m.id !== shown) read(); });
+  on("view", (m) => {
+    if (m.view === "servo" && (!$("#items tbody").children.length || shown !== picked())) read();
+  });
 })();
