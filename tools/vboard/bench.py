@@ -10,7 +10,8 @@ Three cases per board, each in this one process (one core):
 - bus of 3: three boards, the same stream to each in turn.
 
 A speed of 1.0 keeps up with real time; below it, every client with its own
-timeouts sees a slow servo. The figures go in docs/virtual-boards.md."""
+timeouts sees a slow servo. The figures go in docs/virtual-boards.md.
+VBOARD_SKIP=0 emulates every idle pass the cores would skip (idle_skip.py)."""
 import argparse
 import sys
 import tempfile
@@ -35,11 +36,13 @@ def runner_for(board: str, ids, state_dir: str) -> Runner:
     return runner
 
 
-def measure(runner: Runner, seconds: float, ping_ids=()) -> tuple:
+def measure(runner: Runner, seconds: float, ping_ids=(), cpu: list = None) -> tuple:
     """Runs seconds of simulated time as fast as it goes; returns (speed,
-    pings sent, answers heard). The answers still on the wire at the end
-    are waited for, untimed, before they are counted."""
-    start_sim, start_wall = runner.now_s, time.perf_counter()
+    pings sent, answers heard), and appends to cpu, if given, simulated
+    seconds per second of this process's CPU time (what a machine shared
+    with other work still shows). The answers still on the wire at the
+    end are waited for, untimed, before they are counted."""
+    start_sim, start_wall, start_cpu = runner.now_s, time.perf_counter(), time.process_time()
     next_ping, sent, k = runner.now_s, 0, 0
     runner.bus.to_host.clear()
     while runner.now_s - start_sim < seconds:
@@ -51,6 +54,8 @@ def measure(runner: Runner, seconds: float, ping_ids=()) -> tuple:
         runner.bus.flush_to_host(runner.now_s)  # what the adapter has handed over
     wall = time.perf_counter() - start_wall
     speed = (runner.now_s - start_sim) / wall
+    if cpu is not None:
+        cpu.append((runner.now_s - start_sim) / (time.process_time() - start_cpu))
     drained = max(runner.now_s, next_ping) + DRAIN_S
     while runner.now_s < drained:
         runner.step()
@@ -63,21 +68,22 @@ def main(argv=None) -> int:
     ap.add_argument("--board", choices=sorted(PARTS), action="append", help="default: both")
     ap.add_argument("--seconds", type=float, default=2.0, help="simulated seconds per case (default 2)")
     args = ap.parse_args(argv)
-    print(f"{'board':<12} {'case':<8} {'speed (sim s / wall s)':>23} {'answered':>10}")
+    print(f"{'board':<12} {'case':<8} {'speed (sim s / wall s)':>23} {'(/ CPU s)':>10} {'answered':>10}")
     worst = float("inf")
     for board in args.board or sorted(PARTS):
         cases = (("idle", (1,), ()), ("stream", (1,), (1,)), ("bus of 3", (1, 2, 3), (1, 2, 3)))
         for name, ids, pings in cases:
             with tempfile.TemporaryDirectory(prefix="vboard-bench-") as state:
                 runner = runner_for(board, ids, state)
+                cpu = []
                 try:
-                    speed, sent, heard = measure(runner, args.seconds, pings)
+                    speed, sent, heard = measure(runner, args.seconds, pings, cpu)
                 finally:
                     runner.bus.close()
                     runner.control.close()
                     runner.clock.close()
             answered = f"{heard}/{sent}" if sent else "-"
-            print(f"{board:<12} {name:<8} {speed:>22.2f}x {answered:>10}", flush=True)
+            print(f"{board:<12} {name:<8} {speed:>22.2f}x {cpu[0]:>9.2f}x {answered:>10}", flush=True)
             worst = min(worst, speed)
             if sent and heard < sent:
                 print(f"vboard.bench: {board} answered {heard} of {sent} pings", file=sys.stderr)

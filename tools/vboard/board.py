@@ -22,6 +22,7 @@ from .core import Core, Stop
 from .system_space import FIRST_IRQ
 from .dma import Dma
 from .flash import Flash
+from .idle_skip import pass_facts
 from .model import Model
 from .native import Motor, factory_config, stored_id
 from .timers import BridgeTimer, Watchdog
@@ -76,6 +77,11 @@ def images(board: str) -> tuple:
     of the board's build."""
     folder = REPO / "build" / PARTS[board].build / "firmware/boards" / board
     return folder / f"servo_{board}_boot.bin", folder / f"servo_{board}.img", folder / f"servo_{board}.bin"
+
+
+def elf(board: str) -> Path:
+    """The application's ELF, which names the main loop's pass (idle_skip.py)."""
+    return REPO / "build" / PARTS[board].build / "firmware/boards" / board / f"servo_{board}.elf"
 
 
 class Memory:
@@ -149,6 +155,9 @@ class Board:
         self.stepped = [m for m in self.models if type(m).step is not Model.step]
         self.station = bus.attach(self.usart)
         self.usart.bus_station = self.station
+        self.pass_start = pass_facts(elf(board))  # (address, code, _ebss) or None
+        if self.pass_start is not None:
+            self.core.skip_memory(self.ram.buf, h["BOARD_RAM_BASE"], self.pass_start[2] - h["BOARD_RAM_BASE"])
         self.resets = {"power": 0, "software": 0, "watchdog": 0}
         self.last_reset = None
         self.powered = True
@@ -276,8 +285,17 @@ class Board:
         if "syscfg" in self.part.names:
             self.alias_zero(self.flash_mem, self.flash_size)
         self.core.reset(self.flash_base)
+        self.core.skip_at = self._pass_start()
         self.motor.coast()
         self.duty = None  # the bridge's, as the motor was last told
+
+    def _pass_start(self) -> int:
+        """Where the main loop's pass begins, if the flash holds the ELF's
+        code there (an update may have brought other code): else 0."""
+        if self.pass_start is None:
+            return 0
+        address, code, _ = self.pass_start
+        return address if self.flash_mem.read(address - self.flash_base, len(code)) == code else 0
 
     def power_cycle(self, off_s: float = 0.1) -> None:
         """Power off (the motor coasts, RAM is lost), then on."""

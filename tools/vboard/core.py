@@ -11,11 +11,14 @@ set, a CPSIE I right after the WFI is carried out here and the exception
 taken. Whenever PRIMASK holds back a pending exception, awake or after a
 wake, the run ends at the CPSIE I that clears it: the exception is taken
 right after that instruction, as on silicon, not at the slice's end.
+The main loop's awake passes that find nothing to do are counted as run
+without running them (idle_skip.py), with the same result.
 
 Its memory and register writes are memory.py's (MemoryMap), its
 exceptions exceptions.py's (Exceptions), the system control space's
 registers system_space.py's."""
 import ctypes
+import math
 import os
 import sys
 
@@ -25,6 +28,7 @@ from unicorn import arm_const as arm
 from unicorn.unicorn_py3.unicorn import uclib
 
 from .exceptions import Exceptions
+from .idle_skip import STATE_REGS, IdleSkip
 from .memory import MemoryMap
 from .native import lib as native_lib
 from .system_space import (NVIC_ICER, NVIC_ICPR, NVIC_ISER, NVIC_ISPR, SCB_AIRCR, SCB_ICSR, SYST_CSR, SYST_CVR,
@@ -37,7 +41,13 @@ WFI, CPSIE_I = 0xBF30, 0xB662
 class InstructionCount(ctypes.Structure):
     """native/instruction_count.c's struct vboard_count."""
     _fields_ = [("executed", ctypes.c_uint64), ("limit", ctypes.c_uint64), ("stop", ctypes.c_void_p),
-                ("read", ctypes.c_void_p), ("until_cpsie", ctypes.c_uint32), ("at_cpsie", ctypes.c_uint32)]
+                ("read", ctypes.c_void_p), ("until_cpsie", ctypes.c_uint32), ("at_cpsie", ctypes.c_uint32),
+                ("pass_at", ctypes.c_uint32), ("tries", ctypes.c_uint32), ("reg_read", ctypes.c_void_p),
+                ("reg_ids", ctypes.c_int32 * len(STATE_REGS)), ("ram", ctypes.c_void_p), ("seen_ram", ctypes.c_void_p),
+                ("ram_base", ctypes.c_uint32), ("ram_size", ctypes.c_uint32), ("static_end", ctypes.c_uint32),
+                ("hooks", ctypes.c_uint32), ("skipped", ctypes.c_uint64), ("have_seen", ctypes.c_uint32),
+                ("seen_hooks", ctypes.c_uint32), ("seen_live", ctypes.c_uint32),
+                ("seen_regs", ctypes.c_uint32 * len(STATE_REGS)), ("seen_at", ctypes.c_uint64)]
 
 
 def plain_store_size(hw: int, hw2: int) -> tuple:
@@ -64,7 +74,7 @@ class Stop(Exception):
     """Raised by run() when the board must reset (cause in .args[0])."""
 
 
-class Core(MemoryMap, Exceptions, SystemControlSpace):
+class Core(MemoryMap, Exceptions, SystemControlSpace, IdleSkip):
     def __init__(self, cpu_model: int, hz: int, cpi: float, has_vtor: bool, irq_words: int):
         self.uc = Uc(UC_ARCH_ARM, UC_MODE_THUMB | UC_MODE_MCLASS)
         self.uc.ctl_set_cpu_model(cpu_model)
@@ -119,6 +129,7 @@ class Core(MemoryMap, Exceptions, SystemControlSpace):
         if uclib.uc_hook_add(self.uc._uch, ctypes.byref(self._count_hook), UC_HOOK_CODE, counter,
                              ctypes.addressof(self.count), 1, 0):
             raise RuntimeError("Unicorn refused the instruction counter")
+        self._init_skip()
 
     # ---- registers: Unicorn's C API directly (its Python wrapper costs more
     # than the call, and exceptions touch a dozen registers) ----------------
@@ -162,7 +173,10 @@ class Core(MemoryMap, Exceptions, SystemControlSpace):
             self.idle(max_s)
             self.cycles += max_s * self.hz
             return max_s
-        count = max(1, int(max_s * self.hz / self.cpi))
+        # Up to the first instruction that ends at or past max_s: a run that
+        # stopped short of an event by a part of an instruction would need
+        # another run of its own to get there.
+        count = max(1, math.ceil(max_s * self.hz / self.cpi - 1e-6))
         self.ran = False
         if self.asleep:
             if not self.wake_pending():
@@ -185,6 +199,7 @@ class Core(MemoryMap, Exceptions, SystemControlSpace):
         # CPSIE I, so the run ends before that (native/instruction_count.c).
         masked = self.pending and self.reg(arm.UC_ARM_REG_PRIMASK) & 1
         self.count.until_cpsie = bool(masked and self.wake_pending())
+        self._arm_skip()
         self.count.at_cpsie = 0
         faulted = False
         self.running = self.ran = True

@@ -153,6 +153,7 @@ class MemoryMap:
         self.uc.emu_stop()
 
     def _write_hook(self, uc, access, address, size, value, data):
+        self.count.hooks += 1  # a pass that stores here is no idle pass (idle_skip.py)
         if self._passthrough == address:
             self._passthrough = None
             return
