@@ -45,6 +45,18 @@ enum { READY_AFTER_US = 5000 };
 /* How often a paced simulator standing still looks at the host's clock
  * word (sim_clock.h) when no byte wakes it. */
 enum { PACED_POLL_US = 200 };
+/* How long after the host was handed its last byte it counts as taking
+ * its turn (host_turn_bound); later, it is idle, and a simulator behind
+ * the wall clock catches up. */
+enum { HOST_TURN_US = 50000 };
+/* For this long of it the simulator does not sleep: a host that answers
+ * within it has its bytes taken as they come, at the bus time they came,
+ * not after the PC has woken the simulator (or at the bus time the
+ * simulator went to sleep at). */
+enum { HOST_SPIN_US = 200 };
+/* When the host was last handed bytes: the bus clock then, and the wall
+ * clock (sim_now_us) as the simulator handed them over. */
+static uint64_t handed_bus_us, handed_wall_us;
 /* A paced clock's start: the wall clock's at the start, a millisecond. */
 enum { PACED_START_US = 1000 };
 static int refused[REFUSED_MAX] = {-1, -1, -1, -1};
@@ -102,7 +114,12 @@ static void run_to(uint64_t target, bool until_answer)
              * before it. */
             sim_clock_publish(at);
         }
+        unsigned long host_bytes = bus.host_bytes;
         sim_bus_deliver(&bus, at);
+        if (bus.host_bytes != host_bytes) {
+            handed_bus_us = bus.now_us;
+            handed_wall_us = sim_now_us();
+        }
         for (unsigned i = 0; i < bus.station_count; i++) {
             sim_servo_poll(&servos[i], bus.now_us);
         }
@@ -118,6 +135,29 @@ static void run_to(uint64_t target, bool until_answer)
 static bool paced_may_run(bool answered, uint64_t waits)
 {
     return !answered && waits > bus.now_us && sim_clock_host_sent() <= host_read_total;
+}
+
+/* Where a simulator behind the wall clock may run to while its host takes
+ * its turn (it has been handed bytes since it last wrote, and the wire
+ * and its adapter are quiet): no further than the wall time since the
+ * host was handed its last byte. The host's reaction time is its own,
+ * real time; caught up at full speed meanwhile, the bus clock would charge
+ * the host with the simulator's lag (a 16-servo round that the simulator
+ * ran slower than real time: 0.25-1 ms of host gap, scripts/c_loop_bench.sh). */
+static bool host_turn(uint64_t wall_us, uint64_t within_us)
+{
+    return bus.host_bytes != host_bytes_then && bus.count == 0 && sim_usb_due(&bus.usb) == SIM_USB_NONE &&
+           wall_us - handed_wall_us < within_us;
+}
+
+static uint64_t host_turn_bound(uint64_t target, uint64_t wall_us)
+{
+    if (!host_turn(wall_us, HOST_TURN_US)) {
+        return target;
+    }
+    uint64_t bound = handed_bus_us + (wall_us - handed_wall_us);
+    bound = bound > bus.now_us ? bound : bus.now_us;
+    return bound < target ? bound : target;
 }
 
 static void on_signal(int sig)
@@ -222,7 +262,10 @@ int main(int argc, char **argv)
         waits &= ~SIM_CLOCK_UNTIL_ANSWER;
         if (o.paced) {
             wait_us = paced_may_run(answered, waits) ? 0 : PACED_POLL_US;
-        } else if (sim_bus_step_to(&bus, wall) < wall || (waits > wall && !answered)) {
+        } else if ((sim_bus_step_to(&bus, wall) < wall && !host_turn(wall, HOST_TURN_US)) ||
+                   (waits > wall && !answered) || host_turn(wall, HOST_SPIN_US)) {
+            /* Behind the wall clock (not held back by the host's turn), or
+             * running ahead for the host, or the host's turn just begun. */
             wait_us = 0;
         }
         struct timespec timeout = {.tv_sec = 0, .tv_nsec = wait_us * 1000};
@@ -295,7 +338,7 @@ int main(int argc, char **argv)
             sim_skip_us(skip < SIM_BUS_STEP_US ? skip : SIM_BUS_STEP_US);
             wall_now = sim_now_us();
         }
-        uint64_t target = sim_bus_step_to(&bus, wall_now);
+        uint64_t target = host_turn_bound(sim_bus_step_to(&bus, wall_now), wall_now);
         if (wall_now - target > most_behind_us) {
             most_behind_us = wall_now - target;
         }
