@@ -146,8 +146,12 @@ static bool paced_may_run(bool answered, uint64_t waits)
  * ran slower than real time: 0.25-1 ms of host gap, scripts/c_loop_bench.sh). */
 static bool host_turn(uint64_t wall_us, uint64_t within_us)
 {
-    return bus.host_bytes != host_bytes_then && bus.count == 0 && sim_usb_due(&bus.usb) == SIM_USB_NONE &&
-           wall_us - handed_wall_us < within_us;
+    /* A host that moves the clock itself (its waits in the clock file,
+     * sim_clock.h: servoctl's fast and paced simulators) is not timed in
+     * real time: a simulator behind catches up at once for it, and may
+     * then run ahead. */
+    return sim_clock_host_waits() == 0u && bus.host_bytes != host_bytes_then && bus.count == 0 &&
+           sim_usb_due(&bus.usb) == SIM_USB_NONE && wall_us - handed_wall_us < within_us;
 }
 
 static uint64_t host_turn_bound(uint64_t target, uint64_t wall_us)
