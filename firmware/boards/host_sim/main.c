@@ -91,6 +91,19 @@ static bool host_answered(uint64_t waits)
            bus.host_bytes > sim_clock_host_received() && bus.count == 0 && sim_usb_due(&bus.usb) == SIM_USB_NONE;
 }
 
+/* The host takes its turn: it has been handed bytes since it last wrote,
+ * the wire and its adapter are quiet, and it was handed its last byte
+ * within within_us of the wall clock. */
+static bool host_turn(uint64_t wall_us, uint64_t within_us)
+{
+    /* A host that moves the clock itself (its waits in the clock file,
+     * sim_clock.h: servoctl's fast and paced simulators) is not timed in
+     * real time: a simulator behind catches up at once for it, and may
+     * then run ahead. */
+    return sim_clock_host_waits() == 0u && bus.host_bytes != host_bytes_then && bus.count == 0 &&
+           sim_usb_due(&bus.usb) == SIM_USB_NONE && wall_us - handed_wall_us < within_us;
+}
+
 /* The servos and the wire up to target on the bus clock, event by event:
  * each byte as it ends on the wire, and each servo's main-loop pass when
  * its CPU would run it (sim_servo_wake_at): when the loop was late, the
@@ -118,13 +131,16 @@ static void run_to(uint64_t target, bool until_answer)
         sim_bus_deliver(&bus, at);
         if (bus.host_bytes != host_bytes) {
             handed_bus_us = bus.now_us;
-            handed_wall_us = sim_now_us();
+            handed_wall_us = bus.handed_wall_us; /* before the write: the host may start at once */
         }
         for (unsigned i = 0; i < bus.station_count; i++) {
             sim_servo_poll(&servos[i], bus.now_us);
         }
         if (until_answer && host_answered(SIM_CLOCK_UNTIL_ANSWER)) {
             break;
+        }
+        if (!paced_clock && bus.host_bytes != host_bytes && host_turn(sim_now_us(), HOST_TURN_US)) {
+            break; /* the host's turn runs from here, on the wall clock (host_turn_bound) */
         }
     } while (bus.now_us < target);
     sim_clock_publish(bus.now_us);
@@ -138,22 +154,11 @@ static bool paced_may_run(bool answered, uint64_t waits)
 }
 
 /* Where a simulator behind the wall clock may run to while its host takes
- * its turn (it has been handed bytes since it last wrote, and the wire
- * and its adapter are quiet): no further than the wall time since the
- * host was handed its last byte. The host's reaction time is its own,
- * real time; caught up at full speed meanwhile, the bus clock would charge
- * the host with the simulator's lag (a 16-servo round that the simulator
- * ran slower than real time: 0.25-1 ms of host gap, scripts/c_loop_bench.sh). */
-static bool host_turn(uint64_t wall_us, uint64_t within_us)
-{
-    /* A host that moves the clock itself (its waits in the clock file,
-     * sim_clock.h: servoctl's fast and paced simulators) is not timed in
-     * real time: a simulator behind catches up at once for it, and may
-     * then run ahead. */
-    return sim_clock_host_waits() == 0u && bus.host_bytes != host_bytes_then && bus.count == 0 &&
-           sim_usb_due(&bus.usb) == SIM_USB_NONE && wall_us - handed_wall_us < within_us;
-}
-
+ * its turn: no further than the wall time since the host was handed its
+ * last byte. The host's reaction time is its own, real time; caught up at
+ * full speed meanwhile, the bus clock would charge the host with the
+ * simulator's lag (a 16-servo round that the simulator ran slower than
+ * real time: 0.25-1 ms of host gap, scripts/c_loop_bench.sh). */
 static uint64_t host_turn_bound(uint64_t target, uint64_t wall_us)
 {
     if (!host_turn(wall_us, HOST_TURN_US)) {
@@ -162,6 +167,18 @@ static uint64_t host_turn_bound(uint64_t target, uint64_t wall_us)
     uint64_t bound = handed_bus_us + (wall_us - handed_wall_us);
     bound = bound > bus.now_us ? bound : bus.now_us;
     return bound < target ? bound : target;
+}
+
+/* Where the host's bytes just read go on the wire: at the bus clock; in a
+ * real-time host's turn, at the wall time it took since its last byte
+ * (host_turn_bound), not at the bus time of the simulator's last pass. */
+static uint64_t host_bytes_at(bool paced)
+{
+    uint64_t wall_us = sim_now_us();
+    if (paced || !host_turn(wall_us, HOST_TURN_US)) {
+        return bus.now_us;
+    }
+    return host_turn_bound(sim_bus_step_to(&bus, wall_us), wall_us);
 }
 
 static void on_signal(int sig)
@@ -183,6 +200,7 @@ int main(int argc, char **argv)
     uint64_t wall_start = sim_now_us();
     sim_bus_init(&bus, o.paced ? PACED_START_US : wall_start); /* paced: every run alike */
     bus.usb = o.host_link;
+    bus.wall_us = sim_now_us;
     char clock_path[256];
     bool clock_mapped = sim_clock_open(o.state_dir, clock_path, sizeof clock_path);
     for (unsigned i = 0; i < o.id_count; i++) {
@@ -286,7 +304,7 @@ int main(int argc, char **argv)
             uint8_t buf[512];
             ssize_t n = read(bus.host_fd, buf, sizeof buf);
             if (n > 0) {
-                sim_bus_from_host(&bus, buf, (unsigned)n, bus.now_us);
+                sim_bus_from_host(&bus, buf, (unsigned)n, host_bytes_at(o.paced));
                 host_bytes_then = bus.host_bytes;
                 host_read_total += (uint64_t)n;
             } else if (listen_fd >= 0 && (n == 0 || errno != EAGAIN)) {
