@@ -5,7 +5,9 @@ the wire's log (on the simulated clock) shows it as it was, not stretched
 by the simulator's catching up (firmware/boards/host_sim/main.c,
 host_turn_bound). A 16-servo robot loop, whose rounds the sanitised
 simulator runs slower than real time, had 0.25-1 ms of host gap a cycle
-so, and reached 0.84 of the wire (scripts/c_loop_bench.sh)."""
+so, and reached 0.84 of the wire (scripts/c_loop_bench.sh). And a host's
+bytes go on the wire at the time it wrote them, not at the bus time the
+simulator last ran to before it slept (host_bytes_at)."""
 import os
 import select
 import signal
@@ -20,6 +22,7 @@ from .test_bus_timing import wire_spans
 
 PING_ANSWER = 6  # bytes: header 2, code, size, ID, checksum
 HOST_TURN_S = 0.005  # how long this host takes to answer, in real time
+PINGS = 60  # the original took one in ten or so at 0-2 us
 
 
 def answer(conn):
@@ -31,6 +34,32 @@ def answer(conn):
         assert chunk, "the simulator closed the connection"
         got += chunk
     return got
+
+
+def host_gaps(spans):
+    """Each host burst's start less the end of the answer before it, us."""
+    return [spans[k][0] - spans[k - 1][1] for k in range(1, len(spans)) if spans[k][3] == "host"]
+
+
+def test_a_host_takes_the_time_it_took(tmp_path):
+    """A simulator asleep when the host's bytes came put them on the wire at
+    the bus time it had run to before it slept: a host answering at once
+    in 0-2 us, faster than the loopback's own round trip (6 us both ends
+    awake)."""
+    sim = Simulator(ids=[1], host_link="raw", state_dir=str(tmp_path / "state")).start()
+    try:
+        host, port = sim.url.removeprefix("socket://").rsplit(":", 1)
+        ping = p.request_frame(p.PING, bytes([1]))
+        with socket.create_connection((host, int(port)), timeout=5.0) as conn:
+            conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+            for _ in range(PINGS):
+                conn.sendall(ping)
+                answer(conn)
+        gaps = host_gaps(wire_spans(sim))
+    finally:
+        finish(sim, [1])
+    assert len(gaps) == PINGS - 1
+    assert min(gaps) >= 3, gaps
 
 
 def test_a_late_simulator_does_not_charge_its_host_for_catching_up(tmp_path):
@@ -53,9 +82,9 @@ def test_a_late_simulator_does_not_charge_its_host_for_catching_up(tmp_path):
         spans = wire_spans(sim)
     finally:
         finish(sim, [1])
-    hosts = [k for k, span in enumerate(spans) if span[3] == "host"]
-    assert len(hosts) == 2, spans
-    gap_us = spans[hosts[1]][0] - spans[hosts[1] - 1][1]
+    gaps = host_gaps(spans)
+    assert len(gaps) == 1, spans
+    gap_us = gaps[0]
     # The host's 5 ms, and what the PC adds to it; caught up meanwhile at
     # full speed, the bus clock ran on by some 100-300 ms.
     assert gap_us < 30000, f"the host's turn took {gap_us} us of the simulated clock"
