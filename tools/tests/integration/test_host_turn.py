@@ -36,6 +36,14 @@ def answer(conn):
     return got
 
 
+def connect(sim):
+    """A real-time host's connection to the simulator's bus (no Nagle delay)."""
+    host, port = sim.url.removeprefix("socket://").rsplit(":", 1)
+    conn = socket.create_connection((host, int(port)), timeout=5.0)
+    conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+    return conn
+
+
 def host_gaps(spans):
     """Each host burst's start less the end of the answer before it, us."""
     return [spans[k][0] - spans[k - 1][1] for k in range(1, len(spans)) if spans[k][3] == "host"]
@@ -48,10 +56,8 @@ def test_a_host_takes_the_time_it_took(tmp_path):
     awake)."""
     sim = Simulator(ids=[1], host_link="raw", state_dir=str(tmp_path / "state")).start()
     try:
-        host, port = sim.url.removeprefix("socket://").rsplit(":", 1)
         ping = p.request_frame(p.PING, bytes([1]))
-        with socket.create_connection((host, int(port)), timeout=5.0) as conn:
-            conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        with connect(sim) as conn:
             for _ in range(PINGS):
                 conn.sendall(ping)
                 answer(conn)
@@ -65,10 +71,8 @@ def test_a_host_takes_the_time_it_took(tmp_path):
 def test_a_late_simulator_does_not_charge_its_host_for_catching_up(tmp_path):
     sim = Simulator(ids=[1], host_link="raw", state_dir=str(tmp_path / "state")).start()
     try:
-        host, port = sim.url.removeprefix("socket://").rsplit(":", 1)
         ping = p.request_frame(p.PING, bytes([1]))
-        with socket.create_connection((host, int(port)), timeout=5.0) as conn:
-            conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        with connect(sim) as conn:
             os.kill(sim.process.pid, signal.SIGSTOP)  # a PC that keeps the simulator waiting
             try:
                 conn.sendall(ping)
