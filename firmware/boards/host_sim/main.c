@@ -171,10 +171,12 @@ static uint64_t host_turn_bound(uint64_t target, uint64_t wall_us)
 
 /* Where the host's bytes just read go on the wire: at the bus clock; in a
  * real-time host's turn, at the wall time it took since its last byte
- * (host_turn_bound), not at the bus time of the simulator's last pass. */
-static uint64_t host_bytes_at(bool paced)
+ * (host_turn_bound) until they arrived (ago_us before now), not at the bus
+ * time of the simulator's last pass. */
+static uint64_t host_bytes_at(bool paced, uint64_t ago_us)
 {
     uint64_t wall_us = sim_now_us();
+    wall_us -= ago_us < wall_us - handed_wall_us ? ago_us : wall_us - handed_wall_us;
     if (paced || !host_turn(wall_us, HOST_TURN_US)) {
         return bus.now_us;
     }
@@ -302,9 +304,10 @@ int main(int argc, char **argv)
         if (host_slot >= 0 && (fds[host_slot].revents & (POLLIN | POLLHUP | POLLERR)) &&
             sim_bus_room(&bus) >= 512u) {
             uint8_t buf[512];
-            ssize_t n = read(bus.host_fd, buf, sizeof buf);
+            uint64_t ago_us;
+            ssize_t n = sim_read_host(bus.host_fd, buf, sizeof buf, &ago_us);
             if (n > 0) {
-                sim_bus_from_host(&bus, buf, (unsigned)n, host_bytes_at(o.paced));
+                sim_bus_from_host(&bus, buf, (unsigned)n, host_bytes_at(o.paced, ago_us));
                 host_bytes_then = bus.host_bytes;
                 host_read_total += (uint64_t)n;
             } else if (listen_fd >= 0 && (n == 0 || errno != EAGAIN)) {
@@ -333,6 +336,7 @@ int main(int argc, char **argv)
             } else if (fd >= 0) {
                 int one = 1; /* a UART does not wait to fill packets */
                 setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
+                sim_stamp_arrivals(fd);
                 fcntl(fd, F_SETFL, O_NONBLOCK);
                 bus.host_fd = fd;
             }
