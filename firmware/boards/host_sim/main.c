@@ -45,6 +45,18 @@ enum { READY_AFTER_US = 5000 };
 /* How often a paced simulator standing still looks at the host's clock
  * word (sim_clock.h) when no byte wakes it. */
 enum { PACED_POLL_US = 200 };
+/* How long after the host was handed its last byte it counts as taking
+ * its turn (host_turn_bound); later, it is idle, and a simulator behind
+ * the wall clock catches up. */
+enum { HOST_TURN_US = 50000 };
+/* For this long of it the simulator does not sleep: a host that answers
+ * within it has its bytes taken as they come, at the bus time they came,
+ * not after the PC has woken the simulator (or at the bus time the
+ * simulator went to sleep at). */
+enum { HOST_SPIN_US = 200 };
+/* When the host was last handed bytes: the bus clock then, and the wall
+ * clock (sim_now_us) as the simulator handed them over. */
+static uint64_t handed_bus_us, handed_wall_us;
 /* A paced clock's start: the wall clock's at the start, a millisecond. */
 enum { PACED_START_US = 1000 };
 static int refused[REFUSED_MAX] = {-1, -1, -1, -1};
@@ -65,6 +77,7 @@ static void take_client(int fd)
 {
     int one = 1; /* a UART does not wait to fill packets */
     setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
+    sim_stamp_arrivals(fd);
     fcntl(fd, F_SETFL, O_NONBLOCK);
     bus.host_fd = fd;
 }
@@ -99,6 +112,19 @@ static bool host_answered(uint64_t waits)
            bus.host_bytes > sim_clock_host_received() && bus.count == 0 && sim_usb_due(&bus.usb) == SIM_USB_NONE;
 }
 
+/* The host takes its turn: it has been handed bytes since it last wrote,
+ * the wire and its adapter are quiet, and it was handed its last byte
+ * within within_us of the wall clock. */
+static bool host_turn(uint64_t wall_us, uint64_t within_us)
+{
+    /* A host that moves the clock itself (its waits in the clock file,
+     * sim_clock.h: servoctl's fast and paced simulators) is not timed in
+     * real time: a simulator behind catches up at once for it, and may
+     * then run ahead. */
+    return sim_clock_host_waits() == 0u && bus.host_bytes != host_bytes_then && bus.count == 0 &&
+           sim_usb_due(&bus.usb) == SIM_USB_NONE && wall_us - handed_wall_us < within_us;
+}
+
 /* The servos and the wire up to target on the bus clock, event by event:
  * each byte as it ends on the wire, and each servo's main-loop pass when
  * its CPU would run it (sim_servo_wake_at): when the loop was late, the
@@ -122,12 +148,20 @@ static void run_to(uint64_t target, bool until_answer)
              * before it. */
             sim_clock_publish(at);
         }
+        unsigned long host_bytes = bus.host_bytes;
         sim_bus_deliver(&bus, at);
+        if (bus.host_bytes != host_bytes) {
+            handed_bus_us = bus.now_us;
+            handed_wall_us = bus.handed_wall_us; /* before the write: the host may start at once */
+        }
         for (unsigned i = 0; i < bus.station_count; i++) {
             sim_servo_poll(&servos[i], bus.now_us);
         }
         if (until_answer && host_answered(SIM_CLOCK_UNTIL_ANSWER)) {
             break;
+        }
+        if (!paced_clock && bus.host_bytes != host_bytes && host_turn(sim_now_us(), HOST_TURN_US)) {
+            break; /* the host's turn runs from here, on the wall clock (host_turn_bound) */
         }
     } while (bus.now_us < target);
     sim_clock_publish(bus.now_us);
@@ -138,6 +172,36 @@ static void run_to(uint64_t target, bool until_answer)
 static bool paced_may_run(bool answered, uint64_t waits)
 {
     return !answered && waits > bus.now_us && sim_clock_host_sent() <= host_read_total;
+}
+
+/* Where a simulator behind the wall clock may run to while its host takes
+ * its turn: no further than the wall time since the host was handed its
+ * last byte. The host's reaction time is its own, real time; caught up at
+ * full speed meanwhile, the bus clock would charge the host with the
+ * simulator's lag (a 16-servo round that the simulator ran slower than
+ * real time: 0.25-1 ms of host gap, scripts/c_loop_bench.sh). */
+static uint64_t host_turn_bound(uint64_t target, uint64_t wall_us)
+{
+    if (!host_turn(wall_us, HOST_TURN_US)) {
+        return target;
+    }
+    uint64_t bound = handed_bus_us + (wall_us - handed_wall_us);
+    bound = bound > bus.now_us ? bound : bus.now_us;
+    return bound < target ? bound : target;
+}
+
+/* Where the host's bytes just read go on the wire: at the bus clock; in a
+ * real-time host's turn, at the wall time it took since its last byte
+ * (host_turn_bound) until they arrived (ago_us before now), not at the bus
+ * time of the simulator's last pass. */
+static uint64_t host_bytes_at(bool paced, uint64_t ago_us)
+{
+    uint64_t wall_us = sim_now_us();
+    wall_us -= ago_us < wall_us - handed_wall_us ? ago_us : wall_us - handed_wall_us;
+    if (paced || !host_turn(wall_us, HOST_TURN_US)) {
+        return bus.now_us;
+    }
+    return host_turn_bound(sim_bus_step_to(&bus, wall_us), wall_us);
 }
 
 static void on_signal(int sig)
@@ -159,6 +223,7 @@ int main(int argc, char **argv)
     uint64_t wall_start = sim_now_us();
     sim_bus_init(&bus, o.paced ? PACED_START_US : wall_start); /* paced: every run alike */
     bus.usb = o.host_link;
+    bus.wall_us = sim_now_us;
     char clock_path[256];
     bool clock_mapped = sim_clock_open(o.state_dir, clock_path, sizeof clock_path);
     for (unsigned i = 0; i < o.id_count; i++) {
@@ -242,7 +307,10 @@ int main(int argc, char **argv)
         waits &= ~SIM_CLOCK_UNTIL_ANSWER;
         if (o.paced) {
             wait_us = paced_may_run(answered, waits) ? 0 : PACED_POLL_US;
-        } else if (sim_bus_step_to(&bus, wall) < wall || (waits > wall && !answered)) {
+        } else if ((sim_bus_step_to(&bus, wall) < wall && !host_turn(wall, HOST_TURN_US)) ||
+                   (waits > wall && !answered) || host_turn(wall, HOST_SPIN_US)) {
+            /* Behind the wall clock (not held back by the host's turn), or
+             * running ahead for the host, or the host's turn just begun. */
             wait_us = 0;
         }
         struct timespec timeout = {.tv_sec = 0, .tv_nsec = wait_us * 1000};
@@ -257,9 +325,10 @@ int main(int argc, char **argv)
         if (host_slot >= 0 && (fds[host_slot].revents & (POLLIN | POLLHUP | POLLERR)) &&
             sim_bus_room(&bus) >= 512u) {
             uint8_t buf[512];
-            ssize_t n = read(bus.host_fd, buf, sizeof buf);
+            uint64_t ago_us;
+            ssize_t n = sim_read_host(bus.host_fd, buf, sizeof buf, &ago_us);
             if (n > 0) {
-                sim_bus_from_host(&bus, buf, (unsigned)n, bus.now_us);
+                sim_bus_from_host(&bus, buf, (unsigned)n, host_bytes_at(o.paced, ago_us));
                 host_bytes_then = bus.host_bytes;
                 host_read_total += (uint64_t)n;
             } else if (listen_fd >= 0 && (n == 0 || errno != EAGAIN)) {
@@ -318,7 +387,7 @@ int main(int argc, char **argv)
             sim_skip_us(skip < SIM_BUS_STEP_US ? skip : SIM_BUS_STEP_US);
             wall_now = sim_now_us();
         }
-        uint64_t target = sim_bus_step_to(&bus, wall_now);
+        uint64_t target = host_turn_bound(sim_bus_step_to(&bus, wall_now), wall_now);
         if (wall_now - target > most_behind_us) {
             most_behind_us = wall_now - target;
         }

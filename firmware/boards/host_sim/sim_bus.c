@@ -135,6 +135,7 @@ static void hand_over(struct sim_bus *b, uint64_t now_us)
     uint8_t out[256];
     unsigned n;
     while ((n = sim_usb_take(&b->usb, now_us, out, sizeof out)) > 0u) {
+        b->handed_wall_us = b->wall_us != NULL ? b->wall_us() : 0u;
         write_host(b, out, n);
     }
 }

@@ -88,6 +88,8 @@ struct sim_bus {
     unsigned long dropped;    /* queue overflow (servo bytes; the host is held back) */
     unsigned long baud_mismatches; /* bytes no station at that rate received */
     unsigned long host_bytes; /* bytes the host was sent */
+    uint64_t (*wall_us)(void); /* the wall clock, if set: handed_wall_us */
+    uint64_t handed_wall_us;  /* as the host was last handed bytes (before the write) */
     struct sim_bus_span spans[SIM_BUS_SPANS];
     unsigned long span_count; /* in all: the latest SIM_BUS_SPANS are kept */
 };

@@ -9,7 +9,9 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/socket.h>
+#include <sys/uio.h>
 #include <termios.h>
+#include <time.h>
 #include <unistd.h>
 
 int sim_listen_on(int port, int *bound_port)
@@ -53,4 +55,36 @@ int sim_open_pty(const char *link, char *name, size_t name_size, int *slave_fd)
         }
     }
     return master;
+}
+
+void sim_stamp_arrivals(int fd)
+{
+    int one = 1;
+    setsockopt(fd, SOL_SOCKET, SO_TIMESTAMPNS, &one, sizeof one);
+}
+
+ssize_t sim_read_host(int fd, uint8_t *buf, size_t len, uint64_t *ago_us)
+{
+    struct iovec iov = {.iov_base = buf, .iov_len = len};
+    union {
+        char space[CMSG_SPACE(sizeof(struct timespec))];
+        struct cmsghdr align;
+    } control;
+    struct msghdr msg = {.msg_iov = &iov, .msg_iovlen = 1, .msg_control = control.space,
+                         .msg_controllen = sizeof control.space};
+    *ago_us = 0;
+    ssize_t n = recvmsg(fd, &msg, 0);
+    if (n < 0 && errno == ENOTSOCK) {
+        return read(fd, buf, len); /* a pty */
+    }
+    for (struct cmsghdr *c = n > 0 ? CMSG_FIRSTHDR(&msg) : NULL; c != NULL; c = CMSG_NXTHDR(&msg, c)) {
+        if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SCM_TIMESTAMPNS) {
+            struct timespec at, now;
+            memcpy(&at, CMSG_DATA(c), sizeof at);
+            clock_gettime(CLOCK_REALTIME, &now);
+            int64_t ago = ((int64_t)now.tv_sec - at.tv_sec) * 1000000 + (now.tv_nsec - at.tv_nsec) / 1000;
+            *ago_us = ago > 0 ? (uint64_t)ago : 0u;
+        }
+    }
+    return n;
 }

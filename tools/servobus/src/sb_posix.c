@@ -43,6 +43,7 @@ static void reset(sb_posix *p)
     p->fd = -1;
     p->low_water = 1;
     p->latency_timer_ms = -1;
+    p->spin_us = SB_POSIX_SPIN_US;
 }
 
 int sb_tcp_open(sb_posix *p, const char *host, unsigned port)
@@ -229,10 +230,34 @@ static int posix_write(void *ctx, const uint8_t *data, size_t len)
     return 0;
 }
 
+static ssize_t read_now(const sb_posix *p, uint8_t *buf, size_t cap)
+{
+    return p->is_socket ? recv(p->fd, buf, cap, MSG_DONTWAIT) : read(p->fd, buf, cap);
+}
+
+/* Up to spin_us (at most wait_us) of looking without sleeping: > 0 bytes
+ * read, < 0 an error, 0 none came (*wait_us then what is left). */
+static ssize_t spin(sb_posix *p, uint8_t *buf, size_t cap, uint32_t *wait_us)
+{
+    uint32_t most = p->spin_us < *wait_us ? p->spin_us : *wait_us;
+    uint64_t start = sb_monotonic_us(NULL), spent = 0;
+    ssize_t n = 0;
+    while (most > 0 && spent < most) {
+        n = read_now(p, buf, cap);
+        if (n != 0 && !(n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR)))
+            return n;
+        spent = sb_monotonic_us(NULL) - start;
+    }
+    *wait_us -= spent < *wait_us ? (uint32_t)spent : *wait_us;
+    return 0;
+}
+
 static int posix_read(void *ctx, uint8_t *buf, size_t cap, size_t want, uint32_t wait_us)
 {
     sb_posix *p = (sb_posix *)ctx;
-    ssize_t n;
+    ssize_t n = wait_us > 0 ? spin(p, buf, cap, &wait_us) : 0;
+    if (n != 0)
+        goto got;
     if (wait_us > 0) {
         struct pollfd pf = {p->fd, POLLIN, 0};
         struct timespec ts = {(time_t)(wait_us / 1000000u), (long)(wait_us % 1000000u) * 1000L};
@@ -248,7 +273,8 @@ static int posix_read(void *ctx, uint8_t *buf, size_t cap, size_t want, uint32_t
         if (ppoll(&pf, 1, &ts, NULL) < 0 && errno != EINTR)
             return -errno;
     }
-    n = p->is_socket ? recv(p->fd, buf, cap, MSG_DONTWAIT) : read(p->fd, buf, cap);
+    n = read_now(p, buf, cap);
+got:
     if (n < 0)
         return errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR ? 0 : -errno;
     if (n == 0 && p->is_socket)

@@ -134,6 +134,34 @@ static void a_write_the_link_never_takes_fails(void **state)
     close(master);
 }
 
+/* A wait looks for bytes without sleeping first (spin_us), then sleeps
+ * for the rest; bytes there, or come meanwhile, are read either way, and
+ * none in the wait is no error. */
+static void a_wait_spins_then_sleeps_and_reads_what_comes(void **state)
+{
+    int master = -1, slave = -1;
+    char name[128];
+    uint8_t buf[16];
+    sb_posix p;
+    sb_transport t;
+    (void)state;
+    assert_int_equal(openpty(&master, &slave, name, NULL, NULL), 0);
+    assert_int_equal(sb_serial_open(&p, name, 115200), 0);
+    assert_int_equal(p.spin_us, SB_POSIX_SPIN_US);
+    t = sb_posix_transport(&p);
+    assert_int_equal(t.read(t.ctx, buf, sizeof buf, 1, 2000), 0); /* spun, slept: nothing */
+    assert_int_equal(write(master, "\x55\xAA", 2), 2);
+    assert_int_equal(t.read(t.ctx, buf, sizeof buf, 2, 1000000), 2); /* found while spinning */
+    assert_int_equal(buf[0], 0x55);
+    p.spin_us = 0; /* sleeps at once */
+    assert_int_equal(write(master, "\x01", 1), 1);
+    assert_int_equal(t.read(t.ctx, buf, sizeof buf, 1, 1000000), 1);
+    assert_int_equal(buf[0], 0x01);
+    sb_posix_close(&p);
+    close(slave);
+    close(master);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -142,6 +170,7 @@ int main(void)
         cmocka_unit_test(a_rate_termios_has_not_is_refused),
         cmocka_unit_test(a_port_another_program_holds_is_refused),
         cmocka_unit_test(a_write_the_link_never_takes_fails),
+        cmocka_unit_test(a_wait_spins_then_sleeps_and_reads_what_comes),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

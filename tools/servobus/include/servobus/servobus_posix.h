@@ -18,7 +18,13 @@ typedef struct sb_posix {
     bool low_latency;    /* the serial driver took ASYNC_LOW_LATENCY */
     int latency_timer_ms; /* the adapter's latency timer (sysfs), -1: none found */
     char advice[200];    /* what to do about a slow latency timer, or "" */
+    /* A wait for bytes first looks this long without sleeping (0: sleeps
+     * at once): bytes due soon are taken as they come, without the
+     * process's wake-up. Opened: SB_POSIX_SPIN_US. */
+    uint32_t spin_us;
 } sb_posix;
+
+#define SB_POSIX_SPIN_US 100u
 
 /* A TCP connection to host:port (TCP_NODELAY). 0, or -errno. */
 int sb_tcp_open(sb_posix *p, const char *host, unsigned port);
