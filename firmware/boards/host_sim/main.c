@@ -45,20 +45,17 @@ enum { READY_AFTER_US = 5000 };
 /* How often a paced simulator standing still looks at the host's clock
  * word (sim_clock.h) when no byte wakes it. */
 enum { PACED_POLL_US = 200 };
-/* How long after the host was handed its last byte it counts as taking
- * its turn (host_turn_bound); later, it is idle, and a simulator behind
- * the wall clock catches up. */
+/* How long after its last byte the host counts as taking its turn
+ * (host_turn_bound); later, a simulator behind the wall clock catches up. */
 enum { HOST_TURN_US = 50000 };
 /* For this long of it the simulator does not sleep: a host that answers
- * within it has its bytes taken as they come, at the bus time they came,
- * not after the PC has woken the simulator (or at the bus time the
- * simulator went to sleep at). */
+ * within it has its bytes taken at the bus time they came, not when the PC
+ * woke the simulator (or when the simulator went to sleep). */
 enum { HOST_SPIN_US = 200 };
 /* When the host was last handed bytes: the bus clock then, and the wall
  * clock (sim_now_us) as the simulator handed them over. */
 static uint64_t handed_bus_us, handed_wall_us;
-/* A paced clock's start: the wall clock's at the start, a millisecond. */
-enum { PACED_START_US = 1000 };
+enum { PACED_START_US = 1000 }; /* a paced clock's start: the wall clock's */
 static int refused[REFUSED_MAX] = {-1, -1, -1, -1};
 /* A client that came while the one on the bus had hung up, its last bytes
  * still unread (a loaded PC held this process up while one host sent a
@@ -113,8 +110,7 @@ static bool host_answered(uint64_t waits)
 }
 
 /* The host takes its turn: it has been handed bytes since it last wrote,
- * the wire and its adapter are quiet, and it was handed its last byte
- * within within_us of the wall clock. */
+ * the wire and its adapter are quiet, its last byte within within_us. */
 static bool host_turn(uint64_t wall_us, uint64_t within_us)
 {
     /* A host that moves the clock itself (its waits in the clock file,
