@@ -351,12 +351,7 @@ class Simulator(_Child):
 
     def _host_read(self, count: int, waits_for_more: bool = False) -> None:
         self._read_bytes += count
-        # Only of bytes come since the host last sent (a Sync Monitor's
-        # first answers): the bytes before are the last request's answer,
-        # and a simulator a loaded PC held up may not yet have stood still
-        # where that answer ended. Told it has them all, it took them for
-        # looked at and ran on past it, to where it read the next request
-        # (identify's play came out 0.3-16.8 % off under load).
+        # Only once bytes came since the host last sent (docs/simulator.md: not the last answer's)
         if waits_for_more and self._read_bytes > self._read_at_send:
             _CLOCK_US.pack_into(self._clock_map, 24, self._read_bytes)
 
