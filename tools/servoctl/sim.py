@@ -124,6 +124,7 @@ class Simulator(_Child):
         self._clock_map = None  # servo_sim's clock file, mapped (sim_clock.h)
         self._sent_bytes = 0  # on the bus, in all: a paced servo_sim's offset 16
         self._read_bytes = 0  # off the bus, in all: its offset 24
+        self._read_at_send = 0  # _read_bytes when the host last sent
 
     @classmethod
     def running(cls, control_port: int) -> "Simulator":
@@ -248,7 +249,7 @@ class Simulator(_Child):
         host time, which is simulated time on an idle PC."""
         if self._clock_map is not None:
             self._clock_map.close()  # a restarted simulator's file is mapped anew
-        self._sent_bytes = self._read_bytes = 0
+        self._sent_bytes = self._read_bytes = self._read_at_send = 0
         try:
             writes = self.fast or self.paced
             with open(path, "r+b" if writes else "rb") as f:
@@ -337,6 +338,7 @@ class Simulator(_Child):
 
     def _host_sent(self, count: int) -> None:
         self._sent_bytes += count
+        self._read_at_send = self._read_bytes
         _CLOCK_US.pack_into(self._clock_map, 16, self._sent_bytes)
 
     @property
@@ -349,7 +351,8 @@ class Simulator(_Child):
 
     def _host_read(self, count: int, waits_for_more: bool = False) -> None:
         self._read_bytes += count
-        if waits_for_more:
+        # Only once bytes came since the host last sent (docs/simulator.md: not the last answer's)
+        if waits_for_more and self._read_bytes > self._read_at_send:
             _CLOCK_US.pack_into(self._clock_map, 24, self._read_bytes)
 
     @property

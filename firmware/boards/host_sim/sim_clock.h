@@ -22,7 +22,9 @@
  * writes how many bytes it has read off the bus in all: one that waits for
  * an answer having read every byte it was sent waits for more (a Sync
  * Monitor's answers after an absent servo's silent slot), and the
- * simulator runs on to them. */
+ * simulator runs on to them. Written only once bytes have come since the
+ * host last sent: those before are the last answer's, which a simulator
+ * held up may not yet have stood still at. */
 #ifndef SIM_CLOCK_H
 #define SIM_CLOCK_H
 

@@ -119,17 +119,22 @@ def _sent_late(bus, host_late_s: float) -> None:
     bus.send_burst = late
 
 
-def _step_record(tmp_path, name: str, host_late_s: float) -> list:
+def _step_record(tmp_path, name: str, host_late_s: float, jam_seed=None) -> list:
     """One of identify's open-loop steps (ReadMotion after ReadMotion, as
     fast as the host goes) on a paced servo_sim, each request sent
-    host_late_s of host time late: a host a loaded PC holds up."""
+    host_late_s of host time late: a host a loaded PC holds up; with
+    jam_seed, the simulator held up too (_jammed)."""
     from servoctl.identify import record_step
     from servoctl.servo import Servo
 
     with Simulator(state_dir=str(tmp_path / name), host_link="raw", paced=True) as sim:
         with sim.bus(timeout=0.2) as bus:
             _sent_late(bus, host_late_s)
-            step = record_step(Servo(bus, 1), 0.3, 300, sim.sleep)  # then damped to rest: sim.sleep
+            unjam = _jammed(sim, jam_seed) if jam_seed is not None else (lambda: None)
+            try:
+                step = record_step(Servo(bus, 1), 0.3, 300, sim.sleep)  # then damped to rest: sim.sleep
+            finally:
+                unjam()
             sim.wait_until(lambda: sim.state(1)["velocity"] == 0.0, 1.0)
             ended = sim.clock_s()
         assert sim.state(1)["collisions"] == 0
@@ -145,6 +150,58 @@ def test_a_paced_simulator_sees_the_same_host_whatever_its_speed(tmp_path):
     on_time = _step_record(tmp_path, "on-time", 0.0)
     assert len(on_time) > 80 and max(abs(s[1]) for s in on_time[:-1]) > 0.2  # it turned (rad)
     assert _step_record(tmp_path, "late", 0.003) == on_time
+
+
+def _jammed(sim, seed: int):
+    """The simulator stopped (SIGSTOP) again and again, up to 3 ms of host
+    time each, 3 ms apart at most (seeded), as a loaded PC holds it up at
+    moments of its making; until the function returned is called (and
+    has it running again)."""
+    import random
+    import time
+
+    rng, done = random.Random(seed), threading.Event()
+
+    def jam():
+        while not done.wait(0.003 * rng.random()):
+            os.kill(sim.process.pid, signal.SIGSTOP)
+            time.sleep(0.003 * rng.random())
+            os.kill(sim.process.pid, signal.SIGCONT)
+    thread = threading.Thread(target=jam, daemon=True)
+    thread.start()
+    return lambda: (done.set(), thread.join())
+
+
+def test_a_paced_simulator_held_up_by_the_pc_sees_the_same_host(tmp_path):
+    """One of identify's steps on a paced servo_sim, the simulator itself
+    held up now and then (_jammed): the same samples to the bit. A host
+    that had read an answer before the simulator stood still at its end
+    said, waiting for its next one, that it had looked at every byte; the
+    simulator ran past the answer to where it read the next request, 248 us
+    later (identify's play came out 0.3-16.8 % off under load)."""
+    on_time = _step_record(tmp_path, "on-time", 0.0)
+    for seed in (1, 2):
+        assert _step_record(tmp_path, f"jammed-{seed}", 0.0, seed) == on_time
+
+
+def test_a_paced_host_waiting_for_an_answer_not_begun_tells_nothing(tmp_path):
+    """Bytes read before the host's request are the last answer's: while
+    none of the next has come (the simulator held up), the host does not
+    tell the paced simulator it has looked at them all (the clock file's
+    offset 24, read on its way to an answer's end: _host_read)."""
+    from servoctl import protocol as p
+    from servoctl.servo import Servo
+
+    with Simulator(state_dir=str(tmp_path / "state"), paced=True) as sim:
+        with sim.bus(timeout=0.2) as bus:
+            Servo(bus, 1).read_motion()
+            told = bytes(sim._clock_map[24:32])
+            seen = []
+            resume = _lagging(sim, None)
+            threading.Timer(0.05, lambda: (seen.append(bytes(sim._clock_map[24:32])), resume.run())).start()
+            bus.send(p.READ_MOTION, bytes([1]))
+            assert bus.read_response(p.READ_MOTION, 1)
+            assert seen == [told]
 
 
 def _monitor_past_a_silent_slot(tmp_path, name: str, host_late_s: float) -> tuple:
