@@ -67,6 +67,7 @@ static void take_client(int fd)
     setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
     fcntl(fd, F_SETFL, O_NONBLOCK);
     bus.host_fd = fd;
+    sim_bus_new_host(&bus); /* the answers to one that left are not its */
 }
 
 static void tell_in_use(int fd)
