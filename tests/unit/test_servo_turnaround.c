@@ -128,6 +128,35 @@ static void test_a_tick_waits_for_a_request_about_to_end(void **state)
     assert_int_equal(servo.next_tick_us, due + CONTROL_TICK_US);
 }
 
+/* The cases around the send ahead: listed twice, it answers once, as
+ * listed first; a Monitor record of another length, or a round that does
+ * not list it, sends nothing (the send ahead takes only what the full
+ * dispatch answers). */
+static void feed_round(const uint8_t *content, size_t n)
+{
+    request_length = make_request(request, PKT_SYNC_COMMAND, content, n);
+    feed_at_1mbaud(request, request_length);
+    harness_run_ms(20); /* every turn passes */
+}
+
+static void test_the_send_ahead_answers_only_what_a_dispatch_does(void **state)
+{
+    (void)state;
+    static const uint8_t twice[] = {22, 1, 3, 0, 5, 0};
+    feed_round(twice, sizeof twice);
+    assert_int_equal(hal.sends, 1u);
+    assert_int_equal(hal.sent_length, 4u + 16u + 1u);
+    assert_memory_equal(hal.head_at_send, hal.sent, sizeof hal.head_at_send);
+    hal_double_clear_sent(&hal);
+    static const uint8_t longer[] = {22, 2, 2, 0, 0, 5, 0};
+    feed_round(longer, sizeof longer);
+    assert_int_equal(hal.sends, 0u);
+    assert_true(servo.regs.status.status & STATUS_COMMAND_ERROR);
+    static const uint8_t others[] = {22, 1, 2, 5, 6};
+    feed_round(others, sizeof others);
+    assert_int_equal(hal.sends, 0u);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -135,6 +164,7 @@ int main(void)
         cmocka_unit_test_setup(test_a_request_with_a_bad_checksum_is_not_answered, setup),
         cmocka_unit_test_setup(test_a_cut_request_is_not_answered, setup),
         cmocka_unit_test_setup(test_a_tick_waits_for_a_request_about_to_end, setup),
+        cmocka_unit_test_setup(test_the_send_ahead_answers_only_what_a_dispatch_does, setup),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

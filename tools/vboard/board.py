@@ -155,7 +155,7 @@ class Board:
         self.stepped = [m for m in self.models if type(m).step is not Model.step]
         self.station = bus.attach(self.usart)
         self.usart.bus_station = self.station
-        self.pass_start = pass_facts(elf(board))  # (address, code, _ebss) or None
+        self.pass_start = pass_facts(elf(board))  # (address, (section, code), _ebss) or None
         if self.pass_start is not None:
             self.core.skip_memory(self.ram.buf, h["BOARD_RAM_BASE"], self.pass_start[2] - h["BOARD_RAM_BASE"])
         self.resets = {"power": 0, "software": 0, "watchdog": 0}
@@ -291,11 +291,11 @@ class Board:
 
     def _pass_start(self) -> int:
         """Where the main loop's pass begins, if the flash holds the ELF's
-        code there (an update may have brought other code): else 0."""
+        code section (an update may have brought another image): else 0."""
         if self.pass_start is None:
             return 0
-        address, code, _ = self.pass_start
-        return address if self.flash_mem.read(address - self.flash_base, len(code)) == code else 0
+        address, (section, code), _ = self.pass_start
+        return address if self.flash_mem.read(section - self.flash_base, len(code)) == code else 0
 
     def power_cycle(self, off_s: float = 0.1) -> None:
         """Power off (the motor coasts, RAM is lost), then on."""

@@ -22,6 +22,8 @@ import select
 import socket
 import tty
 
+from servoctl.codec import ANSWER_FRAME_MAX
+
 from .native import wire_overlap
 from .usb import Adapter
 
@@ -37,6 +39,11 @@ HOST_TURNAROUND_S = 125e-6
 # A second TCP client while one holds the bus is told so (servo_sim's
 # words, which servoctl recognises) and ignored until it leaves.
 BUS_IN_USE = b"vboard: the bus is in use by another client\n"
+# A client taken in place of one that left hears no servo byte that began
+# before its own first byte, up to the longest answer's time after what
+# the wire holds (sim_bus.c, sim_bus_new_host): that answers the one that
+# left: the longest answer's time, and 5 ms.
+ANSWER_SLACK_S = 0.005
 
 
 class Bus:
@@ -63,6 +70,7 @@ class Bus:
         self.link_path = None
         self.refused = []
         self._next = None  # a client come while the last one leaves (_in_place_of_one_leaving)
+        self.deaf_before_s = -1.0  # a servo byte begun before this is not the connected client's
 
     def attach(self, usart) -> int:
         self.stations.append(usart)
@@ -135,14 +143,18 @@ class Bus:
                     pass
                 self.refused.append(conn)
             elif conn is not None:
-                self._take(conn)
+                self._take(conn, now_s)
         self.flush_to_host(now_s)
 
-    def _take(self, conn) -> None:
+    def _take(self, conn, now_s: float) -> None:
         conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
         conn.setblocking(False)
         self._conn = conn
         self.host_fd = conn.fileno()
+        self.to_host.clear()
+        self.adapter.held.clear()  # the answers to one that left are not its
+        longest = ANSWER_FRAME_MAX * FRAME_BITS / self.host_baud + ANSWER_SLACK_S
+        self.deaf_before_s = max(self.wire_until_s, now_s) + longest
 
     def _in_place_of_one_leaving(self, conn) -> bool:
         """A client that came while the one on the bus has hung up, its last
@@ -168,7 +180,7 @@ class Bus:
             except OSError:
                 data = b""
             if data == b"" and self.listen is not None:
-                self._drop_client()
+                self._drop_client(now_s)
                 return
             if data:
                 self.host_bytes_then = self.host_bytes
@@ -189,19 +201,20 @@ class Bus:
             except (BlockingIOError, OSError):
                 pass
 
-    def _drop_client(self) -> None:
+    def _drop_client(self, now_s: float) -> None:
         self._conn.close()
         self.host_fd = None
         self.to_host.clear()
         self.adapter.held.clear()
         if self._next is not None:
             self._next, conn = None, self._next
-            self._take(conn)
+            self._take(conn, now_s)
 
     def queue_host(self, byte: int, now_s: float) -> None:
         """A host byte on the wire from now_s, after the host's earlier
         bytes and whatever is on the wire."""
         start = max(now_s, self.host_queue_until_s, self.wire_until_s)
+        self.deaf_before_s = min(self.deaf_before_s, start)  # from its first byte, answers may be its
         end = start + FRAME_BITS / self.host_baud
         self.host_queue_until_s = end
         self.wire_until_s = max(self.wire_until_s, end)
@@ -246,10 +259,11 @@ class Bus:
 
     def deliver_until(self, t_s: float) -> None:
         while self.events and self.events[0][0] <= t_s:
-            end_s, _, byte, baud, sender, _ = heapq.heappop(self.events)
+            end_s, _, byte, baud, sender, start_s = heapq.heappop(self.events)
             for usart in self.stations:
                 usart.receive(byte, baud)
-            if sender != HOST and abs(baud - self.host_baud) <= 0.03 * self.host_baud:
+            if sender != HOST and abs(baud - self.host_baud) <= 0.03 * self.host_baud and \
+                    start_s >= self.deaf_before_s:
                 self.adapter.hold(byte, end_s, baud)
 
     def close(self) -> None:

@@ -16,7 +16,8 @@ end, is the same pass again.
 
 The instruction counter (native/instruction_count.c) looks where a pass
 begins: servo_poll's first instruction, found by name in the
-application's ELF, and only while the flash holds the ELF's code there.
+application's ELF, and only while the flash holds the ELF's code (its
+whole code section: the static data's end is the ELF's too).
 It compares each pass's start with the one before in the same run (at
 most TRIES of them), and at the first match counts the whole passes left
 in the run as run, at their measured length in instructions, without
@@ -74,9 +75,11 @@ def _symbol(elf, name: str):
 
 
 def pass_facts(path):
-    """(address, code) of the pass's first function and the end of the
-    firmware's static data (_ebss: above it, the stack) in the
-    application's ELF, or None."""
+    """(address of the pass's first function, (address, bytes) of the
+    code section that holds it, end of the firmware's static data: _ebss,
+    above it the stack) in the application's ELF, or None. The whole
+    section, not the function's bytes alone: another image may hold the
+    same function at the same address, its static data laid out anew."""
     elf = _elf(path)
     found = elf and _symbol(elf, PASS_START)
     ebss = elf and _symbol(elf, "_ebss")
@@ -85,8 +88,7 @@ def pass_facts(path):
     address, size = found[0] & ~1, found[1]
     for s in elf[1]:
         if s[1] == 1 and s[3] <= address and address + size <= s[3] + s[5]:  # PROGBITS
-            at = s[4] + address - s[3]
-            return address, elf[0][at:at + size], ebss[0]
+            return address, (s[3], elf[0][s[4]:s[4] + s[5]]), ebss[0]
     return None
 
 

@@ -58,9 +58,8 @@ static uint64_t handed_bus_us, handed_wall_us;
 enum { PACED_START_US = 1000 }; /* a paced clock's start: the wall clock's */
 static int refused[REFUSED_MAX] = {-1, -1, -1, -1};
 /* A client that came while the one on the bus had hung up, its last bytes
- * still unread (a loaded PC held this process up while one host sent a
- * request and left and the next started): taken once those bytes are read
- * and the leaving seen, not told the bus is in use. -1: none. */
+ * unread (a loaded PC held this process up): taken once those bytes are
+ * read and the leaving seen, not told the bus is in use. -1: none. */
 static int next_fd = -1;
 
 /* The TCP client on the bus has hung up (its bytes may still be unread). */
@@ -77,6 +76,7 @@ static void take_client(int fd)
     sim_stamp_arrivals(fd);
     fcntl(fd, F_SETFL, O_NONBLOCK);
     bus.host_fd = fd;
+    sim_bus_new_host(&bus); /* the answers to one that left are not its */
 }
 
 static void tell_in_use(int fd)

@@ -1,6 +1,7 @@
 #include "sim_bus.h"
 
 #include "ports/host/wire_overlap.h"
+#include "protocol/frame_tx.h"
 
 #include <errno.h>
 #include <stdbool.h>
@@ -157,7 +158,9 @@ void sim_bus_deliver(struct sim_bus *b, uint64_t now_us)
         }
         if (e->sender != SIM_HOST && b->host_baud == e->baud) {
             received = true;
-            sim_usb_hold(&b->usb, e->byte, e->at_us, e->baud);
+            if (e->start_us >= b->deaf_before_us) {
+                sim_usb_hold(&b->usb, e->byte, e->at_us, e->baud);
+            }
         }
         b->baud_mismatches += !received;
         b->head = (b->head + 1u) % SIM_BUS_QUEUE;
@@ -181,7 +184,18 @@ void sim_bus_attach(struct sim_bus *b, struct sim_station station)
 void sim_bus_from_host(struct sim_bus *b, const uint8_t *data, unsigned len, uint64_t now_us)
 {
     uint64_t start = now_us > b->wire_until_us ? now_us : b->wire_until_us;
+    if (start < b->deaf_before_us) {
+        b->deaf_before_us = start; /* from its first byte on, answers may be its own */
+    }
     (void)enqueue(b, SIM_HOST, data, len, b->host_baud, start);
+}
+
+void sim_bus_new_host(struct sim_bus *b)
+{
+    b->usb.count = 0; /* held for the one that left */
+    uint64_t longest = (uint64_t)RESPONSE_FRAME_MAX * byte_time_us(b->host_baud) + 5000u;
+    uint64_t from = b->wire_until_us > b->now_us ? b->wire_until_us : b->now_us;
+    b->deaf_before_us = from + longest;
 }
 
 unsigned sim_bus_room(const struct sim_bus *b)

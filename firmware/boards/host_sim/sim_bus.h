@@ -90,9 +90,17 @@ struct sim_bus {
     unsigned long host_bytes; /* bytes the host was sent */
     uint64_t (*wall_us)(void); /* the wall clock, if set: handed_wall_us */
     uint64_t handed_wall_us;  /* as the host was last handed bytes (before the write) */
+    /* A servo's byte that began before this is not the connected host's:
+     * it answers a client that left (sim_bus_new_host). */
+    uint64_t deaf_before_us;
     struct sim_bus_span spans[SIM_BUS_SPANS];
     unsigned long span_count; /* in all: the latest SIM_BUS_SPANS are kept */
 };
+
+/* A TCP client taken in place of one that left: what answers the one
+ * that left (the bytes on the wire or due on it before the next client's
+ * first byte, the longest answer's time at most) is not handed to it. */
+void sim_bus_new_host(struct sim_bus *b);
 
 /* Room for this many more bytes: the host is read no faster. */
 unsigned sim_bus_room(const struct sim_bus *b);

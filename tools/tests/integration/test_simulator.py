@@ -68,27 +68,51 @@ def test_a_second_client_of_the_tcp_bus_is_told_it_is_in_use(tmp_path, capsys, b
         assert main(["--port", sim.url, "ping", "1"], clock=sim.clock_s) == 0  # and again at once
 
 
-@pytest.mark.parametrize("board", [None, "stm32f103"])
-def test_the_next_client_is_served_after_one_that_left_while_the_simulator_was_held_up(tmp_path, board):
-    """One client sends a Ping and leaves, and the next connects, while a
-    loaded PC holds the simulator up (SIGSTOP): the simulator reads the
-    first one's last bytes and its leaving before it takes the next, which
-    it serves (both told it the bus was in use: servoctl's exit 4)."""
+def _one_leaves_as_the_next_comes(sim, next_client):
+    """One client sends a Ping and leaves, and the next connects
+    (next_client()), while a loaded PC holds the simulator up (SIGSTOP)."""
     import os
     import signal
     import socket
 
-    ping = p.request_frame(p.PING, bytes([1]))
+    address = ("127.0.0.1", int(sim.url.rsplit(":", 1)[1]))
+    os.kill(sim.process.pid, signal.SIGSTOP)
+    try:
+        with socket.create_connection(address) as first:
+            first.sendall(p.request_frame(p.PING, bytes([1])))
+        return next_client(address)
+    finally:
+        os.kill(sim.process.pid, signal.SIGCONT)
+
+
+@pytest.mark.parametrize("board", [None, "stm32f103"])
+def test_the_next_client_is_served_after_one_that_left_while_the_simulator_was_held_up(tmp_path, board):
+    """The simulator reads the first one's last bytes and its leaving
+    before it takes the next, which it serves (both told it the bus was in
+    use: servoctl's exit 4)."""
     with Simulator(ids=[1], state_dir=str(tmp_path / "state"), board=board) as sim:
-        address = ("127.0.0.1", int(sim.url.rsplit(":", 1)[1]))
-        os.kill(sim.process.pid, signal.SIGSTOP)
-        try:
-            with socket.create_connection(address) as first:
-                first.sendall(ping)
-            second = sim.bus()
-        finally:
-            os.kill(sim.process.pid, signal.SIGCONT)
-        with second as bus:  # sent again if it met the first one's answer on the wire
+        with _one_leaves_as_the_next_comes(sim, lambda _: sim.bus()) as bus:
+            assert Servo(bus, 1).ping()
+
+
+@pytest.mark.parametrize("board", [None, "stm32f103"])
+def test_the_next_client_never_hears_the_answer_to_the_one_that_left(tmp_path, board):
+    """As above, the next client sending nothing: the Ping's answer is the
+    first one's, and it hears nothing of it (before: it did, and one that
+    asked the same would take it for its own answer)."""
+    import socket
+
+    with Simulator(ids=[1], state_dir=str(tmp_path / "state"), board=board) as sim:
+        with _one_leaves_as_the_next_comes(sim, socket.create_connection) as second:
+            second.settimeout(0.05)
+            heard, start = b"", sim.clock_s()
+            while sim.clock_s() - start < 0.05:  # the answer's wire time, many times over
+                try:
+                    heard += second.recv(256)
+                except socket.timeout:
+                    pass
+            assert heard == b""
+        with sim.bus() as bus:  # and the next that talks is answered
             assert Servo(bus, 1).ping()
 
 

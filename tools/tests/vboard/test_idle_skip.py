@@ -8,7 +8,8 @@ times are the simulator's."""
 import pytest
 
 from servoctl import protocol as p
-from vboard import bench
+from vboard import bench, idle_skip
+from vboard.board import elf
 
 from .test_virtual_boards import BOARDS
 
@@ -78,6 +79,24 @@ def test_a_board_runs_no_further_than_an_instruction_past_its_step(tmp_path):
             worst = max(worst, core.time_s - runner.now_s)
         assert len(runner.bus.to_host) == 6
         assert worst <= core.cpi / core.hz * 1.001, worst * 1e6
+    finally:
+        runner.bus.close()
+        runner.control.close()
+        runner.clock.close()
+
+
+def test_no_pass_is_skipped_in_an_image_other_than_the_elfs(tmp_path):
+    """An image that holds servo_poll's bytes where the ELF has them but
+    differs elsewhere (an update, a variant: its static data may lie
+    otherwise, beyond the _ebss the comparison stops at) skips nothing."""
+    runner = bench.runner_for("stm32f103", (1,), str(tmp_path))
+    try:
+        board = runner.boards[0]
+        assert board._pass_start() != 0  # the ELF's own image
+        address, size, _ = idle_skip._symbol(idle_skip._elf(elf("stm32f103")), idle_skip.PASS_START)
+        at = (address & ~1) + size - board.flash_base  # the code right after servo_poll's
+        board.flash_mem.write(at, bytes([board.flash_mem.read(at, 1)[0] ^ 0xFF]))
+        assert board._pass_start() == 0
     finally:
         runner.bus.close()
         runner.control.close()
