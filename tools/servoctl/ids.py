@@ -68,6 +68,7 @@ def bring_up(bus: p.Bus, from_id: int, first_id: int, count: int, wait_s: float,
                 found = f  # alone, or several whose serial numbers all came through
             elif f is not None and f.shared:
                 collided = True
+                bus.heard = True  # answers came at this rate, garbled: no rate hint at the deadline
                 say(f"two or more servos answer at ID {from_id} and their answers collide: "
                     f"connect one new servo at a time")
                 bus.sleep(1.0)

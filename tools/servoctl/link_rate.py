@@ -50,7 +50,11 @@ def simulator(sim_control):
 
 def open_rate(port, baud, sim_control) -> int:
     """The rate to open the link at: --baud, or 115200. On socket:// an
-    explicit --baud is set on the simulator's control port, or refused."""
+    explicit --baud is set on the simulator's control port, or refused;
+    without --baud, the simulator's host rate read there (host_baud), so
+    the wire's limits (stream, bench) are a 1 Mbaud wire's after hostbaud."""
+    if baud is None and is_socket(port) and sim_control:
+        return _host_rate(sim_control) or DEFAULT_BAUD
     if baud is None or not is_socket(port):
         return baud or DEFAULT_BAUD
     if not sim_control:
@@ -59,6 +63,13 @@ def open_rate(port, baud, sim_control) -> int:
                          f"--sim-control PORT and servoctl does it")
     _control(sim_control, f"hostbaud {baud}")
     return baud
+
+
+def _host_rate(sim_control):
+    """The simulator's host rate (host_baud in its state line), or None."""
+    words = dict(w.split("=", 1) for w in _control(sim_control, "state").split() if "=" in w)
+    rate = words.get("host_baud", "")
+    return int(rate) if rate.isdigit() else None
 
 
 def set_rate(bus, sim_control, rate: int) -> None:
@@ -119,13 +130,15 @@ def no_reply_hint(bus, port, sim_control, rate: int) -> str:
         return ""
     if sim_control:
         try:
-            words = dict(w.split("=", 1) for w in _control(sim_control, "state").split() if "=" in w)
+            host = _host_rate(sim_control)
         except ServoError:  # a hint only: the NoReply is the error
-            words = {}
-        host = words.get("host_baud")
-        if host and host.isdigit() and int(host) != rate:
+            host = None
+        if host and host != rate:
             return (f"; the simulator's host rate is {host} baud, not {rate}: give --baud {host} "
                     f"--sim-control {sim_control}")
+        if host:  # servoctl took the host rate; the servo may speak another
+            return (f"; the simulator's host rate is {host} baud: if the servo speaks another, "
+                    f"give --baud RATE --sim-control {sim_control}")
         return ""
     return ("; if the simulator's host rate was changed (hostbaud, or an earlier --sim-control with "
             "--baud), give --baud and --sim-control to set it")

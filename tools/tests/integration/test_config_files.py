@@ -170,3 +170,13 @@ def test_restore_with_link_follows_the_servos_rates(sim3, capsys, tmp_path):
     assert sim3.state(1)["host_baud"] == 1000000
     rc, out, err = run(sim3, capsys, "--baud", "1000000", "--sim-control", control, "scan", "--last", "4")
     assert rc == 0 and "3 servo(s) found" in out, out + err
+
+
+def test_a_socket_link_takes_the_simulators_host_rate(sim, capsys):
+    """After `config set 1 baud 1000000` with --sim-control (hostbaud set),
+    later commands given --sim-control but no --baud take the simulator's
+    host rate: before, bench and stream judged a 1 Mbaud wire at 115200."""
+    control = str(sim.control_port)
+    assert run(sim, capsys, "--sim-control", control, "config", "set", "1", "baud", "1000000")[0] == 0
+    rc, out, err = run(sim, capsys, "--sim-control", control, "bench", "--ids", "1", "--seconds", "0.2")
+    assert rc == 0 and "at 1000000 baud" in out, out + err

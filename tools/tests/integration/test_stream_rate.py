@@ -29,6 +29,7 @@ def test_the_robot_loop_keeps_its_period_on_the_simulated_clock(sim):
             assert list(loop.cycle({1: 0.0})) == [1]
         rate = loop.rate()
     # 25 cycles, the last 24 periods after the first: a paced loop never
-    # beats its period (the wire would take 262 a second). A host starved
-    # of CPU may be late (a LoopLate warning), which is not judged here.
-    assert rate.rate_hz < 53.0 and rate.cycles == 25, rate
+    # beats its period (the wire would take 262 a second), and its rate is
+    # counted over those periods (before: 25 over 24 and a bit, 52 Hz). A
+    # host starved of CPU may be late (a LoopLate warning), not judged here.
+    assert rate.rate_hz <= 50.0 + 1e-6 and rate.cycles == 25, rate

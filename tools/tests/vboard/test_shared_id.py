@@ -31,6 +31,7 @@ def test_new_servos_at_one_id_collide_alike_on_every_simulator(tmp_path, capsys,
         assert rc == 3 and "connect one new servo at a time" in out, out + err
         assert ("no servo alone at ID 0 within 1 s (two or more answer there at once, and their "
                 "answers collide: connect one new servo at a time); 0 numbered") in err, err
+        assert "host rate" not in err, err  # they answered, garbled: not a rate to blame
         assert sim.state(0)["garbled"] > 0
     finally:
         sim.stop()
