@@ -3,7 +3,8 @@
 // ramp), write() (every joint's command). write() sends the setpoints and the
 // next Sync Monitor in one burst; read() takes its answers.
 //
-//   sb_ros2_cycle HOST:PORT [--clock FILE] [--ids 1,2,3] [--seconds S] [--period-ms MS]
+//   sb_ros2_cycle HOST:PORT [--clock FILE] [--ids ID,ID,...] [--seconds S] [--period-ms MS]
+//   (--ids: default 1; --seconds: 1; --period-ms: 10)
 //
 // Exit 0 when nine states in ten or more came and each joint ends within 1
 // degree of its command (tools/tests/test_servobus_examples.py runs it against servo_sim).
@@ -132,11 +133,17 @@ class ServoBusHardware {
 
 } // namespace
 
+static int usage(const char *self)
+{
+    std::fprintf(stderr, "usage: %s HOST:PORT [--clock FILE] [--ids ID,ID,...] [--seconds S] [--period-ms MS]\n"
+                         "  --ids: default 1; --seconds: 1; --period-ms: 10\n", self);
+    return 2;
+}
+
 int main(int argc, char **argv)
 {
-    if (argc < 2 || std::strchr(argv[1], ':') == nullptr) {
-        std::fprintf(stderr, "usage: %s HOST:PORT [--clock FILE] [--ids 1,2] [--seconds S] [--period-ms MS]\n", argv[0]);
-        return 2;
+    if (argc < 2 || std::strchr(argv[1], ':') == nullptr || argc % 2 != 0) {
+        return usage(argv[0]);
     }
     std::string where = argv[1];
     std::string host = where.substr(0, where.rfind(':'));
@@ -151,13 +158,25 @@ int main(int argc, char **argv)
             sim = sim_clock_open(val.c_str()) == 0;
         } else if (opt == "--ids") {
             ids.clear();
-            for (char *tok = std::strtok(&val[0], ","); tok != nullptr; tok = std::strtok(nullptr, ","))
-                ids.push_back(static_cast<uint8_t>(std::atoi(tok)));
+            for (char *tok = std::strtok(&val[0], ","); tok != nullptr; tok = std::strtok(nullptr, ",")) {
+                char *end = nullptr;
+                long id = std::strtol(tok, &end, 10);
+                if (*end != '\0' || id < 0 || id > 253) { /* 254 is broadcast: no joint answers it */
+                    std::fprintf(stderr, "sb_ros2_cycle: --ids: '%s' is not a servo ID (0-253)\n", tok);
+                    return 2;
+                }
+                ids.push_back(static_cast<uint8_t>(id));
+            }
         } else if (opt == "--seconds") {
             seconds = std::atof(val.c_str());
         } else if (opt == "--period-ms") {
             period_ms = static_cast<uint16_t>(std::atoi(val.c_str()));
+        } else {
+            return usage(argv[0]);
         }
+    }
+    if (ids.empty()) {
+        return usage(argv[0]);
     }
     ServoBusHardware hw;
     if (!hw.on_init(host, port, ids, period_ms, sim) || !hw.on_activate())

@@ -38,6 +38,14 @@ def test_the_ros2_control_style_cycle_moves_three_joints(sim3):
     assert abs(sim3.state(2)["angle"] - 10.0) < 1.5  # 10 degrees on from 0
 
 
+def test_the_cycle_refuses_an_id_it_cannot_address_and_an_unknown_option():
+    """No servo is opened: the arguments are refused first, naming what is wrong."""
+    bad_id = _run(["sb_ros2_cycle", "127.0.0.1:1", "--ids", "1,300"])
+    assert bad_id.returncode == 2 and "'300' is not a servo ID (0-253)" in bad_id.stderr, bad_id.stderr
+    unknown = _run(["sb_ros2_cycle", "127.0.0.1:1", "--idz", "1"])
+    assert unknown.returncode == 2 and "usage:" in unknown.stderr, unknown.stderr
+
+
 def test_the_c_robot_loop_reads_every_state(sim3):
     address, clock = _where(sim3)
     done = _run(["sb_loop_bench", address, clock, "115200", "3", "40"])
