@@ -56,7 +56,7 @@ def bring_up(bus: p.Bus, from_id: int, first_id: int, count: int, wait_s: float,
     while len(done) < count:
         deadline = bus.clock() + wait_s
         found = None
-        asked = collided = False
+        asked = collided = False  # each said once a servo: a user reads it, not a log
         while found is None:
             if bus.clock() > deadline:
                 why = (f" (two or more answer there at once, and their answers collide: connect "
@@ -67,15 +67,16 @@ def bring_up(bus: p.Bus, from_id: int, first_id: int, count: int, wait_s: float,
             if f is not None and f.mode == "application" and f.serials and f.serials_complete:
                 found = f  # alone, or several whose serial numbers all came through
             elif f is not None and f.shared:
+                if not collided:
+                    say(f"two or more servos answer at ID {from_id} and their answers collide: "
+                        f"connect one new servo at a time")
                 collided = True
                 bus.heard = True  # answers came at this rate, garbled: no rate hint at the deadline
-                say(f"two or more servos answer at ID {from_id} and their answers collide: "
-                    f"connect one new servo at a time")
                 bus.sleep(1.0)
             else:
-                if not asked:
+                if not asked and not collided:
                     say(f"connect new servo {len(done) + 1} of {count} (it answers at ID {from_id}) ...")
-                    asked = True
+                asked = True
                 bus.sleep(0.2)
         while next_id == from_id or scan.probe(bus, next_id, window) is not None:
             next_id += 1
