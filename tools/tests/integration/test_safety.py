@@ -34,7 +34,10 @@ def test_the_watchdog_acts_within_two_ticks_whatever_the_others_hear(sim3):
         state = sim3.state(1)
         silent_ms = state["coasted_ms"] - state["heard_ms"]
         print(f"servo 1 let go {silent_ms:.2f} ms after its last frame (watchdog 100 ms)")
-        assert 100.0 <= silent_ms <= 102.0
+        # Counted in 1 ms ticks from the tick that saw the frame: within 2
+        # ticks after the timeout, and up to a tick before it where that tick
+        # waited for the request's end (docs/safety.md, "When").
+        assert 99.0 <= silent_ms <= 102.0
         assert s1.read("limiter") == MotionSnapshot.LIMITERS.index("watchdog")
         assert s1.read_motion().limiter == "watchdog"
         assert s1.read_fault(0).kind == "watchdog"
