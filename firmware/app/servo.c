@@ -87,7 +87,7 @@ static void show_executing(struct servo *s)
  * builds the rest behind the bytes going out. The DMA takes the content's
  * second byte four byte times after the start; the build takes less than
  * three on the Cortex-M0 (docs/sleep.md, "The first answer"), and every
- * byte it writes at the front is the value already there (dispatch.c
+ * byte it writes at the front is the value already there (dispatcher.c
  * leaves a sync record's answer length to its handler). The M3 answers
  * within two byte times built first, and leaves it out. */
 #if !defined(__arm__) || defined(__ARM_ARCH_6M__)
