@@ -58,6 +58,9 @@ SEEDS = {
     "read_motion": req(11, struct.pack("<BhHHHH", 0, 900, 300, 100, 100, 0)) + req(0x40, b"\x00"),
     "control_response": req(4, b"\x00\x21\x01") + req(11, struct.pack("<BhHHHH", 0, 1000, 1000, 100, 200, 0)),
     "sync_monitor": req(25, bytes([22, 1, 4, 5, 6, 0, 9])) + resp(22, bytes(16)) + resp(22, bytes(16)),
+    # Listed first: its header goes out before its build (servo.c, send_ahead),
+    # while the host's bytes go on.
+    "sync_monitor_first": req(25, bytes([22, 1, 4, 0, 6, 5, 9])) + resp(22, bytes(16)),
     "sync_move": req(25, bytes([8, 7, 2]) + struct.pack("<BhHH", 4, 0, 0, 0) + struct.pack("<BhHH", 0, 900, 500, 0)),
     "sync_long": req(25, bytes([14, 15, 200]) + b"".join(
         struct.pack("<BiIHHH", (k + 1) % 255, k * 10, 1000, 20, 20, 0) for k in range(200))),
