@@ -1,8 +1,9 @@
 /* The C robot loop as fast as the wire goes, for scripts/c_loop_bench.sh:
- *   sb_loop_bench HOST:PORT|/dev/PORT CLOCK_FILE BAUD COUNT CYCLES
+ *   sb_loop_bench HOST:PORT|/dev/PORT CLOCK_FILE BAUD COUNT CYCLES [paced]
  * (a path: a serial port, or servo_sim's pseudo-terminal)
  * prints "cycles C seconds S rate R wire W ratio Q missed M" on servo_sim's
- * clock (the simulated servos' time). */
+ * clock (the simulated servos' time). paced: servo_sim runs --clock paced
+ * and this is its only host; the host's own time then costs none (tests). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -26,9 +27,10 @@ int main(int argc, char **argv)
     uint32_t baud;
     sb_error e;
     char words[200];
-    colon = argc == 6 ? strrchr(argv[1], ':') : NULL;
-    if (argc != 6 || (colon == NULL && argv[1][0] != '/')) {
-        fprintf(stderr, "usage: %s HOST:PORT|/dev/PORT CLOCK_FILE BAUD COUNT CYCLES\n", argv[0]);
+    int paced = argc == 7 && strcmp(argv[6], "paced") == 0, ok = 1;
+    colon = argc == 6 || paced ? strrchr(argv[1], ':') : NULL;
+    if ((argc != 6 && !paced) || (colon == NULL && argv[1][0] != '/')) {
+        fprintf(stderr, "usage: %s HOST:PORT|/dev/PORT CLOCK_FILE BAUD COUNT CYCLES [paced]\n", argv[0]);
         return 2;
     }
     baud = (uint32_t)strtoul(argv[3], NULL, 10);
@@ -45,6 +47,13 @@ int main(int argc, char **argv)
     {
         sb_transport t = sb_posix_transport(&link);
         t.now_us = sim_clock_us;
+        if (paced)
+            t = sim_clock_paced(argv[2], t, &ok);
+        if (!ok) {
+            fprintf(stderr, "loop_bench: paced: %s cannot be written, or another host has used the simulator "
+                            "(a paced host must be its first)\n", argv[2]);
+            return 2;
+        }
         sb_bus_init(&bus, t, baud);
     }
     for (size_t k = 0; k < count; k++)
