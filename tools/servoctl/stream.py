@@ -12,6 +12,7 @@ them is refused, never clamped: a clamped path is not the host's, and the
 servo, without the next setpoint, brakes to a hold where the last one
 was (docs/streaming.md). A file is checked whole before anything moves."""
 import math
+import time
 from dataclasses import dataclass
 
 from . import protocol as p
@@ -109,6 +110,9 @@ class StreamReport:
     peak_deg: dict
     rate: LoopRate
     missed: int       # states that did not come back
+    # A simulator's clock against the PC's over the stream (None: a real
+    # bus): below 1, a simulator slower than real time held the cycles up.
+    sim_speed: float = None
 
 
 def stream_file(bus: p.Bus, times, angles: dict, progress=None, limits: dict = None) -> StreamReport:
@@ -152,6 +156,7 @@ def stream_file(bus: p.Bus, times, angles: dict, progress=None, limits: dict = N
     # such estimate is the instant, late by the adapter's wait alone.
     answer_s = p.answer_frame_size(p.MONITOR) * BITS_PER_BYTE / bus.serial.baudrate
     start = bus.clock() + period  # row 0 is for a period after it is sent
+    wall_start = time.monotonic()
     for k in range(count):
         bus.sleep(max(0.0, start + (k - 1) * period - bus.clock()))
         states = loop.cycle({i: angles[i][k] for i in ids}, {i: velocity(i, k) for i in ids})
@@ -167,7 +172,9 @@ def stream_file(bus: p.Bus, times, angles: dict, progress=None, limits: dict = N
             progress(k + 1, count)
     rms = {i: math.sqrt(sum(e * e for e in v) / len(v)) if v else math.nan for i, v in errors.items()}
     peak = {i: max(map(abs, v)) if v else math.nan for i, v in errors.items()}
-    return StreamReport(period, count, rms, peak, loop.rate(), loop.missed)
+    wall = time.monotonic() - wall_start
+    speed = None if bus.clock is time.monotonic or wall <= 0 else (bus.clock() - start + period) / wall
+    return StreamReport(period, count, rms, peak, loop.rate(), loop.missed, speed)
 
 
 def cmd_stream(bus, args):
@@ -211,7 +218,7 @@ def cmd_stream(bus, args):
         print(f"  servo {servo_id}: tracking error RMS {report.rms_deg[servo_id]:.2f} deg, "
               f"peak {report.peak_deg[servo_id]:.2f} deg")
     r = report.rate  # the wire could carry the file's rate (check_wire): a shortfall is the host's
-    short = f" (below the file's {1 / period:g} Hz: the host fell behind)" if _late(report) else ""
+    short = f" (below the file's {1 / period:g} Hz: {_who_was_late(report)})" if _late(report) else ""
     print(f"  cycle (setpoints + Sync Monitor) ran at {r.rate_hz:.1f} Hz{short}; the wire allows "
           f"{r.wire_limit_hz:.0f} Hz at {bus.serial.baudrate} baud")
     if report.missed:
@@ -228,6 +235,13 @@ def _late(report) -> bool:
     return report.rate.rate_hz < LATE_BELOW / report.period_s
 
 
+def _who_was_late(report) -> str:
+    if report.sim_speed is not None and report.sim_speed < LATE_BELOW:
+        return (f"on a simulator that ran at {report.sim_speed:.2f}x real time "
+                f"(this PC cannot run the file in real time on it)")
+    return "the host sent them late"
+
+
 def _verdict(report, tolerance: float, report_only: bool) -> int:
     """0 if every servo followed the file within tolerance (RMS, degrees)
     and the setpoints went out at the file's rate; else 1, saying which
@@ -239,7 +253,7 @@ def _verdict(report, tolerance: float, report_only: bool) -> int:
            for i, rms in off.items()]
     if _late(report):
         why.append(f"the setpoints went out at {report.rate.rate_hz:.1f} Hz against the file's "
-                   f"{1 / report.period_s:g} Hz: the host sent them late")
+                   f"{1 / report.period_s:g} Hz: {_who_was_late(report)}")
     if not why or report_only:
         return 0
     print(f"servoctl: error: {'; '.join(why)}", file=sys.stderr)

@@ -126,3 +126,11 @@ def test_a_stream_sent_late_fails_with_its_rate(capsys):
     assert _verdict(report(80), 1.0, False) == 1
     assert "went out at 40.0 Hz against the file's 50 Hz" in capsys.readouterr().err
     assert _verdict(report(80), 1.0, True) == 0
+    # On a simulator slower than real time the shortfall is named as its.
+    slow = StreamReport(0.02, 101, {1: 0.2}, {1: 0.5}, LoopRate(80, 2.0, 260.0), 0, sim_speed=0.62)
+    assert _verdict(slow, 1.0, False) == 1
+    err = capsys.readouterr().err
+    assert "on a simulator that ran at 0.62x real time" in err and "host" not in err, err
+    on_time_sim = StreamReport(0.02, 101, {1: 0.2}, {1: 0.5}, LoopRate(80, 2.0, 260.0), 0, sim_speed=1.0)
+    assert _verdict(on_time_sim, 1.0, False) == 1
+    assert "the host sent them late" in capsys.readouterr().err
