@@ -238,7 +238,7 @@ def _late(report) -> bool:
 def _who_was_late(report) -> str:
     if report.sim_speed is not None and report.sim_speed < LATE_BELOW:
         return (f"on a simulator that ran at {report.sim_speed:.2f}x real time "
-                f"(this PC cannot run the file in real time on it)")
+                f"(this PC cannot run the file in real time on it: a lower rate, fewer servos, or servo_sim)")
     return "the host sent them late"
 
 

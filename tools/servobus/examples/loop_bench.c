@@ -21,37 +21,51 @@ int main(int argc, char **argv)
     int32_t angles[SB_MAX_SERVOS];
     sb_monitor_answer states[SB_MAX_SERVOS];
     bool got[SB_MAX_SERVOS];
-    char *colon;
+    char *where, *colon;
     size_t count;
     long cycles;
     uint32_t baud;
     sb_error e;
     char words[200];
-    int paced = argc == 7 && strcmp(argv[6], "paced") == 0, ok = 1;
-    colon = argc == 6 || paced ? strrchr(argv[1], ':') : NULL;
-    if ((argc != 6 && !paced) || (colon == NULL && argv[1][0] != '/')) {
+    sim_clock_status clock_status = SIM_CLOCK_OK;
+    int paced = argc == 7 && strcmp(argv[6], "paced") == 0;
+    if (argc != 6 && !paced) {
         fprintf(stderr, "usage: %s HOST:PORT|/dev/PORT CLOCK_FILE BAUD COUNT CYCLES [paced]\n", argv[0]);
         return 2;
     }
+    where = argv[1];
+    if (strncmp(where, "socket://", 9) == 0) /* as servo_sim and servoctl print it */
+        where += 9;
+    colon = where[0] == '/' ? NULL : strrchr(where, ':');
     baud = (uint32_t)strtoul(argv[3], NULL, 10);
     count = (size_t)strtoul(argv[4], NULL, 10);
     cycles = strtol(argv[5], NULL, 10);
+    if (where[0] != '/' && colon == NULL) {
+        fprintf(stderr, "loop_bench: '%s' is neither HOST:PORT nor a /dev path\n", argv[1]);
+        return 2;
+    }
+    if (count == 0 || count > SB_MAX_SERVOS || cycles < 1) {
+        fprintf(stderr, "loop_bench: COUNT must be 1-%d servos and CYCLES at least 1\n", SB_MAX_SERVOS);
+        return 2;
+    }
+    if (sim_clock_open(argv[2]) != 0) {
+        fprintf(stderr, "loop_bench: the clock file %s %s\n", argv[2], sim_clock_why(sim_clock_last()));
+        return 2;
+    }
     if (colon != NULL)
         *colon = '\0';
-    if (count == 0 || count > SB_MAX_SERVOS || sim_clock_open(argv[2]) != 0 ||
-        (colon != NULL ? sb_tcp_open(&link, argv[1], (unsigned)atoi(colon + 1))
-                       : sb_serial_open(&link, argv[1], baud)) != 0) {
-        fprintf(stderr, "loop_bench: bad arguments, no clock file or no simulator\n");
+    if ((colon != NULL ? sb_tcp_open(&link, where, (unsigned)atoi(colon + 1)) : sb_serial_open(&link, where, baud)) !=
+        0) {
+        fprintf(stderr, "loop_bench: no simulator at %s\n", argv[1]);
         return 2;
     }
     {
         sb_transport t = sb_posix_transport(&link);
         t.now_us = sim_clock_us;
         if (paced)
-            t = sim_clock_paced(argv[2], t, &ok);
-        if (!ok) {
-            fprintf(stderr, "loop_bench: paced: %s cannot be written, or another host has used the simulator "
-                            "(a paced host must be its first)\n", argv[2]);
+            t = sim_clock_paced(argv[2], t, &clock_status);
+        if (clock_status != SIM_CLOCK_OK) {
+            fprintf(stderr, "loop_bench: paced: the clock file %s %s\n", argv[2], sim_clock_why(clock_status));
             return 2;
         }
         sb_bus_init(&bus, t, baud);
@@ -73,6 +87,11 @@ int main(int argc, char **argv)
     }
     {
         double rate = sb_loop_rate_hz(&loop), wire = sb_wire_limit_hz(count, baud);
+        if (rate <= 0.0) {
+            fprintf(stderr, "loop_bench: the simulator's clock did not move over %lu cycles\n",
+                    (unsigned long)loop.cycles);
+            return 3;
+        }
         printf("cycles %lu seconds %.4f rate %.1f wire %.1f ratio %.4f missed %lu\n", (unsigned long)loop.cycles,
                (double)loop.cycles / rate, rate, wire, rate / wire, (unsigned long)loop.missed);
     }

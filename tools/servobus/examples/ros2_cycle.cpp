@@ -156,6 +156,10 @@ int main(int argc, char **argv)
         std::string opt = argv[k], val = argv[k + 1];
         if (opt == "--clock") {
             sim = sim_clock_open(val.c_str()) == 0;
+            if (!sim) {
+                std::fprintf(stderr, "sb_ros2_cycle: --clock: %s %s\n", val.c_str(), sim_clock_why(sim_clock_last()));
+                return 2;
+            }
         } else if (opt == "--ids") {
             ids.clear();
             for (char *tok = std::strtok(&val[0], ","); tok != nullptr; tok = std::strtok(nullptr, ",")) {

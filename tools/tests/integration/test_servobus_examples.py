@@ -42,8 +42,8 @@ def _paced_loop(tmp_path, ids, cycles, unplugged=None):
     try:
         if unplugged is not None:
             assert sim.control(f"unplug 1 {unplugged}").strip() == "ok"
-        address, clock = _where(sim)
-        done = _run(["sb_loop_bench", address, clock, "115200", str(len(ids)), str(cycles), "paced"])
+        clock = _where(sim)[1]  # the bus as servo_sim prints it, socket:// and all
+        done = _run(["sb_loop_bench", sim.url, clock, "115200", str(len(ids)), str(cycles), "paced"])
     finally:
         finish(sim, ids)
     assert done.returncode == 0, done.stdout + done.stderr
@@ -91,6 +91,40 @@ def test_a_paced_loop_refuses_a_simulator_another_host_has_used(tmp_path):
     finally:
         finish(sim, [1])
     assert done.returncode == 2 and "a paced host must be its first" in done.stderr, done.stderr
+
+
+def test_the_bench_and_the_cycle_say_what_is_wrong(tmp_path):
+    """A wrong clock file, count or address is named (exit 2), not a crash:
+    an empty file was mapped past its end (SIGBUS)."""
+    (tmp_path / "empty").write_bytes(b"")
+    for clock, why in ((tmp_path / "empty", "is not a simulator's clock file"),
+                       (tmp_path / "none", "cannot be opened")):
+        for paced in ([], ["paced"]):
+            done = _run(["sb_loop_bench", "127.0.0.1:1", str(clock), "115200", "3", "2", *paced])
+            assert done.returncode == 2 and why in done.stderr, done.stderr
+        cycle = _run(["sb_ros2_cycle", "127.0.0.1:1", "--clock", str(clock)])
+        assert cycle.returncode == 2 and why in cycle.stderr, cycle.stderr
+    done = _run(["sb_loop_bench", "127.0.0.1:1", str(tmp_path / "empty"), "115200", "40", "2"])
+    assert done.returncode == 2 and "COUNT must be 1-32" in done.stderr, done.stderr
+    done = _run(["sb_loop_bench", "localhost", str(tmp_path / "empty"), "115200", "3", "2"])
+    assert done.returncode == 2 and "neither HOST:PORT nor a /dev path" in done.stderr, done.stderr
+
+
+def test_an_unpaced_loop_on_a_paced_simulator_says_so(tmp_path):
+    """Without 'paced' the loop never tells a paced simulator it waits, so
+    its clock stands still: after SB_SIM_CLOCK_STALLED_S of the PC's time
+    (30 s unless set) it says so and exits 3 (it hung, silent)."""
+    import os
+
+    sim = _paced_sim(tmp_path, [1])
+    try:
+        address, clock = _where(sim)
+        done = subprocess.run([str(EXAMPLES / "sb_loop_bench"), address, clock, "115200", "1", "5"],
+                              capture_output=True, text=True, timeout=60,
+                              env={**os.environ, "SB_SIM_CLOCK_STALLED_S": "1"})
+    finally:
+        finish(sim, [1])
+    assert done.returncode == 3 and "--clock paced and this program does not pace it" in done.stderr, done.stderr
 
 
 def test_the_serial_transport_on_servo_sims_pseudo_terminal(tmp_path):
