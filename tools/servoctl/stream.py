@@ -111,8 +111,10 @@ class StreamReport:
     rate: LoopRate
     missed: int       # states that did not come back
     # A simulator's clock against the PC's over the stream (None: a real
-    # bus): below 1, a simulator slower than real time held the cycles up.
+    # bus, or a paced simulator): below 1, a simulator slower than real
+    # time held the cycles up.
     sim_speed: float = None
+    paced: bool = False  # a paced simulator: the host's time cost none
 
 
 def stream_file(bus: p.Bus, times, angles: dict, progress=None, limits: dict = None) -> StreamReport:
@@ -173,8 +175,9 @@ def stream_file(bus: p.Bus, times, angles: dict, progress=None, limits: dict = N
     rms = {i: math.sqrt(sum(e * e for e in v) / len(v)) if v else math.nan for i, v in errors.items()}
     peak = {i: max(map(abs, v)) if v else math.nan for i, v in errors.items()}
     wall = time.monotonic() - wall_start
-    speed = None if bus.clock is time.monotonic or wall <= 0 else (bus.clock() - start + period) / wall
-    return StreamReport(period, count, rms, peak, loop.rate(), loop.missed, speed)
+    paced = getattr(bus, "note_sent", None) is not None  # it runs only while the host waits
+    speed = None if paced or bus.clock is time.monotonic or wall <= 0 else (bus.clock() - start + period) / wall
+    return StreamReport(period, count, rms, peak, loop.rate(), loop.missed, speed, paced)
 
 
 def cmd_stream(bus, args):
@@ -236,6 +239,10 @@ def _late(report) -> bool:
 
 
 def _who_was_late(report) -> str:
+    if report.paced:
+        return (f"a cycle took {1000 / report.rate.rate_hz:.2f} ms of the paced simulator's time (the "
+                f"host's own time costs it none): the wire, the servos' turnarounds and the USB adapter's "
+                f"frames cannot carry the file's rate" if report.rate.rate_hz > 0 else "no cycle ran")
     if report.sim_speed is not None and report.sim_speed < LATE_BELOW:
         return (f"on a simulator that ran at {report.sim_speed:.2f}x real time "
                 f"(this PC cannot run the file in real time on it: a lower rate, fewer servos, or servo_sim)")

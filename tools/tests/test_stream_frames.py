@@ -134,3 +134,8 @@ def test_a_stream_sent_late_fails_with_its_rate(capsys):
     on_time_sim = StreamReport(0.02, 101, {1: 0.2}, {1: 0.5}, LoopRate(80, 2.0, 260.0), 0, sim_speed=1.0)
     assert _verdict(on_time_sim, 1.0, False) == 1
     assert "the host sent them late" in capsys.readouterr().err
+    # On a paced simulator the PC's time is nobody's: the cycle's own length is the reason.
+    paced = StreamReport(0.0095, 101, {1: 0.2}, {1: 0.5}, LoopRate(90, 1.0, 105.7), 0, paced=True)
+    assert _verdict(paced, 1.0, False) == 1
+    err = capsys.readouterr().err
+    assert "a cycle took 11.11 ms of the paced simulator's time" in err and "host sent" not in err, err

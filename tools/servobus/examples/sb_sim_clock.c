@@ -22,6 +22,12 @@ enum { CLOCK_NOW, CLOCK_HOST_WAITS, CLOCK_HOST_SENT, CLOCK_HOST_READ, CLOCK_WORD
  * SB_SIM_CLOCK_STALLED_S another number of seconds (tests). */
 #define STALLED_S 30u
 
+/* One paced host a process: the examples run one bus. */
+static struct paced {
+    sb_transport inner;
+    uint64_t sent, read, read_at_send;
+} paced;
+
 static volatile uint64_t *clock_words;
 static sim_clock_status last_status = SIM_CLOCK_NO_FILE;
 
@@ -96,18 +102,14 @@ uint64_t sim_clock_us(void *ctx)
         seen = now;
         seen_at = pc;
     } else if (pc - seen_at > stalled_s() * 1000000u) {
-        fprintf(stderr, "servo_sim's clock stood still for %lu s: the simulator stopped, or it runs "
-                        "--clock paced and this program does not pace it\n", (unsigned long)stalled_s());
+        fprintf(stderr, "servo_sim's clock stood still for %lu s: the simulator stopped, or %s\n",
+                (unsigned long)stalled_s(),
+                paced.inner.read != NULL ? "a host before this one did not pace it (a paced host must be its first)"
+                                         : "it runs --clock paced and this program does not pace it");
         exit(3);
     }
     return now;
 }
-
-/* One paced host a process: the examples run one bus. */
-static struct paced {
-    sb_transport inner;
-    uint64_t sent, read, read_at_send;
-} paced;
 
 static int paced_write(void *ctx, const uint8_t *data, size_t len)
 {
@@ -123,6 +125,11 @@ static int paced_write(void *ctx, const uint8_t *data, size_t len)
 
 static int paced_read(void *ctx, uint8_t *buf, size_t cap, size_t want, uint32_t wait_us)
 {
+    /* The wait ends once the clock is past its end, the simulator stood
+     * still a microsecond on: it publishes an event's time before it hands
+     * the host that event's bytes, so a host that stopped at the end
+     * itself could look before the last of them came (and a run missed
+     * more or fewer answers by the PC's timing). */
     uint64_t stop = sim_clock_us(NULL) + wait_us;
     int n;
     if (wait_us > 0) {
@@ -130,11 +137,11 @@ static int paced_read(void *ctx, uint8_t *buf, size_t cap, size_t want, uint32_t
          * only once bytes came since the host last sent (sim_clock.h). */
         if (paced.read > paced.read_at_send)
             clock_words[CLOCK_HOST_READ] = paced.read;
-        clock_words[CLOCK_HOST_WAITS] = stop | UNTIL_ANSWER;
+        clock_words[CLOCK_HOST_WAITS] = (stop + 1u) | UNTIL_ANSWER;
     }
     for (;;) {
         n = paced.inner.read(ctx, buf, cap, want, wait_us > 0 ? PACED_LOOK_US : 0u);
-        if (n != 0 || wait_us == 0 || sim_clock_us(NULL) >= stop)
+        if (n != 0 || wait_us == 0 || sim_clock_us(NULL) > stop)
             break;
     }
     if (n > 0)
