@@ -115,16 +115,34 @@ static void check_angle(void)
     CHECK(a.turns == a.multi_turn_decideg / 3600);
 }
 
+/* A frame the UART is still sending (tx_busy, the slow UART's passes): its
+ * bytes as they were read, which no later pass may change under it. */
+static struct {
+    const uint8_t *data;
+    uint16_t length;
+    uint8_t read[HAL_DOUBLE_SENT_MAX];
+} flight;
+
 /* The DMA reads a frame as its bytes go out: one sent ahead of its build
  * (servo.c, send_ahead) is read once the pass has built it, and what the
- * UART had taken by then must not have changed. */
+ * UART had taken by then must not have changed; nor may a frame still
+ * going out change in the passes after. */
 static void pass(void)
 {
-    servo_poll(&live.servo);
     struct hal_double *h = &live.hal;
+    if (!h->tx_busy) {
+        flight.data = NULL; /* the UART finished before this pass */
+    }
+    servo_poll(&live.servo);
+    if (flight.data != NULL) {
+        CHECK(memcmp(flight.data, flight.read, flight.length) == 0);
+    }
     if (h->sending != NULL) {
         size_t at = h->sending_at;
         size_t head = h->sending_length < sizeof h->head_at_send ? h->sending_length : sizeof h->head_at_send;
+        flight.data = h->sending;
+        flight.length = h->sending_length < sizeof flight.read ? h->sending_length : (uint16_t)sizeof flight.read;
+        memcpy(flight.read, h->sending, flight.length);
         hal_double_dma_reads(h);
         CHECK(at + head > h->sent_length || memcmp(h->head_at_send, &h->sent[at], head) == 0);
     }
@@ -213,6 +231,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     }
     uint8_t setup = data[0];
     live = snapshots[setup & 3u];
+    flight.data = NULL;
     last_valid = live.servo.regs.user;
     spin_per_tick = 0;
     encoder_mode = 1;
