@@ -256,6 +256,7 @@ static int posix_read(void *ctx, uint8_t *buf, size_t cap, size_t want, uint32_t
 {
     sb_posix *p = (sb_posix *)ctx;
     ssize_t n = wait_us > 0 ? spin(p, buf, cap, &wait_us) : 0;
+    bool hung_up = false;
     if (n != 0)
         goto got;
     if (wait_us > 0) {
@@ -272,14 +273,17 @@ static int posix_read(void *ctx, uint8_t *buf, size_t cap, size_t want, uint32_t
         }
         if (ppoll(&pf, 1, &ts, NULL) < 0 && errno != EINTR)
             return -errno;
+        hung_up = (pf.revents & (POLLHUP | POLLERR)) != 0;
     }
     n = read_now(p, buf, cap);
 got:
-    if (n < 0)
-        return errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR ? 0 : -errno;
-    if (n == 0 && p->is_socket)
+    if (n < 0 && errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR)
+        return -errno;
+    if (n <= 0 && p->is_socket && n == 0)
         return -ECONNRESET; /* the other end closed the connection */
-    return (int)n;
+    if (n <= 0 && hung_up)
+        return -EIO; /* a pseudo-terminal whose other end closed, an adapter unplugged */
+    return n < 0 ? 0 : (int)n;
 }
 
 sb_transport sb_posix_transport(sb_posix *p)

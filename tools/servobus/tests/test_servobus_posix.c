@@ -162,6 +162,26 @@ static void a_wait_spins_then_sleeps_and_reads_what_comes(void **state)
     close(master);
 }
 
+/* servo_sim killed under a loop on its pseudo-terminal: the wait reported
+ * "nothing yet" for ever (the hang-up read as no bytes). */
+static void a_port_whose_other_end_hung_up_fails(void **state)
+{
+    int master = -1, slave = -1;
+    char name[128];
+    uint8_t buf[16];
+    sb_posix p;
+    sb_transport t;
+    (void)state;
+    assert_int_equal(openpty(&master, &slave, name, NULL, NULL), 0);
+    assert_int_equal(sb_serial_open(&p, name, 115200), 0);
+    t = sb_posix_transport(&p);
+    assert_int_equal(t.read(t.ctx, buf, sizeof buf, 1, 1000), 0); /* open, quiet */
+    close(slave);
+    close(master);
+    assert_true(t.read(t.ctx, buf, sizeof buf, 1, 1000000) < 0); /* a wait sees it; a drain's look need not */
+    sb_posix_close(&p);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -171,6 +191,7 @@ int main(void)
         cmocka_unit_test(a_port_another_program_holds_is_refused),
         cmocka_unit_test(a_write_the_link_never_takes_fails),
         cmocka_unit_test(a_wait_spins_then_sleeps_and_reads_what_comes),
+        cmocka_unit_test(a_port_whose_other_end_hung_up_fails),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
