@@ -110,28 +110,53 @@ static void a_port_another_program_holds_is_refused(void **state)
     close(master);
 }
 
+/* The serial transport on a pseudo-terminal: the test plays the far end. */
+typedef struct pty_port {
+    int master, slave;
+    char name[128];
+    sb_posix p;
+    sb_transport t;
+} pty_port;
+
+static void open_pty_port(pty_port *port)
+{
+    port->master = port->slave = -1;
+    assert_int_equal(openpty(&port->master, &port->slave, port->name, NULL, NULL), 0);
+    assert_int_equal(sb_serial_open(&port->p, port->name, 115200), 0);
+    port->t = sb_posix_transport(&port->p);
+}
+
+static void close_pty_far_end(pty_port *port)
+{
+    if (port->slave >= 0)
+        close(port->slave);
+    if (port->master >= 0)
+        close(port->master);
+    port->master = port->slave = -1;
+}
+
+static void close_pty_port(pty_port *port)
+{
+    sb_posix_close(&port->p);
+    close_pty_far_end(port);
+}
+
 /* A link that stops taking bytes (nobody reads the pty's master: a wedged
  * adapter) fails the write in about a second; it hung the loop for ever. */
 static void a_write_the_link_never_takes_fails(void **state)
 {
-    int master = -1, slave = -1, rc = 0;
-    char name[128];
+    int rc = 0;
     uint8_t frame[200];
-    sb_posix p;
-    sb_transport t;
+    pty_port port;
     (void)state;
     memset(frame, 0x55, sizeof frame);
-    assert_int_equal(openpty(&master, &slave, name, NULL, NULL), 0);
-    assert_int_equal(sb_serial_open(&p, name, 115200), 0);
-    t = sb_posix_transport(&p);
+    open_pty_port(&port);
     alarm(20); /* the original waited for ever: ctest sees the alarm */
     for (int k = 0; k < 100000 && rc == 0; k++)
-        rc = t.write(t.ctx, frame, sizeof frame);
+        rc = port.t.write(port.t.ctx, frame, sizeof frame);
     alarm(0);
     assert_int_equal(rc, -110); /* -ETIMEDOUT */
-    sb_posix_close(&p);
-    close(slave);
-    close(master);
+    close_pty_port(&port);
 }
 
 /* A wait looks for bytes without sleeping first (spin_us), then sleeps
@@ -139,47 +164,36 @@ static void a_write_the_link_never_takes_fails(void **state)
  * none in the wait is no error. */
 static void a_wait_spins_then_sleeps_and_reads_what_comes(void **state)
 {
-    int master = -1, slave = -1;
-    char name[128];
     uint8_t buf[16];
-    sb_posix p;
-    sb_transport t;
+    pty_port port;
+    sb_transport *t = &port.t;
     (void)state;
-    assert_int_equal(openpty(&master, &slave, name, NULL, NULL), 0);
-    assert_int_equal(sb_serial_open(&p, name, 115200), 0);
-    assert_int_equal(p.spin_us, SB_POSIX_SPIN_US);
-    t = sb_posix_transport(&p);
-    assert_int_equal(t.read(t.ctx, buf, sizeof buf, 1, 2000), 0); /* spun, slept: nothing */
-    assert_int_equal(write(master, "\x55\xAA", 2), 2);
-    assert_int_equal(t.read(t.ctx, buf, sizeof buf, 2, 1000000), 2); /* found while spinning */
+    open_pty_port(&port);
+    assert_int_equal(port.p.spin_us, SB_POSIX_SPIN_US);
+    assert_int_equal(t->read(t->ctx, buf, sizeof buf, 1, 2000), 0); /* spun, slept: nothing */
+    assert_int_equal(write(port.master, "\x55\xAA", 2), 2);
+    assert_int_equal(t->read(t->ctx, buf, sizeof buf, 2, 1000000), 2); /* found while spinning */
     assert_int_equal(buf[0], 0x55);
-    p.spin_us = 0; /* sleeps at once */
-    assert_int_equal(write(master, "\x01", 1), 1);
-    assert_int_equal(t.read(t.ctx, buf, sizeof buf, 1, 1000000), 1);
+    port.p.spin_us = 0; /* sleeps at once */
+    assert_int_equal(write(port.master, "\x01", 1), 1);
+    assert_int_equal(t->read(t->ctx, buf, sizeof buf, 1, 1000000), 1);
     assert_int_equal(buf[0], 0x01);
-    sb_posix_close(&p);
-    close(slave);
-    close(master);
+    close_pty_port(&port);
 }
 
 /* servo_sim killed under a loop on its pseudo-terminal: the wait reported
  * "nothing yet" for ever (the hang-up read as no bytes). */
 static void a_port_whose_other_end_hung_up_fails(void **state)
 {
-    int master = -1, slave = -1;
-    char name[128];
     uint8_t buf[16];
-    sb_posix p;
-    sb_transport t;
+    pty_port port;
+    sb_transport *t = &port.t;
     (void)state;
-    assert_int_equal(openpty(&master, &slave, name, NULL, NULL), 0);
-    assert_int_equal(sb_serial_open(&p, name, 115200), 0);
-    t = sb_posix_transport(&p);
-    assert_int_equal(t.read(t.ctx, buf, sizeof buf, 1, 1000), 0); /* open, quiet */
-    close(slave);
-    close(master);
-    assert_true(t.read(t.ctx, buf, sizeof buf, 1, 1000000) < 0); /* a wait sees it; a drain's look need not */
-    sb_posix_close(&p);
+    open_pty_port(&port);
+    assert_int_equal(t->read(t->ctx, buf, sizeof buf, 1, 1000), 0); /* open, quiet */
+    close_pty_far_end(&port);
+    assert_true(t->read(t->ctx, buf, sizeof buf, 1, 1000000) < 0); /* a wait sees it; a drain's look need not */
+    close_pty_port(&port);
 }
 
 int main(void)
