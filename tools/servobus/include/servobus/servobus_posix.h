@@ -20,11 +20,14 @@ typedef struct sb_posix {
     char advice[200];    /* what to do about a slow latency timer, or "" */
     /* A wait for bytes first looks this long without sleeping (0: sleeps
      * at once): bytes due soon are taken as they come, without the
-     * process's wake-up. Opened: SB_POSIX_SPIN_US. */
+     * process's wake-up. Opened: SB_POSIX_SPIN_US, 1.5 ms, longer than a
+     * 6-servo robot loop's request takes on the wire at 1 Mbaud (760 us):
+     * a sleeping host's wake-up has tails of up to 1 ms on a busy or
+     * virtual PC (docs/c-library.md). A CPU's time for it. */
     uint32_t spin_us;
 } sb_posix;
 
-#define SB_POSIX_SPIN_US 100u
+#define SB_POSIX_SPIN_US 1500u
 
 /* A TCP connection to host:port (TCP_NODELAY). 0, or -errno. */
 int sb_tcp_open(sb_posix *p, const char *host, unsigned port);
