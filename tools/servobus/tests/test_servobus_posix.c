@@ -141,6 +141,22 @@ static void close_pty_port(pty_port *port)
     close_pty_far_end(port);
 }
 
+/* cmocka's set-up and tear-down for the tests that read from the port. */
+static pty_port fixture_port;
+
+static int open_fixture_port(void **state)
+{
+    open_pty_port(&fixture_port);
+    *state = &fixture_port;
+    return 0;
+}
+
+static int close_fixture_port(void **state)
+{
+    close_pty_port(*state);
+    return 0;
+}
+
 /* A link that stops taking bytes (nobody reads the pty's master: a wedged
  * adapter) fails the write in about a second; it hung the loop for ever. */
 static void a_write_the_link_never_takes_fails(void **state)
@@ -165,20 +181,17 @@ static void a_write_the_link_never_takes_fails(void **state)
 static void a_wait_spins_then_sleeps_and_reads_what_comes(void **state)
 {
     uint8_t buf[16];
-    pty_port port;
-    sb_transport *t = &port.t;
-    (void)state;
-    open_pty_port(&port);
-    assert_int_equal(port.p.spin_us, SB_POSIX_SPIN_US);
+    pty_port *port = *state;
+    sb_transport *t = &port->t;
+    assert_int_equal(port->p.spin_us, SB_POSIX_SPIN_US);
     assert_int_equal(t->read(t->ctx, buf, sizeof buf, 1, 2000), 0); /* spun, slept: nothing */
-    assert_int_equal(write(port.master, "\x55\xAA", 2), 2);
+    assert_int_equal(write(port->master, "\x55\xAA", 2), 2);
     assert_int_equal(t->read(t->ctx, buf, sizeof buf, 2, 1000000), 2); /* found while spinning */
     assert_int_equal(buf[0], 0x55);
-    port.p.spin_us = 0; /* sleeps at once */
-    assert_int_equal(write(port.master, "\x01", 1), 1);
+    port->p.spin_us = 0; /* sleeps at once */
+    assert_int_equal(write(port->master, "\x01", 1), 1);
     assert_int_equal(t->read(t->ctx, buf, sizeof buf, 1, 1000000), 1);
     assert_int_equal(buf[0], 0x01);
-    close_pty_port(&port);
 }
 
 /* servo_sim killed under a loop on its pseudo-terminal: the wait reported
@@ -186,14 +199,11 @@ static void a_wait_spins_then_sleeps_and_reads_what_comes(void **state)
 static void a_port_whose_other_end_hung_up_fails(void **state)
 {
     uint8_t buf[16];
-    pty_port port;
-    sb_transport *t = &port.t;
-    (void)state;
-    open_pty_port(&port);
+    pty_port *port = *state;
+    sb_transport *t = &port->t;
     assert_int_equal(t->read(t->ctx, buf, sizeof buf, 1, 1000), 0); /* open, quiet */
-    close_pty_far_end(&port);
+    close_pty_far_end(port);
     assert_true(t->read(t->ctx, buf, sizeof buf, 1, 1000000) < 0); /* a wait sees it; a drain's look need not */
-    close_pty_port(&port);
 }
 
 int main(void)
@@ -204,8 +214,9 @@ int main(void)
         cmocka_unit_test(a_rate_termios_has_not_is_refused),
         cmocka_unit_test(a_port_another_program_holds_is_refused),
         cmocka_unit_test(a_write_the_link_never_takes_fails),
-        cmocka_unit_test(a_wait_spins_then_sleeps_and_reads_what_comes),
-        cmocka_unit_test(a_port_whose_other_end_hung_up_fails),
+        cmocka_unit_test_setup_teardown(a_wait_spins_then_sleeps_and_reads_what_comes, open_fixture_port,
+                                        close_fixture_port),
+        cmocka_unit_test_setup_teardown(a_port_whose_other_end_hung_up_fails, open_fixture_port, close_fixture_port),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
