@@ -220,7 +220,7 @@ def cmd_stream(bus, args):
     for servo_id in angles:
         print(f"  servo {servo_id}: tracking error RMS {report.rms_deg[servo_id]:.2f} deg, "
               f"peak {report.peak_deg[servo_id]:.2f} deg")
-    r = report.rate  # the wire could carry the file's rate (check_wire): a shortfall is the host's
+    r = report.rate  # check_wire let the file's rate through: _who_was_late says what held it up
     short = f" (below the file's {1 / period:g} Hz: {_who_was_late(report)})" if _late(report) else ""
     print(f"  cycle (setpoints + Sync Monitor) ran at {r.rate_hz:.1f} Hz{short}; the wire allows "
           f"{r.wire_limit_hz:.0f} Hz at {bus.serial.baudrate} baud")

@@ -235,6 +235,12 @@ static ssize_t read_now(const sb_posix *p, uint8_t *buf, size_t cap)
     return p->is_socket ? recv(p->fd, buf, cap, MSG_DONTWAIT) : read(p->fd, buf, cap);
 }
 
+/* A read that found no byte yet, as opposed to one that failed. */
+static bool none_yet(ssize_t n)
+{
+    return n == 0 || (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR));
+}
+
 /* Up to spin_us (at most wait_us) of looking without sleeping: > 0 bytes
  * read, < 0 an error, 0 none came (*wait_us then what is left). */
 static ssize_t spin(sb_posix *p, uint8_t *buf, size_t cap, uint32_t *wait_us)
@@ -244,7 +250,7 @@ static ssize_t spin(sb_posix *p, uint8_t *buf, size_t cap, uint32_t *wait_us)
     ssize_t n = 0;
     while (most > 0 && spent < most) {
         n = read_now(p, buf, cap);
-        if (n != 0 && !(n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR)))
+        if (!none_yet(n))
             return n;
         spent = sb_monotonic_us(NULL) - start;
     }
@@ -277,13 +283,13 @@ static int posix_read(void *ctx, uint8_t *buf, size_t cap, size_t want, uint32_t
     }
     n = read_now(p, buf, cap);
 got:
-    if (n < 0 && errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR)
-        return -errno;
-    if (n <= 0 && p->is_socket && n == 0)
+    if (!none_yet(n))
+        return n < 0 ? -errno : (int)n;
+    if (n == 0 && p->is_socket)
         return -ECONNRESET; /* the other end closed the connection */
-    if (n <= 0 && hung_up)
+    if (hung_up)
         return -EIO; /* a pseudo-terminal whose other end closed, an adapter unplugged */
-    return n < 0 ? 0 : (int)n;
+    return 0;
 }
 
 sb_transport sb_posix_transport(sb_posix *p)
