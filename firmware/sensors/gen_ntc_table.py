@@ -4,26 +4,31 @@ as a table of ADC values at whole temperatures, so the firmware converts
 without log/exp. Run by the build; the divider constants are the protocol's
 (R1 = 10 kohm to the supply, NTC 10 kohm at 25 degC to ground, B = 3435,
 12-bit ADC)."""
-import math
 import sys
+from decimal import Decimal, localcontext
 
-R1 = 10000.0
-R25 = 10000.0
-B = 3435.0
-K = 273.15
-FULL_SCALE = 4096.0
+R1 = Decimal(10000)
+R25 = Decimal(10000)
+B = Decimal(3435)
+K = Decimal("273.15")
+FULL_SCALE = 4096
 FIRST_C, LAST_C, STEP_C = -40, 150, 5
 
 
-def adc_at(celsius: float) -> float:
-    rt = R25 * math.exp(B * (1.0 / (K + celsius) - 1.0 / (K + 25.0)))
-    return rt * FULL_SCALE / (rt + R1)
+def adc_at(celsius: int) -> int:
+    """Rounded half to even. Decimal's exp is correctly rounded in software,
+    so the image is the same whichever machine builds it (libm's exp may
+    differ in its last bit with the CPU)."""
+    with localcontext() as ctx:
+        ctx.prec = 34
+        rt = R25 * (B * (1 / (K + celsius) - 1 / (K + 25))).exp()
+        return int((rt * FULL_SCALE / (rt + R1)).to_integral_value())
 
 
 def main() -> int:
     out = sys.argv[1]
     temps = list(range(FIRST_C, LAST_C + 1, STEP_C))
-    values = [round(adc_at(t)) for t in temps]
+    values = [adc_at(t) for t in temps]
     assert all(a > b for a, b in zip(values, values[1:])), "ADC must fall as it heats"
     rows = "\n".join(f"    {v}, /* {t} degC */" for t, v in zip(temps, values))
     with open(out, "w") as f:
