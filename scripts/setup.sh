@@ -28,9 +28,14 @@ if [ ! -x .venv/bin/python ]; then
   echo "setup: creating .venv"
   python3 -m venv .venv
 fi
-if ! .venv/bin/python -m pip install -q --disable-pip-version-check -r tools/requirements.txt \
-     || ! .venv/bin/python -m pip install -q --disable-pip-version-check -e tools; then
-  echo "setup: pip could not install tools/requirements.txt or the servoctl package" >&2
+# The versions in tools/constraints.txt, those the suite was measured with;
+# --unpinned takes the newest the requirements allow (to renew the pins).
+pins=(-c tools/constraints.txt)
+[ "${1:-}" = "--unpinned" ] && pins=()
+if ! .venv/bin/python -m pip install -q --disable-pip-version-check "${pins[@]}" -r tools/requirements.txt \
+     || ! .venv/bin/python -m pip install -q --disable-pip-version-check "${pins[@]}" -e tools; then
+  echo "setup: pip could not install tools/requirements.txt or the servoctl package" \
+       "(within tools/constraints.txt's versions)" >&2
   exit 1
 fi
 echo "setup: ready"
