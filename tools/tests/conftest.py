@@ -92,13 +92,34 @@ def pytest_runtest_makereport(item, call):
         item.passed_call = report.passed
 
 
+def _parent(pid: int) -> int:
+    try:
+        with open(f"/proc/{pid}/stat") as f:
+            return int(f.read().rsplit(")", 1)[1].split()[1])
+    except (OSError, ValueError, IndexError):
+        return 0
+
+
+def _owned_by(pid: int, before: set) -> bool:
+    """Whether pid descends from a process that was up before the test (a
+    module's browser starting a helper while a test runs): that process's
+    fixture stops it, not the test."""
+    for _ in range(64):
+        pid = _parent(pid)
+        if pid <= 1 or pid == os.getpid():
+            return False
+        if pid in before:
+            return True
+    return False
+
+
 @pytest.fixture(autouse=True)
 def _no_process_outlives_its_test(request):
     """Torn down after every other fixture of the test (autouse fixtures
     are set up first)."""
     before = set(_marked())
     yield
-    left = {pid: cmd for pid, cmd in _marked().items() if pid not in before}
+    left = {pid: cmd for pid, cmd in _marked().items() if pid not in before and not _owned_by(pid, before)}
     if left:
         _kill(left)
         if getattr(request.node, "passed_call", False):

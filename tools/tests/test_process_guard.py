@@ -60,3 +60,37 @@ def test_its_process_lives_through_the_other_workers_tests():
     result.assert_outcomes(passed=2)
     pid = int(marker.read_text())
     assert not Path(f"/proc/{pid}").exists() or "Z" in Path(f"/proc/{pid}/stat").read_text().split()[2]
+
+
+def test_a_helper_that_a_modules_process_starts_during_a_test_is_not_the_tests(pytester, monkeypatch):
+    """A module's long-lived process (the UI tests' browser) may start a
+    helper of its own while a test runs (chromium's zygote): that helper is
+    its fixture's to stop, not a leak of the test; a process the test starts
+    still is (the first test above)."""
+    pytester.makeconftest(GUARD)
+    pytester.makepyfile(test_spawner="""
+import os, signal, subprocess, sys
+import pytest
+
+HELPER = "import subprocess, sys, time; sys.stdin.readline(); " \\
+         "c = subprocess.Popen([sys.executable, '-c', 'import time; time.sleep(120)']); " \\
+         "print(c.pid, flush=True); time.sleep(120)"
+
+@pytest.fixture(scope="module")
+def spawner():
+    p = subprocess.Popen([sys.executable, "-c", HELPER], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+    yield p
+    os.kill(p.helper, signal.SIGKILL)
+    p.kill()
+    p.wait()
+
+def test_the_module_process_starts_a_helper(spawner):
+    spawner.stdin.write("\\n")
+    spawner.stdin.flush()
+    spawner.helper = int(spawner.stdout.readline())
+    assert os.path.exists(f"/proc/{spawner.helper}")
+""")
+    monkeypatch.delenv("SERVO_TEST_RUN")
+    result = pytester.runpytest_subprocess("-p", "no:cacheprovider")
+    assert result.ret == 0, result.stdout.str()
+    assert "process guard" not in result.stdout.str()
