@@ -32,6 +32,7 @@ class _Lines(io.TextIOBase):
 
     def __init__(self, say):
         self.say, self.part, self.all = say, "", []
+        self.shown = str  # the staged copies' names as the folder's (files.Staging.shown)
 
     def writable(self):
         return True
@@ -43,12 +44,13 @@ class _Lines(io.TextIOBase):
         self.part += text
         while "\n" in self.part:
             line, self.part = self.part.split("\n", 1)
+            line = self.shown(line)
             self.all.append(line)
             self.say(line)
         return len(text)
 
     def text(self) -> str:
-        return "\n".join(self.all + ([self.part] if self.part else []))
+        return "\n".join(self.all + ([self.shown(self.part)] if self.part else []))
 
 
 class Worker:
@@ -104,15 +106,18 @@ class Worker:
             return self._result(tag, argv, 2, "", f"servoctl: error: {msg}")
         out, err = _Lines(lambda line: self.publish({"type": "line", "tag": tag, "text": line})), _Lines(
             lambda line: self.publish({"type": "line", "tag": tag, "text": line, "err": True}))
-        code = 0
+        code, staging = 0, None
         with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
             try:
                 args = build_parser().parse_args(self.global_argv + list(argv))
                 if args.command == "config":
                     cli.args_.config_operands(args)
-                self.files.confine(args)
+                staging = self.files.confine(args)
+                out.shown = err.shown = staging.shown
                 args.on_progress = self._progress(tag)
                 code = cli.run_command(self.bus, args)
+                if code == 0:
+                    staging.write_out()
             except KeyboardInterrupt:
                 print("servoctl: interrupted by stop-all", file=err)
                 code = EXIT_INTERRUPTED
@@ -124,6 +129,9 @@ class Worker:
             except Exception as e:  # noqa: BLE001 - an argument check's (ArgumentTypeError)
                 print(f"servoctl: error: {e}", file=err)
                 code = 2
+            finally:
+                if staging is not None:
+                    staging.close()
         return self._result(tag, argv, code, out.text(), err.text())
 
     def _progress(self, tag):
