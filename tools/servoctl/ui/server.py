@@ -12,6 +12,8 @@ from pathlib import Path
 
 from aiohttp import WSMsgType, web
 
+from .worker import QueueFull
+
 STATIC = Path(__file__).parent / "static"
 ASSETS = {p.name for p in STATIC.iterdir() if p.is_file()}
 
@@ -88,6 +90,8 @@ class Page:
                     continue
                 try:
                     self._dispatch(ask)
+                except QueueFull as e:
+                    await _send(ws, {"type": "error", "tag": ask.get("tag"), "text": str(e)})
                 except (KeyError, TypeError, ValueError) as e:  # {"op": "items"} without its id
                     await ws.send_json({"type": "error", "text": f"servoctl ui: a malformed request: {e!r}"})
         finally:
@@ -118,7 +122,7 @@ class Page:
         elif op == "table":
             w.submit(w.table)
         elif op == "stopall":
-            w.submit_urgent(w.stop_all, "damping" if ask.get("mode") == "damping" else "release")
+            w.stop_now("damping" if ask.get("mode") == "damping" else "release")
 
     # From the bus thread ----------------------------------------------------
 
