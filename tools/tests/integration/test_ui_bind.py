@@ -1,14 +1,16 @@
 """servoctl ui without a browser: its first line is an address a browser
-opens, whatever --bind says (urllib asks for the page), and what a tab
-sends that is not a request leaves it connected."""
+opens, whatever --bind says (urllib asks for the page); what a tab sends
+that is not a request is answered with an error and leaves it connected;
+every response forbids framing; the Origin is the listening address's."""
 import asyncio
 import json
+import urllib.error
 import urllib.request
 
 import pytest
 
 from servoctl.sim import Simulator
-from ..ui_launch import UiProcess
+from ..ui_launch import UiProcess, http_status as _status
 
 
 def test_the_address_of_an_ipv6_bind_opens_the_page():
@@ -44,3 +46,70 @@ def test_a_malformed_request_leaves_the_tab_connected():
         assert said["code"] == 0, said
         code, err = ui.stop()
     assert code == 0 and "Traceback" not in err, err
+
+
+def _ws_url(ui):
+    return ui.base.replace("http", "ws", 1) + "/ws?token=" + ui.token
+
+
+async def _next(ws, aiohttp, what):
+    """The next message what(msg) is true of; a closed socket fails."""
+    while True:
+        msg = await ws.receive(timeout=20)
+        assert msg.type == aiohttp.WSMsgType.TEXT, f"the tab's connection ended: {msg}"
+        said = json.loads(msg.data)
+        if what(said):
+            return said
+
+
+def test_every_malformed_message_is_answered_with_an_error():
+    """{"id": Infinity} and JSON nested 100 000 deep dropped the tab's
+    connection (and the driving role passed on); now each is answered with
+    an error, in order, and the tab goes on driving."""
+    aiohttp = pytest.importorskip("aiohttp")
+    bad = ('{"op": "items", "id": Infinity}', '{"op": "plot", "ids": [NaN]}', "[" * 100000 + "]" * 100000,
+           '{"a": ' * 100000 + "1" + "}" * 100000, '{"op": "run", "argv": {"x": 1}}', '{"op": "items", "id": 1e400}',
+           '{"op": "plot", "ids": 5}', '{"op": "nothing"}', b"\xff\xfe")
+
+    async def talk(ui):
+        async with aiohttp.ClientSession() as s:
+            async with s.ws_connect(_ws_url(ui), headers={"Origin": ui.base}) as ws:
+                errors = []
+                for message in bad:
+                    await (ws.send_bytes if isinstance(message, bytes) else ws.send_str)(message)
+                    errors.append(await _next(ws, aiohttp, lambda m: m["type"] == "error"))
+                await ws.send_str(json.dumps({"op": "run", "argv": ["ping", "1"], "tag": "t"}))
+                return errors, await _next(ws, aiohttp, lambda m: m["type"] == "result")
+
+    with Simulator(ids=[1], fast=True) as sim, UiProcess(sim) as ui:
+        errors, result = asyncio.run(talk(ui))
+        code, err = ui.stop()
+    assert all("malformed request" in e["text"] for e in errors), errors
+    assert result["code"] == 0, result
+    assert code == 0 and "Traceback" not in err, err
+
+
+def test_every_response_forbids_framing():
+    """No X-Frame-Options or CSP frame-ancestors: another site could frame
+    the page and have its STOP or move buttons clicked through."""
+    with Simulator(ids=[1], fast=True) as sim, UiProcess(sim) as ui:
+        for url in (ui.url, ui.base + "/static/app.js?token=" + ui.token, ui.base + "/"):
+            try:
+                with urllib.request.urlopen(url, timeout=10) as r:
+                    headers = r.headers
+            except urllib.error.HTTPError as e:  # the one without the token: 403, framed neither
+                headers = e.headers
+            assert headers["X-Frame-Options"] == "DENY", url
+            assert "frame-ancestors 'none'" in headers["Content-Security-Policy"], url
+
+
+def test_the_origin_is_compared_with_the_address_it_listens_on():
+    """The Origin was compared with the request's own Host header: a page
+    of a name rebound to this computer sends both alike. Listening on
+    0.0.0.0 (no check of the host name), it drove the bus."""
+    with Simulator(ids=[1], fast=True) as sim, UiProcess(sim, ["--bind", "0.0.0.0"]) as ui:
+        port = ui.base.rsplit(":", 1)[1]
+        rebound = f"rebound.example:{port}"
+        assert _status(ui.url, origin=f"http://{rebound}", host=rebound) == 403
+        assert _status(ui.url, origin=ui.base) == 200
+        assert _status(ui.url.replace("127.0.0.1", "localhost"), origin=f"http://localhost:{port}") == 200
