@@ -3,8 +3,9 @@ WebSocket, all behind the random token in the page's address. A request
 without the token, or from a page of another origin (a web site asking the
 local server to move the robot), is refused with 403. One tab drives the
 bus; another is told which one does and only watches until that one
-closes. Every response forbids framing; a malformed request is answered
-with an error and the tab stays connected."""
+closes. Connections are let in by a doorman (doorman.py); every response
+forbids framing; a malformed request is answered with an error and the tab
+stays connected."""
 import asyncio
 import datetime
 import hmac
@@ -14,6 +15,7 @@ from pathlib import Path
 
 from aiohttp import WSMsgType, web
 
+from .doorman import Doorman
 from .worker import QueueFull
 
 STATIC = Path(__file__).parent / "static"
@@ -21,6 +23,7 @@ ASSETS = {p.name for p in STATIC.iterdir() if p.is_file()}
 # No page of another site may frame this one (a click on its STOP or its
 # move buttons through a transparent frame): both headers, for old browsers too.
 NO_FRAMES = {"X-Frame-Options": "DENY", "Content-Security-Policy": "frame-ancestors 'none'"}
+KEEPALIVE_S = 15  # an idle keep-alive connection with the token closes after this
 
 
 class Malformed(ValueError):
@@ -35,6 +38,7 @@ class Page:
         self.driver = None  # the tab that drives the bus
         self.who = {}       # ws: how the other tabs are told of it
         self.loop = None
+        self.doorman = None
 
     # Safety -----------------------------------------------------------------
 
@@ -58,6 +62,8 @@ class Page:
         why = self._refusal(request, need_origin=request.path == "/ws")
         if why:
             return web.Response(status=403, text=why + "\n")
+        if self.doorman is not None:
+            self.doorman.trust(request.transport)
         return await handler(request)
 
     @staticmethod
@@ -222,15 +228,15 @@ def _own_origins(request) -> list:
 async def serve(page: Page, bind: str, port: int, ready, stop: asyncio.Event):
     """Serves until stop is set; ready(url_port) once listening."""
     page.loop = asyncio.get_running_loop()
-    runner = web.AppRunner(page.app(), access_log=None, handle_signals=False)
+    runner = web.AppRunner(page.app(), access_log=None, handle_signals=False, keepalive_timeout=KEEPALIVE_S)
     await runner.setup()
-    site = web.TCPSite(runner, bind, port)
-    await site.start()
-    bound = runner.addresses[0][1]
-    ready(bound)
+    page.doorman = Doorman(runner.server)
+    server = await page.loop.create_server(page.doorman, bind or None, port)
+    ready(server.sockets[0].getsockname()[1])
     try:
         await stop.wait()
     finally:
+        server.close()
         for ws in list(page.sockets):
             await ws.close()
         await runner.cleanup()

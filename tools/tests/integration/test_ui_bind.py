@@ -1,9 +1,12 @@
 """servoctl ui without a browser: its first line is an address a browser
 opens, whatever --bind says (urllib asks for the page); what a tab sends
 that is not a request is answered with an error and leaves it connected;
-every response forbids framing; the Origin is the listening address's."""
+every response forbids framing; the Origin is the listening address's;
+connections without the token are capped and timed out."""
 import asyncio
 import json
+import socket
+import time
 import urllib.error
 import urllib.request
 
@@ -113,3 +116,41 @@ def test_the_origin_is_compared_with_the_address_it_listens_on():
         assert _status(ui.url, origin=f"http://{rebound}", host=rebound) == 403
         assert _status(ui.url, origin=ui.base) == 200
         assert _status(ui.url.replace("127.0.0.1", "localhost"), origin=f"http://localhost:{port}") == 200
+
+
+def test_connections_without_the_token_are_capped_and_timed_out():
+    """Half-open connections without the token were never closed: 3000 took
+    every file descriptor and page loads timed out. Now at most 32 are
+    open (the oldest closed first), each for 10 s at most, and a page
+    load with the token still comes through."""
+    with Simulator(ids=[1], fast=True) as sim, UiProcess(sim) as ui:
+        port = int(ui.base.rsplit(":", 1)[1])
+        idle = []
+        for _ in range(100):
+            c = socket.create_connection(("127.0.0.1", port), timeout=10)
+            c.sendall(b"GET /?token=" + ui.token.encode() + b" HTTP/1.1\r\nHost: 127.0.0.1\r\n")  # never ends
+            idle.append(c)
+        assert _status(ui.url) == 200
+        deadline = time.monotonic() + 5  # host time: a bound on failure only
+        while sum(not _closed(c) for c in idle) > 32:
+            assert time.monotonic() < deadline, f"{sum(not _closed(c) for c in idle)} of 100 still open"
+            time.sleep(0.05)
+        deadline = time.monotonic() + 30  # the 10 s limit, and a bound on failure only
+        while not all(_closed(c) for c in idle):
+            assert time.monotonic() < deadline, "connections without a whole request stay open"
+            time.sleep(0.2)
+        for c in idle:
+            c.close()
+        code, err = ui.stop()
+    assert code == 0 and "Traceback" not in err, err
+
+
+def _closed(c) -> bool:
+    """Whether the server has closed c (its end read, or reset)."""
+    c.setblocking(False)
+    try:
+        return c.recv(4096) == b""
+    except BlockingIOError:
+        return False
+    except OSError:
+        return True
