@@ -99,7 +99,8 @@ class Page:
         finally:
             self.sockets.remove(ws)
             self.who.pop(ws, None)
-            if self.driver is ws:
+            if self.driver is ws:  # what it asked for ends with it
+                self.worker.abandon()
                 self.driver = self.sockets[0] if self.sockets else None
                 await self._roles()
         return ws

@@ -71,7 +71,7 @@ class Worker:
         self.bus, self.global_argv, self.publish = bus, list(global_argv), publish
         self.files = Folder(files if files is not None else os.getcwd())  # the only files the page names
         self.jobs = collections.deque()    # the page's requests, QUEUE_MAX at most
-        self.urgent = collections.deque()  # stop-all
+        self.urgent = collections.deque()  # stop-all, and what a closed tab leaves
         self.cond = threading.Condition()  # guards both, current, and the interrupt's setting
         self.known = []     # the live table's IDs (after a scan)
         self.plot_ids = []  # sampled while the queue is empty
@@ -118,6 +118,16 @@ class Worker:
         # After the interrupt: a command's write that follows this on the
         # wire sees it (preempt.py's lock) and is not sent.
         self.preempt.broadcast_stop(mode)
+
+    def abandon(self):
+        """The driving tab closed: its queued requests dropped, its command
+        interrupted, its plot's sampling stopped."""
+        with self.cond:
+            self.jobs.clear()
+            if self.current != self.stop_all:
+                self.preempt.interrupt("the tab that asked for it closing")
+            self.urgent.append((self.plot, ([],)))
+            self.cond.notify()
 
     # What the page asks for -------------------------------------------------
 

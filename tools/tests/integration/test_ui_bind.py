@@ -2,7 +2,8 @@
 opens, whatever --bind says (urllib asks for the page); what a tab sends
 that is not a request is answered with an error and leaves it connected;
 every response forbids framing; the Origin is the listening address's;
-connections without the token are capped and timed out."""
+connections without the token are capped and timed out; a closed tab's
+command and sampling end with it."""
 import asyncio
 import json
 import socket
@@ -143,6 +144,37 @@ def test_connections_without_the_token_are_capped_and_timed_out():
             c.close()
         code, err = ui.stop()
     assert code == 0 and "Traceback" not in err, err
+
+
+def test_a_closed_tabs_command_and_sampling_end_with_it():
+    """A tab closed mid-action left its command (a 5 s move that waits)
+    and its plot's sampling running; the next tab waited behind them."""
+    aiohttp = pytest.importorskip("aiohttp")
+
+    async def talk(ui, sim):
+        async with aiohttp.ClientSession() as s:
+            async with s.ws_connect(_ws_url(ui), headers={"Origin": ui.base}) as ws:
+                await ws.send_str(json.dumps({"op": "plot", "ids": [1]}))
+                await _next(ws, aiohttp, lambda m: m["type"] == "samples")
+                await ws.send_str(json.dumps({"op": "run", "argv": ["move", "1", "90", "--interval", "5000",
+                                                                    "--wait"], "tag": 1}))
+                sim.wait_until(lambda: abs(sim.state(1)["velocity"]) > 5, timeout_s=5)  # under way
+            closed_at = sim.clock_s()
+            async with s.ws_connect(_ws_url(ui), headers={"Origin": ui.base}) as ws:
+                await ws.send_str(json.dumps({"op": "run", "argv": ["ping", "1"], "tag": 2}))
+                said = await _next(ws, aiohttp, lambda m: m["type"] == "result" and m["tag"] == 2)
+                waited = sim.clock_s() - closed_at
+                sim.sleep(0.3)
+                await ws.send_str(json.dumps({"op": "run", "argv": ["ping", "1"], "tag": 3}))
+                after = []
+                while not after or after[-1].get("tag") != 3:
+                    after.append(await _next(ws, aiohttp, lambda m: m["type"] in ("samples", "result")))
+                return said, waited, after
+
+    with Simulator(ids=[1], fast=True) as sim, UiProcess(sim) as ui:
+        said, waited, after = asyncio.run(talk(ui, sim))
+    assert said["code"] == 0 and waited < 1.0, (said, waited)  # not behind the 5 s move
+    assert not [m for m in after if m["type"] == "samples"], "the closed tab's plot is still sampled"
 
 
 def _closed(c) -> bool:
