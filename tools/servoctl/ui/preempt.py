@@ -71,6 +71,12 @@ class Preemption:
 
     def _stop_thread(self):
         while (mode := self._stops.get()) is not None:
+            # Clicks that came meanwhile (a page gone wild): one broadcast for
+            # them all, the last one's mode, not a wire full of stops.
+            while not self._stops.empty() and mode is not None:
+                mode = self._stops.get_nowait()
+            if mode is None:
+                return
             frame = p.request_frame(p.STOP_ON_CONTROL, p.encode_request(
                 p.STOP_ON_CONTROL, p.BROADCAST, STOP_METHOD[mode], 0))
             # Written as Bus.send writes, without its look at what came in:

@@ -149,7 +149,7 @@ class Worker:
                 out.shown = err.shown = staging.shown
                 args.on_progress = self._progress(tag)
                 code = cli.run_command(self.bus, args)
-                if code == 0:
+                if not code:  # 0, or None: what a command that ends well may return
                     staging.write_out()
             except KeyboardInterrupt:
                 print(f"servoctl: interrupted by {self.preempt.why}", file=err)
