@@ -28,9 +28,9 @@ def main() -> int:
         cells = []
         for silent in SILENT:
             r = by_silent[silent]
-            note = "" if r["interrupted"] in (True, None) else " (had ended)"
+            note = "" if r["under_way"] in (True, None) else " (had ended before it)"
             cells.append(f"{r['ms']:.1f} ms{note}")
-            if r["ms"] > LIMIT_MS or r["interrupted"] is False:
+            if r["ms"] > LIMIT_MS or r["under_way"] is False:
                 bad.append(f"{name}, {silent} silent: {r['ms']:.1f} ms{note}")
         print(f"| {name} | " + " | ".join(cells) + " |")
     for b in bad:

@@ -13,6 +13,7 @@ clock). The simulator runs in real time (neither fast nor paced): the
 host's reaction is in its clock, as a real servo would see it."""
 import asyncio
 import json
+import re
 import tempfile
 from pathlib import Path
 
@@ -32,8 +33,14 @@ def _run(*argv):
     return {"op": "run", "argv": list(argv)}
 
 
+def _last_step(msg) -> bool:
+    """identify's "step N/N": its experiment done, the fit begins."""
+    return msg["type"] == "line" and re.fullmatch(r"\s*step (\d+)/\1", msg["text"]) is not None
+
+
 # name, what starts it (None: nothing, the page's idle round), the message
-# that says it is under way, then simulated seconds before the click.
+# that says it is under way (its type, or a test of it), then simulated
+# seconds before the click.
 SITUATIONS = {
     "idle live-table round": (None, "table", 1.1),
     "plot sampling": ({"op": "plot", "ids": "all"}, "samples", 0.3),
@@ -42,6 +49,7 @@ SITUATIONS = {
                               None, 0.5),
     "identify, as it starts (the fit's import)": (_run("identify", str(WORKED_ON)), None, 0.02),
     "identify": (_run("identify", str(WORKED_ON)), "line", 0.3),
+    "identify's fit": (_run("identify", str(WORKED_ON)), _last_step, 0.0),
     "tune": (_run("tune", str(WORKED_ON), "--dry-run"), "line", 0.3),
     "calibrate": (_run("calibrate", str(WORKED_ON)), "line", 0.3),
     "64 page actions queued": ("queue", None, 0.2),
@@ -84,7 +92,7 @@ class Page:
 
 
 async def _one(page: Page, sim, ids: list, name: str) -> dict:
-    start, under_way, delay_s = SITUATIONS[name]
+    start, sign, delay_s = SITUATIONS[name]
     tag = await page.send({"op": "run", "argv": ["wheel", str(WHEEL), "run", "--speed", "180"]})
     assert (await page.result(tag))["code"] == 0
     while abs(sim.state(WHEEL)["velocity"]) < 30:
@@ -97,8 +105,8 @@ async def _one(page: Page, sim, ids: list, name: str) -> dict:
             await page.send(_run("ping", str(WORKED_ON)))
     elif start is not None:
         tag = await page.send({**start, "ids": ids} if start.get("ids") == "all" else start)
-    if under_way:
-        await page.until(lambda m: m["type"] == under_way, mark)
+    if sign:
+        await page.until(sign if callable(sign) else lambda m: m["type"] == sign, mark)
     await page.sim_sleep(delay_s)
     t0_ms = sim.clock_s() * 1000.0
     clicked = len(page.heard)
@@ -106,16 +114,18 @@ async def _one(page: Page, sim, ids: list, name: str) -> dict:
     while (coasted := sim.state(WHEEL)["coasted_ms"]) < t0_ms:
         await asyncio.sleep(0.001)
     await page.until(lambda m: m["type"] == "stopped", clicked)
-    interrupted = None
+    # Under way at the click: the command ended after it (interrupted, or in
+    # its last step, a fit, with no bus step left), or queued ones went unrun.
+    under_way = None
     if start is not None and start != "queue" and start["op"] != "plot":
         done = await page.until(lambda m: m["type"] in ("result", "scan") and m.get("tag", tag) == tag, mark)
-        interrupted = done["code"] == 130
+        under_way = page.heard.index(done) >= clicked
     elif start == "queue":
-        interrupted = any(m["type"] == "result" and "not run" in m["err"] for m in page.heard[clicked:])
+        under_way = any(m["type"] == "result" and "not run" in m["err"] for m in page.heard[clicked:])
     if start is not None and start != "queue" and start["op"] == "plot":
         await page.send({"op": "plot", "ids": []})
         await page.until(lambda m: m["type"] == "plotting" and not m["ids"], clicked)
-    return {"situation": name, "ms": coasted - t0_ms, "interrupted": interrupted}
+    return {"situation": name, "ms": coasted - t0_ms, "under_way": under_way}
 
 
 async def _bench(ui, sim, ids, silent_ids, names):
@@ -131,7 +141,7 @@ async def _bench(ui, sim, ids, silent_ids, names):
 
 
 def measure(silent: int, names=tuple(SITUATIONS)) -> list:
-    """[{situation, ms, interrupted}] on a bus of servos 1 and 2 and
+    """[{situation, ms, under_way}] on a bus of servos 1 and 2 and
     silent unplugged ones."""
     silent_ids = list(range(3, 3 + silent))
     ids = [WHEEL, WORKED_ON] + silent_ids

@@ -15,5 +15,5 @@ def test_stop_all_preempts_the_table_round_a_full_queue_and_identify(silent):
     done = measure(silent, ("idle live-table round", "64 page actions queued",
                             "identify, as it starts (the fit's import)"))
     for r in done:
-        assert r["interrupted"] is not False, r  # it was under way when STOP ALL came
+        assert r["under_way"] is not False, r  # it was under way when STOP ALL came
         assert r["ms"] <= LIMIT_MS, done
