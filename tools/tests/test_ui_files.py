@@ -130,3 +130,12 @@ def test_a_file_the_command_reads_is_read_through_the_folder(tmp_path):
         assert staging.shown(f"cannot read {args.file}") == f"cannot read {tmp_path / 'c.json'}"
     finally:
         staging.close()
+
+
+def test_a_fifo_in_the_folder_is_refused_not_waited_on(tmp_path):
+    """A FIFO named as an update's image or a restore's file held the bus
+    thread in open() until someone wrote to it."""
+    os.mkfifo(tmp_path / "image.img")
+    args = build_parser().parse_args(["--port", "loop://", "restore", "image.img"])
+    with pytest.raises(UsageError, match="'image.img': not a regular file"):
+        Folder(tmp_path).confine(args)

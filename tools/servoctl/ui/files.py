@@ -12,13 +12,15 @@ in after the check is then refused, not followed."""
 import errno
 import os
 import shutil
+import stat
 import tempfile
 from pathlib import Path
 
 from ..errors import UsageError
 
-READ = os.O_RDONLY | os.O_NOFOLLOW | os.O_CLOEXEC
-WRITE = os.O_WRONLY | os.O_CREAT | os.O_TRUNC | os.O_NOFOLLOW | os.O_CLOEXEC
+# O_NONBLOCK: a FIFO put in the folder does not hold the bus thread in open().
+READ = os.O_RDONLY | os.O_NOFOLLOW | os.O_CLOEXEC | os.O_NONBLOCK
+WRITE = os.O_WRONLY | os.O_CREAT | os.O_TRUNC | os.O_NOFOLLOW | os.O_CLOEXEC | os.O_NONBLOCK
 
 
 class Folder:
@@ -72,25 +74,31 @@ class Folder:
         """config diff's side: an ID and 'factory' as they are, a file inside."""
         return text if text == "factory" or (text.isascii() and text.isdigit()) else staging.add(text)
 
-    def open(self, real: str, flags: int) -> int:
-        """A descriptor of real (a path path() gave) opened from the
+    def open(self, real: str, flags: int, name: str) -> int:
+        """A descriptor of real (the path path(name) gave) opened from the
         folder's descriptor down, no symlink followed on the way."""
         parts = Path(real).relative_to(self.root).parts
         if not parts:
-            self._refuse(real, "the folder itself, not a file")
+            self._refuse(name, "the folder itself, not a file")
         fd = os.dup(self.fd)
         try:
             for part in parts[:-1]:
                 inner = os.open(part, os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW | os.O_CLOEXEC, dir_fd=fd)
                 os.close(fd)
                 fd = inner
-            return os.open(parts[-1], flags, 0o666, dir_fd=fd)
+            opened = os.open(parts[-1], flags, 0o666, dir_fd=fd)
         except OSError as e:
             if e.errno in (errno.ELOOP, errno.ENOTDIR):
-                self._refuse(real, "a symlink now, put there after it was checked")
+                self._refuse(name, "a symlink now, put there after it was checked")
+            if e.errno == errno.ENXIO:  # a FIFO nobody reads
+                self._refuse(name, "not a regular file")
             raise
         finally:
             os.close(fd)
+        if not stat.S_ISREG(os.fstat(opened).st_mode):
+            os.close(opened)
+            self._refuse(name, "not a regular file")
+        return opened
 
 
 class Staging:
@@ -100,7 +108,7 @@ class Staging:
     def __init__(self, folder: Folder):
         self.folder = folder
         self.dir = None
-        self.writes = []  # (real path in the folder, the copy's path)
+        self.writes = []  # (the name, its real path in the folder, the copy's path)
 
     def add(self, name: str, writes: bool = False) -> str:
         real = self.folder.path(name)
@@ -109,10 +117,10 @@ class Staging:
         copy = os.path.join(self.dir, os.path.relpath(real, self.folder.root))
         os.makedirs(os.path.dirname(copy), exist_ok=True)
         if writes:
-            self.writes.append((real, copy))
+            self.writes.append((name, real, copy))
             return copy
         try:
-            fd = self.folder.open(real, READ)
+            fd = self.folder.open(real, READ, name)
         except FileNotFoundError:
             return copy  # none: the command says so, of the name shown()
         with os.fdopen(fd, "rb") as src, open(copy, "wb") as dst:
@@ -121,9 +129,9 @@ class Staging:
 
     def write_out(self) -> None:
         """What the command wrote, into the folder (after it succeeded)."""
-        for real, copy in self.writes:
+        for name, real, copy in self.writes:
             if os.path.exists(copy):
-                with open(copy, "rb") as src, os.fdopen(self.folder.open(real, WRITE), "wb") as dst:
+                with open(copy, "rb") as src, os.fdopen(self.folder.open(real, WRITE, name), "wb") as dst:
                     shutil.copyfileobj(src, dst)
 
     def shown(self, text: str) -> str:
