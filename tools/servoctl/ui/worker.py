@@ -223,7 +223,7 @@ class Worker:
         self.publish({"type": "items", "id": servo_id, "items": sampling.items_of(self.bus, servo_id)})
 
     def plot(self, ids: list):
-        ids = [int(i) for i in ids]
+        ids = list(dict.fromkeys(int(i) for i in ids))  # each once: a page's list, not a Sync Monitor of 10 000
         for servo_id in ids:
             check_range("servo ID", servo_id, 0, p.MAX_ID)
         self.plot_ids = ids
