@@ -106,9 +106,9 @@ class Worker:
             self.cond.notify()
 
     def stop_now(self, mode: str):
-        """STOP ALL: the broadcast stop on the wire at once (the stop
-        thread), what runs interrupted, then stop_all before anything
-        queued."""
+        """STOP ALL (on the server's thread): what runs interrupted, the
+        broadcast stop on the wire at once (preempt.py), then stop_all
+        before anything queued."""
         with self.cond:
             if self.current != self.stop_all:
                 self.preempt.interrupt("stop-all")
@@ -232,9 +232,9 @@ class Worker:
 
     def stop_all(self, mode: str):
         """Every known servo damped or released (servoctl stop ID --mode);
-        the commands still queued are dropped, unrun. The stop thread's
-        broadcast is on the wire already; it goes again here, at the host's
-        own rate (a scan of all rates may have been at another)."""
+        the commands still queued are dropped, unrun. stop_now's broadcast
+        is on the wire already; it goes again here, at the host's own rate
+        (a scan of all rates may have been at another)."""
         failed = []
         try:  # every servo at this baud rate first: one not in the last scan (none yet, a
             # shared or a new ID) is stopped too; then each known one, its answer checked
