@@ -14,10 +14,18 @@ from servoctl.ui.opener import PageOpener
 
 
 def _confined(folder, *argv):
+    """The parsed command, each file it names as the page's folder shows it
+    (the command itself is handed a private copy's path: files.Staging)."""
     args = build_parser().parse_args(["--port", "loop://", *argv])
     if args.command == "config":
         args_.config_operands(args)
-    folder.confine(args)
+    staging = folder.confine(args)
+    for attr in ("file", "image", "mujoco", "target", "other"):
+        if isinstance(getattr(args, attr, None), str):
+            setattr(args, attr, staging.shown(getattr(args, attr)))
+    if args.command == "update":
+        args.targets = [staging.shown(t) for t in args.targets]
+    staging.close()
     return args
 
 
@@ -79,3 +87,55 @@ def test_the_browser_is_not_handed_the_token(tmp_path):
     assert f'location.replace("{url}")' in page.read_text()
     opener.close()
     assert not page.exists()
+
+
+@pytest.mark.parametrize("swapped", ["the file", "its folder"])
+def test_a_symlink_swapped_in_after_the_check_is_not_followed(tmp_path, swapped):
+    """The name was checked, then the command opened it by name: a symlink
+    put in its place meanwhile (by another user of a shared folder) was
+    followed, and config save wrote outside the folder."""
+    root, outside = tmp_path / "bench", tmp_path / "secret"
+    root.mkdir()
+    outside.mkdir()
+    (root / "sub").mkdir()
+    (outside / "servo.json").write_text("precious")
+    args = build_parser().parse_args(["--port", "loop://", "config", "save", "1", "sub/servo.json"])
+    args_.config_operands(args)
+    staging = Folder(root).confine(args)  # checked: inside
+    if swapped == "the file":
+        (root / "sub" / "servo.json").symlink_to(outside / "servo.json")
+    else:
+        (root / "sub").rmdir()
+        (root / "sub").symlink_to(outside)
+    with open(args.file, "w") as f:  # what config save does with the name it is given
+        f.write("written")
+    try:
+        if staging is not None:
+            with pytest.raises(UsageError, match="a symlink now, put there after it was checked"):
+                staging.write_out()
+    finally:
+        if staging is not None:
+            staging.close()
+    assert (outside / "servo.json").read_text() == "precious"
+
+
+def test_a_file_the_command_reads_is_read_through_the_folder(tmp_path):
+    """config load, restore, diff and update read a copy taken with no
+    symlink followed; the command's words name the folder's file."""
+    (tmp_path / "c.json").write_text("{}")
+    args = build_parser().parse_args(["--port", "loop://", "restore", "c.json"])
+    staging = Folder(tmp_path).confine(args)
+    try:
+        assert args.file != str(tmp_path / "c.json") and open(args.file).read() == "{}"
+        assert staging.shown(f"cannot read {args.file}") == f"cannot read {tmp_path / 'c.json'}"
+    finally:
+        staging.close()
+
+
+def test_a_fifo_in_the_folder_is_refused_not_waited_on(tmp_path):
+    """A FIFO named as an update's image or a restore's file held the bus
+    thread in open() until someone wrote to it."""
+    os.mkfifo(tmp_path / "image.img")
+    args = build_parser().parse_args(["--port", "loop://", "restore", "image.img"])
+    with pytest.raises(UsageError, match="'image.img': not a regular file"):
+        Folder(tmp_path).confine(args)

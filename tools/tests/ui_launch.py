@@ -7,6 +7,8 @@ import signal
 import subprocess
 import sys
 import tempfile
+import urllib.error
+import urllib.request
 from pathlib import Path
 
 CHROMIUM = os.environ.get("SERVO_UI_CHROMIUM", "/usr/bin/chromium")
@@ -61,6 +63,17 @@ class UiProcess:
     @property
     def token(self) -> str:
         return self.url.split("token=", 1)[1]
+
+
+def http_status(url: str, origin: str = None, host: str = None) -> int:
+    """A GET's status, with the Origin and Host headers given."""
+    req = urllib.request.Request(url, headers={**({"Origin": origin} if origin else {}),
+                                               **({"Host": host} if host else {})})
+    try:
+        with urllib.request.urlopen(req, timeout=10) as r:
+            return r.status
+    except urllib.error.HTTPError as e:
+        return e.code
 
 
 def launch_chromium(playwright):

@@ -3,17 +3,31 @@ WebSocket, all behind the random token in the page's address. A request
 without the token, or from a page of another origin (a web site asking the
 local server to move the robot), is refused with 403. One tab drives the
 bus; another is told which one does and only watches until that one
-closes."""
+closes. Connections are let in by a doorman (doorman.py); every response
+forbids framing; a malformed request is answered with an error and the tab
+stays connected."""
 import asyncio
 import datetime
 import hmac
+import ipaddress
 import json
 from pathlib import Path
 
 from aiohttp import WSMsgType, web
 
+from .doorman import Doorman
+from .worker import QueueFull
+
 STATIC = Path(__file__).parent / "static"
 ASSETS = {p.name for p in STATIC.iterdir() if p.is_file()}
+# No page of another site may frame this one (a click on its STOP or its
+# move buttons through a transparent frame): both headers, for old browsers too.
+NO_FRAMES = {"X-Frame-Options": "DENY", "Content-Security-Policy": "frame-ancestors 'none'"}
+KEEPALIVE_S = 15  # an idle keep-alive connection with the token closes after this
+
+
+class Malformed(ValueError):
+    pass
 
 
 class Page:
@@ -24,6 +38,7 @@ class Page:
         self.driver = None  # the tab that drives the bus
         self.who = {}       # ws: how the other tabs are told of it
         self.loop = None
+        self.doorman = None
 
     # Safety -----------------------------------------------------------------
 
@@ -35,11 +50,11 @@ class Page:
         if self.hosts is not None and host not in self.hosts:
             return f"refused: a request for host {host!r}, not this computer's (DNS rebinding?)"
         origin = request.headers.get("Origin")
-        own = f"{request.scheme}://{request.host}"
+        own = _own_origins(request)
         if origin is None and need_origin:
             return "refused: a WebSocket without an Origin"
-        if origin is not None and origin != own:
-            return f"refused: a request from another origin ({origin}), not {own}"
+        if origin is not None and origin not in own:
+            return f"refused: a request from another origin ({origin}), not {' or '.join(own)}"
         return None
 
     @web.middleware
@@ -47,7 +62,13 @@ class Page:
         why = self._refusal(request, need_origin=request.path == "/ws")
         if why:
             return web.Response(status=403, text=why + "\n")
+        if self.doorman is not None:
+            self.doorman.trust(request.transport)
         return await handler(request)
+
+    @staticmethod
+    async def no_frames(request, response):
+        response.headers.update(NO_FRAMES)
 
     # Routes -----------------------------------------------------------------
 
@@ -74,29 +95,36 @@ class Page:
         await self._roles()
         try:
             async for msg in ws:
-                if msg.type != WSMsgType.TEXT:
-                    continue
-                try:
-                    ask = json.loads(msg.data)
-                except ValueError:
-                    continue
-                if not isinstance(ask, dict):  # [1], 5, "x": not a request; the tab stays
-                    continue
-                if ws is not self.driver and ask.get("op") != "stopall":  # any tab may stop
-                    await ws.send_json({"type": "busy", "holder": self.who[self.driver],
-                                        "text": f"{self.who[self.driver]} drives the bus"})
-                    continue
-                try:
-                    self._dispatch(ask)
-                except (KeyError, TypeError, ValueError) as e:  # {"op": "items"} without its id
-                    await ws.send_json({"type": "error", "text": f"servoctl ui: a malformed request: {e!r}"})
+                await self._take(ws, msg)
         finally:
             self.sockets.remove(ws)
             self.who.pop(ws, None)
-            if self.driver is ws:
+            if self.driver is ws:  # what it asked for ends with it
+                self.worker.abandon()
                 self.driver = self.sockets[0] if self.sockets else None
                 await self._roles()
         return ws
+
+    async def _take(self, ws, msg):
+        """One message of a tab: a request, or an error said back (a
+        malformed one, one the queue has no room for); the tab stays."""
+        if msg.type not in (WSMsgType.TEXT, WSMsgType.BINARY):
+            return
+        tag = None
+        try:
+            ask = _parse(msg.data)
+            tag = ask.get("tag")
+            if ws is not self.driver and ask.get("op") != "stopall":  # any tab may stop
+                await _send(ws, {"type": "busy", "holder": self.who[self.driver],
+                                 "text": f"{self.who[self.driver]} drives the bus"})
+                return
+            self._dispatch(ask)
+        except QueueFull as e:
+            await _send(ws, {"type": "error", "tag": tag, "text": str(e)})
+        except (Malformed, KeyError, TypeError, ValueError, OverflowError) as e:
+            await _send(ws, {"type": "error", "tag": tag, "text": f"servoctl ui: a malformed request: {e}"})
+        except Exception as e:  # noqa: BLE001 - whatever a request does, the tab stays and hears why
+            await _send(ws, {"type": "error", "tag": tag, "text": f"servoctl ui: {type(e).__name__}: {e}"})
 
     async def _roles(self):
         for ws in list(self.sockets):
@@ -107,18 +135,23 @@ class Page:
     def _dispatch(self, ask: dict):
         op, w = ask.get("op"), self.worker
         tag = ask.get("tag")
-        if op == "run":
-            w.submit(w.run, [str(a) for a in ask.get("argv", [])], tag)
+        if op == "stopall":
+            w.stop_now("damping" if ask.get("mode") == "damping" else "release")
+        elif op == "run":
+            w.submit(w.run, _strings(ask.get("argv", []), "argv"), tag)
         elif op == "scan":
             w.submit(w.scan, bool(ask.get("all_bauds")), tag)
         elif op == "items":
-            w.submit(w.items, int(ask["id"]))
+            w.submit(w.items, _whole(ask["id"], "id"))
         elif op == "plot":
-            w.submit(w.plot, ask.get("ids", []))
+            ids = ask.get("ids", [])
+            if not isinstance(ids, list):
+                raise Malformed(f"ids must be a list, not {ids!r:.40}")
+            w.submit(w.plot, [_whole(i, "ids") for i in ids])
         elif op == "table":
             w.submit(w.table)
-        elif op == "stopall":
-            w.submit_urgent(w.stop_all, "damping" if ask.get("mode") == "damping" else "release")
+        else:
+            raise Malformed(f"no such op: {op!r:.40}")
 
     # From the bus thread ----------------------------------------------------
 
@@ -133,6 +166,7 @@ class Page:
 
     def app(self) -> web.Application:
         a = web.Application(middlewares=[self.guard])
+        a.on_response_prepare.append(self.no_frames)
         a.router.add_get("/", self.index)
         a.router.add_get("/ws", self.socket)
         a.router.add_get("/static/{name}", self.asset)
@@ -147,18 +181,63 @@ async def _send(ws, msg):
             pass
 
 
+def _parse(data) -> dict:
+    """A request: a JSON object of finite numbers. Infinity, NaN and
+    nesting deeper than Python's recursion limit are refused as malformed."""
+    def no_constant(name):
+        raise Malformed(f"{name} is not a number a request may carry")
+    try:
+        ask = json.loads(data, parse_constant=no_constant)
+    except RecursionError:
+        raise Malformed("nested too deep") from None
+    except UnicodeDecodeError:
+        raise Malformed("not UTF-8") from None
+    except json.JSONDecodeError as e:
+        raise Malformed(f"not JSON: {e}") from None
+    if not isinstance(ask, dict):  # [1], 5, "x": not a request
+        raise Malformed(f"a request is a JSON object, not {type(ask).__name__}")
+    return ask
+
+
+def _whole(value, name: str) -> int:
+    if isinstance(value, bool) or not isinstance(value, (int, str)):
+        raise Malformed(f"{name} must be a whole number, not {value!r:.40}")
+    return int(value)  # "x" raises ValueError, said as malformed
+
+
+def _strings(values, name: str) -> list:
+    if not isinstance(values, list) or not all(isinstance(v, (str, int, float)) for v in values):
+        raise Malformed(f"{name} must be a list of strings")
+    return [str(v) for v in values]
+
+
+def _own_origins(request) -> list:
+    """The page's own origins: the address and port this connection
+    reached (the listening socket's, not the Host header a rebound name
+    sets), and on loopback the name localhost too."""
+    sockname = request.transport.get_extra_info("sockname") if request.transport else None
+    if not sockname:  # the connection has gone
+        return []
+    address, port = sockname[:2]
+    ip = ipaddress.ip_address(address.split("%")[0])
+    if ip.version == 6 and ip.ipv4_mapped:
+        ip = ip.ipv4_mapped
+    shown = f"[{ip}]" if ip.version == 6 else str(ip)
+    return [f"http://{shown}:{port}"] + ([f"http://localhost:{port}"] if ip.is_loopback else [])
+
+
 async def serve(page: Page, bind: str, port: int, ready, stop: asyncio.Event):
     """Serves until stop is set; ready(url_port) once listening."""
     page.loop = asyncio.get_running_loop()
-    runner = web.AppRunner(page.app(), access_log=None, handle_signals=False)
+    runner = web.AppRunner(page.app(), access_log=None, handle_signals=False, keepalive_timeout=KEEPALIVE_S)
     await runner.setup()
-    site = web.TCPSite(runner, bind, port)
-    await site.start()
-    bound = runner.addresses[0][1]
-    ready(bound)
+    page.doorman = Doorman(runner.server)
+    server = await page.loop.create_server(page.doorman, bind or None, port)
+    ready(server.sockets[0].getsockname()[1])
     try:
         await stop.wait()
     finally:
+        server.close()
         for ws in list(page.sockets):
             await ws.close()
         await runner.cleanup()

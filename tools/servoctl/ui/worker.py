@@ -1,13 +1,15 @@
 """The one thread that owns the bus for `servoctl ui`: it runs servoctl's own
 commands (cli.run_command, as the command line would, their output and
 refusals word for word), the live table's info rounds and the plots'
-samples, one at a time. The page's requests queue here; stop-all jumps the
-queue. Results go back through publish (called on this thread)."""
+samples, one at a time. The page's requests queue here (QUEUE_MAX at
+most); stop-all jumps the queue and interrupts what runs (preempt.py).
+Results go back through publish (called on this thread)."""
+import collections
 import contextlib
+import importlib
 import io
 import json
 import os
-import queue
 import shlex
 import threading
 
@@ -18,12 +20,23 @@ from ..checks import check_range
 from ..errors import EXIT_INTERRUPTED, ServoError
 from . import sampling
 from .files import Folder
+from .preempt import STOP_METHOD, Preemption
 
 # Commands the page may run as they are: those that end on their own. A
 # monitor, a stream and the ui itself run until stopped; sim and image need
 # no bus.
 RUNNABLE = set(cli.COMMANDS) - {"monitor", "stream", "record", "ui"}
 TABLE_EVERY_S = (1.0, 3.0)  # the live table's info round, bus time: idle, plotting
+QUEUE_MAX = 64  # page actions waiting; more are refused (a page gone wild, a script)
+# What identify, tune, calibrate and update load on first use (scipy takes
+# a second): loaded as the ui starts, on a thread of their own, not on the
+# bus thread in the middle of a command.
+SLOW_IMPORTS = ("servoctl.identify_report", "servoctl.calibrate", "servoctl.tune", "servoctl.update",
+                "servoctl.bench", "servoctl.console")
+
+
+class QueueFull(Exception):
+    pass
 
 
 class _Lines(io.TextIOBase):
@@ -32,6 +45,7 @@ class _Lines(io.TextIOBase):
 
     def __init__(self, say):
         self.say, self.part, self.all = say, "", []
+        self.shown = str  # the staged copies' names as the folder's (files.Staging.shown)
 
     def writable(self):
         return True
@@ -43,56 +57,77 @@ class _Lines(io.TextIOBase):
         self.part += text
         while "\n" in self.part:
             line, self.part = self.part.split("\n", 1)
+            line = self.shown(line)
             self.all.append(line)
             self.say(line)
         return len(text)
 
     def text(self) -> str:
-        return "\n".join(self.all + ([self.part] if self.part else []))
+        return "\n".join(self.all + ([self.shown(self.part)] if self.part else []))
 
 
 class Worker:
     def __init__(self, bus, global_argv: list, publish, files=None):
         self.bus, self.global_argv, self.publish = bus, list(global_argv), publish
         self.files = Folder(files if files is not None else os.getcwd())  # the only files the page names
-        self.jobs = queue.Queue()
-        self.urgent = queue.Queue()  # stop-all
+        self.jobs = collections.deque()    # the page's requests, QUEUE_MAX at most
+        self.urgent = collections.deque()  # stop-all, and what a closed tab leaves
+        self.cond = threading.Condition()  # guards both, current, and the interrupt's setting
         self.known = []     # the live table's IDs (after a scan)
         self.plot_ids = []  # sampled while the queue is empty
         self.sampler = None
         self.stopping = threading.Event()
-        self.interrupt = threading.Event()  # stop-all: the running command ends at its next bus step
-        self.busy, self.current = False, None
-        for name in ("request", "send", "sleep", "gather"):
-            setattr(bus, name, self._interruptible(getattr(bus, name)))
+        self.preempt = Preemption(bus)  # the running command ends at its next look at the port
+        self.current = None
         self.thread = threading.Thread(target=self._loop, name="servoctl-ui-bus", daemon=True)
         self._next_table = 0.0
 
     def start(self):
+        threading.Thread(target=_import_slow_parts, name="servoctl-ui-imports", daemon=True).start()
         self.thread.start()
 
     def stop(self):
         """Ctrl-C: a command still running ends at its next bus step."""
-        self.stopping.set()
-        self.interrupt.set()
-        self.jobs.put(None)
+        with self.cond:
+            self.stopping.set()
+            self.preempt.interrupt("the ui stopping")
+            self.cond.notify()
         self.thread.join(timeout=5)
+        self.preempt.close()
 
     def submit(self, fn, *a):
-        self.jobs.put((fn, a))
+        """A page's request, run after those before it; QueueFull if
+        QUEUE_MAX wait already."""
+        with self.cond:
+            if len(self.jobs) >= QUEUE_MAX:
+                raise QueueFull(f"servoctl ui: {QUEUE_MAX} actions are waiting for the bus: this one is "
+                                f"refused (wait for them, or STOP ALL drops them)")
+            self.jobs.append((fn, a))
+            self.cond.notify()
 
-    def submit_urgent(self, fn, *a):
-        self.urgent.put((fn, a))
-        if self.busy and self.current != self.stop_all:
-            self.interrupt.set()
-        self.jobs.put(("wake", ()))
+    def stop_now(self, mode: str):
+        """STOP ALL (on the server's thread): what runs interrupted, the
+        broadcast stop on the wire at once (preempt.py), then stop_all
+        before anything queued."""
+        with self.cond:
+            if self.current != self.stop_all:
+                self.preempt.interrupt("stop-all")
+            if (self.stop_all, (mode,)) not in self.urgent:
+                self.urgent.append((self.stop_all, (mode,)))
+            self.cond.notify()
+        # After the interrupt: a command's write that follows this on the
+        # wire sees it (preempt.py's lock) and is not sent.
+        self.preempt.broadcast_stop(mode)
 
-    def _interruptible(self, step):
-        def step_unless_stopped(*a, **kw):
-            if self.interrupt.is_set():
-                raise KeyboardInterrupt
-            return step(*a, **kw)
-        return step_unless_stopped
+    def abandon(self):
+        """The driving tab closed: its queued requests dropped, its command
+        interrupted, its plot's sampling stopped."""
+        with self.cond:
+            self.jobs.clear()
+            if self.current != self.stop_all:
+                self.preempt.interrupt("the tab that asked for it closing")
+            self.urgent.append((self.plot, ([],)))
+            self.cond.notify()
 
     # What the page asks for -------------------------------------------------
 
@@ -104,17 +139,20 @@ class Worker:
             return self._result(tag, argv, 2, "", f"servoctl: error: {msg}")
         out, err = _Lines(lambda line: self.publish({"type": "line", "tag": tag, "text": line})), _Lines(
             lambda line: self.publish({"type": "line", "tag": tag, "text": line, "err": True}))
-        code = 0
+        code, staging = 0, None
         with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
             try:
                 args = build_parser().parse_args(self.global_argv + list(argv))
                 if args.command == "config":
                     cli.args_.config_operands(args)
-                self.files.confine(args)
+                staging = self.files.confine(args)
+                out.shown = err.shown = staging.shown
                 args.on_progress = self._progress(tag)
                 code = cli.run_command(self.bus, args)
+                if not code:  # 0, or None: what a command that ends well may return
+                    staging.write_out()
             except KeyboardInterrupt:
-                print("servoctl: interrupted by stop-all", file=err)
+                print(f"servoctl: interrupted by {self.preempt.why}", file=err)
                 code = EXIT_INTERRUPTED
             except SystemExit as e:  # argparse's usage error, printed to err
                 code = e.code if isinstance(e.code, int) else 2
@@ -124,6 +162,9 @@ class Worker:
             except Exception as e:  # noqa: BLE001 - an argument check's (ArgumentTypeError)
                 print(f"servoctl: error: {e}", file=err)
                 code = 2
+            finally:
+                if staging is not None:
+                    staging.close()
         return self._result(tag, argv, code, out.text(), err.text())
 
     def _progress(self, tag):
@@ -150,8 +191,12 @@ class Worker:
             found = json.loads(r["out"].splitlines()[-1]) if r["out"] else []
         except (ValueError, IndexError):
             found = []
-        self.known = sorted({f["id"] for f in found if f["mode"] == "application" and not f["shared"]})
+        ids = {f["id"] for f in found if f["mode"] == "application" and not f["shared"]}
+        if r["code"] == EXIT_INTERRUPTED:  # a part of the bus: those known before are kept for stop-all
+            ids |= set(self.known)
+        self.known = sorted(ids)
         self.publish({"type": "scan", "found": found, "err": r["err"], "code": r["code"]})
+        self.preempt.check()
         self.table()
 
     def table(self):
@@ -160,6 +205,7 @@ class Worker:
         rows = []
         for servo_id in (i for i in self.known if i not in self.plot_ids):
             r = self.run_quiet(["info", str(servo_id), "--json"])
+            self.preempt.check()  # interrupted: no row is "gone" for it
             if r["code"] == 0:
                 rows.append(json.loads(r["out"]))
             else:
@@ -177,7 +223,7 @@ class Worker:
         self.publish({"type": "items", "id": servo_id, "items": sampling.items_of(self.bus, servo_id)})
 
     def plot(self, ids: list):
-        ids = [int(i) for i in ids]
+        ids = list(dict.fromkeys(int(i) for i in ids))  # each once: a page's list, not a Sync Monitor of 10 000
         for servo_id in ids:
             check_range("servo ID", servo_id, 0, p.MAX_ID)
         self.plot_ids = ids
@@ -186,67 +232,60 @@ class Worker:
 
     def stop_all(self, mode: str):
         """Every known servo damped or released (servoctl stop ID --mode);
-        the commands still queued are dropped, unrun."""
-        self.interrupt.clear()
-        while True:
-            try:
-                job = self.jobs.get_nowait()
-            except queue.Empty:
-                break
-            if job and job[0] == self.run:
-                argv, tag = job[1]
-                self._result(tag, argv, EXIT_INTERRUPTED, "", "servoctl ui: not run: stop-all came first")
-        ids = self.known or self.plot_ids
+        the commands still queued are dropped, unrun. stop_now's broadcast
+        is on the wire already; it goes again here, at the host's own rate
+        (a scan of all rates may have been at another)."""
         failed = []
         try:  # every servo at this baud rate first: one not in the last scan (none yet, a
             # shared or a new ID) is stopped too; then each known one, its answer checked
-            method = {"release": 0x10, "damping": 0x12}[mode]  # as Servo.stop's
-            self.bus.send(p.STOP_ON_CONTROL, p.encode_request(p.STOP_ON_CONTROL, p.BROADCAST, method, 0))
+            self.bus.send(p.STOP_ON_CONTROL, p.encode_request(p.STOP_ON_CONTROL, p.BROADCAST,
+                                                              STOP_METHOD[mode], 0))
         except ServoError as e:
             failed.append(f"broadcast stop: {e}")
+        with self.cond:
+            dropped, self.jobs = list(self.jobs), collections.deque()
+        for fn, a in dropped:
+            if fn == self.run:
+                argv, tag = a
+                self._result(tag, argv, EXIT_INTERRUPTED, "", "servoctl ui: not run: stop-all came first")
+        ids = self.known or self.plot_ids
         said = [self.run_quiet(["stop", str(i), "--mode", mode]) for i in ids]
         failed += [r["err"] for r in said if r["code"]]
-        self.interrupt.clear()  # one set as this began: it interrupts nothing later
         self.publish({"type": "stopped", "mode": mode, "ids": ids, "failed": failed})
 
     # The thread -------------------------------------------------------------
 
     def _loop(self):
-        while not self.stopping.is_set():
-            while not self.urgent.empty():
-                self._do(self.urgent.get())
+        while True:
+            with self.cond:
+                if not (self.urgent or self.jobs or self.plot_ids or self.stopping.is_set()):
+                    self.cond.wait(0.2)
+                if self.stopping.is_set():
+                    return
+                job = self.urgent.popleft() if self.urgent else self.jobs.popleft() if self.jobs else None
+                # What the interrupt was for has ended; one set after this (under
+                # the lock) comes with its own urgent job and interrupts this one.
+                self.preempt.clear()
+                self.current = job[0] if job else self._idle
             try:
-                job = self.jobs.get(timeout=0 if self.plot_ids else 0.2)
-            except queue.Empty:
-                job = "idle"
-            if job is None:
-                return
-            if job == "idle":
-                try:
+                if job is None:
                     self._idle()
-                except KeyboardInterrupt:
-                    self.interrupt.clear()  # stop-all, a moment late: it runs next
-                except Exception as e:  # noqa: BLE001 - a lost link: the page hears it, stop-all still runs
-                    self.publish({"type": "error", "text": f"servoctl ui: {type(e).__name__}: {e}"})
+                else:
+                    job[0](*job[1])
+            except KeyboardInterrupt:
+                if job is not None:
+                    self.publish({"type": "error", "text": f"servoctl ui: interrupted by {self.preempt.why}"})
+            except Exception as e:  # noqa: BLE001 - the page hears it; the thread goes on, stop-all still runs
+                self.publish({"type": "error", "text": f"servoctl ui: {type(e).__name__}: {e}"})
+                if job is None:  # a lost link: not a round every 0.2 s
                     self.stopping.wait(1.0)
-            elif job[0] != "wake":
-                self._do(job)
-
-    def _do(self, job):
-        fn, a = job
-        self.busy, self.current = True, fn
-        try:
-            fn(*a)
-        except KeyboardInterrupt:
-            self.publish({"type": "error", "text": "servoctl ui: interrupted by stop-all"})
-        except Exception as e:  # noqa: BLE001 - the page hears it; the thread goes on
-            self.publish({"type": "error", "text": f"servoctl ui: {type(e).__name__}: {e}"})
-        finally:
-            self.busy = False
+            finally:
+                self.current = None
 
     def _idle(self):
-        if self.sampler is not None:
-            rows = self.sampler.take()
+        sampler = self.sampler  # plot() replaces it on this thread only
+        if sampler is not None:
+            rows = sampler.take()
             if rows:
                 self.publish({"type": "samples", "rows": rows})
         try:
@@ -258,3 +297,11 @@ class Worker:
         if self.known and now >= self._next_table:
             self._next_table = now + TABLE_EVERY_S[bool(self.plot_ids)]
             self.table()
+
+
+def _import_slow_parts():
+    for name in SLOW_IMPORTS:
+        try:
+            importlib.import_module(name)
+        except ImportError:  # an extra not installed: the command says so when asked
+            pass

@@ -11,8 +11,6 @@ SERVO_UI_SCREENSHOTS=DIR saves a screenshot of each view there (docs/ui:
 import os
 import shutil
 import time
-import urllib.error
-import urllib.request
 from pathlib import Path
 
 import pytest
@@ -20,7 +18,7 @@ import pytest
 from servoctl import image as img
 from servoctl.servo import Servo
 from servoctl.sim import Simulator
-from ..ui_launch import CHROMIUM, UiProcess, launch_chromium, navigation_ms
+from ..ui_launch import CHROMIUM, UiProcess, http_status as _status, launch_chromium, navigation_ms
 
 playwright_api = pytest.importorskip("playwright.sync_api")
 IDS = [1, 2, 3, 4, 5, 6]
@@ -60,16 +58,6 @@ def _shot(page, name: str):
 
 def _view(page, name: str):
     page.click(f"#tabs button[data-view={name}]")
-
-
-def _status(url: str, origin: str = None, host: str = None) -> int:
-    req = urllib.request.Request(url, headers={**({"Origin": origin} if origin else {}),
-                                               **({"Host": host} if host else {})})
-    try:
-        with urllib.request.urlopen(req, timeout=5) as r:
-            return r.status
-    except urllib.error.HTTPError as e:
-        return e.code
 
 
 def test_first_line_is_the_address_with_its_token(bench):

@@ -2,6 +2,8 @@
 page's requests do on servo_sim, judged on the simulator's state."""
 import time
 
+import pytest
+
 from servoctl.protocol import Bus
 from servoctl.sim import Simulator
 from servoctl.ui.worker import Worker
@@ -69,3 +71,31 @@ def _heard(said, what):
     while not any(what(m) for m in list(said)):
         assert time.monotonic() < deadline, said[-3:]
         time.sleep(0.01)
+
+
+def test_the_queue_is_bounded_and_a_full_one_refuses_with_a_message():
+    """The page's actions queued without bound (50 000 of them held STOP
+    ALL back 4.6 s, each answered "not run" before it)."""
+    from servoctl.ui import worker as ui_worker
+
+    with Simulator(ids=[1], fast=True) as sim:
+        w = _worker(sim, [])
+        for i in range(ui_worker.QUEUE_MAX):
+            w.submit(w.run, ["ping", "1"], i)
+        with pytest.raises(ui_worker.QueueFull, match="actions are waiting for the bus: this one is refused"):
+            w.submit(w.run, ["ping", "1"], "one too many")
+        w.preempt.close()
+
+
+def test_a_burst_of_stop_all_clicks_puts_few_stops_on_the_wire():
+    """Each click wrote a broadcast: a page that floods STOP ALL filled the
+    wire (and blocked the server's thread on a full socket)."""
+    with Simulator(ids=[1], fast=True) as sim:
+        w = _worker(sim, [])
+        for _ in range(2000):
+            w.preempt.broadcast_stop("release")
+        sim.sleep(0.3)
+        w.preempt.close()
+        runs = [line.split() for line in sim.control("wire 1024").splitlines() if line.strip() not in ("", "end")]
+        sent = sum(int(r[2]) for r in runs if r[3] == "host")
+        assert 0 < sent <= 50 * 9, runs  # a stop frame is 9 bytes; 2000 of them without the limit

@@ -38,6 +38,10 @@ const UI = (() => {
 
   function handle(msg) {
     if (msg.type === "line" && waiting[msg.tag] && waiting[msg.tag].onLine) waiting[msg.tag].onLine(msg);
+    if (msg.type === "error" && msg.tag != null && waiting[msg.tag]) {  // refused before it ran: a full queue
+      waiting[msg.tag].resolve({code: 2, out: "", err: msg.text});
+      delete waiting[msg.tag];
+    }
     if (msg.type === "result") {
       log(`$ ${msg.command}  -> exit ${msg.code}`, msg.code ? "refused" : "");
       if (waiting[msg.tag]) { waiting[msg.tag].resolve(msg); delete waiting[msg.tag]; }

@@ -1,0 +1,19 @@
+"""STOP ALL in `servoctl ui` on the wire within 50 ms of the click, on the
+simulator's clock, whatever the bus thread is doing (docs/ui.md, "STOP ALL";
+scripts/ui_stop_bench.py measures every case). Before, with 11 silent servos
+on the bus, it waited for the live table's round (1.4-4.7 s), behind every
+queued action, and behind the first identify's import of scipy."""
+import pytest
+
+from ..ui_stop_bench import LIMIT_MS, measure
+
+pytest.importorskip("aiohttp")
+
+
+@pytest.mark.parametrize("silent", [11])
+def test_stop_all_preempts_the_table_round_a_full_queue_and_identify(silent):
+    done = measure(silent, ("idle live-table round", "64 page actions queued",
+                            "identify, as it starts (the fit's import)"))
+    for r in done:
+        assert r["under_way"] is not False, r  # it was under way when STOP ALL came
+        assert r["ms"] <= LIMIT_MS, done
