@@ -47,6 +47,14 @@ def test_connect_holds_the_arm_where_it_is_and_arms_the_watchdog(seen):
     assert seen["watchdog_after"] == [0] * 7  # as it was before connect
 
 
+def test_the_first_actions_after_connect_ramp_at_the_default_speed(seen):
+    # 40 deg from where the arm was: at 45 deg/s (give or take the servo's ripple),
+    # not the 740 deg/s a target may move in a frame; there within 1.5 s.
+    assert seen["ramp_speed_deg_s"] == 45.0
+    assert 40 <= seen["ramp_peak_dps"] <= 56, seen["ramp_peak_dps"]
+    assert abs(seen["ramp_reached"]) <= 0.3, seen["ramp_reached"]
+
+
 def test_max_relative_target_clamps_a_step(seen):
     assert seen["clamped"] == pytest.approx(5.0)
 
