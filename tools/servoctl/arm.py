@@ -16,9 +16,12 @@ and out, a frame at a time.
   is to what is asked at ramp_speed_deg_s (DEFAULT_RAMP_DEG_S; 0: no
   ramp); a joint follows freely from the frame its target is reached.
 - On this firmware the bus watchdog (items 64, 65) is armed while the arm
-  is driven, and put back as it was on close.
+  is driven, and put back as it was on close; the servo's own setting is
+  kept on the host meanwhile (watchdog_record.py), so a run that ended
+  without putting it back is not taken for the servo's own.
 
 Time is the bus's clock (the simulator's on servo_sim)."""
+import logging
 import math
 
 from . import protocol as p
@@ -27,6 +30,9 @@ from .errors import NoReply, ServoError, UsageError, ValueOutOfRange
 from .group import sync_monitor
 from .servo import Servo
 from .setpoints import MAX_SPEED_DECIDEG_S, Stream, read_limits
+from .watchdog_record import WatchdogRecords
+
+log = logging.getLogger(__name__)
 
 WATCHDOG_ACTIONS = {"hold": 0, "damp": 1, "release": 2}  # item 65
 # Status bits with which the servo has let its output go (frame.toml).
@@ -67,6 +73,13 @@ def fault_text(servo: Servo, newest: int = 3) -> str:
     return f"its newest faults: {said} ('servoctl faults {servo.id}')"
 
 
+def watchdog_text(setting: tuple) -> str:
+    """(watchdog_ms, watchdog_action) as a phrase: '500 ms, hold', 'off'."""
+    ms, action = setting
+    named = {v: k for k, v in WATCHDOG_ACTIONS.items()}.get(action, f"action {action}")
+    return f"{ms} ms, {named}" if ms else f"off ({named})"
+
+
 def detect_firmware(bus: p.Bus, servo_id: int) -> str:
     """"servoctl" (this firmware: item 64 reads) or "maker"."""
     try:
@@ -82,13 +95,14 @@ class Arm:
     """joints: {name: servo ID}. fps: the frames a second the host's loop
     sends (a stream's period). firmware: "auto", "servoctl" or "maker"
     (the maker's path runs on this firmware too: its packets are the
-    maker's). watchdog_ms 0 leaves the watchdog as it is.
-    ramp_speed_deg_s: the first targets' top speed from where the arm is
-    held, deg/s; 0: none."""
+    maker's). watchdog_ms 0 leaves the watchdog as it is; records keeps
+    each servo's own setting meanwhile (WatchdogRecords: the user's state
+    folder unless given). ramp_speed_deg_s: the first targets' top speed
+    from where the arm is held, deg/s; 0: none."""
 
     def __init__(self, bus: p.Bus, joints: dict, fps: float = 30.0, firmware: str = "auto",
                  watchdog_ms: int = 500, watchdog_action: str = "hold",
-                 ramp_speed_deg_s: float = DEFAULT_RAMP_DEG_S):
+                 ramp_speed_deg_s: float = DEFAULT_RAMP_DEG_S, records: WatchdogRecords = None):
         if not joints:
             raise UsageError("an arm needs at least one joint")
         if watchdog_action not in WATCHDOG_ACTIONS:
@@ -103,6 +117,7 @@ class Arm:
         self.period_s = 1.0 / fps
         self.firmware = firmware
         self.watchdog_ms, self.watchdog_action = watchdog_ms, watchdog_action
+        self.records = records if records is not None else WatchdogRecords()
         self.ramp_speed_deg_s = ramp_speed_deg_s
         self.ramping = set()  # the joints whose targets still ramp to what is asked
         self._held_at = None  # the bus clock when hold_here held the arm
@@ -111,7 +126,7 @@ class Arm:
         self.stream = None
         self.targets = {}  # {name: degrees}: the last sent, or where hold_here held
         self._before = {}  # the targets before those
-        self._watchdog_before = {}
+        self._watchdog_before = {}  # {id: (serial, the servo's own setting)}
         self._times = []  # the bus clock at the last sends, up to 3
         self.measured_period_s = self.period_s
         self.frames = 0
@@ -131,14 +146,24 @@ class Arm:
     def _arm_watchdog(self) -> None:
         if not self.watchdog_ms:
             return
-        action = WATCHDOG_ACTIONS[self.watchdog_action]
+        ours = (self.watchdog_ms, WATCHDOG_ACTIONS[self.watchdog_action])
         for servo_id in self.ids:
             s = Servo(self.bus, servo_id)
-            before = (s.read("watchdog_ms"), s.read("watchdog_action"))
-            if before != (self.watchdog_ms, action):  # a write is a flash record: only when it changes
-                self._watchdog_before[servo_id] = before
-                s.write("watchdog_ms", self.watchdog_ms)
-                s.write("watchdog_action", action)
+            serial = s.read("serial")
+            holds = (s.read("watchdog_ms"), s.read("watchdog_action"))
+            own, record = self.records.own_setting(serial, holds)
+            if record is not None:
+                log.warning("%s (servo %d): its bus watchdog holds %s, which a run that did not end cleanly "
+                            "wrote; its own setting, %s (kept in %s), is put back on close",
+                            self.names[servo_id], servo_id, watchdog_text(holds), watchdog_text(own), record)
+            if own != ours:
+                self.records.keep(serial, servo_id, own, ours)  # before the servo holds ours
+                self._watchdog_before[servo_id] = (serial, own)
+            elif record is not None:
+                self.records.forget(serial)
+            if holds != ours:  # written only where it differs
+                s.write("watchdog_ms", ours[0])
+                s.write("watchdog_action", ours[1])
             self.limits[servo_id].watchdog_ms = self.watchdog_ms
 
     def hold_here(self) -> dict:
@@ -170,11 +195,12 @@ class Arm:
         if release:
             for servo_id in self.ids:
                 Servo(self.bus, servo_id).stop("release")
-        for servo_id, (ms, action) in self._watchdog_before.items():
+        for servo_id, (serial, (ms, action)) in self._watchdog_before.items():
             try:
                 s = Servo(self.bus, servo_id)
                 s.write("watchdog_ms", ms)
                 s.write("watchdog_action", action)
+                self.records.forget(serial)  # kept where it could not be put back
             except ServoError as e:
                 errors.append(f"{self.names[servo_id]}: {e}")
         self._watchdog_before = {}

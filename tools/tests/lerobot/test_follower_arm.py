@@ -1,12 +1,29 @@
 """servoctl.arm, the LeRobot follower's library, at the edges a user meets
-first, on servo_sim (no LeRobot needed): the first actions after connect.
-Time is the simulator's."""
+first, on servo_sim (no LeRobot needed): the first actions after connect,
+and a run that ended without putting the watchdog back. Time is the
+simulator's."""
+import logging
+
 import pytest
 
 from servoctl.arm import Arm
+from servoctl.servo import Servo
 from servoctl.sim import Simulator
 
 FPS = 30
+FACTORY_WATCHDOG = (0, 1)  # off, damp (items 64, 65 at power-up)
+
+
+@pytest.fixture(autouse=True)
+def state_dir(tmp_path, monkeypatch):
+    """The watchdog's records in the test's own folder, not the user's."""
+    monkeypatch.setenv("SERVOCTL_STATE_DIR", str(tmp_path / "state"))
+    return tmp_path / "state"
+
+
+def watchdog(bus, servo_id: int) -> tuple:
+    s = Servo(bus, servo_id)
+    return s.read("watchdog_ms"), s.read("watchdog_action")
 
 
 def test_the_first_actions_ramp_from_where_the_arm_is():
@@ -40,3 +57,38 @@ def test_no_ramp_when_turned_off():
         held = arm.hold_here()
         sim.sleep(0.01)
         assert arm.send({"a": held["a"] + 20.0})["a"] == pytest.approx(held["a"] + 20.0, abs=0.1)
+
+
+def test_a_run_that_did_not_end_leaves_its_watchdog_not_taken_for_the_servos_own(caplog):
+    """A run that ended without close() (a closed terminal) left 500 ms,
+    hold on the servos; the next clean run read that as the setting to put
+    back, and a later 3 s move stopped after 0.5 s ("limiter watchdog")."""
+    with Simulator(ids=[1, 2], fast=True) as sim:
+        bus = sim.bus()
+        Arm(bus, {"a": 1, "b": 2}).open().hold_here()  # and never closed
+        assert watchdog(bus, 1) == (500, 0)
+        with caplog.at_level(logging.WARNING, logger="servoctl.arm"):
+            arm = Arm(bus, {"a": 1, "b": 2}).open()
+        arm.hold_here()
+        arm.close()
+        assert [watchdog(bus, i) for i in (1, 2)] == [FACTORY_WATCHDOG] * 2
+        assert "a (servo 1): its bus watchdog holds 500 ms, hold, which a run that did not end cleanly wrote; " \
+               "its own setting, off (damp)" in caplog.text, caplog.text
+        s = Servo(bus, 1)
+        s.move_to(30, duration_s=3.0)
+        sim.sleep(3.3)
+        assert abs(sim.state(1)["angle"] - 30) < 0.5  # the move ran its 3 s, no watchdog stopped it
+        assert "watchdog" not in [f.kind for f in s.faults()]
+
+
+def test_a_record_the_servo_no_longer_matches_is_dropped(state_dir):
+    """Set since (or power-cycled: items 64-65 are RAM), the servo's value
+    is its own again: a stale record does not put an old one back."""
+    with Simulator(ids=[1], fast=True) as sim:
+        bus = sim.bus()
+        Arm(bus, {"a": 1}).open()  # never closed: a record of (0, damp) is left
+        Servo(bus, 1).write("watchdog_ms", 2000)  # the user's new setting
+        arm = Arm(bus, {"a": 1}).open()
+        arm.close()
+        assert watchdog(bus, 1) == (2000, 0)
+        assert not list((state_dir / "watchdog").glob("*.json"))

@@ -11,6 +11,7 @@ the figures are the same on an idle and a loaded PC, and the test runs
 in the parallel pass."""
 import json
 import math
+import os
 import subprocess
 
 import pytest
@@ -27,8 +28,15 @@ pytestmark = [pytest.mark.skipif(not PYTHON.exists(), reason="no .venv-lerobot: 
 
 
 @pytest.fixture(scope="module")
-def seen():
-    done = subprocess.run(["bash", str(RUN), str(DRIVER)], capture_output=True, text=True, timeout=240)
+def state_dir(tmp_path_factory):
+    """The follower's watchdog records (servoctl.watchdog_record): the run's own."""
+    return tmp_path_factory.mktemp("servoctl-state")
+
+
+@pytest.fixture(scope="module")
+def seen(state_dir):
+    done = subprocess.run(["bash", str(RUN), str(DRIVER)], capture_output=True, text=True, timeout=240,
+                          env=dict(os.environ, SERVOCTL_STATE_DIR=str(state_dir)))
     assert done.returncode == 0, done.stderr[-4000:]
     return json.loads(done.stdout.strip().splitlines()[-1])
 
@@ -45,6 +53,11 @@ def test_connect_holds_the_arm_where_it_is_and_arms_the_watchdog(seen):
     assert seen["watchdog_connected"] == [[500, 0]] * 7  # 500 ms, hold
     assert seen["faults_after_silence"] == ["watchdog"]  # a host gone quiet: the watchdog took over
     assert seen["watchdog_after"] == [0] * 7  # as it was before connect
+
+
+def test_disconnect_leaves_no_watchdog_record(seen, state_dir):
+    # Kept while connected, where a crash cannot lose it; gone once put back.
+    assert not list(state_dir.rglob("*.json"))
 
 
 def test_the_first_actions_after_connect_ramp_at_the_default_speed(seen):
