@@ -19,13 +19,15 @@ and out, a frame at a time.
   is driven, and put back as it was on close; the servo's own setting is
   kept on the host meanwhile (watchdog_record.py), so a run that ended
   without putting it back is not taken for the servo's own.
+- A joint that does not answer because two servos hold its ID is said to
+  be shared (JointShared: scan's probe hears their answers collide).
 
 Time is the bus's clock (the simulator's on servo_sim)."""
 import logging
 import math
 
 from . import protocol as p
-from . import registers
+from . import registers, scan
 from .errors import NoReply, ServoError, UsageError, ValueOutOfRange
 from .group import sync_monitor
 from .servo import Servo
@@ -53,6 +55,10 @@ class JointSilent(NoReply):
         self.joints = joints
 
 
+class JointShared(JointSilent):
+    """Two or more servos hold a joint's ID: their answers collide."""
+
+
 class JointFault(ServoError):
     """A joint's servo has let its output go: the message has its faults."""
 
@@ -78,6 +84,17 @@ def watchdog_text(setting: tuple) -> str:
     ms, action = setting
     named = {v: k for k, v in WATCHDOG_ACTIONS.items()}.get(action, f"action {action}")
     return f"{ms} ms, {named}" if ms else f"off ({named})"
+
+
+def shared_text(bus: p.Bus, ids: list):
+    """What scan's probe says of the first of ids that two or more servos
+    hold (their answers collide, or come twice), or None."""
+    window = scan.reply_window_s(bus.serial.baudrate)
+    for servo_id in ids:
+        found = scan.probe(bus, servo_id, window)
+        if found is not None and found.shared:
+            return found.describe()
+    return None
 
 
 def detect_firmware(bus: p.Bus, servo_id: int) -> str:
@@ -254,6 +271,10 @@ class Arm:
         if silent:
             named = ", ".join(f"{self.names[i]} (servo {i})" for i in silent)
             names = [self.names[i] for i in silent]
+            shared = shared_text(self.bus, silent)
+            if shared is not None:  # not a cable: two servos answer at once and garble each other
+                raise JointShared(f"{named} did not answer in the Sync Monitor: {shared}; no position is "
+                                  f"given", names)
             if not states:  # none at all: the link's rate or the IDs, more likely than every cable
                 baud = self.bus.serial.baudrate
                 raise JointSilent(f"no joint answered: {named}; no position is given (is the arm powered, "

@@ -1,12 +1,12 @@
 """servoctl.arm, the LeRobot follower's library, at the edges a user meets
 first, on servo_sim (no LeRobot needed): the first actions after connect,
-and a run that ended without putting the watchdog back. Time is the
-simulator's."""
+a run that ended without putting the watchdog back, and two servos at one
+joint's ID. Time is the simulator's."""
 import logging
 
 import pytest
 
-from servoctl.arm import Arm
+from servoctl.arm import Arm, JointSilent
 from servoctl.servo import Servo
 from servoctl.sim import Simulator
 
@@ -92,3 +92,17 @@ def test_a_record_the_servo_no_longer_matches_is_dropped(state_dir):
         arm.close()
         assert watchdog(bus, 1) == (2000, 0)
         assert not list((state_dir / "watchdog").glob("*.json"))
+
+
+def test_a_joint_whose_id_two_servos_hold_is_reported_as_shared():
+    """Two servos at ID 2 answer the Sync Monitor at once and garble each
+    other: the plugin said "did not answer ... is it powered, its cable
+    in?", where servoctl scan says the truth."""
+    with Simulator(ids=[1, 2, 2, 3], fast=True) as sim:
+        arm = Arm(sim.bus(), {"a": 1, "b": 2, "c": 3}, watchdog_ms=0)
+        with pytest.raises(JointSilent) as e:
+            arm.positions()
+    said = str(e.value)
+    assert "b (servo 2)" in said and "TWO OR MORE SERVOS hold this ID" in said, said
+    assert "servoctl id assign" in said and "cable" not in said, said
+    assert "b" in e.value.joints
