@@ -24,7 +24,6 @@ import argparse
 import os
 import signal
 import sys
-import time
 from pathlib import Path
 
 from servoctl import link_rate
@@ -80,14 +79,19 @@ def write_env(path: Path, text: str) -> None:
 
 
 def nudge(env: Path, servo_id: int, arm_name: str = "leader", torque_nm: float = 0.5, seconds: float = 0.2) -> None:
-    """One arm's joint pushed (its control port's load), then let be."""
+    """One arm's joint pushed (its control port's load), then let be; for
+    seconds of the simulator's clock, which a loaded PC does not stretch."""
     ports = read_env(env)
     leader, follower = int(ports["LEADER_CONTROL"]), int(ports["FOLLOWER_CONTROL"])
     pushed = leader if arm_name == "leader" else follower
-    control_command(pushed, f"load {torque_nm} {servo_id}")
-    time.sleep(seconds)
-    control_command(pushed, f"load 0 {servo_id}")
-    time.sleep(1.0)
+    clock = Simulator.running(pushed)
+    try:
+        control_command(pushed, f"load {torque_nm} {servo_id}")
+        clock.sleep(seconds)
+        control_command(pushed, f"load 0 {servo_id}")
+        clock.sleep(1.0)
+    finally:
+        clock.stop()  # its connection, not the simulator
     for name, port in (("leader", leader), ("follower", follower)):
         angles = [_fields(line)["angle"] for line in control_command(port, "state").splitlines() if line.strip()]
         print(f"{name:8} horns (deg): {' '.join(f'{a:7.1f}' for a in angles)}")
