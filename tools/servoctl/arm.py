@@ -13,8 +13,8 @@ and out, a frame at a time.
   a cubic, docs/streaming.md); the maker's gets angle moves in one
   SyncCommand, each timed to the frame period measured between sends.
 - send(): the first targets after hold_here() ramp from where each joint
-  is to what is asked at ramp_speed_deg_s (DEFAULT_RAMP_DEG_S; 0: no
-  ramp); a joint follows freely from the frame its target is reached.
+  is to what is asked at ramp_speed_deg_s (arm_ramp.py; 0: no ramp); a
+  joint follows freely from the frame its target is reached.
 - On this firmware the bus watchdog (items 64, 65) is armed while the arm
   is driven, and put back as it was on close; the servo's own setting is
   kept on the host meanwhile (watchdog_record.py), so a run that ended
@@ -29,6 +29,7 @@ import math
 from . import protocol as p
 from . import registers, scan
 from .errors import NoReply, ServoError, UsageError, ValueOutOfRange
+from .arm_ramp import DEFAULT_SPEED_DEG_S, Ramp
 from .group import sync_monitor
 from .servo import Servo
 from .setpoints import MAX_SPEED_DECIDEG_S, Stream, read_limits
@@ -41,10 +42,6 @@ WATCHDOG_ACTIONS = {"hold": 0, "damp": 1, "release": 2}  # item 65
 RELEASED_BY = ("high_voltage", "low_voltage", "over_temperature")
 # The maker's moves: the shortest and longest time fitted to the frames.
 MOVE_MS = (10, 1000)
-# The first targets after hold_here(), deg/s: a 34 deg gap to a leader's
-# pose takes a second, not the two frames the servo's top speed allows.
-DEFAULT_RAMP_DEG_S = 45.0
-RAMP_RISE_S = 0.25  # from rest to the ramp's speed
 
 
 class JointSilent(NoReply):
@@ -119,7 +116,7 @@ class Arm:
 
     def __init__(self, bus: p.Bus, joints: dict, fps: float = 30.0, firmware: str = "auto",
                  watchdog_ms: int = 500, watchdog_action: str = "hold",
-                 ramp_speed_deg_s: float = DEFAULT_RAMP_DEG_S, records: WatchdogRecords = None):
+                 ramp_speed_deg_s: float = DEFAULT_SPEED_DEG_S, records: WatchdogRecords = None):
         if not joints:
             raise UsageError("an arm needs at least one joint")
         if watchdog_action not in WATCHDOG_ACTIONS:
@@ -135,10 +132,8 @@ class Arm:
         self.firmware = firmware
         self.watchdog_ms, self.watchdog_action = watchdog_ms, watchdog_action
         self.records = records if records is not None else WatchdogRecords()
-        self.ramp_speed_deg_s = ramp_speed_deg_s
-        self.ramping = set()  # the joints whose targets still ramp to what is asked
+        self.ramp = Ramp(ramp_speed_deg_s, self.period_s)
         self._held_at = None  # the bus clock when hold_here held the arm
-        self._ramp_speeds, self._ramp_wanted = {}, {}
         self.limits = {}
         self.stream = None
         self.targets = {}  # {name: degrees}: the last sent, or where hold_here held
@@ -196,9 +191,7 @@ class Arm:
             raise UsageError(f"{', '.join(turned)}: beyond one turn (wheel mode or multi-turn moves); "
                              f"release it and reset its turns ('servoctl origin ID --reset-turns') first")
         self.targets, self._before = here, {}
-        self.ramping = set(here) if self.ramp_speed_deg_s > 0 else set()
-        self._ramp_speeds = {}  # {name: deg/s} of the ramp's last step
-        self._ramp_wanted = {}  # {name: deg} asked at the last send
+        self.ramp.start(here)
         self._held_at = self.bus.clock()
         if self.firmware == "servoctl":
             self.stream = Stream(self.bus, self.ids, self.period_s, self.limits)
@@ -321,7 +314,8 @@ class Arm:
         if not self.targets:
             raise UsageError("hold_here() first: the arm's first target is where it is")
         now = self.bus.clock()
-        sent = self._ramp(self.clamp({**self.targets, **targets}), now)
+        since = now - (self._times[-1] if self._times else self._held_at)
+        sent = self.ramp.step(self.clamp({**self.targets, **targets}), self.targets, since)
         if self._times:
             # The frame period as the host keeps it: the maker's moves are fitted to it.
             self.measured_period_s += 0.3 * (min(now - self._times[-1], 1.0) - self.measured_period_s)
@@ -333,36 +327,6 @@ class Arm:
         self._before = self.targets
         self.targets = sent
         return {n: round(d, 1) for n, d in sent.items()}
-
-    def _ramp(self, wanted: dict, now: float) -> dict:
-        """wanted, with each joint still ramping moved toward it from its
-        last target at up to ramp_speed_deg_s: up to that speed in
-        RAMP_RISE_S, slowing down to arrive with the target's own speed
-        (a step from rest, or to rest, jolts the horn to twice the speed),
-        over the time since the last send, a frame period at most (a late
-        frame is no licence to jump). A joint whose target is within that
-        step is there, and follows freely from then: a leader that moves
-        slower than the ramp is caught up."""
-        if not self.ramping:
-            return wanted
-        since = now - (self._times[-1] if self._times else self._held_at)
-        dt = min(max(since, 0.0), self.period_s)
-        top, accel = self.ramp_speed_deg_s, self.ramp_speed_deg_s / RAMP_RISE_S
-        out = dict(wanted)
-        for name in list(self.ramping):
-            last, speed = self.targets[name], self._ramp_speeds.get(name, 0.0)
-            gap = wanted[name] - last
-            moving = (wanted[name] - self._ramp_wanted.get(name, wanted[name])) / since if since > 0 else 0.0
-            goal = min(max(moving + math.copysign(math.sqrt(2 * accel * abs(gap)), gap), -top), top)
-            speed += min(max(goal - speed, -accel * dt), accel * dt)
-            step = speed * dt
-            if abs(gap) <= abs(step) and step * gap >= 0:
-                self.ramping.discard(name)  # there: from now on it follows
-            else:
-                out[name] = last + step
-                self._ramp_speeds[name] = speed
-            self._ramp_wanted[name] = wanted[name]
-        return out
 
     def _velocities(self, sent: dict) -> dict:
         """{id: deg/s} at each new setpoint, from the last three and the

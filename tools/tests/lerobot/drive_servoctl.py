@@ -88,7 +88,7 @@ def ramped(out: dict) -> None:
     try:
         robot = follower(sim)
         robot.connect(calibrate=False)
-        out["ramp_speed_deg_s"] = robot.arm.ramp_speed_deg_s
+        out["ramp_speed_deg_s"] = robot.arm.ramp.speed_deg_s
         goal = robot.get_observation()["Motor_1.pos"] + 40.0
         t0, peak = sim.clock_s(), 0.0
         for k in range(45):

@@ -3,7 +3,7 @@ from dataclasses import dataclass, field
 
 from lerobot.cameras import CameraConfig
 from lerobot.robots.config import RobotConfig
-from servoctl.arm import DEFAULT_RAMP_DEG_S
+from servoctl.arm_ramp import DEFAULT_SPEED_DEG_S
 
 from .joints import ArmBusConfig
 
@@ -16,7 +16,7 @@ class ServoctlArmConfig(RobotConfig, ArmBusConfig):
     # The first actions after connect() ramp from where the arm is to what is asked, at
     # most this fast (deg/s); each joint follows freely once it is there. 0: no ramp (the
     # servo's top speed, 740 deg/s).
-    ramp_speed_deg_s: float = DEFAULT_RAMP_DEG_S
+    ramp_speed_deg_s: float = DEFAULT_SPEED_DEG_S
     # This firmware's bus watchdog while connected (items 64, 65): a host silent this long
     # leaves the arm holding ("hold"), damped ("damp") or free ("release"). 0: left as it is.
     watchdog_ms: int = 500
