@@ -2,7 +2,7 @@
 # Runs Python in the LeRobot environment (.venv-lerobot, scripts/lerobot_env.sh)
 # with this checkout's LeRobot plugins (tools/lerobot_plugins: servoctl_arm,
 # servoctl_leader) installed by pip as LeRobot finds them, and servoctl
-# from tools/:
+# from tools/ (with its schema and image packages):
 #     bash scripts/lerobot_run.sh -m lerobot.scripts.lerobot_teleoperate ...
 # The plugins go to build/lerobot-plugins/<hash of their files>, installed
 # once for each version of them, so the environment shared by every clone
@@ -26,5 +26,7 @@ if [ ! -d "$TARGET" ]; then
   # A run beside this one may have put it there first: its copy is as good.
   mv -T "$NEW" "$TARGET" 2>/dev/null || rm -rf "$NEW"
 fi
-export PYTHONPATH="$TARGET:$ROOT/tools:$ROOT/protocol${PYTHONPATH:+:$PYTHONPATH}"
+# servoctl's packages where `pip install -e tools` finds them (tools/pyproject.toml's
+# package-dir): the schema in protocol/, the update image's maker in firmware/bootloader/.
+export PYTHONPATH="$TARGET:$ROOT/tools:$ROOT/protocol:$ROOT/firmware/bootloader${PYTHONPATH:+:$PYTHONPATH}"
 exec "$PY" "$@"

@@ -2,20 +2,28 @@
 (docs/lerobot.md): a follower on socket://127.0.0.1:5100 and a leader on
 socket://127.0.0.1:5200, each servo_sim with IDs 0-6 at 1 Mbaud, soft
 start off. Writes their ports to build/sim-arms.env (FOLLOWER_PORT,
-FOLLOWER_CONTROL, LEADER_PORT, LEADER_CONTROL: a shell's `source`), prints
-the lerobot-teleoperate command that drives them and runs until Ctrl-C or
-SIGTERM, which stop both.
+FOLLOWER_CONTROL, LEADER_PORT, LEADER_CONTROL: a shell's `source`; --env
+puts it elsewhere), prints the lerobot-teleoperate command that drives
+them and runs until Ctrl-C or SIGTERM, which stop both.
 
     .venv/bin/python tools/lerobot_plugins/sim_arms.py [--follower 5100] [--leader 5200]
+        [--env FILE] [--state DIR]
 
-and, while they run, a hand on the leader: a torque on one released joint
-for a moment, then both arms' horn angles once the follower has followed:
+--state DIR keeps the servos' flash (DIR/follower, DIR/leader), so what
+a calibration stores on them is there at the next start. An env file
+that a running instance wrote is left alone: this one stops, saying so
+(a second instance takes its own --env, and its own ports; 0 is any free
+one).
 
-    .venv/bin/python tools/lerobot_plugins/sim_arms.py --nudge JOINT_ID"""
+While they run, a hand on an arm: a torque on one released joint for a
+moment (the leader's, or the follower's while it calibrates), then both
+arms' horn angles a second later:
+
+    .venv/bin/python tools/lerobot_plugins/sim_arms.py --nudge JOINT_ID [--arm follower] [--torque -0.5]"""
 import argparse
+import os
 import signal
 import sys
-import time
 from pathlib import Path
 
 from servoctl import link_rate
@@ -27,24 +35,63 @@ ENV = Path(__file__).resolve().parents[2] / "build" / "sim-arms.env"
 BAUD_1M = 8  # item 36's index for 1 000 000 baud
 
 
-def arm(tcp_port: int) -> Simulator:
-    sim = Simulator(ids=IDS, tcp_port=tcp_port).start()
-    with sim.bus(timeout=0.2) as bus:
-        for i in IDS:
-            Servo(bus, i).write("soft_start_on", 0)
-            Servo(bus, i).write("baud", BAUD_1M)  # answered at 115200, then it switches
-    link_rate.open_rate(sim.url, 1000000, str(sim.control_port))  # the host's rate on the socket
+def arm(tcp_port: int, state_dir=None) -> Simulator:
+    """An arm at 1 Mbaud, soft start off; servos that kept that from an
+    earlier run (--state) are left as they are."""
+    sim = Simulator(ids=IDS, tcp_port=tcp_port, state_dir=state_dir).start()
+    try:
+        link_rate.open_rate(sim.url, 1000000, str(sim.control_port))  # the host's rate on the socket
+        with sim.bus(timeout=0.02, baud=1000000) as bus:
+            new = [i for i in IDS if not Servo(bus, i).ping()]
+        if new:
+            link_rate.open_rate(sim.url, 115200, str(sim.control_port))
+            with sim.bus(timeout=0.2) as bus:
+                for i in new:
+                    Servo(bus, i).write("soft_start_on", 0)
+                    Servo(bus, i).write("baud", BAUD_1M)  # answered at 115200, then it switches
+            link_rate.open_rate(sim.url, 1000000, str(sim.control_port))
+    except BaseException:
+        sim.stop()
+        raise
     return sim
 
 
-def nudge(servo_id: int, torque_nm: float = 0.5, seconds: float = 0.2) -> None:
-    """The leader's joint pushed (its control port's load), then let be."""
-    env = dict(line.split("=", 1) for line in ENV.read_text().split())
-    leader, follower = int(env["LEADER_CONTROL"]), int(env["FOLLOWER_CONTROL"])
-    control_command(leader, f"load {torque_nm} {servo_id}")
-    time.sleep(seconds)
-    control_command(leader, f"load 0 {servo_id}")
-    time.sleep(1.0)
+def read_env(path: Path) -> dict:
+    return dict(line.split("=", 1) for line in path.read_text().split())
+
+
+def running_owner(path: Path):
+    """The pid of the running sim_arms.py that wrote path, or None."""
+    try:
+        pid = int(read_env(path).get("SIM_ARMS_PID", ""))
+        cmdline = Path(f"/proc/{pid}/cmdline").read_bytes()
+    except (OSError, ValueError):
+        return None  # no file, an older one, or its writer is gone
+    return pid if b"sim_arms" in cmdline and pid != os.getpid() else None
+
+
+def write_env(path: Path, text: str) -> None:
+    """Whole or not at all: a shell waiting for the file sources it whole."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    new = path.with_name(f".{path.name}.{os.getpid()}")
+    new.write_text(text)
+    os.replace(new, path)
+
+
+def nudge(env: Path, servo_id: int, arm_name: str = "leader", torque_nm: float = 0.5, seconds: float = 0.2) -> None:
+    """One arm's joint pushed (its control port's load), then let be; for
+    seconds of the simulator's clock, which a loaded PC does not stretch."""
+    ports = read_env(env)
+    leader, follower = int(ports["LEADER_CONTROL"]), int(ports["FOLLOWER_CONTROL"])
+    pushed = leader if arm_name == "leader" else follower
+    clock = Simulator.running(pushed)
+    try:
+        control_command(pushed, f"load {torque_nm} {servo_id}")
+        clock.sleep(seconds)
+        control_command(pushed, f"load 0 {servo_id}")
+        clock.sleep(1.0)
+    finally:
+        clock.stop()  # its connection, not the simulator
     for name, port in (("leader", leader), ("follower", follower)):
         angles = [_fields(line)["angle"] for line in control_command(port, "state").splitlines() if line.strip()]
         print(f"{name:8} horns (deg): {' '.join(f'{a:7.1f}' for a in angles)}")
@@ -52,25 +99,38 @@ def nudge(servo_id: int, torque_nm: float = 0.5, seconds: float = 0.2) -> None:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--follower", type=int, default=5100, help="the follower's TCP port")
-    ap.add_argument("--leader", type=int, default=5200, help="the leader's TCP port")
-    ap.add_argument("--nudge", type=int, metavar="JOINT_ID", help="push the running leader's joint, then show both")
+    ap.add_argument("--follower", type=int, default=5100, help="the follower's TCP port (0: any free one)")
+    ap.add_argument("--leader", type=int, default=5200, help="the leader's TCP port (0: any free one)")
+    ap.add_argument("--env", type=Path, default=ENV, help=f"the file of their ports (default {ENV})")
+    ap.add_argument("--state", type=Path, metavar="DIR",
+                    help="keep the servos' flash in DIR/follower and DIR/leader (default: a new one each run)")
+    ap.add_argument("--nudge", type=int, metavar="JOINT_ID", help="push a running arm's joint, then show both")
+    ap.add_argument("--arm", choices=("leader", "follower"), default="leader", help="the arm --nudge pushes")
+    ap.add_argument("--torque", type=float, default=0.5, help="--nudge's torque, N m (negative: the other way)")
     args = ap.parse_args(argv)
     if args.nudge is not None:
-        nudge(args.nudge)
+        nudge(args.env, args.nudge, args.arm, args.torque)
         return 0
-    sims = []
+    owner = running_owner(args.env)
+    if owner is not None:
+        print(f"sim_arms: another sim_arms.py (pid {owner}) runs with {args.env}: stop it, or give this one "
+              f"its own --env FILE and ports", file=sys.stderr)
+        return 1
+    sims, text = [], None
     signal.signal(signal.SIGTERM, lambda *_: sys.exit(0))
     try:
-        follower = arm(args.follower)
+        states = [None, None] if args.state is None else [args.state / "follower", args.state / "leader"]
+        for d in filter(None, states):
+            d.mkdir(parents=True, exist_ok=True)
+        follower = arm(args.follower, states[0] and str(states[0]))
         sims.append(follower)
-        leader = arm(args.leader)
+        leader = arm(args.leader, states[1] and str(states[1]))
         sims.append(leader)
-        ENV.parent.mkdir(exist_ok=True)
-        ENV.write_text(f"FOLLOWER_PORT={follower.url}\nFOLLOWER_CONTROL={follower.control_port}\n"
-                       f"LEADER_PORT={leader.url}\nLEADER_CONTROL={leader.control_port}\n")
+        text = (f"FOLLOWER_PORT={follower.url}\nFOLLOWER_CONTROL={follower.control_port}\n"
+                f"LEADER_PORT={leader.url}\nLEADER_CONTROL={leader.control_port}\nSIM_ARMS_PID={os.getpid()}\n")
+        write_env(args.env, text)
         print(f"follower: {follower.url} (control {follower.control_port}); "
-              f"leader: {leader.url} (control {leader.control_port}); in {ENV}")
+              f"leader: {leader.url} (control {leader.control_port}); in {args.env}")
         print(f"teleoperate:\n  bash scripts/lerobot_run.sh -m lerobot.scripts.lerobot_teleoperate "
               f"--robot.type=servoctl_arm --robot.port={follower.url} --robot.sim_control={follower.control_port} "
               f"--robot.id=sim_follower --teleop.type=servoctl_leader --teleop.port={leader.url} "
@@ -82,7 +142,11 @@ def main(argv=None) -> int:
     finally:
         for sim in sims:
             sim.stop()
-        ENV.unlink(missing_ok=True)
+        try:
+            if text is not None and args.env.read_text() == text:  # ours still: another's is left alone
+                args.env.unlink()
+        except FileNotFoundError:
+            pass
     return 0
 
 

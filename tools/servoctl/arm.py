@@ -12,18 +12,30 @@ and out, a frame at a time.
 - send(): this firmware gets streamed setpoints (the servo joins them with
   a cubic, docs/streaming.md); the maker's gets angle moves in one
   SyncCommand, each timed to the frame period measured between sends.
+- send(): the first targets after hold_here() ramp from where each joint
+  is to what is asked at ramp_speed_deg_s (arm_ramp.py; 0: no ramp); a
+  joint follows freely from the frame its target is reached.
 - On this firmware the bus watchdog (items 64, 65) is armed while the arm
-  is driven, and put back as it was on close.
+  is driven, and put back as it was on close; the servo's own setting is
+  kept on the host meanwhile (watchdog_record.py), so a run that ended
+  without putting it back is not taken for the servo's own.
+- A joint that does not answer because two servos hold its ID is said to
+  be shared (JointShared: scan's probe hears their answers collide).
 
 Time is the bus's clock (the simulator's on servo_sim)."""
+import logging
 import math
 
 from . import protocol as p
-from . import registers
+from . import registers, scan
 from .errors import NoReply, ServoError, UsageError, ValueOutOfRange
+from .arm_ramp import DEFAULT_SPEED_DEG_S, Ramp
 from .group import sync_monitor
 from .servo import Servo
 from .setpoints import MAX_SPEED_DECIDEG_S, Stream, read_limits
+from .watchdog_record import WatchdogRecords
+
+log = logging.getLogger(__name__)
 
 WATCHDOG_ACTIONS = {"hold": 0, "damp": 1, "release": 2}  # item 65
 # Status bits with which the servo has let its output go (frame.toml).
@@ -38,6 +50,10 @@ class JointSilent(NoReply):
     def __init__(self, message: str, joints: list):
         super().__init__(message)
         self.joints = joints
+
+
+class JointShared(JointSilent):
+    """Two or more servos hold a joint's ID: their answers collide."""
 
 
 class JointFault(ServoError):
@@ -60,6 +76,24 @@ def fault_text(servo: Servo, newest: int = 3) -> str:
     return f"its newest faults: {said} ('servoctl faults {servo.id}')"
 
 
+def watchdog_text(setting: tuple) -> str:
+    """(watchdog_ms, watchdog_action) as a phrase: '500 ms, hold', 'off'."""
+    ms, action = setting
+    named = {v: k for k, v in WATCHDOG_ACTIONS.items()}.get(action, f"action {action}")
+    return f"{ms} ms, {named}" if ms else f"off ({named})"
+
+
+def shared_text(bus: p.Bus, ids: list):
+    """What scan's probe says of the first of ids that two or more servos
+    hold (their answers collide, or come twice), or None."""
+    window = scan.reply_window_s(bus.serial.baudrate)
+    for servo_id in ids:
+        found = scan.probe(bus, servo_id, window)
+        if found is not None and found.shared:
+            return found.describe()
+    return None
+
+
 def detect_firmware(bus: p.Bus, servo_id: int) -> str:
     """"servoctl" (this firmware: item 64 reads) or "maker"."""
     try:
@@ -75,27 +109,36 @@ class Arm:
     """joints: {name: servo ID}. fps: the frames a second the host's loop
     sends (a stream's period). firmware: "auto", "servoctl" or "maker"
     (the maker's path runs on this firmware too: its packets are the
-    maker's). watchdog_ms 0 leaves the watchdog as it is."""
+    maker's). watchdog_ms 0 leaves the watchdog as it is; records keeps
+    each servo's own setting meanwhile (WatchdogRecords: the user's state
+    folder unless given). ramp_speed_deg_s: the first targets' top speed
+    from where the arm is held, deg/s; 0: none."""
 
     def __init__(self, bus: p.Bus, joints: dict, fps: float = 30.0, firmware: str = "auto",
-                 watchdog_ms: int = 500, watchdog_action: str = "hold"):
+                 watchdog_ms: int = 500, watchdog_action: str = "hold",
+                 ramp_speed_deg_s: float = DEFAULT_SPEED_DEG_S, records: WatchdogRecords = None):
         if not joints:
             raise UsageError("an arm needs at least one joint")
         if watchdog_action not in WATCHDOG_ACTIONS:
             raise UsageError(f"watchdog_action is one of {', '.join(WATCHDOG_ACTIONS)}, not {watchdog_action!r}")
         if firmware not in ("auto", "servoctl", "maker"):
             raise UsageError(f"firmware is auto, servoctl or maker, not {firmware!r}")
+        if not (ramp_speed_deg_s >= 0 and math.isfinite(ramp_speed_deg_s)):
+            raise UsageError(f"ramp_speed_deg_s is 0 (no ramp) or a speed in deg/s, not {ramp_speed_deg_s!r}")
         self.bus, self.joints = bus, dict(joints)
         self.ids = list(self.joints.values())
         self.names = {i: n for n, i in self.joints.items()}
         self.period_s = 1.0 / fps
         self.firmware = firmware
         self.watchdog_ms, self.watchdog_action = watchdog_ms, watchdog_action
+        self.records = records if records is not None else WatchdogRecords()
+        self.ramp = Ramp(ramp_speed_deg_s, self.period_s)
+        self._held_at = None  # the bus clock when hold_here held the arm
         self.limits = {}
         self.stream = None
         self.targets = {}  # {name: degrees}: the last sent, or where hold_here held
         self._before = {}  # the targets before those
-        self._watchdog_before = {}
+        self._watchdog_before = {}  # {id: (serial, the servo's own setting)}
         self._times = []  # the bus clock at the last sends, up to 3
         self.measured_period_s = self.period_s
         self.frames = 0
@@ -115,14 +158,24 @@ class Arm:
     def _arm_watchdog(self) -> None:
         if not self.watchdog_ms:
             return
-        action = WATCHDOG_ACTIONS[self.watchdog_action]
+        ours = (self.watchdog_ms, WATCHDOG_ACTIONS[self.watchdog_action])
         for servo_id in self.ids:
             s = Servo(self.bus, servo_id)
-            before = (s.read("watchdog_ms"), s.read("watchdog_action"))
-            if before != (self.watchdog_ms, action):  # a write is a flash record: only when it changes
-                self._watchdog_before[servo_id] = before
-                s.write("watchdog_ms", self.watchdog_ms)
-                s.write("watchdog_action", action)
+            serial = s.read("serial")
+            holds = (s.read("watchdog_ms"), s.read("watchdog_action"))
+            own, record = self.records.own_setting(serial, holds)
+            if record is not None:
+                log.warning("%s (servo %d): its bus watchdog holds %s, which a run that did not end cleanly "
+                            "wrote; its own setting, %s (kept in %s), is put back on close",
+                            self.names[servo_id], servo_id, watchdog_text(holds), watchdog_text(own), record)
+            if own != ours:
+                self.records.keep(serial, servo_id, own, ours)  # before the servo holds ours
+                self._watchdog_before[servo_id] = (serial, own)
+            elif record is not None:
+                self.records.forget(serial)
+            if holds != ours:  # written only where it differs
+                s.write("watchdog_ms", ours[0])
+                s.write("watchdog_action", ours[1])
             self.limits[servo_id].watchdog_ms = self.watchdog_ms
 
     def hold_here(self) -> dict:
@@ -138,6 +191,8 @@ class Arm:
             raise UsageError(f"{', '.join(turned)}: beyond one turn (wheel mode or multi-turn moves); "
                              f"release it and reset its turns ('servoctl origin ID --reset-turns') first")
         self.targets, self._before = here, {}
+        self.ramp.start(here)
+        self._held_at = self.bus.clock()
         if self.firmware == "servoctl":
             self.stream = Stream(self.bus, self.ids, self.period_s, self.limits)
         self._times = []
@@ -150,11 +205,12 @@ class Arm:
         if release:
             for servo_id in self.ids:
                 Servo(self.bus, servo_id).stop("release")
-        for servo_id, (ms, action) in self._watchdog_before.items():
+        for servo_id, (serial, (ms, action)) in self._watchdog_before.items():
             try:
                 s = Servo(self.bus, servo_id)
                 s.write("watchdog_ms", ms)
                 s.write("watchdog_action", action)
+                self.records.forget(serial)  # kept where it could not be put back
             except ServoError as e:
                 errors.append(f"{self.names[servo_id]}: {e}")
         self._watchdog_before = {}
@@ -208,6 +264,10 @@ class Arm:
         if silent:
             named = ", ".join(f"{self.names[i]} (servo {i})" for i in silent)
             names = [self.names[i] for i in silent]
+            shared = shared_text(self.bus, silent)
+            if shared is not None:  # not a cable: two servos answer at once and garble each other
+                raise JointShared(f"{named} did not answer in the Sync Monitor: {shared}; no position is "
+                                  f"given", names)
             if not states:  # none at all: the link's rate or the IDs, more likely than every cable
                 baud = self.bus.serial.baudrate
                 raise JointSilent(f"no joint answered: {named}; no position is given (is the arm powered, "
@@ -253,8 +313,9 @@ class Arm:
             raise UsageError(f"no joint named {', '.join(unknown)} (the arm's: {', '.join(self.joints)})")
         if not self.targets:
             raise UsageError("hold_here() first: the arm's first target is where it is")
-        sent = self.clamp({**self.targets, **targets})
         now = self.bus.clock()
+        since = now - (self._times[-1] if self._times else self._held_at)
+        sent = self.ramp.step(self.clamp({**self.targets, **targets}), self.targets, since)
         if self._times:
             # The frame period as the host keeps it: the maker's moves are fitted to it.
             self.measured_period_s += 0.3 * (min(now - self._times[-1], 1.0) - self.measured_period_s)

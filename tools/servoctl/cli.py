@@ -7,7 +7,7 @@ import os
 import sys
 
 from . import args as args_
-from . import console, link_rate, scan
+from . import console, extras, link_rate, scan
 from .args import build_parser
 from .cmd_bus import cmd_bench, cmd_id, cmd_ping, cmd_scan
 from .cmd_config import cmd_config, cmd_store
@@ -72,6 +72,11 @@ def main(argv=None, clock=None) -> int:
         return e.exit_code
     except argparse.ArgumentTypeError as e:  # a value checked after parsing (id assign's ID)
         print(f"servoctl: error: {e}", file=sys.stderr)
+        return UsageError.exit_code
+    except ModuleNotFoundError as e:  # an optional part's library (servoctl.extras)
+        if extras.missing_text(e.name) is None:
+            raise
+        print(f"servoctl: error: {extras.missing_text(e.name)}", file=sys.stderr)
         return UsageError.exit_code
     except KeyboardInterrupt:
         print("servoctl: interrupted", file=sys.stderr)

@@ -48,7 +48,8 @@ def frames(robot, sim, targets: dict, n: int) -> None:
 def follower_session(out: dict) -> None:
     sim = compare.prepare(paced=True)
     try:
-        robot = follower(sim, max_relative_target=5.0)
+        # max_relative_target alone: no ramp after connect (ramped() has it)
+        robot = follower(sim, max_relative_target=5.0, ramp_speed_deg_s=0)
         out["robot_class"] = type(robot).__name__
         robot.connect(calibrate=False)
         bus = robot.arm.bus
@@ -76,6 +77,28 @@ def follower_session(out: dict) -> None:
         robot.disconnect()
         with sim.bus(timeout=0.2, baud=1000000) as b:
             out["watchdog_after"] = [Servo(b, i).read("watchdog_ms") for i in IDS]
+    finally:
+        sim.stop()
+
+
+def ramped(out: dict) -> None:
+    """The default config: the first actions after connect, 40 deg from
+    where the arm is, ramp there (the horn's top speed, on the models)."""
+    sim = compare.prepare(paced=True)
+    try:
+        robot = follower(sim)
+        robot.connect(calibrate=False)
+        out["ramp_speed_deg_s"] = robot.arm.ramp.speed_deg_s
+        goal = robot.get_observation()["Motor_1.pos"] + 40.0
+        t0, peak = sim.clock_s(), 0.0
+        for k in range(45):
+            robot.send_action({"Motor_1.pos": goal})
+            while sim.clock_s() < t0 + (k + 1) / 30:
+                sim.sleep(0.005)
+                peak = max(peak, abs(sim.state(1)["velocity"]))
+        out["ramp_peak_dps"] = peak
+        out["ramp_reached"] = robot.get_observation()["Motor_1.pos"] - goal
+        robot.disconnect()
     finally:
         sim.stop()
 
@@ -170,6 +193,7 @@ def main() -> int:
     out = {}
     try:
         follower_session(out)
+        ramped(out)
         makers_path(out)
         calibration(out)
         leader(out)

@@ -11,6 +11,7 @@ the figures are the same on an idle and a loaded PC, and the test runs
 in the parallel pass."""
 import json
 import math
+import os
 import subprocess
 
 import pytest
@@ -27,8 +28,15 @@ pytestmark = [pytest.mark.skipif(not PYTHON.exists(), reason="no .venv-lerobot: 
 
 
 @pytest.fixture(scope="module")
-def seen():
-    done = subprocess.run(["bash", str(RUN), str(DRIVER)], capture_output=True, text=True, timeout=240)
+def state_dir(tmp_path_factory):
+    """The follower's watchdog records (servoctl.watchdog_record): the run's own."""
+    return tmp_path_factory.mktemp("servoctl-state")
+
+
+@pytest.fixture(scope="module")
+def seen(state_dir):
+    done = subprocess.run(["bash", str(RUN), str(DRIVER)], capture_output=True, text=True, timeout=240,
+                          env=dict(os.environ, SERVOCTL_STATE_DIR=str(state_dir)))
     assert done.returncode == 0, done.stderr[-4000:]
     return json.loads(done.stdout.strip().splitlines()[-1])
 
@@ -45,6 +53,23 @@ def test_connect_holds_the_arm_where_it_is_and_arms_the_watchdog(seen):
     assert seen["watchdog_connected"] == [[500, 0]] * 7  # 500 ms, hold
     assert seen["faults_after_silence"] == ["watchdog"]  # a host gone quiet: the watchdog took over
     assert seen["watchdog_after"] == [0] * 7  # as it was before connect
+
+
+def test_disconnect_leaves_a_watchdog_record_only_where_it_could_not_put_it_back(seen, state_dir):
+    # Kept while connected, where a crash cannot lose it; gone once put back. The
+    # comparison's run ends with servo 3 unplugged: its own setting (off, damp) is kept
+    # for the next run to put back.
+    left = sorted(state_dir.rglob("*.json"))
+    assert [p.name for p in left] == ["51a00003.json"]
+    assert json.loads(left[0].read_text())["own"] == [0, 1]
+
+
+def test_the_first_actions_after_connect_ramp_at_the_default_speed(seen):
+    # 40 deg from where the arm was: at 45 deg/s (give or take the servo's ripple),
+    # not the 740 deg/s a target may move in a frame; there within 1.5 s.
+    assert seen["ramp_speed_deg_s"] == 45.0
+    assert 40 <= seen["ramp_peak_dps"] <= 56, seen["ramp_peak_dps"]
+    assert abs(seen["ramp_reached"]) <= 0.3, seen["ramp_reached"]
 
 
 def test_max_relative_target_clamps_a_step(seen):

@@ -3,6 +3,7 @@ from dataclasses import dataclass, field
 
 from lerobot.cameras import CameraConfig
 from lerobot.robots.config import RobotConfig
+from servoctl.arm_ramp import DEFAULT_SPEED_DEG_S
 
 from .joints import ArmBusConfig
 
@@ -12,6 +13,10 @@ from .joints import ArmBusConfig
 class ServoctlArmConfig(RobotConfig, ArmBusConfig):
     # The most a target may be from where the joint is, degrees (one number, or one a joint).
     max_relative_target: float | dict[str, float] | None = None
+    # The first actions after connect() ramp from where the arm is to what is asked, at
+    # most this fast (deg/s); each joint follows freely once it is there. 0: no ramp (the
+    # servo's top speed, 740 deg/s).
+    ramp_speed_deg_s: float = DEFAULT_SPEED_DEG_S
     # This firmware's bus watchdog while connected (items 64, 65): a host silent this long
     # leaves the arm holding ("hold"), damped ("damp") or free ("release"). 0: left as it is.
     watchdog_ms: int = 500

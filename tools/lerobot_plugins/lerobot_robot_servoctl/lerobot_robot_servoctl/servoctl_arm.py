@@ -1,7 +1,8 @@
 """servoctl_arm: a follower arm of UART bus servos, through servoctl's Arm.
 
 - connect() never moves the arm: each joint is held where it is, and that
-  is the first target. On this firmware the bus watchdog is armed while
+  is the first target; the first actions ramp from there at
+  ramp_speed_deg_s. On this firmware the bus watchdog is armed while
   connected (watchdog_ms, watchdog_action).
 - send_action() streams setpoints on this firmware (the servo joins the
   frames with a cubic); on the maker's it sends angle moves timed to the
@@ -53,7 +54,7 @@ class ServoctlArm(j.OnArm, Robot):
             raise DeviceAlreadyConnectedError(f"{self} already connected")
         bus = j.open_bus(self.config, self.clock)
         arm = Arm(bus, self.config.joints, self.config.fps, self.config.firmware,
-                  self.config.watchdog_ms, self.config.watchdog_action)
+                  self.config.watchdog_ms, self.config.watchdog_action, self.config.ramp_speed_deg_s)
         try:
             with j.answering(self):
                 arm.open()

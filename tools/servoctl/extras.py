@@ -1,0 +1,24 @@
+"""servoctl's optional parts, tools/pyproject.toml's extras: what the
+core (pyserial, numpy, rich: every command on a bus, and the LeRobot
+plugins) leaves out, which module each needs and the extra that brings
+it. scripts/setup.sh installs them all (tools/requirements.txt)."""
+
+# {module: (its distribution, the extra that installs it, what needs it)}
+OPTIONAL = {
+    "scipy": ("scipy", "identify", "identify, tune and calibrate (the drive train's fits)"),
+    "mujoco": ("mujoco", "mujoco", "identify --mujoco (the actuator model)"),
+    "unicorn": ("unicorn", "vboard", "the virtual boards (sim --board)"),
+    "cmsis_svd": ("cmsis-svd", "vboard", "the virtual boards (sim --board)"),
+    "matplotlib": ("matplotlib", "plot", "record's and monitor's plots"),
+    "aiohttp": ("aiohttp", "ui", "the bench in a browser (ui)"),
+}
+
+
+def missing_text(name: str):
+    """The line for an optional module that is not installed (a
+    ModuleNotFoundError's name), or None if it is not one of them."""
+    found = OPTIONAL.get((name or "").partition(".")[0])
+    if found is None:
+        return None
+    distribution, extra, needs = found
+    return f"{distribution} is not installed (servoctl's extra for {needs}): pip install 'servoctl[{extra}]'"
