@@ -135,7 +135,12 @@ def test_version(capsys):
 
 
 def test_ctrl_c_stops_cleanly(sim):
-    proc = servoctl_child("--port", sim.url, "scan", "--reply-timeout", "0.05",  # 254 IDs: 12 s
+    # Its reply time-out on the simulator's clock (--sim-control): a loaded
+    # PC that holds up the simulator makes the answers late on the host's
+    # clock, and servo 1's answer, arriving in servo 2's window, read as two
+    # servos at ID 2.
+    proc = servoctl_child("--port", sim.url, "--sim-control", str(sim.control_port), "scan",
+                          "--reply-timeout", "0.05",  # 254 IDs: 12 s
                           stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     # Interrupted once it has found servo 1 (a loaded PC may take seconds
     # to start Python); stdout ends when it exits.
