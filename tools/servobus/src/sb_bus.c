@@ -15,59 +15,117 @@ void sb_parser_init(sb_parser *p, bool requests)
     p->header[1] = requests ? SB_REQUEST_HEADER_1 : SB_RESPONSE_HEADER_1;
 }
 
-/* The frame's whole size once its head is in, else 0. */
-static size_t frame_size(const sb_parser *p)
+/* The frame finder holds buf[0..len), seen of them examined, and starts at
+ * a header (or holds nothing). Any header in the examined bytes begins a
+ * candidate frame. A frame is returned the moment its last byte is
+ * examined with a good checksum, the earliest-starting first: bytes before
+ * it were noise that looked like a header, or an answer cut short. A
+ * candidate at the start that fails (a bad checksum, too long to be a
+ * frame) costs only its first byte: the search goes on from the next. */
+
+/* The size of the candidate at `at` once its head is examined, else 0. */
+static size_t size_at(const sb_parser *p, size_t at)
 {
-    if (p->len < 4)
+    const uint8_t *b = p->buf + at;
+    size_t have = p->seen - at;
+    if (have < 4)
         return 0;
-    if (p->buf[3] != SB_EXTENDED_LENGTH)
-        return 5u + p->buf[3];
-    return p->len < 6 ? 0 : 7u + ((size_t)p->buf[4] | (size_t)p->buf[5] << 8);
+    if (b[3] != SB_EXTENDED_LENGTH)
+        return 5u + b[3];
+    return have < 6 ? 0 : 7u + ((size_t)b[4] | (size_t)b[5] << 8);
+}
+
+static bool header_at(const sb_parser *p, size_t at)
+{
+    return p->buf[at] == p->header[0] && (p->seen - at < 2 || p->buf[at + 1] == p->header[1]);
+}
+
+static bool checksum_ok(const sb_parser *p, size_t at, size_t size)
+{
+    return sb_checksum(p->buf + at, size - 1u) == p->buf[at + size - 1u];
+}
+
+/* Drops the first n bytes held (n <= seen). */
+static void drop(sb_parser *p, size_t n)
+{
+    memmove(p->buf, p->buf + n, p->len - n);
+    p->len -= n;
+    p->seen -= n;
+}
+
+/* Drops examined bytes until the start is a header whose frame may still
+ * end there (not too long, its end not passed: a candidate inside that
+ * failed). stray: count them (not the rest of a frame that failed). */
+static void settle(sb_parser *p, bool stray)
+{
+    while (p->seen > 0) {
+        bool header = header_at(p, 0);
+        size_t size = header ? size_at(p, 0) : 0;
+        if (header && (size == 0 || (size <= SB_RX_MAX && size >= p->seen)))
+            return;
+        p->stray_bytes += stray ? 1u : 0u;
+        drop(p, 1);
+    }
+}
+
+/* After the byte at seen - 1 is examined: true when a frame starting at 0
+ * ends there. */
+static bool frame_ends(sb_parser *p)
+{
+    bool stray = true;
+    for (;;) {
+        settle(p, stray);
+        if (p->seen == 0)
+            return false;
+        if (size_at(p, 0) != p->seen)
+            break;
+        if (checksum_ok(p, 0, p->seen))
+            return true;
+        p->bad_frames++;
+        drop(p, 1);
+        stray = false;
+    }
+    /* A frame that ends here, begun inside the unfinished one at the start:
+     * that one's header was noise, or it was cut short. */
+    for (size_t at = 1; at + 5u <= p->seen; at++)
+        if (header_at(p, at) && size_at(p, at) == p->seen - at && checksum_ok(p, at, p->seen - at)) {
+            p->stray_bytes += (uint32_t)at;
+            drop(p, at);
+            return true;
+        }
+    return false;
 }
 
 size_t sb_parser_missing(const sb_parser *p)
 {
-    size_t size = frame_size(p);
+    size_t size = p->taken == 0 ? size_at(p, 0) : 0, held = p->len - p->taken;
     if (size == 0)
-        return p->len < 5 ? 5u - p->len : 1u;
-    return size > p->len ? size - p->len : 1u;
+        return held < 5 ? 5u - held : 1u;
+    return size > held ? size - held : 1u;
 }
 
 int sb_parse(sb_parser *p, const uint8_t *data, size_t len, size_t *used, uint8_t *code, const uint8_t **content,
              size_t *clen)
 {
     size_t k = 0;
-    if (p->len > 0 && frame_size(p) == p->len)
-        p->len = 0; /* the frame returned last time */
-    while (k < len) {
-        uint8_t b = data[k++];
-        size_t size;
-        if (p->len < 2 && b != p->header[p->len]) {
-            p->stray_bytes += (uint32_t)p->len + (b == p->header[0] ? 0u : 1u);
-            p->len = b == p->header[0] ? 1u : 0u;
-            if (b == p->header[0])
-                p->buf[0] = b;
-            continue;
+    drop(p, p->taken); /* the frame returned last time */
+    p->taken = 0;
+    for (;;) {
+        if (p->seen == p->len) { /* the held bytes examined: take the next (a live start leaves room) */
+            if (k == len)
+                break;
+            p->buf[p->len++] = data[k++];
         }
-        p->buf[p->len++] = b;
-        size = frame_size(p);
-        if (size == 0 || p->len < size) {
-            if (size > SB_RX_MAX) { /* no answer is this long: not a frame */
-                p->stray_bytes += (uint32_t)p->len;
-                p->len = 0;
-            }
-            continue;
+        p->seen++;
+        if (frame_ends(p)) {
+            size_t head = p->buf[3] == SB_EXTENDED_LENGTH ? 6u : 4u;
+            p->taken = p->seen;
+            *used = k;
+            *code = p->buf[2];
+            *content = p->buf + head;
+            *clen = p->seen - head - 1u;
+            return 1;
         }
-        if (sb_checksum(p->buf, size - 1u) != p->buf[size - 1u]) {
-            p->bad_frames++;
-            p->len = 0;
-            continue;
-        }
-        *used = k;
-        *code = p->buf[2];
-        *content = p->buf + (p->buf[3] == SB_EXTENDED_LENGTH ? 6 : 4);
-        *clen = size - (p->buf[3] == SB_EXTENDED_LENGTH ? 7u : 5u);
-        return 1;
     }
     *used = k;
     return 0;
@@ -111,7 +169,7 @@ sb_error sb_send(sb_bus *bus, const uint8_t *frame, size_t len)
             break;
     }
     bus->pending_len = 0;
-    bus->rx.len = 0;
+    bus->rx.len = bus->rx.seen = bus->rx.taken = 0;
     bus->sent_end_us = bus->t.now_us(bus->t.ctx) + wire_us(bus, len);
     rc = bus->t.write(bus->t.ctx, frame, len);
     return rc < 0 ? link_error(rc, len > 2 ? frame[2] : 0) : sb_ok();
@@ -125,14 +183,16 @@ static sb_error receive(sb_bus *bus, uint8_t code, int servo, uint64_t deadline_
     sb_error e = sb_ok();
     bool looked = false; /* the deadline passed: one last look at what came meanwhile */
     for (;;) {
-        while (bus->pending_len > 0) {
+        for (;;) { /* every frame in what came and what the finder holds */
             size_t used = 0, clen = 0;
             uint8_t fcode = 0;
             const uint8_t *fcontent = NULL;
             int got = sb_parse(&bus->rx, bus->pending, bus->pending_len, &used, &fcode, &fcontent, &clen);
             memmove(bus->pending, bus->pending + used, bus->pending_len - used);
             bus->pending_len -= used;
-            if (got && fcode == code && (servo < 0 || (clen > 0 && fcontent[0] == servo))) {
+            if (!got)
+                break;
+            if (fcode == code && (servo < 0 || (clen > 0 && fcontent[0] == servo))) {
                 if (clen > SB_ANSWER_CONTENT_MAX) {
                     e.status = SB_E_BAD_ANSWER;
                     e.servo = (int16_t)fcontent[0];

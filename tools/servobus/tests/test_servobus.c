@@ -133,6 +133,43 @@ static void the_frame_finder_skips_garbage_and_bad_frames(void **state)
     assert_int_equal(sb_parse(&p, stream, 0, &used, &code, &content, &clen), 0);
 }
 
+/* Every frame the finder returns from stream, at once: their servos in order. */
+static size_t servos_found(const uint8_t *stream, size_t n, uint8_t *servos)
+{
+    sb_parser p;
+    size_t found = 0, at = 0, used = 0, clen = 0;
+    uint8_t code = 0;
+    const uint8_t *content = NULL;
+    sb_parser_init(&p, false);
+    while (sb_parse(&p, stream + at, n - at, &used, &code, &content, &clen)) {
+        at += used;
+        servos[found++] = content[0];
+    }
+    assert_int_equal(at + used, n);
+    return found;
+}
+
+static void the_frame_finder_rescans_after_a_false_header(void **state)
+{
+    uint8_t stream[96], servos[4];
+    size_t n = 0, len = 0;
+    sb_value v[2] = {{1, NULL, 0}, {-5, NULL, 0}};
+    stream[n++] = SB_RESPONSE_HEADER_0; /* noise that looks like a header: a 33-byte frame */
+    stream[n++] = SB_RESPONSE_HEADER_1;
+    for (int id = 1; id <= 3; id++, n += len) {
+        v[0].n = id;
+        assert_int_equal(sb_encode_answer(SB_PKT_READ_ANGLE, v, 2, stream + n, sizeof stream - n, &len).status, SB_OK);
+    }
+    assert_int_equal(servos_found(stream, n, servos), 3);
+    assert_memory_equal(servos, "\x01\x02\x03", 3);
+    /* one answer alone behind the noise: found without a byte more */
+    assert_int_equal(servos_found(stream, 2 + len, servos), 1);
+    /* the first answer cut short after 5 bytes: the next two found */
+    memmove(stream + 7, stream + 2 + len, 2 * len);
+    assert_int_equal(servos_found(stream + 2, 5 + 2 * len, servos), 2);
+    assert_memory_equal(servos, "\x02\x03", 2);
+}
+
 static void a_long_sync_command_takes_the_extended_length(void **state)
 {
     uint8_t records[30 * 9], f[300];
@@ -169,6 +206,7 @@ int main(void)
         cmocka_unit_test(the_frame_finder_skips_garbage_and_bad_frames),
         cmocka_unit_test(a_long_sync_command_takes_the_extended_length),
         cmocka_unit_test(the_wire_limit_is_servoctls),
+        cmocka_unit_test(the_frame_finder_rescans_after_a_false_header),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -78,17 +78,23 @@ uint8_t sb_checksum(const uint8_t *data, size_t len);
 
 /* A frame finder over a stream of bytes: sb_parse returns 1 when a frame
  * (header as given) ends in the bytes fed so far, with its code and
- * content; bytes outside frames and frames with a bad checksum are counted. */
+ * content; bytes outside frames and frames with a bad checksum are counted.
+ * A false header (noise, an answer cut short) costs only its bytes: the
+ * search goes on from the byte after it, through the bytes held. */
 typedef struct sb_parser {
     uint8_t header[2];
     uint8_t buf[SB_RX_MAX];
-    size_t len;
+    size_t len;   /* bytes held */
+    size_t seen;  /* of them examined */
+    size_t taken; /* the frame returned last, at buf's start */
     uint32_t stray_bytes;
     uint32_t bad_frames;
 } sb_parser;
 void sb_parser_init(sb_parser *p, bool requests);
 /* Takes what it can of data (*used: how much); 1: a frame (code, content
- * valid until the next call), 0: none yet. */
+ * valid until the next call), 0: none yet and all of data taken. Call it
+ * again after a 1, with no data if none is left: the bytes held may hold
+ * another frame. */
 int sb_parse(sb_parser *p, const uint8_t *data, size_t len, size_t *used, uint8_t *code, const uint8_t **content,
              size_t *clen);
 /* The bytes that would complete the frame the parser is in (at least 1). */

@@ -1,0 +1,68 @@
+/* servobus's bus on a link that misbehaves: noise that looks like a header,
+ * an answer cut short. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "tests/fake_servo.h"
+
+static fake_bus fake;
+static sb_bus bus;
+static const uint8_t three[3] = {1, 2, 3};
+static sb_monitor_answer states[3];
+static bool got[3];
+
+static int set_up(void **state)
+{
+    fake_init(&fake, 1000000);
+    sb_bus_init(&bus, fake_transport(&fake), 1000000);
+    fake.present[1] = fake.present[2] = fake.present[3] = true;
+    return 0;
+}
+
+/* Two noise bytes that look like an answer's header, ahead of this request's answers. */
+static void noise_ahead(void)
+{
+    fake.late[0] = SB_RESPONSE_HEADER_0;
+    fake.late[1] = SB_RESPONSE_HEADER_1;
+    fake.late_len = 2;
+}
+
+static void noise_that_looks_like_a_header_costs_only_its_bytes(void **state)
+{
+    noise_ahead();
+    assert_int_equal(sb_sync_monitor(&bus, three, 3, states, got).status, SB_OK);
+    assert_true(got[0] && got[1] && got[2]);
+    assert_int_equal(states[0].id, 1);
+    /* A single call: its answer found behind the noise, not at its time-out. */
+    sb_read_angle_request r = {3};
+    sb_read_angle_answer a;
+    uint64_t before = fake.now_us;
+    noise_ahead();
+    assert_int_equal(sb_call_read_angle(&bus, &r, &a).status, SB_OK);
+    assert_int_equal(a.angle, -123);
+    assert_true(fake.now_us - before < 1000u); /* the fake's clock: the wire's time, not 100 ms */
+}
+
+static void an_answer_cut_short_costs_only_its_bytes(void **state)
+{
+    fake.cut[1] = 6; /* header, code, length, ID and a byte: then servo 2's answer */
+    sb_error e = sb_sync_monitor(&bus, three, 3, states, got);
+    assert_int_equal(e.status, SB_E_BAD_CHECKSUM); /* servo 1's, with servo 2's first bytes */
+    assert_int_equal(e.servo, 1);
+    assert_true(!got[0] && got[1] && got[2]);
+    assert_int_equal(states[1].id, 2);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test_setup(noise_that_looks_like_a_header_costs_only_its_bytes, set_up),
+        cmocka_unit_test_setup(an_answer_cut_short_costs_only_its_bytes, set_up),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
