@@ -193,6 +193,7 @@ static sb_error receive(sb_bus *bus, uint8_t code, int servo, uint64_t deadline_
             if (!got)
                 break;
             if (fcode == code && (servo < 0 || (clen > 0 && fcontent[0] == servo))) {
+                bus->arrived_us = bus->t.now_us(bus->t.ctx);
                 if (clen > SB_ANSWER_CONTENT_MAX) {
                     e.status = SB_E_BAD_ANSWER;
                     e.servo = (int16_t)fcontent[0];
@@ -201,7 +202,6 @@ static sb_error receive(sb_bus *bus, uint8_t code, int servo, uint64_t deadline_
                 }
                 memcpy(content, fcontent, clen);
                 *len = clen;
-                bus->arrived_us = bus->t.now_us(bus->t.ctx);
                 return e;
             }
         }
@@ -271,6 +271,7 @@ sb_error sb_sync_monitor_answers(sb_bus *bus, const uint8_t *ids, size_t count, 
     uint64_t last = bus->sent_end_us;
     uint32_t bad = bus->rx.bad_frames;
     bool jumped = false; /* the last answer taken came before a listed servo's that had not passed its turn */
+    size_t misshapen = count; /* the first listed servo whose answer was of the wrong length */
     sb_error e = sb_ok();
     for (size_t k = 0; k < count; k++)
         got[k] = false;
@@ -289,24 +290,32 @@ sb_error sb_sync_monitor_answers(sb_bus *bus, const uint8_t *ids, size_t count, 
             next++;
             continue;
         }
-        if (e.status != SB_OK)
+        if (e.status == SB_OK)
+            e = sb_decode_monitor(content, len, &a);
+        if (e.status == SB_E_BAD_ANSWER) { /* its checksum good, its length not: skipped, its turn taken */
+            k = e.servo >= 0 ? slot_of(ids, count, (uint8_t)e.servo) : count;
+            misshapen = k < misshapen ? k : misshapen;
+            e = sb_ok();
+            last = bus->arrived_us;
+            if (k == count || k < next)
+                continue;
+        } else if (e.status != SB_OK) {
             break;
-        e = sb_decode_monitor(content, len, &a);
-        if (e.status != SB_OK)
-            break;
-        k = slot_of(ids, count, a.id);
-        if (k == count)
-            continue; /* not asked for */
-        /* A round answers in the list's order: what was taken of ids[k] or
-         * later came before this, so it was an earlier round's, late. */
-        for (size_t j = k; j < count; j++)
-            if (got[j]) {
-                got[j] = false;
-                left++;
-            }
-        states[k] = a;
-        got[k] = true;
-        left--;
+        } else {
+            k = slot_of(ids, count, a.id);
+            if (k == count)
+                continue; /* not asked for */
+            /* A round answers in the list's order: what was taken of ids[k] or
+             * later came before this, so it was an earlier round's, late. */
+            for (size_t j = k; j < count; j++)
+                if (got[j]) {
+                    got[j] = false;
+                    left++;
+                }
+            states[k] = a;
+            got[k] = true;
+            left--;
+        }
         last = bus->arrived_us;
         silent = 0;
         jumped = k > next;
@@ -316,7 +325,9 @@ sb_error sb_sync_monitor_answers(sb_bus *bus, const uint8_t *ids, size_t count, 
         e = sb_ok();
         for (size_t k = 0; k < count; k++)
             if (!got[k]) { /* the first that did not answer */
-                e.status = bus->rx.bad_frames != bad ? SB_E_BAD_CHECKSUM : SB_E_NO_ANSWER;
+                e.status = k == misshapen               ? SB_E_BAD_ANSWER
+                           : bus->rx.bad_frames != bad ? SB_E_BAD_CHECKSUM
+                                                       : SB_E_NO_ANSWER;
                 e.servo = ids[k];
                 e.packet = SB_PKT_MONITOR;
                 break;

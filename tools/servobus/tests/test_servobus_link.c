@@ -1,5 +1,6 @@
 /* servobus's bus on a link that misbehaves: noise that looks like a header,
- * an answer cut short. */
+ * an answer cut short or of the wrong length, requests no servo would
+ * answer, and a transport's odd return values. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -58,11 +59,22 @@ static void an_answer_cut_short_costs_only_its_bytes(void **state)
     assert_int_equal(states[1].id, 2);
 }
 
+static void an_answer_of_the_wrong_length_is_skipped_and_the_round_goes_on(void **state)
+{
+    fake.one_short[2] = true;
+    sb_error e = sb_sync_monitor(&bus, three, 3, states, got);
+    assert_int_equal(e.status, SB_E_BAD_ANSWER);
+    assert_int_equal(e.servo, 2);
+    assert_true(got[0] && !got[1] && got[2]);
+    assert_int_equal(states[2].id, 3);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test_setup(noise_that_looks_like_a_header_costs_only_its_bytes, set_up),
         cmocka_unit_test_setup(an_answer_cut_short_costs_only_its_bytes, set_up),
+        cmocka_unit_test_setup(an_answer_of_the_wrong_length_is_skipped_and_the_round_goes_on, set_up),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
