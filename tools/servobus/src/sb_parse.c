@@ -1,0 +1,129 @@
+/* The frame finder: frames in a stream of bytes, noise and cut frames
+ * costing only their own bytes. */
+#include <string.h>
+
+#include "servobus/servobus.h"
+
+/* ---- the frame finder ---------------------------------------------------- */
+void sb_parser_init(sb_parser *p, bool requests)
+{
+    memset(p, 0, sizeof *p);
+    p->header[0] = requests ? SB_REQUEST_HEADER_0 : SB_RESPONSE_HEADER_0;
+    p->header[1] = requests ? SB_REQUEST_HEADER_1 : SB_RESPONSE_HEADER_1;
+}
+
+/* The frame finder holds buf[0..len), seen of them examined, and starts at
+ * a header (or holds nothing). Any header in the examined bytes begins a
+ * candidate frame. A frame is returned the moment its last byte is
+ * examined with a good checksum, the earliest-starting first: bytes before
+ * it were noise that looked like a header, or an answer cut short. A
+ * candidate at the start that fails (a bad checksum, too long to be a
+ * frame) costs only its first byte: the search goes on from the next. */
+
+/* The size of the candidate at `at` once its head is examined, else 0. */
+static size_t size_at(const sb_parser *p, size_t at)
+{
+    const uint8_t *b = p->buf + at;
+    size_t have = p->seen - at;
+    if (have < 4)
+        return 0;
+    if (b[3] != SB_EXTENDED_LENGTH)
+        return 5u + b[3];
+    return have < 6 ? 0 : 7u + ((size_t)b[4] | (size_t)b[5] << 8);
+}
+
+static bool header_at(const sb_parser *p, size_t at)
+{
+    return p->buf[at] == p->header[0] && (p->seen - at < 2 || p->buf[at + 1] == p->header[1]);
+}
+
+static bool checksum_ok(const sb_parser *p, size_t at, size_t size)
+{
+    return sb_checksum(p->buf + at, size - 1u) == p->buf[at + size - 1u];
+}
+
+/* Drops the first n bytes held (n <= seen). */
+static void drop(sb_parser *p, size_t n)
+{
+    memmove(p->buf, p->buf + n, p->len - n);
+    p->len -= n;
+    p->seen -= n;
+}
+
+/* Drops examined bytes until the start is a header whose frame may still
+ * end there (not too long, its end not passed: a candidate inside that
+ * failed). stray: count them (not the rest of a frame that failed). */
+static void settle(sb_parser *p, bool stray)
+{
+    while (p->seen > 0) {
+        bool header = header_at(p, 0);
+        size_t size = header ? size_at(p, 0) : 0;
+        if (header && (size == 0 || (size <= SB_RX_MAX && size >= p->seen)))
+            return;
+        p->stray_bytes += stray ? 1u : 0u;
+        drop(p, 1);
+    }
+}
+
+/* After the byte at seen - 1 is examined: true when a frame starting at 0
+ * ends there. */
+static bool frame_ends(sb_parser *p)
+{
+    bool stray = true;
+    for (;;) {
+        settle(p, stray);
+        if (p->seen == 0)
+            return false;
+        if (size_at(p, 0) != p->seen)
+            break;
+        if (checksum_ok(p, 0, p->seen))
+            return true;
+        p->bad_frames++;
+        drop(p, 1);
+        stray = false;
+    }
+    /* A frame that ends here, begun inside the unfinished one at the start:
+     * that one's header was noise, or it was cut short. */
+    for (size_t at = 1; at + 5u <= p->seen; at++)
+        if (header_at(p, at) && size_at(p, at) == p->seen - at && checksum_ok(p, at, p->seen - at)) {
+            p->stray_bytes += (uint32_t)at;
+            drop(p, at);
+            return true;
+        }
+    return false;
+}
+
+size_t sb_parser_missing(const sb_parser *p)
+{
+    size_t size = p->taken == 0 ? size_at(p, 0) : 0, held = p->len - p->taken;
+    if (size == 0)
+        return held < 5 ? 5u - held : 1u;
+    return size > held ? size - held : 1u;
+}
+
+int sb_parse(sb_parser *p, const uint8_t *data, size_t len, size_t *used, uint8_t *code, const uint8_t **content,
+             size_t *clen)
+{
+    size_t k = 0;
+    drop(p, p->taken); /* the frame returned last time */
+    p->taken = 0;
+    for (;;) {
+        if (p->seen == p->len) { /* the held bytes examined: take the next (a live start leaves room) */
+            if (k == len)
+                break;
+            p->buf[p->len++] = data[k++];
+        }
+        p->seen++;
+        if (frame_ends(p)) {
+            size_t head = p->buf[3] == SB_EXTENDED_LENGTH ? 6u : 4u;
+            p->taken = p->seen;
+            *used = k;
+            *code = p->buf[2];
+            *content = p->buf + head;
+            *clen = p->seen - head - 1u;
+            return 1;
+        }
+    }
+    *used = k;
+    return 0;
+}
