@@ -1,10 +1,12 @@
 /* The bus: answers matched to requests on the bus's clock (their frames
  * found by sb_parse.c); a microcontroller's UART as a transport. */
+#include <errno.h>
 #include <string.h>
 
 #include "servobus/servobus.h"
 
 #define WAIT_SLICE_US 5000u /* the longest single wait on the transport */
+#define EINTR_TRIES 16      /* a call a signal interrupted is made again, but not forever */
 
 /* ---- the bus ------------------------------------------------------------- */
 void sb_bus_init(sb_bus *bus, sb_transport t, uint32_t baud)
@@ -32,12 +34,31 @@ static sb_error link_error(int rc, uint8_t code)
     return e;
 }
 
+/* The transport's read into pending, its return checked: more than it
+ * holds is a broken link (it wrote past the buffer). */
+static int link_read(sb_bus *bus, size_t want, uint32_t wait_us)
+{
+    int rc = -EINTR;
+    for (int tries = 0; rc == -EINTR && tries < EINTR_TRIES; tries++)
+        rc = bus->t.read(bus->t.ctx, bus->pending, sizeof bus->pending, want, wait_us);
+    return rc > (int)sizeof bus->pending ? -EOVERFLOW : rc;
+}
+
+/* The transport's write: 0 (or len, a count of all of it), else -errno. */
+static int link_write(sb_bus *bus, const uint8_t *frame, size_t len)
+{
+    int rc = -EINTR;
+    for (int tries = 0; rc == -EINTR && tries < EINTR_TRIES; tries++)
+        rc = bus->t.write(bus->t.ctx, frame, len);
+    return rc > 0 && (size_t)rc != len ? -EIO : rc > 0 ? 0 : rc;
+}
+
 sb_error sb_send(sb_bus *bus, const uint8_t *frame, size_t len)
 {
     int rc;
     /* What waits unread is dropped: a late answer is not the next one's. */
     for (int k = 0; k < 64; k++) {
-        rc = bus->t.read(bus->t.ctx, bus->pending, sizeof bus->pending, 1, 0);
+        rc = link_read(bus, 1, 0);
         if (rc < 0)
             return link_error(rc, len > 2 ? frame[2] : 0);
         if (rc == 0)
@@ -46,7 +67,7 @@ sb_error sb_send(sb_bus *bus, const uint8_t *frame, size_t len)
     bus->pending_len = 0;
     bus->rx.len = bus->rx.seen = bus->rx.taken = 0;
     bus->sent_end_us = bus->t.now_us(bus->t.ctx) + wire_us(bus, len);
-    rc = bus->t.write(bus->t.ctx, frame, len);
+    rc = link_write(bus, frame, len);
     return rc < 0 ? link_error(rc, len > 2 ? frame[2] : 0) : sb_ok();
 }
 
@@ -86,7 +107,7 @@ static sb_error receive(sb_bus *bus, uint8_t code, int servo, uint64_t deadline_
             int rc;
             if (left == 0 && !looked) { /* the host may have slept past the deadline: bytes wait */
                 looked = true;
-                rc = bus->t.read(bus->t.ctx, bus->pending, sizeof bus->pending, 1, 0);
+                rc = link_read(bus, 1, 0);
                 if (rc > 0) {
                     bus->pending_len = (size_t)rc;
                     continue;
@@ -100,8 +121,7 @@ static sb_error receive(sb_bus *bus, uint8_t code, int servo, uint64_t deadline_
             }
             /* want_after: the bytes of every frame still to come, from this one's first. */
             size_t want = want_after > bus->rx.len ? want_after - bus->rx.len : sb_parser_missing(&bus->rx);
-            rc = bus->t.read(bus->t.ctx, bus->pending, sizeof bus->pending, want,
-                             (uint32_t)(left < WAIT_SLICE_US ? left : WAIT_SLICE_US));
+            rc = link_read(bus, want, (uint32_t)(left < WAIT_SLICE_US ? left : WAIT_SLICE_US));
             if (rc < 0) {
                 e = link_error(rc, code);
                 e.servo = (int16_t)servo;

@@ -1,6 +1,7 @@
 /* servobus's bus on a link that misbehaves: noise that looks like a header,
  * an answer cut short or of the wrong length, requests no servo would
  * answer, and a transport's odd return values. */
+#include <errno.h>
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -69,12 +70,70 @@ static void an_answer_of_the_wrong_length_is_skipped_and_the_round_goes_on(void 
     assert_int_equal(states[2].id, 3);
 }
 
+/* A transport over the fake that misbehaves as told. */
+static int eintr_reads, eintr_writes;
+static bool reads_too_much;
+
+static int odd_read(void *ctx, uint8_t *buf, size_t cap, size_t want, uint32_t wait_us)
+{
+    int n;
+    if (eintr_reads > 0) {
+        eintr_reads--;
+        return -EINTR;
+    }
+    n = fake_transport(&fake).read(ctx, buf, cap, want, wait_us);
+    return reads_too_much && n > 0 ? (int)cap + 1 : n;
+}
+
+static int odd_write(void *ctx, const uint8_t *data, size_t len)
+{
+    if (eintr_writes > 0) {
+        eintr_writes--;
+        return -EINTR;
+    }
+    return fake_transport(&fake).write(ctx, data, len);
+}
+
+static int odd_set_up(void **state)
+{
+    set_up(state);
+    eintr_reads = eintr_writes = 0;
+    reads_too_much = false;
+    bus.t.read = odd_read;
+    bus.t.write = odd_write;
+    return 0;
+}
+
+static void a_read_beyond_its_cap_is_a_link_error(void **state)
+{
+    sb_read_angle_request r = {3};
+    sb_read_angle_answer a;
+    reads_too_much = true;
+    sb_error e = sb_call_read_angle(&bus, &r, &a);
+    assert_int_equal(e.status, SB_E_LINK);
+    assert_int_equal(e.os_error, EOVERFLOW);
+    assert_int_equal(e.servo, 3);
+}
+
+static void an_interrupted_read_or_write_is_tried_again(void **state)
+{
+    sb_read_angle_request r = {3};
+    sb_read_angle_answer a;
+    eintr_writes = 2;
+    eintr_reads = 3;
+    assert_int_equal(sb_call_read_angle(&bus, &r, &a).status, SB_OK);
+    assert_int_equal(a.angle, -123);
+    assert_int_equal(eintr_reads + eintr_writes, 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test_setup(noise_that_looks_like_a_header_costs_only_its_bytes, set_up),
         cmocka_unit_test_setup(an_answer_cut_short_costs_only_its_bytes, set_up),
         cmocka_unit_test_setup(an_answer_of_the_wrong_length_is_skipped_and_the_round_goes_on, set_up),
+        cmocka_unit_test_setup(a_read_beyond_its_cap_is_a_link_error, odd_set_up),
+        cmocka_unit_test_setup(an_interrupted_read_or_write_is_tried_again, odd_set_up),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
