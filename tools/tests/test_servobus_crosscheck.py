@@ -18,7 +18,7 @@ from .launchers import REPO
 
 BINARY = REPO / "build" / "host" / "tools" / "servobus" / "sb_crosscheck"
 S = servo_schema.load()
-SB_E_RANGE, SB_E_UNKNOWN_ITEM, SB_E_BAD_ANSWER = 1, 4, 8
+SB_E_RANGE, SB_E_UNKNOWN_ITEM, SB_E_BAD_ANSWER, SB_E_BROADCAST = 1, 4, 8, 11
 USER_AREA = bytes(range(7, 7 + registers.USER_AREA_SIZE))
 
 
@@ -59,6 +59,14 @@ def edge_cases(fields) -> list:
     return cases
 
 
+def refused(p, part: str, values: list):
+    """(status, field) where the C library refuses a request within every
+    field's range, as the servo would not carry it out as sent; else None."""
+    if part == "request" and p.has("addressed") and not p.has("broadcast") and values[0] == S.frame["broadcast_id"]:
+        return SB_E_BROADCAST, p.request[0].name
+    return None
+
+
 def fixed(p, part: str) -> bool:
     return getattr(S, f"{part}_format")(p.code) is not None
 
@@ -73,8 +81,8 @@ def test_every_fixed_request_and_answer_at_every_field_edge():
             fmt = getattr(S, f"{part}_format")(p.code)
             for values, out in edge_cases(fields):
                 lines.append(f"{kind} {p.code} " + " ".join(map(word, values)))
-                if out:
-                    expect.append((p, part, values, out, None))
+                if out or refused(p, part, values):
+                    expect.append((p, part, values, out, refused(p, part, values)))
                     continue
                 content = struct.pack(fmt, *values)
                 frame = (codec.request_frame if part == "request" else codec.response_frame)(p.code, content)
@@ -84,7 +92,9 @@ def test_every_fixed_request_and_answer_at_every_field_edge():
     answers = c_side(lines)
     checked = 0
     for line, got, (p, part, values, out, frame) in zip(lines, answers, expect):
-        if out:
+        if isinstance(frame, tuple) and not out:
+            assert got.split()[:2] == ["err", str(frame[0])] and got.split()[3] == frame[1], (line, got)
+        elif out:
             assert got.split()[:2] == ["err", str(SB_E_RANGE)] and got.split()[3] == out, (line, got)
             assert not S.field(p.code, out, part).range[0] <= values[[f.name for f in getattr(p, part)].index(out)] \
                 <= S.field(p.code, out, part).range[1]

@@ -139,7 +139,9 @@ sb_error sb_receive(sb_bus *bus, uint8_t code, int servo, uint64_t deadline_us, 
 
 sb_error sb_request(sb_bus *bus, size_t len, uint8_t code, int servo, uint8_t *content, size_t *clen)
 {
-    sb_error e = sb_send(bus, bus->tx, len);
+    sb_error e = servo == SB_BROADCAST_ID ? sb_error_of(SB_E_BROADCAST, servo, code, "id") : sb_ok();
+    if (e.status == SB_OK)
+        e = sb_send(bus, bus->tx, len);
     if (e.status != SB_OK) {
         e.servo = (int16_t)servo;
         return e;
@@ -234,7 +236,9 @@ sb_error sb_sync_monitor_answers(sb_bus *bus, const uint8_t *ids, size_t count, 
 sb_error sb_sync_monitor(sb_bus *bus, const uint8_t *ids, size_t count, sb_monitor_answer *states, bool *got)
 {
     size_t len = 0;
-    sb_error e = sb_sync_frame(SB_PKT_MONITOR, ids, 1, count, bus->tx, sizeof bus->tx, &len);
+    sb_error e = sb_check_ids(ids, count, SB_PKT_MONITOR);
+    if (e.status == SB_OK)
+        e = sb_sync_frame(SB_PKT_MONITOR, ids, 1, count, bus->tx, sizeof bus->tx, &len);
     if (e.status == SB_OK)
         e = sb_send(bus, bus->tx, len);
     return e.status == SB_OK ? sb_sync_monitor_answers(bus, ids, count, states, got) : e;

@@ -92,6 +92,18 @@ static int64_t get_le(const uint8_t *in, size_t size, bool is_signed)
     return (int64_t)u;
 }
 
+sb_error sb_check_ids(const uint8_t *ids, size_t count, uint8_t code)
+{
+    for (size_t k = 0; k < count; k++) {
+        if (ids[k] > SB_MAX_ID)
+            return fail(SB_E_BROADCAST, ids[k], code, "ids");
+        for (size_t j = 0; j < k; j++)
+            if (ids[j] == ids[k])
+                return fail(SB_E_DUPLICATE_ID, ids[k], code, "ids");
+    }
+    return sb_ok();
+}
+
 /* The servo a packet's fields name: an addressed packet's first field. */
 static int servo_of(const sb_packet_desc *p, const sb_value *v, size_t count)
 {
@@ -122,6 +134,9 @@ static sb_error encode_fields(const sb_packet_desc *p, bool request, const sb_va
     size_t at = 0;
     if (count != fields)
         return fail(SB_E_USAGE, servo, p->code, NULL);
+    /* A servo takes a packet sent to the broadcast ID only if it is a broadcast one (and then never answers). */
+    if (request && servo == SB_BROADCAST_ID && !(p->flags & SB_PF_BROADCAST))
+        return fail(SB_E_BROADCAST, servo, p->code, f[0].name);
     for (size_t k = 0; k < fields; k++) {
         size_t size = type_size(f[k].type);
         int64_t least = f[k].min, most = f[k].max;

@@ -42,17 +42,16 @@ sb_error sb_sync_command(sb_bus *bus, uint8_t cmd, const uint8_t *records, size_
 sb_error sb_stream_init(sb_stream *s, const uint8_t *ids, size_t count, uint16_t period_ms)
 {
     const sb_field_desc *angle = &sb_packet(SB_PKT_STREAM_SETPOINT)->request[1];
+    sb_error e;
     memset(s, 0, sizeof *s);
     if (count == 0 || count > SB_MAX_SERVOS)
         return usage(-1, SB_PKT_STREAM_SETPOINT, "ids");
     if (period_ms == 0)
         return usage(-1, SB_PKT_STREAM_SETPOINT, "period");
+    e = sb_check_ids(ids, count, SB_PKT_STREAM_SETPOINT);
+    if (e.status != SB_OK)
+        return e;
     for (size_t k = 0; k < count; k++) {
-        if (ids[k] > SB_MAX_ID)
-            return usage(ids[k], SB_PKT_STREAM_SETPOINT, "id");
-        for (size_t j = 0; j < k; j++)
-            if (ids[j] == ids[k])
-                return usage(ids[k], SB_PKT_STREAM_SETPOINT, "id"); /* listed twice */
         s->ids[k] = ids[k];
         s->angle_min[k] = (int32_t)angle->min;
         s->angle_max[k] = (int32_t)angle->max;
@@ -198,6 +197,7 @@ static void put_number(text *t, int64_t n)
 static const char *const WHAT[] = {
     "ok", "out of range", "not allowed", "not a packet of the protocol", "no such writable data item",
     "the buffer is too small", "no answer", "an answer with a bad checksum", "a bad answer", "the link failed",
+    "listed twice", "is the broadcast ID: no servo answers it or carries it out",
 };
 
 size_t sb_error_text(const sb_error *e, char *buf, size_t cap)
@@ -230,6 +230,8 @@ size_t sb_error_text(const sb_error *e, char *buf, size_t cap)
         put_number(&t, e->least);
         put(&t, "..");
         put_number(&t, e->most);
+        put(&t, "; nothing was sent");
+    } else if (e->status == SB_E_DUPLICATE_ID || e->status == SB_E_BROADCAST) {
         put(&t, "; nothing was sent");
     } else if (e->status == SB_E_NO_ANSWER) {
         put(&t, " in time (is it on the bus, at this baud rate?)");

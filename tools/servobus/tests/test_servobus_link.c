@@ -70,6 +70,40 @@ static void an_answer_of_the_wrong_length_is_skipped_and_the_round_goes_on(void 
     assert_int_equal(states[2].id, 3);
 }
 
+static void duplicate_ids_are_refused_before_anything_is_sent(void **state)
+{
+    uint8_t ids[3] = {1, 2, 1};
+    char text[120];
+    sb_error e = sb_sync_monitor(&bus, ids, 3, states, got);
+    assert_int_equal(e.status, SB_E_DUPLICATE_ID);
+    assert_int_equal(e.servo, 1);
+    assert_int_equal(e.packet, SB_PKT_MONITOR);
+    assert_int_equal(fake.frames, 0);
+    sb_error_text(&e, text, sizeof text);
+    assert_string_equal(text, "servo 1: Monitor: ids listed twice; nothing was sent");
+}
+
+static void a_request_that_answers_is_not_sent_to_the_broadcast_id(void **state)
+{
+    sb_ping_request p = {SB_BROADCAST_ID};
+    sb_ping_answer pa;
+    uint8_t ids[2] = {1, SB_BROADCAST_ID};
+    char text[120];
+    uint64_t before = fake.now_us;
+    sb_error e = sb_call_ping(&bus, &p, &pa);
+    assert_int_equal(e.status, SB_E_BROADCAST);
+    assert_int_equal(e.servo, SB_BROADCAST_ID);
+    assert_int_equal(fake.frames, 0);
+    assert_int_equal(fake.now_us, before); /* no time-out waited */
+    sb_error_text(&e, text, sizeof text);
+    assert_string_equal(text, "servo 255: Ping: id is the broadcast ID: no servo answers it or carries it out; "
+                              "nothing was sent");
+    assert_int_equal(sb_sync_monitor(&bus, ids, 2, states, got).status, SB_E_BROADCAST);
+    assert_int_equal(fake.frames, 0);
+    sb_move_angle_request m = {SB_BROADCAST_ID, 0, 100, 0}; /* every servo moves, none answers */
+    assert_int_equal(sb_send_move_angle(&bus, &m).status, SB_OK);
+}
+
 /* A transport over the fake that misbehaves as told. */
 static int eintr_reads, eintr_writes;
 static bool reads_too_much;
@@ -132,6 +166,8 @@ int main(void)
         cmocka_unit_test_setup(noise_that_looks_like_a_header_costs_only_its_bytes, set_up),
         cmocka_unit_test_setup(an_answer_cut_short_costs_only_its_bytes, set_up),
         cmocka_unit_test_setup(an_answer_of_the_wrong_length_is_skipped_and_the_round_goes_on, set_up),
+        cmocka_unit_test_setup(duplicate_ids_are_refused_before_anything_is_sent, set_up),
+        cmocka_unit_test_setup(a_request_that_answers_is_not_sent_to_the_broadcast_id, set_up),
         cmocka_unit_test_setup(a_read_beyond_its_cap_is_a_link_error, odd_set_up),
         cmocka_unit_test_setup(an_interrupted_read_or_write_is_tried_again, odd_set_up),
     };

@@ -206,7 +206,7 @@ static void the_stream_refuses_what_the_servo_would_not_follow(void **state)
     assert_int_equal(e.status, SB_E_RANGE);
     assert_string_equal(e.field, "velocity");
     uint8_t twice[2] = {1, 1};
-    assert_int_equal(sb_stream_init(&s, twice, 2, 10).status, SB_E_USAGE);
+    assert_int_equal(sb_stream_init(&s, twice, 2, 10).status, SB_E_DUPLICATE_ID);
 }
 
 /* The UART callbacks: the fake's bytes handed over one at a time. */

@@ -55,6 +55,9 @@ sb_transport sb_transport_make(void *ctx, int (*write)(void *, const uint8_t *, 
 /* The error in words, NUL-terminated in buf: "servo 3: ReadAngle: no answer
  * within 100000 us". Returns the length written (cut to cap - 1). */
 size_t sb_error_text(const sb_error *e, char *buf, size_t cap);
+/* The IDs a round lists (code: its packet, for the error): each a servo's,
+ * once (SB_E_BROADCAST, SB_E_DUPLICATE_ID naming it). */
+sb_error sb_check_ids(const uint8_t *ids, size_t count, uint8_t code);
 const sb_packet_desc *sb_packet(uint8_t code); /* NULL: not in the schema */
 const sb_item_desc *sb_item(uint8_t id);       /* NULL: not in the schema */
 
@@ -139,7 +142,8 @@ sb_error sb_sync_command(sb_bus *bus, uint8_t cmd, const uint8_t *records, size_
  * silent servo's SB_SYNC_SILENCE_US before the next takes its turn, and
  * answer_margin_us; a silent servo costs one such slot, not a time-out.
  * Answers come in the list's order: an answer of ids[k] drops any taken of
- * ids[k] or later (a previous round's, late). */
+ * ids[k] or later (a previous round's, late). An ID listed twice, or the
+ * broadcast ID, is refused before anything is sent (sb_check_ids). */
 sb_error sb_sync_monitor(sb_bus *bus, const uint8_t *ids, size_t count, sb_monitor_answer *states, bool *got);
 /* The same after a frame already sent (a robot loop's burst). */
 sb_error sb_sync_monitor_answers(sb_bus *bus, const uint8_t *ids, size_t count, sb_monitor_answer *states,

@@ -23,7 +23,9 @@ typedef enum sb_status {
     SB_E_NO_ANSWER,      /* the servo did not answer in time */
     SB_E_BAD_CHECKSUM,   /* an answer came with a bad checksum */
     SB_E_BAD_ANSWER,     /* an answer of the wrong length, or a field beyond its range */
-    SB_E_LINK            /* the transport failed (os_error says why) */
+    SB_E_LINK,           /* the transport failed (os_error says why) */
+    SB_E_DUPLICATE_ID,   /* a servo listed twice (each answers once a round): nothing sent */
+    SB_E_BROADCAST       /* the broadcast ID where no servo would carry it out or answer: nothing sent */
 } sb_status;
 
 /* An error as a value: which servo (-1: none or unknown), which packet
