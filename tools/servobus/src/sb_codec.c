@@ -172,6 +172,11 @@ static sb_error encode_fields(const sb_packet_desc *p, bool request, const sb_va
     }
     if (request && (at < p->length_min || (p->length_max != 0xFFFFu && at > p->length_max)))
         return fail(SB_E_USAGE, servo, p->code, NULL);
+    if (request) {
+        sb_error e = sb_check_request(p->code, v, count);
+        if (e.status != SB_OK)
+            return e;
+    }
     *len = at;
     return sb_ok();
 }

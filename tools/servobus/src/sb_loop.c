@@ -13,17 +13,20 @@ static sb_error usage(int servo, uint8_t code, const char *field)
 sb_error sb_sync_frame(uint8_t cmd, const uint8_t *records, size_t record_len, size_t count, uint8_t *frame,
                        size_t cap, size_t *len)
 {
-    const sb_packet_desc *p = sb_packet(cmd);
+    sb_value v[4] = {{cmd, NULL, 0}, {0, NULL, 0}, {0, NULL, 0}, {0, NULL, 0}};
     size_t clen = 3u + record_len * count;
-    if (p == NULL || !(p->flags & SB_PF_SYNCABLE) || record_len != p->length_min || record_len != p->length_max)
-        return usage(-1, SB_PKT_SYNC_COMMAND, "cmd");
-    if (count == 0 || count > 255u)
-        return usage(-1, SB_PKT_SYNC_COMMAND, "count");
-    if (7u + clen > cap) {
-        sb_error e = usage(-1, SB_PKT_SYNC_COMMAND, NULL);
-        e.status = SB_E_SPACE;
+    sb_error e;
+    if (record_len > 255u || count > 255u)
+        return usage(-1, SB_PKT_SYNC_COMMAND, record_len > 255u ? "cmd" : "count");
+    v[1].n = (int64_t)record_len;
+    v[2].n = (int64_t)count;
+    v[3].bytes = records;
+    v[3].len = record_len * count;
+    e = sb_check_request(SB_PKT_SYNC_COMMAND, v, 4); /* what the typed encoder checks too */
+    if (e.status != SB_OK)
         return e;
-    }
+    if (7u + clen > cap)
+        return sb_error_of(SB_E_SPACE, -1, SB_PKT_SYNC_COMMAND, NULL);
     memmove(frame + 9, records, record_len * count); /* the content at 6, then moved to its place */
     frame[6] = cmd;
     frame[7] = (uint8_t)record_len;

@@ -170,6 +170,29 @@ static void the_frame_finder_rescans_after_a_false_header(void **state)
     assert_memory_equal(servos, "\x02\x03", 2);
 }
 
+static void the_typed_sync_command_checks_what_sb_sync_frame_checks(void **state)
+{
+    uint8_t records[4] = {1, 2, 3, 4}, f[32];
+    size_t len = 0;
+    sb_sync_command_request r = {SB_PKT_MONITOR, 1, 4, records, 4};
+    assert_int_equal(sb_encode_sync_command(&r, f, sizeof f, &len).status, SB_OK);
+    r.cmd = SB_PKT_PING; /* not syncable */
+    assert_int_equal(sb_encode_sync_command(&r, f, sizeof f, &len).status, SB_E_USAGE);
+    r.cmd = SB_PKT_MONITOR;
+    r.record_len = 2; /* not Monitor's length */
+    r.count = 2;
+    assert_int_equal(sb_encode_sync_command(&r, f, sizeof f, &len).status, SB_E_USAGE);
+    r.record_len = 1;
+    r.count = 0;
+    r.records_len = 0;
+    assert_int_equal(sb_encode_sync_command(&r, f, sizeof f, &len).status, SB_E_USAGE);
+    r.count = 3; /* three records said, four given */
+    r.records_len = 4;
+    sb_error e = sb_encode_sync_command(&r, f, sizeof f, &len);
+    assert_int_equal(e.status, SB_E_USAGE);
+    assert_string_equal(e.field, "records");
+}
+
 static void a_long_sync_command_takes_the_extended_length(void **state)
 {
     uint8_t records[30 * 9], f[300];
@@ -207,6 +230,7 @@ int main(void)
         cmocka_unit_test(a_long_sync_command_takes_the_extended_length),
         cmocka_unit_test(the_wire_limit_is_servoctls),
         cmocka_unit_test(the_frame_finder_rescans_after_a_false_header),
+        cmocka_unit_test(the_typed_sync_command_checks_what_sb_sync_frame_checks),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
