@@ -13,6 +13,8 @@ import pytest
 
 import servo_schema
 from servoctl import codec, registers
+from servoctl.checks import MIN_RAMP_MS, check_profile
+from servoctl.errors import ValueOutOfRange
 
 from .launchers import REPO
 
@@ -43,7 +45,8 @@ def type_range(f) -> tuple:
 def edge_cases(fields) -> list:
     """(values, the field out of range or None): every field at its least and
     most, and just beyond where the schema's range is narrower than its type's."""
-    base = [USER_AREA if f.type == "user_area" else f.range[0] for f in fields]
+    # A move's time at its most, so that the other fields' edges keep its ramps.
+    base = [USER_AREA if f.type == "user_area" else f.range[f.name == "interval"] for f in fields]
     cases = [(base, None)]
     for k, f in enumerate(fields):
         if f.type == "user_area":
@@ -62,8 +65,21 @@ def edge_cases(fields) -> list:
 def refused(p, part: str, values: list):
     """(status, field) where the C library refuses a request within every
     field's range, as the servo would not carry it out as sent; else None."""
-    if part == "request" and p.has("addressed") and not p.has("broadcast") and values[0] == S.frame["broadcast_id"]:
+    if part != "request":
+        return None
+    named = dict(zip((f.name for f in p.request), values))
+    if p.has("addressed") and not p.has("broadcast") and values[0] == S.frame["broadcast_id"]:
         return SB_E_BROADCAST, p.request[0].name
+    if "interval" in named:  # a move's time shorter than its ramps (8 and 13 ramp 20 ms): servoctl refuses it too
+        try:
+            check_profile(named.get("acc_interval", MIN_RAMP_MS), named.get("dec_interval", MIN_RAMP_MS),
+                          named["interval"])
+        except ValueOutOfRange:
+            return SB_E_RANGE, "interval"
+    # A wheel run for a time (action 3) shorter than its two 20 ms ramps (motion/planning.c).
+    if p.code == codec.CODES["WHEEL"] and named["method"] & 0x7F == 3 and named["speed"] and \
+            named["value"] < 2 * MIN_RAMP_MS:
+        return SB_E_RANGE, "value"
     return None
 
 

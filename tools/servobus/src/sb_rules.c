@@ -1,5 +1,41 @@
-/* The rules across a request's fields: a SyncCommand's records. */
+/* The rules across a request's fields: what the servo would clamp or not
+ * carry out as sent (docs/protocol.md, "Moves"), refused before anything is
+ * sent, as servoctl's checks refuse it; and a SyncCommand's records. */
 #include "servobus/servobus.h"
+
+#define FIXED_RAMP_MS 20u  /* the ramps of 8 and 13, and of a wheel's run (motion/planning.c) */
+#define WHEEL_ACTION 0x7Fu /* MoveOnWheelMode's method: its action, without the direction bit */
+#define WHEEL_FOR_A_TIME 3u
+
+/* A move's time must hold both its ramps: the servo stretches it to them. */
+typedef struct ramp_rule {
+    uint8_t code;
+    uint8_t time;     /* the field of the move's time */
+    uint8_t acc, dec; /* its ramps' fields; 0: FIXED_RAMP_MS each */
+} ramp_rule;
+
+static const ramp_rule RAMP_RULES[] = {
+    {SB_PKT_MOVE_WHEEL, 3, 0, 0}, /* a run for value ms */
+    {SB_PKT_MOVE_ANGLE, 2, 0, 0},
+    {SB_PKT_MOVE_ANGLE_BY_INTERVAL, 2, 3, 4},
+    {SB_PKT_MOVE_MULTI_TURN, 2, 0, 0},
+    {SB_PKT_MOVE_MULTI_TURN_BY_INTERVAL, 2, 3, 4},
+};
+
+static sb_error ramps_held(const sb_packet_desc *p, const ramp_rule *r, const sb_value *v)
+{
+    int64_t ramps = r->acc != 0 ? v[r->acc].n + v[r->dec].n : 2 * (int64_t)FIXED_RAMP_MS;
+    sb_error e = sb_ok();
+    if (p->code == SB_PKT_MOVE_WHEEL && ((v[1].n & WHEEL_ACTION) != WHEEL_FOR_A_TIME || v[2].n == 0))
+        return e; /* a wheel's stop, run or turns: no time */
+    if (v[r->time].n < ramps) {
+        e = sb_error_of(SB_E_RANGE, (int)v[0].n, p->code, p->request[r->time].name);
+        e.value = v[r->time].n;
+        e.least = ramps;
+        e.most = p->request[r->time].max;
+    }
+    return e;
+}
 
 /* A SyncCommand: records of a syncable packet at its length, as many as it says. */
 static sb_error records_fit(const sb_value *v)
@@ -20,5 +56,10 @@ sb_error sb_check_request(uint8_t code, const sb_value *v, size_t count)
     const sb_packet_desc *p = sb_packet(code);
     if (p == NULL || count != p->request_count)
         return sb_error_of(p == NULL ? SB_E_UNKNOWN_PACKET : SB_E_USAGE, -1, code, NULL);
-    return code == SB_PKT_SYNC_COMMAND ? records_fit(v) : sb_ok();
+    if (code == SB_PKT_SYNC_COMMAND)
+        return records_fit(v);
+    for (size_t k = 0; k < sizeof RAMP_RULES / sizeof RAMP_RULES[0]; k++)
+        if (RAMP_RULES[k].code == code)
+            return ramps_held(p, &RAMP_RULES[k], v);
+    return sb_ok();
 }

@@ -193,6 +193,39 @@ static void the_typed_sync_command_checks_what_sb_sync_frame_checks(void **state
     assert_string_equal(e.field, "records");
 }
 
+static void a_profile_the_servo_would_stretch_is_refused(void **state)
+{
+    uint8_t f[32];
+    size_t len = 0;
+    sb_move_angle_by_interval_request a = {1, 900, 199, 100, 100, 0};
+    sb_error e = sb_encode_move_angle_by_interval(&a, f, sizeof f, &len);
+    assert_int_equal(e.status, SB_E_RANGE);
+    assert_string_equal(e.field, "interval");
+    assert_int_equal(e.value, 199);
+    assert_int_equal(e.least, 200); /* acc + dec */
+    a.interval = 200;
+    assert_int_equal(sb_encode_move_angle_by_interval(&a, f, sizeof f, &len).status, SB_OK);
+    sb_move_multi_turn_by_interval_request m = {1, 36000, 39, 20, 20, 0};
+    assert_int_equal(sb_encode_move_multi_turn_by_interval(&m, f, sizeof f, &len).status, SB_E_RANGE);
+    m.interval = 40;
+    assert_int_equal(sb_encode_move_multi_turn_by_interval(&m, f, sizeof f, &len).status, SB_OK);
+    /* The plain moves ramp 20 ms each way: 40 ms at least. */
+    sb_move_angle_request p = {1, 900, 39, 0};
+    assert_int_equal(sb_encode_move_angle(&p, f, sizeof f, &len).status, SB_E_RANGE);
+    sb_move_multi_turn_request pm = {1, 900, 39, 0};
+    assert_int_equal(sb_encode_move_multi_turn(&pm, f, sizeof f, &len).status, SB_E_RANGE);
+    /* A wheel run for a time shorter than its two 20 ms ramps. */
+    sb_move_wheel_request w = {1, 3, 100, 39};
+    e = sb_encode_move_wheel(&w, f, sizeof f, &len);
+    assert_int_equal(e.status, SB_E_RANGE);
+    assert_string_equal(e.field, "value");
+    w.value = 40;
+    assert_int_equal(sb_encode_move_wheel(&w, f, sizeof f, &len).status, SB_OK);
+    w.method = 2; /* turns: any number */
+    w.value = 1;
+    assert_int_equal(sb_encode_move_wheel(&w, f, sizeof f, &len).status, SB_OK);
+}
+
 static void a_long_sync_command_takes_the_extended_length(void **state)
 {
     uint8_t records[30 * 9], f[300];
@@ -231,6 +264,7 @@ int main(void)
         cmocka_unit_test(the_wire_limit_is_servoctls),
         cmocka_unit_test(the_frame_finder_rescans_after_a_false_header),
         cmocka_unit_test(the_typed_sync_command_checks_what_sb_sync_frame_checks),
+        cmocka_unit_test(a_profile_the_servo_would_stretch_is_refused),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
