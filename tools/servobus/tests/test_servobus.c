@@ -193,6 +193,30 @@ static void the_typed_sync_command_checks_what_sb_sync_frame_checks(void **state
     assert_string_equal(e.field, "records");
 }
 
+static void every_item_decodes_at_its_size_and_signedness(void **state)
+{
+    uint8_t c[2 + 4] = {1, SB_ITEM_SERIAL_NUMBER, 0xFF, 0xFF, 0xFF, 0xFF};
+    sb_read_data_answer a;
+    assert_int_equal(sb_decode_read_data(c, 6, &a).status, SB_OK);
+    assert_true(a.data == INT64_C(0xFFFFFFFF)); /* a serial number above 0x7FFFFFFF, not negative */
+    for (size_t k = 0; k < SB_ITEM_COUNT; k++) {
+        const sb_item_desc *item = &sb_items[k];
+        int64_t most = item->is_signed ? (INT64_C(1) << (8 * item->size - 1)) - 1 : (INT64_C(1) << (8 * item->size)) - 1;
+        int64_t least = item->is_signed ? -most - 1 : 0;
+        if (item->access == SB_ACCESS_RESERVED)
+            continue;
+        for (int end = 0; end < 2; end++) {
+            uint8_t f[16];
+            size_t len = 0;
+            sb_value v[3] = {{1, NULL, 0}, {item->id, NULL, 0}, {end ? most : least, NULL, 0}};
+            assert_int_equal(sb_encode_answer(SB_PKT_READ_DATA, v, 3, f, sizeof f, &len).status, SB_OK);
+            assert_int_equal(sb_decode_read_data(f + 4, len - 5, &a).status, SB_OK);
+            assert_true(a.data == v[2].n);
+            assert_int_equal(a.data_size, item->size);
+        }
+    }
+}
+
 static void a_profile_the_servo_would_stretch_is_refused(void **state)
 {
     uint8_t f[32];
@@ -264,6 +288,7 @@ int main(void)
         cmocka_unit_test(the_wire_limit_is_servoctls),
         cmocka_unit_test(the_frame_finder_rescans_after_a_false_header),
         cmocka_unit_test(the_typed_sync_command_checks_what_sb_sync_frame_checks),
+        cmocka_unit_test(every_item_decodes_at_its_size_and_signedness),
         cmocka_unit_test(a_profile_the_servo_would_stretch_is_refused),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
