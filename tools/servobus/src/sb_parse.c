@@ -15,10 +15,14 @@ void sb_parser_init(sb_parser *p, bool requests)
 /* The frame finder holds buf[0..len), seen of them examined, and starts at
  * a header (or holds nothing). Any header in the examined bytes begins a
  * candidate frame. A frame is returned the moment its last byte is
- * examined with a good checksum, the earliest-starting first: bytes before
- * it were noise that looked like a header, or an answer cut short. A
- * candidate at the start that fails (a bad checksum, too long to be a
- * frame) costs only its first byte: the search goes on from the next. */
+ * examined with a good checksum, the earliest-starting first. A frame that
+ * ends inside the unfinished candidate at the start is handed back and the
+ * candidate kept: it may be noise that looked like a header or an answer
+ * cut short, or a whole answer whose content holds a frame of its own (a
+ * Monitor answer at 7173 mV holds 05 1c 03 00 24); it is returned too if it
+ * ends with a good checksum. A candidate at the start that fails (a bad
+ * checksum, too long to be a frame) costs only its first byte: the search
+ * goes on from the next. */
 
 /* The size of the candidate at `at` once its head is examined, else 0. */
 static size_t size_at(const sb_parser *p, size_t at)
@@ -48,6 +52,7 @@ static void drop(sb_parser *p, size_t n)
     memmove(p->buf, p->buf + n, p->len - n);
     p->len -= n;
     p->seen -= n;
+    p->inner_from = p->inner_from > n ? p->inner_from - n : 0;
 }
 
 /* Drops examined bytes until the start is a header whose frame may still
@@ -65,11 +70,12 @@ static void settle(sb_parser *p, bool stray)
     }
 }
 
-/* After the byte at seen - 1 is examined: true when a frame starting at 0
- * ends there. */
-static bool frame_ends(sb_parser *p)
+/* After the byte at seen - 1 is examined: true when a frame ends there,
+ * starting at *start (0, or inside the candidate at 0). */
+static bool frame_ends(sb_parser *p, size_t *start)
 {
     bool stray = true;
+    *start = 0;
     for (;;) {
         settle(p, stray);
         if (p->seen == 0)
@@ -79,15 +85,16 @@ static bool frame_ends(sb_parser *p)
         if (checksum_ok(p, 0, p->seen))
             return true;
         p->bad_frames++;
-        drop(p, 1);
+        drop(p, p->inner_from > 1 ? p->inner_from : 1); /* and the frames handed back inside it */
         stray = false;
     }
-    /* A frame that ends here, begun inside the unfinished one at the start:
-     * that one's header was noise, or it was cut short. */
-    for (size_t at = 1; at + 5u <= p->seen; at++)
+    /* A frame that ends here, begun inside the unfinished one at the start
+     * (after the last such frame handed back): handed back at `at`, the
+     * one at the start kept. */
+    for (size_t at = p->inner_from > 1 ? p->inner_from : 1; at + 5u <= p->seen; at++)
         if (header_at(p, at) && size_at(p, at) == p->seen - at && checksum_ok(p, at, p->seen - at)) {
-            p->stray_bytes += (uint32_t)at;
-            drop(p, at);
+            p->inner_from = p->seen;
+            *start = at;
             return true;
         }
     return false;
@@ -104,8 +111,8 @@ size_t sb_parser_missing(const sb_parser *p)
 int sb_parse(sb_parser *p, const uint8_t *data, size_t len, size_t *used, uint8_t *code, const uint8_t **content,
              size_t *clen)
 {
-    size_t k = 0;
-    drop(p, p->taken); /* the frame returned last time */
+    size_t k = 0, at = 0;
+    drop(p, p->taken); /* the frame returned last time (none if it lay inside another) */
     p->taken = 0;
     for (;;) {
         if (p->seen == p->len) { /* the held bytes examined: take the next (a live start leaves room) */
@@ -114,13 +121,13 @@ int sb_parse(sb_parser *p, const uint8_t *data, size_t len, size_t *used, uint8_
             p->buf[p->len++] = data[k++];
         }
         p->seen++;
-        if (frame_ends(p)) {
-            size_t head = p->buf[3] == SB_EXTENDED_LENGTH ? 6u : 4u;
-            p->taken = p->seen;
+        if (frame_ends(p, &at)) {
+            size_t head = p->buf[at + 3] == SB_EXTENDED_LENGTH ? 6u : 4u;
+            p->taken = at == 0 ? p->seen : 0;
             *used = k;
-            *code = p->buf[2];
-            *content = p->buf + head;
-            *clen = p->seen - head - 1u;
+            *code = p->buf[at + 2];
+            *content = p->buf + at + head;
+            *clen = p->seen - at - head - 1u;
             return 1;
         }
     }

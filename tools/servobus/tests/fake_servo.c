@@ -37,7 +37,9 @@ static void monitor(fake_bus *f, uint8_t id)
     sb_value v[8];
     memset(v, 0, sizeof v);
     v[0].n = id;
-    v[1].n = 7400;
+    v[1].n = f->power[0] != 0 ? f->power[0] : 7400;
+    v[2].n = f->power[1];
+    v[3].n = f->power[2];
     v[5].n = 1;
     v[6].n = f->setpoint[id];
     if (f->present[id])

@@ -70,6 +70,25 @@ static void an_answer_of_the_wrong_length_is_skipped_and_the_round_goes_on(void 
     assert_int_equal(states[2].id, 3);
 }
 
+/* 7173 mV, 3 mA, 36 mW: the answer's content holds a whole frame of its own
+ * (05 1c 03 00 24); the answer is still found, at once. */
+static void an_answer_whose_content_holds_a_frame_is_not_lost(void **state)
+{
+    sb_monitor_request r = {2};
+    sb_monitor_answer a;
+    uint64_t before;
+    fake.power[0] = 7173;
+    fake.power[1] = 3;
+    fake.power[2] = 36;
+    assert_int_equal(sb_sync_monitor(&bus, three, 3, states, got).status, SB_OK);
+    assert_true(got[0] && got[1] && got[2]);
+    assert_int_equal(states[0].voltage, 7173);
+    before = fake.now_us;
+    assert_int_equal(sb_call_monitor(&bus, &r, &a).status, SB_OK);
+    assert_int_equal(a.voltage, 7173);
+    assert_true(fake.now_us - before < 1000u); /* the fake's clock: the wire's time, not 100 ms */
+}
+
 static void duplicate_ids_are_refused_before_anything_is_sent(void **state)
 {
     uint8_t ids[3] = {1, 2, 1};
@@ -166,6 +185,7 @@ int main(void)
         cmocka_unit_test_setup(noise_that_looks_like_a_header_costs_only_its_bytes, set_up),
         cmocka_unit_test_setup(an_answer_cut_short_costs_only_its_bytes, set_up),
         cmocka_unit_test_setup(an_answer_of_the_wrong_length_is_skipped_and_the_round_goes_on, set_up),
+        cmocka_unit_test_setup(an_answer_whose_content_holds_a_frame_is_not_lost, set_up),
         cmocka_unit_test_setup(duplicate_ids_are_refused_before_anything_is_sent, set_up),
         cmocka_unit_test_setup(a_request_that_answers_is_not_sent_to_the_broadcast_id, set_up),
         cmocka_unit_test_setup(a_read_beyond_its_cap_is_a_link_error, odd_set_up),

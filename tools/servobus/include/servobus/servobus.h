@@ -88,13 +88,17 @@ uint8_t sb_checksum(const uint8_t *data, size_t len);
  * (header as given) ends in the bytes fed so far, with its code and
  * content; bytes outside frames and frames with a bad checksum are counted.
  * A false header (noise, an answer cut short) costs only its bytes: the
- * search goes on from the byte after it, through the bytes held. */
+ * search goes on from the byte after it, through the bytes held. A frame
+ * that ends inside a longer one not yet complete is returned as it ends,
+ * and the longer one still when it ends: an answer whose content holds a
+ * whole frame is not lost (the caller skips what it did not ask for). */
 typedef struct sb_parser {
     uint8_t header[2];
     uint8_t buf[SB_RX_MAX];
     size_t len;   /* bytes held */
     size_t seen;  /* of them examined */
-    size_t taken; /* the frame returned last, at buf's start */
+    size_t taken; /* the frame returned last, at buf's start (0: none, or it lay inside another) */
+    size_t inner_from; /* a frame inside the one at the start begins here or later */
     uint32_t stray_bytes;
     uint32_t bad_frames;
 } sb_parser;
