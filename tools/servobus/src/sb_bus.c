@@ -25,6 +25,12 @@ static uint64_t wire_us(const sb_bus *bus, size_t bytes)
     return bus->baud > 0 ? ((uint64_t)bytes * SB_BITS_PER_BYTE * 1000000u + bus->baud - 1u) / bus->baud : 0u;
 }
 
+/* A time us after t on the bus clock, held at its end rather than wrapping. */
+static uint64_t later(uint64_t t, uint64_t us)
+{
+    return t > UINT64_MAX - us ? UINT64_MAX : t + us;
+}
+
 static sb_error link_error(int rc, uint8_t code)
 {
     sb_error e = sb_ok();
@@ -71,13 +77,15 @@ sb_error sb_send(sb_bus *bus, const uint8_t *frame, size_t len)
     return rc < 0 ? link_error(rc, len > 2 ? frame[2] : 0) : sb_ok();
 }
 
-/* sb_receive; the transport may wait for want_after bytes (0: this frame's). */
+/* sb_receive; the transport may wait for want_after bytes (0: this frame's);
+ * look: once the deadline has passed, one last look at what came meanwhile
+ * (else only the bytes held are searched). */
 static sb_error receive(sb_bus *bus, uint8_t code, int servo, uint64_t deadline_us, uint8_t *content, size_t *len,
-                        size_t want_after)
+                        size_t want_after, bool look)
 {
     uint32_t bad = bus->rx.bad_frames;
     sb_error e = sb_ok();
-    bool looked = false; /* the deadline passed: one last look at what came meanwhile */
+    bool looked = !look; /* the deadline passed: one last look at what came meanwhile */
     for (;;) {
         for (;;) { /* every frame in what came and what the finder holds */
             size_t used = 0, clen = 0;
@@ -134,7 +142,7 @@ static sb_error receive(sb_bus *bus, uint8_t code, int servo, uint64_t deadline_
 
 sb_error sb_receive(sb_bus *bus, uint8_t code, int servo, uint64_t deadline_us, uint8_t *content, size_t *len)
 {
-    return receive(bus, code, servo, deadline_us, content, len, 0);
+    return receive(bus, code, servo, deadline_us, content, len, 0, true);
 }
 
 sb_error sb_request(sb_bus *bus, size_t len, uint8_t code, int servo, uint8_t *content, size_t *clen)
@@ -146,7 +154,7 @@ sb_error sb_request(sb_bus *bus, size_t len, uint8_t code, int servo, uint8_t *c
         e.servo = (int16_t)servo;
         return e;
     }
-    return receive(bus, code, servo, bus->t.now_us(bus->t.ctx) + bus->timeout_us, content, clen, 0);
+    return receive(bus, code, servo, bus->t.now_us(bus->t.ctx) + bus->timeout_us, content, clen, 0, true);
 }
 
 /* The slot in the list an answer of id takes, or count (not asked for). */
@@ -166,6 +174,9 @@ sb_error sb_sync_monitor_answers(sb_bus *bus, const uint8_t *ids, size_t count, 
      * that stays silent adds the silence that passes its turn. */
     uint64_t slot = SB_TURNAROUND_US + wire_us(bus, 2u + answer) + bus->answer_margin_us;
     uint64_t last = bus->sent_end_us;
+    /* The round's end, however the line babbles: each listed servo's slot and silence. */
+    uint64_t end = later(last, (uint64_t)count * (slot + SB_SYNC_SILENCE_US));
+    bool over = false; /* the end has passed: only the bytes held are searched */
     uint32_t bad = bus->rx.bad_frames;
     bool jumped = false; /* the last answer taken came before a listed servo's that had not passed its turn */
     size_t misshapen = count; /* the first listed servo whose answer was of the wrong length */
@@ -178,9 +189,11 @@ sb_error sb_sync_monitor_answers(sb_bus *bus, const uint8_t *ids, size_t count, 
         uint8_t content[SB_ANSWER_CONTENT_MAX];
         size_t len = 0, k;
         sb_monitor_answer a;
-        e = receive(bus, SB_PKT_MONITOR, -1, last + silent * SB_SYNC_SILENCE_US + slot, content, &len,
-                    left * answer);
-        if ((e.status == SB_E_NO_ANSWER || e.status == SB_E_BAD_CHECKSUM) && next >= count)
+        uint64_t deadline = later(last, silent * SB_SYNC_SILENCE_US + slot);
+        deadline = deadline < end ? deadline : end;
+        e = receive(bus, SB_PKT_MONITOR, -1, deadline, content, &len, left * answer, !over);
+        over = over || bus->t.now_us(bus->t.ctx) >= end;
+        if ((e.status == SB_E_NO_ANSWER || e.status == SB_E_BAD_CHECKSUM) && (next >= count || deadline == end))
             break;
         if (e.status == SB_E_NO_ANSWER || e.status == SB_E_BAD_CHECKSUM) {
             silent++; /* ids[next] passes its turn; the next answers after the silence */
@@ -193,9 +206,8 @@ sb_error sb_sync_monitor_answers(sb_bus *bus, const uint8_t *ids, size_t count, 
             k = e.servo >= 0 ? slot_of(ids, count, (uint8_t)e.servo) : count;
             misshapen = k < misshapen ? k : misshapen;
             e = sb_ok();
-            last = bus->arrived_us;
             if (k == count || k < next)
-                continue;
+                continue; /* not asked for, or its turn passed: the round's times stay */
         } else if (e.status != SB_OK) {
             break;
         } else {

@@ -150,9 +150,13 @@ sb_error sb_sync_command(sb_bus *bus, uint8_t cmd, const uint8_t *records, size_
  * the wire takes: its bytes at the baud rate, the servos' turnaround, a
  * silent servo's SB_SYNC_SILENCE_US before the next takes its turn, and
  * answer_margin_us; a silent servo costs one such slot, not a time-out.
- * Answers come in the list's order: an answer of ids[k] drops any taken of
- * ids[k] or later (a previous round's, late). An ID listed twice, or the
- * broadcast ID, is refused before anything is sent (sb_check_ids). */
+ * Only an answer that takes a listed servo's turn moves that schedule (a
+ * frame of a servo not listed, or whose turn has passed, does not), and
+ * however the line babbles the round ends by the request's end plus count
+ * times (such a slot + SB_SYNC_SILENCE_US). Answers come in the list's
+ * order: an answer of ids[k] drops any taken of ids[k] or later (a
+ * previous round's, late). An ID listed twice, or the broadcast ID, is
+ * refused before anything is sent (sb_check_ids). */
 sb_error sb_sync_monitor(sb_bus *bus, const uint8_t *ids, size_t count, sb_monitor_answer *states, bool *got);
 /* The same after a frame already sent (a robot loop's burst). */
 sb_error sb_sync_monitor_answers(sb_bus *bus, const uint8_t *ids, size_t count, sb_monitor_answer *states,

@@ -1,0 +1,115 @@
+/* servobus's rounds on a hostile line: a servo or a stray frame that
+ * babbles cannot hold a Sync Monitor open past its schedule. The clock is
+ * the line's, never the host's. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "tests/fake_servo.h"
+
+/* A line on which one frame comes again every every_us until stop_us. */
+typedef struct babble {
+    uint64_t now_us, next_us, every_us, stop_us;
+    uint8_t frame[32];
+    size_t len;
+} babble;
+
+static babble line;
+static sb_bus bus;
+static const uint8_t two[2] = {1, 2};
+static sb_monitor_answer states[2];
+static bool got[2];
+
+static int babble_write(void *ctx, const uint8_t *data, size_t len)
+{
+    (void)data;
+    ((babble *)ctx)->now_us += len * 10u; /* 1 Mbaud */
+    return 0;
+}
+
+static int babble_read(void *ctx, uint8_t *buf, size_t cap, size_t want, uint32_t wait_us)
+{
+    babble *b = (babble *)ctx;
+    uint64_t ready = b->next_us + b->len * 10u;
+    if (b->len == 0 || b->next_us >= b->stop_us || ready > b->now_us + wait_us || cap < b->len) {
+        b->now_us += wait_us;
+        return 0;
+    }
+    b->now_us = ready > b->now_us ? ready : b->now_us;
+    b->next_us += b->every_us;
+    memcpy(buf, b->frame, b->len);
+    return (int)b->len;
+}
+
+static uint64_t babble_now(void *ctx)
+{
+    return ((babble *)ctx)->now_us;
+}
+
+static int set_up(void **state)
+{
+    memset(&line, 0, sizeof line);
+    line.next_us = 100;
+    line.every_us = 2000;
+    line.stop_us = 1000000; /* a second of babble: far past any round */
+    sb_bus_init(&bus, sb_transport_make(&line, babble_write, babble_read, babble_now), 1000000);
+    return 0;
+}
+
+/* The latest a round of count may end: each servo's slot and silence. */
+static uint64_t round_end(size_t count)
+{
+    uint64_t slot = SB_TURNAROUND_US + (2u + sb_answer_frame_size(SB_PKT_MONITOR)) * 10u + bus.answer_margin_us;
+    return bus.sent_end_us + count * (slot + SB_SYNC_SILENCE_US);
+}
+
+static void servo_1_babbles(void)
+{
+    sb_value v[8];
+    memset(v, 0, sizeof v);
+    v[0].n = 1;
+    v[1].n = 7400;
+    v[5].n = 1;
+    assert_int_equal(sb_encode_answer(SB_PKT_MONITOR, v, 8, line.frame, sizeof line.frame, &line.len).status, SB_OK);
+}
+
+static void a_servo_answering_again_and_again_cannot_hold_a_round_open(void **state)
+{
+    sb_loop l;
+    int32_t angles[2] = {0, 0};
+    servo_1_babbles();
+    sb_error e = sb_sync_monitor(&bus, two, 2, states, got);
+    assert_true(line.now_us <= round_end(2));
+    assert_int_equal(e.status, SB_E_NO_ANSWER);
+    assert_int_equal(e.servo, 2);
+    assert_true(got[0] && !got[1]);
+    assert_int_equal(sb_loop_init(&l, &bus, two, 2, 10).status, SB_OK);
+    e = sb_loop_cycle(&l, angles, NULL, states, got);
+    assert_true(line.now_us <= round_end(2));
+    assert_int_equal(e.status, SB_E_NO_ANSWER);
+}
+
+static void a_misshapen_frame_of_another_servo_cannot_hold_a_round_open(void **state)
+{
+    uint8_t content[3] = {9, 0, 0}; /* servo 9's Monitor, its checksum good, its length not */
+    assert_int_equal(sb_frame(false, SB_PKT_MONITOR, content, 3, line.frame, sizeof line.frame, &line.len).status,
+                     SB_OK);
+    sb_error e = sb_sync_monitor(&bus, two, 2, states, got);
+    assert_true(line.now_us <= round_end(2));
+    assert_int_equal(e.status, SB_E_NO_ANSWER);
+    assert_int_equal(e.servo, 1);
+    assert_true(!got[0] && !got[1]);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test_setup(a_servo_answering_again_and_again_cannot_hold_a_round_open, set_up),
+        cmocka_unit_test_setup(a_misshapen_frame_of_another_servo_cannot_hold_a_round_open, set_up),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
