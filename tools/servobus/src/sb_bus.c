@@ -248,7 +248,10 @@ sb_error sb_sync_monitor_answers(sb_bus *bus, const uint8_t *ids, size_t count, 
 sb_error sb_sync_monitor(sb_bus *bus, const uint8_t *ids, size_t count, sb_monitor_answer *states, bool *got)
 {
     size_t len = 0;
-    sb_error e = sb_check_ids(ids, count, SB_PKT_MONITOR);
+    sb_error e;
+    for (size_t k = 0; k < count; k++)
+        got[k] = false; /* none, if the round is refused or the link fails */
+    e = sb_check_ids(ids, count, SB_PKT_MONITOR);
     if (e.status == SB_OK)
         e = sb_sync_frame(SB_PKT_MONITOR, ids, 1, count, bus->tx, sizeof bus->tx, &len);
     if (e.status == SB_OK)

@@ -126,7 +126,10 @@ sb_error sb_loop_cycle(sb_loop *l, const int32_t *angles, const int16_t *velocit
 {
     sb_bus *bus = l->bus;
     size_t len = 0;
-    sb_error e = sb_stream_frame(&l->stream, angles, velocities, bus->tx, sizeof bus->tx - l->monitor_len, &len);
+    sb_error e;
+    for (size_t k = 0; k < l->stream.count; k++)
+        got[k] = false; /* none, if the setpoints are refused or the link fails */
+    e = sb_stream_frame(&l->stream, angles, velocities, bus->tx, sizeof bus->tx - l->monitor_len, &len);
     if (e.status != SB_OK)
         return e;
     if (l->cycles == 0)

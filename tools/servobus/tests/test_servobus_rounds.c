@@ -1,6 +1,7 @@
 /* servobus's rounds on a hostile line: a servo or a stray frame that
- * babbles cannot hold a Sync Monitor open past its schedule. The clock is
- * the line's, never the host's. */
+ * babbles cannot hold a Sync Monitor open past its schedule; what an early
+ * refusal leaves in got[]. The clock is the line's, never the host's. */
+#include <errno.h>
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -16,6 +17,7 @@ typedef struct babble {
     uint64_t now_us, next_us, every_us, stop_us;
     uint8_t frame[32];
     size_t len;
+    int read_rc; /* 1: reads as told above; else what every read returns */
 } babble;
 
 static babble line;
@@ -35,6 +37,8 @@ static int babble_read(void *ctx, uint8_t *buf, size_t cap, size_t want, uint32_
 {
     babble *b = (babble *)ctx;
     uint64_t ready = b->next_us + b->len * 10u;
+    if (b->read_rc != 1)
+        return b->read_rc;
     if (b->len == 0 || b->next_us >= b->stop_us || ready > b->now_us + wait_us || cap < b->len) {
         b->now_us += wait_us;
         return 0;
@@ -53,6 +57,7 @@ static uint64_t babble_now(void *ctx)
 static int set_up(void **state)
 {
     memset(&line, 0, sizeof line);
+    line.read_rc = 1;
     line.next_us = 100;
     line.every_us = 2000;
     line.stop_us = 1000000; /* a second of babble: far past any round */
@@ -105,11 +110,32 @@ static void a_misshapen_frame_of_another_servo_cannot_hold_a_round_open(void **s
     assert_true(!got[0] && !got[1]);
 }
 
+static void got_says_none_after_a_refusal_or_a_link_error(void **state)
+{
+    uint8_t twice[2] = {1, 1};
+    sb_loop l;
+    int32_t angles[2] = {0, 0};
+    got[0] = got[1] = true; /* as a round before left them */
+    assert_int_equal(sb_sync_monitor(&bus, twice, 2, states, got).status, SB_E_DUPLICATE_ID);
+    assert_true(!got[0] && !got[1]);
+    assert_int_equal(sb_loop_init(&l, &bus, two, 2, 10).status, SB_OK);
+    assert_int_equal(sb_loop_cycle(&l, angles, NULL, states, got).status, SB_E_NO_ANSWER);
+    got[0] = got[1] = true;
+    angles[0] = 1000; /* 100 deg in 10 ms: faster than the servo moves */
+    assert_int_equal(sb_loop_cycle(&l, angles, NULL, states, got).status, SB_E_RANGE);
+    assert_true(!got[0] && !got[1]);
+    got[0] = got[1] = true;
+    line.read_rc = -EIO;
+    assert_int_equal(sb_sync_monitor(&bus, two, 2, states, got).status, SB_E_LINK);
+    assert_true(!got[0] && !got[1]);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test_setup(a_servo_answering_again_and_again_cannot_hold_a_round_open, set_up),
         cmocka_unit_test_setup(a_misshapen_frame_of_another_servo_cannot_hold_a_round_open, set_up),
+        cmocka_unit_test_setup(got_says_none_after_a_refusal_or_a_link_error, set_up),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

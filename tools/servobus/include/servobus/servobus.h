@@ -156,7 +156,8 @@ sb_error sb_sync_command(sb_bus *bus, uint8_t cmd, const uint8_t *records, size_
  * times (such a slot + SB_SYNC_SILENCE_US). Answers come in the list's
  * order: an answer of ids[k] drops any taken of ids[k] or later (a
  * previous round's, late). An ID listed twice, or the broadcast ID, is
- * refused before anything is sent (sb_check_ids). */
+ * refused before anything is sent (sb_check_ids); got[] is all false after
+ * any error before the answers (a refusal, a link error). */
 sb_error sb_sync_monitor(sb_bus *bus, const uint8_t *ids, size_t count, sb_monitor_answer *states, bool *got);
 /* The same after a frame already sent (a robot loop's burst). */
 sb_error sb_sync_monitor_answers(sb_bus *bus, const uint8_t *ids, size_t count, sb_monitor_answer *states,
@@ -181,7 +182,9 @@ sb_error sb_stream_frame(sb_stream *s, const int32_t *angles, const int16_t *vel
 
 /* ---- the robot loop ----------------------------------------------------- */
 /* A cycle: one SyncCommand of setpoints and one Sync Monitor in one write,
- * then every servo's state. */
+ * then every servo's state (got[] all false if the setpoints are refused or
+ * the link fails). Called once per period_ms: the setpoints' speeds and
+ * time stamps count on it. */
 typedef struct sb_loop {
     sb_bus *bus;
     sb_stream stream;
