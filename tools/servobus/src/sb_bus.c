@@ -1,6 +1,7 @@
 /* The bus: answers matched to requests on the bus's clock (their frames
  * found by sb_parse.c); a microcontroller's UART as a transport. */
 #include <errno.h>
+#include <limits.h>
 #include <string.h>
 
 #include "servobus/servobus.h"
@@ -36,7 +37,7 @@ static sb_error link_error(int rc, uint8_t code)
     sb_error e = sb_ok();
     e.status = SB_E_LINK;
     e.packet = code;
-    e.os_error = -rc;
+    e.os_error = rc >= -INT_MAX ? -rc : EIO; /* INT_MIN has no errno (nor a negation) */
     return e;
 }
 
@@ -72,7 +73,7 @@ sb_error sb_send(sb_bus *bus, const uint8_t *frame, size_t len)
     }
     bus->pending_len = 0;
     bus->rx.len = bus->rx.seen = bus->rx.taken = bus->rx.inner_from = 0;
-    bus->sent_end_us = bus->t.now_us(bus->t.ctx) + wire_us(bus, len);
+    bus->sent_end_us = later(bus->t.now_us(bus->t.ctx), wire_us(bus, len));
     rc = link_write(bus, frame, len);
     return rc < 0 ? link_error(rc, len > 2 ? frame[2] : 0) : sb_ok();
 }
@@ -154,7 +155,7 @@ sb_error sb_request(sb_bus *bus, size_t len, uint8_t code, int servo, uint8_t *c
         e.servo = (int16_t)servo;
         return e;
     }
-    return receive(bus, code, servo, bus->t.now_us(bus->t.ctx) + bus->timeout_us, content, clen, 0, true);
+    return receive(bus, code, servo, later(bus->t.now_us(bus->t.ctx), bus->timeout_us), content, clen, 0, true);
 }
 
 /* The slot in the list an answer of id takes, or count (not asked for). */

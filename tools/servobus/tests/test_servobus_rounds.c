@@ -1,7 +1,9 @@
 /* servobus's rounds on a hostile line: a servo or a stray frame that
  * babbles cannot hold a Sync Monitor open past its schedule; what an early
- * refusal leaves in got[]. The clock is the line's, never the host's. */
+ * refusal leaves in got[]; the bus clock near its end; a transport's
+ * returns that have no errno. The clock is the line's, never the host's. */
 #include <errno.h>
+#include <limits.h>
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -130,12 +132,37 @@ static void got_says_none_after_a_refusal_or_a_link_error(void **state)
     assert_true(!got[0] && !got[1]);
 }
 
+static void a_transport_return_without_an_errno_is_a_link_error(void **state)
+{
+    sb_ping_request r = {1};
+    sb_ping_answer a;
+    line.read_rc = INT_MIN; /* its negation would overflow */
+    sb_error e = sb_call_ping(&bus, &r, &a);
+    assert_int_equal(e.status, SB_E_LINK);
+    assert_int_equal(e.os_error, EIO);
+}
+
+static void a_bus_clock_near_its_end_does_not_wrap_a_deadline(void **state)
+{
+    fake_bus fake;
+    sb_ping_request r = {1};
+    sb_ping_answer a;
+    fake_init(&fake, 1000000);
+    fake.present[1] = true;
+    sb_bus_init(&bus, fake_transport(&fake), 1000000);
+    fake.now_us = UINT64_MAX - 50000u; /* 50 ms before the clock's end: the 100 ms time-out passes it */
+    assert_int_equal(sb_call_ping(&bus, &r, &a).status, SB_OK);
+    assert_int_equal(a.id, 1);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test_setup(a_servo_answering_again_and_again_cannot_hold_a_round_open, set_up),
         cmocka_unit_test_setup(a_misshapen_frame_of_another_servo_cannot_hold_a_round_open, set_up),
         cmocka_unit_test_setup(got_says_none_after_a_refusal_or_a_link_error, set_up),
+        cmocka_unit_test_setup(a_transport_return_without_an_errno_is_a_link_error, set_up),
+        cmocka_unit_test_setup(a_bus_clock_near_its_end_does_not_wrap_a_deadline, set_up),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
