@@ -150,9 +150,13 @@ def _functions(p) -> str:
     enc = f"sb_encode_{n}({'r, ' if req else ''}bus->tx, sizeof bus->tx, &len)"
     if p.has("answers") and p.answer:
         who = "-1" if p.has("one_answers") else "r->id"
+        # An answer that names the item asked about (ReadData, WriteData) must name it: another is a late one.
+        item = len(p.request) > 1 and len(p.answer) > 1 and p.request[1].name == p.answer[1].name == "data_id"
+        call = (f"sb_request_item(bus, len, {code}, {who}, r->data_id, content, &len)" if item
+                else f"sb_request(bus, len, {code}, {who}, content, &len)")
         out.append(f"\nsb_error sb_call_{n}(sb_bus *bus, {arg + ', ' if arg else ''}sb_{n}_answer *a)\n{{\n"
                    f"    size_t len = 0;\n    uint8_t content[SB_ANSWER_CONTENT_MAX];\n    sb_error e = {enc};\n"
-                   f"    if (e.status == SB_OK)\n        e = sb_request(bus, len, {code}, {who}, content, &len);\n"
+                   f"    if (e.status == SB_OK)\n        e = {call};\n"
                    f"    return e.status == SB_OK ? sb_decode_{n}(content, len, a) : e;\n}}\n")
     elif not p.has("carries_records"):
         out.append(f"\nsb_error sb_send_{n}(sb_bus *bus{', ' + arg if arg else ''})\n{{\n    size_t len = 0;\n"

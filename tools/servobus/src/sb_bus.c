@@ -78,15 +78,17 @@ sb_error sb_send(sb_bus *bus, const uint8_t *frame, size_t len)
     return rc < 0 ? link_error(rc, len > 2 ? frame[2] : 0) : sb_ok();
 }
 
-/* sb_receive; the transport may wait for want_after bytes (0: this frame's);
- * look: once the deadline has passed, one last look at what came meanwhile
- * (else only the bytes held are searched). */
-static sb_error receive(sb_bus *bus, uint8_t code, int servo, uint64_t deadline_us, uint8_t *content, size_t *len,
-                        size_t want_after, bool look)
+/* sb_receive of an answer about item (its second byte; -1: any); the
+ * transport may wait for want_after bytes (0: this frame's); look: once the
+ * deadline has passed, one last look at what came meanwhile (else only the
+ * bytes held are searched). */
+static sb_error receive(sb_bus *bus, uint8_t code, int servo, int item, uint64_t deadline_us, uint8_t *content,
+                        size_t *len, size_t want_after, bool look)
 {
     uint32_t bad = bus->rx.bad_frames;
     sb_error e = sb_ok();
     bool looked = !look; /* the deadline passed: one last look at what came meanwhile */
+    int other = -1;      /* the item of an answer about another, skipped */
     for (;;) {
         for (;;) { /* every frame in what came and what the finder holds */
             size_t used = 0, clen = 0;
@@ -97,7 +99,10 @@ static sb_error receive(sb_bus *bus, uint8_t code, int servo, uint64_t deadline_
             bus->pending_len -= used;
             if (!got)
                 break;
-            if (fcode == code && (servo < 0 || (clen > 0 && fcontent[0] == servo))) {
+            if (fcode == code && (servo < 0 || (clen > 0 && fcontent[0] == servo)) && item >= 0 &&
+                (clen < 2 || fcontent[1] != item)) {
+                other = clen < 2 ? 256 : fcontent[1]; /* a late answer about another item: skipped */
+            } else if (fcode == code && (servo < 0 || (clen > 0 && fcontent[0] == servo))) {
                 bus->arrived_us = bus->t.now_us(bus->t.ctx);
                 if (clen > SB_ANSWER_CONTENT_MAX) {
                     e.status = SB_E_BAD_ANSWER;
@@ -126,6 +131,11 @@ static sb_error receive(sb_bus *bus, uint8_t code, int servo, uint64_t deadline_
                 e.status = bus->rx.bad_frames != bad ? SB_E_BAD_CHECKSUM : SB_E_NO_ANSWER;
                 e.servo = (int16_t)servo;
                 e.packet = code;
+                if (other >= 0) { /* only answers about another item came */
+                    e = sb_error_of(SB_E_BAD_ANSWER, servo, code, "data_id");
+                    e.value = other;
+                    e.least = e.most = item;
+                }
                 return e;
             }
             /* want_after: the bytes of every frame still to come, from this one's first. */
@@ -143,10 +153,15 @@ static sb_error receive(sb_bus *bus, uint8_t code, int servo, uint64_t deadline_
 
 sb_error sb_receive(sb_bus *bus, uint8_t code, int servo, uint64_t deadline_us, uint8_t *content, size_t *len)
 {
-    return receive(bus, code, servo, deadline_us, content, len, 0, true);
+    return receive(bus, code, servo, -1, deadline_us, content, len, 0, true);
 }
 
 sb_error sb_request(sb_bus *bus, size_t len, uint8_t code, int servo, uint8_t *content, size_t *clen)
+{
+    return sb_request_item(bus, len, code, servo, -1, content, clen);
+}
+
+sb_error sb_request_item(sb_bus *bus, size_t len, uint8_t code, int servo, int item, uint8_t *content, size_t *clen)
 {
     sb_error e = servo == SB_BROADCAST_ID ? sb_error_of(SB_E_BROADCAST, servo, code, "id") : sb_ok();
     if (e.status == SB_OK)
@@ -155,7 +170,8 @@ sb_error sb_request(sb_bus *bus, size_t len, uint8_t code, int servo, uint8_t *c
         e.servo = (int16_t)servo;
         return e;
     }
-    return receive(bus, code, servo, later(bus->t.now_us(bus->t.ctx), bus->timeout_us), content, clen, 0, true);
+    return receive(bus, code, servo, item, later(bus->t.now_us(bus->t.ctx), bus->timeout_us), content, clen, 0,
+                   true);
 }
 
 /* The slot in the list an answer of id takes, or count (not asked for). */
@@ -192,7 +208,7 @@ sb_error sb_sync_monitor_answers(sb_bus *bus, const uint8_t *ids, size_t count, 
         sb_monitor_answer a;
         uint64_t deadline = later(last, silent * SB_SYNC_SILENCE_US + slot);
         deadline = deadline < end ? deadline : end;
-        e = receive(bus, SB_PKT_MONITOR, -1, deadline, content, &len, left * answer, !over);
+        e = receive(bus, SB_PKT_MONITOR, -1, -1, deadline, content, &len, left * answer, !over);
         over = over || bus->t.now_us(bus->t.ctx) >= end;
         if ((e.status == SB_E_NO_ANSWER || e.status == SB_E_BAD_CHECKSUM) && (next >= count || deadline == end))
             break;

@@ -1,7 +1,7 @@
 /* servobus's rounds on a hostile line: a servo or a stray frame that
  * babbles cannot hold a Sync Monitor open past its schedule; what an early
- * refusal leaves in got[]; the bus clock near its end; a transport's
- * returns that have no errno. The clock is the line's, never the host's. */
+ * refusal leaves in got[]; a late answer about another item; the bus clock
+ * near its end; a transport's returns that have no errno. The clock is the line's, never the host's. */
 #include <errno.h>
 #include <limits.h>
 #include <setjmp.h>
@@ -142,6 +142,22 @@ static void a_transport_return_without_an_errno_is_a_link_error(void **state)
     assert_int_equal(e.os_error, EIO);
 }
 
+/* The answer of a ReadData about item 8 before (late), to one about item 1. */
+static void an_answer_about_another_item_is_not_taken_for_this_one(void **state)
+{
+    sb_read_data_request r = {1, 1};
+    sb_read_data_answer a;
+    sb_value v[3] = {{1, NULL, 0}, {8, NULL, 0}, {0x12345678, NULL, 0}};
+    assert_int_equal(sb_encode_answer(SB_PKT_READ_DATA, v, 3, line.frame, sizeof line.frame, &line.len).status, SB_OK);
+    line.stop_us = line.next_us + 1u; /* once */
+    sb_error e = sb_call_read_data(&bus, &r, &a);
+    assert_int_equal(e.status, SB_E_BAD_ANSWER);
+    assert_string_equal(e.field, "data_id");
+    assert_int_equal(e.value, 8);
+    assert_int_equal(e.least, 1);
+    assert_int_equal(e.most, 1);
+}
+
 static void a_bus_clock_near_its_end_does_not_wrap_a_deadline(void **state)
 {
     fake_bus fake;
@@ -162,6 +178,7 @@ int main(void)
         cmocka_unit_test_setup(a_misshapen_frame_of_another_servo_cannot_hold_a_round_open, set_up),
         cmocka_unit_test_setup(got_says_none_after_a_refusal_or_a_link_error, set_up),
         cmocka_unit_test_setup(a_transport_return_without_an_errno_is_a_link_error, set_up),
+        cmocka_unit_test_setup(an_answer_about_another_item_is_not_taken_for_this_one, set_up),
         cmocka_unit_test_setup(a_bus_clock_near_its_end_does_not_wrap_a_deadline, set_up),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -135,6 +135,10 @@ sb_error sb_send(sb_bus *bus, const uint8_t *frame, size_t len);
 sb_error sb_receive(sb_bus *bus, uint8_t code, int servo, uint64_t deadline_us, uint8_t *content, size_t *len);
 /* sb_send the frame in bus->tx (len bytes), then sb_receive within timeout_us. */
 sb_error sb_request(sb_bus *bus, size_t len, uint8_t code, int servo, uint8_t *content, size_t *clen);
+/* The same for an answer about item (its content's second byte: ReadData's
+ * and WriteData's data_id); answers about another are skipped, and if only
+ * they came, SB_E_BAD_ANSWER on "data_id" (value: theirs, least = most: item). */
+sb_error sb_request_item(sb_bus *bus, size_t len, uint8_t code, int servo, int item, uint8_t *content, size_t *clen);
 /* The bytes of a packet's answer frame (its fields fixed), or 0. */
 size_t sb_answer_frame_size(uint8_t code);
 
