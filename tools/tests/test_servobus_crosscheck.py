@@ -70,6 +70,8 @@ def refused(p, part: str, values: list):
     named = dict(zip((f.name for f in p.request), values))
     if p.has("addressed") and not p.has("broadcast") and values[0] == S.frame["broadcast_id"]:
         return SB_E_BROADCAST, p.request[0].name
+    if "data_id" in named and named["data_id"] not in {item.id for item in registers.ITEMS}:
+        return SB_E_UNKNOWN_ITEM, "data_id"  # an item the schema does not have: ReadData refused as WriteData
     if "interval" in named:  # a move's time shorter than its ramps (8 and 13 ramp 20 ms): servoctl refuses it too
         try:
             check_profile(named.get("acc_interval", MIN_RAMP_MS), named.get("dec_interval", MIN_RAMP_MS),

@@ -162,6 +162,11 @@ static sb_error encode_fields(const sb_packet_desc *p, bool request, const sb_va
         }
         if (number && (v[k].n < least || v[k].n > most))
             return out_of_range(servo, p->code, f[k].name, v[k].n, least, most);
+        if (request && strcmp(f[k].name, "data_id") == 0 && sb_item((uint8_t)v[k].n) == NULL) {
+            sb_error e = fail(SB_E_UNKNOWN_ITEM, servo, p->code, f[k].name); /* ReadData's, WriteData's */
+            e.value = v[k].n;
+            return e;
+        }
         if (at + size > cap)
             return fail(SB_E_SPACE, servo, p->code, f[k].name);
         if (number)

@@ -66,6 +66,14 @@ static void write_data_takes_the_items_size_and_range(void **state)
     assert_int_equal(sb_encode_write_data(&r, f, sizeof f, &len).status, SB_E_UNKNOWN_ITEM);
     r.data_id = 1; /* read-only */
     assert_int_equal(sb_encode_write_data(&r, f, sizeof f, &len).status, SB_E_UNKNOWN_ITEM);
+    sb_read_data_request q = {1, 200};
+    assert_null(sb_item(200)); /* no item of the schema: ReadData refused as WriteData is */
+    sb_error e = sb_encode_read_data(&q, f, sizeof f, &len);
+    assert_int_equal(e.status, SB_E_UNKNOWN_ITEM);
+    assert_string_equal(e.field, "data_id");
+    assert_int_equal(e.value, 200);
+    q.data_id = 35; /* reserved: the servo answers it without a value */
+    assert_int_equal(sb_encode_read_data(&q, f, sizeof f, &len).status, SB_OK);
 }
 
 static void answers_are_checked(void **state)
