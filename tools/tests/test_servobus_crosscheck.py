@@ -62,6 +62,13 @@ def edge_cases(fields) -> list:
     return cases
 
 
+def record(cmd: int, k: int) -> bytes:
+    """A SyncCommand's record k that C checks as a request: each servo
+    once, none the broadcast ID, every value within its field's range."""
+    values = (k * 7) % 255, (k * 37) % 1800 - 900, k - 15, 20 * k
+    return struct.pack(S.request_format(cmd), *values[:len(S.packet(cmd).request)])
+
+
 def refused(p, part: str, values: list):
     """(status, field) where the C library refuses a request within every
     field's range, as the servo would not carry it out as sent; else None."""
@@ -170,7 +177,7 @@ def test_blocks_and_sync_commands():
         lines.append(f"req 82 5 4096 {word(chunk)} {zlib.crc32(chunk)}")
         frames.append(codec.request_frame(codec.CODES["UPDATE_WRITE"], content))
     for cmd, rlen, count in ((22, 1, 16), (0x45, 9, 6), (0x45, 9, 30)):
-        records = bytes((k * 7) % 256 for k in range(rlen * count))
+        records = b"".join(record(cmd, k) for k in range(count))
         lines.append(f"req 25 {cmd} {rlen} {count} {word(records)}")
         frames.append(codec.request_frame(codec.CODES["SYNC"], bytes([cmd, rlen, count]) + records))
     got = c_side(lines + [f"dreq {f.hex()}" for f in frames])
@@ -205,7 +212,7 @@ def test_the_extended_length_begins_at_255_content_bytes():
     to 254, the extended from 255 (0xFF is its mark), as servoctl's."""
     lines, frames = [], []
     for count in (251, 252, 253):
-        records = bytes((k * 7) % 256 for k in range(count))
+        records = bytes((k * 7) % 255 for k in range(count))  # each servo once, none the broadcast ID
         lines.append(f"req 25 22 1 {count} {word(records)}")
         frames.append(codec.request_frame(codec.CODES["SYNC"], bytes([22, 1, count]) + records))
     got = c_side(lines + [f"dreq {f.hex()}" for f in frames])

@@ -37,18 +37,44 @@ static sb_error ramps_held(const sb_packet_desc *p, const ramp_rule *r, const sb
     return e;
 }
 
-/* A SyncCommand: records of a syncable packet at its length, as many as it says. */
+#define RECORD_FIELDS 8u /* the most fields a syncable packet has */
+
+/* Each record as its packet's request: its fields' ranges, the rules
+ * across them, its servo's ID a servo's and no other record's. */
+static sb_error records_hold(const sb_packet_desc *cmd, const sb_value *v)
+{
+    bool listed[256] = {false};
+    sb_value r[RECORD_FIELDS];
+    for (size_t k = 0; k < (size_t)v[2].n; k++) {
+        sb_error e = sb_decode_request(cmd->code, v[3].bytes + k * (size_t)v[1].n, (size_t)v[1].n, r,
+                                       cmd->request_count);
+        if (e.status == SB_E_USAGE && e.least < e.most) /* a value beyond its field's range */
+            e.status = SB_E_RANGE;
+        if (e.status == SB_OK)
+            e = sb_check_request(cmd->code, r, cmd->request_count);
+        if (e.status == SB_OK && (cmd->flags & SB_PF_ADDRESSED) && (r[0].n > SB_MAX_ID || listed[r[0].n]))
+            e = sb_error_of(r[0].n > SB_MAX_ID ? SB_E_BROADCAST : SB_E_DUPLICATE_ID, (int)r[0].n, cmd->code,
+                            cmd->request[0].name);
+        if (e.status != SB_OK)
+            return e;
+        listed[r[0].n] = true;
+    }
+    return sb_ok();
+}
+
+/* A SyncCommand: records of a syncable packet at its length, as many as it says, each one that holds. */
 static sb_error records_fit(const sb_value *v)
 {
     const sb_packet_desc *cmd = sb_packet((uint8_t)v[0].n);
     const char *wrong = NULL;
-    if (cmd == NULL || !(cmd->flags & SB_PF_SYNCABLE) || v[1].n != cmd->length_min || v[1].n != cmd->length_max)
+    if (cmd == NULL || !(cmd->flags & SB_PF_SYNCABLE) || v[1].n != cmd->length_min || v[1].n != cmd->length_max ||
+        cmd->request_count > RECORD_FIELDS)
         wrong = "cmd";
     else if (v[2].n == 0)
         wrong = "count";
-    else if (v[3].len != (size_t)v[1].n * (size_t)v[2].n)
+    else if (v[3].len != (size_t)v[1].n * (size_t)v[2].n || v[3].bytes == NULL)
         wrong = "records";
-    return wrong != NULL ? sb_error_of(SB_E_USAGE, -1, SB_PKT_SYNC_COMMAND, wrong) : sb_ok();
+    return wrong != NULL ? sb_error_of(SB_E_USAGE, -1, SB_PKT_SYNC_COMMAND, wrong) : records_hold(cmd, v);
 }
 
 sb_error sb_check_request(uint8_t code, const sb_value *v, size_t count)

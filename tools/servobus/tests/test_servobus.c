@@ -201,6 +201,35 @@ static void the_typed_sync_command_checks_what_sb_sync_frame_checks(void **state
     assert_string_equal(e.field, "records");
 }
 
+/* Each record is checked as its packet's request would be. */
+static void a_sync_command_s_records_are_checked_as_requests(void **state)
+{
+    /* MoveOnAngleMode: servo 1 to 180.0 deg in 100 ms, servo 2 to 0 in 100 ms */
+    uint8_t m[14] = {1, 0x08, 0x07, 100, 0, 0, 0, 2, 0, 0, 100, 0, 0, 0}, f[64];
+    size_t len = 0;
+    assert_int_equal(sb_sync_frame(SB_PKT_MOVE_ANGLE, m, 7, 2, f, sizeof f, &len).status, SB_OK);
+    m[1] = 0xB8; /* 300.0 deg: beyond the angle's range */
+    m[2] = 0x0B;
+    sb_error e = sb_sync_frame(SB_PKT_MOVE_ANGLE, m, 7, 2, f, sizeof f, &len);
+    assert_int_equal(e.status, SB_E_RANGE);
+    assert_int_equal(e.servo, 1);
+    assert_int_equal(e.value, 3000);
+    m[1] = m[2] = 0;
+    m[10] = 0; /* servo 2's move in 0 ms: shorter than its ramps */
+    e = sb_sync_frame(SB_PKT_MOVE_ANGLE, m, 7, 2, f, sizeof f, &len);
+    assert_int_equal(e.status, SB_E_RANGE);
+    assert_int_equal(e.servo, 2);
+    m[10] = 100;
+    m[7] = 1; /* servo 1 twice */
+    e = sb_sync_frame(SB_PKT_MOVE_ANGLE, m, 7, 2, f, sizeof f, &len);
+    assert_int_equal(e.status, SB_E_DUPLICATE_ID);
+    assert_int_equal(e.servo, 1);
+    m[7] = SB_BROADCAST_ID;
+    assert_int_equal(sb_sync_frame(SB_PKT_MOVE_ANGLE, m, 7, 2, f, sizeof f, &len).status, SB_E_BROADCAST);
+    uint8_t ids[3] = {1, 1, SB_BROADCAST_ID};
+    assert_int_equal(sb_sync_frame(SB_PKT_MONITOR, ids, 1, 3, f, sizeof f, &len).status, SB_E_DUPLICATE_ID);
+}
+
 static void every_item_decodes_at_its_size_and_signedness(void **state)
 {
     uint8_t c[2 + 4] = {1, SB_ITEM_SERIAL_NUMBER, 0xFF, 0xFF, 0xFF, 0xFF};
@@ -263,6 +292,8 @@ static void a_long_sync_command_takes_the_extended_length(void **state)
     uint8_t records[30 * 9], f[300];
     size_t len = 0;
     memset(records, 0, sizeof records);
+    for (size_t k = 0; k < 30; k++)
+        records[k * 9] = (uint8_t)k; /* servos 0 to 29 */
     assert_int_equal(sb_sync_frame(SB_PKT_STREAM_SETPOINT, records, 9, 30, f, sizeof f, &len).status, SB_OK);
     assert_int_equal(len, 6 + 3 + 270 + 1);
     assert_int_equal(f[3], 0xFF);
@@ -296,6 +327,7 @@ int main(void)
         cmocka_unit_test(the_wire_limit_is_servoctls),
         cmocka_unit_test(the_frame_finder_rescans_after_a_false_header),
         cmocka_unit_test(the_typed_sync_command_checks_what_sb_sync_frame_checks),
+        cmocka_unit_test(a_sync_command_s_records_are_checked_as_requests),
         cmocka_unit_test(every_item_decodes_at_its_size_and_signedness),
         cmocka_unit_test(a_profile_the_servo_would_stretch_is_refused),
     };
