@@ -77,11 +77,33 @@ static sb_error records_fit(const sb_value *v)
     return wrong != NULL ? sb_error_of(SB_E_USAGE, -1, SB_PKT_SYNC_COMMAND, wrong) : records_hold(cmd, v);
 }
 
+/* Each number within its field's range (an item's value is the encoder's to check). */
+static sb_error ranges_held(const sb_packet_desc *p, const sb_value *v)
+{
+    for (size_t k = 0; k < p->request_count; k++) {
+        const sb_field_desc *f = &p->request[k];
+        bool number = f->type != SB_ITEM && f->type != SB_USER_AREA && f->type != SB_BYTES;
+        if (number && (v[k].n < f->min || v[k].n > f->max)) {
+            bool named = (p->flags & SB_PF_ADDRESSED) && k > 0; /* its ID within its own range */
+            sb_error e = sb_error_of(SB_E_RANGE, named ? (int)v[0].n : -1, p->code, f->name);
+            e.value = v[k].n;
+            e.least = f->min;
+            e.most = f->max;
+            return e;
+        }
+    }
+    return sb_ok();
+}
+
 sb_error sb_check_request(uint8_t code, const sb_value *v, size_t count)
 {
     const sb_packet_desc *p = sb_packet(code);
+    sb_error e;
     if (p == NULL || count != p->request_count)
         return sb_error_of(p == NULL ? SB_E_UNKNOWN_PACKET : SB_E_USAGE, -1, code, NULL);
+    e = ranges_held(p, v); /* first: the rules' sums stay within int64_t */
+    if (e.status != SB_OK)
+        return e;
     if (code == SB_PKT_SYNC_COMMAND)
         return records_fit(v);
     for (size_t k = 0; k < sizeof RAMP_RULES / sizeof RAMP_RULES[0]; k++)

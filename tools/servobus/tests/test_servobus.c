@@ -201,6 +201,21 @@ static void the_typed_sync_command_checks_what_sb_sync_frame_checks(void **state
     assert_string_equal(e.field, "records");
 }
 
+/* sb_check_request checks the fields' ranges before the rules that add them up. */
+static void the_rules_check_the_ranges_first(void **state)
+{
+    sb_value v[6];
+    memset(v, 0, sizeof v);
+    v[0].n = 1;
+    v[3].n = INT64_MAX; /* acc_interval: acc + dec would overflow */
+    v[4].n = 1;
+    sb_error e = sb_check_request(SB_PKT_MOVE_ANGLE_BY_INTERVAL, v, 6);
+    assert_int_equal(e.status, SB_E_RANGE);
+    assert_int_equal(e.servo, 1);
+    assert_string_equal(e.field, sb_packet(SB_PKT_MOVE_ANGLE_BY_INTERVAL)->request[3].name);
+    assert_true(e.value == INT64_MAX);
+}
+
 /* Each record is checked as its packet's request would be. */
 static void a_sync_command_s_records_are_checked_as_requests(void **state)
 {
@@ -328,6 +343,7 @@ int main(void)
         cmocka_unit_test(the_frame_finder_rescans_after_a_false_header),
         cmocka_unit_test(the_typed_sync_command_checks_what_sb_sync_frame_checks),
         cmocka_unit_test(a_sync_command_s_records_are_checked_as_requests),
+        cmocka_unit_test(the_rules_check_the_ranges_first),
         cmocka_unit_test(every_item_decodes_at_its_size_and_signedness),
         cmocka_unit_test(a_profile_the_servo_would_stretch_is_refused),
     };

@@ -68,13 +68,14 @@ const sb_item_desc *sb_item(uint8_t id);       /* NULL: not in the schema */
  * range; a request's length against the packet's. */
 sb_error sb_encode_content(uint8_t code, const sb_value *v, size_t count, uint8_t *out, size_t cap, size_t *len);
 sb_error sb_encode_request(uint8_t code, const sb_value *v, size_t count, uint8_t *frame, size_t cap, size_t *len);
-/* The rules across a request's fields: a move's time shorter than its
- * ramps (the servo would stretch it: SB_E_RANGE); a SyncCommand's records
+/* A request's fields' ranges (each number's: SB_E_RANGE; an item's value
+ * is the encoders'), then the rules across them: a move's time shorter
+ * than its ramps (the servo would stretch it: SB_E_RANGE); a SyncCommand's records
  * not of a syncable packet at its length, or not as many as it says
  * (SB_E_USAGE), and each record checked as its packet's request (its
  * fields' ranges: SB_E_RANGE; these rules; its servo's ID: SB_E_BROADCAST
  * for 255, SB_E_DUPLICATE_ID for one listed twice). The encoders above
- * apply it after each field's range. */
+ * apply it. */
 sb_error sb_check_request(uint8_t code, const sb_value *v, size_t count);
 /* An answer's frame (a servo's side: the tests' fake servos, cross-checks). */
 sb_error sb_encode_answer(uint8_t code, const sb_value *v, size_t count, uint8_t *frame, size_t cap, size_t *len);
