@@ -132,8 +132,12 @@ static sb_error encode_fields(const sb_packet_desc *p, bool request, const sb_va
     size_t fields = request ? p->request_count : p->answer_count;
     int servo = servo_of(p, v, count);
     size_t at = 0;
-    if (count != fields)
-        return fail(SB_E_USAGE, servo, p->code, NULL);
+    if (count != fields) { /* "fields: 3, not 4" */
+        sb_error e = fail(SB_E_USAGE, servo, p->code, "fields");
+        e.value = (int64_t)count;
+        e.least = e.most = (int64_t)fields;
+        return e;
+    }
     /* A servo takes a packet sent to the broadcast ID only if it is a broadcast one (and then never answers). */
     if (request && servo == SB_BROADCAST_ID && !(p->flags & SB_PF_BROADCAST))
         return fail(SB_E_BROADCAST, servo, p->code, f[0].name);
@@ -175,8 +179,13 @@ static sb_error encode_fields(const sb_packet_desc *p, bool request, const sb_va
             memcpy(out + at, v[k].bytes, size);
         at += size;
     }
-    if (request && (at < p->length_min || (p->length_max != 0xFFFFu && at > p->length_max)))
-        return fail(SB_E_USAGE, servo, p->code, NULL);
+    if (request && (at < p->length_min || (p->length_max != 0xFFFFu && at > p->length_max))) {
+        sb_error e = fail(SB_E_USAGE, servo, p->code, "length"); /* the content's bytes */
+        e.value = (int64_t)at;
+        e.least = p->length_min;
+        e.most = p->length_max;
+        return e;
+    }
     if (request) {
         sb_error e = sb_check_request(p->code, v, count);
         if (e.status != SB_OK)

@@ -66,15 +66,24 @@ static sb_error records_hold(const sb_packet_desc *cmd, const sb_value *v)
 static sb_error records_fit(const sb_value *v)
 {
     const sb_packet_desc *cmd = sb_packet((uint8_t)v[0].n);
-    const char *wrong = NULL;
-    if (cmd == NULL || !(cmd->flags & SB_PF_SYNCABLE) || v[1].n != cmd->length_min || v[1].n != cmd->length_max ||
-        cmd->request_count > RECORD_FIELDS)
-        wrong = "cmd";
-    else if (v[2].n == 0)
-        wrong = "count";
-    else if (v[3].len != (size_t)v[1].n * (size_t)v[2].n || v[3].bytes == NULL)
-        wrong = "records";
-    return wrong != NULL ? sb_error_of(SB_E_USAGE, -1, SB_PKT_SYNC_COMMAND, wrong) : records_hold(cmd, v);
+    sb_error e = sb_error_of(SB_E_USAGE, -1, SB_PKT_SYNC_COMMAND, NULL);
+    if (cmd == NULL || !(cmd->flags & SB_PF_SYNCABLE) || cmd->length_min != cmd->length_max ||
+        cmd->request_count > RECORD_FIELDS) {
+        e.field = "cmd";
+    } else if (v[1].n != cmd->length_min) { /* "record_len: 2, not 1" */
+        e.field = "record_len";
+        e.value = v[1].n;
+        e.least = e.most = cmd->length_min;
+    } else if (v[2].n == 0) {
+        e.field = "count";
+        e.least = 1;
+        e.most = 255;
+    } else if (v[3].len != (size_t)v[1].n * (size_t)v[2].n || v[3].bytes == NULL) {
+        e.field = "records"; /* "records: 4, not 3" (bytes) */
+        e.value = (int64_t)v[3].len;
+        e.least = e.most = v[1].n * v[2].n;
+    }
+    return e.field != NULL ? e : records_hold(cmd, v);
 }
 
 /* Each number within its field's range (an item's value is the encoder's to check). */

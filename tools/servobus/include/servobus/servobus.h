@@ -52,8 +52,14 @@ sb_error sb_error_of(sb_status status, int servo, uint8_t packet, const char *fi
 /* A transport from its parts (sb_transport's fields). */
 sb_transport sb_transport_make(void *ctx, int (*write)(void *, const uint8_t *, size_t),
                                int (*read)(void *, uint8_t *, size_t, size_t, uint32_t), uint64_t (*now_us)(void *));
-/* The error in words, NUL-terminated in buf: "servo 3: ReadAngle: no answer
- * within 100000 us". Returns the length written (cut to cap - 1). */
+/* The error in words, NUL-terminated in buf: the servo, the packet, the
+ * field, what went wrong and the value and range it carries, e.g.
+ * "servo 3: MoveOnAngleMode: angle out of range: 1801 is beyond
+ * -1800..1800; nothing was sent", "StreamSetpoint: ids not allowed: 33
+ * servos is beyond 1..32 (SB_MAX_SERVOS)", "servo 3: ReadAngle: no answer
+ * in time (is it on the bus, ...)", "servo 3: Ping: the link failed (errno
+ * 5: Input/output error)" (the errno's name on a POSIX host). Returns the
+ * length written (cut to cap - 1). */
 size_t sb_error_text(const sb_error *e, char *buf, size_t cap);
 /* The IDs a round lists (code: its packet, for the error): each a servo's,
  * once (SB_E_BROADCAST, SB_E_DUPLICATE_ID naming it). */
