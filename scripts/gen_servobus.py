@@ -52,8 +52,10 @@ def _m(f) -> str:
     return f.name + "_" if f.name in KEYWORDS else f.name
 
 
-def _members(fields) -> str:
+def _members(fields, request: bool = False) -> str:
     out = []
+    # A request's item size is not read (the encoder takes the item's); an answer's says what came.
+    size = "not read: the value goes at its item's size" if request else "its bytes (the item's size; 0: none)"
     for f in fields:
         f = dataclasses.replace(f, name=_m(f))
         if f.type == "user_area":
@@ -62,7 +64,7 @@ def _members(fields) -> str:
             out.append(f"    const uint8_t *{f.name}; /* {f.what} */\n    size_t {f.name}_len;\n")
         elif f.type == "item":
             out.append(f"    int64_t {f.name}; /* {f.what} */\n"
-                       f"    uint8_t {f.name}_size; /* its bytes (the item's size; 0: none) */\n")
+                       f"    uint8_t {f.name}_size; /* {size} */\n")
         else:
             unit = f" ({f.unit})" if f.unit else ""
             out.append(f"    {C_TYPES[f.type]} {f.name}; /* {f.what}{unit} */\n")
@@ -84,7 +86,7 @@ def servobus_h(s) -> str:
         n = _name(p)
         decls.append(f"\n/* {p.code:#04x} {p.name}: {p.what.strip()[:90]} */\n")
         if p.request:
-            decls.append(f"typedef struct sb_{n}_request {{\n{_members(p.request)}}} sb_{n}_request;\n")
+            decls.append(f"typedef struct sb_{n}_request {{\n{_members(p.request, True)}}} sb_{n}_request;\n")
         if p.answer:
             decls.append(f"typedef struct sb_{n}_answer {{\n{_members(p.answer)}}} sb_{n}_answer;\n")
         req = f"const sb_{n}_request *r, " if p.request else ""
