@@ -72,7 +72,7 @@ sb_error sb_send(sb_bus *bus, const uint8_t *frame, size_t len)
             break;
     }
     bus->pending_len = 0;
-    bus->rx.len = bus->rx.seen = bus->rx.taken = bus->rx.inner_from = 0;
+    sb_parser_clear(&bus->rx);
     bus->sent_end_us = later(bus->t.now_us(bus->t.ctx), wire_us(bus, len));
     rc = link_write(bus, frame, len);
     return rc < 0 ? link_error(rc, len > 2 ? frame[2] : 0) : sb_ok();

@@ -15,14 +15,15 @@ void sb_parser_init(sb_parser *p, bool requests)
 /* The frame finder holds buf[0..len), seen of them examined, and starts at
  * a header (or holds nothing). Any header in the examined bytes begins a
  * candidate frame. A frame is returned the moment its last byte is
- * examined with a good checksum, the earliest-starting first. A frame that
- * ends inside the unfinished candidate at the start is handed back and the
- * candidate kept: it may be noise that looked like a header or an answer
- * cut short, or a whole answer whose content holds a frame of its own (a
- * Monitor answer at 7173 mV holds 05 1c 03 00 24); it is returned too if it
- * ends with a good checksum. A candidate at the start that fails (a bad
- * checksum, too long to be a frame) costs only its first byte: the search
- * goes on from the next. */
+ * examined with a good checksum, whichever frames it overlaps: the one at
+ * the start, else the earliest-starting that ends there. Nothing is dropped
+ * for it but what can begin no frame any more: a frame inside another
+ * (noise that looked like a header, an answer cut short, or a whole answer
+ * whose content holds a frame of its own: a Monitor answer at 7173 mV holds
+ * 05 1c 03 00 24) and a frame that begins inside one returned (noise that
+ * made a good checksum with an answer's first bytes) are found too. A
+ * candidate at the start that fails (a bad checksum, too long to be a
+ * frame) costs only its first byte: the search goes on from the next. */
 
 /* The size of the candidate at `at` once its head is examined, else 0. */
 static size_t size_at(const sb_parser *p, size_t at)
@@ -52,12 +53,14 @@ static void drop(sb_parser *p, size_t n)
     memmove(p->buf, p->buf + n, p->len - n);
     p->len -= n;
     p->seen -= n;
-    p->inner_from = p->inner_from > n ? p->inner_from - n : 0;
+    p->owned = p->owned > n ? p->owned - n : 0;
+    p->tie_from = p->tie_from > n ? p->tie_from - n : 0;
 }
 
 /* Drops examined bytes until the start is a header whose frame may still
  * end there (not too long, its end not passed: a candidate inside that
- * failed). stray: count them (not the rest of a frame that failed). */
+ * failed). stray: count them (not the rest of a frame that failed, nor a
+ * frame's returned). */
 static void settle(sb_parser *p, bool stray)
 {
     while (p->seen > 0) {
@@ -65,9 +68,20 @@ static void settle(sb_parser *p, bool stray)
         size_t size = header ? size_at(p, 0) : 0;
         if (header && (size == 0 || (size <= SB_RX_MAX && size >= p->seen)))
             return;
-        p->stray_bytes += stray ? 1u : 0u;
+        p->stray_bytes += stray && p->owned == 0 ? 1u : 0u;
         drop(p, 1);
     }
+}
+
+/* A frame that ends at the byte examined last and starts at from or after it. */
+static bool ends_inside(const sb_parser *p, size_t from, size_t *start)
+{
+    for (size_t at = from; at + 5u <= p->seen; at++)
+        if (header_at(p, at) && size_at(p, at) == p->seen - at && checksum_ok(p, at, p->seen - at)) {
+            *start = at;
+            return true;
+        }
+    return false;
 }
 
 /* After the byte at seen - 1 is examined: true when a frame ends there,
@@ -84,20 +98,26 @@ static bool frame_ends(sb_parser *p, size_t *start)
             break;
         if (checksum_ok(p, 0, p->seen))
             return true;
-        p->bad_frames++;
-        drop(p, p->inner_from > 1 ? p->inner_from : 1); /* and the frames handed back inside it */
+        p->bad_frames += p->owned == 0 ? 1u : 0u; /* not a header inside a frame returned */
+        drop(p, 1);
         stray = false;
     }
     /* A frame that ends here, begun inside the unfinished one at the start
-     * (after the last such frame handed back): handed back at `at`, the
-     * one at the start kept. */
-    for (size_t at = p->inner_from > 1 ? p->inner_from : 1; at + 5u <= p->seen; at++)
-        if (header_at(p, at) && size_at(p, at) == p->seen - at && checksum_ok(p, at, p->seen - at)) {
-            p->inner_from = p->seen;
-            *start = at;
-            return true;
-        }
-    return false;
+     * (inside a frame returned before, too: which of two frames that
+     * overlap is the answer, the caller tells): returned, the one at the
+     * start kept. */
+    return ends_inside(p, 1, start);
+}
+
+/* Another frame that ends at the byte the one returned last ended at (two
+ * overlapping frames, noise and an answer, may end at one byte). */
+static bool another(sb_parser *p, size_t *start)
+{
+    *start = 0;
+    if (p->tie_from == 0 && p->seen >= 5 && header_at(p, 0) && size_at(p, 0) == p->seen &&
+        checksum_ok(p, 0, p->seen))
+        return true;
+    return ends_inside(p, p->tie_from > 1 ? p->tie_from : 1, start);
 }
 
 size_t sb_parser_missing(const sb_parser *p)
@@ -108,12 +128,37 @@ size_t sb_parser_missing(const sb_parser *p)
     return size > held ? size - held : 1u;
 }
 
+void sb_parser_clear(sb_parser *p)
+{
+    p->len = p->seen = p->taken = p->owned = p->tie_from = 0;
+    p->tie = false;
+}
+
+/* The frame at `at`, ending at the byte examined last, handed back. */
+static int hand(sb_parser *p, size_t at, uint8_t *code, const uint8_t **content, size_t *clen)
+{
+    size_t head = p->buf[at + 3] == SB_EXTENDED_LENGTH ? 6u : 4u;
+    p->taken = at == 0 ? 1u : 0u;
+    p->owned = at == 0 ? p->seen : p->owned;
+    p->tie = true;
+    p->tie_from = at + 1u;
+    *code = p->buf[at + 2];
+    *content = p->buf + at + head;
+    *clen = p->seen - at - head - 1u;
+    return 1;
+}
+
 int sb_parse(sb_parser *p, const uint8_t *data, size_t len, size_t *used, uint8_t *code, const uint8_t **content,
              size_t *clen)
 {
     size_t k = 0, at = 0;
-    drop(p, p->taken); /* the frame returned last time (none if it lay inside another) */
+    drop(p, p->taken); /* the first byte of the frame returned last at the start */
     p->taken = 0;
+    settle(p, true); /* and of its bytes, what can begin no frame any more */
+    *used = 0;
+    if (p->tie && another(p, &at))
+        return hand(p, at, code, content, clen);
+    p->tie = false;
     for (;;) {
         if (p->seen == p->len) { /* the held bytes examined: take the next (a live start leaves room) */
             if (k == len)
@@ -122,13 +167,8 @@ int sb_parse(sb_parser *p, const uint8_t *data, size_t len, size_t *used, uint8_
         }
         p->seen++;
         if (frame_ends(p, &at)) {
-            size_t head = p->buf[at + 3] == SB_EXTENDED_LENGTH ? 6u : 4u;
-            p->taken = at == 0 ? p->seen : 0;
             *used = k;
-            *code = p->buf[at + 2];
-            *content = p->buf + at + head;
-            *clen = p->seen - at - head - 1u;
-            return 1;
+            return hand(p, at, code, content, clen);
         }
     }
     *used = k;

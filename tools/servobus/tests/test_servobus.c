@@ -178,6 +178,31 @@ static void the_frame_finder_rescans_after_a_false_header(void **state)
     assert_memory_equal(servos, "\x02\x03", 2);
 }
 
+/* Noise that makes a frame with a good checksum out of an answer's first
+ * bytes, or one that ends where the answer does: both frames found. */
+static void the_frame_finder_misses_no_answer_that_overlaps_noise(void **state)
+{
+    uint8_t stream[64], servos[4];
+    size_t len = 0;
+    sb_value v[8];
+    memset(v, 0, sizeof v);
+    v[0].n = 1;
+    v[1].n = 7400;
+    assert_int_equal(sb_encode_answer(SB_PKT_MONITOR, v, 8, stream + 4, sizeof stream - 4, &len).status, SB_OK);
+    stream[0] = SB_RESPONSE_HEADER_0;
+    stream[1] = SB_RESPONSE_HEADER_1;
+    stream[3] = 5; /* a 10-byte frame: its last byte the answer's sixth */
+    stream[2] = (uint8_t)(stream[9] - sb_checksum(stream, 9) + stream[2]);
+    assert_int_equal(sb_checksum(stream, 9), stream[9]);
+    assert_int_equal(servos_found(stream, 4 + len, servos), 2);
+    assert_int_equal(servos[1], 1);
+    stream[3] = (uint8_t)(len - 1u); /* a frame that ends where the answer does */
+    stream[2] = (uint8_t)(0u - sb_checksum(stream, 2) - stream[3]);
+    assert_int_equal(sb_checksum(stream, 4 + len - 1u), stream[4 + len - 1u]);
+    assert_int_equal(servos_found(stream, 4 + len, servos), 2);
+    assert_int_equal(servos[1], 1);
+}
+
 static void the_typed_sync_command_checks_what_sb_sync_frame_checks(void **state)
 {
     uint8_t records[4] = {1, 2, 3, 4}, f[32];
@@ -341,6 +366,7 @@ int main(void)
         cmocka_unit_test(a_long_sync_command_takes_the_extended_length),
         cmocka_unit_test(the_wire_limit_is_servoctls),
         cmocka_unit_test(the_frame_finder_rescans_after_a_false_header),
+        cmocka_unit_test(the_frame_finder_misses_no_answer_that_overlaps_noise),
         cmocka_unit_test(the_typed_sync_command_checks_what_sb_sync_frame_checks),
         cmocka_unit_test(a_sync_command_s_records_are_checked_as_requests),
         cmocka_unit_test(the_rules_check_the_ranges_first),

@@ -98,17 +98,20 @@ uint8_t sb_checksum(const uint8_t *data, size_t len);
  * (header as given) ends in the bytes fed so far, with its code and
  * content; bytes outside frames and frames with a bad checksum are counted.
  * A false header (noise, an answer cut short) costs only its bytes: the
- * search goes on from the byte after it, through the bytes held. A frame
- * that ends inside a longer one not yet complete is returned as it ends,
- * and the longer one still when it ends: an answer whose content holds a
- * whole frame is not lost (the caller skips what it did not ask for). */
+ * search goes on from the byte after it, through the bytes held. Every
+ * frame is returned as its last byte comes, whatever frames it overlaps:
+ * an answer whose content holds a whole frame, or whose first bytes made a
+ * good checksum with noise before it, is not lost (the caller skips what
+ * it did not ask for). */
 typedef struct sb_parser {
     uint8_t header[2];
     uint8_t buf[SB_RX_MAX];
     size_t len;   /* bytes held */
     size_t seen;  /* of them examined */
-    size_t taken; /* the frame returned last, at buf's start (0: none, or it lay inside another) */
-    size_t inner_from; /* a frame inside the one at the start begins here or later */
+    size_t taken; /* to drop at the next call: the first byte of a frame returned at buf's start */
+    size_t owned; /* the bytes held from the start up to a frame's end returned: not stray */
+    bool tie;        /* another frame may end where the one returned last did, */
+    size_t tie_from; /* starting here or later */
     uint32_t stray_bytes;
     uint32_t bad_frames;
 } sb_parser;
@@ -119,6 +122,8 @@ void sb_parser_init(sb_parser *p, bool requests);
  * another frame. */
 int sb_parse(sb_parser *p, const uint8_t *data, size_t len, size_t *used, uint8_t *code, const uint8_t **content,
              size_t *clen);
+/* Drops every byte held (the counts stay): a new request's answers. */
+void sb_parser_clear(sb_parser *p);
 /* The bytes that would complete the frame the parser is in (at least 1). */
 size_t sb_parser_missing(const sb_parser *p);
 
