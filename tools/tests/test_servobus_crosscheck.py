@@ -13,12 +13,14 @@ import pytest
 
 import servo_schema
 from servoctl import codec, registers
+from servoctl.checks import MIN_RAMP_MS, check_profile
+from servoctl.errors import ValueOutOfRange
 
 from .launchers import REPO
 
 BINARY = REPO / "build" / "host" / "tools" / "servobus" / "sb_crosscheck"
 S = servo_schema.load()
-SB_E_RANGE, SB_E_UNKNOWN_ITEM, SB_E_BAD_ANSWER = 1, 4, 8
+SB_E_RANGE, SB_E_UNKNOWN_ITEM, SB_E_BAD_ANSWER, SB_E_BROADCAST = 1, 4, 8, 11
 USER_AREA = bytes(range(7, 7 + registers.USER_AREA_SIZE))
 
 
@@ -43,7 +45,8 @@ def type_range(f) -> tuple:
 def edge_cases(fields) -> list:
     """(values, the field out of range or None): every field at its least and
     most, and just beyond where the schema's range is narrower than its type's."""
-    base = [USER_AREA if f.type == "user_area" else f.range[0] for f in fields]
+    # A move's time at its most, so that the other fields' edges keep its ramps.
+    base = [USER_AREA if f.type == "user_area" else f.range[f.name == "interval"] for f in fields]
     cases = [(base, None)]
     for k, f in enumerate(fields):
         if f.type == "user_area":
@@ -57,6 +60,36 @@ def edge_cases(fields) -> list:
             values[k] = value
             cases.append((values, out))
     return cases
+
+
+def record(cmd: int, k: int) -> bytes:
+    """A SyncCommand's record k that C checks as a request: each servo
+    once, none the broadcast ID, every value within its field's range."""
+    values = (k * 7) % 255, (k * 37) % 1800 - 900, k - 15, 20 * k
+    return struct.pack(S.request_format(cmd), *values[:len(S.packet(cmd).request)])
+
+
+def refused(p, part: str, values: list):
+    """(status, field) where the C library refuses a request within every
+    field's range, as the servo would not carry it out as sent; else None."""
+    if part != "request":
+        return None
+    named = dict(zip((f.name for f in p.request), values))
+    if p.has("addressed") and not p.has("broadcast") and values[0] == S.frame["broadcast_id"]:
+        return SB_E_BROADCAST, p.request[0].name
+    if "data_id" in named and named["data_id"] not in {item.id for item in registers.ITEMS}:
+        return SB_E_UNKNOWN_ITEM, "data_id"  # an item the schema does not have: ReadData refused as WriteData
+    if "interval" in named:  # a move's time shorter than its ramps (8 and 13 ramp 20 ms): servoctl refuses it too
+        try:
+            check_profile(named.get("acc_interval", MIN_RAMP_MS), named.get("dec_interval", MIN_RAMP_MS),
+                          named["interval"])
+        except ValueOutOfRange:
+            return SB_E_RANGE, "interval"
+    # A wheel run for a time (action 3) shorter than its two 20 ms ramps (motion/planning.c).
+    if p.code == codec.CODES["WHEEL"] and named["method"] & 0x7F == 3 and named["speed"] and \
+            named["value"] < 2 * MIN_RAMP_MS:
+        return SB_E_RANGE, "value"
+    return None
 
 
 def fixed(p, part: str) -> bool:
@@ -73,8 +106,8 @@ def test_every_fixed_request_and_answer_at_every_field_edge():
             fmt = getattr(S, f"{part}_format")(p.code)
             for values, out in edge_cases(fields):
                 lines.append(f"{kind} {p.code} " + " ".join(map(word, values)))
-                if out:
-                    expect.append((p, part, values, out, None))
+                if out or refused(p, part, values):
+                    expect.append((p, part, values, out, refused(p, part, values)))
                     continue
                 content = struct.pack(fmt, *values)
                 frame = (codec.request_frame if part == "request" else codec.response_frame)(p.code, content)
@@ -84,7 +117,9 @@ def test_every_fixed_request_and_answer_at_every_field_edge():
     answers = c_side(lines)
     checked = 0
     for line, got, (p, part, values, out, frame) in zip(lines, answers, expect):
-        if out:
+        if isinstance(frame, tuple) and not out:
+            assert got.split()[:2] == ["err", str(frame[0])] and got.split()[3] == frame[1], (line, got)
+        elif out:
             assert got.split()[:2] == ["err", str(SB_E_RANGE)] and got.split()[3] == out, (line, got)
             assert not S.field(p.code, out, part).range[0] <= values[[f.name for f in getattr(p, part)].index(out)] \
                 <= S.field(p.code, out, part).range[1]
@@ -142,7 +177,7 @@ def test_blocks_and_sync_commands():
         lines.append(f"req 82 5 4096 {word(chunk)} {zlib.crc32(chunk)}")
         frames.append(codec.request_frame(codec.CODES["UPDATE_WRITE"], content))
     for cmd, rlen, count in ((22, 1, 16), (0x45, 9, 6), (0x45, 9, 30)):
-        records = bytes((k * 7) % 256 for k in range(rlen * count))
+        records = b"".join(record(cmd, k) for k in range(count))
         lines.append(f"req 25 {cmd} {rlen} {count} {word(records)}")
         frames.append(codec.request_frame(codec.CODES["SYNC"], bytes([cmd, rlen, count]) + records))
     got = c_side(lines + [f"dreq {f.hex()}" for f in frames])
@@ -177,7 +212,7 @@ def test_the_extended_length_begins_at_255_content_bytes():
     to 254, the extended from 255 (0xFF is its mark), as servoctl's."""
     lines, frames = [], []
     for count in (251, 252, 253):
-        records = bytes((k * 7) % 256 for k in range(count))
+        records = bytes((k * 7) % 255 for k in range(count))  # each servo once, none the broadcast ID
         lines.append(f"req 25 22 1 {count} {word(records)}")
         frames.append(codec.request_frame(codec.CODES["SYNC"], bytes([22, 1, count]) + records))
     got = c_side(lines + [f"dreq {f.hex()}" for f in frames])

@@ -21,7 +21,8 @@ int main(int argc, char **argv)
     int32_t angles[SB_MAX_SERVOS];
     sb_monitor_answer states[SB_MAX_SERVOS];
     bool got[SB_MAX_SERVOS];
-    char *where, *colon;
+    const char *where, *colon;
+    char host[256]; /* HOST of HOST:PORT (argv stays as given, for the messages) */
     size_t count;
     long cycles;
     uint32_t baud;
@@ -52,9 +53,16 @@ int main(int argc, char **argv)
         fprintf(stderr, "loop_bench: the clock file %s %s\n", argv[2], sim_clock_why(sim_clock_last()));
         return 2;
     }
-    if (colon != NULL)
-        *colon = '\0';
-    if ((colon != NULL ? sb_tcp_open(&link, where, (unsigned)atoi(colon + 1)) : sb_serial_open(&link, where, baud)) !=
+    if (colon != NULL && (size_t)(colon - where) >= sizeof host) {
+        fprintf(stderr, "loop_bench: the host in '%s' is longer than %u characters\n", argv[1],
+                (unsigned)sizeof host - 1u);
+        return 2;
+    }
+    if (colon != NULL) {
+        memcpy(host, where, (size_t)(colon - where));
+        host[colon - where] = '\0';
+    }
+    if ((colon != NULL ? sb_tcp_open(&link, host, (unsigned)atoi(colon + 1)) : sb_serial_open(&link, where, baud)) !=
         0) {
         fprintf(stderr, "loop_bench: no simulator at %s\n", argv[1]);
         return 2;

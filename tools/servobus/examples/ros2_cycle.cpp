@@ -135,7 +135,7 @@ class ServoBusHardware {
 
 static int usage(const char *self)
 {
-    std::fprintf(stderr, "usage: %s HOST:PORT [--clock FILE] [--ids ID,ID,...] [--seconds S] [--period-ms MS]\n"
+    std::fprintf(stderr, "usage: %s [socket://]HOST:PORT [--clock FILE] [--ids ID,ID,...] [--seconds S] [--period-ms MS]\n"
                          "  --ids: default 1; --seconds: 1; --period-ms: 10\n", self);
     return 2;
 }
@@ -146,6 +146,8 @@ int main(int argc, char **argv)
         return usage(argv[0]);
     }
     std::string where = argv[1];
+    if (where.compare(0, 9, "socket://") == 0) // as servoctl sim and servo_sim print it
+        where = where.substr(9);
     std::string host = where.substr(0, where.rfind(':'));
     unsigned port = static_cast<unsigned>(std::atoi(where.substr(where.rfind(':') + 1).c_str()));
     std::vector<uint8_t> ids = {1};
@@ -165,8 +167,8 @@ int main(int argc, char **argv)
             for (char *tok = std::strtok(&val[0], ","); tok != nullptr; tok = std::strtok(nullptr, ",")) {
                 char *end = nullptr;
                 long id = std::strtol(tok, &end, 10);
-                if (*end != '\0' || id < 0 || id > 253) { /* 254 is broadcast: no joint answers it */
-                    std::fprintf(stderr, "sb_ros2_cycle: --ids: '%s' is not a servo ID (0-253)\n", tok);
+                if (*end != '\0' || id < 0 || id > SB_MAX_ID) { /* 255 is broadcast: no joint answers it */
+                    std::fprintf(stderr, "sb_ros2_cycle: --ids: '%s' is not a servo ID (0-%u)\n", tok, SB_MAX_ID);
                     return 2;
                 }
                 ids.push_back(static_cast<uint8_t>(id));

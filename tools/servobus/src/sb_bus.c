@@ -1,77 +1,13 @@
-/* The bus: frames found in the bytes the transport hands over, answers
- * matched to requests on the bus's clock; a microcontroller's UART as a
- * transport; errors in words. */
+/* The bus: answers matched to requests on the bus's clock (their frames
+ * found by sb_parse.c); a microcontroller's UART as a transport. */
+#include <errno.h>
+#include <limits.h>
 #include <string.h>
 
 #include "servobus/servobus.h"
 
 #define WAIT_SLICE_US 5000u /* the longest single wait on the transport */
-
-/* ---- the frame finder ---------------------------------------------------- */
-void sb_parser_init(sb_parser *p, bool requests)
-{
-    memset(p, 0, sizeof *p);
-    p->header[0] = requests ? SB_REQUEST_HEADER_0 : SB_RESPONSE_HEADER_0;
-    p->header[1] = requests ? SB_REQUEST_HEADER_1 : SB_RESPONSE_HEADER_1;
-}
-
-/* The frame's whole size once its head is in, else 0. */
-static size_t frame_size(const sb_parser *p)
-{
-    if (p->len < 4)
-        return 0;
-    if (p->buf[3] != SB_EXTENDED_LENGTH)
-        return 5u + p->buf[3];
-    return p->len < 6 ? 0 : 7u + ((size_t)p->buf[4] | (size_t)p->buf[5] << 8);
-}
-
-size_t sb_parser_missing(const sb_parser *p)
-{
-    size_t size = frame_size(p);
-    if (size == 0)
-        return p->len < 5 ? 5u - p->len : 1u;
-    return size > p->len ? size - p->len : 1u;
-}
-
-int sb_parse(sb_parser *p, const uint8_t *data, size_t len, size_t *used, uint8_t *code, const uint8_t **content,
-             size_t *clen)
-{
-    size_t k = 0;
-    if (p->len > 0 && frame_size(p) == p->len)
-        p->len = 0; /* the frame returned last time */
-    while (k < len) {
-        uint8_t b = data[k++];
-        size_t size;
-        if (p->len < 2 && b != p->header[p->len]) {
-            p->stray_bytes += (uint32_t)p->len + (b == p->header[0] ? 0u : 1u);
-            p->len = b == p->header[0] ? 1u : 0u;
-            if (b == p->header[0])
-                p->buf[0] = b;
-            continue;
-        }
-        p->buf[p->len++] = b;
-        size = frame_size(p);
-        if (size == 0 || p->len < size) {
-            if (size > SB_RX_MAX) { /* no answer is this long: not a frame */
-                p->stray_bytes += (uint32_t)p->len;
-                p->len = 0;
-            }
-            continue;
-        }
-        if (sb_checksum(p->buf, size - 1u) != p->buf[size - 1u]) {
-            p->bad_frames++;
-            p->len = 0;
-            continue;
-        }
-        *used = k;
-        *code = p->buf[2];
-        *content = p->buf + (p->buf[3] == SB_EXTENDED_LENGTH ? 6 : 4);
-        *clen = size - (p->buf[3] == SB_EXTENDED_LENGTH ? 7u : 5u);
-        return 1;
-    }
-    *used = k;
-    return 0;
-}
+#define EINTR_TRIES 16      /* a call a signal interrupted is made again, but not forever */
 
 /* ---- the bus ------------------------------------------------------------- */
 void sb_bus_init(sb_bus *bus, sb_transport t, uint32_t baud)
@@ -90,13 +26,38 @@ static uint64_t wire_us(const sb_bus *bus, size_t bytes)
     return bus->baud > 0 ? ((uint64_t)bytes * SB_BITS_PER_BYTE * 1000000u + bus->baud - 1u) / bus->baud : 0u;
 }
 
+/* A time us after t on the bus clock, held at its end rather than wrapping. */
+static uint64_t later(uint64_t t, uint64_t us)
+{
+    return t > UINT64_MAX - us ? UINT64_MAX : t + us;
+}
+
 static sb_error link_error(int rc, uint8_t code)
 {
     sb_error e = sb_ok();
     e.status = SB_E_LINK;
     e.packet = code;
-    e.os_error = -rc;
+    e.os_error = rc >= -INT_MAX ? -rc : EIO; /* INT_MIN has no errno (nor a negation) */
     return e;
+}
+
+/* The transport's read into pending, its return checked: more than it
+ * holds is a broken link (it wrote past the buffer). */
+static int link_read(sb_bus *bus, size_t want, uint32_t wait_us)
+{
+    int rc = -EINTR;
+    for (int tries = 0; rc == -EINTR && tries < EINTR_TRIES; tries++)
+        rc = bus->t.read(bus->t.ctx, bus->pending, sizeof bus->pending, want, wait_us);
+    return rc > (int)sizeof bus->pending ? -EOVERFLOW : rc;
+}
+
+/* The transport's write: 0 (or len, a count of all of it), else -errno. */
+static int link_write(sb_bus *bus, const uint8_t *frame, size_t len)
+{
+    int rc = -EINTR;
+    for (int tries = 0; rc == -EINTR && tries < EINTR_TRIES; tries++)
+        rc = bus->t.write(bus->t.ctx, frame, len);
+    return rc > 0 && (size_t)rc != len ? -EIO : rc > 0 ? 0 : rc;
 }
 
 sb_error sb_send(sb_bus *bus, const uint8_t *frame, size_t len)
@@ -104,35 +65,45 @@ sb_error sb_send(sb_bus *bus, const uint8_t *frame, size_t len)
     int rc;
     /* What waits unread is dropped: a late answer is not the next one's. */
     for (int k = 0; k < 64; k++) {
-        rc = bus->t.read(bus->t.ctx, bus->pending, sizeof bus->pending, 1, 0);
+        rc = link_read(bus, 1, 0);
         if (rc < 0)
             return link_error(rc, len > 2 ? frame[2] : 0);
         if (rc == 0)
             break;
     }
     bus->pending_len = 0;
-    bus->rx.len = 0;
-    bus->sent_end_us = bus->t.now_us(bus->t.ctx) + wire_us(bus, len);
-    rc = bus->t.write(bus->t.ctx, frame, len);
+    sb_parser_clear(&bus->rx);
+    bus->sent_end_us = later(bus->t.now_us(bus->t.ctx), wire_us(bus, len));
+    rc = link_write(bus, frame, len);
     return rc < 0 ? link_error(rc, len > 2 ? frame[2] : 0) : sb_ok();
 }
 
-/* sb_receive; the transport may wait for want_after bytes (0: this frame's). */
-static sb_error receive(sb_bus *bus, uint8_t code, int servo, uint64_t deadline_us, uint8_t *content, size_t *len,
-                        size_t want_after)
+/* sb_receive of an answer about item (its second byte; -1: any); the
+ * transport may wait for want_after bytes (0: this frame's); look: once the
+ * deadline has passed, one last look at what came meanwhile (else only the
+ * bytes held are searched). */
+static sb_error receive(sb_bus *bus, uint8_t code, int servo, int item, uint64_t deadline_us, uint8_t *content,
+                        size_t *len, size_t want_after, bool look)
 {
     uint32_t bad = bus->rx.bad_frames;
     sb_error e = sb_ok();
-    bool looked = false; /* the deadline passed: one last look at what came meanwhile */
+    bool looked = !look; /* the deadline passed: one last look at what came meanwhile */
+    int other = -1;      /* the item of an answer about another, skipped */
     for (;;) {
-        while (bus->pending_len > 0) {
+        for (;;) { /* every frame in what came and what the finder holds */
             size_t used = 0, clen = 0;
             uint8_t fcode = 0;
             const uint8_t *fcontent = NULL;
             int got = sb_parse(&bus->rx, bus->pending, bus->pending_len, &used, &fcode, &fcontent, &clen);
             memmove(bus->pending, bus->pending + used, bus->pending_len - used);
             bus->pending_len -= used;
-            if (got && fcode == code && (servo < 0 || (clen > 0 && fcontent[0] == servo))) {
+            if (!got)
+                break;
+            if (fcode == code && (servo < 0 || (clen > 0 && fcontent[0] == servo)) && item >= 0 &&
+                (clen < 2 || fcontent[1] != item)) {
+                other = clen < 2 ? 256 : fcontent[1]; /* a late answer about another item: skipped */
+            } else if (fcode == code && (servo < 0 || (clen > 0 && fcontent[0] == servo))) {
+                bus->arrived_us = bus->t.now_us(bus->t.ctx);
                 if (clen > SB_ANSWER_CONTENT_MAX) {
                     e.status = SB_E_BAD_ANSWER;
                     e.servo = (int16_t)fcontent[0];
@@ -141,7 +112,6 @@ static sb_error receive(sb_bus *bus, uint8_t code, int servo, uint64_t deadline_
                 }
                 memcpy(content, fcontent, clen);
                 *len = clen;
-                bus->arrived_us = bus->t.now_us(bus->t.ctx);
                 return e;
             }
         }
@@ -151,7 +121,7 @@ static sb_error receive(sb_bus *bus, uint8_t code, int servo, uint64_t deadline_
             int rc;
             if (left == 0 && !looked) { /* the host may have slept past the deadline: bytes wait */
                 looked = true;
-                rc = bus->t.read(bus->t.ctx, bus->pending, sizeof bus->pending, 1, 0);
+                rc = link_read(bus, 1, 0);
                 if (rc > 0) {
                     bus->pending_len = (size_t)rc;
                     continue;
@@ -161,12 +131,16 @@ static sb_error receive(sb_bus *bus, uint8_t code, int servo, uint64_t deadline_
                 e.status = bus->rx.bad_frames != bad ? SB_E_BAD_CHECKSUM : SB_E_NO_ANSWER;
                 e.servo = (int16_t)servo;
                 e.packet = code;
+                if (other >= 0) { /* only answers about another item came */
+                    e = sb_error_of(SB_E_BAD_ANSWER, servo, code, "data_id");
+                    e.value = other;
+                    e.least = e.most = item;
+                }
                 return e;
             }
             /* want_after: the bytes of every frame still to come, from this one's first. */
             size_t want = want_after > bus->rx.len ? want_after - bus->rx.len : sb_parser_missing(&bus->rx);
-            rc = bus->t.read(bus->t.ctx, bus->pending, sizeof bus->pending, want,
-                             (uint32_t)(left < WAIT_SLICE_US ? left : WAIT_SLICE_US));
+            rc = link_read(bus, want, (uint32_t)(left < WAIT_SLICE_US ? left : WAIT_SLICE_US));
             if (rc < 0) {
                 e = link_error(rc, code);
                 e.servo = (int16_t)servo;
@@ -179,17 +153,25 @@ static sb_error receive(sb_bus *bus, uint8_t code, int servo, uint64_t deadline_
 
 sb_error sb_receive(sb_bus *bus, uint8_t code, int servo, uint64_t deadline_us, uint8_t *content, size_t *len)
 {
-    return receive(bus, code, servo, deadline_us, content, len, 0);
+    return receive(bus, code, servo, -1, deadline_us, content, len, 0, true);
 }
 
 sb_error sb_request(sb_bus *bus, size_t len, uint8_t code, int servo, uint8_t *content, size_t *clen)
 {
-    sb_error e = sb_send(bus, bus->tx, len);
+    return sb_request_item(bus, len, code, servo, -1, content, clen);
+}
+
+sb_error sb_request_item(sb_bus *bus, size_t len, uint8_t code, int servo, int item, uint8_t *content, size_t *clen)
+{
+    sb_error e = servo == SB_BROADCAST_ID ? sb_error_of(SB_E_BROADCAST, servo, code, "id") : sb_ok();
+    if (e.status == SB_OK)
+        e = sb_send(bus, bus->tx, len);
     if (e.status != SB_OK) {
         e.servo = (int16_t)servo;
         return e;
     }
-    return receive(bus, code, servo, bus->t.now_us(bus->t.ctx) + bus->timeout_us, content, clen, 0);
+    return receive(bus, code, servo, item, later(bus->t.now_us(bus->t.ctx), bus->timeout_us), content, clen, 0,
+                   true);
 }
 
 /* The slot in the list an answer of id takes, or count (not asked for). */
@@ -209,8 +191,12 @@ sb_error sb_sync_monitor_answers(sb_bus *bus, const uint8_t *ids, size_t count, 
      * that stays silent adds the silence that passes its turn. */
     uint64_t slot = SB_TURNAROUND_US + wire_us(bus, 2u + answer) + bus->answer_margin_us;
     uint64_t last = bus->sent_end_us;
+    /* The round's end, however the line babbles: each listed servo's slot and silence. */
+    uint64_t end = later(last, (uint64_t)count * (slot + SB_SYNC_SILENCE_US));
+    bool over = false; /* the end has passed: only the bytes held are searched */
     uint32_t bad = bus->rx.bad_frames;
     bool jumped = false; /* the last answer taken came before a listed servo's that had not passed its turn */
+    size_t misshapen = count; /* the first listed servo whose answer was of the wrong length */
     sb_error e = sb_ok();
     for (size_t k = 0; k < count; k++)
         got[k] = false;
@@ -220,33 +206,42 @@ sb_error sb_sync_monitor_answers(sb_bus *bus, const uint8_t *ids, size_t count, 
         uint8_t content[SB_ANSWER_CONTENT_MAX];
         size_t len = 0, k;
         sb_monitor_answer a;
-        e = receive(bus, SB_PKT_MONITOR, -1, last + silent * SB_SYNC_SILENCE_US + slot, content, &len,
-                    left * answer);
-        if ((e.status == SB_E_NO_ANSWER || e.status == SB_E_BAD_CHECKSUM) && next >= count)
+        uint64_t deadline = later(last, silent * SB_SYNC_SILENCE_US + slot);
+        deadline = deadline < end ? deadline : end;
+        e = receive(bus, SB_PKT_MONITOR, -1, -1, deadline, content, &len, left * answer, !over);
+        over = over || bus->t.now_us(bus->t.ctx) >= end;
+        if ((e.status == SB_E_NO_ANSWER || e.status == SB_E_BAD_CHECKSUM) && (next >= count || deadline == end))
             break;
         if (e.status == SB_E_NO_ANSWER || e.status == SB_E_BAD_CHECKSUM) {
             silent++; /* ids[next] passes its turn; the next answers after the silence */
             next++;
             continue;
         }
-        if (e.status != SB_OK)
+        if (e.status == SB_OK)
+            e = sb_decode_monitor(content, len, &a);
+        if (e.status == SB_E_BAD_ANSWER) { /* its checksum good, its length not: skipped, its turn taken */
+            k = e.servo >= 0 ? slot_of(ids, count, (uint8_t)e.servo) : count;
+            misshapen = k < misshapen ? k : misshapen;
+            e = sb_ok();
+            if (k == count || k < next)
+                continue; /* not asked for, or its turn passed: the round's times stay */
+        } else if (e.status != SB_OK) {
             break;
-        e = sb_decode_monitor(content, len, &a);
-        if (e.status != SB_OK)
-            break;
-        k = slot_of(ids, count, a.id);
-        if (k == count)
-            continue; /* not asked for */
-        /* A round answers in the list's order: what was taken of ids[k] or
-         * later came before this, so it was an earlier round's, late. */
-        for (size_t j = k; j < count; j++)
-            if (got[j]) {
-                got[j] = false;
-                left++;
-            }
-        states[k] = a;
-        got[k] = true;
-        left--;
+        } else {
+            k = slot_of(ids, count, a.id);
+            if (k == count)
+                continue; /* not asked for */
+            /* A round answers in the list's order: what was taken of ids[k] or
+             * later came before this, so it was an earlier round's, late. */
+            for (size_t j = k; j < count; j++)
+                if (got[j]) {
+                    got[j] = false;
+                    left++;
+                }
+            states[k] = a;
+            got[k] = true;
+            left--;
+        }
         last = bus->arrived_us;
         silent = 0;
         jumped = k > next;
@@ -256,7 +251,9 @@ sb_error sb_sync_monitor_answers(sb_bus *bus, const uint8_t *ids, size_t count, 
         e = sb_ok();
         for (size_t k = 0; k < count; k++)
             if (!got[k]) { /* the first that did not answer */
-                e.status = bus->rx.bad_frames != bad ? SB_E_BAD_CHECKSUM : SB_E_NO_ANSWER;
+                e.status = k == misshapen               ? SB_E_BAD_ANSWER
+                           : bus->rx.bad_frames != bad ? SB_E_BAD_CHECKSUM
+                                                       : SB_E_NO_ANSWER;
                 e.servo = ids[k];
                 e.packet = SB_PKT_MONITOR;
                 break;
@@ -268,7 +265,12 @@ sb_error sb_sync_monitor_answers(sb_bus *bus, const uint8_t *ids, size_t count, 
 sb_error sb_sync_monitor(sb_bus *bus, const uint8_t *ids, size_t count, sb_monitor_answer *states, bool *got)
 {
     size_t len = 0;
-    sb_error e = sb_sync_frame(SB_PKT_MONITOR, ids, 1, count, bus->tx, sizeof bus->tx, &len);
+    sb_error e;
+    for (size_t k = 0; k < count; k++)
+        got[k] = false; /* none, if the round is refused or the link fails */
+    e = sb_check_ids(ids, count, SB_PKT_MONITOR);
+    if (e.status == SB_OK)
+        e = sb_sync_frame(SB_PKT_MONITOR, ids, 1, count, bus->tx, sizeof bus->tx, &len);
     if (e.status == SB_OK)
         e = sb_send(bus, bus->tx, len);
     return e.status == SB_OK ? sb_sync_monitor_answers(bus, ids, count, states, got) : e;

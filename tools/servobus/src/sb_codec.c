@@ -92,6 +92,18 @@ static int64_t get_le(const uint8_t *in, size_t size, bool is_signed)
     return (int64_t)u;
 }
 
+sb_error sb_check_ids(const uint8_t *ids, size_t count, uint8_t code)
+{
+    for (size_t k = 0; k < count; k++) {
+        if (ids[k] > SB_MAX_ID)
+            return fail(SB_E_BROADCAST, ids[k], code, "ids");
+        for (size_t j = 0; j < k; j++)
+            if (ids[j] == ids[k])
+                return fail(SB_E_DUPLICATE_ID, ids[k], code, "ids");
+    }
+    return sb_ok();
+}
+
 /* The servo a packet's fields name: an addressed packet's first field. */
 static int servo_of(const sb_packet_desc *p, const sb_value *v, size_t count)
 {
@@ -120,8 +132,15 @@ static sb_error encode_fields(const sb_packet_desc *p, bool request, const sb_va
     size_t fields = request ? p->request_count : p->answer_count;
     int servo = servo_of(p, v, count);
     size_t at = 0;
-    if (count != fields)
-        return fail(SB_E_USAGE, servo, p->code, NULL);
+    if (count != fields) { /* "fields: 3, not 4" */
+        sb_error e = fail(SB_E_USAGE, servo, p->code, "fields");
+        e.value = (int64_t)count;
+        e.least = e.most = (int64_t)fields;
+        return e;
+    }
+    /* A servo takes a packet sent to the broadcast ID only if it is a broadcast one (and then never answers). */
+    if (request && servo == SB_BROADCAST_ID && !(p->flags & SB_PF_BROADCAST))
+        return fail(SB_E_BROADCAST, servo, p->code, f[0].name);
     for (size_t k = 0; k < fields; k++) {
         size_t size = type_size(f[k].type);
         int64_t least = f[k].min, most = f[k].max;
@@ -147,6 +166,11 @@ static sb_error encode_fields(const sb_packet_desc *p, bool request, const sb_va
         }
         if (number && (v[k].n < least || v[k].n > most))
             return out_of_range(servo, p->code, f[k].name, v[k].n, least, most);
+        if (request && strcmp(f[k].name, "data_id") == 0 && sb_item((uint8_t)v[k].n) == NULL) {
+            sb_error e = fail(SB_E_UNKNOWN_ITEM, servo, p->code, f[k].name); /* ReadData's, WriteData's */
+            e.value = v[k].n;
+            return e;
+        }
         if (at + size > cap)
             return fail(SB_E_SPACE, servo, p->code, f[k].name);
         if (number)
@@ -155,8 +179,18 @@ static sb_error encode_fields(const sb_packet_desc *p, bool request, const sb_va
             memcpy(out + at, v[k].bytes, size);
         at += size;
     }
-    if (request && (at < p->length_min || (p->length_max != 0xFFFFu && at > p->length_max)))
-        return fail(SB_E_USAGE, servo, p->code, NULL);
+    if (request && (at < p->length_min || (p->length_max != 0xFFFFu && at > p->length_max))) {
+        sb_error e = fail(SB_E_USAGE, servo, p->code, "length"); /* the content's bytes */
+        e.value = (int64_t)at;
+        e.least = p->length_min;
+        e.most = p->length_max;
+        return e;
+    }
+    if (request) {
+        sb_error e = sb_check_request(p->code, v, count);
+        if (e.status != SB_OK)
+            return e;
+    }
     *len = at;
     return sb_ok();
 }

@@ -1,4 +1,4 @@
-/* SyncCommand, the stream of setpoints and the robot loop; errors in words. */
+/* SyncCommand, the stream of setpoints and the robot loop. */
 #include <string.h>
 
 #include "servobus/servobus.h"
@@ -10,20 +10,35 @@ static sb_error usage(int servo, uint8_t code, const char *field)
     return sb_error_of(SB_E_USAGE, servo, code, field);
 }
 
+/* A number the call does not allow: value, and the range it must be in. */
+static sb_error usage_of(uint8_t code, const char *field, int64_t value, int64_t least, int64_t most)
+{
+    sb_error e = usage(-1, code, field);
+    e.value = value;
+    e.least = least;
+    e.most = most;
+    return e;
+}
+
 sb_error sb_sync_frame(uint8_t cmd, const uint8_t *records, size_t record_len, size_t count, uint8_t *frame,
                        size_t cap, size_t *len)
 {
-    const sb_packet_desc *p = sb_packet(cmd);
+    sb_value v[4] = {{cmd, NULL, 0}, {0, NULL, 0}, {0, NULL, 0}, {0, NULL, 0}};
     size_t clen = 3u + record_len * count;
-    if (p == NULL || !(p->flags & SB_PF_SYNCABLE) || record_len != p->length_min || record_len != p->length_max)
-        return usage(-1, SB_PKT_SYNC_COMMAND, "cmd");
-    if (count == 0 || count > 255u)
-        return usage(-1, SB_PKT_SYNC_COMMAND, "count");
-    if (7u + clen > cap) {
-        sb_error e = usage(-1, SB_PKT_SYNC_COMMAND, NULL);
-        e.status = SB_E_SPACE;
+    sb_error e;
+    if (record_len > 255u)
+        return usage_of(SB_PKT_SYNC_COMMAND, "record_len", (int64_t)record_len, 1, 255);
+    if (count > 255u)
+        return usage_of(SB_PKT_SYNC_COMMAND, "count", (int64_t)count, 1, 255);
+    v[1].n = (int64_t)record_len;
+    v[2].n = (int64_t)count;
+    v[3].bytes = records;
+    v[3].len = record_len * count;
+    e = sb_check_request(SB_PKT_SYNC_COMMAND, v, 4); /* what the typed encoder checks too */
+    if (e.status != SB_OK)
         return e;
-    }
+    if (7u + clen > cap)
+        return sb_error_of(SB_E_SPACE, -1, SB_PKT_SYNC_COMMAND, NULL);
     memmove(frame + 9, records, record_len * count); /* the content at 6, then moved to its place */
     frame[6] = cmd;
     frame[7] = (uint8_t)record_len;
@@ -42,17 +57,16 @@ sb_error sb_sync_command(sb_bus *bus, uint8_t cmd, const uint8_t *records, size_
 sb_error sb_stream_init(sb_stream *s, const uint8_t *ids, size_t count, uint16_t period_ms)
 {
     const sb_field_desc *angle = &sb_packet(SB_PKT_STREAM_SETPOINT)->request[1];
+    sb_error e;
     memset(s, 0, sizeof *s);
-    if (count == 0 || count > SB_MAX_SERVOS)
-        return usage(-1, SB_PKT_STREAM_SETPOINT, "ids");
+    if (count == 0 || count > SB_MAX_SERVOS) /* none listed, or more than the structs hold */
+        return usage_of(SB_PKT_STREAM_SETPOINT, "ids", (int64_t)count, 1, SB_MAX_SERVOS);
     if (period_ms == 0)
-        return usage(-1, SB_PKT_STREAM_SETPOINT, "period");
+        return usage_of(SB_PKT_STREAM_SETPOINT, "period_ms", 0, 1, 65535);
+    e = sb_check_ids(ids, count, SB_PKT_STREAM_SETPOINT);
+    if (e.status != SB_OK)
+        return e;
     for (size_t k = 0; k < count; k++) {
-        if (ids[k] > SB_MAX_ID)
-            return usage(ids[k], SB_PKT_STREAM_SETPOINT, "id");
-        for (size_t j = 0; j < k; j++)
-            if (ids[j] == ids[k])
-                return usage(ids[k], SB_PKT_STREAM_SETPOINT, "id"); /* listed twice */
         s->ids[k] = ids[k];
         s->angle_min[k] = (int32_t)angle->min;
         s->angle_max[k] = (int32_t)angle->max;
@@ -124,7 +138,10 @@ sb_error sb_loop_cycle(sb_loop *l, const int32_t *angles, const int16_t *velocit
 {
     sb_bus *bus = l->bus;
     size_t len = 0;
-    sb_error e = sb_stream_frame(&l->stream, angles, velocities, bus->tx, sizeof bus->tx - l->monitor_len, &len);
+    sb_error e;
+    for (size_t k = 0; k < l->stream.count; k++)
+        got[k] = false; /* none, if the setpoints are refused or the link fails */
+    e = sb_stream_frame(&l->stream, angles, velocities, bus->tx, sizeof bus->tx - l->monitor_len, &len);
     if (e.status != SB_OK)
         return e;
     if (l->cycles == 0)
@@ -161,86 +178,4 @@ double sb_loop_rate_hz(const sb_loop *l)
 {
     uint64_t now = l->bus->t.now_us(l->bus->t.ctx);
     return now > l->started_us ? (double)l->cycles * 1e6 / (double)(now - l->started_us) : 0.0;
-}
-
-/* ---- errors in words -------------------------------------------------------- */
-typedef struct text {
-    char *buf;
-    size_t cap, len;
-} text;
-
-static void put(text *t, const char *s)
-{
-    while (*s != '\0') {
-        if (t->len + 1 < t->cap)
-            t->buf[t->len++] = *s;
-        s++;
-    }
-    if (t->cap > 0)
-        t->buf[t->len < t->cap ? t->len : t->cap - 1] = '\0';
-}
-
-static void put_number(text *t, int64_t n)
-{
-    char digits[24];
-    size_t k = sizeof digits - 1;
-    uint64_t u = n < 0 ? 0u - (uint64_t)n : (uint64_t)n;
-    digits[k] = '\0';
-    do {
-        digits[--k] = (char)('0' + u % 10u);
-        u /= 10u;
-    } while (u > 0);
-    if (n < 0)
-        digits[--k] = '-';
-    put(t, digits + k);
-}
-
-static const char *const WHAT[] = {
-    "ok", "out of range", "not allowed", "not a packet of the protocol", "no such writable data item",
-    "the buffer is too small", "no answer", "an answer with a bad checksum", "a bad answer", "the link failed",
-};
-
-size_t sb_error_text(const sb_error *e, char *buf, size_t cap)
-{
-    text t = {buf, cap, 0};
-    const sb_packet_desc *p = e->packet != 0 ? sb_packet(e->packet) : NULL;
-    put(&t, "");
-    if (e->servo >= 0) {
-        put(&t, "servo ");
-        put_number(&t, e->servo);
-        put(&t, ": ");
-    }
-    if (p != NULL) {
-        put(&t, p->name);
-        put(&t, ": ");
-    } else if (e->packet != 0) {
-        put(&t, "packet ");
-        put_number(&t, e->packet);
-        put(&t, ": ");
-    }
-    if (e->field != NULL) {
-        put(&t, e->field);
-        put(&t, " ");
-    }
-    put(&t, (size_t)e->status < sizeof WHAT / sizeof WHAT[0] ? WHAT[e->status] : "unknown error");
-    if (e->status == SB_E_RANGE) {
-        put(&t, ": ");
-        put_number(&t, e->value);
-        put(&t, " is beyond ");
-        put_number(&t, e->least);
-        put(&t, "..");
-        put_number(&t, e->most);
-        put(&t, "; nothing was sent");
-    } else if (e->status == SB_E_NO_ANSWER) {
-        put(&t, " in time (is it on the bus, at this baud rate?)");
-    } else if (e->status == SB_E_LINK) {
-        put(&t, " (errno ");
-        put_number(&t, e->os_error);
-        put(&t, ")");
-    } else if (e->status == SB_E_UNKNOWN_ITEM) {
-        put(&t, " (item ");
-        put_number(&t, e->value);
-        put(&t, ")");
-    }
-    return t.len;
 }

@@ -2,6 +2,7 @@
 #define _GNU_SOURCE
 #include <errno.h>
 #include <fcntl.h>
+#include <limits.h>
 #include <netdb.h>
 #include <netinet/in.h>
 #include <netinet/tcp.h>
@@ -99,18 +100,35 @@ static speed_t speed_of(uint32_t baud)
     }
 }
 
-/* The adapter's latency-timer file for a port's path (NAME of /dev/NAME),
- * under $SERVOBUS_SYSFS if set (the tests'), else /sys. */
+/* A port's device name (NAME of /dev/NAME) into name (NAME_MAX + 1 bytes),
+ * its links resolved first: /dev/serial/by-id/usb-FTDI_...-port0 is ttyUSB0. */
+static void port_name(const char *path, char *name)
+{
+    char real[PATH_MAX];
+    const char *base;
+    size_t n;
+    if (realpath(path, real) != NULL)
+        path = real;
+    base = strrchr(path, '/');
+    base = base != NULL ? base + 1 : path;
+    n = strlen(base) < NAME_MAX ? strlen(base) : NAME_MAX;
+    memcpy(name, base, n);
+    name[n] = '\0';
+}
+
+/* The adapter's latency-timer file for a port's path, under
+ * $SERVOBUS_SYSFS if set (the tests'), else /sys. */
 static void timer_file(const char *path, char *out, size_t cap)
 {
-    const char *name = strrchr(path, '/'), *root = getenv("SERVOBUS_SYSFS");
-    snprintf(out, cap, "%s/class/tty/%s/device/latency_timer", root != NULL ? root : "/sys",
-             name != NULL ? name + 1 : path);
+    char name[NAME_MAX + 1];
+    const char *root = getenv("SERVOBUS_SYSFS");
+    port_name(path, name);
+    snprintf(out, cap, "%s/class/tty/%s/device/latency_timer", root != NULL ? root : "/sys", name);
 }
 
 int sb_serial_latency_timer(const char *path)
 {
-    char sys[256];
+    char sys[256 + NAME_MAX];
     FILE *f;
     int ms = -1;
     timer_file(path, sys, sizeof sys);
@@ -128,10 +146,10 @@ int sb_serial_latency_timer(const char *path)
  * at 16 ms it crawls. */
 void sb_serial_check_latency(sb_posix *p, const char *path)
 {
-    const char *name = strrchr(path, '/');
-    char sys[256];
+    char name[NAME_MAX + 1], sys[256 + NAME_MAX];
     FILE *f;
-    name = name != NULL ? name + 1 : path;
+    int cut;
+    port_name(path, name);
     p->advice[0] = '\0';
     p->latency_timer_ms = sb_serial_latency_timer(path);
     if (p->latency_timer_ms <= 1)
@@ -145,10 +163,11 @@ void sb_serial_check_latency(sb_posix *p, const char *path)
         if (written && p->latency_timer_ms <= 1)
             return;
     }
-    snprintf(p->advice, sizeof p->advice,
-             "%s's latency timer is %d ms: every answer waits for it. Run "
-             "'echo 1 | sudo tee /sys/bus/usb-serial/devices/%s/latency_timer' "
-             "(or a udev rule setting ATTR{latency_timer}=\"1\")", name, p->latency_timer_ms, name);
+    cut = snprintf(p->advice, sizeof p->advice,
+                   "%s's latency timer is %d ms: every answer waits for it. Run "
+                   "'echo 1 | sudo tee /sys/bus/usb-serial/devices/%s/latency_timer' "
+                   "(or a udev rule setting ATTR{latency_timer}=\"1\")", name, p->latency_timer_ms, name);
+    (void)cut; /* a device name of over 40 characters cuts it short */
 }
 
 int sb_serial_open(sb_posix *p, const char *path, uint32_t baud)

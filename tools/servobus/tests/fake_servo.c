@@ -16,9 +16,14 @@ static void queue(fake_bus *f, size_t len, uint64_t us)
 static void answer(fake_bus *f, uint8_t code, const sb_value *v, size_t count)
 {
     size_t len = 0;
-    sb_error e = sb_encode_answer(code, v, count, f->out + f->out_len, sizeof f->out - f->out_len, &len);
+    uint8_t id = (uint8_t)v[0].n, *frame = f->out + f->out_len;
+    sb_error e = sb_encode_answer(code, v, count, frame, sizeof f->out - f->out_len, &len);
     if (e.status != SB_OK)
         return;
+    if (f->one_short[id]) /* its content less its last byte, framed anew */
+        sb_frame(false, code, frame + 4, (size_t)frame[3] - 1u, frame, sizeof f->out - f->out_len, &len);
+    if (f->cut[id] > 0 && f->cut[id] < len)
+        len = f->cut[id];
     if (f->garble_next) {
         f->out[f->out_len + len - 1] ^= 0x55u;
         f->garble_next = false;
@@ -32,7 +37,9 @@ static void monitor(fake_bus *f, uint8_t id)
     sb_value v[8];
     memset(v, 0, sizeof v);
     v[0].n = id;
-    v[1].n = 7400;
+    v[1].n = f->power[0] != 0 ? f->power[0] : 7400;
+    v[2].n = f->power[1];
+    v[3].n = f->power[2];
     v[5].n = 1;
     v[6].n = f->setpoint[id];
     if (f->present[id])
@@ -87,13 +94,15 @@ static int fake_write(void *ctx, const uint8_t *data, size_t len)
     f->now_us += len * 10000000u / f->baud;
     f->line_us = f->now_us;
     f->first = true;
-    while (at < len) {
+    for (;;) {
         size_t used = 0, clen = 0;
         uint8_t code = 0;
         const uint8_t *content = NULL;
-        if (sb_parse(&p, data + at, len - at, &used, &code, &content, &clen))
-            take(f, code, content, clen);
+        int got = sb_parse(&p, data + at, len - at, &used, &code, &content, &clen);
         at += used;
+        if (!got)
+            break;
+        take(f, code, content, clen);
     }
     return 0;
 }

@@ -28,6 +28,9 @@ typedef struct fake_bus {
     uint32_t frames;       /* request frames taken */
     uint32_t setpoint_frames;
     bool garble_next;      /* the next answer's checksum is wrong */
+    uint8_t cut[256];      /* a servo's answers stop after this many bytes (0: whole) */
+    bool one_short[256];   /* a servo's answers a byte short, their checksum good */
+    int64_t power[3];      /* the Monitor answers' mV, mA and mW (mV 0: 7400) */
 } fake_bus;
 
 void fake_init(fake_bus *f, uint32_t baud);

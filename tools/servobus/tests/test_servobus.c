@@ -66,6 +66,14 @@ static void write_data_takes_the_items_size_and_range(void **state)
     assert_int_equal(sb_encode_write_data(&r, f, sizeof f, &len).status, SB_E_UNKNOWN_ITEM);
     r.data_id = 1; /* read-only */
     assert_int_equal(sb_encode_write_data(&r, f, sizeof f, &len).status, SB_E_UNKNOWN_ITEM);
+    sb_read_data_request q = {1, 200};
+    assert_null(sb_item(200)); /* no item of the schema: ReadData refused as WriteData is */
+    sb_error e = sb_encode_read_data(&q, f, sizeof f, &len);
+    assert_int_equal(e.status, SB_E_UNKNOWN_ITEM);
+    assert_string_equal(e.field, "data_id");
+    assert_int_equal(e.value, 200);
+    q.data_id = 35; /* reserved: the servo answers it without a value */
+    assert_int_equal(sb_encode_read_data(&q, f, sizeof f, &len).status, SB_OK);
 }
 
 static void answers_are_checked(void **state)
@@ -133,11 +141,199 @@ static void the_frame_finder_skips_garbage_and_bad_frames(void **state)
     assert_int_equal(sb_parse(&p, stream, 0, &used, &code, &content, &clen), 0);
 }
 
+/* Every frame the finder returns from stream, at once: their servos in order. */
+static size_t servos_found(const uint8_t *stream, size_t n, uint8_t *servos)
+{
+    sb_parser p;
+    size_t found = 0, at = 0, used = 0, clen = 0;
+    uint8_t code = 0;
+    const uint8_t *content = NULL;
+    sb_parser_init(&p, false);
+    while (sb_parse(&p, stream + at, n - at, &used, &code, &content, &clen)) {
+        at += used;
+        servos[found++] = content[0];
+    }
+    assert_int_equal(at + used, n);
+    return found;
+}
+
+static void the_frame_finder_rescans_after_a_false_header(void **state)
+{
+    uint8_t stream[96], servos[4];
+    size_t n = 0, len = 0;
+    sb_value v[2] = {{1, NULL, 0}, {-5, NULL, 0}};
+    stream[n++] = SB_RESPONSE_HEADER_0; /* noise that looks like a header: a 33-byte frame */
+    stream[n++] = SB_RESPONSE_HEADER_1;
+    for (int id = 1; id <= 3; id++, n += len) {
+        v[0].n = id;
+        assert_int_equal(sb_encode_answer(SB_PKT_READ_ANGLE, v, 2, stream + n, sizeof stream - n, &len).status, SB_OK);
+    }
+    assert_int_equal(servos_found(stream, n, servos), 3);
+    assert_memory_equal(servos, "\x01\x02\x03", 3);
+    /* one answer alone behind the noise: found without a byte more */
+    assert_int_equal(servos_found(stream, 2 + len, servos), 1);
+    /* the first answer cut short after 5 bytes: the next two found */
+    memmove(stream + 7, stream + 2 + len, 2 * len);
+    assert_int_equal(servos_found(stream + 2, 5 + 2 * len, servos), 2);
+    assert_memory_equal(servos, "\x02\x03", 2);
+}
+
+/* Noise that makes a frame with a good checksum out of an answer's first
+ * bytes, or one that ends where the answer does: both frames found. */
+static void the_frame_finder_misses_no_answer_that_overlaps_noise(void **state)
+{
+    uint8_t stream[64], servos[4];
+    size_t len = 0;
+    sb_value v[8];
+    memset(v, 0, sizeof v);
+    v[0].n = 1;
+    v[1].n = 7400;
+    assert_int_equal(sb_encode_answer(SB_PKT_MONITOR, v, 8, stream + 4, sizeof stream - 4, &len).status, SB_OK);
+    stream[0] = SB_RESPONSE_HEADER_0;
+    stream[1] = SB_RESPONSE_HEADER_1;
+    stream[3] = 5; /* a 10-byte frame: its last byte the answer's sixth */
+    stream[2] = (uint8_t)(stream[9] - sb_checksum(stream, 9) + stream[2]);
+    assert_int_equal(sb_checksum(stream, 9), stream[9]);
+    assert_int_equal(servos_found(stream, 4 + len, servos), 2);
+    assert_int_equal(servos[1], 1);
+    stream[3] = (uint8_t)(len - 1u); /* a frame that ends where the answer does */
+    stream[2] = (uint8_t)(0u - sb_checksum(stream, 2) - stream[3]);
+    assert_int_equal(sb_checksum(stream, 4 + len - 1u), stream[4 + len - 1u]);
+    assert_int_equal(servos_found(stream, 4 + len, servos), 2);
+    assert_int_equal(servos[1], 1);
+}
+
+static void the_typed_sync_command_checks_what_sb_sync_frame_checks(void **state)
+{
+    uint8_t records[4] = {1, 2, 3, 4}, f[32];
+    size_t len = 0;
+    sb_sync_command_request r = {SB_PKT_MONITOR, 1, 4, records, 4};
+    assert_int_equal(sb_encode_sync_command(&r, f, sizeof f, &len).status, SB_OK);
+    r.cmd = SB_PKT_PING; /* not syncable */
+    assert_int_equal(sb_encode_sync_command(&r, f, sizeof f, &len).status, SB_E_USAGE);
+    r.cmd = SB_PKT_MONITOR;
+    r.record_len = 2; /* not Monitor's length */
+    r.count = 2;
+    assert_int_equal(sb_encode_sync_command(&r, f, sizeof f, &len).status, SB_E_USAGE);
+    r.record_len = 1;
+    r.count = 0;
+    r.records_len = 0;
+    assert_int_equal(sb_encode_sync_command(&r, f, sizeof f, &len).status, SB_E_USAGE);
+    r.count = 3; /* three records said, four given */
+    r.records_len = 4;
+    sb_error e = sb_encode_sync_command(&r, f, sizeof f, &len);
+    assert_int_equal(e.status, SB_E_USAGE);
+    assert_string_equal(e.field, "records");
+}
+
+/* sb_check_request checks the fields' ranges before the rules that add them up. */
+static void the_rules_check_the_ranges_first(void **state)
+{
+    sb_value v[6];
+    memset(v, 0, sizeof v);
+    v[0].n = 1;
+    v[3].n = INT64_MAX; /* acc_interval: acc + dec would overflow */
+    v[4].n = 1;
+    sb_error e = sb_check_request(SB_PKT_MOVE_ANGLE_BY_INTERVAL, v, 6);
+    assert_int_equal(e.status, SB_E_RANGE);
+    assert_int_equal(e.servo, 1);
+    assert_string_equal(e.field, sb_packet(SB_PKT_MOVE_ANGLE_BY_INTERVAL)->request[3].name);
+    assert_true(e.value == INT64_MAX);
+}
+
+/* Each record is checked as its packet's request would be. */
+static void a_sync_command_s_records_are_checked_as_requests(void **state)
+{
+    /* MoveOnAngleMode: servo 1 to 180.0 deg in 100 ms, servo 2 to 0 in 100 ms */
+    uint8_t m[14] = {1, 0x08, 0x07, 100, 0, 0, 0, 2, 0, 0, 100, 0, 0, 0}, f[64];
+    size_t len = 0;
+    assert_int_equal(sb_sync_frame(SB_PKT_MOVE_ANGLE, m, 7, 2, f, sizeof f, &len).status, SB_OK);
+    m[1] = 0xB8; /* 300.0 deg: beyond the angle's range */
+    m[2] = 0x0B;
+    sb_error e = sb_sync_frame(SB_PKT_MOVE_ANGLE, m, 7, 2, f, sizeof f, &len);
+    assert_int_equal(e.status, SB_E_RANGE);
+    assert_int_equal(e.servo, 1);
+    assert_int_equal(e.value, 3000);
+    m[1] = m[2] = 0;
+    m[10] = 0; /* servo 2's move in 0 ms: shorter than its ramps */
+    e = sb_sync_frame(SB_PKT_MOVE_ANGLE, m, 7, 2, f, sizeof f, &len);
+    assert_int_equal(e.status, SB_E_RANGE);
+    assert_int_equal(e.servo, 2);
+    m[10] = 100;
+    m[7] = 1; /* servo 1 twice */
+    e = sb_sync_frame(SB_PKT_MOVE_ANGLE, m, 7, 2, f, sizeof f, &len);
+    assert_int_equal(e.status, SB_E_DUPLICATE_ID);
+    assert_int_equal(e.servo, 1);
+    m[7] = SB_BROADCAST_ID;
+    assert_int_equal(sb_sync_frame(SB_PKT_MOVE_ANGLE, m, 7, 2, f, sizeof f, &len).status, SB_E_BROADCAST);
+    uint8_t ids[3] = {1, 1, SB_BROADCAST_ID};
+    assert_int_equal(sb_sync_frame(SB_PKT_MONITOR, ids, 1, 3, f, sizeof f, &len).status, SB_E_DUPLICATE_ID);
+}
+
+static void every_item_decodes_at_its_size_and_signedness(void **state)
+{
+    uint8_t c[2 + 4] = {1, SB_ITEM_SERIAL_NUMBER, 0xFF, 0xFF, 0xFF, 0xFF};
+    sb_read_data_answer a;
+    assert_int_equal(sb_decode_read_data(c, 6, &a).status, SB_OK);
+    assert_true(a.data == INT64_C(0xFFFFFFFF)); /* a serial number above 0x7FFFFFFF, not negative */
+    for (size_t k = 0; k < SB_ITEM_COUNT; k++) {
+        const sb_item_desc *item = &sb_items[k];
+        int64_t most = item->is_signed ? (INT64_C(1) << (8 * item->size - 1)) - 1 : (INT64_C(1) << (8 * item->size)) - 1;
+        int64_t least = item->is_signed ? -most - 1 : 0;
+        if (item->access == SB_ACCESS_RESERVED)
+            continue;
+        for (int end = 0; end < 2; end++) {
+            uint8_t f[16];
+            size_t len = 0;
+            sb_value v[3] = {{1, NULL, 0}, {item->id, NULL, 0}, {end ? most : least, NULL, 0}};
+            assert_int_equal(sb_encode_answer(SB_PKT_READ_DATA, v, 3, f, sizeof f, &len).status, SB_OK);
+            assert_int_equal(sb_decode_read_data(f + 4, len - 5, &a).status, SB_OK);
+            assert_true(a.data == v[2].n);
+            assert_int_equal(a.data_size, item->size);
+        }
+    }
+}
+
+static void a_profile_the_servo_would_stretch_is_refused(void **state)
+{
+    uint8_t f[32];
+    size_t len = 0;
+    sb_move_angle_by_interval_request a = {1, 900, 199, 100, 100, 0};
+    sb_error e = sb_encode_move_angle_by_interval(&a, f, sizeof f, &len);
+    assert_int_equal(e.status, SB_E_RANGE);
+    assert_string_equal(e.field, "interval");
+    assert_int_equal(e.value, 199);
+    assert_int_equal(e.least, 200); /* acc + dec */
+    a.interval = 200;
+    assert_int_equal(sb_encode_move_angle_by_interval(&a, f, sizeof f, &len).status, SB_OK);
+    sb_move_multi_turn_by_interval_request m = {1, 36000, 39, 20, 20, 0};
+    assert_int_equal(sb_encode_move_multi_turn_by_interval(&m, f, sizeof f, &len).status, SB_E_RANGE);
+    m.interval = 40;
+    assert_int_equal(sb_encode_move_multi_turn_by_interval(&m, f, sizeof f, &len).status, SB_OK);
+    /* The plain moves ramp 20 ms each way: 40 ms at least. */
+    sb_move_angle_request p = {1, 900, 39, 0};
+    assert_int_equal(sb_encode_move_angle(&p, f, sizeof f, &len).status, SB_E_RANGE);
+    sb_move_multi_turn_request pm = {1, 900, 39, 0};
+    assert_int_equal(sb_encode_move_multi_turn(&pm, f, sizeof f, &len).status, SB_E_RANGE);
+    /* A wheel run for a time shorter than its two 20 ms ramps. */
+    sb_move_wheel_request w = {1, 3, 100, 39};
+    e = sb_encode_move_wheel(&w, f, sizeof f, &len);
+    assert_int_equal(e.status, SB_E_RANGE);
+    assert_string_equal(e.field, "value");
+    w.value = 40;
+    assert_int_equal(sb_encode_move_wheel(&w, f, sizeof f, &len).status, SB_OK);
+    w.method = 2; /* turns: any number */
+    w.value = 1;
+    assert_int_equal(sb_encode_move_wheel(&w, f, sizeof f, &len).status, SB_OK);
+}
+
 static void a_long_sync_command_takes_the_extended_length(void **state)
 {
     uint8_t records[30 * 9], f[300];
     size_t len = 0;
     memset(records, 0, sizeof records);
+    for (size_t k = 0; k < 30; k++)
+        records[k * 9] = (uint8_t)k; /* servos 0 to 29 */
     assert_int_equal(sb_sync_frame(SB_PKT_STREAM_SETPOINT, records, 9, 30, f, sizeof f, &len).status, SB_OK);
     assert_int_equal(len, 6 + 3 + 270 + 1);
     assert_int_equal(f[3], 0xFF);
@@ -169,6 +365,13 @@ int main(void)
         cmocka_unit_test(the_frame_finder_skips_garbage_and_bad_frames),
         cmocka_unit_test(a_long_sync_command_takes_the_extended_length),
         cmocka_unit_test(the_wire_limit_is_servoctls),
+        cmocka_unit_test(the_frame_finder_rescans_after_a_false_header),
+        cmocka_unit_test(the_frame_finder_misses_no_answer_that_overlaps_noise),
+        cmocka_unit_test(the_typed_sync_command_checks_what_sb_sync_frame_checks),
+        cmocka_unit_test(a_sync_command_s_records_are_checked_as_requests),
+        cmocka_unit_test(the_rules_check_the_ranges_first),
+        cmocka_unit_test(every_item_decodes_at_its_size_and_signedness),
+        cmocka_unit_test(a_profile_the_servo_would_stretch_is_refused),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,5 +1,6 @@
 /* servobus's bus on fake servos: a request's answer, the Sync Monitor with
  * a servo missing, the stream's checks, the robot loop, the UART callbacks. */
+#include <errno.h>
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -38,7 +39,51 @@ static void a_call_returns_the_servos_answer(void **state)
     assert_true(fake.now_us - before >= bus.timeout_us); /* on the bus's clock */
     char text[120];
     sb_error_text(&e, text, sizeof text);
-    assert_string_equal(text, "servo 4: Ping: no answer in time (is it on the bus, at this baud rate?)");
+    assert_string_equal(text, "servo 4: Ping: no answer in time (is it on the bus, at this baud rate? "
+                              "two servos at one ID garble each other)");
+}
+
+/* Each error says what was wrong: the list, the field, the value and the range. */
+static void an_error_says_what_is_wrong(void **state)
+{
+    uint8_t ids[SB_MAX_SERVOS + 1], f[32];
+    char text[160];
+    size_t len = 0;
+    sb_stream s;
+    for (size_t k = 0; k < sizeof ids; k++)
+        ids[k] = (uint8_t)k;
+    sb_error e = sb_stream_init(&s, ids, SB_MAX_SERVOS + 1, 10);
+    sb_error_text(&e, text, sizeof text);
+    assert_string_equal(text, "StreamSetpoint: ids not allowed: 33 servos is beyond 1..32 (SB_MAX_SERVOS)");
+    e = sb_stream_init(&s, ids, 0, 10);
+    sb_error_text(&e, text, sizeof text);
+    assert_string_equal(text, "StreamSetpoint: ids not allowed: 0 servos is beyond 1..32 (SB_MAX_SERVOS)");
+    e = sb_sync_frame(SB_PKT_MONITOR, ids, 2, 1, f, sizeof f, &len);
+    sb_error_text(&e, text, sizeof text);
+    assert_string_equal(text, "SyncCommand: record_len not allowed: 2, not 1");
+    e = sb_sync_frame(SB_PKT_PING, ids, 1, 1, f, sizeof f, &len);
+    sb_error_text(&e, text, sizeof text);
+    assert_string_equal(text, "SyncCommand: cmd not allowed: not a packet SyncCommand carries");
+    e = sb_error_of(SB_E_BAD_ANSWER, 3, SB_PKT_READ_FAULTS, "count"); /* as sb_decode_answer fills it */
+    e.value = 17;
+    e.most = 16;
+    sb_error_text(&e, text, sizeof text);
+    assert_string_equal(text, "servo 3: ReadFaults: count a bad answer: 17 is beyond 0..16");
+    e = sb_error_of(SB_E_BAD_ANSWER, 1, SB_PKT_READ_DATA, "data_id");
+    e.value = 8;
+    e.least = e.most = 1;
+    sb_error_text(&e, text, sizeof text);
+    assert_string_equal(text, "servo 1: ReadData: data_id a bad answer: 8, not 1");
+    e = sb_error_of(SB_E_LINK, 1, SB_PKT_PING, NULL);
+    e.os_error = EIO;
+    sb_error_text(&e, text, sizeof text);
+    assert_non_null(strstr(text, "servo 1: Ping: the link failed (errno 5: "));
+    assert_non_null(strstr(text, strerror(EIO)));
+    sb_read_data_request r = {1, 200};
+    e = sb_encode_read_data(&r, f, sizeof f, &len);
+    sb_error_text(&e, text, sizeof text);
+    assert_string_equal(text, "servo 1: ReadData: data_id is no data item of the schema, or not one the packet "
+                              "may write (item 200)");
 }
 
 static void a_bad_checksum_is_told(void **state)
@@ -140,7 +185,8 @@ static void a_silent_servo_costs_one_slot_not_a_time_out(void **state)
         assert_true(last_silent <= all + SB_TURNAROUND_US + SB_ANSWER_MARGIN_US + 200u);
     }
     sb_error_text(&e, text, sizeof text);
-    assert_string_equal(text, "servo 6: Monitor: no answer in time (is it on the bus, at this baud rate?)");
+    assert_string_equal(text, "servo 6: Monitor: no answer in time (is it on the bus, at this baud rate? "
+                              "two servos at one ID garble each other)");
     fake.present[6] = true;
     fake.present[3] = false; /* one in the middle: the servos' own silence, then the rest answer */
     mid_silent = cycle_us(&e);
@@ -206,7 +252,7 @@ static void the_stream_refuses_what_the_servo_would_not_follow(void **state)
     assert_int_equal(e.status, SB_E_RANGE);
     assert_string_equal(e.field, "velocity");
     uint8_t twice[2] = {1, 1};
-    assert_int_equal(sb_stream_init(&s, twice, 2, 10).status, SB_E_USAGE);
+    assert_int_equal(sb_stream_init(&s, twice, 2, 10).status, SB_E_DUPLICATE_ID);
 }
 
 /* The UART callbacks: the fake's bytes handed over one at a time. */
@@ -258,6 +304,7 @@ int main(void)
         cmocka_unit_test_setup(the_robot_loop_sends_setpoints_and_reads_every_state, set_up),
         cmocka_unit_test_setup(a_silent_servo_costs_one_slot_not_a_time_out, set_up),
         cmocka_unit_test_setup(a_late_answer_to_the_round_before_is_dropped, set_up),
+        cmocka_unit_test_setup(an_error_says_what_is_wrong, set_up),
         cmocka_unit_test_setup(the_stream_refuses_what_the_servo_would_not_follow, set_up),
         cmocka_unit_test_setup(the_uart_callbacks_carry_a_request, set_up),
     };

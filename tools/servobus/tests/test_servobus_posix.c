@@ -82,6 +82,23 @@ static void a_timer_that_cannot_be_set_names_the_fix(void **state)
     assert_non_null(strstr(p.advice, "ttyUSB7's latency timer is "));
 }
 
+/* /dev/serial/by-id/usb-FTDI_...-port0 is a link to ../../ttyUSB7: the timer is ttyUSB7's. */
+static void a_port_by_a_link_has_its_device_s_timer(void **state)
+{
+    sb_posix p;
+    char dev[200], link[200];
+    memset(&p, 0, sizeof p);
+    snprintf(dev, sizeof dev, "%s/ttyUSB7", root);
+    put("16\n");
+    fclose(fopen(dev, "w"));
+    snprintf(link, sizeof link, "%s/usb-FTDI_FT232R_USB_UART_A10K-if00-port0", root);
+    assert_int_equal(symlink("ttyUSB7", link), 0);
+    assert_int_equal(sb_serial_latency_timer(link), 16);
+    sb_serial_check_latency(&p, link);
+    assert_int_equal(p.latency_timer_ms, 1);
+    assert_int_equal(sb_serial_latency_timer(dev), 1);
+}
+
 static void a_rate_termios_has_not_is_refused(void **state)
 {
     sb_posix p;
@@ -210,6 +227,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test_setup_teardown(the_latency_timer_is_read_and_set_to_1_ms, set_up, tear_down),
+        cmocka_unit_test_setup_teardown(a_port_by_a_link_has_its_device_s_timer, set_up, tear_down),
         cmocka_unit_test_setup_teardown(a_timer_that_cannot_be_set_names_the_fix, set_up, tear_down),
         cmocka_unit_test(a_rate_termios_has_not_is_refused),
         cmocka_unit_test(a_port_another_program_holds_is_refused),

@@ -65,9 +65,25 @@ def test_the_ros2_control_style_cycle_moves_three_joints(sim3):
 def test_the_cycle_refuses_an_id_it_cannot_address_and_an_unknown_option():
     """No servo is opened: the arguments are refused first, naming what is wrong."""
     bad_id = _run(["sb_ros2_cycle", "127.0.0.1:1", "--ids", "1,300"])
-    assert bad_id.returncode == 2 and "'300' is not a servo ID (0-253)" in bad_id.stderr, bad_id.stderr
+    assert bad_id.returncode == 2 and "'300' is not a servo ID (0-254)" in bad_id.stderr, bad_id.stderr
     unknown = _run(["sb_ros2_cycle", "127.0.0.1:1", "--idz", "1"])
     assert unknown.returncode == 2 and "usage:" in unknown.stderr, unknown.stderr
+    broadcast = _run(["sb_ros2_cycle", "127.0.0.1:1", "--ids", "255"])
+    assert broadcast.returncode == 2 and "'255' is not a servo ID (0-254)" in broadcast.stderr, broadcast.stderr
+
+
+def test_the_cycle_takes_id_254_and_the_address_servoctl_sim_prints():
+    """254 is a servo's ID; socket://HOST:PORT is how servoctl sim prints the
+    bus: both taken, up to the connection (no simulator listens at port 1)."""
+    done = _run(["sb_ros2_cycle", "socket://127.0.0.1:1", "--ids", "254"])
+    assert done.returncode == 1 and "cannot connect to 127.0.0.1:1\n" in done.stderr, done.stderr
+
+
+def test_the_c_robot_loop_names_the_address_it_could_not_reach(tmp_path):
+    clock = tmp_path / "bus.clock"
+    clock.write_bytes(bytes(32))  # a clock file no simulator writes
+    done = _run(["sb_loop_bench", "socket://127.0.0.1:1", str(clock), "115200", "1", "1"])
+    assert done.returncode == 2 and "no simulator at socket://127.0.0.1:1\n" in done.stderr, done.stderr
 
 
 def test_the_c_robot_loop_reads_every_state(tmp_path):

@@ -40,12 +40,15 @@ struct master_state {
 };
 volatile struct master_state master;
 
-static volatile uint32_t ms;
+/* The ms since start in 64 bits, as two words the M3 reads whole (a 32-bit
+ * count alone wraps after 49.7 days, and the bus clock with it). */
+static volatile uint32_t ms, ms_wraps;
 
 void SysTick_Handler(void);
 void SysTick_Handler(void)
 {
-    ms++;
+    if (++ms == 0u)
+        ms_wraps++;
 }
 
 /* The board's clock, as its bootloader sets it (HSE 8 MHz, PLL x9), if it
@@ -69,13 +72,14 @@ static void clock_init(void)
 
 static uint64_t now_us(void *ctx)
 {
-    uint32_t before, ticks;
+    uint32_t before, wraps, ticks;
     (void)ctx;
-    do {
+    do { /* again if a tick came in between */
+        wraps = ms_wraps;
         before = ms;
         ticks = SYST_RVR - SYST_CVR;
-    } while (before != ms);
-    return (uint64_t)before * 1000u + ticks / (SYSCLK_HZ / 1000000u);
+    } while (before != ms || wraps != ms_wraps);
+    return ((uint64_t)wraps << 32 | before) * 1000u + ticks / (SYSCLK_HZ / 1000000u);
 }
 
 /* A received byte, or -1. Reading DR after SR clears RXNE (and an

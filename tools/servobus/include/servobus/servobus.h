@@ -52,9 +52,18 @@ sb_error sb_error_of(sb_status status, int servo, uint8_t packet, const char *fi
 /* A transport from its parts (sb_transport's fields). */
 sb_transport sb_transport_make(void *ctx, int (*write)(void *, const uint8_t *, size_t),
                                int (*read)(void *, uint8_t *, size_t, size_t, uint32_t), uint64_t (*now_us)(void *));
-/* The error in words, NUL-terminated in buf: "servo 3: ReadAngle: no answer
- * within 100000 us". Returns the length written (cut to cap - 1). */
+/* The error in words, NUL-terminated in buf: the servo, the packet, the
+ * field, what went wrong and the value and range it carries, e.g.
+ * "servo 3: MoveOnAngleMode: angle out of range: 1801 is beyond
+ * -1800..1800; nothing was sent", "StreamSetpoint: ids not allowed: 33
+ * servos is beyond 1..32 (SB_MAX_SERVOS)", "servo 3: ReadAngle: no answer
+ * in time (is it on the bus, ...)", "servo 3: Ping: the link failed (errno
+ * 5: Input/output error)" (the errno's name on a POSIX host). Returns the
+ * length written (cut to cap - 1). */
 size_t sb_error_text(const sb_error *e, char *buf, size_t cap);
+/* The IDs a round lists (code: its packet, for the error): each a servo's,
+ * once (SB_E_BROADCAST, SB_E_DUPLICATE_ID naming it). */
+sb_error sb_check_ids(const uint8_t *ids, size_t count, uint8_t code);
 const sb_packet_desc *sb_packet(uint8_t code); /* NULL: not in the schema */
 const sb_item_desc *sb_item(uint8_t id);       /* NULL: not in the schema */
 
@@ -65,6 +74,15 @@ const sb_item_desc *sb_item(uint8_t id);       /* NULL: not in the schema */
  * range; a request's length against the packet's. */
 sb_error sb_encode_content(uint8_t code, const sb_value *v, size_t count, uint8_t *out, size_t cap, size_t *len);
 sb_error sb_encode_request(uint8_t code, const sb_value *v, size_t count, uint8_t *frame, size_t cap, size_t *len);
+/* A request's fields' ranges (each number's: SB_E_RANGE; an item's value
+ * is the encoders'), then the rules across them: a move's time shorter
+ * than its ramps (the servo would stretch it: SB_E_RANGE); a SyncCommand's records
+ * not of a syncable packet at its length, or not as many as it says
+ * (SB_E_USAGE), and each record checked as its packet's request (its
+ * fields' ranges: SB_E_RANGE; these rules; its servo's ID: SB_E_BROADCAST
+ * for 255, SB_E_DUPLICATE_ID for one listed twice). The encoders above
+ * apply it. */
+sb_error sb_check_request(uint8_t code, const sb_value *v, size_t count);
 /* An answer's frame (a servo's side: the tests' fake servos, cross-checks). */
 sb_error sb_encode_answer(uint8_t code, const sb_value *v, size_t count, uint8_t *frame, size_t cap, size_t *len);
 /* A frame around a content: header, code, length (extended from 255), checksum. */
@@ -78,19 +96,34 @@ uint8_t sb_checksum(const uint8_t *data, size_t len);
 
 /* A frame finder over a stream of bytes: sb_parse returns 1 when a frame
  * (header as given) ends in the bytes fed so far, with its code and
- * content; bytes outside frames and frames with a bad checksum are counted. */
+ * content; bytes outside frames and frames with a bad checksum are counted.
+ * A false header (noise, an answer cut short) costs only its bytes: the
+ * search goes on from the byte after it, through the bytes held. Every
+ * frame is returned as its last byte comes, whatever frames it overlaps:
+ * an answer whose content holds a whole frame, or whose first bytes made a
+ * good checksum with noise before it, is not lost (the caller skips what
+ * it did not ask for). */
 typedef struct sb_parser {
     uint8_t header[2];
     uint8_t buf[SB_RX_MAX];
-    size_t len;
+    size_t len;   /* bytes held */
+    size_t seen;  /* of them examined */
+    size_t taken; /* to drop at the next call: the first byte of a frame returned at buf's start */
+    size_t owned; /* the bytes held from the start up to a frame's end returned: not stray */
+    bool tie;        /* another frame may end where the one returned last did, */
+    size_t tie_from; /* starting here or later */
     uint32_t stray_bytes;
     uint32_t bad_frames;
 } sb_parser;
 void sb_parser_init(sb_parser *p, bool requests);
 /* Takes what it can of data (*used: how much); 1: a frame (code, content
- * valid until the next call), 0: none yet. */
+ * valid until the next call), 0: none yet and all of data taken. Call it
+ * again after a 1, with no data if none is left: the bytes held may hold
+ * another frame. */
 int sb_parse(sb_parser *p, const uint8_t *data, size_t len, size_t *used, uint8_t *code, const uint8_t **content,
              size_t *clen);
+/* Drops every byte held (the counts stay): a new request's answers. */
+void sb_parser_clear(sb_parser *p);
 /* The bytes that would complete the frame the parser is in (at least 1). */
 size_t sb_parser_missing(const sb_parser *p);
 
@@ -117,6 +150,10 @@ sb_error sb_send(sb_bus *bus, const uint8_t *frame, size_t len);
 sb_error sb_receive(sb_bus *bus, uint8_t code, int servo, uint64_t deadline_us, uint8_t *content, size_t *len);
 /* sb_send the frame in bus->tx (len bytes), then sb_receive within timeout_us. */
 sb_error sb_request(sb_bus *bus, size_t len, uint8_t code, int servo, uint8_t *content, size_t *clen);
+/* The same for an answer about item (its content's second byte: ReadData's
+ * and WriteData's data_id); answers about another are skipped, and if only
+ * they came, SB_E_BAD_ANSWER on "data_id" (value: theirs, least = most: item). */
+sb_error sb_request_item(sb_bus *bus, size_t len, uint8_t code, int servo, int item, uint8_t *content, size_t *clen);
 /* The bytes of a packet's answer frame (its fields fixed), or 0. */
 size_t sb_answer_frame_size(uint8_t code);
 
@@ -132,8 +169,14 @@ sb_error sb_sync_command(sb_bus *bus, uint8_t cmd, const uint8_t *records, size_
  * the wire takes: its bytes at the baud rate, the servos' turnaround, a
  * silent servo's SB_SYNC_SILENCE_US before the next takes its turn, and
  * answer_margin_us; a silent servo costs one such slot, not a time-out.
- * Answers come in the list's order: an answer of ids[k] drops any taken of
- * ids[k] or later (a previous round's, late). */
+ * Only an answer that takes a listed servo's turn moves that schedule (a
+ * frame of a servo not listed, or whose turn has passed, does not), and
+ * however the line babbles the round ends by the request's end plus count
+ * times (such a slot + SB_SYNC_SILENCE_US). Answers come in the list's
+ * order: an answer of ids[k] drops any taken of ids[k] or later (a
+ * previous round's, late). An ID listed twice, or the broadcast ID, is
+ * refused before anything is sent (sb_check_ids); got[] is all false after
+ * any error before the answers (a refusal, a link error). */
 sb_error sb_sync_monitor(sb_bus *bus, const uint8_t *ids, size_t count, sb_monitor_answer *states, bool *got);
 /* The same after a frame already sent (a robot loop's burst). */
 sb_error sb_sync_monitor_answers(sb_bus *bus, const uint8_t *ids, size_t count, sb_monitor_answer *states,
@@ -158,7 +201,9 @@ sb_error sb_stream_frame(sb_stream *s, const int32_t *angles, const int16_t *vel
 
 /* ---- the robot loop ----------------------------------------------------- */
 /* A cycle: one SyncCommand of setpoints and one Sync Monitor in one write,
- * then every servo's state. */
+ * then every servo's state (got[] all false if the setpoints are refused or
+ * the link fails). Called once per period_ms: the setpoints' speeds and
+ * time stamps count on it. */
 typedef struct sb_loop {
     sb_bus *bus;
     sb_stream stream;

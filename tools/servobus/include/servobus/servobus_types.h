@@ -16,14 +16,16 @@ extern "C" {
 typedef enum sb_status {
     SB_OK = 0,
     SB_E_RANGE,          /* a field's value beyond the schema's range: nothing sent */
-    SB_E_USAGE,          /* a call the protocol does not allow (wrong count, not syncable, ...) */
+    SB_E_USAGE,          /* a call the protocol does not allow (field: what; value, least, most: how) */
     SB_E_UNKNOWN_PACKET, /* a code the schema does not have */
-    SB_E_UNKNOWN_ITEM,   /* a data item the schema does not have, or not writable */
+    SB_E_UNKNOWN_ITEM,   /* a data item the schema does not have (ReadData, WriteData), or not writable */
     SB_E_SPACE,          /* the caller's buffer is too small */
     SB_E_NO_ANSWER,      /* the servo did not answer in time */
     SB_E_BAD_CHECKSUM,   /* an answer came with a bad checksum */
     SB_E_BAD_ANSWER,     /* an answer of the wrong length, or a field beyond its range */
-    SB_E_LINK            /* the transport failed (os_error says why) */
+    SB_E_LINK,           /* the transport failed (os_error says why) */
+    SB_E_DUPLICATE_ID,   /* a servo listed twice (each answers once a round): nothing sent */
+    SB_E_BROADCAST       /* the broadcast ID where no servo would carry it out or answer: nothing sent */
 } sb_status;
 
 /* An error as a value: which servo (-1: none or unknown), which packet

@@ -1,0 +1,129 @@
+/* Errors in words: the servo, the packet, the field, what went wrong and
+ * the value and range it carries. */
+#include <string.h>
+
+#include "servobus/servobus.h"
+
+#if defined(__unix__) || defined(__APPLE__)
+#define SB_HAS_STRERROR 1 /* a host's C library names errno's values; a microcontroller's may not */
+#endif
+
+typedef struct text {
+    char *buf;
+    size_t cap, len;
+} text;
+
+static void put(text *t, const char *s)
+{
+    while (*s != '\0') {
+        if (t->len + 1 < t->cap)
+            t->buf[t->len++] = *s;
+        s++;
+    }
+    if (t->cap > 0)
+        t->buf[t->len < t->cap ? t->len : t->cap - 1] = '\0';
+}
+
+static void put_number(text *t, int64_t n)
+{
+    char digits[24];
+    size_t k = sizeof digits - 1;
+    uint64_t u = n < 0 ? 0u - (uint64_t)n : (uint64_t)n;
+    digits[k] = '\0';
+    do {
+        digits[--k] = (char)('0' + u % 10u);
+        u /= 10u;
+    } while (u > 0);
+    if (n < 0)
+        digits[--k] = '-';
+    put(t, digits + k);
+}
+
+static const char *const WHAT[] = {
+    "ok",
+    "out of range",
+    "not allowed",
+    "not a packet of the protocol",
+    "is no data item of the schema, or not one the packet may write",
+    "the buffer is too small",
+    "no answer",
+    "an answer with a bad checksum",
+    "a bad answer",
+    "the link failed",
+    "listed twice",
+    "is the broadcast ID: no servo answers it or carries it out",
+};
+
+/* ": 33 is beyond 1..32", or ": 8, not 1" where one value is right. */
+static void put_range(text *t, const sb_error *e)
+{
+    bool servos = e->status == SB_E_USAGE && e->field != NULL && strcmp(e->field, "ids") == 0;
+    put(t, ": ");
+    put_number(t, e->value);
+    put(t, servos ? " servos" : "");
+    if (e->least == e->most) {
+        put(t, ", not ");
+        put_number(t, e->least);
+        return;
+    }
+    put(t, " is beyond ");
+    put_number(t, e->least);
+    put(t, "..");
+    put_number(t, e->most);
+    put(t, servos ? " (SB_MAX_SERVOS)" : "");
+}
+
+size_t sb_error_text(const sb_error *e, char *buf, size_t cap)
+{
+    text t = {buf, cap, 0};
+    const sb_packet_desc *p = e->packet != 0 ? sb_packet(e->packet) : NULL;
+    bool ranged = e->value != 0 || e->least != 0 || e->most != 0;
+    put(&t, "");
+    if (e->servo >= 0) {
+        put(&t, "servo ");
+        put_number(&t, e->servo);
+        put(&t, ": ");
+    }
+    if (p != NULL) {
+        put(&t, p->name);
+        put(&t, ": ");
+    } else if (e->packet != 0) {
+        put(&t, "packet ");
+        put_number(&t, e->packet);
+        put(&t, ": ");
+    }
+    if (e->field != NULL) {
+        put(&t, e->field);
+        put(&t, " ");
+    }
+    put(&t, (size_t)e->status < sizeof WHAT / sizeof WHAT[0] ? WHAT[e->status] : "unknown error");
+    if (e->status == SB_E_RANGE) {
+        put_range(&t, e);
+        put(&t, "; nothing was sent");
+    } else if (e->status == SB_E_USAGE && ranged) {
+        put_range(&t, e);
+    } else if (e->status == SB_E_USAGE && e->field != NULL && strcmp(e->field, "cmd") == 0) {
+        put(&t, ": not a packet SyncCommand carries");
+    } else if (e->status == SB_E_BAD_ANSWER && ranged) {
+        put_range(&t, e);
+    } else if (e->status == SB_E_DUPLICATE_ID || e->status == SB_E_BROADCAST) {
+        put(&t, "; nothing was sent");
+    } else if (e->status == SB_E_NO_ANSWER) {
+        put(&t, " in time (is it on the bus, at this baud rate? two servos at one ID garble each other)");
+    } else if (e->status == SB_E_BAD_CHECKSUM) {
+        put(&t, " (noise on the line, or two servos at one ID answering together)");
+    } else if (e->status == SB_E_LINK) {
+        put(&t, " (errno ");
+        put_number(&t, e->os_error);
+#ifdef SB_HAS_STRERROR
+        put(&t, ": ");
+        put(&t, strerror(e->os_error));
+#endif
+        put(&t, ")");
+    } else if (e->status == SB_E_UNKNOWN_ITEM) {
+        put(&t, " (item ");
+        put_number(&t, e->value);
+        put(&t, ")");
+    }
+    return t.len;
+}
