@@ -99,3 +99,21 @@ def test_a_burst_of_stop_all_clicks_puts_few_stops_on_the_wire():
         runs = [line.split() for line in sim.control("wire 1024").splitlines() if line.strip() not in ("", "end")]
         sent = sum(int(r[2]) for r in runs if r[3] == "host")
         assert 0 < sent <= 50 * 9, runs  # a stop frame is 9 bytes; 2000 of them without the limit
+
+
+def test_a_file_written_into_a_missing_folder_is_refused_before_the_command_runs(tmp_path):
+    """config save into a folder that is not there said "saved", then a
+    bare errno; now refused first, the folder named."""
+    with Simulator(ids=[1], fast=True) as sim:
+        said = []
+        w = Worker(sim.bus(), ["--port", sim.url], said.append, files=tmp_path)
+        for argv, name in ((["config", "save", "1", "nosub/deeper/servo.json"], "nosub/deeper/servo.json"),
+                           (["backup", "nosub/bus.json"], "nosub/bus.json")):
+            done = w.run(argv)
+            assert done["code"] == 2 and "saved" not in done["out"], done
+            assert f"ui: {name!r} is not written: no such folder: nosub in {tmp_path}" in done["err"], done
+            assert "Errno" not in done["err"], done
+        (tmp_path / "nosub").mkdir()
+        assert w.run(["backup", "nosub/bus.json"])["code"] == 0
+        assert (tmp_path / "nosub" / "bus.json").exists()
+        w.preempt.close()
