@@ -201,9 +201,9 @@ class Worker:
 
     def table(self):
         """Every known servo's info (servoctl info --json), or why it is
-        silent; a servo being plotted is left to its samples."""
+        silent; those being plotted too (the round comes every 3 s then)."""
         rows = []
-        for servo_id in (i for i in self.known if i not in self.plot_ids):
+        for servo_id in self.known:
             r = self.run_quiet(["info", str(servo_id), "--json"])
             self.preempt.check()  # interrupted: no row is "gone" for it
             if r["code"] == 0:

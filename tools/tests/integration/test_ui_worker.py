@@ -117,3 +117,19 @@ def test_a_file_written_into_a_missing_folder_is_refused_before_the_command_runs
         assert w.run(["backup", "nosub/bus.json"])["code"] == 0
         assert (tmp_path / "nosub" / "bus.json").exists()
         w.preempt.close()
+
+
+def test_the_live_table_refreshes_a_plotted_servo():
+    """The table skipped every plotted ID: a plotted servo that went silent
+    stayed "answering" (docs/ui.md: every 3 s while plotting)."""
+    with Simulator(ids=[1, 2], fast=True) as sim:
+        said = []
+        w = _worker(sim, said)
+        w.known = [1, 2]
+        w.plot([1])
+        assert sim.control("unplug 1 1").strip() == "ok"
+        w.table()
+        rows = {r["id"]: r for r in said[-1]["rows"]}
+        assert said[-1]["type"] == "table" and set(rows) == {1, 2}, said[-1]
+        assert rows[1].get("gone") and not rows[2].get("gone"), rows
+        w.preempt.close()
