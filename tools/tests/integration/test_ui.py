@@ -192,6 +192,24 @@ def test_bring_up_updates_two_servos_in_a_row_and_reads_faults(bench):
     out.filter(has_text="servo 1: no faults").wait_for(timeout=WAIT_MS)
 
 
+def test_bring_up_buttons_stay_off_while_a_step_runs(bench):
+    """The live table's redraw (each second) turned them back on mid-step:
+    a second step's output mixed into the first's box, the bar hid."""
+    _, _, _, page = bench
+    _view(page, "bringup")
+    # One turn of the page's script: a step started, then a live table of
+    # this firmware's servo (what greyOwn re-enabled the buttons on).
+    seen = page.evaluate("""() => {
+        document.querySelector('#fl-read').click();
+        UI.handle({type: 'table', rows: [Object.assign({}, UI.state.servos[UI.picked()].info)]});
+        return {on: [...document.querySelectorAll('#view-bringup button')].filter((b) => !b.disabled)
+                    .map((b) => b.id), bar: !document.querySelector('#br-prog').hidden}; }""")
+    assert seen == {"on": [], "bar": True}, seen
+    page.locator("#bringup-out", has_text="no faults").wait_for(timeout=WAIT_MS)
+    page.wait_for_function("!document.querySelector('#fl-read').disabled"
+                           " && document.querySelector('#br-prog').hidden", timeout=WAIT_MS)
+
+
 def test_the_maker_firmware_s_missing_features_are_greyed_with_the_reason(bench):
     """servoctl info of a servo that answers none of items 64-67 (the
     maker's firmware) has no winding_c: the page greys what needs them."""

@@ -7,7 +7,7 @@ const UI = (() => {
   const handlers = {};        // message type: [fn]
   const waiting = {};         // tag: {resolve, onLine}
   let ws = null, tag = 0, role = "connecting";
-  const state = {servos: {}, picked: null, about: {}};
+  const state = {servos: {}, picked: null, about: {}, stepping: false};
 
   const $ = (sel) => document.querySelector(sel);
   const el = (tagName, attrs = {}, ...kids) => {
@@ -121,7 +121,8 @@ const UI = (() => {
     document.querySelectorAll("[data-needs=own]").forEach((f) => {
       f.classList.toggle("off", !!why);
       f.dataset.why = why;
-      f.querySelectorAll("button,input,select").forEach((b) => { b.disabled = !!why; });
+      // A Bring-up step that runs keeps them off until it ends (bringup.js).
+      f.querySelectorAll("button,input,select").forEach((b) => { b.disabled = !!why || state.stepping; });
     });
   }
 
