@@ -17,7 +17,7 @@ from .. import cli
 from .. import protocol as p
 from ..args import build_parser
 from ..checks import check_range
-from ..errors import EXIT_INTERRUPTED, ServoError
+from ..errors import EXIT_INTERRUPTED, NoReply, ServoError
 from . import sampling
 from .files import Folder
 from .preempt import STOP_METHOD, Preemption
@@ -220,7 +220,10 @@ class Worker:
             self.publish = publish
 
     def items(self, servo_id: int):
-        self.publish({"type": "items", "id": servo_id, "items": sampling.items_of(self.bus, servo_id)})
+        try:
+            self.publish({"type": "items", "id": servo_id, "items": sampling.items_of(self.bus, servo_id)})
+        except NoReply as e:  # said once, not as each item missing
+            self.publish({"type": "items", "id": servo_id, "items": [], "silent": str(e)})
 
     def plot(self, ids: list):
         ids = list(dict.fromkeys(int(i) for i in ids))  # each once: a page's list, not a Sync Monitor of 10 000

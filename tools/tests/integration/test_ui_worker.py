@@ -133,3 +133,22 @@ def test_the_live_table_refreshes_a_plotted_servo():
         assert said[-1]["type"] == "table" and set(rows) == {1, 2}, said[-1]
         assert rows[1].get("gone") and not rows[2].get("gone"), rows
         w.preempt.close()
+
+
+def test_a_silent_servo_s_items_are_said_once_not_blamed_on_its_firmware():
+    """An unplugged servo's Read every item took a wait for each item
+    (11 s) and said each was "not on this servo's firmware"."""
+    with Simulator(ids=[1, 2], fast=True) as sim:
+        said = []
+        w = _worker(sim, said)
+        w.items(1)
+        assert said[-1]["items"] and not said[-1].get("silent"), said[-1]
+        assert sim.control("unplug 1 2").strip() == "ok"
+        t0 = w.bus.clock()
+        w.items(2)
+        took_s = w.bus.clock() - t0  # the simulator's clock
+        heard = said[-1]
+        assert heard["type"] == "items" and heard["items"] == [], heard
+        assert "servo 2 does not answer" in heard["silent"] and "firmware" not in heard["silent"], heard
+        assert took_s < 1.0, took_s  # one wait for an answer, not one for each of ~30 items
+        w.preempt.close()

@@ -15,8 +15,16 @@
     send({op: "items", id});
   }
 
+  // Said in the items' table: a servo that does not answer (once).
+  function said(text) {
+    const body = $("#items tbody");
+    body.innerHTML = "";
+    body.append(el("tr", {class: "said"}, el("td", {colspan: 7, class: "why refused", text})));
+  }
+
   on("items", (m) => {
     if (m.id !== picked()) return;
+    if (m.silent) { said(m.silent); return; }
     const body = $("#items tbody");
     body.innerHTML = "";
     for (const it of m.items) body.append(row(m.id, it));
