@@ -28,6 +28,7 @@ from .preempt import STOP_METHOD, Preemption
 RUNNABLE = set(cli.COMMANDS) - {"monitor", "stream", "record", "ui"}
 TABLE_EVERY_S = (1.0, 3.0)  # the live table's info round, bus time: idle, plotting
 QUEUE_MAX = 64  # page actions waiting; more are refused (a page gone wild, a script)
+NOT_RUN = "servoctl ui: not run: stop-all came first"
 # What identify, tune, calibrate and update load on first use (scipy takes
 # a second): loaded as the ui starts, on a thread of their own, not on the
 # bus thread in the middle of a command.
@@ -219,13 +220,14 @@ class Worker:
         finally:
             self.publish = publish
 
-    def items(self, servo_id: int):
+    def items(self, servo_id: int, tag=None):
         try:
-            self.publish({"type": "items", "id": servo_id, "items": sampling.items_of(self.bus, servo_id)})
+            self.publish({"type": "items", "id": servo_id, "tag": tag,
+                          "items": sampling.items_of(self.bus, servo_id)})
         except NoReply as e:  # said once, not as each item missing
-            self.publish({"type": "items", "id": servo_id, "items": [], "silent": str(e)})
+            self.publish({"type": "items", "id": servo_id, "tag": tag, "items": [], "silent": str(e)})
 
-    def plot(self, ids: list):
+    def plot(self, ids: list, tag=None):
         ids = list(dict.fromkeys(int(i) for i in ids))  # each once: a page's list, not a Sync Monitor of 10 000
         for servo_id in ids:
             check_range("servo ID", servo_id, 0, p.MAX_ID)
@@ -247,10 +249,13 @@ class Worker:
             failed.append(f"broadcast stop: {e}")
         with self.cond:
             dropped, self.jobs = list(self.jobs), collections.deque()
-        for fn, a in dropped:
+        for fn, a in dropped:  # each answered, where the page shows that action's output
             if fn == self.run:
                 argv, tag = a
-                self._result(tag, argv, EXIT_INTERRUPTED, "", "servoctl ui: not run: stop-all came first")
+                self._result(tag, argv, EXIT_INTERRUPTED, "", NOT_RUN)
+            else:
+                self.publish({"type": "error", "op": fn.__name__, "tag": a[-1] if len(a) > 1 else None,
+                              "text": NOT_RUN})
         ids = self.known or self.plot_ids
         said = [self.run_quiet(["stop", str(i), "--mode", mode]) for i in ids]
         failed += [r["err"] for r in said if r["code"]]

@@ -156,6 +156,38 @@ def test_stop_all_ends_a_running_command_first(bench):
     assert sim.state(1)["angle"] > -60
 
 
+def test_refused_and_dropped_requests_are_said_in_their_own_box(bench):
+    """A full queue's refusal was in the footer log only, a move dropped by
+    STOP ALL showed its command line alone, a scan refused or dropped said
+    "scanning…" for ever, a dropped Read every item nothing: each is said
+    where that action's output goes."""
+    sim, _, _, page = bench
+    _view(page, "bus")  # the other views' boxes are hidden, not gone
+    page.evaluate("() => { window.waiting = UI.run(['move', 1, 90, '--interval', 20000, '--wait']); }")
+    sim.wait_until(lambda: abs(sim.state(1)["velocity"]) > 1, timeout_s=10)  # the bus thread is in it
+    page.evaluate("""() => {
+        document.querySelector('#mv-angle').value = '-30';
+        document.querySelector('#mv-go').click();      // queued: 1
+        document.querySelector('#scan').click();       // 2
+        document.querySelector('#items-read').click(); // 3
+        for (let i = 0; i < 61; i++) UI.run(['ping', 2]);  // 64: the queue is full
+        document.querySelector('#cfg-diff').click();   // refused
+    }""")
+    refused = "actions are waiting for the bus: this one is refused"
+    page.locator("#servo-out", has_text=refused).wait_for(state="attached", timeout=WAIT_MS)
+    page.click("#scan")  # refused too
+    page.locator("#scan-line", has_text=refused).wait_for(state="attached", timeout=WAIT_MS)
+    page.click("#stop-all")
+    not_run = "servoctl ui: not run: stop-all came first"
+    page.locator("#motion-out", has_text=not_run).wait_for(state="attached", timeout=WAIT_MS)
+    page.locator("#scan-line", has_text=not_run).wait_for(state="attached", timeout=WAIT_MS)
+    page.locator("#items tbody", has_text=not_run).wait_for(state="attached", timeout=WAIT_MS)
+    assert page.evaluate("window.waiting")["code"] == 130
+    assert sim.state(1)["angle"] > -25  # the dropped move to -30 never ran
+    page.click("#scan")  # the page's list again, for the tests after
+    page.locator("#scan-line", has_text="6 ID(s) answered").wait_for(timeout=WAIT_MS)
+
+
 def test_a_servo_unplugged_mid_session_is_shown_gone(bench):
     sim, _, _, page = bench
     page.evaluate("servoUiPlots && UI.send({op: 'plot', ids: []})")

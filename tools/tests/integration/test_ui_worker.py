@@ -152,3 +152,23 @@ def test_a_silent_servo_s_items_are_said_once_not_blamed_on_its_firmware():
         assert "servo 2 does not answer" in heard["silent"] and "firmware" not in heard["silent"], heard
         assert took_s < 1.0, took_s  # one wait for an answer, not one for each of ~30 items
         w.preempt.close()
+
+
+def test_stop_all_answers_every_request_it_drops():
+    """A queued scan, Read every item or plot dropped by STOP ALL had no
+    answer: the page said "scanning…" for ever."""
+    NOT_RUN = "servoctl ui: not run: stop-all came first"
+    with Simulator(ids=[1], fast=True) as sim:
+        said = []
+        w = _worker(sim, said)
+        w.known = [1]
+        w.submit(w.run, ["ping", "1"], 1)
+        w.submit(w.scan, False, 2)
+        w.submit(w.items, 1, 3)
+        w.submit(w.plot, [1], 4)
+        w.stop_all("release")
+        answers = {m.get("tag"): m for m in said if m["type"] in ("result", "error")}
+        assert answers[1]["type"] == "result" and answers[1]["err"] == NOT_RUN, answers
+        for tag, op in ((2, "scan"), (3, "items"), (4, "plot")):
+            assert answers[tag]["op"] == op and answers[tag]["text"] == NOT_RUN, answers
+        w.preempt.close()

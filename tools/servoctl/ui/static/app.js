@@ -38,9 +38,13 @@ const UI = (() => {
 
   function handle(msg) {
     if (msg.type === "line" && waiting[msg.tag] && waiting[msg.tag].onLine) waiting[msg.tag].onLine(msg);
-    if (msg.type === "error" && msg.tag != null && waiting[msg.tag]) {  // refused before it ran: a full queue
+    // Refused before it ran (a full queue, a watching tab): the request that asked hears it.
+    if ((msg.type === "error" || msg.type === "busy") && msg.tag != null && waiting[msg.tag]) {
       waiting[msg.tag].resolve({code: 2, out: "", err: msg.text});
       delete waiting[msg.tag];
+    }
+    if ((msg.type === "error" || msg.type === "busy") && msg.op) {  // a scan, items or a plot refused or dropped
+      (handlers[`refused-${msg.op}`] || []).forEach((fn) => fn(msg));
     }
     if (msg.type === "result") {
       log(`$ ${msg.command}  -> exit ${msg.code}`, msg.code ? "refused" : "");
@@ -69,11 +73,20 @@ const UI = (() => {
   }
 
   // A command's output into a <pre>: its lines as they come, the error red.
+  // An answer that came with no line (refused by a full queue, dropped by
+  // STOP ALL, a watching tab's) is shown here too, not only in the log.
   async function runInto(pre, argv) {
     pre.textContent = `$ servoctl ${argv.join(" ")}\n`;
-    const r = await run(argv, (m) => { pre.textContent += m.text + "\n"; pre.scrollTop = pre.scrollHeight; });
+    let heard = 0;
+    const r = await run(argv, (m) => {
+      heard++;
+      pre.textContent += m.text + "\n";
+      pre.scrollTop = pre.scrollHeight;
+    });
     pre.classList.toggle("refused", r.code !== 0);
-    if (!r.out && !r.err) pre.textContent += r.code ? `exit ${r.code}\n` : "done\n";
+    const said = heard ? "" : [r.out, r.err].filter((t) => t).join("\n").trim();
+    if (said) pre.textContent += said + "\n";
+    else if (!r.out && !r.err) pre.textContent += r.code ? `exit ${r.code}\n` : "done\n";
     return r;
   }
 
@@ -92,7 +105,7 @@ const UI = (() => {
     $("#bus-port").textContent = `${m.port}${m.simulator ? " (simulator)" : ""}`;
     setRole(m.role, m.holder ? `${m.holder} drives the bus` : "");
   });
-  on("busy", (m) => { setRole("viewer", m.text); log(m.text, "refused"); });
+  on("busy", (m) => { setRole("viewer", `${m.holder} drives the bus`); log(m.text, "refused"); });
   on("error", (m) => log(m.text, "refused"));
   on("stopped", (m) => log(`stop-all: ${m.ids.length} servo(s) ${m.mode === "damping" ? "damped" : "released"}` +
       (m.failed.length ? `; ${m.failed.join("; ")}` : ""), m.failed.length ? "refused" : "done"));
@@ -145,6 +158,8 @@ const UI = (() => {
     (handlers["view"] || []).forEach((fn) => fn({view}));
   }
 
-  return {$, el, on, handle, send, run, runInto, log, state, picked, setServos, whyNot, greyOwn, show,
+  const onRefused = (op, fn) => on(`refused-${op}`, fn);
+
+  return {$, el, on, onRefused, handle, send, run, runInto, log, state, picked, setServos, whyNot, greyOwn, show,
           role: () => role};
 })();

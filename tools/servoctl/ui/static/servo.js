@@ -15,7 +15,8 @@
     send({op: "items", id});
   }
 
-  // Said in the items' table: a servo that does not answer (once).
+  // Said in the items' table: a servo that does not answer (once), or a
+  // read refused by a full queue or dropped by STOP ALL.
   function said(text) {
     const body = $("#items tbody");
     body.innerHTML = "";
@@ -29,6 +30,7 @@
     body.innerHTML = "";
     for (const it of m.items) body.append(row(m.id, it));
   });
+  UI.onRefused("items", (m) => said(m.text));
 
   function row(id, it) {
     const why = el("td", {class: "why"});
