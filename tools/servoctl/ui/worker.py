@@ -29,6 +29,9 @@ RUNNABLE = set(cli.COMMANDS) - {"monitor", "stream", "record", "ui"}
 TABLE_EVERY_S = (1.0, 3.0)  # the live table's info round, bus time: idle, plotting
 QUEUE_MAX = 64  # page actions waiting; more are refused (a page gone wild, a script)
 NOT_RUN = "servoctl ui: not run: stop-all came first"
+# An update stopped part-way: a servo it had switched over waits in its bootloader.
+UPDATE_CUT = ("servoctl ui: the update stopped part-way: a servo it had switched to its bootloader is left "
+              "there (a scan shows it so); run the update again to install an application")
 # What identify, tune, calibrate and update load on first use (scipy takes
 # a second): loaded as the ui starts, on a thread of their own, not on the
 # bus thread in the middle of a command.
@@ -140,7 +143,7 @@ class Worker:
             return self._result(tag, argv, 2, "", f"servoctl: error: {msg}")
         out, err = _Lines(lambda line: self.publish({"type": "line", "tag": tag, "text": line})), _Lines(
             lambda line: self.publish({"type": "line", "tag": tag, "text": line, "err": True}))
-        code, staging = 0, None
+        code, staging, args = 0, None, None
         with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
             try:
                 args = build_parser().parse_args(self.global_argv + list(argv))
@@ -154,6 +157,8 @@ class Worker:
                     staging.write_out()
             except KeyboardInterrupt:
                 print(f"servoctl: interrupted by {self.preempt.why}", file=err)
+                if args is not None and args.command == "update":
+                    print(UPDATE_CUT, file=err)
                 code = EXIT_INTERRUPTED
             except SystemExit as e:  # argparse's usage error, printed to err
                 code = e.code if isinstance(e.code, int) else 2

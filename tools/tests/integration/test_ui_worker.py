@@ -172,3 +172,24 @@ def test_stop_all_answers_every_request_it_drops():
         for tag, op in ((2, "scan"), (3, "items"), (4, "plot")):
             assert answers[tag]["op"] == op and answers[tag]["text"] == NOT_RUN, answers
         w.preempt.close()
+
+
+def test_an_update_stop_all_cuts_short_says_its_servo_is_left_in_its_bootloader(tmp_path):
+    """The box said "interrupted by stop-all" alone; the servo waits in its
+    bootloader, and the user must know to run the update again."""
+    from servoctl import image as img
+
+    (tmp_path / "fw.img").write_bytes(img.build(bytes(range(256)) * 6, 0x0042, img.BOARDS["host_sim"]))
+    with Simulator(ids=[1], fast=True) as sim:
+        said = []
+
+        def publish(msg):  # STOP ALL as the first block's progress is told (on the bus thread)
+            said.append(msg)
+            if msg["type"] == "progress":
+                w.preempt.interrupt("stop-all")
+        w = Worker(sim.bus(), ["--port", sim.url], publish, files=tmp_path)
+        done = w.run(["update", "1", "fw.img"])
+        assert done["code"] == 130 and "servoctl: interrupted by stop-all" in done["err"], done
+        assert "a servo it had switched to its bootloader is left there" in done["err"], done
+        assert sim.state(1)["mode"] != "app"
+        w.preempt.close()
