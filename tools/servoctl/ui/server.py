@@ -39,6 +39,7 @@ class Page:
         self.who = {}       # ws: how the other tabs are told of it
         self.loop = None
         self.doorman = None
+        self.last_scan = None  # told to a tab that opens later: its Bus table has rows
 
     # Safety -----------------------------------------------------------------
 
@@ -93,6 +94,8 @@ class Page:
         if self.driver is None:
             self.driver = ws
         await self._roles()
+        if self.last_scan is not None:
+            await _send(ws, self.last_scan)
         try:
             async for msg in ws:
                 await self._take(ws, msg)
@@ -163,6 +166,8 @@ class Page:
             self.loop.call_soon_threadsafe(self._broadcast, msg)
 
     def _broadcast(self, msg: dict):
+        if msg.get("type") == "scan":
+            self.last_scan = msg
         for ws in list(self.sockets):
             asyncio.ensure_future(_send(ws, msg))
 

@@ -271,6 +271,11 @@ def test_a_second_tab_is_told_who_drives(bench):
         second.goto(ui.url)
         second.locator("#role", has_text="drives the bus").wait_for(timeout=WAIT_MS)
         assert "watching: the tab opened at" in second.inner_text("#role")
+        # Its controls out of reach of mouse and keyboard; a request it sends anyway is answered.
+        assert second.evaluate("document.querySelector('main').inert")
+        said = second.evaluate("UI.run(['ping', 1])")
+        assert said["code"] == 2 and "drives the bus" in said["err"], said
+        second.locator("#bus-table tbody tr[data-id='6']").wait_for(timeout=WAIT_MS)  # the last scan's
         second.select_option("#stop-mode", "release")
         second.click("#stop-all")  # a watching tab may still stop every servo
         second.locator("#log div", has_text="stop-all: 6 servo(s) released").wait_for(timeout=WAIT_MS)

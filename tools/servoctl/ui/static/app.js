@@ -97,6 +97,7 @@ const UI = (() => {
     badge.textContent = r === "driver" ? "this tab drives the bus" :
       r === "viewer" ? `watching: ${holder}` : holder || r;
     document.body.classList.toggle("viewer", r !== "driver");
+    $("main").inert = r !== "driver";  // neither click nor keyboard reaches a watching tab's controls
     $("#stop-all").disabled = r === "closed";  // a watching tab may stop every servo too
   }
 
