@@ -184,6 +184,8 @@ def test_refused_and_dropped_requests_are_said_in_their_own_box(bench):
     page.locator("#items tbody", has_text=not_run).wait_for(state="attached", timeout=WAIT_MS)
     assert page.evaluate("window.waiting")["code"] == 130
     assert sim.state(1)["angle"] > -25  # the dropped move to -30 never ran
+    said = page.evaluate("UI.run(['move', null, 5])")  # no servo in the picker
+    assert said["code"] == 2 and "no servo picked: scan found none" in said["err"], said
     page.click("#scan")  # the page's list again, for the tests after
     page.locator("#scan-line", has_text="6 ID(s) answered").wait_for(timeout=WAIT_MS)
 
@@ -279,6 +281,8 @@ def test_a_second_tab_is_told_who_drives(bench):
         second.select_option("#stop-mode", "release")
         second.click("#stop-all")  # a watching tab may still stop every servo
         second.locator("#log div", has_text="stop-all: 6 servo(s) released").wait_for(timeout=WAIT_MS)
+        second.evaluate("UI.handle({type: 'scan', found: [], err: 'servoctl: interrupted by stop-all', code: 130})")
+        assert "the list is partial" in second.inner_text("#scan-line")  # this tab's page only
     finally:
         second.close()
 

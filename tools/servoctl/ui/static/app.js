@@ -63,6 +63,9 @@ const UI = (() => {
   // resolves with {code, out, err}; onLine hears each line as it is printed.
   function run(argv, onLine) {
     const t = ++tag;
+    if (argv.some((a) => a === null || a === undefined)) {  // the servo picker is empty
+      return Promise.resolve({code: 2, out: "", err: "servoctl ui: no servo picked: scan found none"});
+    }
     return new Promise((resolve) => {
       waiting[t] = {resolve, onLine};
       if (!send({op: "run", argv: argv.map(String), tag: t})) {

@@ -98,9 +98,11 @@
     rows = {};
     const n = found.length;
     const lines = (m.err || "").split("\n").filter((l) => l);
-    $("#scan-line").className = "note";
-    $("#scan-line").textContent = n ? `${n} ID(s) answered` + (lines.length ? `; ${lines.join("; ")}` : "")
-      : "no servo answered" + (lines.length ? `: ${lines.join("; ")}` : "");
+    // Interrupted (STOP ALL): only the part of the bus it reached is listed.
+    const part = m.code === 130 ? "scan interrupted, the list is partial (scan again for the whole bus); " : "";
+    $("#scan-line").className = m.code === 130 ? "note refused" : "note";
+    $("#scan-line").textContent = part + (n ? `${n} ID(s) answered` + (lines.length ? `; ${lines.join("; ")}` : "")
+      : "no servo answered" + (lines.length ? `: ${lines.join("; ")}` : ""));
     UI.setServos(found.filter((f) => f.mode === "application" && !f.shared).map((f) => f.id));
     build();
   });

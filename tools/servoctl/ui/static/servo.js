@@ -10,7 +10,7 @@
   function read() {
     const id = picked();
     shown = id;
-    if (id === null) return;
+    if (id === null) { said("servoctl ui: no servo picked: scan found none"); return; }
     $("#items tbody").innerHTML = "";
     send({op: "items", id});
   }
