@@ -139,3 +139,19 @@ def test_a_fifo_in_the_folder_is_refused_not_waited_on(tmp_path):
     args = build_parser().parse_args(["--port", "loop://", "restore", "image.img"])
     with pytest.raises(UsageError, match="'image.img': not a regular file"):
         Folder(tmp_path).confine(args)
+
+
+def test_a_file_written_into_a_folder_that_is_not_there_is_refused(tmp_path):
+    """config save, backup and identify --mujoco into a missing folder:
+    refused before the command runs, the folder named."""
+    folder = Folder(tmp_path)
+    (tmp_path / "plain").write_text("")
+    for argv in (["config", "save", "1", "none/c.json"], ["backup", "none/c.json"],
+                 ["identify", "1", "--mujoco", "none/c.xml"]):
+        with pytest.raises(UsageError, match=f"is not written: no such folder: none in {tmp_path}"):
+            _confined(folder, *argv)
+    with pytest.raises(UsageError, match="not a folder: plain"):
+        _confined(folder, "backup", "plain/c.json")
+    with pytest.raises(UsageError, match="not a folder"):
+        Folder(tmp_path / "plain")
+    assert _confined(folder, "config", "load", "1", "none/c.json").file == str(tmp_path / "none" / "c.json")

@@ -27,7 +27,7 @@ class Folder:
     def __init__(self, root):
         self.root = Path(root).resolve()
         if not self.root.is_dir():
-            raise UsageError(f"ui: --files {root}: no such folder")
+            raise UsageError(f"ui: --files {root}: " + ("not a folder" if self.root.exists() else "no such folder"))
         self.fd = os.open(self.root, os.O_RDONLY | os.O_DIRECTORY | os.O_CLOEXEC)
 
     def path(self, name: str) -> str:
@@ -117,6 +117,7 @@ class Staging:
         copy = os.path.join(self.dir, os.path.relpath(real, self.folder.root))
         os.makedirs(os.path.dirname(copy), exist_ok=True)
         if writes:
+            self._folder_of(name, real)
             self.writes.append((name, real, copy))
             return copy
         try:
@@ -127,11 +128,29 @@ class Staging:
             shutil.copyfileobj(src, dst)
         return copy
 
+    def _folder_of(self, name: str, real: str) -> None:
+        """A file the command writes goes into a folder that exists: refused
+        now, before the command runs (it said "saved" of a copy, then the
+        copy out failed with a bare errno)."""
+        parent = Path(real).parent
+        if not parent.is_dir():
+            missing = parent
+            while not missing.parent.is_dir():
+                missing = missing.parent
+            what = "not a folder" if missing.exists() else "no such folder"
+            raise UsageError(f"ui: {name!r} is not written: {what}: {missing.relative_to(self.folder.root)} "
+                             f"in {self.folder.root} (make the folder first)")
+
     def write_out(self) -> None:
         """What the command wrote, into the folder (after it succeeded)."""
         for name, real, copy in self.writes:
             if os.path.exists(copy):
-                with open(copy, "rb") as src, os.fdopen(self.folder.open(real, WRITE, name), "wb") as dst:
+                try:
+                    fd = self.folder.open(real, WRITE, name)
+                except OSError as e:  # the folder removed meanwhile, a full disk
+                    raise UsageError(f"ui: {name!r} is not written into {self.folder.root}: "
+                                     f"{e.strerror}") from None
+                with open(copy, "rb") as src, os.fdopen(fd, "wb") as dst:
                     shutil.copyfileobj(src, dst)
 
     def shown(self, text: str) -> str:

@@ -8,7 +8,7 @@ import collections
 import math
 
 from .. import group, registers, units
-from ..errors import ServoError
+from ..errors import NoReply, ServoError
 from ..live import _celsius
 from ..servo import Servo
 
@@ -20,11 +20,17 @@ NO_MOTION = "the maker's firmware has no ReadMotion (0x40): no target or winding
 def items_of(bus, servo_id: int) -> list:
     """Every public item of one servo: value in units, the text an edit
     starts from (what config set takes back), range, factory value, RAM or
-    stored, writable; or why it is missing on this servo."""
+    stored, writable; or why it is missing on this servo. NoReply if the
+    servo answers nothing at all: said once, after one wait, not as every
+    item missing from its firmware (a wait for each, 11 s)."""
     s = Servo(bus, servo_id)
     out = []
     try:
         batch = s.read_all()  # the user area in one ReadBatchData
+    except NoReply as e:
+        if type(e) is NoReply:  # silence, not a garbled answer
+            raise NoReply(f"servo {servo_id} does not answer ({e}): is it powered and at this baud rate?") from None
+        batch = {}
     except ServoError:
         batch = {}
     for item in registers.ITEMS:

@@ -39,6 +39,7 @@ class Page:
         self.who = {}       # ws: how the other tabs are told of it
         self.loop = None
         self.doorman = None
+        self.last_scan = None  # told to a tab that opens later: its Bus table has rows
 
     # Safety -----------------------------------------------------------------
 
@@ -93,6 +94,8 @@ class Page:
         if self.driver is None:
             self.driver = ws
         await self._roles()
+        if self.last_scan is not None:
+            await _send(ws, self.last_scan)
         try:
             async for msg in ws:
                 await self._take(ws, msg)
@@ -110,21 +113,23 @@ class Page:
         malformed one, one the queue has no room for); the tab stays."""
         if msg.type not in (WSMsgType.TEXT, WSMsgType.BINARY):
             return
-        tag = None
+        tag = op = None
         try:
             ask = _parse(msg.data)
-            tag = ask.get("tag")
-            if ws is not self.driver and ask.get("op") != "stopall":  # any tab may stop
-                await _send(ws, {"type": "busy", "holder": self.who[self.driver],
-                                 "text": f"{self.who[self.driver]} drives the bus"})
+            tag, op = ask.get("tag"), ask.get("op")
+            if ws is not self.driver and op != "stopall":  # any tab may stop
+                # Its tag and op with it: the page answers the request that asked.
+                await _send(ws, {"type": "busy", "holder": self.who[self.driver], "tag": tag, "op": op,
+                                 "text": f"not run: {self.who[self.driver]} drives the bus"})
                 return
             self._dispatch(ask)
-        except QueueFull as e:
-            await _send(ws, {"type": "error", "tag": tag, "text": str(e)})
+        except QueueFull as e:  # said where the page shows that action's output (tag, op)
+            await _send(ws, {"type": "error", "tag": tag, "op": op, "text": str(e)})
         except (Malformed, KeyError, TypeError, ValueError, OverflowError) as e:
-            await _send(ws, {"type": "error", "tag": tag, "text": f"servoctl ui: a malformed request: {e}"})
+            await _send(ws, {"type": "error", "tag": tag, "op": op,
+                             "text": f"servoctl ui: a malformed request: {e}"})
         except Exception as e:  # noqa: BLE001 - whatever a request does, the tab stays and hears why
-            await _send(ws, {"type": "error", "tag": tag, "text": f"servoctl ui: {type(e).__name__}: {e}"})
+            await _send(ws, {"type": "error", "tag": tag, "op": op, "text": f"servoctl ui: {type(e).__name__}: {e}"})
 
     async def _roles(self):
         for ws in list(self.sockets):
@@ -142,12 +147,12 @@ class Page:
         elif op == "scan":
             w.submit(w.scan, bool(ask.get("all_bauds")), tag)
         elif op == "items":
-            w.submit(w.items, _whole(ask["id"], "id"))
+            w.submit(w.items, _whole(ask["id"], "id"), tag)
         elif op == "plot":
             ids = ask.get("ids", [])
             if not isinstance(ids, list):
                 raise Malformed(f"ids must be a list, not {ids!r:.40}")
-            w.submit(w.plot, [_whole(i, "ids") for i in ids])
+            w.submit(w.plot, [_whole(i, "ids") for i in ids], tag)
         elif op == "table":
             w.submit(w.table)
         else:
@@ -161,6 +166,8 @@ class Page:
             self.loop.call_soon_threadsafe(self._broadcast, msg)
 
     def _broadcast(self, msg: dict):
+        if msg.get("type") == "scan":
+            self.last_scan = msg
         for ws in list(self.sockets):
             asyncio.ensure_future(_send(ws, msg))
 

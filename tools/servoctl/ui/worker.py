@@ -17,7 +17,7 @@ from .. import cli
 from .. import protocol as p
 from ..args import build_parser
 from ..checks import check_range
-from ..errors import EXIT_INTERRUPTED, ServoError
+from ..errors import EXIT_INTERRUPTED, NoReply, ServoError
 from . import sampling
 from .files import Folder
 from .preempt import STOP_METHOD, Preemption
@@ -28,6 +28,10 @@ from .preempt import STOP_METHOD, Preemption
 RUNNABLE = set(cli.COMMANDS) - {"monitor", "stream", "record", "ui"}
 TABLE_EVERY_S = (1.0, 3.0)  # the live table's info round, bus time: idle, plotting
 QUEUE_MAX = 64  # page actions waiting; more are refused (a page gone wild, a script)
+NOT_RUN = "servoctl ui: not run: stop-all came first"
+# An update stopped part-way: a servo it had switched over waits in its bootloader.
+UPDATE_CUT = ("servoctl ui: the update stopped part-way: a servo it had switched to its bootloader is left "
+              "there (a scan shows it so); run the update again to install an application")
 # What identify, tune, calibrate and update load on first use (scipy takes
 # a second): loaded as the ui starts, on a thread of their own, not on the
 # bus thread in the middle of a command.
@@ -139,7 +143,7 @@ class Worker:
             return self._result(tag, argv, 2, "", f"servoctl: error: {msg}")
         out, err = _Lines(lambda line: self.publish({"type": "line", "tag": tag, "text": line})), _Lines(
             lambda line: self.publish({"type": "line", "tag": tag, "text": line, "err": True}))
-        code, staging = 0, None
+        code, staging, args = 0, None, None
         with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
             try:
                 args = build_parser().parse_args(self.global_argv + list(argv))
@@ -153,6 +157,8 @@ class Worker:
                     staging.write_out()
             except KeyboardInterrupt:
                 print(f"servoctl: interrupted by {self.preempt.why}", file=err)
+                if args is not None and args.command == "update":
+                    print(UPDATE_CUT, file=err)
                 code = EXIT_INTERRUPTED
             except SystemExit as e:  # argparse's usage error, printed to err
                 code = e.code if isinstance(e.code, int) else 2
@@ -201,9 +207,9 @@ class Worker:
 
     def table(self):
         """Every known servo's info (servoctl info --json), or why it is
-        silent; a servo being plotted is left to its samples."""
+        silent; those being plotted too (the round comes every 3 s then)."""
         rows = []
-        for servo_id in (i for i in self.known if i not in self.plot_ids):
+        for servo_id in self.known:
             r = self.run_quiet(["info", str(servo_id), "--json"])
             self.preempt.check()  # interrupted: no row is "gone" for it
             if r["code"] == 0:
@@ -219,10 +225,14 @@ class Worker:
         finally:
             self.publish = publish
 
-    def items(self, servo_id: int):
-        self.publish({"type": "items", "id": servo_id, "items": sampling.items_of(self.bus, servo_id)})
+    def items(self, servo_id: int, tag=None):
+        try:
+            self.publish({"type": "items", "id": servo_id, "tag": tag,
+                          "items": sampling.items_of(self.bus, servo_id)})
+        except NoReply as e:  # said once, not as each item missing
+            self.publish({"type": "items", "id": servo_id, "tag": tag, "items": [], "silent": str(e)})
 
-    def plot(self, ids: list):
+    def plot(self, ids: list, tag=None):
         ids = list(dict.fromkeys(int(i) for i in ids))  # each once: a page's list, not a Sync Monitor of 10 000
         for servo_id in ids:
             check_range("servo ID", servo_id, 0, p.MAX_ID)
@@ -244,10 +254,13 @@ class Worker:
             failed.append(f"broadcast stop: {e}")
         with self.cond:
             dropped, self.jobs = list(self.jobs), collections.deque()
-        for fn, a in dropped:
+        for fn, a in dropped:  # each answered, where the page shows that action's output
             if fn == self.run:
                 argv, tag = a
-                self._result(tag, argv, EXIT_INTERRUPTED, "", "servoctl ui: not run: stop-all came first")
+                self._result(tag, argv, EXIT_INTERRUPTED, "", NOT_RUN)
+            else:
+                self.publish({"type": "error", "op": fn.__name__, "tag": a[-1] if len(a) > 1 else None,
+                              "text": NOT_RUN})
         ids = self.known or self.plot_ids
         said = [self.run_quiet(["stop", str(i), "--mode", mode]) for i in ids]
         failed += [r["err"] for r in said if r["code"]]

@@ -156,6 +156,40 @@ def test_stop_all_ends_a_running_command_first(bench):
     assert sim.state(1)["angle"] > -60
 
 
+def test_refused_and_dropped_requests_are_said_in_their_own_box(bench):
+    """A full queue's refusal was in the footer log only, a move dropped by
+    STOP ALL showed its command line alone, a scan refused or dropped said
+    "scanning…" for ever, a dropped Read every item nothing: each is said
+    where that action's output goes."""
+    sim, _, _, page = bench
+    _view(page, "bus")  # the other views' boxes are hidden, not gone
+    page.evaluate("() => { window.waiting = UI.run(['move', 1, 90, '--interval', 20000, '--wait']); }")
+    sim.wait_until(lambda: abs(sim.state(1)["velocity"]) > 1, timeout_s=10)  # the bus thread is in it
+    page.evaluate("""() => {
+        document.querySelector('#mv-angle').value = '-30';
+        document.querySelector('#mv-go').click();      // queued: 1
+        document.querySelector('#scan').click();       // 2
+        document.querySelector('#items-read').click(); // 3
+        for (let i = 0; i < 61; i++) UI.run(['ping', 2]);  // 64: the queue is full
+        document.querySelector('#cfg-diff').click();   // refused
+    }""")
+    refused = "actions are waiting for the bus: this one is refused"
+    page.locator("#servo-out", has_text=refused).wait_for(state="attached", timeout=WAIT_MS)
+    page.click("#scan")  # refused too
+    page.locator("#scan-line", has_text=refused).wait_for(state="attached", timeout=WAIT_MS)
+    page.click("#stop-all")
+    not_run = "servoctl ui: not run: stop-all came first"
+    page.locator("#motion-out", has_text=not_run).wait_for(state="attached", timeout=WAIT_MS)
+    page.locator("#scan-line", has_text=not_run).wait_for(state="attached", timeout=WAIT_MS)
+    page.locator("#items tbody", has_text=not_run).wait_for(state="attached", timeout=WAIT_MS)
+    assert page.evaluate("window.waiting")["code"] == 130
+    assert sim.state(1)["angle"] > -25  # the dropped move to -30 never ran
+    said = page.evaluate("UI.run(['move', null, 5])")  # no servo in the picker
+    assert said["code"] == 2 and "no servo picked: scan found none" in said["err"], said
+    page.click("#scan")  # the page's list again, for the tests after
+    page.locator("#scan-line", has_text="6 ID(s) answered").wait_for(timeout=WAIT_MS)
+
+
 def test_a_servo_unplugged_mid_session_is_shown_gone(bench):
     sim, _, _, page = bench
     page.evaluate("servoUiPlots && UI.send({op: 'plot', ids: []})")
@@ -192,6 +226,24 @@ def test_bring_up_updates_two_servos_in_a_row_and_reads_faults(bench):
     out.filter(has_text="servo 1: no faults").wait_for(timeout=WAIT_MS)
 
 
+def test_bring_up_buttons_stay_off_while_a_step_runs(bench):
+    """The live table's redraw (each second) turned them back on mid-step:
+    a second step's output mixed into the first's box, the bar hid."""
+    _, _, _, page = bench
+    _view(page, "bringup")
+    # One turn of the page's script: a step started, then a live table of
+    # this firmware's servo (what greyOwn re-enabled the buttons on).
+    seen = page.evaluate("""() => {
+        document.querySelector('#fl-read').click();
+        UI.handle({type: 'table', rows: [Object.assign({}, UI.state.servos[UI.picked()].info)]});
+        return {on: [...document.querySelectorAll('#view-bringup button')].filter((b) => !b.disabled)
+                    .map((b) => b.id), bar: !document.querySelector('#br-prog').hidden}; }""")
+    assert seen == {"on": [], "bar": True}, seen
+    page.locator("#bringup-out", has_text="no faults").wait_for(timeout=WAIT_MS)
+    page.wait_for_function("!document.querySelector('#fl-read').disabled"
+                           " && document.querySelector('#br-prog').hidden", timeout=WAIT_MS)
+
+
 def test_the_maker_firmware_s_missing_features_are_greyed_with_the_reason(bench):
     """servoctl info of a servo that answers none of items 64-67 (the
     maker's firmware) has no winding_c: the page greys what needs them."""
@@ -221,9 +273,16 @@ def test_a_second_tab_is_told_who_drives(bench):
         second.goto(ui.url)
         second.locator("#role", has_text="drives the bus").wait_for(timeout=WAIT_MS)
         assert "watching: the tab opened at" in second.inner_text("#role")
+        # Its controls out of reach of mouse and keyboard; a request it sends anyway is answered.
+        assert second.evaluate("document.querySelector('main').inert")
+        said = second.evaluate("UI.run(['ping', 1])")
+        assert said["code"] == 2 and "drives the bus" in said["err"], said
+        second.locator("#bus-table tbody tr[data-id='6']").wait_for(timeout=WAIT_MS)  # the last scan's
         second.select_option("#stop-mode", "release")
         second.click("#stop-all")  # a watching tab may still stop every servo
         second.locator("#log div", has_text="stop-all: 6 servo(s) released").wait_for(timeout=WAIT_MS)
+        second.evaluate("UI.handle({type: 'scan', found: [], err: 'servoctl: interrupted by stop-all', code: 130})")
+        assert "the list is partial" in second.inner_text("#scan-line")  # this tab's page only
     finally:
         second.close()
 

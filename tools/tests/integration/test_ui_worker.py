@@ -99,3 +99,97 @@ def test_a_burst_of_stop_all_clicks_puts_few_stops_on_the_wire():
         runs = [line.split() for line in sim.control("wire 1024").splitlines() if line.strip() not in ("", "end")]
         sent = sum(int(r[2]) for r in runs if r[3] == "host")
         assert 0 < sent <= 50 * 9, runs  # a stop frame is 9 bytes; 2000 of them without the limit
+
+
+def test_a_file_written_into_a_missing_folder_is_refused_before_the_command_runs(tmp_path):
+    """config save into a folder that is not there said "saved", then a
+    bare errno; now refused first, the folder named."""
+    with Simulator(ids=[1], fast=True) as sim:
+        said = []
+        w = Worker(sim.bus(), ["--port", sim.url], said.append, files=tmp_path)
+        for argv, name in ((["config", "save", "1", "nosub/deeper/servo.json"], "nosub/deeper/servo.json"),
+                           (["backup", "nosub/bus.json"], "nosub/bus.json")):
+            done = w.run(argv)
+            assert done["code"] == 2 and "saved" not in done["out"], done
+            assert f"ui: {name!r} is not written: no such folder: nosub in {tmp_path}" in done["err"], done
+            assert "Errno" not in done["err"], done
+        (tmp_path / "nosub").mkdir()
+        assert w.run(["backup", "nosub/bus.json"])["code"] == 0
+        assert (tmp_path / "nosub" / "bus.json").exists()
+        w.preempt.close()
+
+
+def test_the_live_table_refreshes_a_plotted_servo():
+    """The table skipped every plotted ID: a plotted servo that went silent
+    stayed "answering" (docs/ui.md: every 3 s while plotting)."""
+    with Simulator(ids=[1, 2], fast=True) as sim:
+        said = []
+        w = _worker(sim, said)
+        w.known = [1, 2]
+        w.plot([1])
+        assert sim.control("unplug 1 1").strip() == "ok"
+        w.table()
+        rows = {r["id"]: r for r in said[-1]["rows"]}
+        assert said[-1]["type"] == "table" and set(rows) == {1, 2}, said[-1]
+        assert rows[1].get("gone") and not rows[2].get("gone"), rows
+        w.preempt.close()
+
+
+def test_a_silent_servo_s_items_are_said_once_not_blamed_on_its_firmware():
+    """An unplugged servo's Read every item took a wait for each item
+    (11 s) and said each was "not on this servo's firmware"."""
+    with Simulator(ids=[1, 2], fast=True) as sim:
+        said = []
+        w = _worker(sim, said)
+        w.items(1)
+        assert said[-1]["items"] and not said[-1].get("silent"), said[-1]
+        assert sim.control("unplug 1 2").strip() == "ok"
+        t0 = w.bus.clock()
+        w.items(2)
+        took_s = w.bus.clock() - t0  # the simulator's clock
+        heard = said[-1]
+        assert heard["type"] == "items" and heard["items"] == [], heard
+        assert "servo 2 does not answer" in heard["silent"] and "firmware" not in heard["silent"], heard
+        assert took_s < 1.0, took_s  # one wait for an answer, not one for each of ~30 items
+        w.preempt.close()
+
+
+def test_stop_all_answers_every_request_it_drops():
+    """A queued scan, Read every item or plot dropped by STOP ALL had no
+    answer: the page said "scanning…" for ever."""
+    NOT_RUN = "servoctl ui: not run: stop-all came first"
+    with Simulator(ids=[1], fast=True) as sim:
+        said = []
+        w = _worker(sim, said)
+        w.known = [1]
+        w.submit(w.run, ["ping", "1"], 1)
+        w.submit(w.scan, False, 2)
+        w.submit(w.items, 1, 3)
+        w.submit(w.plot, [1], 4)
+        w.stop_all("release")
+        answers = {m.get("tag"): m for m in said if m["type"] in ("result", "error")}
+        assert answers[1]["type"] == "result" and answers[1]["err"] == NOT_RUN, answers
+        for tag, op in ((2, "scan"), (3, "items"), (4, "plot")):
+            assert answers[tag]["op"] == op and answers[tag]["text"] == NOT_RUN, answers
+        w.preempt.close()
+
+
+def test_an_update_stop_all_cuts_short_says_its_servo_is_left_in_its_bootloader(tmp_path):
+    """The box said "interrupted by stop-all" alone; the servo waits in its
+    bootloader, and the user must know to run the update again."""
+    from servoctl import image as img
+
+    (tmp_path / "fw.img").write_bytes(img.build(bytes(range(256)) * 6, 0x0042, img.BOARDS["host_sim"]))
+    with Simulator(ids=[1], fast=True) as sim:
+        said = []
+
+        def publish(msg):  # STOP ALL as the first block's progress is told (on the bus thread)
+            said.append(msg)
+            if msg["type"] == "progress":
+                w.preempt.interrupt("stop-all")
+        w = Worker(sim.bus(), ["--port", sim.url], publish, files=tmp_path)
+        done = w.run(["update", "1", "fw.img"])
+        assert done["code"] == 130 and "servoctl: interrupted by stop-all" in done["err"], done
+        assert "a servo it had switched to its bootloader is left there" in done["err"], done
+        assert sim.state(1)["mode"] != "app"
+        w.preempt.close()

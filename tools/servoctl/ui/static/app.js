@@ -7,7 +7,7 @@ const UI = (() => {
   const handlers = {};        // message type: [fn]
   const waiting = {};         // tag: {resolve, onLine}
   let ws = null, tag = 0, role = "connecting";
-  const state = {servos: {}, picked: null, about: {}};
+  const state = {servos: {}, picked: null, about: {}, stepping: false};
 
   const $ = (sel) => document.querySelector(sel);
   const el = (tagName, attrs = {}, ...kids) => {
@@ -38,9 +38,13 @@ const UI = (() => {
 
   function handle(msg) {
     if (msg.type === "line" && waiting[msg.tag] && waiting[msg.tag].onLine) waiting[msg.tag].onLine(msg);
-    if (msg.type === "error" && msg.tag != null && waiting[msg.tag]) {  // refused before it ran: a full queue
+    // Refused before it ran (a full queue, a watching tab): the request that asked hears it.
+    if ((msg.type === "error" || msg.type === "busy") && msg.tag != null && waiting[msg.tag]) {
       waiting[msg.tag].resolve({code: 2, out: "", err: msg.text});
       delete waiting[msg.tag];
+    }
+    if ((msg.type === "error" || msg.type === "busy") && msg.op) {  // a scan, items or a plot refused or dropped
+      (handlers[`refused-${msg.op}`] || []).forEach((fn) => fn(msg));
     }
     if (msg.type === "result") {
       log(`$ ${msg.command}  -> exit ${msg.code}`, msg.code ? "refused" : "");
@@ -59,6 +63,9 @@ const UI = (() => {
   // resolves with {code, out, err}; onLine hears each line as it is printed.
   function run(argv, onLine) {
     const t = ++tag;
+    if (argv.some((a) => a === null || a === undefined)) {  // the servo picker is empty
+      return Promise.resolve({code: 2, out: "", err: "servoctl ui: no servo picked: scan found none"});
+    }
     return new Promise((resolve) => {
       waiting[t] = {resolve, onLine};
       if (!send({op: "run", argv: argv.map(String), tag: t})) {
@@ -69,11 +76,20 @@ const UI = (() => {
   }
 
   // A command's output into a <pre>: its lines as they come, the error red.
+  // An answer that came with no line (refused by a full queue, dropped by
+  // STOP ALL, a watching tab's) is shown here too, not only in the log.
   async function runInto(pre, argv) {
     pre.textContent = `$ servoctl ${argv.join(" ")}\n`;
-    const r = await run(argv, (m) => { pre.textContent += m.text + "\n"; pre.scrollTop = pre.scrollHeight; });
+    let heard = 0;
+    const r = await run(argv, (m) => {
+      heard++;
+      pre.textContent += m.text + "\n";
+      pre.scrollTop = pre.scrollHeight;
+    });
     pre.classList.toggle("refused", r.code !== 0);
-    if (!r.out && !r.err) pre.textContent += r.code ? `exit ${r.code}\n` : "done\n";
+    const said = heard ? "" : [r.out, r.err].filter((t) => t).join("\n").trim();
+    if (said) pre.textContent += said + "\n";
+    else if (!r.out && !r.err) pre.textContent += r.code ? `exit ${r.code}\n` : "done\n";
     return r;
   }
 
@@ -84,6 +100,7 @@ const UI = (() => {
     badge.textContent = r === "driver" ? "this tab drives the bus" :
       r === "viewer" ? `watching: ${holder}` : holder || r;
     document.body.classList.toggle("viewer", r !== "driver");
+    $("main").inert = r !== "driver";  // neither click nor keyboard reaches a watching tab's controls
     $("#stop-all").disabled = r === "closed";  // a watching tab may stop every servo too
   }
 
@@ -92,7 +109,7 @@ const UI = (() => {
     $("#bus-port").textContent = `${m.port}${m.simulator ? " (simulator)" : ""}`;
     setRole(m.role, m.holder ? `${m.holder} drives the bus` : "");
   });
-  on("busy", (m) => { setRole("viewer", m.text); log(m.text, "refused"); });
+  on("busy", (m) => { setRole("viewer", `${m.holder} drives the bus`); log(m.text, "refused"); });
   on("error", (m) => log(m.text, "refused"));
   on("stopped", (m) => log(`stop-all: ${m.ids.length} servo(s) ${m.mode === "damping" ? "damped" : "released"}` +
       (m.failed.length ? `; ${m.failed.join("; ")}` : ""), m.failed.length ? "refused" : "done"));
@@ -121,7 +138,8 @@ const UI = (() => {
     document.querySelectorAll("[data-needs=own]").forEach((f) => {
       f.classList.toggle("off", !!why);
       f.dataset.why = why;
-      f.querySelectorAll("button,input,select").forEach((b) => { b.disabled = !!why; });
+      // A Bring-up step that runs keeps them off until it ends (bringup.js).
+      f.querySelectorAll("button,input,select").forEach((b) => { b.disabled = !!why || state.stepping; });
     });
   }
 
@@ -144,6 +162,8 @@ const UI = (() => {
     (handlers["view"] || []).forEach((fn) => fn({view}));
   }
 
-  return {$, el, on, handle, send, run, runInto, log, state, picked, setServos, whyNot, greyOwn, show,
+  const onRefused = (op, fn) => on(`refused-${op}`, fn);
+
+  return {$, el, on, onRefused, handle, send, run, runInto, log, state, picked, setServos, whyNot, greyOwn, show,
           role: () => role};
 })();

@@ -10,12 +10,16 @@
     const prog = $("#br-prog");
     prog.removeAttribute("value");  // no figure yet: indeterminate
     prog.hidden = false;
-    document.querySelectorAll("#view-bringup button").forEach((b) => { b.dataset.was = b.disabled; b.disabled = true; });
+    // Off until the step ends: the live table's greyOwn() (each second) keeps them so.
+    UI.state.stepping = true;
+    document.querySelectorAll("#view-bringup button").forEach((b) => { b.disabled = true; });
     try {
       return await runInto($("#bringup-out"), argv);
     } finally {
       prog.hidden = true;
-      document.querySelectorAll("#view-bringup button").forEach((b) => { b.disabled = b.dataset.was === "true"; });
+      UI.state.stepping = false;
+      document.querySelectorAll("#view-bringup button").forEach((b) => { b.disabled = false; });
+      UI.greyOwn();  // what this servo's firmware lacks stays off
     }
   }
 

@@ -81,17 +81,28 @@
   }
 
   function scan(allBauds) {
-    $("#scan-line").textContent = allBauds ? "scanning every baud rate…" : "scanning…";
-    send({op: "scan", all_bauds: allBauds});
+    const line = $("#scan-line");
+    line.className = "note";
+    line.textContent = allBauds ? "scanning every baud rate…" : "scanning…";
+    if (!send({op: "scan", all_bauds: allBauds})) line.textContent = "not scanned: not connected";
   }
+
+  // A scan refused (a full queue, a watching tab) or dropped by STOP ALL: said on its line.
+  UI.onRefused("scan", (m) => {
+    $("#scan-line").textContent = m.text;
+    $("#scan-line").className = "note refused";
+  });
 
   on("scan", (m) => {
     found = m.found;
     rows = {};
     const n = found.length;
     const lines = (m.err || "").split("\n").filter((l) => l);
-    $("#scan-line").textContent = n ? `${n} ID(s) answered` + (lines.length ? `; ${lines.join("; ")}` : "")
-      : "no servo answered" + (lines.length ? `: ${lines.join("; ")}` : "");
+    // Interrupted (STOP ALL): only the part of the bus it reached is listed.
+    const part = m.code === 130 ? "scan interrupted, the list is partial (scan again for the whole bus); " : "";
+    $("#scan-line").className = m.code === 130 ? "note refused" : "note";
+    $("#scan-line").textContent = part + (n ? `${n} ID(s) answered` + (lines.length ? `; ${lines.join("; ")}` : "")
+      : "no servo answered" + (lines.length ? `: ${lines.join("; ")}` : ""));
     UI.setServos(found.filter((f) => f.mode === "application" && !f.shared).map((f) => f.id));
     build();
   });

@@ -81,6 +81,8 @@
     dirty = true;
   });
 
+  UI.onRefused("plot", (m) => { $("#plot-note").textContent = m.text; });
+
   on("plotting", (m) => {
     ids = m.ids;
     rows = [];    // a new round of sampling: its clock starts at 0

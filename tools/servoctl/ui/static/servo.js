@@ -10,17 +10,27 @@
   function read() {
     const id = picked();
     shown = id;
-    if (id === null) return;
+    if (id === null) { said("servoctl ui: no servo picked: scan found none"); return; }
     $("#items tbody").innerHTML = "";
     send({op: "items", id});
   }
 
+  // Said in the items' table: a servo that does not answer (once), or a
+  // read refused by a full queue or dropped by STOP ALL.
+  function said(text) {
+    const body = $("#items tbody");
+    body.innerHTML = "";
+    body.append(el("tr", {class: "said"}, el("td", {colspan: 7, class: "why refused", text})));
+  }
+
   on("items", (m) => {
     if (m.id !== picked()) return;
+    if (m.silent) { said(m.silent); return; }
     const body = $("#items tbody");
     body.innerHTML = "";
     for (const it of m.items) body.append(row(m.id, it));
   });
+  UI.onRefused("items", (m) => said(m.text));
 
   function row(id, it) {
     const why = el("td", {class: "why"});
