@@ -66,7 +66,12 @@ def into_limits(arm, here: dict, speed_deg_s: float) -> dict:
     is moved to the nearest at up to speed_deg_s and waited for, on the
     bus's clock, a Sync Monitor a frame (which feeds every bus watchdog);
     its setpoints, and the ramp, then start there, as the servo takes them
-    (it clamps a streamed setpoint to its limits: one outside is a jump)."""
+    (it clamps a streamed setpoint to its limits: one outside is a jump).
+    A refusal outside the limits (arm.limits) then advises as for an arm
+    whose limits are its calibration, not to switch them off."""
+    for lim in arm.limits.values():  # its range, as calibrated: never to be switched off to get by
+        lim.advice = ("The arm keeps its targets within the limits read at connect: were they changed since? "
+                      "Connect again (calibrate again to change them)")
     held = {n: within(d, arm.limits[arm.joints[n]]) for n, d in here.items()}
     out = {n: d for n, d in held.items() if d != here[n]}
     for name, deg in out.items():

@@ -100,6 +100,8 @@ def test_a_joint_resting_outside_its_limits_ramps_from_the_nearest(monkeypatch):
                     peak[0] = max(peak[0], abs(horn["velocity"]))
         assert peak[0] <= 56, peak[0]  # the ramp's 45 deg/s, and the ripple the first test allows
         assert [round(sim.state(i)["angle"]) for i in (1, 2, 3)] == [10, -37, -37]
+        said = arm.limits[1].check(1, 400)  # were a setpoint refused, the advice is a calibrated arm's
+        assert "calibrate again" in said and "angle_limit_on 0" not in said, said
 
 
 def test_a_run_that_did_not_end_leaves_its_watchdog_not_taken_for_the_servos_own(caplog):
