@@ -255,8 +255,11 @@ class Arm:
         self.limits = read_limits(self.bus, self.ids)
 
     def ranges_stored(self) -> bool:
-        """Whether every joint's servo keeps its angle limits on."""
-        return all(lim.angle_min is not None for lim in self.limits.values())
+        """Whether every joint's servo keeps its angle limits on, and not
+        the factory's (on, +-135 deg: a new servo's, no calibration's)."""
+        factory = (registers.find("angle_min").default, registers.find("angle_max").default)
+        return all(lim.angle_min is not None and (lim.angle_min, lim.angle_max) != factory
+                   for lim in self.limits.values())
 
     # ---- a frame -----------------------------------------------------
     def positions(self) -> dict:

@@ -1,7 +1,8 @@
 """servoctl.arm, the LeRobot follower's library, at the edges a user meets
 first, on servo_sim (no LeRobot needed): the first actions after connect,
 a joint resting outside its limits, a run that ended without putting the
-watchdog back, and two servos at one joint's ID. Time is the simulator's."""
+watchdog back, two servos at one joint's ID, and a new arm taken for a
+calibrated one. Time is the simulator's."""
 import logging
 
 import pytest
@@ -102,6 +103,20 @@ def test_a_joint_resting_outside_its_limits_ramps_from_the_nearest(monkeypatch):
         assert [round(sim.state(i)["angle"]) for i in (1, 2, 3)] == [10, -37, -37]
         said = arm.limits[1].check(1, 400)  # were a setpoint refused, the advice is a calibrated arm's
         assert "calibrate again" in said and "angle_limit_on 0" not in said, said
+
+
+def test_a_new_arm_is_not_taken_for_a_calibrated_one():
+    """Factory servos keep their angle limits on (+-135 deg, item 48 = 1):
+    a new arm counted as calibrated, and connect() never asked for it.
+    Calibrated now means ranges stored by a calibration, not the factory's."""
+    with Simulator(ids=[1, 2], fast=True) as sim:
+        bus = sim.bus()
+        arm = Arm(bus, {"a": 1, "b": 2}, watchdog_ms=0).open()
+        assert not arm.ranges_stored()
+        arm.set_zero_here()  # the documented calibration: the middle, then the ranges (joints.calibrate)
+        arm.store_ranges({"a": (-41.3, 36.8), "b": (-90.0, 88.2)})
+        assert arm.ranges_stored()
+        assert Arm(bus, {"a": 1, "b": 2}, watchdog_ms=0).open().ranges_stored()  # the next connect
 
 
 def test_a_run_that_did_not_end_leaves_its_watchdog_not_taken_for_the_servos_own(caplog):
