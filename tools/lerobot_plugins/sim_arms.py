@@ -33,11 +33,15 @@ from servoctl.sim import Simulator, _fields, control_command
 IDS = range(7)
 ENV = Path(__file__).resolve().parents[2] / "build" / "sim-arms.env"
 BAUD_1M = 8  # item 36's index for 1 000 000 baud
+RANGE_DECIDEG = (-1200, 1200)  # each joint's, as a calibration stores it (items 52, 51; 48 is on)
 
 
 def arm(tcp_port: int, state_dir=None) -> Simulator:
-    """An arm at 1 Mbaud, soft start off; servos that kept that from an
-    earlier run (--state) are left as they are."""
+    """An arm at 1 Mbaud, soft start off, calibrated as the walk-through
+    takes it (RANGE_DECIDEG stored as the angle limits: a new servo's
+    factory +-135 deg is no calibration, and connect() would ask for one);
+    servos that kept that from an earlier run (--state) are left as they
+    are."""
     sim = Simulator(ids=IDS, tcp_port=tcp_port, state_dir=state_dir).start()
     try:
         link_rate.open_rate(sim.url, 1000000, str(sim.control_port))  # the host's rate on the socket
@@ -48,6 +52,8 @@ def arm(tcp_port: int, state_dir=None) -> Simulator:
             with sim.bus(timeout=0.2) as bus:
                 for i in new:
                     Servo(bus, i).write("soft_start_on", 0)
+                    Servo(bus, i).write("angle_min", RANGE_DECIDEG[0])
+                    Servo(bus, i).write("angle_max", RANGE_DECIDEG[1])
                     Servo(bus, i).write("baud", BAUD_1M)  # answered at 115200, then it switches
             link_rate.open_rate(sim.url, 1000000, str(sim.control_port))
     except BaseException:

@@ -4,7 +4,8 @@ and out, a frame at a time.
 
 - Which firmware: this one (it answers item 64, the bus watchdog) or the
   maker's (it does not).
-- hold_here(): torque on where each joint is; nothing moves.
+- hold_here(): torque on where each joint is; nothing moves (but a joint
+  outside its angle limits, to the nearest: arm_ramp.into_limits).
 - positions(): every joint's angle from one Sync Monitor (0.1 deg), fresh
   or JointSilent naming the joints that did not answer in their slot;
   a joint whose servo released its output (supply, heat) raises
@@ -29,7 +30,7 @@ import math
 from . import protocol as p
 from . import registers, scan
 from .errors import NoReply, ServoError, UsageError, ValueOutOfRange
-from .arm_ramp import DEFAULT_SPEED_DEG_S, Ramp
+from .arm_ramp import DEFAULT_SPEED_DEG_S, Ramp, into_limits
 from .group import sync_monitor
 from .servo import Servo
 from .setpoints import MAX_SPEED_DECIDEG_S, Stream, read_limits
@@ -180,7 +181,8 @@ class Arm:
 
     def hold_here(self) -> dict:
         """Torque on where every joint is (StopOnControlMode's hold: no
-        target, so nothing moves); the first target is that pose. A joint
+        target, so nothing moves); the first target is that pose, within
+        the angle limits (a joint outside goes to the nearest first). A joint
         beyond one turn (after wheel mode) is refused, left holding: its
         targets are single-turn, and the first would spin it back."""
         for servo_id in self.ids:
@@ -190,7 +192,8 @@ class Arm:
         if turned:  # the first target would be taken within one turn: the joint would spin back
             raise UsageError(f"{', '.join(turned)}: beyond one turn (wheel mode or multi-turn moves); "
                              f"release it and reset its turns ('servoctl origin ID --reset-turns') first")
-        self.targets, self._before = here, {}
+        # One outside its limits goes to the nearest first: the ramp starts where the servo takes a setpoint.
+        self.targets, self._before = into_limits(self, here, self.ramp.speed_deg_s or DEFAULT_SPEED_DEG_S), {}
         self.ramp.start(here)
         self._held_at = self.bus.clock()
         if self.firmware == "servoctl":
@@ -252,8 +255,11 @@ class Arm:
         self.limits = read_limits(self.bus, self.ids)
 
     def ranges_stored(self) -> bool:
-        """Whether every joint's servo keeps its angle limits on."""
-        return all(lim.angle_min is not None for lim in self.limits.values())
+        """Whether every joint's servo keeps its angle limits on, and not
+        the factory's (on, +-135 deg: a new servo's, no calibration's)."""
+        factory = (registers.find("angle_min").default, registers.find("angle_max").default)
+        return all(lim.angle_min is not None and (lim.angle_min, lim.angle_max) != factory
+                   for lim in self.limits.values())
 
     # ---- a frame -----------------------------------------------------
     def positions(self) -> dict:

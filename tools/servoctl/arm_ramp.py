@@ -1,8 +1,13 @@
 """The first targets of an arm's loop (servoctl.arm), from where it was
 held to what the loop asks: a leader that stands away from the follower
 is not a target to jump to (a target may move 740 deg/s a frame; a 34 deg
-jump in two frames in a recorded episode). Degrees and seconds."""
+jump in two frames in a recorded episode); nor is a joint resting outside
+its angle limits a start the servo takes (into_limits). Degrees and
+seconds."""
 import math
+
+from .errors import ServoError
+from .servo import Servo
 
 DEFAULT_SPEED_DEG_S = 45.0  # a 34 deg gap to a leader's pose takes a second
 RISE_S = 0.25  # from rest to the ramp's speed
@@ -48,3 +53,35 @@ class Ramp:
                 self._speeds[name] = speed
             self._asked[name] = wanted[name]
         return out
+
+
+def within(deg: float, lim) -> float:
+    """deg within a servo's angle limits (setpoints.Limits), if they are on."""
+    return deg if lim.angle_min is None else min(max(deg, lim.angle_min / 10.0), lim.angle_max / 10.0)
+
+
+def into_limits(arm, here: dict, speed_deg_s: float) -> dict:
+    """here ({name: deg}, where arm's joints are held) within their limits:
+    a joint outside them (it rests a hair past one, or was pushed far out)
+    is moved to the nearest at up to speed_deg_s and waited for, on the
+    bus's clock, a Sync Monitor a frame (which feeds every bus watchdog);
+    its setpoints, and the ramp, then start there, as the servo takes them
+    (it clamps a streamed setpoint to its limits: one outside is a jump).
+    A refusal outside the limits (arm.limits) then advises as for an arm
+    whose limits are its calibration, not to switch them off."""
+    for lim in arm.limits.values():  # its range, as calibrated: never to be switched off to get by
+        lim.advice = ("The arm keeps its targets within the limits read at connect: were they changed since? "
+                      "Connect again (calibrate again to change them)")
+    held = {n: within(d, arm.limits[arm.joints[n]]) for n, d in here.items()}
+    out = {n: d for n, d in held.items() if d != here[n]}
+    for name, deg in out.items():
+        Servo(arm.bus, arm.joints[name]).move_to(deg, speed_dps=speed_deg_s, accel_s=RISE_S, decel_s=RISE_S)
+    start = arm.bus.clock()
+    end = start + 2.0 * max((abs(here[n] - d) for n, d in out.items()), default=0) / speed_deg_s + 2.0
+    while out and not all(abs(within(d, arm.limits[arm.joints[n]]) - d) <= 0.1  # within them, or a reading off
+                          for n, d in arm.positions().items() if n in out):
+        if arm.bus.clock() > end:
+            raise ServoError(f"{', '.join(out)}: outside its angle limits, and not at the nearest within "
+                             f"{end - start:.1f} s (blocked?): move it within its range and connect again")
+        arm.bus.sleep(arm.period_s)
+    return held

@@ -50,11 +50,13 @@ class Limits:
     else None; the top speed, the servo's own clamp for moves and
     setpoints (docs/streaming.md), between a setpoint and the next; and its
     bus watchdog's watchdog_ms (item 64, ms; 0 off), which a stream's
-    period must keep fed."""
+    period must keep fed. advice: what a refusal outside the angle limits
+    advises, if not to change them or turn them off (a calibrated arm's)."""
     angle_min: int = None
     angle_max: int = None
     speed: int = MAX_SPEED_DECIDEG_S
     watchdog_ms: int = 0
+    advice: str = None
 
     @classmethod
     def of(cls, cfg: dict) -> "Limits":
@@ -86,7 +88,8 @@ class Limits:
         if self.angle_min is not None and not self.angle_min <= angle <= self.angle_max:
             return (f"servo {servo_id} limits its angle to {self.angle_min / 10:.1f}..{self.angle_max / 10:.1f} deg "
                     f"(angle_min, angle_max, angle_limit_on): a setpoint of {angle / 10:.1f} deg is outside them. "
-                    f"Change the limits, or turn them off with 'servoctl config set {servo_id} angle_limit_on 0'")
+                    + (self.advice or f"Change the limits, or turn them off with 'servoctl config set {servo_id} "
+                                      f"angle_limit_on 0'"))
         if last is not None and abs(angle - last) * 1000 > self.speed * period_ms:
             return (f"servo {servo_id}: {abs(angle - last) / 10:.1f} deg in {period_ms} ms (from {last / 10:.1f} to "
                     f"{angle / 10:.1f} deg) is {abs(angle - last) * 100 / period_ms:.0f} deg/s, beyond the "

@@ -1,7 +1,8 @@
 """servoctl.arm, the LeRobot follower's library, at the edges a user meets
 first, on servo_sim (no LeRobot needed): the first actions after connect,
-a run that ended without putting the watchdog back, and two servos at one
-joint's ID. Time is the simulator's."""
+a joint resting outside its limits, a run that ended without putting the
+watchdog back, two servos at one joint's ID, and a new arm taken for a
+calibrated one. Time is the simulator's."""
 import logging
 
 import pytest
@@ -57,6 +58,65 @@ def test_no_ramp_when_turned_off():
         held = arm.hold_here()
         sim.sleep(0.01)
         assert arm.send({"a": held["a"] + 20.0})["a"] == pytest.approx(held["a"] + 20.0, abs=0.1)
+
+
+def test_a_joint_resting_outside_its_limits_ramps_from_the_nearest(monkeypatch):
+    """A joint that settled a hair past its limit (reads 37.3, limits
+    +-37.2), or was pushed far past one (136.2, limits -36.9..38.5): the
+    first frame raised ValueOutOfRange (the ramp started where it was,
+    outside). Now it goes to the nearest limit at the ramp's speed at
+    connect, and the first actions, inside and outside, ramp from there."""
+    limits = {"a": (-37.2, 37.2), "b": (-36.9, 38.5), "c": (-37.2, 37.2)}
+    action = {"a": 10.0, "b": -90.0, "c": -80.0}  # inside; outside, across the range; outside, where it is
+    with Simulator(ids=[1, 2, 3], paced=True) as sim:
+        bus = sim.bus()
+        for servo_id, deg in ((1, 37.35), (2, 136.2), (3, -60.0)):
+            s = Servo(bus, servo_id)
+            s.write("angle_limit_on", 0)
+            s.move_to(deg, duration_s=1.0, wait=True)
+            s.stop("release")  # at rest there, as a hand left it
+        arm = Arm(bus, {"a": 1, "b": 2, "c": 3}, fps=FPS, watchdog_ms=0)
+        arm.store_ranges(limits)
+        here = arm.open().positions()
+        assert 37.2 < here["a"] <= 37.5 and here["b"] > 135 and here["c"] < -59, here
+        peak, sleep = [0.0], bus.sleep
+
+        def sampled(seconds):  # the horns' speed while connect takes them to their limits
+            sleep(seconds)
+            peak[0] = max([peak[0]] + [abs(sim.state(i)["velocity"]) for i in (1, 2, 3)])
+
+        monkeypatch.setattr(bus, "sleep", sampled)
+        held = arm.hold_here()
+        monkeypatch.undo()
+        assert held == {"a": 37.2, "b": 38.5, "c": -37.2}
+        t0 = sim.clock_s()
+        for k in range(3 * FPS):
+            sent = arm.send(action)
+            assert all(limits[n][0] <= d <= limits[n][1] for n, d in sent.items()), sent
+            while sim.clock_s() < t0 + (k + 1) / FPS:
+                sim.sleep(0.005)
+                for servo_id, (name, (low, high)) in enumerate(limits.items(), start=1):
+                    horn = sim.state(servo_id)
+                    assert low - 0.1 <= horn["angle"] <= high + 0.1, (name, horn["angle"])
+                    peak[0] = max(peak[0], abs(horn["velocity"]))
+        assert peak[0] <= 56, peak[0]  # the ramp's 45 deg/s, and the ripple the first test allows
+        assert [round(sim.state(i)["angle"]) for i in (1, 2, 3)] == [10, -37, -37]
+        said = arm.limits[1].check(1, 400)  # were a setpoint refused, the advice is a calibrated arm's
+        assert "calibrate again" in said and "angle_limit_on 0" not in said, said
+
+
+def test_a_new_arm_is_not_taken_for_a_calibrated_one():
+    """Factory servos keep their angle limits on (+-135 deg, item 48 = 1):
+    a new arm counted as calibrated, and connect() never asked for it.
+    Calibrated now means ranges stored by a calibration, not the factory's."""
+    with Simulator(ids=[1, 2], fast=True) as sim:
+        bus = sim.bus()
+        arm = Arm(bus, {"a": 1, "b": 2}, watchdog_ms=0).open()
+        assert not arm.ranges_stored()
+        arm.set_zero_here()  # the documented calibration: the middle, then the ranges (joints.calibrate)
+        arm.store_ranges({"a": (-41.3, 36.8), "b": (-90.0, 88.2)})
+        assert arm.ranges_stored()
+        assert Arm(bus, {"a": 1, "b": 2}, watchdog_ms=0).open().ranges_stored()  # the next connect
 
 
 def test_a_run_that_did_not_end_leaves_its_watchdog_not_taken_for_the_servos_own(caplog):

@@ -101,6 +101,7 @@ def test_calibration_stores_the_zero_and_the_ranges_on_the_servos(seen):
     for lo, hi, on in seen["cal_limits"]:
         assert on == 1 and lo == pytest.approx(-300, abs=5) and hi == pytest.approx(300, abs=5)
     assert len(set(seen["cal_zero"])) == 7  # each its own encoder count (item 90)
+    assert not seen["new_is_calibrated"]  # a new arm, its servos at the factory's +-135 deg, asks for it
     assert seen["cal_file"] and seen["is_calibrated"]
 
 

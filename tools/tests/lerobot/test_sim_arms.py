@@ -72,6 +72,7 @@ def test_state_keeps_the_servos_flash_from_one_start_to_the_next(tmp_path, procs
         link_rate.open_rate(ports["FOLLOWER_PORT"], 1000000, ports["FOLLOWER_CONTROL"])
         with Bus(ports["FOLLOWER_PORT"], 1000000, timeout=0.2) as bus:
             if run == 0:
+                assert Servo(bus, 1).read("angle_max") == 1200  # a calibration's range: not asked for one
                 Servo(bus, 1).write("angle_max", 600)  # as a calibration stores a range
             assert Servo(bus, 1).read("angle_max") == 600
         stop(proc)
