@@ -27,7 +27,7 @@ import logging
 import math
 
 from . import protocol as p
-from . import registers, scan
+from . import registers
 from .errors import NoReply, ServoError, UsageError, ValueOutOfRange
 from .arm_ramp import DEFAULT_SPEED_DEG_S, Ramp
 from .group import sync_monitor
@@ -86,6 +86,8 @@ def watchdog_text(setting: tuple) -> str:
 def shared_text(bus: p.Bus, ids: list):
     """What scan's probe says of the first of ids that two or more servos
     hold (their answers collide, or come twice), or None."""
+    from . import scan  # when a joint is silent only: scan reaches the update images' tools
+
     window = scan.reply_window_s(bus.serial.baudrate)
     for servo_id in ids:
         found = scan.probe(bus, servo_id, window)
