@@ -317,7 +317,7 @@ class Arm:
             raise UsageError("hold_here() first: the arm's first target is where it is")
         now = self.bus.clock()
         since = now - (self._times[-1] if self._times else self._held_at)
-        sent = self.ramp.step(self.clamp({**self.targets, **targets}), self.targets, since)
+        sent = self.ramp.step(self.clamp({**self.targets, **targets}), self.targets, since, set(targets))
         if self._times:
             # The frame period as the host keeps it: the maker's moves are fitted to it.
             self.measured_period_s += 0.3 * (min(now - self._times[-1], 1.0) - self.measured_period_s)
