@@ -160,25 +160,40 @@ class Arm:
     def _arm_watchdog(self) -> None:
         if not self.watchdog_ms:
             return
-        ours = (self.watchdog_ms, WATCHDOG_ACTIONS[self.watchdog_action])
         for servo_id in self.ids:
-            s = Servo(self.bus, servo_id)
-            serial = s.read("serial")
-            holds = (s.read("watchdog_ms"), s.read("watchdog_action"))
-            own, record = self.records.own_setting(serial, holds)
-            if record is not None:
-                log.warning("%s (servo %d): its bus watchdog holds %s, which a run that did not end cleanly "
-                            "wrote; its own setting, %s (kept in %s), is put back on close",
-                            self.names[servo_id], servo_id, watchdog_text(holds), watchdog_text(own), record)
-            if own != ours:
-                self.records.keep(serial, servo_id, own, ours)  # before the servo holds ours
-                self._watchdog_before[servo_id] = (serial, own)
-            elif record is not None:
-                self.records.forget(serial)
-            if holds != ours:  # written only where it differs
-                s.write("watchdog_ms", ours[0])
-                s.write("watchdog_action", ours[1])
-            self.limits[servo_id].watchdog_ms = self.watchdog_ms
+            self._arm_one(servo_id)
+
+    def _arm_one(self, servo_id: int) -> None:
+        """Ours on the servo, its own kept first (WatchdogRecords), said
+        where it is not what the servo holds."""
+        ours = (self.watchdog_ms, WATCHDOG_ACTIONS[self.watchdog_action])
+        s, who = Servo(self.bus, servo_id), f"{self.names[servo_id]} (servo {servo_id})"
+        serial = s.read("serial")
+        holds = (s.read("watchdog_ms"), s.read("watchdog_action"))
+        own, found = self.records.own_setting(serial, holds, ours)
+        for said in self.records.warnings:
+            log.warning("%s: %s", who, said)
+        self.records.warnings.clear()
+        if found == "record":
+            log.warning("%s: its bus watchdog holds %s, which a run that did not end cleanly wrote; its own "
+                        "setting, %s (kept in %s), is put back on close", who, watchdog_text(holds),
+                        watchdog_text(own), self.records.path(serial))
+        elif found == "ours":
+            log.warning("%s: its bus watchdog holds %s, the follower's own setting, and no record of the servo's "
+                        "own is kept here (%s): a run on another computer, by another user or with another "
+                        "state folder that did not end cleanly left it. The power-up setting, %s, is put back "
+                        "on close; if %s was set on purpose, set it again after disconnecting ('servoctl config "
+                        "set %d watchdog_ms %d')", who, watchdog_text(holds), self.records.folder,
+                        watchdog_text(own), watchdog_text(holds), servo_id, holds[0])
+        if own != ours:
+            self.records.keep(serial, servo_id, own, ours)  # before the servo holds ours
+            self._watchdog_before[servo_id] = (serial, own)
+        if holds != ours:  # written only where it differs
+            s.write("watchdog_ms", ours[0])
+            s.write("watchdog_action", ours[1])
+        if own == ours and found == "record":
+            self.records.forget(serial)  # once the servo holds it: a crash before leaves the record
+        self.limits[servo_id].watchdog_ms = self.watchdog_ms
 
     def hold_here(self) -> dict:
         """Torque on where every joint is (StopOnControlMode's hold: no
@@ -213,7 +228,7 @@ class Arm:
                 s.write("watchdog_ms", ms)
                 s.write("watchdog_action", action)
                 self.records.forget(serial)  # kept where it could not be put back
-            except ServoError as e:
+            except (ServoError, OSError) as e:  # the next servos' still put back
                 errors.append(f"{self.names[servo_id]}: {e}")
         self._watchdog_before = {}
         self.stream = None
