@@ -18,7 +18,9 @@ and out, a frame at a time.
 - On this firmware the bus watchdog (items 64, 65) is armed while the arm
   is driven, and put back as it was on close; the servo's own setting is
   kept on the host meanwhile (watchdog_record.py), so a run that ended
-  without putting it back is not taken for the servo's own.
+  without putting it back is not taken for the servo's own. A servo that
+  restarts mid-run (its watchdog back to off) is armed again and ramps
+  from where its horn is (arm_reset.py).
 - A joint that does not answer because two servos hold its ID is said to
   be shared (JointShared: scan's probe hears their answers collide).
 
@@ -30,6 +32,8 @@ from . import protocol as p
 from . import registers
 from .errors import NoReply, ServoError, UsageError, ValueOutOfRange
 from .arm_ramp import DEFAULT_SPEED_DEG_S, Ramp
+from .arm_reset import ResetWatch
+from .arm_watchdog import WATCHDOG_ACTIONS, arm_one
 from .group import sync_monitor
 from .servo import Servo
 from .setpoints import MAX_SPEED_DECIDEG_S, Stream, read_limits
@@ -37,7 +41,6 @@ from .watchdog_record import WatchdogRecords
 
 log = logging.getLogger(__name__)
 
-WATCHDOG_ACTIONS = {"hold": 0, "damp": 1, "release": 2}  # item 65
 # Status bits with which the servo has let its output go (frame.toml).
 RELEASED_BY = ("high_voltage", "low_voltage", "over_temperature")
 # The maker's moves: the shortest and longest time fitted to the frames.
@@ -74,13 +77,6 @@ def fault_text(servo: Servo, newest: int = 3) -> str:
     said = ", ".join(f"#{f.number} {f.kind} at {f.angle_decideg / 10:.1f} deg, {f.voltage_mv / 1000:.2f} V, "
                      f"{f.winding_decic / 10:.0f} C winding" for f in faults)
     return f"its newest faults: {said} ('servoctl faults {servo.id}')"
-
-
-def watchdog_text(setting: tuple) -> str:
-    """(watchdog_ms, watchdog_action) as a phrase: '500 ms, hold', 'off'."""
-    ms, action = setting
-    named = {v: k for k, v in WATCHDOG_ACTIONS.items()}.get(action, f"action {action}")
-    return f"{ms} ms, {named}" if ms else f"off ({named})"
 
 
 def shared_text(bus: p.Bus, ids: list):
@@ -144,6 +140,7 @@ class Arm:
         self._times = []  # the bus clock at the last sends, up to 3
         self.measured_period_s = self.period_s
         self.frames = 0
+        self.watch = None  # ResetWatch while the watchdog is armed on this firmware
 
     # ---- the session -------------------------------------------------
     def open(self) -> "Arm":
@@ -153,47 +150,38 @@ class Arm:
         if self.firmware == "auto":
             self.firmware = detect_firmware(self.bus, self.ids[0])
         self.limits = read_limits(self.bus, self.ids)
-        if self.firmware == "servoctl":
+        if self.firmware == "servoctl" and self.watchdog_ms:
             self._arm_watchdog()
+            self.watch = ResetWatch(self.ids, self.watchdog_ms)
         return self
 
     def _arm_watchdog(self) -> None:
-        if not self.watchdog_ms:
-            return
         for servo_id in self.ids:
             self._arm_one(servo_id)
 
     def _arm_one(self, servo_id: int) -> None:
-        """Ours on the servo, its own kept first (WatchdogRecords), said
-        where it is not what the servo holds."""
         ours = (self.watchdog_ms, WATCHDOG_ACTIONS[self.watchdog_action])
-        s, who = Servo(self.bus, servo_id), f"{self.names[servo_id]} (servo {servo_id})"
-        serial = s.read("serial")
-        holds = (s.read("watchdog_ms"), s.read("watchdog_action"))
-        own, found = self.records.own_setting(serial, holds, ours)
-        for said in self.records.warnings:
-            log.warning("%s: %s", who, said)
-        self.records.warnings.clear()
-        if found == "record":
-            log.warning("%s: its bus watchdog holds %s, which a run that did not end cleanly wrote; its own "
-                        "setting, %s (kept in %s), is put back on close", who, watchdog_text(holds),
-                        watchdog_text(own), self.records.path(serial))
-        elif found == "ours":
-            log.warning("%s: its bus watchdog holds %s, the follower's own setting, and no record of the servo's "
-                        "own is kept here (%s): a run on another computer, by another user or with another "
-                        "state folder that did not end cleanly left it. The power-up setting, %s, is put back "
-                        "on close; if %s was set on purpose, set it again after disconnecting ('servoctl config "
-                        "set %d watchdog_ms %d')", who, watchdog_text(holds), self.records.folder,
-                        watchdog_text(own), watchdog_text(holds), servo_id, holds[0])
-        if own != ours:
-            self.records.keep(serial, servo_id, own, ours)  # before the servo holds ours
-            self._watchdog_before[servo_id] = (serial, own)
-        if holds != ours:  # written only where it differs
-            s.write("watchdog_ms", ours[0])
-            s.write("watchdog_action", ours[1])
-        if own == ours and found == "record":
-            self.records.forget(serial)  # once the servo holds it: a crash before leaves the record
+        kept = arm_one(Servo(self.bus, servo_id), f"{self.names[servo_id]} (servo {servo_id})", self.records, ours)
+        if kept is not None:
+            self._watchdog_before[servo_id] = kept
         self.limits[servo_id].watchdog_ms = self.watchdog_ms
+
+    def _again(self, servo_id: int, ms: int) -> None:
+        """A servo that restarted (arm_reset.py): armed again, held where
+        its horn is, and its joint ramped from there."""
+        name = self.names[servo_id]
+        self._arm_one(servo_id)
+        Servo(self.bus, servo_id).stop("hold")
+        state = sync_monitor(self.bus, [servo_id]).get(servo_id)
+        if state is None:
+            raise JointSilent(f"{name} (servo {servo_id}) restarted and then did not answer: no target is sent", [name])
+        log.warning("%s (servo %d): its bus watchdog read %d ms, not the arm's %d ms: it restarted (its supply or "
+                    "its connector?) or another program set it; armed again, held at %.1f deg, and ramped from "
+                    "there", name, servo_id, ms, self.watchdog_ms, state.angle_decideg / 10.0)
+        self.targets[name] = state.angle_decideg / 10.0
+        self._before.pop(name, None)
+        self.ramp.again(name)
+        self.stream.restart(servo_id)
 
     def hold_here(self) -> dict:
         """Torque on where every joint is (StopOnControlMode's hold: no
@@ -279,6 +267,8 @@ class Arm:
         states = sync_monitor(self.bus, self.ids)
         silent = [i for i in self.ids if i not in states]
         if silent:
+            if self.watch is not None:
+                self.watch.went_silent(silent)  # restarting? read every frame until it answers
             named = ", ".join(f"{self.names[i]} (servo {i})" for i in silent)
             names = [self.names[i] for i in silent]
             shared = shared_text(self.bus, silent)
@@ -343,6 +333,9 @@ class Arm:
             self._send_moves(sent)
         self._before = self.targets
         self.targets = sent
+        if self.watch is not None:  # after the setpoints: their times are the frames'
+            for servo_id, ms in self.watch.restarted(self.bus, self.measured_period_s):
+                self._again(servo_id, ms)
         return {n: round(d, 1) for n, d in sent.items()}
 
     def _velocities(self, sent: dict) -> dict:

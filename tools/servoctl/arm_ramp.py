@@ -30,6 +30,14 @@ class Ramp:
         self.joints = set(names) if self.speed_deg_s > 0 else set()
         self._speeds, self._asked = {}, {}
 
+    def again(self, name: str) -> None:
+        """The joint ramps again from rest, from its last target (its
+        servo restarted: the target is where its horn is)."""
+        if self.speed_deg_s > 0:
+            self.joints.add(name)
+        self._speeds.pop(name, None)
+        self._asked.pop(name, None)
+
     def step(self, wanted: dict, last: dict, since_s: float, asked=None) -> dict:
         """wanted ({name: deg}) as far as the ramp lets each joint go from
         last (its last target) in since_s, the time since that was sent;

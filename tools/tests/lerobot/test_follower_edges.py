@@ -191,3 +191,34 @@ def test_a_planted_link_is_not_followed(state_dir, tmp_path):
         path.with_name(f".{path.name}.{os.getpid()}").symlink_to(victim)
         Arm(bus, {"a": 1}).open().close()
     assert victim.read_text() == "mine"
+
+
+def test_a_servo_that_restarts_mid_run_ramps_again_from_where_it_is(caplog):
+    """Power-cycled under a load (items 64-72 back to the factory's, the
+    output released), the servo fell 18 deg and was then driven back at
+    276 deg/s with no ramp, its watchdog off, and nothing said."""
+    with Simulator(ids=[1, 2], paced=True) as sim:
+        bus = sim.bus()
+        arm = Arm(bus, {"a": 1, "b": 2}, fps=FPS).open()
+        held = arm.hold_here()
+        goal = {"a": held["a"] + 30, "b": held["b"]}
+        t0 = sim.clock_s()
+        frames(sim, arm, t0, 0, 60, lambda k: goal, 1)
+        assert abs(sim.state(1)["angle"] - goal["a"]) < 0.5
+        sim.control("load 0.6 1")
+        sim.control("powercycle 1")
+        angles = []
+        with caplog.at_level(logging.WARNING, logger="servoctl.arm"):
+            for k in range(60, 100):
+                if k == 64:
+                    sim.control("load 0 1")  # let go within the bootloader's 0.2 s
+                frames(sim, arm, t0, k, 1, lambda k: goal, 1)
+                angles.append(sim.state(1)["angle"])
+        fallen = min(angles)
+        assert fallen < goal["a"] - 10, angles  # it did fall: released at power-up
+        rises = [b - a for a, b in zip(angles, angles[6:])]  # over 0.2 s
+        assert max(rises) <= 45 * 0.2 + 2, (max(rises), angles)
+        assert "a (servo 1): its bus watchdog read 0 ms, not the arm's 500 ms: it restarted" in caplog.text
+        assert watchdog(bus, 1) == (500, 0)
+        arm.close()
+        assert [watchdog(bus, i) for i in (1, 2)] == [FACTORY_WATCHDOG] * 2
