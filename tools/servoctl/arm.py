@@ -117,6 +117,10 @@ class Arm:
                  ramp_speed_deg_s: float = DEFAULT_SPEED_DEG_S, records: WatchdogRecords = None):
         if not joints:
             raise UsageError("an arm needs at least one joint")
+        twice = {i: [n for n, j in joints.items() if j == i] for i in set(joints.values())}
+        twice = [f"{' and '.join(names)} (servo {i})" for i, names in twice.items() if len(names) > 1]
+        if twice:  # one servo would be driven to two joints' targets, and read as both
+            raise UsageError(f"each joint has its own servo ID: {'; '.join(twice)} share one")
         if watchdog_action not in WATCHDOG_ACTIONS:
             raise UsageError(f"watchdog_action is one of {', '.join(WATCHDOG_ACTIONS)}, not {watchdog_action!r}")
         if firmware not in ("auto", "servoctl", "maker"):

@@ -11,7 +11,7 @@ import threading
 import pytest
 
 from servoctl.arm import Arm
-from servoctl.errors import ServoError
+from servoctl.errors import ServoError, UsageError
 from servoctl.servo import Servo
 from servoctl.sim import Simulator
 from servoctl.watchdog_record import WatchdogRecords
@@ -222,3 +222,9 @@ def test_a_servo_that_restarts_mid_run_ramps_again_from_where_it_is(caplog):
         assert watchdog(bus, 1) == (500, 0)
         arm.close()
         assert [watchdog(bus, i) for i in (1, 2)] == [FACTORY_WATCHDOG] * 2
+
+
+def test_one_id_in_two_joints_is_refused_naming_both():
+    with pytest.raises(UsageError) as e:
+        Arm(None, {"a": 1, "b": 2, "c": 1})
+    assert "a and c (servo 1)" in str(e.value), e.value
