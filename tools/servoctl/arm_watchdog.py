@@ -9,6 +9,7 @@ from .watchdog_record import WatchdogRecords
 log = logging.getLogger("servoctl.arm")
 
 WATCHDOG_ACTIONS = {"hold": 0, "damp": 1, "release": 2}  # item 65
+DEFAULT = (500, 0)  # the follower's unless told: 500 ms, hold (servoctl.arm.Arm, the plugin's config)
 
 
 def watchdog_text(setting: tuple) -> str:
@@ -24,7 +25,7 @@ def arm_one(s: Servo, who: str, records: WatchdogRecords, ours: tuple):
     or None where its own is ours."""
     serial = s.read("serial")
     holds = (s.read("watchdog_ms"), s.read("watchdog_action"))
-    own, found = records.own_setting(serial, holds, ours)
+    own, found = records.own_setting(serial, holds, [ours, DEFAULT])  # the default: another run's
     for said in records.warnings:
         log.warning("%s: %s", who, said)
     records.warnings.clear()

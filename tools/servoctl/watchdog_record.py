@@ -84,26 +84,27 @@ class WatchdogRecords:
     def path(self, serial: int) -> Path:
         return self.folder / f"{serial:08x}.json"
 
-    def own_setting(self, serial: int, holds: tuple, ours: tuple = None) -> tuple:
+    def own_setting(self, serial: int, holds: tuple, ours=()) -> tuple:
         """(the servo's own setting, where it came from): "record" (the
         path's: the servo holds what the record says a loop wrote, or half
-        of it), "ours" (no record, and the servo holds exactly ours, the
-        loop's setting: FACTORY is taken), or None (what it holds)."""
+        of it), "ours" (no record, and the servo holds exactly one of ours,
+        a list of the settings a loop writes, its own and its default:
+        FACTORY is taken), or None (what it holds)."""
         path = self.path(serial)
         holds = tuple(holds)
         try:
             record = json.loads(_read(path))
             own, wrote = _setting(record["own"]), _setting(record["wrote"])
         except FileNotFoundError:
-            return (FACTORY, "ours") if holds == ours else (holds, None)
+            return (FACTORY, "ours") if holds in ours else (holds, None)
         except (OSError, ValueError, KeyError, TypeError) as e:
             self.warnings.append(f"{path} is not a record of a watchdog setting ({e}): dropped")
             self._drop(path)
-            return (FACTORY, "ours") if holds == ours else (holds, None)
+            return (FACTORY, "ours") if holds in ours else (holds, None)
         if holds[0] in (own[0], wrote[0]) and holds[1] in (own[1], wrote[1]) and holds != own:
             return own, "record"
         self._drop(path)
-        return (FACTORY, "ours") if holds == ours else (holds, None)
+        return (FACTORY, "ours") if holds in ours else (holds, None)
 
     def keep(self, serial: int, servo_id: int, own: tuple, wrote: tuple) -> None:
         """Before the loop's setting (wrote) goes onto the servo: whole on

@@ -104,15 +104,17 @@ def test_a_crash_between_the_two_watchdog_writes_leaves_the_servos_own(phase, cr
         assert watchdog(bus, 1) == own
 
 
-def test_the_followers_own_setting_with_no_record_here_is_said_and_not_kept(tmp_path, caplog):
+@pytest.mark.parametrize("ms", [500, 1000])
+def test_the_followers_own_setting_with_no_record_here_is_said_and_not_kept(tmp_path, caplog, ms):
     """Another computer's (or user's, or state folder's) run that did not
     end cleanly left 500 ms, hold: with no record here it was silently
-    taken for the servo's own, and put back on close."""
+    taken for the servo's own, and put back on close; so too by a run
+    that arms its own 1000 ms."""
     with Simulator(ids=[1, 2], fast=True) as sim:
         bus = sim.bus()
         Arm(bus, {"a": 1, "b": 2}, records=WatchdogRecords(tmp_path / "elsewhere")).open()  # never closed
         with caplog.at_level(logging.WARNING, logger="servoctl.arm"):
-            arm = Arm(bus, {"a": 1, "b": 2}).open()
+            arm = Arm(bus, {"a": 1, "b": 2}, watchdog_ms=ms).open()
         said = caplog.text
         assert "a (servo 1): its bus watchdog holds 500 ms, hold, the follower's own setting" in said, said
         assert "no record" in said and "servoctl config set 1 watchdog_ms 500" in said, said
