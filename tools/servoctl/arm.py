@@ -19,7 +19,9 @@ and out, a frame at a time.
 - On this firmware the bus watchdog (items 64, 65) is armed while the arm
   is driven, and put back as it was on close; the servo's own setting is
   kept on the host meanwhile (watchdog_record.py), so a run that ended
-  without putting it back is not taken for the servo's own.
+  without putting it back is not taken for the servo's own. A servo that
+  restarts mid-run (its watchdog back to off) is armed again and ramps
+  from where its horn is (arm_reset.py).
 - A joint that does not answer because two servos hold its ID is said to
   be shared (JointShared: scan's probe hears their answers collide).
 
@@ -28,9 +30,11 @@ import logging
 import math
 
 from . import protocol as p
-from . import registers, scan
+from . import registers
 from .errors import NoReply, ServoError, UsageError, ValueOutOfRange
 from .arm_ramp import DEFAULT_SPEED_DEG_S, Ramp, into_limits
+from .arm_reset import ResetWatch
+from .arm_watchdog import WATCHDOG_ACTIONS, arm_one
 from .group import sync_monitor
 from .servo import Servo
 from .setpoints import MAX_SPEED_DECIDEG_S, Stream, read_limits
@@ -38,7 +42,6 @@ from .watchdog_record import WatchdogRecords
 
 log = logging.getLogger(__name__)
 
-WATCHDOG_ACTIONS = {"hold": 0, "damp": 1, "release": 2}  # item 65
 # Status bits with which the servo has let its output go (frame.toml).
 RELEASED_BY = ("high_voltage", "low_voltage", "over_temperature")
 # The maker's moves: the shortest and longest time fitted to the frames.
@@ -77,16 +80,11 @@ def fault_text(servo: Servo, newest: int = 3) -> str:
     return f"its newest faults: {said} ('servoctl faults {servo.id}')"
 
 
-def watchdog_text(setting: tuple) -> str:
-    """(watchdog_ms, watchdog_action) as a phrase: '500 ms, hold', 'off'."""
-    ms, action = setting
-    named = {v: k for k, v in WATCHDOG_ACTIONS.items()}.get(action, f"action {action}")
-    return f"{ms} ms, {named}" if ms else f"off ({named})"
-
-
 def shared_text(bus: p.Bus, ids: list):
     """What scan's probe says of the first of ids that two or more servos
     hold (their answers collide, or come twice), or None."""
+    from . import scan  # when a joint is silent only: scan reaches the update images' tools
+
     window = scan.reply_window_s(bus.serial.baudrate)
     for servo_id in ids:
         found = scan.probe(bus, servo_id, window)
@@ -120,6 +118,10 @@ class Arm:
                  ramp_speed_deg_s: float = DEFAULT_SPEED_DEG_S, records: WatchdogRecords = None):
         if not joints:
             raise UsageError("an arm needs at least one joint")
+        twice = {i: [n for n, j in joints.items() if j == i] for i in set(joints.values())}
+        twice = [f"{' and '.join(names)} (servo {i})" for i, names in twice.items() if len(names) > 1]
+        if twice:  # one servo would be driven to two joints' targets, and read as both
+            raise UsageError(f"each joint has its own servo ID: {'; '.join(twice)} share one")
         if watchdog_action not in WATCHDOG_ACTIONS:
             raise UsageError(f"watchdog_action is one of {', '.join(WATCHDOG_ACTIONS)}, not {watchdog_action!r}")
         if firmware not in ("auto", "servoctl", "maker"):
@@ -143,6 +145,7 @@ class Arm:
         self._times = []  # the bus clock at the last sends, up to 3
         self.measured_period_s = self.period_s
         self.frames = 0
+        self.watch = None  # ResetWatch while the watchdog is armed on this firmware
 
     # ---- the session -------------------------------------------------
     def open(self) -> "Arm":
@@ -152,32 +155,38 @@ class Arm:
         if self.firmware == "auto":
             self.firmware = detect_firmware(self.bus, self.ids[0])
         self.limits = read_limits(self.bus, self.ids)
-        if self.firmware == "servoctl":
+        if self.firmware == "servoctl" and self.watchdog_ms:
             self._arm_watchdog()
+            self.watch = ResetWatch(self.ids, self.watchdog_ms)
         return self
 
     def _arm_watchdog(self) -> None:
-        if not self.watchdog_ms:
-            return
-        ours = (self.watchdog_ms, WATCHDOG_ACTIONS[self.watchdog_action])
         for servo_id in self.ids:
-            s = Servo(self.bus, servo_id)
-            serial = s.read("serial")
-            holds = (s.read("watchdog_ms"), s.read("watchdog_action"))
-            own, record = self.records.own_setting(serial, holds)
-            if record is not None:
-                log.warning("%s (servo %d): its bus watchdog holds %s, which a run that did not end cleanly "
-                            "wrote; its own setting, %s (kept in %s), is put back on close",
-                            self.names[servo_id], servo_id, watchdog_text(holds), watchdog_text(own), record)
-            if own != ours:
-                self.records.keep(serial, servo_id, own, ours)  # before the servo holds ours
-                self._watchdog_before[servo_id] = (serial, own)
-            elif record is not None:
-                self.records.forget(serial)
-            if holds != ours:  # written only where it differs
-                s.write("watchdog_ms", ours[0])
-                s.write("watchdog_action", ours[1])
-            self.limits[servo_id].watchdog_ms = self.watchdog_ms
+            self._arm_one(servo_id)
+
+    def _arm_one(self, servo_id: int) -> None:
+        ours = (self.watchdog_ms, WATCHDOG_ACTIONS[self.watchdog_action])
+        kept = arm_one(Servo(self.bus, servo_id), f"{self.names[servo_id]} (servo {servo_id})", self.records, ours)
+        if kept is not None:
+            self._watchdog_before[servo_id] = kept
+        self.limits[servo_id].watchdog_ms = self.watchdog_ms
+
+    def _again(self, servo_id: int, ms: int) -> None:
+        """A servo that restarted (arm_reset.py): armed again, held where
+        its horn is, and its joint ramped from there."""
+        name = self.names[servo_id]
+        self._arm_one(servo_id)
+        Servo(self.bus, servo_id).stop("hold")
+        state = sync_monitor(self.bus, [servo_id]).get(servo_id)
+        if state is None:
+            raise JointSilent(f"{name} (servo {servo_id}) restarted and then did not answer: no target is sent", [name])
+        log.warning("%s (servo %d): its bus watchdog read %d ms, not the arm's %d ms: it restarted (its supply or "
+                    "its connector?) or another program set it; armed again, held at %.1f deg, and ramped from "
+                    "there", name, servo_id, ms, self.watchdog_ms, state.angle_decideg / 10.0)
+        self.targets[name] = state.angle_decideg / 10.0
+        self._before.pop(name, None)
+        self.ramp.again(name)
+        self.stream.restart(servo_id)
 
     def hold_here(self) -> dict:
         """Torque on where every joint is (StopOnControlMode's hold: no
@@ -214,7 +223,7 @@ class Arm:
                 s.write("watchdog_ms", ms)
                 s.write("watchdog_action", action)
                 self.records.forget(serial)  # kept where it could not be put back
-            except ServoError as e:
+            except (ServoError, OSError) as e:  # the next servos' still put back
                 errors.append(f"{self.names[servo_id]}: {e}")
         self._watchdog_before = {}
         self.stream = None
@@ -268,6 +277,8 @@ class Arm:
         states = sync_monitor(self.bus, self.ids)
         silent = [i for i in self.ids if i not in states]
         if silent:
+            if self.watch is not None:
+                self.watch.went_silent(silent)  # restarting? read every frame until it answers
             named = ", ".join(f"{self.names[i]} (servo {i})" for i in silent)
             names = [self.names[i] for i in silent]
             shared = shared_text(self.bus, silent)
@@ -321,7 +332,7 @@ class Arm:
             raise UsageError("hold_here() first: the arm's first target is where it is")
         now = self.bus.clock()
         since = now - (self._times[-1] if self._times else self._held_at)
-        sent = self.ramp.step(self.clamp({**self.targets, **targets}), self.targets, since)
+        sent = self.ramp.step(self.clamp({**self.targets, **targets}), self.targets, since, set(targets))
         if self._times:
             # The frame period as the host keeps it: the maker's moves are fitted to it.
             self.measured_period_s += 0.3 * (min(now - self._times[-1], 1.0) - self.measured_period_s)
@@ -332,6 +343,9 @@ class Arm:
             self._send_moves(sent)
         self._before = self.targets
         self.targets = sent
+        if self.watch is not None:  # after the setpoints: their times are the frames'
+            for servo_id, ms in self.watch.restarted(self.bus, self.measured_period_s):
+                self._again(servo_id, ms)
         return {n: round(d, 1) for n, d in sent.items()}
 
     def _velocities(self, sent: dict) -> dict:

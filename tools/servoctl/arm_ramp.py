@@ -20,8 +20,10 @@ class Ramp:
     the horn to twice the speed), over the time since the last send, a
     frame period at most (a late frame is no licence to jump). A joint
     whose target is within that step is there, and follows freely from
-    then: a leader that moves slower than the ramp is caught up. A speed
-    of 0: no ramp."""
+    then: a leader that moves slower than the ramp is caught up. Only a
+    joint asked for leaves the ramp: one left out of an action keeps its
+    target where it is, and ramps when it is asked. A speed of 0: no
+    ramp."""
 
     def __init__(self, speed_deg_s: float, period_s: float):
         self.speed_deg_s, self.period_s = speed_deg_s, period_s
@@ -33,15 +35,28 @@ class Ramp:
         self.joints = set(names) if self.speed_deg_s > 0 else set()
         self._speeds, self._asked = {}, {}
 
-    def step(self, wanted: dict, last: dict, since_s: float) -> dict:
+    def again(self, name: str) -> None:
+        """The joint ramps again from rest, from its last target (its
+        servo restarted: the target is where its horn is)."""
+        if self.speed_deg_s > 0:
+            self.joints.add(name)
+        self._speeds.pop(name, None)
+        self._asked.pop(name, None)
+
+    def step(self, wanted: dict, last: dict, since_s: float, asked=None) -> dict:
         """wanted ({name: deg}) as far as the ramp lets each joint go from
-        last (its last target) in since_s, the time since that was sent."""
+        last (its last target) in since_s, the time since that was sent;
+        asked: the joints the action named (None: all of wanted)."""
         if not self.joints:
             return wanted
         dt = min(max(since_s, 0.0), self.period_s)
         top, accel = self.speed_deg_s, self.speed_deg_s / RISE_S
         out = dict(wanted)
         for name in list(self.joints):
+            if asked is not None and name not in asked:
+                out[name] = last[name]  # where it is, still ramping: not asked, so not reached
+                self._speeds[name] = 0.0
+                continue
             speed, gap = self._speeds.get(name, 0.0), wanted[name] - last[name]
             moving = (wanted[name] - self._asked.get(name, wanted[name])) / since_s if since_s > 0 else 0.0
             goal = min(max(moving + math.copysign(math.sqrt(2 * accel * abs(gap)), gap), -top), top)

@@ -181,6 +181,11 @@ class Stream:
             return code, body
         return p.SYNC, bytes([code, len(body) // len(records), len(records)]) + body
 
+    def restart(self, servo_id: int) -> None:
+        """The servo restarted (servoctl.arm_reset): its next setpoint
+        follows none, and is not checked against the last."""
+        self._last.pop(servo_id, None)
+
     def send(self, targets: dict, velocities: dict = None, then=()) -> None:
         """The setpoints, and the requests then (code, content) after them
         in the same burst."""

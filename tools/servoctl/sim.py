@@ -115,7 +115,7 @@ class Simulator(_Child):
         # times its answers on the wall clock (the maker's SDK) then meets
         # a servo that keeps up on a loaded PC. None: as started.
         self.nice = nice
-        self.process = None
+        self.process, self.preexec = None, None  # preexec: run in the child before servo_sim (sim_arms.py)
         self.url = None
         self.control_port = None
         self._clock_seen, self._clock_moved_at = None, 0.0
@@ -170,7 +170,7 @@ class Simulator(_Child):
         env = dict(os.environ, PYTHONPATH=os.pathsep.join(
             [str(PACKAGES)] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]))
         self.process = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                                        text=True, env=env)
+                                        text=True, env=env, preexec_fn=self.preexec)
         try:
             return self._until_ready(cmd)
         except BaseException:

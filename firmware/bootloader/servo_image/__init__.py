@@ -60,7 +60,11 @@ def _read_board(folder: Path):
 
 
 def boards() -> dict:
-    """{name: Board} of every board the build knows."""
+    """{name: Board} of every board the build knows; none where the
+    firmware's tree is not beside this package (servoctl installed
+    without -e: its images name their boards by number)."""
+    if not BOARDS_DIR.is_dir():
+        return {}
     found = (_read_board(f) for f in sorted(BOARDS_DIR.iterdir()) if (f / "board.h").is_file())
     return {b.name: b for b in found if b is not None}
 

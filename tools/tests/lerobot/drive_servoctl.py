@@ -93,8 +93,8 @@ def ramped(out: dict) -> None:
         t0, peak = sim.clock_s(), 0.0
         for k in range(45):
             robot.send_action({"Motor_1.pos": goal})
-            while sim.clock_s() < t0 + (k + 1) / 30:
-                sim.sleep(0.005)
+            while sim.clock_s() < t0 + (k + 1) / 30:  # the next frame on time, however long a send took
+                sim.sleep(max(min(0.005, t0 + (k + 1) / 30 - sim.clock_s()), 2e-6))
                 peak = max(peak, abs(sim.state(1)["velocity"]))
         out["ramp_peak_dps"] = peak
         out["ramp_reached"] = robot.get_observation()["Motor_1.pos"] - goal

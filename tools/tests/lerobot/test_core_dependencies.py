@@ -6,10 +6,13 @@ plugins can reach (their lazy imports too), and an arm driven by a Python
 that sees servoctl's core dependencies and nothing else."""
 import importlib.metadata as metadata
 import modulefinder
+import shutil
 import re
 import subprocess
 import sys
 import tomllib
+
+import pytest
 
 from servoctl.extras import OPTIONAL
 from servoctl.sim import Simulator
@@ -106,3 +109,52 @@ sys.exit(main(["--port", sys.argv[1], "identify", "1"]))
     assert done.returncode == 2, done.stderr
     assert "scipy is not installed (servoctl's extra for identify, tune and calibrate" in done.stderr, done.stderr
     assert "pip install 'servoctl[identify]'" in done.stderr, done.stderr
+
+
+LEROBOT_PYTHON = REPO / ".venv-lerobot" / "bin" / "python"  # its setuptools builds a wheel offline
+
+
+@pytest.mark.skipif(not LEROBOT_PYTHON.exists(), reason="no .venv-lerobot (scripts/lerobot_env.sh)")
+def test_an_installed_copy_imports_the_arm_without_the_firmware_tree(tmp_path):
+    """`pip install tools` (not -e) leaves firmware/boards behind: servo_image
+    listed that folder when imported (scan -> update -> image), so
+    servoctl.arm raised FileNotFoundError and LeRobot dropped the plugins.
+    Installed from a copy of the sources, imported by a Python that sees
+    that installation and the core's modules only; a shared ID is still
+    told (scan's probe, imported when it is needed)."""
+    source = tmp_path / "src"
+    for part in ("tools/pyproject.toml", "tools/servoctl", "tools/vboard", "protocol/servo_schema",
+                 "firmware/bootloader/servo_image"):
+        copy = shutil.copytree if (REPO / part).is_dir() else shutil.copy
+        (source / part).parent.mkdir(parents=True, exist_ok=True)
+        copy(REPO / part, source / part, **({"ignore": shutil.ignore_patterns("__pycache__")}
+                                            if (REPO / part).is_dir() else {}))
+    site = tmp_path / "site"
+    subprocess.run([str(LEROBOT_PYTHON), "-m", "pip", "install", "-q", "--no-deps", "--no-build-isolation",
+                    "--no-index", "--target", str(site), str(source / "tools")], check=True, timeout=300,
+                   capture_output=True)
+    installed = metadata.distribution("pyserial").locate_file("")
+    for module in core_modules():
+        for found in (installed / module, installed / f"{module}.py"):
+            if found.exists() and not (site / found.name).exists():
+                (site / found.name).symlink_to(found)
+    script = """
+import sys
+import servoctl.arm
+from servoctl.arm import Arm, JointShared
+from servoctl.protocol import Bus
+print(servoctl.arm.__file__)
+with Bus(sys.argv[1], 115200) as bus:
+    try:
+        Arm(bus, {"a": 1}).positions()
+    except JointShared as e:
+        print("shared:", e)
+"""
+    with Simulator(ids=[1, 1], fast=True) as sim:
+        done = subprocess.run([sys.executable, "-S", "-c", script, sim.url], capture_output=True, text=True,
+                              timeout=120, cwd=tmp_path, env={"PYTHONPATH": str(site),
+                                                              "SERVOCTL_STATE_DIR": str(tmp_path / "state")})
+    assert done.returncode == 0, done.stderr
+    where, said = done.stdout.splitlines()[:2]
+    assert where.startswith(str(site)), where
+    assert "TWO OR MORE SERVOS hold this ID" in said, said

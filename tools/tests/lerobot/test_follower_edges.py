@@ -1,0 +1,232 @@
+"""servoctl.arm at the edges an attacker found: a joint left out of the
+first actions, a crash between the two watchdog writes, a servo that
+holds the follower's own setting with no record of its own, a servo
+power-cycled mid-run, records and IDs that are not what they should be.
+On servo_sim; time is the simulator's."""
+import json
+import logging
+import os
+import threading
+
+import pytest
+
+from servoctl.arm import Arm
+from servoctl.errors import ServoError, UsageError
+from servoctl.servo import Servo
+from servoctl.sim import Simulator
+from servoctl.watchdog_record import WatchdogRecords
+
+from .test_follower_arm import FACTORY_WATCHDOG, FPS, state_dir, watchdog  # noqa: F401 - the fixture too
+
+RAMP_TOP = 56  # 45 deg/s, give or take the servo's ripple on the paced clock's frames
+
+
+def frames(sim, arm, t0: float, first: int, count: int, goal, watch: int) -> float:
+    """count frames from frame first on (goal(k): the action), each on the
+    simulated clock; the peak horn speed of servo watch."""
+    peak = 0.0
+    for k in range(first, first + count):
+        arm.send(goal(k))
+        while sim.clock_s() < t0 + (k + 1) / FPS:
+            sim.sleep(0.005)
+            peak = max(peak, abs(sim.state(watch)["velocity"]))
+    return peak
+
+
+def test_a_joint_left_out_of_the_first_action_still_ramps():
+    """The first action named only a: b's gap was taken as 0, b left the
+    ramp, and when first asked 40 deg away it jumped at the motor's top
+    speed; a first send_action({}) took every joint out of the ramp."""
+    with Simulator(ids=[1, 2], paced=True) as sim:
+        arm = Arm(sim.bus(), {"a": 1, "b": 2}, fps=FPS, watchdog_ms=0).open()
+        held = arm.hold_here()
+        t0 = sim.clock_s()
+        frames(sim, arm, t0, 0, 1, lambda k: {"a": held["a"] + 40}, 2)
+        assert "b" in arm.ramp.joints  # not asked, not reached
+        peak = frames(sim, arm, t0, 1, 45, lambda k: {"a": held["a"] + 40, "b": held["b"] + 40}, 2)
+        assert peak <= RAMP_TOP, peak
+    with Simulator(ids=[1, 2], paced=True) as sim:
+        arm = Arm(sim.bus(), {"a": 1, "b": 2}, fps=FPS, watchdog_ms=0).open()
+        held = arm.hold_here()
+        t0 = sim.clock_s()
+        assert arm.send({}) == {n: round(d, 1) for n, d in held.items()}
+        assert arm.ramp.joints == {"a", "b"}
+        peak = frames(sim, arm, t0, 1, 45, lambda k: {"a": held["a"] + 40, "b": held["b"] - 40}, 1)
+        assert peak <= RAMP_TOP, peak
+
+
+class Crash(BaseException):
+    """The process killed (kill -9, a pulled plug) right after a write."""
+
+
+@pytest.fixture
+def crash_after(monkeypatch):
+    """crash_after(item, n): the n-th write of item from now on raises Crash
+    once it has reached the servo."""
+    def arm(item: str, n: int):
+        count, write = [0], Servo.write
+
+        def crashing(self, name, value, *a, **k):
+            out = write(self, name, value, *a, **k)
+            if name == item:
+                count[0] += 1
+                if count[0] == n:
+                    monkeypatch.setattr(Servo, "write", write)
+                    raise Crash(f"after {name} = {value}")
+            return out
+        monkeypatch.setattr(Servo, "write", crashing)
+    return arm
+
+
+@pytest.mark.parametrize("phase", ["open", "close"])
+def test_a_crash_between_the_two_watchdog_writes_leaves_the_servos_own(phase, crash_after):
+    """Items 64 then 65: a crash between them left 500 ms with the servo's
+    own action (connecting) or its own ms with hold (closing), which the
+    next run took for the servo's own, for good."""
+    with Simulator(ids=[1], fast=True) as sim:
+        bus = sim.bus()
+        Servo(bus, 1).write("watchdog_action", 2)  # the servo's own: off, release
+        own = (0, 2)
+        arm = Arm(bus, {"a": 1})
+        if phase == "open":
+            crash_after("watchdog_ms", 1)
+            with pytest.raises(Crash):
+                arm.open()
+        else:
+            arm.open()
+            crash_after("watchdog_ms", 1)
+            with pytest.raises(Crash):
+                arm.close()
+        assert watchdog(bus, 1) in ((500, 2), (0, 0))  # half written
+        again = Arm(bus, {"a": 1}).open()
+        assert watchdog(bus, 1) == (500, 0)
+        again.close()
+        assert watchdog(bus, 1) == own
+
+
+@pytest.mark.parametrize("ms", [500, 1000])
+def test_the_followers_own_setting_with_no_record_here_is_said_and_not_kept(tmp_path, caplog, ms):
+    """Another computer's (or user's, or state folder's) run that did not
+    end cleanly left 500 ms, hold: with no record here it was silently
+    taken for the servo's own, and put back on close; so too by a run
+    that arms its own 1000 ms."""
+    with Simulator(ids=[1, 2], fast=True) as sim:
+        bus = sim.bus()
+        Arm(bus, {"a": 1, "b": 2}, records=WatchdogRecords(tmp_path / "elsewhere")).open()  # never closed
+        with caplog.at_level(logging.WARNING, logger="servoctl.arm"):
+            arm = Arm(bus, {"a": 1, "b": 2}, watchdog_ms=ms).open()
+        said = caplog.text
+        assert "a (servo 1): its bus watchdog holds 500 ms, hold, the follower's own setting" in said, said
+        assert "no record" in said and "servoctl config set 1 watchdog_ms 500" in said, said
+        arm.close()
+        assert [watchdog(bus, i) for i in (1, 2)] == [FACTORY_WATCHDOG] * 2
+
+
+def test_a_record_that_cannot_be_removed_leaves_the_next_servos_put_back(state_dir):
+    """close() raised the bare OSError of the first record it could not
+    remove, and the servos after it kept the follower's setting."""
+    with Simulator(ids=[1, 2], fast=True) as sim:
+        bus = sim.bus()
+        arm = Arm(bus, {"a": 1, "b": 2}).open()
+        first = arm.records.path(Servo(bus, 1).read("serial"))
+        first.unlink()
+        first.mkdir()  # unlink() fails on it
+        with pytest.raises(ServoError) as e:
+            arm.close()
+        assert str(first) in str(e.value) and "record of the servo's own bus watchdog" in str(e.value), e.value
+        assert [watchdog(bus, i) for i in (1, 2)] == [FACTORY_WATCHDOG] * 2
+
+
+def test_a_state_folder_that_cannot_be_made_is_named(tmp_path):
+    (tmp_path / "file").write_text("")
+    with Simulator(ids=[1], fast=True) as sim:
+        bus = sim.bus()
+        with pytest.raises(ServoError) as e:
+            Arm(bus, {"a": 1}, records=WatchdogRecords(tmp_path / "file" / "watchdog")).open()
+        assert "record of the servo's own bus watchdog" in str(e.value) and "SERVOCTL_STATE_DIR" in str(e.value)
+        assert watchdog(bus, 1) == FACTORY_WATCHDOG  # nothing written before it is kept
+
+
+@pytest.mark.parametrize("own", [["x", 1], [70000, 0], [0], "off"])
+def test_a_malformed_record_is_dropped_with_a_warning(state_dir, own, caplog):
+    """A record whose own setting was not two items in range made close()
+    fail at every run."""
+    with Simulator(ids=[1], fast=True) as sim:
+        bus = sim.bus()
+        Arm(bus, {"a": 1}).open()  # never closed: the servo holds 500 ms, hold
+        path = WatchdogRecords().path(Servo(bus, 1).read("serial"))
+        path.write_text(f'{{"own": {json.dumps(own)}, "wrote": [500, 0]}}')
+        with caplog.at_level(logging.WARNING, logger="servoctl.arm"):
+            arm = Arm(bus, {"a": 1}).open()
+        assert "is not a record of a watchdog setting" in caplog.text, caplog.text
+        arm.close()
+        assert watchdog(bus, 1) == FACTORY_WATCHDOG
+
+
+def test_a_fifo_in_place_of_a_record_does_not_hang_connect(state_dir):
+    with Simulator(ids=[1], fast=True) as sim:
+        bus = sim.bus()
+        path = WatchdogRecords().path(Servo(bus, 1).read("serial"))
+        path.parent.mkdir(parents=True)
+        os.mkfifo(path)
+        done = []
+        opening = threading.Thread(target=lambda: done.append(Arm(bus, {"a": 1}).open()), daemon=True)
+        opening.start()
+        opening.join(30)
+        if not done:  # hung on the FIFO's open: a writer lets it go
+            os.close(os.open(path, os.O_WRONLY | os.O_NONBLOCK))
+            opening.join(5)
+            pytest.fail("connect hung opening a FIFO named like a record")
+        done[0].close()
+        assert watchdog(bus, 1) == FACTORY_WATCHDOG
+
+
+def test_a_planted_link_is_not_followed(state_dir, tmp_path):
+    """The record was written to .SERIAL.json.PID first, following a
+    link planted there."""
+    victim = tmp_path / "victim"
+    victim.write_text("mine")
+    with Simulator(ids=[1], fast=True) as sim:
+        bus = sim.bus()
+        path = WatchdogRecords().path(Servo(bus, 1).read("serial"))
+        path.parent.mkdir(parents=True)
+        path.with_name(f".{path.name}.{os.getpid()}").symlink_to(victim)
+        Arm(bus, {"a": 1}).open().close()
+    assert victim.read_text() == "mine"
+
+
+def test_a_servo_that_restarts_mid_run_ramps_again_from_where_it_is(caplog):
+    """Power-cycled under a load (items 64-72 back to the factory's, the
+    output released), the servo fell 18 deg and was then driven back at
+    276 deg/s with no ramp, its watchdog off, and nothing said."""
+    with Simulator(ids=[1, 2], paced=True) as sim:
+        bus = sim.bus()
+        arm = Arm(bus, {"a": 1, "b": 2}, fps=FPS).open()
+        held = arm.hold_here()
+        goal = {"a": held["a"] + 30, "b": held["b"]}
+        t0 = sim.clock_s()
+        frames(sim, arm, t0, 0, 60, lambda k: goal, 1)
+        assert abs(sim.state(1)["angle"] - goal["a"]) < 0.5
+        sim.control("load 0.6 1")
+        sim.control("powercycle 1")
+        angles = []
+        with caplog.at_level(logging.WARNING, logger="servoctl.arm"):
+            for k in range(60, 100):
+                if k == 64:
+                    sim.control("load 0 1")  # let go within the bootloader's 0.2 s
+                frames(sim, arm, t0, k, 1, lambda k: goal, 1)
+                angles.append(sim.state(1)["angle"])
+        fallen = min(angles)
+        assert fallen < goal["a"] - 10, angles  # it did fall: released at power-up
+        rises = [b - a for a, b in zip(angles, angles[6:])]  # over 0.2 s
+        assert max(rises) <= 45 * 0.2 + 2, (max(rises), angles)
+        assert "a (servo 1): its bus watchdog read 0 ms, not the arm's 500 ms: it restarted" in caplog.text
+        assert watchdog(bus, 1) == (500, 0)
+        arm.close()
+        assert [watchdog(bus, i) for i in (1, 2)] == [FACTORY_WATCHDOG] * 2
+
+
+def test_one_id_in_two_joints_is_refused_naming_both():
+    with pytest.raises(UsageError) as e:
+        Arm(None, {"a": 1, "b": 2, "c": 1})
+    assert "a and c (servo 1)" in str(e.value), e.value
