@@ -15,6 +15,7 @@ from pathlib import Path
 
 from aiohttp import WSMsgType, web
 
+from . import quiet
 from .doorman import Doorman
 from .worker import QueueFull
 
@@ -229,6 +230,14 @@ def _own_origins(request) -> list:
 async def serve(page: Page, bind: str, port: int, ready, stop: asyncio.Event):
     """Serves until stop is set; ready(url_port) once listening."""
     page.loop = asyncio.get_running_loop()
+    log = quiet.start()  # aiohttp's and asyncio's logs: one line a second at most, never blocking
+    try:
+        await _serve(page, bind, port, ready, stop)
+    finally:
+        log.close()
+
+
+async def _serve(page: Page, bind: str, port: int, ready, stop: asyncio.Event):
     runner = web.AppRunner(page.app(), access_log=None, handle_signals=False, keepalive_timeout=KEEPALIVE_S)
     await runner.setup()
     page.doorman = Doorman(runner.server)
