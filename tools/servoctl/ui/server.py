@@ -14,6 +14,7 @@ import json
 from pathlib import Path
 
 from aiohttp import WSMsgType, web
+from yarl import URL
 
 from . import quiet
 from .doorman import Doorman
@@ -47,9 +48,12 @@ class Page:
         given = request.query.get("token", "")
         if not hmac.compare_digest(given.encode(), self.token.encode()):
             return "refused: the address lacks this session's token (see servoctl ui's first line)"
-        host = (request.url.host or "").strip("[]")
-        if self.hosts is not None and host not in self.hosts:
-            return f"refused: a request for host {host!r}, not this computer's (DNS rebinding?)"
+        if self.hosts is not None:
+            # Both the request line's host (an absolute-form request) and the Host header.
+            for host in (request.url.host, _header_host(request)):
+                host = (host or "").strip("[]")
+                if host not in self.hosts:
+                    return f"refused: a request for host {host!r:.80}, not this computer's (DNS rebinding?)"
         origin = request.headers.get("Origin")
         own = _own_origins(request)
         if origin is None and need_origin:
@@ -210,6 +214,17 @@ def _strings(values, name: str) -> list:
     if not isinstance(values, list) or not all(isinstance(v, (str, int, float)) for v in values):
         raise Malformed(f"{name} must be a list of strings")
     return [str(v) for v in values]
+
+
+def _header_host(request):
+    """The Host header's host name, without its port; None if absent or unreadable."""
+    given = request.headers.get("Host")
+    if not given:
+        return None
+    try:
+        return URL(f"http://{given}/").host
+    except ValueError:
+        return None
 
 
 def _own_origins(request) -> list:
