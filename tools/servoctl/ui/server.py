@@ -26,6 +26,15 @@ ASSETS = {p.name for p in STATIC.iterdir() if p.is_file()}
 # move buttons through a transparent frame): both headers, for old browsers too.
 NO_FRAMES = {"X-Frame-Options": "DENY", "Content-Security-Policy": "frame-ancestors 'none'"}
 KEEPALIVE_S = 15  # an idle keep-alive connection with the token closes after this
+# What a tab may send (docs/ui.md, "Malformed requests"): a request is a few
+# hundred bytes; a longer one is refused by its length, before it is parsed.
+# aiohttp reads up to READ_MAX (beyond it, it closes the connection with
+# 1009), no compression: a small frame must not inflate to megabytes.
+REQUEST_MAX = 64 * 1024
+READ_MAX = 16 * 1024 * 1024
+WATCHER_MAX = 1024  # a watching tab's request is STOP ALL's, a few dozen bytes
+ARGV_MAX, ARG_MAX, TAG_MAX = 64, 1024, 64  # argv's words, a word's characters, a tag's
+TABS_MAX = 8  # open tabs (WebSockets); one more is told so and closed
 
 
 class Malformed(ValueError):
@@ -89,8 +98,13 @@ class Page:
         return web.FileResponse(STATIC / name)
 
     async def socket(self, request):
-        ws = web.WebSocketResponse(heartbeat=20)
+        ws = web.WebSocketResponse(heartbeat=20, compress=False, max_msg_size=READ_MAX)
         await ws.prepare(request)
+        if len(self.sockets) >= TABS_MAX:
+            await _send(ws, {"type": "error", "text": f"servoctl ui: {TABS_MAX} tabs are open already: "
+                                                      f"close one and reload this one"})
+            await ws.close(code=1013, message=b"too many tabs")  # 1013: try again later
+            return ws
         opened = datetime.datetime.now().strftime("%H:%M:%S")
         agent = request.headers.get("User-Agent", "a client").split(" ")[-1]
         self.who[ws] = f"the tab opened at {opened} from {request.remote} ({agent})"
@@ -117,11 +131,16 @@ class Page:
             return
         tag = None
         try:
+            driving = ws is self.driver
+            if not driving and len(msg.data) > WATCHER_MAX:
+                await self._busy(ws)  # not parsed: it is not STOP ALL
+                return
+            if len(msg.data) > REQUEST_MAX:
+                raise Malformed(f"{len(msg.data)} bytes long, over the {REQUEST_MAX} a request may be")
             ask = _parse(msg.data)
-            tag = ask.get("tag")
-            if ws is not self.driver and ask.get("op") != "stopall":  # any tab may stop
-                await _send(ws, {"type": "busy", "holder": self.who[self.driver],
-                                 "text": f"{self.who[self.driver]} drives the bus"})
+            tag = _tag(ask.get("tag"))
+            if not driving and ask.get("op") != "stopall":  # any tab may stop
+                await self._busy(ws)
                 return
             self._dispatch(ask)
         except QueueFull as e:
@@ -131,11 +150,15 @@ class Page:
         except Exception as e:  # noqa: BLE001 - whatever a request does, the tab stays and hears why
             await _send(ws, {"type": "error", "tag": tag, "text": f"servoctl ui: {type(e).__name__}: {e}"})
 
+    async def _busy(self, ws):
+        await _send(ws, {"type": "busy", "holder": self.who[self.driver],
+                         "text": f"{self.who[self.driver]} drives the bus"})
+
     async def _roles(self):
+        told = {role: json.dumps({"type": "hello", "role": role, "holder": holder, **self.about})
+                for role, holder in (("driver", None), ("viewer", self.who.get(self.driver)))}
         for ws in list(self.sockets):
-            driving = ws is self.driver
-            await _send(ws, {"type": "hello", "role": "driver" if driving else "viewer",
-                             "holder": None if driving else self.who[self.driver], **self.about})
+            await _send(ws, told["driver" if ws is self.driver else "viewer"])
 
     def _dispatch(self, ask: dict):
         op, w = ask.get("op"), self.worker
@@ -161,13 +184,14 @@ class Page:
     # From the bus thread ----------------------------------------------------
 
     def publish(self, msg: dict):
-        """Called on the bus thread: every tab hears it."""
+        """Called on the bus thread: every tab hears it, serialised once,
+        here, off the server's thread."""
         if self.loop is not None and not self.loop.is_closed():
-            self.loop.call_soon_threadsafe(self._broadcast, msg)
+            self.loop.call_soon_threadsafe(self._broadcast, json.dumps(msg))
 
-    def _broadcast(self, msg: dict):
+    def _broadcast(self, text: str):
         for ws in list(self.sockets):
-            asyncio.ensure_future(_send(ws, msg))
+            asyncio.ensure_future(_send(ws, text))
 
     def app(self) -> web.Application:
         a = web.Application(middlewares=[self.guard])
@@ -179,9 +203,10 @@ class Page:
 
 
 async def _send(ws, msg):
+    """msg: a dict, or the text of one already serialised."""
     if not ws.closed:
         try:
-            await ws.send_str(json.dumps(msg))
+            await ws.send_str(msg if isinstance(msg, str) else json.dumps(msg))
         except (ConnectionError, RuntimeError):
             pass
 
@@ -213,7 +238,22 @@ def _whole(value, name: str) -> int:
 def _strings(values, name: str) -> list:
     if not isinstance(values, list) or not all(isinstance(v, (str, int, float)) for v in values):
         raise Malformed(f"{name} must be a list of strings")
-    return [str(v) for v in values]
+    if len(values) > ARGV_MAX:
+        raise Malformed(f"{name} has {len(values)} words, over the {ARGV_MAX} a request may have")
+    words = [str(v) for v in values]
+    if any(len(w) > ARG_MAX for w in words):
+        raise Malformed(f"a word of {name} is over the {ARG_MAX} characters a request may have")
+    return words
+
+
+def _tag(value):
+    """What the page tags a request with, said back with its answers: a
+    number or a short string."""
+    if value is None or (isinstance(value, int) and not isinstance(value, bool) and abs(value) < 2 ** 53):
+        return value
+    if isinstance(value, str) and len(value) <= TAG_MAX:
+        return value
+    raise Malformed(f"tag must be a number or a string of {TAG_MAX} characters at most, not {value!r:.40}")
 
 
 def _header_host(request):
