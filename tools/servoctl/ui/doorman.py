@@ -1,7 +1,9 @@
 """Who may hold a connection to `servoctl ui`'s server: one that has not
 yet brought a request with the token is closed after FIRST_REQUEST_S (a
 half-open connection, a request sent a byte a minute), and at most
-UNTRUSTED_MAX such are open at once, the oldest closed for a new one.
+UNTRUSTED_MAX such are open at once, one closed for a new one: the oldest
+that has sent nothing yet, else the oldest (a page load whose request is
+under way is not reset by a flood of idle connections).
 Without it, thousands of idle connections took every file descriptor the
 process may open and page loads timed out.
 
@@ -21,19 +23,26 @@ class Doorman:
         self.factory = protocol_factory
         self.first_request_s, self.untrusted_max = first_request_s, untrusted_max
         self.untrusted = collections.OrderedDict()  # transport: its timer, oldest first
+        self.silent = collections.OrderedDict()     # those of them that sent nothing yet: None
 
     def __call__(self) -> asyncio.Protocol:
         return _Watched(self.factory(), self)
 
     def admit(self, transport) -> None:
         loop = asyncio.get_running_loop()
+        while len(self.untrusted) >= self.untrusted_max:  # room for this one
+            self._close(next(iter(self.silent or self.untrusted)))
         self.untrusted[transport] = loop.call_later(self.first_request_s, self._close, transport)
-        while len(self.untrusted) > self.untrusted_max:
-            self._close(next(iter(self.untrusted)))
+        self.silent[transport] = None
+
+    def heard(self, transport) -> None:
+        """Bytes came on it: a request under way, closed last."""
+        self.silent.pop(transport, None)
 
     def trust(self, transport) -> None:
         """A request with the token came on it: aiohttp's keep-alive and
         the WebSocket's heartbeat time it out from now on."""
+        self.silent.pop(transport, None)
         timer = self.untrusted.pop(transport, None)
         if timer is not None:
             timer.cancel()
@@ -63,6 +72,7 @@ class _Watched(asyncio.Protocol):
         self.inner.connection_lost(exc)
 
     def data_received(self, data):
+        self.doorman.heard(self.transport)
         self.inner.data_received(data)
 
     def eof_received(self):

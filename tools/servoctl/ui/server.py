@@ -14,7 +14,9 @@ import json
 from pathlib import Path
 
 from aiohttp import WSMsgType, web
+from yarl import URL
 
+from . import quiet
 from .doorman import Doorman
 from .worker import QueueFull
 
@@ -24,6 +26,15 @@ ASSETS = {p.name for p in STATIC.iterdir() if p.is_file()}
 # move buttons through a transparent frame): both headers, for old browsers too.
 NO_FRAMES = {"X-Frame-Options": "DENY", "Content-Security-Policy": "frame-ancestors 'none'"}
 KEEPALIVE_S = 15  # an idle keep-alive connection with the token closes after this
+# What a tab may send (docs/ui.md, "Malformed requests"): a request is a few
+# hundred bytes; a longer one is refused by its length, before it is parsed.
+# aiohttp reads up to READ_MAX (beyond it, it closes the connection with
+# 1009), no compression: a small frame must not inflate to megabytes.
+REQUEST_MAX = 64 * 1024
+READ_MAX = 16 * 1024 * 1024
+WATCHER_MAX = 1024  # a watching tab's request is STOP ALL's, a few dozen bytes
+ARGV_MAX, ARG_MAX, TAG_MAX = 64, 1024, 64  # argv's words, a word's characters, a tag's
+TABS_MAX = 8  # open tabs (WebSockets); one more is told so and closed
 
 
 class Malformed(ValueError):
@@ -47,9 +58,12 @@ class Page:
         given = request.query.get("token", "")
         if not hmac.compare_digest(given.encode(), self.token.encode()):
             return "refused: the address lacks this session's token (see servoctl ui's first line)"
-        host = (request.url.host or "").strip("[]")
-        if self.hosts is not None and host not in self.hosts:
-            return f"refused: a request for host {host!r}, not this computer's (DNS rebinding?)"
+        if self.hosts is not None:
+            # Both the request line's host (an absolute-form request) and the Host header.
+            for host in (request.url.host, _header_host(request)):
+                host = (host or "").strip("[]")
+                if host not in self.hosts:
+                    return f"refused: a request for host {host!r:.80}, not this computer's (DNS rebinding?)"
         origin = request.headers.get("Origin")
         own = _own_origins(request)
         if origin is None and need_origin:
@@ -85,8 +99,13 @@ class Page:
         return web.FileResponse(STATIC / name)
 
     async def socket(self, request):
-        ws = web.WebSocketResponse(heartbeat=20)
+        ws = web.WebSocketResponse(heartbeat=20, compress=False, max_msg_size=READ_MAX)
         await ws.prepare(request)
+        if len(self.sockets) >= TABS_MAX:
+            await _send(ws, {"type": "error", "text": f"servoctl ui: {TABS_MAX} tabs are open already: "
+                                                      f"close one and reload this one"})
+            await ws.close(code=1013, message=b"too many tabs")  # 1013: try again later
+            return ws
         opened = datetime.datetime.now().strftime("%H:%M:%S")
         agent = request.headers.get("User-Agent", "a client").split(" ")[-1]
         self.who[ws] = f"the tab opened at {opened} from {request.remote} ({agent})"
@@ -115,12 +134,16 @@ class Page:
             return
         tag = op = None
         try:
+            driving = ws is self.driver
+            if not driving and len(msg.data) > WATCHER_MAX:
+                await self._busy(ws)  # not parsed: it is not STOP ALL
+                return
+            if len(msg.data) > REQUEST_MAX:
+                raise Malformed(f"{len(msg.data)} bytes long, over the {REQUEST_MAX} a request may be")
             ask = _parse(msg.data)
-            tag, op = ask.get("tag"), ask.get("op")
-            if ws is not self.driver and op != "stopall":  # any tab may stop
-                # Its tag and op with it: the page answers the request that asked.
-                await _send(ws, {"type": "busy", "holder": self.who[self.driver], "tag": tag, "op": op,
-                                 "text": f"not run: {self.who[self.driver]} drives the bus"})
+            tag, op = _tag(ask.get("tag")), ask.get("op")
+            if not driving and op != "stopall":  # any tab may stop
+                await self._busy(ws, tag, op)  # its tag and op: the page answers the request that asked
                 return
             self._dispatch(ask)
         except QueueFull as e:  # said where the page shows that action's output (tag, op)
@@ -131,11 +154,15 @@ class Page:
         except Exception as e:  # noqa: BLE001 - whatever a request does, the tab stays and hears why
             await _send(ws, {"type": "error", "tag": tag, "op": op, "text": f"servoctl ui: {type(e).__name__}: {e}"})
 
+    async def _busy(self, ws, tag=None, op=None):
+        await _send(ws, {"type": "busy", "holder": self.who[self.driver], "tag": tag, "op": op,
+                         "text": f"not run: {self.who[self.driver]} drives the bus"})
+
     async def _roles(self):
+        told = {role: json.dumps({"type": "hello", "role": role, "holder": holder, **self.about})
+                for role, holder in (("driver", None), ("viewer", self.who.get(self.driver)))}
         for ws in list(self.sockets):
-            driving = ws is self.driver
-            await _send(ws, {"type": "hello", "role": "driver" if driving else "viewer",
-                             "holder": None if driving else self.who[self.driver], **self.about})
+            await _send(ws, told["driver" if ws is self.driver else "viewer"])
 
     def _dispatch(self, ask: dict):
         op, w = ask.get("op"), self.worker
@@ -161,15 +188,16 @@ class Page:
     # From the bus thread ----------------------------------------------------
 
     def publish(self, msg: dict):
-        """Called on the bus thread: every tab hears it."""
+        """Called on the bus thread: every tab hears it, serialised once,
+        here, off the server's thread."""
         if self.loop is not None and not self.loop.is_closed():
-            self.loop.call_soon_threadsafe(self._broadcast, msg)
+            self.loop.call_soon_threadsafe(self._broadcast, msg, json.dumps(msg))
 
-    def _broadcast(self, msg: dict):
+    def _broadcast(self, msg: dict, text: str):
         if msg.get("type") == "scan":
-            self.last_scan = msg
+            self.last_scan = text
         for ws in list(self.sockets):
-            asyncio.ensure_future(_send(ws, msg))
+            asyncio.ensure_future(_send(ws, text))
 
     def app(self) -> web.Application:
         a = web.Application(middlewares=[self.guard])
@@ -181,9 +209,10 @@ class Page:
 
 
 async def _send(ws, msg):
+    """msg: a dict, or the text of one already serialised."""
     if not ws.closed:
         try:
-            await ws.send_str(json.dumps(msg))
+            await ws.send_str(msg if isinstance(msg, str) else json.dumps(msg))
         except (ConnectionError, RuntimeError):
             pass
 
@@ -215,7 +244,33 @@ def _whole(value, name: str) -> int:
 def _strings(values, name: str) -> list:
     if not isinstance(values, list) or not all(isinstance(v, (str, int, float)) for v in values):
         raise Malformed(f"{name} must be a list of strings")
-    return [str(v) for v in values]
+    if len(values) > ARGV_MAX:
+        raise Malformed(f"{name} has {len(values)} words, over the {ARGV_MAX} a request may have")
+    words = [str(v) for v in values]
+    if any(len(w) > ARG_MAX for w in words):
+        raise Malformed(f"a word of {name} is over the {ARG_MAX} characters a request may have")
+    return words
+
+
+def _tag(value):
+    """What the page tags a request with, said back with its answers: a
+    number or a short string."""
+    if value is None or (isinstance(value, int) and not isinstance(value, bool) and abs(value) < 2 ** 53):
+        return value
+    if isinstance(value, str) and len(value) <= TAG_MAX:
+        return value
+    raise Malformed(f"tag must be a number or a string of {TAG_MAX} characters at most, not {value!r:.40}")
+
+
+def _header_host(request):
+    """The Host header's host name, without its port; None if absent or unreadable."""
+    given = request.headers.get("Host")
+    if not given:
+        return None
+    try:
+        return URL(f"http://{given}/").host
+    except ValueError:
+        return None
 
 
 def _own_origins(request) -> list:
@@ -236,6 +291,14 @@ def _own_origins(request) -> list:
 async def serve(page: Page, bind: str, port: int, ready, stop: asyncio.Event):
     """Serves until stop is set; ready(url_port) once listening."""
     page.loop = asyncio.get_running_loop()
+    log = quiet.start()  # aiohttp's and asyncio's logs: one line a second at most, never blocking
+    try:
+        await _serve(page, bind, port, ready, stop)
+    finally:
+        log.close()
+
+
+async def _serve(page: Page, bind: str, port: int, ready, stop: asyncio.Event):
     runner = web.AppRunner(page.app(), access_log=None, handle_signals=False, keepalive_timeout=KEEPALIVE_S)
     await runner.setup()
     page.doorman = Doorman(runner.server)
