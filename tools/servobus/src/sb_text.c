@@ -54,6 +54,11 @@ static const char *const WHAT[] = {
     "is the broadcast ID: no servo answers it or carries it out",
 };
 
+static bool named(const sb_error *e, const char *field)
+{
+    return e->field != NULL && strcmp(e->field, field) == 0;
+}
+
 /* ": 33 is beyond 1..32", or ": 8, not 1" where one value is right. */
 static void put_range(text *t, const sb_error *e)
 {
@@ -71,6 +76,17 @@ static void put_range(text *t, const sb_error *e)
     put(t, "..");
     put_number(t, e->most);
     put(t, servos ? " (SB_MAX_SERVOS)" : "");
+}
+
+/* A loop's period shorter than its cycle's bytes on the wire (sb_loop_init). */
+static void put_wire(text *t, const sb_error *e)
+{
+    put(t, ": ");
+    put_number(t, e->value);
+    put(t, " ms is shorter than the wire's cycle (the setpoints, the Sync Monitor and every answer back to "
+           "back at the bus's baud rate: sb_cycle_bytes): at least ");
+    put_number(t, e->least);
+    put(t, " ms; use a longer period, a higher baud rate or fewer servos");
 }
 
 size_t sb_error_text(const sb_error *e, char *buf, size_t cap)
@@ -100,6 +116,8 @@ size_t sb_error_text(const sb_error *e, char *buf, size_t cap)
     if (e->status == SB_E_RANGE) {
         put_range(&t, e);
         put(&t, "; nothing was sent");
+    } else if (e->status == SB_E_USAGE && named(e, "period_ms") && e->least > 1 && e->value < e->least) {
+        put_wire(&t, e);
     } else if (e->status == SB_E_USAGE && ranged) {
         put_range(&t, e);
     } else if (e->status == SB_E_USAGE && e->field != NULL && strcmp(e->field, "cmd") == 0) {
