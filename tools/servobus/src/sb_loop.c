@@ -37,8 +37,12 @@ sb_error sb_sync_frame(uint8_t cmd, const uint8_t *records, size_t record_len, s
     e = sb_check_request(SB_PKT_SYNC_COMMAND, v, 4); /* what the typed encoder checks too */
     if (e.status != SB_OK)
         return e;
-    if (7u + clen > cap)
-        return sb_error_of(SB_E_SPACE, -1, SB_PKT_SYNC_COMMAND, NULL);
+    if (7u + clen > cap) { /* "40 bytes needed, 32 given" */
+        e = sb_error_of(SB_E_SPACE, -1, SB_PKT_SYNC_COMMAND, NULL);
+        e.value = (int64_t)(7u + clen);
+        e.most = (int64_t)cap;
+        return e;
+    }
     memmove(frame + 9, records, record_len * count); /* the content at 6, then moved to its place */
     frame[6] = cmd;
     frame[7] = (uint8_t)record_len;
