@@ -38,7 +38,7 @@ int main(int argc, char **argv)
     long cycles;
     uint32_t baud;
     sb_error e;
-    char words[200];
+    char words[256];
     sim_clock_status clock_status = SIM_CLOCK_OK;
     int paced = argc == 7 && strcmp(argv[6], "paced") == 0;
     if (argc != 6 && !paced) {

@@ -25,7 +25,7 @@ constexpr double kDeciDegPerRad = 1800.0 / M_PI;
 
 std::string text(const sb_error &e)
 {
-    char buf[200];
+    char buf[256];
     sb_error_text(&e, buf, sizeof buf);
     return buf;
 }

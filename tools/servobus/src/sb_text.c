@@ -102,9 +102,9 @@ static void put_item(text *t, const sb_error *e)
 /* A stream's step beyond the servo's top speed at the stream's period. */
 static void put_step(text *t)
 {
-    put(t, " (0.1 deg): faster than the servo's top speed, ");
+    put(t, ": over ");
     put_number(t, sb_packet(SB_PKT_STREAM_SETPOINT)->request[2].max / 10);
-    put(t, " deg/s, at this period; use a longer period or a smaller step");
+    put(t, " deg/s at this period: use a longer period or a smaller step");
 }
 
 /* A loop's period shorter than its cycle's bytes on the wire (sb_loop_init). */
@@ -112,10 +112,9 @@ static void put_wire(text *t, const sb_error *e)
 {
     put(t, ": ");
     put_number(t, e->value);
-    put(t, " ms is shorter than the wire's cycle (the setpoints, the Sync Monitor and every answer back to "
-           "back at the bus's baud rate: sb_cycle_bytes): at least ");
+    put(t, " ms is shorter than the wire's cycle at this baud rate (sb_cycle_bytes): at least ");
     put_number(t, e->least);
-    put(t, " ms; use a longer period, a higher baud rate or fewer servos");
+    put(t, " ms");
 }
 
 size_t sb_error_text(const sb_error *e, char *buf, size_t cap)
