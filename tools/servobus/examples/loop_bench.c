@@ -12,6 +12,17 @@
 #include "servobus/servobus_posix.h"
 #include "examples/sb_sim_clock.h"
 
+/* A whole decimal number within least..most, or -1. */
+static long whole(const char *s, long least, long most)
+{
+    char *end = NULL;
+    long n;
+    if (s[0] < '0' || s[0] > '9')
+        return -1;
+    n = strtol(s, &end, 10);
+    return *end == '\0' && n >= least && n <= most ? n : -1;
+}
+
 int main(int argc, char **argv)
 {
     sb_posix link;
@@ -27,7 +38,7 @@ int main(int argc, char **argv)
     long cycles;
     uint32_t baud;
     sb_error e;
-    char words[200];
+    char words[256];
     sim_clock_status clock_status = SIM_CLOCK_OK;
     int paced = argc == 7 && strcmp(argv[6], "paced") == 0;
     if (argc != 6 && !paced) {
@@ -38,11 +49,15 @@ int main(int argc, char **argv)
     if (strncmp(where, "socket://", 9) == 0) /* as servo_sim and servoctl print it */
         where += 9;
     colon = where[0] == '/' ? NULL : strrchr(where, ':');
-    baud = (uint32_t)strtoul(argv[3], NULL, 10);
-    count = (size_t)strtoul(argv[4], NULL, 10);
-    cycles = strtol(argv[5], NULL, 10);
+    baud = (uint32_t)(whole(argv[3], 1, 4000000) > 0 ? whole(argv[3], 1, 4000000) : 0);
+    count = (size_t)(whole(argv[4], 1, SB_MAX_SERVOS) > 0 ? whole(argv[4], 1, SB_MAX_SERVOS) : 0);
+    cycles = whole(argv[5], 1, 100000000);
     if (where[0] != '/' && colon == NULL) {
         fprintf(stderr, "loop_bench: '%s' is neither HOST:PORT nor a /dev path\n", argv[1]);
+        return 2;
+    }
+    if (baud == 0) {
+        fprintf(stderr, "loop_bench: BAUD '%s' is not a baud rate (a whole number, 1-4000000)\n", argv[3]);
         return 2;
     }
     if (count == 0 || count > SB_MAX_SERVOS || cycles < 1) {
@@ -80,7 +95,13 @@ int main(int argc, char **argv)
     }
     for (size_t k = 0; k < count; k++)
         ids[k] = (uint8_t)(k + 1);
-    e = sb_loop_init(&loop, &bus, ids, count, 20);
+    /* The cycles go back to back, as fast as the wire and the host go: the
+     * period given is the wire's own cycle (the shortest sb_loop_init
+     * allows), the one a loop this fast keeps at best. */
+    {
+        uint64_t wire_ms = ((uint64_t)sb_cycle_bytes(count) * SB_BITS_PER_BYTE * 1000u + baud - 1u) / baud;
+        e = sb_loop_init(&loop, &bus, ids, count, (uint16_t)(wire_ms < 65535u ? wire_ms : 65535u));
+    }
     for (long c = 0; c < cycles && e.status == SB_OK; c++) {
         for (size_t k = 0; k < count; k++)
             angles[k] = (int32_t)lround(100.0 * sin((double)c / 20.0)); /* 10 deg, as stream_bench.sh's */

@@ -25,7 +25,7 @@ constexpr double kDeciDegPerRad = 1800.0 / M_PI;
 
 std::string text(const sb_error &e)
 {
-    char buf[200];
+    char buf[256];
     sb_error_text(&e, buf, sizeof buf);
     return buf;
 }
@@ -35,8 +35,10 @@ class ServoBusHardware {
     bool on_init(const std::string &host, unsigned port, const std::vector<uint8_t> &ids, uint16_t period_ms,
                  bool sim_clock)
     {
-        if (sb_tcp_open(&link_, host.c_str(), port) != 0) {
-            std::fprintf(stderr, "cannot connect to %s:%u\n", host.c_str(), port);
+        int rc = sb_tcp_open(&link_, host.c_str(), port);
+        if (rc != 0) {
+            std::fprintf(stderr, "sb_ros2_cycle: cannot connect to %s:%u (errno %d: %s)\n", host.c_str(), port, -rc,
+                         std::strerror(-rc));
             return false;
         }
         sb_transport t = sb_posix_transport(&link_);
@@ -49,7 +51,13 @@ class ServoBusHardware {
         command_.assign(ids.size(), 0.0);
         got_.assign(ids.size(), 0);
         states_.resize(ids.size());
-        return check(sb_loop_init(&loop_, &bus_, ids_.data(), ids_.size(), period_ms));
+        sb_error e = sb_loop_init(&loop_, &bus_, ids_.data(), ids_.size(), period_ms);
+        if (e.status != SB_OK && e.field != nullptr && std::strcmp(e.field, "period_ms") == 0 && e.least > 1)
+            std::fprintf(stderr,
+                         "sb_ros2_cycle: a cycle of %zu joint(s) is %zu bytes on the wire, %.2f ms at %u baud\n",
+                         ids_.size(), sb_cycle_bytes(ids_.size()), 1000.0 / sb_wire_limit_hz(ids_.size(), 115200),
+                         115200u);
+        return check(e);
     }
 
     // Every joint answers; commands start where the joints are.
@@ -133,6 +141,22 @@ class ServoBusHardware {
 
 } // namespace
 
+// A whole number within least..most, or -1.
+static long whole(const std::string &s, long least, long most)
+{
+    char *end = nullptr;
+    if (s.empty() || s[0] < '0' || s[0] > '9')
+        return -1;
+    long n = std::strtol(s.c_str(), &end, 10);
+    return *end == '\0' && n >= least && n <= most ? n : -1;
+}
+
+static int refuse(const char *opt, const std::string &val, const char *what)
+{
+    std::fprintf(stderr, "sb_ros2_cycle: %s: '%s' is not %s\n", opt, val.c_str(), what);
+    return 2;
+}
+
 static int usage(const char *self)
 {
     std::fprintf(stderr, "usage: %s [socket://]HOST:PORT [--clock FILE] [--ids ID,ID,...] [--seconds S] [--period-ms MS]\n"
@@ -149,7 +173,10 @@ int main(int argc, char **argv)
     if (where.compare(0, 9, "socket://") == 0) // as servoctl sim and servo_sim print it
         where = where.substr(9);
     std::string host = where.substr(0, where.rfind(':'));
-    unsigned port = static_cast<unsigned>(std::atoi(where.substr(where.rfind(':') + 1).c_str()));
+    long port_n = whole(where.substr(where.rfind(':') + 1), 1, 65535);
+    if (port_n < 0)
+        return refuse("address", argv[1], "HOST:PORT (a port 1-65535)");
+    unsigned port = static_cast<unsigned>(port_n);
     std::vector<uint8_t> ids = {1};
     double seconds = 1.0;
     uint16_t period_ms = 10;
@@ -164,19 +191,28 @@ int main(int argc, char **argv)
             }
         } else if (opt == "--ids") {
             ids.clear();
-            for (char *tok = std::strtok(&val[0], ","); tok != nullptr; tok = std::strtok(nullptr, ",")) {
-                char *end = nullptr;
-                long id = std::strtol(tok, &end, 10);
-                if (*end != '\0' || id < 0 || id > SB_MAX_ID) { /* 255 is broadcast: no joint answers it */
-                    std::fprintf(stderr, "sb_ros2_cycle: --ids: '%s' is not a servo ID (0-%u)\n", tok, SB_MAX_ID);
+            for (size_t at = 0; at <= val.size();) { // every ID between commas: none empty
+                size_t comma = std::min(val.find(',', at), val.size());
+                std::string tok = val.substr(at, comma - at);
+                long id = whole(tok, 0, SB_MAX_ID); // 255 is broadcast: no joint answers it
+                if (id < 0) {
+                    std::fprintf(stderr, "sb_ros2_cycle: --ids: '%s' is not a servo ID (0-%u) in '%s'\n", tok.c_str(),
+                                 SB_MAX_ID, val.c_str());
                     return 2;
                 }
                 ids.push_back(static_cast<uint8_t>(id));
+                at = comma + 1;
             }
         } else if (opt == "--seconds") {
-            seconds = std::atof(val.c_str());
+            char *end = nullptr;
+            seconds = std::strtod(val.c_str(), &end);
+            if (val.empty() || *end != '\0' || !(seconds > 0.0 && seconds <= 3600.0))
+                return refuse("--seconds", val, "a time in seconds (above 0, at most 3600)");
         } else if (opt == "--period-ms") {
-            period_ms = static_cast<uint16_t>(std::atoi(val.c_str()));
+            long n = whole(val, 1, 1000); // a stream's period: item 69's range, but for its 0 (off)
+            if (n < 0)
+                return refuse("--period-ms", val, "a period of 1-1000 ms");
+            period_ms = static_cast<uint16_t>(n);
         } else {
             return usage(argv[0]);
         }
@@ -184,9 +220,13 @@ int main(int argc, char **argv)
     if (ids.empty()) {
         return usage(argv[0]);
     }
+    if (seconds * 1000.0 < period_ms) {
+        std::fprintf(stderr, "sb_ros2_cycle: --seconds %g is shorter than a period (%u ms)\n", seconds, period_ms);
+        return 2;
+    }
     ServoBusHardware hw;
     if (!hw.on_init(host, port, ids, period_ms, sim) || !hw.on_activate())
-        return 1;
+        return 1; // each has said why
     std::vector<double> start = hw.command();
     const double target = 10.0 / 180.0 * M_PI; // each joint 10 degrees on, in the first half
     const int cycles = static_cast<int>(seconds * 1000.0 / period_ms);
@@ -210,5 +250,14 @@ int main(int argc, char **argv)
     std::printf("cycles %d joints %zu missed %u worst error %.2f deg\n", cycles, ids.size(), hw.missed(), worst);
     // A state may be missed where a loaded PC stalls the host past a round's
     // time-out; the joints must still end where they were sent.
-    return hw.missed() * 10 <= static_cast<unsigned>(cycles * ids.size()) && worst < 1.0 ? 0 : 1;
+    if (hw.missed() * 10 > static_cast<unsigned>(cycles * ids.size())) {
+        std::fprintf(stderr, "sb_ros2_cycle: %u of %zu states missed: more than one in ten\n", hw.missed(),
+                     cycles * ids.size());
+        return 1;
+    }
+    if (worst >= 1.0) {
+        std::fprintf(stderr, "sb_ros2_cycle: a joint ended %.2f deg from its command: 1 deg at most\n", worst);
+        return 1;
+    }
+    return 0;
 }

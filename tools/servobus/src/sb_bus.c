@@ -105,9 +105,9 @@ static sb_error receive(sb_bus *bus, uint8_t code, int servo, int item, uint64_t
             } else if (fcode == code && (servo < 0 || (clen > 0 && fcontent[0] == servo))) {
                 bus->arrived_us = bus->t.now_us(bus->t.ctx);
                 if (clen > SB_ANSWER_CONTENT_MAX) {
-                    e.status = SB_E_BAD_ANSWER;
-                    e.servo = (int16_t)fcontent[0];
-                    e.packet = code;
+                    e = sb_error_of(SB_E_BAD_ANSWER, fcontent[0], code, "length");
+                    e.value = (int64_t)clen;
+                    e.most = SB_ANSWER_CONTENT_MAX;
                     return e;
                 }
                 memcpy(content, fcontent, clen);
@@ -170,8 +170,14 @@ sb_error sb_request_item(sb_bus *bus, size_t len, uint8_t code, int servo, int i
         e.servo = (int16_t)servo;
         return e;
     }
-    return receive(bus, code, servo, item, later(bus->t.now_us(bus->t.ctx), bus->timeout_us), content, clen, 0,
-                   true);
+    e = receive(bus, code, servo, item, later(bus->t.now_us(bus->t.ctx), bus->timeout_us), content, clen, 0, true);
+    if (e.status == SB_E_NO_ANSWER && code == SB_PKT_ASSIGN_ID && len >= 10u) {
+        /* Only the servo with the serial answers, whatever its ID: none did. */
+        e.field = "serial";
+        e.value = (int64_t)((uint32_t)bus->tx[5] | (uint32_t)bus->tx[6] << 8 | (uint32_t)bus->tx[7] << 16 |
+                            (uint32_t)bus->tx[8] << 24);
+    }
+    return e;
 }
 
 /* The slot in the list an answer of id takes, or count (not asked for). */
@@ -269,6 +275,11 @@ sb_error sb_sync_monitor(sb_bus *bus, const uint8_t *ids, size_t count, sb_monit
     for (size_t k = 0; k < count; k++)
         got[k] = false; /* none, if the round is refused or the link fails */
     e = sb_check_ids(ids, count, SB_PKT_MONITOR);
+    if (e.status == SB_OK && count == 0) { /* the Sync Monitor's, not the SyncCommand it rides in */
+        e = sb_error_of(SB_E_USAGE, -1, SB_PKT_MONITOR, "ids");
+        e.least = 1;
+        e.most = 255;
+    }
     if (e.status == SB_OK)
         e = sb_sync_frame(SB_PKT_MONITOR, ids, 1, count, bus->tx, sizeof bus->tx, &len);
     if (e.status == SB_OK)

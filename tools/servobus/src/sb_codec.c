@@ -125,6 +125,28 @@ static const sb_item_desc *item_of(const sb_value *v, size_t k)
     return k > 0 ? sb_item((uint8_t)v[k - 1].n) : NULL;
 }
 
+/* SB_E_SPACE: "40 bytes needed, 32 given". */
+static sb_error no_space(int servo, uint8_t code, size_t needed, size_t given)
+{
+    sb_error e = fail(SB_E_SPACE, servo, code, NULL);
+    e.value = (int64_t)needed;
+    e.most = (int64_t)given;
+    return e;
+}
+
+/* The content's bytes the fields' values make. */
+static size_t content_size(const sb_field_desc *f, size_t fields, const sb_value *v)
+{
+    size_t n = 0;
+    for (size_t k = 0; k < fields; k++) {
+        const sb_item_desc *item = f[k].type == SB_ITEM ? item_of(v, k) : NULL;
+        n += f[k].type == SB_ITEM ? (item != NULL ? item->size : 0u)
+             : f[k].type == SB_USER_AREA || f[k].type == SB_BYTES ? v[k].len
+                                                                   : type_size(f[k].type);
+    }
+    return n;
+}
+
 static sb_error encode_fields(const sb_packet_desc *p, bool request, const sb_value *v, size_t count, uint8_t *out,
                               size_t cap, size_t *len)
 {
@@ -148,8 +170,8 @@ static sb_error encode_fields(const sb_packet_desc *p, bool request, const sb_va
         if (f[k].type == SB_ITEM) {
             const sb_item_desc *item = item_of(v, k);
             if (item == NULL || (request ? item->access != SB_ACCESS_READ_WRITE : item->access == SB_ACCESS_RESERVED)) {
-                sb_error e = fail(SB_E_UNKNOWN_ITEM, servo, p->code, f[k].name);
-                e.value = k > 0 ? v[k - 1].n : 0;
+                sb_error e = fail(SB_E_UNKNOWN_ITEM, servo, p->code, k > 0 ? f[k - 1].name : f[k].name);
+                e.value = k > 0 ? v[k - 1].n : 0; /* data_id's: the item refused */
                 return e;
             }
             size = item->size;
@@ -172,7 +194,7 @@ static sb_error encode_fields(const sb_packet_desc *p, bool request, const sb_va
             return e;
         }
         if (at + size > cap)
-            return fail(SB_E_SPACE, servo, p->code, f[k].name);
+            return no_space(servo, p->code, content_size(f, fields, v), cap);
         if (number)
             put_le(out + at, v[k].n, size);
         else if (size > 0)
@@ -208,7 +230,7 @@ sb_error sb_frame(bool request, uint8_t code, const uint8_t *content, size_t cle
 {
     size_t head = clen >= SB_EXTENDED_LENGTH ? 6u : 4u;
     if (clen > 0xFFFFu || head + clen + 1u > cap)
-        return fail(SB_E_SPACE, -1, code, NULL);
+        return no_space(-1, code, head + clen + 1u, cap);
     memmove(frame + head, content, clen); /* content may already lie in frame */
     frame[0] = request ? SB_REQUEST_HEADER_0 : SB_RESPONSE_HEADER_0;
     frame[1] = request ? SB_REQUEST_HEADER_1 : SB_RESPONSE_HEADER_1;
@@ -233,10 +255,18 @@ static sb_error encode_frame(uint8_t code, bool request, const sb_value *v, size
     sb_error e;
     if (p == NULL)
         return fail(SB_E_UNKNOWN_PACKET, -1, code, NULL);
-    if (cap < 7u)
-        return fail(SB_E_SPACE, servo_of(p, v, count), code, NULL);
+    if (cap < 5u) /* not even a frame's header and checksum */
+        return no_space(servo_of(p, v, count), code,
+                        5u + (count == (request ? p->request_count : p->answer_count)
+                                  ? content_size(request ? p->request : p->answer, count, v)
+                                  : 0u),
+                        cap);
     /* The content goes where a short frame's lies, then moves if extended. */
     e = encode_fields(p, request, v, count, frame + 4, cap - 5u, &clen);
+    if (e.status == SB_E_SPACE) { /* the frame's bytes, not the content's */
+        e.value += (size_t)e.value >= SB_EXTENDED_LENGTH ? 7 : 5;
+        e.most = (int64_t)cap;
+    }
     if (e.status != SB_OK)
         return e;
     e = sb_frame(request, code, frame + 4, clen, frame, cap, len);
@@ -263,6 +293,14 @@ static size_t fixed_after(const sb_field_desc *f, size_t fields, size_t k)
     return n;
 }
 
+static sb_error bad_length(sb_status bad, int servo, uint8_t code, const char *field, size_t got, size_t want)
+{
+    sb_error e = fail(bad, servo, code, field);
+    e.value = (int64_t)got;
+    e.least = e.most = (int64_t)want;
+    return e;
+}
+
 static sb_error decode_fields(const sb_packet_desc *p, bool request, const uint8_t *in, size_t len, sb_value *v,
                               size_t count)
 {
@@ -271,8 +309,12 @@ static sb_error decode_fields(const sb_packet_desc *p, bool request, const uint8
     int servo = (p->flags & SB_PF_ADDRESSED) && len > 0 ? in[0] : -1;
     size_t at = 0;
     sb_status bad = request ? SB_E_USAGE : SB_E_BAD_ANSWER;
-    if (count != fields)
-        return fail(SB_E_USAGE, servo, p->code, NULL);
+    if (count != fields) { /* "fields: 3, not 2" */
+        sb_error e = fail(SB_E_USAGE, servo, p->code, "fields");
+        e.value = (int64_t)count;
+        e.least = e.most = (int64_t)fields;
+        return e;
+    }
     memset(v, 0, count * sizeof *v);
     for (size_t k = 0; k < fields; k++) {
         size_t size = type_size(f[k].type);
@@ -283,13 +325,13 @@ static sb_error decode_fields(const sb_packet_desc *p, bool request, const uint8
             size_t rest = fixed_after(f, fields, k + 1);
             size = len >= at + rest ? len - at - rest : 0;
         }
-        if (at + size > len)
-            return fail(bad, servo, p->code, f[k].name);
+        if (at + size > len) /* "length: 5 bytes, not 6": the fixed fields' bytes */
+            return bad_length(bad, servo, p->code, "length", len, at + size + fixed_after(f, fields, k + 1));
         if (f[k].type == SB_ITEM) {
             const sb_item_desc *item = item_of(v, k);
             size_t want = item != NULL && item->access != SB_ACCESS_RESERVED ? item->size : 0;
-            if (size != want)
-                return fail(bad, servo, p->code, f[k].name);
+            if (size != want) /* "data: 3 bytes, not 4": the item's size */
+                return bad_length(bad, servo, p->code, f[k].name, size, want);
             is_signed = item != NULL && item->is_signed;
         }
         v[k].len = size;
@@ -308,7 +350,7 @@ static sb_error decode_fields(const sb_packet_desc *p, bool request, const uint8
         at += size;
     }
     if (at != len)
-        return fail(bad, servo, p->code, NULL);
+        return bad_length(bad, servo, p->code, "length", len, at);
     return sb_ok();
 }
 

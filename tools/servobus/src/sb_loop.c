@@ -37,8 +37,12 @@ sb_error sb_sync_frame(uint8_t cmd, const uint8_t *records, size_t record_len, s
     e = sb_check_request(SB_PKT_SYNC_COMMAND, v, 4); /* what the typed encoder checks too */
     if (e.status != SB_OK)
         return e;
-    if (7u + clen > cap)
-        return sb_error_of(SB_E_SPACE, -1, SB_PKT_SYNC_COMMAND, NULL);
+    if (7u + clen > cap) { /* "40 bytes needed, 32 given" */
+        e = sb_error_of(SB_E_SPACE, -1, SB_PKT_SYNC_COMMAND, NULL);
+        e.value = (int64_t)(7u + clen);
+        e.most = (int64_t)cap;
+        return e;
+    }
     memmove(frame + 9, records, record_len * count); /* the content at 6, then moved to its place */
     frame[6] = cmd;
     frame[7] = (uint8_t)record_len;
@@ -57,12 +61,13 @@ sb_error sb_sync_command(sb_bus *bus, uint8_t cmd, const uint8_t *records, size_
 sb_error sb_stream_init(sb_stream *s, const uint8_t *ids, size_t count, uint16_t period_ms)
 {
     const sb_field_desc *angle = &sb_packet(SB_PKT_STREAM_SETPOINT)->request[1];
+    const sb_item_desc *period = sb_item(SB_ITEM_STREAM_PERIOD_MS);
     sb_error e;
     memset(s, 0, sizeof *s);
     if (count == 0 || count > SB_MAX_SERVOS) /* none listed, or more than the structs hold */
         return usage_of(SB_PKT_STREAM_SETPOINT, "ids", (int64_t)count, 1, SB_MAX_SERVOS);
-    if (period_ms == 0)
-        return usage_of(SB_PKT_STREAM_SETPOINT, "period_ms", 0, 1, 65535);
+    if (period_ms < 1 || period_ms > period->max) /* item 69's range, but for its 0 (off) */
+        return usage_of(SB_PKT_STREAM_SETPOINT, "period_ms", period_ms, 1, period->max);
     e = sb_check_ids(ids, count, SB_PKT_STREAM_SETPOINT);
     if (e.status != SB_OK)
         return e;
@@ -124,12 +129,21 @@ sb_error sb_stream_frame(sb_stream *s, const int32_t *angles, const int16_t *vel
 /* ---- the robot loop ------------------------------------------------------- */
 sb_error sb_loop_init(sb_loop *l, sb_bus *bus, const uint8_t *ids, size_t count, uint16_t period_ms)
 {
+    uint64_t wire;
     sb_error e;
     memset(l, 0, sizeof *l);
     l->bus = bus;
     e = sb_stream_init(&l->stream, ids, count, period_ms);
     if (e.status != SB_OK)
         return e;
+    if (bus->baud == 0) /* no wire's time to pace a loop by */
+        return usage_of(SB_PKT_STREAM_SETPOINT, "baud", 0, 1, UINT32_MAX);
+    /* A period shorter than the cycle's own bytes on the wire cannot be kept
+     * (servoctl's check_wire): the least is that time, rounded up to a ms. */
+    wire = ((uint64_t)sb_cycle_bytes(count) * SB_BITS_PER_BYTE * 1000u + bus->baud - 1u) / bus->baud;
+    if ((uint64_t)period_ms < wire)
+        return usage_of(SB_PKT_STREAM_SETPOINT, "period_ms", period_ms, (int64_t)wire,
+                        sb_item(SB_ITEM_STREAM_PERIOD_MS)->max);
     return sb_sync_frame(SB_PKT_MONITOR, ids, 1, count, l->monitor, sizeof l->monitor, &l->monitor_len);
 }
 

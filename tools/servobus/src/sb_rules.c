@@ -108,8 +108,14 @@ sb_error sb_check_request(uint8_t code, const sb_value *v, size_t count)
 {
     const sb_packet_desc *p = sb_packet(code);
     sb_error e;
-    if (p == NULL || count != p->request_count)
-        return sb_error_of(p == NULL ? SB_E_UNKNOWN_PACKET : SB_E_USAGE, -1, code, NULL);
+    if (p == NULL)
+        return sb_error_of(SB_E_UNKNOWN_PACKET, -1, code, NULL);
+    if (count != p->request_count) { /* "fields: 3, not 2" */
+        e = sb_error_of(SB_E_USAGE, -1, code, "fields");
+        e.value = (int64_t)count;
+        e.least = e.most = p->request_count;
+        return e;
+    }
     e = ranges_held(p, v); /* first: the rules' sums stay within int64_t */
     if (e.status != SB_OK)
         return e;

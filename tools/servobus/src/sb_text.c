@@ -44,7 +44,7 @@ static const char *const WHAT[] = {
     "out of range",
     "not allowed",
     "not a packet of the protocol",
-    "is no data item of the schema, or not one the packet may write",
+    "refused",
     "the buffer is too small",
     "no answer",
     "an answer with a bad checksum",
@@ -54,13 +54,24 @@ static const char *const WHAT[] = {
     "is the broadcast ID: no servo answers it or carries it out",
 };
 
+static bool named(const sb_error *e, const char *field)
+{
+    return e->field != NULL && strcmp(e->field, field) == 0;
+}
+
+static bool assign_unknown(const sb_error *e)
+{
+    return e->status == SB_E_NO_ANSWER && e->packet == SB_PKT_ASSIGN_ID && named(e, "serial");
+}
+
 /* ": 33 is beyond 1..32", or ": 8, not 1" where one value is right. */
 static void put_range(text *t, const sb_error *e)
 {
-    bool servos = e->status == SB_E_USAGE && e->field != NULL && strcmp(e->field, "ids") == 0;
+    bool servos = e->status == SB_E_USAGE && named(e, "ids");
+    bool bytes = e->status == SB_E_BAD_ANSWER && (named(e, "length") || named(e, "data"));
     put(t, ": ");
     put_number(t, e->value);
-    put(t, servos ? " servos" : "");
+    put(t, servos ? " servos" : bytes ? " bytes" : "");
     if (e->least == e->most) {
         put(t, ", not ");
         put_number(t, e->least);
@@ -70,7 +81,40 @@ static void put_range(text *t, const sb_error *e)
     put_number(t, e->least);
     put(t, "..");
     put_number(t, e->most);
-    put(t, servos ? " (SB_MAX_SERVOS)" : "");
+    put(t, servos && e->most == SB_MAX_SERVOS ? " (SB_MAX_SERVOS)" : "");
+}
+
+/* "no data item 200 in the schema", "item 1 (voltage_mv) is read-only" */
+static void put_item(text *t, const sb_error *e)
+{
+    const sb_item_desc *item = e->value >= 0 && e->value <= 255 ? sb_item((uint8_t)e->value) : NULL;
+    put(t, item == NULL ? ": no data item " : ": item ");
+    put_number(t, e->value);
+    if (item == NULL) {
+        put(t, " in the schema");
+        return;
+    }
+    put(t, " (");
+    put(t, item->name);
+    put(t, item->access == SB_ACCESS_READ ? ") is read-only" : ") is reserved");
+}
+
+/* A stream's step beyond the servo's top speed at the stream's period. */
+static void put_step(text *t)
+{
+    put(t, ": over ");
+    put_number(t, sb_packet(SB_PKT_STREAM_SETPOINT)->request[2].max / 10);
+    put(t, " deg/s at this period: use a longer period or a smaller step");
+}
+
+/* A loop's period shorter than its cycle's bytes on the wire (sb_loop_init). */
+static void put_wire(text *t, const sb_error *e)
+{
+    put(t, ": ");
+    put_number(t, e->value);
+    put(t, " ms is shorter than the wire's cycle at this baud rate (sb_cycle_bytes): at least ");
+    put_number(t, e->least);
+    put(t, " ms");
 }
 
 size_t sb_error_text(const sb_error *e, char *buf, size_t cap)
@@ -92,6 +136,12 @@ size_t sb_error_text(const sb_error *e, char *buf, size_t cap)
         put_number(&t, e->packet);
         put(&t, ": ");
     }
+    if (assign_unknown(e)) { /* AssignId at 255: only the servo with the serial answers */
+        put(&t, "no servo has serial ");
+        put_number(&t, e->value);
+        put(&t, " (item 8): none answered (is the servo on the bus, at this baud rate?)");
+        return t.len;
+    }
     if (e->field != NULL) {
         put(&t, e->field);
         put(&t, " ");
@@ -99,7 +149,11 @@ size_t sb_error_text(const sb_error *e, char *buf, size_t cap)
     put(&t, (size_t)e->status < sizeof WHAT / sizeof WHAT[0] ? WHAT[e->status] : "unknown error");
     if (e->status == SB_E_RANGE) {
         put_range(&t, e);
+        if (e->packet == SB_PKT_STREAM_SETPOINT && named(e, "angle step"))
+            put_step(&t);
         put(&t, "; nothing was sent");
+    } else if (e->status == SB_E_USAGE && named(e, "period_ms") && e->least > 1 && e->value < e->least) {
+        put_wire(&t, e);
     } else if (e->status == SB_E_USAGE && ranged) {
         put_range(&t, e);
     } else if (e->status == SB_E_USAGE && e->field != NULL && strcmp(e->field, "cmd") == 0) {
@@ -121,9 +175,13 @@ size_t sb_error_text(const sb_error *e, char *buf, size_t cap)
 #endif
         put(&t, ")");
     } else if (e->status == SB_E_UNKNOWN_ITEM) {
-        put(&t, " (item ");
+        put_item(&t, e);
+    } else if (e->status == SB_E_SPACE && e->value > 0) {
+        put(&t, ": ");
         put_number(&t, e->value);
-        put(&t, ")");
+        put(&t, " bytes needed, ");
+        put_number(&t, e->most);
+        put(&t, " given");
     }
     return t.len;
 }

@@ -82,8 +82,7 @@ static void an_error_says_what_is_wrong(void **state)
     sb_read_data_request r = {1, 200};
     e = sb_encode_read_data(&r, f, sizeof f, &len);
     sb_error_text(&e, text, sizeof text);
-    assert_string_equal(text, "servo 1: ReadData: data_id is no data item of the schema, or not one the packet "
-                              "may write (item 200)");
+    assert_string_equal(text, "servo 1: ReadData: data_id refused: no data item 200 in the schema");
 }
 
 static void a_bad_checksum_is_told(void **state)

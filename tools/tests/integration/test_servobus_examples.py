@@ -76,7 +76,28 @@ def test_the_cycle_takes_id_254_and_the_address_servoctl_sim_prints():
     """254 is a servo's ID; socket://HOST:PORT is how servoctl sim prints the
     bus: both taken, up to the connection (no simulator listens at port 1)."""
     done = _run(["sb_ros2_cycle", "socket://127.0.0.1:1", "--ids", "254"])
-    assert done.returncode == 1 and "cannot connect to 127.0.0.1:1\n" in done.stderr, done.stderr
+    assert done.returncode == 1 and "cannot connect to 127.0.0.1:1 (errno " in done.stderr, done.stderr
+
+
+def test_the_cycle_parses_its_numbers_strictly():
+    """A number that is not one, or beyond its range, is refused by name
+    (exit 2), not wrapped or read as 0; an empty ID is no ID."""
+    for args, why in ((["--seconds", "-1"], "--seconds: '-1' is not a time in seconds"),
+                      (["--period-ms", "65536"], "--period-ms: '65536' is not a period of 1-1000 ms"),
+                      (["--period-ms", "70000"], "--period-ms: '70000' is not a period of 1-1000 ms"),
+                      (["--period-ms", "abc"], "--period-ms: 'abc' is not a period of 1-1000 ms"),
+                      (["--ids", "1,,2"], "--ids: '' is not a servo ID (0-254) in '1,,2'")):
+        done = _run(["sb_ros2_cycle", "127.0.0.1:1", *args])
+        assert done.returncode == 2 and why in done.stderr, (args, done.stderr)
+
+
+def test_the_cycle_refuses_a_period_shorter_than_the_wire_s_cycle(sim3):
+    """1 ms at 115200 baud: a cycle's bytes take longer than the period."""
+    address, clock = _where(sim3)
+    done = _run(["sb_ros2_cycle", address, "--clock", clock, "--period-ms", "1"])
+    assert done.returncode == 1, done.stdout + done.stderr
+    assert "1 ms is shorter than the wire's cycle" in done.stderr, done.stderr
+    assert "bytes on the wire" in done.stderr and "at 115200 baud" in done.stderr, done.stderr
 
 
 def test_the_c_robot_loop_names_the_address_it_could_not_reach(tmp_path):
@@ -120,6 +141,9 @@ def test_the_bench_and_the_cycle_say_what_is_wrong(tmp_path):
             assert done.returncode == 2 and why in done.stderr, done.stderr
         cycle = _run(["sb_ros2_cycle", "127.0.0.1:1", "--clock", str(clock)])
         assert cycle.returncode == 2 and why in cycle.stderr, cycle.stderr
+    for baud in ("0", "115200x"):
+        done = _run(["sb_loop_bench", "127.0.0.1:1", str(tmp_path / "empty"), baud, "3", "2"])
+        assert done.returncode == 2 and f"BAUD '{baud}' is not a baud rate" in done.stderr, done.stderr
     done = _run(["sb_loop_bench", "127.0.0.1:1", str(tmp_path / "empty"), "115200", "40", "2"])
     assert done.returncode == 2 and "COUNT must be 1-32" in done.stderr, done.stderr
     done = _run(["sb_loop_bench", "localhost", str(tmp_path / "empty"), "115200", "3", "2"])

@@ -191,6 +191,9 @@ typedef struct sb_stream {
     int32_t last[SB_MAX_SERVOS]; /* the last angle sent (0.1 deg) */
     int32_t angle_min[SB_MAX_SERVOS], angle_max[SB_MAX_SERVOS]; /* each servo's limits (0.1 deg) */
 } sb_stream;
+/* period_ms: 1..1000, item 69's range (stream_period_ms) but for its 0
+ * (off); else SB_E_USAGE on "period_ms". Keep it at most half of each
+ * servo's watchdog_ms (item 64), which servobus does not read. */
 sb_error sb_stream_init(sb_stream *s, const uint8_t *ids, size_t count, uint16_t period_ms);
 /* The next setpoints' frame: angles in 0.1 deg, velocities in 0.1 deg/s
  * (NULL: from the last two setpoints). An angle beyond its field or its
@@ -213,6 +216,9 @@ typedef struct sb_loop {
     uint32_t missed; /* states that did not come */
     uint64_t started_us;
 } sb_loop;
+/* As sb_stream_init, and a period shorter than the cycle's bytes on the
+ * wire at bus->baud (sb_cycle_bytes; least: the shortest, in whole ms) or a
+ * bus at baud 0 is SB_E_USAGE (servoctl's RobotLoop, check_wire). */
 sb_error sb_loop_init(sb_loop *l, sb_bus *bus, const uint8_t *ids, size_t count, uint16_t period_ms);
 sb_error sb_loop_cycle(sb_loop *l, const int32_t *angles, const int16_t *velocities, sb_monitor_answer *states,
                        bool *got);

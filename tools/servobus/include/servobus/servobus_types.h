@@ -18,8 +18,8 @@ typedef enum sb_status {
     SB_E_RANGE,          /* a field's value beyond the schema's range: nothing sent */
     SB_E_USAGE,          /* a call the protocol does not allow (field: what; value, least, most: how) */
     SB_E_UNKNOWN_PACKET, /* a code the schema does not have */
-    SB_E_UNKNOWN_ITEM,   /* a data item the schema does not have (ReadData, WriteData), or not writable */
-    SB_E_SPACE,          /* the caller's buffer is too small */
+    SB_E_UNKNOWN_ITEM,   /* a data item the schema does not have (ReadData, WriteData), or not writable (value: it) */
+    SB_E_SPACE,          /* the caller's buffer is too small (value: bytes needed, most: given) */
     SB_E_NO_ANSWER,      /* the servo did not answer in time */
     SB_E_BAD_CHECKSUM,   /* an answer came with a bad checksum */
     SB_E_BAD_ANSWER,     /* an answer of the wrong length, or a field beyond its range */
