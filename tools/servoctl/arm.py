@@ -222,7 +222,7 @@ class Arm:
                 s = Servo(self.bus, servo_id)
                 s.write("watchdog_ms", ms)
                 s.write("watchdog_action", action)
-                self.records.forget(serial)  # kept where it could not be put back
+                self.records.forget(serial, self.bus.port)  # kept where it could not be put back
             except (ServoError, OSError) as e:  # the next servos' still put back
                 errors.append(f"{self.names[servo_id]}: {e}")
         self._watchdog_before = {}

@@ -128,7 +128,7 @@ def test_a_record_that_cannot_be_removed_leaves_the_next_servos_put_back(state_d
     with Simulator(ids=[1, 2], fast=True) as sim:
         bus = sim.bus()
         arm = Arm(bus, {"a": 1, "b": 2}).open()
-        first = arm.records.path(Servo(bus, 1).read("serial"))
+        first = arm.records.path(Servo(bus, 1).read("serial"), bus.port)
         first.unlink()
         first.mkdir()  # unlink() fails on it
         with pytest.raises(ServoError) as e:
@@ -154,7 +154,7 @@ def test_a_malformed_record_is_dropped_with_a_warning(state_dir, own, caplog):
     with Simulator(ids=[1], fast=True) as sim:
         bus = sim.bus()
         Arm(bus, {"a": 1}).open()  # never closed: the servo holds 500 ms, hold
-        path = WatchdogRecords().path(Servo(bus, 1).read("serial"))
+        path = WatchdogRecords().path(Servo(bus, 1).read("serial"), bus.port)
         path.write_text(f'{{"own": {json.dumps(own)}, "wrote": [500, 0]}}')
         with caplog.at_level(logging.WARNING, logger="servoctl.arm"):
             arm = Arm(bus, {"a": 1}).open()
@@ -166,7 +166,7 @@ def test_a_malformed_record_is_dropped_with_a_warning(state_dir, own, caplog):
 def test_a_fifo_in_place_of_a_record_does_not_hang_connect(state_dir):
     with Simulator(ids=[1], fast=True) as sim:
         bus = sim.bus()
-        path = WatchdogRecords().path(Servo(bus, 1).read("serial"))
+        path = WatchdogRecords().path(Servo(bus, 1).read("serial"), bus.port)
         path.parent.mkdir(parents=True)
         os.mkfifo(path)
         done = []
@@ -188,7 +188,7 @@ def test_a_planted_link_is_not_followed(state_dir, tmp_path):
     victim.write_text("mine")
     with Simulator(ids=[1], fast=True) as sim:
         bus = sim.bus()
-        path = WatchdogRecords().path(Servo(bus, 1).read("serial"))
+        path = WatchdogRecords().path(Servo(bus, 1).read("serial"), bus.port)
         path.parent.mkdir(parents=True)
         path.with_name(f".{path.name}.{os.getpid()}").symlink_to(victim)
         Arm(bus, {"a": 1}).open().close()
@@ -230,3 +230,27 @@ def test_one_id_in_two_joints_is_refused_naming_both():
     with pytest.raises(UsageError) as e:
         Arm(None, {"a": 1, "b": 2, "c": 1})
     assert "a and c (servo 1)" in str(e.value), e.value
+
+
+def test_two_simulators_keep_their_own_records(state_dir, caplog):
+    """servo_sim's serials (0x51a0UUNN) are the same in every simulator:
+    arm B's clean run removed arm A's record (one file a serial), and A's
+    next run put back the factory's setting, not A's own, blaming another
+    computer. A real servo's serial is its own: its record keeps its name
+    whatever the device is called."""
+    assert WatchdogRecords().path(0x51A00001, "/dev/ttyUSB0").name == "51a00001.json"
+    with Simulator(ids=[1], fast=True) as sa, Simulator(ids=[1], fast=True) as sb:
+        ba, bb = sa.bus(), sb.bus()
+        assert Servo(ba, 1).read("serial") == Servo(bb, 1).read("serial")  # as the simulator gives them
+        own = (2000, 2)
+        Servo(ba, 1).write("watchdog_ms", own[0])
+        Servo(ba, 1).write("watchdog_action", own[1])
+        Arm(ba, {"j": 1}).open()  # its run never ends cleanly
+        Arm(bb, {"j": 1}).open().close()  # the other follower's clean run
+        assert watchdog(bb, 1) == FACTORY_WATCHDOG
+        with caplog.at_level(logging.WARNING, logger="servoctl.arm"):
+            again = Arm(ba, {"j": 1}).open()
+        assert "another computer" not in caplog.text, caplog.text
+        assert "which a run that did not end cleanly wrote" in caplog.text, caplog.text
+        again.close()
+        assert watchdog(ba, 1) == own
