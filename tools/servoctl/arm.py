@@ -21,7 +21,8 @@ and out, a frame at a time.
   kept on the host meanwhile (watchdog_record.py), so a run that ended
   without putting it back is not taken for the servo's own. A servo that
   restarts mid-run (its watchdog back to off) is armed again and ramps
-  from where its horn is (arm_reset.py).
+  from where its horn is (arm_reset.py), or from the nearest limit where
+  it fell outside them (moved there first, as at connect).
 - A joint that does not answer because two servos hold its ID is said to
   be shared (JointShared: scan's probe hears their answers collide).
 
@@ -173,17 +174,22 @@ class Arm:
 
     def _again(self, servo_id: int, ms: int) -> None:
         """A servo that restarted (arm_reset.py): armed again, held where
-        its horn is, and its joint ramped from there."""
+        its horn is (outside its limits: moved to the nearest, into_limits),
+        and its joint ramped from there."""
         name = self.names[servo_id]
         self._arm_one(servo_id)
         Servo(self.bus, servo_id).stop("hold")
         state = sync_monitor(self.bus, [servo_id]).get(servo_id)
         if state is None:
             raise JointSilent(f"{name} (servo {servo_id}) restarted and then did not answer: no target is sent", [name])
+        here = state.angle_decideg / 10.0
+        # Fallen outside its limits: to the nearest first, as at connect (a setpoint outside is clamped: a jump).
+        held = into_limits(self, {name: here}, self.ramp.speed_deg_s or DEFAULT_SPEED_DEG_S, restarted=True)[name]
         log.warning("%s (servo %d): its bus watchdog read %d ms, not the arm's %d ms: it restarted (its supply or "
-                    "its connector?) or another program set it; armed again, held at %.1f deg, and ramped from "
-                    "there", name, servo_id, ms, self.watchdog_ms, state.angle_decideg / 10.0)
-        self.targets[name] = state.angle_decideg / 10.0
+                    "its connector?) or another program set it; armed again, held at %.1f deg%s, and ramped from "
+                    "there", name, servo_id, ms, self.watchdog_ms, here,
+                    "" if held == here else f" (outside its angle limits: moved to the nearest, {held:.1f} deg)")
+        self.targets[name] = held
         self._before.pop(name, None)
         self.ramp.again(name)
         self.stream.restart(servo_id)
@@ -222,7 +228,7 @@ class Arm:
                 s = Servo(self.bus, servo_id)
                 s.write("watchdog_ms", ms)
                 s.write("watchdog_action", action)
-                self.records.forget(serial)  # kept where it could not be put back
+                self.records.forget(serial, self.bus.port)  # kept where it could not be put back
             except (ServoError, OSError) as e:  # the next servos' still put back
                 errors.append(f"{self.names[servo_id]}: {e}")
         self._watchdog_before = {}

@@ -75,7 +75,7 @@ def within(deg: float, lim) -> float:
     return deg if lim.angle_min is None else min(max(deg, lim.angle_min / 10.0), lim.angle_max / 10.0)
 
 
-def into_limits(arm, here: dict, speed_deg_s: float) -> dict:
+def into_limits(arm, here: dict, speed_deg_s: float, restarted: bool = False) -> dict:
     """here ({name: deg}, where arm's joints are held) within their limits:
     a joint outside them (it rests a hair past one, or was pushed far out)
     is moved to the nearest at up to speed_deg_s and waited for, on the
@@ -83,18 +83,33 @@ def into_limits(arm, here: dict, speed_deg_s: float) -> dict:
     its setpoints, and the ramp, then start there, as the servo takes them
     (it clamps a streamed setpoint to its limits: one outside is a jump).
     A refusal outside the limits (arm.limits) then advises as for an arm
-    whose limits are its calibration, not to switch them off."""
+    whose limits are its calibration, not to switch them off. restarted:
+    here is one joint whose servo restarted mid-run (arm_reset.py: it fell
+    while its output was released), and the error says so; the other
+    joints hold their last setpoints meanwhile (a stream a period late
+    brakes to a hold)."""
     for lim in arm.limits.values():  # its range, as calibrated: never to be switched off to get by
         lim.advice = ("The arm keeps its targets within the limits read at connect: were they changed since? "
                       "Connect again (calibrate again to change them)")
     held = {n: within(d, arm.limits[arm.joints[n]]) for n, d in here.items()}
     out = {n: d for n, d in held.items() if d != here[n]}
+    soft = 0.0  # the first move after power-up lasts the soft-start time (items 49, 50): a restart's does
     for name, deg in out.items():
-        Servo(arm.bus, arm.joints[name]).move_to(deg, speed_dps=speed_deg_s, accel_s=RISE_S, decel_s=RISE_S)
+        s = Servo(arm.bus, arm.joints[name])
+        soft = max(soft, s.read("soft_start_time") / 1000.0 if s.read("soft_start_on") else 0.0)
+        s.move_to(deg, speed_dps=speed_deg_s, accel_s=RISE_S, decel_s=RISE_S)
     start = arm.bus.clock()
-    end = start + 2.0 * max((abs(here[n] - d) for n, d in out.items()), default=0) / speed_deg_s + 2.0
+    end = start + 2.0 * max((abs(here[n] - d) for n, d in out.items()), default=0) / speed_deg_s + soft + 2.0
     while out and not all(abs(within(d, arm.limits[arm.joints[n]]) - d) <= 0.1  # within them, or a reading off
                           for n, d in arm.positions().items() if n in out):
+        if arm.bus.clock() > end and restarted:
+            name = next(iter(out))
+            lim = arm.limits[arm.joints[name]]
+            raise ServoError(f"{name} (servo {arm.joints[name]}) restarted mid-run (its supply or its connector?) "
+                             f"and came back at {here[name]:.1f} deg, outside its angle limits "
+                             f"({lim.angle_min / 10:.1f}..{lim.angle_max / 10:.1f} deg), and did not reach the "
+                             f"nearest within {end - start:.1f} s (blocked?): it holds where it is; move it "
+                             f"within its range and connect again")
         if arm.bus.clock() > end:
             raise ServoError(f"{', '.join(out)}: outside its angle limits, and not at the nearest within "
                              f"{end - start:.1f} s (blocked?): move it within its range and connect again")

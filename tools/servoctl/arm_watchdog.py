@@ -25,14 +25,15 @@ def arm_one(s: Servo, who: str, records: WatchdogRecords, ours: tuple):
     or None where its own is ours."""
     serial = s.read("serial")
     holds = (s.read("watchdog_ms"), s.read("watchdog_action"))
-    own, found = records.own_setting(serial, holds, [ours, DEFAULT])  # the default: another run's
+    port = s.bus.port  # a simulator's serials repeat in every simulator: its port tells them apart
+    own, found = records.own_setting(serial, holds, [ours, DEFAULT], port)  # the default: another run's
     for said in records.warnings:
         log.warning("%s: %s", who, said)
     records.warnings.clear()
     if found == "record":
         log.warning("%s: its bus watchdog holds %s, which a run that did not end cleanly wrote; its own "
                     "setting, %s (kept in %s), is put back on close", who, watchdog_text(holds),
-                    watchdog_text(own), records.path(serial))
+                    watchdog_text(own), records.path(serial, port))
     elif found == "ours":
         log.warning("%s: its bus watchdog holds %s, the follower's own setting, and no record of the servo's "
                     "own is kept here (%s): a run on another computer, by another user or with another state "
@@ -41,10 +42,10 @@ def arm_one(s: Servo, who: str, records: WatchdogRecords, ours: tuple):
                     "watchdog_ms %d')", who, watchdog_text(holds), records.folder, watchdog_text(own),
                     watchdog_text(holds), s.id, holds[0])
     if own != ours:
-        records.keep(serial, s.id, own, ours)  # before the servo holds ours
+        records.keep(serial, s.id, own, ours, port)  # before the servo holds ours
     if holds != ours:  # written only where it differs
         s.write("watchdog_ms", ours[0])
         s.write("watchdog_action", ours[1])
     if own == ours and found == "record":
-        records.forget(serial)  # once the servo holds it: a crash before leaves the record
+        records.forget(serial, port)  # once the servo holds it: a crash before leaves the record
     return (serial, own) if own != ours else None

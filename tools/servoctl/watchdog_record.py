@@ -2,7 +2,11 @@
 while a host's loop (servoctl.arm: the LeRobot follower) has put its own
 there: one file a servo, named by its serial number, written before the
 loop's setting goes onto the servo and removed once the servo's own is
-back.
+back. A servo on a serial device is known by its serial number alone (a
+real servo's is its own; the device's name may change when it is plugged
+in again); one on a socket:// bus (a simulator: servo_sim gives each
+simulator's servos the same serials, 0x51a0UUNN) by its serial and that
+port, or one simulator's record would be taken for another's.
 
 A run that ends without putting it back (a closed terminal, a pulled
 plug) leaves the loop's setting on the servo and the file on the host.
@@ -27,6 +31,7 @@ watchdog, else ~/.local/state/servoctl/watchdog."""
 import errno
 import json
 import os
+import re
 import stat
 import tempfile
 from pathlib import Path
@@ -81,16 +86,20 @@ class WatchdogRecords:
         self.folder = Path(folder) if folder is not None else state_dir() / "watchdog"
         self.warnings = []
 
-    def path(self, serial: int) -> Path:
-        return self.folder / f"{serial:08x}.json"
+    def path(self, serial: int, port: str = None) -> Path:
+        """The record of the servo serial on the bus at port (Bus.port)."""
+        where = str(port or "")
+        if "://" not in where:  # a serial device: the serial number is the servo's
+            return self.folder / f"{serial:08x}.json"
+        return self.folder / f"{serial:08x}@{re.sub(r'[^A-Za-z0-9.-]+', '-', where)}.json"
 
-    def own_setting(self, serial: int, holds: tuple, ours=()) -> tuple:
+    def own_setting(self, serial: int, holds: tuple, ours=(), port: str = None) -> tuple:
         """(the servo's own setting, where it came from): "record" (the
         path's: the servo holds what the record says a loop wrote, or half
         of it), "ours" (no record, and the servo holds exactly one of ours,
         a list of the settings a loop writes, its own and its default:
-        FACTORY is taken), or None (what it holds)."""
-        path = self.path(serial)
+        FACTORY is taken), or None (what it holds). port: path's."""
+        path = self.path(serial, port)
         holds = tuple(holds)
         try:
             record = json.loads(_read(path))
@@ -106,10 +115,10 @@ class WatchdogRecords:
         self._drop(path)
         return (FACTORY, "ours") if holds in ours else (holds, None)
 
-    def keep(self, serial: int, servo_id: int, own: tuple, wrote: tuple) -> None:
+    def keep(self, serial: int, servo_id: int, own: tuple, wrote: tuple, port: str = None) -> None:
         """Before the loop's setting (wrote) goes onto the servo: whole on
         disk, or not there (written aside, then renamed over)."""
-        path = self.path(serial)
+        path = self.path(serial, port)
         try:
             self.folder.mkdir(parents=True, exist_ok=True)
             fd, new = tempfile.mkstemp(prefix=f".{path.name}.", dir=self.folder)  # O_EXCL: no link followed
@@ -125,9 +134,9 @@ class WatchdogRecords:
         except OSError as e:
             raise RecordError(self._cannot("keep", path, e)) from None
 
-    def forget(self, serial: int) -> None:
+    def forget(self, serial: int, port: str = None) -> None:
         """The servo's own setting is back on it."""
-        path = self.path(serial)
+        path = self.path(serial, port)
         try:
             path.unlink(missing_ok=True)
         except OSError as e:

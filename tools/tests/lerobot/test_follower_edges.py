@@ -128,7 +128,7 @@ def test_a_record_that_cannot_be_removed_leaves_the_next_servos_put_back(state_d
     with Simulator(ids=[1, 2], fast=True) as sim:
         bus = sim.bus()
         arm = Arm(bus, {"a": 1, "b": 2}).open()
-        first = arm.records.path(Servo(bus, 1).read("serial"))
+        first = arm.records.path(Servo(bus, 1).read("serial"), bus.port)
         first.unlink()
         first.mkdir()  # unlink() fails on it
         with pytest.raises(ServoError) as e:
@@ -154,7 +154,7 @@ def test_a_malformed_record_is_dropped_with_a_warning(state_dir, own, caplog):
     with Simulator(ids=[1], fast=True) as sim:
         bus = sim.bus()
         Arm(bus, {"a": 1}).open()  # never closed: the servo holds 500 ms, hold
-        path = WatchdogRecords().path(Servo(bus, 1).read("serial"))
+        path = WatchdogRecords().path(Servo(bus, 1).read("serial"), bus.port)
         path.write_text(f'{{"own": {json.dumps(own)}, "wrote": [500, 0]}}')
         with caplog.at_level(logging.WARNING, logger="servoctl.arm"):
             arm = Arm(bus, {"a": 1}).open()
@@ -166,7 +166,7 @@ def test_a_malformed_record_is_dropped_with_a_warning(state_dir, own, caplog):
 def test_a_fifo_in_place_of_a_record_does_not_hang_connect(state_dir):
     with Simulator(ids=[1], fast=True) as sim:
         bus = sim.bus()
-        path = WatchdogRecords().path(Servo(bus, 1).read("serial"))
+        path = WatchdogRecords().path(Servo(bus, 1).read("serial"), bus.port)
         path.parent.mkdir(parents=True)
         os.mkfifo(path)
         done = []
@@ -188,7 +188,7 @@ def test_a_planted_link_is_not_followed(state_dir, tmp_path):
     victim.write_text("mine")
     with Simulator(ids=[1], fast=True) as sim:
         bus = sim.bus()
-        path = WatchdogRecords().path(Servo(bus, 1).read("serial"))
+        path = WatchdogRecords().path(Servo(bus, 1).read("serial"), bus.port)
         path.parent.mkdir(parents=True)
         path.with_name(f".{path.name}.{os.getpid()}").symlink_to(victim)
         Arm(bus, {"a": 1}).open().close()
@@ -226,7 +226,91 @@ def test_a_servo_that_restarts_mid_run_ramps_again_from_where_it_is(caplog):
         assert [watchdog(bus, i) for i in (1, 2)] == [FACTORY_WATCHDOG] * 2
 
 
+def test_a_servo_that_restarts_outside_its_limits_goes_to_the_nearest_and_ramps(caplog):
+    """Power-cycled under a load, it fell below its lower limit: the ramp
+    started where it fell, outside the limits, and the next send raised
+    ValueOutOfRange advising to connect again or calibrate."""
+    with Simulator(ids=[1, 2], paced=True) as sim:
+        bus = sim.bus()
+        here = Arm(bus, {"a": 1, "b": 2}, watchdog_ms=0).open().positions()
+        low = here["a"] + 24  # the goal 6 deg above it: the fall (18 deg) ends below it
+        Arm(bus, {"a": 1, "b": 2}, watchdog_ms=0).open().store_ranges(
+            {"a": (low, low + 66), "b": (here["b"] - 90, here["b"] + 90)})
+        arm = Arm(bus, {"a": 1, "b": 2}, fps=FPS).open()
+        held = arm.hold_here()
+        goal = {"a": low + 6, "b": held["b"]}
+        t0 = sim.clock_s()
+        frames(sim, arm, t0, 0, 60, lambda k: goal, 1)
+        sim.control("load 0.6 1")
+        sim.control("powercycle 1")
+        angles, times = [], []
+        with caplog.at_level(logging.WARNING, logger="servoctl.arm"):
+            for k in range(60, 110):
+                if k == 64:
+                    sim.control("load 0 1")  # let go within the bootloader's 0.2 s
+                frames(sim, arm, sim.clock_s(), 0, 1, lambda k: goal, 1)  # one send waits for the move
+                times.append(sim.clock_s())
+                angles.append(sim.state(1)["angle"])
+        assert min(angles) < low - 5, angles  # it fell outside its limits
+        assert "it restarted" in caplog.text and "outside its angle limits: moved to the nearest" in caplog.text, \
+            caplog.text
+        # Over 0.2 s or more (the move to the limit takes one send's while): the ramp's speed, give or take.
+        rates = [(b - a) / (u - t) for a, b, t, u in zip(angles, angles[6:], times, times[6:])]
+        assert max(rates) <= 45 + 10, (max(rates), angles)
+        assert abs(angles[-1] - goal["a"]) < 0.5, angles  # ramped to the goal from the limit
+        assert watchdog(bus, 1) == (500, 0)
+        arm.close()
+
+
+def test_a_servo_that_restarts_outside_its_limits_and_is_blocked_names_the_restart():
+    """Held where it fell, it cannot reach its limit: the error says it
+    restarted, not that the limits were changed since connect."""
+    with Simulator(ids=[1], paced=True) as sim:
+        bus = sim.bus()
+        arm = Arm(bus, {"a": 1}, fps=FPS).open()
+        held = arm.hold_here()
+        frames(sim, arm, sim.clock_s(), 0, 3, lambda k: held, 1)
+        lim = arm.limits[1]
+        # The arm's limits as read at connect: 20-40 deg above it (the servo's own stay wide, so its
+        # move toward them is taken, and only the load stops it).
+        lim.angle_min, lim.angle_max = round(held["a"] * 10) + 200, round(held["a"] * 10) + 400
+        sim.control("powercycle 1")
+        sim.control("load 5 1")  # held against it: it falls, and cannot rise
+        with pytest.raises(ServoError) as e:
+            t0 = sim.clock_s()
+            frames(sim, arm, t0, 0, 30, lambda k: {"a": held["a"] + 25}, 1)
+        said = str(e.value)
+        assert "a (servo 1) restarted mid-run" in said and "outside its angle limits" in said, said
+        assert "were they changed since" not in said, said
+        sim.control("load 0 1")
+        arm.close()
+
+
 def test_one_id_in_two_joints_is_refused_naming_both():
     with pytest.raises(UsageError) as e:
         Arm(None, {"a": 1, "b": 2, "c": 1})
     assert "a and c (servo 1)" in str(e.value), e.value
+
+
+def test_two_simulators_keep_their_own_records(state_dir, caplog):
+    """servo_sim's serials (0x51a0UUNN) are the same in every simulator:
+    arm B's clean run removed arm A's record (one file a serial), and A's
+    next run put back the factory's setting, not A's own, blaming another
+    computer. A real servo's serial is its own: its record keeps its name
+    whatever the device is called."""
+    assert WatchdogRecords().path(0x51A00001, "/dev/ttyUSB0").name == "51a00001.json"
+    with Simulator(ids=[1], fast=True) as sa, Simulator(ids=[1], fast=True) as sb:
+        ba, bb = sa.bus(), sb.bus()
+        assert Servo(ba, 1).read("serial") == Servo(bb, 1).read("serial")  # as the simulator gives them
+        own = (2000, 2)
+        Servo(ba, 1).write("watchdog_ms", own[0])
+        Servo(ba, 1).write("watchdog_action", own[1])
+        Arm(ba, {"j": 1}).open()  # its run never ends cleanly
+        Arm(bb, {"j": 1}).open().close()  # the other follower's clean run
+        assert watchdog(bb, 1) == FACTORY_WATCHDOG
+        with caplog.at_level(logging.WARNING, logger="servoctl.arm"):
+            again = Arm(ba, {"j": 1}).open()
+        assert "another computer" not in caplog.text, caplog.text
+        assert "which a run that did not end cleanly wrote" in caplog.text, caplog.text
+        again.close()
+        assert watchdog(ba, 1) == own
