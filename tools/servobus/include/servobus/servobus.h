@@ -146,7 +146,10 @@ void sb_bus_init(sb_bus *bus, sb_transport t, uint32_t baud);
 /* Drops what waits unread, then writes frame in one write. */
 sb_error sb_send(sb_bus *bus, const uint8_t *frame, size_t len);
 /* The next answer of packet code from servo (-1: any) by deadline_us (bus
- * clock); other frames skipped. content: SB_ANSWER_CONTENT_MAX bytes. */
+ * clock); other frames skipped. content: SB_ANSWER_CONTENT_MAX bytes. Of a
+ * servo given, a frame that does not fit the packet (the wrong length for
+ * a fixed-size answer, else one that does not decode: a frame inside the
+ * answer) is skipped too; if only such came, SB_E_BAD_ANSWER on it. */
 sb_error sb_receive(sb_bus *bus, uint8_t code, int servo, uint64_t deadline_us, uint8_t *content, size_t *len);
 /* sb_send the frame in bus->tx (len bytes), then sb_receive within timeout_us. */
 sb_error sb_request(sb_bus *bus, size_t len, uint8_t code, int servo, uint8_t *content, size_t *clen);
@@ -173,8 +176,12 @@ sb_error sb_sync_command(sb_bus *bus, uint8_t cmd, const uint8_t *records, size_
  * frame of a servo not listed, or whose turn has passed, does not), and
  * however the line babbles the round ends by the request's end plus count
  * times (such a slot + SB_SYNC_SILENCE_US). Answers come in the list's
- * order: an answer of ids[k] drops any taken of ids[k] or later (a
- * previous round's, late). An ID listed twice, or the broadcast ID, is
+ * order: an answer of ids[k] drops any taken of a later servo (a previous
+ * round's, late); a frame naming a servo that answered, or one before a
+ * servo that answered in its turn, is ignored (a frame made of two
+ * answers' bytes); a frame of the wrong length does not take the turn
+ * while the answer may yet end (SB_E_BAD_ANSWER on "length" if it
+ * does not). An ID listed twice, or the broadcast ID, is
  * refused before anything is sent (sb_check_ids); got[] is all false after
  * any error before the answers (a refusal, a link error). */
 sb_error sb_sync_monitor(sb_bus *bus, const uint8_t *ids, size_t count, sb_monitor_answer *states, bool *got);
