@@ -105,13 +105,18 @@ uint8_t sb_checksum(const uint8_t *data, size_t len);
  * it did not ask for). */
 typedef struct sb_parser {
     uint8_t header[2];
-    uint8_t buf[SB_RX_MAX];
-    size_t len;   /* bytes held */
-    size_t seen;  /* of them examined */
-    size_t taken; /* to drop at the next call: the first byte of a frame returned at buf's start */
-    size_t owned; /* the bytes held from the start up to a frame's end returned: not stray */
-    bool tie;        /* another frame may end where the one returned last did, */
-    size_t tie_from; /* starting here or later */
+    uint8_t buf[2 * SB_RX_MAX]; /* byte x at x % SB_RX_MAX and again SB_RX_MAX on: a frame is in one piece */
+    uint8_t sum[SB_RX_MAX];     /* at x % SB_RX_MAX: the sum of the bytes before byte x */
+    uint16_t size[SB_RX_MAX];   /* at s % SB_RX_MAX: the frame begun at byte s, its size and state */
+    uint16_t next[SB_RX_MAX];   /* the next frame (by start) that ends where the one at s does */
+    uint16_t ends[SB_RX_MAX];   /* at e % SB_RX_MAX: the first frame (by start) ending at byte e */
+    uint32_t now;               /* bytes taken */
+    uint32_t lo;                /* the first byte of the earliest frame still open (now: none) */
+    uint32_t reach;             /* the end of the frames returned */
+    uint32_t cover;             /* the end of the frames begun at the bytes judged stray or not */
+    uint16_t cursor;            /* the next frame to check that ends at byte now - 1 */
+    bool open;                  /* the byte now - 1's frames not all checked */
+    size_t len;                 /* bytes held: now - lo */
     uint32_t stray_bytes;
     uint32_t bad_frames;
 } sb_parser;
