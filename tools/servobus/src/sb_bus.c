@@ -78,15 +78,35 @@ sb_error sb_send(sb_bus *bus, const uint8_t *frame, size_t len)
     return rc < 0 ? link_error(rc, len > 2 ? frame[2] : 0) : sb_ok();
 }
 
+/* Whether a frame of a call's answer decodes: a packet with a fixed
+ * answer size, by its length; another, decoded. */
+static sb_error fits(uint8_t code, const uint8_t *content, size_t len)
+{
+    size_t size = sb_answer_frame_size(code);
+    const sb_packet_desc *p = sb_packet(code);
+    sb_value v[SB_ANSWER_CONTENT_MAX];
+    sb_error e = sb_ok();
+    if (size > 0 && len + 5u != size) { /* "length: 2 bytes, not 16" */
+        e = sb_error_of(SB_E_BAD_ANSWER, len > 0 ? content[0] : -1, code, "length");
+        e.value = (int64_t)len;
+        e.least = e.most = (int64_t)size - 5;
+    } else if (size == 0 && p != NULL && p->answer_count <= SB_ANSWER_CONTENT_MAX) {
+        e = sb_decode_answer(code, content, len, v, p->answer_count);
+    }
+    return e;
+}
+
 /* sb_receive of an answer about item (its second byte; -1: any); the
  * transport may wait for want_after bytes (0: this frame's); look: once the
  * deadline has passed, one last look at what came meanwhile (else only the
- * bytes held are searched). */
+ * bytes held are searched). A frame of the servo's that does not fit the
+ * packet (one inside its answer) is skipped, the answer may yet end; if
+ * only such frames came, the first one's error. */
 static sb_error receive(sb_bus *bus, uint8_t code, int servo, int item, uint64_t deadline_us, uint8_t *content,
                         size_t *len, size_t want_after, bool look)
 {
     uint32_t bad = bus->rx.bad_frames;
-    sb_error e = sb_ok();
+    sb_error e = sb_ok(), misfit = sb_ok(); /* the first answer of the servo that did not decode: skipped */
     bool looked = !look; /* the deadline passed: one last look at what came meanwhile */
     int other = -1;      /* the item of an answer about another, skipped */
     for (;;) {
@@ -103,6 +123,11 @@ static sb_error receive(sb_bus *bus, uint8_t code, int servo, int item, uint64_t
                 (clen < 2 || fcontent[1] != item)) {
                 other = clen < 2 ? 256 : fcontent[1]; /* a late answer about another item: skipped */
             } else if (fcode == code && (servo < 0 || (clen > 0 && fcontent[0] == servo))) {
+                sb_error d = servo >= 0 && clen <= SB_ANSWER_CONTENT_MAX ? fits(code, fcontent, clen) : sb_ok();
+                if (d.status != SB_OK) { /* a frame inside the answer, say: the answer may yet end */
+                    misfit = misfit.status != SB_OK ? misfit : d;
+                    continue;
+                }
                 bus->arrived_us = bus->t.now_us(bus->t.ctx);
                 if (clen > SB_ANSWER_CONTENT_MAX) {
                     e = sb_error_of(SB_E_BAD_ANSWER, fcontent[0], code, "length");
@@ -136,6 +161,7 @@ static sb_error receive(sb_bus *bus, uint8_t code, int servo, int item, uint64_t
                     e.value = other;
                     e.least = e.most = item;
                 }
+                e = misfit.status != SB_OK ? misfit : e; /* only answers that did not decode came */
                 return e;
             }
             /* want_after: the bytes of every frame still to come, from this one's first. */
@@ -196,18 +222,25 @@ sb_error sb_sync_monitor_answers(sb_bus *bus, const uint8_t *ids, size_t count, 
      * turnaround, its bytes, the link's margin; each listed servo before it
      * that stays silent adds the silence that passes its turn. */
     uint64_t slot = SB_TURNAROUND_US + wire_us(bus, 2u + answer) + bus->answer_margin_us;
-    uint64_t last = bus->sent_end_us;
+    uint64_t last = bus->sent_end_us, held_us = 0;
     /* The round's end, however the line babbles: each listed servo's slot and silence. */
     uint64_t end = later(last, (uint64_t)count * (slot + SB_SYNC_SILENCE_US));
     bool over = false; /* the end has passed: only the bytes held are searched */
     uint32_t bad = bus->rx.bad_frames;
+    size_t misshapen = count, misshapen_len = 0; /* the first listed servo whose answer was of the wrong length */
+    size_t held = count; /* a servo not passed whose frame of the wrong length came this turn */
+    size_t floor = 0;    /* every servo before it has passed its turn: a servo after it answered in turn */
     bool jumped = false; /* the last answer taken came before a listed servo's that had not passed its turn */
-    size_t misshapen = count; /* the first listed servo whose answer was of the wrong length */
     sb_error e = sb_ok();
     for (size_t k = 0; k < count; k++)
         got[k] = false;
-    /* After an answer that jumped ahead (a late one of the round before, or
-     * a servo's after silences shorter than the margin), one more slot. */
+    /* Only a servo whose turn has not passed is taken: not one that
+     * answered, nor one before a servo that answered in its turn (a frame
+     * inside two answers can name either); one merely slower than its slot
+     * still is. An
+     * answer ahead of ids[next] (a late one of the round before, or a
+     * servo's after silences shorter than the margin) gives one more slot,
+     * and the servos it passed may still answer, dropping it. */
     while (left > 0 && (next < count || jumped)) {
         uint8_t content[SB_ANSWER_CONTENT_MAX];
         size_t len = 0, k;
@@ -218,40 +251,60 @@ sb_error sb_sync_monitor_answers(sb_bus *bus, const uint8_t *ids, size_t count, 
         over = over || bus->t.now_us(bus->t.ctx) >= end;
         if ((e.status == SB_E_NO_ANSWER || e.status == SB_E_BAD_CHECKSUM) && (next >= count || deadline == end))
             break;
+        if ((e.status == SB_E_NO_ANSWER || e.status == SB_E_BAD_CHECKSUM) && held < count) {
+            /* no answer ended after the frame of the wrong length: it took the turn */
+            last = held_us;
+            silent = 0;
+            next = held + 1;
+            held = count;
+            jumped = false;
+            continue;
+        }
         if (e.status == SB_E_NO_ANSWER || e.status == SB_E_BAD_CHECKSUM) {
             silent++; /* ids[next] passes its turn; the next answers after the silence */
             next++;
+            jumped = false;
             continue;
         }
         if (e.status == SB_OK)
             e = sb_decode_monitor(content, len, &a);
-        if (e.status == SB_E_BAD_ANSWER) { /* its checksum good, its length not: skipped, its turn taken */
+        if (e.status == SB_E_BAD_ANSWER) { /* its checksum good, its length not: skipped */
             k = e.servo >= 0 ? slot_of(ids, count, (uint8_t)e.servo) : count;
-            misshapen = k < misshapen ? k : misshapen;
+            len = len > 0 ? len : (size_t)e.value; /* longer than any answer: receive's length */
             e = sb_ok();
-            if (k == count || k < next)
-                continue; /* not asked for, or its turn passed: the round's times stay */
-        } else if (e.status != SB_OK) {
-            break;
-        } else {
-            k = slot_of(ids, count, a.id);
-            if (k == count)
-                continue; /* not asked for */
-            /* A round answers in the list's order: what was taken of ids[k] or
-             * later came before this, so it was an earlier round's, late. */
-            for (size_t j = k; j < count; j++)
-                if (got[j]) {
-                    got[j] = false;
-                    left++;
-                }
-            states[k] = a;
-            got[k] = true;
-            left--;
+            if (k == count || k < floor || got[k])
+                continue; /* not asked for, or its turn passed */
+            if (k < misshapen) {
+                misshapen = k;
+                misshapen_len = len;
+            }
+            if (k >= next && k < held) { /* the real answer may yet end within the slot */
+                held = k;
+                held_us = bus->arrived_us;
+            }
+            continue;
         }
+        if (e.status != SB_OK)
+            break;
+        k = slot_of(ids, count, a.id);
+        if (k == count || k < floor || got[k])
+            continue; /* not asked for, or its turn passed */
+        /* A round answers in the list's order: what was taken of a later
+         * servo came before this, so it was an earlier round's, late. */
+        for (size_t j = k + 1; j < count; j++)
+            if (got[j]) {
+                got[j] = false;
+                left++;
+            }
+        states[k] = a;
+        got[k] = true;
+        left--;
         last = bus->arrived_us;
         silent = 0;
         jumped = k > next;
+        floor = jumped ? floor : k + 1;
         next = k + 1;
+        held = count;
     }
     if (e.status == SB_OK || e.status == SB_E_NO_ANSWER || e.status == SB_E_BAD_CHECKSUM) {
         e = sb_ok();
@@ -262,6 +315,11 @@ sb_error sb_sync_monitor_answers(sb_bus *bus, const uint8_t *ids, size_t count, 
                                                        : SB_E_NO_ANSWER;
                 e.servo = ids[k];
                 e.packet = SB_PKT_MONITOR;
+                if (k == misshapen) { /* "length: 2 bytes, not 16" */
+                    e.field = "length";
+                    e.value = (int64_t)misshapen_len;
+                    e.least = e.most = (int64_t)answer - 5;
+                }
                 break;
             }
     }

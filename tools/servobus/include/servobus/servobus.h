@@ -105,13 +105,18 @@ uint8_t sb_checksum(const uint8_t *data, size_t len);
  * it did not ask for). */
 typedef struct sb_parser {
     uint8_t header[2];
-    uint8_t buf[SB_RX_MAX];
-    size_t len;   /* bytes held */
-    size_t seen;  /* of them examined */
-    size_t taken; /* to drop at the next call: the first byte of a frame returned at buf's start */
-    size_t owned; /* the bytes held from the start up to a frame's end returned: not stray */
-    bool tie;        /* another frame may end where the one returned last did, */
-    size_t tie_from; /* starting here or later */
+    uint8_t buf[2 * SB_RX_MAX]; /* byte x at x % SB_RX_MAX and again SB_RX_MAX on: a frame is in one piece */
+    uint8_t sum[SB_RX_MAX];     /* at x % SB_RX_MAX: the sum of the bytes before byte x */
+    uint16_t size[SB_RX_MAX];   /* at s % SB_RX_MAX: the frame begun at byte s, its size and state */
+    uint16_t next[SB_RX_MAX];   /* the next frame (by start) that ends where the one at s does */
+    uint16_t ends[SB_RX_MAX];   /* at e % SB_RX_MAX: the first frame (by start) ending at byte e */
+    uint32_t now;               /* bytes taken */
+    uint32_t lo;                /* the first byte of the earliest frame still open (now: none) */
+    uint32_t reach;             /* the end of the frames returned */
+    uint32_t cover;             /* the end of the frames begun at the bytes judged stray or not */
+    uint16_t cursor;            /* the next frame to check that ends at byte now - 1 */
+    bool open;                  /* the byte now - 1's frames not all checked */
+    size_t len;                 /* bytes held: now - lo */
     uint32_t stray_bytes;
     uint32_t bad_frames;
 } sb_parser;
@@ -146,7 +151,10 @@ void sb_bus_init(sb_bus *bus, sb_transport t, uint32_t baud);
 /* Drops what waits unread, then writes frame in one write. */
 sb_error sb_send(sb_bus *bus, const uint8_t *frame, size_t len);
 /* The next answer of packet code from servo (-1: any) by deadline_us (bus
- * clock); other frames skipped. content: SB_ANSWER_CONTENT_MAX bytes. */
+ * clock); other frames skipped. content: SB_ANSWER_CONTENT_MAX bytes. Of a
+ * servo given, a frame that does not fit the packet (the wrong length for
+ * a fixed-size answer, else one that does not decode: a frame inside the
+ * answer) is skipped too; if only such came, SB_E_BAD_ANSWER on it. */
 sb_error sb_receive(sb_bus *bus, uint8_t code, int servo, uint64_t deadline_us, uint8_t *content, size_t *len);
 /* sb_send the frame in bus->tx (len bytes), then sb_receive within timeout_us. */
 sb_error sb_request(sb_bus *bus, size_t len, uint8_t code, int servo, uint8_t *content, size_t *clen);
@@ -173,8 +181,12 @@ sb_error sb_sync_command(sb_bus *bus, uint8_t cmd, const uint8_t *records, size_
  * frame of a servo not listed, or whose turn has passed, does not), and
  * however the line babbles the round ends by the request's end plus count
  * times (such a slot + SB_SYNC_SILENCE_US). Answers come in the list's
- * order: an answer of ids[k] drops any taken of ids[k] or later (a
- * previous round's, late). An ID listed twice, or the broadcast ID, is
+ * order: an answer of ids[k] drops any taken of a later servo (a previous
+ * round's, late); a frame naming a servo that answered, or one before a
+ * servo that answered in its turn, is ignored (a frame made of two
+ * answers' bytes); a frame of the wrong length does not take the turn
+ * while the answer may yet end (SB_E_BAD_ANSWER on "length" if it
+ * does not). An ID listed twice, or the broadcast ID, is
  * refused before anything is sent (sb_check_ids); got[] is all false after
  * any error before the answers (a refusal, a link error). */
 sb_error sb_sync_monitor(sb_bus *bus, const uint8_t *ids, size_t count, sb_monitor_answer *states, bool *got);
