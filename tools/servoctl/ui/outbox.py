@@ -7,10 +7,14 @@ the new tab never reached its loop and its STOP ALL was never read; and the
 server held every broadcast for such a tab without limit."""
 import asyncio
 import collections
+import fcntl
 import json
 import logging
+import struct
+import termios
 
-# What a tab has not read yet: its outbox and its socket's write buffer. Over
+# What a tab has not read yet: its outbox, its transport's write buffer and
+# the kernel's send queue (a stuck tab's takes megabytes on loopback). Over
 # OUTBOX_MAX the tab is aborted (it stopped reading; a browser on this
 # computer reads megabytes a second); over READING_MAX it is behind, and is
 # not given the driving role (asyncio pauses writing at 64 KiB).
@@ -22,7 +26,7 @@ LOG = logging.getLogger("servoctl.ui")  # through quiet.py: a line a second at m
 class Outbox:
     """What one tab is told, in order, written by a task of its own: put()
     never waits, whether or not the tab reads. A tab that has not read
-    OUTBOX_MAX bytes (its outbox and its socket's write buffer) is aborted,
+    OUTBOX_MAX bytes (its outbox, its socket's buffers) is aborted,
     not closed: a close would wait for the buffer it does not read."""
 
     def __init__(self, page, ws, transport, who: str):
@@ -34,8 +38,9 @@ class Outbox:
         self.task = asyncio.ensure_future(self._write())
 
     def unread(self) -> int:
-        buffered = self.transport.get_write_buffer_size() if self.transport is not None else 0
-        return self.size + buffered
+        if self.transport is None:
+            return self.size
+        return self.size + self.transport.get_write_buffer_size() + _queued(self.transport)
 
     def reading(self) -> bool:
         return not self.cut and not self.ws.closed and self.unread() <= READING_MAX
@@ -80,6 +85,16 @@ class Outbox:
             self.size -= len(text)
             if self.page.driver is None and self.reading():  # caught up: it may drive
                 self.page._elect()
+
+
+def _queued(transport) -> int:
+    """Bytes in the socket's kernel send queue, sent or not, that the peer
+    has not taken (Linux's SIOCOUTQ); 0 where it cannot be asked."""
+    sock = transport.get_extra_info("socket")
+    try:
+        return struct.unpack("i", fcntl.ioctl(sock.fileno(), termios.TIOCOUTQ, b"\0" * 4))[0]
+    except (AttributeError, OSError, ValueError):
+        return 0
 
 
 async def send(ws, msg):
