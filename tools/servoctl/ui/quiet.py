@@ -1,5 +1,5 @@
-"""What `servoctl ui`'s server says on stderr of its own (aiohttp's and
-asyncio's logs): one line a second at most, no tracebacks, and never
+"""What `servoctl ui`'s server says on stderr of its own (aiohttp's,
+asyncio's and its own logs): one line a second at most, no tracebacks, and never
 written by the server's thread. aiohttp logged a 10-line traceback for each
 malformed request (no Host header, a bad Content-Length, a path over 8190
 characters), written on the event loop: 2 865 such requests printed 20 620
@@ -16,7 +16,7 @@ import threading
 import time
 
 LOGGERS = ("aiohttp.server", "aiohttp.access", "aiohttp.web", "aiohttp.websocket",
-           "aiohttp.internal", "asyncio")
+           "aiohttp.internal", "asyncio", "servoctl.ui")
 EVERY_S = 1.0    # host time: at most one line this often
 QUEUE_MAX = 256  # lines waiting for the writer; more are dropped and counted
 LINE_MAX = 200   # characters of one line

@@ -5,7 +5,8 @@ local server to move the robot), is refused with 403. One tab drives the
 bus; another is told which one does and only watches until that one
 closes. Connections are let in by a doorman (doorman.py); every response
 forbids framing; a malformed request is answered with an error and the tab
-stays connected."""
+stays connected. What a tab is told goes through its own outbox (outbox.py):
+no tab waits for another to read, and one that does not read is cut off."""
 import asyncio
 import datetime
 import hmac
@@ -18,6 +19,7 @@ from yarl import URL
 
 from . import quiet
 from .doorman import Doorman
+from .outbox import Outbox, send as _send
 from .worker import QueueFull
 
 STATIC = Path(__file__).parent / "static"
@@ -35,6 +37,7 @@ READ_MAX = 16 * 1024 * 1024
 WATCHER_MAX = 1024  # a watching tab's request is STOP ALL's, a few dozen bytes
 ARGV_MAX, ARG_MAX, TAG_MAX = 64, 1024, 64  # argv's words, a word's characters, a tag's
 TABS_MAX = 8  # open tabs (WebSockets); one more is told so and closed
+CLOSE_S = 1.0  # host seconds: a tab's close at shutdown, then it is aborted
 
 
 class Malformed(ValueError):
@@ -48,6 +51,7 @@ class Page:
         self.sockets = []   # every open tab's WebSocket, in order of opening
         self.driver = None  # the tab that drives the bus
         self.who = {}       # ws: how the other tabs are told of it
+        self.outbox = {}    # ws: its Outbox
         self.loop = None
         self.doorman = None
         self.last_scan = None  # told to a tab that opens later: its Bus table has rows
@@ -102,30 +106,59 @@ class Page:
         ws = web.WebSocketResponse(heartbeat=20, compress=False, max_msg_size=READ_MAX)
         await ws.prepare(request)
         if len(self.sockets) >= TABS_MAX:
-            await _send(ws, {"type": "error", "text": f"servoctl ui: {TABS_MAX} tabs are open already: "
-                                                      f"close one and reload this one"})
-            await ws.close(code=1013, message=b"too many tabs")  # 1013: try again later
+            try:  # this tab's own answer: at most CLOSE_S of its not reading
+                await asyncio.wait_for(_send(ws, {"type": "error", "text": f"servoctl ui: {TABS_MAX} tabs are "
+                                                  f"open already: close one and reload this one"}), CLOSE_S)
+                await asyncio.wait_for(ws.close(code=1013, message=b"too many tabs"), CLOSE_S)  # try again later
+            except asyncio.TimeoutError:
+                if request.transport is not None:
+                    request.transport.abort()
             return ws
         opened = datetime.datetime.now().strftime("%H:%M:%S")
         agent = request.headers.get("User-Agent", "a client").split(" ")[-1]
         self.who[ws] = f"the tab opened at {opened} from {request.remote} ({agent})"
+        self.outbox[ws] = Outbox(self, ws, request.transport, self.who[ws])
         self.sockets.append(ws)
         if self.driver is None:
             self.driver = ws
-        await self._roles()
+        self._roles()
         if self.last_scan is not None:
-            await _send(ws, self.last_scan)
+            self._tell(ws, self.last_scan)
         try:
             async for msg in ws:
                 await self._take(ws, msg)
         finally:
             self.sockets.remove(ws)
             self.who.pop(ws, None)
+            self.outbox.pop(ws).close()
             if self.driver is ws:  # what it asked for ends with it
                 self.worker.abandon()
-                self.driver = self.sockets[0] if self.sockets else None
-                await self._roles()
+                self.driver = None
+                self._elect()
         return ws
+
+    def _tell(self, ws, msg):
+        """Puts msg (a dict, or its text) in ws's outbox, never waiting."""
+        box = self.outbox.get(ws)
+        if box is not None:
+            box.put(msg if isinstance(msg, str) else json.dumps(msg))
+
+    def _elect(self):
+        """With no tab driving: the first open tab that reads drives (one
+        that has not read outbox.READING_MAX bytes is not given the role), and every
+        tab is told its role. With none reading, none drives until one
+        opens, asks or catches up."""
+        if self.driver is None:
+            self.driver = next((ws for ws in self.sockets if self.outbox[ws].reading()), None)
+            if self.driver is not None:
+                self._roles()
+
+    def _cut(self, ws):
+        """ws was aborted for not reading: it drives no more."""
+        if self.driver is ws:
+            self.worker.abandon()
+            self.driver = None
+            self._elect()
 
     async def _take(self, ws, msg):
         """One message of a tab: a request, or an error said back (a
@@ -134,6 +167,8 @@ class Page:
             return
         tag = op = None
         try:
+            if self.driver is None and self.outbox[ws].reading():  # none read when the driver closed
+                self._elect()
             driving = ws is self.driver
             if not driving and len(msg.data) > WATCHER_MAX:
                 await self._busy(ws)  # not parsed: it is not STOP ALL
@@ -147,22 +182,24 @@ class Page:
                 return
             self._dispatch(ask)
         except QueueFull as e:  # said where the page shows that action's output (tag, op)
-            await _send(ws, {"type": "error", "tag": tag, "op": op, "text": str(e)})
+            self._tell(ws, {"type": "error", "tag": tag, "op": op, "text": str(e)})
         except (Malformed, KeyError, TypeError, ValueError, OverflowError) as e:
-            await _send(ws, {"type": "error", "tag": tag, "op": op,
-                             "text": f"servoctl ui: a malformed request: {e}"})
+            self._tell(ws, {"type": "error", "tag": tag, "op": op,
+                            "text": f"servoctl ui: a malformed request: {e}"})
         except Exception as e:  # noqa: BLE001 - whatever a request does, the tab stays and hears why
-            await _send(ws, {"type": "error", "tag": tag, "op": op, "text": f"servoctl ui: {type(e).__name__}: {e}"})
+            self._tell(ws, {"type": "error", "tag": tag, "op": op, "text": f"servoctl ui: {type(e).__name__}: {e}"})
 
     async def _busy(self, ws, tag=None, op=None):
-        await _send(ws, {"type": "busy", "holder": self.who[self.driver], "tag": tag, "op": op,
-                         "text": f"not run: {self.who[self.driver]} drives the bus"})
+        holder = self.who.get(self.driver, "no tab")  # none read when the driver closed
+        self._tell(ws, {"type": "busy", "holder": holder, "tag": tag, "op": op,
+                        "text": f"not run: {holder} drives the bus"})
 
-    async def _roles(self):
+    def _roles(self):
+        """Tells every tab its role, through its outbox: none waits for another."""
         told = {role: json.dumps({"type": "hello", "role": role, "holder": holder, **self.about})
                 for role, holder in (("driver", None), ("viewer", self.who.get(self.driver)))}
         for ws in list(self.sockets):
-            await _send(ws, told["driver" if ws is self.driver else "viewer"])
+            self._tell(ws, told["driver" if ws is self.driver else "viewer"])
 
     def _dispatch(self, ask: dict):
         op, w = ask.get("op"), self.worker
@@ -197,7 +234,7 @@ class Page:
         if msg.get("type") == "scan":
             self.last_scan = text
         for ws in list(self.sockets):
-            asyncio.ensure_future(_send(ws, text))
+            self._tell(ws, text)
 
     def app(self) -> web.Application:
         a = web.Application(middlewares=[self.guard])
@@ -206,15 +243,6 @@ class Page:
         a.router.add_get("/ws", self.socket)
         a.router.add_get("/static/{name}", self.asset)
         return a
-
-
-async def _send(ws, msg):
-    """msg: a dict, or the text of one already serialised."""
-    if not ws.closed:
-        try:
-            await ws.send_str(msg if isinstance(msg, str) else json.dumps(msg))
-        except (ConnectionError, RuntimeError):
-            pass
 
 
 def _parse(data) -> dict:
@@ -309,5 +337,9 @@ async def _serve(page: Page, bind: str, port: int, ready, stop: asyncio.Event):
     finally:
         server.close()
         for ws in list(page.sockets):
-            await ws.close()
+            try:  # a tab that does not read would hold the close: CLOSE_S at most, then aborted
+                await asyncio.wait_for(ws.close(), CLOSE_S)
+            except asyncio.TimeoutError:
+                if ws in page.outbox:
+                    page.outbox[ws].abort()
         await runner.cleanup()

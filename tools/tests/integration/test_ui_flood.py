@@ -10,7 +10,9 @@ answered with an error, the tab still driving; tabs and connections
 without the token are capped; the Host header is checked as the request
 line is. Floods are on 127.0.0.1, bounded in count and time."""
 import asyncio
+import base64
 import json
+import os
 import socket
 import time
 
@@ -228,3 +230,132 @@ def test_a_request_under_way_is_closed_after_idle_connections():
         for c in idle + [loading]:
             c.close()
     assert status.startswith(b"HTTP/1.1 200"), status
+
+
+WRITE_LIMIT = 256 * 1024  # aiohttp's WebSocket writer waits for the peer to drain past this
+
+
+def _frame(n: int) -> int:
+    """A server frame's bytes on the wire for a text of n bytes (unmasked)."""
+    return n + (2 if n < 126 else 4 if n < 65536 else 10)
+
+
+def _stuck_tab(ui):
+    """A tab on a raw socket with a small receive buffer: it reads its
+    hello and then nothing more. (socket, the hello frame's bytes)."""
+    port = int(ui.base.rsplit(":", 1)[1])
+    s = socket.socket()
+    s.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
+    s.settimeout(WAIT_S)
+    s.connect(("127.0.0.1", port))
+    key = base64.b64encode(os.urandom(16)).decode()
+    s.sendall((f"GET /ws?token={ui.token} HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nOrigin: {ui.base}\r\n"
+               f"Upgrade: websocket\r\nConnection: Upgrade\r\nSec-WebSocket-Key: {key}\r\n"
+               f"Sec-WebSocket-Version: 13\r\n\r\n").encode())
+    head = b""
+    while b"\r\n\r\n" not in head:
+        head += s.recv(1)
+    first = s.recv(2)
+    n, size = first[1] & 127, 2
+    if n == 126:
+        n, size = int.from_bytes(s.recv(2), "big"), 4
+    body = b""
+    while len(body) < n:
+        body += s.recv(n - len(body))
+    assert json.loads(body)["type"] == "hello", body
+    return s, size + n
+
+
+def _cut_off(s) -> bool:
+    """Whether the server aborted the stuck tab: its socket reset, or ended
+    once what it buffered is read."""
+    s.settimeout(2.0)
+    try:
+        while s.recv(65536):
+            pass
+        return True
+    except ConnectionResetError:
+        return True
+    except OSError:
+        return False
+
+
+async def _stuck_and_new_tab(ui, sim):
+    async with aiohttp.ClientSession() as s:
+        async with s.ws_connect(_ws_url(ui), headers={"Origin": ui.base}) as driver:
+            assert json.loads((await driver.receive(timeout=WAIT_S)).data)["type"] == "hello"
+            stuck, told = _stuck_tab(ui)  # what aiohttp's writer counts toward WRITE_LIMIT for it
+            await driver.receive(timeout=WAIT_S)  # the driver's hello again, as the stuck tab opened
+            answers = {}
+
+            async def read():  # every broadcast the driver hears, the stuck tab is sent too
+                nonlocal told
+                while (msg := await driver.receive()).type == aiohttp.WSMsgType.TEXT:
+                    said = json.loads(msg.data)
+                    if said.get("type") != "hello":  # the driver's own role; the stuck tab's is counted below
+                        told += _frame(len(msg.data.encode()))
+                        told = 0 if told > WRITE_LIMIT else told  # the writer waited to drain, and counts anew
+                    if said.get("type") in ("result", "error"):
+                        answers[said.get("tag")] = said
+
+            reader = asyncio.ensure_future(read())
+
+            async def run(argv, tag):
+                await driver.send_str(json.dumps({"op": "run", "argv": argv, "tag": tag}))
+                deadline = time.monotonic() + WAIT_S
+                while tag not in answers:
+                    assert time.monotonic() < deadline, f"no answer to {tag}"
+                    await asyncio.sleep(0.002)
+                return answers[tag]
+
+            for i in range(40):  # ~60 KB each, 2.4 MB in all: the stuck tab's buffers fill
+                await run(["config"] + ["x" * 1000] * 60, f"f{i}")
+            assert (await run(["wheel", "1", "run", "--speed", "180"], "spin"))["code"] == 0
+            # Near the writer's limit: a new tab's hello to the stuck one is what crosses it.
+            i = 0
+            while WRITE_LIMIT - told > 8000:
+                room = WRITE_LIMIT - told
+                words = max(0, min(60, (room - 8000) // 2005))
+                await run(["config", "y" * 1000] + ["z" * 1000] * words, f"n{i}")
+                i += 1
+            while abs(sim.state(1)["velocity"]) < 30:
+                await asyncio.sleep(0.01)
+            for _ in range(60):  # a tab opened, as a reload does, until one is not told hello
+                new = await s.ws_connect(_ws_url(ui), headers={"Origin": ui.base})
+                try:
+                    hello = await new.receive(timeout=2.0)
+                except asyncio.TimeoutError:
+                    break
+                assert json.loads(hello.data)["type"] == "hello", hello
+                told += _frame(len(hello.data.encode()))  # the stuck tab's hello, as long as this one's
+                if told > WRITE_LIMIT:
+                    break  # the writer's limit crossed, and the new tab told hello all the same
+                await new.close()
+            t0_ms = sim.clock_s() * 1000.0
+            await new.send_str(json.dumps({"op": "stopall", "mode": "release"}))
+            deadline = time.monotonic() + WAIT_S
+            while (coasted := sim.state(1)["coasted_ms"]) < t0_ms and time.monotonic() < deadline:
+                await asyncio.sleep(0.002)
+            stopped = coasted >= t0_ms
+            await driver.send_str(json.dumps({"op": "stopall", "mode": "release"}))
+            cut = _cut_off(stuck)
+            stuck.close()
+            await new.close()
+            reader.cancel()
+            return stopped, coasted - t0_ms, cut
+
+
+def test_a_tab_that_does_not_read_holds_no_other_tab():
+    """A tab that stopped reading once its buffers were full held the
+    hello a new tab's opening sends every tab (aiohttp's writer waited for
+    it to drain): the new tab never reached its loop, and its STOP ALL was
+    never read. Now each tab's messages go through an outbox of its own and
+    one that leaves OUTBOX_MAX bytes unread is aborted, said on stderr."""
+    with Simulator(ids=[1, 2]) as sim, UiProcess(sim) as ui:
+        stopped, ms, cut = asyncio.run(_stuck_and_new_tab(ui, sim))
+        code, err = ui.stop()
+    assert stopped, "the new tab's STOP ALL did not reach the wire"
+    assert ms <= PREEMPTED_MS, ms
+    assert cut, "the stuck tab was not cut off"
+    assert "is cut off" in err and "unread" in err, err[:2000]
+    assert code == 0 and "Traceback" not in err, err[:2000]
