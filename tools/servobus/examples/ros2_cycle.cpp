@@ -7,8 +7,13 @@
 //   (--ids: default 1; --seconds: 1; --period-ms: 10)
 //
 // Exit 0 when nine states in ten or more came and each joint ends within 1
-// degree of its command (tools/tests/test_servobus_examples.py runs it against servo_sim).
+// degree of its command, kept within its angle limits; a joint resting
+// outside them is refused, exit 1 (tools/tests/test_servobus_examples.py
+// runs it against servo_sim).
+#include <algorithm>
+#include <climits>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -50,6 +55,8 @@ class ServoBusHardware {
         velocity_.assign(ids.size(), 0.0);
         command_.assign(ids.size(), 0.0);
         got_.assign(ids.size(), 0);
+        low_.assign(ids.size(), INT32_MIN);
+        high_.assign(ids.size(), INT32_MAX);
         states_.resize(ids.size());
         sb_error e = sb_loop_init(&loop_, &bus_, ids_.data(), ids_.size(), period_ms);
         if (e.status != SB_OK && e.field != nullptr && std::strcmp(e.field, "period_ms") == 0 && e.least > 1)
@@ -60,21 +67,43 @@ class ServoBusHardware {
         return check(e);
     }
 
-    // Every joint answers; commands start where the joints are.
+    // Every joint answers, within its angle limits; commands start where
+    // the joints are. The servo clamps a streamed setpoint into its limits
+    // (items 48, 51, 52), so a stream begun outside them would throw the
+    // horn to the nearest at full speed: such a joint is refused here.
     bool on_activate()
     {
-        for (uint8_t id : ids_) {
-            sb_ping_request p = {id};
+        for (size_t k = 0; k < ids_.size(); k++) {
+            sb_ping_request p = {ids_[k]};
             sb_ping_answer a;
-            if (!check(sb_call_ping(&bus_, &p, &a)))
+            if (!check(sb_call_ping(&bus_, &p, &a)) || !read_limits(k))
                 return false;
         }
         bool got[SB_MAX_SERVOS];
         if (!check(sb_sync_monitor(&bus_, ids_.data(), ids_.size(), states_.data(), got)))
             return false;
-        for (size_t k = 0; k < ids_.size(); k++)
-            command_[k] = position_[k] = states_[k].angle / kDeciDegPerRad;
+        for (size_t k = 0; k < ids_.size(); k++) {
+            int32_t at = states_[k].angle;
+            if (at < low_[k] || at > high_[k]) {
+                std::fprintf(stderr,
+                             "sb_ros2_cycle: servo %u is at %.1f deg, outside its angle limits %.1f..%.1f deg "
+                             "(angle_min, angle_max, angle_limit_on): a setpoint there would be clamped into "
+                             "them, a jump at full speed. Move it within them first (servoctl move %u %.1f "
+                             "--velocity 45), or change the limits\n",
+                             ids_[k], at / 10.0, low_[k] / 10.0, high_[k] / 10.0, ids_[k],
+                             (at < low_[k] ? low_[k] : high_[k]) / 10.0);
+                return false;
+            }
+            command_[k] = position_[k] = at / kDeciDegPerRad;
+        }
         return true;
+    }
+
+    // A command within joint k's angle limits (radians): a ramp past one
+    // stops there, as the servo would hold it.
+    double within(size_t k, double rad) const
+    {
+        return std::min(std::max(rad, low_[k] / kDeciDegPerRad), high_[k] / kDeciDegPerRad);
     }
 
     // The joints' states: the answers to the Sync Monitor the last write()
@@ -120,6 +149,23 @@ class ServoBusHardware {
     ~ServoBusHardware() { sb_posix_close(&link_); }
 
   private:
+    // Joint k's angle limits (0.1 deg); off: no limit but the stream's range.
+    bool read_limits(size_t k)
+    {
+        int64_t v[3];
+        const uint8_t items[3] = {SB_ITEM_ANGLE_LIMIT_ON, SB_ITEM_ANGLE_MIN_DECIDEG, SB_ITEM_ANGLE_MAX_DECIDEG};
+        for (int i = 0; i < 3; i++) {
+            sb_read_data_request r = {ids_[k], items[i]};
+            sb_read_data_answer a;
+            if (!check(sb_call_read_data(&bus_, &r, &a)))
+                return false;
+            v[i] = a.data;
+        }
+        low_[k] = v[0] ? static_cast<int32_t>(v[1]) : INT32_MIN;
+        high_[k] = v[0] ? static_cast<int32_t>(v[2]) : INT32_MAX;
+        return true;
+    }
+
     bool check(const sb_error &e)
     {
         if (e.status == SB_OK)
@@ -134,6 +180,7 @@ class ServoBusHardware {
     std::vector<uint8_t> ids_;
     std::vector<double> position_, velocity_, command_;
     std::vector<unsigned> got_;
+    std::vector<int32_t> low_, high_;
     std::vector<sb_monitor_answer> states_;
     bool pending_ = false;
     unsigned missed_ = 0;
@@ -236,7 +283,7 @@ int main(int argc, char **argv)
             return 1;
         double f = std::min(1.0, 2.0 * c / cycles);
         for (size_t k = 0; k < ids.size(); k++)
-            hw.command()[k] = start[k] + target * f;
+            hw.command()[k] = hw.within(k, start[k] + target * f);
         if (!hw.write())
             return 1;
         due += period_ms * 1000u;

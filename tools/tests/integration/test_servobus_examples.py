@@ -62,6 +62,43 @@ def test_the_ros2_control_style_cycle_moves_three_joints(sim3):
     assert abs(sim3.state(2)["angle"] - 10.0) < 1.5  # 10 degrees on from 0
 
 
+def test_the_cycle_refuses_a_joint_resting_outside_its_angle_limits(sim3):
+    """Limits of +-90 deg, horn at 130 deg: the cycle streamed from there,
+    the servo clamped its setpoint into the limits and threw the horn 40
+    deg at top speed. It reads each joint's limits first and refuses,
+    naming the servo and its limits; nothing moves."""
+    with sim3.bus(timeout=0.2) as bus:
+        for i in (1, 2, 3):
+            Servo(bus, i).write("soft_start_on", 0)
+        s = Servo(bus, 2)
+        s.write("angle_limit_on", 0)
+        s.move_to(130, speed_dps=200, wait=True)
+        s.write("angle_max", 900)
+        s.write("angle_min", -900)
+        s.write("angle_limit_on", 1)
+    at = sim3.state(2)["angle"]
+    address, clock = _where(sim3)
+    done = _run(["sb_ros2_cycle", address, "--clock", clock, "--ids", "1,2,3", "--seconds", "1", "--period-ms", "10"])
+    assert done.returncode == 1, done.stdout + done.stderr
+    assert "servo 2 is at 130." in done.stderr and "outside its angle limits -90.0..90.0 deg" in done.stderr, \
+        done.stderr
+    assert abs(sim3.state(2)["angle"] - at) < 0.5 and abs(sim3.state(2)["velocity"]) < 2  # never streamed
+    assert abs(sim3.state(1)["angle"]) < 0.5  # nor the others
+
+
+def test_the_cycle_keeps_its_commands_within_the_limits(sim3):
+    """A joint 5 deg below its upper limit: its 10-deg ramp stops at the
+    limit, where the servo holds it, and the cycle ends there (exit 0)."""
+    with sim3.bus(timeout=0.2) as bus:
+        for i in (1, 2, 3):
+            Servo(bus, i).write("soft_start_on", 0)
+        Servo(bus, 3).write("angle_max", 50)
+    address, clock = _where(sim3)
+    done = _run(["sb_ros2_cycle", address, "--clock", clock, "--ids", "1,2,3", "--seconds", "1", "--period-ms", "10"])
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert abs(sim3.state(3)["angle"] - 5.0) < 1.0 and abs(sim3.state(1)["angle"] - 10.0) < 1.5
+
+
 def test_the_cycle_refuses_an_id_it_cannot_address_and_an_unknown_option():
     """No servo is opened: the arguments are refused first, naming what is wrong."""
     bad_id = _run(["sb_ros2_cycle", "127.0.0.1:1", "--ids", "1,300"])
