@@ -5,7 +5,7 @@ import json
 
 from . import args as args_
 from . import config_diff, config_file, group, link_rate, registers, units
-from .errors import UsageError
+from .errors import NotSent, UsageError
 from .servo import Servo
 
 
@@ -79,6 +79,11 @@ def cmd_config(bus, args):
         value = args_.raw_value(item, args.value) if args.raw else units.to_raw(item, args.value)
         if item.name == "servo_id":
             group.id_is_free(bus, args.id, value)
+        # The servo would refuse it and say only that: said here, in the unit typed, and why.
+        said = (lambda it, raw: _shown(it, raw, True)) if args.raw else \
+            (lambda it, raw: units.show_as_typed(it, args.value, raw))
+        if why := s.out_of_order(item, value, said):
+            raise NotSent(f"servo {args.id}: {item.name} = {said(item, value)} not sent: {why}")
         s.write(item.id, value)
         print(f"{item.name} = {_shown(item, value, args.raw)}")
         link_rate.after_set(bus, args, item.name, value)

@@ -103,6 +103,29 @@ def status_names(status: int) -> list:
     return [name for bit, name in enumerate(STATUS_BITS) if status & (1 << bit)]
 
 
+# Items the servo keeps in order, each pair (lower, upper): it refuses a
+# write that breaks it (registers/data_table.c, cross_item_rules_hold).
+ORDERED = (("low_voltage", "high_voltage"), ("angle_min", "angle_max"))
+
+
+def out_of_order(name: str, value: int, values: dict):
+    """Where value of item name breaks its pair's order against values
+    ({name: raw}, the other item's at least): (the other's name, "below"
+    or "above", what name must stay); None where it keeps it, or name is
+    in no pair."""
+    for low, high in ORDERED:
+        if name == low and not value < values[high]:
+            return high, "below"
+        if name == high and not value > values[low]:
+            return low, "above"
+    return None
+
+
+def pair_of(name: str):
+    """The other item of name's pair (ORDERED), or None."""
+    return next((b if name == a else a for a, b in ORDERED if name in (a, b)), None)
+
+
 def encode_user_area(values: dict) -> bytes:
     """The 32-byte block of WriteBatchData from {name: value}; every item
     checked, cross rules included (39 < 40, 51 > 52)."""
@@ -112,10 +135,9 @@ def encode_user_area(values: dict) -> bytes:
         if item.writable:
             item.check(value)
         out += item.pack(value)
-    if not values["low_voltage"] < values["high_voltage"]:
-        raise ValueOutOfRange("low_voltage (39) must be below high_voltage (40)")
-    if not values["angle_max"] > values["angle_min"]:
-        raise ValueOutOfRange("angle_max (51) must be above angle_min (52)")
+    for low, high in ORDERED:
+        if not values[low] < values[high]:
+            raise ValueOutOfRange(f"{low} ({find(low).id}) must be below {high} ({find(high).id})")
     return out
 
 

@@ -2,7 +2,7 @@
 protocol units (0.1 degree, ms, mW) unless the name says otherwise."""
 from . import frame, outcome
 from . import protocol as p
-from . import registers, stability
+from . import registers, stability, units
 from .answers import Fault, Monitor, MotionSnapshot, StoreHealth
 from .checks import check_range, scaled, to_ms
 from .errors import BadAnswer, Refused, ServoError, ValueOutOfRange
@@ -72,8 +72,9 @@ class Servo:
         else:
             took = lambda: self.read(item.id) == value  # noqa: E731
         if not self._write_kept(p.WRITE_DATA, bytes([self.id, item.id]) + item.pack(value), took):
-            raise Refused(f"servo {self.id} refused {item.name} = {value}"
-                          f"{self._size_first(item, value) or self._why_refused()}")
+            why = self.out_of_order(item, value)
+            raise Refused(f"servo {self.id} refused {item.name} = {units.show(item, value) if item.quantity else value}"
+                          f"{self._size_first(item, value) or (why and ': ' + why) or self._why_refused()}")
 
     def _is_at(self, new_id: int, serial: int):
         """A read-back: whether this servo (its serial number, read before
@@ -147,6 +148,19 @@ class Servo:
     def reset_user_data(self) -> None:
         if not self._write_kept(p.RESET_USER_DATA, bytes([self.id]), None):
             raise Refused(f"servo {self.id} refused the reset{self._why_refused()}")
+
+    def out_of_order(self, item, value: int, said=units.show) -> str:
+        """Why the servo refuses value of item for its pair's order
+        (registers.ORDERED: angle_min below angle_max, low_voltage below
+        high_voltage) against the other item now, values as said(item, raw)
+        puts them; "" where it keeps the order (one read), or item is in no pair."""
+        other = registers.pair_of(item.name)
+        broken = other and registers.out_of_order(item.name, value, {other: (now := self.read(other))})
+        if not broken:
+            return ""
+        way = "above" if broken[1] == "below" else "below"
+        return (f"{item.name} must stay {broken[1]} {other} ({said(registers.find(other), now)} now): "
+                f"set {other} {way} {said(item, value)} first")
 
     def _size_first(self, item, value: int) -> str:
         """": <why>" where value is beyond what the Cortex-M0 image takes

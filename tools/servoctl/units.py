@@ -149,6 +149,17 @@ def exact(item, raw: int) -> str:
     return str(raw)
 
 
+def show_as_typed(item, text, raw: int) -> str:
+    """raw in the unit text was typed in ("20V": "20 V"); as show() says it
+    where text has no unit of its own or the item one unit only."""
+    m = _NUMBER.match(str(text))
+    suffix = m.group(2).lower() if m else ""
+    factors = SCALES.get(item.quantity, ("", {}))[1]
+    if item.quantity == "angle" or not suffix or suffix not in factors:
+        return show(item, raw)
+    return f"{raw / factors[suffix]:g} {_SPELLING[suffix]}"
+
+
 def show(item, raw: int) -> str:
     """A raw protocol value in the item's engineering unit, for people: a
     temperature with its ADC value, a baud rate with its code."""

@@ -50,6 +50,28 @@ def test_an_ambiguous_or_rounded_value_is_refused(sim, capsys, name, text, said)
     assert run(sim, capsys, "config", "get", "1", name, "--raw")[1] == before
 
 
+def test_a_value_out_of_order_with_its_pair_is_said_in_the_unit_typed_with_why(sim, capsys):
+    """angle_min 100 with angle_max 90 was sent and came back as "servo 1
+    refused angle_min = 1000": protocol units, no reason. servoctl checks
+    the pair first (nothing sent, exit 2); the servo's own refusal (the
+    Python API sends it) says why too."""
+    from servoctl.errors import Refused
+    from servoctl.servo import Servo
+
+    assert run(sim, capsys, "config", "set", "1", "angle_max", "90")[0] == 0
+    rc, _, err = run(sim, capsys, "config", "set", "1", "angle_min", "100")
+    assert rc == 2 and "angle_min = 100.0 deg not sent: angle_min must stay below angle_max (90.0 deg now): " \
+        "set angle_max above 100.0 deg first" in err, err
+    rc, _, err = run(sim, capsys, "config", "set", "1", "low_voltage", "20V")
+    assert rc == 2 and "low_voltage = 20 V not sent: low_voltage must stay below high_voltage (8.4 V now)" in err, err
+    rc, _, err = run(sim, capsys, "config", "set", "1", "angle_min", "1000", "--raw")
+    assert rc == 2 and "angle_min = 1000 0.1deg not sent" in err and "(900 0.1deg now)" in err, err
+    assert run(sim, capsys, "config", "get", "1", "angle_min", "--raw")[1] == "angle_min = -1350 0.1deg\n"
+    with sim.bus() as bus, pytest.raises(Refused, match=r"refused angle_min = 100\.0 deg: angle_min must stay "
+                                                         r"below angle_max \(90\.0 deg now\)"):
+        Servo(bus, 1).write("angle_min", 1000)
+
+
 @pytest.mark.parametrize("name,text,raw", [
     ("angle_min", "-45.5", -455), ("angle_min", "-45.5deg", -455), ("center_offset", "10°", 100),
     ("current_limit", "1.2A", 1200), ("current_limit", "800mA", 800), ("baud", "1000000", 8),
