@@ -12,6 +12,7 @@ import datetime
 import hmac
 import ipaddress
 import json
+import math
 from pathlib import Path
 
 from aiohttp import WSMsgType, web
@@ -212,6 +213,10 @@ class Page:
             w.submit(w.scan, bool(ask.get("all_bauds")), tag)
         elif op == "items":
             w.submit(w.items, _whole(ask["id"], "id"), tag)
+        elif op == "angle":
+            w.submit(w.angle, _whole(ask["id"], "id"), tag)
+        elif op == "jog":
+            w.submit(w.jog, _whole(ask["id"], "id"), _number(ask["angle"], "angle"), tag)
         elif op == "plot":
             ids = ask.get("ids", [])
             if not isinstance(ids, list):
@@ -267,6 +272,15 @@ def _whole(value, name: str) -> int:
     if isinstance(value, bool) or not isinstance(value, (int, str)):
         raise Malformed(f"{name} must be a whole number, not {value!r:.40}")
     return int(value)  # "x" raises ValueError, said as malformed
+
+
+def _number(value, name: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float, str)):
+        raise Malformed(f"{name} must be a number, not {value!r:.40}")
+    n = float(value)  # "x" raises ValueError, said as malformed
+    if not math.isfinite(n):
+        raise Malformed(f"{name} must be a finite number, not {value!r:.40}")
+    return n
 
 
 def _strings(values, name: str) -> list:

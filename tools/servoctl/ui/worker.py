@@ -18,6 +18,7 @@ from .. import protocol as p
 from ..args import build_parser
 from ..checks import check_range
 from ..errors import EXIT_INTERRUPTED, NoReply, ServoError
+from ..servo import Servo
 from . import sampling
 from .files import Folder
 from .preempt import STOP_METHOD, Preemption
@@ -37,6 +38,15 @@ UPDATE_CUT = ("servoctl ui: the update stopped part-way: a servo it had switched
 # bus thread in the middle of a command.
 SLOW_IMPORTS = ("servoctl.identify_report", "servoctl.calibrate", "servoctl.tune", "servoctl.update",
                 "servoctl.bench", "servoctl.console")
+
+
+# The Motion view's jog: a move of at most the slider's step (1 deg,
+# index.html's #jog) from the angle the servo is at, read first, and the
+# 0.5 deg a move may end off its target (outcome.TOLERANCE_DEG). A slider
+# that stood anywhere else (at 0 when the page opened) threw the horn there
+# at full speed.
+JOG_MAX_DEG = 1.5
+JOG_MS = 200
 
 
 class QueueFull(Exception):
@@ -172,6 +182,33 @@ class Worker:
                 if staging is not None:
                     staging.close()
         return self._result(tag, argv, code, out.text(), err.text())
+
+    def jog(self, servo_id: int, angle: float, tag=None) -> dict:
+        """The jog slider's angle: moved to in JOG_MS if it is within
+        JOG_MAX_DEG of where the servo is (read now), else refused. The page
+        asks for the angle after it (angle()) and puts the slider there."""
+        argv = ["move", str(servo_id), f"{angle:g}", "--interval", str(JOG_MS), "--wait"]
+        try:
+            at = Servo(self.bus, servo_id).multi_turn_angle()[0] / 10
+        except KeyboardInterrupt:  # its answer all the same: the page waits for it
+            return self._result(tag, argv, EXIT_INTERRUPTED, "", f"servoctl: interrupted by {self.preempt.why}")
+        except ServoError as e:
+            return self._result(tag, argv, e.exit_code, "", f"servoctl: error: {e}")
+        if abs(angle - at) > JOG_MAX_DEG:
+            return self._result(tag, argv, 2, "", f"servoctl ui: a jog moves {JOG_MAX_DEG:g} deg at most from where "
+                                f"the servo is: servo {servo_id} is at {at:.1f} deg, not near {angle:g}; not moved "
+                                f"(Move takes it farther)")
+        return self.run(argv, tag)
+
+    def angle(self, servo_id: int, tag=None):
+        """Tells the page where servo_id is ({"type": "angle"}: its
+        multi-turn angle in deg, or None and why); returns it."""
+        try:
+            deg, why = Servo(self.bus, servo_id).multi_turn_angle()[0] / 10, None
+        except ServoError as e:
+            deg, why = None, f"servoctl: error: {e}"
+        self.publish({"type": "angle", "id": servo_id, "tag": tag, "angle_deg": deg, "why": why})
+        return deg
 
     def _progress(self, tag):
         """update's progress, a line each tenth of an image."""

@@ -49,6 +49,27 @@ def test_the_bus_thread_outlives_a_lost_link_and_a_bad_plot_request():
         assert not w.thread.is_alive()
 
 
+def test_a_jog_moves_a_step_from_where_the_servo_is_and_no_farther():
+    """The Motion view's slider stood at 0 deg whatever the servo's angle:
+    a nudge threw a servo resting at 60 deg to 1 deg at full speed. The
+    bus thread reads the angle and takes a jog within a slider's step of
+    it only; the page hears the angle after it."""
+    with Simulator(ids=[1], fast=True) as sim:
+        said = []
+        w = _worker(sim, said)
+        assert w.run(["config", "set", "1", "soft_start_on", "0"])["code"] == 0
+        assert w.run(["move", "1", "60", "--velocity", "200", "--wait"])["code"] == 0
+        far = w.jog(1, 1.0, "t")
+        assert far["code"] == 2 and "a jog moves 1.5 deg at most from where the servo is: servo 1 is at 60" \
+            in far["err"], far
+        assert abs(sim.state(1)["angle"] - 60) < 0.5 and abs(sim.state(1)["velocity"]) < 2
+        near = w.jog(1, 61.0, "t")
+        assert near["code"] == 0 and near["argv"] == ["move", "1", "61", "--interval", "200", "--wait"], near
+        assert abs(sim.state(1)["angle"] - 61) < 0.5
+        assert abs(w.angle(1) - 61) < 0.5 and said[-1]["type"] == "angle" and said[-1]["id"] == 1
+        assert w.jog(7, 0.0)["code"] == 3  # no servo 7: said, nothing sent to move
+
+
 def test_the_page_names_files_in_its_folder_only(tmp_path):
     """With the token, config save/load, backup and
     restore read and wrote any file the server's user could. Now only

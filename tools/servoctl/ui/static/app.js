@@ -61,14 +61,16 @@ const UI = (() => {
 
   // Runs one servoctl command line (without "servoctl" and the bus options):
   // resolves with {code, out, err}; onLine hears each line as it is printed.
-  function run(argv, onLine) {
+  // req: a request of another op answered as a command is (a jog), argv
+  // then only what it runs.
+  function run(argv, onLine, req) {
     const t = ++tag;
     if (argv.some((a) => a === null || a === undefined)) {  // the servo picker is empty
       return Promise.resolve({code: 2, out: "", err: "servoctl ui: no servo picked: scan found none"});
     }
     return new Promise((resolve) => {
       waiting[t] = {resolve, onLine};
-      if (!send({op: "run", argv: argv.map(String), tag: t})) {
+      if (!send(req ? Object.assign({}, req, {tag: t}) : {op: "run", argv: argv.map(String), tag: t})) {
         delete waiting[t];
         resolve({code: -1, out: "", err: "not connected"});
       }
@@ -78,14 +80,14 @@ const UI = (() => {
   // A command's output into a <pre>: its lines as they come, the error red.
   // An answer that came with no line (refused by a full queue, dropped by
   // STOP ALL, a watching tab's) is shown here too, not only in the log.
-  async function runInto(pre, argv) {
+  async function runInto(pre, argv, req) {
     pre.textContent = `$ servoctl ${argv.join(" ")}\n`;
     let heard = 0;
     const r = await run(argv, (m) => {
       heard++;
       pre.textContent += m.text + "\n";
       pre.scrollTop = pre.scrollHeight;
-    });
+    }, req);
     pre.classList.toggle("refused", r.code !== 0);
     const said = heard ? "" : [r.out, r.err].filter((t) => t).join("\n").trim();
     if (said) pre.textContent += said + "\n";

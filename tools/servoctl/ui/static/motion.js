@@ -2,25 +2,60 @@
 // mode, hold, damp and release; each one servoctl command.
 "use strict";
 (() => {
-  const {$, runInto, picked} = UI;
-  let jogBusy = false, jogNext = null;
+  const {$, on, send, runInto, picked} = UI;
+  let jogBusy = false, jogNext = null, shownId;  // shownId: whose angle the slider shows
+
+  // The slider where the servo is (deg: the server's read, the live
+  // table's): a key then nudges it a step from there. It stood at 0 deg
+  // whatever the servo's angle, and a nudge threw the horn there. Off while
+  // the angle is not known, or beyond the slider's turn.
+  function putSlider(deg) {
+    if (jogBusy || jogNext !== null) return;  // a jog under way: the read after it says
+    const slider = $("#jog"), known = typeof deg === "number";
+    slider.disabled = !known || Math.abs(deg) > 180;
+    if (!slider.disabled) slider.value = Math.round(deg);
+    $("#jog-at").textContent = !known ? "angle not read yet" :
+      `${deg.toFixed(1)} deg` + (slider.disabled ? " (beyond the slider's turn: Move, multi-turn)" : "");
+  }
+  function readAngle() {
+    if (picked() === null) putSlider(null); else send({op: "angle", id: picked()});
+  }
 
   async function jog(angle) {
     // The slider sends its newest angle once the last move was taken: a
-    // drag does not queue a move for every pixel.
+    // drag does not queue a move for every pixel. The server refuses one
+    // beyond a step from the servo's angle (worker.JOG_MAX_DEG).
     if (jogBusy) { jogNext = angle; return; }
     jogBusy = true;
-    await runInto($("#motion-out"), ["move", picked(), angle, "--interval", 200]);
+    const id = picked();
+    await runInto($("#motion-out"), ["move", id, angle, "--interval", 200, "--wait"],
+      {op: "jog", id, angle: Number(angle)});
     jogBusy = false;
     if (jogNext !== null) { const a = jogNext; jogNext = null; jog(a); }
+    else readAngle();  // the slider back where the servo is: moved, or refused
   }
 
+  // Each Motion action, then the slider where the servo is.
+  const act = (argv) => runInto($("#motion-out"), argv).then(readAngle);
+
+  on("angle", (m) => { if (m.id === picked()) putSlider(m.angle_deg); });
+  on("table", (m) => {
+    const row = m.rows.find((r) => r.id === picked() && !r.gone);
+    if (row) putSlider(row.angle_deg);
+  });
+  on("picked", (m) => {  // a scan's answer picks the same servo again: the slider keeps its focus
+    if (m.id === shownId) return;
+    shownId = m.id;
+    putSlider(null);
+    if (!$("#view-motion").hidden) readAngle();
+  });
+  on("view", (m) => { if (m.view === "motion") readAngle(); });
+
   document.addEventListener("DOMContentLoaded", () => {
-    const out = $("#motion-out");
     $("#mv-go").addEventListener("click", () => {
       const argv = ["move", picked(), $("#mv-angle").value, `--${$("#mv-how").value}`, $("#mv-value").value];
       if ($("#mv-multi").checked) argv.push("--multi-turn");
-      runInto(out, argv);
+      act(argv);
     });
     $("#jog").addEventListener("input", (e) => {
       $("#jog-at").textContent = `${e.target.value} deg`;
@@ -29,11 +64,11 @@
     $("#wh-run").addEventListener("click", () => {
       const argv = ["wheel", picked(), "run", "--speed", $("#wh-speed").value];
       if ($("#wh-cw").checked) argv.push("--cw");
-      runInto(out, argv);
+      act(argv);
     });
-    $("#wh-stop").addEventListener("click", () => runInto(out, ["wheel", picked(), "stop"]));
+    $("#wh-stop").addEventListener("click", () => act(["wheel", picked(), "stop"]));
     document.querySelectorAll("[data-stop]").forEach((b) => b.addEventListener("click",
-      () => runInto(out, ["stop", picked(), "--mode", b.dataset.stop])));
-    $("#origin").addEventListener("click", () => runInto(out, ["origin", picked()]));
+      () => act(["stop", picked(), "--mode", b.dataset.stop])));
+    $("#origin").addEventListener("click", () => act(["origin", picked()]));
   });
 })();
