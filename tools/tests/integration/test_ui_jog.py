@@ -92,6 +92,26 @@ def test_a_jog_far_from_the_servo_is_refused_and_the_slider_put_back(bench):
     assert abs(sim.state(1)["angle"] - at) < 0.5
 
 
+def test_stop_all_drops_a_jog_the_slider_kept(bench):
+    """The slider keeps its newest angle while a jog is under way and sent
+    it when that jog came back, even stopped (130): after STOP ALL the servo
+    moved again."""
+    sim, page = bench
+    page.click("#tabs button[data-view=motion]")
+    at = round(sim.state(1)["angle"])
+    page.wait_for_function(f"!document.querySelector('#jog').disabled"
+                           f" && document.querySelector('#jog').value === '{at}'", timeout=WAIT_MS)
+    page.evaluate(f"""() => {{ const j = document.querySelector('#jog');
+        j.value = '{at + 1}'; j.dispatchEvent(new Event('input'));
+        j.value = '{at + 1}'; j.dispatchEvent(new Event('input'));
+        document.querySelector('#stop-all').click(); }}""")
+    page.locator("#log", has_text="stop-all:").wait_for(timeout=WAIT_MS)
+    stopped = sim.state(1)["angle"]
+    with _Watch(sim) as watch:
+        sim.sleep(1.5)
+    assert max(abs(a - stopped) for a in watch.seen) < 0.2, (stopped, min(watch.seen), max(watch.seen))
+
+
 def test_the_servo_view_says_an_item_out_of_order_in_the_unit_typed(bench):
     """angle_min 100 with angle_max 90 was said "servo 1 refused angle_min
     = 1000": protocol units, no reason."""

@@ -28,12 +28,19 @@
     if (jogBusy) { jogNext = angle; return; }
     jogBusy = true;
     const id = picked();
-    await runInto($("#motion-out"), ["move", id, angle, "--interval", 200, "--wait"],
+    const r = await runInto($("#motion-out"), ["move", id, angle, "--interval", 200, "--wait"],
       {op: "jog", id, angle: Number(angle)});
     jogBusy = false;
+    // A jog stopped (130: STOP ALL, or dropped) drops the angle the slider
+    // kept meanwhile: it was sent after the stop, and moved the servo again.
+    if (r.code === 130) jogNext = null;
     if (jogNext !== null) { const a = jogNext; jogNext = null; jog(a); }
     else readAngle();  // the slider back where the servo is: moved, or refused
   }
+  // STOP ALL (this tab's or another's) forgets a jog not yet sent.
+  on("stopped", () => { jogNext = null; });
+  document.addEventListener("DOMContentLoaded", () =>
+    $("#stop-all").addEventListener("click", () => { jogNext = null; }));
 
   // Each Motion action, then the slider where the servo is.
   const act = (argv) => runInto($("#motion-out"), argv).then(readAngle);
