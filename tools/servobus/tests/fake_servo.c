@@ -1,3 +1,4 @@
+#include <errno.h>
 #include <string.h>
 
 #include "tests/fake_servo.h"
@@ -85,6 +86,10 @@ static int fake_write(void *ctx, const uint8_t *data, size_t len)
     sb_parser p;
     size_t at = 0;
     sb_parser_init(&p, true);
+    if (f->fail_writes > 0) {
+        f->fail_writes--;
+        return -EIO;
+    }
     if (f->late_len > 0) { /* a late answer, its last byte off the wire as the request starts */
         memcpy(f->out + f->out_len, f->late, f->late_len);
         f->line_us = f->now_us;

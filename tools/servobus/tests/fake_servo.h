@@ -30,6 +30,7 @@ typedef struct fake_bus {
     bool garble_next;      /* the next answer's checksum is wrong */
     uint8_t cut[256];      /* a servo's answers stop after this many bytes (0: whole) */
     bool one_short[256];   /* a servo's answers a byte short, their checksum good */
+    uint32_t fail_writes;  /* writes to fail (-EIO), nothing sent */
     int64_t power[3];      /* the Monitor answers' mV, mA and mW (mV 0: 7400) */
 } fake_bus;
 

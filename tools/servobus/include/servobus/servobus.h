@@ -210,15 +210,19 @@ sb_error sb_stream_init(sb_stream *s, const uint8_t *ids, size_t count, uint16_t
 /* The next setpoints' frame: angles in 0.1 deg, velocities in 0.1 deg/s
  * (NULL: from the last two setpoints). An angle beyond its field or its
  * servo's limits, a step faster than the servo moves, a velocity beyond
- * the field's range: SB_E_RANGE naming the servo, nothing made. */
+ * the field's range: SB_E_RANGE naming the servo, nothing made. The stream
+ * then counts the frame sent: if it is not, put back a copy of s taken
+ * before (sb_loop_cycle does), or the next step is checked from a setpoint
+ * the servos never got. */
 sb_error sb_stream_frame(sb_stream *s, const int32_t *angles, const int16_t *velocities, uint8_t *frame,
                          size_t cap, size_t *len);
 
 /* ---- the robot loop ----------------------------------------------------- */
 /* A cycle: one SyncCommand of setpoints and one Sync Monitor in one write,
  * then every servo's state (got[] all false if the setpoints are refused or
- * the link fails). Called once per period_ms: the setpoints' speeds and
- * time stamps count on it. */
+ * the link fails; a failed write leaves the stream as it was). Called once
+ * per period_ms: the setpoints' speeds and time stamps count on it. On a
+ * loop sb_loop_init refused: SB_E_USAGE on "loop", nothing sent. */
 typedef struct sb_loop {
     sb_bus *bus;
     sb_stream stream;
