@@ -228,7 +228,7 @@ sb_error sb_stream_frame(sb_stream *s, const int32_t *angles, const int16_t *vel
 typedef struct sb_loop {
     sb_bus *bus;
     sb_stream stream;
-    uint8_t monitor[8u + SB_MAX_SERVOS];
+    uint8_t monitor[10u + SB_MAX_SERVOS]; /* what sb_sync_frame asks: 7 + its content */
     size_t monitor_len;
     uint32_t cycles;
     uint32_t missed; /* states that did not come */
