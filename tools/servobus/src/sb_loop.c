@@ -122,7 +122,10 @@ sb_error sb_stream_frame(sb_stream *s, const int32_t *angles, const int16_t *vel
         return e;
     for (size_t k = 0; k < s->count; k++)
         s->last[k] = angles[k];
-    s->sent++;
+    /* Past UINT32_MAX, 65536 rather than 0: the step stays checked and the
+     * time stamps (sent * period mod 65536) run on without a jump. */
+    if (++s->sent == 0)
+        s->sent = 65536u;
     return e;
 }
 
@@ -144,17 +147,24 @@ sb_error sb_loop_init(sb_loop *l, sb_bus *bus, const uint8_t *ids, size_t count,
     if ((uint64_t)period_ms < wire)
         return usage_of(SB_PKT_STREAM_SETPOINT, "period_ms", period_ms, (int64_t)wire,
                         sb_item(SB_ITEM_STREAM_PERIOD_MS)->max);
-    return sb_sync_frame(SB_PKT_MONITOR, ids, 1, count, l->monitor, sizeof l->monitor, &l->monitor_len);
+    e = sb_sync_frame(SB_PKT_MONITOR, ids, 1, count, l->monitor, sizeof l->monitor, &l->monitor_len);
+    if (e.status != SB_OK)
+        l->monitor_len = 0;
+    return e;
 }
 
 sb_error sb_loop_cycle(sb_loop *l, const int32_t *angles, const int16_t *velocities, sb_monitor_answer *states,
                        bool *got)
 {
     sb_bus *bus = l->bus;
+    sb_stream before;
     size_t len = 0;
     sb_error e;
+    if (l->monitor_len == 0) /* sb_loop_init refused it: nothing is sent */
+        return usage(-1, SB_PKT_STREAM_SETPOINT, "loop");
     for (size_t k = 0; k < l->stream.count; k++)
         got[k] = false; /* none, if the setpoints are refused or the link fails */
+    before = l->stream;
     e = sb_stream_frame(&l->stream, angles, velocities, bus->tx, sizeof bus->tx - l->monitor_len, &len);
     if (e.status != SB_OK)
         return e;
@@ -163,8 +173,12 @@ sb_error sb_loop_cycle(sb_loop *l, const int32_t *angles, const int16_t *velocit
     /* One write: the Sync Monitor follows the setpoints without a gap. */
     memcpy(bus->tx + len, l->monitor, l->monitor_len);
     e = sb_send(bus, bus->tx, len + l->monitor_len);
-    if (e.status != SB_OK)
+    if (e.status != SB_OK) {
+        /* The servos did not get these setpoints: the next step is checked
+         * (and its speed made) from the last they got. */
+        l->stream = before;
         return e;
+    }
     e = sb_sync_monitor_answers(bus, l->stream.ids, l->stream.count, states, got);
     for (size_t k = 0; k < l->stream.count; k++)
         l->missed += got[k] ? 0u : 1u;

@@ -158,6 +158,8 @@ size_t sb_error_text(const sb_error *e, char *buf, size_t cap)
         put_range(&t, e);
     } else if (e->status == SB_E_USAGE && e->field != NULL && strcmp(e->field, "cmd") == 0) {
         put(&t, ": not a packet SyncCommand carries");
+    } else if (e->status == SB_E_USAGE && named(e, "loop")) {
+        put(&t, ": sb_loop_init refused it; nothing was sent");
     } else if (e->status == SB_E_BAD_ANSWER && ranged) {
         put_range(&t, e);
     } else if (e->status == SB_E_DUPLICATE_ID || e->status == SB_E_BROADCAST) {

@@ -22,6 +22,7 @@ typedef struct fake_bus {
     bool first;            /* the next answer is the request's first */
     uint8_t late[64];      /* bytes that come at the start of the next request: */
     size_t late_len;       /* a late answer to the one before */
+    uint64_t late_us;      /* its last byte this long after the request's end (0: at its start) */
     int32_t setpoint[256]; /* the last StreamSetpoint angle each servo got */
     int16_t velocity[256];
     uint16_t stamp[256];
@@ -30,6 +31,7 @@ typedef struct fake_bus {
     bool garble_next;      /* the next answer's checksum is wrong */
     uint8_t cut[256];      /* a servo's answers stop after this many bytes (0: whole) */
     bool one_short[256];   /* a servo's answers a byte short, their checksum good */
+    uint32_t fail_writes;  /* writes to fail (-EIO), nothing sent */
     int64_t power[3];      /* the Monitor answers' mV, mA and mW (mV 0: 7400) */
 } fake_bus;
 

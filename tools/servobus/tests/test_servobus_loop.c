@@ -224,6 +224,71 @@ static void a_late_answer_to_the_round_before_is_dropped(void **state)
     assert_int_equal(six_states[0].angle, six_angles[0]);
 }
 
+static void a_failed_write_leaves_the_stream_where_the_servos_are(void **state)
+{
+    uint8_t ids[1] = {1};
+    int32_t a = 0;
+    sb_monitor_answer st[1];
+    bool got[1];
+    sb_loop l;
+    fake.present[1] = true;
+    assert_int_equal(sb_loop_init(&l, &bus, ids, 1, 10).status, SB_OK); /* 7.5 deg a step at most */
+    assert_int_equal(sb_loop_cycle(&l, &a, NULL, st, got).status, SB_OK);
+    a = 75;
+    for (int k = 0; k < 3; k++) { /* 7.5 deg, each write failing: the servo stays at 0 */
+        fake.fail_writes = 1;
+        assert_int_equal(sb_loop_cycle(&l, &a, NULL, st, got).status, SB_E_LINK);
+    }
+    assert_int_equal(l.stream.sent, 1);
+    assert_int_equal(l.stream.last[0], 0);
+    a = 150; /* 15 deg from the 0 the servo got: refused, nothing sent */
+    sb_error e = sb_loop_cycle(&l, &a, NULL, st, got);
+    assert_int_equal(e.status, SB_E_RANGE);
+    assert_string_equal(e.field, "angle step");
+    assert_int_equal(fake.setpoint[1], 0);
+    a = 75;
+    assert_int_equal(sb_loop_cycle(&l, &a, NULL, st, got).status, SB_OK);
+    assert_int_equal(fake.setpoint[1], 75);
+    assert_int_equal(fake.velocity[1], 7500); /* from the 0 it got */
+}
+
+static void a_refused_loop_sends_nothing(void **state)
+{
+    uint8_t ids[2] = {1, 2};
+    int32_t a[2] = {900, -900};
+    sb_monitor_answer st[2];
+    bool got[2] = {true, true};
+    sb_loop l;
+    sb_bus_init(&bus, fake_transport(&fake), 115200);
+    assert_int_equal(sb_loop_init(&l, &bus, ids, 2, 1).status, SB_E_USAGE); /* 1 ms: shorter than its wire */
+    sb_error e = sb_loop_cycle(&l, a, NULL, st, got);
+    assert_int_equal(e.status, SB_E_USAGE);
+    assert_int_equal(fake.frames, 0);
+    assert_int_equal(fake.now_us, 0);
+    char text[120];
+    sb_error_text(&e, text, sizeof text);
+    assert_string_equal(text, "StreamSetpoint: loop not allowed: sb_loop_init refused it; nothing was sent");
+    sb_bus_init(&bus, fake_transport(&fake), 0);
+    assert_int_equal(sb_loop_init(&l, &bus, ids, 2, 10).status, SB_E_USAGE);
+    assert_int_equal(sb_loop_cycle(&l, a, NULL, st, got).status, SB_E_USAGE);
+    assert_int_equal(fake.frames, 0);
+}
+
+static void the_stream_counts_on_past_its_counter(void **state)
+{
+    uint8_t ids[1] = {1};
+    int32_t a = 0;
+    uint8_t f[64];
+    size_t len = 0;
+    sb_stream s;
+    assert_int_equal(sb_stream_init(&s, ids, 1, 10).status, SB_OK);
+    s.sent = UINT32_MAX;
+    assert_int_equal(sb_stream_frame(&s, &a, NULL, f, sizeof f, &len).status, SB_OK);
+    assert_true(s.sent != 0);
+    a = 760; /* 76 deg in 10 ms: still checked after the counter's wrap */
+    assert_int_equal(sb_stream_frame(&s, &a, NULL, f, sizeof f, &len).status, SB_E_RANGE);
+}
+
 static void the_stream_refuses_what_the_servo_would_not_follow(void **state)
 {
     uint8_t ids[2] = {1, 2};
@@ -305,6 +370,9 @@ int main(void)
         cmocka_unit_test_setup(a_late_answer_to_the_round_before_is_dropped, set_up),
         cmocka_unit_test_setup(an_error_says_what_is_wrong, set_up),
         cmocka_unit_test_setup(the_stream_refuses_what_the_servo_would_not_follow, set_up),
+        cmocka_unit_test_setup(a_failed_write_leaves_the_stream_where_the_servos_are, set_up),
+        cmocka_unit_test_setup(a_refused_loop_sends_nothing, set_up),
+        cmocka_unit_test_setup(the_stream_counts_on_past_its_counter, set_up),
         cmocka_unit_test_setup(the_uart_callbacks_carry_a_request, set_up),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

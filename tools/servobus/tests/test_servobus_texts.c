@@ -67,6 +67,25 @@ static void a_loop_s_period_holds_its_cycle_on_the_wire(void **state)
     assert_string_equal(e.field, "baud");
 }
 
+/* As many servos as the structs hold: the Sync Monitor's frame fits. */
+static void a_loop_takes_sb_max_servos(void **state)
+{
+    uint8_t ids[SB_MAX_SERVOS];
+    int32_t angles[SB_MAX_SERVOS];
+    sb_monitor_answer st[SB_MAX_SERVOS];
+    bool got[SB_MAX_SERVOS];
+    sb_loop loop;
+    for (size_t k = 0; k < SB_MAX_SERVOS; k++) {
+        ids[k] = (uint8_t)(k + 1);
+        angles[k] = 0;
+        fake.present[k + 1] = true;
+    }
+    for (size_t n = SB_MAX_SERVOS - 2; n <= SB_MAX_SERVOS; n++)
+        assert_int_equal(sb_loop_init(&loop, &bus, ids, n, 1000).status, SB_OK);
+    assert_int_equal(sb_loop_cycle(&loop, angles, NULL, st, got).status, SB_OK);
+    assert_true(got[SB_MAX_SERVOS - 1]);
+}
+
 /* An item the schema lacks, and one the packet may not write, apart. */
 static void an_item_refused_says_why(void **state)
 {
@@ -92,7 +111,8 @@ static void a_wrong_count_of_fields_is_told(void **state)
                         "servo 1: Ping: fields not allowed: 3, not 1");
 }
 
-/* A transport that answers every request with one frame, at once. */
+/* A transport that answers every request with one frame, as soon as the
+ * request's and the answer's bytes have crossed the wire at 115200. */
 static uint8_t canned[64];
 static size_t canned_len, canned_at;
 static uint64_t canned_now;
@@ -100,6 +120,7 @@ static uint64_t canned_now;
 static int canned_write(void *ctx, const uint8_t *data, size_t len)
 {
     canned_at = 0;
+    canned_now += (len + canned_len) * 10000000u / 115200u + 1u;
     return 0;
 }
 
@@ -192,6 +213,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test_setup(a_stream_s_period_is_item_69_s, set_up),
         cmocka_unit_test_setup(a_loop_s_period_holds_its_cycle_on_the_wire, set_up),
+        cmocka_unit_test_setup(a_loop_takes_sb_max_servos, set_up),
         cmocka_unit_test_setup(an_item_refused_says_why, set_up),
         cmocka_unit_test_setup(a_wrong_count_of_fields_is_told, set_up),
         cmocka_unit_test_setup(a_bad_answer_says_its_length, set_up),

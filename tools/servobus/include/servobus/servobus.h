@@ -151,7 +151,9 @@ void sb_bus_init(sb_bus *bus, sb_transport t, uint32_t baud);
 /* Drops what waits unread, then writes frame in one write. */
 sb_error sb_send(sb_bus *bus, const uint8_t *frame, size_t len);
 /* The next answer of packet code from servo (-1: any) by deadline_us (bus
- * clock); other frames skipped. content: SB_ANSWER_CONTENT_MAX bytes. Of a
+ * clock); other frames skipped, and any read before the last request's end
+ * (sent_end_us) plus its own bytes' time at baud: a late answer of an
+ * earlier request (the link's latency only delays answers). content: SB_ANSWER_CONTENT_MAX bytes. Of a
  * servo given, a frame that does not fit the packet (the wrong length for
  * a fixed-size answer, else one that does not decode: a frame inside the
  * answer) is skipped too; if only such came, SB_E_BAD_ANSWER on it. */
@@ -210,19 +212,23 @@ sb_error sb_stream_init(sb_stream *s, const uint8_t *ids, size_t count, uint16_t
 /* The next setpoints' frame: angles in 0.1 deg, velocities in 0.1 deg/s
  * (NULL: from the last two setpoints). An angle beyond its field or its
  * servo's limits, a step faster than the servo moves, a velocity beyond
- * the field's range: SB_E_RANGE naming the servo, nothing made. */
+ * the field's range: SB_E_RANGE naming the servo, nothing made. The stream
+ * then counts the frame sent: if it is not, put back a copy of s taken
+ * before (sb_loop_cycle does), or the next step is checked from a setpoint
+ * the servos never got. */
 sb_error sb_stream_frame(sb_stream *s, const int32_t *angles, const int16_t *velocities, uint8_t *frame,
                          size_t cap, size_t *len);
 
 /* ---- the robot loop ----------------------------------------------------- */
 /* A cycle: one SyncCommand of setpoints and one Sync Monitor in one write,
  * then every servo's state (got[] all false if the setpoints are refused or
- * the link fails). Called once per period_ms: the setpoints' speeds and
- * time stamps count on it. */
+ * the link fails; a failed write leaves the stream as it was). Called once
+ * per period_ms: the setpoints' speeds and time stamps count on it. On a
+ * loop sb_loop_init refused: SB_E_USAGE on "loop", nothing sent. */
 typedef struct sb_loop {
     sb_bus *bus;
     sb_stream stream;
-    uint8_t monitor[8u + SB_MAX_SERVOS];
+    uint8_t monitor[10u + SB_MAX_SERVOS]; /* what sb_sync_frame asks: 7 + its content */
     size_t monitor_len;
     uint32_t cycles;
     uint32_t missed; /* states that did not come */
