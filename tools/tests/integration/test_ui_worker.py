@@ -62,7 +62,8 @@ def test_a_jog_moves_a_step_from_where_the_servo_is_and_no_farther():
         far = w.jog(1, 1.0, "t")
         assert far["code"] == 2 and "a jog moves 1.5 deg at most from where the servo is: servo 1 is at 60" \
             in far["err"], far
-        assert abs(sim.state(1)["angle"] - 60) < 0.5 and abs(sim.state(1)["velocity"]) < 2
+        sim.sleep(0.3)  # a jog to 1 deg sent would have the horn tens of degrees on by now
+        assert abs(sim.state(1)["angle"] - 60) < 0.5
         near = w.jog(1, 61.0, "t")
         assert near["code"] == 0 and near["argv"] == ["move", "1", "61", "--interval", "200", "--wait"], near
         assert abs(sim.state(1)["angle"] - 61) < 0.5
