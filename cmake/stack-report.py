@@ -9,7 +9,7 @@ indirect call is bounded by the worst target of its kind:
   in dispatch(_packet) the packet handlers (handle_*)
   in usart_hd_irq      the clock that stamps received bytes (systick_now_us)
   in a packet handler  the application's hooks (servo_persist_config, the fault
-                       history's read_fault and clear_faults), or a HAL op
+                       history's fault_log_read and clear_faults), or a HAL op
   anywhere else        the port's HAL operations (everything else)
 Recursion is an error. A library function without a call graph (memcpy, libgcc) is charged
 LIBRARY_BYTES. All interrupts share one priority, so they do not nest: the
@@ -109,7 +109,7 @@ def main() -> int:
         # systick_now_us is also called directly, so it is no pointer target.
         "usart_hd_irq": [t for t in stack if short(t) == "systick_now_us"],
     }
-    app_hooks = ("servo_persist_config", "read_fault", "clear_faults")
+    app_hooks = ("servo_persist_config", "fault_log_read", "clear_faults")
     persist = [t for t in pointer_targets if short(t) in app_hooks]
     hal_ops = [t for t in pointer_targets
                if not short(t).startswith("handle_") and short(t) not in app_hooks]

@@ -13,7 +13,7 @@ enum packet_outcome handle_read_faults(const struct packet_call *c, struct respo
     p[1] = h->fault_count;
     le_put_u16(&p[2], h->faults_not_logged);
     /* The entry's bytes go straight into the answer: they are its wire image. */
-    if (d->read_fault == NULL || !d->read_fault(d->faults_ctx, c->content[1], &p[4])) {
+    if (d->read_fault == NULL || !d->read_fault(d->read_fault_ctx, c->content[1], &p[4])) {
         for (unsigned i = 0; i < FAULT_ENTRY_BYTES; i++) {
             p[4u + i] = 0; /* what 0: none at this index */
         }

@@ -80,12 +80,6 @@ __attribute__((noinline)) static void note_faults(struct servo *s, uint8_t trips
     }
 }
 
-static bool read_fault(void *ctx, uint8_t index, uint8_t *out)
-{
-    const struct servo *s = ctx;
-    return fault_log_read(&s->faults, index, out);
-}
-
 /* Not through log_fault: the readings would take the M0's answer past
  * its 30 us (target benchmark, answer_clear_faults). */
 static bool clear_faults(void *ctx)
@@ -174,7 +168,8 @@ void safety_init(struct servo *s)
     if (fault_log_spare_dirty(&s->faults) && !fault_log_erase_spare(&s->faults)) {
         s->regs.status.status |= STATUS_COMMAND_ERROR; /* nobody waits at power-up */
     }
-    s->dispatcher.read_fault = read_fault;
+    s->dispatcher.read_fault = fault_log_read;
+    s->dispatcher.read_fault_ctx = &s->faults;
     s->dispatcher.clear_faults = clear_faults;
     s->dispatcher.faults_ctx = s;
 }

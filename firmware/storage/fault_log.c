@@ -280,8 +280,9 @@ bool fault_log_erase_spare(struct fault_log *l)
     return true;
 }
 
-bool fault_log_read(const struct fault_log *l, uint8_t index, uint8_t out[FAULT_ENTRY_BYTES])
+bool fault_log_read(void *log, uint8_t index, uint8_t *out)
 {
+    const struct fault_log *l = log;
     if (index >= l->shown_count) {
         return false;
     }

@@ -75,7 +75,9 @@ bool fault_log_step(struct fault_log *l);
 bool fault_log_spare_dirty(const struct fault_log *l);
 MUST_CHECK bool fault_log_erase_spare(struct fault_log *l);
 /* The index-th newest fault shown (0 the newest), as its bytes (struct
- * fault_entry's image): false beyond. */
-bool fault_log_read(const struct fault_log *l, uint8_t index, uint8_t out[FAULT_ENTRY_BYTES]);
+ * fault_entry's image, FAULT_ENTRY_BYTES): false beyond. log is a struct
+ * fault_log: the form ReadFaults calls back (dispatcher.h), with no call
+ * between, which took the M0's answer past its 30 us. */
+bool fault_log_read(void *log, uint8_t index, uint8_t *out);
 
 #endif

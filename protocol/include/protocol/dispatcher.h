@@ -37,8 +37,10 @@ struct dispatcher {
     /* The fault history (ReadFaults, ClearFaults): the index-th newest
      * fault's bytes (struct fault_entry's image) into out, false beyond
      * the count (store_health has the count); and a clear. NULL where none
-     * is kept. */
+     * is kept. Each with its own context: the read is the store's own
+     * function, called straight. */
     bool (*read_fault)(void *ctx, uint8_t index, uint8_t *out);
+    void *read_fault_ctx;
     bool (*clear_faults)(void *ctx);
     void *faults_ctx;
 };
