@@ -31,11 +31,7 @@ static inline uint64_t mul_u32_by_halves(uint32_t a, uint32_t b)
  * __aeabi_lmul (41 instructions): four 16 x 16 products take about a third. */
 static inline uint64_t mul_u32(uint32_t a, uint32_t b)
 {
-#if defined(__ARM_ARCH_6M__)
-    return mul_u32_by_halves(a, b);
-#else
     return (uint64_t)a * b;
-#endif
 }
 /* num / den rounded to nearest, halves away from zero; den > 0. */
 int64_t div64_round(int64_t num, int64_t den);
