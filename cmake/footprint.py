@@ -19,9 +19,8 @@ MODULES = [  # (part of the object's path in the map, name)
     ("libservo_stm32f0.a", "STM32F0 port (USART)"),
     ("libservo_stm32_common.a", "STM32 common (DMA receive, SysTick, flash, PWM, IWDG, boot jump)"),
     ("startup_stm32", "startup, vector table"),
-    ("small_div.c", "the small run-time: mem*, 32-bit division, 64-bit multiply (size first)"),
-    ("small_mul.c", "the small run-time: mem*, 32-bit division, 64-bit multiply (size first)"),
-    ("small_mem.c", "the small run-time: mem*, 32-bit division, 64-bit multiply (size first)"),
+    ("small_div.c", "the small run-time: mem*, 32-bit division (size first)"),
+    ("small_mem.c", "the small run-time: mem*, 32-bit division (size first)"),
     ("boards/", "board (main, wiring, board_io: clocks, pins, ADC; the static servo state)"),
 ]
 

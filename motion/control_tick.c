@@ -196,11 +196,11 @@ static void guard_braking(struct motion *m)
     uint32_t speed = v < 0 ? -(uint32_t)v : (uint32_t)v;
     uint32_t room = r < 0 ? -(uint32_t)r : (uint32_t)r;
     uint32_t capped = speed < 0xFFFFu ? speed : 0xFFFFu;
-    uint64_t stopping = mul_u32(capped * capped, (uint32_t)m->drive.ka);
+    uint64_t stopping = (uint64_t)(capped * capped) * (uint32_t)m->drive.ka;
     /* The least braking the output can count on settles most ticks without
      * working out the exact one. */
-    if (stopping <= mul_u32(room, (uint32_t)m->brake_floor_duty) << 9 ||
-        stopping <= mul_u32(room, (uint32_t)motion_brake_duty(m, v)) << 9) {
+    if (stopping <= ((uint64_t)room * (uint32_t)m->brake_floor_duty) << 9 ||
+        stopping <= ((uint64_t)room * (uint32_t)motion_brake_duty(m, v)) << 9) {
         return;
     }
     uint64_t n = div64_u(2u * (uint64_t)room + speed - 1u, speed);

@@ -58,28 +58,6 @@ static void test_random(void **state_)
     }
 }
 
-/* The Cortex-M0's 32 x 32 -> 64 multiply against C's. */
-static void test_multiply_by_halves(void **state_)
-{
-    (void)state_;
-    const uint32_t edges[] = {0, 1, 0xFFFFu, 0x10000u, 0xFFFFFFFFu, 0x80000000u, 0x7FFFFFFFu, 12345u};
-    for (size_t i = 0; i < sizeof edges / sizeof edges[0]; i++) {
-        for (size_t j = 0; j < sizeof edges / sizeof edges[0]; j++) {
-            assert_true(mul_u32_by_halves(edges[i], edges[j]) == (uint64_t)edges[i] * edges[j]);
-        }
-    }
-    uint64_t x = 88172645463325252ull;
-    for (int n = 0; n < 1000000; n++) {
-        x ^= x << 13;
-        x ^= x >> 7;
-        x ^= x << 17;
-        uint32_t a = (uint32_t)x;
-        uint32_t b = (uint32_t)(x >> 32);
-        assert_true(mul_u32_by_halves(a, b) == (uint64_t)a * b);
-        assert_true(mul_u32(a, b) == (uint64_t)a * b);
-    }
-}
-
 static void test_rounding(void **state_)
 {
     (void)state_;
@@ -124,7 +102,6 @@ int main(void)
         cmocka_unit_test(test_edges),
         cmocka_unit_test(test_random),
         cmocka_unit_test(test_rounding),
-        cmocka_unit_test(test_multiply_by_halves),
         cmocka_unit_test(test_whole_turns),
         cmocka_unit_test(test_thousandths),
     };

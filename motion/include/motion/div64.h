@@ -15,24 +15,6 @@
 /* n / d, exactly. */
 uint64_t div64_u(uint64_t n, uint64_t d);
 
-/* a x b from four 16 x 16 products (test_div64 checks it on the host). */
-static inline uint64_t mul_u32_by_halves(uint32_t a, uint32_t b)
-{
-    uint32_t al = a & 0xFFFFu;
-    uint32_t ah = a >> 16;
-    uint32_t bl = b & 0xFFFFu;
-    uint32_t bh = b >> 16;
-    uint64_t middle = (uint64_t)(ah * bl) + (al * bh);
-    return ((uint64_t)(ah * bh) << 32) + (middle << 16) + al * bl;
-}
-
-/* a x b, all 64 bits of it. The Cortex-M3 has UMULL for this; the M0
- * multiplies 32 x 32 -> 32 only, and the compiler calls libgcc's 64 x 64
- * __aeabi_lmul (41 instructions): four 16 x 16 products take about a third. */
-static inline uint64_t mul_u32(uint32_t a, uint32_t b)
-{
-    return (uint64_t)a * b;
-}
 /* num / den rounded to nearest, halves away from zero; den > 0. */
 int64_t div64_round(int64_t num, int64_t den);
 
