@@ -96,7 +96,7 @@ static void measure(struct motion *m)
 
 /* The supply moves slowly: the duty margin for the power follows it every
  * SUPPLY_CHECK_TICKS ticks, when it has moved more than the hysteresis. */
-enum { SUPPLY_CHECK_TICKS = 32 };
+enum { SUPPLY_CHECK_TICKS = 32 }; /* a power of two */
 
 static void follow_supply(struct motion *m)
 {
@@ -229,8 +229,8 @@ static inline __attribute__((always_inline)) void bridge(const struct motion *m,
 void motion_tick(struct motion *m)
 {
     measure(m);
-    if (++m->supply_check == SUPPLY_CHECK_TICKS) {
-        m->supply_check = 0;
+    /* The servo's ms clock (a stream's, stream.c) times the supply's look too. */
+    if ((++m->stream_clock_ms & (SUPPLY_CHECK_TICKS - 1u)) == 0u) {
         follow_supply(m);
     }
     switch (m->mode) {

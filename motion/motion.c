@@ -25,7 +25,7 @@ static void hold_here(struct motion *m)
 void motion_init(struct motion *m, const struct registers *regs, const struct hal_port *hal)
 {
     *m = (struct motion){.regs = regs, .hal = hal, .soft_start_pending = 1,
-                        .stream_period_ms = STREAM_DEFAULT_PERIOD_MS};
+                        .stream_period_q4 = STREAM_DEFAULT_PERIOD_MS << 4};
     encoder_start(&m->encoder, hal->motor.read_encoder(hal->ctx));
     m->measured_q8 = counts_to_q8(m->encoder.counts);
     /* Item 90 is the horn's zero. Powered up, the horn is in the turn in

@@ -1,10 +1,12 @@
-/* Streamed setpoints (StreamSetpoint): each one starts a segment from
- * where the setpoint is (position and speed) to the host's, a cubic
- * (Hermite) one period long, walked at the tick rate; the segment's end
- * speed goes on until the next setpoint comes, and a period after that the
- * servo brakes to a hold. A setpoint the cubic cannot reach within the
- * stream's limits in its period is reached as a move at them instead
- * (docs/streaming.md). Plans: divides. */
+/* Streamed setpoints (StreamSetpoint): each one is for a moment of the
+ * host's timeline, its stamp, played a depth after it on the servo's clock
+ * (docs/streaming.md, "On the host's timeline"): a segment from where the
+ * setpoint is (position and speed) to the host's, a cubic (Hermite) that
+ * ends at that moment, walked at the tick rate; the segment's end speed
+ * goes on until the next setpoint comes, and a segment's time after its end
+ * the servo brakes to a hold. A setpoint the cubic cannot reach within the
+ * stream's limits is reached as a move at them instead (docs/streaming.md).
+ * Plans: divides. */
 #include "motion/motion_internal.h"
 #include "motion/saturate.h"
 
@@ -23,17 +25,43 @@ enum {
     STREAM_ACCEL_Q8 = STREAM_SPEED_Q8 / MIN_RAMP_MS,                /* 96 */
 };
 
-/* The period: item 69 if set, else the step between the host's stamps
- * (learned while a stream runs; 20 ms, 50 Hz, until then: motion_init). */
-static uint32_t stream_period(struct motion *m, uint16_t host_ms)
+/* The servo's clock less the host's (Q16 ms: its whole ms wrap as the
+ * host's stamps do) and the host's period (Q4 ms) are followed by 1/8 ms a
+ * setpoint toward each new one (not at all on the mark): a median, which a
+ * late frame or a burst hardly moves, and which moves the host's timeline smoothly (a segment's
+ * end is placed to 1/16 ms); it follows a host clock that drifts by up to
+ * 1/8 ms a period (0.375 % at 30 Hz). */
+enum { TRACK_STEP_Q16 = 1 << 13, TRACK_STEP_Q4 = 2 };
+
+static uint32_t track(uint32_t value, uint32_t sample, uint32_t step)
+{
+    int32_t away = (int32_t)(sample - value);
+    return away > 0 ? value + step : away < 0 ? value - step : value;
+}
+
+/* The period, ms Q4: item 69 if set, else the step between the host's
+ * stamps (a stream's first step, then followed; 20 ms, 50 Hz, until then).
+ * A gap of none, or longer than a segment, is a new stream: the servo's
+ * clock at its first stamp is the offset then. *late_q4: how much later
+ * than its place (the stamp + the offset) this setpoint came, ms Q4. */
+static int32_t stream_period(struct motion *m, uint16_t host_ms, int32_t *late_q4)
 {
     uint32_t since = (uint16_t)(host_ms - m->stream_host_ms);
+    uint32_t offset_q16 = (uint32_t)(m->stream_clock_ms - host_ms) << 16; /* wraps as 16 bits */
     m->stream_host_ms = host_ms;
-    if (m->streaming && since - 1u < PROFILE_MAX_SEGMENT) {
-        m->stream_period_ms = (uint16_t)since;
+    bool fresh = !m->streaming || since - 1u >= PROFILE_MAX_SEGMENT;
+    if (fresh) {
+        m->stream_offset_q16 = offset_q16;
+    } else {
+        m->stream_period_q4 = (uint16_t)(m->streaming == 1u ? since << 4
+                                                           : track(m->stream_period_q4, since << 4, TRACK_STEP_Q4));
     }
-    uint32_t period = m->regs->firmware.stream_period_ms;
-    return period != 0u ? period : m->stream_period_ms;
+    m->streaming = fresh ? 1u : 2u;
+    uint32_t median = m->stream_offset_q16;
+    *late_q4 = (int32_t)(offset_q16 - median) >> 12; /* +-32 s */
+    m->stream_offset_q16 = track(median, offset_q16, TRACK_STEP_Q16);
+    uint32_t told = (uint32_t)m->regs->firmware.stream_period_ms << 4;
+    return (int32_t)(told != 0u ? told : m->stream_period_q4);
 }
 
 /* |v| <= limit, limit >= 0. */
@@ -117,7 +145,18 @@ enum motion_submit_result motion_stream(struct motion *m, const struct motion_se
         return MOTION_REFUSED; /* not counted (motion_submit) */
     }
     m->commands++;
-    uint32_t period = stream_period(m, sp->host_ms);
+    int32_t late_q4;
+    int32_t period_q4 = stream_period(m, sp->host_ms, &late_q4);
+    /* The setpoint's place: a depth of 3/2 period after its stamp on the
+     * servo's clock, so a frame up to that late changes nothing. The
+     * segment ends on the tick before it, its target run back along the
+     * setpoint's velocity by the fraction; one later than half a period
+     * before its place ends half a period on, the target run on as far (at
+     * most a period). */
+    int32_t half = period_q4 >> 5;
+    int32_t place_q4 = period_q4 + (period_q4 >> 1) - late_q4;
+    int32_t ticks = clamp_i32(place_q4 >> 4, half + 1, (int32_t)PROFILE_MAX_SEGMENT);
+    int32_t run_on_q4 = clamp_i32(ticks * 16 - place_q4, -16, period_q4);
     /* The stream's reference goes on from the setpoint, however the horn
      * lags (the profile's clock keeps the two together, and slows the
      * segment where it asks more than the output can give), or from the
@@ -132,21 +171,24 @@ enum motion_submit_result motion_stream(struct motion *m, const struct motion_se
     /* 0.1 deg/s to Q8 decideg per tick: x 256 / 1000, as 16777 / 2^16
      * (an arithmetic shift: toward minus infinity, under 2^-8 decideg). */
     int32_t v1 = (clamp_i32(sp->velocity_decideg_s, -MAX_VELOCITY, MAX_VELOCITY) * 16777) >> 16;
+    /* Within 1920 x 16000: the path's checks hold it within the limits. */
+    int32_t placed = target + ((v1 * run_on_q4) >> 4);
 
     m->queue.count = 0;
     m->answer_packet = 0;
     m->power_mw = 0;
     motion_update_limits(m);
-    bool cubic = segment_within(target - start, v0, v1, (int32_t)period) &&
-                 path_within(m, start, target, v0, v1, (int32_t)period);
+    bool cubic = segment_within(placed - start, v0, v1, ticks) && path_within(m, start, placed, v0, v1, ticks);
     if (cubic) {
-        profile_plan_segment(&m->profile, start, v0, target, v1, period);
+        profile_plan_segment(&m->profile, start, v0, placed, v1, (uint32_t)ticks);
     } else {
         plan_at_limits(&m->profile, start, v0, target);
     }
     motion_begin_profile(m, END_HOLD);
     m->endless = cubic && v1 != 0;
-    m->streaming = 1;
-    m->endless_until = 2u * period;
+    /* A segment's time again with no setpoint: the stream has stopped (its
+     * run-on is that long at most: path_within's hull). A period late, and
+     * jitter on top, is not a stop. */
+    m->endless_until = 2u * (uint32_t)ticks;
     return MOTION_ACCEPTED;
 }

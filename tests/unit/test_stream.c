@@ -35,13 +35,37 @@ static void move_angle(int16_t angle_decideg, uint16_t interval_ms)
             (uint8_t)(interval_ms >> 8), 0x00, 0x00);
 }
 
+/* A StreamSetpoint frame's time on the wire: 16 bytes. */
+enum { STREAM_FRAME_US = 16 * HARNESS_BYTE_US };
+
+/* Runs the servo until hal.now_us is us, exactly. */
+static void run_until_us(uint64_t us)
+{
+    while (hal.now_us < us) {
+        hal.now_us += us - hal.now_us < 250u ? us - hal.now_us : 250u;
+        servo_poll(&servo);
+        hal_double_dma_reads(&hal);
+    }
+}
+
+/* A setpoint whose frame ends at end_us: a punctual host's, whose stamps
+ * keep the servo's time. */
+static void stream_on_time(uint64_t end_us, int32_t angle_decideg, int16_t velocity, uint16_t host_ms)
+{
+    run_until_us(end_us - STREAM_FRAME_US);
+    stream(0, angle_decideg, velocity, host_ms);
+}
+
 static double setpoint_deg(void)
 {
     return (double)servo.motion.setpoint_q8 / 2560.0;
 }
 
 /* The path: a 0.5 Hz sine of +-60 degrees, sent at 50 Hz. */
-enum { PERIOD_MS = 20, PATH_MS = 4000 };
+/* Measured from MEASURE_MS on: the servo's estimate of the host's clock
+ * starts at the first frame's arrival, up to 10 ms off with a jittery host,
+ * and moves 1/8 ms a frame (80 frames, 1.6 s, at most). */
+enum { PERIOD_MS = 20, PATH_MS = 5000, MEASURE_MS = 2000 };
 #define AMPLITUDE_DEG 60.0
 #define OMEGA (2.0 * M_PI * 0.5)
 
@@ -51,61 +75,114 @@ static double path_deg(double t_s)
 }
 
 struct tracking {
-    double rms_deg;   /* of the horn against the path, after the first cycle */
+    double rms_deg;   /* of the horn against the path */
     double peak_deg_s2; /* of the setpoint's second difference */
+    double shape_rms_deg; /* against the path at the lag that fits best */
+    double lag_ms;
 };
+
+/* The lags tried: 0 to 20 ms in 0.5 ms steps. */
+enum { LAGS = 41 };
+#define LAG_STEP_S 0.0005
 
 static double now_s(void)
 {
     return (double)hal.now_us / 1e6;
 }
 
-/* Sends the path one period ahead (each setpoint is where to be a period
- * after it is sent), streamed or as 20 ms angle moves, on the servo's own
- * clock (a request takes its bytes' time on the wire), and measures after
- * the first second: the horn against the path, and the setpoint's
- * acceleration (the walk's second difference, tick by tick). */
-static struct tracking follow_path(bool streamed)
+/* A host's timing (docs/streaming.md, "On the host's timeline"): each
+ * frame sent up to jitter_ms early or late (uniform), one in late_every a
+ * whole period late (with the next, a burst), 0 for none. */
+struct host_timing {
+    uint32_t jitter_ms;
+    uint32_t late_every;
+};
+
+static uint64_t rng_state = 0x2545F4914F6CDD1Du;
+
+static uint32_t rng_next(void)
 {
-    double sum = 0, peak = 0;
+    rng_state ^= rng_state << 13;
+    rng_state ^= rng_state >> 7;
+    rng_state ^= rng_state << 17;
+    return (uint32_t)(rng_state >> 32);
+}
+
+/* Where frame k leaves the host, s: on its period's grid, moved by the
+ * host's timing; never before the one before it. */
+static double send_time_s(uint32_t k, struct host_timing h, double last_s)
+{
+    double at = (double)k * PERIOD_MS / 1000.0;
+    if (h.jitter_ms != 0u) {
+        at += ((double)(rng_next() % (2000u * h.jitter_ms + 1u)) / 1000.0 - (double)h.jitter_ms) / 1000.0;
+    }
+    if (h.late_every != 0u && k % h.late_every == h.late_every - 1u) {
+        at = (double)(k + 1u) * PERIOD_MS / 1000.0;
+    }
+    return at > last_s ? at : last_s;
+}
+
+/* Sends the path, streamed or as 20 ms angle moves, on the servo's own
+ * clock (a request takes its bytes' time on the wire), and measures from
+ * MEASURE_MS: the horn against the path, and the setpoint's
+ * acceleration (the walk's second difference, tick by tick). A setpoint is
+ * stamped with its period's moment on the host's timeline and is where
+ * the path is a depth (3/2 period) later, when the servo reaches it; an
+ * angle move is where the path is a period after it is sent. */
+static struct tracking follow_path(bool streamed, struct host_timing h)
+{
+    double sum = 0, peak = 0, lagged[LAGS] = {0};
     unsigned n = 0;
-    double t0 = now_s(), next = 0;
+    double t0 = now_s();
+    uint32_t k = 0;
+    double next = send_time_s(0, h, 0.0);
     while (now_s() - t0 < PATH_MS / 1000.0) {
         double t = now_s() - t0;
-        if (t >= next) {
-            double at = next + PERIOD_MS / 1000.0;
+        while (t >= next) {
+            double moment = (double)k * PERIOD_MS / 1000.0;
+            double at = moment + (streamed ? 1.5 : 1.0) * PERIOD_MS / 1000.0;
             int32_t angle = (int32_t)lround(path_deg(at) * 10.0);
             if (streamed) {
                 int16_t v = (int16_t)lround(AMPLITUDE_DEG * OMEGA * cos(OMEGA * at) * 10.0);
-                stream(0, angle, v, (uint16_t)lround(next * 1000.0));
+                stream(0, angle, v, (uint16_t)(k * PERIOD_MS));
             } else {
                 move_angle((int16_t)angle, PERIOD_MS);
             }
-            next += PERIOD_MS / 1000.0;
+            next = send_time_s(++k, h, next);
         }
         hal.now_us += 250u; /* a main-loop pass, as harness_run_ms */
         servo_poll(&servo);
-        if (now_s() - t0 >= 1.0) {
+        if (now_s() - t0 >= MEASURE_MS / 1000.0) {
             double acc = fabs((double)servo.motion.walk.change_q40) / 1099511627776.0 * 1e5; /* deg/s^2 */
             peak = acc > peak ? acc : peak;
             double e = plant_angle_deg(&plant) - path_deg(now_s() - t0);
             sum += e * e;
+            for (int l = 0; l < LAGS; l++) {
+                double el = plant_angle_deg(&plant) - path_deg(now_s() - t0 - l * LAG_STEP_S);
+                lagged[l] += el * el;
+            }
             n++;
         }
     }
-    return (struct tracking){sqrt(sum / n), peak};
+    int best = 0;
+    for (int l = 1; l < LAGS; l++) {
+        best = lagged[l] < lagged[best] ? l : best;
+    }
+    return (struct tracking){sqrt(sum / n), peak, sqrt(lagged[best] / n), best * LAG_STEP_S * 1000.0};
 }
+
+static const struct host_timing PUNCTUAL = {0, 0};
 
 static void test_a_stream_tracks_the_path_smoothly(void **state)
 {
     (void)state;
     stream(0, 0, 0, 0); /* start from rest at 0 */
     harness_run_ms(200);
-    struct tracking streamed = follow_path(true);
+    struct tracking streamed = follow_path(true, PUNCTUAL);
     plant_harness_setup(state);
     move_angle(0, 100);
     harness_run_ms(200);
-    struct tracking moves = follow_path(false);
+    struct tracking moves = follow_path(false, PUNCTUAL);
     printf("# 0.5 Hz +-60 deg at 50 Hz: streamed RMS %.3f deg, peak setpoint acceleration %.0f deg/s^2; "
            "angle moves %.3f deg, %.0f deg/s^2 (the path's own: %.0f)\n",
            streamed.rms_deg, streamed.peak_deg_s2, moves.rms_deg, moves.peak_deg_s2,
@@ -118,16 +195,45 @@ static void test_a_stream_tracks_the_path_smoothly(void **state)
     assert_true(streamed.peak_deg_s2 < moves.peak_deg_s2 / 4);
 }
 
+/* Frames that leave the host up to 10 ms early or late, and one in twenty
+ * a whole period late (a burst with the next), keep the motion's shape and
+ * its delay: at the lag that fits best, nearly the punctual host's error
+ * and lag, and no sharper bend. A servo that played each setpoint from
+ * its arrival saw 5 deg and thousands of deg/s^2 (issue 67). */
+static void test_a_host_late_or_early_changes_nothing(void **state)
+{
+    (void)state;
+    stream(0, 0, 0, 0);
+    harness_run_ms(200);
+    struct tracking punctual = follow_path(true, PUNCTUAL);
+    printf("# punctual: RMS %.3f deg, at its best lag (%.1f ms) %.3f deg, peak setpoint acceleration %.0f deg/s^2\n",
+           punctual.rms_deg, punctual.lag_ms, punctual.shape_rms_deg, punctual.peak_deg_s2);
+    const struct host_timing timings[] = {{5, 0}, {10, 0}, {10, 20}};
+    for (size_t i = 0; i < sizeof timings / sizeof timings[0]; i++) {
+        plant_harness_setup(state);
+        stream(0, 0, 0, 0);
+        harness_run_ms(200);
+        struct tracking t = follow_path(true, timings[i]);
+        printf("# +-%u ms%s: RMS %.3f deg, at its best lag (%.1f ms) %.3f deg, peak setpoint acceleration "
+               "%.0f deg/s^2\n", timings[i].jitter_ms, timings[i].late_every ? ", 1 in 20 a period late" : "",
+               t.rms_deg, t.lag_ms, t.shape_rms_deg, t.peak_deg_s2);
+        assert_true(t.shape_rms_deg < punctual.shape_rms_deg + 0.1);
+        assert_true(fabs(t.lag_ms - punctual.lag_ms) <= 1.0);
+        assert_true(t.peak_deg_s2 < 2000.0); /* issue 67's bound for the horn; the setpoint's is sharper */
+    }
+}
+
 /* The host stops at full speed (100 deg/s): the segment's end speed goes
  * on for a period, then the servo brakes at the output's braking, never
  * jumps, and holds. */
 static void test_a_late_stream_brakes_to_a_hold(void **state)
 {
     (void)state;
+    uint64_t base = hal.now_us + 10000u;
     for (uint16_t ms = 0; ms <= 400; ms += PERIOD_MS) {
-        stream(0, (int32_t)ms * 1 + PERIOD_MS, 1000, ms); /* 0.1 deg per ms: 100 deg/s */
-        harness_run_ms(PERIOD_MS);
+        stream_on_time(base + ms * 1000u, (int32_t)ms * 1 + 3 * PERIOD_MS / 2, 1000, ms); /* 0.1 deg per ms: 100 deg/s */
     }
+    run_until_us(base + 400000u + 3000u * PERIOD_MS / 2u); /* the last setpoint's place */
     double last = setpoint_deg(), last_step = 0.1, peak_acc = 0;
     uint32_t stopped_at = 0;
     for (uint32_t ms = 1; ms <= 500; ms++) {
@@ -152,37 +258,60 @@ static void test_a_late_stream_brakes_to_a_hold(void **state)
     assert_false(servo.motion.running);
 }
 
+/* Each segment ends a depth of 3/2 period after its setpoint's place on the
+ * host's timeline: with the frames on time, 3/2 period after each arrives. */
 static void test_the_period_is_learned_or_told(void **state)
 {
     (void)state;
+    uint64_t base = hal.now_us + 10000u;
     /* Steps of 0.3 deg: segments within the stream's limits. */
-    stream(0, 0, 0, 1000);
-    assert_int_equal(servo.motion.profile.accel_ticks, 20); /* nothing learned yet: 50 Hz */
-    harness_run_ms(10);
-    stream(0, 3, 0, 1010);
-    assert_int_equal(servo.motion.stream_period_ms, 10);
-    assert_int_equal(servo.motion.profile.accel_ticks, 10);
-    harness_run_ms(10);
-    stream(0, 6, 0, 1020);
-    assert_int_equal(servo.motion.profile.accel_ticks, 10);
+    stream_on_time(base, 0, 0, 0);
+    assert_int_equal(servo.motion.profile.accel_ticks, 30); /* nothing learned yet: 50 Hz */
+    stream_on_time(base + 10000u, 3, 0, 10);
+    assert_int_equal(servo.motion.stream_period_q4 >> 4, 10);
+    assert_int_equal(servo.motion.profile.accel_ticks, 15);
+    stream_on_time(base + 20000u, 6, 0, 20);
+    assert_int_equal(servo.motion.profile.accel_ticks, 15);
     WRITE_ITEM(0, ITEM_STREAM_PERIOD_MS, 30); /* told: the stamps no longer count */
-    harness_run_ms(10);
-    stream(0, 9, 0, 1030);
-    assert_int_equal(servo.motion.profile.accel_ticks, 30);
+    stream_on_time(base + 30000u, 9, 0, 30);
+    assert_int_equal(servo.motion.profile.accel_ticks, 45);
     /* A stamp from another stream (a gap of more than PROFILE_MAX_SEGMENT)
-     * teaches nothing. */
+     * teaches nothing, and starts the host's timeline afresh. */
     WRITE_ITEM(0, ITEM_STREAM_PERIOD_MS, 0);
     stream(0, 9, 0, 5000);
-    assert_int_equal(servo.motion.profile.accel_ticks, 10);
+    assert_int_equal(servo.motion.profile.accel_ticks, 15);
+}
+
+/* A frame late by less than its depth less half a period keeps its place:
+ * its segment is shorter by as much. One later ends half a period (and a
+ * tick) on, its target run on along its velocity to where its path is
+ * then. */
+static void test_a_late_frame_keeps_its_place(void **state)
+{
+    (void)state;
+    uint64_t base = hal.now_us + 10000u;
+    /* A path at 100 deg/s: 0.1 deg a ms. */
+    stream_on_time(base, 0, 1000, 0);
+    stream_on_time(base + 20000u, 20, 1000, 20);
+    stream_on_time(base + 45000u, 40, 1000, 40); /* 5 ms late */
+    assert_int_equal(servo.motion.profile.accel_ticks, 30 - 5);
+    stream_on_time(base + 85000u, 60, 1000, 60); /* 25 ms late */
+    assert_int_equal(servo.motion.profile.accel_ticks, 11);
+    /* Its place was 5 ms on; the segment ends 11 ms on: 6 ms further on
+     * its path, 0.6 deg. */
+    double target = (double)servo.motion.target_q8 / 2560.0;
+    printf("# 25 ms late: its segment 11 ms, the target %.3f deg (stamped 6.0 at 100 deg/s)\n", target);
+    assert_true(fabs(target - 6.6) < 0.02);
 }
 
 static void test_the_host_clock_wraps(void **state)
 {
     (void)state;
-    stream(0, 0, 0, 65530);
-    harness_run_ms(15);
-    stream(0, 10, 0, 9); /* 65530 + 15 */
-    assert_int_equal(servo.motion.stream_period_ms, 15);
+    uint64_t base = hal.now_us + 10000u;
+    stream_on_time(base, 0, 0, 65530);
+    stream_on_time(base + 15000u, 10, 0, 9); /* 65530 + 15 */
+    assert_int_equal(servo.motion.stream_period_q4 >> 4, 15);
+    assert_int_equal(servo.motion.profile.accel_ticks, 22); /* on time: 3/2 of 15 ms */
 }
 
 /* A stream takes over from a long move and drops what is queued behind it;
@@ -415,8 +544,10 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test_setup(test_a_stream_tracks_the_path_smoothly, plant_harness_setup),
+        cmocka_unit_test_setup(test_a_host_late_or_early_changes_nothing, plant_harness_setup),
         cmocka_unit_test_setup(test_a_late_stream_brakes_to_a_hold, plant_harness_setup),
         cmocka_unit_test_setup(test_the_period_is_learned_or_told, plant_harness_setup),
+        cmocka_unit_test_setup(test_a_late_frame_keeps_its_place, plant_harness_setup),
         cmocka_unit_test_setup(test_the_host_clock_wraps, plant_harness_setup),
         cmocka_unit_test_setup(test_a_stream_takes_over_a_move, plant_harness_setup),
         cmocka_unit_test_setup(test_a_broadcast_setpoint_is_taken_silently, plant_harness_setup),

@@ -131,9 +131,8 @@ struct motion {
     uint8_t endless;           /* wheel run, stream: finished once at speed */
     uint8_t end;               /* enum motion_end */
     uint8_t drive_limiter;     /* enum limiter: what sets the duty limit */
-    uint8_t streaming;         /* a stream's segment runs, or its end speed goes on */
+    uint8_t streaming;         /* a stream runs: 1 after its first setpoint, 2 after more */
     uint8_t angle_clamped;     /* the running move's target was clamped (51, 52) */
-    uint8_t supply_check;      /* ticks since the supply was last looked at */
     uint8_t running;           /* a command runs: status bit 0 */
     struct encoder_track encoder;
     int32_t origin_counts;     /* encoder counts of angle 0 (before offset 53) */
@@ -176,7 +175,9 @@ struct motion {
      * restarts, a stream whose next setpoint has not come brakes. */
     uint32_t endless_until;
     uint16_t stream_host_ms;   /* the host's stamp of the last setpoint */
-    uint16_t stream_period_ms; /* learned from the stamps */
+    uint16_t stream_period_q4; /* learned from the stamps, ms Q4 */
+    uint16_t stream_clock_ms;  /* the servo's clock, a tick a ms (stream.c) */
+    uint32_t stream_offset_q16; /* the servo's clock less the host's, followed, ms Q16 */
     uint8_t answer_packet;     /* owed when the running command finishes */
     uint8_t soft_start_pending;
     struct motion_queue queue;
