@@ -29,8 +29,11 @@ def test_new_servos_at_one_id_collide_alike_on_every_simulator(tmp_path, capsys,
         assert "IDs held by two or more servos: 0" in err
         rc, out, err = run("id", "bringup", "--first", "1", "--count", str(count), "--wait-s", "3")
         assert rc == 3 and "connect one new servo at a time" in out, out + err
-        # Said once while the collisions go on, not at every probe (a probe a second).
-        assert out.count("their answers collide") == 1 and "connect new servo" not in out, out
+        # Said once while the collisions go on, not at every probe (a probe a second). An
+        # emulated board slowed by a loaded PC may miss the first probe (no answer in time):
+        # the prompt for a new servo comes once, before the collisions.
+        assert out.count("their answers collide") == 1, out
+        assert out.count("connect new servo") <= 1 and out.find("connect new servo") < out.find("collide"), out
         assert ("no servo alone at ID 0 within 3 s (two or more answer there at once, and their "
                 "answers collide: connect one new servo at a time); 0 numbered") in err, err
         assert "host rate" not in err, err  # they answered, garbled: not a rate to blame
