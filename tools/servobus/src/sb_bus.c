@@ -96,17 +96,6 @@ static sb_error fits(uint8_t code, const uint8_t *content, size_t len)
     return e;
 }
 
-/* Whether a frame of clen content bytes, ending now, ended before the last
- * request's end plus its own bytes on the wire: no answer to that request
- * can, so it is an earlier one's, handed over late. A link's latency only
- * delays an answer; its bytes' time is rounded down, the request's up. */
-static bool too_early(sb_bus *bus, size_t clen)
-{
-    uint64_t bytes = (clen >= SB_EXTENDED_LENGTH ? 7u : 5u) + (uint64_t)clen;
-    uint64_t own = bus->baud > 0 ? bytes * SB_BITS_PER_BYTE * 1000000u / bus->baud : 0u;
-    return bus->t.now_us(bus->t.ctx) < later(bus->sent_end_us, own);
-}
-
 /* sb_receive of an answer about item (its second byte; -1: any); the
  * transport may wait for want_after bytes (0: this frame's); look: once the
  * deadline has passed, one last look at what came meanwhile (else only the
@@ -130,8 +119,6 @@ static sb_error receive(sb_bus *bus, uint8_t code, int servo, int item, uint64_t
             bus->pending_len -= used;
             if (!got)
                 break;
-            if (too_early(bus, clen))
-                continue;
             if (fcode == code && (servo < 0 || (clen > 0 && fcontent[0] == servo)) && item >= 0 &&
                 (clen < 2 || fcontent[1] != item)) {
                 other = clen < 2 ? 256 : fcontent[1]; /* a late answer about another item: skipped */

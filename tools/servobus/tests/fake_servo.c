@@ -90,7 +90,7 @@ static int fake_write(void *ctx, const uint8_t *data, size_t len)
         f->fail_writes--;
         return -EIO;
     }
-    if (f->late_len > 0 && f->late_us == 0) { /* a late answer, its last byte off the wire as the request starts */
+    if (f->late_len > 0) { /* a late answer, its last byte off the wire as the request starts */
         memcpy(f->out + f->out_len, f->late, f->late_len);
         f->line_us = f->now_us;
         queue(f, f->late_len, 0);
@@ -99,11 +99,6 @@ static int fake_write(void *ctx, const uint8_t *data, size_t len)
     f->now_us += len * 10000000u / f->baud;
     f->line_us = f->now_us;
     f->first = true;
-    if (f->late_len > 0) { /* one handed over late_us after the request's end */
-        memcpy(f->out + f->out_len, f->late, f->late_len);
-        queue(f, f->late_len, f->late_us);
-        f->late_len = 0;
-    }
     for (;;) {
         size_t used = 0, clen = 0;
         uint8_t code = 0;

@@ -22,7 +22,6 @@ typedef struct fake_bus {
     bool first;            /* the next answer is the request's first */
     uint8_t late[64];      /* bytes that come at the start of the next request: */
     size_t late_len;       /* a late answer to the one before */
-    uint64_t late_us;      /* its last byte this long after the request's end (0: at its start) */
     int32_t setpoint[256]; /* the last StreamSetpoint angle each servo got */
     int16_t velocity[256];
     uint16_t stamp[256];

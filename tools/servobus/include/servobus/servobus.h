@@ -151,9 +151,7 @@ void sb_bus_init(sb_bus *bus, sb_transport t, uint32_t baud);
 /* Drops what waits unread, then writes frame in one write. */
 sb_error sb_send(sb_bus *bus, const uint8_t *frame, size_t len);
 /* The next answer of packet code from servo (-1: any) by deadline_us (bus
- * clock); other frames skipped, and any read before the last request's end
- * (sent_end_us) plus its own bytes' time at baud: a late answer of an
- * earlier request (the link's latency only delays answers). content: SB_ANSWER_CONTENT_MAX bytes. Of a
+ * clock); other frames skipped. content: SB_ANSWER_CONTENT_MAX bytes. Of a
  * servo given, a frame that does not fit the packet (the wrong length for
  * a fixed-size answer, else one that does not decode: a frame inside the
  * answer) is skipped too; if only such came, SB_E_BAD_ANSWER on it. */
