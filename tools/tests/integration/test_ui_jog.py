@@ -112,6 +112,36 @@ def test_stop_all_drops_a_jog_the_slider_kept(bench):
     assert max(abs(a - stopped) for a in watch.seen) < 0.2, (stopped, min(watch.seen), max(watch.seen))
 
 
+def test_another_tabs_stop_all_drops_a_jog_the_slider_kept(bench):
+    """A watching tab's STOP ALL answers a jog still queued "not run", not
+    exit 130, and the driving tab then sent the angle its slider kept: the
+    servo moved, and held, after the stop (round-4 review)."""
+    sim, page = bench
+    page.click("#tabs button[data-view=motion]")
+    at = round(sim.state(1)["angle"])
+    page.wait_for_function(f"!document.querySelector('#jog').disabled"
+                           f" && document.querySelector('#jog').value === '{at}'", timeout=WAIT_MS)
+    other = page.context.new_page()
+    try:
+        other.goto(page.url)
+        other.locator("#role", has_text="watching").wait_for(timeout=WAIT_MS)
+        page.bring_to_front()
+        # A job that holds the bus without moving the servo; two jogs behind it: one queued, one kept.
+        page.evaluate(f"""() => {{ UI.run(["move", "1", "{at}", "--interval", "1500", "--wait"]);
+            const j = document.querySelector('#jog');
+            j.value = '{at + 1}'; j.dispatchEvent(new Event('input'));
+            j.value = '{at + 1}'; j.dispatchEvent(new Event('input')); }}""")
+        sim.sleep(0.3)
+        other.click("#stop-all")
+        page.locator("#log", has_text="stop-all:").wait_for(timeout=WAIT_MS)
+        stopped = sim.state(1)["angle"]
+        with _Watch(sim) as watch:
+            sim.sleep(1.5)
+        assert max(abs(a - stopped) for a in watch.seen) < 0.2, (stopped, min(watch.seen), max(watch.seen))
+    finally:
+        other.close()
+
+
 def test_the_servo_view_says_an_item_out_of_order_in_the_unit_typed(bench):
     """angle_min 100 with angle_max 90 was said "servo 1 refused angle_min
     = 1000": protocol units, no reason."""

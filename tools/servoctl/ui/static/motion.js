@@ -31,9 +31,10 @@
     const r = await runInto($("#motion-out"), ["move", id, angle, "--interval", 200, "--wait"],
       {op: "jog", id, angle: Number(angle)});
     jogBusy = false;
-    // A jog stopped (130: STOP ALL, or dropped) drops the angle the slider
-    // kept meanwhile: it was sent after the stop, and moved the servo again.
-    if (r.code === 130) jogNext = null;
+    // A jog that did not run (stopped, dropped by STOP ALL, refused) drops
+    // the angle the slider kept meanwhile: sent after a stop, it moved the
+    // servo again (another tab's STOP ALL answers a dropped jog "not run").
+    if (r.code !== 0) jogNext = null;
     if (jogNext !== null) { const a = jogNext; jogNext = null; jog(a); }
     else readAngle();  // the slider back where the servo is: moved, or refused
   }
