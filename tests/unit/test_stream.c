@@ -199,7 +199,7 @@ static void test_a_stream_tracks_the_path_smoothly(void **state)
  * a whole period late (a burst with the next), keep the motion's shape and
  * its delay: at the lag that fits best, nearly the punctual host's error
  * and lag, and no sharper bend. A servo that played each setpoint from
- * its arrival saw 5 deg and thousands of deg/s^2 (issue 67). */
+ * its arrival saw 5 deg and thousands of deg/s^2. */
 static void test_a_host_late_or_early_changes_nothing(void **state)
 {
     (void)state;
@@ -219,7 +219,8 @@ static void test_a_host_late_or_early_changes_nothing(void **state)
                t.rms_deg, t.lag_ms, t.shape_rms_deg, t.peak_deg_s2);
         assert_true(t.shape_rms_deg < punctual.shape_rms_deg + 0.1);
         assert_true(fabs(t.lag_ms - punctual.lag_ms) <= 1.0);
-        assert_true(t.peak_deg_s2 < 2000.0); /* issue 67's bound for the horn; the setpoint's is sharper */
+        /* The horn's bound (docs/streaming.md); the setpoint bends sharper. */
+        assert_true(t.peak_deg_s2 < 2000.0);
     }
 }
 
@@ -231,7 +232,8 @@ static void test_a_late_stream_brakes_to_a_hold(void **state)
     (void)state;
     uint64_t base = hal.now_us + 10000u;
     for (uint16_t ms = 0; ms <= 400; ms += PERIOD_MS) {
-        stream_on_time(base + ms * 1000u, (int32_t)ms * 1 + 3 * PERIOD_MS / 2, 1000, ms); /* 0.1 deg per ms: 100 deg/s */
+        /* 0.1 deg a ms: 100 deg/s, each setpoint where the path is at its place. */
+        stream_on_time(base + ms * 1000u, (int32_t)ms + 3 * PERIOD_MS / 2, 1000, ms);
     }
     run_until_us(base + 400000u + 3000u * PERIOD_MS / 2u); /* the last setpoint's place */
     double last = setpoint_deg(), last_step = 0.1, peak_acc = 0;
