@@ -344,7 +344,9 @@ class Arm:
             self.measured_period_s += 0.3 * (min(now - self._times[-1], 1.0) - self.measured_period_s)
         self._times = (self._times + [now])[-3:]
         if self.firmware == "servoctl":
-            self.stream.send({self.joints[n]: d for n, d in sent.items()}, self._velocities(sent))
+            # Stamped now: a target is where the arm should be when it was
+            # sent, and the servo plays it at that moment's place.
+            self.stream.send({self.joints[n]: d for n, d in sent.items()}, self._velocities(sent), at_s=now)
         else:
             self._send_moves(sent)
         self._before = self.targets

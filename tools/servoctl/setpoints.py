@@ -152,12 +152,16 @@ class Stream:
         record = p.request_format(p.STREAM_SETPOINT)
         self._records = struct.Struct(record[0] + record[1:] * len(self.ids))
 
-    def frame_content(self, targets: dict, velocities: dict = None) -> tuple:
-        """(code, content) of the next send: checks every value first."""
+    def frame_content(self, targets: dict, velocities: dict = None, at_s: float = None) -> tuple:
+        """(code, content) of the next send: checks every value first. at_s:
+        the moment on the host's clock (s) the setpoints are for, their
+        stamp; else the send's place on the period's grid. The servo plays
+        each at its stamp's place, 3/2 period after a punctual send
+        (docs/streaming.md, "On the host's timeline")."""
         missing = [i for i in self.ids if i not in targets]
         if missing or len(targets) != len(self.ids):
             raise UsageError(f"a setpoint for every streamed servo ({self.ids}), not for {sorted(targets)}")
-        stamp = (self.sent * self.period_ms) % 65536
+        stamp = (self.sent * self.period_ms if at_s is None else round(at_s * 1000)) % 65536
         records = []
         for servo_id in self.ids:
             angle = check_range("angle", scaled(targets[servo_id], 10, "degrees"),
@@ -186,10 +190,10 @@ class Stream:
         follows none, and is not checked against the last."""
         self._last.pop(servo_id, None)
 
-    def send(self, targets: dict, velocities: dict = None, then=()) -> None:
-        """The setpoints, and the requests then (code, content) after them
-        in the same burst."""
-        self.bus.send_burst([self.frame_content(targets, velocities), *then])
+    def send(self, targets: dict, velocities: dict = None, then=(), at_s: float = None) -> None:
+        """The setpoints (stamped at_s, frame_content), and the requests then
+        (code, content) after them in the same burst."""
+        self.bus.send_burst([self.frame_content(targets, velocities, at_s), *then])
         self.sent += 1
 
 
@@ -233,15 +237,18 @@ class RobotLoop:
             self.bus.sleep(self.due - now)
         self.due += self.period_s
 
-    def cycle(self, targets: dict, velocities: dict = None) -> dict:
+    def cycle(self, targets: dict, velocities: dict = None, at_s: float = None) -> dict:
+        """at_s: the moment the setpoints are for (Stream.frame_content); a
+        paced loop's is its slot on the period's grid, a late cycle's too."""
         if self.pace:
             self._wait_turn()
+            at_s = self.due - self.period_s if at_s is None else at_s
         elif self.started is None:
             self.started = self.bus.clock()
         self.last_start = self.bus.clock()
         # One write: the Sync Monitor follows the setpoints on the wire
         # without a host's gap between them.
-        self.stream.send(targets, velocities, then=[self._monitor])
+        self.stream.send(targets, velocities, then=[self._monitor], at_s=at_s)
         states = monitor_answers(self.bus, self.stream.ids, arrivals=self.arrivals)
         self.missed += len(self.stream.ids) - len(states)
         self.cycles += 1

@@ -12,13 +12,14 @@ them is refused, never clamped: a clamped path is not the host's, and the
 servo, without the next setpoint, brakes to a hold where the last one
 was (docs/streaming.md). A file is checked whole before anything moves."""
 import math
+import struct
 import time
 from dataclasses import dataclass
 
 from . import protocol as p
 from .checks import scaled, to_ms
 from .frame import jerk_limit
-from .errors import NoReply, Refused
+from .errors import NoReply, Refused, UsageError
 from .group import sync_monitor
 from .loop_rate import BITS_PER_BYTE, LoopLate, LoopRate, check_wire  # noqa: F401 (LoopLate: the API's)
 from .move_request import MoveRequest
@@ -117,10 +118,14 @@ class StreamReport:
     paced: bool = False  # a paced simulator: the host's time cost none
 
 
-def stream_file(bus: p.Bus, times, angles: dict, progress=None, limits: dict = None) -> StreamReport:
+def stream_file(bus: p.Bus, times, angles: dict, progress=None, limits: dict = None,
+                host=None) -> StreamReport:
     """Streams the trajectory at its own period, the servos already at its
-    first row (lead_in): each row is sent a period before its time
-    (velocities by central differences, 0 at the first and last rows), and
+    first row (lead_in): each row is stamped with its time and sent the
+    servo's depth (3/2 period) before it, where the servo plays it
+    (velocities by central differences, 0 at the first and last rows);
+    host (host_timing.HostTiming) moves each send as a real host's, and
+    changes nothing where the servo plays it; and
     each servo's state from the cycle's Sync Monitor is compared with the
     trajectory at the moment it arrived. Every row is checked against the
     servos' limits (read from them if not given) before the first is sent."""
@@ -157,11 +162,21 @@ def stream_file(bus: p.Bus, times, angles: dict, progress=None, limits: dict = N
     # over together, so the nth arrives at the earliest then: the earliest
     # such estimate is the instant, late by the adapter's wait alone.
     answer_s = p.answer_frame_size(p.MONITOR) * BITS_PER_BYTE / bus.serial.baudrate
-    start = bus.clock() + period  # row 0 is for a period after it is sent
+    # A punctual setpoint is played the servo's depth after its last byte
+    # arrives: each row leaves that and its frame's time on the wire ahead.
+    record = p.request_format(p.STREAM_SETPOINT)
+    frame = p.request_frame(p.SYNC, bytes(3 + struct.calcsize(record) * len(ids))) if len(ids) > 1 else \
+        p.request_frame(p.STREAM_SETPOINT, bytes(struct.calcsize(record)))
+    depth = 1.5 * period + len(frame) * BITS_PER_BYTE / bus.serial.baudrate
+    start = bus.clock() + depth
     wall_start = time.monotonic()
     for k in range(count):
-        bus.sleep(max(0.0, start + (k - 1) * period - bus.clock()))
-        states = loop.cycle({i: angles[i][k] for i in ids}, {i: velocity(i, k) for i in ids})
+        leaves = start + k * period - depth
+        if host:
+            leaves = host.leaves(k, leaves, period)
+        bus.sleep(max(0.0, leaves - bus.clock()))
+        states = loop.cycle({i: angles[i][k] for i in ids}, {i: velocity(i, k) for i in ids},
+                            at_s=start + k * period)
         if k > 0 and states:  # a state is compared with the trajectory when it was taken
             taken = min(loop.arrivals[i] - (n + 1) * answer_s for n, i in enumerate(ids) if i in states)
             for servo_id in ids:
@@ -178,6 +193,17 @@ def stream_file(bus: p.Bus, times, angles: dict, progress=None, limits: dict = N
     paced = getattr(bus, "note_sent", None) is not None  # it runs only while the host waits
     speed = None if paced or bus.clock is time.monotonic or wall <= 0 else (bus.clock() - start + period) / wall
     return StreamReport(period, count, rms, peak, loop.rate(), loop.missed, speed, paced)
+
+
+def host_timing(args):
+    """The --host-jitter-ms / --host-late-every model, or None."""
+    from .host_timing import HostTiming
+
+    try:
+        host = HostTiming(args.host_jitter_ms / 1000.0, args.host_late_every)
+    except ValueError as e:
+        raise UsageError(f"--host-jitter-ms, --host-late-every: {e}") from None
+    return host or None
 
 
 def cmd_stream(bus, args):
@@ -202,7 +228,8 @@ def cmd_stream(bus, args):
     with Progress(transient=True, disable=not sys.stderr.isatty()) as progress:
         task = progress.add_task("streaming", total=len(trajectory.times))
         report = stream_file(bus, trajectory.times, angles,
-                             lambda done, total: progress.update(task, completed=done), limits)
+                             lambda done, total: progress.update(task, completed=done), limits,
+                             host_timing(args))
     period = report.period_s
     stretched = ""
     if lead.soft_start_s and lead.took_s > args.lead_in + 0.1:

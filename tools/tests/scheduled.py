@@ -39,14 +39,15 @@ def schedule(sim, frames) -> None:
 def followed(sim, times, angles: dict, baud: int = 115200) -> dict:
     """Streams a trajectory ({id: [degrees...]} at times, evenly spaced,
     the servos at rest at its first row) as servoctl stream does (each row
-    a period before its time, velocities the central differences of the
+    stamped with its time and sent the servo's depth, 3/2 period, before
+    it; velocities the central differences of the
     rows, 0 at both ends; one SyncCommand of setpoints a period), every
     frame put on the simulated wire at its time before the first is due
     (a setpoint is not answered: nothing else is on the wire meanwhile).
     Meanwhile the models' state (the control port's, each with its own
     simulated time) is read as often as the host can: each horn's angle is
     compared with the trajectory as the servo was given it, each row
-    reached a period after its setpoints' last byte arrived
+    reached the depth after its setpoints' last byte arrived
     (docs/streaming.md). {id: (RMS, peak, samples)} in deg."""
     ids = list(angles)
     period = times[1] - times[0]
@@ -62,9 +63,9 @@ def followed(sim, times, angles: dict, baud: int = 115200) -> dict:
     for k in range(count):
         code, content = stream.frame_content({i: angles[i][k] for i in ids}, {i: velocity(i, k) for i in ids})
         stream.sent += 1
-        frames.append((row0_s + (k - 1) * period, p.request_frame(code, content)))
+        frames.append((row0_s + (k - 1.5) * period, p.request_frame(code, content)))
     schedule(sim, frames)
-    lag = len(frames[0][1]) * 10 / baud  # a row is reached a period after its frame's last byte
+    lag = len(frames[0][1]) * 10 / baud  # a row is reached the depth after its frame's last byte
 
     def reference(i, t):
         x = min(max((t - lag - row0_s) / period, 0.0), count - 1.0)
