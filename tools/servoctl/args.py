@@ -314,6 +314,8 @@ def build_parser():
                         f"setpoints sent late, exit 1 (default {STREAM_TOLERANCE_DEG})")
     c.add_argument("--report-only", action="store_true",
                    help="print the figures and exit 0 however the servos followed")
+    c.add_argument("--host-jitter-ms", type=finite, default=0.0, metavar="MS", help="model a host: rows sent ±MS")
+    c.add_argument("--host-late-every", type=int, default=0, metavar="N", help="model a host: 1 row in N a period late")
 
     c = sub.add_parser("identify", help="the drive train's constants from open-loop duty steps (horn free)")
     c.add_argument("id", type=int)
@@ -391,10 +393,8 @@ def build_parser():
     c.add_argument("--tcp", type=int, nargs="?", const=0, default=None, metavar="PORT",
                    help="a TCP port instead of a pty (any free port if none given)")
     c.add_argument("--link", help="symlink to the pty (not with --tcp)")
-    c.add_argument("--host-link", metavar="usb|ftdi[:MS]|raw",
-                   help="how the host's USB-serial adapter hands over the bytes off the wire: usb "
-                        "(default), ftdi (a 16 ms latency timer, or MS) or raw (docs/simulator.md)")
+    c.add_argument("--host-link", metavar="usb|ftdi[:MS]|raw", help="the host's USB adapter: usb (default), "
+                   "ftdi (a 16 ms latency timer, or MS) or raw (docs/simulator.md)")
     c.add_argument("--state", help="folder for the flash files")
-    c.add_argument("--plant", help="the servo's motor, gears and heat from a plant file "
-                                   "(hal/ports/host/plants/*.toml; default: the reference servo)")
+    c.add_argument("--plant", help="a plant file: motor, gears, heat (hal/ports/host/plants/*.toml)")
     return ap
