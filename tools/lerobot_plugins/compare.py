@@ -2,7 +2,8 @@
 the same simulated arm: 7 servos, IDs 0-6, 1 Mbaud, servo_sim. Run in the
 LeRobot environment (scripts/lerobot_compare.sh; docs/lerobot.md):
 
-    python compare.py [--only ours|maker] [--json FILE]
+    python compare.py [--only ours|maker] [--json FILE] [--fps N]
+                      [--jitter-ms MS] [--late-every N] [--real-time]
 
 Each plugin, made by LeRobot's make_robot_from_config, runs a follower loop
 at 30 Hz: a lead-in from where the arm is to -45 deg, then a 0.5 Hz +-45
@@ -27,7 +28,13 @@ maker's SDK times its reads on the host's clock and knows nothing of the
 simulator's clock, which a paced servo_sim would never see move: its
 simulator keeps real time, and its figures move with the load. The
 servos start at different angles (START) so that a move at connect
-shows."""
+shows.
+
+--jitter-ms and --late-every move each frame's send as a real host's
+would (servoctl.host_timing, on the simulated clock): up to MS early or
+late, one in N a whole period late with the next. --real-time runs ours
+on a simulator that keeps real time too: then the host's own jitter is
+the PC's."""
 import argparse
 import dataclasses
 import json
@@ -42,6 +49,7 @@ from pathlib import Path
 from lerobot.robots.config import RobotConfig
 from lerobot.robots.utils import make_robot_from_config
 from lerobot.utils.import_utils import register_third_party_plugins
+from servoctl.host_timing import HostTiming
 from servoctl.servo import Servo
 from servoctl.sim import Simulator, _fields, on_us_grid
 
@@ -103,10 +111,12 @@ def config(robot_type: str, sim, cal_dir, **kw):
 
 class Ours:
     name = "servoctl_arm (ours)"
-    paced = True
+
+    def __init__(self, paced: bool = True, fps: int = FPS):
+        self.paced, self.fps = paced, fps
 
     def make(self, sim, cal_dir):
-        robot = make_robot_from_config(config("servoctl_arm", sim, cal_dir, fps=FPS))
+        robot = make_robot_from_config(config("servoctl_arm", sim, cal_dir, fps=self.fps))
         robot.clock = sim.clock_s  # the simulated clock, which moves while its bus waits
         return robot
 
@@ -120,6 +130,7 @@ class Ours:
 class Makers:
     name = "lerobot-robot-viola (maker's)"
     paced = False
+    fps = FPS
 
     def make(self, sim, cal_dir):
         cfg = config("lerobot_robot_viola", sim, cal_dir, use_degrees=True)
@@ -184,25 +195,32 @@ def silence(sim, servo_id: int) -> None:
     sim.control(f"unplug 1 {servo_id}")
 
 
-def run(plugin) -> dict:
+def run(plugin, host: HostTiming = None) -> dict:
+    """host: the host's timing model for each frame's send (None: on time)."""
     sim = prepare(plugin.paced)
     cal = Path(tempfile.mkdtemp(prefix="lerobot-cal-"))
     robot = None
-    result = {"plugin": plugin.name, "clock": "paced" if plugin.paced else "real time"}
+    result = {"plugin": plugin.name, "clock": "paced" if plugin.paced else "real time", "fps": plugin.fps,
+              "host": "on time" if not host else f"±{host.jitter_s * 1000:g} ms" +
+              (f", 1 in {host.late_every} a frame late" if host.late_every else "")}
     try:
         robot = plugin.make(sim, cal)
         result["connect_move_deg"] = connect_movement(sim, plugin, robot)
         start = plugin.read(robot, robot.get_observation())
         samples, reads = [], {i: set() for i in IDS}
         t0 = sim.clock_s()
-        frames = round((LEAD_S + SINE_S) * FPS)
+        fps = plugin.fps
+        frames = round((LEAD_S + SINE_S) * fps)
         for k in range(frames):
             for i, d in plugin.read(robot, robot.get_observation()).items():
                 if d is not None:
                     reads[i].add(round(d, 4))
             now = sim.clock_s() - t0
             robot.send_action(plugin.action(robot, {i: path_deg(now, start[i]) for i in IDS}))
-            wait_sampling(sim, t0 + (k + 1) / FPS, samples)  # the frame's wait: on the simulated clock
+            due = t0 + (k + 1) / fps
+            if host:
+                due = max(host.leaves(k + 1, due, 1 / fps), sim.clock_s())
+            wait_sampling(sim, due, samples)  # the frame's wait: on the simulated clock
         result.update(tracking(samples, t0, start))
         result["peak_accel_dps2"] = peak_accel(samples, t0)
         result["read_step_deg"] = min(min(b - a for a, b in zip(v, v[1:])) for v in map(sorted, reads.values()))
@@ -278,7 +296,9 @@ def table(results) -> str:
             ("peak horn acceleration (deg/s^2)", "peak_accel_dps2", "{:.0f}", "<= 2000"),
             ("horn movement during connect (deg)", "connect_move_deg", "{:.2f}", "<= 0.2"),
             ("read resolution (deg)", "read_step_deg", "{:.3f}", "0.1"),
-            ("simulator's clock", "clock", "{}", "")]
+            ("simulator's clock", "clock", "{}", ""),
+            ("the loop (Hz)", "fps", "{}", ""),
+            ("the host's timing", "host", "{}", "")]
     head = "| | " + " | ".join(r["plugin"] for r in results) + " | target (ours) |"
     lines = [head, "|---|" + "---:|" * len(results) + "---|"]
     for label, key, fmt, target in rows:
@@ -297,10 +317,14 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--only", choices=("ours", "maker"))
     ap.add_argument("--json", help="write the figures here too")
+    ap.add_argument("--fps", type=int, default=FPS, help=f"ours' loop rate (default {FPS}; the maker's: {FPS})")
+    ap.add_argument("--jitter-ms", type=float, default=0.0, help="each frame sent up to MS early or late")
+    ap.add_argument("--late-every", type=int, default=0, help="one frame in N a whole period late")
+    ap.add_argument("--real-time", action="store_true", help="ours on a simulator in real time too")
     args = ap.parse_args(argv)
     register_third_party_plugins()
-    plugins = [x for x in (Ours(), Makers()) if args.only is None or args.only in x.name]
-    results = [run(x) for x in plugins]
+    plugins = [x for x in (Ours(not args.real_time, args.fps), Makers()) if args.only is None or args.only in x.name]
+    results = [run(x, HostTiming(args.jitter_ms / 1000.0, args.late_every) or None) for x in plugins]
     for r in results:
         print(f"{r['plugin']}: silent servo: {r['silent']}", file=sys.stderr)
     print(table(results))

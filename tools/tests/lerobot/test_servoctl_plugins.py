@@ -122,12 +122,25 @@ def test_the_follower_meets_the_comparisons_targets(seen):
     c = seen["compare"]
     print(c)
     assert c["clock"] == "paced"
-    assert c["rms_deg"] <= 0.5
+    assert c["rms_deg"] <= 0.3
     assert c["peak_accel_dps2"] <= 2000
     assert c["connect_move_deg"] <= 0.2
     assert c["read_step_deg"] == pytest.approx(0.1)
     assert c["silent"]["frames"] is not None and c["silent"]["frames"] <= 3
     assert "Motor_3 (servo 3) did not answer" in c["silent"]["error"]
+
+
+def test_the_follower_keeps_its_figures_with_a_real_hosts_timing(seen):
+    """Frames sent +-10 ms early or late, one in twenty a period late
+    (servoctl.host_timing): docs/lerobot.md's targets, where playing each setpoint
+    from its arrival gave 2-7.9 deg worst and 2 121-16 013 deg/s^2 on
+    real-time simulators."""
+    c = seen["compare_jitter"]
+    print(c)
+    assert c["host"] == "±10 ms, 1 in 20 a frame late"
+    assert c["rms_deg"] <= 0.3 and c["worst_deg"] <= 1.0
+    assert c["peak_accel_dps2"] <= 2000
+    assert c["lag_ms"] <= 2 * 1000 / c["fps"]  # within two frames
 
 
 def test_the_comparison_gives_no_acceleration_where_it_kept_no_samples(seen):
