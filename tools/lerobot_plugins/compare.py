@@ -207,7 +207,7 @@ def run(plugin, host: HostTiming = None) -> dict:
         robot = plugin.make(sim, cal)
         result["connect_move_deg"] = connect_movement(sim, plugin, robot)
         start = plugin.read(robot, robot.get_observation())
-        samples, reads = [], {i: set() for i in IDS}
+        samples, reads, sends = [], {i: set() for i in IDS}, []
         t0 = sim.clock_s()
         fps = plugin.fps
         frames = round((LEAD_S + SINE_S) * fps)
@@ -216,11 +216,15 @@ def run(plugin, host: HostTiming = None) -> dict:
                 if d is not None:
                     reads[i].add(round(d, 4))
             now = sim.clock_s() - t0
+            sends.append(now)
             robot.send_action(plugin.action(robot, {i: path_deg(now, start[i]) for i in IDS}))
             due = t0 + (k + 1) / fps
             if host:
                 due = max(host.leaves(k + 1, due, 1 / fps), sim.clock_s())
             wait_sampling(sim, due, samples)  # the frame's wait: on the simulated clock
+        # The host's largest gap between two frames, on the simulator's clock: on a
+        # simulator in real time, the PC's (and the simulator's own catching up).
+        result["gap_ms"] = 1000 * max(b - a for a, b in zip(sends, sends[1:]))
         result.update(tracking(samples, t0, start))
         result["peak_accel_dps2"] = peak_accel(samples, t0)
         result["read_step_deg"] = min(min(b - a for a, b in zip(v, v[1:])) for v in map(sorted, reads.values()))
@@ -298,7 +302,8 @@ def table(results) -> str:
             ("read resolution (deg)", "read_step_deg", "{:.3f}", "0.1"),
             ("simulator's clock", "clock", "{}", ""),
             ("the loop (Hz)", "fps", "{}", ""),
-            ("the host's timing", "host", "{}", "")]
+            ("the host's timing", "host", "{}", ""),
+            ("the largest gap between frames (ms)", "gap_ms", "{:.0f}", "")]
     head = "| | " + " | ".join(r["plugin"] for r in results) + " | target (ours) |"
     lines = [head, "|---|" + "---:|" * len(results) + "---|"]
     for label, key, fmt, target in rows:
