@@ -142,6 +142,40 @@ def test_another_tabs_stop_all_drops_a_jog_the_slider_kept(bench):
         other.close()
 
 
+def test_a_drag_that_goes_on_after_another_tabs_stop_all_jogs_nothing(bench):
+    """The driving tab's drag (input events every 8 ms about the servo's
+    angle) went on after a watching tab's STOP ALL, and each jog after it
+    drove the servo again (round-5 review). Now the slider holds until the
+    hand on it lets go (a pointerup or keyup), which a drag has not."""
+    sim, page = bench
+    page.click("#tabs button[data-view=motion]")
+    at = round(sim.state(1)["angle"])
+    page.wait_for_function(f"!document.querySelector('#jog').disabled"
+                           f" && document.querySelector('#jog').value === '{at}'", timeout=WAIT_MS)
+    other = page.context.new_page()
+    try:
+        other.goto(page.url)
+        other.locator("#role", has_text="watching").wait_for(timeout=WAIT_MS)
+        page.bring_to_front()
+        page.evaluate(f"""() => {{ const j = document.querySelector('#jog'); let k = 0;
+            window.dragging = setInterval(() => {{ j.value = String({at} + (k++ % 2));
+                j.dispatchEvent(new Event('input')); }}, 8); }}""")
+        sim.sleep(0.5)
+        other.click("#stop-all")
+        page.locator("#log", has_text="stop-all:").wait_for(timeout=WAIT_MS)
+        sim.sleep(0.3)  # a jog the stop interrupted has come back
+        stopped = sim.state(1)["angle"]
+        with _Watch(sim) as watch:
+            sim.sleep(1.0)
+        page.evaluate("() => clearInterval(window.dragging)")
+        assert max(abs(a - stopped) for a in watch.seen) < 0.2, (stopped, min(watch.seen), max(watch.seen))
+        assert page.inner_text("#jog-at") == "stopped: let go of the slider to jog again"
+        page.keyboard.up("Shift")  # a hand let go: the slider jogs again
+        page.wait_for_function("!document.querySelector('#jog').disabled", timeout=WAIT_MS)
+    finally:
+        other.close()
+
+
 def test_the_servo_view_says_an_item_out_of_order_in_the_unit_typed(bench):
     """angle_min 100 with angle_max 90 was said "servo 1 refused angle_min
     = 1000": protocol units, no reason."""

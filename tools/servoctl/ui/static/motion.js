@@ -4,13 +4,18 @@
 (() => {
   const {$, on, send, runInto, picked} = UI;
   let jogBusy = false, jogNext = null, shownId;  // shownId: whose angle the slider shows
+  // After a STOP ALL (any tab's) the slider jogs nothing until the hand on it
+  // lets go: a drag or a held key went on moving the servo after another
+  // tab's stop.
+  let jogStopped = false;
 
   // The slider where the servo is (deg: the server's read, the live
   // table's): a key then nudges it a step from there. It stood at 0 deg
   // whatever the servo's angle, and a nudge threw the horn there. Off while
   // the angle is not known, or beyond the slider's turn.
   function putSlider(deg) {
-    if (jogBusy || jogNext !== null) return;  // a jog under way: the read after it says
+    // A jog under way: the read after it says; stopped: the hand's letting go.
+    if (jogBusy || jogNext !== null || jogStopped) return;
     const slider = $("#jog"), known = typeof deg === "number";
     slider.disabled = !known || Math.abs(deg) > 180;
     if (!slider.disabled) slider.value = Math.round(deg);
@@ -25,6 +30,7 @@
     // The slider sends its newest angle once the last move was taken: a
     // drag does not queue a move for every pixel. The server refuses one
     // beyond a step from the servo's angle (worker.JOG_MAX_DEG).
+    if (jogStopped) return;
     if (jogBusy) { jogNext = angle; return; }
     jogBusy = true;
     const id = picked();
@@ -38,10 +44,25 @@
     if (jogNext !== null) { const a = jogNext; jogNext = null; jog(a); }
     else readAngle();  // the slider back where the servo is: moved, or refused
   }
-  // STOP ALL (this tab's or another's) forgets a jog not yet sent.
-  on("stopped", () => { jogNext = null; });
-  document.addEventListener("DOMContentLoaded", () =>
-    $("#stop-all").addEventListener("click", () => { jogNext = null; }));
+  // STOP ALL (this tab's or another's) forgets a jog not yet sent, and holds
+  // the slider until the pointer or key on it is let go.
+  function stopJogs() {
+    jogNext = null;
+    jogStopped = true;
+    $("#jog").disabled = true;
+    $("#jog-at").textContent = "stopped: let go of the slider to jog again";
+  }
+  function letGo() {
+    if (!jogStopped) return;
+    jogStopped = false;
+    readAngle();
+  }
+  on("stopped", stopJogs);
+  document.addEventListener("DOMContentLoaded", () => {
+    $("#stop-all").addEventListener("click", stopJogs);
+    document.addEventListener("pointerup", letGo);
+    document.addEventListener("keyup", letGo);
+  });
 
   // Each Motion action, then the slider where the servo is.
   const act = (argv) => runInto($("#motion-out"), argv).then(readAngle);
@@ -66,6 +87,7 @@
       act(argv);
     });
     $("#jog").addEventListener("input", (e) => {
+      if (jogStopped) return;
       $("#jog-at").textContent = `${e.target.value} deg`;
       jog(e.target.value);
     });
