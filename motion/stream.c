@@ -3,8 +3,8 @@
  * (docs/streaming.md, "On the host's timeline"): a segment from where the
  * setpoint is (position and speed) to the host's, a cubic (Hermite) that
  * ends at that moment, walked at the tick rate; the segment's end speed
- * goes on until the next setpoint comes, and a segment's time after its end
- * the servo brakes to a hold. A setpoint the cubic cannot reach within the
+ * goes on until the next setpoint comes, and a depth after its end (no
+ * more than the segment's length) the servo brakes to a hold. A setpoint the cubic cannot reach within the
  * stream's limits is reached as a move at them instead (docs/streaming.md).
  * Plans: divides. */
 #include "motion/motion_internal.h"
@@ -40,7 +40,9 @@ static uint32_t track(uint32_t value, uint32_t sample, uint32_t step)
 }
 
 /* The period, ms Q4: item 69 if set, else the step between the host's
- * stamps (a stream's first step, then followed; 20 ms, 50 Hz, until then).
+ * stamps (a stream's first step, its second where shorter: a host that
+ * sends a first setpoint and waits; then followed; 20 ms, 50 Hz, until
+ * then).
  * A gap of none, or longer than a segment, is a new stream: the servo's
  * clock at its first stamp is the offset then. *late_q4: how much later
  * than its place (the stamp + the offset) this setpoint came, ms Q4. */
@@ -50,13 +52,16 @@ static int32_t stream_period(struct motion *m, uint16_t host_ms, int32_t *late_q
     uint32_t offset_q16 = (uint32_t)(m->stream_clock_ms - host_ms) << 16; /* wraps as 16 bits */
     m->stream_host_ms = host_ms;
     bool fresh = !m->streaming || since - 1u >= PROFILE_MAX_SEGMENT;
+    uint32_t count = fresh ? 0u : m->streaming;
+    uint32_t step_q4 = since << 4;
     if (fresh) {
         m->stream_offset_q16 = offset_q16;
+    } else if (count == 1u || ((count == 2u) & (step_q4 < m->stream_period_q4))) {
+        m->stream_period_q4 = (uint16_t)step_q4; /* a first setpoint and a wait: the second step says */
     } else {
-        m->stream_period_q4 = (uint16_t)(m->streaming == 1u ? since << 4
-                                                           : track(m->stream_period_q4, since << 4, TRACK_STEP_Q4));
+        m->stream_period_q4 = (uint16_t)track(m->stream_period_q4, step_q4, TRACK_STEP_Q4);
     }
-    m->streaming = fresh ? 1u : 2u;
+    m->streaming = (uint8_t)(count + (count < 3u));
     uint32_t median = m->stream_offset_q16;
     *late_q4 = (int32_t)(offset_q16 - median) >> 12; /* +-32 s */
     m->stream_offset_q16 = track(median, offset_q16, TRACK_STEP_Q16);
@@ -154,7 +159,8 @@ enum motion_submit_result motion_stream(struct motion *m, const struct motion_se
      * before its place ends half a period on, the target run on as far (at
      * most a period). */
     int32_t half = period_q4 >> 5;
-    int32_t place_q4 = period_q4 + (period_q4 >> 1) - late_q4;
+    int32_t depth_q4 = period_q4 + (period_q4 >> 1);
+    int32_t place_q4 = depth_q4 - late_q4;
     int32_t ticks = clamp_i32(place_q4 >> 4, half + 1, (int32_t)PROFILE_MAX_SEGMENT);
     int32_t run_on_q4 = clamp_i32(ticks * 16 - place_q4, -16, period_q4);
     /* The stream's reference goes on from the setpoint, however the horn
@@ -186,9 +192,11 @@ enum motion_submit_result motion_stream(struct motion *m, const struct motion_se
     }
     motion_begin_profile(m, END_HOLD);
     m->endless = cubic && v1 != 0;
-    /* A segment's time again with no setpoint: the stream has stopped (its
-     * run-on is that long at most: path_within's hull). A period late, and
-     * jitter on top, is not a stop. */
-    m->endless_until = 2u * (uint32_t)ticks;
+    /* A depth after the segment's end (no more than the segment, which
+     * path_within's hull holds) with no setpoint: the stream has stopped. A
+     * frame a period late, jitter on top, is not a stop; an early one's
+     * run-on is no longer for its long segment. */
+    uint32_t depth = (uint32_t)depth_q4 >> 4;
+    m->endless_until = (uint32_t)ticks + ((uint32_t)ticks < depth ? (uint32_t)ticks : depth);
     return MOTION_ACCEPTED;
 }

@@ -306,6 +306,65 @@ static void test_a_late_frame_keeps_its_place(void **state)
     assert_true(fabs(target - 6.6) < 0.02);
 }
 
+/* Runs until the setpoint has not moved for 20 ms (at most 3 s): how long
+ * that took, ms, and where it stopped, deg. */
+static uint32_t run_until_still(double *at_deg)
+{
+    double last = setpoint_deg();
+    uint32_t still = 0, ms = 0;
+    while (still < 20u && ms < 3000u) {
+        harness_run_ms(1);
+        ms++;
+        still = fabs(setpoint_deg() - last) < 1e-6 ? still + 1u : 0u;
+        last = setpoint_deg();
+    }
+    *at_deg = last;
+    return ms - still;
+}
+
+/* A first setpoint, a wait of 300 ms, then a 50 Hz stream: the period was
+ * the wait's (1/8 ms a setpoint back to 20 ms took 45 s), the depth 450
+ * ms, and the servo ran on 70 deg past the host's last setpoint once it
+ * stopped. The second step, shorter, says the period. */
+static void test_a_first_setpoint_and_a_wait_teach_no_period(void **state)
+{
+    (void)state;
+    WRITE_ITEM(0, ITEM_ANGLE_LIMIT_ON, 0);
+    uint64_t base = hal.now_us + 10000u;
+    stream_on_time(base, 0, 0, 0);
+    uint16_t ms = 300;
+    for (int k = 0; k < 30; k++, ms = (uint16_t)(ms + PERIOD_MS)) {
+        stream_on_time(base + ms * 1000u, (ms - 300) * 2, 2000, ms); /* 200 deg/s */
+    }
+    assert_int_equal(servo.motion.stream_period_q4 >> 4, PERIOD_MS);
+    double last = (double)((ms - PERIOD_MS - 300) * 2) / 10.0, at = 0;
+    uint32_t took = run_until_still(&at);
+    printf("# a first setpoint, 300 ms, then 50 Hz at 200 deg/s: still %u ms after the last frame, "
+           "%.1f deg past its setpoint\n", took, at - last);
+    assert_true(took < 200u && at - last < 15.0);
+}
+
+/* One frame stamped 500 ms early, the host then gone: its segment ends at
+ * its place, and ran on as long again (156 deg past its setpoint at 300
+ * deg/s). A run-on is the depth, 3/2 period, at most. */
+static void test_an_early_last_frame_stops_within_periods(void **state)
+{
+    (void)state;
+    WRITE_ITEM(0, ITEM_ANGLE_LIMIT_ON, 0);
+    uint64_t base = hal.now_us + 10000u;
+    for (uint16_t ms = 0; ms <= 400; ms += PERIOD_MS) {
+        uint16_t stamp = ms == 400 ? 900 : ms;
+        stream_on_time(base + ms * 1000u, ms * 3 + 3 * PERIOD_MS * 3 / 2, 3000, stamp); /* 300 deg/s */
+    }
+    assert_int_equal(servo.motion.profile.accel_ticks, 3 * PERIOD_MS / 2 + 500);
+    double at = 0;
+    uint32_t took = run_until_still(&at);
+    printf("# a last frame 500 ms early at 300 deg/s: still %u ms after it, at %.1f deg (its setpoint 129)\n",
+           took, at);
+    /* Its place, the depth's run-on (9 deg) and the brake. */
+    assert_true(took < 530u + 3u * PERIOD_MS / 2u + 100u && at < 129.0 + 20.0);
+}
+
 static void test_the_host_clock_wraps(void **state)
 {
     (void)state;
@@ -550,6 +609,8 @@ int main(void)
         cmocka_unit_test_setup(test_a_late_stream_brakes_to_a_hold, plant_harness_setup),
         cmocka_unit_test_setup(test_the_period_is_learned_or_told, plant_harness_setup),
         cmocka_unit_test_setup(test_a_late_frame_keeps_its_place, plant_harness_setup),
+        cmocka_unit_test_setup(test_a_first_setpoint_and_a_wait_teach_no_period, plant_harness_setup),
+        cmocka_unit_test_setup(test_an_early_last_frame_stops_within_periods, plant_harness_setup),
         cmocka_unit_test_setup(test_the_host_clock_wraps, plant_harness_setup),
         cmocka_unit_test_setup(test_a_stream_takes_over_a_move, plant_harness_setup),
         cmocka_unit_test_setup(test_a_broadcast_setpoint_is_taken_silently, plant_harness_setup),
