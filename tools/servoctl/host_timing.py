@@ -10,8 +10,9 @@ import random
 
 class HostTiming:
     def __init__(self, jitter_s: float = 0.0, late_every: int = 0, seed: int = 67):
-        if jitter_s < 0 or late_every < 0:
-            raise ValueError("a host's jitter and its late frames are counted from 0")
+        if not 0 <= jitter_s <= 1.0 or late_every < 0:
+            raise ValueError(f"a host's jitter is 0 to 1000 ms and its late frames one in 0 (none) or more, "
+                             f"not {jitter_s * 1000:g} ms and {late_every}")
         self.jitter_s, self.late_every = jitter_s, late_every
         self._rng = random.Random(seed)
         self._last = None

@@ -126,8 +126,9 @@ def read_limits(bus: p.Bus, ids) -> dict:
 
 class Stream:
     """Setpoints for ids every period_s: send({id: degrees}) once a period,
-    one period ahead of where the servos should be (each servo reaches a
-    setpoint a period after it arrives). Velocities, in degrees per second,
+    each stamped with the moment it is for (at_s, or its place on the
+    period's grid); a servo plays it 3/2 period after a punctual send
+    (docs/streaming.md, "On the host's timeline"). Velocities, in degrees per second,
     are given or taken from the last two setpoints. One servo gets its own
     packet; several, one SyncCommand frame, so they start together.
 

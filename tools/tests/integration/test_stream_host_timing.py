@@ -62,5 +62,6 @@ def test_the_host_timing_model():
     assert all(m == pytest.approx(0.02) for m in late)  # a whole period late
     rest = [m for k, m in enumerate(moved) if k % 20 not in (19, 0)]
     assert max(rest) <= 0.01 + 1e-12 and min(rest) >= -0.01 - 1e-12 and max(rest) - min(rest) > 0.015
-    with pytest.raises(ValueError):
-        HostTiming(-0.001)
+    for bad in ((-0.001, 0), (1e6, 0), (float("nan"), 0), (0.01, -1)):
+        with pytest.raises(ValueError):
+            HostTiming(*bad)
