@@ -197,7 +197,8 @@ class Page:
 
     def _roles(self):
         """Tells every tab its role, through its outbox: none waits for another."""
-        told = {role: json.dumps({"type": "hello", "role": role, "holder": holder, **self.about})
+        told = {role: json.dumps({"type": "hello", "role": role, "holder": holder, "stops": self.worker.stops,
+                                  **self.about})
                 for role, holder in (("driver", None), ("viewer", self.who.get(self.driver)))}
         for ws in list(self.sockets):
             self._tell(ws, told["driver" if ws is self.driver else "viewer"])
@@ -216,7 +217,8 @@ class Page:
         elif op == "angle":
             w.submit(w.angle, _whole(ask["id"], "id"), tag)
         elif op == "jog":
-            w.submit(w.jog, _whole(ask["id"], "id"), _number(ask["angle"], "angle"), tag)
+            w.submit(w.jog, _whole(ask["id"], "id"), _number(ask["angle"], "angle"), _whole(ask.get("stops", 0),
+                                                                                            "stops"), tag)
         elif op == "plot":
             ids = ask.get("ids", [])
             if not isinstance(ids, list):

@@ -88,6 +88,7 @@ class Worker:
         self.urgent = collections.deque()  # stop-all, and what a closed tab leaves
         self.cond = threading.Condition()  # guards both, current, and the interrupt's setting
         self.known = []     # the live table's IDs (after a scan)
+        self.stops = 0      # STOP ALLs so far: a jog asked before the last is not run
         self.plot_ids = []  # sampled while the queue is empty
         self.sampler = None
         self.stopping = threading.Event()
@@ -124,6 +125,7 @@ class Worker:
         broadcast stop on the wire at once (preempt.py), then stop_all
         before anything queued."""
         with self.cond:
+            self.stops += 1
             if self.current != self.stop_all:
                 self.preempt.interrupt("stop-all")
             if (self.stop_all, (mode,)) not in self.urgent:
@@ -183,11 +185,17 @@ class Worker:
                     staging.close()
         return self._result(tag, argv, code, out.text(), err.text())
 
-    def jog(self, servo_id: int, angle: float, tag=None) -> dict:
+    def jog(self, servo_id: int, angle: float, stops: int, tag=None) -> dict:
         """The jog slider's angle: moved to in JOG_MS if it is within
-        JOG_MAX_DEG of where the servo is (read now), else refused. The page
-        asks for the angle after it (angle()) and puts the slider there."""
+        JOG_MAX_DEG of where the servo is (read now), else refused; not run
+        if a STOP ALL came since the page last heard of one (stops: the
+        count it has; a drag goes on sending through another tab's stop).
+        The page asks for the angle after it (angle()) and puts the slider
+        there."""
         argv = ["move", str(servo_id), f"{angle:g}", "--interval", str(JOG_MS), "--wait"]
+        if stops < self.stops:
+            return self._result(tag, argv, EXIT_INTERRUPTED, "", "servoctl ui: not run: STOP ALL came after this "
+                                "jog was asked; let go of the slider to jog again")
         try:
             at = Servo(self.bus, servo_id).multi_turn_angle()[0] / 10
         except KeyboardInterrupt:  # its answer all the same: the page waits for it
@@ -295,13 +303,15 @@ class Worker:
             if fn == self.run:
                 argv, tag = a
                 self._result(tag, argv, EXIT_INTERRUPTED, "", NOT_RUN)
+            elif fn == self.jog:  # a move not made, as a stopped one: the page holds its slider
+                self._result(a[-1], ["move", str(a[0]), f"{a[1]:g}"], EXIT_INTERRUPTED, "", NOT_RUN)
             else:
                 self.publish({"type": "error", "op": fn.__name__, "tag": a[-1] if len(a) > 1 else None,
                               "text": NOT_RUN})
         ids = self.known or self.plot_ids
         said = [self.run_quiet(["stop", str(i), "--mode", mode]) for i in ids]
         failed += [r["err"] for r in said if r["code"]]
-        self.publish({"type": "stopped", "mode": mode, "ids": ids, "failed": failed})
+        self.publish({"type": "stopped", "mode": mode, "ids": ids, "failed": failed, "stops": self.stops})
 
     # The thread -------------------------------------------------------------
 

@@ -163,12 +163,11 @@ def test_a_drag_that_goes_on_after_another_tabs_stop_all_jogs_nothing(bench):
         sim.sleep(0.5)
         other.click("#stop-all")
         page.locator("#log", has_text="stop-all:").wait_for(timeout=WAIT_MS)
-        sim.sleep(0.3)  # a jog the stop interrupted has come back
-        stopped = sim.state(1)["angle"]
+        stopped = sim.state(1)["angle"]  # a jog after the stop ran 250-460 ms after it
         with _Watch(sim) as watch:
-            sim.sleep(1.0)
+            sim.sleep(1.5)
         page.evaluate("() => clearInterval(window.dragging)")
-        assert max(abs(a - stopped) for a in watch.seen) < 0.2, (stopped, min(watch.seen), max(watch.seen))
+        assert max(abs(a - stopped) for a in watch.seen) < 0.3, (stopped, min(watch.seen), max(watch.seen))
         assert page.inner_text("#jog-at") == "stopped: let go of the slider to jog again"
         page.keyboard.up("Shift")  # a hand let go: the slider jogs again
         page.wait_for_function("!document.querySelector('#jog').disabled", timeout=WAIT_MS)

@@ -59,16 +59,26 @@ def test_a_jog_moves_a_step_from_where_the_servo_is_and_no_farther():
         w = _worker(sim, said)
         assert w.run(["config", "set", "1", "soft_start_on", "0"])["code"] == 0
         assert w.run(["move", "1", "60", "--velocity", "200", "--wait"])["code"] == 0
-        far = w.jog(1, 1.0, "t")
+        far = w.jog(1, 1.0, 0, "t")
         assert far["code"] == 2 and "a jog moves 1.5 deg at most from where the servo is: servo 1 is at 60" \
             in far["err"], far
         sim.sleep(0.3)  # a jog to 1 deg sent would have the horn tens of degrees on by now
         assert abs(sim.state(1)["angle"] - 60) < 0.5
-        near = w.jog(1, 61.0, "t")
+        near = w.jog(1, 61.0, 0, "t")
         assert near["code"] == 0 and near["argv"] == ["move", "1", "61", "--interval", "200", "--wait"], near
         assert abs(sim.state(1)["angle"] - 61) < 0.5
         assert abs(w.angle(1) - 61) < 0.5 and said[-1]["type"] == "angle" and said[-1]["id"] == 1
-        assert w.jog(7, 0.0)["code"] == 3  # no servo 7: said, nothing sent to move
+        assert w.jog(7, 0.0, 0)["code"] == 3  # no servo 7: said, nothing sent to move
+        # A jog asked before a STOP ALL the page had not heard of (a drag in one tab, the
+        # stop from another) is not run: it moved the servo again after the stop.
+        w.stop_now("release")
+        w.preempt.clear()  # as the bus thread does before it runs the stop
+        w.stop_all("release")
+        assert said[-1]["type"] == "stopped" and said[-1]["stops"] == 1
+        late = w.jog(1, 61.5, 0, "t")
+        assert late["code"] == 130 and "STOP ALL came after this jog was asked" in late["err"], late
+        again = w.jog(1, 61.5, w.stops, "t")
+        assert again["code"] == 0, again
 
 
 def test_the_page_names_files_in_its_folder_only(tmp_path):

@@ -7,7 +7,7 @@
   // After a STOP ALL (any tab's) the slider jogs nothing until the hand on it
   // lets go: a drag or a held key went on moving the servo after another
   // tab's stop.
-  let jogStopped = false;
+  let jogStopped = false, stopsSeen = 0;  // the server's STOP ALL count, sent with each jog
 
   // The slider where the servo is (deg: the server's read, the live
   // table's): a key then nudges it a step from there. It stood at 0 deg
@@ -35,12 +35,13 @@
     jogBusy = true;
     const id = picked();
     const r = await runInto($("#motion-out"), ["move", id, angle, "--interval", 200, "--wait"],
-      {op: "jog", id, angle: Number(angle)});
+      {op: "jog", id, angle: Number(angle), stops: stopsSeen});
     jogBusy = false;
-    // A jog that did not run (stopped, dropped by STOP ALL, refused) drops
-    // the angle the slider kept meanwhile: sent after a stop, it moved the
-    // servo again (another tab's STOP ALL answers a dropped jog "not run").
-    if (r.code !== 0) jogNext = null;
+    // A jog that did not run drops the angle the slider kept meanwhile; one
+    // a STOP ALL stopped or dropped (130) holds the slider until the hand
+    // lets go too: the "stopped" message comes later, and a drag went on.
+    if (r.code === 130) stopJogs();
+    else if (r.code !== 0) jogNext = null;
     if (jogNext !== null) { const a = jogNext; jogNext = null; jog(a); }
     else readAngle();  // the slider back where the servo is: moved, or refused
   }
@@ -57,7 +58,8 @@
     jogStopped = false;
     readAngle();
   }
-  on("stopped", stopJogs);
+  on("stopped", (m) => { stopsSeen = m.stops; stopJogs(); });
+  on("hello", (m) => { stopsSeen = m.stops; });
   document.addEventListener("DOMContentLoaded", () => {
     $("#stop-all").addEventListener("click", stopJogs);
     document.addEventListener("pointerup", letGo);
