@@ -7,7 +7,7 @@
   // After a STOP ALL (any tab's) the slider jogs nothing until the hand on it
   // lets go: a drag or a held key went on moving the servo after another
   // tab's stop.
-  let jogStopped = false, stopsSeen = 0;  // the server's STOP ALL count, sent with each jog
+  let jogStopped = false, stopsSeen = null;  // the server's STOP ALL count, sent with each jog
 
   // The slider where the servo is (deg: the server's read, the live
   // table's): a key then nudges it a step from there. It stood at 0 deg
@@ -35,7 +35,7 @@
     jogBusy = true;
     const id = picked();
     const r = await runInto($("#motion-out"), ["move", id, angle, "--interval", 200, "--wait"],
-      {op: "jog", id, angle: Number(angle), stops: stopsSeen});
+      {op: "jog", id, angle: Number(angle), stops: stopsSeen || 0});
     jogBusy = false;
     // A jog that did not run drops the angle the slider kept meanwhile; one
     // a STOP ALL stopped or dropped (130) holds the slider until the hand
@@ -59,7 +59,13 @@
     readAngle();
   }
   on("stopped", (m) => { stopsSeen = m.stops; stopJogs(); });
-  on("hello", (m) => { stopsSeen = m.stops; });
+  // A tab opening tells every tab the count: one higher than this tab's is a
+  // stop whose "stopped" has not come yet (a silent servo's stop takes
+  // 0.7 s), and holds the slider as that would.
+  on("hello", (m) => {
+    if (stopsSeen !== null && m.stops > stopsSeen) stopJogs();
+    stopsSeen = m.stops;
+  });
   document.addEventListener("DOMContentLoaded", () => {
     $("#stop-all").addEventListener("click", stopJogs);
     document.addEventListener("pointerup", letGo);
