@@ -93,7 +93,7 @@ function(servo_arm_bootloader name)
   set(small ${PROJECT_SOURCE_DIR}/protocol/wire/frame_rx.c ${PROJECT_SOURCE_DIR}/protocol/wire/frame_rx_queue.c
       ${PROJECT_SOURCE_DIR}/firmware/runtime/small_mem.c ${boot}/bootloader.c
       ${boot}/boot_packets.c ${boot}/boot_flow.c ${boot}/app_image.c ${boot}/slot_write.c
-      ${PROJECT_SOURCE_DIR}/firmware/storage/config_peek.c ${PROJECT_SOURCE_DIR}/firmware/storage/crc32.c)
+      ${PROJECT_SOURCE_DIR}/firmware/storage/config_peek.c ${PROJECT_SOURCE_DIR}/firmware/runtime/crc32.c)
   foreach(lib ${SERVO_BOARD_PORT} servo_stm32_common)
     get_target_property(dir ${lib} SOURCE_DIR)
     get_target_property(sources ${lib} SOURCES)

@@ -49,11 +49,11 @@ LAYERS = {
     "startup": {"ports", "hal"},  # a family's vector table names its port's handlers
     "sensors": {"hal"},
     "wire": {"registers", "hal"},
-    "storage": {"registers", "hal"},
+    "storage": {"registers", "hal", "runtime"},
     "motion": {"registers", "hal"},
     "protection": {"registers", "sensors", "hal"},
     "dispatch": {"wire", "registers", "motion", "hal"},
-    "bootloader": {"wire", "storage", "registers", "hal"},
+    "bootloader": {"wire", "storage", "registers", "hal", "runtime"},
     "ports": {"hal", "runtime"},
     "app": {"dispatch", "wire", "registers", "motion", "storage", "sensors", "protection", "hal"},
     "boards": None,  # a board puts everything together
@@ -91,7 +91,7 @@ def sources(root):
 
 
 # Where an include's name is looked up: each layer's headers are named
-# from one of these (firmware/storage/crc32.h is "storage/crc32.h").
+# from one of these (firmware/runtime/crc32.h is "runtime/crc32.h").
 INCLUDE_ROOTS = ("hal/include", "motion/include", "protocol/wire/include", "protocol/include",
                  "registers/include", "firmware", "hal", "tests", "tools/servobus/include", "tools/servobus", "")
 BOARD_FOLDER = re.compile(r"^firmware/boards/[^/]+/")
@@ -110,7 +110,7 @@ def resolve(root, including, name):
 
 
 def include_breaches(root):
-    """Every include names its layer ("storage/crc32.h") and one file; no
+    """Every include names its layer ("runtime/crc32.h") and one file; no
     two headers share a name, but for a board's own (board.h in each)."""
     out = []
     files = [p for p in sorted(root.rglob("*")) if p.suffix in (".c", ".h", ".in") and p.is_file()]

@@ -2,7 +2,7 @@
 
 #include <string.h>
 
-#include "storage/crc32.h"
+#include "runtime/crc32.h"
 #include "protocol/wire.h"
 
 void app_image_make_header(uint8_t header[APP_HEADER_SIZE], const uint8_t *code, uint32_t size,

@@ -2,7 +2,7 @@
 
 #include <string.h>
 
-#include "storage/crc32.h"
+#include "runtime/crc32.h"
 
 enum slot_write_result slot_erase_page(const struct app_slot *slot, uint32_t page)
 {

@@ -1,7 +1,7 @@
 #include "storage/config_peek.h"
 
 #include "storage/config_record.h"
-#include "storage/crc32.h"
+#include "runtime/crc32.h"
 #include "registers/byte_order.h"
 
 /* The newest format-3 record whose CRC checks (config_record.h). The

@@ -3,7 +3,7 @@
 #include <string.h>
 
 #include "storage/config_record.h"
-#include "storage/crc32.h"
+#include "runtime/crc32.h"
 #include "storage/flash_erased.h"
 #include "registers/byte_order.h"
 #include "registers/data_table.h"

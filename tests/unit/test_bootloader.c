@@ -11,7 +11,7 @@
 #include "bootloader/app_image.h"
 #include "bootloader/boot_flow.h"
 #include "bootloader/boot_packets.h"
-#include "storage/crc32.h"
+#include "runtime/crc32.h"
 #include "protocol/packet_codes.h"
 #include "bootloader/slot_write.h"
 #include "protocol/wire.h"

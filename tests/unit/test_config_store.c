@@ -11,7 +11,7 @@
 
 #include "storage/config_peek.h"
 #include "storage/config_store.h"
-#include "storage/crc32.h"
+#include "runtime/crc32.h"
 #include "doubles/flash_double.h"
 #include "registers/data_table.h"
 

@@ -8,13 +8,13 @@
 
 #include <cmocka.h>
 
-#include "storage/crc32.h"
+#include "runtime/crc32.h"
 
 /* The bootloader's build of the same source, under other names. */
 #define CRC32_BITWISE
 #define crc32 crc32_bitwise
 #define crc32_update crc32_update_bitwise
-#include "storage/crc32.c"
+#include "runtime/crc32.c"
 #undef crc32
 #undef crc32_update
 

@@ -14,7 +14,7 @@
 
 #include "registers/byte_order.h"
 #include "registers/faults.h"
-#include "storage/crc32.h"
+#include "runtime/crc32.h"
 #include "support/by_name.h"
 #include "support/servo_harness.h"
 

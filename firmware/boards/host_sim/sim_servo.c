@@ -7,7 +7,7 @@
 #include <time.h>
 
 #include "storage/config_store.h"
-#include "storage/crc32.h"
+#include "runtime/crc32.h"
 #include "registers/data_table.h"
 #include "sim_bus.h"
 #include "bootloader/slot_write.h"

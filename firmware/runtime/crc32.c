@@ -1,4 +1,4 @@
-#include "storage/crc32.h"
+#include "runtime/crc32.h"
 
 #ifdef CRC32_BITWISE
 /* The bootloaders' and the Cortex-M0 application's: no table, where flash

@@ -1,5 +1,5 @@
-#ifndef STORAGE_CRC32_H
-#define STORAGE_CRC32_H
+#ifndef RUNTIME_CRC32_H
+#define RUNTIME_CRC32_H
 
 #include <stddef.h>
 #include <stdint.h>
