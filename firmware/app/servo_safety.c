@@ -10,7 +10,7 @@
  * own limit is added as item 67 or ReadMotion is read). */
 static void note_held_by(struct servo *s, uint8_t bits)
 {
-    s->regs.held_by = s->watchdog.fired                                          ? LIMITER_WATCHDOG
+    s->regs.held_by = s->watchdog.fired || s->regs.firmware.safe_mode != 0u      ? LIMITER_WATCHDOG
                       : (bits & (STATUS_LOW_VOLTAGE | STATUS_HIGH_VOLTAGE)) != 0u ? LIMITER_SUPPLY
                       : (bits & STATUS_OVER_TEMPERATURE) != 0u                    ? LIMITER_HEAT
                       : (bits & STATUS_STALL) != 0u && s->regs.user.stall_release ? LIMITER_STALL
@@ -39,7 +39,7 @@ void safety_guard(struct servo *s, uint8_t bits)
     uint16_t stall_cap = p->act.power_cap_mw;
     uint16_t heat_cap = s->heat_cap_mw;
     bool heat_binds = heat_cap != 0u && (stall_cap == 0u || heat_cap < stall_cap);
-    motion_guard(&s->motion, protection_inhibits(p->threshold_bits),
+    motion_guard(&s->motion, protection_inhibits(p->threshold_bits) || s->regs.firmware.safe_mode != 0u,
                  protection_derates(p->threshold_bits), heat_binds ? heat_cap : stall_cap,
                  heat_binds ? LIMITER_HEAT : LIMITER_STALL);
     note_held_by(s, bits);
@@ -150,9 +150,45 @@ void safety_tend(struct servo *s)
     }
     if (++s->heat_ticks == SENSE_ROUND_TICKS) {
         s->heat_ticks = 0;
+        if (s->hal->stack_unused != NULL) {
+            s->regs.firmware.stack_unused = *s->hal->stack_unused;
+        }
         if (winding_sample(&s->winding, s->regs.status.current_ma)) {
             heat_step(s);
         }
+    }
+}
+
+_Static_assert((int)HAL_RESET_FIRMWARE_FAULT == (int)FAULT_FIRMWARE &&
+                   (int)HAL_RESET_WATCHDOG == (int)FAULT_RESET_WATCHDOG &&
+                   (int)HAL_RESET_SOFTWARE == (int)FAULT_RESET_SOFTWARE &&
+                   (int)HAL_RESET_BROWN_OUT == (int)FAULT_BROWN_OUT && (int)HAL_RESET_PIN == (int)FAULT_RESET_PIN &&
+                   (int)HAL_RESET_LOW_POWER == (int)FAULT_RESET_LOW_POWER,
+               "a reset's kind is its fault's");
+
+/* The reset the board read at start-up: its counts (item 73), its fault
+ * history entry, and safe mode after SAFE_MODE_RESETS in a row, which
+ * logs no more of them (a boot loop would wear the log's pages). */
+static void take_reset(struct servo *s, const struct hal_reset *r)
+{
+    s->regs.firmware.reset_counts = (uint32_t)r->counts[0] | (uint32_t)r->counts[1] << 8 |
+                                    (uint32_t)r->counts[2] << 16 | (uint32_t)r->counts[3] << 24;
+    if (r->kind >= FAULT_FIRMWARE && r->in_row <= SAFE_MODE_RESETS) {
+        struct fault_entry e; /* field by field: an initialiser is a memset call on the M0 */
+        e.number = 0;
+        e.op_seconds = save_policy_op_seconds(&s->saver);
+        e.code.pc = r->pc; /* a firmware fault's record; zeros with another kind */
+        e.code.lr = r->lr;
+        e.code.sp_offset = r->sp_offset;
+        e.code.mm_bus_status = r->mm_bus_status;
+        e.code.exception = r->exception;
+        e.code.usage_status = r->usage_status;
+        e.what = r->kind;
+        (void)fault_log_add(&s->faults, &e);
+    }
+    if (r->in_row >= SAFE_MODE_RESETS) {
+        s->regs.firmware.safe_mode = 1;
+        s->protection.act_changes++; /* the guard takes it at the first tick */
     }
 }
 
@@ -167,6 +203,9 @@ void safety_init(struct servo *s)
     }
     if (fault_log_spare_dirty(&s->faults) && !fault_log_erase_spare(&s->faults)) {
         s->regs.status.status |= STATUS_COMMAND_ERROR; /* nobody waits at power-up */
+    }
+    if (s->hal->reset != NULL) {
+        take_reset(s, s->hal->reset);
     }
     s->dispatcher.read_fault = fault_log_read;
     s->dispatcher.read_fault_ctx = &s->faults;

@@ -8,8 +8,13 @@
 
 #include "app/servo_state.h"
 
-/* After the store's load and the dispatcher's init: the fault history and
- * its packets' hooks. */
+/* Fault resets in a row (hal_reset.in_row) that put the servo in safe
+ * mode: the output held off, the bus answered (item 75, docs/safety.md). */
+#define SAFE_MODE_RESETS 3u
+
+/* After the store's load and the dispatcher's init: the fault history,
+ * the reset the board read (logged, counted; safe mode) and the history's
+ * packets' hooks. */
 void safety_init(struct servo *s);
 /* After a frame, while the watchdog has acted: a motion command clears it
  * at once (what item 67 and ReadMotion say with it). */

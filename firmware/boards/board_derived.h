@@ -5,6 +5,18 @@
 #ifndef BOARD_DERIVED_H
 #define BOARD_DERIVED_H
 
+/* RAM a reset keeps, left out of both images' linker scripts: the word
+ * that keeps the bootloader last (boot_jump.h), the kept record at the
+ * start (ports/stm32_common/kept_ram.h). */
+#define BOARD_RAM_KEPT 64
+/* The register whose clearing turns the bridge's outputs off at once, for
+ * the fault handler's first store (startup/core_vectors.h): TIM3's CCER
+ * unless the board says otherwise (a timer's enable bits are not preloaded,
+ * RM0008 15.4.9, RM0360 13.4.9). */
+#ifndef BOARD_BRIDGE_OFF_REG
+#define BOARD_BRIDGE_OFF_REG 0x40000420
+#endif
+
 #ifndef BOARD_FOR_LINKER
 #include <stdint.h>
 

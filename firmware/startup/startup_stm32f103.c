@@ -13,12 +13,6 @@ void Reset_Handler(void)
     }
 }
 
-void Default_Handler(void)
-{
-    for (;;) {
-    }
-}
-
 enum { DMA1_CHANNEL5_IRQ = 15, USART1_IRQ = 37 };
 
 /* Core exceptions, then device interrupts up to USART1; the bootloader,

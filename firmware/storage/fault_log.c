@@ -4,7 +4,7 @@
 #include <string.h>
 
 #include "registers/byte_order.h"
-#include "storage/crc32.h"
+#include "runtime/crc32.h"
 #include "storage/flash_erased.h"
 
 /* The record: magic u16, format u8, 0xFF, the entry's bytes
@@ -151,7 +151,7 @@ uint32_t fault_log_load(struct fault_log *l, const struct hal_flash *flash)
         l->slot = (uint8_t)(f.at % slots_per_page(l));
         latest = f.op_seconds + 1u;
         for (;;) {
-            uint8_t kind = f.what <= FAULT_WATCHDOG ? f.what : FAULT_WATCHDOG;
+            uint8_t kind = f.what <= FAULT_OSCILLATION ? f.what : FAULT_CLEARED;
             if (l->last_seen[kind] == 0u) {
                 l->last_seen[kind] = f.op_seconds + 1u;
             }
@@ -179,16 +179,18 @@ uint32_t fault_log_load(struct fault_log *l, const struct hal_flash *flash)
 
 bool fault_log_add(struct fault_log *l, const struct fault_entry *e)
 {
-    uint8_t what = e->what <= FAULT_OSCILLATION ? e->what : FAULT_OSCILLATION;
+    /* A reset's kind (FAULT_FIRMWARE on) has no repeat rule: the
+     * application logs at most three in a row. */
+    uint8_t what = e->what <= FAULT_OSCILLATION ? e->what : FAULT_CLEARED;
     /* last_seen: each kind's last record's operating second + 1; 0 none.
      * A fault is held back as a repeat; a clear, promised within
      * milliseconds, where its record could wait for an erase (no erased
      * spare, and the page in use full or records queued before it: it is
      * refused, and taken once they are written). */
     uint32_t since = e->op_seconds + 1u - l->last_seen[what];
-    bool held_back = what == FAULT_CLEARED
+    bool held_back = e->what == FAULT_CLEARED
                          ? !l->spare_erased && (l->next_page != l->page || l->pending_count != 0u)
-                         : l->last_seen[what] != 0u && since < FAULT_REPEAT_S;
+                         : what != FAULT_CLEARED && l->last_seen[what] != 0u && since < FAULT_REPEAT_S;
     uint32_t records = l->newest + l->pending_count;
     if (l->flash == NULL || held_back || l->pending_count == FAULT_PENDING_MAX ||
         (records >= FAULT_ALLOWANCE &&

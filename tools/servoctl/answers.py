@@ -75,7 +75,10 @@ class Fault:
     what: int
 
     KINDS = {0: "none", 2: "stall", 3: "high_voltage", 4: "low_voltage", 5: "over_current",
-             6: "over_power", 7: "over_temperature", 8: "watchdog", 9: "oscillation"}
+             6: "over_power", 7: "over_temperature", 8: "watchdog", 9: "oscillation",
+             10: "firmware_fault", 11: "watchdog_reset", 12: "software_reset", 13: "brown_out",
+             14: "pin_reset", 15: "low_power_reset"}
+    FIRMWARE_FAULT = 10  # the readings' bytes hold the code's frame (fault_code.py)
 
     @classmethod
     def decode(cls, content: bytes) -> "Fault":

@@ -12,8 +12,7 @@ from .checks import MIN_RAMP_MS
 from .errors import UsageError
 from .move_request import MoveRequest
 
-# The most tracking error (RMS) `servoctl stream` takes for a servo that
-# followed its file (docs/streaming.md, "The verdict").
+# The most tracking error (RMS) `servoctl stream` takes for a servo that followed its file (docs/streaming.md).
 STREAM_TOLERANCE_DEG = 1.0
 
 # The description servoctl --help shows.
@@ -209,6 +208,7 @@ def build_parser():
     c.add_argument("id", type=int)
     c.add_argument("--clear", action="store_true", help="clear the history")
     c.add_argument("--json", action="store_true", help="as one JSON object")
+    c.add_argument("--elf", help="the image's ELF: names a firmware fault's code")
 
     c = sub.add_parser("id", help="IDs by serial number: assign SERIAL ID; bringup numbers new "
                                   "servos connected one at a time")

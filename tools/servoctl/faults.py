@@ -4,6 +4,8 @@ each kind)."""
 import json
 from dataclasses import asdict
 
+from .answers import Fault
+from .fault_code import FaultCode, Symbols
 from .servo import Servo
 
 # What a host can do about each kind (docs/safety.md, "Faults").
@@ -17,6 +19,13 @@ ADVICE = {
     "watchdog": "the host fell silent for longer than item 64: check the host and the bus",
     "oscillation": "the horn ran or swung away from its setpoint (item 72): check the drive items "
                    "(80-88) against the motor ('servoctl tune'), the encoder and the load",
+    "firmware_fault": "the servo's own code faulted: its output went off, it restarted; report it with "
+                      "the line above and the image ('servoctl faults ID --elf IMAGE.elf' names the code)",
+    "watchdog_reset": "the main loop hung and the watchdog restarted the servo: report it",
+    "software_reset": "the servo restarted itself unplanned: report it",
+    "brown_out": "the supply dipped below the MCU's reset level: check the supply under load and its wiring",
+    "pin_reset": "the reset pin was pulled: check the programming header and the board for noise",
+    "low_power_reset": "a low-power reset the firmware never asks for: report it",
 }
 
 
@@ -32,9 +41,10 @@ def cmd_faults(bus, args):
         return 0
     faults = s.faults()
     first = faults[0] if faults else s.read_fault(0)
+    symbols = Symbols(args.elf) if args.elf else None
     if args.json:
         print(json.dumps({"id": args.id, "not_logged": first.not_logged,
-                          "faults": [dict(asdict(f), kind=f.kind) for f in faults]}))
+                          "faults": [_as_json(f, symbols) for f in faults]}))
         return 0
     if not faults:
         print(f"servo {args.id}: no faults{_not_logged(first.not_logged)}")
@@ -42,9 +52,14 @@ def cmd_faults(bus, args):
     print(f"servo {args.id}: {len(faults)} fault(s), newest first{_not_logged(first.not_logged)}")
     print("   #   op time  fault               supply  current   power  winding     case    angle")
     for f in faults:
-        print(f"{f.number:>4} {_hms(f.op_seconds):>9}  {f.kind:<17} {f.voltage_mv / 1000:>6.2f} V "
-              f"{f.current_ma / 1000:>6.3f} A {f.power_mw / 1000:>5.2f} W {f.winding_decic / 10:>6.1f} C "
-              f"{f.case_decic / 10:>6.1f} C {f.angle_decideg / 10:>7.1f}")
+        if f.what == Fault.FIRMWARE_FAULT:
+            print(f"{f.number:>4} {_hms(f.op_seconds):>9}  {f.kind:<17} {FaultCode.of(f).describe(symbols)}")
+        elif f.what > Fault.FIRMWARE_FAULT:  # a reset: no readings
+            print(f"{f.number:>4} {_hms(f.op_seconds):>9}  {f.kind:<17}")
+        else:
+            print(f"{f.number:>4} {_hms(f.op_seconds):>9}  {f.kind:<17} {f.voltage_mv / 1000:>6.2f} V "
+                  f"{f.current_ma / 1000:>6.3f} A {f.power_mw / 1000:>5.2f} W {f.winding_decic / 10:>6.1f} C "
+                  f"{f.case_decic / 10:>6.1f} C {f.angle_decideg / 10:>7.1f}")
     for kind in dict.fromkeys(f.kind for f in faults):
         print(f"  {kind}: {ADVICE.get(kind, '')}")
     return 0
@@ -52,3 +67,12 @@ def cmd_faults(bus, args):
 
 def _not_logged(n: int) -> str:
     return f" ({n} more since power-up not logged: repeats within 10 s, or the wear budget)" if n else ""
+
+
+def _as_json(f, symbols) -> dict:
+    out = dict(asdict(f), kind=f.kind)
+    if f.what == Fault.FIRMWARE_FAULT:
+        code = FaultCode.of(f)
+        out["code"] = dict(asdict(code), exception_name=code.exception_name, status_bits=code.status_bits,
+                           pc_function=symbols.name(code.pc) if symbols else None)
+    return out

@@ -15,6 +15,8 @@
 #include "boards/common/app_hooks.h"
 #include "boards/test_build.h"
 #include "ports/stm32_common/cortex_sleep.h"
+#include "ports/stm32_common/fault_keep.h"
+#include "ports/stm32_common/kept_ram.h"
 #include "ports/stm32_common/flash_f0f1.h"
 #include "ports/stm32_common/systick_clock.h"
 
@@ -25,6 +27,10 @@ static struct hal_rx_ring rx_ring = HAL_RX_RING_OVER(rx_bytes);
 static struct dma_rx rx_dma;
 static struct hal_flash flash;
 static struct hal_flash fault_flash;
+
+/* A run this long without a fault reset makes the next one the first in a
+ * row again (safe mode: servo_safety.h). */
+#define HEALTHY_RUN_US 10000000u
 
 static const struct sensor_calibration calibration = BOARD_SENSOR_CALIBRATION;
 
@@ -39,11 +45,15 @@ static const struct hal_port port = {
     .flash = &flash,
     .fault_flash = &fault_flash,
     .serial_number = unique_id_serial,
+    .reset = &_kept_ram.reset, /* reset_cause_take's, before servo_init */
+    .stack_unused = &stack_unused_bytes,
     APP_HOOKS_PORT_FIELDS,
 };
 
 int main(void)
 {
+    (void)reset_cause_take();
+    stack_guard_start();
     board_clock_init();
     board_pins_init();
     systick_clock_init(BOARD_CORE_HZ);
@@ -55,9 +65,16 @@ int main(void)
     servo_init(&servo, &port);
     board_interrupts_on();
     iwdg_start();
+    uint32_t started_us = systick_now_us();
+    bool healthy = false;
     for (;;) {
         servo_poll(&servo);
         test_build_main_loop();
+        stack_watch_pass();
+        if (!healthy && systick_now_us() - started_us >= HEALTHY_RUN_US) {
+            healthy = true;
+            kept_healthy();
+        }
         iwdg_kick();
         CORTEX_SLEEP_IF(servo_may_sleep(&servo));
     }

@@ -12,6 +12,7 @@
 #include <stdint.h>
 
 #include "hal/hal_flash.h"
+#include "hal/hal_reset.h"
 #include "hal/hal_rx_ring.h"
 #include "hal/hal_sensors.h"
 
@@ -71,6 +72,11 @@ struct hal_port {
     /* Restarts into the bootloader, which then stays (UpdateEnter); NULL
      * where there is none. Does not return on silicon. */
     void (*enter_bootloader)(void *ctx);
+    /* Why the MCU last started (hal_reset.h), read by the board before
+     * servo_init; NULL: a power-on (a port that cannot tell). */
+    const struct hal_reset *reset;
+    /* Bytes of stack never written since start (item 74); NULL: unknown. */
+    const volatile uint16_t *stack_unused;
     /* The board images are built for (the update image header's board). */
     uint16_t board;
     /* Longest gap between the bytes of one frame the link can produce, in

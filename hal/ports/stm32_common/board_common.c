@@ -42,7 +42,7 @@ void iwdg_start(void)
     IWDG_KR = IWDG_KEY_START;
     IWDG_KR = IWDG_KEY_ACCESS;
     IWDG_PR = 0; /* 40 kHz / 4 */
-    IWDG_RLR = 1250u; /* 125 ms */
+    IWDG_RLR = IWDG_TIMEOUT_MS * 10u;
     IWDG_KR = IWDG_KEY_RELOAD;
 }
 

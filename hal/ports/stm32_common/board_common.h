@@ -36,7 +36,14 @@ void pwm_bridge_drive(int16_t duty_q15);
 /* Both inputs low: the bridge's outputs float (coast). */
 void pwm_bridge_coast(void);
 
-/* Independent watchdog, about 125 ms: the main loop must come round. */
+/* The independent watchdog: the main loop must come round within
+ * IWDG_TIMEOUT_MS at the LSI's nominal 40 kHz. Its longest pass is one page
+ * erase, which stalls the CPU up to 40 ms (tERASE, DS5319 and DS9773; one
+ * erase a pass, servo_store.c), plus the pass itself (under 0.1 ms); the
+ * LSI may run at up to 60 kHz (DS5319; 50 kHz DS9773), which shortens the
+ * timeout to 48 ms, still 8 ms over the erase; at its slowest, 30 kHz, a
+ * hung loop leaves the output driven for 96 ms. */
+#define IWDG_TIMEOUT_MS 72u
 void iwdg_start(void);
 void iwdg_kick(void);
 

@@ -23,6 +23,16 @@
 #define SCB_ICSR_PENDSTSET (1u << 26)
 #define SCB_AIRCR REG32(0xE000ED0Cu)
 #define SCB_AIRCR_RESET (0x05FA0000u | (1u << 2)) /* VECTKEY, SYSRESETREQ */
+/* ARMv7-M only (B3.2): fault enables and status, and the MPU (B3.5) */
+#define SCB_SHCSR REG32(0xE000ED24u)
+#define SCB_SHCSR_FAULTS_OWN (7u << 16) /* MemManage, BusFault, UsageFault taken as themselves */
+#define SCB_CFSR REG32(0xE000ED28u)
+#define SCB_HFSR REG32(0xE000ED2Cu)
+#define MPU_CTRL REG32(0xE000ED94u)
+#define MPU_RNR REG32(0xE000ED98u)
+#define MPU_RBAR REG32(0xE000ED9Cu)
+#define MPU_RASR REG32(0xE000EDA0u)
+#define MPU_CTRL_ON_DEFAULT_MAP 5u /* ENABLE, PRIVDEFENA: the default map elsewhere */
 
 /* RCC: the registers and bits both families place alike */
 #define RCC_BASE 0x40021000u
@@ -31,6 +41,15 @@
 #define RCC_AHBENR REG32(RCC_BASE + 0x14u)
 #define RCC_APB2ENR REG32(RCC_BASE + 0x18u)
 #define RCC_APB1ENR REG32(RCC_BASE + 0x1Cu)
+#define RCC_CSR REG32(RCC_BASE + 0x24u)
+/* RCC_CSR's reset flags (RM0008 7.3.10; RM0360, RCC_CSR) and the bit that clears them */
+#define RCC_CSR_RMVF (1u << 24)
+#define RCC_CSR_PINRSTF (1u << 26)
+#define RCC_CSR_PORRSTF (1u << 27)
+#define RCC_CSR_SFTRSTF (1u << 28)
+#define RCC_CSR_IWDGRSTF (1u << 29)
+#define RCC_CSR_WWDGRSTF (1u << 30)
+#define RCC_CSR_LPWRRSTF (1u << 31)
 #define RCC_CR_HSEON (1u << 16)
 #define RCC_CR_HSERDY (1u << 17)
 #define RCC_CR_PLLON (1u << 24)

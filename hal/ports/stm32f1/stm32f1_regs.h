@@ -6,7 +6,6 @@
 #include "ports/stm32_common/stm32_core_regs.h"
 
 /* RCC */
-#define RCC_CSR REG32(RCC_BASE + 0x24u)
 #define RCC_CFGR_PPRE1_DIV2 (4u << 8)
 #define RCC_CFGR_ADCPRE_DIV6 (2u << 14)
 #define RCC_CFGR_PLLMUL9 (7u << 18)

@@ -1,0 +1,97 @@
+#include "ports/stm32_common/kept_ram.h"
+
+#include <string.h>
+
+#include "ports/stm32_common/stm32_core_regs.h"
+#include "runtime/crc32.h"
+
+_Static_assert(sizeof(struct kept_ram) <= 64u - 4u, "the kept record fits the kept bytes (board_derived.h) before the stay word");
+
+static uint32_t kept_crc(const struct kept_ram *k)
+{
+    return crc32((const uint8_t *)k, offsetof(struct kept_ram, crc));
+}
+
+void kept_seal(struct kept_ram *k)
+{
+    k->magic = KEPT_MAGIC;
+    k->crc = kept_crc(k);
+}
+
+/* The reset flags in the order they explain a reset, and their kinds:
+ * every reset sets PINRSTF (the chip drives its own NRST low), so alone it
+ * means the pin; a power-on flag with the record held is a brown-out. */
+static const uint32_t FLAGS[] = {RCC_CSR_IWDGRSTF | RCC_CSR_WWDGRSTF, RCC_CSR_SFTRSTF, RCC_CSR_LPWRRSTF,
+                                 RCC_CSR_PORRSTF, RCC_CSR_PINRSTF};
+static const uint8_t FLAG_KIND[] = {HAL_RESET_WATCHDOG, HAL_RESET_SOFTWARE, HAL_RESET_LOW_POWER,
+                                    HAL_RESET_BROWN_OUT, HAL_RESET_PIN};
+/* Which of item 73's counts each kind from HAL_RESET_FIRMWARE_FAULT on adds to. */
+static const uint8_t KIND_COUNT[] = {HAL_COUNT_FIRMWARE_FAULT, HAL_COUNT_WATCHDOG, HAL_COUNT_OTHER,
+                                     HAL_COUNT_BROWN_OUT, HAL_COUNT_OTHER, HAL_COUNT_OTHER};
+/* The kinds that are the firmware's own failures (not the supply's, not
+ * the pin's): they count towards safe mode. */
+#define OWN_KINDS ((1u << HAL_RESET_FIRMWARE_FAULT) | (1u << HAL_RESET_WATCHDOG) | \
+                   (1u << HAL_RESET_SOFTWARE) | (1u << HAL_RESET_LOW_POWER))
+
+static uint8_t saturating_inc(uint8_t n)
+{
+    return (uint8_t)(n + (n < UINT8_MAX));
+}
+
+void reset_classify(uint32_t csr, struct kept_ram *k)
+{
+    bool held = k->magic == KEPT_MAGIC && k->crc == kept_crc(k);
+    if (!held) {
+        memset(k, 0, sizeof *k);
+    }
+    uint8_t kind = HAL_RESET_POWER_ON;
+    for (unsigned i = 0; i < sizeof FLAGS / sizeof FLAGS[0]; i++) {
+        if (csr & FLAGS[i]) {
+            kind = FLAG_KIND[i];
+            break;
+        }
+    }
+    if (kind == HAL_RESET_BROWN_OUT && !held) {
+        kind = HAL_RESET_POWER_ON;
+    }
+    if (k->note != KEPT_NONE) {
+        kind = k->note == KEPT_FAULT ? HAL_RESET_FIRMWARE_FAULT : HAL_RESET_PLANNED;
+    }
+    struct hal_reset *r = &k->reset;
+    r->kind = kind;
+    if (kind != HAL_RESET_FIRMWARE_FAULT) { /* a fault's details only with a fault */
+        memset(&r->sp_offset, 0, sizeof *r - offsetof(struct hal_reset, sp_offset));
+    }
+    if (kind < HAL_RESET_FIRMWARE_FAULT) {
+        r->in_row = 0;
+    } else {
+        uint8_t *count = &r->counts[KIND_COUNT[kind - HAL_RESET_FIRMWARE_FAULT]];
+        *count = saturating_inc(*count);
+        if (OWN_KINDS >> kind & 1u) {
+            r->in_row = saturating_inc(r->in_row);
+        }
+    }
+    k->note = KEPT_NONE;
+    kept_seal(k);
+}
+
+const struct hal_reset *reset_cause_take(void)
+{
+    reset_classify(RCC_CSR, &_kept_ram);
+    RCC_CSR |= RCC_CSR_RMVF;
+    return &_kept_ram.reset;
+}
+
+void kept_note_planned(void)
+{
+    _kept_ram.note = KEPT_PLANNED;
+    kept_seal(&_kept_ram);
+}
+
+void kept_healthy(void)
+{
+    if (_kept_ram.reset.in_row != 0u) {
+        _kept_ram.reset.in_row = 0;
+        kept_seal(&_kept_ram);
+    }
+}

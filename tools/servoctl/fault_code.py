@@ -1,0 +1,73 @@
+"""A firmware fault's record (ReadFaults' kind 10, docs/safety.md): the
+readings' bytes hold the faulting code's frame instead (registers/faults.h,
+struct fault_code), decoded here and named with the image's ELF symbols."""
+from dataclasses import dataclass
+
+EXCEPTIONS = {0: "stack guard (main loop)", 2: "NMI", 3: "HardFault", 4: "MemManage", 5: "BusFault",
+              6: "UsageFault", 11: "SVCall", 14: "PendSV", 15: "SysTick"}
+# CFSR bits 0-15 (ARMv7-M ARM B3.2.15-B3.2.16) and the record's usage byte.
+MM_BUS_BITS = {0: "IACCVIOL", 1: "DACCVIOL", 3: "MUNSTKERR", 4: "MSTKERR", 7: "MMARVALID",
+               8: "IBUSERR", 9: "PRECISERR", 10: "IMPRECISERR", 11: "UNSTKERR", 12: "STKERR", 15: "BFARVALID"}
+USAGE_BITS = {0: "UNDEFINSTR", 1: "INVSTATE", 2: "INVPC", 3: "NOCP", 4: "UNALIGNED", 5: "DIVBYZERO",
+              6: "VECTTBL", 7: "FORCED"}
+
+
+@dataclass
+class FaultCode:
+    pc: int
+    lr: int
+    sp_offset: int      # the stack pointer less the RAM's base
+    mm_bus_status: int
+    exception: int
+    usage_status: int
+
+    @classmethod
+    def of(cls, fault) -> "FaultCode":
+        """From a Fault (answers.py) whose kind is firmware_fault."""
+        return cls(pc=fault.angle_decideg & 0xFFFFFFFF, lr=fault.voltage_mv | fault.current_ma << 16,
+                   sp_offset=fault.power_mw, mm_bus_status=fault.winding_decic & 0xFFFF,
+                   exception=fault.case_decic & 0xFF, usage_status=(fault.case_decic >> 8) & 0xFF)
+
+    @property
+    def exception_name(self) -> str:
+        e = self.exception
+        return EXCEPTIONS.get(e, f"interrupt {e - 16}" if e >= 16 else f"exception {e}")
+
+    @property
+    def status_bits(self) -> list:
+        return ([name for bit, name in MM_BUS_BITS.items() if self.mm_bus_status >> bit & 1] +
+                [name for bit, name in USAGE_BITS.items() if self.usage_status >> bit & 1])
+
+    def describe(self, symbols=None) -> str:
+        where = f"pc {self.pc:#010x}{_in(symbols, self.pc)} lr {self.lr:#010x}{_in(symbols, self.lr)}"
+        bits = " ".join(self.status_bits) or "-"
+        return f"{self.exception_name}: {where} sp RAM+{self.sp_offset:#06x} [{bits}]"
+
+
+def _in(symbols, address: int) -> str:
+    name = symbols.name(address) if symbols else None
+    return f" ({name})" if name else ""
+
+
+class Symbols:
+    """The functions of an image's ELF, by address (pyelftools)."""
+
+    def __init__(self, path):
+        try:
+            from elftools.elf.elffile import ELFFile
+        except ImportError as e:
+            raise SystemExit("naming a fault's code needs pyelftools: pip install 'servoctl[elf]'") from e
+        with open(path, "rb") as f:
+            table = ELFFile(f).get_section_by_name(".symtab")
+            if table is None:
+                raise SystemExit(f"{path}: no symbol table (an ELF built with its symbols is needed)")
+            self.functions = sorted((s["st_value"] & ~1, s["st_size"], s.name) for s in table.iter_symbols()
+                                    if s["st_info"]["type"] == "STT_FUNC" and s["st_size"] > 0)
+
+    def name(self, address: int):
+        """"function+0xOFF" of the function holding address, or None."""
+        address &= ~1
+        for start, size, name in self.functions:
+            if start <= address < start + size:
+                return f"{name}+{address - start:#x}"
+        return None
