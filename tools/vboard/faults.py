@@ -57,6 +57,7 @@ class Faults:
     def _init_faults(self) -> None:
         self.fault_at_s = None        # core time of the last faulting instruction
         self.fault_kind = None
+        self.on_fault = None          # called after a fault is taken (inject.py watches the bridge)
         if self.v7m:
             self.on_write(SCB_CFSR, self._w1c(SCB_CFSR, CFSR_W1C))
             self.on_write(SCB_HFSR, self._w1c(SCB_HFSR, HFSR_W1C))
@@ -116,6 +117,8 @@ class Faults:
             self._enter(exc, self.priority(exc))
         except KeyError:
             self.locked_up = True
+        if self.on_fault is not None:
+            self.on_fault()
 
     def _mark_active(self, exc: int, active: bool) -> None:
         if self.v7m and exc in SHCSR_ACTIVE:
