@@ -23,6 +23,7 @@ from .system_space import FIRST_IRQ
 from .dma import Dma
 from .flash import Flash
 from .idle_skip import pass_facts
+from .inject import Injector
 from .model import Model
 from .native import Motor, factory_config, stored_id
 from .timers import BridgeTimer, Watchdog
@@ -158,6 +159,7 @@ class Board:
         self.pass_start = pass_facts(elf(board))  # (address, (section, code), _ebss) or None
         if self.pass_start is not None:
             self.core.skip_memory(self.ram.buf, h["BOARD_RAM_BASE"], self.pass_start[2] - h["BOARD_RAM_BASE"])
+        self.injector = Injector(self, elf(board))
         self.resets = {"power": 0, "software": 0, "watchdog": 0}
         self.last_reset = None
         self.powered = True
@@ -285,6 +287,7 @@ class Board:
         if "syscfg" in self.part.names:
             self.alias_zero(self.flash_mem, self.flash_size)
         self.core.reset(self.flash_base)
+        self.injector.reset()
         self.core.skip_at = self._pass_start()
         self.motor.coast()
         self.duty = None  # the bridge's, as the motor was last told
@@ -301,6 +304,17 @@ class Board:
         """Power off (the motor coasts, RAM is lost), then on."""
         self.ram.write(0, bytes(self.ram.size))
         self.core.idle(off_s)
+        self._write_uid()
+        self.reset("power")
+
+    def brownout(self, dip_s: float = 5e-3) -> None:
+        """VDD dips below the power-down reset level (VPOR/PDR, 1.88 V
+        typical falling: DS5319 and DS9773, "Embedded reset and power
+        control block characteristics") for dip_s and comes back: a
+        power-on reset (PORRSTF), the motor coasting meanwhile, but the
+        SRAM keeps what it held (a short dip; power_cycle loses it)."""
+        self.injector.brownouts += 1
+        self.core.idle(dip_s)
         self._write_uid()
         self.reset("power")
 
@@ -371,4 +385,4 @@ class Board:
                 "erase_began_ms": round(self.flash.erase_began_s * 1000, 3),
                 "last_sent_ms": round(self.bus.last_sent_s.get(self.station, 0.0) * 1000, 3),
                 "framing_errors": self.usart.framing_errors, "begun_deaf": self.usart.begun_deaf, "overruns": self.usart.overruns,
-                "pc": f"{self.core.uc.reg_read(arm.UC_ARM_REG_PC):#010x}"}
+                "pc": f"{self.core.uc.reg_read(arm.UC_ARM_REG_PC):#010x}", **self.injector.state()}

@@ -22,12 +22,14 @@ import math
 import os
 import sys
 
-from unicorn import UC_ARCH_ARM, UC_HOOK_CODE, UC_HOOK_INTR, UC_MODE_MCLASS, UC_MODE_THUMB
-from unicorn import Uc, UcError
+from unicorn import UC_ARCH_ARM, UC_HOOK_CODE, UC_HOOK_INTR, UC_HOOK_MEM_UNMAPPED, UC_MODE_MCLASS, UC_MODE_THUMB
+from unicorn import UC_ERR_FETCH_UNMAPPED, UC_ERR_INSN_INVALID, Uc, UcError
 from unicorn import arm_const as arm
 from unicorn.unicorn_py3.unicorn import uclib
 
 from .exceptions import Exceptions
+from .faults import Faults
+from .mpu import Mpu
 from .idle_skip import STATE_REGS, IdleSkip
 from .memory import MemoryMap
 from .native import lib as native_lib
@@ -74,11 +76,12 @@ class Stop(Exception):
     """Raised by run() when the board must reset (cause in .args[0])."""
 
 
-class Core(MemoryMap, Exceptions, SystemControlSpace, IdleSkip):
+class Core(MemoryMap, Exceptions, Faults, Mpu, SystemControlSpace, IdleSkip):
     def __init__(self, cpu_model: int, hz: int, cpi: float, has_vtor: bool, irq_words: int):
         self.uc = Uc(UC_ARCH_ARM, UC_MODE_THUMB | UC_MODE_MCLASS)
         self.uc.ctl_set_cpu_model(cpu_model)
         self.hz, self.cpi, self.has_vtor, self.irq_words = hz, cpi, has_vtor, irq_words
+        self.v7m = cpu_model != arm.UC_CPU_ARM_CORTEX_M0  # ARMv7-M: configurable faults, MPU
         self.cycles = 0.0            # HCLK cycles since power-up (SysTick counts these)
         self.time_s = 0.0            # since power-up
         self.handlers = {}           # register address -> handler(value, old, size)
@@ -112,6 +115,12 @@ class Core(MemoryMap, Exceptions, SystemControlSpace, IdleSkip):
             self.on_write(NVIC_ISPR + 4 * w, self._nvic_pend(w, True))
             self.on_write(NVIC_ICPR + 4 * w, self._nvic_pend(w, False))
         self.uc.hook_add(UC_HOOK_INTR, self._interrupt)
+        self.uc.hook_add(UC_HOOK_MEM_UNMAPPED, self._unmapped)
+        self.unmapped_at = None      # the address of the last access to nothing
+        self.fault_pending = None    # (why, kind) of a fault an interrupt hook reported
+        self.spin_at = 0             # thread mode spins here (a hung main loop: run.py's inject hang)
+        self._init_faults()
+        self._init_mpu()
         self._uch = self.uc._uch
         self._regbuf = ctypes.c_uint32()
         self._regbuf_ref = ctypes.byref(self._regbuf)
@@ -194,6 +203,8 @@ class Core(MemoryMap, Exceptions, SystemControlSpace, IdleSkip):
         self._take_exception()
         self._update_systick()
         pc = self.reg(arm.UC_ARM_REG_PC) | 1
+        if self.spin_at and pc == self.spin_at | 1 and not self.reg(arm.UC_ARM_REG_IPSR) & 0x1FF:
+            return self._spin(max_s)
         self.count.executed, self.count.limit = 0, count
         # Masked with an exception waiting: it is taken right after the
         # CPSIE I, so the run ends before that (native/instruction_count.c).
@@ -210,7 +221,11 @@ class Core(MemoryMap, Exceptions, SystemControlSpace, IdleSkip):
             if os.environ.get("VBOARD_TRACE"):
                 r = {n: hex(self.uc.reg_read(getattr(arm, "UC_ARM_REG_" + n))) for n in ("PC", "LR", "SP", "IPSR", "XPSR")}
                 print(f"vboard: fault {e} at {self.time_s:.4f} s: {r}", file=sys.stderr, flush=True)
-            self._fault(str(e))
+            self._fault(str(e), *self._fault_kind(e))
+        if self.fault_pending is not None:
+            faulted = True
+            (why, kind), self.fault_pending = self.fault_pending, None
+            self._fault(why, kind)
         self.running = False
         executed = self.count.executed
         if self.count.at_cpsie and not faulted:  # carried out here; the exception is taken next run
@@ -263,6 +278,30 @@ class Core(MemoryMap, Exceptions, SystemControlSpace, IdleSkip):
         if self.asleep and passed < max_s and not self.wake_pending():
             passed += self._sleep(max_s - passed)  # the rest of the slice: one call, not two
         return passed
+
+    def _unmapped(self, uc, access, address, size, value, data):
+        self.unmapped_at = address
+        return False
+
+    def _fault_kind(self, e: UcError) -> tuple:
+        """(kind, address) of the fault an error of Unicorn's is: nothing
+        there to fetch from, an instruction it cannot decode, or a data
+        access to nothing (a precise bus error, BFAR its address)."""
+        address, self.unmapped_at = self.unmapped_at, None
+        if e.errno == UC_ERR_FETCH_UNMAPPED:
+            return "bus_fetch", None
+        if e.errno == UC_ERR_INSN_INVALID:
+            return "undef", None
+        return "bus_data", address
+
+    def _spin(self, max_s: float) -> float:
+        """A hung main loop: thread mode goes round one instruction, awake,
+        until an exception is taken (at the next run's start)."""
+        cycles = max_s * self.hz
+        self.cycles += cycles
+        self.time_s += max_s
+        self._systick_after(cycles)
+        return max_s
 
     def _after_wfi(self) -> bool:
         """Whether a run that ended early ended on a WFI (Unicorn stops

@@ -15,11 +15,13 @@ import struct
 
 from unicorn import arm_const as arm
 
+from .faults import HARD_FAULT, MEM_MANAGE, USAGE_FAULT
 from .system_space import FIRST_IRQ, ICSR_PENDSTSET, NVIC_IPR, SCB_ICSR, SCB_SHPR3, SCB_VTOR, SCS_BASE, SYSTICK
 
 EXC_RETURN_THREAD_MSP = 0xFFFFFFF9
 EXCP_EXCEPTION_EXIT = 8  # QEMU's, as Unicorn reports it
-HARD_FAULT = 3
+# QEMU's exception numbers (target/arm/cpu.h) as Unicorn reports them -> the fault
+QEMU_FAULT_KINDS = {1: "undef", 3: "bus_fetch", 4: "bus_data", 17: "undef", 18: "invstate"}
 FRAME_REGS = (arm.UC_ARM_REG_R0, arm.UC_ARM_REG_R1, arm.UC_ARM_REG_R2, arm.UC_ARM_REG_R3,
               arm.UC_ARM_REG_R12, arm.UC_ARM_REG_LR)
 ENTRY_READ = FRAME_REGS + (arm.UC_ARM_REG_SP, arm.UC_ARM_REG_XPSR, arm.UC_ARM_REG_PC)
@@ -51,23 +53,13 @@ class Exceptions:
         if not any(e == FIRST_IRQ + irq for e, _ in self.active):
             self.pending.add(FIRST_IRQ + irq)
 
-    def _fault(self, why: str) -> None:
-        """A bus fault or undefined instruction: HardFault, as on silicon
-        (the firmware's handler then spins until the watchdog resets). A
-        fault that cannot be taken (the stack pointer is not in RAM) locks
-        the core up (ARMv7-M ARM B1.5.15): it runs nothing until a reset."""
-        self.fault = why
-        self.pending.add(HARD_FAULT)
-        try:
-            self._take_exception(force=True)
-        except KeyError:
-            self.locked_up = True
-
     def priority(self, exc: int) -> int:
         if exc == HARD_FAULT:
             return -1
         if exc == SYSTICK:
             return self.rd32(SCB_SHPR3) >> 24
+        if self.v7m and MEM_MANAGE <= exc <= USAGE_FAULT:
+            return self.fault_priority(exc)
         if exc >= FIRST_IRQ:
             irq = exc - FIRST_IRQ
             return self.rd32(NVIC_IPR + (irq & ~3)) >> (8 * (irq & 3)) & 0xFF
@@ -84,25 +76,57 @@ class Exceptions:
         if not ready or (ready[0][0] >= running and not force):
             return
         prio, exc = ready[0]
+        self._enter(exc, prio)
+
+    def _enter(self, exc: int, prio: int) -> None:
+        """Exception entry (B1.5.6): the frame pushed, the handler entered.
+        Raises KeyError when SP is not in mapped memory (a lock-up)."""
         self.pending.discard(exc)
         self.taken[exc] = self.taken.get(exc, 0) + 1
         nested = bool(self.active)
-        self.active.append((exc, prio))
         if exc == SYSTICK:
             self.wr32(SCB_ICSR, self.rd32(SCB_ICSR) & ~ICSR_PENDSTSET)
         *stacked, sp, xpsr, pc = self.regs(ENTRY_READ)
         realign = sp & 4
         sp = (sp - 32) & ~7
-        frame = stacked + [pc & ~1, (xpsr | (1 << 24)) | (realign << 7)]
-        self.write(sp, struct.pack("<8I", *frame))
+        frame = struct.pack("<8I", *(stacked + [pc & ~1, (xpsr | (1 << 24)) | (realign << 7)]))
+        self.view(sp + 28)  # KeyError before anything changes: nowhere to stack
+        if self.mpu_on and not self.mpu_allows(sp, 32, write=True):
+            exc, prio = self._stacking_fault(exc, prio, sp, frame)
+            if exc is None:
+                self.locked_up = True
+                return
+        else:
+            self.write(sp, frame)
+        self.active.append((exc, prio))
+        self._mark_active(exc, True)
         base = self.rd32(SCB_VTOR) if self.has_vtor else 0
         self.set_regs(ENTRY_WRITE, (sp, EXC_RETURN_HANDLER if nested else EXC_RETURN_THREAD_MSP, exc,
                                     self.rd32(base + 4 * exc)))
 
+    def _stacking_fault(self, exc: int, prio: int, sp: int, frame: bytes):
+        """The MPU refused some of the frame (MSTKERR): the words it
+        allows are written, and the higher of the fault and the exception
+        is entered on that frame, the other left pending (B1.5.15)."""
+        for at in range(0, 32, 4):
+            if self.mpu_allows(sp + at, 4, write=True):
+                self.write(sp + at, frame[at:at + 4])
+        fault = self.fault_exception("mem_stack")
+        if fault is None or exc == HARD_FAULT:
+            return None, None
+        fault_prio = self.priority(fault)
+        if fault_prio < prio:
+            self.taken[exc] -= 1
+            self.pending.add(exc)
+            self.taken[fault] = self.taken.get(fault, 0) + 1
+            return fault, fault_prio
+        self.pending.add(fault)
+        return exc, prio
+
     def _interrupt(self, uc, intno, data):
         if intno != EXCP_EXCEPTION_EXIT:
             uc.emu_stop()
-            self._fault(f"CPU exception {intno}")
+            self.fault_pending = (f"CPU exception {intno}", QEMU_FAULT_KINDS.get(intno, "undef"))
             return
         sp = self.reg(arm.UC_ARM_REG_SP)
         view, at = self.view(sp)
@@ -113,6 +137,7 @@ class Exceptions:
                                                xpsr & 0x1FF, frame[6] | 1))
         if self.active:
             done, _ = self.active.pop()
+            self._mark_active(done, False)
             line = self.lines.get(done)
             if line is not None and line():
                 self.pending.add(done)
@@ -131,7 +156,10 @@ class Exceptions:
         self.reset_cause = None
         self.locked_up = False
         self.asleep = False
+        self.fault_pending = None
         self.write(SCS_BASE, bytes(0x1000))
+        self._reset_mpu()
+        self.spin_at = 0
         self.set_reg(arm.UC_ARM_REG_PRIMASK, 0)
         self.set_reg(arm.UC_ARM_REG_IPSR, 0)
         self.set_reg(arm.UC_ARM_REG_CONTROL, 0)

@@ -78,6 +78,8 @@ class Runner:
                 return bytes(board.core.uc.mem_read(address, min(n, 256))).hex()
             except (IndexError, ValueError, StopIteration) as e:
                 return f"error: peek takes ADDR N ID ({e})"
+        if cmd in ("inject", "brownout") and cmd in CONTROLS:
+            return self.inject(words)
         control = CONTROLS.get(cmd)
         if control is None:
             return "error: unknown command (try help)"
@@ -139,6 +141,30 @@ class Runner:
             else:
                 return "error: unknown command (try help)"
         return "\n".join(out) if out else "ok"
+
+    def inject(self, words) -> str:
+        """inject ID bus|undef|stack|hang (inject.py); brownout ID [MS]:
+        VDD below the power-down level for MS ms (5), RAM kept."""
+        usage = ("error: inject takes ID and bus, undef, stack or hang" if words[0] == "inject"
+                 else "error: brownout takes ID and a dip of 0.01 to 1000 ms (5 if none)")
+        try:
+            wanted = int(words[1])
+            extra = words[2:]
+        except (IndexError, ValueError):
+            return usage
+        board = next((b for b in self.boards if b.bus_id() == wanted), None)
+        if board is None:
+            return "error: no servo holds that ID"
+        if words[0] == "inject":
+            return board.injector.inject(extra[0]) if len(extra) == 1 else usage
+        try:
+            dip_ms = float(extra[0]) if extra else 5.0
+        except ValueError:
+            return usage
+        if len(extra) > 1 or not 0.01 <= dip_ms <= 1000:
+            return usage
+        board.brownout(dip_ms / 1000)
+        return "ok"
 
     def host_send(self, words) -> str:
         """hostsend MS HEX: the host's bytes on the wire from simulated time
