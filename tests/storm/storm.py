@@ -24,7 +24,13 @@ that was never written), changes lost (acknowledged and gone after a cut:
 an acknowledged change is durable), sanitizer findings. All must be 0.
 An answer the servo did not send because the request arrived during its
 erase is counted apart (answers missed, reported): the host learns of it
-from ReadStore, as docs/decisions.md tells it to.
+from ReadStore, as docs/decisions.md tells it to. So is an answer the host
+talked over: its request started on the wire within about a byte time of a
+finished move's answer, too late for the servo to hear it first, and the
+two garbled each other (docs/decisions.md, "The host"; the simulator's
+garbled bytes beyond its collisions). The request is lost with the answer,
+and with it any frames the servos' framers took for its content; what came
+of the answer runs into the next frame, which the host finds garbled.
 
 Every wait for an answer is in simulated time (the control port's clock):
 on a loaded PC the simulator falls behind the host, and a late answer is
@@ -123,6 +129,7 @@ class Host:
         self.buffer = b""
         self.finished = {i: 0 for i in ANSWERING}
         self.counted = {}  # servo -> answers dropped + bytes lost, as last read
+        self.talked_seen = {}  # what for -> the simulator's talked_over, as last read
 
     def store_counts(self, servo_id: int):
         """What the servo says flash work cost the bus (ReadStore): answers
@@ -145,9 +152,20 @@ class Host:
             if count is not None:
                 self.counted[i] = count
 
+    def talked_over_since(self, what: str) -> bool:
+        """Whether the host has talked over an answer since this was last
+        asked for `what` (a missing answer, a garbled frame)."""
+        talked, before = talked_over(self.sim.state_of(1)), self.talked_seen.get(what, 0)
+        self.talked_seen[what] = talked
+        return talked > before
+
     def missed(self, servo_id: int, what: str) -> bool:
         """An answer did not come. Reported if the servo's own counters
-        rose since they were last read, otherwise a lost frame."""
+        rose since they were last read, talked over if the host garbled an
+        answer meanwhile, otherwise a lost frame."""
+        if self.talked_over_since("missing"):
+            self.stats["answers_talked_over"] += 1
+            return True
         count = self.store_counts(servo_id)
         reported = count is not None and count > self.counted.get(servo_id, count)
         if count is not None:
@@ -161,6 +179,16 @@ class Host:
 
     def send(self, data: bytes):
         self.sim.sock.sendall(data)
+
+    def garbled(self):
+        """A frame failed its checksum. The host's own doing if it has talked
+        over an answer since the last such frame: the answer's first bytes
+        came, the rest was lost under the request, and the next frame ran
+        into them."""
+        if self.talked_over_since("garbled"):
+            self.stats["garbled_talked_over"] += 1
+        else:
+            self.stats["garbled"] += 1
 
     def _frames(self):
         while True:
@@ -177,7 +205,7 @@ class Host:
             end = 4 + self.buffer[3] + 1
             frame, self.buffer = self.buffer[:end], self.buffer[end:]
             if checksum(frame[:-1]) != frame[-1]:
-                self.stats["garbled"] += 1
+                self.garbled()
                 continue
             yield frame[2], frame[4:-1]
 
@@ -242,6 +270,34 @@ def read_item(host: Host, servo_id: int, item: int):
     return struct.unpack("<H", got[1][2:4])[0]
 
 
+def talked_over(bus: dict) -> int:
+    """Bytes a servo sent while the host's were on the wire, from `state`:
+    the host's bytes wait for a quiet wire, so every garbled byte that is
+    not a collision (a servo's over another's) is one of these: an answer
+    and a request the host put on the wire within about a byte time of each
+    other, before the servo could hear the request or the host the answer."""
+    return int(bus["garbled"]) - int(bus["collisions"])
+
+
+def count_finished(stats: dict, expected: dict, heard: dict, bus: dict, log):
+    """At the end of a servo_sim's life (a cut or the storm's end), once the
+    line has been left quiet for the answers: expected and heard, servo ->
+    finished-move answers owed and received since servo_sim started; bus,
+    its `state`. Answers missing where the host talked over an answer are
+    the host's (which moves its garbled request took along cannot be told),
+    elsewhere they are lost."""
+    missing = {i: expected[i] - heard[i] for i in expected if expected[i] > heard[i]}
+    if not missing:
+        return
+    if talked_over(bus) > 0:
+        stats["finished_talked_over"] += sum(missing.values())
+        log(f"finished answers missing {missing}, the host talked over answers "
+            f"({talked_over(bus)} bytes garbled)")
+    else:
+        stats["finished_lost"] += sum(missing.values())
+        log(f"finished answers lost {missing} (owed {expected}, heard {heard})")
+
+
 def check_configs(host: Host, history: dict, stats: dict, log):
     """history: (servo, item) -> [(value, acknowledged)], oldest first; a
     write whose answer the servo did not send may or may not have been
@@ -290,7 +346,8 @@ def run(minutes: float, out: Path, seed: int):
                             "moves", "answered_moves", "finished_answers", "finished_lost",
                             "sync_rounds", "config_writes", "garbage_bytes", "faults",
                             "configs_checked", "writes_refused", "write_bursts", "releases",
-                            "answers_missed_reported")}
+                            "answers_missed_reported", "answers_talked_over", "finished_talked_over",
+                            "garbled_talked_over")}
     stats["lost_examples"] = []
     events = open(out / "events.log", "w")
 
@@ -322,6 +379,9 @@ def run(minutes: float, out: Path, seed: int):
         task = progress.add_task("storm", total=minutes * 60, line="")
     start = time.monotonic()
 
+    def answers_heard():
+        return {i: host.finished[i] - seen_base[i] for i in ANSWERING}
+
     def settle_answers():
         """Leave the line quiet until every finished move has answered
         (each goes out in its slot once the host pauses)."""
@@ -335,9 +395,8 @@ def run(minutes: float, out: Path, seed: int):
         now = time.monotonic()
         if now >= next_cut:
             settle_answers()
-            for i in ANSWERING:
-                stats["finished_lost"] += max(0, expected[i] - (host.finished[i] - seen_base[i]))
             st = sim.state_of(1)
+            count_finished(stats, expected, answers_heard(), st, log)
             stats["collisions"] += int(st["collisions"])
             stats["ticks_dropped"] += sum(int(sim.state_of(i)["dropped_ticks"]) for i in IDS)
             sim.kill()
@@ -391,8 +450,11 @@ def run(minutes: float, out: Path, seed: int):
 
             stats["requests"] += len(present)
             host.listen(0.3 + 0.004 * len(order), round_done)
-            for sid in present:
-                if sid not in heard:
+            absent = [sid for sid in present if sid not in heard]
+            if absent and host.talked_over_since("missing"):  # a garbled round loses all its answers
+                stats["answers_talked_over"] += len(absent)
+            else:
+                for sid in absent:
                     host.missed(sid, f"sync monitor answer of {sid} in {order}")
         elif action == "config" and time.monotonic() >= next_config:
             next_config = time.monotonic() + rng.uniform(1.0, 3.0)
@@ -431,9 +493,9 @@ def run(minutes: float, out: Path, seed: int):
                             line=f"requests {stats['requests']} lost {stats['frames_lost']} "
                                  f"cuts {stats['power_cuts']}")
     settle_answers()
-    for i in ANSWERING:
-        stats["finished_lost"] += max(0, expected[i] - (host.finished[i] - seen_base[i]))
-    stats["collisions"] += int(sim.state_of(1)["collisions"])
+    st = sim.state_of(1)
+    count_finished(stats, expected, answers_heard(), st, log)
+    stats["collisions"] += int(st["collisions"])
     stats["ticks_dropped"] += sum(int(sim.state_of(i)["dropped_ticks"]) for i in IDS)
     stats["page_erases"] = sum(host.page_erases(i) for i in IDS)
     sim.stop()
@@ -441,7 +503,7 @@ def run(minutes: float, out: Path, seed: int):
         progress.stop()
     text = sanitizer_log.read_text()
     stats["sanitizer_findings"] = len(re.findall(r"runtime error|AddressSanitizer|LeakSanitizer", text))
-    stats["finished_answers"] = stats["answered_moves"] - stats["finished_lost"]
+    stats["finished_answers"] = stats["answered_moves"] - stats["finished_lost"] - stats["finished_talked_over"]
     stats["minutes"] = minutes
     stats["seed"] = seed
     stats["lost_examples"] = stats["lost_examples"][:20]
@@ -456,7 +518,10 @@ def run(minutes: float, out: Path, seed: int):
              f" ({stats['configs_checked']} configs checked)",
              f"  {stats['write_bursts']} write bursts, {stats['writes_refused']} writes refused (not durable),"
              f" {stats['releases']} releases, {stats['page_erases']} page erases,"
-             f" {stats['answers_missed_reported']} answers missed and reported in ReadStore"]
+             f" {stats['answers_missed_reported']} answers missed and reported in ReadStore",
+             f"  talked over by the host (its request within a byte time of an answer):"
+             f" {stats['answers_talked_over']} answers asked for, {stats['finished_talked_over']} finished answers,"
+             f" {stats['garbled_talked_over']} frames garbled"]
     lines += [f"  {key.replace('_', ' ')}: {stats[key]}" for key in must_be_zero]
     summary = "\n".join(lines)
     (out / "summary.txt").write_text(summary + "\n")
