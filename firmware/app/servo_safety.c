@@ -138,6 +138,9 @@ static void watch_swing(struct servo *s)
  * lengthens the control tick. */
 void safety_tend(struct servo *s)
 {
+    if (s->hal->stack_watch != NULL) {
+        s->hal->stack_watch();
+    }
     if (s->regs.firmware.watchdog_ms != 0u) {
         watch_bus(s);
     }

@@ -162,6 +162,7 @@ class Board:
         self.injector = Injector(self, elf(board))
         self.resets = {"power": 0, "software": 0, "watchdog": 0}
         self.last_reset = None
+        self.last_reset_s = 0.0
         self.powered = True
         # A flash file without a bootloader (a start that failed before the
         # factory's programming) is a blank chip too.
@@ -281,6 +282,7 @@ class Board:
     def reset(self, cause: str) -> None:
         self.resets[cause] += 1
         self.last_reset = cause
+        self.last_reset_s = self.core.time_s
         for m in self.models:
             m.reset()
         self.rcc.reset_with(cause)
@@ -377,7 +379,7 @@ class Board:
                 "payload": round(m.get("payload_gcm2"), 1),
                 "core_mhz": round(self.core.hz / 1e6, 3), "resets_power": self.resets["power"],
                 "resets_software": self.resets["software"], "resets_watchdog": self.resets["watchdog"],
-                "last_reset": self.last_reset, "mode": "app" if self.in_application() else "bootloader",
+                "last_reset": self.last_reset, "last_reset_ms": round(self.last_reset_s * 1000, 6), "mode": "app" if self.in_application() else "bootloader",
                 "locked_up": int(self.core.locked_up), "asleep_ms": round(self.core.slept_s * 1000, 3),
                 "usart_interrupts": self.core.taken.get(FIRST_IRQ + self.usart.irq, 0),
                 "rx_bytes": self.usart.rx_bytes,

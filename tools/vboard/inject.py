@@ -10,7 +10,7 @@ and brownout), and what a fault handler does about the bridge, measured.
 - undef: the next instruction the application executes in thread mode is
   taken as undefined (UsageFault UNDEFINSTR on the M3, HardFault on the M0).
 - stack: at the entry of the main loop's pass (servo_poll, called every
-  pass), SP is lowered to 8 bytes above the stack's bottom (the ELF's
+  pass), SP is lowered to just above the stack's bottom (STACK_SLACK) (the ELF's
   _estack - STACK_SIZE, firmware/linker/sections_stm32.ld), as if the
   function had a deep local array: its own pushes (48 bytes on the F103,
   20 on the F030) reach below the bottom, over the bottom word where the
@@ -32,7 +32,13 @@ from unicorn import arm_const as arm
 from .idle_skip import _elf, _symbol
 
 KINDS = ("bus", "undef", "stack", "hang")
-STACK_SLACK = 8  # SP at entry: this far above the bottom (8-byte aligned, AAPCS)
+# SP at entry: this far above the bottom (8-byte aligned, AAPCS), so that
+# the function's own pushes (48 bytes on the F103, 20 on the F030) come down
+# across the stack's first words from above, as a stack that grows does: on
+# the M3 through a guard region at the first 32-byte boundary (an MPU
+# region's smallest size and alignment, ARMv7-M B3.5.8), on the M0 over its
+# bottom word.
+STACK_SLACK = {True: 40, False: 8}  # by whether the core is ARMv7-M
 CNDTR = 0x0C  # DMA channel 1's counter; channel n's at 0x0C + 20 (n - 1) (RM0008 13.4.4, RM0360 10.4.4)
 
 
@@ -60,6 +66,7 @@ class Injector:
         self.lowered = None          # (return address, SP lowered to, by how much) while the frame runs
         self.bridge_hook = None
         self.bridge_off_at_s = None
+        self.hung_at_s = None        # core time the main loop stopped (hang)
         self.skip_idle = self.core.skip_idle
         self.core.on_fault = self._faulted
 
@@ -138,13 +145,15 @@ class Injector:
         if not self._thread_mode() or address != self.facts[0]:
             return
         if self.armed == "hang" or core.spin_at == address:  # again after each handler returns here
+            if self.armed == "hang":
+                self.hung_at_s = core.time_s + max(core.count.executed - 1, 0) * core.cpi / core.hz
             self.armed = None
             core.spin_at = address
             core.defer(lambda: None)  # stopped here, not at a WFI
         elif self.armed == "stack":
             self.armed = None
             sp = core.reg(arm.UC_ARM_REG_SP)
-            low = self.facts[1] + STACK_SLACK
+            low = self.facts[1] + STACK_SLACK[core.has_vtor]
             back = core.reg(arm.UC_ARM_REG_LR) & ~1
             self.lowered = (back, low, sp - low)
 
@@ -179,8 +188,9 @@ class Injector:
 
     def state(self) -> dict:
         c = self.core
-        ms = lambda s: "none" if s is None else round(s * 1000, 4)  # noqa: E731
+        ms = lambda s: "none" if s is None else round(s * 1000, 6)  # noqa: E731
         return {"fault_at_ms": ms(c.fault_at_s), "bridge_off_at_ms": ms(self.bridge_off_at_s),
+                "hung_at_ms": ms(self.hung_at_s),
                 "exceptions_taken": ",".join(f"{e}:{n}" for e, n in sorted(c.taken.items())) or "none",
                 "injected": ",".join(f"{k}:{n}" for k, n in self.counts.items()),
                 "inject_armed": self.armed or "none", "brownouts": self.brownouts, "mpu_faults": c.mpu_faults,

@@ -47,6 +47,7 @@ static const struct hal_port port = {
     .serial_number = unique_id_serial,
     .reset = &_kept_ram.reset, /* reset_cause_take's, before servo_init */
     .stack_unused = &stack_unused_bytes,
+    .stack_watch = stack_watch_pass,
     APP_HOOKS_PORT_FIELDS,
 };
 
@@ -70,7 +71,6 @@ int main(void)
     for (;;) {
         servo_poll(&servo);
         test_build_main_loop();
-        stack_watch_pass();
         if (!healthy && systick_now_us() - started_us >= HEALTHY_RUN_US) {
             healthy = true;
             kept_healthy();

@@ -77,6 +77,9 @@ struct hal_port {
     const struct hal_reset *reset;
     /* Bytes of stack never written since start (item 74); NULL: unknown. */
     const volatile uint16_t *stack_unused;
+    /* Each control tick's pass: the stack's guard checked, its depth's scan
+     * a word on (a fault when the guard is gone); NULL: none. */
+    void (*stack_watch)(void);
     /* The board images are built for (the update image header's board). */
     uint16_t board;
     /* Longest gap between the bytes of one frame the link can produce, in

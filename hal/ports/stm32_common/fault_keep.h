@@ -4,8 +4,8 @@
  * bridge's outputs off, then calls fault_keep, which records the fault in
  * the kept RAM (kept_ram.h) and resets the chip; the next start-up logs it.
  * The stack is watched: painted at start, its bottom guarded (the M3's MPU
- * region; the M0's guard word, checked every main-loop pass), its unused
- * depth measured a word a pass. */
+ * region; the M0's guard word, checked every control tick), its unused
+ * depth measured a word a tick. */
 #ifndef STM32_FAULT_KEEP_H
 #define STM32_FAULT_KEEP_H
 
@@ -18,8 +18,9 @@ void fault_keep(const uint32_t *frame, uint32_t ipsr) __attribute__((noreturn));
 /* Before interrupts: the M3's MPU region over the stack's bottom, and its
  * faults taken as MemManage, BusFault, UsageFault (the record says which). */
 void stack_guard_start(void);
-/* Each main-loop pass: the M0's guard word (a fault when overwritten), and
- * a word of the unused-depth scan. */
+/* Each control tick's pass (hal_port.stack_watch; not every pass, so that
+ * a pass with nothing to do changes nothing): the M0's guard word (a fault
+ * when overwritten), and a word of the unused-depth scan. */
 void stack_watch_pass(void);
 /* Bytes of stack never written since start (item 74). */
 extern volatile uint16_t stack_unused_bytes;
