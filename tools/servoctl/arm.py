@@ -5,7 +5,8 @@ and out, a frame at a time.
 - Which firmware: this one (it answers item 64, the bus watchdog) or the
   maker's (it does not).
 - hold_here(): torque on where each joint is; nothing moves (but a joint
-  outside its angle limits, to the nearest: arm_ramp.into_limits).
+  outside its angle limits, to the nearest by the short way, modulo a
+  turn: arm_ramp.into_limits, arm_turns.py).
 - positions(): every joint's angle from one Sync Monitor (0.1 deg), fresh
   or JointSilent naming the joints that did not answer in their slot;
   a joint whose servo released its output (supply, heat) raises
@@ -197,16 +198,13 @@ class Arm:
     def hold_here(self) -> dict:
         """Torque on where every joint is (StopOnControlMode's hold: no
         target, so nothing moves); the first target is that pose, within
-        the angle limits (a joint outside goes to the nearest first). A joint
-        beyond one turn (after wheel mode) is refused, left holding: its
-        targets are single-turn, and the first would spin it back."""
+        the angle limits (a joint outside goes to the nearest first, the
+        short way). One whose reading counts whole turns that a reset puts
+        right (after wheel mode) is refused, left holding: its targets are
+        taken in its limits' turn, and the first would turn it back."""
         for servo_id in self.ids:
             Servo(self.bus, servo_id).stop("hold")
         here = self.positions()
-        turned = [f"{n} (servo {self.joints[n]}) at {d:.1f} deg" for n, d in here.items() if abs(d) > 180]
-        if turned:  # the first target would be taken within one turn: the joint would spin back
-            raise UsageError(f"{', '.join(turned)}: beyond one turn (wheel mode or multi-turn moves); "
-                             f"release it and reset its turns ('servoctl origin ID --reset-turns') first")
         # One outside its limits goes to the nearest first: the ramp starts where the servo takes a setpoint.
         self.targets, self._before = into_limits(self, here, self.ramp.speed_deg_s or DEFAULT_SPEED_DEG_S), {}
         self.ramp.start(here)

@@ -6,7 +6,10 @@ its angle limits a start the servo takes (into_limits). Degrees and
 seconds."""
 import math
 
-from .errors import ServoError
+from .arm_turns import can_reframe, reframe, turned_advice, way_back
+from .checks import to_ms
+from .errors import ServoError, UsageError
+from .move_request import MoveRequest
 from .servo import Servo
 
 DEFAULT_SPEED_DEG_S = 45.0  # a 34 deg gap to a leader's pose takes a second
@@ -78,10 +81,15 @@ def within(deg: float, lim) -> float:
 def into_limits(arm, here: dict, speed_deg_s: float, restarted: bool = False) -> dict:
     """here ({name: deg}, where arm's joints are held) within their limits:
     a joint outside them (it rests a hair past one, or was pushed far out)
-    is moved to the nearest at up to speed_deg_s and waited for, on the
-    bus's clock, a Sync Monitor a frame (which feeds every bus watchdog);
-    its setpoints, and the ramp, then start there, as the servo takes them
-    (it clamps a streamed setpoint to its limits: one outside is a jump).
+    is moved to the nearest by the short way (arm_turns.way_back: 188 deg
+    is 12.8 past 175.2, not 135.1 below -36.9) at up to speed_deg_s and
+    waited for, on the bus's clock, a Sync Monitor a frame (which feeds
+    every bus watchdog); its setpoints, and the ramp, then start there, as
+    the servo takes them (it clamps a streamed setpoint to its limits: one
+    outside is a jump). One whose reading is a turn off where its horn
+    stands (reads -172 for 188) goes the short way across the wrap, and its
+    turns are reset there (arm_turns.reframe); one that counts whole turns
+    a reset puts right is refused (UsageError, left holding), saying so.
     A refusal outside the limits (arm.limits) then advises as for an arm
     whose limits are its calibration, not to switch them off. restarted:
     here is one joint whose servo restarted mid-run (arm_reset.py: it fell
@@ -91,17 +99,37 @@ def into_limits(arm, here: dict, speed_deg_s: float, restarted: bool = False) ->
     for lim in arm.limits.values():  # its range, as calibrated: never to be switched off to get by
         lim.advice = ("The arm keeps its targets within the limits read at connect: were they changed since? "
                       "Connect again (calibrate again to change them)")
-    held = {n: within(d, arm.limits[arm.joints[n]]) for n, d in here.items()}
-    out = {n: d for n, d in held.items() if d != here[n]}
+    ways, turned = {}, []
+    for name, deg in here.items():
+        servo_id, lim = arm.joints[name], arm.limits[arm.joints[name]]
+        ways[name] = way = way_back(round(deg * 10), lim)
+        if way.turns:
+            s = Servo(arm.bus, servo_id)
+            offset = s.read("center_offset")
+            if not can_reframe(way, lim, offset, s.read("angle_limit_on"), arm.firmware):
+                turned.append(turned_advice(name, servo_id, way, lim, offset))
+    if turned:  # its targets are taken in its limits' turn: the first would turn it back
+        raise UsageError("; ".join(turned))
+    held = {n: d if ways[n].limit is None else ways[n].limit / 10 for n, d in here.items()}
+    out = {n: w.goal / 10 for n, w in ways.items() if w.limit is not None}  # in the reading's turn
     soft = 0.0  # the first move after power-up lasts the soft-start time (items 49, 50): a restart's does
     for name, deg in out.items():
         s = Servo(arm.bus, arm.joints[name])
         soft = max(soft, s.read("soft_start_time") / 1000.0 if s.read("soft_start_on") else 0.0)
-        s.move_to(deg, speed_dps=speed_deg_s, accel_s=RISE_S, decel_s=RISE_S)
+        if ways[name].turns:  # beyond the limits in the reading's frame, which the servo's check refuses
+            ramp = to_ms(RISE_S, "accel_s")
+            s.send_move(ways[name].goal, MoveRequest(ramp, ramp, velocity=round(speed_deg_s * 10), multi_turn=True))
+        else:  # past +-180 (188 deg, 0 turns) a single-turn target is taken a turn up: multi-turn there
+            s.move_to(deg, speed_dps=speed_deg_s, accel_s=RISE_S, decel_s=RISE_S,
+                      multi_turn=not -180 <= here[name] < 180)
     start = arm.bus.clock()
     end = start + 2.0 * max((abs(here[n] - d) for n, d in out.items()), default=0) / speed_deg_s + soft + 2.0
-    while out and not all(abs(within(d, arm.limits[arm.joints[n]]) - d) <= 0.1  # within them, or a reading off
-                          for n, d in arm.positions().items() if n in out):
+
+    def there(name, deg):  # within its limits, or a reading off, in the reading's turn
+        lim, deg = arm.limits[arm.joints[name]], deg - ways[name].turns * 360.0
+        return abs(within(deg, lim) - deg) <= 0.1
+
+    while out and not all(there(n, d) for n, d in arm.positions().items() if n in out):
         if arm.bus.clock() > end and restarted:
             name = next(iter(out))
             lim = arm.limits[arm.joints[name]]
@@ -114,4 +142,12 @@ def into_limits(arm, here: dict, speed_deg_s: float, restarted: bool = False) ->
             raise ServoError(f"{', '.join(out)}: outside its angle limits, and not at the nearest within "
                              f"{end - start:.1f} s (blocked?): move it within its range and connect again")
         arm.bus.sleep(arm.period_s)
+    for name, way in ways.items():
+        if way.turns:  # at the limit a turn off: its reading put in the limits' turn
+            servo_id = arm.joints[name]
+            now = reframe(Servo(arm.bus, servo_id), way)
+            if abs(now - way.limit) > 5:
+                raise ServoError(f"{name} (servo {servo_id}): its turns reset at {way.goal / 10:.1f} deg, it reads "
+                                 f"{now / 10:.1f} deg, not {way.limit / 10:.1f}: it holds where it is; connect again")
+            held[name] = now / 10
     return held

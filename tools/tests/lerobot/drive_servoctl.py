@@ -20,6 +20,7 @@ from lerobot.robots.utils import make_robot_from_config  # noqa: E402
 from lerobot.teleoperators.config import TeleoperatorConfig  # noqa: E402
 from lerobot.teleoperators.utils import make_teleoperator_from_config  # noqa: E402
 from lerobot.utils.import_utils import register_third_party_plugins  # noqa: E402
+from servoctl.protocol import Bus  # noqa: E402
 from servoctl.servo import Servo  # noqa: E402
 from servoctl.sim import Simulator  # noqa: E402
 
@@ -199,6 +200,9 @@ def main() -> int:
         calibration(out)
         leader(out)
         clock_connection(out)
+        past_the_wrap(out, reset_turns=False)
+        past_the_wrap(out, reset_turns=True)
+        host_timing(out)
         ours(out)
         out["peak_accel_none_kept"] = compare.peak_accel([], 0.0)  # every frame late: no figure
     finally:
@@ -212,6 +216,62 @@ def ours(out: dict) -> None:
     a real host sends (+-10 ms, one frame in twenty a period late)."""
     out["compare"] = compare.run(compare.Ours())
     out["compare_jitter"] = compare.run(compare.Ours(), compare.HostTiming(0.010, 20))
+
+
+def past_the_wrap(out: dict, reset_turns: bool) -> None:
+    """Servo 5 with limits -36.9..175.2 resting at 188 deg (0 turns), its
+    turns reset or not (-172.0 or 188.0): connect() takes it the short way
+    to 175.2; the simulator's angle of its horn sampled at every wait."""
+    sim = compare.prepare(paced=True)
+    key = "wrap_reset" if reset_turns else "wrap"
+    try:
+        with sim.bus(timeout=0.2, baud=1000000) as b:
+            s = Servo(b, 5)
+            s.move(1880, interval_ms=500, multi_turn=True)
+            sim.sleep(0.8)
+            s.stop("release")
+            for item, value in (("angle_min", -369), ("angle_max", 1752), ("angle_limit_on", 1)):
+                s.write(item, value)
+            if reset_turns:
+                s.reset_multi_turn()
+                sim.sleep(0.01)
+            out[key + "_before"] = [s.multi_turn_angle()[0] / 10, sim.state(5)["angle"]]
+        seen, sleep = [], Bus.sleep
+
+        def sampled(bus, seconds):
+            sleep(bus, seconds)
+            seen.append(sim.state(5)["angle"])
+        Bus.sleep = sampled
+        robot = follower(sim)
+        try:
+            robot.connect(calibrate=False)
+        finally:
+            Bus.sleep = sleep
+        out[key + "_held"] = robot.get_observation()["Motor_5.pos"]
+        out[key + "_seen"] = [min(seen, default=None), max(seen, default=None), len(seen)]
+        out[key + "_after"] = sim.state(5)["angle"]
+        robot.disconnect()
+    finally:
+        sim.stop()
+
+
+def host_timing(out: dict) -> None:
+    """A paced simulator's link without sim_control, the bus on this
+    computer's clock: nothing answers, and the error says the host's
+    timing may be why, not only power and baud."""
+    sim = compare.prepare(paced=True)
+    try:
+        cfg = RobotConfig.get_choice_class("servoctl_arm")(port=sim.url, id="timing", calibration_dir=Path(
+            tempfile.mkdtemp(dir=CAL)), joints={"Motor_0": 0})
+        robot = make_robot_from_config(cfg)
+        try:
+            robot.connect(calibrate=False)
+            out["timing_error"] = None
+            robot.disconnect()
+        except Exception as e:  # noqa: BLE001 - the error is what is tested
+            out["timing_error"] = f"{type(e).__name__}: {e}"
+    finally:
+        sim.stop()
 
 
 def clock_connection(out: dict) -> None:

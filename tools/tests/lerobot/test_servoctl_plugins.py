@@ -153,3 +153,22 @@ def test_disconnect_closes_the_simulators_clock_connection(seen):
     # sim_control without a clock: the bus asks the simulator's clock on a connection
     # it keeps open, which disconnect() left open.
     assert seen["clock_conn"] == [True, True]
+
+
+@pytest.mark.parametrize("key, reads", [("wrap", 188.0), ("wrap_reset", -172.0)])
+def test_connect_brings_a_joint_past_its_limit_back_the_short_way(seen, key, reads):
+    # Servo 5, limits -36.9..175.2, at 188 deg: refused as "beyond one turn" (servoctl
+    # info: 0 turns), and after the advised reset of its turns (-172.0) driven 135 deg
+    # through the range outside its limits to the lower one. Now 12.8 deg back to 175.2.
+    before, horn = seen[key + "_before"]
+    assert before == pytest.approx(reads, abs=0.3) and horn == pytest.approx(188.0, abs=0.3)
+    assert seen[key + "_held"] == pytest.approx(175.2, abs=0.1)
+    low, high, count = seen[key + "_seen"]
+    assert count > 5 and 175.2 - 0.5 <= low and high <= horn + 0.5, seen[key + "_seen"]
+    assert seen[key + "_after"] == pytest.approx(175.2, abs=0.3)
+
+
+def test_no_answer_on_a_simulators_link_without_sim_control_names_the_hosts_timing(seen):
+    said = seen["timing_error"]
+    assert said.startswith("JointNotAnsweringError") and "baud" in said, said
+    assert "the host's timing" in said and "sim_control" in said, said

@@ -3,13 +3,14 @@ the bus, the joints' default layout, the errors LeRobot is given and the
 calibration, on servoctl's Arm (servoctl/arm.py; docs/lerobot.md)."""
 import contextlib
 import logging
+import os
 from dataclasses import dataclass, field
 
 from lerobot.motors import MotorCalibration
 from lerobot.utils.errors import DeviceNotConnectedError
 from lerobot.utils.utils import enter_pressed
 from servoctl import link_rate
-from servoctl.arm import Arm, JointSilent
+from servoctl.arm import Arm, JointShared, JointSilent
 from servoctl.protocol import Bus
 from servoctl.servo import Servo
 
@@ -50,13 +51,32 @@ class JointNotAnsweringError(DeviceNotConnectedError):
         self.joints = list(joints)
 
 
+def host_timing(device) -> str:
+    """What else a silence may be on a simulator's link (socket://, or its
+    pseudo-terminal) without sim_control (or a clock given): the bus waits
+    on this computer's clock, and a simulator behind real time (a slow or
+    loaded host) answers after it gave up. A real servo's answer waits in
+    the adapter for a late read."""
+    config = device.config
+    simulated = link_rate.is_socket(config.port) or os.path.realpath(config.port or "").startswith("/dev/pts/")
+    if not simulated or config.sim_control or device.clock is not None:
+        return ""
+    return ("; or, on a simulator's link without sim_control, the host's timing: the bus waits on this "
+            "computer's clock, and a simulator that falls behind real time (a slow or loaded host) answers "
+            "after the bus has given up; give its control port as sim_control, and the bus waits on the "
+            "simulated clock")
+
+
 @contextlib.contextmanager
 def answering(device):
-    """JointSilent as LeRobot's DeviceNotConnectedError, naming the joint."""
+    """JointSilent as LeRobot's DeviceNotConnectedError, naming the joint
+    (and, on a simulator's link without sim_control, the host's timing)."""
     try:
         yield
-    except JointSilent as e:
+    except JointShared as e:
         raise JointNotAnsweringError(f"{device}: {e}", e.joints) from None
+    except JointSilent as e:
+        raise JointNotAnsweringError(f"{device}: {e}{host_timing(device)}", e.joints) from None
 
 
 def open_bus(config, clock=None) -> Bus:
