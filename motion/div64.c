@@ -17,6 +17,16 @@
     "subs %[hi], %[hi], %[v]\n\t"                                                          \
     "adds %[lo], %[lo], #1\n" label ":\n\t"
 
+unsigned div64_clz(uint32_t x)
+{
+    unsigned n = 0;
+    while ((int32_t)x > 0) {
+        x <<= 1;
+        n++;
+    }
+    return n;
+}
+
 static uint32_t div64_long(uint32_t u1, uint32_t u0, uint32_t v)
 {
     uint32_t i;
@@ -90,10 +100,13 @@ static uint32_t div64_long(uint32_t u1, uint32_t u0, uint32_t v)
  * (Hacker's Delight 9-5, divdu). */
 static uint64_t div64_wide(uint64_t n, uint64_t d)
 {
-    unsigned s = (unsigned)__builtin_clz((uint32_t)(d >> 32));
-    uint32_t top = (uint32_t)((d << s) >> 32);
+    /* 32-bit shifts only: a 64-bit one by a variable is a libgcc call on
+     * the Cortex-M0 (24 B). s < 32, as d >> 32 != 0. */
+    unsigned s = div64_clz((uint32_t)(d >> 32));
+    uint32_t hi = (uint32_t)(d >> 32);
+    uint32_t top = s != 0u ? hi << s | (uint32_t)d >> (32u - s) : hi;
     uint64_t half = n >> 1;
-    uint64_t q = ((uint64_t)div64_long((uint32_t)(half >> 32), (uint32_t)half, top) << s) >> 31;
+    uint64_t q = div64_long((uint32_t)(half >> 32), (uint32_t)half, top) >> (31u - s);
     if (q != 0u) {
         q--;
     }

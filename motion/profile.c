@@ -115,9 +115,16 @@ struct profile_timing profile_velocity_timing(int64_t distance, int64_t v0, int6
     int64_t rest = distance - ramps;
     if (rest == 0 || (rest > 0) == (v > 0)) {
         /* Ticks at vmax: both scaled until vmax fits 32 bits (fast
-         * division), which changes the count by far less than a tick. */
-        unsigned shift = vmax >> 32 != 0 ? 32u - (unsigned)__builtin_clz((uint32_t)(vmax >> 32)) : 0u;
-        int64_t cruise = div_round(abs64(rest) >> shift, vmax >> shift);
+         * division), which changes the count by far less than a tick. A
+         * bit a step: the Cortex-M0 has no 64-bit shift by a variable but
+         * libgcc's (28 B), and planning has the time. */
+        int64_t r = abs64(rest);
+        int64_t vm = vmax;
+        while (vm >> 32 != 0) {
+            vm >>= 1;
+            r >>= 1;
+        }
+        int64_t cruise = div_round(r, vm);
         t.cruise = cruise < PROFILE_MAX_CRUISE ? (uint32_t)cruise : PROFILE_MAX_CRUISE;
         return t;
     }

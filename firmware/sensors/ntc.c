@@ -29,7 +29,9 @@ int16_t ntc_decicelsius(uint16_t adc)
     int32_t span = ntc_adc_at[lo] - ntc_adc_at[hi];
     int32_t into = ntc_adc_at[lo] - adc;
     int32_t step10 = ntc_step_celsius * 10;
-    return (int16_t)(celsius10_at(lo) + (into * step10 + span / 2) / span);
+    /* Every quotient here is of numbers >= 0: unsigned, so the size-first
+     * image links no signed division (60 B on the Cortex-M0). */
+    return (int16_t)(celsius10_at(lo) + (int32_t)((uint32_t)(into * step10 + span / 2) / (uint32_t)span));
 }
 
 uint16_t ntc_adc(int16_t decicelsius)
@@ -39,12 +41,12 @@ uint16_t ntc_adc(int16_t decicelsius)
     if (from_first <= 0) {
         return ntc_adc_at[0];
     }
-    int32_t i = from_first / step10;
+    int32_t i = (int32_t)((uint32_t)from_first / (uint32_t)step10);
     if (i >= LAST) {
         return ntc_adc_at[LAST];
     }
     int32_t frac = from_first - i * step10;
     int32_t a = ntc_adc_at[i];
     int32_t b = ntc_adc_at[i + 1];
-    return (uint16_t)(a - ((a - b) * frac + step10 / 2) / step10);
+    return (uint16_t)(a - (int32_t)((uint32_t)((a - b) * frac + step10 / 2) / (uint32_t)step10));
 }

@@ -18,6 +18,15 @@ uint64_t div64_u(uint64_t n, uint64_t d);
 /* num / den rounded to nearest, halves away from zero; den > 0. */
 int64_t div64_round(int64_t num, int64_t den);
 
+/* The leading zeros of x != 0. On the Cortex-M0, which has no CLZ, a
+ * shift a bit (div64.c): planning only, where libgcc's __clzsi2 costs its
+ * image 60 B. */
+#if defined(__ARM_ARCH_6M__)
+unsigned div64_clz(uint32_t x);
+#else
+#define div64_clz(x) ((unsigned)__builtin_clz(x))
+#endif
+
 /* x 2^32 / 1000, rounded down, for x < 59 074 (a speed in 0.1 deg/s to
  * Q32 decideg per 1 ms tick), without a division (test_div64 checks every
  * x). */
