@@ -3,6 +3,9 @@
  * back, and the fault history, wired into the servo core. */
 #include "app/servo_safety.h"
 
+#include <stddef.h>
+#include <string.h>
+
 #include "sensors/ntc.h"
 
 /* What a protection or the watchdog holds the output back by (enum
@@ -162,6 +165,10 @@ void safety_tend(struct servo *s)
     }
 }
 
+_Static_assert(sizeof(struct fault_code) == HAL_RESET_FAULT_BYTES &&
+                   offsetof(struct hal_reset, usage_status) - offsetof(struct hal_reset, pc) ==
+                       offsetof(struct fault_code, usage_status),
+               "a reset's fault details are a fault record's bytes");
 _Static_assert((int)HAL_RESET_FIRMWARE_FAULT == (int)FAULT_FIRMWARE &&
                    (int)HAL_RESET_WATCHDOG == (int)FAULT_RESET_WATCHDOG &&
                    (int)HAL_RESET_SOFTWARE == (int)FAULT_RESET_SOFTWARE &&
@@ -180,12 +187,7 @@ static void take_reset(struct servo *s, const struct hal_reset *r)
         struct fault_entry e; /* field by field: an initialiser is a memset call on the M0 */
         e.number = 0;
         e.op_seconds = save_policy_op_seconds(&s->saver);
-        e.code.pc = r->pc; /* a firmware fault's record; zeros with another kind */
-        e.code.lr = r->lr;
-        e.code.sp_offset = r->sp_offset;
-        e.code.mm_bus_status = r->mm_bus_status;
-        e.code.exception = r->exception;
-        e.code.usage_status = r->usage_status;
+        memcpy(&e.code, &r->pc, sizeof e.code); /* a firmware fault's record; zeros with another kind */
         e.what = r->kind;
         (void)fault_log_add(&s->faults, &e);
     }

@@ -28,10 +28,6 @@ static struct dma_rx rx_dma;
 static struct hal_flash flash;
 static struct hal_flash fault_flash;
 
-/* A run this long without a fault reset makes the next one the first in a
- * row again (safe mode: servo_safety.h). */
-#define HEALTHY_RUN_US 10000000u
-
 static const struct sensor_calibration calibration = BOARD_SENSOR_CALIBRATION;
 
 /* The board's wiring: which driver does what, in one place. */
@@ -66,15 +62,9 @@ int main(void)
     servo_init(&servo, &port);
     board_interrupts_on();
     iwdg_start();
-    uint32_t started_us = systick_now_us();
-    bool healthy = false;
     for (;;) {
         servo_poll(&servo);
         test_build_main_loop();
-        if (!healthy && systick_now_us() - started_us >= HEALTHY_RUN_US) {
-            healthy = true;
-            kept_healthy();
-        }
         iwdg_kick();
         CORTEX_SLEEP_IF(servo_may_sleep(&servo));
     }

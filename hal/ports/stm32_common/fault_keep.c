@@ -20,9 +20,14 @@ extern uint32_t _sstack, _estack, _ram_start;
 #define WATCH_FROM (&_sstack + 1) /* the word at the bottom is the guard */
 #endif
 
+/* Control ticks without a fault reset after which the next one is the
+ * first in a row again (safe mode: app/servo_safety.h): 10 s at 1 kHz. */
+#define HEALTHY_TICKS 10000u
+
 volatile uint16_t stack_unused_bytes;
 static uint32_t *scan_at;
 static uint32_t *lowest_used;
+static uint16_t ticks_run;
 
 void fault_keep(const uint32_t *frame, uint32_t ipsr)
 {
@@ -77,6 +82,9 @@ void stack_watch_pass(void)
         fault_keep((const uint32_t *)(uintptr_t)sp, HAL_FAULT_STACK_GUARD);
     }
 #endif
+    if (ticks_run < HEALTHY_TICKS && ++ticks_run == HEALTHY_TICKS) {
+        kept_healthy();
+    }
     uint32_t *at = scan_at;
     if (*at != STACK_PAINT) {
         lowest_used = at;

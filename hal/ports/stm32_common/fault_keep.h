@@ -20,7 +20,8 @@ void fault_keep(const uint32_t *frame, uint32_t ipsr) __attribute__((noreturn));
 void stack_guard_start(void);
 /* Each control tick's pass (hal_port.stack_watch; not every pass, so that
  * a pass with nothing to do changes nothing): the M0's guard word (a fault
- * when overwritten), and a word of the unused-depth scan. */
+ * when overwritten), a word of the unused-depth scan, and after 10 s the
+ * record's fault resets in a row cleared (kept_healthy). */
 void stack_watch_pass(void);
 /* Bytes of stack never written since start (item 74). */
 extern volatile uint16_t stack_unused_bytes;
