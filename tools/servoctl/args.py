@@ -25,7 +25,8 @@ anything is sent.
 
 Exit codes: 0 done; 1 the servo refused, or a move did not arrive (the
 message says why); 2 a usage error (nothing was sent); 3 no reply; 4 the
-serial link failed; 130 interrupted (Ctrl-C)."""
+serial link failed; 5 a command stopped part-way could not put back an
+item it had written (the message names it); 130 interrupted (Ctrl-C)."""
 
 
 def _baud(text: str) -> int:
