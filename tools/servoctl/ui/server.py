@@ -21,6 +21,7 @@ from yarl import URL
 from . import quiet
 from .doorman import Doorman
 from .outbox import Outbox, send as _send
+from .pace import Pace, is_stop
 from .worker import QueueFull
 
 STATIC = Path(__file__).parent / "static"
@@ -125,9 +126,20 @@ class Page:
         self._roles()
         if self.last_scan is not None:
             self._tell(ws, self.last_scan)
+        pace = Pace()
         try:
             async for msg in ws:
-                await self._take(ws, msg)
+                within = pace.take()
+                stop = not within and msg.type in (WSMsgType.TEXT, WSMsgType.BINARY) and is_stop(msg.data)
+                if within or stop:  # a STOP ALL is taken over the rate too, and counted
+                    await self._take(ws, msg)
+                if not within and self._over(ws, pace, said=not stop):
+                    break
+                if self.outbox[ws].cut:  # what it sent before it was cut off is not taken
+                    break
+                # What a tab sent in one burst is all buffered: without a turn of
+                # the loop here, another tab's STOP ALL waits behind all of it.
+                await asyncio.sleep(0)
         finally:
             self.sockets.remove(ws)
             self.who.pop(ws, None)
@@ -137,6 +149,18 @@ class Page:
                 self.driver = None
                 self._elect()
         return ws
+
+    def _over(self, ws, pace, said: bool) -> bool:
+        """A message over the tab's rate (pace.py), counted (and, said,
+        refused unparsed); True once the tab has sent too many: then it is
+        cut off."""
+        text = pace.refuse()
+        if pace.cut():
+            self.outbox[ws].abort(pace.cut_text(self.who.get(ws, "a tab")))
+            return True
+        if said and text is not None:
+            self._tell(ws, {"type": "error", "tag": None, "op": None, "text": text})
+        return False
 
     def _tell(self, ws, msg):
         """Puts msg (a dict, or its text) in ws's outbox, never waiting."""
