@@ -57,6 +57,7 @@ class Page:
         self.loop = None
         self.doorman = None
         self.last_scan = None  # told to a tab that opens later: its Bus table has rows
+        self.stop_mode = {}  # ws: its page's STOP ALL mode, used when it closes driving
 
     # Safety -----------------------------------------------------------------
 
@@ -121,6 +122,7 @@ class Page:
         self.who[ws] = f"the tab opened at {opened} from {request.remote} ({agent})"
         self.outbox[ws] = Outbox(self, ws, request.transport, self.who[ws])
         self.sockets.append(ws)
+        self.worker.watched = True
         if self.driver is None:
             self.driver = ws
         self._roles()
@@ -142,10 +144,12 @@ class Page:
                 await asyncio.sleep(0)
         finally:
             self.sockets.remove(ws)
+            self.worker.watched = bool(self.sockets)
             self.who.pop(ws, None)
             self.outbox.pop(ws).close()
-            if self.driver is ws:  # what it asked for ends with it
-                self.worker.abandon()
+            mode = self.stop_mode.pop(ws, "release")
+            if self.driver is ws:  # what it asked for ends with it, what it set moving too
+                self.worker.abandon(mode)
                 self.driver = None
                 self._elect()
         return ws
@@ -181,7 +185,7 @@ class Page:
     def _cut(self, ws):
         """ws was aborted for not reading: it drives no more."""
         if self.driver is ws:
-            self.worker.abandon()
+            self.worker.abandon(self.stop_mode.get(ws, "release"))
             self.driver = None
             self._elect()
 
@@ -202,6 +206,9 @@ class Page:
                 raise Malformed(f"{len(msg.data)} bytes long, over the {REQUEST_MAX} a request may be")
             ask = _parse(msg.data)
             tag, op = _tag(ask.get("tag")), ask.get("op")
+            if op == "stopmode":  # any tab's: what its close stops the servos with, if it drives then
+                self.stop_mode[ws] = "damping" if ask.get("mode") == "damping" else "release"
+                return
             if not driving and op != "stopall":  # any tab may stop
                 await self._busy(ws, tag, op)  # its tag and op: the page answers the request that asked
                 return
