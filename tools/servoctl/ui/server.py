@@ -58,6 +58,7 @@ class Page:
         self.doorman = None
         self.last_scan = None  # told to a tab that opens later: its Bus table has rows
         self.stop_mode = {}  # ws: its page's STOP ALL mode, used when it closes driving
+        self.closing = False  # the ui stops (Ctrl-C): its tabs' close leaves the servos as they are
 
     # Safety -----------------------------------------------------------------
 
@@ -148,6 +149,7 @@ class Page:
             self.who.pop(ws, None)
             self.outbox.pop(ws).close()
             mode = self.stop_mode.pop(ws, "release")
+            mode = None if self.closing else mode
             if self.driver is ws:  # what it asked for ends with it, what it set moving too
                 self.worker.abandon(mode)
                 self.driver = None
@@ -383,6 +385,7 @@ async def _serve(page: Page, bind: str, port: int, ready, stop: asyncio.Event):
         await stop.wait()
     finally:
         server.close()
+        page.closing = True
         for ws in list(page.sockets):
             try:  # a tab that does not read would hold the close: CLOSE_S at most, then aborted
                 await asyncio.wait_for(ws.close(), CLOSE_S)

@@ -74,3 +74,25 @@ def test_with_no_tab_open_the_bus_is_quiet():
     assert stopped_ms <= STOPPED_MS, stopped_ms
     assert quiet, "the ui still talks to the servos with no tab open: it feeds their bus watchdog"
     assert code == 0 and "Traceback" not in err, err[:2000]
+
+
+async def _spin_and_stay(ui, sim):
+    async with aiohttp.ClientSession() as s:
+        driver = Page(await s.ws_connect(_ws_url(ui), headers={"Origin": ui.base}), sim)
+        await driver.send({"op": "scan"})
+        await driver.until(lambda m: m["type"] == "scan")
+        said = await driver.result(await driver.send({"op": "run", "argv": ["wheel", "1", "run", "--speed", "90"]}))
+        assert said["code"] == 0, said
+        await driver.sim_sleep(0.5)
+        code, err = ui.stop()  # Ctrl-C with the tab still open and driving
+        await driver.sim_sleep(1.0)
+        return code, err, sim.state(1)
+
+
+def test_stopping_the_ui_leaves_the_servos_as_they_are():
+    """Ctrl-C stops the ui, not the servos (as every servoctl command): its
+    tabs' close at shutdown is not a driving tab going away."""
+    with Simulator(ids=[1]) as sim, UiProcess(sim) as ui:
+        code, err, state = asyncio.run(_spin_and_stay(ui, sim))
+    assert code == 0 and "Traceback" not in err, err[:2000]
+    assert abs(state["velocity"]) > 30 and state["coasted_ms"] == 0, state
