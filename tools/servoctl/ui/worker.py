@@ -92,10 +92,11 @@ class Worker:
         self.plot_ids = []  # sampled while the queue is empty
         self.sampler = None
         self.stopping = threading.Event()
-        # A tab is open (server.Page): with none, neither the live table's
-        # rounds nor the plots' samples go on the bus, so a servo's bus
-        # watchdog (item 64) is fed by nobody and acts.
-        self.watched = False
+        # A tab is open (server.Page sets it as the last one closes): with
+        # none, neither the live table's rounds nor the plots' samples go on
+        # the bus, so a servo's bus watchdog (item 64) is fed by nobody and
+        # acts. Before the first tab there is nothing to poll: no scan yet.
+        self.watched = True
         self.preempt = Preemption(bus)  # the running command ends at its next look at the port
         self.current = None
         self.thread = threading.Thread(target=self._loop, name="servoctl-ui-bus", daemon=True)
