@@ -22,9 +22,9 @@ Angles are given in degrees and speeds in degrees per second; the tool turns
 them into the protocol's 0.1 degree units and checks every value before
 anything is sent.
 
-Exit codes: 0 done; 1 the servo refused, or a move did not arrive (the
-message says why); 2 a usage error (nothing was sent); 3 no reply; 4 the
-serial link failed; 130 interrupted (Ctrl-C)."""
+Exit codes: 0 done; 1 the servo refused, or a move did not arrive (why is
+said); 2 a usage error (nothing was sent); 3 no reply; 4 the serial link
+failed; 5 a cut-short command left an item changed; 130 interrupted (Ctrl-C)."""
 
 
 def _baud(text: str) -> int:

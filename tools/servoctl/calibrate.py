@@ -14,11 +14,18 @@ the horn free and stored (data items 82's sign, 90 and 91).
    zero: after every power-up angles are from it. SetOriginPoint makes it so
    now. So start with the horn at its zero mark, or pass --keep-zero.
 
+Every item is written through a PutBack (putback.py): a calibrate that
+does not finish (Ctrl-C, the ui's STOP ALL or its tab closing, an error, a
+servo gone) puts each item it wrote back as it was, the search's midpoints
+in item 91 first of all (left there, the servo reads 0 A while it draws
+current, and its current protections are blind).
+
 Time is the servo's (or the simulator's) clock: sleep(s)."""
 from dataclasses import dataclass
 
 from .errors import ServoError
 from .identify import come_to_rest
+from .putback import PutBack
 
 PUSH_DUTY = 0.25
 PUSH_MS = 150
@@ -38,19 +45,20 @@ class Calibration:
     push_decideg: int       # what the checking push moved, positive
 
 
-def current_zero(servo, sleep) -> int:
-    """The smallest item 91 at which the released servo reads no current."""
+def current_zero(servo, sleep, kept: PutBack) -> int:
+    """The smallest item 91 at which the released servo reads no current;
+    each step written through kept."""
     servo.stop("release")
     lo, hi = 0, ADC_MOST  # the answer is in lo..hi
     while lo < hi:
         mid = (lo + hi) // 2
-        servo.write("current_zero", mid)
+        kept.write("current_zero", mid)
         sleep(CURRENT_SETTLE_S)
         if servo.read("current") == 0:
             hi = mid
         else:
             lo = mid + 1
-    servo.write("current_zero", lo)
+    kept.write("current_zero", lo)
     return lo
 
 
@@ -72,7 +80,7 @@ def push(servo, sleep, duty: float = PUSH_DUTY) -> int:
     return moved
 
 
-def direction(servo, sleep) -> tuple:
+def direction(servo, sleep, kept: PutBack) -> tuple:
     """(reversed, the gear ratio now, the checking push in decidegrees)."""
     ratio = servo.read("gear_ratio")
     moved = push(servo, sleep)
@@ -81,7 +89,7 @@ def direction(servo, sleep) -> tuple:
                          "(and the supply be on)")
     if moved < 0:
         ratio = -ratio
-        servo.write("gear_ratio", ratio)
+        kept.write("gear_ratio", ratio)
         settle_store(sleep)
         moved = push(servo, sleep)
         if moved <= 0:
@@ -89,7 +97,7 @@ def direction(servo, sleep) -> tuple:
     return ratio < 0, ratio, moved
 
 
-def zero(servo, sleep, start_decideg: int) -> int:
+def zero(servo, sleep, start_decideg: int, kept: PutBack) -> int:
     """The horn back at start_decideg, released, and its encoder count
     there stored as the zero (item 90), and taken as the origin now."""
     servo.move(start_decideg, interval_ms=RETURN_MS)
@@ -106,7 +114,7 @@ def zero(servo, sleep, start_decideg: int) -> int:
     servo.stop("release")
     sleep(0.05)
     count = servo.read("encoder_count")
-    servo.write("encoder_zero", count)
+    kept.write("encoder_zero", count)
     servo.set_origin()
     return count
 
@@ -115,10 +123,11 @@ def calibrate(servo, sleep, keep_zero: bool = False) -> Calibration:
     if servo.read("voltage") < 500:
         raise ServoError("the supply reads below 0.5 V: calibrate needs the motor powered")
     start = servo.read_motion().angle_decideg
-    amp = current_zero(servo, sleep)
-    settle_store(sleep)
-    reversed_, ratio, moved = direction(servo, sleep)
-    count = None if keep_zero else zero(servo, sleep, start)
+    with PutBack(servo, "calibrate") as kept:  # all of it, or none: each item as it was
+        amp = current_zero(servo, sleep, kept)
+        settle_store(sleep)
+        reversed_, ratio, moved = direction(servo, sleep, kept)
+        count = None if keep_zero else zero(servo, sleep, start, kept)
     return Calibration(amp, reversed_, ratio, count, moved)
 
 

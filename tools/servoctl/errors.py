@@ -51,3 +51,11 @@ class BadAnswer(NoReply):
 class LinkError(ServoError):
     """The serial port or socket failed: cannot open, gone, write error."""
     exit_code = 4
+
+
+class NotPutBack(ServoError):
+    """A command that stopped part-way could not put back a stored item it
+    had written along the way (putback.py): the servo holds a value no one
+    chose (a binary search's midpoint). Its own exit code, so a script
+    cannot take it for a plain interruption or refusal."""
+    exit_code = 5

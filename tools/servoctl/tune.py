@@ -28,6 +28,7 @@ from dataclasses import dataclass
 from . import registers
 from .errors import ServoError
 from .loop_model import DECIDEG_RAD, Q15, TICK_S, _plant, _si, margins  # noqa: F401 (tune's own names too)
+from .putback import PutBack
 
 ZETA = 0.7
 DEFAULT_MAX_HZ = 8.0      # no faster by default: the reference's factory gains are 8.4 Hz
@@ -152,8 +153,12 @@ def cmd_tune(bus, args):
     if args.dry_run:
         print("dry run: nothing written")
         return 0
-    servo.write_drive(t.items)  # refused, nothing written, if the loop they make would not be stable
-    over, error = check_step(servo, bus.sleep)
+    # Refused, nothing written, if the loop they make would not be stable. Kept
+    # only once the check ran: one cut short (a Ctrl-C, the ui's STOP ALL at a
+    # step that looked wrong, a servo gone) puts back the items the servo had.
+    with PutBack(servo, "tune") as kept:
+        kept.write_drive(t.items)
+        over, error = check_step(servo, bus.sleep)
     print(f"written and kept; a {CHECK_TARGET_DECIDEG / 10:g} deg move in {CHECK_MS} ms: overshoot "
           f"{max(over, 0) / 10:.1f} deg, {error / 10:.1f} deg from the target 1.5 s on")
     return 0

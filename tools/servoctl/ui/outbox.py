@@ -54,13 +54,17 @@ class Outbox:
         if self.unread() > OUTBOX_MAX:
             self.abort()
 
-    def abort(self):
+    def abort(self, why: str = None):
+        """Cut off: for not reading, or why (a tab that floods, pace.py)."""
         unread = self.unread()
         self.cut = True
         self.texts.clear()
         self.size = 0
-        LOG.warning("%s is cut off: %d bytes it was told are unread, over the %d a tab may leave unread",
-                    self.who, unread, OUTBOX_MAX)
+        if why is not None:
+            LOG.warning("%s", why)
+        else:
+            LOG.warning("%s is cut off: %d bytes it was told are unread, over the %d a tab may leave unread",
+                        self.who, unread, OUTBOX_MAX)
         if self.transport is not None:
             self.transport.abort()
         # Once the roles being told, if any, are: then it drives no more.

@@ -7,7 +7,11 @@ thread's command ends at its next look at the port (every STEP_S at most,
 waits included).
 
 One lock orders the bus's writes: a command's write checks the interrupt
-inside it, so nothing a command sends can follow the stop on the wire."""
+inside it, so nothing a command sends can follow the stop on the wire, but
+for one thing: a command stopped part-way puts back the stored items it
+had written (putback.py, through bus.finishing()): writes that drive
+nothing, of what the servo held before."""
+import contextlib
 import queue
 import threading
 import time
@@ -32,6 +36,8 @@ class Preemption:
         self.why = "stop-all"
         self._link, self._sleep = bus._link, bus.sleep
         bus._link, bus.sleep = self._link_unless_interrupted, self._sleep_unless_interrupted
+        bus.finishing = self.finishing
+        self._finishing = 0  # the bus thread's put-backs under way: not interrupted
         self._stops = queue.SimpleQueue()
         self._last_stop = 0.0  # time.monotonic() of the last broadcast written
         self.thread = threading.Thread(target=self._stop_thread, name="servoctl-ui-stop", daemon=True)
@@ -45,8 +51,18 @@ class Preemption:
         self.flag.clear()
 
     def check(self) -> None:
-        if self.flag.is_set():
+        if self.flag.is_set() and not self._finishing:
             raise KeyboardInterrupt(self.why)
+
+    @contextlib.contextmanager
+    def finishing(self):
+        """On the bus thread: what runs inside (a put-back) is not cut by
+        the interrupt; the next look at it after raises as before."""
+        self._finishing += 1
+        try:
+            yield
+        finally:
+            self._finishing -= 1
 
     def broadcast_stop(self, mode: str) -> None:
         """A broadcast StopOnControlMode on the wire now (any thread may

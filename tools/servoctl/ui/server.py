@@ -21,6 +21,7 @@ from yarl import URL
 from . import quiet
 from .doorman import Doorman
 from .outbox import Outbox, send as _send
+from .pace import Pace, is_stop
 from .worker import QueueFull
 
 STATIC = Path(__file__).parent / "static"
@@ -56,6 +57,8 @@ class Page:
         self.loop = None
         self.doorman = None
         self.last_scan = None  # told to a tab that opens later: its Bus table has rows
+        self.stop_mode = {}  # ws: its page's STOP ALL mode, used when it closes driving
+        self.closing = False  # the ui stops (Ctrl-C): its tabs' close leaves the servos as they are
 
     # Safety -----------------------------------------------------------------
 
@@ -120,23 +123,50 @@ class Page:
         self.who[ws] = f"the tab opened at {opened} from {request.remote} ({agent})"
         self.outbox[ws] = Outbox(self, ws, request.transport, self.who[ws])
         self.sockets.append(ws)
+        self.worker.watched = True
         if self.driver is None:
             self.driver = ws
         self._roles()
         if self.last_scan is not None:
             self._tell(ws, self.last_scan)
+        pace = Pace()
         try:
             async for msg in ws:
-                await self._take(ws, msg)
+                within = pace.take()
+                stop = not within and msg.type in (WSMsgType.TEXT, WSMsgType.BINARY) and is_stop(msg.data)
+                if within or stop:  # a STOP ALL is taken over the rate too, and counted
+                    await self._take(ws, msg)
+                if not within and self._over(ws, pace, said=not stop):
+                    break
+                if self.outbox[ws].cut:  # what it sent before it was cut off is not taken
+                    break
+                # What a tab sent in one burst is all buffered: without a turn of
+                # the loop here, another tab's STOP ALL waits behind all of it.
+                await asyncio.sleep(0)
         finally:
             self.sockets.remove(ws)
+            self.worker.watched = bool(self.sockets)
             self.who.pop(ws, None)
             self.outbox.pop(ws).close()
-            if self.driver is ws:  # what it asked for ends with it
-                self.worker.abandon()
+            mode = self.stop_mode.pop(ws, "release")
+            mode = None if self.closing else mode
+            if self.driver is ws:  # what it asked for ends with it, what it set moving too
+                self.worker.abandon(mode)
                 self.driver = None
                 self._elect()
         return ws
+
+    def _over(self, ws, pace, said: bool) -> bool:
+        """A message over the tab's rate (pace.py), counted (and, said,
+        refused unparsed); True once the tab has sent too many: then it is
+        cut off."""
+        text = pace.refuse()
+        if pace.cut():
+            self.outbox[ws].abort(pace.cut_text(self.who.get(ws, "a tab")))
+            return True
+        if said and text is not None:
+            self._tell(ws, {"type": "error", "tag": None, "op": None, "text": text})
+        return False
 
     def _tell(self, ws, msg):
         """Puts msg (a dict, or its text) in ws's outbox, never waiting."""
@@ -157,7 +187,7 @@ class Page:
     def _cut(self, ws):
         """ws was aborted for not reading: it drives no more."""
         if self.driver is ws:
-            self.worker.abandon()
+            self.worker.abandon(self.stop_mode.get(ws, "release"))
             self.driver = None
             self._elect()
 
@@ -178,6 +208,9 @@ class Page:
                 raise Malformed(f"{len(msg.data)} bytes long, over the {REQUEST_MAX} a request may be")
             ask = _parse(msg.data)
             tag, op = _tag(ask.get("tag")), ask.get("op")
+            if op == "stopmode":  # any tab's: what its close stops the servos with, if it drives then
+                self.stop_mode[ws] = "damping" if ask.get("mode") == "damping" else "release"
+                return
             if not driving and op != "stopall":  # any tab may stop
                 await self._busy(ws, tag, op)  # its tag and op: the page answers the request that asked
                 return
@@ -352,6 +385,7 @@ async def _serve(page: Page, bind: str, port: int, ready, stop: asyncio.Event):
         await stop.wait()
     finally:
         server.close()
+        page.closing = True
         for ws in list(page.sockets):
             try:  # a tab that does not read would hold the close: CLOSE_S at most, then aborted
                 await asyncio.wait_for(ws.close(), CLOSE_S)

@@ -92,6 +92,11 @@ class Worker:
         self.plot_ids = []  # sampled while the queue is empty
         self.sampler = None
         self.stopping = threading.Event()
+        # A tab is open (server.Page sets it as the last one closes): with
+        # none, neither the live table's rounds nor the plots' samples go on
+        # the bus, so a servo's bus watchdog (item 64) is fed by nobody and
+        # acts. Before the first tab there is nothing to poll: no scan yet.
+        self.watched = True
         self.preempt = Preemption(bus)  # the running command ends at its next look at the port
         self.current = None
         self.thread = threading.Thread(target=self._loop, name="servoctl-ui-bus", daemon=True)
@@ -135,14 +140,18 @@ class Worker:
         # wire sees it (preempt.py's lock) and is not sent.
         self.preempt.broadcast_stop(mode)
 
-    def abandon(self):
+    def abandon(self, mode: str = None):
         """The driving tab closed: its queued requests dropped, its command
-        interrupted, its plot's sampling stopped."""
+        interrupted, its plot's sampling stopped; given a mode (its STOP
+        ALL's), every servo stopped as STOP ALL stops them: what it set
+        moving does not go on without it."""
         with self.cond:
             self.jobs.clear()
             if self.current != self.stop_all:
                 self.preempt.interrupt("the tab that asked for it closing")
             self.urgent.append((self.plot, ([],)))
+            if mode is not None and (self.stop_all, (mode,)) not in self.urgent:
+                self.urgent.append((self.stop_all, (mode,)))
             self.cond.notify()
 
     # What the page asks for -------------------------------------------------
@@ -318,7 +327,7 @@ class Worker:
     def _loop(self):
         while True:
             with self.cond:
-                if not (self.urgent or self.jobs or self.plot_ids or self.stopping.is_set()):
+                if not (self.urgent or self.jobs or (self.plot_ids and self.watched) or self.stopping.is_set()):
                     self.cond.wait(0.2)
                 if self.stopping.is_set():
                     return
@@ -343,6 +352,8 @@ class Worker:
                 self.current = None
 
     def _idle(self):
+        if not self.watched:  # no tab: nothing on the bus (the servos' watchdogs act)
+            return
         sampler = self.sampler  # plot() replaces it on this thread only
         if sampler is not None:
             rows = sampler.take()

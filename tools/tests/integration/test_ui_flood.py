@@ -240,6 +240,21 @@ def _frame(n: int) -> int:
     return n + (2 if n < 126 else 4 if n < 65536 else 10)
 
 
+def upgrade(s, ui):
+    """A WebSocket's opening handshake on the raw socket s, to the page's
+    own address, read up to the end of the server's answer (byte by byte:
+    what follows is the tab's)."""
+    port = int(ui.base.rsplit(":", 1)[1])
+    key = base64.b64encode(os.urandom(16)).decode()
+    s.sendall((f"GET /ws?token={ui.token} HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nOrigin: {ui.base}\r\n"
+               f"Upgrade: websocket\r\nConnection: Upgrade\r\nSec-WebSocket-Key: {key}\r\n"
+               f"Sec-WebSocket-Version: 13\r\n\r\n").encode())
+    head = b""
+    while b"\r\n\r\n" not in head:
+        head += s.recv(1)
+    assert b" 101 " in head.split(b"\r\n")[0], head[:200]
+
+
 def _stuck_tab(ui):
     """A tab on a raw socket with a small receive buffer: it reads its
     hello and then nothing more. (socket, the hello frame's bytes)."""
@@ -248,13 +263,7 @@ def _stuck_tab(ui):
     s.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
     s.settimeout(WAIT_S)
     s.connect(("127.0.0.1", port))
-    key = base64.b64encode(os.urandom(16)).decode()
-    s.sendall((f"GET /ws?token={ui.token} HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nOrigin: {ui.base}\r\n"
-               f"Upgrade: websocket\r\nConnection: Upgrade\r\nSec-WebSocket-Key: {key}\r\n"
-               f"Sec-WebSocket-Version: 13\r\n\r\n").encode())
-    head = b""
-    while b"\r\n\r\n" not in head:
-        head += s.recv(1)
+    upgrade(s, ui)
     first = s.recv(2)
     n, size = first[1] & 127, 2
     if n == 126:

@@ -33,6 +33,7 @@ const UI = (() => {
     const proto = location.protocol === "https:" ? "wss:" : "ws:";
     ws = new WebSocket(`${proto}//${location.host}/ws?token=${encodeURIComponent(token)}`);
     ws.onmessage = (ev) => handle(JSON.parse(ev.data));
+    ws.onopen = tellStopMode;
     ws.onclose = () => { setRole("closed", "the server has stopped (servoctl ui ended)"); };
   }
 
@@ -52,6 +53,10 @@ const UI = (() => {
     }
     (handlers[msg.type] || []).forEach((fn) => fn(msg));
   }
+
+  // What the server stops every servo with should this tab close while it
+  // drives: STOP ALL's mode, as chosen here.
+  function tellStopMode() { send({op: "stopmode", mode: $("#stop-mode").value}); }
 
   function send(obj) {
     if (!ws || ws.readyState !== 1) return false;
@@ -152,6 +157,7 @@ const UI = (() => {
     });
     on("picked", greyOwn);
     document.querySelectorAll("#tabs button").forEach((b) => b.addEventListener("click", () => show(b.dataset.view)));
+    $("#stop-mode").addEventListener("change", tellStopMode);
     $("#stop-all").addEventListener("click", () => {
       send({op: "stopall", mode: $("#stop-mode").value});
     });
