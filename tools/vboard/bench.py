@@ -11,7 +11,11 @@ Three cases per board, each in this one process (one core):
 
 A speed of 1.0 keeps up with real time; below it, every client with its own
 timeouts sees a slow servo. The figures go in docs/virtual-boards.md.
-VBOARD_SKIP=0 emulates every idle pass the cores would skip (idle_skip.py)."""
+VBOARD_SKIP=0 emulates every idle pass the cores would skip (idle_skip.py).
+--mpu guard sets the Cortex-M3's MPU as a firmware guarding its stack
+would (a 32-byte no-access region at the stack's bottom, PRIVDEFENA: one
+hooked range); --mpu all without PRIVDEFENA (a 4 GB read-write region
+under the guard: every access hooked), for what the MPU's hooks cost."""
 import argparse
 import sys
 import tempfile
@@ -20,6 +24,7 @@ from types import SimpleNamespace
 
 from servoctl import protocol as p
 
+from . import mpu
 from .board import PARTS
 from .run import MAX_SLICE_S, Runner
 
@@ -63,10 +68,22 @@ def measure(runner: Runner, seconds: float, ping_ids=(), cpu: list = None) -> tu
     return speed, sent, len(runner.bus.to_host) // ANSWER
 
 
+def guard_stack(board, how: str) -> None:
+    """The M3's MPU as --mpu says (nothing on the M0, which has none)."""
+    if how == "off" or not board.core.v7m or board.injector.facts is None:
+        return
+    bottom = board.injector.facts[1]
+    regions = {1: (bottom, mpu.no_access())}
+    if how == "all":
+        regions[0] = (0, (3 << 24) | (31 << 1) | 1)  # 4 GB, AP 011: read-write
+    mpu.configure(board.core, regions, mpu.CTRL_ENABLE | (mpu.CTRL_PRIVDEFENA if how == "guard" else 0))
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m vboard.bench", description=__doc__.split("\n\n")[0])
     ap.add_argument("--board", choices=sorted(PARTS), action="append", help="default: both")
     ap.add_argument("--seconds", type=float, default=2.0, help="simulated seconds per case (default 2)")
+    ap.add_argument("--mpu", choices=("off", "guard", "all"), default="off", help="the M3's MPU (default off)")
     args = ap.parse_args(argv)
     print(f"{'board':<12} {'case':<8} {'speed (sim s / wall s)':>23} {'(/ CPU s)':>10} {'answered':>10}")
     worst = float("inf")
@@ -75,6 +92,8 @@ def main(argv=None) -> int:
         for name, ids, pings in cases:
             with tempfile.TemporaryDirectory(prefix="vboard-bench-") as state:
                 runner = runner_for(board, ids, state)
+                for b in runner.boards:
+                    guard_stack(b, args.mpu)
                 cpu = []
                 try:
                     speed, sent, heard = measure(runner, args.seconds, pings, cpu)

@@ -15,8 +15,9 @@ The main loop's awake passes that find nothing to do are counted as run
 without running them (idle_skip.py), with the same result.
 
 Its memory and register writes are memory.py's (MemoryMap), its
-exceptions exceptions.py's (Exceptions), the system control space's
-registers system_space.py's."""
+exceptions exceptions.py's (Exceptions), which exception a fault is and
+the M3's fault status registers faults.py's (Faults), the M3's MPU
+mpu.py's (Mpu), the system control space's registers system_space.py's."""
 import ctypes
 import math
 import os

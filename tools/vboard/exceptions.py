@@ -10,7 +10,9 @@ here. Priorities come from the NVIC's IPR bytes and the SCB's SHPR3 for
 SysTick (B3.2.11, B3.4): a pending, enabled exception is taken when PRIMASK
 is clear and its priority is higher (a lower number) than the running
 handler's, which it then preempts (EXC_RETURN to handler mode); at equal
-priority the lower exception number goes first (B1.5.4). HardFault's is -1."""
+priority the lower exception number goes first (B1.5.4). HardFault's is -1;
+the M3's MemManage, BusFault and UsageFault take SHPR1's (faults.py, which
+also decides which exception a fault is)."""
 import struct
 
 from unicorn import arm_const as arm
@@ -65,15 +67,17 @@ class Exceptions:
             return self.rd32(NVIC_IPR + (irq & ~3)) >> (8 * (irq & 3)) & 0xFF
         return 0
 
-    def _take_exception(self, force: bool = False) -> None:
+    def _take_exception(self) -> None:
+        """The highest pending exception, if above the execution priority
+        (PRIMASK raises it to 0: only HardFault, at -1, gets past)."""
         if not self.pending:
             return
-        if self.reg(arm.UC_ARM_REG_PRIMASK) & 1 and not force:
-            return
         running = self.active[-1][1] if self.active else 256
+        if self.reg(arm.UC_ARM_REG_PRIMASK) & 1:
+            running = min(running, 0)
         ready = sorted((self.priority(e), e) for e in self.pending
                        if e < FIRST_IRQ or (e - FIRST_IRQ) in self.enabled)
-        if not ready or (ready[0][0] >= running and not force):
+        if not ready or ready[0][0] >= running:
             return
         prio, exc = ready[0]
         self._enter(exc, prio)

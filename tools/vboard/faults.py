@@ -57,6 +57,7 @@ class Faults:
     def _init_faults(self) -> None:
         self.fault_at_s = None        # core time of the last faulting instruction
         self.fault_kind = None
+        self.fault_pc = None          # ... and its address (the PC the frame holds)
         self.on_fault = None          # called after a fault is taken (inject.py watches the bridge)
         if self.v7m:
             self.on_write(SCB_CFSR, self._w1c(SCB_CFSR, CFSR_W1C))
@@ -109,6 +110,7 @@ class Faults:
         if at_s is None:
             at_s = self.time_s + (max(self.count.executed - 1, 0) if self.running else 0) * self.cpi / self.hz
         self.fault_at_s = at_s
+        self.fault_pc = self.reg(arm.UC_ARM_REG_PC) & ~1
         exc = self.fault_exception(kind, address)
         if exc is None:
             self.locked_up = True

@@ -23,8 +23,6 @@ at it and its registers and memory are put back. Only while ENABLE is set,
 and only over the enabled regions (with PRIVDEFENA clear: the whole map
 but the PPB), is any access hooked. Instruction fetches (IACCVIOL, XN) are
 not checked: the firmware runs from flash under the default map."""
-import struct
-
 from unicorn import UC_HOOK_MEM_READ, UC_HOOK_MEM_WRITE, UC_MEM_WRITE
 from unicorn import arm_const as arm
 
@@ -171,6 +169,15 @@ class Mpu:
         self.defer(take)
 
 
-def frame_at(core, sp: int) -> tuple:
-    """The eight words of an exception frame at sp."""
-    return struct.unpack("<8I", bytes(core.uc.mem_read(sp, 32)))
+def configure(core, regions: dict, ctrl: int) -> None:
+    """Sets the MPU as a firmware's stores would (bench.py --mpu, tests):
+    regions {number: (RBAR, RASR)}, then MPU_CTRL."""
+    for n, (rbar, rasr) in regions.items():
+        core.mpu_regions[n] = (rbar & ~0x1F, rasr)
+    core.wr32(MPU_CTRL, ctrl)
+    core._mpu_rehook()
+
+
+def no_access(size_log2: int = 5) -> int:
+    """RASR of an enabled region of 2^size_log2 bytes that nothing may access (AP 000)."""
+    return ((size_log2 - 1) << 1) | 1

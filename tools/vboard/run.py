@@ -6,7 +6,9 @@
 
 prints `vboard: bus URL`, `vboard: control 127.0.0.1:PORT`, `vboard: servos
 ...` and `vboard: ready`, so servoctl and the tests drive it as they drive
-servo_sim. The control port takes servo_sim's commands (help lists them).
+servo_sim. The control port takes servo_sim's commands (help lists them),
+and the virtual boards' own: cutprogram, peek, and the servo's faults,
+inject ID bus|undef|stack|hang and brownout ID [MS] (inject.py).
 
 Simulated time follows the wall clock when the boards keep up, and falls
 behind it when they do not (the emulated CPUs are slower than silicon on
