@@ -159,7 +159,8 @@ class Board:
         self.pass_start = pass_facts(elf(board))  # (address, (section, code), _ebss) or None
         if self.pass_start is not None:
             self.core.skip_memory(self.ram.buf, h["BOARD_RAM_BASE"], self.pass_start[2] - h["BOARD_RAM_BASE"])
-        self.injector = Injector(self, elf(board))
+        self.injector_elf = elf(board)
+        self.injector = Injector(self, self.injector_elf)
         self.resets = {"power": 0, "software": 0, "watchdog": 0}
         self.last_reset = None
         self.last_reset_s = 0.0
