@@ -34,12 +34,20 @@ class FaultCode:
         return EXCEPTIONS.get(e, f"interrupt {e - 16}" if e >= 16 else f"exception {e}")
 
     @property
+    def frame_valid(self) -> bool:
+        """Whether pc and lr are the faulting code's: not when the stack
+        overflowed (the M0's guard, exception 0; the core could not stack
+        the frame, MSTKERR or STKERR)."""
+        return self.exception != 0 and not self.mm_bus_status & (1 << 4 | 1 << 12)
+
+    @property
     def status_bits(self) -> list:
         return ([name for bit, name in MM_BUS_BITS.items() if self.mm_bus_status >> bit & 1] +
                 [name for bit, name in USAGE_BITS.items() if self.usage_status >> bit & 1])
 
     def describe(self, symbols=None) -> str:
-        where = f"pc {self.pc:#010x}{_in(symbols, self.pc)} lr {self.lr:#010x}{_in(symbols, self.lr)}"
+        where = (f"pc {self.pc:#010x}{_in(symbols, self.pc)} lr {self.lr:#010x}{_in(symbols, self.lr)}"
+                 if self.frame_valid else "pc unknown (the stack overflowed: no frame)")
         bits = " ".join(self.status_bits) or "-"
         return f"{self.exception_name}: {where} sp RAM+{self.sp_offset:#06x} [{bits}]"
 

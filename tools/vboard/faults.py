@@ -50,6 +50,9 @@ KINDS = {
 }
 
 
+ENTRY_CYCLES = {True: 12, False: 16}  # an exception's entry, by whether the core is ARMv7-M
+
+
 class Faults:
     """Mixed into Core: v7m (an ARMv7-M core), its registers and memory,
     active, pending, on_write and fix."""
@@ -117,6 +120,11 @@ class Faults:
             return
         try:
             self._enter(exc, self.priority(exc))
+            # The entry's own time, which the instruction counts leave out:
+            # 12 cycles on the Cortex-M3, 16 on the Cortex-M0, with no wait
+            # states (Cortex-M3 TRM r1p1 5.5.1, Cortex-M0 TRM r0p0 5.4; the
+            # F103's flash wait states would add to it).
+            self.time_s += ENTRY_CYCLES[self.v7m] / self.hz
         except KeyError:
             self.locked_up = True
         if self.on_fault is not None:
