@@ -78,7 +78,7 @@ class Watchdog(Model):
     running, only reloads follow, one each main-loop pass: the hook goes and
     each slice boundary takes a 0xAAAA found in KR as a reload in that
     slice (and clears it), which is as exact as the slice (1 ms at most,
-    against a timeout of 125 ms)."""
+    against a timeout of 72 ms)."""
 
     def __init__(self, board, periph):
         super().__init__(board, periph)
