@@ -88,7 +88,7 @@ void stack_watch_pass(void)
     uint32_t *at = scan_at;
     if (*at != STACK_PAINT) {
         lowest_used = at;
-        stack_unused_bytes = (uint16_t)((uint32_t)(uintptr_t)at - (uint32_t)(uintptr_t)WATCH_FROM);
+        stack_unused_bytes = (uint16_t)((uint32_t)(uintptr_t)at - (uint32_t)(uintptr_t)&_sstack);
         at = WATCH_FROM;
     } else if (++at >= lowest_used) {
         at = WATCH_FROM;
