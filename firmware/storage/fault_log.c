@@ -247,15 +247,15 @@ bool fault_log_step(struct fault_log *l)
     }
     uint32_t block = l->flash->write_block;
     uint32_t addr = slot_addr(l, l->job_page, l->job_slot) + l->job_next;
-    if (block == 0u || FAULT_RECORD_SIZE % block != 0u ||
-        !l->flash->program(l->flash->ctx, addr, &l->job[l->job_next])) {
-        job_done(l, false);
-        return true;
+    bool ok = block != 0u && FAULT_RECORD_SIZE % block == 0u &&
+              l->flash->program(l->flash->ctx, addr, &l->job[l->job_next]);
+    if (ok) {
+        l->job_next = (uint16_t)(l->job_next + block);
+        if (l->job_next != FAULT_RECORD_SIZE) {
+            return true;
+        }
     }
-    l->job_next = (uint16_t)(l->job_next + block);
-    if (l->job_next == FAULT_RECORD_SIZE) {
-        job_done(l, true);
-    }
+    job_done(l, ok); /* one call: the M0 keeps one copy of it */
     return true;
 }
 
