@@ -60,7 +60,7 @@ void reset_classify(uint32_t csr, struct kept_ram *k)
     struct hal_reset *r = &k->reset;
     r->kind = kind;
     if (kind != HAL_RESET_FIRMWARE_FAULT) { /* a fault's details only with a fault */
-        memset(&r->sp_offset, 0, sizeof *r - offsetof(struct hal_reset, sp_offset));
+        memset(&r->pc, 0, sizeof *r - offsetof(struct hal_reset, pc));
     }
     if (kind < HAL_RESET_FIRMWARE_FAULT) {
         r->in_row = 0;
