@@ -60,6 +60,15 @@ void motion_update_limits(struct motion *m)
     m->brake_floor_duty = brake_duty(m->drive.duty_limit, m->drive.duty_limit / 2);
 }
 
+void motion_take_over(struct motion *m)
+{
+    m->commands++;
+    m->queue.count = 0;
+    m->answer_packet = 0;
+    m->power_mw = 0;
+    motion_update_limits(m);
+}
+
 void motion_drive_train_changed(struct motion *m)
 {
     m->drive_inputs.supply_mv = 0; /* never a supply motion_supply_mv gives */

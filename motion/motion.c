@@ -53,9 +53,7 @@ void motion_guard(struct motion *m, bool inhibit, bool derate, uint16_t power_ca
 {
     m->cap_limiter = cap_limiter;
     if (inhibit && !m->inhibit) {
-        m->queue.count = 0;
-        m->answer_packet = 0;
-        motion_coast(m);
+        motion_release(m);
     }
     m->inhibit = inhibit;
     if (derate != m->derate || power_cap_mw != m->power_cap_mw) {

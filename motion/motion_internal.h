@@ -106,6 +106,10 @@ uint16_t motion_supply_mv(const struct motion *m);
 /* The current limit and the supply-scaled gains for the running command's
  * power (power_mw) (divides: on changes only). */
 void motion_update_limits(struct motion *m);
+/* A command that takes the output over at once (a streamed setpoint,
+ * DriveDuty): counted, the queue and a move's answer dropped, the limits
+ * at the power item 42 allows (no move's own). */
+void motion_take_over(struct motion *m);
 /* The braking duty the output can count on moving in direction dir. */
 int32_t motion_brake_duty(const struct motion *m, int32_t dir);
 /* Lets the output go (released, turning freely); the command ends. */

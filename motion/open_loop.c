@@ -13,14 +13,10 @@ enum motion_submit_result motion_drive_duty(struct motion *m, int16_t duty_q15, 
     if (m->inhibit || ms == 0u || ms > MOTION_OPEN_LOOP_MAX_MS || duty_q15 == 0) {
         return MOTION_REFUSED; /* not counted: it leaves the watchdog's act standing */
     }
-    m->commands++;
-    m->queue.count = 0;
-    m->answer_packet = 0;
-    m->power_mw = 0;
+    motion_take_over(m);
     m->running = 0;
     m->streaming = 0;
     m->endless = 0;
-    motion_update_limits(m);
     m->mode = MODE_OPEN_LOOP;
     m->open_duty_q15 = duty_q15 < -32767 ? -32767 : duty_q15;
     m->open_ticks = (uint16_t)(ms * (MOTION_TICK_HZ / 1000u));

@@ -37,21 +37,25 @@ static bool horn_follows(const struct motion *m)
            speed > -FOLLOW_SPEED_Q8;
 }
 
+/* The reference a profile takes over: the setpoint and its velocity (the
+ * velocity the slowed clock gives it), or the horn as measured. */
+static void reference(const struct motion *m, bool setpoint, int64_t *start, int64_t *v0)
+{
+    int32_t at = setpoint ? m->setpoint_q8 : m->measured_q8;
+    int32_t v = setpoint ? m->setpoint_q8 - m->last_setpoint_q8 : m->measured_velocity_q8;
+    *start = q8_to_q32(at);
+    *v0 = q8_to_q32(v);
+}
+
 /* Where a new profile starts: the current setpoint and its velocity when
- * following one (no jerk to a stop; the velocity the slowed clock gives
- * it), else the measured position at rest. */
+ * following one (no jerk to a stop), else where the horn really is (it is
+ * elsewhere or moves otherwise than the setpoint: a slowed clock, a load),
+ * at rest unless a setpoint drove it. */
 static void start_state(const struct motion *m, int64_t *start, int64_t *v0)
 {
-    if (m->mode == MODE_POSITION && !horn_follows(m)) {
-        /* The horn is elsewhere or moves otherwise than the setpoint (a
-         * slowed clock, a load): take over from where it really is. */
-        *start = q8_to_q32(m->measured_q8);
-        *v0 = q8_to_q32(m->measured_velocity_q8);
-    } else if (m->mode == MODE_POSITION) {
-        *start = q8_to_q32(m->setpoint_q8);
-        *v0 = q8_to_q32(m->setpoint_q8 - m->last_setpoint_q8);
-    } else {
-        *start = q8_to_q32(m->measured_q8);
+    bool position = m->mode == MODE_POSITION;
+    reference(m, position && horn_follows(m), start, v0);
+    if (!position) {
         *v0 = 0;
     }
 }
@@ -213,10 +217,10 @@ static void run_stop(struct motion *m, const struct motion_command *cmd)
     case STOP_HOLD:
         /* Hold where the servo comes to rest, braking as hard as the motor
          * can from where it is, not where it aimed. */
-        if (m->mode == MODE_POSITION) {
-            plan_stop(m, q8_to_q32(m->setpoint_q8), q8_to_q32(m->setpoint_q8 - m->last_setpoint_q8), 0);
-        } else {
-            plan_stop(m, q8_to_q32(m->measured_q8), q8_to_q32(m->measured_velocity_q8), 0);
+        {
+            int64_t start, v0;
+            reference(m, m->mode == MODE_POSITION, &start, &v0);
+            plan_stop(m, start, v0, 0);
         }
         motion_begin_profile(m, END_HOLD);
         break;

@@ -29,8 +29,8 @@ void motion_move_origin(struct motion *m, int32_t counts)
     /* Whole turns of the origin come off the encoder's count too: the raw
      * reading's place in the turn, and the difference, stay as they were
      * (the tracker follows the count's changes, not the count). */
-    int32_t within = m->origin_counts % ENCODER_COUNTS;
-    within = within < 0 ? within + ENCODER_COUNTS : within;
+    _Static_assert((ENCODER_COUNTS & (ENCODER_COUNTS - 1)) == 0, "a mask floors to whole turns");
+    int32_t within = m->origin_counts & (ENCODER_COUNTS - 1);
     int32_t whole = m->origin_counts - within;
     m->origin_counts = within;
     m->encoder.counts -= whole;

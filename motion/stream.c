@@ -149,7 +149,7 @@ enum motion_submit_result motion_stream(struct motion *m, const struct motion_se
     if (m->inhibit) {
         return MOTION_REFUSED; /* not counted (motion_submit) */
     }
-    m->commands++;
+    motion_take_over(m); /* nothing below reads what it sets */
     int32_t late_q4;
     int32_t period_q4 = stream_period(m, sp->host_ms, &late_q4);
     /* The setpoint's place: a depth of 3/2 period after its stamp on the
@@ -180,10 +180,6 @@ enum motion_submit_result motion_stream(struct motion *m, const struct motion_se
     /* Within 1920 x 16000: the path's checks hold it within the limits. */
     int32_t placed = target + ((v1 * run_on_q4) >> 4);
 
-    m->queue.count = 0;
-    m->answer_packet = 0;
-    m->power_mw = 0;
-    motion_update_limits(m);
     bool cubic = segment_within(placed - start, v0, v1, ticks) && path_within(m, start, placed, v0, v1, ticks);
     if (cubic) {
         profile_plan_segment(&m->profile, start, v0, placed, v1, (uint32_t)ticks);

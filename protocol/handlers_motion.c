@@ -17,35 +17,18 @@ _Static_assert(STOP_RELEASE == FIELD_STOP_ON_CONTROL_MODE_METHOD_MIN &&
 /* Ramps of the packets that carry none (8, 13): docs/protocol.md, "Moves". */
 enum { DEFAULT_RAMP_MS = 20 };
 
-enum time_field { TIME_INTERVAL_U16, TIME_INTERVAL_U32, TIME_VELOCITY };
-
-/* Field layout of the angle packets after the ID:
- * angle (2 or 4), interval or velocity, [acc, dec], power. */
-struct angle_layout {
-    uint8_t code;
-    uint8_t angle_size;
-    uint8_t time_field;   /* enum time_field */
-    uint8_t has_ramps;
-};
-
-static const struct angle_layout angle_layouts[] = {
-    {PKT_MOVE_ANGLE, 2, TIME_INTERVAL_U16, 0},
-    {PKT_MOVE_ANGLE_BY_INTERVAL, 2, TIME_INTERVAL_U16, 1},
-    {PKT_MOVE_ANGLE_BY_VELOCITY, 2, TIME_VELOCITY, 1},
-    {PKT_MOVE_MULTI_TURN, 4, TIME_INTERVAL_U32, 0},
-    {PKT_MOVE_MULTI_TURN_BY_INTERVAL, 4, TIME_INTERVAL_U32, 1},
-    {PKT_MOVE_MULTI_TURN_BY_VELOCITY, 4, TIME_VELOCITY, 1},
-};
-
-static const struct angle_layout *angle_layout_of(uint8_t code)
-{
-    for (size_t i = 0; i < sizeof angle_layouts / sizeof angle_layouts[0]; i++) {
-        if (angle_layouts[i].code == code) {
-            return &angle_layouts[i];
-        }
-    }
-    return NULL;
-}
+/* The angle packets' fields after the ID: angle (2 bytes, 4 for a
+ * multi-turn one), interval (2 bytes, 4 for a multi-turn angle) or
+ * velocity (2), [acc, dec] (2 each), power (2). Each kind's three forms,
+ * by their codes: plain, by interval (with ramps), by velocity (with
+ * ramps); worked out from the code, no table. */
+enum { FORM_PLAIN, FORM_INTERVAL, FORM_VELOCITY };
+_Static_assert(PKT_MOVE_ANGLE_BY_VELOCITY == PKT_MOVE_ANGLE_BY_INTERVAL + 1 &&
+                   PKT_MOVE_MULTI_TURN_BY_INTERVAL == PKT_MOVE_MULTI_TURN + FORM_INTERVAL &&
+                   PKT_MOVE_MULTI_TURN_BY_VELOCITY == PKT_MOVE_MULTI_TURN + FORM_VELOCITY &&
+                   PKT_MOVE_MULTI_TURN > PKT_MOVE_ANGLE_BY_VELOCITY &&
+                   PKT_MOVE_ANGLE < PKT_MOVE_ANGLE_BY_INTERVAL,
+               "the angle packets' codes in their forms' order");
 
 /* On the M0 called, not inlined: four handlers' zeroing and stores in one copy. */
 SIZE_FIRST_CALLED static struct motion_command command_for(const struct packet_call *c, uint8_t kind)
@@ -67,33 +50,30 @@ static enum packet_outcome submit(const struct packet_call *c, const struct moti
 enum packet_outcome handle_move_angle(const struct packet_call *c, struct response *r)
 {
     (void)r;
-    const struct angle_layout *layout = angle_layout_of(c->code);
-    if (layout == NULL) {
-        return OUTCOME_ERROR;
-    }
+    uint8_t code = c->code; /* one of the six (the packet table's) */
+    bool multi = code >= PKT_MOVE_MULTI_TURN;
+    unsigned form = multi                    ? (unsigned)(code - PKT_MOVE_MULTI_TURN)
+                    : code == PKT_MOVE_ANGLE ? FORM_PLAIN
+                                             : (unsigned)(code - PKT_MOVE_ANGLE_BY_INTERVAL) + FORM_INTERVAL;
     const uint8_t *p = &c->content[1];
     struct motion_command cmd = command_for(c, MOTION_ANGLE);
-    cmd.multi_turn = layout->angle_size == 4u;
-    cmd.angle_decideg = cmd.multi_turn ? le_get_i32(p) : le_get_i16(p);
-    p += layout->angle_size;
-    switch (layout->time_field) {
-    case TIME_INTERVAL_U16:
-        cmd.interval_ms = le_get_u16(p);
-        p += 2;
-        break;
-    case TIME_INTERVAL_U32:
-        cmd.interval_ms = le_get_u32(p);
-        p += 4;
-        break;
-    default:
+    cmd.multi_turn = multi;
+    cmd.angle_decideg = multi ? le_get_i32(p) : le_get_i16(p);
+    p += multi ? 4 : 2;
+    if (form == FORM_VELOCITY) {
         cmd.profile = PROFILE_VELOCITY;
         cmd.velocity_decideg_s = le_get_u16(p);
         p += 2;
-        break;
+    } else if (multi) {
+        cmd.interval_ms = le_get_u32(p);
+        p += 4;
+    } else {
+        cmd.interval_ms = le_get_u16(p);
+        p += 2;
     }
     cmd.acc_ms = DEFAULT_RAMP_MS;
     cmd.dec_ms = DEFAULT_RAMP_MS;
-    if (layout->has_ramps) {
+    if (form != FORM_PLAIN) {
         cmd.acc_ms = le_get_u16(p);
         cmd.dec_ms = le_get_u16(p + 2);
         p += 4;

@@ -221,13 +221,18 @@ static bool run_control_tick(struct servo *s, uint32_t now)
     return true;
 }
 
-/* What the port has received since the last pass, to the framer; a line
- * silent for the idle timeout drops a partial frame. */
+/* The ring to the framer, a line silent for the idle timeout dropping a
+ * partial frame: a pass's, and after an erase (one copy on the M0). */
+static SERVO_ONE_COPY void frame_ring(struct servo *s, uint32_t now)
+{
+    frame_rx_receive(&s->rx, s->hal->rx, &s->rx_lost, now, s->rx_idle_us);
+}
+
+/* What the port has received since the last pass, to the framer. */
 static void receive(struct servo *s, uint32_t now)
 {
-    struct hal_rx_ring *ring = s->hal->rx;
     hal_rx_sync(s->hal, now);
-    frame_rx_receive(&s->rx, ring, &s->rx_lost, now, s->rx_idle_us);
+    frame_ring(s, now);
 }
 
 /* The pass after a page erase: the control loop resumes on a fresh
@@ -253,7 +258,7 @@ __attribute__((noinline, cold)) static void after_erase(struct servo *s, uint32_
         return;
     }
     for (;;) {
-        frame_rx_receive(&s->rx, ring, &s->rx_lost, now, s->rx_idle_us);
+        frame_ring(s, now);
         for (uint8_t stale = frame_rx_pending(&s->rx); stale != 0u; stale--) {
             handle_next_frame(s, now, true);
         }

@@ -165,16 +165,21 @@ void safety_tend(struct servo *s)
     }
 }
 
-_Static_assert(sizeof(struct fault_code) == HAL_RESET_FAULT_BYTES &&
-                   offsetof(struct hal_reset, usage_status) - offsetof(struct hal_reset, pc) ==
-                       offsetof(struct fault_code, usage_status),
-               "a reset's fault details are a fault record's bytes");
 _Static_assert((int)HAL_RESET_FIRMWARE_FAULT == (int)FAULT_FIRMWARE &&
                    (int)HAL_RESET_WATCHDOG == (int)FAULT_RESET_WATCHDOG &&
                    (int)HAL_RESET_SOFTWARE == (int)FAULT_RESET_SOFTWARE &&
                    (int)HAL_RESET_BROWN_OUT == (int)FAULT_BROWN_OUT && (int)HAL_RESET_PIN == (int)FAULT_RESET_PIN &&
                    (int)HAL_RESET_LOW_POWER == (int)FAULT_RESET_LOW_POWER,
                "a reset's kind is its fault's");
+/* The reset's record from pc on is a fault's code (hal_reset.h). */
+#define CODE_AT(field) (offsetof(struct hal_reset, field) - offsetof(struct hal_reset, pc))
+_Static_assert(CODE_AT(lr) == offsetof(struct fault_code, lr) &&
+                   CODE_AT(sp_offset) == offsetof(struct fault_code, sp_offset) &&
+                   CODE_AT(mm_bus_status) == offsetof(struct fault_code, mm_bus_status) &&
+                   CODE_AT(exception) == offsetof(struct fault_code, exception) &&
+                   CODE_AT(usage_status) == offsetof(struct fault_code, usage_status) &&
+                   CODE_AT(usage_status) + 1u == sizeof(struct fault_code),
+               "a reset's record is laid out as a fault's code");
 
 /* The reset the board read at start-up: its counts (item 73), its fault
  * history entry, and safe mode after SAFE_MODE_RESETS in a row, which
@@ -187,7 +192,8 @@ static void take_reset(struct servo *s, const struct hal_reset *r)
         struct fault_entry e; /* field by field: an initialiser is a memset call on the M0 */
         e.number = 0;
         e.op_seconds = save_policy_op_seconds(&s->saver);
-        memcpy(&e.code, &r->pc, sizeof e.code); /* a firmware fault's record; zeros with another kind */
+        /* A firmware fault's record; zeros with another kind. */
+        memcpy(&e.code, &r->pc, sizeof e.code);
         e.what = r->kind;
         (void)fault_log_add(&s->faults, &e);
     }

@@ -103,8 +103,8 @@ static void plan_next(struct fault_log *l)
     l->next_slot = 0;
 }
 
-/* A record find_below found: its slot (page x slots + slot), kind,
- * number and operating second. */
+/* A record find_below found: its place (as shown: page <<
+ * SHOWN_PAGE_SHIFT | slot), kind, number and operating second. */
 struct found {
     uint32_t number;
     uint32_t op_seconds;
@@ -119,14 +119,16 @@ static bool find_below(const struct fault_log *l, uint32_t below, struct found *
     const uint8_t slots = slots_per_page(l);
     uint8_t rec[FAULT_RECORD_SIZE];
     f->number = 0;
-    for (uint8_t i = 0; i < 2u * slots; i++) {
-        read_record(l, (uint8_t)(i / slots), (uint8_t)(i % slots), rec);
-        uint32_t n = le_get_u32(&rec[FR_NUMBER]);
-        if (n < below && n > f->number && record_valid(rec)) {
-            f->number = n;
-            f->at = i;
-            f->what = rec[FR_WHAT];
-            f->op_seconds = le_get_u32(&rec[FR_OP_SECONDS]);
+    for (uint8_t page = 0; page < 2u; page++) {
+        for (uint8_t slot = 0; slot < slots; slot++) {
+            read_record(l, page, slot, rec);
+            uint32_t n = le_get_u32(&rec[FR_NUMBER]);
+            if (n < below && n > f->number && record_valid(rec)) {
+                f->number = n;
+                f->at = (uint8_t)(page << SHOWN_PAGE_SHIFT | slot);
+                f->what = rec[FR_WHAT];
+                f->op_seconds = le_get_u32(&rec[FR_OP_SECONDS]);
+            }
         }
     }
     return f->number != 0u;
@@ -147,8 +149,8 @@ uint32_t fault_log_load(struct fault_log *l, const struct hal_flash *flash)
     struct found f;
     if (find_below(l, UINT32_MAX, &f)) {
         l->newest = f.number;
-        l->page = (uint8_t)(f.at / slots_per_page(l));
-        l->slot = (uint8_t)(f.at % slots_per_page(l));
+        l->page = (uint8_t)(f.at >> SHOWN_PAGE_SHIFT);
+        l->slot = (uint8_t)(f.at & ((1u << SHOWN_PAGE_SHIFT) - 1u));
         latest = f.op_seconds + 1u;
         for (;;) {
             uint8_t kind = f.what <= FAULT_OSCILLATION ? f.what : FAULT_CLEARED;
@@ -158,8 +160,7 @@ uint32_t fault_log_load(struct fault_log *l, const struct hal_flash *flash)
             if (f.what == FAULT_CLEARED) {
                 break;
             }
-            uint8_t slots = slots_per_page(l);
-            l->shown[l->shown_count++] = (uint8_t)((f.at / slots) << SHOWN_PAGE_SHIFT | f.at % slots);
+            l->shown[l->shown_count++] = f.at;
             if (l->shown_count == FAULT_HISTORY || !find_below(l, f.number, &f)) {
                 break;
             }
@@ -247,15 +248,15 @@ bool fault_log_step(struct fault_log *l)
     }
     uint32_t block = l->flash->write_block;
     uint32_t addr = slot_addr(l, l->job_page, l->job_slot) + l->job_next;
-    if (block == 0u || FAULT_RECORD_SIZE % block != 0u ||
-        !l->flash->program(l->flash->ctx, addr, &l->job[l->job_next])) {
-        job_done(l, false);
-        return true;
+    bool ok = block != 0u && FAULT_RECORD_SIZE % block == 0u &&
+              l->flash->program(l->flash->ctx, addr, &l->job[l->job_next]);
+    if (ok) {
+        l->job_next = (uint16_t)(l->job_next + block);
+        if (l->job_next != FAULT_RECORD_SIZE) {
+            return true;
+        }
     }
-    l->job_next = (uint16_t)(l->job_next + block);
-    if (l->job_next == FAULT_RECORD_SIZE) {
-        job_done(l, true);
-    }
+    job_done(l, ok); /* one call: the M0 keeps one copy of it */
     return true;
 }
 

@@ -30,21 +30,21 @@ enum hal_reset_count {
 /* The exception number a main loop's stack check reports (no exception). */
 #define HAL_FAULT_STACK_GUARD 0u
 
+/* From pc on laid out as the fault history's record of a firmware fault
+ * (registers/faults.h, struct fault_code), which copies it whole. */
 struct hal_reset {
     uint8_t kind;       /* enum hal_reset_kind */
     uint8_t in_row;     /* fault resets with no healthy run between, this one's included */
-    uint8_t counts[HAL_RESET_COUNTS];
-    /* A firmware fault's details (else 0), laid out as the fault history's
-     * record of one (registers/faults.h, struct fault_code), which copies them. */
+    uint8_t spare[2];
+    uint8_t counts[HAL_RESET_COUNTS]; /* word-aligned: item 73's bytes in one load */
     uint32_t pc;        /* the faulting instruction's address, from the exception's frame */
     uint32_t lr;        /* the link register then */
-    uint16_t sp_offset; /* the stack pointer less the RAM's base */
+    uint16_t sp_offset; /* a firmware fault's stack pointer less the RAM's base */
     uint16_t mm_bus_status; /* ARMv7-M CFSR bits 0-15 (MemManage, BusFault); 0 on ARMv6-M */
     uint8_t exception;  /* the exception taken (3 HardFault, 4-6 MemManage, BusFault,
                          * UsageFault, 16 on an interrupt), or HAL_FAULT_STACK_GUARD */
     uint8_t usage_status; /* ARMv7-M CFSR bits 16-19 and 24-25 in bits 0-5, HFSR VECTTBL
                            * in bit 6, FORCED in bit 7; 0 on ARMv6-M */
 };
-#define HAL_RESET_FAULT_BYTES 14u /* from pc to usage_status */
 
 #endif

@@ -75,7 +75,7 @@ def kept(board) -> dict:
     magic, then struct hal_reset, then its note)."""
     address = _symbol(_elf(board.injector_elf), "_kept_ram")[0]
     raw = bytes(board.core.uc.mem_read(address, 36))
-    kind, in_row, *counts = raw[4:10]
+    kind, in_row, counts = raw[4], raw[5], list(raw[8:12])
     pc, lr, sp_offset, mm_bus, exception, usage = struct.unpack_from("<IIHHBB", raw, 12)
     return {"magic": raw[:4], "kind": kind, "in_row": in_row, "counts": counts, "pc": pc, "lr": lr,
             "mm_bus": mm_bus, "exception": exception, "usage": usage}
