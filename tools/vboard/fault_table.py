@@ -68,6 +68,8 @@ def measure(board_name: str, kind: str) -> dict:
                 off_us = (board.last_reset_s - inj.hung_at_s) * 1e6
             elif kind == "brownout":
                 off_us = (board.last_reset_s - at_s) * 1e6 - 5000  # the dip ends in the reset; VDD off at once
+            elif core.fault_at_s is None:  # the M0's overflow: no exception; its check turns the bridge off, then resets
+                off_us = (board.last_reset_s - inj.overflow_at_s) * 1e6
             else:
                 off_us = (inj.bridge_off_at_s - core.fault_at_s) * 1e6
             taken = ",".join(str(e) for e in sorted(core.taken) if 2 <= e < 15 or e == 0) or "-"
@@ -86,7 +88,9 @@ def table(rows) -> str:
     for r in rows:
         off = r["bridge_off_us"]
         shown = ("at once (held in reset)" if r["reset"] == "power" else
-                 f"{off:.2f} µs" if off < 1000 else f"{off / 1000:.1f} ms")
+                 f"{off:.2f} µs" if off < 100 else f"{off / 1000:.2f} ms")
+        if r["exception"] == "-" and r["reset"] == "software":
+            shown = f"under {shown}: the next control tick's check, then the reset"
         out.append(f"| {r['board']} | {r['fault']} | {r['exception']} | {shown} | {r['reset']} | {r['history']} |")
     return "\n".join(out)
 

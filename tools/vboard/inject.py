@@ -67,6 +67,7 @@ class Injector:
         self.bridge_hook = None
         self.bridge_off_at_s = None
         self.hung_at_s = None        # core time the main loop stopped (hang)
+        self.overflow_at_s = None    # core time the stack's frame was lowered (stack)
         self.skip_idle = self.core.skip_idle
         self.core.on_fault = self._faulted
 
@@ -158,6 +159,7 @@ class Injector:
             self.lowered = (back, low, sp - low)
 
             def lower():
+                self.overflow_at_s = core.time_s  # the frame's pushes come next
                 core.set_reg(arm.UC_ARM_REG_SP, low)
                 self._hook_code(self._pass_start, back, back)
             core.defer(lower)

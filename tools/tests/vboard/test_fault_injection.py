@@ -146,11 +146,11 @@ def test_a_stack_that_reaches_its_bottom(runner):
         assert record["mm_bus"] & (DACCVIOL | MMARVALID) == DACCVIOL | MMARVALID
         assert core.mpu_faults >= 1
     else:
-        _, bottom = board.injector.facts
         assert run(runner, 0.05, lambda: board.resets["software"] == 1)
+        assert board.duty is None
+        assert run(runner, 0.5, lambda: board.in_application())
         record = kept(board)
         assert record["exception"] == 0 and record["kind"] == KIND_FIRMWARE  # the guard, not an exception
-        assert board.duty is None
     assert state(runner)["injected"].split(",")[2] == "stack:1"
 
 
@@ -204,7 +204,7 @@ def test_through_the_control_port_a_hang_ends_in_a_watchdog_reset(tmp_path, boar
         sim.sleep(0.3)
         s = sim.state(1)
         assert s["resets_watchdog"] == 1 and s["injected"] == "bus:0,undef:0,stack:0,hang:1"
-        assert s["last_reset"] == "watchdog" and s["reset_flags"] & 0xFF000000 == 0  # read and cleared
+        assert s["last_reset"] == "watchdog"
         assert s["fault_at_ms"] == "none" and s["hung_at_ms"] != "none"  # a hang is no exception
         assert sim.control("brownout 1 5").startswith("ok")
         s = sim.state(1)
