@@ -10,7 +10,7 @@
 
 /* Fault resets in a row (hal_reset.in_row) that put the servo in safe
  * mode: the output held off, the bus answered (item 75, docs/safety.md). */
-#define SAFE_MODE_RESETS 3u
+#define SAFE_MODE_RESETS HAL_SAFE_MODE_RESETS
 
 /* After the store's load and the dispatcher's init: the fault history,
  * the reset the board read (logged, counted; safe mode) and the history's

@@ -134,6 +134,18 @@ static bool find_below(const struct fault_log *l, uint32_t below, struct found *
     return f->number != 0u;
 }
 
+/* A kind's slot in last_seen, for the repeat rule. The firmware's own
+ * resets (10-12, 15) have none (FAULT_CLEARED's slot, which clears do not
+ * use): the application logs at most three in a row. The supply's and the
+ * pin's (13, 14), which a weak supply could repeat at every start, share
+ * slot 1 (no kind of its own) and keep the rule. */
+static uint8_t repeat_slot(uint8_t what)
+{
+    return what <= FAULT_OSCILLATION                          ? what
+           : what == FAULT_BROWN_OUT || what == FAULT_RESET_PIN ? 1u
+                                                                : FAULT_CLEARED;
+}
+
 uint32_t fault_log_load(struct fault_log *l, const struct hal_flash *flash)
 {
     *l = (struct fault_log){.flash = flash};
@@ -153,7 +165,7 @@ uint32_t fault_log_load(struct fault_log *l, const struct hal_flash *flash)
         l->slot = (uint8_t)(f.at & ((1u << SHOWN_PAGE_SHIFT) - 1u));
         latest = f.op_seconds + 1u;
         for (;;) {
-            uint8_t kind = f.what <= FAULT_OSCILLATION ? f.what : FAULT_CLEARED;
+            uint8_t kind = repeat_slot(f.what);
             if (l->last_seen[kind] == 0u) {
                 l->last_seen[kind] = f.op_seconds + 1u;
             }
@@ -180,9 +192,7 @@ uint32_t fault_log_load(struct fault_log *l, const struct hal_flash *flash)
 
 bool fault_log_add(struct fault_log *l, const struct fault_entry *e)
 {
-    /* A reset's kind (FAULT_FIRMWARE on) has no repeat rule: the
-     * application logs at most three in a row. */
-    uint8_t what = e->what <= FAULT_OSCILLATION ? e->what : FAULT_CLEARED;
+    uint8_t what = repeat_slot(e->what);
     /* last_seen: each kind's last record's operating second + 1; 0 none.
      * A fault is held back as a repeat; a clear, promised within
      * milliseconds, where its record could wait for an erase (no erased

@@ -330,6 +330,24 @@ static void test_a_repeat_is_a_repeat_after_a_power_cycle(void **state)
     assert_int_equal(log_.not_logged, 2);
 }
 
+/* The firmware's own resets are logged however close (the application
+ * stops at three in a row); a brown-out or the pin, which a weak supply can
+ * repeat at every start, keep the repeat rule, across a power cycle too. */
+static void test_resets_own_ones_logged_the_supplys_held_back(void **state)
+{
+    (void)state;
+    assert_true(fault_log_add(&log_, &(struct fault_entry){.what = FAULT_FIRMWARE, .op_seconds = 100}));
+    assert_true(fault_log_add(&log_, &(struct fault_entry){.what = FAULT_FIRMWARE, .op_seconds = 101}));
+    assert_true(fault_log_add(&log_, &(struct fault_entry){.what = FAULT_BROWN_OUT, .op_seconds = 102}));
+    assert_true(settle());
+    fault_log_load(&log_, &flash.hal); /* the next start */
+    assert_false(fault_log_add(&log_, &(struct fault_entry){.what = FAULT_BROWN_OUT, .op_seconds = 104}));
+    assert_false(fault_log_add(&log_, &(struct fault_entry){.what = FAULT_RESET_PIN, .op_seconds = 105}));
+    assert_true(fault_log_add(&log_, &(struct fault_entry){.what = FAULT_RESET_WATCHDOG, .op_seconds = 105}));
+    assert_true(fault_log_add(&log_, &(struct fault_entry){.what = FAULT_BROWN_OUT, .op_seconds = 120}));
+    assert_int_equal(log_.not_logged, 2);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -343,6 +361,7 @@ int main(void)
         cmocka_unit_test_setup(test_a_clear_behind_queued_records_waits_for_them, setup),
         cmocka_unit_test_setup(test_the_spare_is_erased_ahead_once_it_shows_nothing, setup),
         cmocka_unit_test_setup(test_a_repeat_is_a_repeat_after_a_power_cycle, setup),
+        cmocka_unit_test_setup(test_resets_own_ones_logged_the_supplys_held_back, setup),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -90,7 +90,7 @@ def table(rows) -> str:
         shown = ("at once (held in reset)" if r["reset"] == "power" else
                  f"{off:.2f} µs" if off < 100 else f"{off / 1000:.2f} ms")
         if r["exception"] == "-" and r["reset"] == "software":
-            shown = f"under {shown}: the next control tick's check, then the reset"
+            shown = f"{shown}: the stack's check found it, then the reset"
         out.append(f"| {r['board']} | {r['fault']} | {r['exception']} | {shown} | {r['reset']} | {r['history']} |")
     return "\n".join(out)
 

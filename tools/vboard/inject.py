@@ -34,11 +34,12 @@ from .idle_skip import _elf, _symbol
 KINDS = ("bus", "undef", "stack", "hang")
 # SP at entry: this far above the bottom (8-byte aligned, AAPCS), so that
 # the function's own pushes (48 bytes on the F103, 20 on the F030) come down
-# across the stack's first words from above, as a stack that grows does: on
-# the M3 through a guard region at the first 32-byte boundary (an MPU
-# region's smallest size and alignment, ARMv7-M B3.5.8), on the M0 over its
-# bottom word.
-STACK_SLACK = {True: 40, False: 8}  # by whether the core is ARMv7-M
+# into the stack's first bytes from above, as a stack that grows does: on
+# the M3 across the bottom (where a firmware's MPU guard sits), on the M0
+# inside its bottom 256 bytes, far enough above the static data below for
+# an interrupt's frame on top of it (a stack that has just run out, not one
+# that jumped past a whole guard).
+STACK_SLACK = {True: 40, False: 96}  # by whether the core is ARMv7-M
 CNDTR = 0x0C  # DMA channel 1's counter; channel n's at 0x0C + 20 (n - 1) (RM0008 13.4.4, RM0360 10.4.4)
 
 

@@ -22,6 +22,10 @@
 /* RAM; its last 16 bytes are the word that keeps the bootloader (boot_jump.h). */
 #define BOARD_RAM_BASE 0x20000000
 #define BOARD_RAM_SIZE 20480
+/* The stack starts on a 256-byte boundary: its bottom 256 bytes are the
+ * MPU's guard region, which must be aligned to its size (ARMv7-M B3.5.8;
+ * ports/stm32_common/fault_keep.c). */
+#define BOARD_STACK_ALIGN 256
 
 
 /* The receive ring (hal/hal_rx_ring.h): a page erase stalls the CPU up

@@ -27,6 +27,11 @@ enum hal_reset_count {
     HAL_RESET_COUNTS = 4,
 };
 
+/* Fault resets in a row that put the servo in safe mode (app/servo_safety.h):
+ * a healthy run does not clear them once there, only a power-on or a planned
+ * restart does. */
+#define HAL_SAFE_MODE_RESETS 3u
+
 /* The exception number a main loop's stack check reports (no exception). */
 #define HAL_FAULT_STACK_GUARD 0u
 

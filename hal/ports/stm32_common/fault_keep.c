@@ -8,16 +8,24 @@
 /* The linker's (firmware/linker): the stack's bottom and top, RAM's start. */
 extern uint32_t _sstack, _estack, _ram_start;
 
+/* The bottom of the stack an overflow must not pass unseen: larger than
+ * any one frame the images' functions take at once (config_store_load's
+ * 164 B on the F103, the largest; cmake/stack-report.py lists them), so no
+ * frame can step over it. */
+#define GUARD_BYTES 256u
 #if defined(__ARM_ARCH_7M__)
-/* The MPU's region: 32 bytes (its smallest, ARMv7-M B3.5.8) at the first
- * 32-byte boundary in the stack, no access, never executed. */
-#define GUARD_BYTES 32u
-#define GUARD_AT (((uint32_t)(uintptr_t)&_sstack + 31u) & ~31u)
+/* The MPU's region over it, aligned to its size (ARMv7-M B3.5.8: the
+ * linker aligns the stack so, BOARD_STACK_ALIGN), no access, never
+ * executed: an overflow faults at the first store into it. */
+#define GUARD_AT (((uint32_t)(uintptr_t)&_sstack + GUARD_BYTES - 1u) & ~(GUARD_BYTES - 1u))
 #define WATCH_FROM ((uint32_t *)(uintptr_t)(GUARD_AT + GUARD_BYTES))
 #define RASR_XN (1u << 28)
-#define RASR_SIZE_32 (4u << 1) /* 2^(SIZE+1) bytes */
+#define RASR_SIZE_256 (7u << 1) /* 2^(SIZE+1) bytes */
 #else
-#define WATCH_FROM (&_sstack + 1) /* the word at the bottom is the guard */
+/* The M0 has no MPU: the word at the bottom is checked every tick, and the
+ * band above it by the depth scan (a word a tick, from the bottom up). */
+#define WATCH_FROM (&_sstack + 1)
+#define BAND_TOP ((uint32_t *)(uintptr_t)((uintptr_t)&_sstack + GUARD_BYTES))
 #endif
 
 /* Control ticks without a fault reset after which the next one is the
@@ -60,7 +68,7 @@ void stack_guard_start(void)
 #if defined(__ARM_ARCH_7M__)
     MPU_RNR = 0;
     MPU_RBAR = GUARD_AT;
-    MPU_RASR = RASR_XN | RASR_SIZE_32 | 1u; /* AP 0: no access */
+    MPU_RASR = RASR_XN | RASR_SIZE_256 | 1u; /* AP 0: no access */
     MPU_CTRL = MPU_CTRL_ON_DEFAULT_MAP;
     SCB_SHCSR |= SCB_SHCSR_FAULTS_OWN;
     __asm__ volatile("dsb\n isb" ::: "memory");
@@ -72,9 +80,9 @@ void stack_guard_start(void)
 void stack_watch_pass(void)
 {
 #if !defined(__ARM_ARCH_7M__)
-    if (_sstack != STACK_PAINT) {
-        /* The stack reached its bottom: the bridge off first, as a fault
-         * handler would, then the record (no frame: this pass's SP). */
+    if (_sstack != STACK_PAINT || lowest_used < BAND_TOP) {
+        /* The stack reached its bottom band: the bridge off first, as a
+         * fault handler would, then the record (no frame: this pass's SP). */
         extern uint32_t _bridge_off;
         *(volatile uint32_t *)(uintptr_t)&_bridge_off = 0u;
         uint32_t sp;

@@ -43,7 +43,7 @@ const struct hal_reset *reset_cause_take(void);
 /* Before a restart the firmware means (UpdateEnter's). */
 void kept_note_planned(void);
 /* The servo ran long enough without a fault: the next fault reset is the
- * first in a row again. */
+ * first in a row again (not in safe mode: HAL_SAFE_MODE_RESETS). */
 void kept_healthy(void);
 
 #endif
