@@ -3,6 +3,11 @@ readings' bytes hold the faulting code's frame instead (registers/faults.h,
 struct fault_code), decoded here and named with the image's ELF symbols."""
 from dataclasses import dataclass
 
+from .errors import UsageError
+
+BOARD_MARK_TAG = 0x5342  # "SB": vector 7's high half (servo_image.BOARD_MARK_TAG)
+FIRMWARE_FAULT = 10  # Fault.what (answers.py): the readings' bytes hold the code's frame; above it, resets
+
 EXCEPTIONS = {0: "stack guard (main loop)", 2: "NMI", 3: "HardFault", 4: "MemManage", 5: "BusFault",
               6: "UsageFault", 11: "SVCall", 14: "PendSV", 15: "SysTick"}
 # CFSR bits 0-15 (ARMv7-M ARM B3.2.15-B3.2.16) and the record's usage byte.
@@ -52,6 +57,21 @@ class FaultCode:
         return f"{self.exception_name}: {where} sp RAM+{self.sp_offset:#06x} [{bits}]"
 
 
+def phrase(fault) -> str:
+    """A Fault (answers.py) as a phrase: its readings, or for the servo's
+    own (kinds 10-15, no readings) a firmware fault's exception and PC, a
+    reset's kind alone."""
+    f = fault
+    if f.what == FIRMWARE_FAULT:
+        code = FaultCode.of(f)
+        where = f"pc {code.pc:#010x}" if code.frame_valid else "no frame"
+        return f"#{f.number} {f.kind} ({code.exception_name}, {where})"
+    if f.what > FIRMWARE_FAULT:
+        return f"#{f.number} {f.kind}"
+    return (f"#{f.number} {f.kind} at {f.angle_decideg / 10:.1f} deg, {f.voltage_mv / 1000:.2f} V, "
+            f"{f.winding_decic / 10:.0f} C winding")
+
+
 def _in(symbols, address: int) -> str:
     name = symbols.name(address) if symbols else None
     return f" ({name})" if name else ""
@@ -62,15 +82,29 @@ class Symbols:
 
     def __init__(self, path):
         try:
+            from elftools.common.exceptions import ELFError
             from elftools.elf.elffile import ELFFile
         except ImportError as e:
             raise SystemExit("naming a fault's code needs pyelftools: pip install 'servoctl[elf]'") from e
-        with open(path, "rb") as f:
-            table = ELFFile(f).get_section_by_name(".symtab")
+        try:
+            f = open(path, "rb")
+        except OSError as e:
+            raise UsageError(f"--elf {path}: {e.strerror or e}") from None
+        with f:
+            try:
+                table = ELFFile(f).get_section_by_name(".symtab")
+            except ELFError:
+                raise UsageError(f"--elf {path}: not an ELF file (give the build's .elf, not its .bin "
+                                 "or a packed image)") from None
             if table is None:
-                raise SystemExit(f"{path}: no symbol table (an ELF built with its symbols is needed)")
+                raise UsageError(f"--elf {path}: no symbol table (an ELF built with its symbols is needed)")
             self.functions = sorted((s["st_value"] & ~1, s["st_size"], s.name) for s in table.iter_symbols()
                                     if s["st_info"]["type"] == "STT_FUNC" and s["st_size"] > 0)
+            marks = table.get_symbol_by_name("_board_mark") or []
+        # The board the image is for: vector 7's mark, the address of the
+        # linker's _board_mark (firmware/startup/board_mark.h); None without it.
+        mark = marks[0]["st_value"] if marks else None
+        self.board = mark & 0xFFFF if mark is not None and mark >> 16 == BOARD_MARK_TAG else None
 
     def name(self, address: int):
         """"function+0xOFF" of the function holding address, or None."""
