@@ -7,7 +7,8 @@ from dataclasses import asdict
 
 from .answers import Fault
 from .errors import ServoError
-from .fault_code import FaultCode, Symbols
+from .fault_code import FaultCode
+from .fault_symbols import Symbols
 from .outcome import SAFE_MODE, in_safe_mode
 from .servo import Servo
 

@@ -98,6 +98,6 @@ def test_sigterm_and_sighup_interrupt_inside_and_the_handlers_come_back():
 
 
 def test_the_firmware_faults_kind_is_the_answers():
-    from servoctl import fault_code
+    from servoctl import fault_code, fault_symbols
     from servoctl.image import BOARD_MARK_TAG
-    assert fault_code.FIRMWARE_FAULT == Fault.FIRMWARE_FAULT and fault_code.BOARD_MARK_TAG == BOARD_MARK_TAG
+    assert fault_code.FIRMWARE_FAULT == Fault.FIRMWARE_FAULT and fault_symbols.BOARD_MARK_TAG == BOARD_MARK_TAG
