@@ -33,6 +33,7 @@ import math
 
 from . import protocol as p
 from . import registers
+from .fault_code import phrase
 from .errors import NoReply, ServoError, UsageError, ValueOutOfRange
 from .arm_ramp import DEFAULT_SPEED_DEG_S, Ramp, into_limits
 from .arm_reset import ResetWatch
@@ -77,8 +78,7 @@ def fault_text(servo: Servo, newest: int = 3) -> str:
         return "it keeps no fault history (the maker's firmware)"
     if not faults:
         return "no fault in its history"
-    said = ", ".join(f"#{f.number} {f.kind} at {f.angle_decideg / 10:.1f} deg, {f.voltage_mv / 1000:.2f} V, "
-                     f"{f.winding_decic / 10:.0f} C winding" for f in faults)
+    said = ", ".join(phrase(f) for f in faults)
     return f"its newest faults: {said} ('servoctl faults {servo.id}')"
 
 

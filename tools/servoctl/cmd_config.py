@@ -71,7 +71,9 @@ def cmd_config(bus, args):
         item = registers.find(args.name)
         raw = s.read(item.id)
         if args.json:
-            print(json.dumps({"id": item.id, "name": item.name, "raw": raw, "value": units.show(item, raw)}))
+            counts = units.parts(item, raw)  # item 73's four counts, by name
+            print(json.dumps({"id": item.id, "name": item.name, "raw": raw, "value": units.show(item, raw),
+                              **({"counts": counts} if counts else {})}))
         else:
             print(f"{item.name} = {_shown(item, raw, args.raw)}")
     elif args.action == "set":

@@ -1,5 +1,7 @@
 """servoctl's commands on the drive train (identify, calibrate, tune): scipy
-is loaded for these commands alone."""
+is loaded for these commands alone. calibrate and tune write stored items
+along the way: a SIGTERM or SIGHUP puts them back as Ctrl-C does."""
+from .putback import signals_interrupt
 
 
 def cmd_identify(bus, args):
@@ -11,10 +13,12 @@ def cmd_identify(bus, args):
 def cmd_calibrate(bus, args):
     from .calibrate import cmd_calibrate as calibrate  # scipy (identify's come_to_rest): this command alone
 
-    return calibrate(bus, args)
+    with signals_interrupt():
+        return calibrate(bus, args)
 
 
 def cmd_tune(bus, args):
     from .tune import cmd_tune as tune  # scipy (identify): loaded for this command alone
 
-    return tune(bus, args)
+    with signals_interrupt():
+        return tune(bus, args)

@@ -1,7 +1,9 @@
 """A firmware fault's record (ReadFaults' kind 10, docs/safety.md): the
 readings' bytes hold the faulting code's frame instead (registers/faults.h,
-struct fault_code), decoded here and named with the image's ELF symbols."""
+struct fault_code), decoded here (fault_symbols.py names it from the image's ELF)."""
 from dataclasses import dataclass
+
+FIRMWARE_FAULT = 10  # Fault.what (answers.py): the readings' bytes hold the code's frame; above it, resets
 
 EXCEPTIONS = {0: "stack guard (main loop)", 2: "NMI", 3: "HardFault", 4: "MemManage", 5: "BusFault",
               6: "UsageFault", 11: "SVCall", 14: "PendSV", 15: "SysTick"}
@@ -52,30 +54,21 @@ class FaultCode:
         return f"{self.exception_name}: {where} sp RAM+{self.sp_offset:#06x} [{bits}]"
 
 
+def phrase(fault) -> str:
+    """A Fault (answers.py) as a phrase: its readings, or for the servo's
+    own (kinds 10-15, no readings) a firmware fault's exception and PC, a
+    reset's kind alone."""
+    f = fault
+    if f.what == FIRMWARE_FAULT:
+        code = FaultCode.of(f)
+        where = f"pc {code.pc:#010x}" if code.frame_valid else "no frame"
+        return f"#{f.number} {f.kind} ({code.exception_name}, {where})"
+    if f.what > FIRMWARE_FAULT:
+        return f"#{f.number} {f.kind}"
+    return (f"#{f.number} {f.kind} at {f.angle_decideg / 10:.1f} deg, {f.voltage_mv / 1000:.2f} V, "
+            f"{f.winding_decic / 10:.0f} C winding")
+
+
 def _in(symbols, address: int) -> str:
     name = symbols.name(address) if symbols else None
     return f" ({name})" if name else ""
-
-
-class Symbols:
-    """The functions of an image's ELF, by address (pyelftools)."""
-
-    def __init__(self, path):
-        try:
-            from elftools.elf.elffile import ELFFile
-        except ImportError as e:
-            raise SystemExit("naming a fault's code needs pyelftools: pip install 'servoctl[elf]'") from e
-        with open(path, "rb") as f:
-            table = ELFFile(f).get_section_by_name(".symtab")
-            if table is None:
-                raise SystemExit(f"{path}: no symbol table (an ELF built with its symbols is needed)")
-            self.functions = sorted((s["st_value"] & ~1, s["st_size"], s.name) for s in table.iter_symbols()
-                                    if s["st_info"]["type"] == "STT_FUNC" and s["st_size"] > 0)
-
-    def name(self, address: int):
-        """"function+0xOFF" of the function holding address, or None."""
-        address &= ~1
-        for start, size, name in self.functions:
-            if start <= address < start + size:
-                return f"{name}+{address - start:#x}"
-        return None

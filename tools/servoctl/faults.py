@@ -2,10 +2,14 @@
 (ReadFaults, ClearFaults; docs/safety.md says what a host should do about
 each kind)."""
 import json
+import sys
 from dataclasses import asdict
 
 from .answers import Fault
-from .fault_code import FaultCode, Symbols
+from .errors import ServoError
+from .fault_code import FaultCode
+from .fault_symbols import Symbols
+from .outcome import SAFE_MODE, in_safe_mode
 from .servo import Servo
 
 # What a host can do about each kind (docs/safety.md, "Faults").
@@ -29,6 +33,9 @@ ADVICE = {
 }
 
 
+READINGS = ("angle_decideg", "voltage_mv", "current_ma", "power_mw", "winding_decic", "case_decic")
+
+
 def _hms(seconds: int) -> str:
     return f"{seconds // 3600}:{seconds // 60 % 60:02d}:{seconds % 60:02d}"
 
@@ -39,15 +46,18 @@ def cmd_faults(bus, args):
         s.clear_faults()
         print(f"servo {args.id}: fault history cleared")
         return 0
+    symbols = Symbols(args.elf) if args.elf else None
+    if symbols is not None:
+        _check_board(bus, args.id, symbols, args.elf)
     faults = s.faults()
     first = faults[0] if faults else s.read_fault(0)
-    symbols = Symbols(args.elf) if args.elf else None
     if args.json:
-        print(json.dumps({"id": args.id, "not_logged": first.not_logged,
+        print(json.dumps({"id": args.id, "not_logged": first.not_logged, "safe_mode": in_safe_mode(s),
                           "faults": [_as_json(f, symbols) for f in faults]}))
         return 0
     if not faults:
         print(f"servo {args.id}: no faults{_not_logged(first.not_logged)}")
+        _say_safe_mode(s, "the history was cleared since")
         return 0
     print(f"servo {args.id}: {len(faults)} fault(s), newest first{_not_logged(first.not_logged)}")
     print("   #   op time  fault               supply  current   power  winding     case    angle")
@@ -62,7 +72,31 @@ def cmd_faults(bus, args):
                   f"{f.case_decic / 10:>6.1f} C {f.angle_decideg / 10:>7.1f}")
     for kind in dict.fromkeys(f.kind for f in faults):
         print(f"  {kind}: {ADVICE.get(kind, '')}")
+    _say_safe_mode(s, "the history above")
     return 0
+
+
+def _say_safe_mode(s, where: str) -> None:
+    if in_safe_mode(s):
+        print(SAFE_MODE.format(where=where))
+
+
+def _check_board(bus, servo_id: int, symbols, path) -> None:
+    """Warns where the ELF's board mark is not the servo's board (from
+    UpdateStatus); says nothing where either cannot be read."""
+    from . import image, update
+    from .protocol import LinkError
+    if symbols.board is None:
+        return
+    try:
+        board = update.status(bus, servo_id).board
+    except LinkError:
+        raise
+    except ServoError:  # no answer, or not one this tool knows (the maker's)
+        return
+    if board != symbols.board:
+        print(f"servoctl: warning: {path} is for {image.board_named(symbols.board)}, servo {servo_id} is "
+              f"{image.board_named(board)}: the names given to its code are not its own", file=sys.stderr)
 
 
 def _not_logged(n: int) -> str:
@@ -71,6 +105,8 @@ def _not_logged(n: int) -> str:
 
 def _as_json(f, symbols) -> dict:
     out = dict(asdict(f), kind=f.kind)
+    if f.what >= Fault.FIRMWARE_FAULT:  # no readings: a firmware fault's frame (its code) or a reset
+        out.update(dict.fromkeys(READINGS))
     if f.what == Fault.FIRMWARE_FAULT:
         code = FaultCode.of(f)
         out["code"] = dict(asdict(code), exception_name=code.exception_name, status_bits=code.status_bits,

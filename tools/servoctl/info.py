@@ -5,6 +5,7 @@ import json
 
 from . import ntc, registers
 from .errors import ServoError
+from .outcome import SAFE_MODE, in_safe_mode
 from .servo import MotionSnapshot, Servo
 
 
@@ -36,16 +37,22 @@ def cmd_info(bus, args):
               f"{'on' if safety['derating'] else 'off'})")
         print(f"  limiter      {safety['limiter']}")
         print(f"  watchdog     {safety['watchdog']}")
+    if safety.get("safe_mode"):
+        print("  " + SAFE_MODE.format(where=f"'servoctl faults {args.id}' says which"))
     return 0
 
 
 def _safety(s: Servo) -> dict:
-    """This firmware's items 64-67; none from a servo without them."""
+    """This firmware's items 64-67 (and 75 where it is 1); none from a
+    servo without them."""
     try:
         watchdog, action = s.read("watchdog_ms"), s.read("watchdog_action")
+        safe = in_safe_mode(s)
+        # Item 67 reads 7 (watchdog) in safe mode too: said as what holds it.
         return {"winding_c": s.read("winding_temperature") / 10, "derating": s.read("derating"),
-                "limiter": MotionSnapshot.LIMITERS[s.read("limiter")],
-                "watchdog": f"{watchdog} ms, then {_action(action)}" if watchdog else "off"}
+                "limiter": "safe mode" if safe else MotionSnapshot.LIMITERS[s.read("limiter")],
+                "watchdog": f"{watchdog} ms, then {_action(action)}" if watchdog else "off",
+                "safe_mode": safe}
     except ServoError:
         return {}
 

@@ -5,7 +5,7 @@ from dataclasses import dataclass
 
 from . import registers
 from .frame import Where, jerk_limit, turn_base
-from .errors import BadAnswer, NoReply, Refused
+from .errors import BadAnswer, LinkError, NoReply, Refused, ServoError
 from .move_request import MoveRequest
 
 TOLERANCE_DEG = 0.5
@@ -16,6 +16,19 @@ INHIBITING = _BIT["high_voltage"] | _BIT["low_voltage"] | _BIT["over_temperature
 STALL = _BIT["stall"]
 COMMAND_ERROR = _BIT["command_error"]
 EXECUTING = _BIT["executing"]
+# Item 75 at 1 (docs/safety.md, "The servo's own faults"): what it means.
+SAFE_MODE = ("safe mode: the output is held off after 3 fault resets in a row ({where}); "
+             "a power cycle or an update ends it")
+
+
+def in_safe_mode(s) -> bool:
+    """Item 75 reads 1; False on a servo without it (the maker's)."""
+    try:
+        return s.read("safe_mode") == 1
+    except LinkError:
+        raise
+    except ServoError:  # the maker's: no item 75
+        return False
 
 
 def taken(s, what: str) -> int:
@@ -31,6 +44,9 @@ def taken(s, what: str) -> int:
         raise Refused(f"servo {s.id} refused {what}: a protection holds it "
                       f"({', '.join(registers.status_names(status & INHIBITING))})")
     if status & COMMAND_ERROR:
+        if in_safe_mode(s):  # read only on a refusal
+            raise Refused(f"servo {s.id} refused {what}: it is in " + SAFE_MODE.format(
+                where=f"'servoctl faults {s.id}' says which"))
         raise Refused(f"servo {s.id} refused {what} (status: {', '.join(registers.status_names(status))})")
     return status
 

@@ -108,17 +108,46 @@ def _finishing(bus):
 
 @contextlib.contextmanager
 def _ctrl_c_waits():
-    """A Ctrl-C during the put-back waits for its end (it is being
-    interrupted already); on the main thread only, where Python takes it."""
+    """A Ctrl-C (or a SIGTERM, SIGHUP) during the put-back waits for its end
+    (it is being interrupted already); on the main thread only, where
+    Python takes it."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
+    before = {}
     try:
-        before = signal.signal(signal.SIGINT, lambda *a: None)
+        for name in ("SIGINT", "SIGTERM", "SIGHUP"):
+            number = getattr(signal, name, None)
+            if number is not None:
+                before[number] = signal.signal(number, lambda *a: None)
     except (ValueError, TypeError):  # not a handler Python may replace here
-        yield
-        return
+        pass
     try:
         yield
     finally:
-        signal.signal(signal.SIGINT, before)
+        for number, handler in before.items():
+            signal.signal(number, handler)
+
+
+@contextlib.contextmanager
+def signals_interrupt(names=("SIGTERM", "SIGHUP")):
+    """SIGTERM and SIGHUP (a kill, a closed terminal) raise KeyboardInterrupt
+    as Ctrl-C does, so that PutBack puts back what a command wrote before
+    the process ends; the previous handlers are put back after. On the main
+    thread only, where Python takes signals."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    before = {}
+
+    def interrupt(number, _frame):
+        raise KeyboardInterrupt(signal.Signals(number).name)
+    try:
+        for name in names:
+            number = getattr(signal, name, None)
+            if number is not None:  # Windows has no SIGHUP
+                before[number] = signal.signal(number, interrupt)
+        yield
+    finally:
+        for number, handler in before.items():
+            signal.signal(number, handler)

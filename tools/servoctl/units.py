@@ -160,10 +160,25 @@ def show_as_typed(item, text, raw: int) -> str:
     return f"{raw / factors[suffix]:g} {_SPELLING[suffix]}"
 
 
+# Item 73's bytes, lowest first (docs/protocol.md): each a count since power-on.
+RESET_COUNTS = ("firmware faults", "watchdog", "other", "brown-out")
+
+
+def parts(item, raw: int):
+    """{name: value} of an item whose bytes are separate counts (73
+    reset_counts), for --json; None for every other item."""
+    if item.name != "reset_counts":
+        return None
+    return {name.replace(" ", "_").replace("-", "_"): raw >> 8 * i & 0xFF for i, name in enumerate(RESET_COUNTS)}
+
+
 def show(item, raw: int) -> str:
     """A raw protocol value in the item's engineering unit, for people: a
-    temperature with its ADC value, a baud rate with its code."""
+    temperature with its ADC value, a baud rate with its code, item 73's
+    four counts by name."""
     q = item.quantity
+    if item.name == "reset_counts":
+        return ", ".join(f"{raw >> 8 * i & 0xFF} {name}" for i, name in enumerate(RESET_COUNTS))
     if q == "temperature":
         return ntc.describe(raw)
     if q == "baud":

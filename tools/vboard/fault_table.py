@@ -17,7 +17,8 @@ import struct
 import sys
 import tempfile
 
-from servoctl.fault_code import FaultCode, Symbols
+from servoctl.fault_code import FaultCode
+from servoctl.fault_symbols import Symbols
 
 from .bench import runner_for
 from .board import PARTS, elf

@@ -110,9 +110,11 @@ def test_a_servo_gone_mid_search_is_said_with_the_item_and_exit_5(tmp_path, monk
         finish(sim, [1])
 
 
-def test_ctrl_c_on_the_command_line_puts_item_91_back(tmp_path):
-    """A real SIGINT to `servoctl calibrate` (a real-time simulator): exit
-    130, item 91 as it was."""
+@pytest.mark.parametrize("how", [signal.SIGINT, signal.SIGTERM, signal.SIGHUP])
+def test_ctrl_c_on_the_command_line_puts_item_91_back(tmp_path, how):
+    """A real SIGINT to `servoctl calibrate` (a real-time simulator), or a
+    SIGTERM or SIGHUP (a kill, a closed terminal) taken as one: exit 130,
+    item 91 as it was."""
     sim = _start(tmp_path, fast=False)
     proc = None
     try:
@@ -122,10 +124,11 @@ def test_ctrl_c_on_the_command_line_puts_item_91_back(tmp_path):
                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         assert "calibrating" in proc.stdout.readline()
         sim.sleep(0.3)  # a few steps of the search
-        proc.send_signal(signal.SIGINT)
+        proc.send_signal(how)
         out, err = proc.communicate(timeout=30)
         assert proc.returncode == 130, err
         assert "put back as they were: current_zero" in err, err
+        assert how == signal.SIGINT or f"interrupted by {how.name})" in err, err
         assert _items(sim) == before, err
     finally:
         if proc is not None and proc.poll() is None:

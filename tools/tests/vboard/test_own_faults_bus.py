@@ -8,7 +8,8 @@ answering with its output off, until a power-on."""
 import pytest
 
 from servoctl.answers import Fault
-from servoctl.fault_code import FaultCode, Symbols
+from servoctl.fault_code import FaultCode
+from servoctl.fault_symbols import Symbols
 from servoctl.servo import Servo
 from vboard.board import elf
 
