@@ -20,7 +20,10 @@
  *          4     flash: n bit 0 every write fails (the config store's and the
  *                fault history's); n bit 1 the power is cut
  *                at the write step the next byte names
- *          5     power cycle: the servo boots again from its flash (3 at most)
+ *          5     power cycle: the servo boots again from its flash (3 at most);
+ *                n bits 0-2 the reset the board reports (0 a power-on, then
+ *                firmware fault, watchdog, software, brown-out, pin, low
+ *                power, planned), bits 3-4 its place in a row less one
  *          6     (n+1) x 50 ms pass at once (the main loop was stalled)
  * Every servo starts from a snapshot taken once per flash image, so an
  * input costs no init. After each main-loop pass: everything sent is a
@@ -50,6 +53,10 @@ static struct user_config last_valid;
 static int32_t spin_per_tick;
 static int encoder_mode; /* 0 spin, 1 follow the setpoint, 2 held */
 static int32_t encoder_counts;
+/* What a board reads at start-up (hal_reset.h): a record of a firmware
+ * fault, the reset counts, and a stack check and depth as the boards have. */
+static struct hal_reset reset_seen;
+static uint16_t stack_unused_bytes;
 
 #define CHECK(cond)              \
     do {                         \
@@ -107,6 +114,20 @@ static void check_invariants(void)
     }
 }
 
+/* Safe mode, entered at start-up after HAL_SAFE_MODE_RESETS fault resets
+ * in a row, holds until the next start: nothing drives the bridge. */
+static void check_safe_mode(void)
+{
+    const struct servo *s = &live.servo;
+    if (reset_seen.in_row >= HAL_SAFE_MODE_RESETS) {
+        CHECK(s->regs.firmware.safe_mode == 1u);
+    }
+    if (s->regs.firmware.safe_mode != 0u) {
+        /* The guard takes it at the first tick (one may wait for a request's end). */
+        CHECK(live.hal.coasting && (s->motion.inhibit || s->guard_seen != s->protection.act_changes));
+    }
+}
+
 static void check_angle(void)
 {
     struct motion_angle a;
@@ -154,9 +175,18 @@ static void poll(void)
     check_invariants();
 }
 
+
+static void stack_watch(void)
+{
+    /* The boards' guard check: nothing to check on the host. */
+}
+
 static void boot(void)
 {
     flash_double_power_on(&live.hal.flash);
+    live.hal.port.reset = &reset_seen;
+    live.hal.port.stack_unused = &stack_unused_bytes;
+    live.hal.port.stack_watch = stack_watch;
     servo_init(&live.servo, &live.hal.port);
     last_valid = live.servo.regs.user;
 }
@@ -208,6 +238,23 @@ static void make_snapshot(int image)
     snapshots[image] = live;
 }
 
+static void reset_at(unsigned n)
+{
+    static const uint8_t kinds[8] = {
+        HAL_RESET_POWER_ON, HAL_RESET_FIRMWARE_FAULT, HAL_RESET_WATCHDOG, HAL_RESET_SOFTWARE,
+        HAL_RESET_BROWN_OUT, HAL_RESET_PIN, HAL_RESET_LOW_POWER, HAL_RESET_PLANNED,
+    };
+    memset(&reset_seen, 0, sizeof reset_seen);
+    reset_seen.kind = kinds[n & 7u];
+    reset_seen.in_row = reset_seen.kind >= HAL_RESET_FIRMWARE_FAULT ? (uint8_t)((n >> 3 & 3u) + 1u) : 0u;
+    reset_seen.counts[HAL_COUNT_FIRMWARE_FAULT] = reset_seen.in_row;
+    reset_seen.pc = 0x08001234u + n;
+    reset_seen.lr = 0xFFFFFFF9u;
+    reset_seen.sp_offset = (uint16_t)(0x0F00u - n);
+    reset_seen.exception = (uint8_t)(3u + (n & 3u));
+    stack_unused_bytes = (uint16_t)(700u - 16u * n);
+}
+
 static void feed(uint8_t byte, unsigned *fed, unsigned poll_every)
 {
     live.hal.now_us += BYTE_US;
@@ -231,6 +278,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     }
     uint8_t setup = data[0];
     live = snapshots[setup & 3u];
+    reset_at(0);
     flight.data = NULL;
     last_valid = live.servo.regs.user;
     spin_per_tick = 0;
@@ -264,6 +312,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                 live.hal.tx_busy = false;
                 check_invariants();
                 check_angle();
+                check_safe_mode();
             }
             break;
         case 2:
@@ -288,6 +337,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             break;
         case 5:
             if (boots++ < MAX_BOOTS) {
+                reset_at(n);
                 boot();
             }
             break;

@@ -127,6 +127,13 @@ def flash(dead: bool = False, cut_at: int = None, mode: int = 0) -> bytes:
 
 
 POWER_CYCLE = bytes([5])
+# The resets a board can report (fuzz_servo.c, op 5), with their place in a row.
+RESETS = {"firmware_fault": 1, "watchdog": 2, "software": 3, "brown_out": 4, "pin": 5,
+          "low_power": 6, "planned": 7}
+
+
+def reset(kind: str, in_row: int = 1) -> bytes:
+    return bytes([(RESETS[kind] | (in_row - 1) << 3) << 3 | 5])
 
 
 def stall_main_loop(t_ms: int) -> bytes:
@@ -271,6 +278,15 @@ SERVO_SEEDS = {
     "fault_with_a_dead_flash": (USED, flash(dead=True) + sensors(3000, 100, 2048) + ms(150) + HEALTHY
                                 + ms(250) + flash(dead=False) + sensors(9600, 100, 2048) + ms(150)
                                 + HEALTHY + ms(100) + wire(req(0x43, b"\x00\x00"))),
+    # The servo's own resets (item 73's counts, the fault history), then safe
+    # mode after the third in a row, which a move cannot leave.
+    "own_resets_logged": (USED, wire(move(900, 300)) + ms(100) + reset("watchdog") + ms(5)
+                          + wire(req(0x43, b"\x00\x00") + req(3, b"\x00\x49")) + ms(10)
+                          + reset("brown_out") + ms(5) + reset("firmware_fault", 2) + ms(20)
+                          + wire(req(0x43, b"\x00\x01")) + ms(10)),
+    "own_resets_safe_mode": (USED, reset("firmware_fault", 3) + ms(5) + wire(move(900, 100)) + ms(120)
+                             + wire(req(3, b"\x00\x4b") + req(0x44, b"\x00") + move(-900, 100)) + ms(60)
+                             + reset("pin", 4) + ms(5) + reset("planned") + wire(move(450, 50)) + ms(60)),
     "hot_case_derates": (USED, wire(move(900, 400)) + sensors(7400, 3000, 720) + ms(300)
                          + wire(write(66, 0) + req(3, b"\x00\x44")) + ms(100) + wire(write(66, 1))
                          + ms(100) + HEALTHY + ms(100)),
