@@ -134,7 +134,9 @@ class ServoBusHardware {
         size_t len = 0;
         for (size_t k = 0; k < ids_.size(); k++)
             angles[k] = static_cast<int32_t>(std::lround(command_[k] * kDeciDegPerRad));
-        sb_error e = sb_stream_frame(&loop_.stream, angles, nullptr, bus_.tx, sizeof bus_.tx - loop_.monitor_len, &len);
+        // Stamped now: the controller's command is for this moment.
+        sb_error e = sb_stream_frame_at(&loop_.stream, angles, nullptr, static_cast<uint32_t>(now_us() / 1000u),
+                                        bus_.tx, sizeof bus_.tx - loop_.monitor_len, &len);
         if (!check(e))
             return false;
         std::memcpy(bus_.tx + len, loop_.monitor, loop_.monitor_len);

@@ -94,6 +94,12 @@ static sb_error refused(int servo, const char *field, int64_t value, int64_t lea
 sb_error sb_stream_frame(sb_stream *s, const int32_t *angles, const int16_t *velocities, uint8_t *frame, size_t cap,
                          size_t *len)
 {
+    return sb_stream_frame_at(s, angles, velocities, s->sent * (uint32_t)s->period_ms, frame, cap, len);
+}
+
+sb_error sb_stream_frame_at(sb_stream *s, const int32_t *angles, const int16_t *velocities, uint32_t at_ms,
+                            uint8_t *frame, size_t cap, size_t *len)
+{
     uint8_t records[SETPOINT_LEN * SB_MAX_SERVOS];
     int64_t top = sb_packet(SB_PKT_STREAM_SETPOINT)->request[2].max; /* the servo's top speed, 0.1 deg/s */
     sb_error e = sb_ok();
@@ -105,7 +111,7 @@ sb_error sb_stream_frame(sb_stream *s, const int32_t *angles, const int16_t *vel
         v[0].n = s->ids[k];
         v[1].n = angles[k];
         v[2].n = velocities != NULL ? velocities[k] : (step * 1000 + (step < 0 ? -1 : 1) * s->period_ms / 2) / s->period_ms;
-        v[3].n = (int64_t)((s->sent * (uint32_t)s->period_ms) & 0xFFFFu);
+        v[3].n = (int64_t)(at_ms & 0xFFFFu);
         if (angles[k] < s->angle_min[k] || angles[k] > s->angle_max[k])
             return refused(s->ids[k], "angle", angles[k], s->angle_min[k], s->angle_max[k]);
         if ((step < 0 ? -step : step) * 1000 > top * s->period_ms)
@@ -123,7 +129,7 @@ sb_error sb_stream_frame(sb_stream *s, const int32_t *angles, const int16_t *vel
     for (size_t k = 0; k < s->count; k++)
         s->last[k] = angles[k];
     /* Past UINT32_MAX, 65536 rather than 0: the step stays checked and the
-     * time stamps (sent * period mod 65536) run on without a jump. */
+     * grid's time stamps (sent * period mod 65536) run on without a jump. */
     if (++s->sent == 0)
         s->sent = 65536u;
     return e;
@@ -158,6 +164,7 @@ sb_error sb_loop_cycle(sb_loop *l, const int32_t *angles, const int16_t *velocit
 {
     sb_bus *bus = l->bus;
     sb_stream before;
+    uint64_t now_us;
     size_t len = 0;
     sb_error e;
     if (l->monitor_len == 0) /* sb_loop_init refused it: nothing is sent */
@@ -165,11 +172,15 @@ sb_error sb_loop_cycle(sb_loop *l, const int32_t *angles, const int16_t *velocit
     for (size_t k = 0; k < l->stream.count; k++)
         got[k] = false; /* none, if the setpoints are refused or the link fails */
     before = l->stream;
-    e = sb_stream_frame(&l->stream, angles, velocities, bus->tx, sizeof bus->tx - l->monitor_len, &len);
+    now_us = bus->t.now_us(bus->t.ctx);
+    /* Stamped with the bus clock's now: the moment the caller's setpoints
+     * are for, late or early, which the servo plays on its own timeline. */
+    e = sb_stream_frame_at(&l->stream, angles, velocities, (uint32_t)(now_us / 1000u), bus->tx,
+                           sizeof bus->tx - l->monitor_len, &len);
     if (e.status != SB_OK)
         return e;
     if (l->cycles == 0)
-        l->started_us = bus->t.now_us(bus->t.ctx);
+        l->started_us = now_us;
     /* One write: the Sync Monitor follows the setpoints without a gap. */
     memcpy(bus->tx + len, l->monitor, l->monitor_len);
     e = sb_send(bus, bus->tx, len + l->monitor_len);

@@ -216,12 +216,22 @@ sb_error sb_stream_init(sb_stream *s, const uint8_t *ids, size_t count, uint16_t
  * the servos never got. */
 sb_error sb_stream_frame(sb_stream *s, const int32_t *angles, const int16_t *velocities, uint8_t *frame,
                          size_t cap, size_t *len);
+/* As sb_stream_frame, stamped at_ms: the moment on the host's clock (ms;
+ * the frame keeps its low 16 bits) the setpoints are for. Each servo plays
+ * them 3/2 period after that moment, so a frame sent late or early by less
+ * than that moves nothing (docs/streaming.md, "On the host's timeline").
+ * sb_stream_frame stamps the frame's place on the period's grid instead
+ * (sent * period_ms): right only for a caller that keeps that grid. */
+sb_error sb_stream_frame_at(sb_stream *s, const int32_t *angles, const int16_t *velocities, uint32_t at_ms,
+                            uint8_t *frame, size_t cap, size_t *len);
 
 /* ---- the robot loop ----------------------------------------------------- */
 /* A cycle: one SyncCommand of setpoints and one Sync Monitor in one write,
  * then every servo's state (got[] all false if the setpoints are refused or
  * the link fails; a failed write leaves the stream as it was). Called once
- * per period_ms: the setpoints' speeds and time stamps count on it. On a
+ * per period_ms: the setpoints' speeds count on it; each cycle is stamped
+ * with the bus clock's now (sb_stream_frame_at), so a late call is played
+ * at the time it was made, not one period after the last. On a
  * loop sb_loop_init refused: SB_E_USAGE on "loop", nothing sent. */
 typedef struct sb_loop {
     sb_bus *bus;
