@@ -137,9 +137,8 @@ class Simulator(_Child):
 
     def start(self) -> "Simulator":
         if self.board is not None:
-            if self.rx is not None or self.cpu is not None or self.paced:
-                raise ServoError("a virtual board runs as its MCU does: --rx, --cpu and a paced clock are "
-                                 "servo_sim's")
+            if self.rx is not None or self.cpu is not None:
+                raise ServoError("a virtual board runs as its MCU does: --rx and --cpu are servo_sim's")
             cmd = [sys.executable, "-m", "vboard", "--board", self.board, "--state", self.state_dir]
             if self.app_image is not None:
                 cmd += ["--app", str(self.app_image)]

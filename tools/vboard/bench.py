@@ -35,7 +35,7 @@ DRAIN_S = 5e-3           # the last request and its answer, and the servo's turn
 
 def runner_for(board: str, ids, state_dir: str) -> Runner:
     args = SimpleNamespace(board=board, id=list(ids), state=state_dir, supply=7400.0, ambient=25.0, plant=None,
-                           app=None, tcp=0, link=None, host_link="usb")
+                           app=None, tcp=0, link=None, host_link="usb", clock="wall")
     runner = Runner(args)
     runner.power_up()
     return runner

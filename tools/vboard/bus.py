@@ -64,6 +64,8 @@ class Bus:
         self.last_sent_s = {}         # station -> when its last byte started
         self.host_bytes = 0           # bytes handed to the host so far
         self.host_bytes_then = 0      # ... when the host last sent bytes itself
+        self.host_read = 0            # bytes read from the host in all (a paced host's offset 16)
+        self.paced = False            # read the host's bytes at once (run.py, --clock paced)
         self.host_fd = None
         self.listen = None
         self.master_fd = None
@@ -172,7 +174,8 @@ class Bus:
         return True
 
     def _read_host(self, now_s: float) -> None:
-        if self.host_queue_until_s - now_s < BACKLOG_S:
+        # Paced, the boards wait until they have read all the host sent.
+        if self.paced or self.host_queue_until_s - now_s < BACKLOG_S:
             try:
                 data = os.read(self.host_fd, 256)
             except BlockingIOError:
@@ -184,6 +187,7 @@ class Bus:
                 return
             if data:
                 self.host_bytes_then = self.host_bytes
+                self.host_read += len(data)
             for byte in data or b"":
                 self.queue_host(byte, max(now_s, self.heard_by_host_s + HOST_TURNAROUND_S))
 
@@ -247,10 +251,12 @@ class Bus:
         self.seq += 1
         heapq.heappush(self.events, [end_s, self.seq, byte, baud, sender, start_s])
 
-    def host_answered(self) -> bool:
-        """The host has been handed bytes since it last sent any, and the
-        wire and the adapter hold none (servo_sim's host_answered)."""
-        return self.host_bytes != self.host_bytes_then and not self.events and not self.adapter.held
+    def host_answered(self, host_received: int = 0) -> bool:
+        """The host has been handed bytes since it last sent any, more than
+        it says it has read (a paced host, else 0), and the wire and the
+        adapter hold none (servo_sim's host_answered)."""
+        return (self.host_bytes != self.host_bytes_then and self.host_bytes > host_received
+                and not self.events and not self.adapter.held)
 
     def next_event_s(self) -> float:
         """The next byte's end on the wire, or the adapter's next hand-over."""

@@ -2,7 +2,7 @@
 
     python -m vboard --board stm32f103 [--id N ...] [--tcp PORT | --link PATH]
                      [--state DIR] [--supply MV] [--ambient DEGC] [--plant FILE]
-                     [--host-link usb|ftdi[:MS]|raw]
+                     [--host-link usb|ftdi[:MS]|raw] [--clock wall|paced]
 
 prints `vboard: bus URL`, `vboard: control 127.0.0.1:PORT`, `vboard: servos
 ...` and `vboard: ready`, so servoctl and the tests drive it as they drive
@@ -15,7 +15,10 @@ behind it when they do not (the emulated CPUs are slower than silicon on
 most PCs); the bus's byte timing is simulated time either way. The clock
 is published in the state folder's bus.clock (`vboard: clock PATH`, as
 servo_sim's), where a host that waits on it (the tests) may tell the boards
-to run ahead as fast as the emulator goes (clock_file.py)."""
+to run ahead as fast as the emulator goes (clock_file.py). With --clock
+paced the boards never follow the wall clock: they run only while such a
+host waits, so what it does between its waits takes no simulated time
+(servo_sim's --clock paced; a test's host-timing model is then exact)."""
 import argparse
 import os
 import select
@@ -33,6 +36,7 @@ from .clock_file import ClockFile
 from .usb import Adapter
 
 MAX_SLICE_S = 1e-3  # longest the CPUs run between two looks at the host and the models
+PACED_POLL_S = 2e-4  # how often paced boards standing still look at the host (servo_sim's)
 # The control port's commands (protocol/control_port.toml, as servo_sim's): what
 # help answers, and the range of each one's number.
 CONTROLS = {c.name: c for c in schema.load().controls_of("vboard")}
@@ -59,6 +63,8 @@ class Runner:
         self.wall0 = time.monotonic()
         self.most_behind_s = 0.0
         self.clock = ClockFile(self.state_dir)
+        self.paced = args.clock == "paced"
+        self.bus.paced = self.paced
         self.stop_requested = False
 
     # ---- control port -----------------------------------------------------
@@ -234,6 +240,9 @@ class Runner:
         self.clock.publish(self.now_s)  # before ready: a host's first look is not at 0
 
     def run(self) -> None:
+        if self.paced:
+            self.run_paced()
+            return
         while not self.stop_requested:
             ahead = self.now_s - self._wall()
             timeout = min(ahead, 0.002) if ahead > 0 and self._host_waits() is None else 0
@@ -251,12 +260,32 @@ class Runner:
             self.clock.publish(self.now_s)
             self.most_behind_s = max(self.most_behind_s, self._wall() - self.now_s)
 
+    def run_paced(self) -> None:
+        """Runs while the host waits for a later time or an answer not yet
+        given, once every byte it has sent is read; stands still otherwise."""
+        while not self.stop_requested:
+            waits = self._host_waits()
+            may_run = waits is not None and self.clock.host_sent() <= self.bus.host_read
+            fds = [self.control] + list(self.clients) + self.bus.fds()
+            readable, _, _ = select.select(fds, [], [], 0 if may_run else PACED_POLL_S)
+            self.serve_control(readable)
+            self.bus.poll_host(self.now_s)
+            waits = self._host_waits()
+            if waits is None or self.clock.host_sent() > self.bus.host_read:
+                continue
+            self.step(waits)
+            # The clock before the bytes: a host that reads it once it has
+            # its answer reads the answer's time, not a slice's before.
+            self.clock.publish(self.now_s)
+            self.bus.flush_to_host(self.now_s)
+
     def _host_waits(self):
         """The bus time a host waiting on the clock file wants reached at
         once (None: the wall clock's pace): not yet reached, and, for a host
         waiting for an answer, not yet answered."""
         until_s, answer = self.clock.host_waits()
-        if until_s <= self.now_s or (answer and self.bus.host_answered()):
+        received = self.clock.host_received() if self.paced else 0
+        if until_s <= self.now_s or (answer and self.bus.host_answered(received)):
             return None
         return until_s
 
@@ -290,6 +319,9 @@ def main(argv=None) -> int:
     ap.add_argument("--plant", help="the motor, gears and heat from a plant file (hal/ports/host/plants/*.toml)")
     ap.add_argument("--ambient", type=float, default=25.0, help="ambient temperature, degC")
     ap.add_argument("--app", help="the update image a blank board's slot gets (default: the build's)")
+    ap.add_argument("--clock", choices=["wall", "paced"], default="wall",
+                    help="paced: run only while the host waits on the clock file (clock_file.py), "
+                         "never following the wall clock (default: wall)")
     args = ap.parse_args(argv)
     if args.link and args.tcp is not None:
         ap.error("--link names a pseudo-terminal, and --tcp makes none: give one or the other")

@@ -11,7 +11,7 @@ def test_the_boards_clock_is_published_and_a_fast_host_waits_on_it(tmp_path):
     state = tmp_path / "state"
     with Simulator(ids=[1], state_dir=str(state), board="stm32f030k6", fast=True) as sim:
         assert sim._clock_map is not None, "the board published no clock file"
-        assert (state / "bus.clock").stat().st_size == 16  # the clock and the host's wait
+        assert (state / "bus.clock").stat().st_size == 32  # the clock, the host's wait, its bytes
         start = sim.clock_s()
         assert start <= float(sim.control("clock").split()[0].split("=")[1]) / 1000 <= sim.clock_s()
         assert sim._clock_conn is None, "the clock was asked for on the control port"
@@ -38,12 +38,13 @@ def test_the_clock_is_published_before_ready(tmp_path):
     from vboard.run import Runner
 
     args = argparse.Namespace(board="stm32f030k6", id=[1], tcp=0, link=None, host_link="usb",
-                              state=str(tmp_path / "state"), supply=None, plant=None, ambient=25.0, app=None)
+                              state=str(tmp_path / "state"), supply=None, plant=None, ambient=25.0, app=None,
+                              clock="wall")
     runner = Runner(args)
     try:
         runner.power_up()
         published = struct.unpack("<Q", (tmp_path / "state" / "bus.clock").read_bytes()[:8])[0]
-        assert published == int(runner.now_s * 1e6) and runner.now_s >= 0.1, (published, runner.now_s)
+        assert published == round(runner.now_s * 1e6) and runner.now_s >= 0.1, (published, runner.now_s)
     finally:
         runner.bus.close()
         runner.control.close()

@@ -3,9 +3,11 @@ images as flashed), as on servo_sim (tests/integration/test_stream_safety.py):
 a row beyond the angle limits and a row that is not a number are refused
 with their line before anything moves; after a power cycle at -30 deg, with
 the factory's 3 s soft start and a 100 ms bus watchdog, the stream waits for
-its lead-in and the joint stays in its turn. Time is the boards' simulated
+its lead-in and the joint stays in its turn; a host late or early by the
+host-timing model's jitter changes nothing. Time is the boards' simulated
 time."""
 import math
+import re
 
 import pytest
 
@@ -13,6 +15,8 @@ from servoctl.cli import main
 from servoctl.servo import Servo
 from servoctl.sim import Simulator
 
+from ..integration.test_stream import sine_csv
+from ..store_pages import bus_to_baud
 from ..stream_report import lead_in_of
 
 BOARDS = ["stm32f103", "stm32f030k6"]
@@ -61,5 +65,40 @@ def test_the_stream_repros_on_the_real_images(tmp_path, board, capsys):
         assert rc == 0
         assert "soft start" in out and lead_in_of(out) == pytest.approx((-30.0, -30.0), abs=0.15), out
         assert abs(sim.state(1)["angle"] - float(rows[-1])) < 2.0
+    finally:
+        sim.stop()
+
+
+# The most RMS each board may follow the sine with: the issue's target on
+# the F103; the F030 measured 0.26 on time and 0.30 with jitter, twice the
+# F103's on time for reasons not yet found (docs/streaming.md, open list).
+MOST_RMS = {"stm32f103": 0.3, "stm32f030k6": 0.35}
+
+
+@pytest.mark.parametrize("board,baud", [("stm32f103", 1000000), ("stm32f030k6", 115200)])
+def test_a_late_or_early_host_on_the_real_images(tmp_path, board, baud, capsys):
+    """The stream on the host's timeline (docs/streaming.md) on the flashed
+    images, the boards paced: they run only while the host waits, so the
+    host-timing model (+-10 ms, one row in twenty a whole period late with
+    the next) is the only jitter there is. A 0.5 Hz +-60 deg sine at 50 Hz
+    follows the file within MOST_RMS either way (the F103 at 1 Mbaud; the
+    F030 at 115 200, where its ring holds an erase's bytes)."""
+    sim = Simulator(ids=[1], state_dir=str(tmp_path / "state"), board=board, paced=True).start()
+    try:
+        if baud != 115200:
+            bus_to_baud(sim, [1], baud, timeout=0.3)
+        with sim.bus(baud=baud, timeout=0.3) as bus:
+            Servo(bus, 1).write("soft_start_on", 0)
+        csv = sine_csv(tmp_path / "sine.csv", [1])
+        rms = []
+        for host in ([], ["--host-jitter-ms", "10", "--host-late-every", "20"]):
+            rc = main(["--port", sim.url, "--baud", str(baud), "--sim-control", str(sim.control_port),
+                       "stream", str(csv), "--lead-in", "0.5", *host], clock=sim.clock_s)
+            out, err = capsys.readouterr()
+            assert rc == 0, out + err
+            rms += [float(x) for x in re.findall(r"tracking error RMS ([0-9.]+) deg", out)]
+        print(f"{board} at {baud}: RMS on time, with +-10 ms and 1 in 20 late: {rms}")  # the docs' figures
+        assert len(rms) == 2 and all(r <= MOST_RMS[board] for r in rms), rms
+        assert sim.state(1)["collisions"] == 0
     finally:
         sim.stop()
