@@ -126,13 +126,11 @@ function(servo_arm_bootloader name)
 endfunction()
 
 # servo_board_images(): the images of the board whose folder calls it: its
-# bootloader (boot_main.c), its application (main.c), and a test build of
-# the application stuck 300 ms after reset, for the watchdog
-# (firmware/boards/test_build.h).
+# bootloader (boot_main.c) and its application (main.c). A main loop that
+# hangs is the virtual boards' injection (tools/vboard/inject.py), on the
+# shipped image.
 function(servo_board_images)
   get_filename_component(board ${CMAKE_CURRENT_SOURCE_DIR} NAME)
   servo_arm_bootloader(servo_${board}_boot SOURCES boot_main.c)
   servo_arm_image(servo_${board} SOURCES main.c)
-  servo_arm_image(servo_${board}_stuck SOURCES main.c)
-  target_compile_definitions(servo_${board}_stuck.elf PRIVATE SERVO_TEST_STUCK_AFTER_MS=300)
 endfunction()

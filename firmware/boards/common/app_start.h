@@ -13,7 +13,6 @@
 
 #include "app/servo.h"
 #include "boards/common/app_hooks.h"
-#include "boards/test_build.h"
 #include "ports/stm32_common/cortex_sleep.h"
 #include "ports/stm32_common/fault_keep.h"
 #include "ports/stm32_common/kept_ram.h"
@@ -64,7 +63,6 @@ int main(void)
     iwdg_start();
     for (;;) {
         servo_poll(&servo);
-        test_build_main_loop();
         iwdg_kick();
         CORTEX_SLEEP_IF(servo_may_sleep(&servo));
     }
