@@ -5,7 +5,9 @@
  * ends at that moment, walked at the tick rate; the segment's end speed
  * goes on until the next setpoint comes, and a depth after its end (no
  * more than the segment's length) the servo brakes to a hold. A setpoint the cubic cannot reach within the
- * stream's limits is reached as a move at them instead (docs/streaming.md).
+ * stream's limits in its time is reached later (a longer segment) where
+ * the host asks a speed, else as a move at them to rest
+ * (docs/streaming.md).
  * Plans: divides. */
 #include "motion/motion_internal.h"
 #include "motion/saturate.h"
@@ -180,7 +182,15 @@ enum motion_submit_result motion_stream(struct motion *m, const struct motion_se
     /* Within 1920 x 16000: the path's checks hold it within the limits. */
     int32_t placed = target + ((v1 * run_on_q4) >> 4);
 
-    bool cubic = segment_within(placed - start, v0, v1, ticks) && path_within(m, start, placed, v0, v1, ticks);
+    /* A segment the cubic cannot make in its time within the stream's
+     * limits is made later (a quarter longer at a time, to 0.32 s) where the
+     * host asks a speed, not as a move to rest: the stream goes on,
+     * behind, and the next setpoint plans from there. */
+    bool fits;
+    while (!(fits = segment_within(placed - start, v0, v1, ticks)) && v1 != 0 && ticks < 256) {
+        ticks += (ticks >> 2) + 1; /* to 321 at most; 256: an immediate on the M0 */
+    }
+    bool cubic = fits && path_within(m, start, placed, v0, v1, ticks);
     if (cubic) {
         profile_plan_segment(&m->profile, start, v0, placed, v1, (uint32_t)ticks);
     } else {

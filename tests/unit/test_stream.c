@@ -533,6 +533,47 @@ static void test_a_step_keeps_to_the_speed_and_acceleration_limits(void **state)
     assert_true(fabs(plant_angle_deg(&plant) - 100.0) < 0.2);
 }
 
+/* A host back from a stall: its path went on at 300 deg/s while the servo
+ * held at 0. Its first setpoint (30 deg at 300 deg/s, one 20 ms period on)
+ * asks more than the stream's limits. It, and every one after it for 40
+ * frames, was planned as a move at the limits to rest at its setpoint, each
+ * cut short by the next (7.6 deg behind after 0.8 s, peak 18 750 deg/s^2).
+ * Now each segment is made later instead: none is a move to rest, the
+ * setpoint never slows far, and it joins the path (6.9 deg behind, peak
+ * 14 091 deg/s^2). */
+static void test_a_segment_past_the_limits_keeps_the_stream_going(void **state)
+{
+    (void)state;
+    WRITE_ITEM(0, ITEM_ANGLE_LIMIT_ON, 0); /* the path runs to 264 deg */
+    WRITE_ITEM(0, ITEM_STREAM_PERIOD_MS, 20);
+    stream(0, 0, 0, 0);
+    harness_run_ms(300); /* the stream has stopped: held at 0 */
+    double slowest = 1e9, last = setpoint_deg(), peak = 0;
+    unsigned moves = 0;
+    for (uint32_t k = 0; k < 40; k++) {
+        stream(0, (int32_t)(300u + 60u * k), 3000, (uint16_t)(300u + 20u * k));
+        moves += servo.motion.profile.accel_j == 0; /* a move to rest, not a segment */
+        for (int ms = 0; ms < 20; ms++) {
+            harness_run_ms(1);
+            double now = setpoint_deg();
+            double acc = fabs((double)servo.motion.walk.change_q40) / 1099511627776.0 * 1e5; /* deg/s^2 */
+            peak = acc > peak ? acc : peak;
+            if (k >= 3u) { /* under way: from the ramp out of rest on */
+                double speed = (now - last) * 1000.0;
+                slowest = speed < slowest ? speed : slowest;
+            }
+            last = now;
+        }
+    }
+    double behind = 30.0 + 6.0 * 39.0 - setpoint_deg();
+    printf("# back from a stall at 300 deg/s: the setpoint's slowest once under way %.1f deg/s, "
+           "%.2f deg behind the last setpoint, peak %.0f deg/s^2, %u of 40 setpoints as moves to rest\n",
+           slowest, behind, peak, moves);
+    assert_int_equal(moves, 0); /* all 40 were, before */
+    assert_true(slowest > 150.0);
+    assert_true(behind < 10.0 && behind > -3.0);
+}
+
 /* Random setpoints (limits off: +-400 deg, +-900 deg/s asked, 5-100 ms
  * periods, sent at any moment of the last segment, so from every speed
  * the stream reaches): no plan asks more than the limits, whether a cubic
@@ -617,6 +658,7 @@ int main(void)
         cmocka_unit_test_setup(test_a_streamed_setpoint_keeps_to_the_angle_limits, plant_harness_setup),
         cmocka_unit_test_setup(test_a_step_keeps_to_the_speed_and_acceleration_limits, plant_harness_setup),
         cmocka_unit_test_setup(test_no_setpoint_asks_more_than_the_limits, plant_harness_setup),
+        cmocka_unit_test_setup(test_a_segment_past_the_limits_keeps_the_stream_going, plant_harness_setup),
         cmocka_unit_test_setup(test_a_far_setpoint_is_reached, plant_harness_setup),
         cmocka_unit_test_setup(test_a_streams_path_keeps_within_the_limits, plant_harness_setup),
     };
