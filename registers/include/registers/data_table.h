@@ -2,8 +2,8 @@
  * range, factory value, storage), and the operations packets 3-6 and 2 need.
  * The code reads the table; no item has code of its own except the two
  * cross-item rules (39 < 40, 51 > 52). */
-#ifndef PROTOCOL_DATA_TABLE_H
-#define PROTOCOL_DATA_TABLE_H
+#ifndef REGISTERS_DATA_TABLE_H
+#define REGISTERS_DATA_TABLE_H
 
 #include <stdbool.h>
 #include <stdint.h>
