@@ -1,0 +1,27 @@
+"""The documents state what is true now: none points at an issue number
+(history belongs in git log and the changelogs, which may)."""
+import re
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+ISSUE = re.compile(r"\b[Ii]ssues? #?\d+")
+
+
+def documents():
+    for path in sorted([ROOT / "README.md", *(ROOT / "docs").rglob("*.md"), *(ROOT / "tools").rglob("*.md")]):
+        if "changelog" in path.name.lower() or ".venv" in path.parts or "build" in path.parts:
+            continue
+        yield path
+
+
+def test_no_document_names_an_issue():
+    said = [f"{path.relative_to(ROOT)}:{n}: {m.group(0)}"
+            for path in documents()
+            for n, line in enumerate(path.read_text().splitlines(), 1)
+            for m in ISSUE.finditer(line)]
+    assert not said, said
+
+
+def test_the_pattern_finds_what_it_is_for():
+    assert ISSUE.search("a move ran away, issue 55)") and ISSUE.search("(issues 56, 57)")
+    assert not ISSUE.search("a known issue with the adapter") and not ISSUE.search("tissue 5")
