@@ -63,9 +63,12 @@ static int link_write(sb_bus *bus, const uint8_t *frame, size_t len)
 sb_error sb_send(sb_bus *bus, const uint8_t *frame, size_t len)
 {
     int rc;
-    /* What waits unread is dropped: a late answer is not the next one's. */
+    /* What waits unread is dropped: a late answer is not the next one's.
+     * As much as the buffer holds each read (a UART's callbacks would give
+     * a byte a call), 64 buffers at most: a line that never stops talking
+     * is not waited out. */
     for (int k = 0; k < 64; k++) {
-        rc = link_read(bus, 1, 0);
+        rc = link_read(bus, sizeof bus->pending, 0);
         if (rc < 0)
             return link_error(rc, len > 2 ? frame[2] : 0);
         if (rc == 0)
@@ -231,6 +234,7 @@ sb_error sb_sync_monitor_answers(sb_bus *bus, const uint8_t *ids, size_t count, 
     size_t held = count; /* a servo not passed whose frame of the wrong length came this turn */
     size_t floor = 0;    /* every servo before it has passed its turn: a servo after it answered in turn */
     bool jumped = false; /* the last answer taken came before a listed servo's that had not passed its turn */
+    uint32_t taken_end = 0; /* the byte after the last answer taken (the parser's count, from the request) */
     sb_error e = sb_ok();
     for (size_t k = 0; k < count; k++)
         got[k] = false;
@@ -289,6 +293,11 @@ sb_error sb_sync_monitor_answers(sb_bus *bus, const uint8_t *ids, size_t count, 
         k = slot_of(ids, count, a.id);
         if (k == count || k < floor || got[k])
             continue; /* not asked for, or its turn passed */
+        /* A frame begun inside an answer taken is made of that answer's
+         * bytes and the next one's (its checksum good by chance): the
+         * answers on the line follow each other. */
+        if ((int32_t)(bus->rx.start - taken_end) < 0)
+            continue;
         /* A round answers in the list's order: what was taken of a later
          * servo came before this, so it was an earlier round's, late. */
         for (size_t j = k + 1; j < count; j++)
@@ -298,6 +307,7 @@ sb_error sb_sync_monitor_answers(sb_bus *bus, const uint8_t *ids, size_t count, 
             }
         states[k] = a;
         got[k] = true;
+        taken_end = bus->rx.end;
         left--;
         last = bus->arrived_us;
         silent = 0;

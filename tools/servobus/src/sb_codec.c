@@ -104,10 +104,11 @@ sb_error sb_check_ids(const uint8_t *ids, size_t count, uint8_t code)
     return sb_ok();
 }
 
-/* The servo a packet's fields name: an addressed packet's first field. */
+/* The servo a packet's fields name: an addressed packet's first field,
+ * if it is an ID at all (an error about ID 256 names no servo 256). */
 static int servo_of(const sb_packet_desc *p, const sb_value *v, size_t count)
 {
-    return (p->flags & SB_PF_ADDRESSED) && count > 0 ? (int)v[0].n : -1;
+    return (p->flags & SB_PF_ADDRESSED) && count > 0 && v[0].n >= 0 && v[0].n <= 255 ? (int)v[0].n : -1;
 }
 
 static sb_error out_of_range(int servo, uint8_t code, const char *field, int64_t value, int64_t least, int64_t most)

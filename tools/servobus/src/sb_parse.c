@@ -122,6 +122,8 @@ static int check(sb_parser *p, uint8_t *code, const uint8_t **content, size_t *c
             p->size[i] |= DONE;
             size_t head = at(p, s + 3u) == SB_EXTENDED_LENGTH ? 6u : 4u;
             p->reach = (int32_t)(e + 1u - p->reach) > 0 ? e + 1u : p->reach;
+            p->start = s;
+            p->end = e + 1u;
             *code = at(p, s + 2u);
             *content = p->buf + i + head;
             *clen = size - head - 1u;

@@ -53,6 +53,8 @@ int sb_tcp_open(sb_posix *p, const char *host, unsigned port)
     char service[8];
     int one = 1, rc;
     reset(p);
+    if (port == 0 || port > 65535u)
+        return -EINVAL; /* getaddrinfo would take 109223 as 43687 */
     memset(&hints, 0, sizeof hints);
     hints.ai_family = AF_UNSPEC;
     hints.ai_socktype = SOCK_STREAM;

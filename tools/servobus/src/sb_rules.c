@@ -37,6 +37,38 @@ static sb_error ramps_held(const sb_packet_desc *p, const ramp_rule *r, const sb
     return e;
 }
 
+/* A value the servo would clamp or not carry out though its field holds
+ * it: refused, naming the field and what it takes. */
+static sb_error refused(const sb_packet_desc *p, const sb_value *v, size_t field, int64_t value, int64_t least,
+                        int64_t most)
+{
+    sb_error e = sb_error_of(SB_E_RANGE, (int)v[0].n, p->code, p->request[field].name);
+    e.value = value;
+    e.least = least;
+    e.most = most;
+    return e;
+}
+
+#define DUTY_MAX 32767       /* DriveDuty: -32768 is clamped to -32767, 0 refused (motion/open_loop.c) */
+#define UPDATE_WRITE_MAX 24u /* UpdateWrite's data: the bootloader's block (boot_packets.h) */
+
+/* The rules of single fields the schema's ranges do not say. */
+static sb_error values_held(const sb_packet_desc *p, const sb_value *v)
+{
+    if (p->code == SB_PKT_DRIVE_DUTY && (v[1].n == 0 || v[1].n < -DUTY_MAX))
+        return refused(p, v, 1, v[1].n, v[1].n == 0 ? 1 : -DUTY_MAX, DUTY_MAX); /* "1..32767" for 0 */
+    if (p->code == SB_PKT_MOVE_WHEEL && (v[1].n & WHEEL_ACTION) > WHEEL_FOR_A_TIME)
+        return refused(p, v, 1, v[1].n & WHEEL_ACTION, 0, WHEEL_FOR_A_TIME); /* an action the servo takes as stop */
+    if (p->code == SB_PKT_UPDATE_WRITE && (v[2].len == 0 || v[2].len > UPDATE_WRITE_MAX)) {
+        sb_error e = sb_error_of(SB_E_USAGE, (int)v[0].n, p->code, p->request[2].name);
+        e.value = (int64_t)v[2].len; /* the bootloader drops it unanswered */
+        e.least = 1;
+        e.most = UPDATE_WRITE_MAX;
+        return e;
+    }
+    return sb_ok();
+}
+
 #define RECORD_FIELDS 8u /* the most fields a syncable packet has */
 
 /* Each record as its packet's request: its fields' ranges, the rules
@@ -121,6 +153,9 @@ sb_error sb_check_request(uint8_t code, const sb_value *v, size_t count)
         return e;
     if (code == SB_PKT_SYNC_COMMAND)
         return records_fit(v);
+    e = values_held(p, v);
+    if (e.status != SB_OK)
+        return e;
     for (size_t k = 0; k < sizeof RAMP_RULES / sizeof RAMP_RULES[0]; k++)
         if (RAMP_RULES[k].code == code)
             return ramps_held(p, &RAMP_RULES[k], v);

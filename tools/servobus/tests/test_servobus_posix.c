@@ -104,6 +104,9 @@ static void a_rate_termios_has_not_is_refused(void **state)
     sb_posix p;
     assert_int_equal(sb_serial_open(&p, "/dev/null", 250000), -22); /* -EINVAL */
     assert_true(sb_serial_open(&p, "/nonexistent/tty", 115200) < 0);
+    /* A TCP port past 65535 is no port (getaddrinfo took 109223 as 43687). */
+    assert_int_equal(sb_tcp_open(&p, "127.0.0.1", 65536u + 43687u), -22);
+    assert_int_equal(sb_tcp_open(&p, "127.0.0.1", 0), -22);
 }
 
 /* servoctl (pyserial's exclusive=True) holds the port: two programs on one

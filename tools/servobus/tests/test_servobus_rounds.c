@@ -171,6 +171,64 @@ static void a_bus_clock_near_its_end_does_not_wrap_a_deadline(void **state)
     assert_int_equal(a.id, 1);
 }
 
+/* A line that carries given bytes after the request, a byte each 10 us (1 Mbaud). */
+typedef struct script {
+    const uint8_t *bytes;
+    size_t len, at;
+    bool sent;
+    uint64_t now_us;
+} script;
+
+static int script_write(void *ctx, const uint8_t *data, size_t len)
+{
+    (void)data;
+    script *w = (script *)ctx;
+    w->now_us += 10u * len;
+    w->sent = true;
+    return 0;
+}
+
+static int script_read(void *ctx, uint8_t *buf, size_t cap, size_t want, uint32_t wait_us)
+{
+    (void)want;
+    script *w = (script *)ctx;
+    if (!w->sent || w->at == w->len || cap == 0) {
+        w->now_us += wait_us;
+        return 0;
+    }
+    w->now_us += 10u;
+    buf[0] = w->bytes[w->at++];
+    return 1;
+}
+
+static uint64_t script_now(void *ctx)
+{
+    return ((script *)ctx)->now_us;
+}
+
+/* Servo 2's Monitor answer (7173 mV, 4118 mA, power 4) and then servo 4's:
+ * a frame that begins inside servo 2's answer at its bytes 05 1c 16 10
+ * and ends on servo 4's ID byte has a good checksum, and names servo 4. It
+ * was taken as servo 4's state (53 249 mV, angle 470 123 264), and servo
+ * 4's real answer dropped as one whose turn had passed. */
+static void a_frame_across_two_answers_is_not_taken_for_either(void **state)
+{
+    static const uint8_t wire[] = {
+        0x05, 0x1c, 0x16, 0x10, 0x02, 0x05, 0x1c, 0x16, 0x10, 0x04, 0x01, 0xd0, 0x07, 0x00, 0x17,
+        0x00, 0x00, 0x00, 0x00, 0x00, 0x83, 0x05, 0x1c, 0x16, 0x10, 0x04, 0xe8, 0x1c, 0x78, 0x00,
+        0x84, 0x03, 0xd0, 0x07, 0x00, 0xc2, 0x01, 0x00, 0x00, 0x00, 0x00, 0xe8};
+    script w = {wire, sizeof wire, 0, false, 1000};
+    sb_bus sbus;
+    sb_bus_init(&sbus, sb_transport_make(&w, script_write, script_read, script_now), 1000000);
+    const uint8_t ids[2] = {2, 4};
+    assert_int_equal(sb_sync_monitor(&sbus, ids, 2, states, got).status, SB_OK);
+    assert_true(got[0] && got[1]);
+    assert_int_equal(states[0].voltage, 7173);
+    assert_int_equal(states[1].voltage, 7400);
+    assert_int_equal(states[1].current, 120);
+    assert_int_equal(states[1].angle, 450);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -180,6 +238,7 @@ int main(void)
         cmocka_unit_test_setup(a_transport_return_without_an_errno_is_a_link_error, set_up),
         cmocka_unit_test_setup(an_answer_about_another_item_is_not_taken_for_this_one, set_up),
         cmocka_unit_test_setup(a_bus_clock_near_its_end_does_not_wrap_a_deadline, set_up),
+        cmocka_unit_test_setup(a_frame_across_two_answers_is_not_taken_for_either, set_up),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

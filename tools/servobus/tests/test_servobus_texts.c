@@ -206,6 +206,18 @@ static void an_empty_sync_monitor_says_monitor(void **state)
                         "Monitor: ids not allowed: 0 servos is beyond 1..255");
 }
 
+/* An ID out of range names no servo of that number. */
+static void an_id_out_of_range_names_no_servo(void **state)
+{
+    uint8_t f[32];
+    size_t len = 0;
+    sb_value v[4] = {{256, NULL, 0}, {900, NULL, 0}, {500, NULL, 0}, {0, NULL, 0}};
+    sb_error e = sb_encode_request(SB_PKT_MOVE_ANGLE, v, 4, f, sizeof f, &len);
+    assert_int_not_equal(e.status, SB_OK);
+    assert_int_equal(e.servo, -1);
+    assert_null(strstr(words(e), "servo 256"));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -219,6 +231,7 @@ int main(void)
         cmocka_unit_test_setup(a_step_too_fast_says_the_speed_and_the_fix, set_up),
         cmocka_unit_test_setup(an_unknown_serial_is_named, set_up),
         cmocka_unit_test_setup(an_empty_sync_monitor_says_monitor, set_up),
+        cmocka_unit_test_setup(an_id_out_of_range_names_no_servo, set_up),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -113,6 +113,7 @@ typedef struct sb_parser {
     uint32_t now;               /* bytes taken */
     uint32_t lo;                /* the first byte of the earliest frame still open (now: none) */
     uint32_t reach;             /* the end of the frames returned */
+    uint32_t start, end;        /* the frame returned last: its first byte, and the byte after its last */
     uint32_t cover;             /* the end of the frames begun at the bytes judged stray or not */
     uint16_t cursor;            /* the next frame to check that ends at byte now - 1 */
     bool open;                  /* the byte now - 1's frames not all checked */
