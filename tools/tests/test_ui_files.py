@@ -20,7 +20,7 @@ def _confined(folder, *argv):
     if args.command == "config":
         args_.config_operands(args)
     staging = folder.confine(args)
-    for attr in ("file", "image", "mujoco", "target", "other"):
+    for attr in ("file", "image", "mujoco", "elf", "target", "other"):
         if isinstance(getattr(args, attr, None), str):
             setattr(args, attr, staging.shown(getattr(args, attr)))
     if args.command == "update":
@@ -57,7 +57,8 @@ def test_every_command_that_names_a_file_is_confined(tmp_path):
     folder = Folder(tmp_path)
     for argv, attr in ((["config", "save", "1", "c.json"], "file"), (["config", "load", "1", "c.json"], "file"),
                        (["backup", "c.json"], "file"), (["restore", "c.json"], "file"),
-                       (["bench", "--ids", "1", "--image", "c.json"], "image"), (["identify", "1", "--mujoco", "c.json"], "mujoco")):
+                       (["bench", "--ids", "1", "--image", "c.json"], "image"), (["identify", "1", "--mujoco", "c.json"], "mujoco"),
+                       (["faults", "1", "--elf", "c.json"], "elf")):
         assert getattr(_confined(folder, *argv), attr) == str(tmp_path / "c.json"), argv
         with pytest.raises(UsageError, match="names files in"):
             _confined(folder, *argv[:-1], "/etc/passwd")
@@ -137,6 +138,10 @@ def test_a_fifo_in_the_folder_is_refused_not_waited_on(tmp_path):
     thread in open() until someone wrote to it."""
     os.mkfifo(tmp_path / "image.img")
     args = build_parser().parse_args(["--port", "loop://", "restore", "image.img"])
+    with pytest.raises(UsageError, match="'image.img': not a regular file"):
+        Folder(tmp_path).confine(args)
+    # faults --elf opened its path itself: outside the folder, and a FIFO held the bus thread.
+    args = build_parser().parse_args(["--port", "loop://", "faults", "1", "--elf", "image.img"])
     with pytest.raises(UsageError, match="'image.img': not a regular file"):
         Folder(tmp_path).confine(args)
 

@@ -1,6 +1,6 @@
 """The one folder whose files `servoctl ui`'s page may name (docs/ui.md,
-"Files"): config save/load/diff, backup, restore, update, bench --image and
-identify --mujoco. Anyone holding the token would otherwise read and write
+"Files"): config save/load/diff, backup, restore, update, bench --image,
+identify --mujoco and faults --elf. Anyone holding the token would otherwise read and write
 any file the server's user can. A name is taken inside the folder; '..',
 an absolute path elsewhere and a symlink that leads out of it are refused
 before the command runs.
@@ -65,6 +65,8 @@ class Folder:
                 args.image = staging.add(args.image)
             elif command == "identify" and args.mujoco:
                 args.mujoco = staging.add(args.mujoco, writes=True)
+            elif command == "faults" and getattr(args, "elf", None):
+                args.elf = staging.add(args.elf)
         except BaseException:
             staging.close()
             raise
