@@ -12,7 +12,6 @@ import datetime
 import hmac
 import ipaddress
 import json
-import math
 from pathlib import Path
 
 from aiohttp import WSMsgType, web
@@ -20,6 +19,8 @@ from yarl import URL
 
 from . import quiet
 from .doorman import Doorman
+from . import fields
+from .fields import Malformed
 from .outbox import Outbox, send as _send
 from .pace import Pace, is_stop
 from .worker import QueueFull
@@ -37,13 +38,8 @@ KEEPALIVE_S = 15  # an idle keep-alive connection with the token closes after th
 REQUEST_MAX = 64 * 1024
 READ_MAX = 16 * 1024 * 1024
 WATCHER_MAX = 1024  # a watching tab's request is STOP ALL's, a few dozen bytes
-ARGV_MAX, ARG_MAX, TAG_MAX = 64, 1024, 64  # argv's words, a word's characters, a tag's
 TABS_MAX = 8  # open tabs (WebSockets); one more is told so and closed
 CLOSE_S = 1.0  # host seconds: a tab's close at shutdown, then it is aborted
-
-
-class Malformed(ValueError):
-    pass
 
 
 class Page:
@@ -206,10 +202,10 @@ class Page:
                 return
             if len(msg.data) > REQUEST_MAX:
                 raise Malformed(f"{len(msg.data)} bytes long, over the {REQUEST_MAX} a request may be")
-            ask = _parse(msg.data)
-            tag, op = _tag(ask.get("tag")), ask.get("op")
+            ask = fields.parse(msg.data)
+            tag, op = fields.tag(ask.get("tag")), ask.get("op")
             if op == "stopmode":  # any tab's: what its close stops the servos with, if it drives then
-                self.stop_mode[ws] = "damping" if ask.get("mode") == "damping" else "release"
+                self.stop_mode[ws] = fields.mode(ask.get("mode"))
                 return
             if not driving and op != "stopall":  # any tab may stop
                 await self._busy(ws, tag, op)  # its tag and op: the page answers the request that asked
@@ -240,23 +236,28 @@ class Page:
         op, w = ask.get("op"), self.worker
         tag = ask.get("tag")
         if op == "stopall":
-            w.stop_now("damping" if ask.get("mode") == "damping" else "release")
+            try:
+                mode = fields.mode(ask.get("mode"))
+            except Malformed:
+                w.stop_now("release")  # stopped all the same, and told why not as asked
+                raise
+            w.stop_now(mode)
         elif op == "run":
-            w.submit(w.run, _strings(ask.get("argv", []), "argv"), tag)
+            w.submit(w.run, fields.strings(ask.get("argv", []), "argv"), tag)
         elif op == "scan":
-            w.submit(w.scan, bool(ask.get("all_bauds")), tag)
+            w.submit(w.scan, fields.flag(ask.get("all_bauds", False), "all_bauds"), tag)
         elif op == "items":
-            w.submit(w.items, _whole(ask["id"], "id"), tag)
+            w.submit(w.items, fields.whole(ask["id"], "id"), tag)
         elif op == "angle":
-            w.submit(w.angle, _whole(ask["id"], "id"), tag)
+            w.submit(w.angle, fields.whole(ask["id"], "id"), tag)
         elif op == "jog":
-            w.submit(w.jog, _whole(ask["id"], "id"), _number(ask["angle"], "angle"), _whole(ask.get("stops", 0),
-                                                                                            "stops"), tag)
+            w.submit(w.jog, fields.whole(ask["id"], "id"), fields.number(ask["angle"], "angle"),
+                     fields.whole(ask.get("stops", 0), "stops"), tag)
         elif op == "plot":
             ids = ask.get("ids", [])
             if not isinstance(ids, list):
                 raise Malformed(f"ids must be a list, not {ids!r:.40}")
-            w.submit(w.plot, [_whole(i, "ids") for i in ids], tag)
+            w.submit(w.plot, [fields.whole(i, "ids") for i in ids], tag)
         elif op == "table":
             w.submit(w.table)
         else:
@@ -283,60 +284,6 @@ class Page:
         a.router.add_get("/ws", self.socket)
         a.router.add_get("/static/{name}", self.asset)
         return a
-
-
-def _parse(data) -> dict:
-    """A request: a JSON object of finite numbers. Infinity, NaN and
-    nesting deeper than Python's recursion limit are refused as malformed."""
-    def no_constant(name):
-        raise Malformed(f"{name} is not a number a request may carry")
-    try:
-        ask = json.loads(data, parse_constant=no_constant)
-    except RecursionError:
-        raise Malformed("nested too deep") from None
-    except UnicodeDecodeError:
-        raise Malformed("not UTF-8") from None
-    except json.JSONDecodeError as e:
-        raise Malformed(f"not JSON: {e}") from None
-    if not isinstance(ask, dict):  # [1], 5, "x": not a request
-        raise Malformed(f"a request is a JSON object, not {type(ask).__name__}")
-    return ask
-
-
-def _whole(value, name: str) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, str)):
-        raise Malformed(f"{name} must be a whole number, not {value!r:.40}")
-    return int(value)  # "x" raises ValueError, said as malformed
-
-
-def _number(value, name: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float, str)):
-        raise Malformed(f"{name} must be a number, not {value!r:.40}")
-    n = float(value)  # "x" raises ValueError, said as malformed
-    if not math.isfinite(n):
-        raise Malformed(f"{name} must be a finite number, not {value!r:.40}")
-    return n
-
-
-def _strings(values, name: str) -> list:
-    if not isinstance(values, list) or not all(isinstance(v, (str, int, float)) for v in values):
-        raise Malformed(f"{name} must be a list of strings")
-    if len(values) > ARGV_MAX:
-        raise Malformed(f"{name} has {len(values)} words, over the {ARGV_MAX} a request may have")
-    words = [str(v) for v in values]
-    if any(len(w) > ARG_MAX for w in words):
-        raise Malformed(f"a word of {name} is over the {ARG_MAX} characters a request may have")
-    return words
-
-
-def _tag(value):
-    """What the page tags a request with, said back with its answers: a
-    number or a short string."""
-    if value is None or (isinstance(value, int) and not isinstance(value, bool) and abs(value) < 2 ** 53):
-        return value
-    if isinstance(value, str) and len(value) <= TAG_MAX:
-        return value
-    raise Malformed(f"tag must be a number or a string of {TAG_MAX} characters at most, not {value!r:.40}")
 
 
 def _header_host(request):

@@ -73,7 +73,10 @@ def test_every_malformed_message_is_answered_with_an_error():
     aiohttp = pytest.importorskip("aiohttp")
     bad = ('{"op": "items", "id": Infinity}', '{"op": "plot", "ids": [NaN]}', "[" * 100000 + "]" * 100000,
            '{"a": ' * 100000 + "1" + "}" * 100000, '{"op": "run", "argv": {"x": 1}}', '{"op": "items", "id": 1e400}',
-           '{"op": "plot", "ids": 5}', '{"op": "nothing"}', b"\xff\xfe")
+           '{"op": "plot", "ids": 5}', '{"op": "nothing"}', b"\xff\xfe",
+           # fields of the wrong type: "false" ran a scan of every baud rate, a list released
+           '{"op": "scan", "all_bauds": "false"}', '{"op": "stopmode", "mode": [1]}',
+           '{"op": "stopall", "mode": {"x": 1}}')
 
     async def talk(ui):
         async with aiohttp.ClientSession() as s:
@@ -121,20 +124,21 @@ def test_the_origin_is_compared_with_the_address_it_listens_on():
 
 def test_connections_without_the_token_are_capped_and_timed_out():
     """Half-open connections without the token were never closed: 3000 took
-    every file descriptor and page loads timed out. Now at most 32 are
-    open (the oldest closed first), each for 10 s at most, and a page
-    load with the token still comes through."""
+    every file descriptor and page loads timed out. Now at most
+    UNTRUSTED_MAX are open (the oldest closed first), each for 10 s at
+    most, and a page load with the token still comes through."""
+    from servoctl.ui.doorman import UNTRUSTED_MAX
     with Simulator(ids=[1], fast=True) as sim, UiProcess(sim) as ui:
         port = int(ui.base.rsplit(":", 1)[1])
         idle = []
-        for _ in range(100):
+        for _ in range(UNTRUSTED_MAX + 72):
             c = socket.create_connection(("127.0.0.1", port), timeout=10)
             c.sendall(b"GET /?token=" + ui.token.encode() + b" HTTP/1.1\r\nHost: 127.0.0.1\r\n")  # never ends
             idle.append(c)
         assert _status(ui.url) == 200
         deadline = time.monotonic() + 5  # host time: a bound on failure only
-        while sum(not _closed(c) for c in idle) > 32:
-            assert time.monotonic() < deadline, f"{sum(not _closed(c) for c in idle)} of 100 still open"
+        while sum(not _closed(c) for c in idle) > UNTRUSTED_MAX:
+            assert time.monotonic() < deadline, f"{sum(not _closed(c) for c in idle)} of {len(idle)} still open"
             time.sleep(0.05)
         deadline = time.monotonic() + 30  # the 10 s limit, and a bound on failure only
         while not all(_closed(c) for c in idle):
