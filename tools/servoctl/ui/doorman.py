@@ -2,8 +2,11 @@
 yet brought a request with the token is closed after FIRST_REQUEST_S (a
 half-open connection, a request sent a byte a minute), and at most
 UNTRUSTED_MAX such are open at once, one closed for a new one: the oldest
-that has sent nothing yet, else the oldest (a page load whose request is
-under way is not reset by a flood of idle connections).
+that has sent nothing for SILENT_S since it opened, else the oldest (a page
+load whose request is under way is not reset by a flood of idle
+connections, and a browser's new connection, silent for the moment its
+request takes to come, is not the first closed by a flood that sends a
+byte on each of its own).
 Without it, thousands of idle connections took every file descriptor the
 process may open and page loads timed out.
 
@@ -14,26 +17,30 @@ import asyncio
 import collections
 
 FIRST_REQUEST_S = 10.0  # host time: a browser sends its request at once
-UNTRUSTED_MAX = 32      # a browser opens 6 connections to a host at most
+SILENT_S = 0.5          # host time: silent for longer, a connection is closed first
+UNTRUSTED_MAX = 128     # a browser opens 6 connections to a host at most; 1024 files a process
 
 
 class Doorman:
     def __init__(self, protocol_factory, first_request_s: float = FIRST_REQUEST_S,
-                 untrusted_max: int = UNTRUSTED_MAX):
+                 untrusted_max: int = UNTRUSTED_MAX, silent_s: float = SILENT_S):
         self.factory = protocol_factory
-        self.first_request_s, self.untrusted_max = first_request_s, untrusted_max
+        self.first_request_s, self.untrusted_max, self.silent_s = first_request_s, untrusted_max, silent_s
         self.untrusted = collections.OrderedDict()  # transport: its timer, oldest first
-        self.silent = collections.OrderedDict()     # those of them that sent nothing yet: None
+        self.silent = collections.OrderedDict()     # those of them that sent nothing yet: when they opened
 
     def __call__(self) -> asyncio.Protocol:
         return _Watched(self.factory(), self)
 
     def admit(self, transport) -> None:
         loop = asyncio.get_running_loop()
+        now = loop.time()
         while len(self.untrusted) >= self.untrusted_max:  # room for this one
-            self._close(next(iter(self.silent or self.untrusted)))
+            idle = next(iter(self.silent.items()), None)  # the oldest silent one
+            self._close(idle[0] if idle is not None and now - idle[1] >= self.silent_s
+                        else next(iter(self.untrusted)))
         self.untrusted[transport] = loop.call_later(self.first_request_s, self._close, transport)
-        self.silent[transport] = None
+        self.silent[transport] = now
 
     def heard(self, transport) -> None:
         """Bytes came on it: a request under way, closed last."""
