@@ -179,11 +179,28 @@ void sim_bus_attach(struct sim_bus *b, struct sim_station station)
     }
 }
 
+/* Where the host's next byte may start: after its own bytes still queued
+ * and what is on the wire by now, and the bytes that follow those back to
+ * back. A servo's answer booked to start later (after a flash stall, the
+ * CPU held) does not hold the host back: on a wire the host's UART sends
+ * while that servo is still silent, and the two garble if they meet. */
+static uint64_t host_start_us(struct sim_bus *b, uint64_t now_us)
+{
+    uint64_t start = now_us;
+    for (unsigned i = 0; i < b->count; i++) {
+        const struct sim_bus_byte *q = queued(b, i);
+        if ((q->sender == SIM_HOST || q->start_us <= start) && q->at_us > start) {
+            start = q->at_us;
+        }
+    }
+    return start;
+}
+
 /* The host's bytes wait for a quiet wire (what the simulator reads of a
  * pty or socket was written before it could be put on the wire). */
 void sim_bus_from_host(struct sim_bus *b, const uint8_t *data, unsigned len, uint64_t now_us)
 {
-    uint64_t start = now_us > b->wire_until_us ? now_us : b->wire_until_us;
+    uint64_t start = host_start_us(b, now_us);
     if (start < b->deaf_before_us) {
         b->deaf_before_us = start; /* from its first byte on, answers may be its own */
     }
