@@ -8,7 +8,7 @@ import os
 
 from . import __version__, ids, outcome, registers, units
 from . import protocol as p
-from .checks import MIN_RAMP_MS
+from .checks import MIN_RAMP_MS, scaled
 from .errors import UsageError
 from .move_request import MoveRequest
 
@@ -46,7 +46,7 @@ def _reply_timeout(text: str) -> float:
 
 
 def decideg(degrees: float) -> int:
-    return int(round(degrees * 10))
+    return scaled(degrees, 10, "angle")
 
 
 def move_request(args) -> MoveRequest:

@@ -43,6 +43,8 @@ def check_profile(acc_ms: int, dec_ms: int, interval_ms: int = None, velocity: i
 def scaled(value: float, factor: int, name: str) -> int:
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
         raise ValueOutOfRange(f"{name} takes a finite number, not {value!r}")
+    if not math.isfinite(value * factor):  # 1e308 degrees: finite, not in any unit's range
+        raise ValueOutOfRange(f"{name} {value!r} is beyond any range it takes")
     return int(round(value * factor))
 
 
