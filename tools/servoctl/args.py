@@ -6,7 +6,7 @@ import dataclasses
 import math
 import os
 
-from . import __version__, ids, outcome, registers, units
+from . import __version__, args_drive, ids, outcome, registers, units
 from . import protocol as p
 from .checks import MIN_RAMP_MS, scaled
 from .errors import UsageError
@@ -241,6 +241,8 @@ def build_parser():
                    help="get NAME | set NAME VALUE | save FILE | load FILE | diff ID|FILE|factory")
     c.add_argument("--with-link", action="store_true",
                    help="config load: also set the ID and baud rate from the file")
+    c.add_argument("--with-calibration", action="store_true",
+                   help="config load of another servo's file: also its calibration and drive train (80-91)")
     c.add_argument("--raw", action="store_true",
                    help="get/set/dump in protocol units (0.1 deg, NTC ADC, baud code); "
                         "load: a file of plain protocol numbers")
@@ -317,27 +319,7 @@ def build_parser():
     c.add_argument("--host-jitter-ms", type=finite, default=0.0, metavar="MS", help="model a host: rows sent ±MS")
     c.add_argument("--host-late-every", type=int, default=0, metavar="N", help="model a host: 1 row in N a period late")
 
-    c = sub.add_parser("identify", help="the drive train's constants from open-loop duty steps (horn free)")
-    c.add_argument("id", type=int)
-    c.add_argument("--duty", type=float, default=0.45,
-                   help="the largest duty, of the supply (default 0.45); four steps up to it, each way")
-    c.add_argument("--step-ms", type=int, default=0,
-                   help="each step's length (default: 12 rise times of a first step, 0.7-10 s)")
-    c.add_argument("--mujoco", metavar="FILE",
-                   help="also write a MuJoCo actuator model (MJCF) and say how closely it replays the steps")
-
-    c = sub.add_parser("calibrate", help="the current amplifier's zero, the direction and the zero angle, "
-                                         "found with the horn free and stored")
-    c.add_argument("id", type=int)
-    c.add_argument("--keep-zero", action="store_true",
-                   help="leave the zero (item 90) as it is (else: the horn's position now becomes angle 0)")
-
-    c = sub.add_parser("tune", help="identify, then the gains for a bandwidth with their margins; stored")
-    c.add_argument("id", type=int)
-    c.add_argument("--bandwidth", type=float, default=0.0, metavar="HZ",
-                   help="the closed loop's natural frequency (default: 8 Hz, or 0.8 of what items 86-88 allow)")
-    c.add_argument("--duty", type=float, default=0.45, help="identify's largest duty (default 0.45)")
-    c.add_argument("--dry-run", action="store_true", help="only show the gains and margins: nothing written")
+    args_drive.add_commands(sub)
 
     c = sub.add_parser("sync-move", help="several servos start their moves in one frame")
     c.add_argument("targets", type=_target, nargs="+", metavar="ID:DEGREES")

@@ -13,6 +13,8 @@ the horn free and stored (data items 82's sign, 90 and 91).
    loop, released, and the encoder's count there (item 71) becomes the
    zero: after every power-up angles are from it. SetOriginPoint makes it so
    now. So start with the horn at its zero mark, or pass --keep-zero.
+   Angle limits narrower than the factory's (a joint's range, kept on the
+   joint) are moved with the zero: they name the same horn positions after.
 
 Every item is written through a PutBack (putback.py): a calibrate that
 does not finish (Ctrl-C, the ui's STOP ALL or its tab closing, an error, a
@@ -23,9 +25,12 @@ current, and its current protections are blind).
 Time is the servo's (or the simulator's) clock: sleep(s)."""
 from dataclasses import dataclass
 
+from .drive_guard import narrowed_limits
 from .errors import ServoError
 from .identify import come_to_rest
 from .putback import PutBack
+
+ANGLE_MOST = 1800  # the limits' range, 0.1 deg (items 51, 52)
 
 PUSH_DUTY = 0.25
 PUSH_MS = 150
@@ -43,6 +48,7 @@ class Calibration:
     gear_ratio: int
     encoder_zero: int       # counts (item 90), or None where kept
     push_decideg: int       # what the checking push moved, positive
+    limits: tuple = None    # the narrowed angle limits moved with the zero: (min, max) before, after; None: not moved
 
 
 def current_zero(servo, sleep, kept: PutBack) -> int:
@@ -119,16 +125,42 @@ def zero(servo, sleep, start_decideg: int, kept: PutBack) -> int:
     return count
 
 
+def move_limits(start_decideg: int, limits: tuple) -> tuple:
+    """A joint's angle limits (min, max) where the new zero reads them: the
+    horn at start reads 0 now, so each is start less; beyond the items'
+    range, ServoError (before the zero is written). Written in the order
+    that keeps min below max at each write."""
+    low, high = (v - start_decideg for v in limits)
+    if low < -ANGLE_MOST or high > ANGLE_MOST:
+        raise ServoError(f"the angle limits {limits[0] / 10:.1f}..{limits[1] / 10:.1f} deg would be "
+                         f"{low / 10:.1f}..{high / 10:.1f} from a zero here, beyond +-180: move the horn "
+                         "nearer the middle of its range, or calibrate with --keep-zero")
+    return low, high
+
+
+def write_limits(limits: tuple, kept: PutBack) -> None:
+    """Lowered, min first; raised, max first: min stays below max (the
+    servo refuses a write that would cross them)."""
+    low, high = limits
+    order = [("angle_min", low), ("angle_max", high)]
+    for name, value in order if low < kept.servo.read("angle_min") else order[::-1]:
+        kept.write(name, value)
+
+
 def calibrate(servo, sleep, keep_zero: bool = False) -> Calibration:
     if servo.read("voltage") < 500:
         raise ServoError("the supply reads below 0.5 V: calibrate needs the motor powered")
     start = servo.read_motion().angle_decideg
+    joint = None if keep_zero else narrowed_limits(servo)
+    moved_to = None if joint is None else move_limits(start, joint)
     with PutBack(servo, "calibrate") as kept:  # all of it, or none: each item as it was
         amp = current_zero(servo, sleep, kept)
         settle_store(sleep)
         reversed_, ratio, moved = direction(servo, sleep, kept)
         count = None if keep_zero else zero(servo, sleep, start, kept)
-    return Calibration(amp, reversed_, ratio, count, moved)
+        if moved_to is not None:
+            write_limits(moved_to, kept)
+    return Calibration(amp, reversed_, ratio, count, moved, None if joint is None else (joint, moved_to))
 
 
 def cmd_calibrate(bus, args):
@@ -149,4 +181,8 @@ def cmd_calibrate(bus, args):
     else:
         print(f"  zero                      encoder count {c.encoder_zero} (item 90): angle 0 here, "
               "now and after every power-up")
+    if c.limits is not None:
+        (low, high), (new_low, new_high) = c.limits
+        print(f"  angle limits              {low / 10:.1f}..{high / 10:.1f} deg from the old zero are "
+              f"{new_low / 10:.1f}..{new_high / 10:.1f} from the new: the same horn positions")
     return 0

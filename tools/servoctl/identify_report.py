@@ -14,7 +14,7 @@ def cmd_identify(bus, args):
     servo = Servo(bus, args.id)
     duties = tuple(args.duty * k / len(DEFAULT_DUTIES) for k in range(1, len(DEFAULT_DUTIES) + 1))
     print(f"servo {args.id}: open-loop steps at duties {', '.join(f'±{d:.2f}' for d in duties)}, then "
-          "two reversals each way (the horn must turn freely: it goes round several times)", flush=True)
+          "two reversals each way (the horn must turn freely: some 120 deg of travel on the reference)", flush=True)
 
     def progress(done, total):
         print(f"  step {done}/{total}", flush=True)

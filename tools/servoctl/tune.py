@@ -35,6 +35,7 @@ DEFAULT_MAX_HZ = 8.0      # no faster by default: the reference's factory gains 
 RANGE_SHARE = 0.8         # the default stays this far inside the gains' item ranges
 CHECK_TARGET_DECIDEG = 450
 CHECK_MS = 500
+CHECK_TOLERANCE_DECIDEG = 20  # the check's error 1.5 s on beyond which the tuning failed
 
 
 @dataclass
@@ -159,6 +160,10 @@ def cmd_tune(bus, args):
     with PutBack(servo, "tune") as kept:
         kept.write_drive(t.items)
         over, error = check_step(servo, bus.sleep)
+        if error > CHECK_TOLERANCE_DECIDEG:  # put back: gains that do not arrive are not kept as tuned
+            raise ServoError(f"the check's {CHECK_TARGET_DECIDEG / 10:g} deg move ended {error / 10:.1f} deg "
+                             f"from its target 1.5 s on (more than {CHECK_TOLERANCE_DECIDEG / 10:g}): a load, "
+                             "a stop or an angle limit in its way? The items it had are put back")
     print(f"written and kept; a {CHECK_TARGET_DECIDEG / 10:g} deg move in {CHECK_MS} ms: overshoot "
           f"{max(over, 0) / 10:.1f} deg, {error / 10:.1f} deg from the target 1.5 s on")
     return 0

@@ -66,3 +66,41 @@ def test_a_servo_built_as_the_reference_keeps_its_items(tmp_path, capsys):
             assert (s.read("current_zero"), s.read("gear_ratio"), s.read("encoder_zero")) == (0, 345, 0)
     finally:
         finish(sim, [1])
+
+
+def test_a_joints_limits_refuse_bring_up_and_move_with_a_new_zero(tmp_path, capsys):
+    """A servo whose angle limits are narrowed (-10..10 deg: a joint's) is
+    in a joint: calibrate, identify and tune refuse to turn it past them,
+    nothing moved, unless told the horn is free. Calibrate then kept the
+    limits as numbers while moving the zero 8 deg: the joint's safe range
+    moved 8 deg on the real horn. Now the limits move with the zero."""
+    sim = start(tmp_path)
+    try:
+        with sim.bus(timeout=0.2) as bus:
+            s = Servo(bus, 1)
+            s.write("soft_start_on", 0)
+            s.write("angle_max", 100)
+            s.write("angle_min", -100)
+            s.move(80, interval_ms=300)
+            sim.sleep(0.6)
+            s.stop("release")
+            sim.sleep(0.2)
+            zero_at = s.read_motion().angle_decideg  # about 80: the zero goes here
+        horn_deg = sim.state(1)["angle"]
+        for command in ("calibrate", "identify", "tune"):
+            assert main(["--port", sim.url, command, "1"], clock=sim.clock_s) == 2, command
+            err = capsys.readouterr().err
+            assert "angle limits are on at -10.0..10.0 deg" in err and "--past-limits" in err, err
+        assert abs(sim.state(1)["angle"] - horn_deg) < 0.05  # nothing moved
+        assert main(["--port", sim.url, "calibrate", "1", "--past-limits"], clock=sim.clock_s) == 0
+        out = capsys.readouterr().out
+        low, high = -100 - zero_at, 100 - zero_at
+        assert f"-10.0..10.0 deg from the old zero are {low / 10:.1f}..{high / 10:.1f} from the new" in out, out
+        with sim.bus(timeout=0.2) as bus:
+            s = Servo(bus, 1)
+            assert (s.read("angle_min"), s.read("angle_max")) == (low, high)
+            s.move(high, interval_ms=300)  # the joint's old 10 deg
+            sim.sleep(0.6)
+            assert abs(sim.state(1)["angle"] - (horn_deg + (100 - zero_at) / 10)) < 0.5  # the same horn position
+    finally:
+        finish(sim, [1])

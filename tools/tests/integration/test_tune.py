@@ -119,3 +119,24 @@ def test_the_command_shows_gains_and_margins_and_a_dry_run_writes_nothing(tmp_pa
         assert "at most" in capsys.readouterr().err
     finally:
         finish(sim, [1])
+
+
+def test_a_check_that_does_not_arrive_fails_and_puts_the_gains_back(tmp_path, capsys):
+    """With angle limits of +-10 deg (--past-limits: the horn is free), the
+    check's 45 deg move stops at 10: tune said "written and kept ... 35.0
+    deg from the target" and exited 0. Now it fails, and the items it had
+    are put back."""
+    sim = start(tmp_path, "reference_st3215.toml")
+    try:
+        with sim.bus(timeout=0.2) as bus:
+            s = Servo(bus, 1)
+            s.write("angle_max", 100)
+            s.write("angle_min", -100)
+            before = {name: s.read(name) for name in ("gain_kp", "gain_kd", "torque_constant")}
+        assert main(["--port", sim.url, "tune", "1", "--past-limits"], clock=sim.clock_s) == 1
+        err = capsys.readouterr().err
+        assert "ended 35.0 deg from its target" in err and "put back" in err, err
+        with sim.bus(timeout=0.2) as bus:
+            assert {name: Servo(bus, 1).read(name) for name in before} == before
+    finally:
+        finish(sim, [1])

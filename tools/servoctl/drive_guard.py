@@ -1,0 +1,32 @@
+"""Before a bring-up command drives the horn open loop through its travel
+(identify, calibrate, tune): a servo whose angle limits are on and
+narrower than the factory's is in a joint, and those limits are the
+joint's range, which the command would turn it past (identify went to
+111 deg on a servo limited to +-10). It refuses unless told the horn is
+free (--past-limits); the factory's limits, on a servo just unpacked, are
+no such sign."""
+from .errors import UsageError
+from .registers import BY_NAME
+
+
+def narrowed_limits(servo):
+    """(min, max) in 0.1 deg where the angle limits are on and narrower
+    than the factory's, else None."""
+    if not servo.read("angle_limit_on"):
+        return None
+    low, high = servo.read("angle_min"), servo.read("angle_max")
+    if low > BY_NAME["angle_min"].default or high < BY_NAME["angle_max"].default:
+        return low, high
+    return None
+
+
+def check_horn_free(servo, command: str, past_limits: bool) -> None:
+    """UsageError (nothing moved) where the limits say the horn is in a joint."""
+    limits = None if past_limits else narrowed_limits(servo)
+    if limits is not None:
+        low, high = limits
+        raise UsageError(
+            f"servo {servo.id}: its angle limits are on at {low / 10:.1f}..{high / 10:.1f} deg, narrower than "
+            f"the factory's: a joint's range. {command} turns the horn past them, open loop (docs/bring-up.md). "
+            f"Free the horn, then give --past-limits (or turn the limits off: 'servoctl config set {servo.id} "
+            f"angle_limit_on 0'); nothing was moved")
