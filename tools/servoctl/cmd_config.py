@@ -100,16 +100,25 @@ def cmd_config(bus, args):
     elif args.action == "load":
         entry = config_file.parse_config(config_file.read(args.file), args.file, args.raw)
         serial, baud = s.read("serial"), s.read("baud")  # before: the load may move the servo
-        kept = group.write_user_area(s, entry.values, args.with_link)  # validated before sending
+        other = entry.serial is not None and entry.serial != serial
+        # Another servo's zero, amplifier offset, direction (gear_ratio's sign) and
+        # drive train are that servo's: here they would move the angles and limits, or
+        # run the loop the wrong way round.
+        own = [i.name for i in registers.DRIVE if i.name in entry.values] if other and not args.with_calibration else []
+        values = {k: v for k, v in entry.values.items() if k not in own}
+        kept = group.write_user_area(s, values, args.with_link)  # validated before sending
         notes = link_rate.after_load(bus, args, s.id, baud, entry.values.get("baud", baud))
         notes += [f"kept {', '.join(f'{k} {s.read(k)}' for k in kept)}; --with-link to change"] if kept else []
         notes += [f"{n} in RAM: lost at power-up"] if (n := sum(i.name in entry.values for i in registers.RAM)) else []
         if entry.raw:
             notes.append("a raw file: protocol units")
-        if entry.serial is not None and entry.serial != serial:
+        if other:
             notes.append(f"the file is servo serial 0x{entry.serial:08x}'s")
+        if own:
+            notes.append(f"its own calibration and drive train not loaded ({', '.join(own)}); "
+                         "--with-calibration to load them")
         note = f" ({'; '.join(notes)})" if notes else ""
-        print(f"loaded {len(entry.values)} item(s) from {args.file} into servo {args.id}{note}")
+        print(f"loaded {len(values)} item(s) from {args.file} into servo {args.id}{note}")
     elif args.action == "reset":
         s.reset_user_data()
         print(f"servo {args.id}: user area reset (ID and baud rate kept)")

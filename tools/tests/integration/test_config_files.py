@@ -180,3 +180,23 @@ def test_a_socket_link_takes_the_simulators_host_rate(sim, capsys):
     assert run(sim, capsys, "--sim-control", control, "config", "set", "1", "baud", "1000000")[0] == 0
     rc, out, err = run(sim, capsys, "--sim-control", control, "bench", "--ids", "1", "--seconds", "0.2")
     assert rc == 0 and "at 1000000 baud" in out, out + err
+
+
+def test_another_servos_calibration_is_not_loaded_unless_asked(tmp_path, capsys):
+    """Servo 2's file into servo 1 carried servo 2's zero, amplifier offset
+    and direction: servo 1 then read 8 deg off (its limits moved with it),
+    and a negated gear ratio from leads swapped on servo 2 would run servo
+    1's loop the wrong way round. They stay servo 1's unless asked."""
+    with Simulator(fast=True, ids=[1, 2], state_dir=str(tmp_path / "state")) as sim:
+        for name, text in {"encoder_zero": "91", "gear_ratio": "-345", "stall_power": "2.5W"}.items():
+            assert run(sim, capsys, "config", "set", "2", name, text)[0] == 0
+        f = tmp_path / "two.json"
+        assert run(sim, capsys, "config", "save", "2", str(f))[0] == 0
+        rc, out, _ = run(sim, capsys, "config", "load", "1", str(f))
+        assert rc == 0 and "its own calibration and drive train not loaded" in out and "encoder_zero" in out, out
+        assert run(sim, capsys, "config", "get", "1", "encoder_zero")[1].startswith("encoder_zero = 0 ")
+        assert run(sim, capsys, "config", "get", "1", "gear_ratio")[1] == "gear_ratio = 345\n"
+        assert run(sim, capsys, "config", "get", "1", "stall_power")[1].startswith("stall_power = 2500")
+        rc, out, _ = run(sim, capsys, "config", "load", "1", str(f), "--with-calibration")
+        assert rc == 0 and "not loaded" not in out, out
+        assert run(sim, capsys, "config", "get", "1", "gear_ratio")[1] == "gear_ratio = -345\n"
