@@ -231,8 +231,9 @@ class Arm:
                 errors.append(f"{self.names[servo_id]}: {e}")
         self._watchdog_before = {}
         self.stream = None
-        if errors:
-            raise ServoError("the bus watchdog could not be put back: " + "; ".join(errors))
+        if errors:  # after an error that said why (a servo gone): this says what it leaves
+            raise ServoError("on disconnect, the bus watchdog this connection set stays on "
+                             + "; ".join(errors) + ": it is on record, and the next connect puts it back")
 
     # ---- calibration (this firmware: stored on the servos) -------------
     def set_zero_here(self) -> dict:

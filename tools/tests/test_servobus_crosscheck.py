@@ -20,7 +20,7 @@ from .launchers import REPO
 
 BINARY = REPO / "build" / "host" / "tools" / "servobus" / "sb_crosscheck"
 S = servo_schema.load()
-SB_E_RANGE, SB_E_UNKNOWN_ITEM, SB_E_BAD_ANSWER, SB_E_BROADCAST = 1, 4, 8, 11
+SB_E_RANGE, SB_E_USAGE, SB_E_UNKNOWN_ITEM, SB_E_BAD_ANSWER, SB_E_BROADCAST = 1, 2, 4, 8, 11
 USER_AREA = bytes(range(7, 7 + registers.USER_AREA_SIZE))
 
 
@@ -89,6 +89,12 @@ def refused(p, part: str, values: list):
     if p.code == codec.CODES["WHEEL"] and named["method"] & 0x7F == 3 and named["speed"] and \
             named["value"] < 2 * MIN_RAMP_MS:
         return SB_E_RANGE, "value"
+    # A wheel action past 3, which the servo takes as a stop (servoctl names the actions 0-3 only).
+    if p.code == codec.CODES["WHEEL"] and named["method"] & 0x7F > 3:
+        return SB_E_RANGE, "method"
+    # DriveDuty's 0 (refused) and -32768 (clamped): servoctl's drive_duty refuses both.
+    if p.code == codec.CODES["DRIVE_DUTY"] and named["duty"] in (0, -32768):
+        return SB_E_RANGE, "duty"
     return None
 
 
@@ -168,10 +174,13 @@ def test_data_items_at_their_sizes_and_ranges():
 
 
 def test_blocks_and_sync_commands():
-    """UpdateWrite's block (0 to 24 bytes), SyncCommand's records (the
-    extended length from 255 content bytes), and each decoded back."""
+    """UpdateWrite's block (1 to 24 bytes: none or more the bootloader
+    drops unanswered, and the C library refuses), SyncCommand's records
+    (the extended length from 255 content bytes), and each decoded back."""
     lines, frames = [], []
-    for n in (0, 1, 8, 24):
+    refused_blocks = [f"req 82 5 4096 {word(bytes(n))} 0" for n in (0, 25)]
+    assert [a.split()[:2] for a in c_side(refused_blocks)] == [["err", str(SB_E_USAGE)]] * 2
+    for n in (1, 8, 24):
         chunk = bytes(range(n))
         content = bytes([5]) + struct.pack("<I", 4096) + chunk + struct.pack("<I", zlib.crc32(chunk))
         lines.append(f"req 82 5 4096 {word(chunk)} {zlib.crc32(chunk)}")

@@ -4,7 +4,8 @@ simulator booked the answer on the wire when the request came, 40 ms
 ahead, and queued the host's bytes behind it: a STOP ALL sent during an
 update's page erase reached a turning wheel 35-40 ms late (servoctl ui's
 figure for it, and none of it the ui's). Now the host's bytes go on the
-wire at once. The requests go out at simulated times (hostsend)."""
+wire at once. The requests go out at simulated times (hostsend), on a
+simulator that stands still while the host is away (paced)."""
 import struct
 
 from servoctl import protocol as p
@@ -16,7 +17,7 @@ ERASE_MS = 40  # the F1's page erase, the simulator's flash stall (RM0008: tERAS
 
 
 def test_a_stop_sent_during_another_servos_erase_is_on_the_wire_at_once(tmp_path):
-    with Simulator(ids=[1, 2], state_dir=str(tmp_path / "state"), fast=True) as sim:
+    with Simulator(ids=[1, 2], state_dir=str(tmp_path / "state"), paced=True) as sim:
         with sim.bus(timeout=0.3) as bus:
             wheel = Servo(bus, 1)
             wheel.write("soft_start_on", 0)
