@@ -40,7 +40,7 @@ from .arm_reset import ResetWatch
 from .arm_watchdog import WATCHDOG_ACTIONS, arm_one
 from .group import sync_monitor
 from .servo import Servo
-from .setpoints import MAX_SPEED_DECIDEG_S, Stream, read_limits
+from .setpoints import MAX_SPEED_DECIDEG_S, Stream, put_back_period, read_limits, tell_period
 from .watchdog_record import WatchdogRecords
 
 log = logging.getLogger(__name__)
@@ -144,6 +144,7 @@ class Arm:
         self.targets = {}  # {name: degrees}: the last sent, or where hold_here held
         self._before = {}  # the targets before those
         self._watchdog_before = {}  # {id: (serial, the servo's own setting)}
+        self._period_before = {}  # {id: item 69 as the servo had it}
         self._times = []  # the bus clock at the last sends, up to 3
         self.measured_period_s = self.period_s
         self.frames = 0
@@ -160,7 +161,12 @@ class Arm:
         if self.firmware == "servoctl" and self.watchdog_ms:
             self._arm_watchdog()
             self.watch = ResetWatch(self.ids, self.watchdog_ms)
+        if self.firmware == "servoctl":  # told, not learned from the stamps (setpoints.tell_period)
+            self._period_before = tell_period(self.bus, self.ids, self._period_ms())
         return self
+
+    def _period_ms(self) -> int:
+        return max(1, round(self.period_s * 1000))
 
     def _arm_watchdog(self) -> None:
         for servo_id in self.ids:
@@ -179,6 +185,7 @@ class Arm:
         and its joint ramped from there."""
         name = self.names[servo_id]
         self._arm_one(servo_id)
+        Servo(self.bus, servo_id).write("stream_period_ms", self._period_ms())  # lost with its RAM
         Servo(self.bus, servo_id).stop("hold")
         state = sync_monitor(self.bus, [servo_id]).get(servo_id)
         if state is None:
@@ -230,6 +237,8 @@ class Arm:
             except (ServoError, OSError) as e:  # the next servos' still put back
                 errors.append(f"{self.names[servo_id]}: {e}")
         self._watchdog_before = {}
+        put_back_period(self.bus, self._period_before)
+        self._period_before = {}
         self.stream = None
         if errors:  # after an error that said why (a servo gone): this says what it leaves
             raise ServoError("on disconnect, the bus watchdog this connection set stays on "

@@ -119,6 +119,34 @@ def read_configs(bus: p.Bus, ids) -> dict:
     return out
 
 
+def tell_period(bus: p.Bus, ids, period_ms: int) -> dict:
+    """Item 69 (stream_period_ms) set on each servo to the host's period:
+    the servo places every setpoint 3/2 of it after its stamp from the
+    first, not after learning it from the stamps' steps (a host's jitter,
+    +-10 ms at 60 Hz, made the steps it learned from short, and a late
+    frame then stopped the stream). {id: the value before}, for
+    put_back_period."""
+    from .servo import Servo
+
+    before = {}
+    for servo_id in ids:
+        before[servo_id] = Servo(bus, servo_id).read("stream_period_ms")
+        Servo(bus, servo_id).write("stream_period_ms", period_ms)
+    return before
+
+
+def put_back_period(bus: p.Bus, before: dict) -> None:
+    """Item 69 as each servo had it (a RAM item: a power-up clears it);
+    a servo gone is left, the error that said so is its caller's."""
+    from .servo import Servo
+
+    for servo_id, ms in before.items():
+        try:
+            Servo(bus, servo_id).write("stream_period_ms", ms)
+        except (ServoError, OSError):
+            pass
+
+
 def read_limits(bus: p.Bus, ids) -> dict:
     """{id: Limits} read from each servo."""
     return {servo_id: Limits.of(cfg) for servo_id, cfg in read_configs(bus, ids).items()}

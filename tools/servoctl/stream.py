@@ -24,7 +24,7 @@ from .group import sync_monitor
 from .loop_rate import BITS_PER_BYTE, LoopLate, LoopRate, check_wire  # noqa: F401 (LoopLate: the API's)
 from .move_request import MoveRequest
 from .outcome import EXECUTING, INHIBITING, STALL, TOLERANCE_DEG
-from .setpoints import Limits, RobotLoop, Stream, read_configs  # noqa: F401 (Stream: the API's)
+from .setpoints import Limits, RobotLoop, Stream, put_back_period, read_configs, tell_period  # noqa: F401 (Stream: the API's)
 from .trajectory import Trajectory, check_trajectory, read_trajectory
 
 
@@ -134,6 +134,16 @@ def stream_file(bus: p.Bus, times, angles: dict, progress=None, limits: dict = N
     check_wire(ids, period, bus.serial.baudrate)
     loop = RobotLoop(bus, ids, period, limits, pace=False)  # paced here, against the rows' times
     check_trajectory(Trajectory(times, angles), loop.stream.limits)
+    told = tell_period(bus, ids, loop.stream.period_ms)  # the servos' depth from the first row
+    try:
+        return _stream_rows(bus, times, angles, loop, progress, host)
+    finally:
+        put_back_period(bus, told)
+
+
+def _stream_rows(bus, times, angles, loop, progress, host) -> StreamReport:
+    ids = list(angles)
+    period = times[1] - times[0]
     count = len(times)
     period_ms = loop.stream.period_ms
     # The rows as sent (0.1 deg): a velocity is theirs, so it is within

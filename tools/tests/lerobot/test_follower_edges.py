@@ -314,3 +314,18 @@ def test_two_simulators_keep_their_own_records(state_dir, caplog):
         assert "which a run that did not end cleanly wrote" in caplog.text, caplog.text
         again.close()
         assert watchdog(ba, 1) == own
+
+
+def test_the_streams_period_is_told_and_put_back():
+    """The follower tells each servo its period (item 69) while connected,
+    and puts back what the servo had: left to learn it from the frames'
+    stamps, a servo under a host's +-10 ms at 60 Hz took steps of 10.75 ms
+    for the period, the stream stopped at a late frame, and the horn
+    swung at 4 342 deg/s^2 (docs/lerobot.md)."""
+    with Simulator(ids=[1, 2], paced=True) as sim:
+        with sim.bus() as bus:
+            Servo(bus, 2).write("stream_period_ms", 40)  # another program's
+            arm = Arm(bus, {"a": 1, "b": 2}, fps=60, watchdog_ms=0).open()
+            assert [Servo(bus, i).read("stream_period_ms") for i in (1, 2)] == [17, 17]
+            arm.close()
+            assert [Servo(bus, i).read("stream_period_ms") for i in (1, 2)] == [0, 40]
