@@ -278,6 +278,7 @@ def build_parser():
     c.add_argument("--speed", type=int, default=90, help="deg/s")
     c.add_argument("--value", type=int, default=0, help="turns or ms")
     c.add_argument("--cw", action="store_true", help="clockwise (default counter-clockwise)")
+    c.add_argument("--past-limits", action="store_true", help=args_drive.PAST_LIMITS)
 
     c = sub.add_parser("damping", help="damping mode")
     c.add_argument("id", type=int)
@@ -291,6 +292,8 @@ def build_parser():
     c = sub.add_parser("origin", help="make here angle 0 (only while released)")
     c.add_argument("id", type=int)
     c.add_argument("--reset-turns", action="store_true", help="only drop the whole turns")
+    c.add_argument("--past-limits", action="store_true",
+                   help="though the angle limits are narrowed: they then name other horn positions until power-up")
 
     c = sub.add_parser("monitor", help="live table (and plot) of angle, speed, V, A, W, degC, status")
     c.add_argument("ids", type=id_number, nargs="+")

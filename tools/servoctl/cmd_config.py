@@ -63,6 +63,14 @@ def cmd_config_diff(bus, args):
     return 1 if any(found) else 0
 
 
+def joint_range(values: dict) -> bool:
+    """A file's angle limits are a joint's: on, and narrower than the factory's."""
+    factory = {n: registers.find(n).default for n in ("angle_limit_on", "angle_min", "angle_max")}
+    on = values.get("angle_limit_on", factory["angle_limit_on"])
+    return bool(on) and (values.get("angle_min", factory["angle_min"]) > factory["angle_min"] or
+                         values.get("angle_max", factory["angle_max"]) < factory["angle_max"])
+
+
 def cmd_config(bus, args):
     if args.action == "diff":
         return cmd_config_diff(bus, args)
@@ -105,6 +113,8 @@ def cmd_config(bus, args):
         # drive train are that servo's: here they would move the angles and limits, or
         # run the loop the wrong way round.
         own = [i.name for i in registers.DRIVE if i.name in entry.values] if other and not args.with_calibration else []
+        if other and not args.with_calibration and joint_range(entry.values):  # in that servo's zero, not this one's
+            own += [n for n in ("angle_limit_on", "angle_min", "angle_max") if n in entry.values]
         values = {k: v for k, v in entry.values.items() if k not in own}
         kept = group.write_user_area(s, values, args.with_link)  # validated before sending
         notes = link_rate.after_load(bus, args, s.id, baud, entry.values.get("baud", baud))
@@ -115,7 +125,7 @@ def cmd_config(bus, args):
         if other:
             notes.append(f"the file is servo serial 0x{entry.serial:08x}'s")
         if own:
-            notes.append(f"its own calibration and drive train not loaded ({', '.join(own)}); "
+            notes.append(f"its own calibration, drive train and joint range not loaded ({', '.join(own)}); "
                          "--with-calibration to load them")
         note = f" ({'; '.join(notes)})" if notes else ""
         print(f"loaded {len(values)} item(s) from {args.file} into servo {args.id}{note}")

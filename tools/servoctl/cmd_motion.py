@@ -4,6 +4,7 @@ import sys
 
 from . import args as args_
 from . import checks, frame, outcome
+from .drive_guard import check_horn_free
 from .errors import Refused
 from .servo import Servo
 
@@ -30,6 +31,9 @@ def cmd_move(bus, args):
 
 def cmd_wheel(bus, args):
     s = Servo(bus, args.id)
+    if args.action != "stop":  # a wheel turns through any angle limits
+        check_horn_free(s, f"wheel {args.action}", args.past_limits, "turns the horn through them (a wheel keeps to none)",
+                        "If the horn is free, give --past-limits (servoctl ui: tick 'horn free')")
     s.wheel(args.action, args.speed, args.value, args.cw)
     outcome.taken(s, f"wheel {args.action}")
     return 0
@@ -51,6 +55,12 @@ def cmd_stop(bus, args):
 
 def cmd_origin(bus, args):
     s = Servo(bus, args.id)
+    if not args.reset_turns:  # the limits' numbers would name other horn positions
+        check_horn_free(s, "origin", args.past_limits,
+                        "makes here angle 0 until power-up, and the limits' numbers would then name other horn "
+                        "positions (the joint's range moved by the angle here)",
+                        f"'servoctl calibrate {s.id} --past-limits' moves the stored zero and the limits together; "
+                        "--past-limits makes the origin anyway")
     if args.reset_turns:
         s.reset_multi_turn()
     else:

@@ -20,13 +20,14 @@ def narrowed_limits(servo):
     return None
 
 
-def check_horn_free(servo, command: str, past_limits: bool) -> None:
+def check_horn_free(servo, command: str, past_limits: bool,
+                    what: str = "turns the horn past them, open loop (docs/bring-up.md)",
+                    fix: str = "Free the horn, then give --past-limits (servoctl ui: tick 'horn free')") -> None:
     """UsageError (nothing moved) where the limits say the horn is in a joint."""
     limits = None if past_limits else narrowed_limits(servo)
     if limits is not None:
         low, high = limits
         raise UsageError(
             f"servo {servo.id}: its angle limits are on at {low / 10:.1f}..{high / 10:.1f} deg, narrower than "
-            f"the factory's: a joint's range. {command} turns the horn past them, open loop (docs/bring-up.md). "
-            f"Free the horn, then give --past-limits (or turn the limits off: 'servoctl config set {servo.id} "
-            f"angle_limit_on 0'); nothing was moved")
+            f"the factory's: a joint's range. {command} {what}. {fix} (or turn the limits off: 'servoctl "
+            f"config set {servo.id} angle_limit_on 0'); nothing was done")

@@ -186,17 +186,21 @@ def test_another_servos_calibration_is_not_loaded_unless_asked(tmp_path, capsys)
     """Servo 2's file into servo 1 carried servo 2's zero, amplifier offset
     and direction: servo 1 then read 8 deg off (its limits moved with it),
     and a negated gear ratio from leads swapped on servo 2 would run servo
-    1's loop the wrong way round. They stay servo 1's unless asked."""
+    1's loop the wrong way round; and servo 2's joint range (narrowed
+    limits, in servo 2's zero). They stay servo 1's unless asked."""
     with Simulator(fast=True, ids=[1, 2], state_dir=str(tmp_path / "state")) as sim:
-        for name, text in {"encoder_zero": "91", "gear_ratio": "-345", "stall_power": "2.5W"}.items():
+        for name, text in {"encoder_zero": "91", "gear_ratio": "-345", "stall_power": "2.5W",
+                           "angle_max": "20", "angle_min": "-20"}.items():
             assert run(sim, capsys, "config", "set", "2", name, text)[0] == 0
         f = tmp_path / "two.json"
         assert run(sim, capsys, "config", "save", "2", str(f))[0] == 0
         rc, out, _ = run(sim, capsys, "config", "load", "1", str(f))
-        assert rc == 0 and "its own calibration and drive train not loaded" in out and "encoder_zero" in out, out
+        assert rc == 0 and "its own calibration, drive train and joint range not loaded" in out and "encoder_zero" in out, out
         assert run(sim, capsys, "config", "get", "1", "encoder_zero")[1].startswith("encoder_zero = 0 ")
         assert run(sim, capsys, "config", "get", "1", "gear_ratio")[1] == "gear_ratio = 345\n"
         assert run(sim, capsys, "config", "get", "1", "stall_power")[1].startswith("stall_power = 2500")
+        # servo 2's joint range, in servo 2's zero, is not servo 1's either
+        assert "angle_max" in out and run(sim, capsys, "config", "get", "1", "angle_max")[1] == "angle_max = 135.0 deg\n"
         rc, out, _ = run(sim, capsys, "config", "load", "1", str(f), "--with-calibration")
         assert rc == 0 and "not loaded" not in out, out
         assert run(sim, capsys, "config", "get", "1", "gear_ratio")[1] == "gear_ratio = -345\n"

@@ -47,11 +47,13 @@
   UI.on("picked", showWatchdog);
 
   document.addEventListener("DOMContentLoaded", () => {
+    const free = () => ($("#br-free").checked ? ["--past-limits"] : []);
     $("#br-cal").addEventListener("click", () =>
-      step(["calibrate", picked()].concat($("#br-keep").checked ? ["--keep-zero"] : [])));
-    $("#br-id").addEventListener("click", () => step(["identify", picked()]));
+      step(["calibrate", picked()].concat($("#br-keep").checked ? ["--keep-zero"] : [], free())));
+    $("#br-id").addEventListener("click", () => step(["identify", picked()].concat(free())));
     $("#br-tune").addEventListener("click", () =>
-      step(["tune", picked(), "--bandwidth", $("#br-bw").value].concat($("#br-dry").checked ? ["--dry-run"] : [])));
+      step(["tune", picked(), "--bandwidth", $("#br-bw").value].concat($("#br-dry").checked ? ["--dry-run"] : [],
+                                                                       free())));
     $("#fl-read").addEventListener("click", () => step(["faults", picked()]));
     $("#fl-clear").addEventListener("click", () => step(["faults", picked(), "--clear"]));
     $("#wd-set").addEventListener("click", async () => {

@@ -102,11 +102,13 @@
     $("#wh-run").addEventListener("click", () => {
       const argv = ["wheel", picked(), "run", "--speed", $("#wh-speed").value];
       if ($("#wh-cw").checked) argv.push("--cw");
+      if ($("#mo-free").checked) argv.push("--past-limits");
       act(argv);
     });
     $("#wh-stop").addEventListener("click", () => act(["wheel", picked(), "stop"]));
     document.querySelectorAll("[data-stop]").forEach((b) => b.addEventListener("click",
       () => act(["stop", picked(), "--mode", b.dataset.stop])));
-    $("#origin").addEventListener("click", () => act(["origin", picked()]));
+    $("#origin").addEventListener("click", () =>
+      act(["origin", picked()].concat($("#mo-free").checked ? ["--past-limits"] : [])));
   });
 })();
