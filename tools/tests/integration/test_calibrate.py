@@ -10,6 +10,7 @@ from servoctl.servo import Servo
 from servoctl.sim import Simulator
 
 from .conftest import finish
+from .joint import narrowed_at_rest
 
 AMP_ZERO = 25
 
@@ -76,16 +77,7 @@ def test_a_joints_limits_refuse_bring_up_and_move_with_a_new_zero(tmp_path, caps
     moved 8 deg on the real horn. Now the limits move with the zero."""
     sim = start(tmp_path)
     try:
-        with sim.bus(timeout=0.2) as bus:
-            s = Servo(bus, 1)
-            s.write("soft_start_on", 0)
-            s.write("angle_max", 100)
-            s.write("angle_min", -100)
-            s.move(80, interval_ms=300)
-            sim.sleep(0.6)
-            s.stop("release")
-            sim.sleep(0.2)
-            zero_at = s.read_motion().angle_decideg  # about 80: the zero goes here
+        zero_at = narrowed_at_rest(sim, 1, 100, 80)  # about 80: the zero goes here
         horn_deg = sim.state(1)["angle"]
         for command in ("calibrate", "identify", "tune"):
             assert main(["--port", sim.url, command, "1"], clock=sim.clock_s) == 2, command

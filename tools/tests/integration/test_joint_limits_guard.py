@@ -9,18 +9,12 @@ from servoctl.cli import main
 from servoctl.servo import Servo
 from servoctl.sim import Simulator
 
+from .joint import narrowed_at_rest
+
 
 def test_origin_and_wheel_refuse_on_a_joints_limits(tmp_path, capsys):
     with Simulator(ids=[1], state_dir=str(tmp_path / "state"), fast=True) as sim:
-        with sim.bus(timeout=0.2) as bus:
-            s = Servo(bus, 1)
-            s.write("soft_start_on", 0)
-            s.write("angle_max", 200)
-            s.write("angle_min", -200)
-            s.move(200, interval_ms=500)
-            sim.sleep(0.8)
-            s.stop("release")
-            sim.sleep(0.2)
+        narrowed_at_rest(sim, 1, 200, 200)
         horn = sim.state(1)["angle"]
         for argv, words in ((["origin", "1"], "'servoctl calibrate 1 --past-limits' moves the stored zero"),
                             (["wheel", "1", "run", "--speed", "50"], "If the horn is free, give --past-limits")):
