@@ -31,6 +31,7 @@ Time is the bus's clock (the simulator's on servo_sim)."""
 import logging
 import math
 
+from . import arm_calibrate
 from . import protocol as p
 from . import registers
 from .fault_code import phrase
@@ -246,43 +247,17 @@ class Arm:
 
     # ---- calibration (this firmware: stored on the servos) -------------
     def set_zero_here(self) -> dict:
-        """Each joint released, its encoder count now stored as its zero
-        (item 90) and taken as the origin (SetOriginPoint): it reads 0 deg
-        here from now on, after a power-up too; its angle limits off until
-        store_ranges() stores the range. {name: the count}."""
-        counts = {}
-        for name, servo_id in self.joints.items():
-            s = Servo(self.bus, servo_id)
-            s.stop("release")
-            # The stored limits are the old zero's angles: off until store_ranges puts
-            # the new ones (a calibration cut short then reads as none, not as shifted).
-            s.write("angle_limit_on", 0)
-            counts[name] = s.read("encoder_count")
-            s.write("encoder_zero", counts[name])
-            s.set_origin()
-        return counts
+        """Each joint's zero here, its range kept (arm_calibrate.set_zero_here)."""
+        return arm_calibrate.set_zero_here(self)
 
     def store_ranges(self, ranges: dict) -> None:
         """{name: (lowest, highest) deg} stored as each servo's angle limits
-        (items 52, 51, switched on by 48), which every move and setpoint
-        keeps to, the servo's own."""
-        for name, (low, high) in ranges.items():
-            s = Servo(self.bus, self.joints[name])
-            lo, hi = round(low * 10), round(high * 10)
-            if hi - lo < 10:
-                raise UsageError(f"{name} moved {abs(hi - lo) / 10:.1f} deg: move each joint through its range")
-            s.write("angle_limit_on", 0)
-            s.write("angle_min", lo)
-            s.write("angle_max", hi)
-            s.write("angle_limit_on", 1)
+        (arm_calibrate.store_ranges)."""
+        arm_calibrate.store_ranges(self, ranges)
         self.limits = read_limits(self.bus, self.ids)
 
     def ranges_stored(self) -> bool:
-        """Whether every joint's servo keeps its angle limits on, and not
-        the factory's (on, +-135 deg: a new servo's, no calibration's)."""
-        factory = (registers.find("angle_min").default, registers.find("angle_max").default)
-        return all(lim.angle_min is not None and (lim.angle_min, lim.angle_max) != factory
-                   for lim in self.limits.values())
+        return arm_calibrate.ranges_stored(self.limits)
 
     # ---- a frame -----------------------------------------------------
     def positions(self) -> dict:

@@ -25,12 +25,11 @@ current, and its current protections are blind).
 Time is the servo's (or the simulator's) clock: sleep(s)."""
 from dataclasses import dataclass
 
-from .drive_guard import narrowed_limits
+from .drive_guard import move_limits, narrowed_limits, write_limits
 from .errors import ServoError
 from .identify import come_to_rest
 from .putback import PutBack
 
-ANGLE_MOST = 1800  # the limits' range, 0.1 deg (items 51, 52)
 
 PUSH_DUTY = 0.25
 PUSH_MS = 150
@@ -125,28 +124,6 @@ def zero(servo, sleep, start_decideg: int, kept: PutBack) -> int:
     return count
 
 
-def move_limits(start_decideg: int, limits: tuple) -> tuple:
-    """A joint's angle limits (min, max) where the new zero reads them: the
-    horn at start reads 0 now, so each is start less; beyond the items'
-    range, ServoError (before the zero is written). Written in the order
-    that keeps min below max at each write."""
-    low, high = (v - start_decideg for v in limits)
-    if low < -ANGLE_MOST or high > ANGLE_MOST:
-        raise ServoError(f"the angle limits {limits[0] / 10:.1f}..{limits[1] / 10:.1f} deg would be "
-                         f"{low / 10:.1f}..{high / 10:.1f} from a zero here, beyond +-180: move the horn "
-                         "nearer the middle of its range, or calibrate with --keep-zero")
-    return low, high
-
-
-def write_limits(limits: tuple, kept: PutBack) -> None:
-    """Lowered, min first; raised, max first: min stays below max (the
-    servo refuses a write that would cross them)."""
-    low, high = limits
-    order = [("angle_min", low), ("angle_max", high)]
-    for name, value in order if low < kept.servo.read("angle_min") else order[::-1]:
-        kept.write(name, value)
-
-
 def calibrate(servo, sleep, keep_zero: bool = False) -> Calibration:
     if servo.read("voltage") < 500:
         raise ServoError("the supply reads below 0.5 V: calibrate needs the motor powered")
@@ -159,7 +136,7 @@ def calibrate(servo, sleep, keep_zero: bool = False) -> Calibration:
         reversed_, ratio, moved = direction(servo, sleep, kept)
         count = None if keep_zero else zero(servo, sleep, start, kept)
         if moved_to is not None:
-            write_limits(moved_to, kept)
+            write_limits(moved_to, kept.servo.read("angle_min"), kept.write)
     return Calibration(amp, reversed_, ratio, count, moved, None if joint is None else (joint, moved_to))
 
 
