@@ -89,7 +89,8 @@ class ServoBusHardware {
                              "sb_ros2_cycle: servo %u is at %.1f deg, outside its angle limits %.1f..%.1f deg "
                              "(angle_min, angle_max, angle_limit_on): a setpoint there would be clamped into "
                              "them, a jump at full speed. Move it within them first (servoctl move %u %.1f "
-                             "--velocity 45), or change the limits\n",
+                             "--velocity 45 --multi-turn: from where it reads, a turn and more), or change the "
+                             "limits\n",
                              ids_[k], at / 10.0, low_[k] / 10.0, high_[k] / 10.0, ids_[k],
                              (at < low_[k] ? low_[k] : high_[k]) / 10.0);
                 return false;

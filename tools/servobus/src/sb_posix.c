@@ -279,6 +279,19 @@ static ssize_t spin(sb_posix *p, uint8_t *buf, size_t cap, uint32_t *wait_us)
     return 0;
 }
 
+/* What servo_sim and the virtual boards send a second client on their bus
+ * (and then nothing): "<who>: the bus is in use by another client". */
+#define BUS_IN_USE "the bus is in use by another client"
+
+static bool holds(const uint8_t *buf, size_t n, const char *text)
+{
+    size_t len = strlen(text);
+    for (size_t k = 0; k + len <= n; k++)
+        if (memcmp(buf + k, text, len) == 0)
+            return true;
+    return false;
+}
+
 static int posix_read(void *ctx, uint8_t *buf, size_t cap, size_t want, uint32_t wait_us)
 {
     sb_posix *p = (sb_posix *)ctx;
@@ -304,6 +317,8 @@ static int posix_read(void *ctx, uint8_t *buf, size_t cap, size_t want, uint32_t
     }
     n = read_now(p, buf, cap);
 got:
+    if (n > 0 && p->is_socket && holds(buf, (size_t)n, BUS_IN_USE))
+        return -EBUSY; /* the simulator's bus is another client's: nothing sent reached it */
     if (!none_yet(n))
         return n < 0 ? -errno : (int)n;
     if (n == 0 && p->is_socket)

@@ -1,5 +1,6 @@
 /* Errors in words: the servo, the packet, the field, what went wrong and
  * the value and range it carries. */
+#include <errno.h>
 #include <string.h>
 
 #include "servobus/servobus.h"
@@ -176,6 +177,10 @@ size_t sb_error_text(const sb_error *e, char *buf, size_t cap)
         put(&t, strerror(e->os_error));
 #endif
         put(&t, ")");
+#ifdef EBUSY
+        if (e->os_error == EBUSY)
+            put(&t, ": another program holds the bus (a simulator's other client): close it, then try again");
+#endif
     } else if (e->status == SB_E_UNKNOWN_ITEM) {
         put_item(&t, e);
     } else if (e->status == SB_E_SPACE && e->value > 0) {

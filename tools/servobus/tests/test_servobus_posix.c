@@ -9,8 +9,12 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <arpa/inet.h>
+#include <errno.h>
 #include <fcntl.h>
+#include <netinet/in.h>
 #include <pty.h>
+#include <sys/socket.h>
 #include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -226,6 +230,40 @@ static void a_port_whose_other_end_hung_up_fails(void **state)
     assert_true(t->read(t->ctx, buf, sizeof buf, 1, 1000000) < 0); /* a wait sees it; a drain's look need not */
 }
 
+/* A simulator whose bus another client holds says so to a second one,
+ * and sends nothing more: servobus said "no answer in time (is it on
+ * the bus ...)" and a send returned SB_OK though nothing reached the bus. */
+static void a_bus_another_client_holds_is_said_so(void **state)
+{
+    int listener = socket(AF_INET, SOCK_STREAM, 0);
+    struct sockaddr_in at = {0};
+    socklen_t len = sizeof at;
+    at.sin_family = AF_INET;
+    at.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    assert_int_equal(bind(listener, (struct sockaddr *)&at, sizeof at), 0);
+    assert_int_equal(listen(listener, 1), 0);
+    assert_int_equal(getsockname(listener, (struct sockaddr *)&at, &len), 0);
+    sb_posix link;
+    assert_int_equal(sb_tcp_open(&link, "127.0.0.1", ntohs(at.sin_port)), 0);
+    int server = accept(listener, NULL, NULL);
+    const char said[] = "servo_sim: the bus is in use by another client\n";
+    assert_int_equal(write(server, said, sizeof said - 1), (ssize_t)(sizeof said - 1));
+    sb_bus bus;
+    sb_bus_init(&bus, sb_posix_transport(&link), 115200);
+    sb_ping_request r = {1};
+    sb_ping_answer a;
+    usleep(20000); /* the message is there before the request */
+    sb_error e = sb_call_ping(&bus, &r, &a);
+    assert_int_equal(e.status, SB_E_LINK);
+    assert_int_equal(e.os_error, EBUSY);
+    char text[200];
+    sb_error_text(&e, text, sizeof text);
+    assert_non_null(strstr(text, "another program holds the bus"));
+    close(server);
+    close(listener);
+    sb_posix_close(&link);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -235,6 +273,7 @@ int main(void)
         cmocka_unit_test(a_rate_termios_has_not_is_refused),
         cmocka_unit_test(a_port_another_program_holds_is_refused),
         cmocka_unit_test(a_write_the_link_never_takes_fails),
+        cmocka_unit_test(a_bus_another_client_holds_is_said_so),
         cmocka_unit_test_setup_teardown(a_wait_spins_then_sleeps_and_reads_what_comes, open_fixture_port,
                                         close_fixture_port),
         cmocka_unit_test_setup_teardown(a_port_whose_other_end_hung_up_fails, open_fixture_port, close_fixture_port),
