@@ -27,7 +27,7 @@ from dataclasses import dataclass
 
 from .drive_guard import move_limits, narrowed_limits, write_limits
 from .errors import ServoError
-from .identify import come_to_rest
+from .identify import come_to_rest, return_to
 from .putback import PutBack
 
 
@@ -35,8 +35,6 @@ PUSH_DUTY = 0.25
 PUSH_MS = 150
 CURRENT_SETTLE_S = 0.06   # the current's filter: 8 ms time constant
 ADC_MOST = 4095
-RETURN_MS = 600
-RETURN_TIMEOUT_S = 8.0
 STORE_SETTLE_S = 0.3
 
 
@@ -105,17 +103,7 @@ def direction(servo, sleep, kept: PutBack) -> tuple:
 def zero(servo, sleep, start_decideg: int, kept: PutBack) -> int:
     """The horn back at start_decideg, released, and its encoder count
     there stored as the zero (item 90), and taken as the origin now."""
-    servo.move(start_decideg, interval_ms=RETURN_MS)
-    waited = 0.0
-    while True:  # a soft start (item 49) may make it the 3 s of item 50
-        sleep(0.05)
-        waited += 0.05
-        snap = servo.read_motion()
-        if abs(snap.angle_decideg - start_decideg) <= 3 and abs(snap.velocity_decideg_s) < 20:
-            break
-        if waited > RETURN_TIMEOUT_S:
-            raise ServoError(f"the horn did not come back to {start_decideg / 10:.1f} deg within "
-                             f"{RETURN_TIMEOUT_S:g} s (it is at {snap.angle_decideg / 10:.1f})")
+    return_to(servo, sleep, start_decideg)
     servo.stop("release")
     sleep(0.05)
     count = servo.read("encoder_count")

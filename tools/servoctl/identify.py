@@ -38,6 +38,8 @@ DEFAULT_STEP_MS = 700   # the least; longer where the rise is slower (step_lengt
 REST_POLL_S = 0.05    # how often come_to_rest looks at the horn
 REVERSALS_EACH_WAY = 2
 REVERSAL_HALF_MAX_MS = 9500  # DriveDuty takes 10 s at most
+BACK_MS = 600              # the closed-loop move back to where identify (or calibrate) began
+BACK_TIMEOUT_S = 8.0
 CHIRP_HZ = (0.5, 8.0)
 CHIRP_S = 4.0
 CHIRP_HOLD_MS = 40        # each DriveDuty of the chirp: released soon should the host stop
@@ -140,6 +142,7 @@ def identify(servo, sleep, duties=DEFAULT_DUTIES, step_ms: int = 0, progress=Non
     supply_v = servo.read("voltage") / 1000.0
     if supply_v <= 0.5:
         raise ServoError(f"the supply reads {supply_v:.2f} V: identify needs the motor powered")
+    start = servo.read_motion().angle_decideg
     if step_ms == 0:
         step_ms = step_length_ms(servo, duties[0], sleep)
         servo.drive_duty(-duties[0], DEFAULT_STEP_MS)  # back to about where it began
@@ -166,6 +169,36 @@ def identify(servo, sleep, duties=DEFAULT_DUTIES, step_ms: int = 0, progress=Non
         spread = float(np.std(plays, ddof=1) / math.sqrt(len(plays))) if len(plays) > 1 else math.radians(0.1)
         drive.backlash = Estimate(float(np.mean(plays)), spread)
     drive.chirp = chirp_error(drive, record_chirp(servo, duties[-1] * 2.0 / 3.0, sleep))
+    back_to(servo, sleep, start)
     if progress is not None:
         progress(total, total)
     return drive
+
+
+def back_to(servo, sleep, start_decideg: int) -> None:
+    """The horn closed loop back where identify found it (it ended up to
+    a quarter turn away, outside the limits it had started within), then
+    released."""
+    come_to_rest(servo, sleep)
+    # Near it is enough: a drive train that is not yet tuned may hold a few degrees off.
+    return_to(servo, sleep, start_decideg, within_decideg=50, insist=False)
+    servo.stop("release")
+
+
+def return_to(servo, sleep, start_decideg: int, within_decideg: int = 3, insist: bool = True) -> None:
+    """A closed-loop move to start_decideg, waited for: within it and still
+    (a soft start, item 49, may stretch it to item 50's 3 s); not there in
+    BACK_TIMEOUT_S, ServoError if insist."""
+    servo.move(start_decideg, interval_ms=BACK_MS)
+    waited = 0.0
+    while True:
+        sleep(0.05)
+        waited += 0.05
+        snap = servo.read_motion()
+        if abs(snap.angle_decideg - start_decideg) <= within_decideg and abs(snap.velocity_decideg_s) < 20:
+            return
+        if waited > BACK_TIMEOUT_S:
+            if not insist:
+                return
+            raise ServoError(f"the horn did not come back to {start_decideg / 10:.1f} deg within "
+                             f"{BACK_TIMEOUT_S:g} s (it is at {snap.angle_decideg / 10:.1f})")

@@ -85,7 +85,10 @@ def test_identify_finds_the_plant_files_drive_train(tmp_path, file):
     sim = start(tmp_path, file)
     try:
         with sim.bus(timeout=0.2) as bus:
+            start_deg = Servo(bus, 1).read_motion().angle_decideg / 10
             drive = identify(Servo(bus, 1), sim.sleep)
+            # Back where it began: it ended up to a quarter turn away, outside the limits it began within.
+            assert abs(Servo(bus, 1).read_motion().angle_decideg / 10 - start_deg) <= 5.0
         errors = relative_errors(drive, truth)
         print(file, {k: f"{100 * e:+.3f} %" for k, e in errors.items()})
         assert all(abs(e) <= 0.15 for e in errors.values()), errors
