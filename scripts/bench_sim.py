@@ -11,11 +11,13 @@ from servoctl.sim import Simulator
 
 
 @contextlib.contextmanager
-def at_baud(ids, baud, host_link=None, nice=None):
+def at_baud(ids, baud, host_link=None, nice=None, paced=False):
     """Simulated servos at baud, soft start off; stopped whatever happens.
-    nice: the simulator's niceness (below 0 needs root; else as started)."""
+    nice: the simulator's niceness (below 0 needs root; else as started);
+    paced: its clock moves only while the host waits (servo_sim --clock
+    paced), so the host's own time and the PC's load are not in the figure."""
     with Simulator(ids=ids, state_dir=tempfile.mkdtemp(prefix="stream-bench-"), host_link=host_link,
-                   nice=nice) as sim:
+                   nice=nice, paced=paced) as sim:
         set_up(sim, ids, baud)
         yield sim
 

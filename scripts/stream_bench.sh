@@ -4,8 +4,8 @@
 #  1. one servo on the plant model (tests/unit/test_stream.c): a 0.5 Hz
 #     +-60 deg sine sent at 50 Hz, streamed and as 20 ms angle moves: the RMS
 #     error to the sine and the setpoint's peak acceleration;
-#  2. the same path on 6 simulated servos (servo_sim) at 1 Mbaud, through
-#     servoctl: the RMS error of each servo's Sync Monitor state;
+#  2. the same path on 6 simulated servos (servo_sim, paced) at 1 Mbaud,
+#     through servoctl: the RMS error of each servo's Sync Monitor state;
 #  3. the robot loop (one SyncCommand of setpoints and one Sync Monitor a
 #     cycle, servoctl.stream.RobotLoop) for 6 and 16 servos at 1 000 000 and
 #     115 200 baud: its rate against the wire limit, the host behind the
@@ -59,7 +59,7 @@ ids = list(range(1, 7))
 times = [k * PERIOD for k in range(int(SECONDS / PERIOD) + 1)]
 print("2. 6 servos at 1 Mbaud, the same path through servoctl (Sync Monitor each period):")
 for streamed in (True, False):
-    with at_baud(ids, 1000000) as sim, sim.bus(baud=1000000, timeout=0.1) as bus:
+    with at_baud(ids, 1000000, paced=True) as sim, sim.bus(baud=1000000, timeout=0.1) as bus:
         sync_move(bus, {i: path(0) for i in ids}, 0.5, multi_turn=True)
         bus.sleep(0.7)
         if streamed:

@@ -12,6 +12,7 @@ them is refused, never clamped: a clamped path is not the host's, and the
 servo, without the next setpoint, brakes to a hold where the last one
 was (docs/streaming.md). A file is checked whole before anything moves."""
 import math
+import sys
 import struct
 import time
 from dataclasses import dataclass
@@ -205,14 +206,19 @@ def _stream_rows(bus, times, angles, loop, progress, host) -> StreamReport:
     return StreamReport(period, count, rms, peak, loop.rate(), loop.missed, speed, paced)
 
 
-def host_timing(args):
-    """The --host-jitter-ms / --host-late-every model, or None."""
+def host_timing(args, bus=None):
+    """The --host-jitter-ms / --host-late-every model, or None; on a bus
+    whose clock is not a paced simulator's, said to add to the PC's own."""
     from .host_timing import HostTiming
 
     try:
         host = HostTiming(args.host_jitter_ms / 1000.0, args.host_late_every)
     except ValueError as e:
         raise UsageError(f"--host-jitter-ms, --host-late-every: {e}") from None
+    if host and bus is not None and getattr(bus, "note_sent", None) is None:
+        print("servoctl: the host-timing model's jitter adds to this PC's own timing here (a simulator in "
+              "real time, or a servo): a paced simulator (servo_sim --clock paced) shows the model alone",
+              file=sys.stderr)
     return host or None
 
 
@@ -239,7 +245,7 @@ def cmd_stream(bus, args):
         task = progress.add_task("streaming", total=len(trajectory.times))
         report = stream_file(bus, trajectory.times, angles,
                              lambda done, total: progress.update(task, completed=done), limits,
-                             host_timing(args))
+                             host_timing(args, bus))
     period = report.period_s
     stretched = ""
     if lead.soft_start_s and lead.took_s > args.lead_in + 0.1:
