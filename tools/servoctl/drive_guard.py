@@ -5,7 +5,7 @@ joint's range, which the command would turn it past (identify went to
 111 deg on a servo limited to +-10). It refuses unless told the horn is
 free (--past-limits); the factory's limits, on a servo just unpacked, are
 no such sign."""
-from .errors import ServoError, UsageError
+from .errors import NoReply, ServoError, UsageError
 from .registers import BY_NAME
 
 ANGLE_MOST = 1800  # the limits' range, 0.1 deg (items 51, 52)
@@ -26,7 +26,10 @@ def check_horn_free(servo, command: str, past_limits: bool,
                     what: str = "turns the horn past them, open loop (docs/bring-up.md)",
                     fix: str = "Free the horn, then give --past-limits (servoctl ui: tick 'horn free')") -> None:
     """UsageError (nothing moved) where the limits say the horn is in a joint."""
-    limits = None if past_limits else narrowed_limits(servo)
+    try:
+        limits = None if past_limits else narrowed_limits(servo)
+    except NoReply:  # as the command itself would say it (outcome.taken)
+        raise NoReply(f"servo {servo.id} did not answer: is it on the bus, at this baud rate?") from None
     if limits is not None:
         low, high = limits
         raise UsageError(

@@ -41,16 +41,21 @@ def test_a_joint_beyond_one_turn_is_refused_when_held_not_spun_back(firmware):
 
 def test_a_calibration_cut_short_leaves_no_limits_of_the_old_zero():
     """A new zero with the range not stored after it (ENTER with nothing
-    moved, Ctrl-C) kept the old limits on, counted as calibrated: 25 deg
-    off, in the new zero's frame."""
+    moved, Ctrl-C) kept the old limits' numbers on, counted as calibrated:
+    25 deg off, in the new zero's frame. Then it turned them off, and the
+    joint's range was gone. Now they move with the zero: the same horn
+    positions, on."""
     with Simulator(ids=[1], fast=True) as sim:
         bus = sim.bus()
         arm = Arm(bus, {"a": 1}, firmware="servoctl", watchdog_ms=0).open()
         arm.store_ranges({"a": (-30, 30)})
         Servo(bus, 1).move_to(25, duration_s=0.3, wait=True)
+        here = Servo(bus, 1).read_motion().angle_decideg
         arm.set_zero_here()
         with pytest.raises(UsageError, match="moved 0.5 deg"):
             arm.store_ranges({"a": (0.0, 0.5)})
-        assert not Arm(bus, {"a": 1}, firmware="servoctl", watchdog_ms=0).open().ranges_stored()
+        s = Servo(bus, 1)
+        assert (s.read("angle_min"), s.read("angle_max")) == (-300 - here, 300 - here)  # not -300..300
+        assert Arm(bus, {"a": 1}, firmware="servoctl", watchdog_ms=0).open().ranges_stored()
         arm.store_ranges({"a": (-20, 20)})
         assert arm.ranges_stored() and Servo(bus, 1).read("angle_max") == 200
