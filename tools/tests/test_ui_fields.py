@@ -3,7 +3,7 @@ is malformed, never taken for another value. "false" ran a scan of every
 baud rate; a mode of [1] or {"x": 1} meant release without a word."""
 import pytest
 
-from servoctl.ui.fields import Malformed, flag, mode
+from servoctl.ui.fields import Malformed, flag, mode, servo_id
 
 
 def test_a_flag_is_true_or_false_only():
@@ -18,3 +18,12 @@ def test_a_stop_mode_is_release_or_damping_only():
     for wrong in ([1], {"x": 1}, "hold", "", 1, True):
         with pytest.raises(Malformed, match="mode must be 'release' or 'damping'"):
             mode(wrong)
+
+
+def test_a_servo_id_out_of_range_is_malformed_here():
+    """{"op": "items", "id": 1000, "tag": 0} was refused on the bus thread,
+    whose answer had lost the tag: the page could not show it by the request."""
+    assert servo_id(0, "id") == 0 and servo_id("254", "id") == 254
+    for wrong in (255, 1000, -1):
+        with pytest.raises(Malformed, match="a servo ID is 0..254"):
+            servo_id(wrong, "id")

@@ -160,3 +160,15 @@ def test_a_file_written_into_a_folder_that_is_not_there_is_refused(tmp_path):
     with pytest.raises(UsageError, match="not a folder"):
         Folder(tmp_path / "plain")
     assert _confined(folder, "config", "load", "1", "none/c.json").file == str(tmp_path / "none" / "c.json")
+
+
+def test_a_write_to_a_folders_name_is_refused_before_the_command_runs(tmp_path):
+    """backup into "sub/" (a folder there) said "saved 1 servo(s)", then
+    failed copying out; config save "" and "." ran before being refused."""
+    (tmp_path / "sub").mkdir()
+    for argv in (["backup", "sub/"], ["config", "save", "1", "."], ["config", "save", "1", ""]):
+        args = build_parser().parse_args(["--port", "loop://", *argv])
+        if args.command == "config":
+            args_.config_operands(args)
+        with pytest.raises(UsageError, match="a folder, not a file to write"):
+            Folder(tmp_path).confine(args)

@@ -50,6 +50,15 @@ def whole(value, name: str) -> int:
     return int(value)  # "x" raises ValueError, said as malformed
 
 
+def servo_id(value, name: str) -> int:
+    """A servo's ID, 0..254 (255 is every servo's, which answers nothing):
+    refused here, where the tab's tag is still known, not on the bus thread."""
+    n = whole(value, name)
+    if not 0 <= n <= 254:
+        raise Malformed(f"{name}: a servo ID is 0..254, not {n}")
+    return n
+
+
 def number(value, name: str) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float, str)):
         raise Malformed(f"{name} must be a number, not {value!r:.40}")

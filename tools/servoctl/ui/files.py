@@ -119,6 +119,8 @@ class Staging:
         copy = os.path.join(self.dir, os.path.relpath(real, self.folder.root))
         os.makedirs(os.path.dirname(copy), exist_ok=True)
         if writes:
+            if real == str(self.folder.root) or os.path.isdir(real):  # refused now: it said "saved" first
+                self.folder._refuse(name, "a folder, not a file to write")
             self._folder_of(name, real)
             self.writes.append((name, real, copy))
             return copy

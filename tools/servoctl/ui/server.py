@@ -64,7 +64,11 @@ class Page:
             return "refused: the address lacks this session's token (see servoctl ui's first line)"
         if self.hosts is not None:
             # Both the request line's host (an absolute-form request) and the Host header.
-            for host in (request.url.host, _header_host(request)):
+            try:
+                line_host = request.url.host
+            except ValueError:  # "Host: 127.0.0.1:abc": yarl cannot make a URL of it (was a 500)
+                return "refused: a Host header that names no host and port"
+            for host in (line_host, _header_host(request)):
                 host = (host or "").strip("[]")
                 if host not in self.hosts:
                     return f"refused: a request for host {host!r:.80}, not this computer's (DNS rebinding?)"
@@ -247,17 +251,17 @@ class Page:
         elif op == "scan":
             w.submit(w.scan, fields.flag(ask.get("all_bauds", False), "all_bauds"), tag)
         elif op == "items":
-            w.submit(w.items, fields.whole(ask["id"], "id"), tag)
+            w.submit(w.items, fields.servo_id(ask["id"], "id"), tag)
         elif op == "angle":
-            w.submit(w.angle, fields.whole(ask["id"], "id"), tag)
+            w.submit(w.angle, fields.servo_id(ask["id"], "id"), tag)
         elif op == "jog":
-            w.submit(w.jog, fields.whole(ask["id"], "id"), fields.number(ask["angle"], "angle"),
+            w.submit(w.jog, fields.servo_id(ask["id"], "id"), fields.number(ask["angle"], "angle"),
                      fields.whole(ask.get("stops", 0), "stops"), tag)
         elif op == "plot":
             ids = ask.get("ids", [])
             if not isinstance(ids, list):
                 raise Malformed(f"ids must be a list, not {ids!r:.40}")
-            w.submit(w.plot, [fields.whole(i, "ids") for i in ids], tag)
+            w.submit(w.plot, [fields.servo_id(i, "ids") for i in ids], tag)
         elif op == "table":
             w.submit(w.table)
         else:

@@ -108,6 +108,10 @@ def test_every_response_forbids_framing():
                 headers = e.headers
             assert headers["X-Frame-Options"] == "DENY", url
             assert "frame-ancestors 'none'" in headers["Content-Security-Policy"], url
+        # A Host that is no host and port was a 500 (yarl's ValueError): refused as any other.
+        port = ui.base.rsplit(":", 1)[1]
+        assert _status(ui.url, host="127.0.0.1:abc") == 403
+        assert _status(ui.url, host=f"127.0.0.1:{port}, evil.example") == 403
 
 
 def test_the_origin_is_compared_with_the_address_it_listens_on():
