@@ -165,7 +165,7 @@ def write_image(bus, servo_id: int, image: Image, st: Status, progress=lambda do
         raise NotSent(f"the image ({len(image.data)} B) is larger than the slot "
                       f"({st.page_size * st.pages} B)")
     pages = (len(image.data) + st.page_size - 1) // st.page_size
-    step = st.largest_write - st.largest_write % st.write_block
+    step = block_bytes(st, bus.serial.baudrate)
     data = image.data + b"\xff" * (-len(image.data) % st.write_block)
     total = pages + len(data)
     for page in range(pages):  # page 0 first: the old image is invalid from here
@@ -185,6 +185,21 @@ def write_image(bus, servo_id: int, image: Image, st: Status, progress=lambda do
     verdict, size, crc, version, _board = _p.decode_answer(UPDATE_VERIFY, c)[1:]
     if verdict != 0 or (size, crc, version) != (image.size, image.crc, image.version):
         raise Refused(f"servo {servo_id}: the written image does not check: {VERDICTS.get(verdict, verdict)}")
+
+
+# An UpdateWrite frame on the wire at most this long: STOP ALL waits for the
+# frame in flight (at 9600 baud 24 bytes of data took 40 ms, a stop 55 ms).
+FRAME_MS_MOST = 20
+WRITE_OVERHEAD = 14  # an UpdateWrite frame's bytes besides its data: header, ID, offset, CRC, checksum
+
+
+def block_bytes(st: Status, baud: int) -> int:
+    """The data bytes of each UpdateWrite: the most the bootloader takes,
+    in whole write blocks, and no more than FRAME_MS_MOST of wire at baud
+    (a write block at least)."""
+    most = st.largest_write - st.largest_write % st.write_block
+    room = int(FRAME_MS_MOST / 1000 * baud / 10) - WRITE_OVERHEAD
+    return max(st.write_block, min(most, room - room % st.write_block))
 
 
 def update(bus, servo_id: int, image: Image, progress=lambda done, total: None) -> tuple:
