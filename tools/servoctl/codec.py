@@ -48,7 +48,14 @@ def decode_answer(code: int, content: bytes) -> tuple:
         who = content[0] if content else "?"
         raise BadAnswer(f"servo {who}: a {_SCHEMA.packet(code).name} answer of {len(content)} bytes, "
                         f"not {struct.calcsize(fmt)} (garbled, another firmware, or two servos on one ID)")
-    return struct.unpack(fmt, content)
+    values = struct.unpack(fmt, content)
+    for f, value in zip(_SCHEMA.packet(code).answer, values):
+        if f.limits is not None and not f.limits[0] <= value <= f.limits[1]:
+            # A frame made of two answers' bytes with a good checksum by chance (a cut
+            # Monitor answer and the next servo's: angle -402 386 922), as C's decoder says.
+            raise BadAnswer(f"servo {values[0]}: a {_SCHEMA.packet(code).name} answer's {f.name} {value} is "
+                            f"beyond {f.limits[0]}..{f.limits[1]} (garbled, or two servos on one ID)")
+    return values
 
 
 def answer_frame_size(code: int) -> int:

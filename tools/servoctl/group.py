@@ -5,7 +5,7 @@ backup and restore of a whole bus. Angles in degrees, times in seconds."""
 from . import protocol as p
 from . import config_file, registers, stability
 from .frame import check_target
-from .errors import NoReply, NotSent, UsageError
+from .errors import BadAnswer, NoReply, NotSent, UsageError
 from .checks import MIN_RAMP_MS, check_profile, check_range, scaled, to_ms
 from .servo import Monitor, Servo
 
@@ -106,8 +106,12 @@ def monitor_answers(bus: p.Bus, ids: list, timeout_s: float = None, arrivals: di
             servo_id = content[0] if content else None
             if servo_id not in waiting:
                 continue  # not asked for in this round: another host's, or a stale one
+            try:
+                state = Monitor.decode(content)
+            except BadAnswer:  # a garbled frame whose checksum held by chance: no state
+                continue
             waiting.discard(servo_id)
-            out[servo_id] = Monitor.decode(content)
+            out[servo_id] = state
             if arrivals is not None:
                 arrivals[servo_id] = bus.arrived_at
     finally:

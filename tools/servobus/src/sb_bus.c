@@ -230,7 +230,8 @@ sb_error sb_sync_monitor_answers(sb_bus *bus, const uint8_t *ids, size_t count, 
     uint64_t end = later(last, (uint64_t)count * (slot + SB_SYNC_SILENCE_US));
     bool over = false; /* the end has passed: only the bytes held are searched */
     uint32_t bad = bus->rx.bad_frames;
-    size_t misshapen = count, misshapen_len = 0; /* the first listed servo whose answer was of the wrong length */
+    size_t misshapen = count; /* the first listed servo whose answer was bad (its length, a field's range) */
+    sb_error misshapen_e = sb_ok(); /* what was wrong with it */
     size_t held = count; /* a servo not passed whose frame of the wrong length came this turn */
     size_t floor = 0;    /* every servo before it has passed its turn: a servo after it answered in turn */
     bool jumped = false; /* the last answer taken came before a listed servo's that had not passed its turn */
@@ -272,15 +273,15 @@ sb_error sb_sync_monitor_answers(sb_bus *bus, const uint8_t *ids, size_t count, 
         }
         if (e.status == SB_OK)
             e = sb_decode_monitor(content, len, &a);
-        if (e.status == SB_E_BAD_ANSWER) { /* its checksum good, its length not: skipped */
+        if (e.status == SB_E_BAD_ANSWER) { /* its checksum good, its length or a field's range not: skipped */
+            sb_error bad_e = e;
             k = e.servo >= 0 ? slot_of(ids, count, (uint8_t)e.servo) : count;
-            len = len > 0 ? len : (size_t)e.value; /* longer than any answer: receive's length */
             e = sb_ok();
             if (k == count || k < floor || got[k])
                 continue; /* not asked for, or its turn passed */
             if (k < misshapen) {
                 misshapen = k;
-                misshapen_len = len;
+                misshapen_e = bad_e;
             }
             if (k >= next && k < held) { /* the real answer may yet end within the slot */
                 held = k;
@@ -320,16 +321,11 @@ sb_error sb_sync_monitor_answers(sb_bus *bus, const uint8_t *ids, size_t count, 
         e = sb_ok();
         for (size_t k = 0; k < count; k++)
             if (!got[k]) { /* the first that did not answer */
-                e.status = k == misshapen               ? SB_E_BAD_ANSWER
-                           : bus->rx.bad_frames != bad ? SB_E_BAD_CHECKSUM
-                                                       : SB_E_NO_ANSWER;
+                e.status = bus->rx.bad_frames != bad ? SB_E_BAD_CHECKSUM : SB_E_NO_ANSWER;
                 e.servo = ids[k];
                 e.packet = SB_PKT_MONITOR;
-                if (k == misshapen) { /* "length: 2 bytes, not 16" */
-                    e.field = "length";
-                    e.value = (int64_t)misshapen_len;
-                    e.least = e.most = (int64_t)answer - 5;
-                }
+                if (k == misshapen) /* what the decoder said: "length: 2 bytes, not 16", a field's range */
+                    e = misshapen_e;
                 break;
             }
     }

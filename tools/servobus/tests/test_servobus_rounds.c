@@ -229,6 +229,32 @@ static void a_frame_across_two_answers_is_not_taken_for_either(void **state)
     assert_int_equal(states[1].angle, 450);
 }
 
+/* Servo 1's answer cut after 12 bytes (a collision, a brown-out), servo
+ * 4's answer whole after it: the frame begun at servo 1's header and
+ * ended inside servo 4's has a good checksum by chance (servo 4's 40 mA),
+ * and was taken as servo 1's state (angle -402 386 922, 10 268 turns),
+ * servo 4's dropped. A Monitor answer's angle and turns have the
+ * multi-turn range: it is a bad answer, and servo 4's is taken. */
+static void a_cut_answer_read_into_the_next_is_a_bad_answer(void **state)
+{
+    static const uint8_t wire[] = {
+        0x05, 0x1c, 0x16, 0x10, 0x01, 0xe8, 0x1c, 0x78, 0x00, 0xf4, 0x01, 0xd0, 0x05, 0x1c, 0x16,
+        0x10, 0x04, 0xe8, 0x1c, 0x28, 0x00, 0xf4, 0x01, 0xd0, 0x07, 0x00, 0xd4, 0xfe, 0xff, 0xff,
+        0x00, 0x00, 0x13,
+    };
+    script w = {wire, sizeof wire, 0, false, 1000};
+    sb_bus sbus;
+    sb_bus_init(&sbus, sb_transport_make(&w, script_write, script_read, script_now), 1000000);
+    const uint8_t ids[2] = {1, 4};
+    sb_error e = sb_sync_monitor(&sbus, ids, 2, states, got);
+    assert_true(!got[0] && got[1]);
+    assert_int_equal(states[1].current, 40);
+    assert_int_equal(states[1].angle, -300);
+    assert_int_equal(e.status, SB_E_BAD_ANSWER);
+    assert_int_equal(e.servo, 1);
+    assert_string_equal(e.field, "angle");
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -239,6 +265,7 @@ int main(void)
         cmocka_unit_test_setup(an_answer_about_another_item_is_not_taken_for_this_one, set_up),
         cmocka_unit_test_setup(a_bus_clock_near_its_end_does_not_wrap_a_deadline, set_up),
         cmocka_unit_test_setup(a_frame_across_two_answers_is_not_taken_for_either, set_up),
+        cmocka_unit_test_setup(a_cut_answer_read_into_the_next_is_a_bad_answer, set_up),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
