@@ -12,6 +12,8 @@ import datetime
 import hmac
 import ipaddress
 import json
+import os
+import socket
 from pathlib import Path
 
 from aiohttp import WSMsgType, web
@@ -40,6 +42,8 @@ READ_MAX = 16 * 1024 * 1024
 WATCHER_MAX = 1024  # a watching tab's request is STOP ALL's, a few dozen bytes
 TABS_MAX = 8  # open tabs (WebSockets); one more is told so and closed
 CLOSE_S = 1.0  # host seconds: a tab's close at shutdown, then it is aborted
+ACCEPT_BATCH = 4  # connections the loop accepts a turn (asyncio's backlog argument)
+LISTEN_QUEUE = 4096  # the kernel's queue of connections not yet accepted (Linux's somaxconn)
 
 
 class Page:
@@ -330,7 +334,15 @@ async def _serve(page: Page, bind: str, port: int, ready, stop: asyncio.Event):
     runner = web.AppRunner(page.app(), access_log=None, handle_signals=False, keepalive_timeout=KEEPALIVE_S)
     await runner.setup()
     page.doorman = Doorman(runner.server)
-    server = await page.loop.create_server(page.doorman, bind or None, port)
+    # asyncio accepts up to its backlog of connections each time the loop
+    # turns: a flood without the token (connections opened as fast as a
+    # process can) held a tab's STOP ALL behind 100 accepts a turn, 20-245
+    # ms. ACCEPT_BATCH a turn; the kernel's queue stays long (LISTEN_QUEUE)
+    # so a page load is not dropped while the loop catches up.
+    server = await page.loop.create_server(page.doorman, bind or None, port, backlog=ACCEPT_BATCH)
+    for listening in server.sockets:
+        with socket.socket(fileno=os.dup(listening.fileno())) as same:
+            same.listen(LISTEN_QUEUE)
     ready(server.sockets[0].getsockname()[1])
     try:
         await stop.wait()
