@@ -92,6 +92,7 @@ class Worker:
         self.plot_ids = []  # sampled while the queue is empty
         self.sampler = None
         self.stopping = threading.Event()
+        self.before_stop = 0  # jobs queued when the latest stop was asked for
         # A tab is open (server.Page sets it as the last one closes): with
         # none, neither the live table's rounds nor the plots' samples go on
         # the bus, so a servo's bus watchdog (item 64) is fed by nobody and
@@ -131,6 +132,7 @@ class Worker:
         before anything queued."""
         with self.cond:
             self.stops += 1
+            self.before_stop = len(self.jobs)  # those stop_all answers "not run"; later ones run
             if self.current != self.stop_all:
                 self.preempt.interrupt("stop-all")
             if (self.stop_all, (mode,)) not in self.urgent:
@@ -147,6 +149,7 @@ class Worker:
         moving does not go on without it."""
         with self.cond:
             self.jobs.clear()
+            self.before_stop = 0  # the next tab's requests, made after this, run after its stop
             if self.current != self.stop_all:
                 self.preempt.interrupt("the tab that asked for it closing")
             self.urgent.append((self.plot, ([],)))
@@ -306,8 +309,9 @@ class Worker:
                                                               STOP_METHOD[mode], 0))
         except ServoError as e:
             failed.append(f"broadcast stop: {e}")
-        with self.cond:
-            dropped, self.jobs = list(self.jobs), collections.deque()
+        with self.cond:  # those queued before the stop was asked for; a tab's after it run
+            dropped = [self.jobs.popleft() for _ in range(min(self.before_stop, len(self.jobs)))]
+            self.before_stop = 0
         for fn, a in dropped:  # each answered, where the page shows that action's output
             if fn == self.run:
                 argv, tag = a

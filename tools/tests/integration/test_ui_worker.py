@@ -198,8 +198,11 @@ def test_stop_all_answers_every_request_it_drops():
         w.submit(w.scan, False, 2)
         w.submit(w.items, 1, 3)
         w.submit(w.plot, [1], 4)
-        w.stop_all("release")
+        w.stop_now("release")  # the click: what is queued now is answered "not run"
+        w.submit(w.run, ["ping", "1"], 5)  # asked after it: runs after the stop
+        w.stop_all("release")  # as the bus thread runs it
         answers = {m.get("tag"): m for m in said if m["type"] in ("result", "error")}
+        assert 5 not in answers and len(w.jobs) == 1, answers
         assert answers[1]["type"] == "result" and answers[1]["err"] == NOT_RUN, answers
         for tag, op in ((2, "scan"), (3, "items"), (4, "plot")):
             assert answers[tag]["op"] == op and answers[tag]["text"] == NOT_RUN, answers
