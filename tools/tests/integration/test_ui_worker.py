@@ -200,7 +200,8 @@ def test_stop_all_answers_every_request_it_drops():
         w.submit(w.plot, [1], 4)
         w.stop_now("release")  # the click: what is queued now is answered "not run"
         w.submit(w.run, ["ping", "1"], 5)  # asked after it: runs after the stop
-        w.stop_all("release")  # as the bus thread runs it
+        w.preempt.clear()  # as the bus thread does before each job, then runs the stop
+        w.stop_all("release")
         answers = {m.get("tag"): m for m in said if m["type"] in ("result", "error")}
         assert 5 not in answers and len(w.jobs) == 1, answers
         assert answers[1]["type"] == "result" and answers[1]["err"] == NOT_RUN, answers
