@@ -5,6 +5,7 @@ import json
 
 from . import args as args_
 from . import config_diff, config_file, group, link_rate, registers, units
+from .drive_guard import narrowed_limits
 from .errors import NotSent, UsageError
 from .servo import Servo
 
@@ -113,7 +114,8 @@ def cmd_config(bus, args):
         # drive train are that servo's: here they would move the angles and limits, or
         # run the loop the wrong way round.
         own = [i.name for i in registers.DRIVE if i.name in entry.values] if other and not args.with_calibration else []
-        if other and not args.with_calibration and joint_range(entry.values):  # in that servo's zero, not this one's
+        # That servo's joint range is in its zero, and this servo's own is its joint's: neither crosses.
+        if other and not args.with_calibration and (joint_range(entry.values) or narrowed_limits(s)):
             own += [n for n in ("angle_limit_on", "angle_min", "angle_max") if n in entry.values]
         values = {k: v for k, v in entry.values.items() if k not in own}
         kept = group.write_user_area(s, values, args.with_link)  # validated before sending

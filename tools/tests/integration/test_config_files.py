@@ -201,6 +201,14 @@ def test_another_servos_calibration_is_not_loaded_unless_asked(tmp_path, capsys)
         assert run(sim, capsys, "config", "get", "1", "stall_power")[1].startswith("stall_power = 2500")
         # servo 2's joint range, in servo 2's zero, is not servo 1's either
         assert "angle_max" in out and run(sim, capsys, "config", "get", "1", "angle_max")[1] == "angle_max = 135.0 deg\n"
+        # And servo 1's own joint range is not replaced by a file's factory limits (or limits off).
+        assert run(sim, capsys, "config", "set", "1", "angle_max", "30")[0] == 0
+        assert run(sim, capsys, "config", "set", "2", "angle_max", "135")[0] == 0
+        assert run(sim, capsys, "config", "set", "2", "angle_min", "-135")[0] == 0
+        factory = tmp_path / "factory.json"
+        assert run(sim, capsys, "config", "save", "2", str(factory))[0] == 0
+        assert run(sim, capsys, "config", "load", "1", str(factory))[0] == 0
+        assert run(sim, capsys, "config", "get", "1", "angle_max")[1] == "angle_max = 30.0 deg\n"
         rc, out, _ = run(sim, capsys, "config", "load", "1", str(f), "--with-calibration")
         assert rc == 0 and "not loaded" not in out, out
         assert run(sim, capsys, "config", "get", "1", "gear_ratio")[1] == "gear_ratio = -345\n"
