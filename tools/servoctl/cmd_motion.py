@@ -4,7 +4,7 @@ import sys
 
 from . import args as args_
 from . import checks, frame, outcome
-from .drive_guard import check_horn_free
+from .drive_guard import check_horn_free, narrowed_limits
 from .errors import Refused
 from .servo import Servo
 
@@ -61,6 +61,8 @@ def cmd_origin(bus, args):
                         "positions (the joint's range moved by the angle here)",
                         f"'servoctl calibrate {s.id} --past-limits' moves the stored zero and the limits together; "
                         "--past-limits makes the origin anyway")
+    joint = None if args.reset_turns else narrowed_limits(s)  # --past-limits: said what it does to them
+    was = s.read_motion().angle_decideg if joint is not None else 0
     if args.reset_turns:
         s.reset_multi_turn()
     else:
@@ -73,4 +75,8 @@ def cmd_origin(bus, args):
                       f"'servoctl stop {args.id}'") from None
     angle, turns = s.multi_turn_angle()
     print(f"servo {args.id}: now {angle / 10:.1f} deg, {turns} turns")
+    if joint is not None:
+        low, high = joint
+        print(f"servo {args.id}: its angle limits keep their numbers, {low / 10:.1f}..{high / 10:.1f} deg: until "
+              f"power-up they are the horn's old {(low + was) / 10:.1f}..{(high + was) / 10:.1f} deg")
     return 0

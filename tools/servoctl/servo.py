@@ -283,7 +283,7 @@ class Servo:
         actions = {"stop": 0, "run": 1, "turns": 2, "time": 3}
         if action not in actions:
             raise ValueOutOfRange(f"wheel action must be one of {', '.join(actions)}, not {action!r}")
-        check_range("wheel speed", speed_dps, 0, 65535, "deg/s")
+        check_range("wheel speed", speed_dps, *p.field_range(p.WHEEL, "speed"), "deg/s")  # above: clamped
         check_range("wheel value", value, 0, 65535)
         method = actions[action] | (0x80 if clockwise else 0)
         return self._move(p.WHEEL, p.encode_request(p.WHEEL, self.id, method, speed_dps, value), wait)

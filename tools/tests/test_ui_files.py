@@ -140,6 +140,10 @@ def test_a_fifo_in_the_folder_is_refused_not_waited_on(tmp_path):
     args = build_parser().parse_args(["--port", "loop://", "restore", "image.img"])
     with pytest.raises(UsageError, match="'image.img': not a regular file"):
         Folder(tmp_path).confine(args)
+    # A FIFO as a file the command writes: it said "saved" (identify ran its whole experiment) first.
+    args = build_parser().parse_args(["--port", "loop://", "backup", "image.img"])
+    with pytest.raises(UsageError, match="'image.img': not a regular file"):
+        Folder(tmp_path).confine(args)
     # faults --elf opened its path itself: outside the folder, and a FIFO held the bus thread.
     args = build_parser().parse_args(["--port", "loop://", "faults", "1", "--elf", "image.img"])
     with pytest.raises(UsageError, match="'image.img': not a regular file"):

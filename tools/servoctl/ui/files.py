@@ -121,6 +121,8 @@ class Staging:
         if writes:
             if real == str(self.folder.root) or os.path.isdir(real):  # refused now: it said "saved" first
                 self.folder._refuse(name, "a folder, not a file to write")
+            if os.path.exists(real) and not os.path.isfile(real):  # a FIFO: refused before the command runs
+                self.folder._refuse(name, "not a regular file")
             self._folder_of(name, real)
             self.writes.append((name, real, copy))
             return copy

@@ -27,4 +27,6 @@ def test_origin_and_wheel_refuse_on_a_joints_limits(tmp_path, capsys):
         assert abs(sim.state(1)["angle"] - horn) < 0.1  # nothing turned
         assert main(["--port", sim.url, "wheel", "1", "stop"], clock=sim.clock_s) == 0  # a stop always goes
         assert main(["--port", sim.url, "origin", "1", "--past-limits"], clock=sim.clock_s) == 0
-        assert "now 0.0 deg" in capsys.readouterr().out
+        out = capsys.readouterr().out
+        assert "now 0.0 deg" in out and "keep their numbers, -20.0..20.0 deg: until power-up they are the horn's old" \
+            in out, out

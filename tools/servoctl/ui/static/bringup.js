@@ -45,6 +45,12 @@
   }
   UI.on("view", (m) => { if (m.view === "bringup") showWatchdog(); });
   UI.on("picked", showWatchdog);
+  // "horn free" is said of one servo: another picked is not (its joint's range held again).
+  let freeOf = null;
+  UI.on("picked", (m) => {
+    if (m.id !== freeOf) { $("#br-free").checked = false; $("#mo-free").checked = false; }
+    freeOf = m.id;
+  });
 
   document.addEventListener("DOMContentLoaded", () => {
     const free = () => ($("#br-free").checked ? ["--past-limits"] : []);
