@@ -4,6 +4,7 @@
  * prints "cycles C seconds S rate R wire W ratio Q missed M" on servo_sim's
  * clock (the simulated servos' time). paced: servo_sim runs --clock paced
  * and this is its only host; the host's own time then costs none (tests). */
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -77,9 +78,10 @@ int main(int argc, char **argv)
         memcpy(host, where, (size_t)(colon - where));
         host[colon - where] = '\0';
     }
-    if ((colon != NULL ? sb_tcp_open(&link, host, (unsigned)atoi(colon + 1)) : sb_serial_open(&link, where, baud)) !=
-        0) {
-        fprintf(stderr, "loop_bench: no simulator at %s\n", argv[1]);
+    int rc = colon != NULL ? sb_tcp_open(&link, host, (unsigned)atoi(colon + 1)) : sb_serial_open(&link, where, baud);
+    if (rc != 0) {
+        fprintf(stderr, rc == -EBUSY ? "loop_bench: another program holds the bus at %s: close it, then try again\n"
+                                     : "loop_bench: no simulator at %s\n", argv[1]);
         return 2;
     }
     {

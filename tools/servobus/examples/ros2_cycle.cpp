@@ -14,6 +14,7 @@
 #include <climits>
 #include <cmath>
 #include <cstdint>
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -42,8 +43,8 @@ class ServoBusHardware {
     {
         int rc = sb_tcp_open(&link_, host.c_str(), port);
         if (rc != 0) {
-            std::fprintf(stderr, "sb_ros2_cycle: cannot connect to %s:%u (errno %d: %s)\n", host.c_str(), port, -rc,
-                         std::strerror(-rc));
+            std::fprintf(stderr, "sb_ros2_cycle: cannot connect to %s:%u (errno %d: %s)%s\n", host.c_str(), port, -rc,
+                         std::strerror(-rc), rc == -EBUSY ? ": another program holds the bus, close it first" : "");
             return false;
         }
         sb_transport t = sb_posix_transport(&link_);

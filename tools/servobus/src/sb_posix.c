@@ -47,6 +47,39 @@ static void reset(sb_posix *p)
     p->spin_us = SB_POSIX_SPIN_US;
 }
 
+/* What servo_sim and the virtual boards send a second client on their bus
+ * (and then nothing): "<who>: the bus is in use by another client". */
+#define BUS_IN_USE "the bus is in use by another client"
+
+static bool holds(const uint8_t *buf, size_t n, const char *text)
+{
+    size_t len = strlen(text);
+    for (size_t k = 0; k + len <= n; k++)
+        if (memcmp(buf + k, text, len) == 0)
+            return true;
+    return false;
+}
+
+/* A simulator tells a second client at once that its bus is another's,
+ * and then takes none of its bytes: a program that only sends (a move, a
+ * stream) would otherwise believe them sent. Looked for (not read) for up
+ * to OPEN_LOOK_MS after connecting; a bus that is free says nothing. */
+#define OPEN_LOOK_MS 50
+
+static bool held_by_another(sb_posix *p)
+{
+    struct pollfd pf = {p->fd, POLLIN, 0};
+    uint8_t peek[96];
+    if (poll(&pf, 1, OPEN_LOOK_MS) <= 0 || !(pf.revents & POLLIN))
+        return false;
+    ssize_t n = recv(p->fd, peek, sizeof peek, MSG_PEEK);
+    if (n <= 0 || !holds(peek, (size_t)n, BUS_IN_USE))
+        return false;
+    close(p->fd);
+    p->fd = -1;
+    return true;
+}
+
 int sb_tcp_open(sb_posix *p, const char *host, unsigned port)
 {
     struct addrinfo hints, *res = NULL, *a;
@@ -80,7 +113,7 @@ int sb_tcp_open(sb_posix *p, const char *host, unsigned port)
         return rc;
     p->is_socket = true;
     setsockopt(p->fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one); /* no Nagle delay on small frames */
-    return 0;
+    return held_by_another(p) ? -EBUSY : 0;
 }
 
 static speed_t speed_of(uint32_t baud)
@@ -277,19 +310,6 @@ static ssize_t spin(sb_posix *p, uint8_t *buf, size_t cap, uint32_t *wait_us)
     }
     *wait_us -= spent < *wait_us ? (uint32_t)spent : *wait_us;
     return 0;
-}
-
-/* What servo_sim and the virtual boards send a second client on their bus
- * (and then nothing): "<who>: the bus is in use by another client". */
-#define BUS_IN_USE "the bus is in use by another client"
-
-static bool holds(const uint8_t *buf, size_t n, const char *text)
-{
-    size_t len = strlen(text);
-    for (size_t k = 0; k + len <= n; k++)
-        if (memcmp(buf + k, text, len) == 0)
-            return true;
-    return false;
 }
 
 static int posix_read(void *ctx, uint8_t *buf, size_t cap, size_t want, uint32_t wait_us)

@@ -15,6 +15,7 @@
 #include <netinet/in.h>
 #include <pty.h>
 #include <sys/socket.h>
+#include <sys/wait.h>
 #include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -230,10 +231,8 @@ static void a_port_whose_other_end_hung_up_fails(void **state)
     assert_true(t->read(t->ctx, buf, sizeof buf, 1, 1000000) < 0); /* a wait sees it; a drain's look need not */
 }
 
-/* A simulator whose bus another client holds says so to a second one,
- * and sends nothing more: servobus said "no answer in time (is it on
- * the bus ...)" and a send returned SB_OK though nothing reached the bus. */
-static void a_bus_another_client_holds_is_said_so(void **state)
+/* A TCP listener on the loopback at a free port, given in port. */
+static int loopback_listener(unsigned *port)
 {
     int listener = socket(AF_INET, SOCK_STREAM, 0);
     struct sockaddr_in at = {0};
@@ -243,8 +242,19 @@ static void a_bus_another_client_holds_is_said_so(void **state)
     assert_int_equal(bind(listener, (struct sockaddr *)&at, sizeof at), 0);
     assert_int_equal(listen(listener, 1), 0);
     assert_int_equal(getsockname(listener, (struct sockaddr *)&at, &len), 0);
+    *port = ntohs(at.sin_port);
+    return listener;
+}
+
+/* A simulator whose bus another client holds says so to a second one,
+ * and sends nothing more: servobus said "no answer in time (is it on
+ * the bus ...)" and a send returned SB_OK though nothing reached the bus. */
+static void a_bus_another_client_holds_is_said_so(void **state)
+{
+    unsigned port;
+    int listener = loopback_listener(&port);
     sb_posix link;
-    assert_int_equal(sb_tcp_open(&link, "127.0.0.1", ntohs(at.sin_port)), 0);
+    assert_int_equal(sb_tcp_open(&link, "127.0.0.1", port), 0);
     int server = accept(listener, NULL, NULL);
     const char said[] = "servo_sim: the bus is in use by another client\n";
     assert_int_equal(write(server, said, sizeof said - 1), (ssize_t)(sizeof said - 1));
@@ -264,6 +274,29 @@ static void a_bus_another_client_holds_is_said_so(void **state)
     sb_posix_close(&link);
 }
 
+/* The same told at once, as servo_sim tells it: the open itself says so,
+ * so a program that only sends (sb_send_move_angle returned SB_OK while
+ * nothing reached the bus) is not fooled. */
+static void an_open_of_a_bus_another_client_holds_is_refused(void **state)
+{
+    unsigned port;
+    int listener = loopback_listener(&port);
+    pid_t child = fork();
+    if (child == 0) { /* the simulator: tells the client at once, then holds the line */
+        int server = accept(listener, NULL, NULL);
+        const char said[] = "servo_sim: the bus is in use by another client\n";
+        if (write(server, said, sizeof said - 1) < 0)
+            _exit(1);
+        usleep(300000);
+        _exit(0);
+    }
+    sb_posix link;
+    assert_int_equal(sb_tcp_open(&link, "127.0.0.1", port), -EBUSY);
+    int status = 0;
+    waitpid(child, &status, 0);
+    close(listener);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -274,6 +307,7 @@ int main(void)
         cmocka_unit_test(a_port_another_program_holds_is_refused),
         cmocka_unit_test(a_write_the_link_never_takes_fails),
         cmocka_unit_test(a_bus_another_client_holds_is_said_so),
+        cmocka_unit_test(an_open_of_a_bus_another_client_holds_is_refused),
         cmocka_unit_test_setup_teardown(a_wait_spins_then_sleeps_and_reads_what_comes, open_fixture_port,
                                         close_fixture_port),
         cmocka_unit_test_setup_teardown(a_port_whose_other_end_hung_up_fails, open_fixture_port, close_fixture_port),

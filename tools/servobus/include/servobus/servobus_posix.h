@@ -30,7 +30,8 @@ typedef struct sb_posix {
 #define SB_POSIX_SPIN_US 1500u
 
 /* A TCP connection to host:port (TCP_NODELAY). 0, or -errno (-EINVAL for a
- * port outside 1..65535, which getaddrinfo would take modulo 65536). */
+ * port outside 1..65535, which getaddrinfo would take modulo 65536; -EBUSY
+ * where a simulator says at once that another client holds its bus). */
 int sb_tcp_open(sb_posix *p, const char *host, unsigned port);
 /* A serial port at baud, 8N1 raw, low latency where the driver has it,
  * the adapter's latency timer read (and set to 1 ms where it may be;
