@@ -110,12 +110,15 @@ def cmd_config(bus, args):
         entry = config_file.parse_config(config_file.read(args.file), args.file, args.raw)
         serial, baud = s.read("serial"), s.read("baud")  # before: the load may move the servo
         other = entry.serial is not None and entry.serial != serial
-        # Another servo's zero, amplifier offset, direction (gear_ratio's sign) and
-        # drive train are that servo's: here they would move the angles and limits, or
-        # run the loop the wrong way round.
-        own = [i.name for i in registers.DRIVE if i.name in entry.values] if other and not args.with_calibration else []
-        # That servo's joint range is in its zero, and this servo's own is its joint's: neither crosses.
-        if other and not args.with_calibration and (joint_range(entry.values) or narrowed_limits(s)):
+        # A file not known to be this servo's (another's, or one with no serial: a raw
+        # dump, a hand-written file) does not bring a zero, an amplifier offset, a
+        # direction (gear_ratio's sign) or a drive train: they would move the angles and
+        # limits, or run the loop the wrong way round.
+        unknown = entry.serial != serial and not args.with_calibration
+        own = [i.name for i in registers.DRIVE if i.name in entry.values] if unknown else []
+        # Nor does it change a joint's range (this servo's narrowed limits), nor bring
+        # another servo's, which is in that servo's zero.
+        if unknown and (narrowed_limits(s) or (other and joint_range(entry.values))):
             own += [n for n in ("angle_limit_on", "angle_min", "angle_max") if n in entry.values]
         values = {k: v for k, v in entry.values.items() if k not in own}
         kept = group.write_user_area(s, values, args.with_link)  # validated before sending
@@ -127,11 +130,15 @@ def cmd_config(bus, args):
         if other:
             notes.append(f"the file is servo serial 0x{entry.serial:08x}'s")
         if own:
-            notes.append(f"its own calibration, drive train and joint range not loaded ({', '.join(own)}); "
-                         "--with-calibration to load them")
+            notes.append(f"{'its' if other else 'a file of no serial: its'} calibration, drive train and "
+                         f"joint range not loaded ({', '.join(own)}); --with-calibration to load them")
         note = f" ({'; '.join(notes)})" if notes else ""
         print(f"loaded {len(values)} item(s) from {args.file} into servo {args.id}{note}")
     elif args.action == "reset":
+        joint = narrowed_limits(s)
         s.reset_user_data()
         print(f"servo {args.id}: user area reset (ID and baud rate kept)")
+        if joint is not None:  # said: the joint's range is gone with the rest
+            print(f"servo {args.id}: its angle limits, {joint[0] / 10:.1f}..{joint[1] / 10:.1f} deg (a joint's range), "
+                  "are the factory's +-135 deg again: set them again before it moves in its joint")
     return 0

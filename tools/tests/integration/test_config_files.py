@@ -195,7 +195,7 @@ def test_another_servos_calibration_is_not_loaded_unless_asked(tmp_path, capsys)
         f = tmp_path / "two.json"
         assert run(sim, capsys, "config", "save", "2", str(f))[0] == 0
         rc, out, _ = run(sim, capsys, "config", "load", "1", str(f))
-        assert rc == 0 and "its own calibration, drive train and joint range not loaded" in out and "encoder_zero" in out, out
+        assert rc == 0 and "its calibration, drive train and joint range not loaded" in out and "encoder_zero" in out, out
         assert run(sim, capsys, "config", "get", "1", "encoder_zero")[1].startswith("encoder_zero = 0 ")
         assert run(sim, capsys, "config", "get", "1", "gear_ratio")[1] == "gear_ratio = 345\n"
         assert run(sim, capsys, "config", "get", "1", "stall_power")[1].startswith("stall_power = 2500")
@@ -212,3 +212,25 @@ def test_another_servos_calibration_is_not_loaded_unless_asked(tmp_path, capsys)
         rc, out, _ = run(sim, capsys, "config", "load", "1", str(f), "--with-calibration")
         assert rc == 0 and "not loaded" not in out, out
         assert run(sim, capsys, "config", "get", "1", "gear_ratio")[1] == "gear_ratio = -345\n"
+
+
+def test_a_file_of_no_serial_brings_no_calibration_nor_changes_a_joints_range(tmp_path, capsys):
+    """A raw dump (no serial) of servo 1 into servo 2, a joint: it reversed
+    servo 2's direction, moved its zero and put its limits back to +-135.
+    A file not known to be this servo's brings none of that; a hand-written
+    file still sets the limits of a servo that is no joint. And config
+    reset says the joint's range it takes away."""
+    with Simulator(fast=True, ids=[1, 2], state_dir=str(tmp_path / "state")) as sim:
+        for name, text in {"encoder_zero": "500", "gear_ratio": "-345"}.items():
+            assert run(sim, capsys, "config", "set", "1", name, text)[0] == 0
+        for name, text in {"angle_min": "-60", "angle_max": "60"}.items():
+            assert run(sim, capsys, "config", "set", "2", name, text)[0] == 0
+        rc, out, _ = run(sim, capsys, "config", "dump", "1", "--json", "--raw")
+        raw = tmp_path / "raw1.json"
+        raw.write_text(out)
+        rc, out, _ = run(sim, capsys, "config", "load", "2", str(raw), "--raw")
+        assert rc == 0 and "a file of no serial" in out, out
+        assert run(sim, capsys, "config", "get", "2", "gear_ratio")[1] == "gear_ratio = 345\n"
+        assert run(sim, capsys, "config", "get", "2", "angle_max")[1] == "angle_max = 60.0 deg\n"
+        rc, out, _ = run(sim, capsys, "config", "reset", "2")
+        assert rc == 0 and "-60.0..60.0 deg (a joint's range), are the factory's +-135 deg again" in out, out
