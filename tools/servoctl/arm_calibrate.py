@@ -2,8 +2,8 @@
 plugins): each joint's zero stored on its servo (item 90) where the
 person holds the arm, and its range as the servo's angle limits."""
 from . import registers
-from .drive_guard import move_limits, narrowed_limits, write_limits
-from .errors import ServoError, UsageError
+from .drive_guard import ANGLE_MOST, narrowed_limits, write_limits
+from .errors import UsageError
 from .servo import Servo
 
 
@@ -12,18 +12,20 @@ def set_zero_here(arm) -> dict:
     (item 90) and taken as the origin (SetOriginPoint): it reads 0 deg
     here from now on, after a power-up too. A joint's range (limits
     narrower than the factory's) is moved with the zero, the same horn
-    positions, until store_ranges() stores the new one: a calibration
-    cut short (Ctrl-C, a crash) leaves the old range on, not none.
-    Other limits are off until then. {name: the count}."""
+    positions (what of it lies beyond +-180 from here cut off), until
+    store_ranges() stores the new one: a calibration cut short (Ctrl-C,
+    a crash) leaves the old range on, not none. Other limits are off
+    until then. {name: the count}."""
     counts = {}
     for name, servo_id in arm.joints.items():
         s = Servo(arm.bus, servo_id)
         s.stop("release")
         joint = narrowed_limits(s)
-        try:
-            moved = None if joint is None else move_limits(s.read_motion().angle_decideg, joint)
-        except ServoError:  # beyond +-180 from here: the range cannot be said in the new zero
-            moved = None
+        moved = None
+        if joint is not None:  # beyond +-180 from here: the part that can be said, still on
+            here = s.read_motion().angle_decideg
+            moved = (max(joint[0] - here, -ANGLE_MOST), min(joint[1] - here, ANGLE_MOST))
+            moved = moved if moved[1] - moved[0] >= 10 else None
         if moved is None:
             s.write("angle_limit_on", 0)
         else:

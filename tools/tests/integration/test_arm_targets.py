@@ -59,3 +59,19 @@ def test_a_calibration_cut_short_leaves_no_limits_of_the_old_zero():
         assert Arm(bus, {"a": 1}, firmware="servoctl", watchdog_ms=0).open().ranges_stored()
         arm.store_ranges({"a": (-20, 20)})
         assert arm.ranges_stored() and Servo(bus, 1).read("angle_max") == 200
+
+
+def test_a_joints_range_past_180_from_the_new_zero_is_cut_not_turned_off():
+    """Limits -130..130 with the horn resting at +60: a zero there would
+    put them at -190..70, beyond the items' +-180, and the range was
+    turned off without a word (the guards then saw no joint). Now the part
+    that can be said stays on."""
+    with Simulator(ids=[1], fast=True) as sim:
+        bus = sim.bus()
+        s = Servo(bus, 1)
+        s.write("angle_max", 1300)
+        s.write("angle_min", -1300)
+        s.move_to(60, duration_s=0.4, wait=True)
+        here = s.read_motion().angle_decideg
+        Arm(bus, {"a": 1}, firmware="servoctl", watchdog_ms=0).open().set_zero_here()
+        assert (s.read("angle_limit_on"), s.read("angle_min"), s.read("angle_max")) == (1, -1800, 1300 - here)
