@@ -69,7 +69,7 @@ def test_a_helper_that_a_modules_process_starts_during_a_test_is_not_the_tests(p
     still is (the first test above)."""
     pytester.makeconftest(GUARD)
     pytester.makepyfile(test_spawner="""
-import os, signal, subprocess, sys
+import os, signal, subprocess, sys, time
 import pytest
 
 HELPER = "import subprocess, sys, time; sys.stdin.readline(); " \\
@@ -83,6 +83,14 @@ def spawner():
     os.kill(p.helper, signal.SIGKILL)
     p.kill()
     p.wait()
+    for _ in range(500):  # SIGKILL is sent, not done: under load the helper ran on past the guard's look
+        try:
+            with open(f"/proc/{p.helper}/stat") as f:
+                if f.read().rsplit(")", 1)[1].split()[0] == "Z":
+                    break
+        except FileNotFoundError:
+            break
+        time.sleep(0.01)
 
 def test_the_module_process_starts_a_helper(spawner):
     spawner.stdin.write("\\n")
