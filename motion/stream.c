@@ -3,8 +3,8 @@
  * (docs/streaming.md, "On the host's timeline"): a segment from where the
  * setpoint is (position and speed) to the host's, a cubic (Hermite) that
  * ends at that moment, walked at the tick rate; the segment's end speed
- * goes on until the next setpoint comes, and a depth after its end (no
- * more than the segment's length) the servo brakes to a hold. A setpoint the cubic cannot reach within the
+ * goes on until the next setpoint comes, and a depth after its end the
+ * servo brakes to a hold. A setpoint the cubic cannot reach within the
  * stream's limits in its time is reached later (a longer segment) where
  * the host asks a speed, else as a move at them to rest
  * (docs/streaming.md).
@@ -100,15 +100,17 @@ static bool segment_within(int32_t d, int32_t v0, int32_t v1, int32_t t)
 
 /* With the angle limits on (48), the segment's path keeps within them
  * (those of the multi-turn reading, after the center offset 53), its run-on
- * included: the cubic lies within the hull of its Bezier points (start,
- * start + v0 t / 3, target - v1 t / 3, target), here taken at t / 2 (further
- * out on the same side: a hull that holds the true one); after it the end
- * speed runs on for a period and then brakes, counted at two thirds of the
- * stream's ramp (v^2 / 2^7, a longer way). The target is within them
- * already (motion_target_q8); a start outside (the limits were off, or
- * changed) may come back, no further out. Products within 2^22 (segment_within's
- * bounds). Where the path does not keep within them, the limiter says
- * angle. */
+ * included. t is the time to the stop, the segment and its run-on (a
+ * depth): the cubic lies within the hull of its Bezier points (start,
+ * start + v0 s / 3, target - v1 s / 3, target, s the segment's ticks),
+ * here taken at t / 2 (further out on the same side: a hull that holds the
+ * true one); after it the end speed runs on, counted for all of t, and
+ * then brakes, counted at two thirds of the stream's ramp (v^2 / 2^7, a
+ * longer way). The target is within them already (motion_target_q8); a
+ * start outside (the limits were off, or changed) may come back, no
+ * further out. t is at most 321 + 1500 ticks (a depth of a 1 s period):
+ * products within 2^22. Where the path does not keep within them, the
+ * limiter says angle. */
 static bool path_within(struct motion *m, int32_t start, int32_t target, int32_t v0, int32_t v1,
                         int32_t t)
 {
@@ -190,7 +192,14 @@ enum motion_submit_result motion_stream(struct motion *m, const struct motion_se
     while (!(fits = segment_within(placed - start, v0, v1, ticks)) && v1 != 0 && ticks < 256) {
         ticks += (ticks >> 2) + 1; /* to 321 at most; 256: an immediate on the M0 */
     }
-    bool cubic = fits && path_within(m, start, placed, v0, v1, ticks);
+    /* A depth after the segment's end with no setpoint: the stream has
+     * stopped. A frame a period late, jitter on top, is not a stop, however
+     * short the segment before it (a frame that looked late). The path's
+     * hull is taken over both (the longer of the two would do, for bytes
+     * the M0 does not have). */
+    int32_t until = ticks + (depth_q4 >> 4);
+    m->endless_until = (uint32_t)until;
+    bool cubic = fits && path_within(m, start, placed, v0, v1, until);
     if (cubic) {
         profile_plan_segment(&m->profile, start, v0, placed, v1, (uint32_t)ticks);
     } else {
@@ -198,11 +207,5 @@ enum motion_submit_result motion_stream(struct motion *m, const struct motion_se
     }
     motion_begin_profile(m, END_HOLD);
     m->endless = cubic && v1 != 0;
-    /* A depth after the segment's end (no more than the segment, which
-     * path_within's hull holds) with no setpoint: the stream has stopped. A
-     * frame a period late, jitter on top, is not a stop; an early one's
-     * run-on is no longer for its long segment. */
-    uint32_t depth = (uint32_t)depth_q4 >> 4;
-    m->endless_until = (uint32_t)ticks + ((uint32_t)ticks < depth ? (uint32_t)ticks : depth);
     return MOTION_ACCEPTED;
 }

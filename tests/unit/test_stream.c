@@ -306,6 +306,80 @@ static void test_a_late_frame_keeps_its_place(void **state)
     assert_true(fabs(target - 6.6) < 0.02);
 }
 
+/* At 60 Hz a first frame 10 ms early makes every frame after it look 10 ms
+ * late until the servo's clock has followed (1/8 ms a frame); one of them
+ * 10 ms late on top looks 20 ms late, its segment is short, and the next,
+ * a whole period late, came after the servo had braked to a hold. The
+ * run-on after a segment is the depth whatever the segment's length: the
+ * stream goes on. */
+static void test_an_early_first_frame_and_a_late_one_stop_nothing(void **state)
+{
+    (void)state;
+    enum { P = 16 }; /* ms */
+    uint64_t base = hal.now_us + 20000u;
+    double last = 0, slowest = 1e9;
+    for (uint16_t k = 0; k <= 20; k++) {
+        uint16_t stamp = (uint16_t)(k * P);
+        int64_t arrive_ms = k == 0 ? -10 : k == 10 ? stamp + 10 : k == 11 ? stamp + P : stamp;
+        uint64_t end_us = (uint64_t)((int64_t)base + arrive_ms * 1000);
+        while (hal.now_us + 1000u <= end_us - STREAM_FRAME_US) {
+            harness_run_ms(1);
+            double step = setpoint_deg() - last;
+            last = setpoint_deg();
+            if (k >= 3u) { /* under way */
+                slowest = step < slowest ? step : slowest;
+            }
+        }
+        /* 100 deg/s, each setpoint where the path is at its place. */
+        stream_on_time(end_us, stamp + 3 * P / 2, 1000, stamp);
+    }
+    printf("# 60 Hz at 100 deg/s, a first frame 10 ms early, one 10 ms late and the next a period late: "
+           "the setpoint's slowest step %.3f deg/ms\n", slowest);
+    assert_true(slowest > 0.05); /* a hold brakes to 0 */
+}
+
+/* The host-timing model at 60 and 50 Hz (every frame up to 10 ms early
+ * or late, one in twenty a whole period late), 60 seeds each, a path at
+ * 100 deg/s: no run stops (brakes the setpoint to a hold) while frames
+ * come. At 100 Hz, where the jitter is the period, runs are counted. */
+static unsigned stops_in_runs(uint32_t period_ms, unsigned runs, void **state)
+{
+    unsigned stopped = 0;
+    for (unsigned run = 0; run < runs; run++) {
+        plant_harness_setup(state);
+        WRITE_ITEM(0, ITEM_ANGLE_LIMIT_ON, 0);
+        rng_state = 0x9E3779B97F4A7C15u * (run + 1u);
+        uint64_t base = hal.now_us + 20000u;
+        double last = 0, slowest = 1e9, at_ms = -20.0;
+        for (uint32_t k = 0; k < 60u; k++) {
+            double send = (double)(k * period_ms) + (double)(rng_next() % 20001u) / 1000.0 - 10.0;
+            send = k % 20u == 19u ? (double)((k + 1u) * period_ms) : send;
+            at_ms = send > at_ms ? send : at_ms; /* never before the one before */
+            uint64_t end_us = (uint64_t)((double)base + at_ms * 1000.0);
+            while (hal.now_us + 1000u <= end_us - STREAM_FRAME_US) {
+                harness_run_ms(1);
+                double step = setpoint_deg() - last;
+                last = setpoint_deg();
+                slowest = k >= 3u && step < slowest ? step : slowest;
+            }
+            uint16_t stamp = (uint16_t)(k * period_ms);
+            stream_on_time(end_us, (int32_t)(stamp + 3u * period_ms / 2u), 1000, stamp);
+        }
+        stopped += slowest < 0.05;
+    }
+    return stopped;
+}
+
+static void test_a_jittery_host_stops_no_stream(void **state)
+{
+    unsigned at_60 = stops_in_runs(16, 60, state), at_50 = stops_in_runs(20, 60, state);
+    unsigned at_100 = stops_in_runs(10, 60, state);
+    printf("# +-10 ms and 1 in 20 a period late: streams stopped of 60 at 60 Hz %u, at 50 Hz %u, "
+           "at 100 Hz %u\n", at_60, at_50, at_100);
+    assert_int_equal(at_60, 0);
+    assert_int_equal(at_50, 0);
+}
+
 /* Runs until the setpoint has not moved for 20 ms (at most 3 s): how long
  * that took, ms, and where it stopped, deg. */
 static uint32_t run_until_still(double *at_deg)
@@ -650,6 +724,8 @@ int main(void)
         cmocka_unit_test_setup(test_a_late_stream_brakes_to_a_hold, plant_harness_setup),
         cmocka_unit_test_setup(test_the_period_is_learned_or_told, plant_harness_setup),
         cmocka_unit_test_setup(test_a_late_frame_keeps_its_place, plant_harness_setup),
+        cmocka_unit_test_setup(test_an_early_first_frame_and_a_late_one_stop_nothing, plant_harness_setup),
+        cmocka_unit_test_setup(test_a_jittery_host_stops_no_stream, plant_harness_setup),
         cmocka_unit_test_setup(test_a_first_setpoint_and_a_wait_teach_no_period, plant_harness_setup),
         cmocka_unit_test_setup(test_an_early_last_frame_stops_within_periods, plant_harness_setup),
         cmocka_unit_test_setup(test_the_host_clock_wraps, plant_harness_setup),
