@@ -18,12 +18,37 @@ function(servo_board_linker_script out template)
   set(${out} ${ld} PARENT_SCOPE)
 endfunction()
 
+# servo_board_check(): the board whose folder calls it against the part its
+# board.cmake names (firmware/parts/parts.toml): its flash map within the
+# part's flash and on its erase unit, its RAM within the part's, its CPU the
+# part's. Once a board, at configure time: a board its part contradicts is
+# not built, and the line says which fact.
+function(servo_board_check)
+  get_property(checked GLOBAL PROPERTY SERVO_BOARD_CHECKED)
+  if(CMAKE_CURRENT_SOURCE_DIR IN_LIST checked)
+    return()
+  endif()
+  set_property(GLOBAL APPEND PROPERTY SERVO_BOARD_CHECKED ${CMAKE_CURRENT_SOURCE_DIR})
+  execute_process(
+    COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/firmware/bootloader/servo_image/board_facts.py
+            --check ${CMAKE_CURRENT_SOURCE_DIR}
+    RESULT_VARIABLE failed ERROR_VARIABLE problems)
+  if(failed)
+    string(STRIP "${problems}" problems)
+    message(FATAL_ERROR "${problems}")
+  endif()
+  set_property(DIRECTORY APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS
+               ${CMAKE_CURRENT_SOURCE_DIR}/board.h ${CMAKE_CURRENT_SOURCE_DIR}/board.cmake
+               ${PROJECT_SOURCE_DIR}/firmware/parts/parts.toml)
+endfunction()
+
 # servo_board_limits(): the limits an image of the board whose folder calls
 # it is checked against, its own, unless its board.cmake sets them: the
 # application's slot (board.h: BOARD_SLOT_PAGES x BOARD_FLASH_PAGE) less the
 # update image's 256-byte header (firmware/bootloader/app_image.h), and the
 # part's RAM (BOARD_RAM_SIZE).
 macro(servo_board_limits)
+  servo_board_check()
   file(STRINGS ${CMAKE_CURRENT_SOURCE_DIR}/board.h _board_defines REGEX "^#define BOARD_(SLOT_PAGES|FLASH_PAGE|RAM_SIZE) ")
   foreach(_line ${_board_defines})
     string(REGEX MATCH "^#define (BOARD_[A-Z_]+) ([0-9]+)" _ ${_line})

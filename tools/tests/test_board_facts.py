@@ -1,5 +1,10 @@
 """A board's facts have one reader (servo_image.board_facts) that every tool
-uses, and a board's CPU comes from the chip family its board.cmake names."""
+uses, a board's CPU comes from the chip family its board.cmake names, and
+the part it names holds its flash map and RAM to the part's own facts."""
+import subprocess
+import sys
+from pathlib import Path
+
 from servo_image import board_facts
 from servoctl import image as img
 from vboard import board as vb
@@ -37,3 +42,67 @@ def test_a_board_h_s_includes_are_followed():
         assert facts["BOARD_SUPPLY_UV_PER_COUNT"] == 8862, name
         assert facts["BOARD_MOTOR_MOHM"] == 2741, name
     assert board_facts.defines("host_sim")["BOARD_ID"] == 0x5100
+
+
+def test_every_shipped_board_fits_its_part():
+    for name in ("stm32f103", "stm32f030k6", "qemu_stm32vl", "host_sim"):
+        assert board_facts.check(name) == [], name
+    assert board_facts.part_name("stm32f030k6") == "stm32f030k6"
+    assert board_facts.parts()["stm32f030k6"]["ram_size"] == 4096
+
+
+def _board_like(tmp_path, name, header_edits=(), part=None):
+    """A copy of a shipped board's folder with board.h's lines edited (old,
+    new) and, given one, another part named in board.cmake."""
+    folder = tmp_path / name
+    folder.mkdir(parents=True)
+    source = board_facts.BOARDS_DIR / name
+    header = (source / "board.h").read_text()
+    for old, new in header_edits:
+        assert old in header, old
+        header = header.replace(old, new)
+    (folder / "board.h").write_text(header)
+    cmake = (source / "board.cmake").read_text()
+    if part is not None:
+        cmake = cmake.replace(f"set(SERVO_BOARD_PART {board_facts.part_name(name)})",
+                              f"set(SERVO_BOARD_PART {part})" if part else "")
+    (folder / "board.cmake").write_text(cmake)
+    return folder
+
+
+def test_a_board_its_part_contradicts_is_named_fact_by_fact(tmp_path):
+    """The review's boards: 64 KB of RAM declared on a 4 KB part, a slot
+    past the flash's end, a config page off its erase unit, 1 KB pages
+    declared on a 2 KB-page part (an erase of the spare page would wipe the
+    newest record), and another CPU."""
+    cases = [
+        ("stm32f030k6", [("#define BOARD_RAM_SIZE 4096", "#define BOARD_RAM_SIZE 65536")], None,
+         "BOARD_RAM_SIZE 65536 are not within the part's 4096 B of RAM"),
+        ("stm32f030k6", [("#define BOARD_SLOT_PAGES 24", "#define BOARD_SLOT_PAGES 56")], None,
+         "ends past the part's 32 KB of flash"),
+        ("stm32f103", [("#define BOARD_CONFIG_PAGE1 0x0800FC00", "#define BOARD_CONFIG_PAGE1 0x0800FA00")], None,
+         "BOARD_CONFIG_PAGE1 at 0x0800FA00, 1024 B, is not on the part's 1024-byte erase unit"),
+        ("stm32f103", [("#define BOARD_FAULT_PAGE1 0x0800F400", "#define BOARD_FAULT_PAGE1 0x0800F800")], None,
+         "BOARD_FAULT_PAGE1 and BOARD_CONFIG_PAGE0 overlap"),
+        ("stm32f030k6", [], "stm32g031k8", "BOARD_FLASH_PAGE 1024 is not the part's erase unit, 2048 B"),
+        ("stm32f030k6", [], "stm32f103c8", "its family's CPU cortex-m0 is not the part's cortex-m3"),
+        ("stm32f030k6", [], "", "board.cmake names no part"),
+        ("stm32f030k6", [], "stm32f999", "names the part 'stm32f999', which firmware/parts/parts.toml does not have"),
+    ]
+    for i, (name, edits, part, said) in enumerate(cases):
+        problems = board_facts.check(_board_like(tmp_path / str(i), name, edits, part))
+        assert any(said in line for line in problems), (said, problems)
+
+
+def test_the_build_s_check_exits_with_a_line_a_problem(tmp_path):
+    """What cmake/arm-image.cmake runs at configure time."""
+    script = Path(board_facts.__file__)
+    good = subprocess.run([sys.executable, script, "--check", board_facts.BOARDS_DIR / "stm32f030k6"],
+                          capture_output=True, text=True)
+    assert good.returncode == 0 and good.stderr == ""
+    bad = _board_like(tmp_path, "stm32f030k6", [("#define BOARD_RAM_SIZE 4096", "#define BOARD_RAM_SIZE 8192")])
+    run = subprocess.run([sys.executable, script, "--check", bad], capture_output=True, text=True)
+    assert run.returncode == 1
+    assert run.stderr.splitlines() == [
+        "board check: stm32f030k6: BOARD_RAM_BASE 0x20000000 and BOARD_RAM_SIZE 8192 are not within "
+        "the part's 4096 B of RAM at 0x20000000 (stm32f030k6)"]

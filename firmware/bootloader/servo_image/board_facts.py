@@ -6,18 +6,24 @@ analogue front end), those of the headers it includes from firmware/boards/
 (boards/common/reference_servo.h; host_sim's, the reference board's) where
 the include stands, and the CPU of the chip family its board.cmake names
 (include(.../cmake/family-NAME.cmake), whose SERVO_BOARD_CPU it is; a
-board.cmake may also set SERVO_BOARD_CPU itself). Standard library only."""
+board.cmake may also set SERVO_BOARD_CPU itself), and the part it names
+(set(SERVO_BOARD_PART name)), whose facts are in firmware/parts/parts.toml;
+check() holds the board to them. Standard library only."""
 import re
+import sys
+import tomllib
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[3]  # firmware/bootloader/servo_image/
 BOARDS_DIR = ROOT / "firmware" / "boards"
 FAMILIES_DIR = ROOT / "cmake"
+PARTS_FILE = ROOT / "firmware" / "parts" / "parts.toml"
 
 _DEFINE = re.compile(r"#define (BOARD_\w+) (0x[0-9a-fA-F]+|\d+)\b")
 _INCLUDE = re.compile(r'#include "(boards/[^"]+)"')
 _CPU = re.compile(r"^set\(SERVO_BOARD_CPU (\S+)\)", re.M)
 _FAMILY = re.compile(r"^include\(\S*family-([\w-]+)\.cmake\)", re.M)
+_PART = re.compile(r"^set\(SERVO_BOARD_PART (\S+)\)", re.M)
 
 
 def folder_of(board) -> Path:
@@ -56,3 +62,95 @@ def cpu(board) -> str:
         text = (FAMILIES_DIR / f"family-{family.group(1)}.cmake").read_text()
     found = _CPU.search(text)
     return found.group(1) if found else ""
+
+
+def part_name(board) -> str:
+    """The part its board.cmake names; "" for none (host_sim)."""
+    cmake = folder_of(board) / "board.cmake"
+    found = _PART.search(cmake.read_text()) if cmake.is_file() else None
+    return found.group(1) if found else ""
+
+
+def parts() -> dict:
+    """{name: {fact: value}} of every part a board may name."""
+    with PARTS_FILE.open("rb") as f:
+        return tomllib.load(f)
+
+
+def _regions(d: dict) -> list:
+    """The flash map's regions, (name, first, bytes), as board.h has them."""
+    page = d.get("BOARD_FLASH_PAGE", 0)
+    out = []
+    if "BOARD_BOOT_SIZE" in d:
+        out.append(("the bootloader (BOARD_FLASH_BASE, BOARD_BOOT_SIZE)", d["BOARD_FLASH_BASE"],
+                    d["BOARD_BOOT_SIZE"]))
+    if "BOARD_SLOT_BASE" in d:
+        out.append(("the slot (BOARD_SLOT_BASE, BOARD_SLOT_PAGES)", d["BOARD_SLOT_BASE"],
+                    d.get("BOARD_SLOT_PAGES", 0) * page))
+    for name in ("BOARD_FAULT_PAGE0", "BOARD_FAULT_PAGE1", "BOARD_CONFIG_PAGE0", "BOARD_CONFIG_PAGE1",
+                 "BOARD_RAM_CONFIG_BASE"):
+        if name in d:
+            out.append((name, d[name], page))
+    return out
+
+
+def check(board) -> list:
+    """What in a board's declaration its part contradicts, a line each
+    naming the fact and the part's own; [] when it fits. A board with
+    no board.cmake (host_sim) is not built for a part."""
+    folder = folder_of(board)
+    if not (folder / "board.cmake").is_file():
+        return []
+    name = part_name(folder)
+    known = parts()
+    if name not in known:
+        said = (f"names the part {name!r}, which firmware/parts/parts.toml does not have" if name
+                else "names no part: add set(SERVO_BOARD_PART name)")
+        return [f"{folder.name}: board.cmake {said} (the parts: {', '.join(sorted(known))})"]
+    p = known[name]
+    d = defines(folder)
+    problems = []
+
+    def say(text):
+        problems.append(f"{folder.name}: {text} ({name})")
+
+    if cpu(folder) != p["cpu"]:
+        say(f"its family's CPU {cpu(folder) or 'none'} is not the part's {p['cpu']}")
+    missing = [k for k in ("BOARD_FLASH_BASE", "BOARD_FLASH_PAGE", "BOARD_RAM_BASE", "BOARD_RAM_SIZE")
+               if k not in d]
+    if missing:
+        say(f"board.h does not declare {', '.join(missing)}")
+        return problems
+    page, end = p["page_size"], p["flash_base"] + p["flash_size"]
+    if d["BOARD_FLASH_PAGE"] != page:
+        say(f"BOARD_FLASH_PAGE {d['BOARD_FLASH_PAGE']} is not the part's erase unit, {page} B: "
+            "an erase would reach another region, or leave part of this one")
+    if d["BOARD_FLASH_BASE"] != p["flash_base"]:
+        say(f"BOARD_FLASH_BASE 0x{d['BOARD_FLASH_BASE']:08X} is not the part's flash, at 0x{p['flash_base']:08X}")
+    regions = _regions(d)
+    for what, first, size in regions:
+        if first % page or size % page:
+            say(f"{what} at 0x{first:08X}, {size} B, is not on the part's {page}-byte erase unit")
+        if first < p["flash_base"] or first + size > end:
+            say(f"{what} at 0x{first:08X}, {size} B, ends past the part's {p['flash_size'] // 1024} KB "
+                f"of flash (0x{p['flash_base']:08X}-0x{end - 1:08X})")
+    for i, (a, first_a, size_a) in enumerate(regions):
+        for b, first_b, size_b in regions[i + 1:]:
+            if first_a < first_b + size_b and first_b < first_a + size_a:
+                say(f"{a} and {b} overlap")
+    ram_end = p["ram_base"] + p["ram_size"]
+    if d["BOARD_RAM_BASE"] != p["ram_base"] or d["BOARD_RAM_BASE"] + d["BOARD_RAM_SIZE"] > ram_end:
+        say(f"BOARD_RAM_BASE 0x{d['BOARD_RAM_BASE']:08X} and BOARD_RAM_SIZE {d['BOARD_RAM_SIZE']} are not "
+            f"within the part's {p['ram_size']} B of RAM at 0x{p['ram_base']:08X}")
+    return problems
+
+
+if __name__ == "__main__":
+    # python3 board_facts.py --check FOLDER...: the build's check of a board
+    # against its part (cmake/arm-image.cmake); exit 1 with a line a problem.
+    if len(sys.argv) < 3 or sys.argv[1] != "--check":
+        sys.exit("usage: board_facts.py --check BOARD_FOLDER...")
+    found = [line for folder in sys.argv[2:] for line in check(Path(folder))]
+    for line in found:
+        print(f"board check: {line}", file=sys.stderr)
+    sys.exit(1 if found else 0)
