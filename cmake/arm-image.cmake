@@ -18,25 +18,28 @@ function(servo_board_linker_script out template)
   set(${out} ${ld} PARENT_SCOPE)
 endfunction()
 
-# servo_board_check(): the board whose folder calls it against the part its
-# board.cmake names (firmware/parts/parts.toml): its flash map within the
-# part's flash and on its erase unit, its RAM within the part's, its CPU the
-# part's. Once a board, at configure time: a board its part contradicts is
-# not built, and the line says which fact.
-function(servo_board_check)
-  get_property(checked GLOBAL PROPERTY SERVO_BOARD_CHECKED)
-  if(CMAKE_CURRENT_SOURCE_DIR IN_LIST checked)
-    return()
-  endif()
-  set_property(GLOBAL APPEND PROPERTY SERVO_BOARD_CHECKED ${CMAKE_CURRENT_SOURCE_DIR})
+# servo_board_facts(): the facts of the board whose folder calls it, through
+# the one reader of them (firmware/bootloader/servo_image/board_facts.py:
+# board.h's numbers, hex or decimal) as _BOARD_* variables, after holding
+# them to the part its board.cmake names (firmware/parts/parts.toml): its
+# flash map within the part's flash and on its erase unit, its RAM within
+# the part's, its CPU the part's. A board its part contradicts is not
+# built, and the configure's error says which fact, a line each.
+function(servo_board_facts)
   execute_process(
     COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/firmware/bootloader/servo_image/board_facts.py
-            --check ${CMAKE_CURRENT_SOURCE_DIR}
-    RESULT_VARIABLE failed ERROR_VARIABLE problems)
+            --check --facts ${CMAKE_CURRENT_SOURCE_DIR}
+    RESULT_VARIABLE failed OUTPUT_VARIABLE facts ERROR_VARIABLE problems)
   if(failed)
     string(STRIP "${problems}" problems)
     message(FATAL_ERROR "${problems}")
   endif()
+  string(REPLACE "\n" ";" facts "${facts}")
+  foreach(fact ${facts})
+    if(fact MATCHES "^(BOARD_[A-Z0-9_]+)=([0-9]+)$")
+      set(_${CMAKE_MATCH_1} ${CMAKE_MATCH_2} PARENT_SCOPE)
+    endif()
+  endforeach()
   set_property(DIRECTORY APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS
                ${CMAKE_CURRENT_SOURCE_DIR}/board.h ${CMAKE_CURRENT_SOURCE_DIR}/board.cmake
                ${PROJECT_SOURCE_DIR}/firmware/parts/parts.toml)
@@ -48,12 +51,7 @@ endfunction()
 # update image's 256-byte header (firmware/bootloader/app_image.h), and the
 # part's RAM (BOARD_RAM_SIZE).
 macro(servo_board_limits)
-  servo_board_check()
-  file(STRINGS ${CMAKE_CURRENT_SOURCE_DIR}/board.h _board_defines REGEX "^#define BOARD_(SLOT_PAGES|FLASH_PAGE|RAM_SIZE) ")
-  foreach(_line ${_board_defines})
-    string(REGEX MATCH "^#define (BOARD_[A-Z_]+) ([0-9]+)" _ ${_line})
-    set(_${CMAKE_MATCH_1} ${CMAKE_MATCH_2})
-  endforeach()
+  servo_board_facts()
   if(NOT DEFINED SERVO_BOARD_FLASH_LIMIT)
     math(EXPR SERVO_BOARD_FLASH_LIMIT "${_BOARD_SLOT_PAGES} * ${_BOARD_FLASH_PAGE} - 256")
   endif()

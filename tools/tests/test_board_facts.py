@@ -95,11 +95,20 @@ def test_a_board_its_part_contradicts_is_named_fact_by_fact(tmp_path):
 
 
 def test_the_build_s_check_exits_with_a_line_a_problem(tmp_path):
-    """What cmake/arm-image.cmake runs at configure time."""
+    """What cmake/arm-image.cmake runs at configure time (servo_board_facts)."""
     script = Path(board_facts.__file__)
     good = subprocess.run([sys.executable, script, "--check", board_facts.BOARDS_DIR / "stm32f030k6"],
                           capture_output=True, text=True)
-    assert good.returncode == 0 and good.stderr == ""
+    assert good.returncode == 0 and good.stderr == "" and good.stdout == ""
+    # With --facts, the numbers the build's limits come from, in decimal
+    # whichever way board.h writes them (a slot of 0x18 pages).
+    hex_pages = _board_like(tmp_path / "hex", "stm32f030k6",
+                            [("#define BOARD_SLOT_PAGES 24", "#define BOARD_SLOT_PAGES 0x18")])
+    facts = subprocess.run([sys.executable, script, "--check", "--facts", hex_pages],
+                           capture_output=True, text=True)
+    assert facts.returncode == 0
+    lines = facts.stdout.splitlines()
+    assert "BOARD_SLOT_PAGES=24" in lines and "BOARD_FLASH_BASE=134217728" in lines
     bad = _board_like(tmp_path, "stm32f030k6", [("#define BOARD_RAM_SIZE 4096", "#define BOARD_RAM_SIZE 8192")])
     run = subprocess.run([sys.executable, script, "--check", bad], capture_output=True, text=True)
     assert run.returncode == 1

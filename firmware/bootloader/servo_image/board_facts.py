@@ -145,12 +145,25 @@ def check(board) -> list:
     return problems
 
 
-if __name__ == "__main__":
-    # python3 board_facts.py --check FOLDER...: the build's check of a board
-    # against its part (cmake/arm-image.cmake); exit 1 with a line a problem.
-    if len(sys.argv) < 3 or sys.argv[1] != "--check":
-        sys.exit("usage: board_facts.py --check BOARD_FOLDER...")
-    found = [line for folder in sys.argv[2:] for line in check(Path(folder))]
+def main(argv) -> int:
+    """board_facts.py --check [--facts] FOLDER: the build's reading of a
+    board (cmake/arm-image.cmake): a line a problem against its part on
+    stderr and 1; else, with --facts, board.h's numbers as NAME=decimal
+    lines on stdout, and 0."""
+    args = [a for a in argv if not a.startswith("--")]
+    if "--check" not in argv or len(args) != 1:
+        print("usage: board_facts.py --check [--facts] BOARD_FOLDER", file=sys.stderr)
+        return 2
+    folder = Path(args[0])
+    found = check(folder)
     for line in found:
         print(f"board check: {line}", file=sys.stderr)
-    sys.exit(1 if found else 0)
+    if found:
+        return 1
+    if "--facts" in argv:
+        print("".join(f"{name}={value}\n" for name, value in defines(folder).items()), end="")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
