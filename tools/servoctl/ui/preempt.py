@@ -16,12 +16,17 @@ import queue
 import threading
 import time
 
+from .. import link_rate, registers
 from .. import protocol as p
+from ..errors import ServoError
 
 STEP_S = 0.005  # the longest a bus wait or sleep goes without looking at the interrupt
 STOP_METHOD = {"release": 0x10, "damping": 0x12}  # StopOnControlMode's, as Servo.stop's
 WRITES = {"write", "_write_all"}  # what Bus._link is handed to write (a port, a socket)
 AGAIN_S = 0.01  # host time: a click this soon after a broadcast adds nothing to the wire
+# After a frame at one rate, before the next at another: the adapter's (or
+# the simulator's) last byte out before the port changes rate.
+RATE_SWITCH_S = 0.002
 
 
 class Preemption:
@@ -125,3 +130,28 @@ class Preemption:
             self._last_stop = time.monotonic()
         except Exception:  # noqa: BLE001 - a lost link: the bus thread's stop_all reports it
             pass
+
+
+def stop_at_every_rate(bus, sim_control, mode: str) -> list:
+    """On the bus thread, after the stops at the host's rate: the broadcast
+    stop again at every other rate item 36 gives a servo, then the host's
+    rate back, so a servo set to another rate (from the page: the host's
+    rate follows the one changed, the others stay at the old) is stopped
+    too. Fastest first, each frame on the wire before the rate changes
+    (about 30 ms in all). Not on socket:// without the simulator's control
+    port: the far end sets the rate there. What failed, a line each."""
+    if link_rate.is_socket(bus.port) and not sim_control:
+        return []
+    host = bus.serial.baudrate
+    content = p.encode_request(p.STOP_ON_CONTROL, p.BROADCAST, STOP_METHOD[mode], 0)
+    wire_bits = len(p.request_frame(p.STOP_ON_CONTROL, content)) * 10
+    failed = []
+    with link_rate.restored(bus, sim_control):
+        for rate in sorted(set(registers.BAUD_RATES.values()) - {host}, reverse=True):
+            try:
+                link_rate.set_rate(bus, sim_control, rate)
+                bus.send(p.STOP_ON_CONTROL, content)
+                bus.sleep(wire_bits / rate + RATE_SWITCH_S)
+            except ServoError as e:
+                failed.append(f"broadcast stop at {rate} baud: {e}")
+    return failed

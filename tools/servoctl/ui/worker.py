@@ -21,7 +21,7 @@ from ..errors import EXIT_INTERRUPTED, NoReply, ServoError
 from ..servo import Servo
 from . import sampling
 from .files import Folder
-from .preempt import STOP_METHOD, Preemption
+from .preempt import STOP_METHOD, Preemption, stop_at_every_rate
 
 # Commands the page may run as they are: those that end on their own. A
 # monitor, a stream and the ui itself run until stopped; sim and image need
@@ -78,6 +78,12 @@ class _Lines(io.TextIOBase):
 
     def text(self) -> str:
         return "\n".join(self.all + ([self.shown(self.part)] if self.part else []))
+
+
+
+def _option(argv: list, name: str):
+    """A global option's value as the page's commands are given it, or None."""
+    return argv[argv.index(name) + 1] if name in argv[:-1] else None
 
 
 class Worker:
@@ -324,6 +330,7 @@ class Worker:
         ids = self.known or self.plot_ids
         said = [self.run_quiet(["stop", str(i), "--mode", mode]) for i in ids]
         failed += [r["err"] for r in said if r["code"]]
+        failed += stop_at_every_rate(self.bus, _option(self.global_argv, "--sim-control"), mode)
         self.publish({"type": "stopped", "mode": mode, "ids": ids, "failed": failed, "stops": self.stops})
 
     # The thread -------------------------------------------------------------

@@ -28,6 +28,26 @@ def test_stop_all_stops_a_servo_the_last_scan_did_not_list():
         assert said[-1]["type"] == "stopped" and not said[-1]["failed"], said[-1]
 
 
+def test_stop_all_stops_a_servo_left_at_another_baud_rate():
+    """A baud change from the page moves the host's rate with the servo
+    changed (the simulator's, on its control port): the others, left at
+    the old rate, were deaf to STOP ALL and turned on. The broadcast goes
+    out at every rate item 36 has, and the host's rate comes back."""
+    with Simulator(ids=[1, 2], fast=True) as sim:
+        said = []
+        w = _worker(sim, said)
+        for servo_id in (1, 2):
+            assert w.run(["wheel", str(servo_id), "run", "--speed", "180"])["code"] == 0
+        changed = w.run(["config", "set", "1", "baud", "1000000"])
+        assert changed["code"] == 0 and w.bus.serial.baudrate == 1000000, changed
+        sim.wait_until(lambda: all(abs(sim.state(i)["velocity"]) > 100 for i in (1, 2)), timeout_s=10)
+        w.known = [1, 2]
+        w.stop_all("damping")
+        sim.wait_until(lambda: all(abs(sim.state(i)["velocity"]) < 2 for i in (1, 2)), timeout_s=5)
+        assert w.bus.serial.baudrate == 1000000  # the host's rate as it was
+        assert said[-1]["type"] == "stopped"
+
+
 def test_the_bus_thread_outlives_a_lost_link_and_a_bad_plot_request():
     """A link that fails while several servos are plotted (a USB adapter
     pulled), or a plot of ID 300, is told to the page; the thread that
