@@ -45,8 +45,7 @@ enum { READY_AFTER_US = 5000 };
 /* How often a paced simulator standing still looks at the host's clock
  * word (sim_clock.h) when no byte wakes it. */
 enum { PACED_POLL_US = 200 };
-/* How long after its last byte the host counts as taking its turn
- * (host_turn_bound); later, a simulator behind the wall clock catches up. */
+/* How long after its last byte the host counts as taking its turn. */
 enum { HOST_TURN_US = 50000 };
 /* For this long of it the simulator does not sleep: a host that answers
  * within it has its bytes taken at the bus time they came, not when the PC
@@ -305,11 +304,9 @@ int main(int argc, char **argv)
             wait_us = paced_may_run(answered, waits) ? 0 : PACED_POLL_US;
         } else if (host_turn_bound(wall, wall) > bus.now_us + SIM_BUS_STEP_US ||
                    (waits > wall && !answered) || host_turn(wall, HOST_SPIN_US)) {
-            /* Behind where it may run (the wall clock, or in the host's turn
-             * the wall time since its last byte: a pass that slept its step
-             * and more would otherwise lose the rest, 0.8 x real time for a
-             * host that takes 20-45 ms a turn), or running ahead for the
-             * host, or the host's turn just begun. */
+            /* A step behind where it may run (the wall clock; in the host's
+             * turn, the wall time since its last byte: else each oversleep
+             * is lost), or running ahead for the host, or its turn begun. */
             wait_us = 0;
         }
         struct timespec timeout = {.tv_sec = 0, .tv_nsec = wait_us * 1000};
