@@ -135,6 +135,9 @@ static speed_t speed_of(uint32_t baud)
     }
 }
 
+/* How much of a device's name the latency advice shows. */
+#define NAME_SHOWN 24
+
 /* A port's device name (NAME of /dev/NAME) into name (NAME_MAX + 1 bytes),
  * its links resolved first: /dev/serial/by-id/usb-FTDI_...-port0 is ttyUSB0. */
 static void port_name(const char *path, char *name)
@@ -198,11 +201,14 @@ void sb_serial_check_latency(sb_posix *p, const char *path)
         if (written && p->latency_timer_ms <= 1)
             return;
     }
+    /* A USB serial device's name (ttyUSB0) is short; a longer one is shown
+     * cut at NAME_SHOWN, so the advice always fits its buffer whole. */
     cut = snprintf(p->advice, sizeof p->advice,
-                   "%s's latency timer is %d ms: every answer waits for it. Run "
-                   "'echo 1 | sudo tee /sys/bus/usb-serial/devices/%s/latency_timer' "
-                   "(or a udev rule setting ATTR{latency_timer}=\"1\")", name, p->latency_timer_ms, name);
-    (void)cut; /* a device name of over 40 characters cuts it short */
+                   "%.*s's latency timer is %d ms: every answer waits for it. Run "
+                   "'echo 1 | sudo tee /sys/bus/usb-serial/devices/%.*s/latency_timer' "
+                   "(or a udev rule setting ATTR{latency_timer}=\"1\")", NAME_SHOWN, name,
+                   p->latency_timer_ms, NAME_SHOWN, name);
+    (void)cut;
 }
 
 int sb_serial_open(sb_posix *p, const char *path, uint32_t baud)

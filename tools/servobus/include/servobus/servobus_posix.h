@@ -17,7 +17,7 @@ typedef struct sb_posix {
     int low_water;       /* the socket's SO_RCVLOWAT now */
     bool low_latency;    /* the serial driver took ASYNC_LOW_LATENCY */
     int latency_timer_ms; /* the adapter's latency timer (sysfs), -1: none found */
-    char advice[200];    /* what to do about a slow latency timer, or "" */
+    char advice[256];    /* what to do about a slow latency timer, or "" */
     /* A wait for bytes first looks this long without sleeping (0: sleeps
      * at once): bytes due soon are taken as they come, without the
      * process's wake-up. Opened: SB_POSIX_SPIN_US, 1.5 ms, longer than a
