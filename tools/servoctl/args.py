@@ -374,7 +374,9 @@ def build_parser():
     c.add_argument("--board", default="host", choices=["host", "stm32f103", "stm32f030k6"],
                    help="host: servo_sim (the firmware built for the PC); stm32f103, stm32f030k6: "
                         "the board's shipped images on its emulated chip (tools/vboard)")
-    c.add_argument("--id", dest="ids", type=int, action="append")
+    c.add_argument("--id", dest="ids", type=int, action="append", metavar="ID",
+                   help="a simulated servo at this ID, one for each --id (default: one at ID 1; "
+                        "a servo new from the factory is at ID 0)")
     c.add_argument("--tcp", type=int, nargs="?", const=0, default=None, metavar="PORT",
                    help="a TCP port instead of a pty (any free port if none given)")
     c.add_argument("--link", help="symlink to the pty (not with --tcp)")

@@ -129,6 +129,8 @@ class Arm:
             raise UsageError(f"watchdog_action is one of {', '.join(WATCHDOG_ACTIONS)}, not {watchdog_action!r}")
         if firmware not in ("auto", "servoctl", "maker"):
             raise UsageError(f"firmware is auto, servoctl or maker, not {firmware!r}")
+        if isinstance(fps, bool) or not isinstance(fps, (int, float)) or not (math.isfinite(fps) and fps > 0):
+            raise UsageError(f"fps is the loop's frames a second, more than 0, not {fps!r}")
         if not (ramp_speed_deg_s >= 0 and math.isfinite(ramp_speed_deg_s)):
             raise UsageError(f"ramp_speed_deg_s is 0 (no ramp) or a speed in deg/s, not {ramp_speed_deg_s!r}")
         self.bus, self.joints = bus, dict(joints)

@@ -217,8 +217,8 @@ def host_timing(args, bus=None):
         raise UsageError(f"--host-jitter-ms, --host-late-every: {e}") from None
     if host and bus is not None and getattr(bus, "note_sent", None) is None:
         print("servoctl: the host-timing model's jitter adds to this PC's own timing here (a simulator in "
-              "real time, or a servo): a paced simulator (servo_sim --clock paced) shows the model alone",
-              file=sys.stderr)
+              "real time, or a servo); the model's figures alone are a paced simulator's (docs/streaming.md, "
+              "\"Figures\")", file=sys.stderr)
     return host or None
 
 
@@ -259,12 +259,12 @@ def cmd_stream(bus, args):
         if abs(moved) >= 180.0:
             print(f"  warning: servo {servo_id} turned {abs(moved):.1f} deg to reach the first row: angles are "
                   f"from its zero, in the turn around it at power-up (docs/servoctl.md)")
-    print(f"{report.cycles} setpoints at {1 / period:g} Hz to {len(angles)} servo(s)")
+    print(f"{report.cycles} setpoints at {1 / period:.4g} Hz to {len(angles)} servo(s)")
     for servo_id in angles:
         print(f"  servo {servo_id}: tracking error RMS {report.rms_deg[servo_id]:.2f} deg, "
               f"peak {report.peak_deg[servo_id]:.2f} deg")
     r = report.rate  # check_wire let the file's rate through: _who_was_late says what held it up
-    short = f" (below the file's {1 / period:g} Hz: {_who_was_late(report)})" if _late(report) else ""
+    short = f" (below the file's {1 / period:.4g} Hz: {_who_was_late(report)})" if _late(report) else ""
     print(f"  cycle (setpoints + Sync Monitor) ran at {r.rate_hz:.1f} Hz{short}; the wire allows "
           f"{r.wire_limit_hz:.0f} Hz at {bus.serial.baudrate} baud")
     if report.missed:

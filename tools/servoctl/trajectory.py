@@ -26,6 +26,11 @@ class Trajectory:
         return f"{self.path} line {self.lines[k]}" if self.lines else f"row {k}"
 
 
+# How far a row's time may be from the rows' even grid: half a ms, a stamp's
+# own rounding (streamed setpoints are stamped in whole ms).
+GRID_S = 0.0005 + 1e-9
+
+
 def _is_number(cell: str) -> bool:
     try:
         float(cell)
@@ -49,10 +54,17 @@ def read_trajectory(path: str) -> Trajectory:
     if len(rows) < 3:
         raise UsageError(f"{path}: a header and at least two rows are needed")
     line, header = rows[0]
+    if len(header) < 2:
+        raise UsageError(f"{path} line {line}: the header is 'time' and servo IDs, separated by commas, not "
+                         f"{','.join(header)!r}")
     try:
         ids = [int(c) for c in header[1:]]
+    except ValueError:
+        cell = next(c for c in header[1:] if not c.strip().lstrip("+-").isdigit())
+        raise UsageError(f"{path} line {line}: the header is 'time' and servo IDs, not {cell.strip()!r}") from None
+    try:
         check_ids(ids)
-    except (ValueError, UsageError) as e:
+    except UsageError as e:
         raise UsageError(f"{path} line {line}: the header is 'time' and servo IDs ({e})") from None
     table, lines = [], []
     for line, r in rows[1:]:
@@ -79,11 +91,18 @@ def read_trajectory(path: str) -> Trajectory:
     period = (times[-1] - times[0]) / (len(times) - 1)
     if period <= 0:
         raise UsageError(f"{path}: the times must be evenly spaced and rising; nothing was sent")
-    for k in range(1, len(times)):
-        if abs(times[k] - times[k - 1] - period) > 1e-4:
-            raise UsageError(f"{path} line {lines[k]}: the times must be evenly spaced and rising "
-                             f"({period * 1000:g} ms apart), not {times[k - 1]:g} then {times[k]:g} s; "
-                             f"nothing was sent")
+    # Times written to the ms (a 30 Hz file's 0.033, 0.067) are on the grid:
+    # each within half a ms of it, each step within a ms of the one before.
+    # The first step unlike the one before names its row; then a drift.
+    steps = [times[k] - times[k - 1] for k in range(1, len(times))]
+    uneven = [k for k in range(1, len(times))
+              if steps[k - 1] <= 0 or abs(steps[k - 1] - steps[max(k - 2, 0)]) > 2 * GRID_S]
+    uneven = uneven or [k for k in range(1, len(times)) if abs(times[k] - times[0] - k * period) > GRID_S]
+    if uneven:
+        k = uneven[0]
+        raise UsageError(f"{path} line {lines[k]}: the times must be evenly spaced and rising "
+                         f"({period * 1000:.4g} ms apart, from the first and last rows), not "
+                         f"{times[k - 1]:g} then {times[k]:g} s; nothing was sent")
     try:
         check_range("period", round(period * 1000), *PERIOD_RANGE_MS, "ms")
     except ValueOutOfRange as e:

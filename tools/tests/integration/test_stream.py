@@ -151,14 +151,26 @@ def test_stream_refuses_what_it_cannot_send():
 @pytest.mark.parametrize("text, why", [
     ("time,1\n0,0\n", "a header and at least two rows"),
     ("time,1\n0,0\n0.02,1\n0.05,2\n", "evenly spaced"),
-    ("time,x\n0,0\n0.02,1\n", "servo IDs"),
+    ("time,x\n0,0\n0.02,1\n", "the header is 'time' and servo IDs, not 'x'"),
+    ("time;1\n0;0\n0.02;1\n", "servo IDs, separated by commas, not 'time;1'"),
     ("time,1,2\n0,0,0\n0.02,1\n", "one finite angle per servo"),
+    # The row at fault is named: the repeated time's, not the one before it.
+    ("time,1\n0,0\n0.02,1\n0.02,2\n0.03,3\n", r"t.csv line 4: .* not 0.02 then 0.02 s"),
 ])
 def test_a_bad_trajectory_file_says_what_is_wrong(tmp_path, text, why):
     path = tmp_path / "t.csv"
     path.write_text(text)
     with pytest.raises(UsageError, match=why):
         read_trajectory(str(path))
+
+
+def test_times_written_to_the_ms_are_evenly_spaced(tmp_path):
+    """A 30 Hz file's times to the ms (0.033, 0.067): refused before, its
+    steps 0.67 ms from their mean; a stamp is whole ms anyway."""
+    path = tmp_path / "t.csv"
+    path.write_text("time,1\n" + "".join(f"{k / 30:.3f},{k}\n" for k in range(31)))
+    trajectory = read_trajectory(str(path))
+    assert trajectory.period_ms == 33
 
 
 def test_a_servo_that_does_not_follow_fails_the_stream_with_its_figures(paced3, tmp_path, capsys):

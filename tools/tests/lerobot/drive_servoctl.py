@@ -46,6 +46,21 @@ def frames(robot, sim, targets: dict, n: int) -> None:
         robot.arm.bus.sleep(t0 + (k + 1) / 30 - sim.clock_s())
 
 
+def refused_settings(out: dict) -> None:
+    """Settings that would drive the arm wrong, refused as the config is
+    made: {setting: the error's text}."""
+    cls = RobotConfig.get_choice_class("servoctl_arm")
+    out["refused"] = {}
+    for name, value in [("max_relative_target", -5.0), ("max_relative_target", float("nan")),
+                        ("max_relative_target", {"Motor_0": 5.0, "Motor_1": -1.0}), ("fps", 0),
+                        ("fps", -30.0)]:
+        try:
+            cls(port="socket://127.0.0.1:1", **{name: value})
+            out["refused"][f"{name}={value}"] = None
+        except ValueError as e:
+            out["refused"][f"{name}={value}"] = str(e)
+
+
 def follower_session(out: dict) -> None:
     sim = compare.prepare(paced=True)
     try:
@@ -194,6 +209,7 @@ def main() -> int:
     register_third_party_plugins()
     out = {}
     try:
+        refused_settings(out)
         follower_session(out)
         ramped(out)
         makers_path(out)

@@ -292,6 +292,13 @@ def test_one_id_in_two_joints_is_refused_naming_both():
     assert "a and c (servo 1)" in str(e.value), e.value
 
 
+@pytest.mark.parametrize("fps", [0, -30.0, float("nan"), float("inf"), True])
+def test_an_fps_that_is_no_rate_is_refused_before_anything_is_written(fps):
+    with pytest.raises(UsageError) as e:
+        Arm(None, {"a": 1}, fps=fps)
+    assert "fps is the loop's frames a second" in str(e.value), e.value
+
+
 def test_two_simulators_keep_their_own_records(state_dir, caplog):
     """servo_sim's serials (0x51a0UUNN) are the same in every simulator:
     arm B's clean run removed arm A's record (one file a serial), and A's

@@ -76,6 +76,15 @@ def test_max_relative_target_clamps_a_step(seen):
     assert seen["clamped"] == pytest.approx(5.0)
 
 
+def test_a_setting_that_would_drive_the_arm_wrong_is_refused_with_the_config(seen):
+    """A negative max_relative_target moved every joint that far from where
+    it was each frame, toward its limit, whatever the action; an fps of 0
+    divided by zero, a negative one wrote item 69 as 1 ms."""
+    for setting, said in seen["refused"].items():
+        name = setting.split("=")[0]
+        assert said is not None and said.startswith(f"{name} is "), (setting, said)
+
+
 def test_a_servo_that_lets_go_raises_with_its_fault_history(seen):
     err = seen["fault_error"]
     assert err.startswith("JointFault: Motor_2 (servo 2) has released its output (high_voltage)"), err

@@ -1,4 +1,5 @@
 """servoctl_arm's settings (docs/lerobot.md)."""
+import math
 from dataclasses import dataclass, field
 
 from lerobot.cameras import CameraConfig
@@ -26,3 +27,25 @@ class ServoctlArmConfig(RobotConfig, ArmBusConfig):
     # the streamed setpoints' period.
     fps: float = 30.0
     cameras: dict[str, CameraConfig] = field(default_factory=dict)
+
+    def __post_init__(self):
+        """A setting that would drive the arm wrong is refused when the
+        config is made: a negative max_relative_target moved every joint
+        that far away from where it was, each frame, whatever the action."""
+        super().__post_init__()
+        cap = self.max_relative_target
+        caps = [] if cap is None else list(cap.values()) if isinstance(cap, dict) else [cap]
+        bad = [c for c in caps if not _distance(c)]
+        if bad:
+            raise ValueError(f"max_relative_target is degrees, 0 or more (one number, or one a joint), "
+                             f"not {bad[0]!r}")
+        if not (_number(self.fps) and self.fps > 0):
+            raise ValueError(f"fps is the loop's frames a second, more than 0, not {self.fps!r}")
+
+
+def _number(x) -> bool:
+    return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
+
+
+def _distance(x) -> bool:
+    return _number(x) and x >= 0
