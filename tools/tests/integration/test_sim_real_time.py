@@ -17,8 +17,9 @@ pytestmark = pytest.mark.wall_clock
 
 RUN_S = 1.5
 # A loaded PC delays the host's turns, not the simulator's clock: it
-# catches up at once whenever it is a step behind. Before: 0.79-0.85.
-KEEPS_PACE = 0.95
+# catches up at once whenever it is a step behind, so only a stall at the
+# very end of the run (over 150 ms) reads below this. Before: 0.79-0.85.
+KEEPS_PACE = 0.9
 
 
 @pytest.mark.parametrize("turn_ms", [20, 33])
