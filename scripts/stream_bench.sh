@@ -6,6 +6,9 @@
 #     error to the sine and the setpoint's peak acceleration;
 #  2. the same path on 6 simulated servos (servo_sim, paced) at 1 Mbaud,
 #     through servoctl: the RMS error of each servo's Sync Monitor state;
+#     then streamed on the optimised simulator in real time, the host on
+#     its own clock, on time and with the host-timing model (+-10 ms, one
+#     frame in twenty a period late): the PC's own timing in the figure;
 #  3. the robot loop (one SyncCommand of setpoints and one Sync Monitor a
 #     cycle, servoctl.stream.RobotLoop) for 6 and 16 servos at 1 000 000 and
 #     115 200 baud: its rate against the wire limit, the host behind the
@@ -18,6 +21,7 @@ cd "$(dirname "$0")/.."
 bash scripts/setup.sh >/dev/null
 cmake --preset host >/dev/null
 cmake --build --preset host --target servo_sim test_stream >/dev/null
+cmake --preset sim >/dev/null && cmake --build --preset sim >/dev/null  # the real-time rows' simulator
 echo "1. one servo on the plant model (tests/unit/test_stream.c):"
 build/host/tests/test_stream 2>/dev/null | sed -n 's/^# /   /p' | head -1
 exec .venv/bin/python - <<'PY'
@@ -26,8 +30,11 @@ import sys
 
 sys.path.insert(0, "scripts")
 from bench_sim import at_baud, cycle_gaps  # the simulated servos at a rate, a cycle's gaps
+import os
+
 from servoctl import protocol as p
 from servoctl.group import sync_move, sync_monitor
+from servoctl.host_timing import HostTiming
 from servoctl.stream import RobotLoop, stream_file
 
 PERIOD, SECONDS = 0.02, 4.0
@@ -69,6 +76,15 @@ for streamed in (True, False):
             rms, peak = plain_moves(bus, ids, times)
     how = "streamed     " if streamed else "angle moves  "
     print(f"   {how} RMS error {rms:.2f} deg, peak {peak:.2f} deg (the worst servo)")
+os.environ["SERVO_SIM"] = "build/sim/firmware/boards/host_sim/servo_sim"
+for host in (None, HostTiming(0.010, 20)):
+    with at_baud(ids, 1000000) as sim, p.Bus(sim.url, baud=1000000, timeout=0.1) as bus:  # the wall clock's
+        sync_move(bus, {i: path(0) for i in ids}, 0.5, multi_turn=True)
+        bus.sleep(0.7)
+        r = stream_file(bus, times, {i: [path(t) for t in times] for i in ids}, host=host)
+    how = "real time, +-10 ms, 1 in 20 late" if host else "real time, on time"
+    print(f"   streamed, {how}: RMS error {max(r.rms_deg.values()):.2f} deg, "
+          f"peak {max(r.peak_deg.values()):.2f} deg (the worst servo)")
 
 print("3. the robot loop through servoctl's Python API (RobotLoop.cycle, 200 cycles):")
 for count, baud, link in [(c, b, l) for l in ("usb", "raw") for c in (6, 16) for b in (1000000, 115200)]:
