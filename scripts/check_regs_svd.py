@@ -64,7 +64,6 @@ FIELD_NAMES = {
 COMPOSITES = {
     "DMA_CCR_ADC_CIRCULAR": ("DMA_CCR", {"MINC": 1, "CIRC": 1, "PSIZE": 1, "MSIZE": 1, "EN": 1}),
     "DMA1_FLAGS": ("DMA1_ISR", {"GIF1": 1, "TCIF1": 1, "HTIF1": 1, "TEIF1": 1}),
-    "DMA1_CH5_FLAGS": ("DMA1_ISR", {"GIF5": 1, "TCIF5": 1, "HTIF5": 1, "TEIF5": 1}),
     "TIM_CCMR1_PWM1_BOTH": ("TIM_CCMR1", {"OC1M": 6, "OC1PE": 1, "OC2M": 6, "OC2PE": 1}),
     "TIM_CCER_CC1E_CC2E": ("TIM_CCER", {"CC1E": 1, "CC2E": 1}),
     "USART_ICR_CLEAR": ("USART_ICR", {"PECF": 1, "FECF": 1, "NCF": 1, "ORECF": 1,
@@ -85,7 +84,10 @@ COMPOSITES = {
 # Interrupt numbers: {macro: {part: the SVD's interrupt name}}.
 IRQS = {
     "USART1_IRQ": {"STM32F103xx": "USART1", "STM32F030": "USART1"},
-    "DMA1_CH5_IRQ": {"STM32F103xx": "DMA1_Channel5"},
+    "USART2_IRQ": {"STM32F103xx": "USART2"},
+    "USART3_IRQ": {"STM32F103xx": "USART3"},
+    "DMA1_CH1_IRQ": {"STM32F103xx": "DMA1_Channel1"},
+    "DMA1_CH7_IRQ": {"STM32F103xx": "DMA1_Channel7"},
     "DMA1_CH3_IRQ": {"STM32F030": "DMA_CH2_3"},
 }
 

@@ -40,7 +40,8 @@ def test_the_ports_headers_match_the_svd(part):
     ("stm32_common/stm32_core_regs.h", "RCC_APB1ENR_TIM3 (1u << 1)", "RCC_APB1ENR_TIM3 (1u << 2)", F0,
      "RCC_APB1ENR_TIM3"),
     # an interrupt number
-    ("stm32f1/stm32f1_regs.h", "DMA1_CH5_IRQ 15u", "DMA1_CH5_IRQ 16u", F1, "DMA1_CH5_IRQ"),
+    ("stm32f1/stm32f1_regs.h", "DMA1_CH1_IRQ 11u", "DMA1_CH1_IRQ 12u", F1, "DMA1_CH1_IRQ"),
+    ("stm32f1/stm32f1_regs.h", "USART2_BASE 0x40004400u", "USART2_BASE 0x40004800u", F1, "USART2_BASE"),
     # a multi-bit value past its field
     ("stm32f1/stm32f1_regs.h", "RCC_CFGR_ADCPRE_DIV6 (2u << 14)", "RCC_CFGR_ADCPRE_DIV6 (2u << 15)", F1,
      "RCC_CFGR_ADCPRE_DIV6"),

@@ -112,6 +112,11 @@ class Board:
         self.part = PARTS[board]
         self.h = board_h(board)
         h, part = self.h, self.part
+        declared = (h.get("BOARD_BUS_USART"), h.get("BOARD_BUS_DMA_TX"), h.get("BOARD_BUS_DMA_RX"))
+        if declared != (1, part.usart_tx_dma, part.usart_rx_dma):
+            raise ValueError(f"{board}: its board.h declares the bus on USART{declared[0]} with DMA channels "
+                             f"{declared[1]} (TX) and {declared[2]} (RX); the virtual {part.svd} wires it on "
+                             f"USART1 (PA9) with {part.usart_tx_dma} and {part.usart_rx_dma} only")
         self.core = Core(part.cpu, 8_000_000, part.cpi, part.has_vtor, part.irq_words)
         self.clock_setting = 0  # counts the firmware's clock switches
         self._pins_for, self._roles = None, None  # _pin_roles's cache

@@ -43,7 +43,7 @@ static const struct hal_port port = {
  * the DMA would go on writing into what is now the application's RAM. */
 static void start_app(const struct app_slot *s)
 {
-    USART_CR1(USART1_BASE) = 0;
+    USART_CR1(BUS_USART_BASE) = 0; /* the board's bus (its port's bus header) */
     board_boot_stop_dma();
     boot_jump(s->base + APP_HEADER_SIZE);
 }

@@ -20,6 +20,12 @@
 #define BOARD_RAM_BASE 0x20000000
 #define BOARD_RAM_SIZE 8192
 
+/* The bus: USART1 (QEMU's serial port), received byte by byte (QEMU 7.2
+ * models no F1 DMA; the channels are RM0008's for it all the same). */
+#define BOARD_BUS_USART 1
+#define BOARD_BUS_DMA_TX 4
+#define BOARD_BUS_DMA_RX 5
+
 /* The analogue front end and the motor: the reference servo's. */
 #include "boards/common/reference_servo.h"
 

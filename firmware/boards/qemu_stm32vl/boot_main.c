@@ -9,6 +9,7 @@
 #include "board.h"
 #include "qemu_board.h"
 #include "ports/stm32f1/stm32f1_regs.h"
+#include "ports/stm32f1/stm32f1_bus.h"
 #include "ports/stm32f1/stm32f1_uart.h"
 
 static bool refuse_erase(void *ctx, uint32_t addr)
@@ -58,11 +59,14 @@ static void qemu_service(struct usart_hd *usart)
 #define board_clock_init() ((void)0) /* QEMU's clock is fixed */
 #define bus_pins_init() ((void)0)    /* and its USART has no pins to set */
 #define board_boot_flash_init qemu_flash_init
+static const struct stm32f1_bus bus_hw = STM32F1_BUS;
+STM32F1_BUS_HANDLERS
+
 /* No DMA model: by interrupt. */
-#define board_boot_uart_start(usart, ring, dma)                  \
-    do {                                                         \
-        (void)(dma);                                             \
-        port_uart_init((usart), (ring), NULL, QEMU_CORE_HZ);     \
+#define board_boot_uart_start(usart, ring, dma)                          \
+    do {                                                                 \
+        (void)(dma);                                                     \
+        port_uart_init((usart), (ring), NULL, QEMU_CORE_HZ, &bus_hw);    \
         usart_hd_tx_polled(usart);                               \
         usart_hd_no_echo(usart);                                 \
     } while (0)

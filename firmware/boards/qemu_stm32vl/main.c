@@ -8,6 +8,7 @@
 #include "boards/common/app_hooks.h"
 #include "ports/stm32f1/stm32f1_regs.h"
 #include "ports/stm32_common/systick_clock.h"
+#include "ports/stm32f1/stm32f1_bus.h"
 #include "ports/stm32f1/stm32f1_uart.h"
 #include "ports/stm32f1/usart_hd.h"
 
@@ -81,6 +82,9 @@ static void ram_read(void *ctx, uint32_t addr, uint8_t *dst, uint32_t len)
     }
 }
 
+static const struct stm32f1_bus bus_hw = STM32F1_BUS;
+STM32F1_BUS_HANDLERS
+
 /* QEMU's part has no unique ID: a fixed serial number. */
 static uint32_t serial_number(void *ctx)
 {
@@ -109,11 +113,11 @@ int main(void)
     }
     flash = hal_flash_two_pages(NULL, FLASH_PAGE, RAM_FLASH_BASE, ram_erase, ram_program, ram_read);
     systick_clock_init(QEMU_CORE_HZ);
-    port_uart_init(&usart, &rx_ring, NULL, QEMU_CORE_HZ); /* no DMA model: by interrupt */
+    port_uart_init(&usart, &rx_ring, NULL, QEMU_CORE_HZ, &bus_hw); /* no DMA model: by interrupt */
     usart_hd_tx_polled(&usart); /* QEMU 7.2's USART raises no transmit interrupts */
     usart_hd_no_echo(&usart);   /* and its socket does not echo our bytes */
     servo_init(&servo, &port);
-    NVIC_ISER(USART1_IRQ / 32u) = 1u << (USART1_IRQ % 32u);
+    NVIC_ISER(BUS_USART_IRQ / 32u) = 1u << (BUS_USART_IRQ % 32u);
     for (;;) {
         usart_hd_service(&usart);
         servo_poll(&servo);

@@ -26,6 +26,12 @@
 #define BOARD_RAM_BASE 0x20000000
 #define BOARD_RAM_SIZE 4096
 #define BOARD_RAM_VECTORS_SIZE 192
+
+/* The bus: USART1 (PA9), its DMA1 requests on channels 2 (TX) and 3 (RX)
+ * (RM0360; ports/stm32f0/stm32f0_bus.h checks). */
+#define BOARD_BUS_USART 1
+#define BOARD_BUS_DMA_TX 2
+#define BOARD_BUS_DMA_RX 3
 /* The application's stack: cmake/stack-report.py's static worst case is
  * 760 B (main's deepest path, every packet handler and HAL operation
  * behind its pointers, the deepest interrupt and its 32 B frame). It does

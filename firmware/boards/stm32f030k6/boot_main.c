@@ -6,6 +6,7 @@
 #include "board.h"
 #include "board_io.h"
 #include "ports/stm32f0/stm32f0_regs.h"
+#include "ports/stm32f0/stm32f0_bus.h"
 #include "ports/stm32f0/stm32f0_uart.h"
 
 #define BOARD_USART struct usart_v2_hd

@@ -27,6 +27,12 @@
  * ports/stm32_common/fault_keep.c). */
 #define BOARD_STACK_ALIGN 256
 
+/* The bus: USART1 (PA9), its DMA1 requests on channels 4 (TX) and 5 (RX),
+ * as RM0008 Table 78 has them (ports/stm32f1/stm32f1_bus.h checks). */
+#define BOARD_BUS_USART 1
+#define BOARD_BUS_DMA_TX 4
+#define BOARD_BUS_DMA_RX 5
+
 
 /* The receive ring (hal/hal_rx_ring.h): a page erase stalls the CPU up
  * to 40 ms (DS5319, "Flash memory characteristics", tERASE) while the DMA

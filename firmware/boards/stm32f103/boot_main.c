@@ -6,19 +6,23 @@
 #include "board.h"
 #include "board_io.h"
 #include "ports/stm32f1/stm32f1_regs.h"
+#include "ports/stm32f1/stm32f1_bus.h"
 #include "ports/stm32f1/stm32f1_uart.h"
 
 #define BOARD_USART struct usart_hd
 #define BOARD_BOOT_BUS PORT_UART_BUS_DMA
 #define BOARD_CORE_HZ F103_CORE_HZ
 #define board_clock_init clock_f103_init
+static const struct stm32f1_bus bus_hw = STM32F1_BUS;
+STM32F1_BUS_HANDLERS
+
 /* No USART interrupt: its vector is not in the table. */
-#define board_boot_uart_start(usart, ring, dma)                \
-    do {                                                       \
-        port_uart_init((usart), (ring), (dma), F103_PCLK2_HZ); \
-        usart_hd_tx_polled(usart);                             \
+#define board_boot_uart_start(usart, ring, dma)                         \
+    do {                                                                \
+        port_uart_init((usart), (ring), (dma), F103_PCLK2_HZ, &bus_hw); \
+        usart_hd_tx_polled(usart);                                      \
     } while (0)
-#define board_boot_stop_dma() (REG32(DMA1_CCR5_ADDR) = 0)
+#define board_boot_stop_dma() (REG32(bus_hw.dma_rx_ccr) = 0)
 #define board_boot_service usart_hd_service
 
 #include "boards/common/boot_start.h"

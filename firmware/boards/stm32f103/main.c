@@ -4,6 +4,7 @@
 #include "board.h"
 #include "board_io.h"
 #include "ports/stm32f1/stm32f1_regs.h"
+#include "ports/stm32f1/stm32f1_bus.h"
 #include "ports/stm32f1/stm32f1_uart.h"
 #include "ports/stm32f1/usart_hd.h"
 
@@ -21,12 +22,15 @@ static void board_pins_init(void)
                 (GPIO_AF_PUSH_PULL_50MHZ << 28) | (0x4u << 16) | (0x4u << 20);
 }
 
+static const struct stm32f1_bus bus_hw = STM32F1_BUS;
+STM32F1_BUS_HANDLERS
+
 /* Sends by DMA; its transmission's end is the USART interrupt's. */
-#define board_uart_start(usart, ring, dma)                    \
-    do {                                                      \
-        port_uart_init((usart), (ring), (dma), F103_PCLK2_HZ); \
-        port_uart_send_by_dma(usart);                         \
+#define board_uart_start(usart, ring, dma)                              \
+    do {                                                                \
+        port_uart_init((usart), (ring), (dma), F103_PCLK2_HZ, &bus_hw); \
+        port_uart_send_by_dma(usart);                                   \
     } while (0)
-#define board_interrupts_on() (NVIC_ISER(USART1_IRQ / 32u) = 1u << (USART1_IRQ % 32u))
+#define board_interrupts_on() (NVIC_ISER(BUS_USART_IRQ / 32u) = 1u << (BUS_USART_IRQ % 32u))
 
 #include "boards/common/app_start.h"

@@ -23,8 +23,10 @@
 #define GPIO_AF_PUSH_PULL_50MHZ 0xBu
 #define GPIO_AF_OPEN_DRAIN_50MHZ 0xFu
 
-/* USART1 */
+/* USART1-3: a board's bus names one (stm32f1_bus.h) */
 #define USART1_BASE 0x40013800u
+#define USART2_BASE 0x40004400u
+#define USART3_BASE 0x40004800u
 #define USART_SR(b) REG32((b) + 0x00u)
 #define USART_DR_OFFSET 0x04u
 #define USART_DR(b) REG32((b) + USART_DR_OFFSET)
@@ -47,6 +49,8 @@
 #define USART_CR1_UE (1u << 13)
 #define USART_CR3_HDSEL (1u << 3)
 #define USART1_IRQ 37u
+#define USART2_IRQ 38u
+#define USART3_IRQ 39u
 
 
 /* ADC1 with DMA1 channel 1 */
@@ -66,12 +70,10 @@
 #define ADC_CR2_EXTSEL_SWSTART (7u << 17)
 #define ADC_CR2_EXTTRIG (1u << 20)
 #define ADC_CR2_SWSTART (1u << 22)
-/* DMA1 channel 1 serves ADC1, channel 4 USART1_TX, channel 5 USART1_RX
- * (RM0008 table 78). */
-#define DMA1_CCR4_ADDR DMA1_CCR_ADDR(4u)
-#define DMA1_CCR5_ADDR DMA1_CCR_ADDR(5u)
-#define DMA1_CH5_FLAGS DMA1_FLAGS(5u)
-#define DMA1_CH5_IRQ 15u
+/* DMA1 channel 1 serves ADC1; a bus's USART its own two channels (RM0008
+ * table 78, stm32f1_bus.h). Channel n's interrupt is DMA1_CH1_IRQ + n - 1. */
+#define DMA1_CH1_IRQ 11u
+#define DMA1_CH7_IRQ 17u
 
 
 /* 96-bit unique device ID (F103) */

@@ -7,35 +7,35 @@
 
 static struct usart_hd *bus_usart;
 static struct dma_rx *bus_dma;
+static const struct stm32f1_bus *bus_hw;
 
-void USART1_IRQHandler(void);
-void USART1_IRQHandler(void)
+void port_uart_irq(void)
 {
     usart_hd_irq(bus_usart);
 }
 
-void DMA1_Channel5_IRQHandler(void);
-void DMA1_Channel5_IRQHandler(void)
+void port_uart_dma_irq(void)
 {
-    DMA1_IFCR = DMA1_CH5_FLAGS;
+    DMA1_IFCR = bus_hw->dma_rx_flags;
     dma_rx_lap(bus_dma);
 }
 
 void port_uart_send_by_dma(struct usart_hd *usart)
 {
-    usart_hd_tx_dma(usart, DMA1_CCR4_ADDR);
+    usart_hd_tx_dma(usart, bus_hw->dma_tx_ccr);
 }
 
 void port_uart_init(struct usart_hd *usart, struct hal_rx_ring *ring, struct dma_rx *dma,
-                    uint32_t pclk_hz)
+                    uint32_t pclk_hz, const struct stm32f1_bus *bus)
 {
     bus_usart = usart;
-    usart_hd_init(usart, USART1_BASE, pclk_hz, 115200u, true, ring, systick_now_us);
+    bus_hw = bus;
+    usart_hd_init(usart, bus->usart_base, pclk_hz, 115200u, true, ring, systick_now_us);
     if (dma != NULL) {
         bus_dma = dma;
         RCC_AHBENR |= RCC_AHBENR_DMA1;
-        dma_rx_start(dma, DMA1_CCR5_ADDR, USART1_BASE + USART_DR_OFFSET, ring);
+        dma_rx_start(dma, bus->dma_rx_ccr, bus->usart_base + USART_DR_OFFSET, ring);
         usart_hd_rx_dma(usart);
-        NVIC_ISER(DMA1_CH5_IRQ / 32u) = 1u << (DMA1_CH5_IRQ % 32u);
+        NVIC_ISER(bus->dma_rx_irq / 32u) = 1u << (bus->dma_rx_irq % 32u);
     }
 }

@@ -1,0 +1,55 @@
+/* The servo bus's instances on an STM32F1, from the board's declaration
+ * (its board.h, included before this file): BOARD_BUS_USART (1, 2 or 3)
+ * and the DMA1 channels of its requests, BOARD_BUS_DMA_TX and
+ * BOARD_BUS_DMA_RX, checked against RM0008 when the board is built. It
+ * names the port's instance (STM32F1_BUS), the handlers the vector table
+ * calls for it, and the USART the bootloader stops before the jump. */
+#ifndef STM32F1_BUS_H
+#define STM32F1_BUS_H
+
+#include "ports/stm32f1/stm32f1_regs.h"
+#include "ports/stm32f1/stm32f1_uart.h"
+
+#if !defined(BOARD_BUS_USART) || !defined(BOARD_BUS_DMA_TX) || !defined(BOARD_BUS_DMA_RX)
+#error "board.h declares the bus: BOARD_BUS_USART, BOARD_BUS_DMA_TX and BOARD_BUS_DMA_RX (docs/building.md)"
+#endif
+
+_Static_assert(BOARD_BUS_USART >= 1 && BOARD_BUS_USART <= 3,
+               "board.h: BOARD_BUS_USART is 1, 2 or 3 on an STM32F1 (RM0008)");
+/* RM0008 Table 78, DMA1's requests: USART1 TX 4 RX 5, USART2 TX 7 RX 6,
+ * USART3 TX 2 RX 3. */
+_Static_assert(BOARD_BUS_DMA_TX == (BOARD_BUS_USART == 1 ? 4 : BOARD_BUS_USART == 2 ? 7 : 2) &&
+                   BOARD_BUS_DMA_RX == (BOARD_BUS_USART == 1 ? 5 : BOARD_BUS_USART == 2 ? 6 : 3),
+               "board.h: BOARD_BUS_DMA_TX and BOARD_BUS_DMA_RX are not its USART's DMA1 channels "
+               "(RM0008 Table 78: USART1 4 and 5, USART2 7 and 6, USART3 2 and 3)");
+
+/* The instances' facts are stm32f1_regs.h's, checked against ST's SVD. */
+#define BUS_USART_BASE (BOARD_BUS_USART == 1 ? USART1_BASE : BOARD_BUS_USART == 2 ? USART2_BASE : USART3_BASE)
+#define BUS_USART_IRQ (BOARD_BUS_USART == 1 ? USART1_IRQ : BOARD_BUS_USART == 2 ? USART2_IRQ : USART3_IRQ)
+#define BUS_DMA_RX_IRQ (DMA1_CH1_IRQ + BOARD_BUS_DMA_RX - 1u)
+_Static_assert(DMA1_CH7_IRQ == DMA1_CH1_IRQ + 6u, "DMA1's channel interrupts are in a row (RM0008)");
+
+#define STM32F1_BUS                                                                                \
+    {.usart_base = BUS_USART_BASE, .dma_tx_ccr = DMA1_CCR_ADDR(BOARD_BUS_DMA_TX),                  \
+     .dma_rx_ccr = DMA1_CCR_ADDR(BOARD_BUS_DMA_RX), .dma_rx_flags = DMA1_FLAGS(BOARD_BUS_DMA_RX),  \
+     .dma_rx_irq = BUS_DMA_RX_IRQ}
+
+/* The handlers by the names the vector table gives them (startup_stm32f103.c). */
+#define STM32F1_CAT3_(a, b, c) a##b##c
+#define STM32F1_CAT3(a, b, c) STM32F1_CAT3_(a, b, c)
+#define BUS_USART_HANDLER STM32F1_CAT3(USART, BOARD_BUS_USART, _IRQHandler)
+#define BUS_DMA_RX_HANDLER STM32F1_CAT3(DMA1_Channel, BOARD_BUS_DMA_RX, _IRQHandler)
+/* Defines both in the board's main.c or boot_main.c (one file an image). */
+#define STM32F1_BUS_HANDLERS          \
+    void BUS_USART_HANDLER(void);     \
+    void BUS_USART_HANDLER(void)      \
+    {                                 \
+        port_uart_irq();              \
+    }                                 \
+    void BUS_DMA_RX_HANDLER(void);    \
+    void BUS_DMA_RX_HANDLER(void)     \
+    {                                 \
+        port_uart_dma_irq();          \
+    }
+
+#endif
