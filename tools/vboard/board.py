@@ -111,6 +111,7 @@ class Board:
         self.name, self.servo_id, self.bus, self.unit = board, servo_id, bus, unit
         self.part = PARTS[board]
         self.h = board_h(board)
+        self.part_facts = board_facts.parts()[board_facts.part_name(board)]  # firmware/parts/parts.toml
         h, part = self.h, self.part
         declared = (h.get("BOARD_BUS_USART"), h.get("BOARD_BUS_DMA_TX"), h.get("BOARD_BUS_DMA_RX"))
         if declared != (1, part.usart_tx_dma, part.usart_rx_dma):
@@ -122,7 +123,7 @@ class Board:
         self._pins_for, self._roles = None, None  # _pin_roles's cache
         uc = self.core.uc
         self.flash_base = h["BOARD_FLASH_BASE"]
-        self.flash_size = h["BOARD_CONFIG_PAGE1"] + h["BOARD_FLASH_PAGE"] - self.flash_base
+        self.flash_size = self.part_facts["flash_size"]
         self.flash_mem = Memory(self.flash_size, 0xFF)
         self.ram = Memory(h["BOARD_RAM_SIZE"], 0)
         self.core.map_host(self.flash_base, self.flash_size, self.flash_mem.buf)

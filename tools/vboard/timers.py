@@ -14,14 +14,13 @@ twice the APB clock: RM0008 7.2's clock tree, RM0360 6.2's) over
 PSC + 1, modulo ARR + 1.
 
 The IWDG (RM0008 19, RM0360 18): started by its key, counting down at the
-LSI's 40 kHz (DS5319/DS9773 typical) divided by 4 << PR from RLR; a reload
+LSI's frequency (the part's typical, firmware/parts/parts.toml: 40 kHz on
+the F103 and F030, DS5319/DS9773) divided by 4 << PR from RLR; a reload
 key starts it over; reaching 0 resets the chip. Once started it cannot be
 stopped."""
 from unicorn import UC_HOOK_MEM_WRITE
 
 from .model import Model
-
-LSI_HZ = 40_000
 
 
 class BridgeTimer(Model):
@@ -100,7 +99,7 @@ class Watchdog(Model):
 
     def _period_s(self) -> float:
         prescaler = 4 << (self.get("PR") & 7)
-        return ((self.get("RLR") & 0xFFF) + 1) * prescaler / LSI_HZ
+        return ((self.get("RLR") & 0xFFF) + 1) * prescaler / self.board.part_facts["lsi_hz"]
 
     def _kr(self, value, old, size):
         """The main loop's reload comes every pass: the fast path first.
