@@ -25,8 +25,7 @@ cmake --build --preset host --target servo_sim servobus >/dev/null
 out=build/c-loop-bench
 mkdir -p "$out"
 gcc -std=c99 -O2 -Wall -Wextra -Werror -Itools/servobus/include -Itools/servobus -Ibuild/host/generated_servobus \
-  tools/servobus/src/sb_codec.c tools/servobus/src/sb_rules.c tools/servobus/src/sb_parse.c tools/servobus/src/sb_bus.c tools/servobus/src/sb_loop.c \
-  tools/servobus/src/sb_text.c tools/servobus/src/sb_posix.c build/host/generated_servobus/servobus/sb_schema.c \
+  tools/servobus/src/sb_*.c build/host/generated_servobus/servobus/sb_*.c \
   tools/servobus/examples/loop_bench.c tools/servobus/examples/sb_sim_clock.c -lm -o "$out/sb_loop_bench"
 CYCLES=${1:-200} HOST_LINK=${HOST_LINK:-raw} BENCH="$out/sb_loop_bench" exec .venv/bin/python - <<'PY'
 import math

@@ -200,7 +200,7 @@ def python_imports(root):
 def symbol_graph(root, build):
     """module -> the modules whose symbols its object uses, from a build's
     compile_commands.json and nm: each firmware source once (its first
-    object), a module being a source without its suffix."""
+    object), and servobus's, a module being a source without its suffix."""
     objects = {}
     for entry in json.loads((build / "compile_commands.json").read_text()):
         source = Path(entry["directory"], entry["file"]).resolve()
@@ -208,7 +208,10 @@ def symbol_graph(root, build):
             rel = source.relative_to(root.resolve()).as_posix()
         except ValueError:
             continue
-        if rel.startswith(("build/", "tests/")) or layer_of(rel) is None or rel in objects:
+        # The C library's files too (its generated ones are in the build):
+        # no circle between them either.
+        servobus = rel.startswith("tools/servobus/src/") or "/generated_servobus/servobus/" in rel
+        if rel in objects or not servobus and (rel.startswith(("build/", "tests/")) or layer_of(rel) is None):
             continue
         # "output" is CMake 3.26's; before it, the command's -o.
         output = entry.get("output") or re.search(r"\s-o\s+(\S+)", entry["command"]).group(1)

@@ -5,7 +5,10 @@ gen_protocol.py (`gen_protocol.py servobus OUTDIR`), which reads the schema.
                            as a struct, the typed encoders, decoders and calls
     servobus/sb_schema.c   the tables the generic codec walks (every field's
                            type and range, every data item's size and range)
-                           and the typed functions over them
+    servobus/sb_codecs.c   the typed encoders and decoders over them (above
+                           the codec, which reads only the tables)
+    servobus/sb_calls.c    the typed sends and calls (above the bus, which
+                           decodes with the typed decoders): no circle
 
 Every field keeps the schema's range: a request field's {min, max} (the
 servo clamps or refuses beyond; the library refuses), else its type's; an
@@ -134,7 +137,9 @@ def _copies(fields, back: bool) -> str:
                    for k, f in enumerate(fields))
 
 
-def _functions(p) -> str:
+def _functions(p, calls: bool) -> str:
+    """A packet's typed encoder, content and decoder (sb_codecs.c), or its
+    send or call on a bus (sb_calls.c, calls)."""
     n, code = _name(p), f"SB_PKT_{p.c}"
     req, nreq, nans = len(p.request) > 0, len(p.request), len(p.answer)
     fill = (f"    sb_value v[{nreq}];\n    memset(v, 0, sizeof v);\n" + _copies(p.request, False)) if req else ""
@@ -148,6 +153,9 @@ def _functions(p) -> str:
         out.append(f"\nsb_error sb_decode_{n}(const uint8_t *content, size_t len, sb_{n}_answer *a)\n{{\n"
                    f"    sb_value v[{nans}];\n    sb_error e = sb_decode_answer({code}, content, len, v, {nans}u);\n"
                    f"    if (e.status != SB_OK)\n        return e;\n{_copies(p.answer, True)}    return e;\n}}\n")
+    if not calls:
+        return "".join(out)
+    out = []
     arg = f"const sb_{n}_request *r" if req else ""
     enc = f"sb_encode_{n}({'r, ' if req else ''}bus->tx, sizeof bus->tx, &len)"
     if p.has("answers") and p.answer:
@@ -180,7 +188,16 @@ def servobus_c(s) -> str:
             ((-(1 << (8 * i.size - 1)), (1 << (8 * i.size - 1)) - 1) if i.signed else (0, (1 << (8 * i.size)) - 1))
         items.append(f'    {{{i.id}, {i.size}, {int(i.signed)}, {ACCESS[i.access]}, {_n(low)}, {_n(high)}, '
                      f'"{i.name}"}},\n')
-    return (NOTICE + "#include <string.h>\n\n#include \"servobus/servobus.h\"\n\n" + "".join(tables)
+    return (NOTICE + "#include <stddef.h>\n\n#include \"servobus/servobus.h\"\n\n" + "".join(tables)
             + f"\nconst sb_packet_desc sb_packets[SB_PACKET_COUNT] = {{\n{''.join(rows)}}};\n"
-            + f"\nconst sb_item_desc sb_items[SB_ITEM_COUNT] = {{\n{''.join(items)}}};\n"
-            + "".join(_functions(p) for p in s.packets))
+            + f"\nconst sb_item_desc sb_items[SB_ITEM_COUNT] = {{\n{''.join(items)}}};\n")
+
+
+def servobus_codecs_c(s) -> str:
+    return (NOTICE + "#include <string.h>\n\n#include \"servobus/servobus.h\"\n"
+            + "".join(_functions(p, calls=False) for p in s.packets))
+
+
+def servobus_calls_c(s) -> str:
+    return (NOTICE + "#include <stddef.h>\n\n#include \"servobus/servobus.h\"\n"
+            + "".join(_functions(p, calls=True) for p in s.packets))

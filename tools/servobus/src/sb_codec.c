@@ -1,8 +1,10 @@
 /* The codec: any packet's request or answer from the schema's tables
- * (sb_schema.c), its fields checked against their ranges. */
+ * (sb_schema.c), its fields checked against their ranges; the rules a
+ * request's fields keep together are sb_encode.c's, above this. */
 #include <string.h>
 
 #include "servobus/servobus.h"
+#include "servobus/sb_codec_inner.h"
 
 #define fail sb_error_of
 
@@ -209,21 +211,17 @@ static sb_error encode_fields(const sb_packet_desc *p, bool request, const sb_va
         e.most = p->length_max;
         return e;
     }
-    if (request) {
-        sb_error e = sb_check_request(p->code, v, count);
-        if (e.status != SB_OK)
-            return e;
-    }
     *len = at;
     return sb_ok();
 }
 
-sb_error sb_encode_content(uint8_t code, const sb_value *v, size_t count, uint8_t *out, size_t cap, size_t *len)
+sb_error sb_encode_fields(uint8_t code, bool request, const sb_value *v, size_t count, uint8_t *out, size_t cap,
+                          size_t *len)
 {
     const sb_packet_desc *p = sb_packet(code);
     if (p == NULL)
         return fail(SB_E_UNKNOWN_PACKET, -1, code, NULL);
-    return encode_fields(p, true, v, count, out, cap, len);
+    return encode_fields(p, request, v, count, out, cap, len);
 }
 
 sb_error sb_frame(bool request, uint8_t code, const uint8_t *content, size_t clen, uint8_t *frame, size_t cap,
@@ -275,9 +273,10 @@ static sb_error encode_frame(uint8_t code, bool request, const sb_value *v, size
     return e;
 }
 
-sb_error sb_encode_request(uint8_t code, const sb_value *v, size_t count, uint8_t *frame, size_t cap, size_t *len)
+sb_error sb_encode_frame(uint8_t code, bool request, const sb_value *v, size_t count, uint8_t *frame, size_t cap,
+                         size_t *len)
 {
-    return encode_frame(code, true, v, count, frame, cap, len);
+    return encode_frame(code, request, v, count, frame, cap, len);
 }
 
 sb_error sb_encode_answer(uint8_t code, const sb_value *v, size_t count, uint8_t *frame, size_t cap, size_t *len)
