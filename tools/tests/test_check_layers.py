@@ -66,6 +66,25 @@ def test_a_circle_of_symbols_is_found(tmp_path):
     assert breaches == ["circle of symbols: motion/a <-> motion/b"]
 
 
+@pytest.mark.skipif(shutil.which("gcc") is None or shutil.which("nm") is None, reason="needs gcc and nm")
+def test_a_circle_between_servobus_files_is_found_generated_ones_too(tmp_path):
+    """servobus is no firmware layer, and its generated files are in the
+    build: a circle between a source and a generated file counts."""
+    root = tree(tmp_path)
+    generated = root / "build/generated_servobus/servobus"
+    write(root, "tools/servobus/src/sb_bus.c", "void call(void);\nvoid send(void);\nvoid send(void) { call(); }\n")
+    write(generated, "sb_calls.c", "void send(void);\nvoid call(void);\nvoid call(void) { send(); }\n")
+    build = root / "build"
+    commands = []
+    for name, source in (("bus", root / "tools/servobus/src/sb_bus.c"), ("calls", generated / "sb_calls.c")):
+        command = f"gcc -c -o {name}.o {source}"
+        subprocess.run(command.split(), cwd=build, check=True)
+        commands.append({"directory": str(build), "command": command, "file": str(source)})
+    (build / "compile_commands.json").write_text(json.dumps(commands))
+    breaches, _ = check_layers.check(root, build)
+    assert breaches == ["circle of symbols: build/generated_servobus/servobus/sb_calls <-> tools/servobus/src/sb_bus"]
+
+
 def test_a_lower_layer_including_a_higher_one_is_found(tmp_path):
     root = tree(tmp_path)
     write(root, "protocol/wire/frame_rx.c", '#include "motion/motion.h"\n')
