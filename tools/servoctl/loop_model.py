@@ -3,8 +3,6 @@ output (J q'' = G d - D q', G = K V / R, D = K^2 / R + B) under the
 firmware's PID with 1.5 ticks of delay (tune.py's docstring)."""
 import math
 
-import numpy as np
-
 TICK_S = 0.001
 DECIDEG_RAD = math.pi / 1800.0
 Q15 = 32768.0
@@ -22,7 +20,10 @@ def _si(kp: float, ki: float, kd: float) -> tuple:
 
 def margins(drive, kp: float, ki: float, kd: float) -> tuple:
     """(phase margin in degrees, gain margin in dB, gain crossover in Hz) of
-    the loop with these firmware gains."""
+    the loop with these firmware gains. numpy is loaded here, by the drive
+    items' check alone: servoctl's library needs only pyserial."""
+    import numpy as np
+
     g, d, j = _plant(drive)
     kp_si, ki_si, kd_si = _si(kp, ki, kd)
     w = np.logspace(-1, 4.5, 20000)
