@@ -139,9 +139,10 @@ def stop_at_every_rate(bus, sim_control, mode: str) -> list:
     rate follows the one changed, the others stay at the old) is stopped
     too. Fastest first, each frame on the wire before the rate changes
     (about 30 ms in all). Not on socket:// without the simulator's control
-    port: the far end sets the rate there. What failed, a line each."""
+    port: the far end sets the rate there. What failed, a line each; None
+    where it could not sweep."""
     if link_rate.is_socket(bus.port) and not sim_control:
-        return []
+        return None
     host = bus.serial.baudrate
     content = p.encode_request(p.STOP_ON_CONTROL, p.BROADCAST, STOP_METHOD[mode], 0)
     wire_bits = len(p.request_frame(p.STOP_ON_CONTROL, content)) * 10

@@ -315,6 +315,11 @@ class Worker:
                                                               STOP_METHOD[mode], 0))
         except ServoError as e:
             failed.append(f"broadcast stop: {e}")
+        # Before the servos one by one: a servo left at another rate (a baud
+        # change from the page) waited out each silent one's timeout (1-1.7 s).
+        host = self.bus.serial.baudrate
+        swept = stop_at_every_rate(self.bus, _option(self.global_argv, "--sim-control"), mode)
+        failed += swept or []
         with self.cond:  # those queued before the stop was asked for; a tab's after it run
             dropped = [self.jobs.popleft() for _ in range(min(self.before_stop, len(self.jobs)))]
             self.before_stop = 0
@@ -330,7 +335,9 @@ class Worker:
         ids = self.known or self.plot_ids
         said = [self.run_quiet(["stop", str(i), "--mode", mode]) for i in ids]
         failed += [r["err"] for r in said if r["code"]]
-        failed += stop_at_every_rate(self.bus, _option(self.global_argv, "--sim-control"), mode)
+        if swept is not None and any(r["code"] for r in said):
+            failed.append(f"the broadcast went out at every rate: a servo that did not answer at {host} baud "
+                          f"is stopped if it speaks another")
         self.publish({"type": "stopped", "mode": mode, "ids": ids, "failed": failed, "stops": self.stops})
 
     # The thread -------------------------------------------------------------

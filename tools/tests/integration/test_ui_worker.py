@@ -42,10 +42,16 @@ def test_stop_all_stops_a_servo_left_at_another_baud_rate():
         assert changed["code"] == 0 and w.bus.serial.baudrate == 1000000, changed
         sim.wait_until(lambda: all(abs(sim.state(i)["velocity"]) > 100 for i in (1, 2)), timeout_s=10)
         w.known = [1, 2]
-        w.stop_all("damping")
+        asked_ms = sim.clock_s() * 1000
+        w.stop_all("release")
         sim.wait_until(lambda: all(abs(sim.state(i)["velocity"]) < 2 for i in (1, 2)), timeout_s=5)
         assert w.bus.serial.baudrate == 1000000  # the host's rate as it was
         assert said[-1]["type"] == "stopped"
+        # Servo 2, at 115 200, before servo 1's answer at the host's rate was
+        # waited for: the sweep comes first (it came after, 1-1.7 s late).
+        took_ms = sim.state(2)["coasted_ms"] - asked_ms
+        assert 0 < took_ms < 100, took_ms
+        assert any("is stopped if it speaks another" in f for f in said[-1]["failed"]) or not said[-1]["failed"]
 
 
 def test_the_bus_thread_outlives_a_lost_link_and_a_bad_plot_request():
