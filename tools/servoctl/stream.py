@@ -22,7 +22,7 @@ from .checks import scaled, to_ms
 from .frame import jerk_limit
 from .errors import NoReply, Refused, UsageError
 from .group import sync_monitor
-from .loop_rate import BITS_PER_BYTE, LoopLate, LoopRate, check_wire  # noqa: F401 (LoopLate: the API's)
+from .loop_rate import BITS_PER_BYTE, LoopLate, LoopRate, check_wire, wire_limit_hz  # noqa: F401 (LoopLate: the API's)
 from .move_request import MoveRequest
 from .outcome import EXECUTING, INHIBITING, STALL, TOLERANCE_DEG
 from .setpoints import Limits, RobotLoop, Stream, put_back_period, read_configs, tell_period  # noqa: F401 (Stream: the API's)
@@ -119,6 +119,13 @@ class StreamReport:
     paced: bool = False  # a paced simulator: the host's time cost none
 
 
+def mean_period(times) -> float:
+    """A file's period: its rows' mean step (read_trajectory has held each
+    row to that grid), not its first step, which times written to the ms
+    make up to 0.5 ms long or short."""
+    return (times[-1] - times[0]) / (len(times) - 1)
+
+
 def stream_file(bus: p.Bus, times, angles: dict, progress=None, limits: dict = None,
                 host=None) -> StreamReport:
     """Streams the trajectory at its own period, the servos already at its
@@ -131,7 +138,7 @@ def stream_file(bus: p.Bus, times, angles: dict, progress=None, limits: dict = N
     trajectory at the moment it arrived. Every row is checked against the
     servos' limits (read from them if not given) before the first is sent."""
     ids = list(angles)
-    period = times[1] - times[0]
+    period = mean_period(times)
     check_wire(ids, period, bus.serial.baudrate)
     loop = RobotLoop(bus, ids, period, limits, pace=False)  # paced here, against the rows' times
     check_trajectory(Trajectory(times, angles), loop.stream.limits)
@@ -144,9 +151,8 @@ def stream_file(bus: p.Bus, times, angles: dict, progress=None, limits: dict = N
 
 def _stream_rows(bus, times, angles, loop, progress, host) -> StreamReport:
     ids = list(angles)
-    period = times[1] - times[0]
+    period = mean_period(times)
     count = len(times)
-    period_ms = loop.stream.period_ms
     # The rows as sent (0.1 deg): a velocity is theirs, so it is within
     # the speed the rows were checked against.
     sent = {i: [scaled(a, 10, "degrees") for a in angles[i]] for i in ids}
@@ -157,8 +163,8 @@ def _stream_rows(bus, times, angles, loop, progress, host) -> StreamReport:
         # reach the first row moving).
         if k in (0, count - 1):
             return 0.0
-        a = sent[servo_id]
-        return (a[k + 1] - a[k - 1]) * 100 / (2 * period_ms)
+        a = sent[servo_id]  # 0.1 deg over the rows' own times: deg/s
+        return (a[k + 1] - a[k - 1]) / 10 / (times[k + 1] - times[k - 1])
 
     def reference(servo_id, t):
         k = min(max((t - times[0]) / period, 0.0), count - 1.0)
@@ -178,16 +184,18 @@ def _stream_rows(bus, times, angles, loop, progress, host) -> StreamReport:
     record = p.request_format(p.STREAM_SETPOINT)
     frame = p.request_frame(p.SYNC, bytes(3 + struct.calcsize(record) * len(ids))) if len(ids) > 1 else \
         p.request_frame(p.STREAM_SETPOINT, bytes(struct.calcsize(record)))
-    depth = 1.5 * period + len(frame) * BITS_PER_BYTE / bus.serial.baudrate
+    # The servo's depth is 3/2 of the period it was told, in whole ms.
+    depth = 1.5 * loop.stream.period_ms / 1000 + len(frame) * BITS_PER_BYTE / bus.serial.baudrate
     start = bus.clock() + depth
     wall_start = time.monotonic()
     for k in range(count):
-        leaves = start + k * period - depth
+        at = start + times[k] - times[0]  # each row stamped with its own time
+        leaves = at - depth
         if host:
             leaves = host.leaves(k, leaves, period)
         bus.sleep(max(0.0, leaves - bus.clock()))
         states = loop.cycle({i: angles[i][k] for i in ids}, {i: velocity(i, k) for i in ids},
-                            at_s=start + k * period)
+                            at_s=at)
         if k > 0 and states:  # a state is compared with the trajectory when it was taken
             taken = min(loop.arrivals[i] - (n + 1) * answer_s for n, i in enumerate(ids) if i in states)
             for servo_id in ids:
@@ -238,8 +246,13 @@ def cmd_stream(bus, args):
     configs = read_configs(bus, angles)
     limits = {i: Limits.of(cfg) for i, cfg in configs.items()}
     check_trajectory(trajectory, limits)
-    check_wire(list(angles), trajectory.times[1] - trajectory.times[0], bus.serial.baudrate,
-               f"{args.file}: ")  # before the lead-in: nothing moves
+    period = mean_period(trajectory.times)
+    check_wire(list(angles), period, bus.serial.baudrate, f"{args.file}: ")  # before the lead-in: nothing moves
+    cycle_s = 1 / wire_limit_hz(list(angles), bus.serial.baudrate)
+    if cycle_s > FULL_CYCLE * period:
+        print(f"servoctl: a cycle takes {cycle_s * 1000:.1f} ms of the {period * 1000:.1f} ms period at "
+              f"{bus.serial.baudrate} baud: a frame the host sends late has little room (docs/streaming.md, "
+              f"\"The cost of a full cycle\"); a higher baud rate or a longer period leaves it some", file=sys.stderr)
     lead = lead_in(bus, {i: a[0] for i, a in angles.items()}, args.lead_in, configs)
     with Progress(transient=True, disable=not sys.stderr.isatty()) as progress:
         task = progress.add_task("streaming", total=len(trajectory.times))
@@ -271,6 +284,11 @@ def cmd_stream(bus, args):
         print(f"  {report.missed} state(s) did not come back: those cycles are not counted")
     return _verdict(report, args.tolerance, args.report_only)
 
+
+# A cycle that fills more than this share of the period leaves a late
+# frame little room: said before the stream (6 servos at 115 200 baud at
+# 50 Hz, a cycle of 17.5 ms: docs/streaming.md).
+FULL_CYCLE = 0.75
 
 # A stream whose cycles ran below this share of the file's rate was sent
 # late: its setpoints reached the servos after their times.
@@ -306,5 +324,6 @@ def _verdict(report, tolerance: float, report_only: bool) -> int:
                    f"{1 / report.period_s:g} Hz: {_who_was_late(report)}")
     if not why or report_only:
         return 0
-    print(f"servoctl: error: {'; '.join(why)}", file=sys.stderr)
+    for reason in why:  # each on its own line, with its figure
+        print(f"servoctl: error: {reason}", file=sys.stderr)
     return 1

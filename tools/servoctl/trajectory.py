@@ -92,11 +92,10 @@ def read_trajectory(path: str) -> Trajectory:
     if period <= 0:
         raise UsageError(f"{path}: the times must be evenly spaced and rising; nothing was sent")
     # Times written to the ms (a 30 Hz file's 0.033, 0.067) are on the grid:
-    # each within half a ms of it, each step within a ms of the one before.
-    # The first step unlike the one before names its row; then a drift.
-    steps = [times[k] - times[k - 1] for k in range(1, len(times))]
-    uneven = [k for k in range(1, len(times))
-              if steps[k - 1] <= 0 or abs(steps[k - 1] - steps[max(k - 2, 0)]) > 2 * GRID_S]
+    # each within half a ms of it.
+    # A time not after the one before names its row; else the first row
+    # off the grid of the first and last rows' mean step.
+    uneven = [k for k in range(1, len(times)) if times[k] <= times[k - 1]]
     uneven = uneven or [k for k in range(1, len(times)) if abs(times[k] - times[0] - k * period) > GRID_S]
     if uneven:
         k = uneven[0]

@@ -13,7 +13,7 @@ from servoctl.errors import UsageError, ValueOutOfRange
 from servoctl.group import sync_move
 from servoctl.servo import Servo
 from servoctl.sim import Simulator
-from servoctl.stream import Limits, RobotLoop, Stream, read_trajectory
+from servoctl.stream import Limits, RobotLoop, Stream, lead_in, read_trajectory, stream_file
 
 from ..scheduled import followed
 from .conftest import finish, _start
@@ -81,6 +81,17 @@ def test_stream_follows_a_csv_trajectory(paced3, tmp_path, capsys):
     burst = len(p.request_frame(p.SYNC, bytes(3 + 9 * len(IDS)))) + len(p.request_frame(p.SYNC, bytes(3 + len(IDS))))
     spans = [line.split() for line in sim3.control("wire 1024").splitlines() if line != "end"]
     assert sum(1 for s in spans if s[3] == "host" and int(s[2]) == burst) == 151
+
+
+def test_a_cycle_that_fills_the_period_is_said_before_the_stream(paced3, tmp_path, capsys):
+    """Three servos at 115 200 baud: a cycle of 9.5 ms, here in 11 ms. A
+    late frame has no room there (docs/streaming.md, "The cost of a full
+    cycle"); at 20 ms nothing is said."""
+    for period, said in ((0.011, True), (0.02, False)):
+        csv = sine_csv(tmp_path / f"{period}.csv", IDS, seconds=0.5, period_s=period)
+        main(["--port", paced3.url, "stream", str(csv), "--lead-in", "0.3", "--report-only"], clock=paced3.clock_s)
+        err = capsys.readouterr().err
+        assert ("a cycle takes 9.5 ms of the 11.0 ms period at 115200 baud" in err) == said, err
 
 
 def test_the_servos_follow_a_trajectory_as_its_setpoints_arrive(sim3):
@@ -156,6 +167,7 @@ def test_stream_refuses_what_it_cannot_send():
     ("time,1,2\n0,0,0\n0.02,1\n", "one finite angle per servo"),
     # The row at fault is named: the repeated time's, not the one before it.
     ("time,1\n0,0\n0.02,1\n0.02,2\n0.03,3\n", r"t.csv line 4: .* not 0.02 then 0.02 s"),
+    ("time,1\n0,0\n0.02,1\n0.04,2\n0.06,3\n0.081,4\n0.10,5\n", r"t.csv line 6: .* not 0.06 then 0.081 s"),
 ])
 def test_a_bad_trajectory_file_says_what_is_wrong(tmp_path, text, why):
     path = tmp_path / "t.csv"
@@ -171,6 +183,24 @@ def test_times_written_to_the_ms_are_evenly_spaced(tmp_path):
     path.write_text("time,1\n" + "".join(f"{k / 30:.3f},{k}\n" for k in range(31)))
     trajectory = read_trajectory(str(path))
     assert trajectory.period_ms == 33
+
+
+def test_a_file_written_to_the_ms_plays_at_its_own_pace(paced3, tmp_path):
+    """35 Hz written to the ms: its first step is 29 ms, its mean 28.57.
+    Sent at the first step's period it played 1.5 % slow, 0.09 s late over
+    6 s; each row now leaves at its own time."""
+    path = tmp_path / "t.csv"
+    path.write_text("time,1\n" + "".join(f"{k / 35:.3f},{30 * math.sin(math.pi * k / 35):.2f}\n"
+                                          for k in range(211)))
+    trajectory = read_trajectory(str(path))
+    with paced3.bus() as bus:
+        lead_in(bus, {1: trajectory.angles[1][0]}, 0.5)
+        start = paced3.clock_s()
+        report = stream_file(bus, trajectory.times, {1: trajectory.angles[1]})
+        took = paced3.clock_s() - start
+    assert abs(1 / report.period_s - 35) < 0.01, report.period_s
+    assert abs(took - 6.0) < 0.05, took  # the file's 6 s, and the depth before its first row
+    assert report.rms_deg[1] < 0.5, report.rms_deg
 
 
 def test_a_servo_that_does_not_follow_fails_the_stream_with_its_figures(paced3, tmp_path, capsys):
