@@ -19,8 +19,8 @@ def is_socket(port) -> bool:
     return bool(port) and port.startswith("socket://")
 
 
-def _control_port(address: str) -> int:
-    host, _, port = address.rpartition(":")
+def _control_port(address) -> int:
+    host, _, port = str(address).rpartition(":")  # a number given as one (a config's int) too
     if host not in ("", "127.0.0.1", "localhost"):
         raise UsageError(f"--sim-control is a simulator's control port on this PC (PORT or "
                          f"127.0.0.1:PORT), not {address}")

@@ -52,8 +52,9 @@ def refused_settings(out: dict) -> None:
     cls = RobotConfig.get_choice_class("servoctl_arm")
     out["refused"] = {}
     for name, value in [("max_relative_target", -5.0), ("max_relative_target", float("nan")),
-                        ("max_relative_target", {"Motor_0": 5.0, "Motor_1": -1.0}), ("fps", 0),
-                        ("fps", -30.0)]:
+                        ("max_relative_target", {"Motor_0": 5.0, "Motor_1": -1.0}),
+                        ("max_relative_target", {"nosuch": 5.0}), ("fps", 0), ("fps", -30.0), ("fps", 10000),
+                        ("watchdog_ms", -1), ("watchdog_action", "explode"), ("ramp_speed_deg_s", -1.0)]:
         try:
             cls(port="socket://127.0.0.1:1", **{name: value})
             out["refused"][f"{name}={value}"] = None
@@ -64,6 +65,15 @@ def refused_settings(out: dict) -> None:
 def follower_session(out: dict) -> None:
     sim = compare.prepare(paced=True)
     try:
+        # A connect() that Arm refuses (two joints, one servo) leaves the port
+        # closed: the next connect() found it "in use by another program".
+        shared = follower(sim, joints={**{f"Motor_{i}": i for i in IDS}, "Motor_extra": 0})
+        try:
+            shared.connect(calibrate=False)
+            out["shared_connect"] = None
+        except Exception as e:  # noqa: BLE001 - what the user sees, said whatever it is
+            out["shared_connect"] = str(e)
+            kept = e  # noqa: F841 - its traceback keeps connect()'s frames, as a REPL's last error does
         # max_relative_target alone: no ramp after connect (ramped() has it)
         robot = follower(sim, max_relative_target=5.0, ramp_speed_deg_s=0)
         out["robot_class"] = type(robot).__name__

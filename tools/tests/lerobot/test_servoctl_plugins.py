@@ -82,7 +82,14 @@ def test_a_setting_that_would_drive_the_arm_wrong_is_refused_with_the_config(see
     divided by zero, a negative one wrote item 69 as 1 ms."""
     for setting, said in seen["refused"].items():
         name = setting.split("=")[0]
-        assert said is not None and said.startswith(f"{name} is "), (setting, said)
+        assert said is not None and said.startswith(f"{name} "), (setting, said)
+    assert "nosuch (its joints: Motor_0" in seen["refused"]["max_relative_target={'nosuch': 5.0}"]
+    assert "fps is the loop's frames a second, 1 to 1000" in seen["refused"]["fps=10000"]
+
+
+def test_a_connect_refused_leaves_the_port_for_the_next(seen):
+    assert "share one" in seen["shared_connect"], seen["shared_connect"]
+    assert seen["robot_class"] == "ServoctlArm"  # the next connect() on the same port came through
 
 
 def test_a_servo_that_lets_go_raises_with_its_fault_history(seen):

@@ -4,7 +4,10 @@ from dataclasses import dataclass, field
 
 from lerobot.cameras import CameraConfig
 from lerobot.robots.config import RobotConfig
+from servoctl import registers
 from servoctl.arm_ramp import DEFAULT_SPEED_DEG_S
+from servoctl.arm_watchdog import WATCHDOG_ACTIONS
+from servoctl.setpoints import PERIOD_RANGE_MS
 
 from .joints import ArmBusConfig
 
@@ -29,9 +32,10 @@ class ServoctlArmConfig(RobotConfig, ArmBusConfig):
     cameras: dict[str, CameraConfig] = field(default_factory=dict)
 
     def __post_init__(self):
-        """A setting that would drive the arm wrong is refused when the
-        config is made: a negative max_relative_target moved every joint
-        that far away from where it was, each frame, whatever the action."""
+        """A setting that would drive the arm wrong, or that connect() would
+        refuse later in other words, is refused when the config is made: a
+        negative max_relative_target moved every joint that far away from
+        where it was, each frame, whatever the action."""
         super().__post_init__()
         cap = self.max_relative_target
         caps = [] if cap is None else list(cap.values()) if isinstance(cap, dict) else [cap]
@@ -39,8 +43,23 @@ class ServoctlArmConfig(RobotConfig, ArmBusConfig):
         if bad:
             raise ValueError(f"max_relative_target is degrees, 0 or more (one number, or one a joint), "
                              f"not {bad[0]!r}")
-        if not (_number(self.fps) and self.fps > 0):
-            raise ValueError(f"fps is the loop's frames a second, more than 0, not {self.fps!r}")
+        unknown = sorted(set(cap) - set(self.joints)) if isinstance(cap, dict) else []
+        if unknown:
+            raise ValueError(f"max_relative_target names joints the arm does not have: {', '.join(unknown)} "
+                             f"(its joints: {', '.join(self.joints)})")
+        slowest, fastest = (1000 / ms for ms in reversed(PERIOD_RANGE_MS))
+        if not (_number(self.fps) and slowest <= self.fps <= fastest):
+            raise ValueError(f"fps is the loop's frames a second, {slowest:g} to {fastest:g} (a period of "
+                             f"{PERIOD_RANGE_MS[0]} to {PERIOD_RANGE_MS[1]} ms), not {self.fps!r}")
+        item = registers.find("watchdog_ms")
+        if not (isinstance(self.watchdog_ms, int) and not isinstance(self.watchdog_ms, bool)
+                and item.low <= self.watchdog_ms <= item.high):
+            raise ValueError(f"watchdog_ms is {item.low}..{item.high} ms (0: left as it is), not "
+                             f"{self.watchdog_ms!r}")
+        if self.watchdog_action not in WATCHDOG_ACTIONS:
+            raise ValueError(f"watchdog_action is one of {', '.join(WATCHDOG_ACTIONS)}, not {self.watchdog_action!r}")
+        if not _distance(self.ramp_speed_deg_s):
+            raise ValueError(f"ramp_speed_deg_s is 0 (no ramp) or a speed in deg/s, not {self.ramp_speed_deg_s!r}")
 
 
 def _number(x) -> bool:

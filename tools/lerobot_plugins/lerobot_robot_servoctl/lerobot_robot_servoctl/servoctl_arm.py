@@ -53,8 +53,12 @@ class ServoctlArm(j.OnArm, Robot):
         if self.arm is not None:
             raise DeviceAlreadyConnectedError(f"{self} already connected")
         bus = j.open_bus(self.config, self.clock)
-        arm = Arm(bus, self.config.joints, self.config.fps, self.config.firmware,
-                  self.config.watchdog_ms, self.config.watchdog_action, self.config.ramp_speed_deg_s)
+        try:  # a refusal leaves no port open: the next connect() found it "in use"
+            arm = Arm(bus, self.config.joints, self.config.fps, self.config.firmware,
+                      self.config.watchdog_ms, self.config.watchdog_action, self.config.ramp_speed_deg_s)
+        except BaseException:
+            bus.close()
+            raise
         try:
             with j.answering(self):
                 arm.open()
