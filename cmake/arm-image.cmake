@@ -31,7 +31,9 @@ function(servo_board_facts)
             --check --facts ${CMAKE_CURRENT_SOURCE_DIR}
     RESULT_VARIABLE failed OUTPUT_VARIABLE facts ERROR_VARIABLE problems)
   if(failed)
+    # A line a fact: a line that begins with a space is not rewrapped.
     string(STRIP "${problems}" problems)
+    string(REPLACE "\n" "\n " problems " ${problems}")
     message(FATAL_ERROR "${problems}")
   endif()
   string(REPLACE "\n" ";" facts "${facts}")

@@ -342,6 +342,17 @@ def main(argv=None) -> int:
     ap.add_argument("--late-every", type=int, default=0, help="one frame in N a whole period late")
     ap.add_argument("--real-time", action="store_true", help="ours on a simulator in real time too")
     args = ap.parse_args(argv)
+    # The follower's watchdog records go to a folder of this run's (a
+    # silenced servo leaves one by design), not the user's.
+    state = tempfile.mkdtemp(prefix="lerobot-compare-state-")
+    os.environ.setdefault("SERVOCTL_STATE_DIR", state)
+    try:
+        return _compare(args)
+    finally:
+        shutil.rmtree(state, ignore_errors=True)
+
+
+def _compare(args) -> int:
     register_third_party_plugins()
     plugins = [x for x in (Ours(not args.real_time, args.fps), Makers()) if args.only is None or args.only in x.name]
     results = [run(x, HostTiming(args.jitter_ms / 1000.0, args.late_every) or None) for x in plugins]
