@@ -107,6 +107,13 @@ def detect_firmware(bus: p.Bus, servo_id: int) -> str:
         return "maker"
 
 
+
+WATCHDOG_MS_MOST = registers.find("watchdog_ms").high  # item 64's range
+
+
+def _number(x) -> bool:
+    return isinstance(x, (int, float)) and not isinstance(x, bool)
+
 class Arm:
     """joints: {name: servo ID}. fps: the frames a second the host's loop
     sends (a stream's period). firmware: "auto", "servoctl" or "maker"
@@ -125,13 +132,16 @@ class Arm:
         twice = [f"{' and '.join(names)} (servo {i})" for i, names in twice.items() if len(names) > 1]
         if twice:  # one servo would be driven to two joints' targets, and read as both
             raise UsageError(f"each joint has its own servo ID: {'; '.join(twice)} share one")
+        # Before anything is written (a watchdog record of -1 was, then refused).
+        if not (_number(watchdog_ms) and isinstance(watchdog_ms, int) and 0 <= watchdog_ms <= WATCHDOG_MS_MOST):
+            raise UsageError(f"watchdog_ms is 0..{WATCHDOG_MS_MOST} ms (0: left as it is), not {watchdog_ms!r}")
         if watchdog_action not in WATCHDOG_ACTIONS:
             raise UsageError(f"watchdog_action is one of {', '.join(WATCHDOG_ACTIONS)}, not {watchdog_action!r}")
         if firmware not in ("auto", "servoctl", "maker"):
             raise UsageError(f"firmware is auto, servoctl or maker, not {firmware!r}")
-        if isinstance(fps, bool) or not isinstance(fps, (int, float)) or not (math.isfinite(fps) and fps > 0):
+        if not (_number(fps) and math.isfinite(fps) and fps > 0):
             raise UsageError(f"fps is the loop's frames a second, more than 0, not {fps!r}")
-        if not (ramp_speed_deg_s >= 0 and math.isfinite(ramp_speed_deg_s)):
+        if not (_number(ramp_speed_deg_s) and ramp_speed_deg_s >= 0 and math.isfinite(ramp_speed_deg_s)):
             raise UsageError(f"ramp_speed_deg_s is 0 (no ramp) or a speed in deg/s, not {ramp_speed_deg_s!r}")
         self.bus, self.joints = bus, dict(joints)
         self.ids = list(self.joints.values())

@@ -2,6 +2,7 @@
 every row against every servo's Limits, before anything moves."""
 import csv
 import math
+import re
 from dataclasses import dataclass
 
 from .checks import check_range, scaled
@@ -31,12 +32,14 @@ class Trajectory:
 GRID_S = 0.0005 + 1e-9
 
 
+# A decimal number as a CSV has it: no underscores (Python's float() takes
+# 1_0 as 10), no Unicode digits; nan and inf are numbers refused apart.
+_NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?|[+-]?(nan|inf|infinity)", re.I)
+_ID = re.compile(r"\d+")
+
+
 def _is_number(cell: str) -> bool:
-    try:
-        float(cell)
-    except ValueError:
-        return False
-    return True
+    return cell.isascii() and _NUMBER.fullmatch(cell.strip()) is not None
 
 
 def read_trajectory(path: str) -> Trajectory:
@@ -44,7 +47,7 @@ def read_trajectory(path: str) -> Trajectory:
     setpoint, evenly spaced. Every row is checked, and an error names its
     line: nothing is sent before the whole file has passed."""
     try:
-        with open(path, newline="") as f:
+        with open(path, newline="", encoding="utf-8-sig") as f:  # a BOM is no part of the header
             rows = [(n, r) for n, r in enumerate(csv.reader(f), 1)
                     if r and not r[0].lstrip().startswith("#")]
     except OSError as e:
@@ -54,14 +57,13 @@ def read_trajectory(path: str) -> Trajectory:
     if len(rows) < 3:
         raise UsageError(f"{path}: a header and at least two rows are needed")
     line, header = rows[0]
-    if len(header) < 2:
+    if len(header) < 2 or header[0].strip().lower() != "time":
         raise UsageError(f"{path} line {line}: the header is 'time' and servo IDs, separated by commas, not "
                          f"{','.join(header)!r}")
-    try:
-        ids = [int(c) for c in header[1:]]
-    except ValueError:
-        cell = next(c for c in header[1:] if not c.strip().lstrip("+-").isdigit())
-        raise UsageError(f"{path} line {line}: the header is 'time' and servo IDs, not {cell.strip()!r}") from None
+    cell = next((c for c in header[1:] if not (_ID.fullmatch(c.strip()) and c.isascii())), None)
+    if cell is not None:
+        raise UsageError(f"{path} line {line}: the header is 'time' and servo IDs, not {cell.strip()!r}")
+    ids = [int(c) for c in header[1:]]
     try:
         check_ids(ids)
     except UsageError as e:
@@ -72,12 +74,11 @@ def read_trajectory(path: str) -> Trajectory:
             return UsageError(f"{path} line {line}: {why}; nothing was sent")
         if len(r) != len(ids) + 1:
             raise bad(f"every row has a time and one finite angle per servo ({len(ids)}), not {len(r)} values")
-        try:
-            values = [float(c) for c in r]
-        except ValueError:
+        if not all(map(_is_number, r)):
             cell = next(c for c in r if not _is_number(c))
             raise bad(f"{cell.strip()!r} is not a number: every row has a time (s) and one angle (deg) "
-                      f"per servo") from None
+                      f"per servo")
+        values = [float(c) for c in r]
         if not all(map(math.isfinite, values)):
             raise bad(f"every row has a time and one finite angle per servo, not {', '.join(r)}")
         for servo_id, degrees in zip(ids, values[1:]):

@@ -164,6 +164,9 @@ def test_stream_refuses_what_it_cannot_send():
     ("time,1\n0,0\n0.02,1\n0.05,2\n", "evenly spaced"),
     ("time,x\n0,0\n0.02,1\n", "the header is 'time' and servo IDs, not 'x'"),
     ("time;1\n0;0\n0.02;1\n", "servo IDs, separated by commas, not 'time;1'"),
+    ("banana,1\n0,0\n0.02,1\n", "the header is 'time' and servo IDs, separated by commas, not 'banana,1'"),
+    ("time,1_0\n0,0\n0.02,1\n", "servo IDs, not '1_0'"),  # Python's int() took it as servo 10
+    ("time,1\n0,0\n0.02,1_0\n", "'1_0' is not a number"),
     ("time,1,2\n0,0,0\n0.02,1\n", "one finite angle per servo"),
     # The row at fault is named: the repeated time's, not the one before it.
     ("time,1\n0,0\n0.02,1\n0.02,2\n0.03,3\n", r"t.csv line 4: .* not 0.02 then 0.02 s"),
@@ -174,6 +177,12 @@ def test_a_bad_trajectory_file_says_what_is_wrong(tmp_path, text, why):
     path.write_text(text)
     with pytest.raises(UsageError, match=why):
         read_trajectory(str(path))
+
+
+def test_a_bom_before_a_comment_is_no_part_of_the_header(tmp_path):
+    path = tmp_path / "t.csv"
+    path.write_text("\ufeff# a sine\ntime,1\n0,0\n0.02,1\n0.04,2\n", encoding="utf-8")
+    assert read_trajectory(str(path)).angles == {1: [0.0, 1.0, 2.0]}
 
 
 def test_times_written_to_the_ms_are_evenly_spaced(tmp_path):

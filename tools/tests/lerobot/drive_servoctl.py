@@ -54,7 +54,8 @@ def refused_settings(out: dict) -> None:
     for name, value in [("max_relative_target", -5.0), ("max_relative_target", float("nan")),
                         ("max_relative_target", {"Motor_0": 5.0, "Motor_1": -1.0}),
                         ("max_relative_target", {"nosuch": 5.0}), ("fps", 0), ("fps", -30.0), ("fps", 10000),
-                        ("watchdog_ms", -1), ("watchdog_action", "explode"), ("ramp_speed_deg_s", -1.0)]:
+                        ("watchdog_ms", -1), ("watchdog_action", "explode"), ("ramp_speed_deg_s", -1.0),
+                        ("baud", 0), ("baud", True), ("baud", 10**12)]:
         try:
             cls(port="socket://127.0.0.1:1", **{name: value})
             out["refused"][f"{name}={value}"] = None
@@ -74,8 +75,9 @@ def follower_session(out: dict) -> None:
         except Exception as e:  # noqa: BLE001 - what the user sees, said whatever it is
             out["shared_connect"] = str(e)
             kept = e  # noqa: F841 - its traceback keeps connect()'s frames, as a REPL's last error does
-        # max_relative_target alone: no ramp after connect (ramped() has it)
-        robot = follower(sim, max_relative_target=5.0, ramp_speed_deg_s=0)
+        # max_relative_target alone: no ramp after connect (ramped() has it); a
+        # cap for one joint (the others uncapped: a KeyError before)
+        robot = follower(sim, max_relative_target={"Motor_0": 5.0}, ramp_speed_deg_s=0)
         out["robot_class"] = type(robot).__name__
         robot.connect(calibrate=False)
         bus = robot.arm.bus
@@ -85,8 +87,9 @@ def follower_session(out: dict) -> None:
         obs = robot.get_observation()
         out["first_obs"] = obs
         # max_relative_target: 40 deg asked, 5 deg given (from where the joint is).
-        sent = robot.send_action({"Motor_0.pos": obs["Motor_0.pos"] + 40.0})
+        sent = robot.send_action({"Motor_0.pos": obs["Motor_0.pos"] + 40.0, "Motor_1.pos": obs["Motor_1.pos"] + 2.0})
         out["clamped"] = sent["Motor_0.pos"] - obs["Motor_0.pos"]
+        out["uncapped"] = sent["Motor_1.pos"] - obs["Motor_1.pos"]
         # A policy that stops: the watchdog (500 ms, hold) takes over and logs it.
         sim.sleep(0.8)
         out["faults_after_silence"] = [f.kind for f in Servo(bus, 0).faults()[:1]]

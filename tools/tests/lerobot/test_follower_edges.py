@@ -299,6 +299,17 @@ def test_an_fps_that_is_no_rate_is_refused_before_anything_is_written(fps):
     assert "fps is the loop's frames a second" in str(e.value), e.value
 
 
+@pytest.mark.parametrize("setting", [{"watchdog_ms": -5}, {"watchdog_ms": 70000}, {"watchdog_ms": 3.7},
+                                     {"watchdog_ms": "500"}, {"watchdog_ms": True}, {"ramp_speed_deg_s": "5"},
+                                     {"ramp_speed_deg_s": None}])
+def test_a_setting_of_the_wrong_kind_is_refused_before_anything_is_written(setting):
+    """A watchdog_ms of -5 or 3.7 wrote the watchdog record, then failed in
+    the write (a bare struct.error); a ramp speed of "5" raised TypeError."""
+    with pytest.raises(UsageError) as e:
+        Arm(None, {"a": 1}, **setting)
+    assert str(e.value).startswith(next(iter(setting)) + " is "), e.value
+
+
 def test_two_simulators_keep_their_own_records(state_dir, caplog):
     """servo_sim's serials (0x51a0UUNN) are the same in every simulator:
     arm B's clean run removed arm A's record (one file a serial), and A's

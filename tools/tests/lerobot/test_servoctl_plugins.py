@@ -73,7 +73,10 @@ def test_the_first_actions_after_connect_ramp_at_the_default_speed(seen):
 
 
 def test_max_relative_target_clamps_a_step(seen):
+    """A cap for Motor_0 alone: its 40 deg step is 5; Motor_1's 2 deg is not
+    capped (a KeyError before)."""
     assert seen["clamped"] == pytest.approx(5.0)
+    assert seen["uncapped"] == pytest.approx(2.0, abs=0.15)
 
 
 def test_a_setting_that_would_drive_the_arm_wrong_is_refused_with_the_config(seen):

@@ -58,6 +58,8 @@ class ServoctlArmConfig(RobotConfig, ArmBusConfig):
                              f"{self.watchdog_ms!r}")
         if self.watchdog_action not in WATCHDOG_ACTIONS:
             raise ValueError(f"watchdog_action is one of {', '.join(WATCHDOG_ACTIONS)}, not {self.watchdog_action!r}")
+        if isinstance(self.baud, bool) or self.baud not in registers.BAUD_RATES.values():
+            raise ValueError(f"baud is one of {', '.join(map(str, registers.BAUD_RATES.values()))}, not {self.baud!r}")
         if not _distance(self.ramp_speed_deg_s):
             raise ValueError(f"ramp_speed_deg_s is 0 (no ramp) or a speed in deg/s, not {self.ramp_speed_deg_s!r}")
 

@@ -13,6 +13,7 @@
 - calibrate(): the zero (item 90) and the ranges stored on the servos on
   this firmware; a LeRobot calibration file on the maker's."""
 import logging
+import math
 from functools import cached_property
 
 from lerobot.robots import Robot
@@ -100,9 +101,13 @@ class ServoctlArm(j.OnArm, Robot):
         if self.config.max_relative_target is not None:
             with j.answering(self):
                 present = cal.observed(self.arm.positions())
+            # A joint the dict leaves out has no cap; one the arm does not have
+            # goes on to Arm.send, which names it.
             cap = self.config.max_relative_target
-            cap = {n: float(cap[n]) for n in goal} if isinstance(cap, dict) else float(cap)
-            goal = ensure_safe_goal_position({n: (g, present[n]) for n, g in goal.items()}, cap)
+            known = {n: g for n, g in goal.items() if n in present}
+            cap = {n: float(cap.get(n, math.inf)) for n in known} if isinstance(cap, dict) else float(cap)
+            if known:
+                goal = {**goal, **ensure_safe_goal_position({n: (g, present[n]) for n, g in known.items()}, cap)}
         with j.answering(self):
             sent = cal.observed(self.arm.send(cal.target(goal)))
         return {f"{n}.pos": sent[n] for n in goal}
