@@ -26,7 +26,7 @@ copy() {
   grep -q "^#define BOARD_BUS_DMA_RX $5" "$h" || { echo "bus not set"; exit 1; }
 }
 copy my_servo 0x0777
-copy my_servo_usart2 0x0778 2 7 6  # a variant from data alone: its bus on USART2
+copy my_servo_usart2 0x0778 0x2 7 6u  # a variant from data alone: its bus on USART2 (as any C number)
 cmake -S "$tmp" -B "$tmp/build" -G Ninja -DCMAKE_TOOLCHAIN_FILE="$tmp/cmake/arm-none-eabi.cmake" \
   -DCMAKE_BUILD_TYPE=MinSizeRel "-DSERVO_BOARDS=my_servo;my_servo_usart2" >"$tmp/configure.log" 2>&1 ||
   { tail -20 "$tmp/configure.log"; echo "the new board did not configure"; exit 1; }

@@ -26,7 +26,7 @@ from .loop_rate import BITS_PER_BYTE, LoopLate, LoopRate, check_wire, wire_limit
 from .move_request import MoveRequest
 from .outcome import EXECUTING, INHIBITING, STALL, TOLERANCE_DEG
 from .setpoints import Limits, RobotLoop, Stream, put_back_period, read_configs, tell_period  # noqa: F401 (Stream: the API's)
-from .trajectory import Trajectory, check_trajectory, read_trajectory
+from .trajectory import Trajectory, check_trajectory, read_trajectory, row_velocity
 
 
 @dataclass
@@ -158,13 +158,7 @@ def _stream_rows(bus, times, angles, loop, progress, host) -> StreamReport:
     sent = {i: [scaled(a, 10, "degrees") for a in angles[i]] for i in ids}
 
     def velocity(servo_id, k):
-        # The servos start from rest and end at rest: no step of speed at
-        # either end, which no motor follows (the cubic would back up to
-        # reach the first row moving).
-        if k in (0, count - 1):
-            return 0.0
-        a = sent[servo_id]  # 0.1 deg over the rows' own times: deg/s
-        return (a[k + 1] - a[k - 1]) / 10 / (times[k + 1] - times[k - 1])
+        return row_velocity(times, sent[servo_id], k)  # as check_trajectory checked it
 
     def reference(servo_id, t):
         k = min(max((t - times[0]) / period, 0.0), count - 1.0)

@@ -111,17 +111,28 @@ def read_trajectory(path: str) -> Trajectory:
                       lines, path)
 
 
+def row_velocity(times, decideg, k: int) -> float:
+    """Row k's velocity as a stream sends it, deg/s: the rows around it (as
+    sent, 0.1 deg) over their own times; 0 at the first and last, which a
+    stream starts and ends at rest (no motor follows a step of speed)."""
+    if k in (0, len(times) - 1):
+        return 0.0
+    return (decideg[k + 1] - decideg[k - 1]) / 10 / (times[k + 1] - times[k - 1])
+
+
 def check_trajectory(trajectory: Trajectory, limits: dict) -> None:
     """Every row against every servo's Limits, as Stream checks a send,
-    before anything moves: a row outside them is refused with its line;
-    the file's period against each servo's bus watchdog first."""
-    period_ms = trajectory.period_ms
-    check_period(limits, period_ms, f"{trajectory.path}: " if trajectory.path else "")
+    before anything moves: its angle, its step over the rows' own spacing
+    and the velocity it is sent with (a file of 2.6 ms rows was checked at
+    3 ms, then refused mid-motion); a row outside them is refused with its
+    line; the file's period against each servo's bus watchdog first."""
+    check_period(limits, trajectory.period_ms, f"{trajectory.path}: " if trajectory.path else "")
+    times = trajectory.times
     for servo_id, rows in trajectory.angles.items():
-        last = None
-        for k, degrees in enumerate(rows):
-            angle = scaled(degrees, 10, "degrees")
-            why = limits[servo_id].check(servo_id, angle, last, period_ms)
+        sent = [scaled(degrees, 10, "degrees") for degrees in rows]
+        for k, angle in enumerate(sent):
+            step_ms = round((times[k] - times[k - 1]) * 1000, 3) if k else 0
+            velocity = scaled(row_velocity(times, sent, k), 10, "velocity")
+            why = limits[servo_id].check(servo_id, angle, sent[k - 1] if k else None, step_ms, velocity)
             if why:
                 raise ValueOutOfRange(f"{trajectory.where(k)}: {why}; nothing was sent")
-            last = angle

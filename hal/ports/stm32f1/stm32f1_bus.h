@@ -34,11 +34,28 @@ _Static_assert(DMA1_CH7_IRQ == DMA1_CH1_IRQ + 6u, "DMA1's channel interrupts are
      .dma_rx_ccr = DMA1_CCR_ADDR(BOARD_BUS_DMA_RX), .dma_rx_flags = DMA1_FLAGS(BOARD_BUS_DMA_RX),  \
      .dma_rx_irq = BUS_DMA_RX_IRQ}
 
-/* The handlers by the names the vector table gives them (startup_stm32f103.c). */
-#define STM32F1_CAT3_(a, b, c) a##b##c
-#define STM32F1_CAT3(a, b, c) STM32F1_CAT3_(a, b, c)
-#define BUS_USART_HANDLER STM32F1_CAT3(USART, BOARD_BUS_USART, _IRQHandler)
-#define BUS_DMA_RX_HANDLER STM32F1_CAT3(DMA1_Channel, BOARD_BUS_DMA_RX, _IRQHandler)
+/* The handlers by the names the vector table gives them
+ * (startup_stm32f103.c), chosen by value: a board.h that writes 0x2 or 6u
+ * gets the same names (pasting its text made USART0x2_IRQHandler, and the
+ * weak default handled the bus). */
+#if BOARD_BUS_USART == 1
+#define BUS_USART_HANDLER USART1_IRQHandler
+#elif BOARD_BUS_USART == 2
+#define BUS_USART_HANDLER USART2_IRQHandler
+#elif BOARD_BUS_USART == 3
+#define BUS_USART_HANDLER USART3_IRQHandler
+#else
+#error "board.h: BOARD_BUS_USART is 1, 2 or 3 on an STM32F1 (RM0008)"
+#endif
+#if BOARD_BUS_DMA_RX == 3
+#define BUS_DMA_RX_HANDLER DMA1_Channel3_IRQHandler
+#elif BOARD_BUS_DMA_RX == 5
+#define BUS_DMA_RX_HANDLER DMA1_Channel5_IRQHandler
+#elif BOARD_BUS_DMA_RX == 6
+#define BUS_DMA_RX_HANDLER DMA1_Channel6_IRQHandler
+#else
+#error "board.h: BOARD_BUS_DMA_RX is a USART's receive channel on an STM32F1: 5, 6 or 3 (RM0008 Table 78)"
+#endif
 /* Defines both in the board's main.c or boot_main.c (one file an image). */
 #define STM32F1_BUS_HANDLERS          \
     void BUS_USART_HANDLER(void);     \

@@ -18,7 +18,6 @@ import time
 
 from .. import link_rate, registers
 from .. import protocol as p
-from ..errors import ServoError
 
 STEP_S = 0.005  # the longest a bus wait or sleep goes without looking at the interrupt
 STOP_METHOD = {"release": 0x10, "damping": 0x12}  # StopOnControlMode's, as Servo.stop's
@@ -133,26 +132,51 @@ class Preemption:
 
 
 def stop_at_every_rate(bus, sim_control, mode: str) -> list:
-    """On the bus thread, after the stops at the host's rate: the broadcast
-    stop again at every other rate item 36 gives a servo, then the host's
-    rate back, so a servo set to another rate (from the page: the host's
-    rate follows the one changed, the others stay at the old) is stopped
-    too. Fastest first, each frame on the wire before the rate changes
-    (about 30 ms in all). Not on socket:// without the simulator's control
-    port: the far end sets the rate there. What failed, a line each; None
-    where it could not sweep."""
+    """On the bus thread, after the broadcast at the host's rate: the
+    broadcast again at every other rate item 36 gives a servo, then the
+    host's rate back, so a servo set to another rate (from the page: the
+    host's rate follows the one changed, the others stay at the old) is
+    stopped too. Fastest first; before each change of rate the port is
+    drained and the frame's wire time waited. Open loop: no servo answers
+    a broadcast. A rate the port refuses, or a failed return to the host's
+    rate, is a line of what failed, never an end to STOP ALL: the servos'
+    own stops follow whatever happened here. None where it cannot sweep
+    (socket:// without the simulator's control port: the far end sets the
+    rate)."""
     if link_rate.is_socket(bus.port) and not sim_control:
         return None
     host = bus.serial.baudrate
     content = p.encode_request(p.STOP_ON_CONTROL, p.BROADCAST, STOP_METHOD[mode], 0)
     wire_bits = len(p.request_frame(p.STOP_ON_CONTROL, content)) * 10
     failed = []
-    with link_rate.restored(bus, sim_control):
-        for rate in sorted(set(registers.BAUD_RATES.values()) - {host}, reverse=True):
-            try:
-                link_rate.set_rate(bus, sim_control, rate)
+    for rate in [*sorted(set(registers.BAUD_RATES.values()) - {host}, reverse=True), host]:
+        try:
+            _drained(bus)
+            link_rate.set_rate(bus, sim_control, rate)
+            if rate != host:
                 bus.send(p.STOP_ON_CONTROL, content)
+                _drained(bus)
                 bus.sleep(wire_bits / rate + RATE_SWITCH_S)
-            except ServoError as e:
-                failed.append(f"broadcast stop at {rate} baud: {e}")
+        except KeyboardInterrupt:
+            _back_to(bus, sim_control, host, failed)
+            raise  # another STOP ALL: it sweeps again
+        except Exception as e:  # noqa: BLE001 - a port that refuses a rate (SerialException, OSError)
+            failed.append(f"broadcast stop at {rate} baud: {e}" if rate != host
+                          else f"the host's rate back to {host} baud: {e}")
+    if bus.serial.baudrate != host:
+        _back_to(bus, sim_control, host, failed)
     return failed
+
+
+def _drained(bus) -> None:
+    """What the port holds written out (tcdrain on a serial port)."""
+    flush = getattr(bus.serial, "flush", None)
+    if flush is not None and bus._sock is None:
+        flush()
+
+
+def _back_to(bus, sim_control, host: int, failed: list) -> None:
+    try:
+        link_rate.set_rate(bus, sim_control, host)
+    except Exception as e:  # noqa: BLE001 - said; the servos' own stops follow
+        failed.append(f"the host's rate back to {host} baud: {e}; it is at {bus.serial.baudrate}")

@@ -336,8 +336,8 @@ class Worker:
         said = [self.run_quiet(["stop", str(i), "--mode", mode]) for i in ids]
         failed += [r["err"] for r in said if r["code"]]
         if swept is not None and any(r["code"] for r in said):
-            failed.append(f"the broadcast went out at every rate: a servo that did not answer at {host} baud "
-                          f"is stopped if it speaks another")
+            failed.append(f"the broadcast was sent at every rate: a servo that did not answer at {host} baud "
+                          f"stops if it speaks another and the frame reached it (no servo answers a broadcast)")
         self.publish({"type": "stopped", "mode": mode, "ids": ids, "failed": failed, "stops": self.stops})
 
     # The thread -------------------------------------------------------------

@@ -13,7 +13,7 @@ from servoctl.errors import UsageError, ValueOutOfRange
 from servoctl.group import sync_move
 from servoctl.servo import Servo
 from servoctl.sim import Simulator
-from servoctl.stream import Limits, RobotLoop, Stream, lead_in, read_trajectory, stream_file
+from servoctl.stream import Limits, RobotLoop, Stream, check_trajectory, lead_in, read_trajectory, stream_file
 
 from ..scheduled import followed
 from .conftest import finish, _start
@@ -177,6 +177,15 @@ def test_a_bad_trajectory_file_says_what_is_wrong(tmp_path, text, why):
     path.write_text(text)
     with pytest.raises(UsageError, match=why):
         read_trajectory(str(path))
+
+
+def test_a_file_s_velocities_are_checked_whole_before_it_moves(tmp_path):
+    """Rows 2.6 ms apart, 2.2 deg each: checked at a period rounded to 3 ms
+    (733 deg/s) and refused mid-motion at 846 deg/s; now before anything moves."""
+    path = tmp_path / "t.csv"
+    path.write_text("time,1\n" + "".join(f"{k * 0.0026:.4f},{k * 2.2:.1f}\n" for k in range(60)))
+    with pytest.raises(ValueOutOfRange, match=r"line 3: servo 1: 2.2 deg in 2.6 ms .* 846 deg/s"):
+        check_trajectory(read_trajectory(str(path)), {1: Limits()})
 
 
 def test_a_bom_before_a_comment_is_no_part_of_the_header(tmp_path):

@@ -51,7 +51,34 @@ def test_stop_all_stops_a_servo_left_at_another_baud_rate():
         # waited for: the sweep comes first (it came after, 1-1.7 s late).
         took_ms = sim.state(2)["coasted_ms"] - asked_ms
         assert 0 < took_ms < 100, took_ms
-        assert any("is stopped if it speaks another" in f for f in said[-1]["failed"]) or not said[-1]["failed"]
+        assert any("stops if it speaks another" in f for f in said[-1]["failed"]) or not said[-1]["failed"]
+
+
+def test_a_rate_the_port_refuses_ends_no_stop_all(monkeypatch):
+    """A port that refuses a rate (a driver without 250 000): STOP ALL
+    raised there, swept no lower rate and stopped no servo; now the rate
+    is said and the sweep and the servos' own stops go on."""
+    from servoctl import link_rate
+    with Simulator(ids=[1, 2], fast=True) as sim:
+        said = []
+        w = _worker(sim, said)
+        for servo_id in (1, 2):
+            assert w.run(["wheel", str(servo_id), "run", "--speed", "180"])["code"] == 0
+        # The host follows servo 2 to 9600; servo 1, at 115 200, is below
+        # the refused rate in the sweep.
+        assert w.run(["config", "set", "2", "baud", "9600"])["code"] == 0 and w.bus.serial.baudrate == 9600
+        set_rate = link_rate.set_rate
+
+        def refusing(bus, sim_control, rate):
+            if rate == 250000:
+                raise OSError("the driver refuses 250000 baud")
+            set_rate(bus, sim_control, rate)
+        monkeypatch.setattr(link_rate, "set_rate", refusing)
+        w.known = [1, 2]
+        w.stop_all("release")
+        sim.wait_until(lambda: all(abs(sim.state(i)["velocity"]) < 2 for i in (1, 2)), timeout_s=5)
+        assert said[-1]["type"] == "stopped" and w.bus.serial.baudrate == 9600
+        assert any("250000 baud: the driver refuses" in f for f in said[-1]["failed"]), said[-1]
 
 
 def test_the_bus_thread_outlives_a_lost_link_and_a_bad_plot_request():

@@ -55,7 +55,8 @@ def refused_settings(out: dict) -> None:
                         ("max_relative_target", {"Motor_0": 5.0, "Motor_1": -1.0}),
                         ("max_relative_target", {"nosuch": 5.0}), ("fps", 0), ("fps", -30.0), ("fps", 10000),
                         ("watchdog_ms", -1), ("watchdog_action", "explode"), ("ramp_speed_deg_s", -1.0),
-                        ("baud", 0), ("baud", True), ("baud", 10**12)]:
+                        ("baud", 0), ("baud", True), ("baud", 10**12), ("joints", ["a"]),
+                        ("max_relative_target", {1: 5.0})]:
         try:
             cls(port="socket://127.0.0.1:1", **{name: value})
             out["refused"][f"{name}={value}"] = None
@@ -90,6 +91,13 @@ def follower_session(out: dict) -> None:
         sent = robot.send_action({"Motor_0.pos": obs["Motor_0.pos"] + 40.0, "Motor_1.pos": obs["Motor_1.pos"] + 2.0})
         out["clamped"] = sent["Motor_0.pos"] - obs["Motor_0.pos"]
         out["uncapped"] = sent["Motor_1.pos"] - obs["Motor_1.pos"]
+        out["bad_actions"] = []
+        for bad in ({"Motor_0.pos": float("inf")}, {"Motor_0.pos": None}):
+            try:
+                robot.send_action(bad)
+                out["bad_actions"].append(None)
+            except ValueError as e:
+                out["bad_actions"].append(str(e))
         # A policy that stops: the watchdog (500 ms, hold) takes over and logs it.
         sim.sleep(0.8)
         out["faults_after_silence"] = [f.kind for f in Servo(bus, 0).faults()[:1]]

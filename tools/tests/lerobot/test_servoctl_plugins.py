@@ -86,8 +86,15 @@ def test_a_setting_that_would_drive_the_arm_wrong_is_refused_with_the_config(see
     for setting, said in seen["refused"].items():
         name = setting.split("=")[0]
         assert said is not None and said.startswith(f"{name} "), (setting, said)
-    assert "nosuch (its joints: Motor_0" in seen["refused"]["max_relative_target={'nosuch': 5.0}"]
+    assert "'nosuch' (its joints: Motor_0" in seen["refused"]["max_relative_target={'nosuch': 5.0}"]
     assert "fps is the loop's frames a second, 1 to 1000" in seen["refused"]["fps=10000"]
+
+
+def test_an_action_that_is_no_finite_angle_is_refused_not_capped(seen):
+    """With a cap, inf became present + cap (the joint moved a cap a frame);
+    None raised a bare TypeError."""
+    assert "Motor_0 is not a finite angle" in seen["bad_actions"][0], seen["bad_actions"]
+    assert "an action's angles are numbers, not Motor_0.pos" in seen["bad_actions"][1], seen["bad_actions"]
 
 
 def test_a_connect_refused_leaves_the_port_for_the_next(seen):

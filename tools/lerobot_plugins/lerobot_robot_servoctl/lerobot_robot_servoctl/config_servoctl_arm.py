@@ -37,13 +37,16 @@ class ServoctlArmConfig(RobotConfig, ArmBusConfig):
         negative max_relative_target moved every joint that far away from
         where it was, each frame, whatever the action."""
         super().__post_init__()
+        if not (isinstance(self.joints, dict) and self.joints and all(isinstance(n, str) for n in self.joints)
+                and all(isinstance(i, int) and not isinstance(i, bool) for i in self.joints.values())):
+            raise ValueError(f"joints is a joint's name -> its servo ID for each joint, not {self.joints!r}")
         cap = self.max_relative_target
         caps = [] if cap is None else list(cap.values()) if isinstance(cap, dict) else [cap]
         bad = [c for c in caps if not _distance(c)]
         if bad:
             raise ValueError(f"max_relative_target is degrees, 0 or more (one number, or one a joint), "
                              f"not {bad[0]!r}")
-        unknown = sorted(set(cap) - set(self.joints)) if isinstance(cap, dict) else []
+        unknown = sorted(map(repr, set(cap) - set(self.joints))) if isinstance(cap, dict) else []
         if unknown:
             raise ValueError(f"max_relative_target names joints the arm does not have: {', '.join(unknown)} "
                              f"(its joints: {', '.join(self.joints)})")

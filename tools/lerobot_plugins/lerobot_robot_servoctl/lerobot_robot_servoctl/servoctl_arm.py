@@ -96,9 +96,18 @@ class ServoctlArm(j.OnArm, Robot):
     def send_action(self, action: dict) -> dict:
         if not self.is_connected:
             raise DeviceNotConnectedError(f"{self} is not connected.")
-        goal = {k.removesuffix(".pos"): float(v) for k, v in action.items() if k.endswith(".pos")}
+        try:
+            goal = {k.removesuffix(".pos"): float(v) for k, v in action.items() if k.endswith(".pos")}
+        except (TypeError, ValueError):
+            wrong = [k for k, v in action.items() if k.endswith(".pos") and not isinstance(v, (int, float))]
+            raise ValueError(f"{self}: an action's angles are numbers, not {', '.join(wrong)}") from None
         cal = self._calibrated()
         if self.config.max_relative_target is not None:
+            # A target that is no number is Arm.send's to refuse, not a cap's
+            # to turn into present + cap (inf moved the joint a cap a frame).
+            wrong = [n for n, g in goal.items() if not math.isfinite(g)]
+            if wrong:
+                raise ValueError(f"{self}: the action's {', '.join(wrong)} is not a finite angle")
             with j.answering(self):
                 present = cal.observed(self.arm.positions())
             # A joint the dict leaves out has no cap; one the arm does not have
