@@ -1,4 +1,6 @@
 #include "board_io.h"
+#include "board.h"
+#include "ports/stm32f1/stm32f1_bus.h"
 
 #include "ports/stm32f1/stm32f1_regs.h"
 
@@ -63,7 +65,10 @@ uint32_t unique_id_serial(void *ctx)
 
 void bus_pins_init(void)
 {
-    RCC_APB2ENR |= RCC_APB2ENR_GPIOA | RCC_APB2ENR_AFIO | RCC_APB2ENR_USART1;
-    /* PA9 USART1 TX, open drain: the single bus wire (external pull-up). */
+    RCC_APB2ENR |= RCC_APB2ENR_GPIOA | RCC_APB2ENR_AFIO;
+    BUS_USART_CLOCK_ON(); /* the USART board.h names */
+    /* PA9 USART1 TX, open drain: the single bus wire (external pull-up).
+     * A bus on another USART needs its TX pin here (RM0008 Table 5:
+     * USART2 PA2, USART3 PB10): the pins are this file's, not data yet. */
     GPIOA_CRH = (GPIOA_CRH & ~(0xFu << 4)) | (GPIO_AF_OPEN_DRAIN_50MHZ << 4);
 }

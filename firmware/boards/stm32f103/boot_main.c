@@ -19,7 +19,7 @@ STM32F1_BUS_HANDLERS
 /* No USART interrupt: its vector is not in the table. */
 #define board_boot_uart_start(usart, ring, dma)                         \
     do {                                                                \
-        port_uart_init((usart), (ring), (dma), F103_PCLK2_HZ, &bus_hw); \
+        port_uart_init((usart), (ring), (dma), BUS_USART_PCLK_HZ(F103_PCLK1_HZ, F103_PCLK2_HZ), &bus_hw); \
         usart_hd_tx_polled(usart);                                      \
     } while (0)
 #define board_boot_stop_dma() (REG32(bus_hw.dma_rx_ccr) = 0)

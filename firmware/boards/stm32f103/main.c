@@ -28,7 +28,7 @@ STM32F1_BUS_HANDLERS
 /* Sends by DMA; its transmission's end is the USART interrupt's. */
 #define board_uart_start(usart, ring, dma)                              \
     do {                                                                \
-        port_uart_init((usart), (ring), (dma), F103_PCLK2_HZ, &bus_hw); \
+        port_uart_init((usart), (ring), (dma), BUS_USART_PCLK_HZ(F103_PCLK1_HZ, F103_PCLK2_HZ), &bus_hw); \
         port_uart_send_by_dma(usart);                                   \
     } while (0)
 #define board_interrupts_on() (NVIC_ISER(BUS_USART_IRQ / 32u) = 1u << (BUS_USART_IRQ % 32u))

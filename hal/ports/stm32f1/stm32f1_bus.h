@@ -27,6 +27,12 @@ _Static_assert(BOARD_BUS_DMA_TX == (BOARD_BUS_USART == 1 ? 4 : BOARD_BUS_USART =
 #define BUS_USART_BASE (BOARD_BUS_USART == 1 ? USART1_BASE : BOARD_BUS_USART == 2 ? USART2_BASE : USART3_BASE)
 #define BUS_USART_IRQ (BOARD_BUS_USART == 1 ? USART1_IRQ : BOARD_BUS_USART == 2 ? USART2_IRQ : USART3_IRQ)
 #define BUS_DMA_RX_IRQ (DMA1_CH1_IRQ + BOARD_BUS_DMA_RX - 1u)
+/* Its clock: USART1 on APB2, USART2 and 3 on APB1 (RM0008's clock tree):
+ * the board gives both bus clocks, the bus takes its own. */
+#define BUS_USART_PCLK_HZ(pclk1_hz, pclk2_hz) (BOARD_BUS_USART == 1 ? (pclk2_hz) : (pclk1_hz))
+#define BUS_USART_CLOCK_ON()                                                                        \
+    (BOARD_BUS_USART == 1 ? (void)(RCC_APB2ENR |= RCC_APB2ENR_USART1)                              \
+                          : (void)(RCC_APB1ENR |= BOARD_BUS_USART == 2 ? RCC_APB1ENR_USART2 : RCC_APB1ENR_USART3))
 _Static_assert(DMA1_CH7_IRQ == DMA1_CH1_IRQ + 6u, "DMA1's channel interrupts are in a row (RM0008)");
 
 #define STM32F1_BUS                                                                                \

@@ -11,6 +11,8 @@
 #define RCC_CFGR_PLLMUL9 (7u << 18)
 #define RCC_APB2ENR_AFIO (1u << 0)
 #define RCC_APB2ENR_GPIOA (1u << 2)
+#define RCC_APB1ENR_USART2 (1u << 17)
+#define RCC_APB1ENR_USART3 (1u << 18)
 
 /* Flash interface (the rest in stm32_core_regs.h) */
 #define FLASH_ACR_LATENCY_2 2u

@@ -338,7 +338,9 @@ class Worker:
         if swept is not None and any(r["code"] for r in said):
             failed.append(f"the broadcast was sent at every rate: a servo that did not answer at {host} baud "
                           f"stops if it speaks another and the frame reached it (no servo answers a broadcast)")
-        self.publish({"type": "stopped", "mode": mode, "ids": ids, "failed": failed, "stops": self.stops})
+        answered = [i for i, r in zip(ids, said) if not r["code"]]
+        self.publish({"type": "stopped", "mode": mode, "ids": ids, "answered": answered, "failed": failed,
+                      "stops": self.stops})
 
     # The thread -------------------------------------------------------------
 

@@ -140,7 +140,7 @@ def test_stop_all_stops_a_wheel(bench):
     page.select_option("#stop-mode", "damping")
     page.click("#stop-all")  # on every view's header
     sim.wait_until(lambda: abs(sim.state(3)["velocity"]) < 2, timeout_s=10)
-    page.locator("#log div", has_text="stop-all: 6 servo(s) damped").wait_for(timeout=WAIT_MS)
+    page.locator("#log div", has_text="stop-all: 6 of 6 servo(s) damped").wait_for(timeout=WAIT_MS)
 
 
 def test_stop_all_ends_a_running_command_first(bench):
@@ -208,7 +208,7 @@ def test_bring_up_updates_two_servos_in_a_row_and_reads_faults(bench):
     image.write_bytes(img.build(bytes(range(256)) * 6, 0x0042, img.BOARDS["host_sim"]))
     page.select_option("#stop-mode", "release")  # an update restarts a servo: never one that holds
     page.click("#stop-all")
-    page.locator("#log div", has_text="stop-all: 6 servo(s) released").wait_for(timeout=WAIT_MS)
+    page.locator("#log div", has_text="stop-all: 6 of 6 servo(s) released").wait_for(timeout=WAIT_MS)
     _view(page, "bringup")
     page.fill("#up-file", str(image))
     page.fill("#up-ids", "5 6")
@@ -280,7 +280,7 @@ def test_a_second_tab_is_told_who_drives(bench):
         second.locator("#bus-table tbody tr[data-id='6']").wait_for(timeout=WAIT_MS)  # the last scan's
         second.select_option("#stop-mode", "release")
         second.click("#stop-all")  # a watching tab may still stop every servo
-        second.locator("#log div", has_text="stop-all: 6 servo(s) released").wait_for(timeout=WAIT_MS)
+        second.locator("#log div", has_text="stop-all: 6 of 6 servo(s) released").wait_for(timeout=WAIT_MS)
         second.evaluate("UI.handle({type: 'scan', found: [], err: 'servoctl: interrupted by stop-all', code: 130})")
         assert "the list is partial" in second.inner_text("#scan-line")  # this tab's page only
     finally:

@@ -56,7 +56,8 @@ def refused_settings(out: dict) -> None:
                         ("max_relative_target", {"nosuch": 5.0}), ("fps", 0), ("fps", -30.0), ("fps", 10000),
                         ("watchdog_ms", -1), ("watchdog_action", "explode"), ("ramp_speed_deg_s", -1.0),
                         ("baud", 0), ("baud", True), ("baud", 10**12), ("joints", ["a"]),
-                        ("max_relative_target", {1: 5.0})]:
+                        ("max_relative_target", {1: 5.0}), ("joints", {"a": 1, "b": 1}), ("joints", {"a": 300}),
+                        ("firmware", "bogus"), ("watchdog_ms", 40)]:
         try:
             cls(port="socket://127.0.0.1:1", **{name: value})
             out["refused"][f"{name}={value}"] = None
@@ -69,7 +70,8 @@ def follower_session(out: dict) -> None:
     try:
         # A connect() that Arm refuses (two joints, one servo) leaves the port
         # closed: the next connect() found it "in use by another program".
-        shared = follower(sim, joints={**{f"Motor_{i}": i for i in IDS}, "Motor_extra": 0})
+        shared = follower(sim)  # its config checked, then changed as a program might
+        shared.config.joints = {**{f"Motor_{i}": i for i in IDS}, "Motor_extra": 0}
         try:
             shared.connect(calibrate=False)
             out["shared_connect"] = None

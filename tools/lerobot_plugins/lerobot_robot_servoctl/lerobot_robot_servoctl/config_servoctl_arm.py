@@ -7,7 +7,8 @@ from lerobot.robots.config import RobotConfig
 from servoctl import registers
 from servoctl.arm_ramp import DEFAULT_SPEED_DEG_S
 from servoctl.arm_watchdog import WATCHDOG_ACTIONS
-from servoctl.setpoints import PERIOD_RANGE_MS
+from servoctl.errors import UsageError, ValueOutOfRange
+from servoctl.setpoints import PERIOD_RANGE_MS, check_ids
 
 from .joints import ArmBusConfig
 
@@ -40,6 +41,12 @@ class ServoctlArmConfig(RobotConfig, ArmBusConfig):
         if not (isinstance(self.joints, dict) and self.joints and all(isinstance(n, str) for n in self.joints)
                 and all(isinstance(i, int) and not isinstance(i, bool) for i in self.joints.values())):
             raise ValueError(f"joints is a joint's name -> its servo ID for each joint, not {self.joints!r}")
+        try:
+            check_ids(list(self.joints.values()))
+        except (UsageError, ValueOutOfRange) as e:
+            raise ValueError(f"joints name servo IDs, each once: {e}") from None
+        if self.firmware not in ("auto", "servoctl", "maker"):
+            raise ValueError(f"firmware is auto, servoctl or maker, not {self.firmware!r}")
         cap = self.max_relative_target
         caps = [] if cap is None else list(cap.values()) if isinstance(cap, dict) else [cap]
         bad = [c for c in caps if not _distance(c)]
@@ -59,6 +66,10 @@ class ServoctlArmConfig(RobotConfig, ArmBusConfig):
                 and item.low <= self.watchdog_ms <= item.high):
             raise ValueError(f"watchdog_ms is {item.low}..{item.high} ms (0: left as it is), not "
                              f"{self.watchdog_ms!r}")
+        if self.watchdog_ms and self.watchdog_ms < 2000 / self.fps:
+            raise ValueError(f"watchdog_ms {self.watchdog_ms} would act between frames: a frame comes every "
+                             f"{1000 / self.fps:g} ms at fps {self.fps:g}, and watchdog_ms must be at least two "
+                             f"frames ({2000 / self.fps:g} ms); set a longer watchdog_ms, a higher fps, or 0")
         if self.watchdog_action not in WATCHDOG_ACTIONS:
             raise ValueError(f"watchdog_action is one of {', '.join(WATCHDOG_ACTIONS)}, not {self.watchdog_action!r}")
         if isinstance(self.baud, bool) or self.baud not in registers.BAUD_RATES.values():

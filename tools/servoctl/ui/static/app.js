@@ -118,7 +118,9 @@ const UI = (() => {
   });
   on("busy", (m) => { setRole("viewer", `${m.holder} drives the bus`); log(m.text, "refused"); });
   on("error", (m) => log(m.text, "refused"));
-  on("stopped", (m) => log(`stop-all: ${m.ids.length} servo(s) ${m.mode === "damping" ? "damped" : "released"}` +
+  // Counted by their answers: a servo silent at the host's rate is not said to be stopped.
+  on("stopped", (m) => log(`stop-all: ${(m.answered || m.ids).length} of ${m.ids.length} servo(s) ` +
+      `${m.mode === "damping" ? "damped" : "released"}, by their answers` +
       (m.failed.length ? `; ${m.failed.join("; ")}` : ""), m.failed.length ? "refused" : "done"));
 
   // The servo the Servo, Motion and Bring-up views act on.
