@@ -128,11 +128,17 @@ def check_trajectory(trajectory: Trajectory, limits: dict) -> None:
     line; the file's period against each servo's bus watchdog first."""
     check_period(limits, trajectory.period_ms, f"{trajectory.path}: " if trajectory.path else "")
     times = trajectory.times
-    for servo_id, rows in trajectory.angles.items():
-        sent = [scaled(degrees, 10, "degrees") for degrees in rows]
-        for k, angle in enumerate(sent):
+    # Each row's angle and step first (a bad row is named, not the one
+    # before it, whose velocity it spoils), then the velocities sent.
+    sent = {i: [scaled(degrees, 10, "degrees") for degrees in rows] for i, rows in trajectory.angles.items()}
+    for servo_id, rows in sent.items():
+        for k, angle in enumerate(rows):
             step_ms = round((times[k] - times[k - 1]) * 1000, 3) if k else 0
-            velocity = scaled(row_velocity(times, sent, k), 10, "velocity")
-            why = limits[servo_id].check(servo_id, angle, sent[k - 1] if k else None, step_ms, velocity)
+            why = limits[servo_id].check(servo_id, angle, rows[k - 1] if k else None, step_ms)
+            if why:
+                raise ValueOutOfRange(f"{trajectory.where(k)}: {why}; nothing was sent")
+    for servo_id, rows in sent.items():
+        for k, angle in enumerate(rows):
+            why = limits[servo_id].check(servo_id, angle, velocity=scaled(row_velocity(times, rows, k), 10, "velocity"))
             if why:
                 raise ValueOutOfRange(f"{trajectory.where(k)}: {why}; nothing was sent")
