@@ -114,6 +114,29 @@ WATCHDOG_MS_MOST = registers.find("watchdog_ms").high  # item 64's range
 def _number(x) -> bool:
     return isinstance(x, (int, float)) and not isinstance(x, bool)
 
+
+def check_settings(joints: dict, fps, firmware, watchdog_ms, watchdog_action, ramp_speed_deg_s) -> None:
+    """An Arm's settings, refused (UsageError) before anything is written
+    (a watchdog record of -1 was, then refused); the LeRobot follower's
+    config checks them with these words too."""
+    if not joints:
+        raise UsageError("an arm needs at least one joint")
+    twice = {i: [n for n, j in joints.items() if j == i] for i in set(joints.values())}
+    twice = [f"{' and '.join(names)} (servo {i})" for i, names in twice.items() if len(names) > 1]
+    if twice:  # one servo would be driven to two joints' targets, and read as both
+        raise UsageError(f"each joint has its own servo ID: {'; '.join(twice)} share one")
+    if not (_number(watchdog_ms) and isinstance(watchdog_ms, int) and 0 <= watchdog_ms <= WATCHDOG_MS_MOST):
+        raise UsageError(f"watchdog_ms is 0..{WATCHDOG_MS_MOST} ms (0: left as it is), not {watchdog_ms!r}")
+    if watchdog_action not in WATCHDOG_ACTIONS:
+        raise UsageError(f"watchdog_action is one of {', '.join(WATCHDOG_ACTIONS)}, not {watchdog_action!r}")
+    if firmware not in ("auto", "servoctl", "maker"):
+        raise UsageError(f"firmware is auto, servoctl or maker, not {firmware!r}")
+    if not (_number(fps) and math.isfinite(fps) and fps > 0):
+        raise UsageError(f"fps is the loop's frames a second, more than 0, not {fps!r}")
+    if not (_number(ramp_speed_deg_s) and ramp_speed_deg_s >= 0 and math.isfinite(ramp_speed_deg_s)):
+        raise UsageError(f"ramp_speed_deg_s is 0 (no ramp) or a speed in deg/s, not {ramp_speed_deg_s!r}")
+
+
 class Arm:
     """joints: {name: servo ID}. fps: the frames a second the host's loop
     sends (a stream's period). firmware: "auto", "servoctl" or "maker"
@@ -126,23 +149,7 @@ class Arm:
     def __init__(self, bus: p.Bus, joints: dict, fps: float = 30.0, firmware: str = "auto",
                  watchdog_ms: int = 500, watchdog_action: str = "hold",
                  ramp_speed_deg_s: float = DEFAULT_SPEED_DEG_S, records: WatchdogRecords = None):
-        if not joints:
-            raise UsageError("an arm needs at least one joint")
-        twice = {i: [n for n, j in joints.items() if j == i] for i in set(joints.values())}
-        twice = [f"{' and '.join(names)} (servo {i})" for i, names in twice.items() if len(names) > 1]
-        if twice:  # one servo would be driven to two joints' targets, and read as both
-            raise UsageError(f"each joint has its own servo ID: {'; '.join(twice)} share one")
-        # Before anything is written (a watchdog record of -1 was, then refused).
-        if not (_number(watchdog_ms) and isinstance(watchdog_ms, int) and 0 <= watchdog_ms <= WATCHDOG_MS_MOST):
-            raise UsageError(f"watchdog_ms is 0..{WATCHDOG_MS_MOST} ms (0: left as it is), not {watchdog_ms!r}")
-        if watchdog_action not in WATCHDOG_ACTIONS:
-            raise UsageError(f"watchdog_action is one of {', '.join(WATCHDOG_ACTIONS)}, not {watchdog_action!r}")
-        if firmware not in ("auto", "servoctl", "maker"):
-            raise UsageError(f"firmware is auto, servoctl or maker, not {firmware!r}")
-        if not (_number(fps) and math.isfinite(fps) and fps > 0):
-            raise UsageError(f"fps is the loop's frames a second, more than 0, not {fps!r}")
-        if not (_number(ramp_speed_deg_s) and ramp_speed_deg_s >= 0 and math.isfinite(ramp_speed_deg_s)):
-            raise UsageError(f"ramp_speed_deg_s is 0 (no ramp) or a speed in deg/s, not {ramp_speed_deg_s!r}")
+        check_settings(joints, fps, firmware, watchdog_ms, watchdog_action, ramp_speed_deg_s)
         self.bus, self.joints = bus, dict(joints)
         self.ids = list(self.joints.values())
         self.names = {i: n for n, i in self.joints.items()}

@@ -59,8 +59,7 @@ static void qemu_service(struct usart_hd *usart)
 #define board_clock_init() ((void)0) /* QEMU's clock is fixed */
 #define bus_pins_init() ((void)0)    /* and its USART has no pins to set */
 #define board_boot_flash_init qemu_flash_init
-static const struct stm32f1_bus bus_hw = STM32F1_BUS;
-STM32F1_BUS_HANDLERS
+STM32F1_BUS_DEFINED
 
 /* No DMA model: by interrupt. */
 #define board_boot_uart_start(usart, ring, dma)                          \

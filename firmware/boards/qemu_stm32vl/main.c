@@ -82,8 +82,7 @@ static void ram_read(void *ctx, uint32_t addr, uint8_t *dst, uint32_t len)
     }
 }
 
-static const struct stm32f1_bus bus_hw = STM32F1_BUS;
-STM32F1_BUS_HANDLERS
+STM32F1_BUS_DEFINED
 
 /* QEMU's part has no unique ID: a fixed serial number. */
 static uint32_t serial_number(void *ctx)

@@ -13,8 +13,7 @@
 #define BOARD_BOOT_BUS PORT_UART_BUS_DMA
 #define BOARD_CORE_HZ F103_CORE_HZ
 #define board_clock_init clock_f103_init
-static const struct stm32f1_bus bus_hw = STM32F1_BUS;
-STM32F1_BUS_HANDLERS
+STM32F1_BUS_DEFINED
 
 /* No USART interrupt: its vector is not in the table. */
 #define board_boot_uart_start(usart, ring, dma)                         \

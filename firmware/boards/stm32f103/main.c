@@ -22,8 +22,7 @@ static void board_pins_init(void)
                 (GPIO_AF_PUSH_PULL_50MHZ << 28) | (0x4u << 16) | (0x4u << 20);
 }
 
-static const struct stm32f1_bus bus_hw = STM32F1_BUS;
-STM32F1_BUS_HANDLERS
+STM32F1_BUS_DEFINED
 
 /* Sends by DMA; its transmission's end is the USART interrupt's. */
 #define board_uart_start(usart, ring, dma)                              \

@@ -62,8 +62,10 @@ _Static_assert(DMA1_CH7_IRQ == DMA1_CH1_IRQ + 6u, "DMA1's channel interrupts are
 #else
 #error "board.h: BOARD_BUS_DMA_RX is a USART's receive channel on an STM32F1: 5, 6 or 3 (RM0008 Table 78)"
 #endif
-/* Defines both in the board's main.c or boot_main.c (one file an image). */
-#define STM32F1_BUS_HANDLERS          \
+/* The board's bus (bus_hw, for port_uart_init) and both handlers, in its
+ * main.c or boot_main.c (one file an image). */
+#define STM32F1_BUS_DEFINED                                 \
+    static const struct stm32f1_bus bus_hw = STM32F1_BUS;   \
     void BUS_USART_HANDLER(void);     \
     void BUS_USART_HANDLER(void)      \
     {                                 \

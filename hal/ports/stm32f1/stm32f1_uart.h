@@ -33,7 +33,7 @@ void port_uart_init(struct usart_hd *usart, struct hal_rx_ring *ring, struct dma
 void port_uart_send_by_dma(struct usart_hd *usart);
 
 /* What the bus's USART and receive-DMA interrupts run (the handlers by
- * their vector names: STM32F1_BUS_HANDLERS). */
+ * their vector names: STM32F1_BUS_DEFINED). */
 void port_uart_irq(void);
 void port_uart_dma_irq(void);
 

@@ -6,7 +6,7 @@ from lerobot.cameras import CameraConfig
 from lerobot.robots.config import RobotConfig
 from servoctl import registers
 from servoctl.arm_ramp import DEFAULT_SPEED_DEG_S
-from servoctl.arm_watchdog import WATCHDOG_ACTIONS
+from servoctl.arm import check_settings
 from servoctl.errors import UsageError, ValueOutOfRange
 from servoctl.setpoints import PERIOD_RANGE_MS, check_ids
 
@@ -45,8 +45,6 @@ class ServoctlArmConfig(RobotConfig, ArmBusConfig):
             check_ids(list(self.joints.values()))
         except (UsageError, ValueOutOfRange) as e:
             raise ValueError(f"joints name servo IDs, each once: {e}") from None
-        if self.firmware not in ("auto", "servoctl", "maker"):
-            raise ValueError(f"firmware is auto, servoctl or maker, not {self.firmware!r}")
         cap = self.max_relative_target
         caps = [] if cap is None else list(cap.values()) if isinstance(cap, dict) else [cap]
         bad = [c for c in caps if not _distance(c)]
@@ -61,21 +59,17 @@ class ServoctlArmConfig(RobotConfig, ArmBusConfig):
         if not (_number(self.fps) and slowest <= self.fps <= fastest):
             raise ValueError(f"fps is the loop's frames a second, {slowest:g} to {fastest:g} (a period of "
                              f"{PERIOD_RANGE_MS[0]} to {PERIOD_RANGE_MS[1]} ms), not {self.fps!r}")
-        item = registers.find("watchdog_ms")
-        if not (isinstance(self.watchdog_ms, int) and not isinstance(self.watchdog_ms, bool)
-                and item.low <= self.watchdog_ms <= item.high):
-            raise ValueError(f"watchdog_ms is {item.low}..{item.high} ms (0: left as it is), not "
-                             f"{self.watchdog_ms!r}")
+        try:  # the firmware, the watchdog and the ramp as Arm checks them
+            check_settings(self.joints, self.fps, self.firmware, self.watchdog_ms, self.watchdog_action,
+                           self.ramp_speed_deg_s)
+        except UsageError as e:
+            raise ValueError(str(e)) from None
         if self.watchdog_ms and self.watchdog_ms < 2000 / self.fps:
             raise ValueError(f"watchdog_ms {self.watchdog_ms} would act between frames: a frame comes every "
                              f"{1000 / self.fps:g} ms at fps {self.fps:g}, and watchdog_ms must be at least two "
                              f"frames ({2000 / self.fps:g} ms); set a longer watchdog_ms, a higher fps, or 0")
-        if self.watchdog_action not in WATCHDOG_ACTIONS:
-            raise ValueError(f"watchdog_action is one of {', '.join(WATCHDOG_ACTIONS)}, not {self.watchdog_action!r}")
         if isinstance(self.baud, bool) or self.baud not in registers.BAUD_RATES.values():
             raise ValueError(f"baud is one of {', '.join(map(str, registers.BAUD_RATES.values()))}, not {self.baud!r}")
-        if not _distance(self.ramp_speed_deg_s):
-            raise ValueError(f"ramp_speed_deg_s is 0 (no ramp) or a speed in deg/s, not {self.ramp_speed_deg_s!r}")
 
 
 def _number(x) -> bool:
