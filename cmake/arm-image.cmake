@@ -1,9 +1,9 @@
 # servo_board_linker_script(OUT TEMPLATE): the board's linker script, made
-# from firmware/linker/TEMPLATE.ld.in and the board's board.h by the C
+# from hal/ports/stm32_common/linker/TEMPLATE.ld.in and the board's board.h by the C
 # preprocessor (the board is the folder whose CMakeLists.txt calls this).
 function(servo_board_linker_script out template)
   get_filename_component(board ${CMAKE_CURRENT_SOURCE_DIR} NAME)
-  set(in ${PROJECT_SOURCE_DIR}/firmware/linker/${template}.ld.in)
+  set(in ${PROJECT_SOURCE_DIR}/hal/ports/stm32_common/linker/${template}.ld.in)
   set(ld ${CMAKE_CURRENT_BINARY_DIR}/${template}.ld)
   add_custom_command(
     OUTPUT ${ld}
@@ -19,15 +19,15 @@ function(servo_board_linker_script out template)
 endfunction()
 
 # servo_board_facts(): the facts of the board whose folder calls it, through
-# the one reader of them (firmware/bootloader/servo_image/board_facts.py:
+# the one reader of them (bootloader/servo_image/board_facts.py:
 # board.h's numbers, hex or decimal) as _BOARD_* variables, after holding
-# them to the part its board.cmake names (firmware/parts/parts.toml): its
+# them to the part its board.cmake names (hal/ports/parts.toml): its
 # flash map within the part's flash and on its erase unit, its RAM within
 # the part's, its CPU the part's. A board its part contradicts is not
 # built, and the configure's error says which fact, a line each.
 function(servo_board_facts)
   execute_process(
-    COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/firmware/bootloader/servo_image/board_facts.py
+    COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/bootloader/servo_image/board_facts.py
             --check --facts ${CMAKE_CURRENT_SOURCE_DIR}
     RESULT_VARIABLE failed OUTPUT_VARIABLE facts ERROR_VARIABLE problems)
   if(failed)
@@ -44,13 +44,13 @@ function(servo_board_facts)
   endforeach()
   set_property(DIRECTORY APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS
                ${CMAKE_CURRENT_SOURCE_DIR}/board.h ${CMAKE_CURRENT_SOURCE_DIR}/board.cmake
-               ${PROJECT_SOURCE_DIR}/firmware/parts/parts.toml)
+               ${PROJECT_SOURCE_DIR}/hal/ports/parts.toml)
 endfunction()
 
 # servo_board_limits(): the limits an image of the board whose folder calls
 # it is checked against, its own, unless its board.cmake sets them: the
 # application's slot (board.h: BOARD_SLOT_PAGES x BOARD_FLASH_PAGE) less the
-# update image's 256-byte header (firmware/bootloader/app_image.h), and the
+# update image's 256-byte header (bootloader/include/bootloader/app_image.h), and the
 # part's RAM (BOARD_RAM_SIZE).
 macro(servo_board_limits)
   servo_board_facts()
@@ -81,13 +81,13 @@ function(servo_arm_image name)
     target_sources(${name}.elf PRIVATE $<TARGET_OBJECTS:servo_small_runtime>
                    $<TARGET_OBJECTS:servo_small_div>)
   endif()
-  target_include_directories(${name}.elf PRIVATE ${PROJECT_SOURCE_DIR}/firmware)
+  target_include_directories(${name}.elf PRIVATE ${PROJECT_SOURCE_DIR}/firmware ${PROJECT_SOURCE_DIR}/bootloader/include)
   add_dependencies(${name}.elf ${board}_app_ld)
   servo_firmware_target(${name}.elf)
-  target_link_options(${name}.elf PRIVATE -L${PROJECT_SOURCE_DIR}/firmware/linker -T${I_LINKER}
+  target_link_options(${name}.elf PRIVATE -L${PROJECT_SOURCE_DIR}/hal/ports/stm32_common/linker -T${I_LINKER}
                       -Wl,-Map=${CMAKE_CURRENT_BINARY_DIR}/${name}.map)
   set_target_properties(${name}.elf PROPERTIES
-    LINK_DEPENDS "${I_LINKER};${PROJECT_SOURCE_DIR}/firmware/linker/sections_stm32.ld;${PROJECT_SOURCE_DIR}/cmake/check-image.sh")
+    LINK_DEPENDS "${I_LINKER};${PROJECT_SOURCE_DIR}/hal/ports/stm32_common/linker/sections_stm32.ld;${PROJECT_SOURCE_DIR}/cmake/check-image.sh")
   add_custom_command(TARGET ${name}.elf POST_BUILD
     COMMAND ${CMAKE_OBJCOPY} -O binary $<TARGET_FILE:${name}.elf> ${CMAKE_CURRENT_BINARY_DIR}/${name}.bin
     COMMAND sh ${PROJECT_SOURCE_DIR}/cmake/check-image.sh $<TARGET_FILE:${name}.elf>
@@ -96,7 +96,7 @@ function(servo_arm_image name)
             $<TARGET_FILE:${name}.elf> ${CMAKE_BINARY_DIR}
     # The update image (header, then the application): what the bootloader
     # starts, servoctl update writes, and the slot holds.
-    COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/firmware/bootloader/servo_image/__init__.py
+    COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/bootloader/servo_image/__init__.py
             ${CMAKE_CURRENT_BINARY_DIR}/${name}.bin
             --version ${SERVO_FIRMWARE_VERSION} --board ${board}
             -o ${CMAKE_CURRENT_BINARY_DIR}/${name}.img
@@ -112,13 +112,13 @@ function(servo_arm_bootloader name)
   # these objects come before the libraries' -Os ones: the bootloader core,
   # the framer byte by byte and deaf to SyncCommand (FRAME_RX_SMALL,
   # FRAME_RX_NO_SYNC), small mem* functions
-  # (firmware/runtime/small_mem.c), and the board's port with the drivers
+  # (hal/runtime/small_mem.c), and the board's port with the drivers
   # it shares (unused ones drop out at the link).
-  set(boot ${PROJECT_SOURCE_DIR}/firmware/bootloader)
+  set(boot ${PROJECT_SOURCE_DIR}/bootloader)
   set(small ${PROJECT_SOURCE_DIR}/protocol/wire/frame_rx.c ${PROJECT_SOURCE_DIR}/protocol/wire/frame_rx_queue.c
-      ${PROJECT_SOURCE_DIR}/firmware/runtime/small_mem.c ${boot}/bootloader.c
+      ${PROJECT_SOURCE_DIR}/hal/runtime/small_mem.c ${boot}/bootloader.c
       ${boot}/boot_packets.c ${boot}/boot_flow.c ${boot}/app_image.c ${boot}/slot_write.c
-      ${PROJECT_SOURCE_DIR}/firmware/storage/config_peek.c ${PROJECT_SOURCE_DIR}/firmware/runtime/crc32.c)
+      ${PROJECT_SOURCE_DIR}/services/storage/config_peek.c ${PROJECT_SOURCE_DIR}/hal/runtime/crc32.c)
   foreach(lib ${SERVO_BOARD_PORT} servo_stm32_common)
     get_target_property(dir ${lib} SOURCE_DIR)
     get_target_property(sources ${lib} SOURCES)
@@ -139,10 +139,10 @@ function(servo_arm_bootloader name)
   servo_board_linker_script(boot_ld boot)
   get_filename_component(board ${CMAKE_CURRENT_SOURCE_DIR} NAME)
   add_dependencies(${name}.elf ${board}_boot_ld)
-  target_link_options(${name}.elf PRIVATE -L${PROJECT_SOURCE_DIR}/firmware/linker
+  target_link_options(${name}.elf PRIVATE -L${PROJECT_SOURCE_DIR}/hal/ports/stm32_common/linker
                       -T${boot_ld} -Wl,-Map=${CMAKE_CURRENT_BINARY_DIR}/${name}.map)
   set_target_properties(${name}.elf PROPERTIES
-    LINK_DEPENDS "${boot_ld};${PROJECT_SOURCE_DIR}/firmware/linker/sections_stm32.ld")
+    LINK_DEPENDS "${boot_ld};${PROJECT_SOURCE_DIR}/hal/ports/stm32_common/linker/sections_stm32.ld")
   add_custom_command(TARGET ${name}.elf POST_BUILD
     COMMAND ${CMAKE_OBJCOPY} -O binary $<TARGET_FILE:${name}.elf> ${CMAKE_CURRENT_BINARY_DIR}/${name}.bin
     COMMAND sh ${PROJECT_SOURCE_DIR}/cmake/check-image.sh $<TARGET_FILE:${name}.elf> 4096

@@ -3,4 +3,4 @@
 set(SERVO_BOARD_FAMILY stm32f0)
 set(SERVO_BOARD_CPU cortex-m0)
 set(SERVO_BOARD_PORT servo_stm32f0)                      # hal/ports/stm32f0
-set(SERVO_BOARD_STARTUP ${PROJECT_SOURCE_DIR}/firmware/startup/startup_stm32f030.c)
+set(SERVO_BOARD_STARTUP ${PROJECT_SOURCE_DIR}/hal/ports/stm32f0/startup_stm32f030.c)

@@ -3,4 +3,4 @@
 set(SERVO_BOARD_FAMILY stm32f1)
 set(SERVO_BOARD_CPU cortex-m3)
 set(SERVO_BOARD_PORT servo_stm32f1)                      # hal/ports/stm32f1
-set(SERVO_BOARD_STARTUP ${PROJECT_SOURCE_DIR}/firmware/startup/startup_stm32f103.c)
+set(SERVO_BOARD_STARTUP ${PROJECT_SOURCE_DIR}/hal/ports/stm32f1/startup_stm32f103.c)

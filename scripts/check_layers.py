@@ -31,12 +31,11 @@ FOLDERS = [
     ("protocol/wire", "wire"),
     ("protocol", "dispatch"),
     ("motion", "motion"),
-    ("firmware/storage", "storage"),
-    ("firmware/sensors", "sensors"),
-    ("firmware/protection", "protection"),
-    ("firmware/bootloader", "bootloader"),
-    ("firmware/runtime", "runtime"),
-    ("firmware/startup", "startup"),
+    ("services/storage", "storage"),
+    ("services/sensors", "sensors"),
+    ("services/protection", "protection"),
+    ("bootloader", "bootloader"),
+    ("hal/runtime", "runtime"),
     ("firmware/app", "app"),
     ("firmware/boards", "boards"),
 ]
@@ -46,7 +45,6 @@ LAYERS = {
     "hal": set(),
     "registers": set(),
     "runtime": set(),
-    "startup": {"ports", "hal"},  # a family's vector table names its port's handlers
     "sensors": {"hal"},
     "wire": {"registers", "hal"},
     "storage": {"registers", "hal", "runtime"},
@@ -91,9 +89,9 @@ def sources(root):
 
 
 # Where an include's name is looked up: each layer's headers are named
-# from one of these (firmware/runtime/crc32.h is "runtime/crc32.h").
+# from one of these (hal/runtime/crc32.h is "runtime/crc32.h").
 INCLUDE_ROOTS = ("hal/include", "motion/include", "protocol/wire/include", "protocol/include",
-                 "registers/include", "firmware", "hal", "tests", "tools/servobus/include", "tools/servobus", "")
+                 "registers/include", "bootloader/include", "services", "firmware", "hal", "tests", "tools/servobus/include", "tools/servobus", "")
 BOARD_FOLDER = re.compile(r"^firmware/boards/[^/]+/")
 
 

@@ -14,9 +14,9 @@ LLVM_PROFILE_FILE="$out/corpus.profraw" \
 llvm-profdata merge -o "$out/corpus.profdata" "$out/corpus.profraw"
 files=(motion/motion.c motion/setpoint.c motion/position.c motion/drive.c motion/planning.c
        motion/command_queue.c motion/control_tick.c motion/profile.c motion/stream.c motion/open_loop.c
-       firmware/protection/protection.c
-       firmware/storage/config_store.c firmware/storage/save_policy.c firmware/storage/fault_log.c
-       firmware/protection/winding.c firmware/protection/bus_watchdog.c firmware/app/servo_safety.c)
+       services/protection/protection.c
+       services/storage/config_store.c services/storage/save_policy.c services/storage/fault_log.c
+       services/protection/winding.c services/protection/bus_watchdog.c firmware/app/servo_safety.c)
 llvm-cov report ./build/coverage/tests/fuzz/fuzz_servo -instr-profile="$out/corpus.profdata" \
   "${files[@]}" | tee "$out/report.txt"
 # Columns: Filename Regions Missed Cover Functions Missed Executed Lines Missed Cover ...

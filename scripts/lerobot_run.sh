@@ -27,6 +27,6 @@ if [ ! -d "$TARGET" ]; then
   mv -T "$NEW" "$TARGET" 2>/dev/null || rm -rf "$NEW"
 fi
 # servoctl's packages where `pip install -e tools` finds them (tools/pyproject.toml's
-# package-dir): the schema in protocol/, the update image's maker in firmware/bootloader/.
-export PYTHONPATH="$TARGET:$ROOT/tools:$ROOT/protocol:$ROOT/firmware/bootloader${PYTHONPATH:+:$PYTHONPATH}"
+# package-dir): the schema in protocol/, the update image's maker in bootloader/.
+export PYTHONPATH="$TARGET:$ROOT/tools:$ROOT/protocol:$ROOT/bootloader${PYTHONPATH:+:$PYTHONPATH}"
 exec "$PY" "$@"

@@ -1,5 +1,5 @@
 /* What a board's C code derives from its board.h, which holds plain numbers
- * so that the linker scripts (firmware/linker/app.ld.in and boot.ld.in,
+ * so that the linker scripts (hal/ports/stm32_common/linker/app.ld.in and boot.ld.in,
  * through the C preprocessor) and servoctl can read it too. Checked here,
  * at build time: the map must fit together. */
 #ifndef BOARD_DERIVED_H
@@ -10,7 +10,7 @@
  * start (ports/stm32_common/kept_ram.h). */
 #define BOARD_RAM_KEPT 64
 /* The register whose clearing turns the bridge's outputs off at once, for
- * the fault handler's first store (startup/core_vectors.h): TIM3's CCER
+ * the fault handler's first store (ports/stm32_common/core_vectors.h): TIM3's CCER
  * unless the board says otherwise (a timer's enable bits are not preloaded,
  * RM0008 15.4.9, RM0360 13.4.9). */
 #ifndef BOARD_BRIDGE_OFF_REG

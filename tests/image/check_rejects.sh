@@ -7,11 +7,11 @@ root=$(cd "$(dirname "$0")/../.." && pwd)
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 # The reference board's application memory map, as the build makes it.
-arm-none-eabi-gcc -E -P -x c -I "$root/firmware" -DSERVO_BOARD_H='"boards/stm32f103/board.h"' "$root/firmware/linker/app.ld.in" \
+arm-none-eabi-gcc -E -P -x c -I "$root/firmware" -DSERVO_BOARD_H='"boards/stm32f103/board.h"' "$root/hal/ports/stm32_common/linker/app.ld.in" \
   -o "$tmp/app.ld" || exit 1
 build() {
   arm-none-eabi-gcc -mcpu=cortex-m3 -mthumb -Os -nostartfiles --specs=nano.specs \
-    --specs=nosys.specs -L "$root/firmware/linker" -T "$tmp/app.ld" "$@" \
+    --specs=nosys.specs -L "$root/hal/ports/stm32_common/linker" -T "$tmp/app.ld" "$@" \
     "$root/tests/image/probe.c" -o "$tmp/probe.elf" || exit 1
 }
 fail=0

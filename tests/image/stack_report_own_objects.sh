@@ -10,7 +10,7 @@ root=$(cd "$(dirname "$0")/../.." && pwd)
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 # The reference board's application memory map, as the build makes it.
-arm-none-eabi-gcc -E -P -x c -I "$root/firmware" -DSERVO_BOARD_H='"boards/stm32f103/board.h"' "$root/firmware/linker/app.ld.in" \
+arm-none-eabi-gcc -E -P -x c -I "$root/firmware" -DSERVO_BOARD_H='"boards/stm32f103/board.h"' "$root/hal/ports/stm32_common/linker/app.ld.in" \
   -o "$tmp/app.ld" || exit 1
 cc() { arm-none-eabi-gcc -mcpu=cortex-m3 -mthumb -Os -ffunction-sections -fcallgraph-info=su "$@"; }
 for port in a b; do
@@ -24,7 +24,7 @@ mkdir -p "$tmp/build/img"
 cc -c "$root/tests/image/stack_ports/main.c" -o "$tmp/build/img/main.c.obj" || exit 1
 link() {
   (cd "$tmp/build" && arm-none-eabi-gcc -mcpu=cortex-m3 -mthumb -nostartfiles --specs=nano.specs \
-    --specs=nosys.specs -L "$root/firmware/linker" -T "$tmp/app.ld" \
+    --specs=nosys.specs -L "$root/hal/ports/stm32_common/linker" -T "$tmp/app.ld" \
     -Wl,--gc-sections -Wl,-Map=img/img.map img/main.c.obj "port_$1/libport_$1.a" -o img/img.elf) || exit 1
 }
 fail=0

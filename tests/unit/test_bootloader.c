@@ -213,7 +213,7 @@ static void test_an_update_by_packets(void **state)
     assert_memory_equal(chip.mem, image, n);
 }
 
-/* The header matches what firmware/bootloader/servo_image builds: the same bytes
+/* The header matches what bootloader/servo_image builds: the same bytes
  * for the same code (tools/tests/test_image.py holds the same vector). */
 static void test_the_header_matches_the_tool(void **state)
 {

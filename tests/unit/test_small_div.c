@@ -1,4 +1,4 @@
-/* The Cortex-M0 image's one-bit-a-step division (firmware/runtime/
+/* The Cortex-M0 image's one-bit-a-step division (hal/runtime/
  * small_div.c) against C's / and % on edge cases and random pairs. */
 #include <setjmp.h>
 #include <stdarg.h>

@@ -1,4 +1,4 @@
-/* The size-first images' mem* (firmware/runtime/small_mem.c), built here
+/* The size-first images' mem* (hal/runtime/small_mem.c), built here
  * under other names: every alignment of source and destination and every
  * length up to 40 against the C library's. */
 #include <setjmp.h>

@@ -30,7 +30,7 @@ class Symbols:
                                     if s["st_info"]["type"] == "STT_FUNC" and s["st_size"] > 0)
             marks = table.get_symbol_by_name("_board_mark") or []
         # The board the image is for: vector 7's mark, the address of the
-        # linker's _board_mark (firmware/startup/board_mark.h); None without it.
+        # linker's _board_mark (hal/ports/stm32_common/board_mark.h); None without it.
         mark = marks[0]["st_value"] if marks else None
         self.board = mark & 0xFFFF if mark is not None and mark >> 16 == BOARD_MARK_TAG else None
 

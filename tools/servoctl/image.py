@@ -1,5 +1,5 @@
 """Application images for the bootloader, as servoctl makes and checks
-them: servo_image (firmware/bootloader/servo_image, which the firmware's
+them: servo_image (bootloader/servo_image, which the firmware's
 build runs too), its errors servoctl's UsageError."""
 import functools
 

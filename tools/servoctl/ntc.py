@@ -4,7 +4,7 @@ The status area reports temperature as the ADC value of an NTC divider
 (10 kohm to the rail, 10 kohm NTC with B = 3435 to ground, 12-bit ADC), so the
 value falls as the servo heats: about 2048 at 25 degC, 651 at about 75 degC.
 The firmware converts with a table generated from the same formula
-(firmware/sensors/gen_ntc_table.py); tools use the formula itself.
+(services/sensors/gen_ntc_table.py); tools use the formula itself.
 """
 from decimal import Decimal, localcontext
 

@@ -87,7 +87,7 @@ def test_a_board_its_part_contradicts_is_named_fact_by_fact(tmp_path):
         ("stm32f030k6", [], "stm32g031k8", "BOARD_FLASH_PAGE 1024 is not the part's erase unit, 2048 B"),
         ("stm32f030k6", [], "stm32f103c8", "its family's CPU cortex-m0 is not the part's cortex-m3"),
         ("stm32f030k6", [], "", "board.cmake names no part"),
-        ("stm32f030k6", [], "stm32f999", "names the part 'stm32f999', which firmware/parts/parts.toml does not have"),
+        ("stm32f030k6", [], "stm32f999", "names the part 'stm32f999', which hal/ports/parts.toml does not have"),
     ]
     for i, (name, edits, part, said) in enumerate(cases):
         problems = board_facts.check(_board_like(tmp_path / str(i), name, edits, part))

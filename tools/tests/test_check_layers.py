@@ -128,11 +128,11 @@ def test_a_generated_file_may_be_long(tmp_path):
 
 def test_an_include_that_names_no_layer_is_found(tmp_path):
     root = tree(tmp_path)
-    write(root, "firmware/storage/crc32.h", "int crc32(void);\n")
-    write(root, "firmware/storage/crc32.c", '#include "crc32.h"\n')  # beside it, but bare
-    write(root, "firmware/storage/save.c", '#include "storage/crc32.h"\n')
+    write(root, "services/storage/crc32.h", "int crc32(void);\n")
+    write(root, "services/storage/crc32.c", '#include "crc32.h"\n')  # beside it, but bare
+    write(root, "services/storage/save.c", '#include "storage/crc32.h"\n')
     breaches, _ = check_layers.check(root)
-    assert breaches == ['include: firmware/storage/crc32.c includes "crc32.h", which names no layer']
+    assert breaches == ['include: services/storage/crc32.c includes "crc32.h", which names no layer']
 
 
 def test_a_board_includes_its_own_files_by_name(tmp_path):

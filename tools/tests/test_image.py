@@ -1,5 +1,5 @@
 """The update image format: the header servoctl builds is the one the
-bootloader checks (firmware/bootloader/app_image.h; test_bootloader.c's
+bootloader checks (bootloader/include/bootloader/app_image.h; test_bootloader.c's
 test_the_header_matches_the_tool holds the same vector)."""
 import struct
 

@@ -27,7 +27,7 @@ def test_firmware_table_agrees(tmp_path):
     import sys
     from pathlib import Path
 
-    gen = Path(__file__).resolve().parents[2] / "firmware" / "sensors" / "gen_ntc_table.py"
+    gen = Path(__file__).resolve().parents[2] / "services" / "sensors" / "gen_ntc_table.py"
     out = tmp_path / "ntc_table.c"
     subprocess.run([sys.executable, str(gen), str(out)], check=True)
     rows = re.findall(r"^\s+(\d+), /\* (-?\d+) degC \*/", out.read_text(), re.M)

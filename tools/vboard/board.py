@@ -111,7 +111,7 @@ class Board:
         self.name, self.servo_id, self.bus, self.unit = board, servo_id, bus, unit
         self.part = PARTS[board]
         self.h = board_h(board)
-        self.part_facts = board_facts.parts()[board_facts.part_name(board)]  # firmware/parts/parts.toml
+        self.part_facts = board_facts.parts()[board_facts.part_name(board)]  # hal/ports/parts.toml
         h, part = self.h, self.part
         declared = (h.get("BOARD_BUS_USART"), h.get("BOARD_BUS_DMA_TX"), h.get("BOARD_BUS_DMA_RX"))
         if declared != (1, part.usart_tx_dma, part.usart_rx_dma):

@@ -11,7 +11,7 @@ and brownout), and what a fault handler does about the bridge, measured.
   taken as undefined (UsageFault UNDEFINSTR on the M3, HardFault on the M0).
 - stack: at the entry of the main loop's pass (servo_poll, called every
   pass), SP is lowered to just above the stack's bottom (STACK_SLACK) (the ELF's
-  _estack - STACK_SIZE, firmware/linker/sections_stm32.ld), as if the
+  _estack - STACK_SIZE, hal/ports/stm32_common/linker/sections_stm32.ld), as if the
   function had a deep local array: its own pushes (48 bytes on the F103,
   20 on the F030) reach below the bottom, over the bottom word where the
   firmware keeps a guard. At its return (its caller's address, its frame

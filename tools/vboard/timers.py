@@ -14,7 +14,7 @@ twice the APB clock: RM0008 7.2's clock tree, RM0360 6.2's) over
 PSC + 1, modulo ARR + 1.
 
 The IWDG (RM0008 19, RM0360 18): started by its key, counting down at the
-LSI's frequency (the part's typical, firmware/parts/parts.toml: 40 kHz on
+LSI's frequency (the part's typical, hal/ports/parts.toml: 40 kHz on
 the F103 and F030, DS5319/DS9773) divided by 4 << PR from RLR; a reload
 key starts it over; reaching 0 resets the chip. Once started it cannot be
 stopped."""

@@ -182,7 +182,7 @@ static void start_app(struct sim_servo *s)
     servo_init(&s->core, &s->port);
 }
 
-/* The bootloader, the boards' loop (firmware/bootloader/bootloader.c) on the
+/* The bootloader, the boards' loop (bootloader/bootloader.c) on the
  * servo's port: its receive ring and UART, the config store's flash file,
  * the slot's. A reset into it (stay: UpdateEnter asked), and its main-loop
  * pass: false once it has started the application. */

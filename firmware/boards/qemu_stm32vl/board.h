@@ -1,6 +1,6 @@
 /* QEMU's stm32vldiscovery (STM32F100RB: 128 KB flash, 8 KB RAM), which
  * models the USART only. Its main.c and boot_main.c, its linker scripts
- * (made from firmware/linker/app.ld.in and boot.ld.in) and servoctl read
+ * (made from hal/ports/stm32_common/linker/app.ld.in and boot.ld.in) and servoctl read
  * this file: plain numbers, one per line. */
 #ifndef BOARD_H
 #define BOARD_H

@@ -4,7 +4,7 @@
 # application, so the 4 KB bootloader, the application, the 2 KB fault history
 # and the 2 KB store fit 32 KB.
 include(${PROJECT_SOURCE_DIR}/cmake/family-stm32f0.cmake)  # CPU, port, startup
-set(SERVO_BOARD_PART stm32f030k6)  # its facts: firmware/parts/parts.toml, checked against board.h
+set(SERVO_BOARD_PART stm32f030k6)  # its facts: hal/ports/parts.toml, checked against board.h
 set(SERVO_BOARD_RAM_LIMIT 4096)
 set(SERVO_BOARD_FLASH_LIMIT 24320) # the application: its 24 KB slot less the update image's 256-byte header (board.h)
 set(SERVO_BOARD_SOURCES ${CMAKE_CURRENT_LIST_DIR}/board_io.c)         # pins, clocks, ADC, PWM: this board's

@@ -1,6 +1,6 @@
 /* The Cortex-M0 servo board: STM32F030K6 (48 MHz, 32 KB flash, 4 KB RAM;
  * RM0360). Its main.c and boot_main.c, its linker scripts (made from
- * firmware/linker/app.ld.in and boot.ld.in) and servoctl's image command
+ * hal/ports/stm32_common/linker/app.ld.in and boot.ld.in) and servoctl's image command
  * read this file: plain numbers, one per line. */
 #ifndef BOARD_H
 #define BOARD_H

@@ -1,6 +1,6 @@
 /* The bootloader on the Cortex-M0 board: the clock, the bus wire and its
  * USART with DMA receive (an answer goes out whole before the loop goes
- * on), the flash, and the portable loop (firmware/bootloader/bootloader.c).
+ * on), the flash, and the portable loop (bootloader/bootloader.c).
  * What differs from the other STM32 boards; the start-up path is the
  * boards' shared one (boards/common/boot_start.h). */
 #include "board.h"

@@ -1,6 +1,6 @@
 /* The reference servo board: STM32F103C8 (Cortex-M3, 72 MHz, 64 KB flash,
  * 20 KB RAM; RM0008). Its main.c and boot_main.c, its linker scripts
- * (made from firmware/linker/app.ld.in and boot.ld.in) and servoctl's image
+ * (made from hal/ports/stm32_common/linker/app.ld.in and boot.ld.in) and servoctl's image
  * command read this file: plain numbers, one per line. */
 #ifndef BOARD_H
 #define BOARD_H

@@ -1,6 +1,6 @@
 /* The bootloader on the reference board: the clock, the bus wire and its
  * USART with DMA receive, the flash, and the portable loop
- * (firmware/bootloader/bootloader.c). What differs from the other STM32
+ * (bootloader/bootloader.c). What differs from the other STM32
  * boards; the start-up path is the boards' shared one
  * (boards/common/boot_start.h). */
 #include "board.h"

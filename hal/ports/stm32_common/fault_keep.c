@@ -5,7 +5,7 @@
 #include "ports/stm32_common/kept_ram.h"
 #include "ports/stm32_common/stm32_core_regs.h"
 
-/* The linker's (firmware/linker): the stack's bottom and top, RAM's start. */
+/* The linker's (hal/ports/stm32_common/linker): the stack's bottom and top, RAM's start. */
 extern uint32_t _sstack, _estack, _ram_start;
 
 /* The bottom of the stack an overflow must not pass unseen: larger than

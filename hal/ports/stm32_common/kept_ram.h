@@ -1,5 +1,5 @@
 /* RAM a reset keeps and start-up does not clear: the last BOARD_RAM_KEPT
- * bytes, left out of both images' linker scripts (firmware/linker). Its
+ * bytes, left out of both images' linker scripts (hal/ports/stm32_common/linker). Its
  * last word keeps the bootloader (boot_jump.h); at its start, this record
  * tells the next start-up what the firmware knew of the reset: a fault it
  * took (a fault handler wrote it), a restart it meant, and what came

@@ -21,7 +21,7 @@ from ..launchers import REPO
 
 TOOLS = REPO / "tools"
 PROJECT = tomllib.loads((TOOLS / "pyproject.toml").read_text())["project"]
-PATHS = [TOOLS, REPO / "protocol", REPO / "firmware" / "bootloader"]  # servoctl, servo_schema, servo_image
+PATHS = [TOOLS, REPO / "protocol", REPO / "bootloader"]  # servoctl, servo_schema, servo_image
 
 
 def name(requirement: str) -> str:
@@ -124,7 +124,7 @@ def test_an_installed_copy_imports_the_arm_without_the_firmware_tree(tmp_path):
     told (scan's probe, imported when it is needed)."""
     source = tmp_path / "src"
     for part in ("tools/pyproject.toml", "tools/servoctl", "tools/vboard", "protocol/servo_schema",
-                 "firmware/bootloader/servo_image"):
+                 "bootloader/servo_image"):
         copy = shutil.copytree if (REPO / part).is_dir() else shutil.copy
         (source / part).parent.mkdir(parents=True, exist_ok=True)
         copy(REPO / part, source / part, **({"ignore": shutil.ignore_patterns("__pycache__")}

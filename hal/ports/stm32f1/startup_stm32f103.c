@@ -1,7 +1,7 @@
 /* Reset handler and vector table for the STM32F103 (Cortex-M3). */
 #include <stdint.h>
 
-#include "startup/core_vectors.h"
+#include "ports/stm32_common/core_vectors.h"
 
 /* The interrupts a board's bus may name (ports/stm32f1/stm32f1_bus.h:
  * USART1-3 and DMA1's channels, RM0008 Table 78), each weak: a board

@@ -14,7 +14,7 @@
  *   24      4     CRC-32 of bytes 0-23
  *   28      228   0xFF (the vector table must sit 256-byte aligned)
  *
- * firmware/bootloader/servo_image writes the same layout. */
+ * bootloader/servo_image writes the same layout. */
 #ifndef BOOTLOADER_APP_IMAGE_H
 #define BOOTLOADER_APP_IMAGE_H
 
@@ -54,7 +54,7 @@ enum app_image_verdict {
 
 uint32_t app_slot_size(const struct app_slot *slot);
 
-/* The header for `size` bytes of code (size even), as firmware/bootloader/servo_image
+/* The header for `size` bytes of code (size even), as bootloader/servo_image
  * writes it; for the simulator's factory image and the tests. */
 void app_image_make_header(uint8_t header[APP_HEADER_SIZE], const uint8_t *code, uint32_t size,
                            uint16_t version, uint16_t board);

@@ -8,7 +8,7 @@
  * USART's interrupt (84 bytes of its 4 KB shorter). */
 #include <stdint.h>
 
-#include "startup/core_vectors.h"
+#include "ports/stm32_common/core_vectors.h"
 #include "ports/stm32f0/stm32f0_regs.h"
 
 void DMA1_Channel2_3_IRQHandler(void) __attribute__((weak, alias("Default_Handler")));

@@ -7,17 +7,17 @@ analogue front end), those of the headers it includes from firmware/boards/
 the include stands, and the CPU of the chip family its board.cmake names
 (include(.../cmake/family-NAME.cmake), whose SERVO_BOARD_CPU it is; a
 board.cmake may also set SERVO_BOARD_CPU itself), and the part it names
-(set(SERVO_BOARD_PART name)), whose facts are in firmware/parts/parts.toml;
+(set(SERVO_BOARD_PART name)), whose facts are in hal/ports/parts.toml;
 check() holds the board to them. Standard library only."""
 import re
 import sys
 import tomllib
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[3]  # firmware/bootloader/servo_image/
+ROOT = Path(__file__).resolve().parents[2]  # bootloader/servo_image/
 BOARDS_DIR = ROOT / "firmware" / "boards"
 FAMILIES_DIR = ROOT / "cmake"
-PARTS_FILE = ROOT / "firmware" / "parts" / "parts.toml"
+PARTS_FILE = ROOT / "hal" / "ports" / "parts.toml"
 
 _DEFINE = re.compile(r"#define (BOARD_\w+) (0x[0-9a-fA-F]+|\d+)\b")
 _INCLUDE = re.compile(r'#include "(boards/[^"]+)"')
@@ -104,7 +104,7 @@ def check(board) -> list:
     name = part_name(folder)
     known = parts()
     if name not in known:
-        said = (f"names the part {name!r}, which firmware/parts/parts.toml does not have" if name
+        said = (f"names the part {name!r}, which hal/ports/parts.toml does not have" if name
                 else "names no part: add set(SERVO_BOARD_PART name)")
         return [f"{folder.name}: board.cmake {said} (the parts: {', '.join(sorted(known))})"]
     p = known[name]

@@ -2,7 +2,7 @@
  * .bss cleared, and in an application the stack painted below the reset
  * handler's own frame, so the main loop can find how deep it has ever
  * reached and whether it reached its bottom (ports/stm32_common/fault_keep.h;
- * symbols from firmware/linker/sections_stm32.ld). */
+ * symbols from hal/ports/stm32_common/linker/sections_stm32.ld). */
 #ifndef STARTUP_MEMORY_H
 #define STARTUP_MEMORY_H
 

@@ -2,7 +2,7 @@
  * ARMv6-M and ARMv7-M reserve and no core reads. Two boards' applications
  * can share a link address and a RAM size; this word tells them apart, so
  * `servoctl image` refuses to pack one board's binary for another
- * (firmware/bootloader/servo_image reads it). Its value is the linker's symbol
+ * (bootloader/servo_image reads it). Its value is the linker's symbol
  * _board_mark (the linker scripts app.ld.in and boot.ld.in, from the
  * board's board.h): "SB" in the high half, BOARD_ID in the low half. */
 #ifndef STARTUP_BOARD_MARK_H

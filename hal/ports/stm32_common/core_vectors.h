@@ -9,8 +9,8 @@
 
 #include <stdint.h>
 
-#include "startup/board_mark.h"
-#include "startup/startup_memory.h"
+#include "ports/stm32_common/board_mark.h"
+#include "ports/stm32_common/startup_memory.h"
 
 int main(void);
 void Reset_Handler(void);

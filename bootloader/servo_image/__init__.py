@@ -1,6 +1,6 @@
 """Application images for the bootloader (docs/packets.md, "Firmware
 update"): a 256-byte header, then the application from its vector table on.
-The layout is firmware/bootloader/app_image.h's. Standard library only,
+The layout is bootloader/include/bootloader/app_image.h's. Standard library only,
 beside the bootloader: the firmware's build makes each board's image with
 it (run as a script), and servoctl's image and update commands use it
 (servoctl.image, whose errors are servoctl's)."""
@@ -27,12 +27,12 @@ CHECKED = 24  # bytes the header's own CRC covers
 
 # The build's boards: each folder with a board.h (BOARD_ID, the header's
 # board field; the flash map and RAM the application's linker script is made
-# from: firmware/linker/app.ld.in).
+# from: hal/ports/stm32_common/linker/app.ld.in).
 BOARDS_DIR = board_facts.BOARDS_DIR
 HEADER_SIZE_IN_SLOT = 256  # the image header before the application (app.ld.in)
 STAY_WORD_BYTES = 16       # RAM's last bytes, left out of the application's
 # Vector 7 (reserved by the core) carries "SB" and the board's ID
-# (firmware/startup/board_mark.h): boards that share a link address and a
+# (hal/ports/stm32_common/board_mark.h): boards that share a link address and a
 # RAM size are told apart by it.
 BOARD_MARK_OFFSET = 7 * 4
 BOARD_MARK_TAG = 0x5342
@@ -187,7 +187,7 @@ def make(binary: str, version: str, board: str, output: str) -> bytes:
 
 
 def main(argv=None) -> int:
-    """python3 firmware/bootloader/servo_image/__init__.py BIN --version V
+    """python3 bootloader/servo_image/__init__.py BIN --version V
     --board B -o OUT (the build's post-link step; servoctl image is the same
     for users)."""
     import argparse
