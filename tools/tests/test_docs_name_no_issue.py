@@ -1,5 +1,5 @@
-"""The documents state what is true now: none points at an issue number
-(history belongs in git log and the changelogs, which may)."""
+"""No document points at an issue number, the changelogs neither: a
+reader has no tracker to follow it to (history is in git log)."""
 import re
 from pathlib import Path
 
@@ -8,8 +8,10 @@ ISSUE = re.compile(r"\b[Ii]ssues? #?\d+")
 
 
 def documents():
-    for path in sorted([ROOT / "README.md", *(ROOT / "docs").rglob("*.md"), *(ROOT / "tools").rglob("*.md")]):
-        if "changelog" in path.name.lower() or ".venv" in path.parts or "build" in path.parts:
+    """Every Markdown file of the project's own (not a build's, nor an environment's)."""
+    for path in sorted(ROOT.rglob("*.md")):
+        parts = path.relative_to(ROOT).parts
+        if any(p.startswith(".") or p.startswith("build") or p == "node_modules" for p in parts):
             continue
         yield path
 
