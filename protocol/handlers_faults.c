@@ -3,6 +3,8 @@
 #include "protocol/wire.h"
 
 enum { READ_FAULTS_ANSWER_LENGTH = 27 };
+_Static_assert(ANSWER_AT_(ANSWER_READ_FAULTS_NUMBER) == 4u && 4u + READ_FAULTS_ENTRY_BYTES == READ_FAULTS_ANSWER_LENGTH,
+               "the entry fills the answer after id, count and not_logged");
 _Static_assert(READ_FAULTS_ANSWER_LENGTH <= RESPONSE_CONTENT_MAX, "ReadFaults fits a response");
 
 enum packet_outcome handle_read_faults(const struct packet_call *c, struct response *r)
@@ -14,7 +16,7 @@ enum packet_outcome handle_read_faults(const struct packet_call *c, struct respo
     le_put_u16(&p[2], h->faults_not_logged);
     /* The entry's bytes go straight into the answer: they are its wire image. */
     if (d->read_fault == NULL || !d->read_fault(d->read_fault_ctx, c->content[1], &p[4])) {
-        for (unsigned i = 0; i < FAULT_ENTRY_BYTES; i++) {
+        for (unsigned i = 0; i < READ_FAULTS_ENTRY_BYTES; i++) {
             p[4u + i] = 0; /* what 0: none at this index */
         }
     }

@@ -218,6 +218,7 @@ void safety_init(struct servo *s)
     if (s->hal->reset != NULL) {
         take_reset(s, s->hal->reset);
     }
+    _Static_assert(FAULT_ENTRY_BYTES == READ_FAULTS_ENTRY_BYTES, "a logged fault is its ReadFaults bytes");
     s->dispatcher.read_fault = fault_log_read;
     s->dispatcher.read_fault_ctx = &s->faults;
     s->dispatcher.clear_faults = clear_faults;

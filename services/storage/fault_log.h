@@ -25,7 +25,7 @@
 
 #include "hal/hal_flash.h"
 #include "hal/must_check.h"
-#include "registers/faults.h"
+#include "storage/fault_record.h"
 
 #define FAULT_RECORD_SIZE 32u
 #define FAULT_PENDING_MAX 4u

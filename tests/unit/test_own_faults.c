@@ -12,7 +12,7 @@
 #include <cmocka.h>
 
 #include "app/servo_safety.h"
-#include "registers/faults.h"
+#include "storage/fault_record.h"
 #include "support/by_name.h"
 #include "support/servo_harness.h"
 

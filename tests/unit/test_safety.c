@@ -13,7 +13,7 @@
 #include <cmocka.h>
 
 #include "registers/byte_order.h"
-#include "registers/faults.h"
+#include "storage/fault_record.h"
 #include "runtime/crc32.h"
 #include "support/by_name.h"
 #include "support/servo_harness.h"

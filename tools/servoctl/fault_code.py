@@ -1,5 +1,5 @@
 """A firmware fault's record (ReadFaults' kind 10, docs/safety.md): the
-readings' bytes hold the faulting code's frame instead (registers/faults.h,
+readings' bytes hold the faulting code's frame instead (storage/fault_record.h,
 struct fault_code), decoded here (fault_symbols.py names it from the image's ELF)."""
 from dataclasses import dataclass
 

@@ -1,7 +1,7 @@
 /* Why the MCU last started, as the board read it once at start-up (on the
  * STM32 boards: RCC_CSR's reset flags and the record kept in RAM across the
  * reset, boards/common/reset_cause.c), for the fault history. The kinds
- * that are faults carry the fault history's numbers (registers/faults.h). */
+ * that are faults carry the fault history's numbers (storage/fault_record.h). */
 #ifndef HAL_RESET_H
 #define HAL_RESET_H
 
@@ -36,7 +36,7 @@ enum hal_reset_count {
 #define HAL_FAULT_STACK_GUARD 0u
 
 /* From pc on laid out as the fault history's record of a firmware fault
- * (registers/faults.h, struct fault_code), which copies it whole. */
+ * (storage/fault_record.h, struct fault_code), which copies it whole. */
 struct hal_reset {
     uint8_t kind;       /* enum hal_reset_kind */
     uint8_t in_row;     /* fault resets with no healthy run between, this one's included */

@@ -16,6 +16,23 @@
 #include "registers/field_ranges.h"
 #include "hal/must_check.h"
 
+/* What holds the output back at this instant (item 67, ReadMotion's
+ * motion_flags bits 5-7), the first that applies in this order: the
+ * watchdog has acted; a protection releases it (the supply, heat); the
+ * controller is at its limit, and which limit that is; a target was
+ * clamped to the angle limits. */
+enum limiter {
+    LIMITER_NONE = 0,
+    LIMITER_POWER = 1,    /* the power limit (42, the move's power) */
+    LIMITER_CURRENT = 2,  /* the current limit (43), or halved by over-current */
+    LIMITER_STALL = 3,    /* the stall cap (38), or released by a stall (37 = 1) */
+    LIMITER_SUPPLY = 4,   /* full duty (the supply's voltage), or out of range */
+    LIMITER_HEAT = 5,     /* derated for heat, or released by over-temperature */
+    LIMITER_ANGLE = 6,    /* the target was clamped to items 51 and 52 */
+    LIMITER_WATCHDOG = 7, /* the bus watchdog acted (64, 65) */
+    LIMITER_SHIFT = 5,    /* its place in ReadMotion's motion_flags */
+};
+
 enum motion_kind {
     MOTION_ANGLE,    /* packets 8, 11-15 */
     MOTION_WHEEL,    /* packet 7 */

@@ -10,7 +10,7 @@
 #include "motion/motion.h"
 #include "protocol/frame_rx.h"
 #include "protocol/frame_tx.h"
-#include "registers/faults.h"
+#include "protocol/packet_fields.h"
 #include "registers/registers.h"
 
 struct dispatcher {
@@ -35,7 +35,7 @@ struct dispatcher {
      * record): the bus watchdog's food. */
     uint32_t heard;
     /* The fault history (ReadFaults, ClearFaults): the index-th newest
-     * fault's bytes (struct fault_entry's image) into out, false beyond
+     * fault's READ_FAULTS_ENTRY_BYTES (the log's entry image) into out, false beyond
      * the count (store_health has the count); and a clear. NULL where none
      * is kept. Each with its own context: the read is the store's own
      * function, called straight. */
@@ -44,6 +44,13 @@ struct dispatcher {
     bool (*clear_faults)(void *ctx);
     void *faults_ctx;
 };
+
+/* A fault's bytes in ReadFaults' answer, `number` to `what` (the schema's
+ * layout): the fault log's entry is copied there whole, so its image must
+ * be this long (the application holds the two together). */
+#define READ_FAULTS_ENTRY_BYTES (ANSWER_AT_(ANSWER_READ_FAULTS_WHAT) + 1u - ANSWER_AT_(ANSWER_READ_FAULTS_NUMBER))
+#define ANSWER_AT_(field) ANSWER_AT_OFFSET_(field)
+#define ANSWER_AT_OFFSET_(offset, size, sign) (offset##u)
 
 struct dispatch_result {
     /* Word-aligned: cleared by one store, not a call (the M0's memset). */

@@ -20,23 +20,6 @@ enum store_flag {
     STORE_AWAITS_ERASE = 1u << 3, /* the last change was refused: no erased slot */
 };
 
-/* What holds the output back at this instant (item 67, ReadMotion's
- * motion_flags bits 5-7), the first that applies in this order: the
- * watchdog has acted; a protection releases it (the supply, heat); the
- * controller is at its limit, and which limit that is; a target was
- * clamped to the angle limits. */
-enum limiter {
-    LIMITER_NONE = 0,
-    LIMITER_POWER = 1,    /* the power limit (42, the move's power) */
-    LIMITER_CURRENT = 2,  /* the current limit (43), or halved by over-current */
-    LIMITER_STALL = 3,    /* the stall cap (38), or released by a stall (37 = 1) */
-    LIMITER_SUPPLY = 4,   /* full duty (the supply's voltage), or out of range */
-    LIMITER_HEAT = 5,     /* derated for heat, or released by over-temperature */
-    LIMITER_ANGLE = 6,    /* the target was clamped to items 51 and 52 */
-    LIMITER_WATCHDOG = 7, /* the bus watchdog acted (64, 65) */
-    LIMITER_SHIFT = 5,    /* its place in ReadMotion's motion_flags */
-};
-
 struct store_health {
     uint8_t flags;          /* enum store_flag */
     uint8_t write_refused;  /* the last WriteData's own refusal: STORE_UNSTABLE or 0 */
@@ -64,7 +47,7 @@ struct registers {
     struct firmware_area firmware;
     struct store_health store;
     /* What a protection or the watchdog holds the output back by (enum
-     * limiter; 0 none): item 67 is this, else the motion's own limit. */
+     * limiter, motion/motion.h; 0 none): item 67 is this, else the motion's own limit. */
     uint8_t held_by;
 };
 

@@ -1,7 +1,7 @@
 /* The fault history's entries (ReadFaults, 0x43): what tripped, when, and
  * the readings at that moment. The log in flash: storage/fault_log.h. */
-#ifndef REGISTERS_FAULTS_H
-#define REGISTERS_FAULTS_H
+#ifndef STORAGE_FAULT_RECORD_H
+#define STORAGE_FAULT_RECORD_H
 
 #include <stdint.h>
 
