@@ -157,9 +157,7 @@ enum packet_outcome handle_read_motion(const struct packet_call *c, struct respo
     /* Taken once: the content's stores could alias them, and every reload
      * is two loads on the answer's path. */
     const struct registers *regs = c->d->regs;
-    const uint32_t *next_tick = c->d->next_tick_us;
-    /* The snapshot is the last tick's: it ran one period before the next. */
-    uint32_t time_us = next_tick != NULL ? *next_tick - 1000000u / MOTION_TICK_HZ : 0u;
+    uint32_t time_us = c->d->tick_us; /* the snapshot is the last tick's */
     uint32_t angle = (uint32_t)d.angle_decideg;
     uint32_t setpoint = (uint32_t)d.setpoint_decideg;
     uint32_t target = (uint32_t)d.target_decideg;

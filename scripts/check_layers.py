@@ -8,7 +8,9 @@ uses and the others define (`--objects BUILD`: a build's objects, read
 with nm), nor may servoctl's modules through their imports; no file
 people read (source, build files, documents) outside the tests and the
 generated files may pass LINE_LIMIT lines,
-nor a line of the protocol's schema SCHEMA_LINE_LIMIT characters; and the
+nor a line of the protocol's schema SCHEMA_LINE_LIMIT characters; no job
+of the application's (firmware/app/servo_*.[ch]) reaches its hub (struct
+servo: servo_state.h, servo.h); and the
 Python the firmware's build runs imports nothing from tools/ (the PC
 tools) and nothing outside the standard library.
 
@@ -128,6 +130,32 @@ def include_breaches(root):
     for name, where in sorted(headers.items()):
         if len(where) > 1:
             out.append(f"header name: {name} is {', '.join(where)}")
+    return out
+
+
+# The application's hub: struct servo, the main loop's state and every
+# job's. Only the main loop (servo.c, servo.h) reaches it; a job's files
+# (firmware/app/servo_*.[ch] but these) are handed what they need.
+HUB_HEADERS = ("app/servo_state.h", "app/servo.h")
+HUB_FILES = ("firmware/app/servo.c", "firmware/app/servo.h", "firmware/app/servo_state.h")
+JOB_FILE = re.compile(r"^firmware/app/servo_\w+\.[ch]$")
+HUB_STRUCT = re.compile(r"\bstruct\s+servo\b(?!_)")
+
+
+def hub_breaches(root):
+    """A job of the application's (safety, store, turns) that includes the
+    hub's headers or names struct servo: it would reach every other
+    module's state."""
+    out = []
+    for rel in sources(root):
+        if not JOB_FILE.match(rel) or rel in HUB_FILES:
+            continue
+        text = (root / rel).read_text(errors="replace")
+        for name in INCLUDE.findall(text):
+            if name in HUB_HEADERS:
+                out.append(f'hub: {rel} includes "{name}": a job is handed what it needs')
+        if HUB_STRUCT.search(text):
+            out.append(f"hub: {rel} names struct servo: a job is handed what it needs")
     return out
 
 
@@ -335,6 +363,7 @@ def check(root, build=None):
         breaches.append(f"long file: {rel} has {n} lines (limit {LINE_LIMIT})")
     for rel, n, length in long_schema_lines(root):
         breaches.append(f"long schema line: {rel}:{n} has {length} characters (limit {SCHEMA_LINE_LIMIT})")
+    breaches += hub_breaches(root)
     breaches += build_import_breaches(root)
     return breaches, graph
 

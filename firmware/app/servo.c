@@ -5,8 +5,9 @@
 #include <string.h>
 
 #include "app/identity.h"
-#include "app/servo_jobs.h"
 #include "app/servo_safety.h"
+#include "app/servo_store.h"
+#include "app/servo_turns.h"
 #include "protocol/wire.h"
 #include "registers/data_table.h"
 
@@ -27,30 +28,30 @@ static void apply_link_settings(struct servo *s)
     /* Divides: on a change of link settings only. */
     uint32_t byte_us = baud != 0u ? (10000000u + baud - 1u) / baud : 0u;
     s->ring_covers_erase = hal_rx_ring_size(s->hal->rx) * byte_us >= STORE_ERASE_MAX_US;
-    s->unsolicited_slot_us = UNSOLICITED_WINDOW_US + 2u * byte_us + UNSOLICITED_DRIFT_GUARD_US;
-    s->unsolicited_first_us = UNSOLICITED_QUIET_US + (uint32_t)s->active_id * s->unsolicited_slot_us;
+    turns_set_link(&s->tx, s->active_id, byte_us);
     s->turn_guard_bytes = (uint8_t)(byte_us != 0u ? s->hal->tick_and_pass_us / byte_us : 0u);
+}
+
+/* The dispatcher's persist hook (ctx: the servo): the store's job. */
+static bool persist_config(void *ctx, const struct user_config *cfg)
+{
+    struct servo *s = ctx;
+    return store_persist(&s->saving, &s->store, &s->regs.store, cfg, s->hal->bus.now_us(s->hal->ctx));
+}
+
+/* ClearFaults (ctx: the servo): the history's marker. */
+static bool clear_faults(void *ctx)
+{
+    struct servo *s = ctx;
+    return store_clear_faults(&s->saving, &s->faults);
 }
 
 void servo_init(struct servo *s, const struct hal_port *hal)
 {
     *s = (struct servo){.hal = hal};
-    config_store_load(&s->store, hal->flash, &s->regs.user);
+    store_start(&s->saving, &s->store, hal->flash, &s->regs.user, hal->bus.now_us(hal->ctx));
     firmware_area_factory(&s->regs.firmware);
     s->sensors.current_zero = s->regs.user.current_zero_counts;
-    /* A store older firmware wrote (formats 1 and 2) is rewritten in format
-     * 3, the one the bootloader reads the ID and baud rate from. Then the spare
-     * page is erased ahead, before the control loop runs: saves need no
-     * erase until the page in use is full. A failure of either stays in the
-     * store (ReadStore reports it, the next save tries again): at power-up
-     * nobody waits for an answer. */
-    bool rewritten = !s->store.legacy ||
-                     config_store_save(&s->store, &s->regs.user, s->store.op_seconds) ==
-                         CONFIG_SAVED;
-    bool spare_ready = !config_store_spare_dirty(&s->store) || config_store_erase_spare(&s->store);
-    (void)rewritten;
-    (void)spare_ready;
-    save_policy_init(&s->saver, &s->store, hal->bus.now_us(hal->ctx));
     s->regs.status.model = SERVO_MODEL;
     uint16_t image_version = hal->image_version != NULL ? hal->image_version(hal->ctx) : 0u;
     s->regs.status.firmware_version = image_version != 0u ? image_version : FIRMWARE_VERSION;
@@ -64,10 +65,18 @@ void servo_init(struct servo *s, const struct hal_port *hal)
     dispatcher_init(&s->dispatcher, &s->regs, &s->motion, &s->active_id);
     s->dispatcher.bootloader_present = hal->enter_bootloader != NULL;
     s->dispatcher.board = hal->board;
-    s->dispatcher.next_tick_us = &s->next_tick_us;
-    s->dispatcher.persist = servo_persist_config;
+    s->dispatcher.persist = persist_config;
     s->dispatcher.persist_ctx = s;
-    safety_init(s);
+    if (!store_load_faults(&s->saving, &s->faults, hal->fault_flash)) {
+        s->regs.status.status |= STATUS_COMMAND_ERROR; /* nobody waits at power-up */
+    }
+    /* Faults go into the history, with the store's operating time. */
+    safety_init(&s->safety, &s->regs, &s->protection,
+                (struct safety_log){.faults = &s->faults, .clock = &s->saving.saver}, hal);
+    s->dispatcher.read_fault = fault_log_read;
+    s->dispatcher.read_fault_ctx = &s->faults;
+    s->dispatcher.clear_faults = clear_faults;
+    s->dispatcher.faults_ctx = s;
     s->active_baud_index = 0; /* forces the first apply to set the UART */
     apply_link_settings(s);
 }
@@ -105,7 +114,7 @@ static __attribute__((noinline)) bool send_ahead(struct servo *s, const struct r
     r->words[0] = WIRE_RESPONSE_HDR0 | (uint32_t)WIRE_RESPONSE_HDR1 << 8 |
                   (uint32_t)PKT_MONITOR << 16 | (uint32_t)MONITOR_ANSWER_LENGTH << 24;
     r->content[0] = f->content[3]; /* the record: this servo's ID */
-    servo_queue_response(s, 0, f->responses_seen, now);
+    turns_queue(&s->tx, s->hal, &s->rx, 0, f->responses_seen, now);
     dispatch(&s->dispatcher, f, r, &s->dispatched);
     s->dispatched.answer = 0; /* on its way already */
     return true;
@@ -122,14 +131,16 @@ static SERVO_ONE_COPY void handle_next_frame(struct servo *s, uint32_t now, bool
 {
     const struct rx_frame *frame = &s->rx.slots[s->rx.tail]; /* the callers know there is one */
     struct dispatch_result *result = &s->dispatched;
+    dispatcher_note_tick(&s->dispatcher, s->next_tick_us - CONTROL_TICK_US);
     if (!SERVO_SENDS_AHEAD || frame->sync_index != 0u || late || !send_ahead(s, frame, now)) {
         dispatch(&s->dispatcher, frame, &s->tx.frame, result);
     }
     uint32_t responses_base = frame->responses_seen;
     frame_rx_release(&s->rx);
     show_executing(s);
-    if (s->watchdog.fired) {
-        safety_after_frame(s); /* a motion command clears what the watchdog did */
+    if (s->safety.watchdog.fired) {
+        /* a motion command clears what the watchdog did */
+        safety_after_frame(&s->safety, &s->regs, s->motion.commands);
     }
     if (result->config_changed) {
         s->link_settings_pending = 1;
@@ -139,20 +150,9 @@ static SERVO_ONE_COPY void handle_next_frame(struct servo *s, uint32_t now, bool
     if (result->answer && late) {
         s->answers_dropped++;
     } else if (result->answer) {
-        servo_queue_response(s, result->wait_responses, responses_base, now);
+        turns_queue(&s->tx, s->hal, &s->rx, result->wait_responses, responses_base, now);
     }
 }
-
-
-_Static_assert(offsetof(struct status_area, current_ma) - offsetof(struct status_area, voltage_mv) ==
-                   offsetof(struct sensor_readings, current_ma) &&
-               offsetof(struct status_area, power_mw) - offsetof(struct status_area, voltage_mv) ==
-                   offsetof(struct sensor_readings, power_mw) &&
-               offsetof(struct status_area, temperature_adc) - offsetof(struct status_area, voltage_mv) ==
-                   offsetof(struct sensor_readings, temperature_adc) &&
-               offsetof(struct sensor_readings, voltage_mv) == 0 &&
-               sizeof(struct sensor_readings) == 8,
-               "the status area's IDs 1-4 lie as struct sensor_readings");
 
 /* Sensors to the status area (IDs 1-4), monitors to what the output may
  * do; returns status bits 2-7. */
@@ -173,7 +173,7 @@ static uint8_t sense_and_protect(struct servo *s)
     }
     if (p->act_changes != s->guard_seen) {
         s->guard_seen = p->act_changes;
-        safety_guard(s, bits);
+        safety_guard(&s->safety, &s->regs, &s->motion, p, bits);
     }
     return bits;
 }
@@ -248,8 +248,9 @@ __attribute__((noinline, cold)) static void after_erase(struct servo *s, uint32_
     s->tick_due_us = s->next_tick_us;
     struct hal_rx_ring *ring = s->hal->rx;
     hal_rx_sync(s->hal, now);
-    uint32_t came = ring->written - s->erase_from;
-    if (!s->ring_covers_erase && (s->erase_from & ring->mask) + came > ring->mask) {
+    uint32_t erase_from = s->saving.erase_from;
+    uint32_t came = ring->written - erase_from;
+    if (!s->ring_covers_erase && (erase_from & ring->mask) + came > ring->mask) {
         /* The ring wrapped during the stall at a rate it cannot cover: how
          * many laps, nobody counted. All of it is dropped, and counted. */
         s->rx_lost += came;
@@ -275,6 +276,21 @@ static void restart_into_bootloader(struct servo *s)
     hal_enter_bootloader(s->hal);
 }
 
+/* The jobs' upkeep, once a control tick: the monitors', then the store's
+ * (a page erase: after_erase takes over the next pass). */
+__attribute__((noinline)) static void tend_jobs(struct servo *s, uint32_t now)
+{
+    safety_tend(&s->safety, &s->regs, &s->motion, s->dispatcher.heard);
+    s->regs.store.answers_dropped = s->answers_dropped;
+    s->regs.store.bytes_lost = s->rx_lost;
+    enum store_tended done = store_tend(&s->saving, &s->store, &s->faults, &s->regs.store,
+                                        s->hal->rx, &s->motion, &s->tx, now);
+    s->erase_passed = (uint8_t)(done != STORE_TENDED);
+    if (done == STORE_ERASE_FAILED) {
+        s->regs.status.status |= STATUS_COMMAND_ERROR;
+    }
+}
+
 void servo_poll(struct servo *s)
 {
     /* One reading of the clock per pass: the ticks due by then run now. */
@@ -290,8 +306,7 @@ void servo_poll(struct servo *s)
     }
     bool ticked = run_control_tick(s, now);
     if (s->tx.sending && s->hal->bus.tx_done(s->hal->ctx)) {
-        s->tx.sending = 0;
-        s->tx.ended_us = now;
+        turns_sent(&s->tx, now);
         if (s->enter_bootloader) { /* UpdateEnter's answer has left */
             restart_into_bootloader(s);
             return;
@@ -308,21 +323,21 @@ void servo_poll(struct servo *s)
     }
     receive(s, now);
     if (ticked) {
-        safety_tend(s); /* the monitors' upkeep, once a control tick */
-        servo_tend_store(s, now);
+        tend_jobs(s, now);
     }
     if (s->tx.sending) {
         return; /* half duplex: nothing else goes out meanwhile */
     }
     if (s->tx.waiting) {
         if (s->rx.stats.requests_seen == s->tx.requests_base) {
-            servo_wait_for_turn(s, now);
+            s->tick_due_us =
+                s->next_tick_us + turns_wait(&s->tx, s->hal, &s->rx, s->turn_guard_bytes, now);
             return;
         }
         /* A new request (to anyone) while this servo waits for its Sync
          * Monitor turn: the host has given up on that round, and is owed
          * this answer instead. */
-        s->tx.waiting = 0;
+        turns_abandon(&s->tx);
         s->sync_turns_abandoned++;
     }
     /* Requests first: the host waits for their answers, while a finished
@@ -331,7 +346,7 @@ void servo_poll(struct servo *s)
         handle_next_frame(s, now, false);
     }
     if (!s->tx.sending && !s->tx.waiting) {
-        servo_answer_finished_move(s, now);
+        turns_answer_finished_move(&s->tx, s->hal, &s->motion, s->active_id, now);
     }
 }
 

@@ -30,4 +30,23 @@ struct bus_watchdog {
 bool bus_watchdog_tick(struct bus_watchdog *w, uint16_t timeout_ms, bool driven, uint32_t heard,
                        uint32_t commands);
 
+/* Another monitor acted for it (the oscillation monitor): the latch is
+ * set as if it had, until a motion command after commands. */
+static inline void bus_watchdog_latch(struct bus_watchdog *w, uint32_t commands)
+{
+    w->fired = 1;
+    w->commands_at_fire = commands;
+}
+
+/* After a frame while the latch is set: a motion command since it acted
+ * clears it. True if it did. */
+static inline bool bus_watchdog_command(struct bus_watchdog *w, uint32_t commands)
+{
+    if (commands == w->commands_at_fire) {
+        return false;
+    }
+    w->fired = 0;
+    return true;
+}
+
 #endif

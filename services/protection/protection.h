@@ -90,6 +90,12 @@ struct protection {
 };
 
 void protection_init(struct protection *p);
+/* Another part changed what the output may do (the derating's cap, safe
+ * mode): the output's guard is worked out again at the next tick. */
+static inline void protection_note_act_change(struct protection *p)
+{
+    p->act_changes++;
+}
 /* The threshold monitors, once a tick: the current, and those of the slow
  * reading refreshed this tick (slot). Returns status bits 3-7. */
 uint8_t protection_update(struct protection *p, const struct user_config *cfg,

@@ -48,6 +48,14 @@ void save_policy_outcome(struct save_policy *p, bool ok, uint32_t now_us);
 /* Not within SAVE_RETRY_US of a failed flash step. */
 bool save_policy_may_retry(const struct save_policy *p, const struct config_store *store,
                            uint32_t now_us);
+/* Another record (the fault history's) counts more operating time than
+ * the store's last: the time goes on from there. */
+static inline void save_policy_carry_op_seconds(struct save_policy *p, uint32_t seen)
+{
+    if (seen > p->op_seconds_at_boot) {
+        p->op_seconds_at_boot = seen;
+    }
+}
 /* Operating seconds so far, across power cycles (as recorded). */
 uint32_t save_policy_op_seconds(const struct save_policy *p);
 /* Records the budget allows by now. */

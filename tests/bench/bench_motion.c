@@ -118,7 +118,7 @@ int main(void)
         servo_control_tick(&servo);
         bench_end("servo_tick");
         bench_begin();
-        safety_tend(&servo);
+        safety_tend(&servo.safety, &servo.regs, &servo.motion, servo.dispatcher.heard);
         bench_end("safety_pass");
     }
     if (servo.regs.status.status & ~STATUS_EXECUTING) {

@@ -85,7 +85,7 @@ static void test_a_runaway_is_released_and_logged(void **state)
     motion_drive_train_changed(&servo.motion);
     move_to(DEG(0)); /* a motion command clears what item 67 says */
     harness_run_ms(5);
-    assert_int_equal(servo.watchdog.fired, 0);
+    assert_int_equal(servo.safety.watchdog.fired, 0);
     assert_int_equal(servo.regs.held_by, LIMITER_NONE);
 }
 
@@ -108,7 +108,7 @@ static void test_normal_moves_never_trip(void **state)
     for (int i = 0; i < 4; i++) {
         move_to(i % 2 ? DEG(-45) : DEG(45));
         harness_run_ms(1500);
-        assert_int_equal(servo.watchdog.fired, 0);
+        assert_int_equal(servo.safety.watchdog.fired, 0);
         assert_int_equal(servo.motion.runaway_ticks, 0);
     }
     REQUEST(PKT_READ_FAULTS, 0, 0);

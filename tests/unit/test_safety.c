@@ -170,24 +170,24 @@ static void test_a_hot_case_derates_the_power_limit(void **state)
     (void)state;
     move_to_90();
     harness_run_ms(200);
-    assert_int_equal(servo.heat_cap_mw, 0);
+    assert_int_equal(servo.safety.heat_cap_mw, 0);
     hal.sensors.ntc = 720; /* about 71 degC: 4.4 below 41's 75.4 */
     harness_run_ms(300);
-    assert_true(servo.heat_cap_mw > 0u && servo.heat_cap_mw < 10000u);
-    assert_int_equal(servo.motion.power_cap_mw, servo.heat_cap_mw);
+    assert_true(servo.safety.heat_cap_mw > 0u && servo.safety.heat_cap_mw < 10000u);
+    assert_int_equal(servo.motion.power_cap_mw, servo.safety.heat_cap_mw);
     assert_int_equal(servo.motion.cap_limiter, LIMITER_HEAT);
     int32_t winding = read_item(ITEM_WINDING_DECIC);
-    print_message("# case at NTC 720: cap %u mW, winding %.1f degC\n", servo.heat_cap_mw, winding / 10.0);
+    print_message("# case at NTC 720: cap %u mW, winding %.1f degC\n", servo.safety.heat_cap_mw, winding / 10.0);
     assert_true(winding > 690 && winding < 730);
     WRITE_ITEM(0, ITEM_DERATING_ON, 0); /* the maker's behaviour: full power until 41 trips */
     harness_run_ms(200);
     assert_int_equal(servo.motion.power_cap_mw, 0);
     WRITE_ITEM(0, ITEM_DERATING_ON, 1);
     harness_run_ms(200);
-    assert_int_equal(servo.motion.power_cap_mw, servo.heat_cap_mw);
+    assert_int_equal(servo.motion.power_cap_mw, servo.safety.heat_cap_mw);
     hal.sensors.ntc = 2048;
     harness_run_ms(300);
-    assert_int_equal(servo.heat_cap_mw, 0);
+    assert_int_equal(servo.safety.heat_cap_mw, 0);
     assert_int_equal(servo.motion.power_cap_mw, 0);
 }
 

@@ -334,7 +334,7 @@ static void test_every_change_is_in_flash_before_its_answer(void **state)
 static void test_writes_in_a_loop_stay_within_the_wear_budget(void **state)
 {
     (void)state;
-    uint32_t per_save = servo.saver.seconds_per_save;
+    uint32_t per_save = servo.saving.saver.seconds_per_save;
     uint32_t records = 2u * FLASH_RATED_CYCLES * config_store_slots_per_page(&servo.store);
     /* 10 years at this rate, and the allowance, within 90 % of the rating */
     assert_true(SAVE_ALLOWANCE + SAVE_LIFE_SECONDS / per_save <= records / 10u * 9u);
@@ -350,16 +350,16 @@ static void test_writes_in_a_loop_stay_within_the_wear_budget(void **state)
         if (i % 12000u == 11999u) { /* each 30 min: a save (1 per per_save s) comes between */
             harness_restart();
         }
-        assert_true(servo.store.sequence <= save_policy_budget(&servo.saver));
+        assert_true(servo.store.sequence <= save_policy_budget(&servo.saving.saver));
     }
-    uint32_t op = save_policy_op_seconds(&servo.saver);
+    uint32_t op = save_policy_op_seconds(&servo.saving.saver);
     printf("# 2 h of writes every 150 ms: %u saves, %u refused, %u page erases; budget %u (1 per %u s)\n",
            (unsigned)servo.store.sequence, (unsigned)refused,
            (unsigned)config_store_page_erases(&servo.store),
-           (unsigned)save_policy_budget(&servo.saver), (unsigned)per_save);
+           (unsigned)save_policy_budget(&servo.saving.saver), (unsigned)per_save);
     assert_true(op > 3600u && op <= 7200u);
     assert_true(refused > 40000u);
-    assert_int_equal(servo.store.sequence, save_policy_budget(&servo.saver));
+    assert_int_equal(servo.store.sequence, save_policy_budget(&servo.saving.saver));
     uint8_t held = servo.regs.user.start_force;
     REQUEST(PKT_WRITE_DATA, 0, ITEM_START_FORCE, (uint8_t)(held ^ 1u));
     EXPECT_RESPONSE(PKT_WRITE_DATA, 0, ITEM_START_FORCE, 0);
@@ -370,7 +370,7 @@ static void test_writes_in_a_loop_stay_within_the_wear_budget(void **state)
     uint32_t pages_started = (servo.store.sequence + per_page - 1u) / per_page;
     assert_int_equal(store_field(ANSWER_READ_STORE_PAGE_ERASES), (pages_started + 1u) / 2u);
     assert_int_equal(store_field(ANSWER_READ_STORE_RATED_CYCLES), FLASH_RATED_CYCLES);
-    assert_int_equal(store_field(ANSWER_READ_STORE_BUDGET), save_policy_budget(&servo.saver));
+    assert_int_equal(store_field(ANSWER_READ_STORE_BUDGET), save_policy_budget(&servo.saving.saver));
     assert_int_equal(store_field(ANSWER_READ_STORE_OPERATING_TIME), op);
     assert_true(servo.store.sequence > SAVE_ALLOWANCE);
     assert_true(servo.store.sequence >= SAVE_ALLOWANCE + op / per_save - 1u);

@@ -93,6 +93,20 @@ def test_a_lower_layer_including_a_higher_one_is_found(tmp_path):
                         "motion/include/motion/motion.h (motion)"]
 
 
+def test_a_job_reaching_the_application_hub_is_found(tmp_path):
+    root = tree(tmp_path)
+    write(root, "firmware/app/servo_state.h", "struct servo { int tick; };\n")
+    write(root, "firmware/app/servo.c", '#include "app/servo_state.h"\n')
+    write(root, "firmware/app/servo_turns.c", "struct servo_tx;\n")
+    assert check_layers.check(root)[0] == []  # the main loop may; a job's own struct is no breach
+    write(root, "firmware/app/servo_store.c", '#include "app/servo_state.h"\n')
+    write(root, "firmware/app/servo_safety.c", "void safety_tend(struct servo *s);\n")
+    breaches, _ = check_layers.check(root)
+    assert breaches == [
+        "hub: firmware/app/servo_safety.c names struct servo: a job is handed what it needs",
+        'hub: firmware/app/servo_store.c includes "app/servo_state.h": a job is handed what it needs']
+
+
 def test_a_circle_of_modules_is_found(tmp_path):
     root = tree(tmp_path)
     write(root, "firmware/boards/sim/a.h", "void a(void);\n")

@@ -27,10 +27,11 @@ struct dispatcher {
      * images are built for (UpdateStatus). */
     uint8_t bootloader_present;
     uint16_t board;
-    /* The control loop's schedule (servo.c's next_tick_us): ReadMotion
-     * stamps its snapshot with the time of the tick that computed it.
-     * NULL where no control loop runs (time 0). */
-    const uint32_t *next_tick_us;
+    /* When the control tick that computed the motion's state ran:
+     * ReadMotion stamps its snapshot with it. Handed in by the control
+     * loop's owner before each dispatch (dispatcher_note_tick); 0 where
+     * none runs. */
+    uint32_t tick_us;
     /* Frames for this servo so far (its ID, a broadcast, its SyncCommand
      * record): the bus watchdog's food. */
     uint32_t heard;
@@ -64,6 +65,13 @@ struct dispatch_result {
 
 void dispatcher_init(struct dispatcher *d, struct registers *regs, struct motion *motion,
                      const volatile uint8_t *own_id);
+
+/* The time of the control tick the motion's state is from, for the
+ * requests dispatched next (ReadMotion's stamp). */
+static inline void dispatcher_note_tick(struct dispatcher *d, uint32_t tick_us)
+{
+    d->tick_us = tick_us;
+}
 
 void dispatch(struct dispatcher *d, const struct rx_frame *frame, struct response *response,
               struct dispatch_result *result);
