@@ -59,7 +59,7 @@ void servo_init(struct servo *s, const struct hal_port *hal)
     protection_init(&s->protection);
     motion_init(&s->motion, &s->regs, hal);
     s->next_tick_us = hal->bus.now_us(hal->ctx) + CONTROL_TICK_US;
-    s->tick_due_us = s->next_tick_us;
+    tick_scheduled(s);
     frame_rx_init(&s->rx, &s->active_id);
     s->rx_idle_us = idle_timeout_us(s, 0);
     dispatcher_init(&s->dispatcher, &s->regs, &s->motion, &s->active_id);
@@ -131,7 +131,6 @@ static SERVO_ONE_COPY void handle_next_frame(struct servo *s, uint32_t now, bool
 {
     const struct rx_frame *frame = &s->rx.slots[s->rx.tail]; /* the callers know there is one */
     struct dispatch_result *result = &s->dispatched;
-    dispatcher_note_tick(&s->dispatcher, s->next_tick_us - CONTROL_TICK_US);
     if (!SERVO_SENDS_AHEAD || frame->sync_index != 0u || late || !send_ahead(s, frame, now)) {
         dispatch(&s->dispatcher, frame, &s->tx.frame, result);
     }
@@ -211,13 +210,13 @@ static bool run_control_tick(struct servo *s, uint32_t now)
         if (n == SERVO_MAX_CATCH_UP) {
             s->ticks_dropped += (uint32_t)(now - s->next_tick_us) / CONTROL_TICK_US + 1u;
             s->next_tick_us = now + CONTROL_TICK_US;
-            s->tick_due_us = s->next_tick_us;
+            tick_scheduled(s);
             return true;
         }
         servo_control_tick(s);
         s->next_tick_us += CONTROL_TICK_US;
     }
-    s->tick_due_us = s->next_tick_us;
+    tick_scheduled(s);
     return true;
 }
 
@@ -245,7 +244,7 @@ __attribute__((noinline, cold)) static void after_erase(struct servo *s, uint32_
 {
     s->erase_passed = 0;
     s->next_tick_us = now + CONTROL_TICK_US;
-    s->tick_due_us = s->next_tick_us;
+    tick_scheduled(s);
     struct hal_rx_ring *ring = s->hal->rx;
     hal_rx_sync(s->hal, now);
     uint32_t erase_from = s->saving.erase_from;

@@ -92,4 +92,13 @@ struct servo {
     struct fault_log faults;
 };
 
+/* The control loop's next tick is due at next_tick_us: the turns' deadline,
+ * and the dispatcher's stamp for the state the last tick left (set when the
+ * schedule moves, not at each request: a request's path stays short). */
+static inline void tick_scheduled(struct servo *s)
+{
+    s->tick_due_us = s->next_tick_us;
+    dispatcher_note_tick(&s->dispatcher, s->next_tick_us - CONTROL_TICK_US);
+}
+
 #endif

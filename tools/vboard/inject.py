@@ -10,11 +10,12 @@ and brownout), and what a fault handler does about the bridge, measured.
 - undef: the next instruction the application executes in thread mode is
   taken as undefined (UsageFault UNDEFINSTR on the M3, HardFault on the M0).
 - stack: at the entry of the main loop's pass (servo_poll, called every
-  pass), SP is lowered to just above the stack's bottom (STACK_SLACK) (the ELF's
+  pass), SP is lowered to just above the stack's bottom (the ELF's
   _estack - STACK_SIZE, hal/ports/stm32_common/linker/sections_stm32.ld), as if the
-  function had a deep local array: its own pushes (48 bytes on the F103,
-  20 on the F030) reach below the bottom, over the bottom word where the
-  firmware keeps a guard. At its return (its caller's address, its frame
+  function had a deep local array: on the M3 its own pushes (48 bytes)
+  reach below the bottom, over the bottom word where the firmware keeps a
+  guard; on the M0 its frame (read from its prologue) ends STACK_BELOW_FRAME
+  bytes above the bottom, so that what it calls runs the stack out. At its return (its caller's address, its frame
   popped) SP is given back. With the M3's MPU guarding the bottom the push
   faults (MemManage, or HardFault if disabled); without, it overwrites.
 - hang: the main loop stops at the start of its pass: thread mode spins
@@ -26,6 +27,8 @@ duty() None with the store applied) and notes the core time of that store's
 instruction. The hook exists only from a fault to the next reset: a write
 hook runs a store outside the IT block it is in (memory.py), and the
 firmware sets its compares under IT while it runs normally."""
+import struct
+
 from unicorn import UC_HOOK_CODE, UC_HOOK_MEM_READ, UC_HOOK_MEM_WRITE
 from unicorn import arm_const as arm
 
@@ -39,19 +42,40 @@ KINDS = ("bus", "undef", "stack", "hang")
 # inside its bottom 256 bytes, far enough above the static data below for
 # an interrupt's frame on top of it (a stack that has just run out, not one
 # that jumped past a whole guard).
-STACK_SLACK = {True: 40, False: 96}  # by whether the core is ARMv7-M
+STACK_SLACK_M3 = 40
+STACK_BELOW_FRAME = 56  # the M0: room under servo_poll's frame for its callees' first pushes
 CNDTR = 0x0C  # DMA channel 1's counter; channel n's at 0x0C + 20 (n - 1) (RM0008 13.4.4, RM0360 10.4.4)
 
 
 def stack_facts(path):
-    """(servo_poll's address, the stack's bottom) from the application's
-    ELF, or None."""
+    """(servo_poll's address, the stack's bottom, its frame's bytes) from the
+    application's ELF, or None."""
     elf = _elf(path)
     poll = elf and _symbol(elf, "servo_poll")
     top, size = elf and _symbol(elf, "_estack"), elf and _symbol(elf, "STACK_SIZE")
     if not poll or not top or not size:
         return None
-    return poll[0] & ~1, top[0] - size[0]
+    return poll[0] & ~1, top[0] - size[0], _frame_bytes(elf, poll[0] & ~1)
+
+
+def _frame_bytes(elf, address: int) -> int:
+    """What a Thumb function's prologue takes off SP: its 16-bit `push` (a
+    register each, LR too) and `sub sp, #imm` (ARMv6-M A6.7.50, A6.7.67),
+    the forms the M0's compiler emits; 0 for others."""
+    data, sections = elf
+    for sh in sections:  # (name, type, flags, addr, offset, size, ...)
+        if sh[3] <= address < sh[3] + sh[5] and sh[1] == 1:  # SHT_PROGBITS
+            code = data[sh[4] + address - sh[3]:sh[4] + address - sh[3] + 12]
+            break
+    else:
+        return 0
+    total = 0
+    for (half,) in struct.iter_unpack("<H", code):
+        if half & 0xFE00 == 0xB400:  # push {registers[, lr]}
+            total += 4 * (bin(half & 0xFF).count("1") + (half >> 8 & 1))
+        elif half & 0xFF80 == 0xB080:  # sub sp, #imm7 * 4
+            total += 4 * (half & 0x7F)
+    return total
 
 
 class Injector:
@@ -155,7 +179,8 @@ class Injector:
         elif self.armed == "stack":
             self.armed = None
             sp = core.reg(arm.UC_ARM_REG_SP)
-            low = self.facts[1] + STACK_SLACK[core.has_vtor]
+            bottom, frame = self.facts[1], self.facts[2]
+            low = bottom + (STACK_SLACK_M3 if core.has_vtor else (frame + STACK_BELOW_FRAME + 7) & ~7)
             back = core.reg(arm.UC_ARM_REG_LR) & ~1
             self.lowered = (back, low, sp - low)
 
