@@ -5,7 +5,8 @@ Each source folder is a layer; a layer may include only the layers below it
 (LAYERS). No module (a .c with its .h) may reach itself through the
 includes of others (a circle), nor through the symbols its object file
 uses and the others define (`--objects BUILD`: a build's objects, read
-with nm), nor may servoctl's modules through their imports; no file
+with nm), nor may servoctl's modules through their imports, nor may servoctl's
+library import its command line, its ui or the virtual boards; no file
 people read (source, build files, documents) outside the tests and the
 generated files may pass LINE_LIMIT lines,
 nor a line of the protocol's schema SCHEMA_LINE_LIMIT characters; no job
@@ -202,24 +203,50 @@ def circles(graph):
     return out
 
 
-def python_imports(root):
-    """servoctl's module graph: module -> the servoctl modules it imports."""
+# What servoctl's library (its modules but these) may not import: its command
+# line, its ui (the command line's page), the virtual boards (a package of tools/).
+NOT_LIBRARY, NOT_LIBRARY_PACKAGES = ("cli", "ui"), ("vboard",)
+
+
+def _imported(here, node, modules):
+    """What an import node in package here (["cli"]) brings: servoctl's
+    modules by name ("cli.app"; a package's own module only when no name
+    imported from it is one), another package as "/name"."""
+    if isinstance(node, ast.Import):
+        return [a.name[9:] if a.name.startswith("servoctl.") else "/" + a.name for a in node.names]
+    if node.level == 0 and not (node.module or "").startswith("servoctl"):
+        return ["/" + node.module] if node.module else []
+    base = node.module[9:].split(".") if node.level == 0 and node.module != "servoctl" else [] if \
+        node.level == 0 else here[:len(here) - node.level + 1] + (node.module.split(".") if node.module else [])
+    names = [".".join(base + [a.name]) for a in node.names]
+    return [n for n in names if n in modules] or [".".join(base)]
+
+
+def python_imports(root, breaches=None):
+    """servoctl's module graph: module -> the servoctl modules it imports
+    (run or not: in a function too); breaches (a list) gets each import of
+    the library's of NOT_LIBRARY."""
     pkg = root / "tools" / "servoctl"
+    paths = {}
+    for path in sorted(pkg.rglob("*.py")):
+        parts = list(path.relative_to(pkg).with_suffix("").parts)
+        paths[".".join(parts[:-1] if parts[-1] == "__init__" else parts)] = path
     graph = {}
-    for path in sorted(pkg.glob("*.py")):
-        tree = ast.parse(path.read_text(), str(path))
-        deps = set()
-        for node in ast.walk(tree):
-            if isinstance(node, ast.ImportFrom):
-                if node.level == 1 and node.module:
-                    deps.add(node.module.split(".")[0])
-                elif node.level == 1:
-                    deps.update(a.name for a in node.names)
-                elif node.module and node.module.startswith("servoctl."):
-                    deps.add(node.module.split(".")[1])
-            elif isinstance(node, ast.Import):
-                deps.update(a.name.split(".")[1] for a in node.names if a.name.startswith("servoctl."))
-        graph[path.stem] = sorted(d for d in deps if (pkg / f"{d}.py").is_file() and d != path.stem)
+    for name, path in paths.items():
+        here = name.split(".") if path.name == "__init__.py" else name.split(".")[:-1]
+        deps, library = set(), name.split(".")[0] not in NOT_LIBRARY
+        for node in ast.walk(ast.parse(path.read_text(), str(path))):
+            for dep in _imported([h for h in here if h], node, paths) if isinstance(
+                    node, (ast.Import, ast.ImportFrom)) else ():
+                top = dep.lstrip("/").split(".")[0]
+                if library and breaches is not None and top in (
+                        NOT_LIBRARY_PACKAGES if dep.startswith("/") else NOT_LIBRARY):
+                    breaches.append(f"library import: {path.relative_to(root).as_posix()} imports "
+                                    f"{top if dep.startswith('/') else 'servoctl.' + dep}: the library "
+                                    f"must not need the command line, the ui or the virtual boards")
+                if dep in paths and dep != name:
+                    deps.add(dep)
+        graph[name] = sorted(deps)
     return graph
 
 
@@ -357,8 +384,10 @@ def check(root, build=None):
     if build is not None:
         for c in circles(symbol_graph(root, build)):
             breaches.append("circle of symbols: " + " <-> ".join(c))
-    for c in circles(python_imports(root)):
+    library = []
+    for c in circles(python_imports(root, library)):
         breaches.append("circle of imports in servoctl: " + " -> ".join(c))
+    breaches += sorted(set(library))
     for rel, n in long_files(root):
         breaches.append(f"long file: {rel} has {n} lines (limit {LINE_LIMIT})")
     for rel, n, length in long_schema_lines(root):

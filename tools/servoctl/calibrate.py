@@ -126,28 +126,3 @@ def calibrate(servo, sleep, keep_zero: bool = False) -> Calibration:
         if moved_to is not None:
             write_limits(moved_to, kept.servo.read("angle_min"), kept.write)
     return Calibration(amp, reversed_, ratio, count, moved, None if joint is None else (joint, moved_to))
-
-
-def cmd_calibrate(bus, args):
-    """servoctl calibrate ID: the current's zero, the direction, the zero;
-    each stored as it is found."""
-    from .servo import Servo
-
-    servo = Servo(bus, args.id)
-    where = "" if args.keep_zero else " (the horn at its zero mark: its position now becomes angle 0)"
-    print(f"servo {args.id}: calibrating with the horn free{where}", flush=True)
-    c = calibrate(servo, bus.sleep, args.keep_zero)
-    print(f"  current amplifier's zero  {c.current_zero} ADC counts (item 91)")
-    print(f"  direction                 {'reversed: the bridge is driven the other way' if c.reversed else 'as wired'}"
-          f" (gear_ratio {c.gear_ratio}); a push at duty {PUSH_DUTY} turns the horn "
-          f"+{c.push_decideg / 10:.1f} deg")
-    if c.encoder_zero is None:
-        print("  zero                      kept")
-    else:
-        print(f"  zero                      encoder count {c.encoder_zero} (item 90): angle 0 here, "
-              "now and after every power-up")
-    if c.limits is not None:
-        (low, high), (new_low, new_high) = c.limits
-        print(f"  angle limits              {low / 10:.1f}..{high / 10:.1f} deg from the old zero are "
-              f"{new_low / 10:.1f}..{new_high / 10:.1f} from the new: the same horn positions")
-    return 0

@@ -1,10 +1,14 @@
 """servoctl's optional parts, tools/pyproject.toml's extras: what the
-core (pyserial, numpy, rich: every command on a bus, and the LeRobot
-plugins) leaves out, which module each needs and the extra that brings
-it. scripts/setup.sh installs them all (tools/requirements.txt)."""
+library (pyserial alone: the bus, servos, units, config files, the loop
+and the stream, the arm the LeRobot plugins drive) leaves out, which
+module each needs and the extra that brings it. The command line is one
+(servoctl[cli]: rich). scripts/setup.sh installs them all
+(tools/requirements.txt)."""
 
 # {module: (its distribution, the extra that installs it, what needs it)}
 OPTIONAL = {
+    "rich": ("rich", "cli", "the command line (the servoctl command)"),
+    "numpy": ("numpy", "identify", "identify, tune and calibrate (the drive train's fits)"),
     "scipy": ("scipy", "identify", "identify, tune and calibrate (the drive train's fits)"),
     "mujoco": ("mujoco", "mujoco", "identify --mujoco (the actuator model)"),
     "unicorn": ("unicorn", "vboard", "the virtual boards (sim --board)"),

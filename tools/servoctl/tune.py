@@ -28,7 +28,6 @@ from dataclasses import dataclass
 from . import registers
 from .errors import ServoError
 from .loop_model import DECIDEG_RAD, Q15, TICK_S, _plant, _si, margins  # noqa: F401 (tune's own names too)
-from .putback import PutBack
 
 ZETA = 0.7
 DEFAULT_MAX_HZ = 8.0      # no faster by default: the reference's factory gains are 8.4 Hz
@@ -133,37 +132,3 @@ def check_step(servo, sleep, target: int = CHECK_TARGET_DECIDEG, ms: int = CHECK
         sleep(0.02)
         angles.append(way * servo.read_motion().angle_decideg)
     return max(angles) - way * target, abs(angles[-1] - way * target)
-
-
-def cmd_tune(bus, args):
-    """servoctl tune ID: identify, the gains, their margins; unless
-    --dry-run, the items written (each kept in flash) and a step checked."""
-    from .identify import DEFAULT_DUTIES, identify
-    from .servo import Servo
-
-    servo = Servo(bus, args.id)
-    duties = tuple(args.duty * k / len(DEFAULT_DUTIES) for k in range(1, len(DEFAULT_DUTIES) + 1))
-    print(f"servo {args.id}: identifying (open-loop steps; the horn must turn freely)", flush=True)
-    drive = identify(servo, bus.sleep, duties, 0, lambda done, total: print(f"  step {done}/{total}", flush=True))
-    t = tune(drive, servo.read("gear_ratio"), args.bandwidth)
-    print(f"gains for {t.bandwidth_hz:.2f} Hz, damping {t.zeta}: kp {t.kp}, ki {t.ki}, kd {t.kd}")
-    print(f"  phase margin {t.phase_margin_deg:.0f} deg, gain margin {t.gain_margin_db:.1f} dB, "
-          f"crossover {t.crossover_hz:.2f} Hz")
-    for name, value in t.items.items():
-        print(f"  {name:18s} {value}")
-    if args.dry_run:
-        print("dry run: nothing written")
-        return 0
-    # Refused, nothing written, if the loop they make would not be stable. Kept
-    # only once the check ran: one cut short (a Ctrl-C, the ui's STOP ALL at a
-    # step that looked wrong, a servo gone) puts back the items the servo had.
-    with PutBack(servo, "tune") as kept:
-        kept.write_drive(t.items)
-        over, error = check_step(servo, bus.sleep)
-        if error > CHECK_TOLERANCE_DECIDEG:  # put back: gains that do not arrive are not kept as tuned
-            raise ServoError(f"the check's {CHECK_TARGET_DECIDEG / 10:g} deg move ended {error / 10:.1f} deg "
-                             f"from its target 1.5 s on (more than {CHECK_TOLERANCE_DECIDEG / 10:g}): a load, "
-                             "a stop or an angle limit in its way? The items it had are put back")
-    print(f"written and kept; a {CHECK_TARGET_DECIDEG / 10:g} deg move in {CHECK_MS} ms: overshoot "
-          f"{max(over, 0) / 10:.1f} deg, {error / 10:.1f} deg from the target 1.5 s on")
-    return 0

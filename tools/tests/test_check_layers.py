@@ -1,6 +1,7 @@
 """scripts/check_layers.py finds what it is there to find: a lower layer
 including a higher one, a circle of modules (by includes, or by the symbols
-their objects define and use) or of servoctl imports, and a long file; and
+their objects define and use) or of servoctl imports, servoctl's library
+importing its command line, and a long file; and
 it passes the tree as it is."""
 import importlib.util
 import json
@@ -122,6 +123,42 @@ def test_a_circle_of_servoctl_imports_is_found(tmp_path):
     write(root, "tools/servoctl/protocol.py", "from .servo import Servo\n")
     breaches, _ = check_layers.check(root)
     assert breaches == ["circle of imports in servoctl: protocol -> servo"]
+
+
+@pytest.mark.parametrize("rel,text,what", [
+    ("tools/servoctl/units.py", "from .cli import app\n", "servoctl.cli.app"),
+    ("tools/servoctl/group.py", "def run():\n    from .cli.cmd_bus import cmd_scan\n", "servoctl.cli.cmd_bus"),
+    ("tools/servoctl/units.py", "from . import ui\n", "servoctl.ui"),
+    ("tools/servoctl/stream.py", "import servoctl.cli\n", "servoctl.cli"),
+    ("tools/servoctl/units.py", "from vboard import board\n", "vboard"),
+    ("tools/servoctl/sub/thing.py", "from ..cli import args\n", "servoctl.cli.args"),
+])
+def test_a_library_module_importing_the_command_line_is_found(tmp_path, rel, text, what):
+    """servoctl's library (all but servoctl.cli and servoctl.ui) imports
+    neither those nor the virtual boards, at the top or in a function;
+    the command line and the ui import the library and each other."""
+    root = tree(tmp_path)
+    write(root, "tools/servoctl/cli/__init__.py", "from .. import protocol\n")
+    write(root, "tools/servoctl/cli/app.py", "from ..servo import Servo\nfrom . import args\n")
+    write(root, "tools/servoctl/cli/cmd_bus.py", "from ..ui import worker\n")
+    write(root, "tools/servoctl/cli/args.py", "import servoctl.protocol\n")
+    write(root, "tools/servoctl/ui/__init__.py", "")
+    write(root, "tools/servoctl/ui/worker.py", "from ..cli import args\nimport vboard\n")
+    assert check_layers.check(root)[0] == []
+    write(root, rel, text)
+    breaches, _ = check_layers.check(root)
+    assert len(breaches) == 1 and breaches[0].startswith(f"library import: {rel} imports {what}: "), breaches
+
+
+def test_a_circle_through_the_command_line_is_found(tmp_path):
+    root = tree(tmp_path)
+    write(root, "tools/servoctl/cli/__init__.py", "")
+    write(root, "tools/servoctl/cli/app.py", "from . import cmd_ui\n")
+    write(root, "tools/servoctl/cli/cmd_ui.py", "def cmd_ui():\n    from ..ui import worker\n")
+    write(root, "tools/servoctl/ui/__init__.py", "")
+    write(root, "tools/servoctl/ui/worker.py", "from ..cli.app import run_command\n")
+    breaches, _ = check_layers.check(root)
+    assert breaches == ["circle of imports in servoctl: cli.app -> cli.cmd_ui -> ui.worker"]
 
 
 def test_a_long_file_is_found(tmp_path):

@@ -8,7 +8,7 @@ from servoctl import outcome, registers, units
 from servoctl.answers import Fault
 from servoctl.errors import Refused, ServoError
 from servoctl.fault_code import phrase
-from servoctl.faults import READINGS, _as_json
+from servoctl.cli.cmd_faults import READINGS, _as_json
 from servoctl.putback import signals_interrupt
 
 

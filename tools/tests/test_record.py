@@ -1,6 +1,6 @@
 """servoctl record's time axis: the servo's profile start found from a
 sample's setpoint, and the plan read before, during and after it."""
-from servoctl.record import _planned_at, _profile_start
+from servoctl.cli.cmd_record import _planned_at, _profile_start
 from servoctl.profile import positions
 from servoctl.servo import MotionSnapshot
 

@@ -113,11 +113,12 @@ def test_the_period_against_the_bus_watchdog():
 
 
 def test_a_stream_sent_late_fails_with_its_rate(capsys):
-    """servoctl stream's verdict (stream._verdict): cycles below 0.95 of the
+    """servoctl stream's verdict (cli/cmd_stream.py's _verdict): cycles below 0.95 of the
     file's rate were sent late, exit 1 with the rate run, even where every
     servo followed what it got; --report-only exits 0."""
     from servoctl.loop_rate import LoopRate
-    from servoctl.stream import StreamReport, _verdict
+    from servoctl.cli.cmd_stream import _verdict
+    from servoctl.stream import StreamReport
 
     def report(cycles):
         return StreamReport(0.02, 101, {1: 0.2}, {1: 0.5}, LoopRate(cycles, 2.0, 260.0), 0)

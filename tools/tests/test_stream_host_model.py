@@ -4,7 +4,7 @@ waits: on a simulator in real time (or a servo) its jitter adds to the
 PC's own, and a review saw 4-6 deg RMS there without a word. It says so."""
 from types import SimpleNamespace
 
-from servoctl.stream import host_timing
+from servoctl.cli.cmd_stream import host_timing
 
 
 class Bus:

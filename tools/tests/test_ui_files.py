@@ -6,8 +6,8 @@ import stat
 
 import pytest
 
-from servoctl import args as args_
-from servoctl.args import build_parser
+from servoctl.cli import args as args_
+from servoctl.cli.args import build_parser
 from servoctl.errors import UsageError
 from servoctl.ui.files import Folder
 from servoctl.ui.opener import PageOpener

@@ -9,7 +9,7 @@ import math
 
 from .. import group, registers, units
 from ..errors import NoReply, ServoError
-from ..live import _celsius
+from ..cli.live import _celsius
 from ..servo import Servo
 
 SPEED_BASE_S = 0.05

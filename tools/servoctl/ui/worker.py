@@ -1,5 +1,5 @@
 """The one thread that owns the bus for `servoctl ui`: it runs servoctl's own
-commands (cli.run_command, as the command line would, their output and
+commands (cli/commands.py's run_command, as the command line would, their output and
 refusals word for word), the live table's info rounds and the plots'
 samples, one at a time. The page's requests queue here (QUEUE_MAX at
 most); stop-all jumps the queue and interrupts what runs (preempt.py).
@@ -13,9 +13,9 @@ import os
 import shlex
 import threading
 
-from .. import cli
+from ..cli import args as args_, commands
 from .. import protocol as p
-from ..args import build_parser
+from ..cli.args import build_parser
 from ..checks import check_range
 from ..errors import EXIT_INTERRUPTED, NoReply, ServoError
 from ..servo import Servo
@@ -26,7 +26,7 @@ from .preempt import STOP_METHOD, Preemption, stop_at_every_rate
 # Commands the page may run as they are: those that end on their own. A
 # monitor, a stream and the ui itself run until stopped; sim and image need
 # no bus.
-RUNNABLE = set(cli.COMMANDS) - {"monitor", "stream", "record", "ui"}
+RUNNABLE = set(commands.COMMANDS) - {"monitor", "stream", "record"}
 TABLE_EVERY_S = (1.0, 3.0)  # the live table's info round, bus time: idle, plotting
 QUEUE_MAX = 64  # page actions waiting; more are refused (a page gone wild, a script)
 NOT_RUN = "servoctl ui: not run: stop-all came first"
@@ -36,8 +36,8 @@ UPDATE_CUT = ("servoctl ui: the update stopped part-way: a servo it had switched
 # What identify, tune, calibrate and update load on first use (scipy takes
 # a second): loaded as the ui starts, on a thread of their own, not on the
 # bus thread in the middle of a command.
-SLOW_IMPORTS = ("servoctl.identify_report", "servoctl.calibrate", "servoctl.tune", "servoctl.update",
-                "servoctl.bench", "servoctl.console")
+SLOW_IMPORTS = ("servoctl.cli.drive_report", "servoctl.calibrate", "servoctl.tune", "servoctl.update",
+                "servoctl.cli.bench", "servoctl.cli.console")
 
 
 # The Motion view's jog: a move of at most the slider's step (1 deg,
@@ -178,11 +178,11 @@ class Worker:
             try:
                 args = build_parser().parse_args(self.global_argv + list(argv))
                 if args.command == "config":
-                    cli.args_.config_operands(args)
+                    args_.config_operands(args)
                 staging = self.files.confine(args)
                 out.shown = err.shown = staging.shown
                 args.on_progress = self._progress(tag)
-                code = cli.run_command(self.bus, args)
+                code = commands.run_command(self.bus, args)
                 if not code:  # 0, or None: what a command that ends well may return
                     staging.write_out()
             except KeyboardInterrupt:

@@ -4,8 +4,8 @@ first ends the bus's quiet and waits the erase out (scan.wake). Time is
 the simulator's."""
 import rich.progress  # noqa: F401  loaded before the sweep: its import takes longer than an erase
 
-from servoctl.args import build_parser
-from servoctl.cli import cmd_scan
+from servoctl.cli.args import build_parser
+from servoctl.cli.cmd_bus import cmd_scan
 from servoctl.servo import Servo
 from servoctl.sim import Simulator
 

@@ -1,10 +1,15 @@
-"""servoctl's heavy parts are pip extras (tools/pyproject.toml,
-servoctl/extras.py): installing servoctl into the LeRobot environment
-pulled in mujoco, unicorn, cmsis-svd, matplotlib and scipy, none of which
-the plugins import. Checked three ways: the metadata, every module the
-plugins can reach (their lazy imports too), and an arm driven by a Python
-that sees servoctl's core dependencies and nothing else."""
+"""servoctl is a library with a command line on top (tools/pyproject.toml,
+servoctl/extras.py): the library, what a program and the LeRobot plugins
+import, needs pyserial alone; the command line (servoctl.cli) is the extra
+servoctl[cli] (rich), the heavy parts are extras too (installing servoctl
+into the LeRobot environment once pulled in mujoco, unicorn, cmsis-svd,
+matplotlib and scipy, none of which the plugins import). Checked by the
+metadata, by every module the plugins can reach (their lazy imports too),
+by a Python that sees pyserial and servoctl alone importing every library
+module and driving a simulated servo and an arm, and by one that sees the
+cli's extra besides running the command line.""" 
 import importlib.metadata as metadata
+import json
 import modulefinder
 import shutil
 import re
@@ -28,9 +33,10 @@ def name(requirement: str) -> str:
     return re.match(r"[A-Za-z0-9_.-]+", requirement).group(0).lower().replace("_", "-")
 
 
-def core_modules() -> set:
-    """The top-level modules of servoctl's core dependencies and theirs."""
-    seen, todo, modules = set(), [name(r) for r in PROJECT["dependencies"]], set()
+def core_modules(requirements=None) -> set:
+    """The top-level modules of servoctl's core dependencies (or of these
+    requirements) and theirs."""
+    seen, todo, modules = set(), [name(r) for r in requirements or PROJECT["dependencies"]], set()
     while todo:
         try:
             dist = metadata.distribution(todo.pop())
@@ -43,6 +49,12 @@ def core_modules() -> set:
         modules |= {f.parts[0].removesuffix(".py") for f in dist.files or ()
                     if not f.parts[0].endswith((".dist-info", ".pth")) and f.parts[0] not in ("..", "__pycache__")}
     return modules
+
+
+def test_the_library_needs_pyserial_alone_and_the_command_line_rich():
+    assert [name(r) for r in PROJECT["dependencies"]] == ["pyserial"]
+    assert [name(r) for r in PROJECT["optional-dependencies"]["cli"]] == ["rich"]
+    assert PROJECT["scripts"] == {"servoctl": "servoctl.cli:main"}
 
 
 def test_the_core_leaves_the_heavy_parts_to_extras():
@@ -76,38 +88,115 @@ def test_the_plugins_reach_no_module_beyond_the_core():
     assert beyond <= core_modules(), sorted(beyond - core_modules())
 
 
-def test_an_arm_runs_with_the_core_alone(tmp_path):
-    """A Python without its site-packages (-S) and with only the core's
-    modules on its path drives an arm as the follower does; a command
-    that needs an extra names it."""
+def site_of(tmp_path, modules) -> str:
+    """A folder with links to these installed top-level modules alone."""
     site = tmp_path / "site"
     site.mkdir()
     installed = metadata.distribution("pyserial").locate_file("")
-    for module in core_modules():
+    for module in modules:
         for found in (installed / module, installed / f"{module}.py"):
             if found.exists():
                 (site / found.name).symlink_to(found)
+    return str(site)
+
+
+def run_alone(tmp_path, script: str, sim, modules):
+    """script, run by a Python without its site-packages (-S) that sees
+    servoctl's sources and these modules only, given the simulator's URL."""
+    return subprocess.run([sys.executable, "-S", "-c", script, sim.url], capture_output=True, text=True,
+                          timeout=120, env={"PYTHONPATH": ":".join(map(str, [*PATHS, site_of(tmp_path, modules)])),
+                                            "SERVOCTL_STATE_DIR": str(tmp_path / "state")})
+
+
+# The library's modules whose import needs an extra (identify's numpy and scipy).
+NEED_AN_EXTRA = {"identify", "identify_fit", "actuator_model", "calibrate"}
+
+
+def test_the_library_runs_with_pyserial_alone(tmp_path):
+    """Every module of the library (servoctl but its cli and ui) imports,
+    but those of identify's extra, which say so (a module extras.py names);
+    a servo is driven and an unstable drive item refused, and an arm run as
+    the follower does; nothing optional is loaded. The console script says
+    which extra it needs."""
+    library = sorted(p.relative_to(TOOLS).with_suffix("").as_posix().replace("/", ".").removesuffix(".__init__")
+                     for p in (TOOLS / "servoctl").rglob("*.py")
+                     if not {"cli", "ui", "__pycache__"} & set(p.relative_to(TOOLS / "servoctl").parts))
+    assert len(library) > 40 and "servoctl.stream" in library and "servoctl.arm" in library
     script = f"""
-import sys
+import importlib, json, sys
+from servoctl.extras import missing_text
+needs = {{}}
+for module in {library!r}:
+    try:
+        importlib.import_module(module)
+    except ModuleNotFoundError as e:
+        needs[module.removeprefix("servoctl.")] = missing_text(e.name)
+from servoctl import stability
 from servoctl.arm import Arm
+from servoctl.errors import ValueOutOfRange
 from servoctl.protocol import Bus
-from servoctl.cli import main
+from servoctl.servo import Servo
+from servoctl.stream import RobotLoop
 with Bus(sys.argv[1], 115200) as bus:
+    servo = Servo(bus, 1)
+    servo.move(450, interval_ms=100)
+    bus.sleep(3.0)  # the first move after power-up: its soft start too
+    angle = servo.read_motion().angle_decideg
+    try:
+        servo.write("gain_ki", 1023)
+        refused = None
+    except ValueOutOfRange as e:
+        refused = str(e)
+    loop = RobotLoop(bus, [1], 0.02)
+    cycled = [sorted(loop.cycle({{1: 45.0}})) for _ in range(5)]
     arm = Arm(bus, {{"a": 1}})
     arm.open()
     arm.send(arm.hold_here())
     arm.positions()
     arm.close()
-print(sorted(m for m in {sorted(OPTIONAL)} if m in sys.modules))
+print(json.dumps({{"needs": needs, "angle": angle, "refused": refused, "cycled": cycled,
+                  "optional": sorted(m for m in {sorted(OPTIONAL)} if m in sys.modules)}}))
+from servoctl.cli import main
+sys.exit(main(["--port", sys.argv[1], "scan"]))
+"""
+    with Simulator(ids=[1], fast=True) as sim:
+        done = run_alone(tmp_path, script, sim, core_modules())
+    assert done.stdout, done.stderr
+    said = json.loads(done.stdout.splitlines()[-1])
+    assert set(said["needs"]) == NEED_AN_EXTRA, said["needs"]
+    assert all("pip install 'servoctl[identify]'" in why for why in said["needs"].values()), said["needs"]
+    assert abs(said["angle"] - 450) <= 20, said
+    assert "gain_ki = 1023 refused, not written" in said["refused"], said
+    assert said["cycled"] == [[1]] * 5, said
+    assert said["optional"] == [], said
+    assert done.returncode == 2, done.stderr
+    assert "rich is not installed (servoctl's extra for the command line" in done.stderr, done.stderr
+    assert "pip install 'servoctl[cli]'" in done.stderr, done.stderr
+
+
+def test_the_command_line_runs_with_its_extra(tmp_path):
+    """pyserial and servoctl[cli]'s rich (and theirs) alone: the commands
+    run, rich's tables included; a command that needs another extra names
+    it."""
+    script = f"""
+import sys
+from servoctl.cli import main
+for argv in (["scan"], ["info", "1"], ["move", "1", "30"], ["monitor", "1", "--count", "2"]):
+    code = main(["--port", sys.argv[1], *argv])
+    print("exit", argv[0], code, flush=True)
+print(sorted(m for m in {sorted(OPTIONAL)} if m in sys.modules), flush=True)
 sys.exit(main(["--port", sys.argv[1], "identify", "1"]))
 """
     with Simulator(ids=[1], fast=True) as sim:
-        done = subprocess.run([sys.executable, "-S", "-c", script, sim.url], capture_output=True, text=True,
-                              timeout=120, env={"PYTHONPATH": ":".join(map(str, [*PATHS, site])),
-                                                "SERVOCTL_STATE_DIR": str(tmp_path / "state")})
-    assert done.stdout.strip() == "[]", done.stdout + done.stderr
+        done = run_alone(tmp_path, script, sim, core_modules(PROJECT["dependencies"] +
+                                                              PROJECT["optional-dependencies"]["cli"]))
+    lines = done.stdout.splitlines()
+    assert [line for line in lines if line.startswith("exit")] == \
+        ["exit scan 0", "exit info 0", "exit move 0", "exit monitor 0"], done.stdout + done.stderr
+    assert lines[-1] == "['rich']", done.stdout + done.stderr
     assert done.returncode == 2, done.stderr
-    assert "scipy is not installed (servoctl's extra for identify, tune and calibrate" in done.stderr, done.stderr
+    assert "scipy is not installed (servoctl's extra for identify, tune and calibrate" in done.stderr or \
+        "numpy is not installed (servoctl's extra for identify, tune and calibrate" in done.stderr, done.stderr
     assert "pip install 'servoctl[identify]'" in done.stderr, done.stderr
 
 

@@ -3,10 +3,10 @@ origin."""
 import sys
 
 from . import args as args_
-from . import checks, frame, outcome
-from .drive_guard import check_horn_free, narrowed_limits
-from .errors import Refused
-from .servo import Servo
+from .. import checks, frame, outcome
+from ..drive_guard import check_horn_free, narrowed_limits
+from ..errors import Refused
+from ..servo import Servo
 
 
 def cmd_move(bus, args):
@@ -80,3 +80,13 @@ def cmd_origin(bus, args):
         print(f"servo {args.id}: its angle limits keep their numbers, {low / 10:.1f}..{high / 10:.1f} deg: until "
               f"power-up they are the horn's old {(low + was) / 10:.1f}..{(high + was) / 10:.1f} deg")
     return 0
+
+
+# This module's commands on a bus, by name (cli/app.py's COMMANDS).
+COMMANDS = {
+    "move": cmd_move,
+    "wheel": cmd_wheel,
+    "damping": cmd_damping,
+    "stop": cmd_stop,
+    "origin": cmd_origin,
+}

@@ -4,9 +4,9 @@ import json
 import sys
 
 from . import args as args_
-from . import ids, link_rate, registers, scan
-from .errors import EXIT_INTERRUPTED, NoReply, Refused
-from .servo import Servo
+from .. import ids, link_rate, registers, scan
+from ..errors import EXIT_INTERRUPTED, NoReply, Refused
+from ..servo import Servo
 
 
 def cmd_scan(bus, args):
@@ -82,7 +82,8 @@ def cmd_id(bus, args):
 
 
 def cmd_bench(bus, args):
-    from . import bench, image as img
+    from .. import image as img
+    from . import bench
 
     figures = [bench.sync_monitor_rounds(bus, args.ids, args.seconds)]
     if args.update_id is not None:
@@ -93,3 +94,12 @@ def cmd_bench(bus, args):
         print(json.dumps({"what": f.what, "measured": f.measured, "limit": f.limit, "unit": f.unit,
                           "ratio": f.ratio}) if args.json else f.line())
     return 0
+
+
+# This module's commands on a bus, by name (cli/app.py's COMMANDS).
+COMMANDS = {
+    "scan": cmd_scan,
+    "ping": cmd_ping,
+    "id": cmd_id,
+    "bench": cmd_bench,
+}

@@ -3,10 +3,10 @@ async, and the whole bus's settings to a file and back (backup, restore)."""
 import sys
 
 from . import args as args_
-from . import group, link_rate, outcome, scan
-from . import protocol as p
-from .errors import NoReply
-from .servo import Servo
+from .. import group, link_rate, outcome, scan
+from .. import protocol as p
+from ..errors import NoReply
+from ..servo import Servo
 
 
 def cmd_sync_move(bus, args):
@@ -64,3 +64,13 @@ def cmd_restore(bus, args):
         who = "servo" if len(moved) == 1 else "servos"
         print(link_rate.after_change(bus, f"{who} {', '.join(map(str, moved))}", rates.pop(), args.sim_control))
     return 0
+
+
+# This module's commands on a bus, by name (cli/app.py's COMMANDS).
+COMMANDS = {
+    "sync-move": cmd_sync_move,
+    "broadcast-move": cmd_broadcast_move,
+    "async": cmd_async,
+    "backup": cmd_backup,
+    "restore": cmd_restore,
+}

@@ -4,10 +4,10 @@ reset, diff)."""
 import json
 
 from . import args as args_
-from . import config_diff, config_file, group, link_rate, registers, units
-from .drive_guard import narrowed_limits
-from .errors import NotSent, UsageError
-from .servo import Servo
+from .. import config_diff, config_file, group, link_rate, registers, units
+from ..drive_guard import narrowed_limits
+from ..errors import NotSent, UsageError
+from ..servo import Servo
 
 
 def cmd_store(bus, args):
@@ -142,3 +142,10 @@ def cmd_config(bus, args):
             print(f"servo {args.id}: its angle limits, {joint[0] / 10:.1f}..{joint[1] / 10:.1f} deg (a joint's range), "
                   "are the factory's +-135 deg again: set them again before it moves in its joint")
     return 0
+
+
+# This module's commands on a bus, by name (cli/app.py's COMMANDS).
+COMMANDS = {
+    "store": cmd_store,
+    "config": cmd_config,
+}

@@ -17,8 +17,8 @@ def cmd_sim(args):
     it made."""
     import signal
 
-    from .errors import EXIT_INTERRUPTED, UsageError
-    from .sim import Simulator
+    from ..errors import EXIT_INTERRUPTED, UsageError
+    from ..sim import Simulator
 
     if args.tcp is not None and args.link:
         raise UsageError("--link names the simulator's pty: not with --tcp")
@@ -46,3 +46,8 @@ def cmd_sim(args):
     if code:
         print("servoctl: interrupted", file=sys.stderr)
     return code
+
+# This module's commands without a bus: they start their own (cli/app.py).
+NO_BUS = {
+    "sim": cmd_sim,
+}

@@ -6,11 +6,12 @@ import dataclasses
 import math
 import os
 
-from . import __version__, args_drive, ids, outcome, registers, units
-from . import protocol as p
-from .checks import MIN_RAMP_MS, scaled
-from .errors import UsageError
-from .move_request import MoveRequest
+from .. import __version__, ids, outcome, registers, units
+from . import args_drive
+from .. import protocol as p
+from ..checks import MIN_RAMP_MS, scaled
+from ..errors import UsageError
+from ..move_request import MoveRequest
 
 # The most tracking error (RMS) `servoctl stream` takes for a servo that followed its file (docs/streaming.md).
 STREAM_TOLERANCE_DEG = 1.0

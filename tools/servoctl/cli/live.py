@@ -7,10 +7,10 @@ import json
 import math
 import sys
 
-from . import group, ntc, registers
-from .protocol import NoReply
-from .errors import ServoError
-from .servo import MotionSnapshot, Servo
+from .. import group, ntc, registers
+from ..protocol import NoReply
+from ..errors import ServoError
+from ..servo import MotionSnapshot, Servo
 
 
 @dataclass

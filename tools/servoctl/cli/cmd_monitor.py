@@ -3,8 +3,8 @@ a plot (live.py; loaded for this command alone)."""
 import os
 import sys
 
-from .errors import EXIT_INTERRUPTED, NoReply
-from .record import check_writable
+from ..errors import EXIT_INTERRUPTED, NoReply
+from .cmd_record import check_writable
 
 
 def cmd_monitor(bus, args):
@@ -30,3 +30,9 @@ def cmd_monitor(bus, args):
     if never:
         raise NoReply("; ".join(why or f"servo {i} never answered" for i, why in sorted(never.items())))
     return 0
+
+
+# This module's commands on a bus, by name (cli/app.py's COMMANDS).
+COMMANDS = {
+    "monitor": cmd_monitor,
+}

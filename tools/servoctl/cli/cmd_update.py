@@ -4,7 +4,7 @@ import sys
 import time
 
 from . import args as args_
-from .errors import ServoError
+from ..errors import ServoError
 
 
 def _version(v) -> str:
@@ -14,8 +14,8 @@ def _version(v) -> str:
 def cmd_update(bus, args):
     from rich.progress import BarColumn, DownloadColumn, TextColumn, TimeRemainingColumn
 
-    from . import image as img
-    from . import update as upd
+    from .. import image as img
+    from .. import update as upd
     from .console import progress as Progress
 
     ids, image_file = args_.update_operands(args.targets)
@@ -48,9 +48,20 @@ def cmd_update(bus, args):
 
 
 def cmd_image(args):
-    from . import image as img
+    from .. import image as img
 
     data = img.make(args.binary, args.version, args.board, args.output)
     header = img.parse(data)
     print(f"{args.output}: {len(data)} B, version 0x{header.version:04x}, board 0x{header.board:04x}")
     return 0
+
+
+# This module's commands on a bus, by name (cli/app.py's COMMANDS).
+COMMANDS = {
+    "update": cmd_update,
+}
+
+# This module's commands without a bus: they start their own (cli/app.py).
+NO_BUS = {
+    "image": cmd_image,
+}

@@ -7,8 +7,8 @@ import secrets
 import signal
 import sys
 
-from . import __version__
-from .errors import UsageError
+from .. import __version__
+from ..errors import UsageError
 
 
 def global_argv(args) -> list:
@@ -22,10 +22,10 @@ def global_argv(args) -> list:
 
 
 def cmd_ui(bus, args):
-    from .ui.server import Page, serve  # aiohttp loads for this command alone
+    from ..ui.server import Page, serve  # aiohttp loads for this command alone
     from .live import has_display
-    from .ui.opener import PageOpener
-    from .ui.worker import Worker
+    from ..ui.opener import PageOpener
+    from ..ui.worker import Worker
 
     token = secrets.token_urlsafe(18)
     about = {"port": args.port, "simulator": bool(args.sim_control), "version": __version__}
@@ -70,3 +70,9 @@ def cmd_ui(bus, args):
         opener.close()
     print("servoctl ui: stopped", file=sys.stderr)
     return 0
+
+
+# This module's commands on a bus, by name (cli/app.py's COMMANDS).
+COMMANDS = {
+    "ui": cmd_ui,
+}

@@ -5,9 +5,9 @@ the bus's clock: the simulator's own on the simulator, the host's on a
 real port."""
 from dataclasses import dataclass
 
-from . import group
-from . import protocol as p
-from . import update as upd
+from .. import group
+from .. import protocol as p
+from .. import update as upd
 
 BITS_PER_BYTE = 10  # start, 8 data, stop
 FRAME_OVERHEAD = 5  # header 2, packet number, content length, checksum
@@ -90,7 +90,7 @@ def update_time(bus: p.Bus, servo_id: int, image: upd.Image) -> Figure:
 def image_of_size(size: int, version: int, board: int) -> upd.Image:
     """A stand-in image of `size` code bytes, for the simulator, whose slot
     holds bytes it never executes."""
-    from . import image as img
+    from .. import image as img
 
     code = bytes((i * 7 + (i >> 8)) & 0xFF for i in range(size))
     return img.parse(img.build(code, version, board))

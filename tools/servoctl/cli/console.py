@@ -1,6 +1,6 @@
 """rich's console for servoctl's output. A reader that stops reading
 (`servoctl scan | head -1`) ends a command the same way whatever printed
-last: cli.main meets the closed pipe and exits 0, quietly, as a Unix
+last: app.main meets the closed pipe and exits 0, quietly, as a Unix
 filter does; rich's own console would exit 1 without a word. A command
 that changes servos is not cut short by it: its output goes nowhere from
 then on, it finishes, and its exit code is its own (pipe_guard)."""
@@ -56,12 +56,12 @@ def pipe_guard(args):
 
 
 def stdout():
-    """A rich Console on stdout that leaves a closed pipe to cli.main."""
+    """A rich Console on stdout that leaves a closed pipe to app.main."""
     from rich.console import Console  # rich loads only where a command uses it
 
     class PipeConsole(Console):
         def on_broken_pipe(self) -> None:
-            raise BrokenPipeError("the reader closed the pipe")  # met by cli.main
+            raise BrokenPipeError("the reader closed the pipe")  # met by app.main
 
     return PipeConsole()
 

@@ -3,10 +3,10 @@ safety items (the winding's temperature, what holds the output back, the
 bus watchdog)."""
 import json
 
-from . import ntc, registers
-from .errors import ServoError
-from .outcome import SAFE_MODE, in_safe_mode
-from .servo import MotionSnapshot, Servo
+from .. import ntc, registers
+from ..errors import ServoError
+from ..outcome import SAFE_MODE, in_safe_mode
+from ..servo import MotionSnapshot, Servo
 
 
 def cmd_info(bus, args):
@@ -60,3 +60,9 @@ def _safety(s: Servo) -> dict:
 def _action(value: int) -> str:
     """Item 65 by the schema's name for it ("hold"), which config set takes."""
     return registers.find("watchdog_action").name_of(value) or str(value)
+
+
+# This module's commands on a bus, by name (cli/app.py's COMMANDS).
+COMMANDS = {
+    "info": cmd_info,
+}

@@ -5,12 +5,12 @@ import json
 import sys
 from dataclasses import asdict
 
-from .answers import Fault
-from .errors import ServoError
-from .fault_code import FaultCode
-from .fault_symbols import Symbols
-from .outcome import SAFE_MODE, in_safe_mode
-from .servo import Servo
+from ..answers import Fault
+from ..errors import ServoError
+from ..fault_code import FaultCode
+from ..fault_symbols import Symbols
+from ..outcome import SAFE_MODE, in_safe_mode
+from ..servo import Servo
 
 # What a host can do about each kind (docs/safety.md, "Faults").
 ADVICE = {
@@ -84,8 +84,8 @@ def _say_safe_mode(s, where: str) -> None:
 def _check_board(bus, servo_id: int, symbols, path) -> None:
     """Warns where the ELF's board mark is not the servo's board (from
     UpdateStatus); says nothing where either cannot be read."""
-    from . import image, update
-    from .protocol import LinkError
+    from .. import image, update
+    from ..protocol import LinkError
     if symbols.board is None:
         return
     try:
@@ -112,3 +112,9 @@ def _as_json(f, symbols) -> dict:
         out["code"] = dict(asdict(code), exception_name=code.exception_name, status_bits=code.status_bits,
                            pc_function=symbols.name(code.pc) if symbols else None)
     return out
+
+
+# This module's commands on a bus, by name (cli/app.py's COMMANDS).
+COMMANDS = {
+    "faults": cmd_faults,
+}

@@ -6,9 +6,9 @@ import math
 import os
 
 from . import args as args_
-from . import frame, outcome, registers
-from .errors import Refused, UsageError
-from .servo import Servo
+from .. import frame, outcome, registers
+from ..errors import Refused, UsageError
+from ..servo import Servo
 
 
 def check_writable(path: str):
@@ -160,3 +160,9 @@ def _plot(rows, plan, path, title, profile_end, finished):
     fig.tight_layout()
     fig.savefig(path, dpi=100)
     plt.close(fig)
+
+
+# This module's commands on a bus, by name (cli/app.py's COMMANDS).
+COMMANDS = {
+    "record": cmd_record,
+}
