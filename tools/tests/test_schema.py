@@ -117,8 +117,8 @@ def test_a_new_item_and_a_new_packet_need_the_schema_and_the_handler_only(tmp_pa
     lists the item), and its docs/protocol.md describes both."""
     tree = tmp_path / "tree"
     with tarfile.open(tmp_path / "tree.tar", "w") as tar:
-        for name in ("CMakeLists.txt", "CMakePresets.json", "cmake", "firmware", "hal", "motion", "protocol",
-                     "registers", "scripts", "tests", "tools"):
+        for name in ("CMakeLists.txt", "CMakePresets.json", "cmake", "firmware", "bootloader", "services", "hal",
+                     "motion", "protocol", "registers", "scripts", "tests", "tools"):
             tar.add(ROOT / name, arcname=name,
                     filter=lambda t: None if "__pycache__" in t.name or t.name.endswith(".egg-info") else t)
     with tarfile.open(tmp_path / "tree.tar") as tar:
