@@ -248,7 +248,8 @@ static void latency(const char *name, uint8_t code, const uint8_t *content, size
     cpu_runs(); /* the main loop takes all but the last byte */
     dma_writes(&frame[n - 1u], 1);
     lap_interrupts(); /* rare (one a ring), and not the answer's path */
-    servo.next_tick_us = servo.tick_due_us = hal.now_us + 0x7FFFFFFFu; /* no control tick inside */
+    servo.next_tick_us = hal.now_us + 0x7FFFFFFFu;
+    tick_scheduled(&servo); /* no control tick inside */
     bench_begin();
     servo_poll(&servo);
     bench_end(name);
@@ -285,7 +286,8 @@ static void finished_move_answer(void)
     dma_writes(frame, n);
     printf("packet 8 finished\n");
     hal.encoder_model = follow;
-    servo.next_tick_us = servo.tick_due_us = hal.now_us; /* the control loop runs again */
+    servo.next_tick_us = hal.now_us;
+    tick_scheduled(&servo); /* the control loop runs again */
     for (unsigned ms = 0; !motion_has_finished(&servo.motion); ms++) {
         if (ms == 10000u) {
             fprintf(stderr, "answer_move_finished: the move did not finish\n");
@@ -301,7 +303,8 @@ static void finished_move_answer(void)
             exit(1);
         }
         hal.now_us += 50u;
-        servo.next_tick_us = servo.tick_due_us = hal.now_us + 0x7FFFFFFFu; /* no control tick inside */
+        servo.next_tick_us = hal.now_us + 0x7FFFFFFFu;
+        tick_scheduled(&servo); /* no control tick inside */
         bench_begin();
         servo_poll(&servo);
         bench_end(usart.tx_busy != 0u ? "answer_move_finished" : "waiting_for_the_slot");
@@ -418,7 +421,8 @@ static void sync_monitor_round(void)
 {
     uint8_t frame[80];
     size_t n = make_request(frame, 25, (const uint8_t[]){22, 1, 6, OWN_ID, 9, 10, 11, 12, 13}, 9);
-    servo.next_tick_us = servo.tick_due_us = hal.now_us + 0x7FFFFFFFu; /* no control tick inside */
+    servo.next_tick_us = hal.now_us + 0x7FFFFFFFu;
+    tick_scheduled(&servo); /* no control tick inside */
     dma_writes(frame, n - 7u);
     cpu_runs();
     dma_writes(&frame[n - 7u], 1); /* this servo's record */
@@ -495,7 +499,8 @@ int main(void)
 
     /* No control tick falls due during the stream: bench_motion counts
      * those; this is the receive path, framer and dispatcher. */
-    servo.next_tick_us = servo.tick_due_us = hal.now_us + 0x7FFFFFFFu;
+    servo.next_tick_us = hal.now_us + 0x7FFFFFFFu;
+    tick_scheduled(&servo);
     run_stream();
     printf("stream_bytes %lu\nstream_messages %u\nframes_for_all %u\nresponses_skipped %u\n",
            (unsigned long)stream_length, messages, (unsigned)servo.rx.stats.frames,

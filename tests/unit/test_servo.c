@@ -207,7 +207,8 @@ static void test_the_idle_time_survives_the_clock_wrap(void **state)
 {
     (void)state;
     hal.now_us = 0xFFFFFFFFu - 3u * HARNESS_BYTE_US;
-    servo.next_tick_us = servo.tick_due_us = hal.now_us;
+    servo.next_tick_us = hal.now_us;
+    tick_scheduled(&servo);
     feed_ping_in_two(100);
     EXPECT_RESPONSE(PKT_PING, 0);
     assert_int_equal(servo.rx.stats.idle_timeouts, 0);

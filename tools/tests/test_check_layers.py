@@ -102,10 +102,52 @@ def test_a_job_reaching_the_application_hub_is_found(tmp_path):
     assert check_layers.check(root)[0] == []  # the main loop may; a job's own struct is no breach
     write(root, "firmware/app/servo_store.c", '#include "app/servo_state.h"\n')
     write(root, "firmware/app/servo_safety.c", "void safety_tend(struct servo *s);\n")
+    # Through another header of the application's, and a typedef: a job still.
+    write(root, "firmware/app/hub_view.h", '#include "app/servo_state.h"\n')
+    write(root, "firmware/app/leds.c", '#include "app/hub_view.h"\n')
+    write(root, "firmware/app/hub_fwd.h", "typedef struct servo hub_t; /* struct servo_tx is another */\n")
     breaches, _ = check_layers.check(root)
     assert breaches == [
+        "hub: firmware/app/hub_fwd.h names struct servo: a job is handed what it needs",
+        "hub: firmware/app/hub_view.h reaches firmware/app/servo_state.h: a job is handed what it needs",
+        "hub: firmware/app/leds.c reaches firmware/app/servo_state.h: a job is handed what it needs",
         "hub: firmware/app/servo_safety.c names struct servo: a job is handed what it needs",
-        'hub: firmware/app/servo_store.c includes "app/servo_state.h": a job is handed what it needs']
+        "hub: firmware/app/servo_store.c reaches firmware/app/servo_state.h: a job is handed what it needs"]
+
+
+@pytest.mark.parametrize("line,said", [
+    ("#include <protection/winding.h>", "include: services/sensors/ntc.c includes <protection/winding.h>: "
+                                        "a project header, named as the system's"),
+    ('#define HUB_H "protection/winding.h"\n#include HUB_H', "include: services/sensors/ntc.c includes HUB_H: "
+                                                           "not a name, so no layer is known"),
+    ('#include "hal/../../services/protection/winding.h"', 'include: services/sensors/ntc.c includes '
+                                                          '"hal/../../services/protection/winding.h": a relative '
+                                                          'path hides the layer it reaches'),
+])
+def test_an_include_that_hides_its_layer_is_found(tmp_path, line, said):
+    """An include in <>, by a macro, or through "..": the layer it reaches
+    is checked or named, never passed unseen. A comment inside the
+    directive changes nothing."""
+    root = tree(tmp_path)
+    write(root, "services/protection/winding.h", "int winding(void);\n")
+    write(root, "hal/include/hal/hal_port.h", "struct hal_port;\n")
+    write(root, "services/sensors/ntc.c", "#include <stdint.h>\n#include /* the port */ \"hal/hal_port.h\"\n")
+    assert check_layers.check(root)[0] == []
+    write(root, "services/sensors/ntc.c", line + "\n")
+    breaches = check_layers.check(root)[0]
+    assert said in breaches, breaches
+    if line.startswith("#include <"):  # and the layer it reaches is judged too
+        assert "layer: services/sensors/ntc.c (sensors) includes services/protection/winding.h (protection)" \
+            in breaches, breaches
+
+
+def test_a_firmware_file_in_no_layers_folder_is_found(tmp_path):
+    root = tree(tmp_path)
+    write(root, "tools/vboard/native/model.c", "int m;\n")  # the PC tools': their own rules
+    assert check_layers.check(root)[0] == []
+    write(root, "hal/extra.c", '#include "app/servo_state.h"\n')
+    assert check_layers.check(root)[0] == [
+        "layer: hal/extra.c is in no layer's folder (scripts/check_layers.py, FOLDERS)"]
 
 
 def test_a_circle_of_modules_is_found(tmp_path):
@@ -132,6 +174,8 @@ def test_a_circle_of_servoctl_imports_is_found(tmp_path):
     ("tools/servoctl/stream.py", "import servoctl.cli\n", "servoctl.cli"),
     ("tools/servoctl/units.py", "from vboard import board\n", "vboard"),
     ("tools/servoctl/sub/thing.py", "from ..cli import args\n", "servoctl.cli.args"),
+    ("tools/servoctl/units.py", "import importlib\nimportlib.import_module('servoctl.cli.app')\n", "servoctl.cli.app"),
+    ("tools/servoctl/units.py", "__import__('vboard', fromlist=['x'])\n", "vboard"),
 ])
 def test_a_library_module_importing_the_command_line_is_found(tmp_path, rel, text, what):
     """servoctl's library (all but servoctl.cli and servoctl.ui) imports
@@ -148,6 +192,19 @@ def test_a_library_module_importing_the_command_line_is_found(tmp_path, rel, tex
     write(root, rel, text)
     breaches, _ = check_layers.check(root)
     assert len(breaches) == 1 and breaches[0].startswith(f"library import: {rel} imports {what}: "), breaches
+
+
+@pytest.mark.parametrize("text,said", [
+    ("exec('from servoctl import cli')\n", "exec"),
+    ("import importlib\nname = 'servoctl.' + 'cli'\nimportlib.import_module(name)\n",
+     "import_module of a computed name"),
+])
+def test_a_library_module_running_code_from_a_string_is_found(tmp_path, text, said):
+    """What exec or an import by a computed name brings no reader can see."""
+    root = tree(tmp_path)
+    write(root, "tools/servoctl/units.py", text)
+    assert check_layers.check(root)[0] == [
+        f"library import: tools/servoctl/units.py runs code from a string ({said}): its imports could not be checked"]
 
 
 def test_a_circle_through_the_command_line_is_found(tmp_path):
@@ -170,11 +227,20 @@ def test_a_long_file_is_found(tmp_path):
 
 
 def test_a_generated_file_may_be_long(tmp_path):
+    """Only when the generator it names exists: a line anyone can write is
+    no pass. A linker script and the CI's script count too."""
     root = tree(tmp_path)
-    write(root, "docs/protocol.md", "# x\n\n<!-- Generated by gen.py: do not edit. -->\n" + "\n" * 500)
+    write(root, "docs/protocol.md", "# x\n\n<!-- Generated by scripts/gen.py: do not edit. -->\n" + "\n" * 500)
+    assert check_layers.check(root)[0] == ["long file: docs/protocol.md has 503 lines (limit 400)"]
+    write(root, "scripts/gen.py", "print()\n")
     assert check_layers.check(root)[0] == []
     write(root, "docs/protocol.md", "# x\n" + "\n" * 500)
-    assert check_layers.check(root)[0] == ["long file: docs/protocol.md has 501 lines (limit 400)"]
+    write(root, "hal/ports/stm32_common/linker/big.ld", "\n" * 401)
+    write(root, ".ci/run", "\n" * 401)
+    assert sorted(check_layers.check(root)[0]) == [
+        "long file: .ci/run has 401 lines (limit 400)",
+        "long file: docs/protocol.md has 501 lines (limit 400)",
+        "long file: hal/ports/stm32_common/linker/big.ld has 401 lines (limit 400)"]
 
 
 def test_an_include_that_names_no_layer_is_found(tmp_path):
@@ -230,6 +296,22 @@ def test_the_build_importing_from_tools_is_found(tmp_path):
     assert sorted(check_layers.check(root)[0])[:2] == [
         "build import: cmake/image.cmake runs ${Python3_EXECUTABLE} -m servoctl.image",
         "build import: cmake/image.cmake runs PYTHONPATH=${PROJECT_SOURCE_DIR}/tools"]
+
+
+def test_the_builds_python_is_followed_however_it_is_named(tmp_path):
+    """A script named from the source tree's root or the CMake file's own
+    folder, a module it imports relatively, one it imports by name."""
+    root = tree(tmp_path)
+    write(root, "tools/servoctl/__init__.py", "")
+    write(root, "gen/CMakeLists.txt", "add_custom_command(OUTPUT x COMMAND ${Python3_EXECUTABLE} "
+                                      "${CMAKE_SOURCE_DIR}/scripts/a.py COMMAND ${Python3_EXECUTABLE} "
+                                      "${CMAKE_CURRENT_LIST_DIR}/b.py)\n")
+    write(root, "scripts/a.py", "import importlib\nimportlib.import_module('servoctl.units')\n")
+    write(root, "gen/b.py", "from . import helper\n")
+    write(root, "gen/helper.py", "import numpy\n")
+    assert sorted(check_layers.check(root)[0]) == [
+        "build import: gen/helper.py imports numpy, not in the standard library",
+        "build import: scripts/a.py imports servoctl, from tools/"]
 
 
 def test_a_long_schema_line_is_found(tmp_path):

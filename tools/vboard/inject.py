@@ -12,9 +12,9 @@ and brownout), and what a fault handler does about the bridge, measured.
 - stack: at the entry of the main loop's pass (servo_poll, called every
   pass), SP is lowered to just above the stack's bottom (the ELF's
   _estack - STACK_SIZE, hal/ports/stm32_common/linker/sections_stm32.ld), as if the
-  function had a deep local array: on the M3 its own pushes (48 bytes)
-  reach below the bottom, over the bottom word where the firmware keeps a
-  guard; on the M0 its frame (read from its prologue) ends STACK_BELOW_FRAME
+  function had a deep local array: on the M3 its frame (its pushes and
+  locals, 64 bytes) reaches below the bottom, over the bottom word where
+  the firmware keeps a guard; on the M0 its frame (read from its prologue) ends STACK_BELOW_FRAME
   bytes above the bottom, so that what it calls runs the stack out. At its return (its caller's address, its frame
   popped) SP is given back. With the M3's MPU guarding the bottom the push
   faults (MemManage, or HardFault if disabled); without, it overwrites.
@@ -59,22 +59,45 @@ def stack_facts(path):
 
 
 def _frame_bytes(elf, address: int) -> int:
-    """What a Thumb function's prologue takes off SP: its 16-bit `push` (a
-    register each, LR too) and `sub sp, #imm` (ARMv6-M A6.7.50, A6.7.67),
-    the forms the M0's compiler emits; 0 for others."""
+    """What a Thumb function's prologue takes off SP, read up to its first
+    branch, call or return (the compiler mixes the body's first
+    instructions into it): `push` (a register each, LR too), `sub sp,
+    #imm`, and a large frame's `ldr rN, =-size; add sp, rN` (ARMv6-M
+    A6.7.50, A6.7.67, A6.7.30, A6.7.3; the M3's `stmdb sp!`, A7.7.160)."""
     data, sections = elf
     for sh in sections:  # (name, type, flags, addr, offset, size, ...)
         if sh[3] <= address < sh[3] + sh[5] and sh[1] == 1:  # SHT_PROGBITS
-            code = data[sh[4] + address - sh[3]:sh[4] + address - sh[3] + 12]
+            base, offset, size = sh[3], sh[4], sh[5]
             break
     else:
         return 0
-    total = 0
-    for (half,) in struct.iter_unpack("<H", code):
-        if half & 0xFE00 == 0xB400:  # push {registers[, lr]}
-            total += 4 * (bin(half & 0xFF).count("1") + (half >> 8 & 1))
-        elif half & 0xFF80 == 0xB080:  # sub sp, #imm7 * 4
-            total += 4 * (half & 0x7F)
+
+    def half(at):
+        return struct.unpack_from("<H", data, offset + at - base)[0] if base <= at < base + size - 1 else None
+
+    total, loaded, at = 0, {}, address
+    for _ in range(16):
+        h = half(at)
+        if h is None:
+            break
+        if h & 0xFE00 == 0xB400:  # push {registers[, lr]}
+            total += 4 * (bin(h & 0xFF).count("1") + (h >> 8 & 1))
+        elif h == 0xE92D:  # stmdb sp!, {registers}
+            total += 4 * bin(half(at + 2) or 0).count("1")
+            at += 2
+        elif h & 0xFF80 == 0xB080:  # sub sp, #imm7 * 4
+            total += 4 * (h & 0x7F)
+        elif h & 0xF800 == 0x4800:  # ldr rN, [pc, #imm8 * 4]: a large frame's size
+            literal = ((at + 4) & ~3) + 4 * (h & 0xFF)
+            if base <= literal < base + size - 3:
+                loaded[h >> 8 & 7] = struct.unpack_from("<i", data, offset + literal - base)[0]
+        elif h & 0xFF87 == 0x4485 and (h >> 3 & 0xF) in loaded:  # add sp, rN
+            total -= loaded[h >> 3 & 0xF]
+        elif h & 0xFF00 in (0x4700, 0xBD00, 0xBC00) or 0xD000 <= h < 0xE800 or h & 0xF800 == 0xF000:
+            break  # bx/blx, pop, a branch, bl: the prologue is over
+        elif h >= 0xE800:
+            at += 2  # another 32-bit instruction: its second half
+        at += 2
     return total
 
 

@@ -29,8 +29,8 @@ struct dispatcher {
     uint16_t board;
     /* When the control tick that computed the motion's state ran:
      * ReadMotion stamps its snapshot with it. Handed in by the control
-     * loop's owner before each dispatch (dispatcher_note_tick); 0 where
-     * none runs. */
+     * loop's owner whenever its schedule moves (dispatcher_note_tick); 0
+     * where none runs. */
     uint32_t tick_us;
     /* Frames for this servo so far (its ID, a broadcast, its SyncCommand
      * record): the bus watchdog's food. */
