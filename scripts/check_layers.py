@@ -2,18 +2,18 @@
 """The firmware's layers and circles, checked from its #include lines.
 
 Each source folder is a layer; a layer may include only the layers below it
-(LAYERS). No module (a .c with its .h) may reach itself through the
-includes of others (a circle), nor through the symbols its object file
-uses and the others define (`--objects BUILD`: a build's objects, read
-with nm), nor may servoctl's modules through their imports, nor may servoctl's
-library import its command line, its ui or the virtual boards; no file
-people read (source, build files, documents) outside the tests and the
-generated files may pass LINE_LIMIT lines,
-nor a line of the protocol's schema SCHEMA_LINE_LIMIT characters; no job
-of the application's (firmware/app/servo_*.[ch]) reaches its hub (struct
-servo: servo_state.h, servo.h); and the
-Python the firmware's build runs imports nothing from tools/ (the PC
-tools) and nothing outside the standard library.
+(LAYERS), and its objects may use only their symbols (`--objects BUILD`: a
+build's objects, read with nm). No module (a .c with its .h) may reach
+itself through the includes of others (a circle), nor through the symbols
+its object uses; nor may servoctl's modules through their imports, nor
+servoctl's library import its command line, its ui or the virtual boards
+(check_python_layers.py). No file people read (source, build files,
+documents) outside the tests and the generated files may pass LINE_LIMIT
+lines, nor a line of the protocol's schema SCHEMA_LINE_LIMIT characters;
+no job of the application's (firmware/app/ but the hub's files) reaches its
+hub (struct servo: servo_state.h, servo.h); every firmware C file is in a
+layer's folder; and the Python the firmware's build runs imports nothing
+from tools/ (the PC tools) and nothing outside the standard library.
 
 Exit 1 with one line per breach; `--graph` prints the layer graph found."""
 import argparse
@@ -313,6 +313,20 @@ def long_schema_lines(root):
                     yield path.relative_to(root).as_posix(), n, len(line)
 
 
+def symbol_layer_breaches(symbols):
+    """A module whose object uses a symbol a higher layer's defines: the
+    includes' rule, held for what is linked too (a declaration written
+    out by hand passes the includes)."""
+    out = []
+    for module, deps in symbols.items():
+        mine = layer_of(module + ".c")
+        for dep in deps:
+            theirs = layer_of(dep + ".c")
+            if mine and theirs and theirs != mine and LAYERS[mine] is not None and theirs not in LAYERS[mine]:
+                out.append(f"layer: {module} ({mine}) uses symbols of {dep} ({theirs})")
+    return out
+
+
 def check(root, build=None):
     breaches = include_breaches(root)
     graph = include_graph(root)
@@ -334,8 +348,10 @@ def check(root, build=None):
     for c in circles({m: sorted(d) for m, d in modules.items()}):
         breaches.append("circle of modules: " + " <-> ".join(c))
     if build is not None:
-        for c in circles(symbol_graph(root, build)):
+        symbols = symbol_graph(root, build)
+        for c in circles(symbols):
             breaches.append("circle of symbols: " + " <-> ".join(c))
+        breaches += symbol_layer_breaches(symbols)
     library = []
     for c in circles(python_imports(root, library)):
         breaches.append("circle of imports in servoctl: " + " -> ".join(c))

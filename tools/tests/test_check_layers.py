@@ -322,3 +322,14 @@ def test_a_long_schema_line_is_found(tmp_path):
     write(root, "protocol/control_port.toml", "# short\n# " + "x" * 119 + "\n")
     assert check_layers.check(root)[0] == [
         "long schema line: protocol/control_port.toml:2 has 121 characters (limit 120)"]
+
+
+def test_a_lower_layer_using_a_higher_ones_symbols_is_found():
+    """A declaration written out by hand passes the includes' rule; the
+    symbols the objects use hold it (check_layers --objects)."""
+    symbols = {"motion/controller": ["registers/data_table"], "protocol/dispatcher": ["motion/motion"],
+               "firmware/boards/stm32f103/main": ["firmware/app/servo"], "tools/servobus/src/sb_bus": []}
+    assert check_layers.symbol_layer_breaches(symbols) == []
+    symbols["motion/controller"].append("firmware/app/servo_safety")
+    assert check_layers.symbol_layer_breaches(symbols) == [
+        "layer: motion/controller (motion) uses symbols of firmware/app/servo_safety (app)"]
