@@ -25,10 +25,9 @@ FORMAT = 1
 HEADER_SIZE = 256
 CHECKED = 24  # bytes the header's own CRC covers
 
-# The build's boards: each folder with a board.h (BOARD_ID, the header's
-# board field; the flash map and RAM the application's linker script is made
-# from: hal/ports/stm32_common/linker/app.ld.in).
-BOARDS_DIR = board_facts.BOARDS_DIR
+# The build's boards: each folder of firmware/boards with a board.h
+# (BOARD_ID, the header's board field; the flash map and RAM the
+# application's linker script is made from: hal/ports/stm32_common/linker/app.ld.in).
 HEADER_SIZE_IN_SLOT = 256  # the image header before the application (app.ld.in)
 STAY_WORD_BYTES = 16       # RAM's last bytes, left out of the application's
 # Vector 7 (reserved by the core) carries "SB" and the board's ID
@@ -60,21 +59,26 @@ def _read_board(folder: Path):
 
 
 def boards() -> dict:
-    """{name: Board} of every board the build knows; none where the
-    firmware's tree is not beside this package (servoctl installed
-    without -e: its images name their boards by number)."""
-    if not BOARDS_DIR.is_dir():
+    """{name: Board} of every board the build knows; none where no
+    firmware tree is found (board_facts.root(): servoctl installed without
+    -e, run outside a clone and without $SERVO_FIRMWARE_ROOT)."""
+    root = board_facts.find_root()
+    if root is None:
         return {}
-    found = (_read_board(f) for f in sorted(BOARDS_DIR.iterdir()) if (f / "board.h").is_file())
+    folder = root / board_facts.BOARDS
+    found = (_read_board(f) for f in sorted(folder.iterdir()) if (f / "board.h").is_file())
     return {b.name: b for b in found if b is not None}
 
 
-BOARDS = {name: b.id for name, b in boards().items()}
+BOARDS = {name: b.id for name, b in boards().items()}  # those of the tree found at import
 
 
 def board_named(board_id: int) -> str:
     """A board ID as people know it: its folder's name, and the number."""
-    name = next((b.name for b in boards().values() if b.id == board_id), None)
+    known = boards()
+    if not known:
+        return f"board 0x{board_id:04x} (unnamed: no firmware tree found; set {board_facts.ENV})"
+    name = next((b.name for b in known.values() if b.id == board_id), None)
     return f"{name} (0x{board_id:04x})" if name else f"an unknown board (0x{board_id:04x})"
 
 
@@ -167,6 +171,11 @@ def make(binary: str, version: str, board: str, output: str) -> bytes:
         except ValueError:
             number = None
         found = next((b for b in known.values() if b.id == number), None)
+    if not known:
+        try:
+            board_facts.root()
+        except board_facts.NoFirmwareTree as e:  # the boards' facts are not at hand
+            raise ImageError(str(e)) from None
     if found is None:
         raise ImageError(f"board must be one of {', '.join(known)} (or its number), not {board!r}")
     try:

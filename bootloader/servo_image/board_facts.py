@@ -8,16 +8,57 @@ the include stands, and the CPU of the chip family its board.cmake names
 (include(.../cmake/family-NAME.cmake), whose SERVO_BOARD_CPU it is; a
 board.cmake may also set SERVO_BOARD_CPU itself), and the part it names
 (set(SERVO_BOARD_PART name)), whose facts are in hal/ports/parts.toml;
-check() holds the board to them. Standard library only."""
+check() holds the board to them. Standard library only.
+
+The firmware's tree they are read from (root()): the one this file is in
+(a clone, the build's and an editable install's), else $SERVO_FIRMWARE_ROOT,
+else the current directory's clone (it or a folder above it); an installed
+copy (pip install ./tools) has none of its own."""
+import os
 import re
 import sys
 import tomllib
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[2]  # bootloader/servo_image/
-BOARDS_DIR = ROOT / "firmware" / "boards"
-FAMILIES_DIR = ROOT / "cmake"
-PARTS_FILE = ROOT / "hal" / "ports" / "parts.toml"
+HERE = Path(__file__).resolve().parent  # bootloader/servo_image/ of a clone
+ENV = "SERVO_FIRMWARE_ROOT"
+NO_TREE = f"no firmware tree found: run from a clone of the firmware or set {ENV}"
+BOARDS = Path("firmware", "boards")  # within the tree
+FAMILIES = Path("cmake")
+PARTS = Path("hal", "ports", "parts.toml")
+
+
+class NoFirmwareTree(LookupError):
+    """No firmware tree to read a board's facts from (NO_TREE; with
+    $SERVO_FIRMWARE_ROOT set, which folder it names)."""
+
+
+def _is_tree(folder: Path) -> bool:
+    return (folder / BOARDS).is_dir() and (folder / PARTS).is_file()
+
+
+def find_root():
+    """The firmware's tree (module docstring), or None."""
+    candidates = [*HERE.parents[1:2]]
+    if os.environ.get(ENV):
+        candidates.append(Path(os.environ[ENV]).expanduser())
+    here = Path.cwd()
+    candidates += [here, *here.parents]
+    return next((c.resolve() for c in candidates if _is_tree(c)), None)
+
+
+def root() -> Path:
+    """The firmware's tree; NoFirmwareTree, which says how to give one, if none."""
+    found = find_root()
+    if found is None:
+        named = os.environ.get(ENV)
+        raise NoFirmwareTree(f"{NO_TREE} ({ENV}={named} has no {BOARDS} and {PARTS})" if named else NO_TREE)
+    return found
+
+
+def boards_dir() -> Path:
+    """firmware/boards of the tree (root())."""
+    return root() / BOARDS
 
 _DEFINE = re.compile(r"#define (BOARD_\w+) (0x[0-9a-fA-F]+|\d+)\b")
 _INCLUDE = re.compile(r'#include "(boards/[^"]+)"')
@@ -28,7 +69,7 @@ _PART = re.compile(r"^set\(SERVO_BOARD_PART (\S+)\)", re.M)
 
 def folder_of(board) -> Path:
     """A board's folder: a path as given, or its name under firmware/boards."""
-    return Path(board) if isinstance(board, Path) else BOARDS_DIR / board
+    return Path(board) if isinstance(board, Path) else boards_dir() / board
 
 
 def _numbers(header: Path) -> dict:
@@ -38,7 +79,7 @@ def _numbers(header: Path) -> dict:
     for line in header.read_text().splitlines():
         included = _INCLUDE.match(line)
         if included:
-            out.update(_numbers(ROOT / "firmware" / included.group(1)))
+            out.update(_numbers(root() / "firmware" / included.group(1)))
         found = _DEFINE.match(line)
         if found:
             out[found.group(1)] = int(found.group(2), 0)
@@ -59,7 +100,7 @@ def cpu(board) -> str:
     text = cmake.read_text()
     family = _FAMILY.search(text)
     if family and not _CPU.search(text):
-        text = (FAMILIES_DIR / f"family-{family.group(1)}.cmake").read_text()
+        text = (root() / FAMILIES / f"family-{family.group(1)}.cmake").read_text()
     found = _CPU.search(text)
     return found.group(1) if found else ""
 
@@ -73,7 +114,7 @@ def part_name(board) -> str:
 
 def parts() -> dict:
     """{name: {fact: value}} of every part a board may name."""
-    with PARTS_FILE.open("rb") as f:
+    with (root() / PARTS).open("rb") as f:
         return tomllib.load(f)
 
 

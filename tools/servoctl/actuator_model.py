@@ -13,7 +13,12 @@ full duty)."""
 import math
 from pathlib import Path
 
-import numpy as np
+from . import extras
+
+try:
+    import numpy as np
+except ModuleNotFoundError as e:  # the extra servoctl[identify]
+    raise extras.missing(e) from None
 
 TIMESTEP_S = 0.0005
 
@@ -50,7 +55,10 @@ def replay(path, step):
     """The model's angle (rad) at each of the step's sample times, driven by
     the duty the servo's bridge was given (held between samples), from rest
     at the step's first angle."""
-    import mujoco  # loaded for --mujoco alone
+    try:
+        import mujoco  # loaded for --mujoco alone
+    except ModuleNotFoundError as e:  # the extra servoctl[mujoco]
+        raise extras.missing(e) from None
 
     model = mujoco.MjModel.from_xml_path(str(path))
     data = mujoco.MjData(model)

@@ -3,7 +3,10 @@ library (pyserial alone: the bus, servos, units, config files, the loop
 and the stream, the arm the LeRobot plugins drive) leaves out, which
 module each needs and the extra that brings it. The command line is one
 (servoctl[cli]: rich). scripts/setup.sh installs them all
-(tools/requirements.txt)."""
+(tools/requirements.txt). A module that needs one raises a
+ModuleNotFoundError saying which (missing()); a command checks the ones
+it needs before it sends anything (require())."""
+import importlib.util
 
 # {module: (its distribution, the extra that installs it, what needs it)}
 OPTIONAL = {
@@ -15,6 +18,7 @@ OPTIONAL = {
     "cmsis_svd": ("cmsis-svd", "vboard", "the virtual boards (sim --board)"),
     "matplotlib": ("matplotlib", "plot", "record's and monitor's plots"),
     "aiohttp": ("aiohttp", "ui", "the bench in a browser (ui)"),
+    "elftools": ("pyelftools", "elf", "faults --elf (a fault's code named by its function)"),
 }
 
 
@@ -25,4 +29,21 @@ def missing_text(name: str):
     if found is None:
         return None
     distribution, extra, needs = found
-    return f"{distribution} is not installed (servoctl's extra for {needs}): pip install 'servoctl[{extra}]'"
+    # Where servoctl is installed pip takes the extra from it (servoctl is not on PyPI).
+    return (f"{distribution} is not installed, servoctl's extra for {needs}: pip install 'servoctl[{extra}]' "
+            f"(in a clone: pip install -e './tools[{extra}]')")
+
+
+def missing(error: ModuleNotFoundError) -> ModuleNotFoundError:
+    """The error an optional module's import raised, saying which extra
+    brings it (missing_text) where it is one; to raise from None."""
+    text = missing_text(error.name)
+    return ModuleNotFoundError(text, name=error.name) if text else error
+
+
+def require(*modules) -> None:
+    """Raises missing()'s error for the first of these optional modules
+    that is not installed: what a command checks before it sends anything."""
+    for module in modules:
+        if importlib.util.find_spec(module) is None:
+            raise ModuleNotFoundError(missing_text(module) or f"No module named {module!r}", name=module)

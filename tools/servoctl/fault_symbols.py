@@ -1,5 +1,6 @@
 """The functions and the board of an image's ELF (pyelftools, loaded only
 where --elf is given; the LeRobot plugins reach fault_code.py, not this)."""
+from . import extras
 from .errors import UsageError
 
 BOARD_MARK_TAG = 0x5342  # "SB": vector 7's high half (servo_image.BOARD_MARK_TAG)
@@ -12,8 +13,8 @@ class Symbols:
         try:
             from elftools.common.exceptions import ELFError
             from elftools.elf.elffile import ELFFile
-        except ImportError as e:
-            raise SystemExit("naming a fault's code needs pyelftools: pip install 'servoctl[elf]'") from e
+        except ModuleNotFoundError as e:  # the extra servoctl[elf]
+            raise extras.missing(e) from None
         try:
             f = open(path, "rb")
         except OSError as e:

@@ -27,10 +27,14 @@ The experiments are here; the fits are identify_fit.py's, the command's
 report identify_report.py's."""
 import math
 
-import numpy as np
-
-from . import registers
+from . import extras, registers
 from .errors import ServoError
+
+try:
+    import numpy as np
+except ModuleNotFoundError as e:  # the extra servoctl[identify]
+    raise extras.missing(e) from None
+
 from .identify_fit import DriveTrain, Estimate, Sample, Step, chirp_error, fit, reversal_play, rise_tau
 
 DEFAULT_DUTIES = (0.15, 0.25, 0.35, 0.45)

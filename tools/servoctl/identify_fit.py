@@ -6,8 +6,13 @@ error."""
 import math
 from dataclasses import dataclass
 
-import numpy as np
-from scipy import optimize
+from . import extras
+
+try:
+    import numpy as np
+    from scipy import optimize
+except ModuleNotFoundError as e:  # the extra servoctl[identify]
+    raise extras.missing(e) from None
 
 from .errors import ServoError
 

@@ -4,7 +4,7 @@ build runs too), its errors servoctl's UsageError."""
 import functools
 
 import servo_image
-from servo_image import (BOARD_MARK_OFFSET, BOARD_MARK_TAG, BOARDS, BOARDS_DIR, CHECKED, FORMAT,  # noqa: F401
+from servo_image import (BOARD_MARK_OFFSET, BOARD_MARK_TAG, BOARDS, CHECKED, FORMAT,  # noqa: F401
                          HEADER_SIZE, MAGIC, Board, Image, board_named, boards)
 
 from .errors import UsageError

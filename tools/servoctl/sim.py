@@ -15,6 +15,7 @@ import tempfile
 import threading
 import time
 
+from . import extras
 from .protocol import Bus, LinkError, ServoError
 from .sim_control import control_command, fields as _fields  # noqa: F401 (control_command: link_rate's)
 
@@ -24,9 +25,8 @@ PACKAGES = Path(__file__).resolve().parent.parent
 # Host seconds a simulator's clock may stand still before a wait gives up
 # on it (a simulator falls behind on a busy PC; it does not stop).
 STALLED_S = 30.0
-# Host seconds a simulator may take to start: a virtual board (Python,
-# unicorn, its images) takes a few on an idle PC, and over 20 on one
-# loaded as a shared CI machine is (scripts/stress.sh).
+# Host seconds a simulator may take to start: a virtual board (Python, unicorn,
+# its images) takes a few on an idle PC, over 20 on a loaded CI machine (scripts/stress.sh).
 READY_S = 60
 _CLOCK_US = struct.Struct("<Q")  # servo_sim's clock file: microseconds
 HOST_BUILD = Path("build", "host", "firmware", "boards", "host_sim", "servo_sim")  # of a checkout
@@ -139,6 +139,7 @@ class Simulator(_Child):
         if self.board is not None:
             if self.rx is not None or self.cpu is not None:
                 raise ServoError("a virtual board runs as its MCU does: --rx and --cpu are servo_sim's")
+            extras.require("unicorn", "cmsis_svd")  # the child's, which would die with its traceback
             cmd = [sys.executable, "-m", "vboard", "--board", self.board, "--state", self.state_dir]
             if self.app_image is not None:
                 cmd += ["--app", str(self.app_image)]

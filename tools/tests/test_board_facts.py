@@ -1,6 +1,7 @@
 """A board's facts have one reader (servo_image.board_facts) that every tool
 uses, a board's CPU comes from the chip family its board.cmake names, and
 the part it names holds its flash map and RAM to the part's own facts."""
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -56,7 +57,7 @@ def _board_like(tmp_path, name, header_edits=(), part=None):
     new) and, given one, another part named in board.cmake."""
     folder = tmp_path / name
     folder.mkdir(parents=True)
-    source = board_facts.BOARDS_DIR / name
+    source = board_facts.boards_dir() / name
     header = (source / "board.h").read_text()
     for old, new in header_edits:
         assert old in header, old
@@ -97,7 +98,7 @@ def test_a_board_its_part_contradicts_is_named_fact_by_fact(tmp_path):
 def test_the_build_s_check_exits_with_a_line_a_problem(tmp_path):
     """What cmake/arm-image.cmake runs at configure time (servo_board_facts)."""
     script = Path(board_facts.__file__)
-    good = subprocess.run([sys.executable, script, "--check", board_facts.BOARDS_DIR / "stm32f030k6"],
+    good = subprocess.run([sys.executable, script, "--check", board_facts.boards_dir() / "stm32f030k6"],
                           capture_output=True, text=True)
     assert good.returncode == 0 and good.stderr == "" and good.stdout == ""
     # With --facts, the numbers the build's limits come from, in decimal
@@ -115,3 +116,38 @@ def test_the_build_s_check_exits_with_a_line_a_problem(tmp_path):
     assert run.stderr.splitlines() == [
         "board check: stm32f030k6: BOARD_RAM_BASE 0x20000000 and BOARD_RAM_SIZE 8192 are not within "
         "the part's 4096 B of RAM at 0x20000000 (stm32f030k6)"]
+
+
+def test_an_installed_copy_reads_the_tree_it_is_given_or_runs_in(tmp_path):
+    """pip install ./tools (not -e) leaves servo_image without the firmware
+    tree beside it: the boards are read from $SERVO_FIRMWARE_ROOT or the
+    clone the command runs in (a folder of it too), and without either
+    the image is refused saying how to give one, not with an empty list."""
+    site = tmp_path / "site"
+    shutil.copytree(Path(board_facts.__file__).parent, site / "servo_image",
+                    ignore=shutil.ignore_patterns("__pycache__"))
+    script = """
+import servo_image
+print(sorted(servo_image.boards()))
+print(servo_image.board_named(servo_image.boards().get("stm32f030k6", servo_image.Board("", 0x30)).id))
+try:
+    servo_image.make("absent.bin", "1", "stm32f030k6", "out.img")
+except servo_image.ImageError as e:
+    print(e)
+"""
+    repo = Path(board_facts.__file__).resolve().parents[2]
+
+    def run(cwd, **env):
+        done = subprocess.run([sys.executable, "-S", "-c", script], capture_output=True, text=True, cwd=cwd,
+                              env={"PYTHONPATH": str(site), **env}, timeout=60)
+        assert done.returncode == 0, done.stderr
+        return done.stdout.splitlines()
+
+    assert run(tmp_path) == ["[]", "board 0x0030 (unnamed: no firmware tree found; set SERVO_FIRMWARE_ROOT)",
+                             "no firmware tree found: run from a clone of the firmware or set SERVO_FIRMWARE_ROOT"]
+    elsewhere = run(tmp_path, SERVO_FIRMWARE_ROOT=str(tmp_path))
+    assert elsewhere[2] == (f"no firmware tree found: run from a clone of the firmware or set SERVO_FIRMWARE_ROOT "
+                            f"(SERVO_FIRMWARE_ROOT={tmp_path} has no firmware/boards and hal/ports/parts.toml)")
+    for found in (run(tmp_path, SERVO_FIRMWARE_ROOT=str(repo)), run(repo / "tools")):
+        assert "'stm32f030k6'" in found[0] and found[1].startswith("stm32f030k6 (0x"), found
+        assert found[2].startswith("cannot read absent.bin"), found

@@ -5,6 +5,7 @@ import struct
 
 import pytest
 
+from servo_image import board_facts
 from servoctl import image as img
 from servoctl.protocol import UsageError
 
@@ -36,7 +37,7 @@ def test_parse_takes_what_build_makes_and_refuses_damage():
 def test_the_boards_are_the_builds():
     """Every folder of firmware/boards with a board.h, the M0 included, with
     the ID and the memory map the build makes its linker scripts from."""
-    folders = {f.name for f in img.BOARDS_DIR.iterdir() if (f / "board.h").is_file()}
+    folders = {f.name for f in board_facts.boards_dir().iterdir() if (f / "board.h").is_file()}
     boards = img.boards()
     assert set(boards) == folders >= {"stm32f103", "stm32f030k6", "qemu_stm32vl", "host_sim"}
     assert boards["stm32f030k6"].id == 0x0030 and boards["stm32f103"].id == 0x0103
@@ -90,7 +91,7 @@ def test_one_boards_application_is_not_packed_for_another(tmp_path, built, packe
     in the F103's RAM as well: only the board mark tells that one apart.
     The build's own binaries (scripts/test.sh builds both before pytest)."""
     preset = "arm-m0" if built == "stm32f030k6" else "arm"
-    binary = img.BOARDS_DIR.parents[1] / "build" / preset / "firmware" / "boards" / built / f"servo_{built}.bin"
+    binary = board_facts.root() / "build" / preset / "firmware" / "boards" / built / f"servo_{built}.bin"
     img.make(str(binary), "0x0011", built, str(tmp_path / "own.img"))  # its own board takes it
     with pytest.raises(UsageError, match=why):
         img.make(str(binary), "0x0011", packed_as, str(tmp_path / "other.img"))

@@ -3,6 +3,7 @@ a plot (live.py; loaded for this command alone)."""
 import os
 import sys
 
+from .. import extras
 from ..errors import EXIT_INTERRUPTED, NoReply
 from .cmd_record import check_writable
 
@@ -17,6 +18,8 @@ def cmd_monitor(bus, args):
         print("servoctl: warning: --plot: no display (DISPLAY and WAYLAND_DISPLAY are unset), so no "
               "window; sampling without it. --plot-file FILE saves the plot instead", file=sys.stderr)
         plot = False
+    if plot or args.plot_file:
+        extras.require("matplotlib")  # not a run sampled for a plot it cannot draw
     never, interrupted = {}, False
     try:
         never = monitor(bus, args.ids, args.every, args.count, args.sync, args.json, plot, args.plot_file)

@@ -6,7 +6,7 @@ import math
 import os
 
 from . import args as args_
-from .. import frame, outcome, registers
+from .. import extras, frame, outcome, registers
 from ..errors import Refused, UsageError
 from ..servo import Servo
 
@@ -22,6 +22,7 @@ def cmd_record(bus, args):
     its own measured speed and tracking error, current and status, all of one
     instant); CSV and a PNG with the plan, the tracking error and the speeds."""
     check_writable(args.out + ".csv")
+    extras.require("matplotlib")  # the plot, drawn after the move: refused before it instead
     s = Servo(bus, args.id)
     target = args_.decideg(args.angle)
     where = frame.check_target(s, target, args.multi_turn)

@@ -6,6 +6,7 @@ step checked; calibrate's findings (calibrate.py). scipy (identify's fits)
 is loaded with this module: cmd_drive imports it for these commands alone."""
 import math
 
+from .. import extras
 from ..calibrate import PUSH_DUTY, calibrate
 from ..errors import ServoError
 from ..identify import CHIRP_HZ, DEFAULT_DUTIES, identify
@@ -17,6 +18,8 @@ from ..tune import CHECK_MS, CHECK_TARGET_DECIDEG, CHECK_TOLERANCE_DECIDEG, chec
 def cmd_identify(bus, args):
     """servoctl identify ID: open-loop steps, the fit, a table with each
     value's standard error."""
+    if args.mujoco:
+        extras.require("mujoco")  # the model is made after the experiment: refused before it
     servo = Servo(bus, args.id)
     duties = tuple(args.duty * k / len(DEFAULT_DUTIES) for k in range(1, len(DEFAULT_DUTIES) + 1))
     print(f"servo {args.id}: open-loop steps at duties {', '.join(f'±{d:.2f}' for d in duties)}, then "
