@@ -120,14 +120,19 @@ function(servo_arm_bootloader name)
       ${PROJECT_SOURCE_DIR}/hal/runtime/small_mem.c ${boot}/bootloader.c
       ${boot}/boot_packets.c ${boot}/boot_flow.c ${boot}/app_image.c ${boot}/slot_write.c
       ${PROJECT_SOURCE_DIR}/services/storage/config_peek.c ${PROJECT_SOURCE_DIR}/hal/runtime/crc32.c)
-  foreach(lib ${SERVO_BOARD_PORT} servo_stm32_common)
+  # The port libraries whose sources it compiles (a family's cmake may name
+  # its own: the G0's port compiles the shared drivers itself).
+  if(NOT DEFINED SERVO_BOARD_PORT_LIBS)
+    set(SERVO_BOARD_PORT_LIBS ${SERVO_BOARD_PORT} servo_stm32_common)
+  endif()
+  foreach(lib ${SERVO_BOARD_PORT_LIBS})
     get_target_property(dir ${lib} SOURCE_DIR)
     get_target_property(sources ${lib} SOURCES)
-    list(TRANSFORM sources PREPEND ${dir}/)
+    list(TRANSFORM sources PREPEND ${dir}/ REGEX "^[^/]") # relative ones
     list(APPEND small ${sources})
   endforeach()
   add_executable(${name}.elf ${I_SOURCES} ${SERVO_BOARD_SOURCES} ${SERVO_BOARD_STARTUP} ${small})
-  if(SERVO_SIZE_FIRST)
+  if(TARGET servo_small_div) # a core without a divide instruction (hal/runtime)
     target_sources(${name}.elf PRIVATE $<TARGET_OBJECTS:servo_small_div>)
   endif()
   target_compile_definitions(${name}.elf PRIVATE FRAME_RX_SMALL FRAME_RX_NO_SYNC STARTUP_BOOTLOADER CRC32_BITWISE)
@@ -137,6 +142,8 @@ function(servo_arm_bootloader name)
   target_include_directories(${name}.elf PRIVATE ${PROJECT_SOURCE_DIR}/firmware)
   servo_firmware_target(${name}.elf)
   servo_board_limits()
+  # The part's VTOR (parts.toml): the jump to the application sets it (boot_jump.c).
+  target_compile_definitions(${name}.elf PRIVATE SERVO_PART_VTOR=${_BOARD_PART_VTOR})
   servo_board_linker_script(boot_ld boot)
   get_filename_component(board ${CMAKE_CURRENT_SOURCE_DIR} NAME)
   add_dependencies(${name}.elf ${board}_boot_ld)

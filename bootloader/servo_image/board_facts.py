@@ -203,6 +203,10 @@ def main(argv) -> int:
         return 1
     if "--facts" in argv:
         print("".join(f"{name}={value}\n" for name, value in defines(folder).items()), end="")
+        # The part's facts the C code is built with (its VTOR: boot_jump.c).
+        part = parts().get(part_name(folder), {})
+        if "vtor" in part:
+            print(f"BOARD_PART_VTOR={int(part['vtor'])}")
     return 0
 
 

@@ -7,7 +7,9 @@
  *   board_clock_init()     the clock tree
  *   board_pins_init()      the bus wire's and the front end's pins
  *   board_uart_start(usart, ring, dma)  the USART, its receive DMA, its sending
- *   board_interrupts_on()  the interrupts the loop needs besides SysTick */
+ *   board_interrupts_on()  the interrupts the loop needs besides SysTick
+ *   board_flash_init(f, page0, page1)  optional: a hal_flash on two pages
+ *                          (else the F0/F1 flash driver's, flash_f0f1_init) */
 #ifndef BOARDS_COMMON_APP_START_H
 #define BOARDS_COMMON_APP_START_H
 
@@ -16,7 +18,10 @@
 #include "ports/stm32_common/cortex_sleep.h"
 #include "ports/stm32_common/fault_keep.h"
 #include "ports/stm32_common/kept_ram.h"
+#ifndef board_flash_init
 #include "ports/stm32_common/flash_f0f1.h"
+#define board_flash_init(f, page0, page1) flash_f0f1_init((f), BOARD_FLASH_PAGE, (page0), (page1))
+#endif
 #include "ports/stm32_common/systick_clock.h"
 
 static struct servo servo;
@@ -55,8 +60,8 @@ int main(void)
     systick_clock_init(BOARD_CORE_HZ);
     adc_scan_init();
     pwm_bridge_init();
-    flash_f0f1_init(&flash, BOARD_FLASH_PAGE, BOARD_CONFIG_PAGE0, BOARD_CONFIG_PAGE1);
-    flash_f0f1_init(&fault_flash, BOARD_FLASH_PAGE, BOARD_FAULT_PAGE0, BOARD_FAULT_PAGE1);
+    board_flash_init(&flash, BOARD_CONFIG_PAGE0, BOARD_CONFIG_PAGE1);
+    board_flash_init(&fault_flash, BOARD_FAULT_PAGE0, BOARD_FAULT_PAGE1);
     board_uart_start(&usart, &rx_ring, &rx_dma);
     servo_init(&servo, &port);
     board_interrupts_on();

@@ -1,6 +1,14 @@
 #include "ports/stm32_common/board_common.h"
 
+#ifdef STM32_FAMILY_G0
+#include "ports/stm32g0/stm32g0_regs.h" /* its LSI: IWDG_COUNTS_PER_MS */
+#else
 #include "ports/stm32_common/stm32_core_regs.h"
+#endif
+
+#ifndef IWDG_COUNTS_PER_MS
+#define IWDG_COUNTS_PER_MS 10u /* the F0's and F1's 40 kHz LSI / 4 (parts.toml lsi_hz) */
+#endif
 
 enum { PWM_HZ = 20000 };
 
@@ -41,8 +49,8 @@ void iwdg_start(void)
 {
     IWDG_KR = IWDG_KEY_START;
     IWDG_KR = IWDG_KEY_ACCESS;
-    IWDG_PR = 0; /* 40 kHz / 4 */
-    IWDG_RLR = IWDG_TIMEOUT_MS * 10u;
+    IWDG_PR = 0; /* LSI / 4 */
+    IWDG_RLR = IWDG_TIMEOUT_MS * IWDG_COUNTS_PER_MS;
     IWDG_KR = IWDG_KEY_RELOAD;
 }
 

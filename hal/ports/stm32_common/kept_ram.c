@@ -2,7 +2,11 @@
 
 #include <string.h>
 
+#ifdef STM32_FAMILY_G0
+#include "ports/stm32g0/stm32g0_regs.h" /* its RCC_CSR: another offset, another RMVF */
+#else
 #include "ports/stm32_common/stm32_core_regs.h"
+#endif
 #include "runtime/crc32.h"
 
 _Static_assert(sizeof(struct kept_ram) <= 64u - 4u, "the kept record fits the kept bytes (board_derived.h) before the stay word");

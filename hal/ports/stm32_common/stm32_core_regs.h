@@ -2,7 +2,8 @@
  * Cortex-M core's SysTick, NVIC and SCB (ARMv6-M and ARMv7-M place them
  * alike), and at the same addresses with the same bits the RCC's first
  * registers, the flash interface (RM0008 3, RM0360 3), DMA1 (RM0008 13,
- * RM0360 10), TIM3 and the IWDG. Our own minimal definitions: no vendor
+ * RM0360 10), TIM3 and the IWDG. The STM32G0 shares the core, DMA1's
+ * channels, TIM3 and the IWDG (RM0444 10, 22, 24) at the same addresses. Our own minimal definitions: no vendor
  * library. */
 #ifndef STM32_CORE_REGS_H
 #define STM32_CORE_REGS_H
@@ -34,7 +35,10 @@
 #define MPU_RASR REG32(0xE000EDA0u)
 #define MPU_CTRL_ON_DEFAULT_MAP 5u /* ENABLE, PRIVDEFENA: the default map elsewhere */
 
-/* RCC: the registers and bits both families place alike */
+#ifndef STM32_FAMILY_G0
+/* RCC: the registers and bits both families place alike (not the G0's,
+ * whose RCC and flash interface are laid out anew: ports/stm32g0/stm32g0_regs.h;
+ * a G0 build, STM32_FAMILY_G0, leaves these out so none is used by mistake) */
 #define RCC_BASE 0x40021000u
 #define RCC_CR REG32(RCC_BASE + 0x00u)
 #define RCC_CFGR REG32(RCC_BASE + 0x04u)
@@ -81,6 +85,7 @@
 #define FLASH_CR_PER (1u << 1)
 #define FLASH_CR_STRT (1u << 6)
 #define FLASH_CR_LOCK (1u << 7)
+#endif /* STM32_FAMILY_G0 */
 
 /* DMA1: the interrupt flags, and channel n's registers from 1 */
 #define DMA1_ISR REG32(0x40020000u)

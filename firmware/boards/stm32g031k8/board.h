@@ -1,0 +1,56 @@
+/* The STM32G031K8 servo board (Cortex-M0+ at 64 MHz, 64 KB flash, 8 KB
+ * RAM; RM0444). Its main.c and boot_main.c, its linker scripts (made from
+ * hal/ports/stm32_common/linker/app.ld.in and boot.ld.in) and servoctl's
+ * image command read this file: plain numbers, one per line. */
+#ifndef BOARD_H
+#define BOARD_H
+
+#define BOARD_ID 0x0031 /* the update image header's board field */
+
+/* Flash (RM0444 3.3.1: 2 KB pages, 64-bit program units with ECC): the
+ * 4 KB (two-page) bootloader, the 52 KB application slot, the fault
+ * history's two pages, the config store's two at the end. */
+#define BOARD_FLASH_BASE 0x08000000
+#define BOARD_FLASH_PAGE 2048
+#define BOARD_BOOT_SIZE 4096
+#define BOARD_SLOT_BASE 0x08001000
+#define BOARD_SLOT_PAGES 26
+#define BOARD_FAULT_PAGE0 0x0800E000
+#define BOARD_FAULT_PAGE1 0x0800E800
+#define BOARD_CONFIG_PAGE0 0x0800F000
+#define BOARD_CONFIG_PAGE1 0x0800F800
+#define BOARD_FLASH_PAGES 32 /* the whole array: flash_g0.c erases a page by its number */
+
+/* RAM; its last BOARD_RAM_KEPT bytes are kept across resets (board_derived.h).
+ * The M0+ has a VTOR: the vector tables stay in flash. */
+#define BOARD_RAM_BASE 0x20000000
+#define BOARD_RAM_SIZE 8192
+
+/* The bus: USART1 (PA9, AF1), its DMAMUX requests 50 (RX) and 51 (TX)
+ * routed to DMA1 channels 3 and 2 (RM0444 11.3.2; ports/stm32g0/stm32g0_bus.h
+ * checks). USART2 (requests 52, 53) takes another TX pin in board_io.c. */
+#define BOARD_BUS_USART 1
+#define BOARD_BUS_DMA_TX 2
+#define BOARD_BUS_DMA_RX 3
+#define BOARD_BUS_DMAMUX_TX 51
+#define BOARD_BUS_DMAMUX_RX 50
+/* The application's stack: the M3's reservation; cmake/stack-report.py
+ * checks it after every link. */
+#define BOARD_APP_STACK_SIZE 1536
+
+/* The receive ring (hal/hal_rx_ring.h): a page erase stalls the CPU for
+ * tens of ms (DS12992, "Flash memory characteristics", tERASE) while the
+ * DMA goes on writing; 2 KB holds 40 ms up to 460 800 baud. The bootloader
+ * erases only while no request waits. */
+#define BOARD_RX_RING_BYTES 2048
+#define BOARD_BOOT_RX_RING_BYTES 256
+/* The longest control tick and a main-loop pass, rounded up to whole us:
+ * not measured on this CPU yet (the target bench has no M0+ build); the
+ * F030's 47 us at 48 MHz, which 64 MHz only shortens. */
+#define BOARD_TICK_AND_PASS_US 47
+/* The analogue front end and the motor: the reference servo's. */
+#include "boards/common/reference_servo.h"
+
+#include "boards/board_derived.h"
+
+#endif
