@@ -153,7 +153,7 @@ function(servo_arm_bootloader name)
     LINK_DEPENDS "${boot_ld};${PROJECT_SOURCE_DIR}/hal/ports/stm32_common/linker/sections_stm32.ld")
   add_custom_command(TARGET ${name}.elf POST_BUILD
     COMMAND ${CMAKE_OBJCOPY} -O binary $<TARGET_FILE:${name}.elf> ${CMAKE_CURRENT_BINARY_DIR}/${name}.bin
-    COMMAND sh ${PROJECT_SOURCE_DIR}/cmake/check-image.sh $<TARGET_FILE:${name}.elf> 4096
+    COMMAND sh ${PROJECT_SOURCE_DIR}/cmake/check-image.sh $<TARGET_FILE:${name}.elf> ${_BOARD_BOOT_SIZE}
             ${SERVO_BOARD_RAM_LIMIT}
     VERBATIM)
 endfunction()

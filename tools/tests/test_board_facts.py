@@ -21,7 +21,7 @@ def test_every_tool_reads_the_same_board_facts():
 def test_the_cpu_is_the_family_s():
     assert {n: b.cpu for n, b in img.boards().items()} == {
         "host_sim": "", "qemu_stm32vl": "cortex-m3", "stm32f030k6": "cortex-m0",
-        "stm32f103": "cortex-m3"}
+        "stm32f103": "cortex-m3", "stm32g031k8": "cortex-m0plus"}
 
 
 def test_a_family_is_declared_once(tmp_path):

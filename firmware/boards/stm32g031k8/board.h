@@ -8,13 +8,14 @@
 #define BOARD_ID 0x0031 /* the update image header's board field */
 
 /* Flash (RM0444 3.3.1: 2 KB pages, 64-bit program units with ECC): the
- * 4 KB (two-page) bootloader, the 52 KB application slot, the fault
- * history's two pages, the config store's two at the end. */
+ * 6 KB (three-page) bootloader (not size-first, with the G0's flash
+ * driver it is 4.2 KB), the 50 KB application slot, the fault history's
+ * two pages, the config store's two at the end. */
 #define BOARD_FLASH_BASE 0x08000000
 #define BOARD_FLASH_PAGE 2048
-#define BOARD_BOOT_SIZE 4096
-#define BOARD_SLOT_BASE 0x08001000
-#define BOARD_SLOT_PAGES 26
+#define BOARD_BOOT_SIZE 6144
+#define BOARD_SLOT_BASE 0x08001800
+#define BOARD_SLOT_PAGES 25
 #define BOARD_FAULT_PAGE0 0x0800E000
 #define BOARD_FAULT_PAGE1 0x0800E800
 #define BOARD_CONFIG_PAGE0 0x0800F000
