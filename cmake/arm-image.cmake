@@ -89,6 +89,10 @@ function(servo_arm_image name)
                       -Wl,-Map=${CMAKE_CURRENT_BINARY_DIR}/${name}.map)
   set_target_properties(${name}.elf PROPERTIES
     LINK_DEPENDS "${I_LINKER};${PROJECT_SOURCE_DIR}/hal/ports/stm32_common/linker/sections_stm32.ld;${PROJECT_SOURCE_DIR}/cmake/check-image.sh")
+  # The link-time partitions' call graphs (stack-report.py) are the last
+  # link's alone.
+  add_custom_command(TARGET ${name}.elf PRE_LINK
+    COMMAND sh -c "rm -f ${CMAKE_CURRENT_BINARY_DIR}/${name}.elf.ltrans*" VERBATIM)
   add_custom_command(TARGET ${name}.elf POST_BUILD
     COMMAND ${CMAKE_OBJCOPY} -O binary $<TARGET_FILE:${name}.elf> ${CMAKE_CURRENT_BINARY_DIR}/${name}.bin
     COMMAND sh ${PROJECT_SOURCE_DIR}/cmake/check-image.sh $<TARGET_FILE:${name}.elf>

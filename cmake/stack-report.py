@@ -68,7 +68,14 @@ def image_call_graphs(elf, build_dir):
         if not found:
             raise SystemExit(f"stack-report: no object {member} of lib{target}.a under {folder}")
         files.update(found)
-    return [f.with_suffix(".ci") for f in files if f.with_suffix(".ci").exists()]
+    # What the link-time optimisation compiled (the application's jobs and
+    # main loop, servo_app): its partitions' own .ci files, named after the
+    # image (the link's -fcallgraph-info; older ones are removed before it).
+    partitions = sorted(pathlib.Path(elf).parent.glob(pathlib.Path(elf).name + ".ltrans*.ci"))
+    # An object compiled for the link-time optimisation holds no code yet:
+    # its own .ci describes nothing that runs (the partitions' do).
+    compiled = [f for f in files if f.with_suffix(".ci").exists() and b".gnu.lto_" not in f.read_bytes()]
+    return [f.with_suffix(".ci") for f in compiled] + partitions
 
 
 def main() -> int:
@@ -109,7 +116,7 @@ def main() -> int:
         # systick_now_us is also called directly, so it is no pointer target.
         "usart_hd_irq": [t for t in stack if short(t) == "systick_now_us"],
     }
-    app_hooks = ("servo_persist_config", "fault_log_read", "clear_faults")
+    app_hooks = ("persist_config", "fault_log_read", "clear_faults")
     persist = [t for t in pointer_targets if short(t) in app_hooks]
     hal_ops = [t for t in pointer_targets
                if not short(t).startswith("handle_") and short(t) not in app_hooks]
