@@ -97,6 +97,12 @@ def main() -> int:
     linked = {line.split()[-1] for line in nm.splitlines() if re.match(r"\S+ [tT] ", line)}
     ci_files = image_call_graphs(args.elf, args.build_dir)
     stack, calls, qualifier = load(ci_files, linked)
+    # A function the image links whose frame no call graph gives would
+    # count as nothing: the main loop's is the one that matters.
+    if "servo_poll" in linked and not any(t.split(":")[-1] == "servo_poll" for t in stack):
+        print("error: the image links servo_poll but no call graph describes it (an object "
+              "compiled for the link-time optimisation, and no partition's .ci?)", file=sys.stderr)
+        return 1
     dynamic = [t for t, q in qualifier.items() if q != "static"]
     roots = [t for t in stack if t.split(":")[-1] == "main" or (
         t.split(":")[-1].endswith("Handler") and t.split(":")[-1] != "Reset_Handler")]
