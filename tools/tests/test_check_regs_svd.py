@@ -14,6 +14,11 @@ spec.loader.exec_module(check_regs_svd)
 
 F1 = "STM32F103xx"
 F0 = "STM32F030"
+G0 = "STM32G031"
+# No package ships ST's STM32G031.svd: the G0's cases run where a folder
+# holds it ($SERVO_SVD_DIR).
+G0_SVD = check_regs_svd.svd_file(G0)
+needs_g0_svd = pytest.mark.skipif(G0_SVD is None, reason="no STM32G031.svd ($SERVO_SVD_DIR)")
 
 
 def ports_with(tmp_path, rel, old, new):
@@ -60,3 +65,23 @@ def test_the_ports_headers_match_the_svd(part):
 def test_a_wrong_definition_is_found(tmp_path, rel, old, new, part, name):
     errors = check_regs_svd.check_part(part, ports_with(tmp_path, rel, old, new))
     assert any(e.startswith(f"{part}: {name}:") for e in errors), errors
+
+
+@needs_g0_svd
+def test_the_g0_header_matches_the_svd():
+    assert check_regs_svd.check_part(G0, ROOT / "hal/ports", G0_SVD) == []
+
+
+@needs_g0_svd
+@pytest.mark.parametrize("old, new, name", [
+    ("RCC_CSR_RMVF (1u << 23)", "RCC_CSR_RMVF (1u << 24)", "RCC_CSR_RMVF"),  # the F0/F1's bit
+    ("G0_FLASH_CR_PNB_SHIFT 3u", "G0_FLASH_CR_PNB_SHIFT 4u", "G0_FLASH_CR_PNB_SHIFT"),
+    ("G0_FLASH_BASE_REG + 0x18u)", "G0_FLASH_BASE_REG + 0x1Cu)", "G0_FLASH_ECCR"),
+    ("G0_USART2_IRQ 28u", "G0_USART2_IRQ 29u", "G0_USART2_IRQ"),
+    ("G0_DMAMUX_BASE 0x40020800u", "G0_DMAMUX_BASE 0x40020900u", "G0_DMAMUX_BASE"),
+    ("(8u << 8) | (1u << 28)", "(9u << 8) | (1u << 28)", "G0_RCC_PLLCFGR_64MHZ_FROM_HSI16"),
+    ("G0_FLASH_SR_RDERR (1u << 14)", "G0_FLASH_SR_RDERR (1u << 13)", "G0_FLASH_SR_RDERR"),
+])
+def test_a_wrong_g0_definition_is_found(tmp_path, old, new, name):
+    errors = check_regs_svd.check_part(G0, ports_with(tmp_path, "stm32g0/stm32g0_regs.h", old, new), G0_SVD)
+    assert any(e.startswith(f"{G0}: {name}:") for e in errors), errors
