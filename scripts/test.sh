@@ -148,7 +148,7 @@ step "host build: the simulator, the virtual boards' models, the unit tests (Add
   host_build
 step "layers: no include from a lower layer to a higher one, no circle (of includes, or of symbols in the host build's objects), no file over 400 lines outside the tests and generated files, no schema line over 120 characters, the build importing nothing from tools/" \
   python3 scripts/check_layers.py --objects build/host
-step "registers: every definition of hal/ports against ST's SVD files (STM32F103xx, STM32F030)" \
+step "registers: every definition of hal/ports against ST's SVD files (STM32F103xx, STM32F030, STM32G031)" \
   .venv/bin/python scripts/check_regs_svd.py
 step "ARM images (STM32F103, and the QEMU board): budget and soft-float checks" arm_m3_images
 step "Cortex-M0 image (STM32F030K6) and its bootloader: 4 KB RAM, 24 KB flash budget, 4 KB bootloader, soft-float" \
