@@ -321,11 +321,15 @@ static ssize_t spin(sb_posix *p, uint8_t *buf, size_t cap, uint32_t *wait_us)
 static int posix_read(void *ctx, uint8_t *buf, size_t cap, size_t want, uint32_t wait_us)
 {
     sb_posix *p = (sb_posix *)ctx;
-    ssize_t n = wait_us > 0 ? spin(p, buf, cap, &wait_us) : 0;
+    bool waits = wait_us > 0;
+    ssize_t n = waits ? spin(p, buf, cap, &wait_us) : 0;
     bool hung_up = false;
     if (n != 0)
         goto got;
-    if (wait_us > 0) {
+    /* A wait polls even when the spin used all of it (a process the PC held
+     * up in the spin): with no time left, the poll only says whether the
+     * other end hung up, which a read of none does not. */
+    if (waits) {
         struct pollfd pf = {p->fd, POLLIN, 0};
         struct timespec ts = {(time_t)(wait_us / 1000000u), (long)(wait_us % 1000000u) * 1000L};
         /* The socket reads as ready once want bytes are there, not at each

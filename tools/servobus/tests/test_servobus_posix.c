@@ -13,6 +13,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <netinet/in.h>
+#include <poll.h>
 #include <pty.h>
 #include <sys/socket.h>
 #include <sys/wait.h>
@@ -231,6 +232,18 @@ static void a_port_whose_other_end_hung_up_fails(void **state)
     assert_true(t->read(t->ctx, buf, sizeof buf, 1, 1000000) < 0); /* a wait sees it; a drain's look need not */
 }
 
+/* The same when the spin took all of the wait, as when the PC held the
+ * process up in it: the wait skipped its poll and said "nothing yet". */
+static void a_hang_up_is_seen_when_the_spin_took_the_whole_wait(void **state)
+{
+    uint8_t buf[16];
+    pty_port *port = *state;
+    sb_transport *t = &port->t;
+    port->p.spin_us = 1000000u; /* longer than the wait: the spin takes all of it */
+    close_pty_far_end(port);
+    assert_true(t->read(t->ctx, buf, sizeof buf, 1, 2000) < 0);
+}
+
 /* A TCP listener on the loopback at a free port, given in port. */
 static int loopback_listener(unsigned *port)
 {
@@ -274,6 +287,25 @@ static void a_bus_another_client_holds_is_said_so(void **state)
     sb_posix_close(&link);
 }
 
+/* The link's poll() (linked with --wrap=poll): given a descriptor in
+ * hold_poll, the next poll first waits for a byte on it, so that the
+ * simulator's process has spoken by the time the open looks (for 50 ms of
+ * the host's time, which a loaded PC may not give a process to wake in). */
+int __real_poll(struct pollfd *fds, nfds_t n, int timeout_ms);
+static int hold_poll = -1;
+
+int __wrap_poll(struct pollfd *fds, nfds_t n, int timeout_ms)
+{
+    if (hold_poll >= 0) {
+        char spoke;
+        int fd = hold_poll;
+        hold_poll = -1;
+        if (read(fd, &spoke, 1) != 1)
+            return -1;
+    }
+    return __real_poll(fds, n, timeout_ms);
+}
+
 /* The same told at once, as servo_sim tells it: the open itself says so,
  * so a program that only sends (sb_send_move_angle returned SB_OK while
  * nothing reached the bus) is not fooled. */
@@ -281,19 +313,27 @@ static void an_open_of_a_bus_another_client_holds_is_refused(void **state)
 {
     unsigned port;
     int listener = loopback_listener(&port);
+    int spoke[2];
+    assert_int_equal(pipe(spoke), 0);
     pid_t child = fork();
     if (child == 0) { /* the simulator: tells the client at once, then holds the line */
         int server = accept(listener, NULL, NULL);
         const char said[] = "servo_sim: the bus is in use by another client\n";
-        if (write(server, said, sizeof said - 1) < 0)
+        if (write(server, said, sizeof said - 1) < 0 || write(spoke[1], "", 1) != 1)
             _exit(1);
         usleep(300000);
         _exit(0);
     }
     sb_posix link;
+    hold_poll = spoke[0];
+    alarm(20); /* a child that never speaks: ctest sees the alarm */
     assert_int_equal(sb_tcp_open(&link, "127.0.0.1", port), -EBUSY);
+    alarm(0);
+    hold_poll = -1;
     int status = 0;
     waitpid(child, &status, 0);
+    close(spoke[0]);
+    close(spoke[1]);
     close(listener);
 }
 
@@ -311,6 +351,8 @@ int main(void)
         cmocka_unit_test_setup_teardown(a_wait_spins_then_sleeps_and_reads_what_comes, open_fixture_port,
                                         close_fixture_port),
         cmocka_unit_test_setup_teardown(a_port_whose_other_end_hung_up_fails, open_fixture_port, close_fixture_port),
+        cmocka_unit_test_setup_teardown(a_hang_up_is_seen_when_the_spin_took_the_whole_wait, open_fixture_port,
+                                        close_fixture_port),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -10,7 +10,6 @@ import asyncio
 import json
 import signal
 import subprocess
-import sys
 import time
 
 import pytest
@@ -21,15 +20,21 @@ from servoctl.putback import PutBack
 from servoctl.servo import Servo
 from servoctl.sim import Simulator
 
-from ..ui_launch import TOOLS, UiProcess
+from ..launchers import servoctl_child
+from ..ui_launch import UiProcess
 from .conftest import finish
 
 AMP_ZERO = 25
 ITEMS = ("current_zero", "gear_ratio", "encoder_zero")
 
 
-def _start(tmp_path, fast=True):
-    sim = Simulator(fast=fast, state_dir=str(tmp_path / "state")).start()
+def _start(tmp_path, paced=True):
+    """Paced (docs/simulator.md, "Running ahead"): calibrate's polls (come
+    to rest, the return) see the servo where it is on the simulated clock
+    however late a loaded PC runs them, so the count of its sleeps is the
+    same on every run. paced=False: a real-time simulator, for a command
+    line or ui that does not pace it."""
+    sim = Simulator(paced=paced, state_dir=str(tmp_path / "state")).start()
     for line in ("magnet 30", "swapleads 1", f"ampzero {AMP_ZERO}"):
         assert sim.control(line).strip() == "ok", line
     return sim
@@ -110,21 +115,41 @@ def test_a_servo_gone_mid_search_is_said_with_the_item_and_exit_5(tmp_path, monk
         finish(sim, [1])
 
 
+def _run_clock(sim, until, limit_s: float):
+    """Moves a paced simulator's clock on 5 ms at a time, each step a host
+    moment apart (about real time on an idle PC, slower on a loaded one),
+    until until() is true; AssertionError after limit_s of simulated time.
+    Between calls its clock stands still, however late the host is."""
+    start = sim.clock_s()
+    while not until():
+        assert sim.clock_s() - start < limit_s, f"not within {limit_s} s of simulated time"
+        sim.sleep(0.005)
+        time.sleep(0.002)
+
+
 @pytest.mark.parametrize("how", [signal.SIGINT, signal.SIGTERM, signal.SIGHUP])
 def test_ctrl_c_on_the_command_line_puts_item_91_back(tmp_path, how):
-    """A real SIGINT to `servoctl calibrate` (a real-time simulator), or a
-    SIGTERM or SIGHUP (a kill, a closed terminal) taken as one: exit 130,
-    item 91 as it was."""
-    sim = _start(tmp_path, fast=False)
+    """A real SIGINT to `servoctl calibrate`, or a SIGTERM or SIGHUP (a
+    kill, a closed terminal) taken as one: exit 130, item 91 as it was.
+    The simulator is paced by the test, not by the command: its clock
+    moves only while the test moves it, so the signal lands in the search
+    (after its third write of item 91) however late a loaded PC delivers
+    it; on a real-time simulator the command could end first."""
+    sim = _start(tmp_path)
     proc = None
     try:
         before = _items(sim)
-        proc = subprocess.Popen([sys.executable, "-m", "servoctl.cli", "--port", sim.url, "--sim-control",
-                                 str(sim.control_port), "calibrate", "1"], cwd=TOOLS,
-                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        saves = sim.state(1)["saves"]
+        # SIGINT as at a terminal, even where the tests run in a background
+        # job (its processes start with SIGINT ignored).
+        proc = servoctl_child("--port", sim.url, "--sim-control", str(sim.control_port), "calibrate", "1",
+                              stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+        # The search under way: each of its steps writes item 91 (a save).
+        _run_clock(sim, lambda: sim.state(1)["saves"] >= saves + 3 or proc.poll() is not None, 60.0)
+        assert proc.poll() is None, proc.communicate()
         assert "calibrating" in proc.stdout.readline()
-        sim.sleep(0.3)  # a few steps of the search
         proc.send_signal(how)
+        _run_clock(sim, lambda: proc.poll() is not None, 10.0)  # the put-back's writes
         out, err = proc.communicate(timeout=30)
         assert proc.returncode == 130, err
         assert "put back as they were: current_zero" in err, err
@@ -164,7 +189,7 @@ async def _ui_cut(ui, sim, how: str):
 
 @pytest.mark.parametrize("how", ["stopall", "close"])
 def test_the_uis_stop_all_or_closed_tab_puts_item_91_back(tmp_path, how):
-    sim = _start(tmp_path, fast=False)
+    sim = _start(tmp_path, paced=False)
     try:
         before = _items(sim)
         with UiProcess(sim) as ui:

@@ -102,10 +102,15 @@ def site_of(tmp_path, modules) -> str:
 
 def run_alone(tmp_path, script: str, sim, modules):
     """script, run by a Python without its site-packages (-S) that sees
-    servoctl's sources and these modules only, given the simulator's URL."""
-    return subprocess.run([sys.executable, "-S", "-c", script, sim.url], capture_output=True, text=True,
-                          timeout=120, env={"PYTHONPATH": ":".join(map(str, [*PATHS, site_of(tmp_path, modules)])),
-                                            "SERVOCTL_STATE_DIR": str(tmp_path / "state")})
+    servoctl's sources and these modules only, given the simulator's URL
+    and its control port (argv[2], and SERVOCTL_SIM_CONTROL for the command
+    line): its waits for answers are on the simulator's clock, which a
+    loaded PC holds back, not the host's."""
+    return subprocess.run([sys.executable, "-S", "-c", script, sim.url, str(sim.control_port)], capture_output=True,
+                          text=True, timeout=120,
+                          env={"PYTHONPATH": ":".join(map(str, [*PATHS, site_of(tmp_path, modules)])),
+                               "SERVOCTL_STATE_DIR": str(tmp_path / "state"),
+                               "SERVOCTL_SIM_CONTROL": str(sim.control_port)})
 
 
 # The library's modules whose import needs an extra (identify's numpy and scipy).
@@ -136,7 +141,8 @@ from servoctl.errors import ValueOutOfRange
 from servoctl.protocol import Bus
 from servoctl.servo import Servo
 from servoctl.stream import RobotLoop
-with Bus(sys.argv[1], 115200) as bus:
+from servoctl.sim import Simulator
+with Bus(sys.argv[1], 115200, clock=Simulator.running(int(sys.argv[2])).clock_s) as bus:
     servo = Servo(bus, 1)
     servo.move(450, interval_ms=100)
     bus.sleep(3.0)  # the first move after power-up: its soft start too
@@ -231,15 +237,17 @@ import sys
 import servoctl.arm
 from servoctl.arm import Arm, JointShared
 from servoctl.protocol import Bus
+from servoctl.sim import Simulator
 print(servoctl.arm.__file__)
-with Bus(sys.argv[1], 115200) as bus:
+with Bus(sys.argv[1], 115200, clock=Simulator.running(int(sys.argv[2])).clock_s) as bus:  # the answers' clock
     try:
         Arm(bus, {"a": 1}).positions()
     except JointShared as e:
         print("shared:", e)
 """
     with Simulator(ids=[1, 1], fast=True) as sim:
-        done = subprocess.run([sys.executable, "-S", "-c", script, sim.url], capture_output=True, text=True,
+        done = subprocess.run([sys.executable, "-S", "-c", script, sim.url, str(sim.control_port)],
+                              capture_output=True, text=True,
                               timeout=120, cwd=tmp_path, env={"PYTHONPATH": str(site),
                                                               "SERVOCTL_STATE_DIR": str(tmp_path / "state")})
     assert done.returncode == 0, done.stderr

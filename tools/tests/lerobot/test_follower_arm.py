@@ -123,7 +123,9 @@ def test_a_run_that_did_not_end_leaves_its_watchdog_not_taken_for_the_servos_own
     """A run that ended without close() (a closed terminal) left 500 ms,
     hold on the servos; the next clean run read that as the setting to put
     back, and a later 3 s move stopped after 0.5 s ("limiter watchdog")."""
-    with Simulator(ids=[1, 2], fast=True) as sim:
+    # Paced: its clock stands still between the test's waits, so a loaded PC
+    # slow between the runs does not let the first run's 500 ms watchdog act.
+    with Simulator(ids=[1, 2], paced=True) as sim:
         bus = sim.bus()
         Arm(bus, {"a": 1, "b": 2}).open().hold_here()  # and never closed
         assert watchdog(bus, 1) == (500, 0)
