@@ -105,12 +105,15 @@ def run_alone(tmp_path, script: str, sim, modules):
     servoctl's sources and these modules only, given the simulator's URL
     and its control port (argv[2], and SERVOCTL_SIM_CONTROL for the command
     line): its waits for answers are on the simulator's clock, which a
-    loaded PC holds back, not the host's."""
-    return subprocess.run([sys.executable, "-S", "-c", script, sim.url, str(sim.control_port)], capture_output=True,
-                          text=True, timeout=120,
-                          env={"PYTHONPATH": ":".join(map(str, [*PATHS, site_of(tmp_path, modules)])),
-                               "SERVOCTL_STATE_DIR": str(tmp_path / "state"),
-                               "SERVOCTL_SIM_CONTROL": str(sim.control_port)})
+    loaded PC holds back, not the host's. Without a simulator (sim has a
+    url alone), the script is given that alone."""
+    control = getattr(sim, "control_port", None)
+    env = {"PYTHONPATH": ":".join(map(str, [*PATHS, site_of(tmp_path, modules)])),
+           "SERVOCTL_STATE_DIR": str(tmp_path / "state")}
+    if control is not None:
+        env["SERVOCTL_SIM_CONTROL"] = str(control)
+    return subprocess.run([sys.executable, "-S", "-c", script, sim.url, *([str(control)] if control else [])],
+                          capture_output=True, text=True, timeout=120, env=env)
 
 
 # The library's modules whose import needs an extra (identify's numpy and scipy).
