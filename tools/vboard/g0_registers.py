@@ -55,7 +55,7 @@ RCC = {
 }
 
 FLASH = {
-    # RM0444 3.7.1 (the SVD's reset 0x00000600: PRFTEN off, ICEN on, ICRST off... as ST has it)
+    # RM0444 3.7.1; reset 0x00000600 as ST's STM32G031 SVD has it (ICEN set)
     "ACR": (0x00, 0x00000600, _bits(LATENCY=(0, 3), PRFTEN=(8, 1), ICEN=(9, 1), ICRST=(11, 1),
                                     EMPTY=(16, 1), DBG_SWEN=(18, 1))),
     "KEYR": (0x08, 0, _bits(KEYR=(0, 32))),                                   # RM0444 3.7.2
