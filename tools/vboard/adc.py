@@ -29,6 +29,7 @@ class Adc(Model):
         self.adc_hz, self.dma, self.channel_value = adc_hz, dma, channel_value
         self.running = False
         self.next_scan_s = float("inf")
+        self.dma_channel = 1  # RM0008 table 78, RM0360 table 26; the G0's DMAMUX routes its own
 
     def reset(self) -> None:
         super().reset()
@@ -49,7 +50,7 @@ class Adc(Model):
         values = [self.channel_value(channel) for channel in self.channels]
         self.put("DR", values[-1])
         if self.dma_requests():
-            self.dma.transfer_many(1, values)
+            self.dma.transfer_many(self.dma_channel, values)
         period = self.period_s
         self.next_scan_s += period * max(1, int((now_s - self.next_scan_s) / period) + 1)
 

@@ -9,7 +9,6 @@ what a factory would program into a blank chip: the bootloader, the
 application's update image in the slot and a config record with the
 board's ID; a --state folder keeps it across runs, as on a real chip."""
 import ctypes
-from dataclasses import dataclass
 from pathlib import Path
 
 from servo_image import board_facts
@@ -22,48 +21,18 @@ from .core import Core, Stop
 from .system_space import FIRST_IRQ
 from .dma import Dma
 from .flash import Flash
+from .g0 import AdcG0, Dmamux, FlashG0, RccG0
 from .idle_skip import pass_facts
 from .inject import Injector
 from .model import Model
 from .native import Motor, factory_config, stored_id
+from .parts import PARTS, Part  # noqa: F401 (Part: the parts' type, imported from here)
 from .timers import BridgeTimer, Watchdog
 from .usart import Usart
 
 REPO = Path(__file__).resolve().parents[2]
-SYSTEM_MEMORY = 0x1FFFF000
 
 
-@dataclass(frozen=True)
-class Part:
-    svd: str
-    cpu: int
-    has_vtor: bool
-    irq_words: int
-    cpi: float          # cycles an instruction: the target benchmark's model for this firmware
-    names: dict         # role -> the SVD's peripheral name
-    usart_rx_dma: int   # DMA channel of USART1_RX (RM0008 table 78, RM0360 table 26)
-    usart_tx_dma: int   # ... and of USART1_TX
-    dma_irqs: dict      # channel -> the SVD's interrupt name
-    uid: int            # 96-bit unique ID (RM0008 30.2, RM0360 29.1)
-    program_s: float    # tPROG, the datasheet's longest
-    erase_s: float      # tERASE, the datasheet's longest
-    build: str          # the CMake preset that builds its images
-
-
-PARTS = {
-    # DS5319 (STM32F103x8/xB) "Flash memory characteristics": tPROG 40-70 us, tERASE 20-40 ms.
-    # CPI 2.0: docs/benchmark.md (72 MHz, 2 wait states; the whole tick 1506 cycles / 762).
-    "stm32f103": Part("STM32F103xx", arm.UC_CPU_ARM_CORTEX_M3, True, 2, 2.0,
-                      {"rcc": "RCC", "flash": "FLASH", "dma": "DMA1", "usart": "USART1", "adc": "ADC1",
-                       "tim": "TIM3", "iwdg": "IWDG", "gpio": "GPIOA"},
-                      5, 4, {1: "DMA1_Channel1", 5: "DMA1_Channel5"}, 0x1FFFF7E8, 70e-6, 40e-3, "arm"),
-    # DS9773 (STM32F030x4/6/8/C) "Flash memory characteristics": tPROG 53.5 us max, tERASE 40 ms max.
-    # CPI 1.9: docs/benchmark.md (48 MHz, 1 wait state; the whole tick 4004 cycles / 2091).
-    "stm32f030k6": Part("STM32F030", arm.UC_CPU_ARM_CORTEX_M0, False, 1, 1.9,
-                        {"rcc": "RCC", "flash": "Flash", "dma": "DMA", "usart": "USART1", "adc": "ADC",
-                         "tim": "TIM3", "iwdg": "IWDG", "gpio": "GPIOA", "syscfg": "SYSCFG"},
-                        3, 2, {1: "DMA_CH1", 3: "DMA_CH2_3"}, 0x1FFFF7AC, 53.5e-6, 40e-3, "arm-m0"),
-}
 HSE_HZ = 8_000_000  # the boards' crystal (firmware/boards/*/board_io.h)
 ADC_INPUTS = {0: "supply", 1: "current", 2: "ntc", 3: "encoder"}  # firmware/boards/*/README.md
 
@@ -118,10 +87,9 @@ class Board:
             raise ValueError(f"{board}: its board.h declares the bus on USART{declared[0]} with DMA channels "
                              f"{declared[1]} (TX) and {declared[2]} (RX); the virtual {part.svd} wires it on "
                              f"USART1 (PA9) with {part.usart_tx_dma} and {part.usart_rx_dma} only")
-        self.core = Core(part.cpu, 8_000_000, part.cpi, part.has_vtor, part.irq_words)
+        self.core = Core(part.cpu, part.reset_hz, part.cpi, part.has_vtor, part.irq_words)
         self.clock_setting = 0  # counts the firmware's clock switches
         self._pins_for, self._roles = None, None  # _pin_roles's cache
-        uc = self.core.uc
         self.flash_base = h["BOARD_FLASH_BASE"]
         self.flash_size = self.part_facts["flash_size"]
         self.flash_mem = Memory(self.flash_size, 0xFF)
@@ -131,24 +99,29 @@ class Board:
         self._alias = None
         self.alias_zero(self.flash_mem, self.flash_size)
         self.core.map_host(0x40000000, 0x30000)
-        if "syscfg" in part.names:  # the F0's GPIO ports sit on AHB2
+        family = self.family = part.family
+        if family == "f0":  # the F0's GPIO ports sit on AHB2
             self.core.map_host(0x48000000, 0x2000)
-        self.core.map_host(SYSTEM_MEMORY, 0x1000)
+        if family == "g0":  # the G0's on the IOPORT bus (RM0444 2.2)
+            self.core.map_host(0x50000000, 0x2000)
+        self.core.map_host(*part.system_memory)
         self.core.map_system_control_space()  # last: see there
         dev = svd.device(part.svd)
         irqs = svd.interrupts(part.svd)
         n = part.names
         self.motor = Motor(supply_v, ambient_c, plant)
-        self.rcc = Rcc(self, dev[n["rcc"]], HSE_HZ, 1)
+        self.rcc = (RccG0 if family == "g0" else Rcc)(self, dev[n["rcc"]], HSE_HZ, 1)
         file = f"{board}-{servo_id}" + (f"-{unit + 1}" if unit else "") + ".flash"
         path = None if state_dir is None else Path(state_dir) / file
-        self.flash = Flash(self, dev[n["flash"]], self.flash_mem, self.flash_base, self.flash_size,
-                           h["BOARD_FLASH_PAGE"], path, part.program_s, part.erase_s)
+        self.flash = (FlashG0 if family == "g0" else Flash)(
+            self, dev[n["flash"]], self.flash_mem, self.flash_base, self.flash_size, h["BOARD_FLASH_PAGE"], path,
+            part.program_s, part.erase_s)
         self.dma = Dma(self, dev[n["dma"]], {ch: irqs[name] for ch, name in part.dma_irqs.items()})
         self.gpio = Model(self, dev[n["gpio"]])
+        routed = family == "g0"  # the DMAMUX routes the channels (0: none until it does)
         self.usart = Usart(self, dev[n["usart"]], self.pclk_hz, irqs["USART1"], self.dma,
-                           part.usart_rx_dma, part.usart_tx_dma, self.bus_pin_ok)
-        adc_class = AdcF0 if "syscfg" in n else AdcF1
+                           0 if routed else part.usart_rx_dma, 0 if routed else part.usart_tx_dma, self.bus_pin_ok)
+        adc_class = {"f1": AdcF1, "f0": AdcF0, "g0": AdcG0}[family]
         self.adc = adc_class(self, dev[n["adc"]], self.adc_hz, self.dma, self.adc_input)
         self.tim = BridgeTimer(self, dev[n["tim"]], self.bridge_pins_ok)
         self.iwdg = Watchdog(self, dev[n["iwdg"]])
@@ -157,6 +130,9 @@ class Board:
             self.syscfg = Model(self, dev[n["syscfg"]])
             self.syscfg.watch("CFGR1", self._mem_mode)
             self.models.append(self.syscfg)
+        if "dmamux" in n:
+            self.dmamux = Dmamux(self, dev[n["dmamux"]], self.dma, self.usart, self.adc)
+            self.models.append(self.dmamux)
         # The ones with something to do between runs, asked once a step.
         self.timed = [m for m in self.models if type(m).next_event_s is not Model.next_event_s]
         self.stepped = [m for m in self.models if type(m).step is not Model.step]
@@ -225,8 +201,11 @@ class Board:
         return self.core.hz >> (0 if code < 4 else code - 3)
 
     def adc_hz(self) -> float:
-        if "syscfg" in self.part.names:
+        if self.family == "f0":
             return 14e6  # the F0's asynchronous HSI14 (CKMODE 0, RM0360 12.3.3)
+        if self.family == "g0":  # CKMODE (RM0444 15.12.4): 0 the kernel clock (SYSCLK from reset), PCLK/2, /4, PCLK
+            ckmode = self.adc.get("CFGR2") >> 30 & 3
+            return self.core.hz if ckmode == 0 else self.pclk_hz() / {1: 2, 2: 4, 3: 1}[ckmode]
         code = (self.rcc.get("CFGR") >> 14) & 3  # ADCPRE: /2, /4, /6, /8
         return self.pclk_hz() / (2 * (code + 1))
 
@@ -244,7 +223,7 @@ class Board:
     def _pins(self) -> tuple:
         """The port's configuration words that say what PA6, PA7 and PA9 are."""
         g = self.gpio
-        if "syscfg" in self.part.names:
+        if self.family != "f1":
             return g.w[g.i["MODER"]], g.w[g.i["AFRL"]], g.w[g.i["AFRH"]]
         return g.w[g.i["CRL"]], g.w[g.i["CRH"]]
 
@@ -253,7 +232,7 @@ class Board:
         again only when the port's configuration changed."""
         key = self._pins()
         if key != self._pins_for:
-            if "syscfg" in self.part.names:  # F0: AF1
+            if self.family != "f1":  # F0, G0: AF1 (DS9773, DS12992 alternate functions)
                 roles = (self._f0_pin_af(9, 1), self._f0_pin_af(6, 1) and self._f0_pin_af(7, 1))
             else:  # F1: alternate-function outputs
                 roles = (self._f1_pin_af_output(9), self._f1_pin_af_output(6) and self._f1_pin_af_output(7))

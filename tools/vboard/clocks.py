@@ -9,6 +9,10 @@ HSI_HZ = 8_000_000  # RM0008 7.2.1, RM0360 6.2.2
 
 
 class Rcc(Model):
+    # RM0008 7.3.10, RM0360 6.4.10: a power-on sets PORRSTF, every reset PINRSTF
+    RESET_FLAGS = {"power": ("PORRSTF", "PINRSTF"), "software": ("SFTRSTF", "PINRSTF"),
+                   "watchdog": ("IWDGRSTF", "PINRSTF"), "pin": ("PINRSTF",)}
+
     def __init__(self, board, periph, hse_hz: int, pll_from_hse_div: int):
         super().__init__(board, periph)
         self.hse_hz, self.pll_div = hse_hz, pll_from_hse_div
@@ -21,12 +25,11 @@ class Rcc(Model):
         (RM0008 7.3.10: a power-on sets PORRSTF, every reset PINRSTF)."""
         flags = self.get("CSR") & 0xFF000000 if cause != "power" else 0
         self.reset()
-        named = {"power": ("PORRSTF", "PINRSTF"), "software": ("SFTRSTF", "PINRSTF"),
-                 "watchdog": ("IWDGRSTF", "PINRSTF"), "pin": ("PINRSTF",)}[cause]
+        named = self.RESET_FLAGS[cause]
         for f in named:
             flags |= self.bit("CSR", f)
         self.put("CSR", (self.get("CSR") & 0x00FFFFFF) | flags)
-        self.board.set_core_hz(HSI_HZ)
+        self.board.set_core_hz(self.sysclk(self.get("CFGR")))
 
     def _cr(self, value, old, size):
         for on, ready in (("HSEON", "HSERDY"), ("PLLON", "PLLRDY"), ("HSION", "HSIRDY")):

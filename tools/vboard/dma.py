@@ -37,7 +37,9 @@ class Dma(Model):
         self.core.fix(self.addr("IFCR"), 0)
 
     def enabled(self, n: int) -> bool:
-        return bool(self.w[self.regs[n][0]] & 1)
+        """Channel n is on (0, or one the part lacks: a request routed
+        nowhere, the G0's DMAMUX before it is set)."""
+        return n in self.regs and bool(self.w[self.regs[n][0]] & 1)
 
     def peripheral_address(self, n: int) -> int:
         return self.w[self.regs[n][2]]
@@ -46,6 +48,8 @@ class Dma(Model):
         """Items from a peripheral to memory, one request each; returns how
         many moved (none while the channel is off, or once a non-circular
         one has counted down to 0)."""
+        if n not in self.regs:
+            return 0
         w, (i_ccr, i_cndtr, _, i_cmar) = self.w, self.regs[n]
         ccr = w[i_ccr]
         left = w[i_cndtr] & 0xFFFF
@@ -70,6 +74,8 @@ class Dma(Model):
     def take(self, n: int):
         """One item from memory for a peripheral (a channel with DIR set),
         or None while the channel is off or has counted down to 0."""
+        if n not in self.regs:
+            return None
         w, (i_ccr, i_cndtr, _, i_cmar) = self.w, self.regs[n]
         ccr = w[i_ccr]
         left = w[i_cndtr] & 0xFFFF

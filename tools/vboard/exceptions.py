@@ -20,6 +20,8 @@ from unicorn import arm_const as arm
 from .faults import HARD_FAULT, MEM_MANAGE, USAGE_FAULT
 from .system_space import FIRST_IRQ, ICSR_PENDSTSET, NVIC_IPR, SCB_ICSR, SCB_SHPR3, SCB_VTOR, SCS_BASE, SYSTICK
 
+NMI = 2
+
 EXC_RETURN_THREAD_MSP = 0xFFFFFFF9
 EXCP_EXCEPTION_EXIT = 8  # QEMU's, as Unicorn reports it
 # QEMU's exception numbers (target/arm/cpu.h) as Unicorn reports them -> the fault
@@ -56,6 +58,8 @@ class Exceptions:
             self.pending.add(FIRST_IRQ + irq)
 
     def priority(self, exc: int) -> int:
+        if exc == NMI:
+            return -2  # B1.5.4: NMI's is fixed at -2
         if exc == HARD_FAULT:
             return -1
         if exc == SYSTICK:

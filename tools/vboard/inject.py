@@ -203,7 +203,7 @@ class Injector:
             self.armed = None
             sp = core.reg(arm.UC_ARM_REG_SP)
             bottom, frame = self.facts[1], self.facts[2]
-            low = bottom + (STACK_SLACK_M3 if core.has_vtor else (frame + STACK_BELOW_FRAME + 7) & ~7)
+            low = bottom + (STACK_SLACK_M3 if core.v7m else (frame + STACK_BELOW_FRAME + 7) & ~7)
             back = core.reg(arm.UC_ARM_REG_LR) & ~1
             self.lowered = (back, low, sp - low)
 

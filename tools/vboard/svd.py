@@ -29,7 +29,11 @@ class Peripheral:
 
 @functools.lru_cache(maxsize=None)
 def device(part: str) -> dict:
-    """{peripheral name: Peripheral} of an STMicro part ("STM32F103xx", "STM32F030")."""
+    """{peripheral name: Peripheral} of an STMicro part ("STM32F103xx", "STM32F030";
+    "STM32G031", which cmsis-svd 0.4 lacks: g0_registers.py's table)."""
+    if part == "STM32G031":
+        from . import g0_registers
+        return g0_registers.device()
     dev = SVDParser.for_packaged_svd("STMicro", part + ".svd").get_device()
     out = {}
     for p in dev.peripherals:
@@ -43,5 +47,8 @@ def device(part: str) -> dict:
 @functools.lru_cache(maxsize=None)
 def interrupts(part: str) -> dict:
     """{interrupt name: number}."""
+    if part == "STM32G031":
+        from . import g0_registers
+        return dict(g0_registers.INTERRUPTS)
     dev = SVDParser.for_packaged_svd("STMicro", part + ".svd").get_device()
     return {i.name: i.value for p in dev.peripherals for i in (p.interrupts or [])}

@@ -372,8 +372,8 @@ def build_parser():
     c.add_argument("-o", "--output", required=True)
 
     c = sub.add_parser("sim", help="run the simulator, or a virtual board (--board)")
-    c.add_argument("--board", default="host", choices=["host", "stm32f103", "stm32f030k6"],
-                   help="host: servo_sim (the firmware built for the PC); stm32f103, stm32f030k6: "
+    c.add_argument("--board", default="host", choices=["host", "stm32f103", "stm32f030k6", "stm32g031k8"],
+                   help="host: servo_sim (the firmware built for the PC); stm32f103, stm32f030k6, stm32g031k8: "
                         "the board's shipped images on its emulated chip (tools/vboard)")
     c.add_argument("--id", dest="ids", type=int, action="append", metavar="ID",
                    help="a simulated servo at this ID, one for each --id (default: one at ID 1; "

@@ -12,7 +12,7 @@ from servoctl import protocol as p
 from servoctl.servo import Servo
 from servoctl.sim import Simulator
 
-BOARDS = ["stm32f103", "stm32f030k6"]
+BOARDS = ["stm32f103", "stm32f030k6", "stm32g031k8"]
 ROUNDS = 100
 # A page erase begins once a released servo's line has been quiet 0.1 s
 # (STORE_ERASE_QUIET_US) and stalls it 40 ms (the boards' tERASE): 25 ms
@@ -78,7 +78,7 @@ def sets_in_turn(sim) -> tuple:
 
 
 def test_two_config_sets_where_one_meets_an_erase_never_fail(tmp_path):
-    """Two config changes, a hundred times over, on both boards. A page
+    """Two config changes, a hundred times over, on each board. A page
     erase runs once a released servo has had 0.1 s of quiet, and lasts
     40 ms: the user's pause of a second never ends inside one; the pause of
     a quicker user, or of a host a loaded PC holds up, can. So each second

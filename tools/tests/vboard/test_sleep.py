@@ -30,11 +30,14 @@ def test_an_idle_board_sleeps_and_answers_within_two_byte_times(tmp_path, board)
             request_ends_s = at_s + len(ping) * BYTE_S
             assert 0 < answer_starts_s - request_ends_s < 2 * BYTE_S, (answer_starts_s - request_ends_s) * 1e6
         # The answer goes out by DMA: the USART interrupts once for the
-        # request (IDLE) and once for the answer (TC), not once a byte.
+        # request (IDLE) and once for the answer (TC), not once a byte; or
+        # once for both, when the main loop, awake at its tick as the
+        # request ends, answers before the line's IDLE (the G0 here: IDLEIE
+        # is off while it sends, and TC's handler finds IDLE set too).
         before = sim.state(1)["usart_interrupts"]
         at_s = sim.clock_s() + 0.05
         assert sim.control(f"hostsend {at_s * 1000:.3f} {ping.hex()}").startswith("ok")
         sim.sleep(at_s + 0.01 - sim.clock_s())
-        assert sim.state(1)["usart_interrupts"] - before == 2
+        assert 1 <= sim.state(1)["usart_interrupts"] - before <= 2
     finally:
         sim.stop()

@@ -19,7 +19,7 @@ from ..integration.test_stream import sine_csv
 from ..store_pages import bus_to_baud
 from ..stream_report import lead_in_of
 
-BOARDS = ["stm32f103", "stm32f030k6"]
+BOARDS = ["stm32f103", "stm32f030k6", "stm32g031k8"]
 
 
 
