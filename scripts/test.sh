@@ -153,7 +153,7 @@ step "registers: every definition of hal/ports against ST's SVD files (STM32F103
 step "ARM images (STM32F103, and the QEMU board): budget and soft-float checks" arm_m3_images
 step "Cortex-M0 image (STM32F030K6) and its bootloader: 4 KB RAM, 24 KB flash budget, 4 KB bootloader, soft-float" \
   arm_m0_images
-step "Cortex-M0+ image (STM32G031K8) and its bootloader: 8 KB RAM, its slot, its 6 KB bootloader, soft-float (built, not yet run)" \
+step "Cortex-M0+ image (STM32G031K8) and its bootloader: 8 KB RAM, its slot, its 6 KB bootloader, soft-float" \
   arm_g0_images
 # beside NAME COMMAND...: a step run beside pytest (below), as step runs
 # one: its output in the job's log, its outcome and time in BESIDE_RESULTS.
