@@ -1,7 +1,7 @@
 /* QEMU TCG plugin: counts the guest instructions executed between two
  * marker addresses, region after region, and models their cycles.
  *
- *   -plugin libqemu_insn_count.so,begin=0xADDR,end=0xADDR,out=FILE[,core=m3|m0][,ws=N]
+ *   -plugin libqemu_insn_count.so,begin=0xADDR,end=0xADDR,out=FILE[,core=m3|m0|m0p][,ws=N]
  *           [,line=BYTES][,profile=PFILE]
  *
  * Instructions: every instruction adds one to a counter (an inline op, no
@@ -10,13 +10,17 @@
  * Cycles (a model, thumb_cycles.h for the instruction costs): each
  * translation block adds its instructions' own costs when it runs, and a
  * block that does not start where the last one ended follows a taken
- * branch: + 2 for the pipeline refill (M3 TRM 18.2: "P", 1-3; M0: a taken
- * branch is 3 cycles) + the flash's wait states (ws; STM32F1 at 72 MHz: 2,
- * RM0008 3.3.3; STM32F030 at 48 MHz: 1, RM0360 3.5.1), which the prefetch
- * buffer cannot hide after a jump. A literal load from flash pays the wait
- * states too, and straight-line code runs no faster than the prefetch
- * buffer fills: one flash line per 1 + ws cycles (line: the F1's flash
- * reads 64 bits, RM0008 3.3.3: 8 bytes; the F0's 32, RM0360 3.2.1: 4).
+ * branch: + the pipeline refill (thumb_refill: 2 on the M3, TRM 18.2: "P",
+ * 1-3, and on the M0, whose taken branch is 3 cycles; 1 on the M0+, whose
+ * is 2) + the flash's wait states (ws; STM32F1 at 72 MHz: 2, RM0008 3.3.3;
+ * STM32F030 at 48 MHz: 1, RM0360 3.5.1; STM32G0 at 64 MHz: 2, RM0444
+ * 3.3.4), which the prefetch buffer cannot hide after a jump. A literal
+ * load from flash pays the wait states too, and straight-line code runs no
+ * faster than the prefetch buffer fills: one flash line per 1 + ws cycles
+ * (line: the F1's flash reads 64 bits, RM0008 3.3.3: 8 bytes; the F0's 32,
+ * RM0360 3.2.1: 4; the G0's 64, RM0444 3.3.1: 8). The G0's instruction
+ * cache (ICEN, which the firmware sets) is not modelled: a jump into code
+ * it holds is charged the wait states all the same.
  *
  * With profile=PFILE, each region's blocks go to PFILE as they end:
  * "region start_address instructions block_length" lines, for a breakdown
@@ -96,7 +100,7 @@ static void on_block(unsigned int vcpu, void *userdata)
     struct block *b = userdata;
     b->hits += (uint64_t)in_region;
     if (b->start != last_end) {
-        cycles += 2u + wait_states; /* after a taken branch */
+        cycles += thumb_refill(core) + wait_states; /* after a taken branch */
     }
     cycles += b->cycles;
     last_end = b->end;
@@ -175,6 +179,8 @@ PLUGIN_EXPORT int qemu_plugin_install(qemu_plugin_id_t id, const qemu_info_t *in
             snprintf(out_path, sizeof out_path, "%s", argv[i] + 4);
         } else if (strcmp(argv[i], "core=m0") == 0) {
             core = CORE_M0;
+        } else if (strcmp(argv[i], "core=m0p") == 0) {
+            core = CORE_M0P;
         } else if (strncmp(argv[i], "profile=", 8) == 0) {
             profile = fopen(argv[i] + 8, "w");
             if (profile == NULL) {

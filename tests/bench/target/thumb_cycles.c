@@ -21,8 +21,8 @@ static struct insn_cost ldst(uint8_t cycles, bool literal, bool pc)
 
 static struct insn_cost thumb16(enum core core, uint16_t hw)
 {
-    uint8_t load = 2;                       /* M3 and M0 alike */
-    uint8_t store = core == CORE_M3 ? 1 : 2; /* the M3 buffers a store */
+    uint8_t load = 2;                       /* M3, M0 and M0+ alike */
+    uint8_t store = core == CORE_M3 ? 1 : 2; /* the M3 buffers a store; the M0 and M0+: 2 */
     if ((hw >> 11) == 0x09) {               /* LDR Rt, [PC, #imm] */
         return ldst(load, true, false);
     }
@@ -86,7 +86,25 @@ static struct insn_cost thumb32(uint16_t hw, uint16_t hw2)
     return cost(1, false, false);
 }
 
+/* ARMv6-M's 32-bit instructions on the M0+: BL, or MRS, MSR and the
+ * barriers (M0+ TRM 3.3). */
+static struct insn_cost m0p_thumb32(uint16_t hw, uint16_t hw2)
+{
+    if ((hw & 0xF800u) == 0xF000u && (hw2 & 0xD000u) == 0xD000u) {
+        return cost(2, false, true);        /* BL: 3 with the refill */
+    }
+    return cost(3, false, false);           /* MRS, MSR, DMB, DSB, ISB */
+}
+
 struct insn_cost thumb_cost(enum core core, uint16_t hw, uint16_t hw2, unsigned size)
 {
-    return size == 4u ? thumb32(hw, hw2) : thumb16(core, hw);
+    if (size == 4u) {
+        return core == CORE_M0P ? m0p_thumb32(hw, hw2) : thumb32(hw, hw2);
+    }
+    return thumb16(core, hw);
+}
+
+unsigned thumb_refill(enum core core)
+{
+    return core == CORE_M0P ? 1u : 2u;
 }
