@@ -1,12 +1,15 @@
 #!/usr/bin/env python3
 """Runs the ARM builds of the benchmarks under qemu-system-arm with the
 instruction-counting plugin and prints Thumb-2 instruction counts per region
-for the Cortex-M3 and the Cortex-M0, beside their budgets.
+for the Cortex-M3, the Cortex-M0 and the Cortex-M0+, beside their budgets.
 
     python3 tests/bench/target/run_target_bench.py [--check] [--json FILE] [--profile REGION]
 
-Needs: cmake --build --preset target-bench-m3, --preset target-bench-m0, and
-the host preset's build/host/tests/libqemu_insn_count.so.
+Needs: cmake --build --preset target-bench-m3, --preset target-bench-m0,
+--preset target-bench-m0p, and the host preset's
+build/host/tests/libqemu_insn_count.so. QEMU has no Cortex-M0+: its image
+(the same ARMv6-M instruction set) runs on QEMU's cortex-m0, and the
+plugin's model is the M0+'s.
 
 Instructions are exact (QEMU's translator, one count per guest
 instruction), less the markers' own cost (the region "overhead"). The
@@ -17,8 +20,8 @@ same instructions every run, never where the host's load puts them.
 Cycles are the plugin's model
 (qemu_insn_count.c, thumb_cycles.h: ARM's timing tables with the M3's
 load pipelining, the STM32F1 flash at 2 wait states for the M3 at 72 MHz,
-the STM32F030's at 1 wait state for the M0 at 48 MHz), an estimate, not a
-measurement."""
+the STM32F030's at 1 wait state for the M0 at 48 MHz, the STM32G031's at 2
+for the M0+ at 64 MHz), an estimate, not a measurement."""
 import argparse
 import bisect
 import json
@@ -30,32 +33,46 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[3]
 PLUGIN = ROOT / "build/host/tests/libqemu_insn_count.so"
-CPUS = {"cortex-m3": ROOT / "build/target-bench-m3/bench", "cortex-m0": ROOT / "build/target-bench-m0/bench"}
+CPUS = {"cortex-m3": ROOT / "build/target-bench-m3/bench", "cortex-m0": ROOT / "build/target-bench-m0/bench",
+        "cortex-m0plus": ROOT / "build/target-bench-m0p/bench"}
+# QEMU 7.2 has no cortex-m0plus: the M0+'s image runs on its cortex-m0
+# (ARMv6-M both; the instruction counts are the image's, the cycles the
+# plugin's M0+ model).
+QEMU_CPU = {"cortex-m3": "cortex-m3", "cortex-m0": "cortex-m0", "cortex-m0plus": "cortex-m0"}
+SHORT = {"cortex-m3": "M3", "cortex-m0": "M0", "cortex-m0plus": "M0+"}
 # The plugin's cycle model per core: its cost table and the flash's wait states.
 # The F103 at 72 MHz: 2 wait states, 64-bit flash lines (RM0008 3.3.3); the
 # F030 at 48 MHz: 1 wait state (RM0360 3.5.1, the FLASH_ACR_LATENCY_1 the
-# firmware sets), 32-bit lines (RM0360 3.2.1); both with the prefetch on.
-MODEL = {"cortex-m3": "core=m3,ws=2,line=8", "cortex-m0": "core=m0,ws=1,line=4"}
-CLOCK_MHZ = {"cortex-m3": 72, "cortex-m0": 48}
+# firmware sets), 32-bit lines (RM0360 3.2.1); the G031 at 64 MHz: 2 wait
+# states in range 1 (RM0444 3.3.4, the LATENCY_2 its board_io.c sets),
+# 64-bit lines (RM0444 3.3.1: 72-bit cells, 64 data and 8 ECC bits); all
+# with the prefetch on. The G0's instruction cache, which its board also
+# turns on (ICEN), is not modelled, as the F0 and F1 have none.
+MODEL = {"cortex-m3": "core=m3,ws=2,line=8", "cortex-m0": "core=m0,ws=1,line=4",
+         "cortex-m0plus": "core=m0p,ws=2,line=8"}
+CLOCK_MHZ = {"cortex-m3": 72, "cortex-m0": 48, "cortex-m0plus": 64}
 KNOWN_LOOP = 200  # 100 more iterations of a 2-instruction loop
 # Budgets, in instructions or modelled us, per CPU (docs/benchmark.md).
-# Each fails the run (--check) when exceeded.
+# Each fails the run (--check) when exceeded. The M0+ runs the M0's
+# instruction set and has its budgets; its image plans jerk-limited moves
+# (not size first), within 3500.
 BUDGETS = {
     "cortex-m3": {"rx_per_byte": 40, "tick": 300, "servo_tick": 450, "plan": 1000, "plan_jerk": 1500},
     "cortex-m0": {"servo_tick": 1000, "plan": 2500},
+    "cortex-m0plus": {"servo_tick": 1000, "plan": 2500, "plan_jerk": 3500},
 }
-RESPONSE_BUDGET_US = {"cortex-m3": 20, "cortex-m0": 30}
+RESPONSE_BUDGET_US = {"cortex-m3": 20, "cortex-m0": 30, "cortex-m0plus": 30}
 # A write that changes the user area is answered once its record is
 # programmed: this budget is the CPU's part; the flash's own
 # 24 half-words x 40-70 us (DS5319) come on top (docs/decisions.md).
-DURABLE_WRITE_BUDGET_US = {"cortex-m3": 200, "cortex-m0": 600}
+DURABLE_WRITE_BUDGET_US = {"cortex-m3": 200, "cortex-m0": 600, "cortex-m0plus": 600}
 # A Sync Monitor round at 1 Mbaud: its first answer within 2 byte times of
 # the request's last stop bit, each later one within 2 of the one before
 # (docs/sleep.md, "The first answer").
 BYTE_US = 10
 TURNAROUND_BUDGET_US = 2 * BYTE_US
 TURNAROUNDS = ("first_answer", "first_answer_of_two", "next_answer")
-# The M0 hands a Sync Monitor's first answer to the UART with its header
+# The M0 and M0+ hand a Sync Monitor's first answer to the UART with its header
 # and ID written, and builds the rest behind them (servo.c, send_ahead):
 # the DMA takes the content's second byte 4 byte times after the start.
 # The build must end within 3, a byte time left for interrupts.
@@ -203,7 +220,7 @@ def run(elf: Path, cpu: str, profile_region: str = "", by_line: bool = False) ->
                   f"end={symbol(elf, 'bench_marker_end'):#x},out={counts_file},{MODEL[cpu]}"
                   f",profile={profile_file}")
         proc = subprocess.run(
-            ["qemu-system-arm", "-M", "lm3s6965evb", "-cpu", cpu, "-nographic",
+            ["qemu-system-arm", "-M", "lm3s6965evb", "-cpu", QEMU_CPU[cpu], "-nographic",
              "-semihosting-config", "enable=on,target=native", "-icount", "shift=0", "-kernel", str(elf), "-plugin", plugin],
             capture_output=True, text=True, timeout=600)
         if proc.returncode != 0:
@@ -325,7 +342,7 @@ def figures(cpu: str, profile_region: str = "", by_line: bool = False) -> dict:
     # the line in use; the worst). The first answer leaves in the pass that
     # frames the checksum byte wherever the record lies; listed first of
     # two (first_answer_of_two) that pass may frame the other record too.
-    # On the M0 the rest of that answer is built behind its first bytes
+    # On the M0 and M0+ the rest of that answer is built behind its first bytes
     # (sync_first_build, the longer of the two rounds').
     out.update({"awake_loop": proto["awake_loop"], "pass_to_ring": proto["pass_to_ring"],
                 "first_answer": after_a_missed_read(proto, proto["sync_first_pass"]),
@@ -353,20 +370,21 @@ def main():
     if not PLUGIN.exists():
         sys.exit(f"run_target_bench: {PLUGIN} is missing: cmake --build --preset host")
     results = {cpu: figures(cpu, args.profile if cpu == args.cpu else "", args.lines) for cpu in CPUS}
-    m3, m0 = results["cortex-m3"], results["cortex-m0"]
     print(f"target benchmark: Thumb instructions executed, exact (QEMU 7.2 + plugin; the "
-          f"calibration loop's {KNOWN_LOOP} counted exactly on both), and modelled cycles")
-    print(f"{'figure':<28} {'M3 instr':>9} {'M3 cycles':>10} {'M3 us':>7} {'M0 instr':>9} "
-          f"{'M0 cycles':>10} {'M0 us':>7}  budget M3 | M0")
+          f"calibration loop's {KNOWN_LOOP} counted exactly on each), and modelled cycles")
+    heads = "".join(f" {SHORT[c] + ' instr':>10} {SHORT[c] + ' cycles':>11} {SHORT[c] + ' us':>7}" for c in CPUS)
+    print(f"{'figure':<28}{heads}  budget {' | '.join(SHORT[c] for c in CPUS)}")
     over = []
-    for key in m3:
-        (i3, c3), (i0, c0) = m3[key], m0[key]
-        mark3, over3 = judge("cortex-m3", key, i3, c3)
-        mark0, over0 = judge("cortex-m0", key, i0, c0)
-        over += [f"{key} (M3)"] * over3 + [f"{key} (M0)"] * over0
-        print(f"{key:<28} {i3:>9.2f} {c3:>10.1f} {c3 / CLOCK_MHZ['cortex-m3']:>7.1f} {i0:>9.1f} "
-              f"{c0:>10.1f} {c0 / CLOCK_MHZ['cortex-m0']:>7.1f}  {mark3} | {mark0}")
-    table = markdown(m3, m0)
+    for key in results["cortex-m3"]:
+        cells, marks = "", []
+        for cpu in CPUS:
+            i, c = results[cpu][key]
+            mark, is_over = judge(cpu, key, i, c)
+            over += [f"{key} ({SHORT[cpu]})"] * is_over
+            marks.append(mark)
+            cells += f" {i:>10.2f} {c:>11.1f} {c / CLOCK_MHZ[cpu]:>7.1f}"
+        print(f"{key:<28}{cells}  {' | '.join(marks)}")
+    table = markdown(results)
     if args.markdown:
         print("\n" + "\n".join(table))
     if args.json:
@@ -381,16 +399,22 @@ def main():
         print(f"run_target_bench: {args.doc}'s table is the benchmark's")
 
 
-def markdown(m3: dict, m0: dict) -> list:
-    """The figures as docs/benchmark.md's table, a line each."""
-    lines = ["| figure | M3 instr | M3 cycles (µs) | M0 instr | M0 cycles (µs) | budget M3 / M0 |",
-             "|---|---:|---:|---:|---:|---|"]
-    for key in m3:
-        (i3, c3), (i0, c0) = m3[key], m0[key]
-        marks = " / ".join(judge(cpu, key, *fig)[0] or "–" for cpu, fig in
-                           (("cortex-m3", m3[key]), ("cortex-m0", m0[key])))
-        lines.append(f"| {key} | {i3:.2f} | {c3:.0f} ({c3 / CLOCK_MHZ['cortex-m3']:.1f}) | {i0:.1f} | "
-                     f"{c0:.0f} ({c0 / CLOCK_MHZ['cortex-m0']:.1f}) | {marks if marks != '– / –' else ''} |")
+def markdown(results: dict) -> list:
+    """The figures as docs/benchmark.md's table, a line each: the M3's
+    instructions to two decimals, the others' to one."""
+    names = [SHORT[c] for c in CPUS]
+    lines = ["| figure | " + " | ".join(f"{n} instr | {n} cycles (µs)" for n in names) +
+             f" | budget {' / '.join(names)} |",
+             "|---|" + "---:|---:|" * len(CPUS) + "---|"]
+    for key in results["cortex-m3"]:
+        cells = []
+        for cpu in CPUS:
+            i, c = results[cpu][key]
+            cells.append(f"{i:.2f}" if cpu == "cortex-m3" else f"{i:.1f}")
+            cells.append(f"{c:.0f} ({c / CLOCK_MHZ[cpu]:.1f})")
+        marks = [judge(cpu, key, *results[cpu][key])[0] or "–" for cpu in CPUS]
+        budget = "" if all(m == "–" for m in marks) else " / ".join(marks)
+        lines.append(f"| {key} | {' | '.join(cells)} | {budget} |")
     return lines
 
 
