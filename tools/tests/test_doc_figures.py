@@ -23,7 +23,7 @@ ROOT = Path(__file__).resolve().parents[2]
 DOCS = ROOT / "docs"
 F103 = ROOT / "build/arm/firmware/boards/stm32f103"
 F030 = ROOT / "build/arm-m0/firmware/boards/stm32f030k6"
-CLOCK_MHZ = {"stm32f103": 72, "stm32f030k6": 48}  # run_target_bench.py's CLOCK_MHZ, by board
+CLOCK_MHZ = {"stm32f103": 72, "stm32f030k6": 48, "stm32g031k8": 64}  # run_target_bench.py's CLOCK_MHZ, by board
 
 
 def number(text: str) -> int:
@@ -95,7 +95,7 @@ def test_the_readme_gives_the_robot_loop_of_streaming_md():
         (said and said.group(0), min(ratios), max(ratios))
 
 
-@pytest.mark.parametrize("board, column", [("stm32f103", 1), ("stm32f030k6", 3)])
+@pytest.mark.parametrize("board, column", [("stm32f103", 1), ("stm32f030k6", 3), ("stm32g031k8", 5)])
 def test_each_boards_tick_and_pass_is_the_benchmarks(board, column):
     """BOARD_TICK_AND_PASS_US: the longest control tick and a main-loop
     pass (servo_tick_worst + idle_poll) at the board's clock, rounded up."""

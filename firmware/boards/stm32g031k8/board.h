@@ -45,10 +45,11 @@
  * erases only while no request waits. */
 #define BOARD_RX_RING_BYTES 2048
 #define BOARD_BOOT_RX_RING_BYTES 256
-/* The longest control tick and a main-loop pass, rounded up to whole us:
- * not measured on this CPU yet (the target bench has no M0+ build); the
- * F030's 47 us at 48 MHz, which 64 MHz only shortens. */
-#define BOARD_TICK_AND_PASS_US 47
+/* The longest control tick and a main-loop pass at 64 MHz, rounded up to
+ * whole us: the target bench's servo_tick_worst + idle_poll on the
+ * Cortex-M0+, in cycles (docs/benchmark.md; tools/tests/test_doc_figures.py
+ * checks it). */
+#define BOARD_TICK_AND_PASS_US 33
 /* The analogue front end and the motor: the reference servo's. */
 #include "boards/common/reference_servo.h"
 
