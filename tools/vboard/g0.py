@@ -92,8 +92,14 @@ class FlashG0(Flash):
                 self._tear(offset, save=False)
 
     def reset(self) -> None:
+        """A torn read's NMI not yet taken goes with the reset: the new run
+        takes its own (one pending across it was taken at the first
+        instruction, ECCR cleared, as a fault: the firmware reset itself)."""
         super().reset()
         self.first = None
+        if self.nmi_hook is not None:
+            self.core.uc.hook_del(self.nmi_hook)
+            self.nmi_hook = None
 
     def _flag(self, name: str) -> int:
         return self.bit("SR", name)

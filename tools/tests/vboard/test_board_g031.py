@@ -157,3 +157,20 @@ def test_an_erase_cut_by_the_power_leaves_its_page_half_erased_and_torn(board):
     assert flash.memory.read(31 * 2048, 1024) == b"\xff" * 1024
     assert flash.memory.read(31 * 2048 + 2040, 8) == struct.pack("<II", 0x33333333, 0x44444444)
     assert sorted(flash.torn) == [31 * 2048 + 1024]
+
+
+def test_an_nmi_a_torn_read_left_pending_goes_with_a_power_cut(board):
+    """A torn double word read as a run of the core ended (its NMI due at
+    the next instruction), then the power cut: the NMI was taken at the
+    new run's first instruction, ECCR already cleared by the reset, so the
+    firmware took it for a fault and reset itself (the power-cut tests saw
+    a software reset and a lost save)."""
+    flash, base = board.flash, board.flash_base
+    unlocked(flash)
+    flash.cut_after_programs = 1
+    program(flash, base + 31 * 2048, 1, 2)
+    board.core.reset_cause = None
+    flash._torn_read(board.core.uc, 0, base + 31 * 2048, 4, 0, None)
+    assert flash.nmi_hook is not None
+    board.power_cycle()
+    assert flash.nmi_hook is None and NMI not in board.core.pending
