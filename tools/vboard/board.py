@@ -369,7 +369,7 @@ class Board:
                 "locked_up": int(self.core.locked_up), "asleep_ms": round(self.core.slept_s * 1000, 3),
                 "usart_interrupts": self.core.taken.get(FIRST_IRQ + self.usart.irq, 0),
                 "rx_bytes": self.usart.rx_bytes,
-                "page_erases": self.flash.erases, "flash_stall_ms": round(self.flash.stalled_s * 1000, 3),
+                "page_erases": self.flash.erases, "flash_ops": self.flash.ops, "flash_stall_ms": round(self.flash.stalled_s * 1000, 3),
                 "erase_began_ms": round(self.flash.erase_began_s * 1000, 3),
                 "last_sent_ms": round(self.bus.last_sent_s.get(self.station, 0.0) * 1000, 3),
                 "framing_errors": self.usart.framing_errors, "begun_deaf": self.usart.begun_deaf, "overruns": self.usart.overruns,

@@ -13,7 +13,15 @@ without PG programs nothing. The wait states must cover the clock (RM0008
 1 up to 48): a CPU faster than its flash reads garbage, here a HardFault.
 
 The contents live in a file (--state): each program and erase writes
-through, so a power cut keeps exactly what was programmed."""
+through, so a power cut keeps exactly what was programmed.
+
+Power cuts (the control port's cutprogram and cutflash): the power goes as
+the Nth program step from now begins (the cell keeps what it held), or as
+the Nth flash operation, program step or page erase, begins. An erase cut
+short leaves its page partly erased: the reference manuals give the erase
+sequence (RM0008 3.3.3, RM0360 3.2.2), not what a power loss in it leaves,
+so the model takes what a reader finds hardest, a page neither erased nor
+as it was: its first half erased, the rest as it held."""
 import os
 
 from .model import Model
@@ -34,6 +42,8 @@ class Flash(Model):
         self.erase_began_s = 0.0  # when the last one began: the state's erase_began_ms
         self.stalled_s = 0.0     # the CPU's stalls for them and for program steps
         self.cut_after_programs = 0  # the power goes as the Nth program step from now begins
+        self.cut_after_ops = 0   # ... as the Nth operation, program step or erase, begins
+        self.ops = 0             # program steps and erases begun, ever: the state's flash_ops
         self.fd = None
         self.blank = True
         if path is not None:
@@ -96,8 +106,31 @@ class Flash(Model):
         clear = value & (self._flag("EOP") | self._flag("PGERR") | self._flag("WRPRTERR"))
         self.core.fix(self.addr("SR"), old & ~clear)
 
+    def cut(self, program: bool) -> bool:
+        """An operation begins: counted; True if the power goes in it."""
+        self.ops += 1
+        cut = False
+        if program and self.cut_after_programs:
+            self.cut_after_programs -= 1
+            cut = self.cut_after_programs == 0
+        if self.cut_after_ops:
+            self.cut_after_ops -= 1
+            cut = cut or self.cut_after_ops == 0
+        return cut
+
+    def cut_erase(self, start: int) -> None:
+        """The power goes as the page at start erases: its first half erased."""
+        self.memory.write(start, b"\xff" * (self.page // 2))
+        self.persist(start, self.page // 2)
+        self.core.stop(reset="power")
+
     def _erase(self, address: int) -> None:
         start = (address - self.base) // self.page * self.page
+        if 0 <= start < self.size and self.cut(program=False):
+            self.erases += 1
+            self.erase_began_s = self.core.now_s()
+            self.cut_erase(start)
+            return
         if 0 <= start < self.size and self.fail_erases == 0:
             self.memory.write(start, b"\xff" * self.page)
             self.persist(start, self.page)
@@ -118,12 +151,10 @@ class Flash(Model):
         cr = self.get("CR")
         programmed = old
         if not cr & self.bit("CR", "LOCK") and cr & self.bit("CR", "PG"):
-            if self.cut_after_programs:
-                self.cut_after_programs -= 1
-                if self.cut_after_programs == 0:  # the cell keeps what it held
-                    self.core.fix(address, old)
-                    self.core.stop(reset="power")
-                    return
+            if self.cut(program=True):  # the cell keeps what it held
+                self.core.fix(address, old)
+                self.core.stop(reset="power")
+                return
             new = value.to_bytes(size, "little")
             cells = []
             for i in range(0, size, 2):

@@ -20,7 +20,12 @@ tERASE. EOP sets only with EOPIE (3.7.4). A double word whose program
 operation the power cut (`cutprogram`) holds data whose ECC does not match:
 each read of it sets ECCR's ECCD with its address (3.3.9, 3.7.6) and raises
 the NMI (RM0444 3.5: a double ECC error is the NMI); erasing its page
-mends it. The torn units live beside the flash file (FILE.ecc).
+mends it. The torn units live beside the flash file (FILE.ecc). An erase
+the power cuts (`cutflash`) leaves its page partly erased: RM0444 3.3.7
+gives the erase sequence, not what a power loss in it leaves, so the model
+takes what a reader finds hardest: the first half of the page erased, the
+double word at its middle torn (it raises the NMI when read, as a program
+cut short), the rest as it held.
 
 DMAMUX (RM0444 11): DMA1 channel n serves the request C(n-1)CR's
 DMAREQ_ID names (11.3.2: 5 ADC, 50 USART1_RX, 51 USART1_TX); a request no
@@ -87,8 +92,14 @@ class FlashG0(Flash):
                 self._tear(offset, save=False)
 
     def reset(self) -> None:
+        """A torn read's NMI not yet taken goes with the reset: the new run
+        takes its own (one pending across it was taken at the first
+        instruction, ECCR cleared, as a fault: the firmware reset itself)."""
         super().reset()
         self.first = None
+        if self.nmi_hook is not None:
+            self.core.uc.hook_del(self.nmi_hook)
+            self.nmi_hook = None
 
     def _flag(self, name: str) -> int:
         return self.bit("SR", name)
@@ -125,14 +136,28 @@ class FlashG0(Flash):
             self.first = None
         self.core.fix(self.addr("CR"), value)
 
+    def cut_erase(self, start: int) -> None:
+        self._mend(start, start + self.page // 2)
+        self._tear(start + self.page // 2)
+        super().cut_erase(start)
+
+    def _mend(self, begin: int, end: int) -> None:
+        """The torn units in [begin, end) erased: whole again."""
+        for offset in [o for o in self.torn if begin <= o < end]:
+            self.core.uc.hook_del(self.torn.pop(offset))
+        self._save_torn()
+
     def _erase_page(self, number: int) -> None:
         start = number * self.page
+        if start < self.size and self.cut(program=False):
+            self.erases += 1
+            self.erase_began_s = self.core.now_s()
+            self.cut_erase(start)
+            return
         if start < self.size and self.fail_erases == 0:
             self.memory.write(start, b"\xff" * self.page)
             self.persist(start, self.page)
-            for offset in [o for o in self.torn if start <= o < start + self.page]:
-                self.core.uc.hook_del(self.torn.pop(offset))
-            self._save_torn()
+            self._mend(start, start + self.page)
             self._done()
         else:
             self.fail_erases = max(0, self.fail_erases - 1)
@@ -171,15 +196,13 @@ class FlashG0(Flash):
     def _program(self, offset: int, data: bytes) -> None:
         was = bytes(self.memory.read(offset, 8))
         self.stalled_s += self.program_s
-        if self.cut_after_programs:
-            self.cut_after_programs -= 1
-            if self.cut_after_programs == 0:  # cut as it programs: data with no ECC to match
-                self.memory.write(offset, bytes(a & b for a, b in zip(was, data)))
-                self.persist(offset, 8)
-                self.core.fix(self.base + offset, bytes(a & b for a, b in zip(was, data)))
-                self._tear(offset)
-                self.core.stop(reset="power")
-                return
+        if self.cut(program=True):  # cut as it programs: data with no ECC to match
+            self.memory.write(offset, bytes(a & b for a, b in zip(was, data)))
+            self.persist(offset, 8)
+            self.core.fix(self.base + offset, bytes(a & b for a, b in zip(was, data)))
+            self._tear(offset)
+            self.core.stop(reset="power")
+            return
         if self.fail_programs or (was != b"\xff" * 8 and data != bytes(8)):
             self.fail_programs = max(0, self.fail_programs - 1)
             self._error("PROGERR" if was != b"\xff" * 8 else "WRPERR")

@@ -7,7 +7,7 @@
 prints `vboard: bus URL`, `vboard: control 127.0.0.1:PORT`, `vboard: servos
 ...` and `vboard: ready`, so servoctl and the tests drive it as they drive
 servo_sim. The control port takes servo_sim's commands (help lists them),
-and the virtual boards' own: cutprogram, peek, and the servo's faults,
+and the virtual boards' own: cutprogram, cutflash, peek, and the servo's faults,
 inject ID bus|undef|stack|hang and brownout ID [MS] (inject.py).
 
 Simulated time follows the wall clock when the boards keep up, and falls
@@ -139,6 +139,8 @@ class Runner:
                 b.flash.fail_programs = int(value)
             elif cmd == "cutprogram":
                 b.flash.cut_after_programs = int(value)
+            elif cmd == "cutflash":
+                b.flash.cut_after_ops = int(value)
             elif cmd == "powercycle":
                 b.power_cycle()
             elif cmd == "state":

@@ -133,3 +133,44 @@ def test_a_config_record_torn_by_a_power_cut_costs_an_nmi_not_the_servo(tmp_path
         sim.sleep(0.6)
         assert servo.read("angle_max") == 900
     finish(sim, [1])
+
+
+def test_an_erase_cut_by_the_power_leaves_its_page_half_erased_and_torn(board):
+    """cutflash: the power goes as the Nth operation begins, program or
+    erase alike (flash_ops counts them). An erase cut short leaves page 31
+    neither erased nor as it was: its first half erased, the double word at
+    its middle torn (a torn unit in that half mended), the rest kept."""
+    flash, base = board.flash, board.flash_base
+    page = base + 31 * 2048
+    unlocked(flash)
+    program(flash, page, 0x11111111, 0x22222222)
+    program(flash, page + 2040, 0x33333333, 0x44444444)
+    flash.cut_after_programs = 1
+    program(flash, page + 8, 5, 6)        # torn, in the half the erase reaches
+    board.core.reset_cause = None
+    assert page + 8 - base in flash.torn and flash.ops == 3
+    flash.cut_after_ops = 2
+    program(flash, page + 16, 7, 8)       # the first operation: programmed
+    assert board.core.reset_cause is None
+    flash._cr(PER | 31 << PNB_SHIFT | STRT, PER | 31 << PNB_SHIFT, 4)  # the second: cut
+    assert board.core.reset_cause == "power" and flash.ops == 5 and flash.erases == 1
+    assert flash.memory.read(31 * 2048, 1024) == b"\xff" * 1024
+    assert flash.memory.read(31 * 2048 + 2040, 8) == struct.pack("<II", 0x33333333, 0x44444444)
+    assert sorted(flash.torn) == [31 * 2048 + 1024]
+
+
+def test_an_nmi_a_torn_read_left_pending_goes_with_a_power_cut(board):
+    """A torn double word read as a run of the core ended (its NMI due at
+    the next instruction), then the power cut: the NMI was taken at the
+    new run's first instruction, ECCR already cleared by the reset, so the
+    firmware took it for a fault and reset itself (the power-cut tests saw
+    a software reset and a lost save)."""
+    flash, base = board.flash, board.flash_base
+    unlocked(flash)
+    flash.cut_after_programs = 1
+    program(flash, base + 31 * 2048, 1, 2)
+    board.core.reset_cause = None
+    flash._torn_read(board.core.uc, 0, base + 31 * 2048, 4, 0, None)
+    assert flash.nmi_hook is not None
+    board.power_cycle()
+    assert flash.nmi_hook is None and NMI not in board.core.pending
