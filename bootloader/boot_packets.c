@@ -28,8 +28,18 @@ static uint8_t on_enter(const struct call *c, struct response *r)
     return 3;
 }
 
+enum app_image_verdict bootloader_check(struct bootloader *b, struct app_image_info *info)
+{
+    enum app_image_verdict verdict = app_image_check(b->slot, b->board, info);
+    b->verdict = (uint8_t)verdict;
+    b->version = info->version;
+    b->checked = 1;
+    return verdict;
+}
+
 static uint8_t on_erase(const struct call *c, struct response *r)
 {
+    c->b->checked = 0;
     enum slot_write_result w = slot_erase_page(c->b->slot, le_get_u16(&c->content[1]));
     r->content[1] = w == SLOT_WRITE_OK;
     r->content[2] = (uint8_t)w;
@@ -39,6 +49,7 @@ static uint8_t on_erase(const struct call *c, struct response *r)
 static uint8_t on_write(const struct call *c, struct response *r)
 {
     uint16_t n = (uint16_t)(c->length - 9u);
+    c->b->checked = 0;
     enum slot_write_result w = slot_write(c->b->slot, le_get_u32(&c->content[1]), &c->content[5],
                                           n, le_get_u32(&c->content[5u + n]));
     r->content[1] = w == SLOT_WRITE_OK;
@@ -49,7 +60,7 @@ static uint8_t on_write(const struct call *c, struct response *r)
 static uint8_t on_verify(const struct call *c, struct response *r)
 {
     struct app_image_info info;
-    r->content[1] = (uint8_t)app_image_check(c->b->slot, c->b->board, &info);
+    r->content[1] = (uint8_t)bootloader_check(c->b, &info);
     le_put_u32(&r->content[2], info.size);
     le_put_u32(&r->content[6], info.crc);
     le_put_u16(&r->content[10], info.version);
@@ -60,7 +71,7 @@ static uint8_t on_verify(const struct call *c, struct response *r)
 static uint8_t on_boot(const struct call *c, struct response *r)
 {
     struct app_image_info info;
-    bool valid = app_image_check(c->b->slot, c->b->board, &info) == APP_IMAGE_VALID;
+    bool valid = bootloader_check(c->b, &info) == APP_IMAGE_VALID;
     c->b->boot_now = valid;
     r->content[1] = valid;
     return 2;
@@ -69,14 +80,15 @@ static uint8_t on_boot(const struct call *c, struct response *r)
 static uint8_t on_status(const struct call *c, struct response *r)
 {
     const struct app_slot *slot = c->b->slot;
-    struct app_image_info info;
-    /* Before the answer's fields: the check fills info. */
-    enum app_image_verdict verdict = app_image_check(slot, c->b->board, &info);
+    if (!c->b->checked) {
+        struct app_image_info info;
+        (void)bootloader_check(c->b, &info);
+    }
     const struct update_status status = {
         .mode = UPDATE_MODE_BOOTLOADER,
         .bootloader_version = BOOTLOADER_VERSION,
-        .image_verdict = (uint8_t)verdict,
-        .app_version = info.version,
+        .image_verdict = c->b->verdict,
+        .app_version = c->b->version,
         .board = c->b->board,
         .page_size = (uint16_t)slot->flash->page_size,
         .pages = (uint16_t)slot->pages,

@@ -19,8 +19,7 @@ void boot_loop_start(struct boot_loop *l, const struct boot_board *b)
     frame_rx_init(&l->rx, &l->id);
     l->core = (struct bootloader){.slot = b->slot, .board = b->board, .id = l->id};
     struct app_image_info info;
-    boot_flow_start(&l->flow, app_image_check(b->slot, b->board, &info) == APP_IMAGE_VALID,
-                    b->stay_word);
+    boot_flow_start(&l->flow, bootloader_check(&l->core, &info) == APP_IMAGE_VALID, b->stay_word);
     l->started_us = port->bus.now_us(port->ctx);
 }
 

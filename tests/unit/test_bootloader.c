@@ -30,6 +30,7 @@ static struct {
     long steps;
     long cut_at; /* -1: never */
     bool dead;
+    long reads;  /* read() calls */
 } chip;
 
 static bool step_survives(void)
@@ -79,6 +80,7 @@ static bool program(void *ctx, uint32_t addr, const uint8_t *data)
 static void read(void *ctx, uint32_t addr, uint8_t *dst, uint32_t len)
 {
     (void)ctx;
+    chip.reads++;
     memcpy(dst, &chip.mem[addr - BASE], len);
 }
 
@@ -92,6 +94,7 @@ static void power_on(void)
     chip.cut_at = -1;
     chip.dead = false;
     boot.boot_now = 0;
+    boot.checked = 0; /* RAM lost: nothing checked yet */
 }
 
 static int setup(void **state)
@@ -284,6 +287,34 @@ static void test_ping_and_status_find_the_bootloader(void **state)
     assert_int_equal(le_get_u16(&last.content[14]), UPDATE_WRITE_MAX);
 }
 
+/* UpdateStatus answers from the slot's last check (a CRC of the whole
+ * image: tens of ms on an M0), checked again only after an erase or a
+ * write changed the slot. */
+static void test_status_answers_from_the_last_check(void **state)
+{
+    (void)state;
+    static uint8_t image[2u * PAGE];
+    size_t size = make_image(image, 2u * PAGE - APP_HEADER_SIZE, 0x0203, BOARD, 4);
+    assert_true(update(image, size));
+    assert_true(request(PKT_UPDATE_STATUS, (const uint8_t[]){ID}, 1));
+    assert_int_equal(last.content[4], APP_IMAGE_VALID);
+    assert_int_equal(le_get_u16(&last.content[5]), 0x0203);
+    long reads = chip.reads;
+    assert_true(request(PKT_UPDATE_STATUS, (const uint8_t[]){ID}, 1));
+    assert_int_equal(chip.reads, reads); /* the slot not read again */
+    assert_int_equal(last.content[4], APP_IMAGE_VALID);
+    memset(&chip.mem[PAGE], 0, 4); /* not through the bootloader: not seen */
+    assert_true(request(PKT_UPDATE_STATUS, (const uint8_t[]){ID}, 1));
+    assert_int_equal(last.content[4], APP_IMAGE_VALID);
+    assert_true(request(PKT_UPDATE_VERIFY, (const uint8_t[]){ID}, 1)); /* Verify reads it all */
+    assert_int_equal(last.content[1], APP_IMAGE_BAD_CRC);
+    assert_true(request(PKT_UPDATE_STATUS, (const uint8_t[]){ID}, 1));
+    assert_int_equal(last.content[4], APP_IMAGE_BAD_CRC);
+    assert_true(erase_page_request(0));
+    assert_true(request(PKT_UPDATE_STATUS, (const uint8_t[]){ID}, 1));
+    assert_int_equal(last.content[4], APP_IMAGE_NO_HEADER);
+}
+
 /* From an old image to a new one, the power cut at every erase and program
  * step in turn. After each cut the slot holds the new image whole, or
  * nothing the bootloader would start (it stays, and the update runs again
@@ -390,6 +421,7 @@ int main(void)
         cmocka_unit_test_setup(test_the_header_matches_the_tool, setup),
         cmocka_unit_test_setup(test_what_the_bootloader_refuses, setup),
         cmocka_unit_test_setup(test_ping_and_status_find_the_bootloader, setup),
+        cmocka_unit_test_setup(test_status_answers_from_the_last_check, setup),
         cmocka_unit_test_setup(test_a_power_cut_at_every_step_never_bricks, setup),
         cmocka_unit_test_setup(test_the_image_crc_guards_any_write_order, setup),
         cmocka_unit_test_setup(test_the_boot_decision, setup),

@@ -24,7 +24,16 @@ struct bootloader {
     uint16_t board;        /* images for another board are refused */
     uint8_t id;            /* the servo's stored ID */
     uint8_t boot_now;      /* UpdateBoot taken: start the image once the answer is out */
+    uint8_t checked;       /* the two below hold: no erase or write since the check */
+    uint8_t verdict;       /* enum app_image_verdict, the slot's last check */
+    uint16_t version;      /* its image's version (app_image_info) */
 };
+
+/* The slot checked (app_image_check) and the verdict kept for UpdateStatus,
+ * which answers from it until an erase or a write: on an M0 the bitwise
+ * CRC of a 28 KB image takes 66 ms, longer than a host waits for that
+ * answer while it polls for the bootloader. */
+enum app_image_verdict bootloader_check(struct bootloader *b, struct app_image_info *info);
 
 /* A request's packet code and content; true with r filled when it is
  * answered. An answered update packet (not a Ping) keeps the bootloader

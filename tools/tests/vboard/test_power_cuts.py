@@ -129,27 +129,3 @@ def test_a_fault_record_and_the_erase_before_it_survive_a_cut_at_every_operation
         newest = servo.faults()
         assert newest[0].what == 11 and [(f.number, f.what) for f in newest[1:]] == shown[:15], (k, newest)
     print(f"{cuts.board.name}: a fault record and its erase, {len(kinds)} operations, cut at {len(points)}")
-
-
-@pytest.mark.parametrize("name", [pytest.param(b, marks=pytest.mark.xfail(
-    b == "stm32g031k8", strict=True,
-    reason="the G0's bootloader hears the bytes (its DMA ring takes them) and answers none")) for b in BOARDS])
-def test_the_bootloader_answers_a_host_that_polls_it_as_it_starts(tmp_path, name):
-    """UpdateEnter, then UpdateStatus every 70 ms from the moment its answer
-    ends, as servoctl's update does with no delay between host and bus
-    (the first request lands while the chip resets, a byte of it begun
-    before the bootloader's receiver was on): the bootloader answers
-    within servoctl's 3 s. The F1/F0's answer the second or third."""
-    cuts = Cuts(name, str(tmp_path / "state"))
-    try:
-        cuts.host.request(p.UPDATE_ENTER, bytes([1]))
-        end = cuts.runner.now_s + 3.0
-        answered = False
-        while not answered and cuts.runner.now_s < end:
-            try:
-                answered = cuts.host.request(p.UPDATE_STATUS, bytes([1]), timeout=0.05)[1] == 1
-            except NoReply:
-                cuts.host.sleep(0.02)
-        assert answered
-    finally:
-        cuts.close()
