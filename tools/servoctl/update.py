@@ -24,6 +24,10 @@ WRITE_REASONS = {1: "damaged on the wire", 2: "outside the slot", 3: "the flash 
 ENTER_OUTPUT_DRIVEN, ENTER_NO_BOOTLOADER = 1, 2  # UpdateEnter's reasons (docs/packets.md)
 RETRIES = 3
 SWITCH_TIMEOUT_S = 3.0  # a restart: the bootloader's 200 ms window, and the application's start
+# The bootloader's check of an image (UpdateVerify, UpdateBoot): a bitwise
+# CRC over it, per KB at most (the virtual boards: F103 1.6, G031 2.5,
+# F030 3.3 ms/KB; tests/vboard/test_power_cuts.py holds them to this).
+CHECK_MS_PER_KB = 4.0
 
 
 @dataclass
@@ -84,14 +88,19 @@ def _answering(bus, servo_id: int) -> Status:
     return st
 
 
-def _switch(bus, servo_id: int, code: int, packet: str, to_mode: int, refusal) -> Status:
+def check_timeout(bus, size: int) -> float:
+    """The wait for an answer that checks an image of size bytes."""
+    return bus.timeout + CHECK_MS_PER_KB / 1000 * size / 1024
+
+
+def _switch(bus, servo_id: int, code: int, packet: str, to_mode: int, refusal, timeout=None) -> Status:
     """UpdateEnter or UpdateBoot, and the servo's Status once it answers in
     to_mode. An answer that is lost is not a failure: the servo answering
     in to_mode shows the request was carried out; in its old mode, that the
     request was lost, and it is sent again."""
     for _ in range(RETRIES):
         try:
-            c = _answer(bus.request(code, bytes([servo_id])), 2, servo_id, packet)
+            c = _answer(bus.request(code, bytes([servo_id]), timeout=timeout), 2, servo_id, packet)
         except BadAnswer:  # garbled, not lost: nothing to learn by asking again
             raise
         except NoReply:
@@ -161,7 +170,7 @@ def write_image(bus, servo_id: int, image: Image, st: Status, progress=lambda do
     writes the image (the header's checked bytes last) and verifies it."""
     if len(image.data) > st.page_size * st.pages:
         if st.verdict == 0:  # nothing erased yet: back to the application
-            bus.request(UPDATE_BOOT, bytes([servo_id]))
+            bus.request(UPDATE_BOOT, bytes([servo_id]), timeout=check_timeout(bus, st.page_size * st.pages))
         raise NotSent(f"the image ({len(image.data)} B) is larger than the slot "
                       f"({st.page_size * st.pages} B)")
     pages = (len(image.data) + st.page_size - 1) // st.page_size
@@ -181,7 +190,7 @@ def write_image(bus, servo_id: int, image: Image, st: Status, progress=lambda do
     for offset in range(0, head, step):
         _write(bus, servo_id, offset, data[offset:offset + step])
     progress(total, total)
-    c = _retry(lambda: bus.request(UPDATE_VERIFY, bytes([servo_id])))
+    c = _retry(lambda: bus.request(UPDATE_VERIFY, bytes([servo_id]), timeout=check_timeout(bus, len(data))))
     verdict, size, crc, version, _board = _p.decode_answer(UPDATE_VERIFY, c)[1:]
     if verdict != 0 or (size, crc, version) != (image.size, image.crc, image.version):
         raise Refused(f"servo {servo_id}: the written image does not check: {VERDICTS.get(verdict, verdict)}")
@@ -213,7 +222,7 @@ def update(bus, servo_id: int, image: Image, progress=lambda done, total: None) 
     if st.mode == MODE_APP:
         st = enter_bootloader(bus, servo_id)
     write_image(bus, servo_id, image, st, progress)
-    return before, start_application(bus, servo_id).version
+    return before, start_application(bus, servo_id, len(image.data)).version
 
 
 def enter_bootloader(bus, servo_id: int) -> Status:
@@ -222,7 +231,9 @@ def enter_bootloader(bus, servo_id: int) -> Status:
                    lambda c: enter_refusal(servo_id, c[2] if len(c) > 2 else None))
 
 
-def start_application(bus, servo_id: int) -> Status:
-    """UpdateBoot; the new application's Status once it answers."""
+def start_application(bus, servo_id: int, size: int = 0) -> Status:
+    """UpdateBoot (it checks the image, size bytes if known); the new
+    application's Status once it answers."""
     return _switch(bus, servo_id, UPDATE_BOOT, "UpdateBoot", MODE_APP,
-                   lambda c: f"servo {servo_id}: the bootloader would not start the image")
+                   lambda c: f"servo {servo_id}: the bootloader would not start the image",
+                   check_timeout(bus, size))
