@@ -1,5 +1,6 @@
 /* memcpy, memmove, memset and memcmp for the size-first images (the
- * bootloaders, the Cortex-M0 application): byte loops, a fraction of
+ * bootloaders, the Cortex-M0 application), and memcpy alone for the
+ * Cortex-M0+ application (SMALL_MEM_MEMCPY_ONLY): byte loops, a fraction of
  * newlib-nano's size, which their budgets need (they copy a few dozen
  * bytes at a time). Built with -fno-tree-loop-distribute-patterns, so the
  * loops do not become calls to themselves. */
