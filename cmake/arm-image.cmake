@@ -81,6 +81,10 @@ function(servo_arm_image name)
   if(SERVO_SIZE_FIRST)
     target_sources(${name}.elf PRIVATE $<TARGET_OBJECTS:servo_small_runtime>
                    $<TARGET_OBJECTS:servo_small_div>)
+  elseif(SERVO_CPU STREQUAL "cortex-m0plus")
+    # The small run-time's mem* too: its memcpy reads an aligned source a
+    # word a load (ReadBatchData's 32 bytes), the C library's a byte a step.
+    target_sources(${name}.elf PRIVATE $<TARGET_OBJECTS:servo_small_memcpy>)
   endif()
   target_include_directories(${name}.elf PRIVATE ${PROJECT_SOURCE_DIR}/firmware ${PROJECT_SOURCE_DIR}/bootloader/include)
   add_dependencies(${name}.elf ${board}_app_ld)

@@ -1,6 +1,8 @@
 /* The size-first images' mem* (hal/runtime/small_mem.c), built here
  * under other names: every alignment of source and destination and every
- * length up to 40 against the C library's. */
+ * length up to 40 against the C library's; and the Cortex-M0+ image's
+ * memcpy (SMALL_MEM_MEMCPY_ONLY: a word a store where both ends are
+ * aligned) the same way. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -10,6 +12,7 @@
 #include <cmocka.h>
 
 void *small_memcpy(void *restrict dst, const void *restrict src, size_t n);
+void *m0p_memcpy(void *restrict dst, const void *restrict src, size_t n);
 void *small_memmove(void *dst, const void *src, size_t n);
 void *small_memset(void *dst, int c, size_t n);
 int small_memcmp(const void *a, const void *b, size_t n);
@@ -18,9 +21,10 @@ enum { SPAN = 48, LONGEST = 40 };
 
 static _Alignas(4) uint8_t source[SPAN];
 
-static void test_copy_every_alignment(void **unused)
+typedef void *copy_fn(void *restrict dst, const void *restrict src, size_t n);
+
+static void copy_every_alignment(copy_fn *copy)
 {
-    (void)unused;
     for (size_t i = 0; i < SPAN; i++) {
         source[i] = (uint8_t)(i * 37u + 11u);
     }
@@ -32,11 +36,23 @@ static void test_copy_every_alignment(void **unused)
                 memset(got, 0xA5, sizeof got);
                 memset(want, 0xA5, sizeof want);
                 memcpy(&want[to], &source[from], n);
-                assert_ptr_equal(small_memcpy(&got[to], &source[from], n), &got[to]);
+                assert_ptr_equal(copy(&got[to], &source[from], n), &got[to]);
                 assert_memory_equal(got, want, sizeof got); /* nothing past n */
             }
         }
     }
+}
+
+static void test_copy_every_alignment(void **unused)
+{
+    (void)unused;
+    copy_every_alignment(small_memcpy);
+}
+
+static void test_the_m0p_copy_every_alignment(void **unused)
+{
+    (void)unused;
+    copy_every_alignment(m0p_memcpy);
 }
 
 static void test_move_overlapping(void **unused)
@@ -78,6 +94,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_copy_every_alignment),
+        cmocka_unit_test(test_the_m0p_copy_every_alignment),
         cmocka_unit_test(test_move_overlapping),
         cmocka_unit_test(test_set_and_compare),
     };

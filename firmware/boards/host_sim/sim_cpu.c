@@ -16,7 +16,7 @@ static const struct sim_cpu cpus[] = {
      .answer_ns = 1153 * 1000 / 72 + 1, .sync_answer_ns = 721 * 1000 / 72 + 1, .tick_and_pass_us = 18},
     {.name = "m0", .pass_ns = 284 * 1000 / 48 + 1, .tick_ns = 1881 * 1000 / 48 + 1,
      .answer_ns = 1439 * 1000 / 48 + 1, .sync_answer_ns = 287 * 1000 / 48 + 1, .sends_ahead = true,
-     .tick_and_pass_us = 47},
+     .tick_and_pass_us = 48},
 };
 
 const struct sim_cpu *sim_cpu_named(const char *name)

@@ -53,7 +53,7 @@
 /* The longest control tick and a main-loop pass at 48 MHz, rounded up to
  * whole us: the target bench's servo_tick_worst + idle_poll, in cycles
  * (docs/benchmark.md; tools/tests/test_doc_figures.py checks it). */
-#define BOARD_TICK_AND_PASS_US 47
+#define BOARD_TICK_AND_PASS_US 48
 /* The analogue front end and the motor: the reference servo's. */
 #include "boards/common/reference_servo.h"
 

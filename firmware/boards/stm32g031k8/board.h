@@ -49,7 +49,7 @@
  * whole us: the target bench's servo_tick_worst + idle_poll on the
  * Cortex-M0+, in cycles (docs/benchmark.md; tools/tests/test_doc_figures.py
  * checks it). */
-#define BOARD_TICK_AND_PASS_US 33
+#define BOARD_TICK_AND_PASS_US 32
 /* The analogue front end and the motor: the reference servo's. */
 #include "boards/common/reference_servo.h"
 

@@ -48,12 +48,15 @@ static bool program(void *ctx, uint32_t addr, const uint8_t *data)
     return ok && *cell == value;
 }
 
-/* Flash reads as memory: a word a load where both ends are aligned (a
- * ReadFaults answer has 30 us on the M0). The barrier: what an erase or a
- * program changed behind the compiler's back is read anew. */
 /* A half-word a load where the address is even (the flash's program unit,
- * which program() reads back the same way): a fault history entry reaches
- * ReadFaults' answer within the M0's 30 us. */
+ * which program() reads back the same way), and a store where the
+ * destination is even too (a fault history entry into ReadFaults' answer,
+ * which has 30 us on the M0). Volatile: what an erase or a program changed
+ * behind the compiler's back is read anew. */
+#ifndef STARTUP_BOOTLOADER
+typedef uint16_t __attribute__((may_alias)) any_half; /* stores into any object */
+#endif
+
 void flash_f0f1_read(void *ctx, uint32_t addr, uint8_t *dst, uint32_t len)
 {
     (void)ctx;
@@ -62,12 +65,11 @@ void flash_f0f1_read(void *ctx, uint32_t addr, uint8_t *dst, uint32_t len)
     /* Not in the bootloader (-Oz, LTO): with the half-word loop the F030's
      * bootloader went silent after UpdateEnter in 3 of 6 runs on the virtual
      * board; a byte a load, 0 of 6. Its reads are not timed. */
-    if ((addr & 1u) == 0u) {
+    if (((addr | (uintptr_t)dst) & 1u) == 0u) {
         const volatile uint16_t *half = (const volatile uint16_t *)(uintptr_t)addr;
+        any_half *to = (any_half *)(void *)dst;
         for (; i + 2u <= len; i += 2u) {
-            uint16_t v = half[i / 2u];
-            dst[i] = (uint8_t)v;
-            dst[i + 1u] = (uint8_t)(v >> 8);
+            to[i / 2u] = half[i / 2u];
         }
     }
 #endif

@@ -86,20 +86,22 @@ static struct insn_cost thumb32(uint16_t hw, uint16_t hw2)
     return cost(1, false, false);
 }
 
-/* ARMv6-M's 32-bit instructions on the M0+: BL, or MRS, MSR and the
- * barriers (M0+ TRM 3.3). */
-static struct insn_cost m0p_thumb32(uint16_t hw, uint16_t hw2)
+/* ARMv6-M's 32-bit instructions: BL, or MRS, MSR and the barriers. BL is
+ * 4 cycles on the M0 (TRM table 3-1) and 3 on the M0+ (TRM 3.3): 2 here
+ * and the refill the plugin adds after it (thumb_refill: 2, 1). MRS, MSR,
+ * DMB, DSB and ISB are 4 on the M0 and 3 on the M0+. */
+static struct insn_cost v6m_thumb32(enum core core, uint16_t hw, uint16_t hw2)
 {
     if ((hw & 0xF800u) == 0xF000u && (hw2 & 0xD000u) == 0xD000u) {
-        return cost(2, false, true);        /* BL: 3 with the refill */
+        return cost(2, false, true);        /* BL */
     }
-    return cost(3, false, false);           /* MRS, MSR, DMB, DSB, ISB */
+    return cost(core == CORE_M0P ? 3 : 4, false, false); /* MRS, MSR, DMB, DSB, ISB */
 }
 
 struct insn_cost thumb_cost(enum core core, uint16_t hw, uint16_t hw2, unsigned size)
 {
     if (size == 4u) {
-        return core == CORE_M0P ? m0p_thumb32(hw, hw2) : thumb32(hw, hw2);
+        return core == CORE_M3 ? thumb32(hw, hw2) : v6m_thumb32(core, hw, hw2);
     }
     return thumb16(core, hw);
 }

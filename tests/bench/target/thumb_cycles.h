@@ -2,8 +2,12 @@
  * for the instruction-counting plugin's cycle model:
  *   Cortex-M3: Cortex-M3 Technical Reference Manual r2p0, table 18-1
  *     ("Cortex-M3 instruction timings");
- *   Cortex-M0: Cortex-M0 Technical Reference Manual r0p0, table 3-1
- *     ("Cortex-M0 instruction summary"), with the single-cycle multiplier;
+ *   Cortex-M0: Cortex-M0 Technical Reference Manual r0p0 (ARM DDI 0432C),
+ *     table 3-1 ("Cortex-M0 instruction summary"), with the single-cycle
+ *     multiplier: a load or store 2, LDM/STM/PUSH/POP 1 + N, POP with the
+ *     PC 4 + N (N its other registers), a taken branch, BX, BLX and MOV or
+ *     ADD to the PC 3 (1 here and the refill, thumb_refill: 2), BL 4 (2 and
+ *     the refill), MRS, MSR, DMB, DSB and ISB 4, the rest 1;
  *   Cortex-M0+: Cortex-M0+ Technical Reference Manual (ARM DDI 0484C),
  *     3.3, the instruction summary, with the single-cycle multiplier (the
  *     TRM's MULS "1 or 32": ST builds its M0+ parts with the fast one, its
@@ -14,7 +18,7 @@
  *     BL (3 in all: 2 here and the refill) and MRS, MSR, DMB, DSB, ISB (3).
  * The cost here is the instruction's own, a branch's as not taken; a taken
  * branch's pipeline refill and the flash's wait states are added by the
- * plugin where they happen (thumb_cycles.c). Where a table gives a range
+ * plugin where they happen (qemu_insn_count.c). Where a table gives a range
  * the middle is used (a multiply-long 3-5: 4; a divide 2-12: 7), and an
  * IT instruction, which the M3 folds into its neighbour (0-1), counts 1.
  * The M3 pipelines neighbouring single loads and stores (TRM 18.3, "Load-
