@@ -170,8 +170,17 @@ endfunction()
 # bootloader (boot_main.c) and its application (main.c). A main loop that
 # hangs is the virtual boards' injection (tools/vboard/inject.py), on the
 # shipped image.
+# Its code is its folder's, or the folder its board.cmake names
+# (SERVO_BOARD_CODE: a family's shared code, which includes the board's
+# board.h by bare name from the board's folder, on the include path).
 function(servo_board_images)
   get_filename_component(board ${CMAKE_CURRENT_SOURCE_DIR} NAME)
-  servo_arm_bootloader(servo_${board}_boot SOURCES boot_main.c)
-  servo_arm_image(servo_${board} SOURCES main.c)
+  if(NOT DEFINED SERVO_BOARD_CODE)
+    set(SERVO_BOARD_CODE ${CMAKE_CURRENT_SOURCE_DIR})
+  endif()
+  servo_arm_bootloader(servo_${board}_boot SOURCES ${SERVO_BOARD_CODE}/boot_main.c)
+  servo_arm_image(servo_${board} SOURCES ${SERVO_BOARD_CODE}/main.c)
+  foreach(image servo_${board}_boot servo_${board})
+    target_include_directories(${image}.elf BEFORE PRIVATE ${CMAKE_CURRENT_SOURCE_DIR})
+  endforeach()
 endfunction()

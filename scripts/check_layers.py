@@ -136,6 +136,7 @@ def sources(root):
 INCLUDE_ROOTS = ("hal/include", "motion/include", "protocol/wire/include", "protocol/include",
                  "registers/include", "bootloader/include", "services", "firmware", "hal", "tests", "tools/servobus/include", "tools/servobus", "")
 BOARD_FOLDER = re.compile(r"^firmware/boards/[^/]+/")
+FAMILY_CODE = re.compile(r"^firmware/boards/common/[^/]+/")  # a family's boards' shared code
 
 
 def resolve(root, including, name):
@@ -145,6 +146,11 @@ def resolve(root, including, name):
     board = BOARD_FOLDER.match(including)
     if board and "/" not in name and (root / board.group(0) / name).is_file():
         return [board.group(0) + name]
+    if FAMILY_CODE.match(including) and name == "board.h":
+        # A family's shared board code includes the board.h of the board
+        # it is built for (its folder on the include path): any board's
+        # stands for it, all in one layer.
+        return sorted(p.relative_to(root).as_posix() for p in (root / "firmware/boards").glob("*/board.h"))[:1]
     if "/" not in name:
         return []
     return [f"{r}/{name}" if r else name for r in INCLUDE_ROOTS if (root / r / name).is_file()]

@@ -6,7 +6,7 @@ interrupts' numbers, and what no SVD describes (the core's registers)."""
 # Arguments for the function-like macros: the instance each port uses.
 CALLS = {
     "USART_": "USART1_BASE", "TIM_": "TIM3_BASE", "NVIC_": "0u",
-    "DMA_": "DMA1_CCR_ADDR(1u)", "DMA1_CCR_ADDR": "1u", "DMA1_FLAGS": "1u",
+    "DMA_": "DMA1_CCR_ADDR(1u)", "DMA1_CCR_ADDR": "1u", "DMA1_FLAGS": "1u", "GPIO_CR": "GPIOA_BASE",
 }
 
 # A part's own instances where its header names them otherwise.
@@ -16,6 +16,11 @@ PART_CALLS = {"STM32G031": {"USART_": "G0_USART1_BASE", "G0_DMAMUX_CCR": "1u"}}
 FIELD_NAMES = {
     ("STM32F103xx", "RCC_APB2ENR_AFIO"): "AFIOEN",
     ("STM32F103xx", "RCC_APB2ENR_GPIOA"): "IOPAEN",
+    ("STM32F103xx", "RCC_APB2ENR_GPIOB"): "IOPBEN",
+    ("STM32F103xx", "RCC_APB2ENR_GPIOC"): "IOPCEN",
+    ("STM32F103xx", "RCC_APB2ENR_GPIOD"): "IOPDEN",
+    ("STM32F103xx", "RCC_APB1ENR_TIM2"): "TIM2EN",
+    ("STM32F103xx", "RCC_APB1ENR_TIM4"): "TIM4EN",
     ("STM32F103xx", "RCC_AHBENR_DMA1"): "DMA1EN",
     ("STM32F103xx", "RCC_APB2ENR_ADC1"): "ADC1EN",
     ("STM32F103xx", "RCC_APB1ENR_USART2"): "USART2EN",

@@ -135,6 +135,46 @@ def _regions(d: dict) -> list:
     return out
 
 
+def pin_name(pin: int) -> str:
+    """A board.h pin, 0xPN (port P: 0 A, 1 B...; pin N), as its name: 0x1A is PB10."""
+    return f"P{'ABCDEFG'[pin >> 4]}{pin & 0xF}" if 0 <= pin < 0x70 else f"0x{pin:X}"
+
+
+def _pins(ranges: list) -> set:
+    """The pins of parts.toml's ranges ("PA0-PA15"), as names."""
+    out = set()
+    for r in ranges:
+        first, _, last = r.partition("-")
+        last = last or first
+        out |= {f"{first[:2]}{n}" for n in range(int(first[2:]), int(last[2:]) + 1)}
+    return out
+
+
+_PIN_FACTS = ("BOARD_BUS_TX_PIN", "BOARD_BRIDGE_IN1_PIN", "BOARD_BRIDGE_IN2_PIN")
+_INSTANCES = (("BOARD_BUS_USART", "usarts", "USART"), ("BOARD_BRIDGE_TIMER", "timers", "TIM"))
+
+
+def _pin_problems(d: dict, p: dict) -> list:
+    """The pins and instances board.h names that its part lacks, where the
+    part lists them (parts.toml: pins, usarts, timers, adc_inputs)."""
+    out = []
+    if "pins" in p:
+        have = _pins(p["pins"])
+        for fact in (f for f in _PIN_FACTS if f in d):
+            if pin_name(d[fact]) not in have:
+                out.append(f"{fact} 0x{d[fact]:02X} ({pin_name(d[fact])}) is not a pin of the part's "
+                           f"package ({', '.join(p['pins'])})")
+    for fact, key, what in _INSTANCES:
+        if key in p and fact in d and d[fact] not in p[key]:
+            out.append(f"{fact} {d[fact]}: the part has no {what}{d[fact]} (its {key}: "
+                       f"{', '.join(str(n) for n in p[key])})")
+    if "adc_inputs" in p:
+        for fact in (f for f in d if f.startswith("BOARD_ADC_")):
+            if not 0 <= d[fact] < p["adc_inputs"]:
+                out.append(f"{fact} {d[fact]}: the part's ADC has inputs 0-{p['adc_inputs'] - 1} on its pins")
+    return out
+
+
 def check(board) -> list:
     """What in a board's declaration its part contradicts, a line each
     naming the fact and the part's own; [] when it fits. A board with
@@ -179,6 +219,7 @@ def check(board) -> list:
         for b, first_b, size_b in regions[i + 1:]:
             if first_a < first_b + size_b and first_b < first_a + size_a:
                 say(f"{a} and {b} overlap")
+    problems += [f"{folder.name}: {line} ({name})" for line in _pin_problems(d, p)]
     ram_end = p["ram_base"] + p["ram_size"]
     if d["BOARD_RAM_BASE"] != p["ram_base"] or d["BOARD_RAM_BASE"] + d["BOARD_RAM_SIZE"] > ram_end:
         say(f"BOARD_RAM_BASE 0x{d['BOARD_RAM_BASE']:08X} and BOARD_RAM_SIZE {d['BOARD_RAM_SIZE']} are not "

@@ -83,7 +83,7 @@ class Simulator(_Child):
 
     def __init__(self, ids=(1,), tcp=True, link=None, state_dir=None, supply_mv=None,
                  ambient_c=None, tcp_port=None, rx=None, board=None, app_image=None, nice=None,
-                 cpu=None, plant=None, host_link=None, fast=False, paced=False):
+                 cpu=None, plant=None, host_link=None, fast=False, paced=False, build=None):
         self.ids = list(ids)
         self.tcp = tcp or tcp_port is not None
         self.tcp_port = tcp_port
@@ -94,8 +94,8 @@ class Simulator(_Child):
         self.ambient_c = ambient_c
         self.rx = rx  # "dma" (default) or "interrupt": how the servos' port receives
         self.cpu = cpu  # "m3" (default) or "m0": whose time a pass, a tick, an answer take
-        self.board = board  # None: servo_sim; else a virtual board (tools/vboard)
-        self.app_image = app_image  # a virtual board's slot, if not the build's image
+        self.board = board  # None: servo_sim; else a virtual board (tools/vboard): a name or a folder's path
+        self.app_image, self.build = app_image, build  # a virtual board's slot and build tree, if not the checkout's
         self.plant = plant  # a plant file (hal/ports/host/plants); None: the reference servo
         self.plant_name = None  # the plant's name, as servo_sim prints it
         # How the host's USB-serial adapter hands over the bytes off the
@@ -141,8 +141,8 @@ class Simulator(_Child):
                 raise ServoError("a virtual board runs as its MCU does: --rx and --cpu are servo_sim's")
             extras.require("unicorn", "cmsis_svd")  # the child's, which would die with its traceback
             cmd = [sys.executable, "-m", "vboard", "--board", self.board, "--state", self.state_dir]
-            if self.app_image is not None:
-                cmd += ["--app", str(self.app_image)]
+            cmd += ["--app", str(self.app_image)] if self.app_image is not None else []
+            cmd += ["--build", str(self.build)] if self.build is not None else []
         else:
             cmd = [str(find_binary()), "--state", self.state_dir]
         for i in self.ids:

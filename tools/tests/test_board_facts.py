@@ -89,6 +89,16 @@ def test_a_board_its_part_contradicts_is_named_fact_by_fact(tmp_path):
         ("stm32f030k6", [], "stm32f103c8", "its family's CPU cortex-m0 is not the part's cortex-m3"),
         ("stm32f030k6", [], "", "board.cmake names no part"),
         ("stm32f030k6", [], "stm32f999", "names the part 'stm32f999', which hal/ports/parts.toml does not have"),
+        # An STM32F1 board's pins and instances, against its part's package.
+        ("stm32f103", [("#define BOARD_BUS_TX_PIN 0x09", "#define BOARD_BUS_TX_PIN 0x38")], None,
+         "BOARD_BUS_TX_PIN 0x38 (PD8) is not a pin of the part's package (PA0-PA15, PB0-PB15, PC13-PC15, "
+         "PD0-PD1)"),
+        ("stm32f103", [("#define BOARD_BRIDGE_TIMER 3", "#define BOARD_BRIDGE_TIMER 5")], None,
+         "BOARD_BRIDGE_TIMER 5: the part has no TIM5 (its timers: 2, 3, 4)"),
+        ("stm32f103", [("#define BOARD_BUS_USART 1", "#define BOARD_BUS_USART 4")], None,
+         "BOARD_BUS_USART 4: the part has no USART4"),
+        ("stm32f103", [("#define BOARD_ADC_NTC 2", "#define BOARD_ADC_NTC 12")], None,
+         "BOARD_ADC_NTC 12: the part's ADC has inputs 0-9 on its pins"),
     ]
     for i, (name, edits, part, said) in enumerate(cases):
         problems = board_facts.check(_board_like(tmp_path / str(i), name, edits, part))

@@ -2,9 +2,10 @@
 part's peripherals, its analogue inputs and bridge wired to the
 simulator's motor (the host build's plant and thermal models).
 
-A board is one folder of firmware/boards/ (its board.h: the flash map, RAM,
-the analogue front end) and one entry of PARTS (the silicon: core, SVD,
-clock tree, pins, the DMA channel its USART receives on). Its flash holds
+A board is one folder of firmware/boards/, or one given by its path (its
+board.h: the flash map, RAM, the bus, the bridge and the analogue front
+end, wiring.py), and one entry of PARTS, by the part its board.cmake names
+(the silicon: core, SVD, clock tree). Its flash holds
 what a factory would program into a blank chip: the bootloader, the
 application's update image in the slot and a config record with the
 board's ID; a --state folder keeps it across runs, as on a real chip."""
@@ -26,32 +27,20 @@ from .idle_skip import pass_facts
 from .inject import Injector
 from .model import Model
 from .native import Motor, factory_config, stored_id
-from .parts import PARTS, Part  # noqa: F401 (Part: the parts' type, imported from here)
+from .parts import PARTS, Part, elf, images, name_of, part_of  # noqa: F401 (Part, PARTS: imported from here)
 from .timers import BridgeTimer, Watchdog
 from .usart import Usart
+from . import wiring
 
 REPO = Path(__file__).resolve().parents[2]
 
 
 HSE_HZ = 8_000_000  # the boards' crystal (firmware/boards/*/board_io.h)
-ADC_INPUTS = {0: "supply", 1: "current", 2: "ntc", 3: "encoder"}  # firmware/boards/*/README.md
 
 
-def board_h(board: str) -> dict:
+def board_h(board) -> dict:
     """board.h's numbers (servo_image.board_facts: the one reader of a board's facts)."""
     return board_facts.defines(board)
-
-
-def images(board: str) -> tuple:
-    """(bootloader .bin, application update image .img, application .bin)
-    of the board's build."""
-    folder = REPO / "build" / PARTS[board].build / "firmware/boards" / board
-    return folder / f"servo_{board}_boot.bin", folder / f"servo_{board}.img", folder / f"servo_{board}.bin"
-
-
-def elf(board: str) -> Path:
-    """The application's ELF, which names the main loop's pass (idle_skip.py)."""
-    return REPO / "build" / PARTS[board].build / "firmware/boards" / board / f"servo_{board}.elf"
 
 
 class Memory:
@@ -73,20 +62,17 @@ class Memory:
 
 class Board:
     def __init__(self, board: str, servo_id: int, bus, state_dir=None, supply_v=7.4, ambient_c=25.0,
-                 boot_image=None, app_image=None, unit=0, plant=None):
+                 boot_image=None, app_image=None, unit=0, plant=None, build=None):
         # unit: boards started before this one with the same ID (a bus of
         # new servos all at ID 0): it names the flash file and the chip's
         # unique ID apart from theirs.
-        self.name, self.servo_id, self.bus, self.unit = board, servo_id, bus, unit
-        self.part = PARTS[board]
+        self.name, self.servo_id, self.bus, self.unit = name_of(board), servo_id, bus, unit
+        self.board, self.build = board, build
+        self.part = part_of(board)
         self.h = board_h(board)
         self.part_facts = board_facts.parts()[board_facts.part_name(board)]  # hal/ports/parts.toml
         h, part = self.h, self.part
-        declared = (h.get("BOARD_BUS_USART"), h.get("BOARD_BUS_DMA_TX"), h.get("BOARD_BUS_DMA_RX"))
-        if declared != (1, part.usart_tx_dma, part.usart_rx_dma):
-            raise ValueError(f"{board}: its board.h declares the bus on USART{declared[0]} with DMA channels "
-                             f"{declared[1]} (TX) and {declared[2]} (RX); the virtual {part.svd} wires it on "
-                             f"USART1 (PA9) with {part.usart_tx_dma} and {part.usart_rx_dma} only")
+        self.wiring = wired = wiring.of(self.name, h, part)
         self.core = Core(part.cpu, part.reset_hz, part.cpi, part.has_vtor, part.irq_words)
         self.clock_setting = 0  # counts the firmware's clock switches
         self._pins_for, self._roles = None, None  # _pin_roles's cache
@@ -116,16 +102,24 @@ class Board:
         self.flash = (FlashG0 if family == "g0" else Flash)(
             self, dev[n["flash"]], self.flash_mem, self.flash_base, self.flash_size, h["BOARD_FLASH_PAGE"], path,
             part.program_s, part.erase_s)
-        self.dma = Dma(self, dev[n["dma"]], {ch: irqs[name] for ch, name in part.dma_irqs.items()})
+        dma_irqs = dict(part.dma_irqs)
+        if family == "f1":  # the bus's receive channel, as board.h names it
+            dma_irqs = {1: dma_irqs[1], wired.dma_rx: f"DMA1_Channel{wired.dma_rx}"}
+        self.dma = Dma(self, dev[n["dma"]], {ch: irqs[name] for ch, name in dma_irqs.items()})
         self.gpio = Model(self, dev[n["gpio"]])
+        # The F1's other ports the board's pins are on (RM0008 9.2: GPIOB-D as GPIOA).
+        self.ports = [self.gpio] + [Model(self, dev[f"GPIO{'ABCD'[k]}"]) for k in wired.ports() if k and family == "f1"]
         routed = family == "g0"  # the DMAMUX routes the channels (0: none until it does)
-        self.usart = Usart(self, dev[n["usart"]], self.pclk_hz, irqs["USART1"], self.dma,
-                           0 if routed else part.usart_rx_dma, 0 if routed else part.usart_tx_dma, self.bus_pin_ok)
+        usart = wired.usart_name
+        # USART1 on APB2, USART2 and 3 on APB1 (RM0008 7.2's clock tree).
+        pclk = self.pclk_hz if wired.usart == 1 or family != "f1" else self.pclk1_hz
+        self.usart = Usart(self, dev[usart], pclk, irqs[usart], self.dma,
+                           0 if routed else wired.dma_rx, 0 if routed else wired.dma_tx, self.bus_pin_ok)
         adc_class = {"f1": AdcF1, "f0": AdcF0, "g0": AdcG0}[family]
         self.adc = adc_class(self, dev[n["adc"]], self.adc_hz, self.dma, self.adc_input)
-        self.tim = BridgeTimer(self, dev[n["tim"]], self.bridge_pins_ok)
+        self.tim = BridgeTimer(self, dev[wired.timer_name], self.bridge_pins_ok)
         self.iwdg = Watchdog(self, dev[n["iwdg"]])
-        self.models = [self.rcc, self.flash, self.dma, self.gpio, self.usart, self.adc, self.tim, self.iwdg]
+        self.models = [self.rcc, self.flash, self.dma, *self.ports, self.usart, self.adc, self.tim, self.iwdg]
         if "syscfg" in n:
             self.syscfg = Model(self, dev[n["syscfg"]])
             self.syscfg.watch("CFGR1", self._mem_mode)
@@ -138,10 +132,10 @@ class Board:
         self.stepped = [m for m in self.models if type(m).step is not Model.step]
         self.station = bus.attach(self.usart)
         self.usart.bus_station = self.station
-        self.pass_start = pass_facts(elf(board))  # (address, (section, code), _ebss) or None
+        self.pass_start = pass_facts(elf(board, build))  # (address, (section, code), _ebss) or None
         if self.pass_start is not None:
             self.core.skip_memory(self.ram.buf, h["BOARD_RAM_BASE"], self.pass_start[2] - h["BOARD_RAM_BASE"])
-        self.injector_elf = elf(board)
+        self.injector_elf = elf(board, build)
         self.injector = Injector(self, self.injector_elf)
         self.resets = {"power": 0, "software": 0, "watchdog": 0}
         self.last_reset = None
@@ -156,7 +150,7 @@ class Board:
 
     # ---- the chip ---------------------------------------------------------
     def _factory(self, boot_image, app_image) -> None:
-        boot, app, _ = images(self.name)
+        boot, app, _ = images(self.board, self.build)
         boot = Path(boot_image or boot).read_bytes()
         app = Path(app_image or app).read_bytes()
         self.flash_mem.write(0, boot)
@@ -194,11 +188,15 @@ class Board:
         self.core.hz = hz
         self.clock_setting += 1
 
-    def pclk_hz(self) -> int:
-        cfgr = self.rcc.get("CFGR")
-        field = "PPRE2" if "PPRE2" in self.rcc.p.registers["CFGR"][2] else "PPRE"
-        code = (cfgr & self.rcc.bit("CFGR", field)) >> self.rcc.p.shift("CFGR", field)
+    def pclk_hz(self, field=None) -> int:
+        """APB2's clock on the F1 (USART1, the ADC), the APB's on the F0 and G0."""
+        field = field or ("PPRE2" if "PPRE2" in self.rcc.p.registers["CFGR"][2] else "PPRE")
+        code = (self.rcc.get("CFGR") & self.rcc.bit("CFGR", field)) >> self.rcc.p.shift("CFGR", field)
         return self.core.hz >> (0 if code < 4 else code - 3)
+
+    def pclk1_hz(self) -> int:
+        """The F1's APB1 clock (USART2 and 3)."""
+        return self.pclk_hz("PPRE1")
 
     def adc_hz(self) -> float:
         if self.family == "f0":
@@ -211,7 +209,9 @@ class Board:
 
     # ---- pins ---------------------------------------------------------------
     def _f1_pin_af_output(self, pin: int) -> bool:
-        reg = self.gpio.get("CRL" if pin < 8 else "CRH")
+        """pin: 0xPN (wiring.py)."""
+        port = self.ports[self.wiring.ports().index(pin >> 4)]
+        reg = port.get("CRL" if pin & 0xF < 8 else "CRH")
         nibble = reg >> (4 * (pin % 8)) & 0xF
         return nibble & 3 != 0 and nibble >> 2 in (2, 3)
 
@@ -221,35 +221,37 @@ class Board:
         return mode == 2 and afr == af
 
     def _pins(self) -> tuple:
-        """The port's configuration words that say what PA6, PA7 and PA9 are."""
-        g = self.gpio
+        """The ports' configuration words that say what the bus's and the
+        bridge's pins are."""
         if self.family != "f1":
+            g = self.gpio
             return g.w[g.i["MODER"]], g.w[g.i["AFRL"]], g.w[g.i["AFRH"]]
-        return g.w[g.i["CRL"]], g.w[g.i["CRH"]]
+        return tuple(w for g in self.ports for w in (g.w[g.i["CRL"]], g.w[g.i["CRH"]]))
 
     def _pin_roles(self) -> tuple:
-        """(PA9 is USART1_TX, PA6 and PA7 are TIM3_CH1/CH2), worked out
-        again only when the port's configuration changed."""
+        """(the TX pin is the USART's, the bridge's pins are its timer's
+        CH1/CH2), worked out again only when a port's configuration changed."""
         key = self._pins()
         if key != self._pins_for:
-            if self.family != "f1":  # F0, G0: AF1 (DS9773, DS12992 alternate functions)
+            w = self.wiring
+            if self.family != "f1":  # F0, G0: PA9, PA6, PA7 on AF1 (DS9773, DS12992 alternate functions)
                 roles = (self._f0_pin_af(9, 1), self._f0_pin_af(6, 1) and self._f0_pin_af(7, 1))
             else:  # F1: alternate-function outputs
-                roles = (self._f1_pin_af_output(9), self._f1_pin_af_output(6) and self._f1_pin_af_output(7))
+                roles = (self._f1_pin_af_output(w.tx_pin), all(map(self._f1_pin_af_output, w.bridge_pins)))
             self._pins_for, self._roles = key, roles
         return self._roles
 
     def bus_pin_ok(self) -> bool:
-        """PA9 is USART1_TX (F1: alternate-function output; F0: AF1)."""
+        """The bus's TX pin is its USART's (F1: alternate-function output; F0, G0: AF1)."""
         return self._pin_roles()[0]
 
     def bridge_pins_ok(self) -> bool:
-        """PA6/PA7 are TIM3_CH1/CH2."""
+        """The bridge's pins are its timer's CH1/CH2."""
         return self._pin_roles()[1]
 
     def adc_input(self, channel: int) -> int:
         """The front end's reading of the models (board.h's scaling; no noise)."""
-        what = ADC_INPUTS.get(channel)
+        what = self.wiring.adc.get(channel)
         h = self.h
         if what == "supply":
             counts = self.motor.get("supply_v") * 1e6 / h["BOARD_SUPPLY_UV_PER_COUNT"]

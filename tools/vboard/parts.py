@@ -1,11 +1,17 @@
 """The silicon a virtual board is built on: its core, its register
 descriptions, its clock tree's reset clock, the DMA channels its USART
-uses, where its unique ID sits, its flash timings and the preset that
-builds its images. The part's memory facts (flash, RAM, page size, LSI)
-are hal/ports/parts.toml's, read through servo_image.board_facts."""
+uses (the F0's and G0's; an F1 board's are its board.h's, wiring.py),
+where its unique ID sits, its flash timings and the preset that builds its
+images, and where a board's images are. The part's memory facts (flash,
+RAM, page size, LSI) are hal/ports/parts.toml's, read through
+servo_image.board_facts."""
 from dataclasses import dataclass
+from pathlib import Path
 
+from servo_image import board_facts
 from unicorn import arm_const as arm
+
+REPO = Path(__file__).resolve().parents[2]
 
 
 @dataclass(frozen=True)
@@ -55,3 +61,47 @@ PARTS = {
                         0x1FFF7590, 125e-6, 40e-3, "arm-g0", family="g0",
                         system_memory=(0x1FFF0000, 0x8000), reset_hz=16_000_000),
 }
+
+# The parts of hal/ports/parts.toml a virtual board emulates, and the
+# shipped board whose PARTS entry models it (the F103CB: the C8 with more
+# flash, which parts.toml gives).
+EMULATED = {"stm32f103c8": "stm32f103", "stm32f103cb": "stm32f103", "stm32f030k6": "stm32f030k6",
+            "stm32g031k8": "stm32g031k8"}
+
+
+def part_of(board) -> Part:
+    """The silicon of a shipped board (by name) or of a board folder (a
+    Path), by the part its board.cmake names."""
+    if not isinstance(board, Path) and board in PARTS:
+        return PARTS[board]
+    name = board_facts.part_name(board)
+    if name not in EMULATED:
+        raise ValueError(f"{board}: its part {name or '(none)'} has no virtual board "
+                         f"(the emulated parts: {', '.join(sorted(EMULATED))})")
+    return PARTS[EMULATED[name]]
+
+
+def name_of(board) -> str:
+    """A board's name: a shipped board's, or its folder's (a Path)."""
+    return board.name if isinstance(board, Path) else board
+
+
+def _built(board, build) -> Path:
+    """The board's folder in its build: the build tree given, else the
+    checkout's build of its part's preset."""
+    tree = Path(build) if build else REPO / "build" / part_of(board).build
+    return tree / "firmware/boards" / name_of(board)
+
+
+def images(board, build=None) -> tuple:
+    """(bootloader .bin, application update image .img, application .bin)
+    of the board's build."""
+    folder, name = _built(board, build), name_of(board)
+    return folder / f"servo_{name}_boot.bin", folder / f"servo_{name}.img", folder / f"servo_{name}.bin"
+
+
+def elf(board, build=None) -> Path:
+    """The application's ELF, which names the main loop's pass (idle_skip.py)."""
+    return _built(board, build) / f"servo_{name_of(board)}.elf"
+
+

@@ -1,6 +1,6 @@
 """Runs virtual boards on one bus with a control port, as servo_sim does:
 
-    python -m vboard --board stm32f103 [--id N ...] [--tcp PORT | --link PATH]
+    python -m vboard --board stm32f103|FOLDER [--build DIR] [--id N ...] [--tcp PORT | --link PATH]
                      [--state DIR] [--supply MV] [--ambient DEGC] [--plant FILE]
                      [--host-link usb|ftdi[:MS]|raw] [--clock wall|paced]
 
@@ -9,6 +9,11 @@ prints `vboard: bus URL`, `vboard: control 127.0.0.1:PORT`, `vboard: servos
 servo_sim. The control port takes servo_sim's commands (help lists them),
 and the virtual boards' own: cutprogram, cutflash, peek, and the servo's faults,
 inject ID bus|undef|stack|hang and brownout ID [MS] (inject.py).
+
+A board is a shipped one by name, or any board folder by its path (a
+board of an emulated part, its instances and pins from its board.h:
+wiring.py), its images from the build tree --build names (default: the
+checkout's build of its part's preset).
 
 Simulated time follows the wall clock when the boards keep up, and falls
 behind it when they do not (the emulated CPUs are slower than silicon on
@@ -30,7 +35,9 @@ import time
 
 import servo_schema as schema
 
-from .board import PARTS, Board, images
+from pathlib import Path
+
+from .board import PARTS, Board, images, part_of
 from .bus import Bus
 from .clock_file import ClockFile
 from .usb import Adapter
@@ -50,7 +57,8 @@ class Runner:
         os.makedirs(self.state_dir, exist_ok=True)
         supply_v = None if args.supply is None else args.supply / 1000.0
         self.boards = [Board(args.board, i, self.bus, self.state_dir, supply_v, args.ambient,
-                             app_image=args.app, unit=args.id[:k].count(i), plant=args.plant)
+                             app_image=args.app, unit=args.id[:k].count(i), plant=args.plant,
+                             build=getattr(args, "build", None))
                        for k, i in enumerate(args.id)]
         self.url = self.bus.serve_tcp(args.tcp) if args.tcp is not None else self.bus.serve_pty(args.link)
         self.control = socket.socket()
@@ -309,7 +317,9 @@ class Runner:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="vboard", description=__doc__.split("\n\n")[0])
-    ap.add_argument("--board", choices=sorted(PARTS), required=True)
+    ap.add_argument("--board", required=True,
+                    help=f"a shipped board ({', '.join(sorted(PARTS))}) or a board folder's path")
+    ap.add_argument("--build", help="the build tree with the board's images (default: the checkout's)")
     ap.add_argument("--id", type=int, action="append", help="a board with this servo ID (repeat for a bus)")
     ap.add_argument("--tcp", type=int, help="the bus on 127.0.0.1:PORT (0: any free port)")
     ap.add_argument("--link", help="the bus's pseudo-terminal, linked here (not with --tcp)")
@@ -332,8 +342,17 @@ def main(argv=None) -> int:
     except ValueError as e:
         ap.error(str(e))
     args.id = args.id or [1]
-    build = PARTS[args.board].build
-    wanted = [images(args.board)[0]] + ([] if args.app else [images(args.board)[1]])
+    if args.board not in PARTS:
+        folder = Path(args.board)
+        if not (folder / "board.h").is_file():
+            ap.error(f"--board {args.board}: neither a shipped board ({', '.join(sorted(PARTS))}) "
+                     "nor a folder with a board.h")
+        args.board = folder.resolve()
+    try:
+        build = part_of(args.board).build
+    except ValueError as e:
+        ap.error(str(e))
+    wanted = [images(args.board, args.build)[0]] + ([] if args.app else [images(args.board, args.build)[1]])
     missing = [str(path) for path in wanted if not path.exists()]
     if missing:
         print(f"vboard: no {' or '.join(missing)}: build the {args.board}'s images first "

@@ -1,7 +1,9 @@
 /* The reference servo board: STM32F103C8 (Cortex-M3, 72 MHz, 64 KB flash,
- * 20 KB RAM; RM0008). Its main.c and boot_main.c, its linker scripts
- * (made from hal/ports/stm32_common/linker/app.ld.in and boot.ld.in) and servoctl's image
- * command read this file: plain numbers, one per line. */
+ * 20 KB RAM; RM0008). The F1 boards' shared main.c, boot_main.c and
+ * board_io.c (firmware/boards/common/stm32f1), its linker scripts (made
+ * from hal/ports/stm32_common/linker/app.ld.in and boot.ld.in), servoctl's
+ * image command and the virtual board read this file: plain numbers, one
+ * per line. */
 #ifndef BOARD_H
 #define BOARD_H
 
@@ -27,11 +29,25 @@
  * ports/stm32_common/fault_keep.c). */
 #define BOARD_STACK_ALIGN 256
 
-/* The bus: USART1 (PA9), its DMA1 requests on channels 4 (TX) and 5 (RX),
- * as RM0008 Table 78 has them (ports/stm32f1/stm32f1_bus.h checks). */
+/* The bus: USART1, its DMA1 requests on channels 4 (TX) and 5 (RX), as
+ * RM0008 Table 78 has them (ports/stm32f1/stm32f1_bus.h checks), its TX
+ * on PA9. A pin is 0xPN: port P (0 A, 1 B, 2 C, 3 D), pin N
+ * (ports/stm32f1/stm32f1_pins.h checks each is its function's). */
 #define BOARD_BUS_USART 1
 #define BOARD_BUS_DMA_TX 4
 #define BOARD_BUS_DMA_RX 5
+#define BOARD_BUS_TX_PIN 0x09
+
+/* The bridge: TIM3's CH1 (PA6) and CH2 (PA7) into IN1 and IN2. */
+#define BOARD_BRIDGE_TIMER 3
+#define BOARD_BRIDGE_IN1_PIN 0x06
+#define BOARD_BRIDGE_IN2_PIN 0x07
+
+/* The ADC1 channels the scan reads: IN0-IN3 on PA0-PA3. */
+#define BOARD_ADC_SUPPLY 0
+#define BOARD_ADC_CURRENT 1
+#define BOARD_ADC_NTC 2
+#define BOARD_ADC_POSITION 3
 
 
 /* The receive ring (hal/hal_rx_ring.h): a page erase stalls the CPU up
@@ -49,9 +65,7 @@
 /* The analogue front end and the motor: the reference servo's. */
 #include "boards/common/reference_servo.h"
 
-/* Pins (this folder's README.md): PA9 the bus (USART1, half duplex); PA6/PA7
- * TIM3 CH1/CH2, the bridge; PA0-PA3 ADC1 IN0-IN3: supply, current, NTC and
- * the encoder's analogue output. The port (hal/ports/stm32f1) drives them. */
+/* Pins: this folder's README.md. */
 
 #include "boards/board_derived.h"
 

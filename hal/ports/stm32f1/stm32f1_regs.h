@@ -11,15 +11,38 @@
 #define RCC_CFGR_PLLMUL9 (7u << 18)
 #define RCC_APB2ENR_AFIO (1u << 0)
 #define RCC_APB2ENR_GPIOA (1u << 2)
+#define RCC_APB2ENR_GPIOB (1u << 3)
+#define RCC_APB2ENR_GPIOC (1u << 4)
+#define RCC_APB2ENR_GPIOD (1u << 5)
+#define RCC_APB1ENR_TIM2 (1u << 0)
+#define RCC_APB1ENR_TIM4 (1u << 2)
 #define RCC_APB1ENR_USART2 (1u << 17)
 #define RCC_APB1ENR_USART3 (1u << 18)
 
 /* Flash interface (the rest in stm32_core_regs.h) */
 #define FLASH_ACR_LATENCY_2 2u
 
-/* GPIOA */
-#define GPIOA_CRL REG32(0x40010800u)
-#define GPIOA_CRH REG32(0x40010804u)
+/* GPIOA-D: a board's pins (stm32f1_pins.h); their clocks are RCC_APB2ENR's
+ * bits 2-5, one a port in order */
+#define GPIOA_BASE 0x40010800u
+#define GPIOB_BASE 0x40010C00u
+#define GPIOC_BASE 0x40011000u
+#define GPIOD_BASE 0x40011400u
+#define GPIO_CRL(b) REG32((b) + 0x00u)
+#define GPIO_CRH(b) REG32((b) + 0x04u)
+#define GPIOA_CRL GPIO_CRL(GPIOA_BASE)
+#define GPIOA_CRH GPIO_CRH(GPIOA_BASE)
+/* AFIO: the USARTs' pin remaps */
+#define AFIO_BASE 0x40010000u
+#define AFIO_MAPR REG32(AFIO_BASE + 0x04u)
+#define AFIO_MAPR_USART1_REMAP (1u << 2)
+#define AFIO_MAPR_USART2_REMAP (1u << 3)
+#define AFIO_MAPR_USART3_REMAP_PARTIAL (1u << 4)
+#define AFIO_MAPR_USART3_REMAP_FULL (3u << 4)
+/* TIM2 and TIM4: a board's bridge may take them instead of TIM3 (its
+ * registers: stm32_core_regs.h's TIM_*) */
+#define TIM2_BASE 0x40000000u
+#define TIM4_BASE 0x40000800u
 /* 4-bit pin configurations (MODE | CNF << 2) */
 #define GPIO_ANALOG 0x0u
 #define GPIO_AF_PUSH_PULL_50MHZ 0xBu

@@ -477,7 +477,7 @@ def test_a_board_without_its_images_says_which_and_leaves_no_flash_file(tmp_path
     F030 board failed with a traceback, and left a blank flash file behind."""
     import vboard.run as run
 
-    monkeypatch.setattr(run, "images", lambda board: (tmp_path / "no_boot.bin", tmp_path / "no_app.img", None))
+    monkeypatch.setattr(run, "images", lambda board, build=None: (tmp_path / "no_boot.bin", tmp_path / "no_app.img", None))
     state = tmp_path / "state"
     assert run.main(["--board", "stm32f030k6", "--state", str(state), "--tcp", "0"]) == 2
     err = capsys.readouterr().err

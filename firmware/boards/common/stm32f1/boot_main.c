@@ -1,10 +1,10 @@
-/* The bootloader on the reference board: the clock, the bus wire and its
+/* The bootloader on an STM32F1 board (the reference board's): the clock, the bus wire and its
  * USART with DMA receive, the flash, and the portable loop
  * (bootloader/bootloader.c). What differs from the other STM32
  * boards; the start-up path is the boards' shared one
  * (boards/common/boot_start.h). */
 #include "board.h"
-#include "board_io.h"
+#include "boards/common/stm32f1/board_io.h"
 #include "ports/stm32f1/stm32f1_regs.h"
 #include "ports/stm32f1/stm32f1_bus.h"
 #include "ports/stm32f1/stm32f1_uart.h"
@@ -21,7 +21,7 @@ STM32F1_BUS_DEFINED
         port_uart_init((usart), (ring), (dma), BUS_USART_PCLK_HZ(F103_PCLK1_HZ, F103_PCLK2_HZ), &bus_hw); \
         usart_hd_tx_polled(usart);                                      \
     } while (0)
-#define board_boot_stop_dma() (REG32(bus_hw.dma_rx_ccr) = 0)
+#define board_boot_stop_dma() (REG32(bus_hw.dma_rx_ccr) = 0) /* the bus's own channel */
 #define board_boot_service usart_hd_service
 
 #include "boards/common/boot_start.h"

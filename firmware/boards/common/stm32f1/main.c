@@ -1,10 +1,12 @@
-/* The reference board: STM32F103 servo controller (pin map: README.md).
- * What differs from the other STM32 boards; the start-up path and the main
+/* An STM32F1 servo board (the reference board's pin map: its README.md),
+ * its pins and instances from its board.h. What differs from the other
+ * STM32 boards; the start-up path and the main
  * loop are the boards' shared one (boards/common/app_start.h). */
 #include "board.h"
-#include "board_io.h"
+#include "boards/common/stm32f1/board_io.h"
 #include "ports/stm32f1/stm32f1_regs.h"
 #include "ports/stm32f1/stm32f1_bus.h"
+#include "ports/stm32f1/stm32f1_pins.h"
 #include "ports/stm32f1/stm32f1_uart.h"
 #include "ports/stm32f1/usart_hd.h"
 
@@ -16,10 +18,9 @@
 static void board_pins_init(void)
 {
     bus_pins_init();
-    /* PA0-PA3 analogue; PA6, PA7 TIM3 CH1/CH2 push-pull. */
-    GPIOA_CRL = (GPIO_ANALOG << 0) | (GPIO_ANALOG << 4) | (GPIO_ANALOG << 8) |
-                (GPIO_ANALOG << 12) | (GPIO_AF_PUSH_PULL_50MHZ << 24) |
-                (GPIO_AF_PUSH_PULL_50MHZ << 28) | (0x4u << 16) | (0x4u << 20);
+    /* The ADC's inputs analogue, the bridge timer's CH1/CH2 push-pull:
+     * the pins board.h names. */
+    FRONT_END_PINS_INIT();
 }
 
 STM32F1_BUS_DEFINED

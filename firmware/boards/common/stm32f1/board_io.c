@@ -1,6 +1,7 @@
-#include "board_io.h"
+#include "boards/common/stm32f1/board_io.h"
 #include "board.h"
 #include "ports/stm32f1/stm32f1_bus.h"
+#include "ports/stm32f1/stm32f1_pins.h"
 
 #include "ports/stm32f1/stm32f1_regs.h"
 
@@ -26,8 +27,8 @@ void clock_f103_init(void)
 
 void pwm_bridge_init(void)
 {
-    RCC_APB1ENR |= RCC_APB1ENR_TIM3;
-    pwm_bridge_start(TIM3_BASE, 2u * F103_PCLK1_HZ); /* the timer runs at 2 x PCLK1 */
+    RCC_APB1ENR |= BRIDGE_TIM_CLOCK; /* the timer board.h names */
+    pwm_bridge_start(BRIDGE_TIM_BASE, 2u * F103_PCLK1_HZ); /* the timer runs at 2 x PCLK1 */
 }
 
 void adc_scan_init(void)
@@ -38,10 +39,10 @@ void adc_scan_init(void)
     DMA_CMAR(DMA1_CCR_ADDR(1u)) = (uint32_t)(uintptr_t)adc_scan_values;
     DMA_CNDTR(DMA1_CCR_ADDR(1u)) = ADC_CHANNELS;
     DMA_CCR(DMA1_CCR_ADDR(1u)) = DMA_CCR_ADC_CIRCULAR;
-    /* Channels 0-3 (PA0-PA3), 55.5 cycles each: 4 x 5.8 us at 12 MHz. */
-    ADC_SMPR2 = 5u | (5u << 3) | (5u << 6) | (5u << 9);
+    /* The channels board.h names, 55.5 cycles each: 4 x 5.8 us at 12 MHz. */
+    ADC_SMPR2 = ADC_SMPR2_ALL(5u);
     ADC_SQR1 = (uint32_t)(ADC_CHANNELS - 1) << 20;
-    ADC_SQR3 = 0u | (1u << 5) | (2u << 10) | (3u << 15);
+    ADC_SQR3 = ADC_SQR3_SCAN;
     ADC_CR1 = ADC_CR1_SCAN;
     ADC_CR2 = ADC_CR2_ADON;
     ADC_CR2 = ADC_CR2_ADON | ADC_CR2_CAL;
@@ -65,10 +66,13 @@ uint32_t unique_id_serial(void *ctx)
 
 void bus_pins_init(void)
 {
-    RCC_APB2ENR |= RCC_APB2ENR_GPIOA | RCC_APB2ENR_AFIO;
+    RCC_APB2ENR |= PIN_CLOCK(BOARD_BUS_TX_PIN) | RCC_APB2ENR_AFIO;
     BUS_USART_CLOCK_ON(); /* the USART board.h names */
-    /* PA9 USART1 TX, open drain: the single bus wire (external pull-up).
-     * A bus on another USART needs its TX pin here (RM0008 Table 5:
-     * USART2 PA2, USART3 PB10): the pins are this file's, not data yet. */
-    GPIOA_CRH = (GPIOA_CRH & ~(0xFu << 4)) | (GPIO_AF_OPEN_DRAIN_50MHZ << 4);
+    if (BUS_TX_REMAP != 0u) { /* its TX on the remapped pin */
+        AFIO_MAPR |= BUS_TX_REMAP;
+    }
+    /* The TX pin board.h names, open drain: the single bus wire (external
+     * pull-up). */
+    PIN_CR(BOARD_BUS_TX_PIN) = (PIN_CR(BOARD_BUS_TX_PIN) & ~(0xFu << PIN_SHIFT(BOARD_BUS_TX_PIN))) |
+                               (GPIO_AF_OPEN_DRAIN_50MHZ << PIN_SHIFT(BOARD_BUS_TX_PIN));
 }
