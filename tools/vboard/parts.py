@@ -51,10 +51,10 @@ PARTS = {
     # The Cortex-M0+ (ARMv6-M, with a VTOR: ARMv6-M B3.2.5) on Unicorn's M0,
     # which runs the same instruction set. DS12992 (STM32G031x4/x6/x8) "Flash
     # memory characteristics": tPROG (a double word) 125 us max, tERASE (a page)
-    # 40 ms max. CPI 1.9: the F030's (the same ARMv6-M code from the same
-    # compiler; the G0's prefetch and cache at 2 wait states not measured).
+    # 40 ms max. CPI 1.86: docs/benchmark.md's M0+ model (64 MHz, 2 wait
+    # states, its cache not modelled: the whole tick 1497 cycles / 806.1).
     # System memory and the unique ID: RM0444 2.2 (0x1FFF0000, the ID at 0x1FFF7590).
-    "stm32g031k8": Part("STM32G031", arm.UC_CPU_ARM_CORTEX_M0, True, 1, 1.9,
+    "stm32g031k8": Part("STM32G031", arm.UC_CPU_ARM_CORTEX_M0, True, 1, 1.86,
                         {"rcc": "RCC", "flash": "FLASH", "dma": "DMA1", "usart": "USART1", "adc": "ADC",
                          "tim": "TIM3", "iwdg": "IWDG", "gpio": "GPIOA", "dmamux": "DMAMUX"},
                         3, 2, {1: "DMA1_Channel1", 2: "DMA1_Channel2_3", 3: "DMA1_Channel2_3"},
