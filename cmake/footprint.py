@@ -20,6 +20,12 @@ MODULES = [  # (part of the object's path in the map, name)
     (".ltrans", "servo core (servo.c, servo_turns.c, servo_store.c, servo_safety.c)"),
     ("libservo_stm32f1.a", "STM32F1 port (USART)"),
     ("libservo_stm32f0.a", "STM32F0 port (USART)"),
+    # The G0's port library compiles the drivers it shares with the F parts
+    # itself (hal/ports/stm32g0/CMakeLists.txt): its own are these three.
+    ("libservo_stm32g0.a(flash_g0.c", "STM32G0 port (USART, DMAMUX, flash)"),
+    ("libservo_stm32g0.a(stm32g0_uart.c", "STM32G0 port (USART, DMAMUX, flash)"),
+    ("libservo_stm32g0.a(usart_v2_hd.c", "STM32G0 port (USART, DMAMUX, flash)"),
+    ("libservo_stm32g0.a", "STM32 common (DMA receive, SysTick, flash, PWM, IWDG, boot jump)"),
     ("libservo_stm32_common.a", "STM32 common (DMA receive, SysTick, flash, PWM, IWDG, boot jump)"),
     ("startup_stm32", "startup, vector table"),
     ("small_div.c", "the small run-time: mem*, 32-bit division (size first)"),

@@ -1,13 +1,14 @@
 """Figures and commands in the docs against what produces them, so they
 cannot drift: docs/footprint.md against the linker maps and images of the
-build (scripts/footprint.sh's own reading), the README's robot loop against
+build (scripts/footprint.sh's own reading) and its stack table against the
+ELFs and cmake/stack-report.py, the README's robot loop against
 docs/streaming.md's table (scripts/stream_bench.sh), each board's
 BOARD_TICK_AND_PASS_US against docs/benchmark.md's table (which the test
 command checks against the target benchmark: run_target_bench.py --doc),
 every `servoctl config set` in the docs against servoctl's own parser, the
 Python servoctl needs against tools/pyproject.toml, building.md's list of
-docs against docs/. Reads files only: it costs the suite well under a
-second."""
+docs against docs/. Reads files and runs the build's own readers: it costs
+the suite a few seconds."""
 import math
 import re
 import subprocess
@@ -23,6 +24,7 @@ ROOT = Path(__file__).resolve().parents[2]
 DOCS = ROOT / "docs"
 F103 = ROOT / "build/arm/firmware/boards/stm32f103"
 F030 = ROOT / "build/arm-m0/firmware/boards/stm32f030k6"
+G031 = ROOT / "build/arm-g0/firmware/boards/stm32g031k8"
 CLOCK_MHZ = {"stm32f103": 72, "stm32f030k6": 48, "stm32g031k8": 64}  # run_target_bench.py's CLOCK_MHZ, by board
 
 
@@ -64,26 +66,42 @@ def image_flash(elf: Path) -> int:
     return int(re.search(r"flash (\d+) B", line).group(1))
 
 
-needs_arm = pytest.mark.skipif(not (F103 / "servo_stm32f103.map").exists() or not (F030 / "servo_stm32f030k6.map").exists(),
-                               reason="no ARM build (cmake --build --preset arm, arm-m0)")
+needs_arm = pytest.mark.skipif(not all((d / f"servo_{d.name}.map").exists() for d in (F103, F030, G031)),
+                               reason="no ARM build (cmake --build --preset arm, arm-m0, arm-g0)")
 
 
 @needs_arm
 def test_footprint_md_is_what_the_build_links():
     doc = (DOCS / "footprint.md").read_text()
-    f103, f030 = footprint_modules(F103 / "servo_stm32f103.map"), footprint_modules(F030 / "servo_stm32f030k6.map")
+    built = [footprint_modules(d / f"servo_{d.name}.map") for d in (F103, F030, G031)]
     modules = table_rows(doc, "| module |")
-    wrong = [f"{name}: {cells[:2]} in the doc, {[f103.get(name, 0), f030.get(name, 0)]} built"
+    wrong = [f"{name}: {cells[:3]} in the doc, {[b.get(name, 0) for b in built]} built"
              for name, cells in modules.items()
-             if [number(c) for c in cells[:2]] != [f103.get(name, 0), f030.get(name, 0)]]
-    missing = sorted((set(f103) | set(f030)) - set(modules))
+             if [number(c) for c in cells[:3]] != [b.get(name, 0) for b in built]]
+    missing = sorted(set().union(*built) - set(modules))
     assert not wrong and not missing, f"docs/footprint.md (bash scripts/footprint.sh): {wrong} {missing}"
     images = table_rows(doc, "| image |")
     for row, elf in (("reference board, STM32F103 (Cortex-M3)", F103 / "servo_stm32f103.elf"),
                      ("Cortex-M0 board, STM32F030K6 (`arm-m0`)", F030 / "servo_stm32f030k6.elf"),
+                     ("Cortex-M0+ board, STM32G031K8 (`arm-g0`)", G031 / "servo_stm32g031k8.elf"),
                      ("bootloader, STM32F103", F103 / "servo_stm32f103_boot.elf"),
-                     ("bootloader, STM32F030K6", F030 / "servo_stm32f030k6_boot.elf")):
+                     ("bootloader, STM32F030K6", F030 / "servo_stm32f030k6_boot.elf"),
+                     ("bootloader, STM32G031K8", G031 / "servo_stm32g031k8_boot.elf")):
         assert number(images[row][0]) == image_flash(elf), f"docs/footprint.md: {row}"
+
+
+@needs_arm
+def test_footprint_mds_stack_table_has_every_board_and_the_builds_figures():
+    """The stack table's boards and its reserved and static columns (the
+    ELF's and stack-report.py's, which do not move); the deepest measured
+    moves a little from run to run (the doc says why), under the static."""
+    from vboard import stack_depth
+    rows = table_rows((DOCS / "footprint.md").read_text(), "| board | stack reserved |")
+    assert list(rows) == list(stack_depth.BOARDS), "docs/footprint.md: rerun python -m vboard.stack_depth --markdown"
+    for board, (reserved, static, deepest) in rows.items():
+        worst, _ = stack_depth.static_worst(board)
+        assert (number(static), number(reserved)) == (worst, stack_depth.reserved_bytes(board)), board
+        assert 0 < number(deepest) < worst, board
 
 
 def test_the_readme_gives_the_robot_loop_of_streaming_md():

@@ -28,6 +28,7 @@ from .board import PARTS, elf
 from .idle_skip import _elf, _symbol
 
 REPO = Path(__file__).resolve().parents[2]
+BOARDS = ("stm32f103", "stm32f030k6", "stm32g031k8")  # docs/footprint.md's rows, in its order
 
 
 def static_worst(board: str) -> tuple:
@@ -36,6 +37,11 @@ def static_worst(board: str) -> tuple:
                           str(REPO / "build" / PARTS[board].build)], capture_output=True, text=True, check=True).stdout
     worst, reserved = re.search(r"worst case (\d+) B of (\d+) B reserved", out).groups()
     return int(worst), int(reserved)
+
+
+def reserved_bytes(board: str) -> int:
+    """The stack itself, without its section's alignment."""
+    return _symbol(_elf(elf(board)), "STACK_SIZE")[0]
 
 
 def work(sim, servo) -> None:
@@ -80,7 +86,7 @@ def measure(board: str) -> dict:
         finally:
             sim.stop()
     worst, _ = static_worst(board)
-    reserved = _symbol(_elf(elf(board)), "STACK_SIZE")[0]  # the stack itself, without its section's alignment
+    reserved = reserved_bytes(board)
     return {"board": board, "reserved": reserved, "static": worst, "deepest": reserved - unused, "unused": unused}
 
 
@@ -88,7 +94,7 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--markdown", action="store_true", help="the table as docs/footprint.md has it")
     args = ap.parse_args(argv)
-    rows = [measure(b) for b in ("stm32f103", "stm32f030k6")]
+    rows = [measure(b) for b in BOARDS]
     print("| board | stack reserved | static worst case (stack-report.py) | deepest measured (item 74) |")
     print("|---|---|---|---|")
     for r in rows:
