@@ -1,5 +1,5 @@
-"""The servo's own faults, each injected into the shipped image on both
-virtual boards (inject.py), and what the firmware does: the table of
+"""The servo's own faults, each injected into the shipped image on each
+virtual board (inject.py), and what the firmware does: the table of
 docs/safety.md, "The servo's own faults":
 
     python -m vboard.fault_table [--markdown]    (from tools/)
@@ -24,6 +24,7 @@ from .bench import runner_for
 from .board import PARTS, elf
 from .idle_skip import _elf, _symbol
 
+BOARDS = ("stm32f103", "stm32f030k6", "stm32g031k8")  # docs/safety.md's rows, in its order
 KINDS = ("bus", "undef", "stack", "hang", "brownout")
 WHAT = {"bus": "bus error on a register read", "undef": "undefined instruction",
         "stack": "stack overflow", "hang": "main loop hung", "brownout": "supply dip (5 ms)"}
@@ -99,10 +100,10 @@ def table(rows) -> str:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--markdown", action="store_true", help="the table as docs/safety.md has it")
-    ap.add_argument("--board", choices=sorted(PARTS), action="append", help="one board (default both)")
+    ap.add_argument("--board", choices=sorted(PARTS), action="append", help="one board (default all three)")
     args = ap.parse_args(argv)
     rows = []
-    for board_name in args.board or ["stm32f103", "stm32f030k6"]:
+    for board_name in args.board or BOARDS:
         for kind in KINDS:
             rows.append(measure(board_name, kind))
             if not args.markdown:

@@ -10,7 +10,7 @@ extern uint32_t _sstack, _estack, _ram_start;
 
 /* The bottom of the stack an overflow must not pass unseen: larger than
  * any one frame the images' functions take at once (config_store_load's
- * 164 B on the F103, the largest; cmake/stack-report.py lists them), so no
+ * 200 B on the F103 and the G031, the largest; the build's .su files), so no
  * frame can step over it. */
 #define GUARD_BYTES 256u
 #if defined(__ARM_ARCH_7M__)
