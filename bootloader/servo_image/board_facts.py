@@ -60,7 +60,10 @@ def boards_dir() -> Path:
     """firmware/boards of the tree (root())."""
     return root() / BOARDS
 
-_DEFINE = re.compile(r"#define (BOARD_\w+) (0x[0-9a-fA-F]+|\d+)\b")
+# Any #define of a BOARD_ name, its value to a comment: a fact is a plain
+# number (what CMake, the linker script and the virtual boards read alike).
+_DEFINE = re.compile(r"\s*#\s*define\s+(BOARD_\w+)(?:\s+(.*?))?\s*(?:(?://|/\*).*)?$")
+_PLAIN = re.compile(r"0x[0-9a-fA-F]+|\d+")
 _INCLUDE = re.compile(r'#include "(boards/[^"]+)"')
 _CPU = re.compile(r"^set\(SERVO_BOARD_CPU (\S+)\)", re.M)
 _FAMILY = re.compile(r"^include\(\S*family-([\w-]+)\.cmake\)", re.M)
@@ -72,17 +75,23 @@ def folder_of(board) -> Path:
     return Path(board) if isinstance(board, Path) else boards_dir() / board
 
 
-def _numbers(header: Path) -> dict:
+def _numbers(header: Path, odd=None) -> dict:
     """A header's plain numbers, an included one's where it stands: a later
-    #define overrides (host_sim's BOARD_ID after the reference board's)."""
+    #define overrides (host_sim's BOARD_ID after the reference board's).
+    A BOARD_ value of this header that is not one is put in odd (a line
+    each), if given; an included header's derived values are not facts."""
     out = {}
     for line in header.read_text().splitlines():
         included = _INCLUDE.match(line)
         if included:
             out.update(_numbers(root() / "firmware" / included.group(1)))
         found = _DEFINE.match(line)
-        if found:
-            out[found.group(1)] = int(found.group(2), 0)
+        if found and found.group(2):  # not a guard
+            if _PLAIN.fullmatch(found.group(2)):
+                out[found.group(1)] = int(found.group(2), 0)
+            elif odd is not None:
+                odd.append(f"{header.name}: {found.group(1)} is {found.group(2)!r}: a board fact is a plain "
+                           "number, decimal or 0x hex (no parentheses, suffix or expression)")
     return out
 
 
@@ -189,7 +198,10 @@ def check(board) -> list:
                 else "names no part: add set(SERVO_BOARD_PART name)")
         return [f"{folder.name}: board.cmake {said} (the parts: {', '.join(sorted(known))})"]
     p = known[name]
-    d = defines(folder)
+    odd = []
+    d = _numbers(folder / "board.h", odd)
+    if odd:
+        return [f"{folder.name}: {line}" for line in odd]
     problems = []
 
     def say(text):

@@ -99,6 +99,14 @@ def test_a_board_its_part_contradicts_is_named_fact_by_fact(tmp_path):
          "BOARD_BUS_USART 4: the part has no USART4"),
         ("stm32f103", [("#define BOARD_ADC_NTC 2", "#define BOARD_ADC_NTC 12")], None,
          "BOARD_ADC_NTC 12: the part's ADC has inputs 0-9 on its pins"),
+        # A fact as anything but a plain number is refused, not skipped (a
+        # config page past the flash in parentheses went unchecked).
+        ("stm32g031k8", [("#define BOARD_CONFIG_PAGE0 0x0800F000", "#define BOARD_CONFIG_PAGE0 (0x08010000)")],
+         None, "BOARD_CONFIG_PAGE0 is '(0x08010000)': a board fact is a plain number"),
+        ("stm32g031k8", [("#define BOARD_CONFIG_PAGE0 0x0800F000", "#define  BOARD_CONFIG_PAGE0  0x08010000u")],
+         None, "BOARD_CONFIG_PAGE0 is '0x08010000u': a board fact is a plain number"),
+        ("stm32g031k8", [("#define BOARD_CONFIG_PAGE0 0x0800F000", "#define BOARD_CONFIG_PAGE0  0x08010000 /* x */")],
+         None, "BOARD_CONFIG_PAGE0 at 0x08010000, 2048 B, ends past the part's 64 KB"),
     ]
     for i, (name, edits, part, said) in enumerate(cases):
         problems = board_facts.check(_board_like(tmp_path / str(i), name, edits, part))

@@ -39,7 +39,12 @@ HSE_HZ = 8_000_000  # the boards' crystal (firmware/boards/*/board_io.h)
 
 
 def board_h(board) -> dict:
-    """board.h's numbers (servo_image.board_facts: the one reader of a board's facts)."""
+    """board.h's numbers (servo_image.board_facts: the one reader of a
+    board's facts); a board its part contradicts is not run (ValueError,
+    the check's lines)."""
+    problems = board_facts.check(board)
+    if problems:
+        raise ValueError("; ".join(problems))
     return board_facts.defines(board)
 
 
@@ -97,7 +102,8 @@ class Board:
         n = part.names
         self.motor = Motor(supply_v, ambient_c, plant)
         self.rcc = (RccG0 if family == "g0" else Rcc)(self, dev[n["rcc"]], HSE_HZ, 1)
-        file = f"{board}-{servo_id}" + (f"-{unit + 1}" if unit else "") + ".flash"
+        # A board given as a folder: its name (a path would leave state_dir).
+        file = f"{Path(str(board)).name}-{servo_id}" + (f"-{unit + 1}" if unit else "") + ".flash"
         path = None if state_dir is None else Path(state_dir) / file
         self.flash = (FlashG0 if family == "g0" else Flash)(
             self, dev[n["flash"]], self.flash_mem, self.flash_base, self.flash_size, h["BOARD_FLASH_PAGE"], path,

@@ -37,6 +37,8 @@ import servo_schema as schema
 
 from pathlib import Path
 
+from servo_image import board_facts
+
 from .board import PARTS, Board, images, part_of
 from .bus import Bus
 from .clock_file import ClockFile
@@ -348,6 +350,9 @@ def main(argv=None) -> int:
             ap.error(f"--board {args.board}: neither a shipped board ({', '.join(sorted(PARTS))}) "
                      "nor a folder with a board.h")
         args.board = folder.resolve()
+        problems = board_facts.check(args.board)
+        if problems:
+            ap.error("; ".join(problems))
     try:
         build = part_of(args.board).build
     except ValueError as e:
