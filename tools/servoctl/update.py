@@ -48,7 +48,16 @@ def status(bus, servo_id: int, timeout=None) -> Status:
 
 
 def decode_status(c: bytes) -> Status:
-    return Status(*_p.decode_answer(UPDATE_STATUS, c)[1:])
+    """An UpdateStatus answer; BadAnswer for a slot's geometry nothing can
+    be written into (no page, no pages, a write block of 0 or above the
+    largest write): an update would divide by it or write nowhere."""
+    st = Status(*_p.decode_answer(UPDATE_STATUS, c)[1:])
+    if st.mode == MODE_BOOTLOADER and not (st.page_size and st.pages and
+                                           0 < st.write_block <= st.largest_write):
+        raise BadAnswer(f"servo {c[0]}: its bootloader gave a slot no image fits (page size "
+                        f"{st.page_size}, {st.pages} pages, write block {st.write_block}, "
+                        f"largest write {st.largest_write})")
+    return st
 
 
 def enter_refusal(servo_id: int, reason) -> str:

@@ -23,13 +23,13 @@ def cmd_update(bus, args):
     failed = []
     say = getattr(args, "on_progress", lambda servo_id, done, total: None)  # servoctl ui's bar
     for servo_id in ids:
-        if args.catch:
-            print(f"servo {servo_id}: power it up now (waiting {args.catch:g} s for its bootloader)",
-                  file=sys.stderr)
-            upd.catch(bus, servo_id, args.catch)
-        started = time.monotonic()
         columns = [TextColumn(f"servo {servo_id}"), BarColumn(), DownloadColumn(), TimeRemainingColumn()]
         try:
+            if args.catch:  # one that does not appear is a failure, and the next is tried
+                print(f"servo {servo_id}: power it up now (waiting {args.catch:g} s for its bootloader)",
+                      file=sys.stderr)
+                upd.catch(bus, servo_id, args.catch)
+            started = time.monotonic()
             with Progress(*columns, transient=True, disable=not sys.stderr.isatty()) as progress:
                 task = progress.add_task("update", total=len(image.data))
                 before, after = upd.update(bus, servo_id, image,
