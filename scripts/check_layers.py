@@ -75,18 +75,20 @@ CI_FOLDER = ".ci/"
 SCHEMA_FILES = ("protocol/servo_schema/*.toml", "protocol/*.toml")
 SCHEMA_LINE_LIMIT = 120
 
-DIRECTIVE = re.compile(r"^[ \t]*#[ \t]*include\b(.*)$", re.M)
-COMMENT = re.compile(r"/\*.*?\*/|//.*")
+C_FILES = (".c", ".h", ".inc", ".def")  # what C code is written in, and includes
+DIRECTIVE = re.compile(r"^[ \t]*(?:#|%:)[ \t]*include\b(.*)$", re.M)
+COMMENT = re.compile(r"/\*.*?\*/|//[^\n]*", re.S)
 NAMED = re.compile(r'^"([^"]+)"$|^<([^>]+)>$')
 
 
 def includes(root, rel, text):
     """(the project files' names a file includes, what is wrong with its
-    includes): every #include directive, in either form; a name that
+    includes): every #include (%:include), comments out, either form; a name that
     reaches above its folder ("..") or no name at all (a macro) hides
     which layer it reaches, and a project header in <> looks like the
     system's. A linker template's board.h comes from the build (a macro)."""
     names, wrong = [], []
+    text = COMMENT.sub(lambda c: " " + "\n" * c.group(0).count("\n"), text)  # lines kept
     for found in DIRECTIVE.findall(text):
         operand = COMMENT.sub("", found).strip()
         named = NAMED.match(operand)
@@ -124,7 +126,7 @@ def unplaced(root):
 
 
 def sources(root):
-    for path in sorted(root.rglob("*.[ch]")):
+    for path in sorted(p for p in root.rglob("*") if p.suffix in C_FILES):
         rel = path.relative_to(root).as_posix()
         if rel.startswith(("build/", "tests/", ".")) or layer_of(rel) is None:
             continue
@@ -160,7 +162,7 @@ def include_breaches(root):
     """Every include names its layer ("runtime/crc32.h") and one file; no
     two headers share a name, but for a board's own (board.h in each)."""
     out = []
-    files = [p for p in sorted(root.rglob("*")) if p.suffix in (".c", ".h", ".in") and p.is_file()]
+    files = [p for p in sorted(root.rglob("*")) if p.suffix in C_FILES + (".in",) and p.is_file()]
     headers = {}
     for path in files:
         rel = path.relative_to(root).as_posix()
@@ -182,9 +184,8 @@ def include_breaches(root):
     return out
 
 
-# The application's hub: struct servo, the main loop's state and every
-# job's. Only the main loop (servo.c, servo.h, servo_state.h) reaches it;
-# every other file of the application's is a job's, handed what it needs.
+# The application's hub: struct servo, the main loop's state and every job's. Only the main
+# loop (servo.c, servo.h, servo_state.h) reaches it; any other file is a job's, handed what it needs.
 HUB_HEADERS = ("firmware/app/servo_state.h", "firmware/app/servo.h")
 HUB_FILES = ("firmware/app/servo.c", "firmware/app/servo.h", "firmware/app/servo_state.h")
 HUB_STRUCT = re.compile(r"\bstruct\s+servo\b(?!_)")

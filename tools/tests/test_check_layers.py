@@ -94,6 +94,19 @@ def test_a_lower_layer_including_a_higher_one_is_found(tmp_path):
                         "motion/include/motion/motion.h (motion)"]
 
 
+@pytest.mark.parametrize("rel, text", [
+    ("protocol/wire/frame_rx.c", '/* a comment first */ #include "motion/motion.h"\n'),
+    ("protocol/wire/frame_rx.c", '%:include "motion/motion.h"\n'),  # the digraph
+    ("protocol/wire/frame_rx.inc", '#include "motion/motion.h"\n'),  # a file included, not compiled
+])
+def test_an_include_in_any_form_the_compiler_takes_is_found(tmp_path, rel, text):
+    root = tree(tmp_path)
+    write(root, rel, text)
+    write(root, "protocol/wire/frame_rx_hidden.c", '/*\n#include "motion/motion.h"\n*/\n')  # not an include
+    breaches, _ = check_layers.check(root)
+    assert breaches == [f"layer: {rel} (wire) includes motion/include/motion/motion.h (motion)"]
+
+
 def test_a_job_reaching_the_application_hub_is_found(tmp_path):
     root = tree(tmp_path)
     write(root, "firmware/app/servo_state.h", "struct servo { int tick; };\n")
