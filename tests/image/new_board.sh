@@ -33,7 +33,7 @@ copy() {
   grep -q "^#define BOARD_BUS_TX_PIN $6" "$h" || { echo "TX pin not set"; exit 1; }
 }
 copy my_servo 0x0777
-copy my_servo_usart2 0x0778 0x2 7 6u 0x02  # a variant from data alone: its bus on USART2, PA2 (as any C number)
+copy my_servo_usart2 0x0778 0x2 7 6 0x02  # a variant from data alone: its bus on USART2, PA2
 cmake -S "$tmp" -B "$tmp/build" -G Ninja -DCMAKE_TOOLCHAIN_FILE="$tmp/cmake/arm-none-eabi.cmake" \
   -DCMAKE_BUILD_TYPE=MinSizeRel "-DSERVO_BOARDS=my_servo;my_servo_usart2" >"$tmp/configure.log" 2>&1 ||
   { tail -20 "$tmp/configure.log"; echo "the new board did not configure"; exit 1; }
@@ -68,4 +68,13 @@ cmake -S "$tmp" -B "$tmp/bad" -G Ninja -DCMAKE_TOOLCHAIN_FILE="$tmp/cmake/arm-no
 if cmake --build "$tmp/bad" -- -k 0 >"$tmp/bad.log" 2>&1; then echo "a bus on the wrong DMA channels or pin built"; exit 1; fi
 grep -q "are not its USART.*DMA1 channels (RM0008 Table 78" "$tmp/bad.log" || { tail -5 "$tmp/bad.log"; echo "no reason given"; exit 1; }
 grep -q "BOARD_BUS_TX_PIN is not its USART's TX (RM0008 9.3.8" "$tmp/bad.log" || { tail -5 "$tmp/bad.log"; echo "no reason for the pin"; exit 1; }
+# A fact written other than as a plain number (a C suffix) stops the
+# configure, naming it: the linker script and the tools read them as numbers.
+copy suffixed 0x077B 0x2 7 6u 0x02
+if cmake -S "$tmp" -B "$tmp/suffixed" -G Ninja -DCMAKE_TOOLCHAIN_FILE="$tmp/cmake/arm-none-eabi.cmake" \
+  -DCMAKE_BUILD_TYPE=MinSizeRel "-DSERVO_BOARDS=suffixed" >"$tmp/suffixed.log" 2>&1; then
+  echo "a board fact with a suffix configured"; exit 1
+fi
+grep -q "BOARD_BUS_DMA_RX is '6u': a board fact is a plain number" "$tmp/suffixed.log" ||
+  { tail -5 "$tmp/suffixed.log"; echo "no reason for the suffix"; exit 1; }
 echo "new board: a copied folder builds as my_servo (board 0x0777), one with its bus on USART2 as data"
