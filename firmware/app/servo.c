@@ -272,7 +272,7 @@ __attribute__((noinline, cold)) static void after_erase(struct servo *s, uint32_
 static void restart_into_bootloader(struct servo *s)
 {
     s->enter_bootloader = 0;
-    hal_enter_bootloader(s->hal);
+    hal_enter_bootloader(s->hal, s->active_id, s->active_baud_index);
 }
 
 /* The jobs' upkeep, once a control tick: the monitors', then the store's

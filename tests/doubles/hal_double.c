@@ -81,9 +81,11 @@ static void sensors_read(void *ctx, struct sensor_raw *out)
     out->ntc = h->sensors.ntc;
 }
 
-void hal_double_enter_bootloader(void *ctx)
+void hal_double_enter_bootloader(void *ctx, uint8_t id, uint8_t baud_index)
 {
-    ((struct hal_double *)ctx)->bootloader_entries++;
+    struct hal_double *h = ctx;
+    h->bootloader_entries++;
+    h->bootloader_link = (uint16_t)(id | baud_index << 8);
 }
 
 void hal_double_init(struct hal_double *h)

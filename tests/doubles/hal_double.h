@@ -44,6 +44,7 @@ struct hal_double {
     struct sensor_raw sensors;
     struct sensor_calibration calibration;
     unsigned bootloader_entries; /* hal_double_enter_bootloader calls */
+    uint16_t bootloader_link;    /* the last one's ID | baud index << 8 */
 };
 
 void hal_double_init(struct hal_double *h);
@@ -53,6 +54,6 @@ void hal_double_dma_reads(struct hal_double *h);
 void hal_double_clear_sent(struct hal_double *h);
 /* An enter_bootloader op that counts its calls (port.enter_bootloader is
  * NULL until a test sets it to this). */
-void hal_double_enter_bootloader(void *ctx);
+void hal_double_enter_bootloader(void *ctx, uint8_t id, uint8_t baud_index);
 
 #endif

@@ -12,7 +12,7 @@
 
 #include "ports/stm32_common/kept_ram.c"
 
-struct kept_ram _kept_ram; /* the linker's on the boards; never read here */
+struct kept_ram _kept_ram; /* the linker's on the boards */
 
 static struct kept_ram kept;
 
@@ -117,6 +117,28 @@ static void test_an_update_restart_is_no_fault(void **state)
     assert_int_equal(r->counts[HAL_COUNT_OTHER], 0);
 }
 
+/* UpdateEnter's restart hands its bootloader the ID and baud index the
+ * application answered at, in the kept record: only an intact record of a
+ * planned restart hands them. */
+static void test_a_planned_restart_hands_the_bootloader_its_link(void **state)
+{
+    (void)state;
+    memset(&_kept_ram, 0xA5, sizeof _kept_ram); /* what a power-on leaves */
+    uint8_t id = 0;
+    uint8_t baud_index = 0;
+    assert_false(kept_link(&id, &baud_index));
+    kept_note_planned(7, 8);
+    assert_true(kept_link(&id, &baud_index));
+    assert_int_equal(id, 7);
+    assert_int_equal(baud_index, 8);
+    _kept_ram.link_id = 9; /* a bit changed: the CRC no longer checks */
+    assert_false(kept_link(&id, &baud_index));
+    kept_note_planned(7, 8);
+    _kept_ram.note = KEPT_FAULT;
+    kept_seal(&_kept_ram); /* a fault's record, not a planned restart */
+    assert_false(kept_link(&id, &baud_index));
+}
+
 static void test_own_faults_count_in_a_row_the_supplys_do_not(void **state)
 {
     (void)state;
@@ -174,6 +196,7 @@ int main(void)
         cmocka_unit_test(test_a_fault_is_reported_once_with_its_frame),
         cmocka_unit_test(test_the_flags_name_the_rest),
         cmocka_unit_test(test_an_update_restart_is_no_fault),
+        cmocka_unit_test(test_a_planned_restart_hands_the_bootloader_its_link),
         cmocka_unit_test(test_own_faults_count_in_a_row_the_supplys_do_not),
         cmocka_unit_test(test_a_record_cut_or_corrupt_is_a_power_on),
         cmocka_unit_test(test_counts_stop_at_255),

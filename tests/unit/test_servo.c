@@ -770,6 +770,9 @@ static void test_update_enter_restarts_into_the_bootloader(void **state)
     hal.tx_busy = false;
     harness_poll(2);
     assert_int_equal(hal.bootloader_entries, 1);
+    /* The bootloader is told where the application answered: ID 0 at
+     * 115 200 (index 5), whatever it would read from the store. */
+    assert_int_equal(hal.bootloader_link, 0 | 5 << 8);
     harness_restart();
     REQUEST(PKT_READ_DATA, 0, ITEM_CURRENT_LIMIT_MA);
     EXPECT_ITEM(0, ITEM_CURRENT_LIMIT_MA, 1621);

@@ -21,6 +21,12 @@ struct boot_board {
     const struct app_slot *slot;
     uint16_t board;
     uint32_t stay_word;          /* what UpdateEnter left in RAM */
+    /* Where UpdateEnter's application answered (link_handed): the ID and
+     * baud index to answer at, not the store's newest record's (a record
+     * the application refused, or a format it could not rewrite). */
+    uint8_t link_handed;
+    uint8_t link_id;
+    uint8_t link_baud;
     /* Starts the image in the slot (its vector table after the header);
      * does not return. */
     void (*start_app)(const struct app_slot *slot);

@@ -17,10 +17,10 @@ static uint16_t image_version(void *ctx)
 }
 
 /* UpdateEnter: the word that keeps the bootloader, then a restart. */
-static void enter_bootloader(void *ctx)
+static void enter_bootloader(void *ctx, uint8_t id, uint8_t baud_index)
 {
     (void)ctx;
-    kept_note_planned(); /* not a fault: the next start-up is told */
+    kept_note_planned(id, baud_index); /* not a fault: the next start-up is told */
     boot_restart_with(BOOT_STAY_WORD_ADDR(BOARD_RAM_END), BOOT_STAY_MAGIC);
 }
 

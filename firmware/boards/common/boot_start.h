@@ -18,6 +18,7 @@
 #include "bootloader/bootloader.h"
 #include "ports/stm32_common/boot_jump.h"
 #include "ports/stm32_common/flash_f0f1.h"
+#include "ports/stm32_common/kept_ram.h"
 #include "ports/stm32_common/systick_clock.h"
 
 static BOARD_USART usart;
@@ -70,6 +71,9 @@ static void service(void)
 int main(void)
 {
     uint32_t stay = boot_take_word(BOOT_STAY_WORD_ADDR(BOARD_RAM_END));
+    uint8_t link_id = 0;
+    uint8_t link_baud = 0;
+    bool handed = stay == BOOT_STAY_MAGIC && kept_link(&link_id, &link_baud);
     board_clock_init();
     bus_pins_init();
     systick_clock_init(BOARD_CORE_HZ);
@@ -78,6 +82,7 @@ int main(void)
     board_boot_uart_start(&usart, &rx_ring, &rx_dma);
     const struct boot_board board = {.port = &port, .slot = &slot, .board = BOARD_ID,
                                      .stay_word = stay, .start_app = start_app,
+                                     .link_handed = handed, .link_id = link_id, .link_baud = link_baud,
                                      .service = BOOT_SERVICE};
     bootloader_run(&board);
     return 0;

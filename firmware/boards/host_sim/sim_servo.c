@@ -208,8 +208,10 @@ bool sim_servo_boot_poll(struct sim_servo *s)
     return false;
 }
 
-static void enter_bootloader(void *ctx)
+static void enter_bootloader(void *ctx, uint8_t id, uint8_t baud_index)
 {
+    (void)id; /* the simulated bootloader reads the same store the servo did */
+    (void)baud_index;
     boot_reset(ctx, true);
 }
 

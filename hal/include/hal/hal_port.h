@@ -69,9 +69,11 @@ struct hal_port {
      * application was started from, read once at start; 0 where there is
      * none (the core then reports the version it was built as). Optional. */
     uint16_t (*image_version)(void *ctx);
-    /* Restarts into the bootloader, which then stays (UpdateEnter); NULL
-     * where there is none. Does not return on silicon. */
-    void (*enter_bootloader)(void *ctx);
+    /* Restarts into the bootloader, which then stays (UpdateEnter) and
+     * answers at the ID and baud index given (the application's: its own
+     * reading of the store could differ); NULL where there is none. Does
+     * not return on silicon. */
+    void (*enter_bootloader)(void *ctx, uint8_t id, uint8_t baud_index);
     /* Why the MCU last started (hal_reset.h), read by the board before
      * servo_init; NULL: a power-on (a port that cannot tell). */
     const struct hal_reset *reset;
@@ -114,12 +116,11 @@ static inline void hal_rx_sync(const struct hal_port *h, uint32_t now_us)
     }
 }
 
-/* UpdateEnter's restart; nothing where the board has no bootloader. */
-static inline void hal_enter_bootloader(const struct hal_port *h)
+/* UpdateEnter's restart, on a board with a bootloader (enter_bootloader
+ * set: the dispatcher refuses UpdateEnter elsewhere). */
+static inline void hal_enter_bootloader(const struct hal_port *h, uint8_t id, uint8_t baud_index)
 {
-    if (h->enter_bootloader != NULL) {
-        h->enter_bootloader(h->ctx);
-    }
+    h->enter_bootloader(h->ctx, id, baud_index);
 }
 
 #endif

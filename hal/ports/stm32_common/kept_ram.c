@@ -88,10 +88,23 @@ const struct hal_reset *reset_cause_take(void)
     return &_kept_ram.reset;
 }
 
-void kept_note_planned(void)
+void kept_note_planned(uint8_t id, uint8_t baud_index)
 {
     _kept_ram.note = KEPT_PLANNED;
+    _kept_ram.link_id = id;
+    _kept_ram.link_baud = baud_index;
     kept_seal(&_kept_ram);
+}
+
+bool kept_link(uint8_t *id, uint8_t *baud_index)
+{
+    const struct kept_ram *k = &_kept_ram;
+    if (k->magic != KEPT_MAGIC || k->crc != kept_crc(k) || k->note != KEPT_PLANNED) {
+        return false;
+    }
+    *id = k->link_id;
+    *baud_index = k->link_baud;
+    return true;
 }
 
 void kept_healthy(void)

@@ -26,7 +26,9 @@ struct kept_ram {
     uint32_t magic;
     struct hal_reset reset; /* the last reset's, as the port gives it (hal_port.reset) */
     uint8_t note;           /* enum kept_note */
-    uint8_t spare[3];
+    uint8_t link_id;        /* KEPT_PLANNED: the ID and baud index the application */
+    uint8_t link_baud;      /* answered at, where its bootloader answers (kept_link) */
+    uint8_t spare;
     uint32_t crc;           /* CRC-32 of the bytes before it */
 };
 
@@ -40,8 +42,12 @@ void reset_classify(uint32_t csr, struct kept_ram *k);
 /* reset_classify of this start's flags, which are then cleared: the
  * reset, kept in place. */
 const struct hal_reset *reset_cause_take(void);
-/* Before a restart the firmware means (UpdateEnter's). */
-void kept_note_planned(void);
+/* Before a restart the firmware means (UpdateEnter's): the ID and baud
+ * index it answers at, which its bootloader then answers at too. */
+void kept_note_planned(uint8_t id, uint8_t baud_index);
+/* The bootloader's start: true with the link kept_note_planned left, when
+ * a restart the application meant left an intact record. */
+bool kept_link(uint8_t *id, uint8_t *baud_index);
 /* The servo ran long enough without a fault: the next fault reset is the
  * first in a row again (not in safe mode: HAL_SAFE_MODE_RESETS). */
 void kept_healthy(void);

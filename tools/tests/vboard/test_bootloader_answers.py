@@ -1,14 +1,22 @@
 """The bootloader's answers on the virtual boards (the shipped images), as
 servoctl's update waits for them: polled as it starts, and the image check.
 Runs in this process (power_cuts.py); time is the boards' simulated time."""
+import struct
+import zlib
+
 import pytest
 
 from servoctl import protocol as p
 from servoctl import update as upd
 from servoctl.protocol import NoReply
 
+from vboard.board import board_h
+
 from .power_cuts import Cuts
+from .test_power_cuts import RECORD
 from .test_virtual_boards import BOARDS
+
+RECORD_MAGIC = b"\xf1\xc0"  # a config record's first bytes (config_record.h)
 
 
 @pytest.mark.parametrize("name", BOARDS)
@@ -55,5 +63,37 @@ def test_the_image_check_answers_within_servoctls_allowance(tmp_path, name):
         assert verdict == 0 and size > 16 * 1024
         wire_ms = (6 + 19) * 10 / 115200 * 1000  # the request's and the answer's bytes
         assert took_ms <= upd.CHECK_MS_PER_KB * size / 1024 + wire_ms + 1.0
+    finally:
+        cuts.close()
+
+
+@pytest.mark.parametrize("name", BOARDS)
+def test_the_bootloader_answers_where_the_application_did(tmp_path, name):
+    """A newest config record whose CRC checks but whose items this
+    firmware refuses (another firmware's ranges: here ID 7 with an angle
+    limit out of range): the application loads the record before it (ID 1),
+    the bootloader's own reading would take ID 7. Entered by UpdateEnter it
+    answers at the ID the application answered at."""
+    cuts = Cuts(name, str(tmp_path / "state"))
+    try:
+        assert cuts.in_application()
+        h = board_h(name)
+        page0 = h["BOARD_CONFIG_PAGE0"]
+        raw = bytes(cuts.board.flash_mem.read(page0 - cuts.board.flash_base, h["BOARD_FLASH_PAGE"]))
+        starts = [at for at in range(0, len(raw) - RECORD + 1, RECORD) if raw[at:at + 2] == RECORD_MAGIC]
+        newest = bytearray(raw[starts[-1]:starts[-1] + RECORD])
+        struct.pack_into("<I", newest, 4, struct.unpack_from("<I", newest, 4)[0] + 1)  # its sequence
+        newest[14] = 7  # the servo ID
+        struct.pack_into("<h", newest, 12 + 26, -32768)  # angle_max, out of its range
+        struct.pack_into("<I", newest, RECORD - 4, zlib.crc32(bytes(newest[:RECORD - 4])))
+        cuts.write_flash(page0 + starts[-1] + RECORD, bytes(newest))
+        cuts.flash.persist(0, cuts.board.flash_size)
+        cuts.board.power_cycle()
+        assert cuts.in_application(2.0)
+        cuts.host.request(p.PING, bytes([1]), timeout=0.05)  # the application loaded ID 1
+        st = upd.enter_bootloader(cuts.host, 1)
+        assert st.mode == upd.MODE_BOOTLOADER
+        with pytest.raises(NoReply):
+            cuts.host.request(p.PING, bytes([7]), timeout=0.05)
     finally:
         cuts.close()
