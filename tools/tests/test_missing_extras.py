@@ -31,18 +31,21 @@ for argv in (["record", "1", "-45", "--out", "{tmp_path / 'rec'}"],
              ["monitor", "1", "--count", "2", "--plot-file", "{tmp_path / 'run.png'}"],
              ["faults", "1", "--elf", "{tmp_path / 'app.elf'}"]):
     print("exit", argv[0], main(["--port", sys.argv[1], *argv]), flush=True)
+# A port that does not open: the missing extra is named all the same (not exit 4).
+print("exit record-no-port", main(["--port", "socket://127.0.0.1:9", "record", "1", "-45",
+                                   "--out", "{tmp_path / 'rec'}"]), flush=True)
 print("exit sim", main(["sim", "--board", "stm32f030k6"]), flush=True)
 print("moved", abs(angle() - before) > 20)
 """
     with Simulator(ids=[1], fast=True) as sim:
         done = run_alone(tmp_path, script, sim, core_modules(PROJECT["dependencies"] +
                                                               PROJECT["optional-dependencies"]["cli"]))
-    assert done.stdout.splitlines() == ["exit record 2", "exit monitor 2", "exit faults 2", "exit sim 2",
-                                        "moved False"], done.stdout + done.stderr
+    assert done.stdout.splitlines() == ["exit record 2", "exit monitor 2", "exit faults 2", "exit record-no-port 2",
+                                        "exit sim 2", "moved False"], done.stdout + done.stderr
     lines = done.stderr.splitlines()
     assert [line.partition(" is not installed")[0] for line in lines] == [
         "servoctl: error: matplotlib", "servoctl: error: matplotlib", "servoctl: error: pyelftools",
-        "servoctl: error: unicorn"], done.stderr
+        "servoctl: error: matplotlib", "servoctl: error: unicorn"], done.stderr
     assert all("pip install 'servoctl[" in line for line in lines), done.stderr
     assert not (tmp_path / "rec.csv").exists()
 

@@ -56,6 +56,7 @@ def _run(args, clock=None) -> int:
         return NO_BUS[args.command](args)
     if args.command == "config":
         args_.config_operands(args)
+    extras.require(*commands.EXTRAS.get(args.command, ()))  # before the port: its extra named first
     if not args.port:
         raise UsageError("no port: give --port or set SERVOCTL_PORT")
     baud = link_rate.open_rate(args.port, args.baud, args.sim_control)

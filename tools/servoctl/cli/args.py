@@ -172,6 +172,16 @@ def update_operands(targets) -> tuple:
     return [int(i) for i in ids_], images[0]
 
 
+class _TreeBoards:
+    """The boards of the firmware tree servoctl finds (servo_image.boards()),
+    named when a help text is printed: a help's %(boards)s, read then, so no
+    other command pays for reading the boards' board.h."""
+
+    def __str__(self) -> str:
+        from .. import image
+        return ", ".join(image.boards()) or "none: no firmware tree found; set SERVO_FIRMWARE_ROOT"
+
+
 def build_parser():
     ap = argparse.ArgumentParser(prog="servoctl", description=DESCRIPTION,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -368,7 +378,8 @@ def build_parser():
     c = sub.add_parser("image", help="make an update image from an application binary")
     c.add_argument("binary", help="the application from its vector table (objcopy -O binary)")
     c.add_argument("--version", required=True, help="firmware version, data item 7 (e.g. 0x0011)")
-    c.add_argument("--board", required=True, help="a board of firmware/boards (stm32f103, stm32f030k6, qemu_stm32vl, host_sim) or its number")
+    c.add_argument("--board", required=True,
+                   help="a board of firmware/boards (%(boards)s) or its number").boards = _TreeBoards()
     c.add_argument("-o", "--output", required=True)
 
     c = sub.add_parser("sim", help="run the simulator, or a virtual board (--board)")

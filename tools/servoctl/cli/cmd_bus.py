@@ -40,7 +40,7 @@ def cmd_scan(bus, args):
     if args.json:
         print(json.dumps([f.as_json() for f in found]))
     else:
-        print(scan.count_line(found), "(interrupted)" if interrupted else "")
+        print(scan.count_line(found) + (" (interrupted)" if interrupted else ""))
     if interrupted:
         print("servoctl: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED

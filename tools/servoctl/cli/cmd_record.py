@@ -167,3 +167,8 @@ def _plot(rows, plan, path, title, profile_end, finished):
 COMMANDS = {
     "record": cmd_record,
 }
+# The optional modules a command needs, checked before its port opens
+# (app.py): a missing plot library named, not a port's error first.
+EXTRAS = {
+    "record": ("matplotlib",),
+}

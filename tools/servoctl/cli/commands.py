@@ -12,6 +12,9 @@ from . import (cmd_bus, cmd_config, cmd_drive, cmd_faults, cmd_group, cmd_info, 
 _MODULES = (cmd_bus, cmd_info, cmd_faults, cmd_config, cmd_motion, cmd_monitor, cmd_record, cmd_stream,
             cmd_drive, cmd_group, cmd_update)
 COMMANDS = {name: run for module in _MODULES for name, run in module.COMMANDS.items()}
+# The optional modules each command needs whatever its options (extras.py),
+# from the modules that say: app.py checks them before it opens the port.
+EXTRAS = {name: needs for module in _MODULES for name, needs in getattr(module, "EXTRAS", {}).items()}
 
 
 def run_command(bus, args, table=None) -> int:

@@ -15,7 +15,7 @@ def run(sim, capsys, *args):
 
 def test_scan_ping_info(sim, capsys):
     rc, out, _ = run(sim, capsys, "scan", "--last", "5")
-    assert rc == 0 and "servo 1 at 115200 baud, serial 0x51a00001\n" in out and "1 servo(s) found" in out
+    assert rc == 0 and "servo 1 at 115200 baud, serial 0x51a00001\n" in out and "1 servo(s) found\n" in out
     assert run(sim, capsys, "ping", "1")[0] == 0
     rc, out, _ = run(sim, capsys, "ping", "9")
     assert rc == 3 and "no reply" in out
