@@ -31,12 +31,22 @@ enum slot_write_result slot_write(const struct app_slot *slot, uint32_t offset,
     }
     /* A block that already holds its bytes is left alone: a write repeated
      * because its answer was lost succeeds instead of meeting flash it
-     * cannot program twice. */
+     * cannot program twice. One that holds neither them nor the erased
+     * state (a program step the power cut short; on the G0 its torn double
+     * word reads as zeros) is not programmed: only erasing its page mends it. */
     uint8_t held[8];
     for (uint32_t i = 0; i < len; i += block) {
         uint32_t at = slot->base + offset + i;
         f->read(f->ctx, at, held, block);
-        if (memcmp(held, &data[i], block) != 0 && !f->program(f->ctx, at, &data[i])) {
+        if (memcmp(held, &data[i], block) == 0) {
+            continue;
+        }
+        for (uint32_t k = 0; k < block; k++) {
+            if (held[k] != 0xFFu) {
+                return SLOT_WRITE_NOT_ERASED;
+            }
+        }
+        if (!f->program(f->ctx, at, &data[i])) {
             return SLOT_WRITE_FLASH_FAILED;
         }
     }
