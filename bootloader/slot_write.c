@@ -1,5 +1,6 @@
 #include "bootloader/slot_write.h"
 
+#include <stddef.h>
 #include <string.h>
 
 #include "runtime/crc32.h"
@@ -31,12 +32,24 @@ enum slot_write_result slot_write(const struct app_slot *slot, uint32_t offset,
     }
     /* A block that already holds its bytes is left alone: a write repeated
      * because its answer was lost succeeds instead of meeting flash it
-     * cannot program twice. */
+     * cannot program twice. One that holds neither them nor the erased
+     * state is not programmed: only erasing its page mends it. So is one
+     * that cannot be read (on the G0 a double word a cut left torn, read as
+     * zeros: not its bytes, though they be zeros). */
     uint8_t held[8];
     for (uint32_t i = 0; i < len; i += block) {
         uint32_t at = slot->base + offset + i;
         f->read(f->ctx, at, held, block);
-        if (memcmp(held, &data[i], block) != 0 && !f->program(f->ctx, at, &data[i])) {
+        bool unreadable = slot->read_failed != NULL && slot->read_failed();
+        if (!unreadable && memcmp(held, &data[i], block) == 0) {
+            continue;
+        }
+        for (uint32_t k = 0; k < block; k++) {
+            if (unreadable || held[k] != 0xFFu) {
+                return SLOT_WRITE_NOT_ERASED;
+            }
+        }
+        if (!f->program(f->ctx, at, &data[i])) {
             return SLOT_WRITE_FLASH_FAILED;
         }
     }

@@ -12,11 +12,13 @@
 
 #include <cmocka.h>
 
+#include "bootloader/slot_write.h"
 #include "doubles/flash_g0_model.h"
 #include "ports/stm32g0/flash_g0.h"
 #include "ports/stm32g0/flash_g0_logic.h"
 #include "ports/stm32g0/stm32g0_regs.h"
 #include "registers/data_table.h"
+#include "runtime/crc32.h"
 #include "storage/config_store.h"
 #include "storage/fault_log.h"
 
@@ -141,6 +143,34 @@ static void test_a_read_that_meets_a_torn_double_word_returns_zeros(void **state
         assert_false(hal.program(hal.ctx, a + 8u, DATA));
         assert_false(m.misuse);
     }
+}
+
+/* An update resumed after a cut: the bootloader's write of a block the cut
+ * left torn is refused (the page to be erased), though the block is to
+ * hold zeros, which is what the torn double word reads as. */
+static void test_a_slot_write_over_a_torn_double_word_is_refused_until_erased(void **state)
+{
+    (void)state;
+    setup(NULL);
+    const struct app_slot slot = {.flash = &hal, .base = g0_model_addr(&m, 4, 0), .pages = 4,
+                                  .read_failed = flash_g0_read_failed};
+    uint8_t data[16] = {0};
+    memcpy(data, DATA, 8);
+    assert_int_equal(slot_write(&slot, 0, DATA, 8, crc32(DATA, 8)), SLOT_WRITE_OK);
+    m.cut_at = m.steps;
+    m.tear = G0_TEAR_ECC;
+    assert_false(hal.program(hal.ctx, slot.base + 8u, &data[8])); /* zeros, torn */
+    g0_model_power_on(&m);
+    assert_int_equal(slot_write(&slot, 0, data, 16, crc32(data, 16)), SLOT_WRITE_NOT_ERASED);
+    assert_true(flash_g0_read_failed()); /* its last read: the torn block */
+    assert_int_equal(slot_write(&slot, 0, DATA, 8, crc32(DATA, 8)), SLOT_WRITE_OK);
+    assert_int_equal(slot_erase_page(&slot, 0), SLOT_WRITE_OK);
+    assert_int_equal(slot_write(&slot, 0, data, 16, crc32(data, 16)), SLOT_WRITE_OK);
+    uint8_t got[16];
+    hal.read(hal.ctx, slot.base, got, 16);
+    assert_false(flash_g0_read_failed());
+    assert_memory_equal(got, data, 16);
+    assert_false(m.misuse);
 }
 
 static struct user_config config_n(unsigned n)
@@ -306,6 +336,7 @@ int main(void)
         cmocka_unit_test_setup(test_a_page_is_erased_by_its_number, setup),
         cmocka_unit_test_setup(test_a_program_step_is_a_whole_aligned_double_word, setup),
         cmocka_unit_test(test_a_read_that_meets_a_torn_double_word_returns_zeros),
+        cmocka_unit_test(test_a_slot_write_over_a_torn_double_word_is_refused_until_erased),
         cmocka_unit_test(test_the_config_store_takes_a_torn_record_for_none),
         cmocka_unit_test(test_the_fault_log_takes_a_torn_record_for_none),
     };

@@ -20,7 +20,9 @@ MODE_APP, MODE_BOOTLOADER = 0, 1
 VERDICTS = {0: "valid", 1: "no image", 2: "header damaged", 3: "another board's image",
             4: "image does not match its CRC"}
 WRITE_REASONS = {1: "damaged on the wire", 2: "outside the slot", 3: "the flash refused",
-                 4: "reads back otherwise"}  # 4: bootloader version 1 only
+                 4: "reads back otherwise",  # 4: bootloader version 1 only
+                 5: "neither erased nor holding the bytes"}  # 5: version 3 on
+NOT_ERASED = 5  # a program step the power cut short: its page is erased and written again
 ENTER_OUTPUT_DRIVEN, ENTER_NO_BOOTLOADER = 1, 2  # UpdateEnter's reasons (docs/packets.md)
 RETRIES = 3
 SWITCH_TIMEOUT_S = 3.0  # a restart: the bootloader's 200 ms window, and the application's start
@@ -164,14 +166,41 @@ def _retry(fn):
     return fn()
 
 
-def _write(bus, servo_id: int, offset: int, chunk: bytes):
+def _write(bus, servo_id: int, offset: int, chunk: bytes, mend: bool = False) -> bool:
+    """True once written; False for a block neither erased nor holding its
+    bytes (NOT_ERASED), if mend says the caller mends its page."""
     content = bytes([servo_id]) + struct.pack("<I", offset) + chunk + struct.pack("<I", zlib.crc32(chunk))
     for attempt in range(RETRIES):
         c = _answer(_retry(lambda: bus.request(UPDATE_WRITE, content)), 2, servo_id, "UpdateWrite")
         if c[1] == 1:
-            return
+            return True
+        if mend and c[2:3] == bytes([NOT_ERASED]):
+            return False
         if c[2:3] != b"\x01" or attempt == RETRIES - 1:  # 1: damaged on the wire, worth again
             raise Refused(f"servo {servo_id}: writing offset {offset} refused: {_reason(c, WRITE_REASONS)}")
+    return True
+
+
+def _erase(bus, servo_id: int, page: int) -> None:
+    c = _answer(_retry(lambda: bus.request(UPDATE_ERASE, bytes([servo_id]) + struct.pack("<H", page))),
+                2, servo_id, "UpdateErase")
+    if c[1] != 1:
+        raise Refused(f"servo {servo_id}: erasing page {page} refused: {_reason(c, WRITE_REASONS)}")
+
+
+def _write_mending(bus, servo_id: int, data: bytes, offset: int, step: int, page_size: int, done: list):
+    """data's step bytes at offset. A block there neither erased nor holding
+    its bytes (an update resumed after a power cut in a program step; on the
+    G0 a torn double word) is mended: the pages the write touches erased,
+    and their blocks written so far (done, offsets) written again, then it."""
+    if not _write(bus, servo_id, offset, data[offset:offset + step], mend=True):
+        first, last = offset // page_size, (offset + step - 1) // page_size
+        for page in range(first, last + 1):
+            _erase(bus, servo_id, page)
+        lo, hi = first * page_size, (last + 1) * page_size
+        for again in [o for o in done if o < hi and o + step > lo] + [offset]:
+            _write(bus, servo_id, again, data[again:again + step])
+    done.append(offset)
 
 
 def write_image(bus, servo_id: int, image: Image, st: Status, progress=lambda done, total: None):
@@ -187,17 +216,15 @@ def write_image(bus, servo_id: int, image: Image, st: Status, progress=lambda do
     data = image.data + b"\xff" * (-len(image.data) % st.write_block)
     total = pages + len(data)
     for page in range(pages):  # page 0 first: the old image is invalid from here
-        c = _answer(_retry(lambda: bus.request(UPDATE_ERASE, bytes([servo_id]) + struct.pack("<H", page))),
-                    2, servo_id, "UpdateErase")
-        if c[1] != 1:
-            raise Refused(f"servo {servo_id}: erasing page {page} refused: {_reason(c, WRITE_REASONS)}")
+        _erase(bus, servo_id, page)
         progress(page + 1, total)
     head = -(-CHECKED // step) * step  # the checked header bytes go last
+    done = []
     for offset in range(head, len(data), step):
-        _write(bus, servo_id, offset, data[offset:offset + step])
+        _write_mending(bus, servo_id, data, offset, step, st.page_size, done)
         progress(min(pages + offset + step, total), total)
     for offset in range(0, head, step):
-        _write(bus, servo_id, offset, data[offset:offset + step])
+        _write_mending(bus, servo_id, data, offset, step, st.page_size, done)
     progress(total, total)
     c = _retry(lambda: bus.request(UPDATE_VERIFY, bytes([servo_id]), timeout=check_timeout(bus, len(data))))
     verdict, size, crc, version, _board = _p.decode_answer(UPDATE_VERIFY, c)[1:]

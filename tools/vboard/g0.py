@@ -38,7 +38,7 @@ reset, RCC_CCIPR ADCSEL)."""
 import json
 import os
 
-from unicorn import UC_HOOK_CODE, UC_HOOK_MEM_READ
+from unicorn import UC_HOOK_MEM_READ
 
 from .adc import AdcF0
 from .clocks import Rcc
@@ -82,7 +82,6 @@ class RccG0(Rcc):
 class FlashG0(Flash):
     def __init__(self, board, periph, memory, base, size, page, path, program_s, erase_s):
         self.torn = {}      # offset of a torn double word -> its read hook
-        self.nmi_hook = None  # the NMI's, due at the next instruction
         self.first = None   # (offset, word) of a program operation's first word
         super().__init__(board, periph, memory, base, size, page, path, program_s, erase_s)
         self.watch("ECCR", self._eccr)
@@ -92,14 +91,10 @@ class FlashG0(Flash):
                 self._tear(offset, save=False)
 
     def reset(self) -> None:
-        """A torn read's NMI not yet taken goes with the reset: the new run
-        takes its own (one pending across it was taken at the first
-        instruction, ECCR cleared, as a fault: the firmware reset itself)."""
+        """A torn read's NMI not yet taken goes with the reset (the core's
+        reset clears what is pending): the new run takes its own."""
         super().reset()
         self.first = None
-        if self.nmi_hook is not None:
-            self.core.uc.hook_del(self.nmi_hook)
-            self.nmi_hook = None
 
     def _flag(self, name: str) -> int:
         return self.bit("SR", name)
@@ -229,20 +224,18 @@ class FlashG0(Flash):
 
     def _torn_read(self, uc, access, address, size, value, data) -> None:
         """A read of a torn double word: ECCD, its address, and the NMI,
-        taken once the load is done (at the next instruction: a stop here
-        would run the load again, and raise it again, for ever)."""
+        taken once the load is done: the run ends before the next
+        instruction (the core's instruction count). A stop here would undo
+        the load, which would run again and raise it again, for ever; and a
+        code hook added now would miss the code Unicorn has translated
+        already (a bootloader's loop: the NMI never came)."""
         eccr = self.get("ECCR")
         if not eccr & self.bit("ECCR", "ECCD"):
             unit = ((address - self.base) >> 3) & self.bit("ECCR", "ADDR_ECC")
             self.put("ECCR", (eccr & ~self.bit("ECCR", "ADDR_ECC")) | unit | self.bit("ECCR", "ECCD"))
-        if self.nmi_hook is None:
-            self.nmi_hook = uc.hook_add(UC_HOOK_CODE, self._nmi_now, begin=1, end=0)
-
-    def _nmi_now(self, uc, address, size, data) -> None:
-        uc.hook_del(self.nmi_hook)
-        self.nmi_hook = None
         self.core.pending.add(NMI)
-        uc.emu_stop()
+        if self.core.running:
+            self.core.count.limit = self.core.count.executed
 
 
 class Dmamux(Model):

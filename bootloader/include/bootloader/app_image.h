@@ -35,6 +35,10 @@ struct app_slot {
     const struct hal_flash *flash; /* page_size, write_block, erase, program, read */
     uint32_t base;
     uint32_t pages;
+    /* Whether flash->read's last read met bytes that cannot be read (the
+     * G0: a double word a power cut left torn, read as zeros); NULL on a
+     * part where none can be. */
+    bool (*read_failed)(void);
 };
 
 struct app_image_info {

@@ -13,7 +13,7 @@
 #include "protocol/frame_tx.h"
 #include "hal/must_check.h"
 
-#define BOOTLOADER_VERSION 2u /* 2: a repeated UpdateWrite succeeds */
+#define BOOTLOADER_VERSION 3u /* 2: a repeated UpdateWrite succeeds; 3: reason 5 */
 /* Largest data in one UpdateWrite: the request (9 + 24 bytes) fits the
  * framer every build shares (FRAME_CONTENT_MAX, 34), so the bootloader
  * needs no framer of its own. */

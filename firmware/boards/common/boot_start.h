@@ -49,6 +49,10 @@ static void start_app(const struct app_slot *s)
     boot_jump(s->base + APP_HEADER_SIZE);
 }
 
+#ifndef BOARD_SLOT_READ_FAILED /* a part whose flash reads always */
+#define BOARD_SLOT_READ_FAILED NULL
+#endif
+
 #ifndef board_boot_flash_init
 /* The same flash: any page by its address. */
 static void board_boot_flash_init(struct hal_flash *config, struct hal_flash *slot_pages)
@@ -78,7 +82,8 @@ int main(void)
     bus_pins_init();
     systick_clock_init(BOARD_CORE_HZ);
     board_boot_flash_init(&config_flash, &slot_flash);
-    slot = (struct app_slot){.flash = &slot_flash, .base = BOARD_SLOT_BASE, .pages = BOARD_SLOT_PAGES};
+    slot = (struct app_slot){.flash = &slot_flash, .base = BOARD_SLOT_BASE, .pages = BOARD_SLOT_PAGES,
+                             .read_failed = BOARD_SLOT_READ_FAILED};
     board_boot_uart_start(&usart, &rx_ring, &rx_dma);
     const struct boot_board board = {.port = &port, .slot = &slot, .board = BOARD_ID,
                                      .stay_word = stay, .start_app = start_app,

@@ -28,5 +28,6 @@ static void g0_boot_flash_init(struct hal_flash *config, struct hal_flash *slot_
     *slot_pages = *config;
 }
 #define board_boot_flash_init g0_boot_flash_init
+#define BOARD_SLOT_READ_FAILED flash_g0_read_failed
 
 #include "boards/common/boot_start.h"

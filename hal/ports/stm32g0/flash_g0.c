@@ -4,6 +4,7 @@
 #include "ports/stm32g0/stm32g0_regs.h"
 
 static volatile uint32_t ecc_errors;
+static bool last_read_failed;
 
 /* Before an operation (RM0444 3.3.7, 3.3.8): none under way, no error
  * left from an earlier one, the interface unlocked (KEYR, 3.3.6). */
@@ -85,13 +86,19 @@ void flash_g0_read(void *ctx, uint32_t addr, uint8_t *dst, uint32_t len)
     for (; i < len; i++) {
         dst[i] = src[i];
     }
-    if (ecc_errors != before) {
+    last_read_failed = ecc_errors != before;
+    if (last_read_failed) {
         /* A torn double word in what was read (the NMI came between):
          * what it held is not to be trusted, nor is its record. */
         for (i = 0; i < len; i++) {
             dst[i] = 0;
         }
     }
+}
+
+bool flash_g0_read_failed(void)
+{
+    return last_read_failed;
 }
 
 /* used: the NMI handler calls it from assembly, which link-time optimisation

@@ -26,6 +26,9 @@ struct flash_g0 {
 void flash_g0_init(struct hal_flash *f, struct flash_g0 *chip, uint32_t page0, uint32_t page1);
 /* hal_flash.read: memory-mapped; zeros where an ECC double error was met. */
 void flash_g0_read(void *ctx, uint32_t addr, uint8_t *dst, uint32_t len);
+/* Whether the last flash_g0_read met an ECC double error (a double word
+ * a power cut left torn): its zeros are not what the flash holds. */
+bool flash_g0_read_failed(void);
 /* From the NMI: true if it was the flash's ECC double error (then cleared
  * and counted), false for any other cause (a fault). */
 bool flash_g0_nmi_ecc(void);

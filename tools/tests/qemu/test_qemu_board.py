@@ -45,7 +45,7 @@ def test_update_enter_and_boot_round_trip(servo):
     from servoctl import update as upd
     assert servo.bus.request(upd.UPDATE_ENTER, bytes([0]))[1] == 1
     st = upd._wait_for_mode(servo.bus, 0, upd.MODE_BOOTLOADER)
-    assert (st.verdict, st.bootloader_version, st.page_size) == (0, 2, 1024)
+    assert (st.verdict, st.bootloader_version, st.page_size) == (0, 3, 1024)
     assert servo.ping()
     assert servo.bus.request(upd.UPDATE_BOOT, bytes([0]))[1] == 1
     upd._wait_for_mode(servo.bus, 0, upd.MODE_APP)

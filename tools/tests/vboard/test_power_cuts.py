@@ -129,3 +129,55 @@ def test_a_fault_record_and_the_erase_before_it_survive_a_cut_at_every_operation
         newest = servo.faults()
         assert newest[0].what == 11 and [(f.number, f.what) for f in newest[1:]] == shown[:15], (k, newest)
     print(f"{cuts.board.name}: a fault record and its erase, {len(kinds)} operations, cut at {len(points)}")
+
+
+def test_a_page_change_that_finds_the_spare_not_erased_survives_a_cut_at_each_operation(tmp_path):
+    """A host writes a page of records with the line never quiet for 0.1 s:
+    the page left, the spare now, is not erased, so when the page in use is
+    full the next change is refused (ReadStore's bit 3, nothing lost: it was
+    not acknowledged), the spare is erased once the line is quiet, the change
+    sent again lands in its slot 0, and the full page is erased in turn.
+    The power cut as each of those operations begins (the spare's erase
+    leaves it half erased, torn at its middle): the board starts (erasing a
+    spare that is not erased), keeps every change it acknowledged, and saves
+    again. On the G0, whose program steps are double words (9 a record)."""
+    cuts = Cuts("stm32g031k8", str(tmp_path / "state"))
+    try:
+        servo = Servo(cuts.host, 1)
+        slots = board_h(cuts.board.name)["BOARD_FLASH_PAGE"] // RECORD
+        while servo.read_store().records % slots != 0:
+            servo.write("current_limit", 3000 + servo.read_store().records % 2)
+        cuts.host.sleep(0.3)  # quiet: the spare erased
+        old, new = servo.read("angle_max"), 1000
+        image = cuts.save()
+        acked = []
+
+        def page_change():
+            for n in range(slots):  # the other page filled, the one left not erased
+                servo.write("current_limit", 2000 + n % 2)
+            acked.append(write_angle_max(cuts, new))  # refused: no erased slot
+            cuts.host.sleep(0.3)  # quiet: the spare erased
+            acked.append(write_angle_max(cuts, new))
+            cuts.host.sleep(0.4)  # the full page erased
+
+        kinds = cuts.count(page_change)
+        steps = RECORD // cuts.board.part_facts["program_unit"]  # a record's program steps
+        tail = [True] + [False] * steps + [True]
+        assert acked == [False, True] and kinds == [False] * (slots * steps) + tail, kinds
+        first = len(kinds) - len(tail) + 1
+        for k in range(first, len(kinds) + 1):
+            cuts.put_back(image)
+            assert cuts.in_application()
+            acked.clear()
+            assert cuts.cut_at(k, page_change), f"no cut at operation {k}"
+            assert cuts.boots() and cuts.in_application(), f"no start after a cut at operation {k}"
+            assert acked[0] is False and servo.read("current_limit") == 2000 + (slots - 1) % 2, k
+            value = servo.read("angle_max")
+            assert value == new if acked[1:] == [True] else value in (old, new), (k, value)
+            servo.write("angle_max", 900)
+            cuts.board.power_cycle()
+            assert cuts.in_application() and servo.read("angle_max") == 900, k
+        print(f"{cuts.board.name}: a page change that finds the spare not erased, {len(kinds)} "
+              f"operations, cut at the last {len(kinds) - first + 1}")
+    finally:
+        cuts.close()
