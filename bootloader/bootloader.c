@@ -2,19 +2,14 @@
 
 #include <stddef.h>
 
-#include "storage/config_peek.h"
 #include "registers/data_table.h"
 #include "protocol/packet_codes.h"
 
 void boot_loop_start(struct boot_loop *l, const struct boot_board *b)
 {
     const struct hal_port *port = b->port;
-    uint8_t baud_index = b->link_baud;
     l->id = b->link_id;
-    if (!b->link_handed) {
-        config_peek_link(port->flash, &l->id, &baud_index);
-    }
-    uint32_t baud = baud_rate_of_index(baud_index);
+    uint32_t baud = baud_rate_of_index(b->link_baud);
     port->bus.set_baud(port->ctx, baud);
     l->idle_us = frame_rx_port_idle_us(frame_rx_idle_us(baud), port->rx_gap_tolerance_us);
     l->board = b;

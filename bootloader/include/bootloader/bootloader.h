@@ -21,10 +21,9 @@ struct boot_board {
     const struct app_slot *slot;
     uint16_t board;
     uint32_t stay_word;          /* what UpdateEnter left in RAM */
-    /* Where UpdateEnter's application answered (link_handed): the ID and
-     * baud index to answer at, not the store's newest record's (a record
-     * the application refused, or a format it could not rewrite). */
-    uint8_t link_handed;
+    /* The ID and baud index to answer at: where UpdateEnter's application
+     * answered (kept_link), else the store's newest record's
+     * (config_peek_link), which could be one the application refused. */
     uint8_t link_id;
     uint8_t link_baud;
     /* Starts the image in the slot (its vector table after the header);

@@ -19,6 +19,7 @@
 #include "ports/stm32_common/boot_jump.h"
 #include "ports/stm32_common/flash_f0f1.h"
 #include "ports/stm32_common/kept_ram.h"
+#include "storage/config_peek.h"
 #include "ports/stm32_common/systick_clock.h"
 
 static BOARD_USART usart;
@@ -75,19 +76,21 @@ static void service(void)
 int main(void)
 {
     uint32_t stay = boot_take_word(BOOT_STAY_WORD_ADDR(BOARD_RAM_END));
-    uint8_t link_id = 0;
-    uint8_t link_baud = 0;
-    bool handed = stay == BOOT_STAY_MAGIC && kept_link(&link_id, &link_baud);
+    uint8_t link_id;
+    uint8_t link_baud;
     board_clock_init();
     bus_pins_init();
     systick_clock_init(BOARD_CORE_HZ);
     board_boot_flash_init(&config_flash, &slot_flash);
+    if (!kept_link(&link_id, &link_baud)) { /* not a restart UpdateEnter made */
+        config_peek_link(&config_flash, &link_id, &link_baud);
+    }
     slot = (struct app_slot){.flash = &slot_flash, .base = BOARD_SLOT_BASE, .pages = BOARD_SLOT_PAGES,
                              .read_failed = BOARD_SLOT_READ_FAILED};
     board_boot_uart_start(&usart, &rx_ring, &rx_dma);
     const struct boot_board board = {.port = &port, .slot = &slot, .board = BOARD_ID,
                                      .stay_word = stay, .start_app = start_app,
-                                     .link_handed = handed, .link_id = link_id, .link_baud = link_baud,
+                                     .link_id = link_id, .link_baud = link_baud,
                                      .service = BOOT_SERVICE};
     bootloader_run(&board);
     return 0;

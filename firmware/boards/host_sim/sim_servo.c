@@ -6,6 +6,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "storage/config_peek.h"
 #include "storage/config_store.h"
 #include "runtime/crc32.h"
 #include "registers/data_table.h"
@@ -186,11 +187,15 @@ static void start_app(struct sim_servo *s)
  * servo's port: its receive ring and UART, the config store's flash file,
  * the slot's. A reset into it (stay: UpdateEnter asked), and its main-loop
  * pass: false once it has started the application. */
-static void boot_reset(struct sim_servo *s, bool stay)
+static void boot_reset(struct sim_servo *s, bool stay, uint8_t link_id, uint8_t link_baud)
 {
     struct sim_boot *b = &s->boot;
+    if (!stay) { /* a power-up: the store's newest record */
+        config_peek_link(s->port.flash, &link_id, &link_baud);
+    }
     b->board = (struct boot_board){.port = &s->port, .slot = &s->slot, .board = SIM_BOARD,
-                                   .stay_word = stay ? BOOT_STAY_MAGIC : 0u};
+                                   .stay_word = stay ? BOOT_STAY_MAGIC : 0u,
+                                   .link_id = link_id, .link_baud = link_baud};
     s->rx.read = s->rx.written; /* what the application had not read is gone */
     boot_loop_start(&b->loop, &b->board);
     run_models(s);
@@ -210,15 +215,13 @@ bool sim_servo_boot_poll(struct sim_servo *s)
 
 static void enter_bootloader(void *ctx, uint8_t id, uint8_t baud_index)
 {
-    (void)id; /* the simulated bootloader reads the same store the servo did */
-    (void)baud_index;
-    boot_reset(ctx, true);
+    boot_reset(ctx, true, id, baud_index); /* where the application answered */
 }
 
 void sim_servo_power_cycle(struct sim_servo *s)
 {
     s->power_ups++;
-    boot_reset(s, false);
+    boot_reset(s, false, 0, 0);
 }
 
 bool sim_servo_start(struct sim_servo *s, struct sim_bus *bus, unsigned index, uint8_t id,
@@ -283,7 +286,7 @@ bool sim_servo_start(struct sim_servo *s, struct sim_bus *bus, unsigned index, u
     if (app_image_check(&s->slot, SIM_BOARD, &info) == APP_IMAGE_VALID) {
         start_app(s);
     } else {
-        boot_reset(s, false);
+        boot_reset(s, false, 0, 0);
     }
     s->flash.stall_us = 0; /* power-up, before the servo joins the bus */
     s->slot_flash.stall_us = 0;

@@ -99,7 +99,7 @@ void kept_note_planned(uint8_t id, uint8_t baud_index)
 bool kept_link(uint8_t *id, uint8_t *baud_index)
 {
     const struct kept_ram *k = &_kept_ram;
-    if (k->magic != KEPT_MAGIC || k->crc != kept_crc(k) || k->note != KEPT_PLANNED) {
+    if (k->magic != KEPT_MAGIC || k->note != KEPT_PLANNED) {
         return false;
     }
     *id = k->link_id;

@@ -46,7 +46,10 @@ const struct hal_reset *reset_cause_take(void);
  * index it answers at, which its bootloader then answers at too. */
 void kept_note_planned(uint8_t id, uint8_t baud_index);
 /* The bootloader's start: true with the link kept_note_planned left, when
- * a restart the application meant left an intact record. */
+ * the record (its magic) says the application restarted on purpose: the
+ * application clears the note as it starts (reset_classify). No CRC here:
+ * the bootloader of the small part has no room for it, and a power-on's
+ * random RAM holds the magic and the note one time in 2^40. */
 bool kept_link(uint8_t *id, uint8_t *baud_index);
 /* The servo ran long enough without a fault: the next fault reset is the
  * first in a row again (not in safe mode: HAL_SAFE_MODE_RESETS). */
