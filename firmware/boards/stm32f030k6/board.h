@@ -1,7 +1,9 @@
 /* The Cortex-M0 servo board: STM32F030K6 (48 MHz, 32 KB flash, 4 KB RAM;
- * RM0360). Its main.c and boot_main.c, its linker scripts (made from
- * hal/ports/stm32_common/linker/app.ld.in and boot.ld.in) and servoctl's image command
- * read this file: plain numbers, one per line. */
+ * RM0360). The F0 boards' shared main.c, boot_main.c and board_io.c
+ * (firmware/boards/common/stm32f0), its linker scripts (made from
+ * hal/ports/stm32_common/linker/app.ld.in and boot.ld.in), servoctl's
+ * image command and the virtual board read this file: plain numbers, one
+ * per line. */
 #ifndef BOARD_H
 #define BOARD_H
 
@@ -27,11 +29,25 @@
 #define BOARD_RAM_SIZE 4096
 #define BOARD_RAM_VECTORS_SIZE 192
 
-/* The bus: USART1 (PA9), its DMA1 requests on channels 2 (TX) and 3 (RX)
- * (RM0360; ports/stm32f0/stm32f0_bus.h checks). */
+/* The bus: USART1, its DMA1 requests on channels 2 (TX) and 3 (RX)
+ * (RM0360; ports/stm32f0/stm32f0_bus.h checks), its TX on PA9. A pin is
+ * 0xPN: port P (0 A, 1 B), pin N (ports/stm32f0/stm32f0_pins.h checks
+ * each is its function's). */
 #define BOARD_BUS_USART 1
 #define BOARD_BUS_DMA_TX 2
 #define BOARD_BUS_DMA_RX 3
+#define BOARD_BUS_TX_PIN 0x09
+
+/* The bridge: TIM3's CH1 (PA6) and CH2 (PA7) into IN1 and IN2. */
+#define BOARD_BRIDGE_TIMER 3
+#define BOARD_BRIDGE_IN1_PIN 0x06
+#define BOARD_BRIDGE_IN2_PIN 0x07
+
+/* The ADC channels the scan reads, in ascending order: IN0-IN3 on PA0-PA3. */
+#define BOARD_ADC_SUPPLY 0
+#define BOARD_ADC_CURRENT 1
+#define BOARD_ADC_NTC 2
+#define BOARD_ADC_POSITION 3
 /* The application's stack: cmake/stack-report.py's static worst case is
  * 760 B (main's deepest path, every packet handler and HAL operation
  * behind its pointers, the deepest interrupt and its 32 B frame). It does
@@ -57,7 +73,7 @@
 /* The analogue front end and the motor: the reference servo's. */
 #include "boards/common/reference_servo.h"
 
-/* Pins: this folder's README.md; the port (hal/ports/stm32f0) drives them. */
+/* Pins: this folder's README.md. */
 
 #include "boards/board_derived.h"
 

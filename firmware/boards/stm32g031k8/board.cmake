@@ -4,4 +4,8 @@
 # update image's 256-byte header, 50 944 B, and the part's 8 KB of RAM.
 include(${PROJECT_SOURCE_DIR}/cmake/family-stm32g0.cmake)  # CPU, port, startup
 set(SERVO_BOARD_PART stm32g031k8)  # its facts: hal/ports/parts.toml, checked against board.h
-set(SERVO_BOARD_SOURCES ${CMAKE_CURRENT_LIST_DIR}/board_io.c)         # pins, clocks, ADC, PWM: this board's
+# Its code: the G0 boards' shared main.c, boot_main.c and board_io.c (pins,
+# clocks, ADC, PWM), which take the bus pin, the bridge and the ADC inputs
+# from board.h; a board whose code differs names its own folder here.
+set(SERVO_BOARD_CODE ${PROJECT_SOURCE_DIR}/firmware/boards/common/stm32g0)
+set(SERVO_BOARD_SOURCES ${SERVO_BOARD_CODE}/board_io.c)

@@ -1,7 +1,9 @@
 /* The STM32G031K8 servo board (Cortex-M0+ at 64 MHz, 64 KB flash, 8 KB
- * RAM; RM0444). Its main.c and boot_main.c, its linker scripts (made from
- * hal/ports/stm32_common/linker/app.ld.in and boot.ld.in) and servoctl's
- * image command read this file: plain numbers, one per line. */
+ * RAM; RM0444). The G0 boards' shared main.c, boot_main.c and board_io.c
+ * (firmware/boards/common/stm32g0), its linker scripts (made from
+ * hal/ports/stm32_common/linker/app.ld.in and boot.ld.in), servoctl's
+ * image command and the virtual board read this file: plain numbers, one
+ * per line. */
 #ifndef BOARD_H
 #define BOARD_H
 
@@ -27,14 +29,28 @@
 #define BOARD_RAM_BASE 0x20000000
 #define BOARD_RAM_SIZE 8192
 
-/* The bus: USART1 (PA9, AF1), its DMAMUX requests 50 (RX) and 51 (TX)
- * routed to DMA1 channels 3 and 2 (RM0444 11.3.2; ports/stm32g0/stm32g0_bus.h
- * checks). USART2 (requests 52, 53) takes another TX pin in board_io.c. */
+/* The bus: USART1, its DMAMUX requests 50 (RX) and 51 (TX) routed to
+ * DMA1 channels 3 and 2 (RM0444 11.3.2; ports/stm32g0/stm32g0_bus.h
+ * checks; USART2's are 52 and 53), its TX on PA9. A pin is 0xPN: port P
+ * (0 A, 1 B, 2 C), pin N (ports/stm32g0/stm32g0_pins.h checks each is its
+ * function's: USART1 PA9, USART2 PA2 or PA14, on AF1). */
 #define BOARD_BUS_USART 1
 #define BOARD_BUS_DMA_TX 2
 #define BOARD_BUS_DMA_RX 3
 #define BOARD_BUS_DMAMUX_TX 51
 #define BOARD_BUS_DMAMUX_RX 50
+#define BOARD_BUS_TX_PIN 0x09
+
+/* The bridge: TIM3's CH1 (PA6) and CH2 (PA7) into IN1 and IN2. */
+#define BOARD_BRIDGE_TIMER 3
+#define BOARD_BRIDGE_IN1_PIN 0x06
+#define BOARD_BRIDGE_IN2_PIN 0x07
+
+/* The ADC channels the scan reads, in ascending order: IN0-IN3 on PA0-PA3. */
+#define BOARD_ADC_SUPPLY 0
+#define BOARD_ADC_CURRENT 1
+#define BOARD_ADC_NTC 2
+#define BOARD_ADC_POSITION 3
 /* The application's stack: the M3's reservation; cmake/stack-report.py
  * checks it after every link. */
 #define BOARD_APP_STACK_SIZE 1536

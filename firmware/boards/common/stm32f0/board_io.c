@@ -1,5 +1,7 @@
-#include "board_io.h"
+#include "boards/common/stm32f0/board_io.h"
 
+#include "board.h"
+#include "ports/stm32f0/stm32f0_pins.h"
 #include "ports/stm32f0/stm32f0_regs.h"
 
 enum { HSE_STARTUP_TRIES = 100000 };
@@ -50,17 +52,18 @@ void bus_pins_init(void)
 {
     RCC_AHBENR |= RCC_AHBENR_GPIOA;
     RCC_APB2ENR |= RCC_APB2ENR_USART1;
-    /* PA9 USART1 TX (AF1), open drain: the single bus wire (external pull-up). */
-    GPIOA_OTYPER |= 1u << 9;
-    GPIOA_OSPEEDR |= 3u << (2u * 9u);
-    pin_af1(9u);
+    /* The TX pin board.h names (stm32f0_pins.h: PA9, USART1 TX, AF1), open
+     * drain: the single bus wire (external pull-up). */
+    GPIOA_OTYPER |= 1u << BUS_TX_PA;
+    GPIOA_OSPEEDR |= 3u << (2u * BUS_TX_PA);
+    pin_af1(BUS_TX_PA);
 }
 
 void pwm_bridge_init(void)
 {
     RCC_APB1ENR |= RCC_APB1ENR_TIM3;
-    pin_af1(6u);
-    pin_af1(7u);
+    pin_af1((uint32_t)BOARD_BRIDGE_IN1_PIN); /* TIM3 CH1 and CH2, as board.h names them */
+    pin_af1((uint32_t)BOARD_BRIDGE_IN2_PIN);
     pwm_bridge_start(TIM3_BASE, F030_PCLK_HZ);
 }
 
@@ -68,8 +71,10 @@ void adc_scan_init(void)
 {
     RCC_AHBENR |= RCC_AHBENR_DMA1;
     RCC_APB2ENR |= RCC_APB2ENR_ADC1;
-    for (uint32_t pin = 0; pin < ADC_CHANNELS; pin++) {
-        pin_mode(pin, GPIO_MODE_ANALOG);
+    for (uint32_t pin = ADC_FIRST_PIN; pin <= ADC_LAST_PIN; pin++) { /* the inputs board.h names */
+        if (ADC_PINS_IN_A_ROW || ((ADC_PIN_MASK >> pin) & 1u) != 0u) {
+            pin_mode(pin, GPIO_MODE_ANALOG);
+        }
     }
     uintptr_t ch = DMA1_CCR_ADDR(1u);
     DMA_CPAR(ch) = ADC_DR_ADDR;
@@ -88,7 +93,7 @@ void adc_scan_init(void)
     }
     /* 55.5 cycles a channel (SMP 5): 4 x 4.9 us at 14 MHz, as the F1's. */
     ADC_SMPR = 5u;
-    ADC_CHSELR = (1u << ADC_CHANNELS) - 1u;
+    ADC_CHSELR = ADC_PIN_MASK; /* scanned in ascending order: board.h's (stm32f0_pins.h) */
     ADC_CFGR1 = ADC_CFGR1_DMAEN | ADC_CFGR1_DMACFG | ADC_CFGR1_CONT;
     ADC_CR = ADC_CR_ADEN | ADC_CR_ADSTART;
 }

@@ -1,8 +1,9 @@
-/* The Cortex-M0 board: STM32F030K6 servo controller (pin map: README.md).
- * What differs from the other STM32 boards; the start-up path and the main
- * loop are the boards' shared one (boards/common/app_start.h). */
+/* An STM32F030 servo board (Cortex-M0; the reference one, stm32f030k6: its
+ * README.md), its pins from its board.h. What differs from the other STM32
+ * boards; the start-up path and the main loop are the boards' shared one
+ * (boards/common/app_start.h). */
 #include "board.h"
-#include "board_io.h"
+#include "boards/common/stm32f0/board_io.h"
 #include "ports/stm32f0/stm32f0_regs.h"
 #include "ports/stm32f0/stm32f0_bus.h"
 #include "ports/stm32f0/stm32f0_uart.h"

@@ -1,9 +1,10 @@
-/* The Cortex-M0 board's own use of the STM32F030K6 (48 MHz, 32 KB flash,
- * 4 KB RAM): clock tree, the bus pin, H-bridge pins, the ADC channels it
- * scans. A board on other pins changes this file (pin map: this folder's
- * README.md). */
-#ifndef BOARD_IO_H
-#define BOARD_IO_H
+/* An STM32F030 board's clock tree, bus pin, H-bridge PWM pins and the ADC
+ * channels it scans (48 MHz; the reference part, the STM32F030K6: 32 KB
+ * flash, 4 KB RAM), the F0 boards' shared code: the pins are the board's
+ * board.h's (ports/stm32f0/stm32f0_pins.h); a board with another clock
+ * tree or front end brings its own (docs/building.md). */
+#ifndef BOARDS_COMMON_STM32F0_BOARD_IO_H
+#define BOARDS_COMMON_STM32F0_BOARD_IO_H
 
 #include <stdint.h>
 
@@ -18,13 +19,14 @@
  * tolerates, so the board has the crystal as the F103 does. */
 void clock_f030_init(void);
 
-/* The bus: GPIOA and USART1 clocked, PA9 the open-drain wire (AF1). */
+/* The bus: GPIOA and USART1 clocked, its TX pin (PA9) the open-drain wire (AF1). */
 void bus_pins_init(void);
 
-/* TIM3 CH1/CH2 (PA6/PA7, AF1) at 20 kHz into the bridge's IN1/IN2. */
+/* TIM3 CH1/CH2 (board.h's pins, PA6/PA7, AF1) at 20 kHz into the bridge's IN1/IN2. */
 void pwm_bridge_init(void);
 
-/* ADC1 scans channels 0-3 into adc_scan_values[] (board_common.h). */
+/* ADC1 scans the board's four channels (the reference board's 0-3) into
+ * adc_scan_values[] (board_common.h). */
 void adc_scan_init(void);
 
 /* The 96-bit unique ID folded to the 32-bit serial number (data ID 8). */

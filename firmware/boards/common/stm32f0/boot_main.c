@@ -4,7 +4,7 @@
  * What differs from the other STM32 boards; the start-up path is the
  * boards' shared one (boards/common/boot_start.h). */
 #include "board.h"
-#include "board_io.h"
+#include "boards/common/stm32f0/board_io.h"
 #include "ports/stm32f0/stm32f0_regs.h"
 #include "ports/stm32f0/stm32f0_bus.h"
 #include "ports/stm32f0/stm32f0_uart.h"

@@ -4,7 +4,7 @@
  * (bootloader/bootloader.c). The start-up path is the boards' shared one
  * (boards/common/boot_start.h). */
 #include "board.h"
-#include "board_io.h"
+#include "boards/common/stm32g0/board_io.h"
 #include "ports/stm32g0/flash_g0.h"
 #include "ports/stm32g0/stm32g0_bus.h"
 #include "ports/stm32g0/stm32g0_uart.h"

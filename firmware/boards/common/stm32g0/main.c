@@ -1,9 +1,9 @@
-/* The STM32G031K8 board (Cortex-M0+). What differs from the other STM32
- * boards: its USART's DMAMUX routing, its flash (64-bit units, pages by
- * number); the start-up path and the main loop are the boards' shared one
+/* An STM32G031 servo board (Cortex-M0+), its pins from its board.h. What
+ * differs from the other STM32 boards: its USART's DMAMUX routing, its
+ * flash (64-bit units, pages by number); the start-up path and the main loop are the boards' shared one
  * (boards/common/app_start.h). */
 #include "board.h"
-#include "board_io.h"
+#include "boards/common/stm32g0/board_io.h"
 #include "ports/stm32g0/flash_g0.h"
 #include "ports/stm32g0/stm32g0_bus.h"
 #include "ports/stm32g0/stm32g0_uart.h"

@@ -1,8 +1,10 @@
-/* The STM32G031K8 board's own use of the part (64 MHz, 64 KB flash, 8 KB
- * RAM): clock tree, the bus pin, H-bridge pins, the ADC channels it scans.
- * A board on other pins changes this file. */
-#ifndef BOARD_IO_H
-#define BOARD_IO_H
+/* An STM32G031 board's clock tree, bus pin, H-bridge PWM pins and the ADC
+ * channels it scans (64 MHz; the reference part, the STM32G031K8: 64 KB
+ * flash, 8 KB RAM), the G0 boards' shared code: the pins are the board's
+ * board.h's (ports/stm32g0/stm32g0_pins.h); a board with another clock
+ * tree or front end brings its own (docs/building.md). */
+#ifndef BOARDS_COMMON_STM32G0_BOARD_IO_H
+#define BOARDS_COMMON_STM32G0_BOARD_IO_H
 
 #include <stdint.h>
 
@@ -20,10 +22,11 @@ void clock_g031_init(void);
 /* The bus: GPIOA and the bus's USART clocked, its TX pin the open-drain wire. */
 void bus_pins_init(void);
 
-/* TIM3 CH1/CH2 (PA6/PA7, AF1) at 20 kHz into the bridge's IN1/IN2. */
+/* TIM3 CH1/CH2 (board.h's pins, PA6/PA7, AF1) at 20 kHz into the bridge's IN1/IN2. */
 void pwm_bridge_init(void);
 
-/* The ADC scans channels 0-3 (PA0-PA3) into adc_scan_values[] by DMA1
+/* The ADC scans the board's four channels (the reference board's 0-3,
+ * PA0-PA3) into adc_scan_values[] by DMA1
  * channel 1 (DMAMUX request 5). */
 void adc_scan_init(void);
 

@@ -1,6 +1,7 @@
-#include "board_io.h"
+#include "boards/common/stm32g0/board_io.h"
 
 #include "board.h"
+#include "ports/stm32g0/stm32g0_pins.h"
 #include "ports/stm32g0/stm32g0_regs.h"
 
 void clock_g031_init(void)
@@ -45,11 +46,10 @@ void bus_pins_init(void)
     G0_RCC_IOPENR |= G0_RCC_IOPENR_GPIOA;
 #if BOARD_BUS_USART == 1
     G0_RCC_APBENR2 |= G0_RCC_APBENR2_USART1;
-    uint32_t tx = 9u; /* PA9 USART1_TX, AF1 (DS12992, alternate functions) */
 #else
     G0_RCC_APBENR1 |= G0_RCC_APBENR1_USART2;
-    uint32_t tx = 14u; /* PA14 USART2_TX, AF1 (PA2's is the ADC's here): SWCLK's pin */
 #endif
+    uint32_t tx = BUS_TX_PA; /* the TX pin board.h names, AF1 (stm32g0_pins.h) */
     /* Open drain: the single bus wire (external pull-up). */
     G0_GPIOA_OTYPER |= 1u << tx;
     G0_GPIOA_OSPEEDR |= 3u << (2u * tx);
@@ -59,8 +59,8 @@ void bus_pins_init(void)
 void pwm_bridge_init(void)
 {
     G0_RCC_APBENR1 |= G0_RCC_APBENR1_TIM3;
-    pin_af1(6u);
-    pin_af1(7u);
+    pin_af1((uint32_t)BOARD_BRIDGE_IN1_PIN); /* TIM3 CH1 and CH2, as board.h names them */
+    pin_af1((uint32_t)BOARD_BRIDGE_IN2_PIN);
     pwm_bridge_start(TIM3_BASE, G031_PCLK_HZ);
 }
 
@@ -68,8 +68,10 @@ void adc_scan_init(void)
 {
     G0_RCC_AHBENR |= G0_RCC_AHBENR_DMA1;
     G0_RCC_APBENR2 |= G0_RCC_APBENR2_ADC;
-    for (uint32_t pin = 0; pin < ADC_CHANNELS; pin++) {
-        pin_mode(pin, G0_GPIO_MODE_ANALOG);
+    for (uint32_t pin = ADC_FIRST_PIN; pin <= ADC_LAST_PIN; pin++) { /* the inputs board.h names */
+        if (ADC_PINS_IN_A_ROW || ((ADC_PIN_MASK >> pin) & 1u) != 0u) {
+            pin_mode(pin, G0_GPIO_MODE_ANALOG);
+        }
     }
     G0_DMAMUX_CCR(1u) = G0_DMAMUX_REQ_ADC;
     uintptr_t ch = DMA1_CCR_ADDR(1u);
@@ -92,7 +94,7 @@ void adc_scan_init(void)
     }
     /* 79.5 cycles a channel (SMP1 6): 4 x 5.8 us at 16 MHz, near the F1's. */
     G0_ADC_SMPR = 6u;
-    G0_ADC_CHSELR = (1u << ADC_CHANNELS) - 1u;
+    G0_ADC_CHSELR = ADC_PIN_MASK; /* scanned in ascending order: board.h's (stm32g0_pins.h) */
     while (!(G0_ADC_ISR & G0_ADC_ISR_CCRDY)) { /* the channel set taken (15.3.8) */
     }
     G0_ADC_CFGR1 = G0_ADC_CFGR1_DMAEN | G0_ADC_CFGR1_DMACFG | G0_ADC_CFGR1_CONT;
