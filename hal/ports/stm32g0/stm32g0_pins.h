@@ -20,11 +20,7 @@
 
 #include <stdint.h>
 
-#if !defined(BOARD_BUS_TX_PIN) || !defined(BOARD_BRIDGE_TIMER) || !defined(BOARD_BRIDGE_IN1_PIN) || \
-    !defined(BOARD_BRIDGE_IN2_PIN) || !defined(BOARD_ADC_SUPPLY) || !defined(BOARD_ADC_CURRENT) ||   \
-    !defined(BOARD_ADC_NTC) || !defined(BOARD_ADC_POSITION)
-#error "board.h declares its pins: BOARD_BUS_TX_PIN, BOARD_BRIDGE_TIMER and _IN1_PIN/_IN2_PIN, BOARD_ADC_* (docs/building.md)"
-#endif
+#include "ports/stm32_common/port_a_pins.h"
 
 /* The bus: its USART's TX (DS12992, port A's AF1). */
 _Static_assert(BOARD_BUS_USART == 1 ? BOARD_BUS_TX_PIN == 0x09
@@ -52,17 +48,5 @@ _Static_assert(BOARD_ADC_SUPPLY < BOARD_ADC_CURRENT && BOARD_ADC_CURRENT < BOARD
                    BOARD_ADC_NTC < BOARD_ADC_POSITION,
                "board.h: the G0's ADC scans its channels in ascending order (RM0444 15.3.8): BOARD_ADC_SUPPLY < "
                "_CURRENT < _NTC < _POSITION");
-#define ADC_PIN_MASK                                                                                \
-    ((1u << BOARD_ADC_SUPPLY) | (1u << BOARD_ADC_CURRENT) | (1u << BOARD_ADC_NTC) | (1u << BOARD_ADC_POSITION))
-#define ADC_FIRST_PIN ((uint32_t)BOARD_ADC_SUPPLY)
-#define ADC_LAST_PIN ((uint32_t)BOARD_ADC_POSITION)
-/* All the pins from the first to the last: the loop sets each. */
-#define ADC_PINS_IN_A_ROW (BOARD_ADC_POSITION - BOARD_ADC_SUPPLY == 3)
-
-/* No pin two things: the bus, the bridge and the inputs are on port A. */
-_Static_assert((ADC_PIN_MASK & ((1u << BOARD_BUS_TX_PIN) | (1u << BOARD_BRIDGE_IN1_PIN) |
-                                (1u << BOARD_BRIDGE_IN2_PIN))) == 0u &&
-                   BOARD_BUS_TX_PIN != BOARD_BRIDGE_IN1_PIN && BOARD_BUS_TX_PIN != BOARD_BRIDGE_IN2_PIN,
-               "board.h: two of the bus, the bridge and the ADC inputs are on one pin");
 
 #endif
